@@ -1,0 +1,130 @@
+# egofuse - build, test, demo.
+#
+#   make            library, io library, the egofuse program, tests, tools
+#   make demo       install what is missing, generate samples, run the demo
+#   make test       install what is missing, build, run every test
+#   make debug      the same tests under ASan + UBSan (build-debug/)
+#   make bench      benchmarks (they report, never pass or fail)
+#   make clean
+#
+# Core (src/raster, src/kin, src/fuse): libc + libm + pthreads only, built
+# into build/libegofuse.a. src/io holds every other dependency and builds
+# into build/libegofuse_io.a. C++ only in src/io/*.cpp.
+
+BUILD    ?= build
+CC       ?= cc
+CXX      ?= c++
+OPT      ?= -O2
+SAN      ?=
+# Deterministic float: no contraction into FMA, no fast-math (docs/rounding.md).
+CFLAGS_COMMON = $(OPT) -g -Wall -Wextra -ffp-contract=off -fno-fast-math \
+                -fno-strict-aliasing -D_GNU_SOURCE -MMD -MP $(SAN)
+CFLAGS   += -std=c11 $(CFLAGS_COMMON)
+CXXFLAGS += -std=c++17 $(CFLAGS_COMMON)
+LDFLAGS  += $(SAN)
+
+CORE_SRC := $(wildcard src/raster/*.c src/kin/*.c src/fuse/*.c)
+IO_SRC   := $(wildcard src/io/*.c)
+IO_CXX   := $(wildcard src/io/*.cpp)
+CLI_SRC  := $(wildcard src/cli/*.c)
+GEN_SRC  := $(wildcard samples/gen/*.c)
+TEST_SRC := $(wildcard tests/test_*.c)
+TEST_SHARED := $(wildcard tests/support/*.c)
+BENCH_SRC := $(wildcard bench/bench_*.c)
+
+obj = $(patsubst %,$(BUILD)/obj/%.o,$(1))
+CORE_OBJ := $(call obj,$(CORE_SRC))
+IO_OBJ   := $(call obj,$(IO_SRC) $(IO_CXX))
+CLI_OBJ  := $(call obj,$(CLI_SRC))
+GEN_OBJ  := $(call obj,$(GEN_SRC))
+TEST_SHARED_OBJ := $(call obj,$(TEST_SHARED))
+TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
+BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
+
+IO_PKGS  := OpenImageIO libusb-1.0 libv4l2
+IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) 2>/dev/null)
+IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -ltinygltf -lstdc++
+SYS_LIBS := -lm -lpthread
+
+LIB      := $(BUILD)/libegofuse.a
+IOLIB    := $(BUILD)/libegofuse_io.a
+EGOFUSE  := $(BUILD)/egofuse
+GEN      := $(BUILD)/gen_samples
+SAMPLES  := $(BUILD)/samples
+
+.PHONY: all deps demo test test-only debug bench clean samples
+.DEFAULT_GOAL := all
+
+all: $(LIB) $(IOLIB) $(EGOFUSE) $(GEN) $(TEST_BIN) $(BENCH_BIN)
+
+deps:
+	@sh scripts/deps.sh
+
+# Per-ISA files get their own flags; everything else stays at the baseline.
+$(BUILD)/obj/%_avx2.c.o: CFLAGS += -mavx2 -mf16c
+$(BUILD)/obj/%_avx512.c.o: CFLAGS += -mavx512f -mavx512bw -mavx512dq -mavx512vl -mavx2 -mf16c
+$(BUILD)/obj/%_sse41.c.o: CFLAGS += -msse4.1
+
+$(BUILD)/obj/src/io/%.o: CFLAGS += $(IO_CFLAGS)
+$(BUILD)/obj/src/io/%.o: CXXFLAGS += $(IO_CFLAGS) -Wno-unused-parameter
+
+$(BUILD)/obj/%.c.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -c $< -o $@
+
+$(BUILD)/obj/%.cpp.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -c $< -o $@
+
+$(LIB): $(CORE_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@ && ar rcs $@ $^
+
+$(IOLIB): $(IO_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@ && ar rcs $@ $^
+
+$(EGOFUSE): $(CLI_OBJ) $(IOLIB) $(LIB)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
+
+$(GEN): $(GEN_OBJ) $(IOLIB) $(LIB)
+	$(CXX) $(LDFLAGS) -o $@ $(GEN_OBJ) $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
+
+$(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(IOLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(IOLIB) $(LIB) \
+	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
+
+$(BUILD)/bench/%: bench/%.c $(IOLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
+
+# Sample data: generated, never downloaded (samples/README.md).
+$(SAMPLES)/scene.txt: $(GEN)
+	$(GEN) --out $(SAMPLES)
+
+samples: deps
+	@$(MAKE) --no-print-directory $(SAMPLES)/scene.txt
+
+demo: deps
+	@$(MAKE) --no-print-directory $(EGOFUSE) $(SAMPLES)/scene.txt
+	$(EGOFUSE) demo --samples $(SAMPLES) --out out/demo
+
+test: deps
+	@$(MAKE) --no-print-directory all
+	@sh tests/run_tests.sh $(BUILD)
+
+# Tests under AddressSanitizer and UndefinedBehaviorSanitizer.
+debug: deps
+	@$(MAKE) --no-print-directory BUILD=build-debug OPT=-O1 \
+	    SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" all
+	@ASAN_OPTIONS=detect_leaks=1 sh tests/run_tests.sh build-debug
+
+bench: deps
+	@$(MAKE) --no-print-directory all
+	@sh bench/run_bench.sh $(BUILD)
+
+clean:
+	rm -rf build build-debug out
+
+-include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

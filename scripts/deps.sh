@@ -1,0 +1,35 @@
+#!/bin/sh
+# Installs the Debian packages egofuse needs to build, test and run its demo.
+# Called by `make demo`, `make test` and `make bench`; safe to run again (it
+# only installs what is missing). As a non-root user it prints the exact
+# apt-get line and stops.
+set -eu
+
+PKGS="build-essential pkg-config
+libopenimageio-dev openimageio-tools
+libtinygltf-dev
+libv4l-dev libusb-1.0-0-dev
+libcmocka-dev
+gnuplot-nox
+libpixman-1-dev
+libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri"
+
+missing=""
+for p in $PKGS; do
+    st=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
+    [ "$st" = "installed" ] || missing="$missing $p"
+done
+[ -z "$missing" ] && exit 0
+
+if [ "$(id -u)" != "0" ]; then
+    echo "egofuse: these Debian packages are missing:$missing" >&2
+    echo "egofuse: install them as root, then run make again:" >&2
+    echo "  sudo apt-get install -y$missing" >&2
+    exit 1
+fi
+
+echo "egofuse: installing missing Debian packages:$missing"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+# shellcheck disable=SC2086
+apt-get install -y -qq --no-install-recommends $missing

@@ -1,0 +1,143 @@
+/* io.h - files and devices of egofuse: images (OpenImageIO), glTF models
+ * (tinygltf) and scene files. The core (raster, kin, fuse) never includes
+ * this header.
+ *
+ * ERRORS
+ *   Every call returns an io_result (IO_OK = 0) and, on failure, fills the
+ *   caller's io_error with the code and a message that names the input and
+ *   the reason, e.g. "model.glb: accessor 3 (JOINTS_0) reads past the end of
+ *   buffer view 2". No global error state; no C++ exception crosses this
+ *   header (the C++ shims catch everything).
+ *
+ * OUTPUT FILES
+ *   Writers never leave a half-written file: they write "<path>.tmp.<pid>"
+ *   and rename it over <path> only when complete.
+ *
+ * USAGE
+ *   io_error err;
+ *   kin_model m;
+ *   if (io_gltf_load("arms.glb", &m, &err) != IO_OK) {
+ *       fprintf(stderr, "egofuse: %s\n", err.msg); return 1; }
+ *   io_image img;
+ *   if (io_image_load("cam.png", IO_U8, 4, &img, &err) != IO_OK) ...
+ *   io_image_save("out.png", &img, &err);
+ *   io_image_free(&img); kin_model_free(&m);
+ */
+#ifndef EGOFUSE_IO_H
+#define EGOFUSE_IO_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "../kin/kin.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define IO_RESULT_LIST(X)                                              \
+    X(IO_OK,            "ok")                                          \
+    X(IO_ERR_ARGS,      "invalid arguments")                           \
+    X(IO_ERR_NOT_FOUND, "file not found")                              \
+    X(IO_ERR_READ,      "read error")                                  \
+    X(IO_ERR_WRITE,     "write error")                                 \
+    X(IO_ERR_FORMAT,    "corrupt or unsupported file")                 \
+    X(IO_ERR_MISSING,   "required data missing")                       \
+    X(IO_ERR_SIZE,      "wrong size")                                  \
+    X(IO_ERR_VALUE,     "invalid value")                               \
+    X(IO_ERR_NOMEM,     "out of memory")                               \
+    X(IO_ERR_DEVICE,    "device error")
+
+typedef enum io_result {
+#define IO__ENUM(name, text) name,
+    IO_RESULT_LIST(IO__ENUM)
+#undef IO__ENUM
+    IO_RESULT_COUNT
+} io_result;
+
+typedef struct io_error {
+    io_result code;
+    char msg[1024];
+} io_error;
+
+const char *io_result_str(io_result r);
+/* Sets err (if not NULL) with a printf-style message and returns code. */
+io_result io_fail(io_error *err, io_result code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* --------------------------------------------------------------- images */
+
+typedef enum io_type { IO_U8 = 0, IO_F32 = 1 } io_type;
+
+/* Interleaved pixels, rows top to bottom. */
+typedef struct io_image {
+    void *data;           /* owned: io_image_free() releases it */
+    int width, height;
+    int channels;         /* 1..4 */
+    io_type type;
+    size_t stride;        /* bytes per row */
+} io_image;
+
+/* Allocates a zeroed image (stride = width * channels * size of type). */
+io_result io_image_alloc(io_image *img, int width, int height, int channels,
+                         io_type type, io_error *err);
+/* Loads any format OpenImageIO reads (PNG, EXR, ...), converted to `type`
+ * with `channels` channels (0 = as in the file; 1 -> 3/4 replicates grey,
+ * missing alpha becomes opaque, extra channels are dropped). */
+io_result io_image_load(const char *path, io_type type, int channels,
+                        io_image *out, io_error *err);
+/* Writes by extension (.png, .exr, .tif, .jpg, .ppm ...); PNG and other
+ * 8-bit formats from IO_F32 are clamped to [0,1] and scaled. */
+io_result io_image_save(const char *path, const io_image *img,
+                        io_error *err);
+void io_image_free(io_image *img);
+
+/* ----------------------------------------------------------------- glTF */
+
+/* Loads a glTF 2.0 model (.gltf with embedded or external buffers, or
+ * .glb) of the default scene: every node (sorted parent first), every
+ * TRIANGLES primitive of every mesh node as one kin_mesh (positions
+ * required; normals, JOINTS_0 / WEIGHTS_0 when present; non-indexed
+ * primitives get 0..n-1), skins and animations. The result is validated
+ * with kin_model_validate(); free it with kin_model_free(). */
+io_result io_gltf_load(const char *path, kin_model *out, io_error *err);
+
+/* ---------------------------------------------------------------- scene */
+
+#define IO_PATH_MAX 1024
+
+/* A recorded sequence to composite (`egofuse render --scene FILE`). The
+ * text format is documented in docs/scene.md; relative paths in it are
+ * resolved against the scene file's folder. */
+typedef struct io_scene {
+    char dir[IO_PATH_MAX];            /* folder of the scene file */
+    char model[IO_PATH_MAX];          /* glTF of the mask model */
+    char animation[KIN_NAME_MAX];     /* animation name, or "" for index 0 */
+    char head_node[KIN_NAME_MAX];     /* node whose world matrix is the head */
+    int frames;                       /* number of frames */
+    float fps;                        /* frames per second */
+    char camera[2][IO_PATH_MAX];      /* printf patterns (%d of the frame),
+                                         left and right camera images */
+    char virt[2][IO_PATH_MAX];        /* virtual scene colour, per eye */
+    char virt_depth[2][IO_PATH_MAX];  /* virtual scene depth, or "" */
+    /* lighting of the virtual scene, world space directions */
+    int light_count;
+    float light_dir[8][3];
+    float light_color[8][3];
+    float ambient[3];
+    float kd, ks, shininess, kf;
+    float tone[3];
+    int has_lighting;                 /* 0 = use fuse_lighting_default() */
+} io_scene;
+
+io_result io_scene_load(const char *path, io_scene *out, io_error *err);
+/* Expands a frame pattern of the scene into an absolute-or-relative path. */
+void io_scene_frame_path(const io_scene *s, const char *pattern, int frame,
+                         char *out, size_t out_size);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,122 @@
+/* raster.h - the triangle rasterizer of egofuse (scalar reference).
+ *
+ * WHAT IT DOES
+ *   Draws indexed triangles given in homogeneous clip space (OpenGL
+ *   convention: visible when -w <= x, y, z <= w) into a target made of
+ *   a depth plane, an 8-bit coverage mask and optional interpolated
+ *   attributes (e.g. view-space normals), at any resolution up to
+ *   RAST_MAX_DIM. Per triangle:
+ *     1. drop triangles with a NaN or infinite coordinate;
+ *     2. clip in homogeneous space against near (z >= -w), far (z <= w) and
+ *        a guard band (|x|, |y| <= w * guard) so that screen coordinates stay
+ *        within RAST_GUARD_PX pixels of the target;
+ *     3. perspective divide, viewport: sx = (x/w*0.5+0.5)*width,
+ *        sy = (0.5-y/w*0.5)*height (row 0 is the top of the view);
+ *     4. snap to RAST_SUBPIXEL_BITS sub-pixel fixed point, round half to
+ *        even; drop zero-area triangles; optional back/front culling
+ *        (front = counter-clockwise in NDC, as OpenGL);
+ *     5. exact int64 edge functions at pixel centres (x+0.5, y+0.5) with the
+ *        top-left fill rule, so a pixel centre on an edge shared by two
+ *        triangles is drawn exactly once;
+ *     6. depth: window z = z/w*0.5+0.5 interpolated linearly in screen space,
+ *        test LESS against the depth plane (if any), then write depth,
+ *        mask = 255 and the perspective-correct attributes.
+ *   Plane equations are evaluated in float with one fixed order of
+ *   operations (docs/rounding.md), so SIMD paths can reproduce every byte.
+ *
+ * WHAT IT DOES NOT
+ *   No allocation, no threads, no global state: a target may be drawn by
+ *   one thread at a time; different targets on different threads.
+ *   No textures, no blending, no anti-aliasing in the reference.
+ *
+ * USAGE
+ *   float depth[W*H], nrm[W*H*3]; uint8_t mask[W*H];
+ *   rast_target t = { W, H, depth, W, mask, W, nrm, W*3, 3 };
+ *   rast_target_clear(&t);
+ *   rast_mesh_desc d = { clip, nverts, normals, 3, indices, ntris };
+ *   rast_stats st;
+ *   if (rast_draw(&t, &d, &st) != RAST_OK) ...;
+ */
+#ifndef EGOFUSE_RASTER_H
+#define EGOFUSE_RASTER_H
+
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define RAST_SUBPIXEL_BITS 8              /* 1/256 pixel */
+#define RAST_MAX_DIM 8192                 /* width and height limit */
+#define RAST_GUARD_PX 8192                /* guard band around the target */
+#define RAST_MAX_ATTRS 8                  /* interpolated floats per vertex */
+
+typedef enum rast_result {
+    RAST_OK = 0,
+    RAST_ERR_ARGS,       /* NULL pointers, negative counts, bad strides */
+    RAST_ERR_SIZE,       /* target size 0 or above RAST_MAX_DIM */
+    RAST_ERR_INDEX       /* an index >= vertex_count (nothing drawn) */
+} rast_result;
+
+typedef enum rast_cull {
+    RAST_CULL_NONE = 0,  /* default: both faces drawn */
+    RAST_CULL_BACK,
+    RAST_CULL_FRONT
+} rast_cull;
+
+/* The render target: caller-owned planes. depth and attr may be NULL. */
+typedef struct rast_target {
+    int width, height;        /* 1..RAST_MAX_DIM */
+    float *depth;             /* window depth in [0,1], cleared to 1; NULL =
+                                 no depth test (later triangles win) */
+    int depth_stride;         /* floats per row, >= width */
+    uint8_t *mask;            /* 255 where drawn, 0 elsewhere; required */
+    int mask_stride;          /* bytes per row, >= width */
+    float *attr;              /* attr_count floats per pixel, or NULL */
+    int attr_stride;          /* floats per row, >= width * attr_count */
+    int attr_count;           /* 0..RAST_MAX_ATTRS, must match the mesh */
+} rast_target;
+
+typedef struct rast_mesh_desc {
+    const float *clip;        /* 4 floats (x, y, z, w) per vertex */
+    int vertex_count;
+    const float *attr;        /* attr_count floats per vertex, or NULL */
+    int attr_count;           /* 0..RAST_MAX_ATTRS */
+    const uint32_t *indices;  /* 3 per triangle */
+    int tri_count;
+    rast_cull cull;
+} rast_mesh_desc;
+
+typedef struct rast_stats {
+    long tris_in;             /* triangles submitted */
+    long tris_nonfinite;      /* dropped: NaN or infinite vertex */
+    long tris_clipped_away;   /* entirely outside after clipping */
+    long tris_degenerate;     /* zero area after snapping */
+    long tris_culled;         /* removed by the cull mode */
+    long tris_drawn;          /* set up and scanned (after clipping a
+                                 triangle may become several) */
+    long pixels_written;      /* depth-test passes */
+} rast_stats;
+
+/* Sets depth to 1.0, mask to 0 and attributes to 0. */
+void rast_target_clear(const rast_target *t);
+
+/* Draws the mesh (see the steps above). Stats are added to *stats when it
+ * is not NULL (zero it first). Validates everything before drawing. */
+rast_result rast_draw(const rast_target *t, const rast_mesh_desc *mesh,
+                      rast_stats *stats);
+
+/* clip[i] = mvp * (pos[i], 1) for n points (pos: 3 floats each, mvp a
+ * column-major 4x4 matrix). */
+void rast_transform_points(const float mvp[16], const float *pos, int n,
+                           float *clip);
+/* out[i] = normalize(m3x3 * v[i]) where m3x3 is the upper 3x3 of the
+ * column-major 4x4 m: for rotating normals into view space. */
+void rast_transform_dirs(const float m[16], const float *v, int n, float *out);
+
+const char *rast_result_str(rast_result r);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,77 @@
+#include "testutil.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+const char *tu_shared_path(const char *rel, char *buf, size_t n)
+{
+    const char *s = getenv("EGOFUSE_SHARED");
+    snprintf(buf, n, "%s/%s", s && *s ? s : "../shared", rel);
+    return buf;
+}
+
+const char *tu_tmp_path(const char *name, char *buf, size_t n)
+{
+    const char *s = getenv("EGOFUSE_TMP");
+    char dir[512];
+    snprintf(dir, sizeof dir, "%s/t%ld", s && *s ? s : "/tmp", (long)getpid());
+    mkdir(dir, 0777);
+    snprintf(buf, n, "%s/%s", dir, name);
+    return buf;
+}
+
+const char *tu_root_path(const char *rel, char *buf, size_t n)
+{
+    const char *s = getenv("EGOFUSE_ROOT");
+    snprintf(buf, n, "%s/%s", s && *s ? s : ".", rel);
+    return buf;
+}
+
+int tu_exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0;
+}
+
+uint32_t tu_crc32(uint32_t crc, const void *data, size_t n)
+{
+    const uint8_t *p = data;
+    crc = ~crc;
+    for (size_t i = 0; i < n; i++) {
+        crc ^= p[i];
+        for (int k = 0; k < 8; k++)
+            crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+    }
+    return ~crc;
+}
+
+int tu_run(char *const argv[], char *out, size_t out_size)
+{
+    int fd[2];
+    if (pipe(fd) != 0) return -1;
+    pid_t pid = fork();
+    if (pid < 0) return -1;
+    if (pid == 0) {
+        dup2(fd[1], 1); dup2(fd[1], 2);
+        close(fd[0]); close(fd[1]);
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    close(fd[1]);
+    size_t len = 0;
+    ssize_t r;
+    char tmp[4096];
+    while ((r = read(fd[0], tmp, sizeof tmp)) > 0) {
+        size_t k = (size_t)r;
+        if (out_size && len + k >= out_size) k = out_size - 1 - len;
+        if (out_size) { memcpy(out + len, tmp, k); len += k; }
+    }
+    if (out_size) out[len] = 0;
+    close(fd[0]);
+    int st;
+    if (waitpid(pid, &st, 0) < 0) return -1;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}

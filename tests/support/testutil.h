@@ -1,0 +1,42 @@
+/* testutil.h - shared helpers for the cmocka tests: a seeded PRNG (never
+ * rand()), paths of the shared glTF models and of a scratch folder, CRC32.
+ * Every test binary includes <cmocka.h> after this header. */
+#ifndef EGOFUSE_TESTUTIL_H
+#define EGOFUSE_TESTUTIL_H
+
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <stdio.h>
+
+/* splitmix64: deterministic on every machine. */
+typedef struct tu_rng { uint64_t s; } tu_rng;
+static inline uint64_t tu_next(tu_rng *r)
+{
+    uint64_t z = (r->s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+/* Uniform in [0, 1) with 24 bits. */
+static inline float tu_unit(tu_rng *r) { return (float)(tu_next(r) >> 40) * (1.0f / 16777216.0f); }
+static inline float tu_range(tu_rng *r, float lo, float hi) { return lo + (hi - lo) * tu_unit(r); }
+static inline int tu_int(tu_rng *r, int n) { return (int)(tu_next(r) % (uint64_t)n); }
+
+/* Folder of the shared glTF models (EGOFUSE_SHARED/gltf); path of a file. */
+const char *tu_shared_path(const char *rel, char *buf, size_t n);
+/* A scratch path (EGOFUSE_TMP or /tmp) unique to this process. */
+const char *tu_tmp_path(const char *name, char *buf, size_t n);
+/* Root of the source tree (EGOFUSE_ROOT or "."). */
+const char *tu_root_path(const char *rel, char *buf, size_t n);
+/* 1 if the file exists. */
+int tu_exists(const char *path);
+/* CRC-32 (IEEE), chainable: start with crc = 0. */
+uint32_t tu_crc32(uint32_t crc, const void *data, size_t n);
+/* Runs argv (argv[0] = program path) with stdout+stderr captured into
+ * out[out_size]; returns the exit status, or -1 if it could not start or
+ * died from a signal. */
+int tu_run(char *const argv[], char *out, size_t out_size);
+
+#endif
