@@ -1,0 +1,359 @@
+/* test_cli.c - the egofuse program: error cases (message naming the input,
+ * exit code, no half-written output) and small end-to-end results on
+ * models and scenes that the test writes itself. */
+#include "support/testutil.h"
+
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/io/io.h"
+
+static char out[65536];
+
+static const char *bin(void)
+{
+    const char *b = getenv("EGOFUSE_BIN");
+    return b && *b ? b : "build/egofuse";
+}
+
+/* Runs egofuse with up to 30 arguments (NULL-terminated list). */
+static int run(const char *a0, ...)
+{
+    char *argv[32];
+    int n = 0;
+    argv[n++] = (char *)bin();
+    va_list ap;
+    va_start(ap, a0);
+    for (const char *a = a0; a && n < 31; a = va_arg(ap, const char *))
+        argv[n++] = (char *)a;
+    va_end(ap);
+    argv[n] = NULL;
+    return tu_run(argv, out, sizeof out);
+}
+
+static void b64(const uint8_t *in, size_t n, char *o)
+{
+    static const char *t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    size_t i = 0;
+    for (; i + 2 < n; i += 3) {
+        uint32_t v = (uint32_t)in[i] << 16 | (uint32_t)in[i + 1] << 8 | in[i + 2];
+        *o++ = t[v >> 18]; *o++ = t[(v >> 12) & 63]; *o++ = t[(v >> 6) & 63]; *o++ = t[v & 63];
+    }
+    if (i < n) {
+        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0);
+        *o++ = t[v >> 18]; *o++ = t[(v >> 12) & 63];
+        *o++ = i + 1 < n ? t[(v >> 6) & 63] : '=';
+        *o++ = '=';
+    }
+    *o = 0;
+}
+
+/* A glTF with a node "head" and an unskinned quad [x0,x1]x[y0,y1] at depth
+ * z facing +Z, normals +Z. */
+static void write_quad_gltf(const char *path, float x0, float x1, float y0, float y1, float z)
+{
+    uint8_t buf[108];
+    float pos[12] = {x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z};
+    float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(buf, pos, 48);
+    memcpy(buf + 48, nrm, 48);
+    memcpy(buf + 96, idx, 12);
+    char enc[200];
+    b64(buf, sizeof buf, enc);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f,
+            "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
+            "\"nodes\":[{\"name\":\"head\"},{\"name\":\"quad\",\"mesh\":0}],"
+            "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],"
+            "\"buffers\":[{\"byteLength\":108,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+            "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+            "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":96,\"byteLength\":12}],"
+            "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+            "\"min\":[%g,%g,%g],\"max\":[%g,%g,%g]},"
+            "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+            "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}\n",
+            enc, x0, y0, z, x1, y1, z);
+    fclose(f);
+}
+
+static void write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+static void write_solid(const char *path, int w, int h, uint8_t r, uint8_t g, uint8_t b)
+{
+    io_image img;
+    io_error err;
+    assert_int_equal(io_image_alloc(&img, w, h, 3, IO_U8, &err), IO_OK);
+    uint8_t *p = img.data;
+    for (int i = 0; i < w * h; i++) { p[3 * i] = r; p[3 * i + 1] = g; p[3 * i + 2] = b; }
+    assert_int_equal(io_image_save(path, &img, &err), IO_OK);
+    io_image_free(&img);
+}
+
+/* ------------------------------------------------------------- usage */
+
+static void usage_errors(void **state)
+{
+    (void)state;
+    assert_int_equal(run(NULL), 2);
+    assert_non_null(strstr(out, "usage: egofuse"));
+    assert_int_equal(run("frobnicate", NULL), 2);
+    assert_non_null(strstr(out, "unknown command 'frobnicate'"));
+    assert_int_equal(run("--help", NULL), 0);
+    assert_int_equal(run("mask", "--help", NULL), 0);
+    assert_non_null(strstr(out, "--fov-y"));
+    assert_int_equal(run("render", "--help", NULL), 0);
+    assert_int_equal(run("demo", "--help", NULL), 0);
+    assert_int_equal(run("mask", "m.glb", "--width", "abc", NULL), 2);
+    assert_non_null(strstr(out, "--width 'abc'"));
+    assert_int_equal(run("mask", "m.glb", "--width", "64", "--height", "64", "--fov-y", "60",
+                         "--eye", "0,0,1", "--target", "0,0", "--out", "x.png", NULL), 2);
+    assert_non_null(strstr(out, "--target '0,0'"));
+    assert_int_equal(run("mask", "m.glb", "--width", "64", "--height", "64", "--fov-y", "60",
+                         "--eye", "0,0,1", "--target", "0,0,0", NULL), 2);
+    assert_non_null(strstr(out, "--out is required"));
+    assert_int_equal(run("mask", "m.glb", "--width", "64", "--height", "64", "--fov-y", "60",
+                         "--eye", "0,0,1", "--target", "0,0,1", "--out", "x.png", NULL), 2);
+    assert_non_null(strstr(out, "same point"));
+    assert_int_equal(run("mask", "m.glb", "--width", "64", "--height", "64", "--fov-y", "nan",
+                         "--eye", "0,0,1", "--target", "0,0,0", "--out", "x.png", NULL), 2);
+    assert_int_equal(run("render", "--scene", "s.txt", NULL), 2);
+    assert_non_null(strstr(out, "--out is required"));
+    assert_int_equal(run("render", "--bogus", NULL), 2);
+}
+
+/* ------------------------------------------------------------- mask */
+
+static void mask_bad_models(void **state)
+{
+    (void)state;
+    char model[512], png[512];
+    tu_tmp_path("missing.glb", model, sizeof model);
+    tu_tmp_path("bad_mask.png", png, sizeof png);
+    remove(png);
+    assert_int_equal(run("mask", model, "--width", "32", "--height", "32", "--fov-y", "60",
+                         "--eye", "0,0,2", "--target", "0,0,0", "--out", png, NULL), 1);
+    assert_non_null(strstr(out, "missing.glb"));
+    assert_false(tu_exists(png));
+
+    tu_tmp_path("corrupt.gltf", model, sizeof model);
+    write_file(model, "{\"asset\":{\"version\":\"2.0\"}, \"nodes\": [ {\"mesh\": 0 } ");
+    assert_int_equal(run("mask", model, "--width", "32", "--height", "32", "--fov-y", "60",
+                         "--eye", "0,0,2", "--target", "0,0,0", "--out", png, NULL), 1);
+    assert_non_null(strstr(out, "corrupt.gltf"));
+    assert_false(tu_exists(png));
+
+    tu_tmp_path("quad.gltf", model, sizeof model);
+    write_quad_gltf(model, -1, 1, -1, 1, 0);
+    assert_int_equal(run("mask", model, "--width", "32", "--height", "32", "--fov-y", "60",
+                         "--eye", "0,0,2", "--target", "0,0,0", "--anim", "0",
+                         "--out", png, NULL), 1);
+    assert_non_null(strstr(out, "0 animations"));
+    assert_false(tu_exists(png));
+    /* Output folder that does not exist: an error naming it, nothing left. */
+    char bad[600];
+    snprintf(bad, sizeof bad, "%s.nodir/m.png", model);
+    assert_int_equal(run("mask", model, "--width", "32", "--height", "32", "--fov-y", "60",
+                         "--eye", "0,0,2", "--target", "0,0,0", "--out", bad, NULL), 1);
+    assert_non_null(strstr(out, "m.png"));
+}
+
+/* A quad [-1,1]^2 seen from z = 2 with a 90 degree FOV covers exactly the
+ * middle half of the image: pixel centres 16.5 .. 47.5 of 64. */
+static void mask_exact_quad(void **state)
+{
+    (void)state;
+    char model[512], png[512], nrm[512], dep[512];
+    tu_tmp_path("quad2.gltf", model, sizeof model);
+    tu_tmp_path("quad2_mask.png", png, sizeof png);
+    tu_tmp_path("quad2_n.png", nrm, sizeof nrm);
+    tu_tmp_path("quad2_d.exr", dep, sizeof dep);
+    write_quad_gltf(model, -1, 1, -1, 1, 0);
+    int rc = run("mask", model, "--width", "64", "--height", "64", "--fov-y", "90",
+                 "--eye", "0,0,2", "--target", "0,0,0", "--up", "0,1,0", "--out", png,
+                 "--normals", nrm, "--depth", dep, NULL);
+    if (rc != 0) fprintf(stderr, "%s\n", out);
+    assert_int_equal(rc, 0);
+    io_image m, n, d;
+    io_error err;
+    assert_int_equal(io_image_load(png, IO_U8, 0, &m, &err), IO_OK);
+    assert_int_equal(m.channels, 1);
+    assert_int_equal(m.width, 64);
+    const uint8_t *p = m.data;
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++) {
+            int inside = x >= 16 && x < 48 && y >= 16 && y < 48;
+            assert_int_equal(p[y * 64 + x], inside ? 255 : 0);
+        }
+    assert_int_equal(io_image_load(nrm, IO_U8, 3, &n, &err), IO_OK);
+    const uint8_t *q = n.data;
+    /* Facing the camera: view-space normal (0,0,1) -> (128,128,255). */
+    assert_int_equal(q[(32 * 64 + 32) * 3 + 2], 255);
+    assert_int_equal(q[(32 * 64 + 32) * 3 + 0], 128);
+    assert_int_equal(q[0], 0);
+    assert_int_equal(io_image_load(dep, IO_F32, 1, &d, &err), IO_OK);
+    const float *z = d.data;
+    /* Plane at distance 2: z_ndc = (f+n)/(f-n) - 2fn/((f-n) * 2). */
+    double fn = 100.0, nn = 0.01;
+    double zn = (fn + nn) / (fn - nn) - 2.0 * fn * nn / ((fn - nn) * 2.0);
+    assert_true(fabs(z[32 * 64 + 32] - (zn * 0.5 + 0.5)) < 1e-6);
+    assert_true(z[0] == 1.0f);
+    io_image_free(&m);
+    io_image_free(&n);
+    io_image_free(&d);
+}
+
+static void mask_shared_models(void **state)
+{
+    (void)state;
+    char model[512], png[512];
+    tu_shared_path("gltf/CesiumMan/CesiumMan.glb", model, sizeof model);
+    if (!tu_exists(model)) {
+        printf("SKIP shared glTF models not found at %s\n", model);
+        skip();
+    }
+    tu_tmp_path("cesium.png", png, sizeof png);
+    int rc = run("mask", model, "--width", "96", "--height", "128", "--fov-y", "50",
+                 "--eye", "0,1,3", "--target", "0,0.8,0", "--anim", "0", "--time", "0.5",
+                 "--out", png, NULL);
+    if (rc != 0) fprintf(stderr, "%s\n", out);
+    assert_int_equal(rc, 0);
+    io_image m;
+    io_error err;
+    assert_int_equal(io_image_load(png, IO_U8, 1, &m, &err), IO_OK);
+    int covered = 0;
+    const uint8_t *p = m.data;
+    for (int i = 0; i < 96 * 128; i++) {
+        assert_true(p[i] == 0 || p[i] == 255);
+        covered += p[i] == 255;
+    }
+    /* A standing figure fills part of the frame, not none and not all. */
+    assert_true(covered > 300);
+    assert_true(covered < 96 * 128 / 2);
+    io_image_free(&m);
+}
+
+/* --------------------------------------------------------- render */
+
+static void write_scene(const char *dir, int cam_w, int cam_h)
+{
+    char p[600];
+    snprintf(p, sizeof p, "%s/quad.gltf", dir);
+    /* 0.2 m square, 0.6 m in front of the head: both cameras see it. */
+    write_quad_gltf(p, -0.1f, 0.1f, -0.1f, 0.1f, -0.6f);
+    snprintf(p, sizeof p, "%s/cam_l_0.png", dir);
+    write_solid(p, cam_w, cam_h, 200, 150, 120);
+    snprintf(p, sizeof p, "%s/cam_r_0.png", dir);
+    write_solid(p, cam_w, cam_h, 200, 150, 120);
+    snprintf(p, sizeof p, "%s/virt_l_0.png", dir);
+    write_solid(p, 1280, 800, 10, 40, 90);
+    snprintf(p, sizeof p, "%s/virt_r_0.png", dir);
+    write_solid(p, 1280, 800, 10, 40, 90);
+    snprintf(p, sizeof p, "%s/scene.txt", dir);
+    write_file(p, "egofuse-scene 1\n"
+                  "model = quad.gltf\n"
+                  "head_node = head\n"
+                  "frames = 1\n"
+                  "fps = 60\n"
+                  "camera_left = cam_l_%d.png\n"
+                  "camera_right = cam_r_%d.png\n"
+                  "virtual_left = virt_l_%d.png\n"
+                  "virtual_right = virt_r_%d.png\n");
+}
+
+static void render_end_to_end(void **state)
+{
+    (void)state;
+    char dir[512], scene[600], odir[600], png[700];
+    tu_tmp_path("scene_ok", dir, sizeof dir);
+    char cmd[700];
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+    write_scene(dir, 640, 480);
+    snprintf(scene, sizeof scene, "%s/scene.txt", dir);
+    snprintf(odir, sizeof odir, "%s/out", dir);
+    int rc = run("render", "--scene", scene, "--out", odir, "--quiet", NULL);
+    if (rc != 0) fprintf(stderr, "%s\n", out);
+    assert_int_equal(rc, 0);
+    for (int e = 0; e < 2; e++) {
+        snprintf(png, sizeof png, "%s/%s_0000.png", odir, e ? "right" : "left");
+        io_image r;
+        io_error err;
+        assert_int_equal(io_image_load(png, IO_U8, 3, &r, &err), IO_OK);
+        assert_int_equal(r.width, 1280);
+        assert_int_equal(r.height, 800);
+        const uint8_t *p = r.data;
+        /* Corners (outside the viewport and the quad) are the virtual scene. */
+        assert_memory_equal(p, (uint8_t[]){10, 40, 90}, 3);
+        assert_memory_equal(p + 3 * (1280 * 800 - 1), (uint8_t[]){10, 40, 90}, 3);
+        /* The quad is seen near the centre (shifted by the eye offset): the
+         * camera's colour, lit, replaces the virtual scene there. */
+        int hits = 0;
+        for (int x = 560; x < 720; x++) {
+            const uint8_t *c = p + 3 * (400 * 1280 + x);
+            if (c[0] > 100 && c[0] > c[2]) hits++;
+        }
+        assert_true(hits > 40);
+        io_image_free(&r);
+    }
+}
+
+static void render_bad_inputs(void **state)
+{
+    (void)state;
+    char dir[512], scene[600], odir[600], png[700];
+    tu_tmp_path("scene_bad", dir, sizeof dir);
+    char cmd[700];
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+    snprintf(scene, sizeof scene, "%s/scene.txt", dir);
+    snprintf(odir, sizeof odir, "%s/out", dir);
+
+    /* Missing scene file. */
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, NULL), 1);
+    assert_non_null(strstr(out, "scene.txt"));
+
+    /* A camera image of the wrong size: named, and no output frame. */
+    write_scene(dir, 320, 240);
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--quiet", NULL), 1);
+    assert_non_null(strstr(out, "cam_l_0.png"));
+    assert_non_null(strstr(out, "320x240"));
+    snprintf(png, sizeof png, "%s/left_0000.png", odir);
+    assert_false(tu_exists(png));
+
+    /* A missing frame is found before anything is written. */
+    write_scene(dir, 640, 480);
+    snprintf(png, sizeof png, "%s/virt_r_0.png", dir);
+    remove(png);
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--quiet", NULL), 1);
+    assert_non_null(strstr(out, "virt_r_0.png"));
+    snprintf(png, sizeof png, "%s/left_0000.png", odir);
+    assert_false(tu_exists(png));
+
+    /* Frames beyond the scene. */
+    write_scene(dir, 640, 480);
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--first", "3", NULL), 1);
+    assert_non_null(strstr(out, "1 frames"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(usage_errors),
+        cmocka_unit_test(mask_bad_models),
+        cmocka_unit_test(mask_exact_quad),
+        cmocka_unit_test(mask_shared_models),
+        cmocka_unit_test(render_end_to_end),
+        cmocka_unit_test(render_bad_inputs),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
