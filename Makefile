@@ -41,9 +41,9 @@ TEST_SHARED_OBJ := $(call obj,$(TEST_SHARED))
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-IO_PKGS  := OpenImageIO libusb-1.0 libv4l2
+IO_PKGS  := OpenImageIO tinygltf libusb-1.0 libv4l2
 IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) 2>/dev/null)
-IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -ltinygltf -lstdc++
+IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lstdc++
 SYS_LIBS := -lm -lpthread
 
 LIB      := $(BUILD)/libegofuse.a
@@ -52,7 +52,7 @@ EGOFUSE  := $(BUILD)/egofuse
 GEN      := $(BUILD)/gen_samples
 SAMPLES  := $(BUILD)/samples
 
-.PHONY: all deps demo test test-only debug bench clean samples
+.PHONY: all deps demo test debug bench clean samples check-headers
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(IOLIB) $(EGOFUSE) $(GEN) $(TEST_BIN) $(BENCH_BIN)
@@ -111,8 +111,16 @@ demo: deps
 	$(EGOFUSE) demo --samples $(SAMPLES) --out out/demo
 
 test: deps
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory all check-headers
 	@sh tests/run_tests.sh $(BUILD)
+
+# Every public header compiles on its own as C and as C++ (sokol's rule).
+HEADERS := src/raster/raster.h src/kin/kin.h src/fuse/fuse.h src/io/io.h
+check-headers:
+	@for h in $(HEADERS); do \
+	    echo "#include \"$$h\"" | $(CC) -std=c99 -Wall -Wextra -Werror -x c -fsyntax-only - || exit 1; \
+	    echo "#include \"$$h\"" | $(CXX) -Wall -Wextra -Werror -x c++ -fsyntax-only - || exit 1; \
+	done
 
 # Tests under AddressSanitizer and UndefinedBehaviorSanitizer.
 debug: deps

@@ -18,10 +18,9 @@ for t in "$ROOT/$BUILD"/tests/test_*; do
     log="$EGOFUSE_TMP/$name.log"
     "$t" >"$log" 2>&1
     rc=$?
-    p=$(sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -n 1)
-    f=$(sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' "$log" | tail -n 1)
-    s=$(sed -n 's/^\[  SKIPPED \] \([0-9]*\) test.*/\1/p' "$log" | tail -n 1)
-    p=${p:-0}; f=${f:-0}; s=${s:-0}
+    # cmocka prints one summary per group: add them all up.
+    sum() { sed -n "s/^\[  $1 *\] \([0-9][0-9]*\) test(s).*/\1/p" "$log" | awk '{n+=$1} END {print n+0}'; }
+    p=$(sum PASSED); f=$(sum FAILED); s=$(sum SKIPPED)
     if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then f=1; fi
     passed=$((passed + p)); failed=$((failed + f)); skipped=$((skipped + s))
     if [ "$f" -ne 0 ]; then

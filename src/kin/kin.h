@@ -83,6 +83,7 @@ kin_mat4 kin_mat4_mul(const kin_mat4 *a, const kin_mat4 *b);   /* a * b */
 kin_mat4 kin_mat4_from_transform(const kin_transform *t);
 /* General inverse; returns 0 (and leaves *out as identity) when singular. */
 int      kin_mat4_inverse(const kin_mat4 *a, kin_mat4 *out);
+/* Affine transforms: the bottom row of a is ignored (no divide by w). */
 kin_vec3 kin_mat4_mul_point(const kin_mat4 *a, kin_vec3 p);     /* w = 1 */
 kin_vec3 kin_mat4_mul_dir(const kin_mat4 *a, kin_vec3 d);       /* w = 0 */
 /* Right-handed look-at view matrix (world -> view), like gluLookAt. */
@@ -198,7 +199,8 @@ void kin_anim_sample(const kin_animation *anim, int node_count, float t,
 
 /* Forward kinematics: world[i] = world[parent[i]] * M(locals[i]), with
  * root = root_or_null (identity if NULL) as the parent of roots.
- * Requires parents[i] < i. */
+ * Requires parents[i] < i (a node whose parent index is not an earlier node
+ * is treated as a root). */
 void kin_fk(const int16_t *parents, int count, const kin_transform *locals,
             const kin_mat4 *root_or_null, kin_mat4 *world);
 
@@ -214,7 +216,9 @@ void kin_skin_joint_matrices(const kin_skin *skin, const kin_mat4 *world,
  * mesh->normals and nrm_out are non-NULL) with joint matrices jm.
  * pos_out / nrm_out: 3 floats per vertex. Normals are transformed by the
  * cofactor (inverse transpose up to scale) of the blended matrix and
- * renormalised. A vertex whose weights sum to 0 keeps its bind position. */
+ * renormalised. A vertex whose weights sum to 0 keeps its bind position.
+ * Normals use sign(det) * cofactor, so mirroring keeps them outward.
+ * pos_out / nrm_out must not alias the mesh arrays. */
 void kin_skin_lbs(const kin_mesh *mesh, const kin_mat4 *jm,
                   float *pos_out, float *nrm_out);
 
@@ -225,7 +229,7 @@ void kin_mesh_transform(const kin_mesh *mesh, const kin_mat4 *m,
 
 /* ------------------------------------------------- STHMD camera model */
 
-/* Zero means default for every field. */
+/* Zero means default for every field (negative values too). */
 typedef struct kin_sthmd_desc {
     int   cam_width, cam_height;    /* camera sensor, default 640 x 480 */
     float cam_hfov_deg;             /* camera horizontal FOV, default 62 */

@@ -1,0 +1,105 @@
+/* kin_skin.c - linear blend skinning (glTF 2.0) and rigid mesh transforms.
+ *
+ * Per vertex: B = sum_i w_i * jm[joint_i] (only influences with w_i != 0
+ * are read), p' = B p. Normals: n' = C n with C = sign(det A) * cof(A),
+ * A the upper 3x3 of B, cof(A) = det(A) A^-T its cofactor matrix, so C is
+ * the inverse transpose times |det A| (a positive scale) and needs no
+ * division; n' is then renormalised. A vertex whose weights sum to 0 keeps
+ * its bind position and normal. No allocation. */
+#include "kin.h"
+
+#include <math.h>
+
+void kin_skin_joint_matrices(const kin_skin *skin, const kin_mat4 *world,
+                             kin_mat4 *jm)
+{
+    if (!skin || !world || !jm) return;
+    for (int j = 0; j < skin->joint_count; j++) {
+        const kin_mat4 *w = &world[skin->joints[j]];
+        jm[j] = skin->inverse_bind ? kin_mat4_mul(w, &skin->inverse_bind[j]) : *w;
+    }
+}
+
+/* Affine 3x4 part of a matrix, column-major like kin_mat4 (a[col*3+row]). */
+typedef struct affine { float a[12]; } affine;
+
+static void affine_of(const kin_mat4 *m, affine *out)
+{
+    for (int c = 0; c < 4; c++)
+        for (int r = 0; r < 3; r++) out->a[c * 3 + r] = m->m[c * 4 + r];
+}
+
+static void xform_point(const affine *b, const float *p, float *o)
+{
+    const float *a = b->a;
+    o[0] = a[0] * p[0] + a[3] * p[1] + a[6] * p[2] + a[9];
+    o[1] = a[1] * p[0] + a[4] * p[1] + a[7] * p[2] + a[10];
+    o[2] = a[2] * p[0] + a[5] * p[1] + a[8] * p[2] + a[11];
+}
+
+/* n' = sign(det A) cof(A) n, renormalised. cof(A) has the columns
+ * a1 x a2, a2 x a0, a0 x a1 (a_i the columns of A). */
+static void xform_normal(const affine *b, const float *n, float *o)
+{
+    const float *a = b->a;
+    kin_vec3 a0 = kin_v3(a[0], a[1], a[2]);
+    kin_vec3 a1 = kin_v3(a[3], a[4], a[5]);
+    kin_vec3 a2 = kin_v3(a[6], a[7], a[8]);
+    kin_vec3 c0 = kin_v3_cross(a1, a2), c1 = kin_v3_cross(a2, a0),
+             c2 = kin_v3_cross(a0, a1);
+    float det = kin_v3_dot(a0, c0);
+    kin_vec3 r = kin_v3_add(kin_v3_add(kin_v3_scale(c0, n[0]), kin_v3_scale(c1, n[1])),
+                            kin_v3_scale(c2, n[2]));
+    if (det < 0.0f) r = kin_v3_scale(r, -1.0f);
+    r = kin_v3_norm(r);
+    o[0] = r.x; o[1] = r.y; o[2] = r.z;
+}
+
+void kin_skin_lbs(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
+                  float *nrm_out)
+{
+    if (!mesh || !pos_out) return;
+    const int do_n = mesh->normals && nrm_out;
+    const int skinned = mesh->joints && mesh->weights && jm;
+    for (int v = 0; v < mesh->vertex_count; v++) {
+        const float *p = mesh->positions + (size_t)v * 3;
+        float *po = pos_out + (size_t)v * 3;
+        const float *n = do_n ? mesh->normals + (size_t)v * 3 : NULL;
+        float *no = do_n ? nrm_out + (size_t)v * 3 : NULL;
+
+        affine b = { { 0 } };
+        float wsum = 0.0f;
+        if (skinned) {
+            const uint16_t *j = mesh->joints + (size_t)v * 4;
+            const float *w = mesh->weights + (size_t)v * 4;
+            for (int i = 0; i < 4; i++) {
+                if (w[i] == 0.0f) continue;
+                const float *m = jm[j[i]].m;
+                for (int c = 0; c < 4; c++)
+                    for (int r = 0; r < 3; r++) b.a[c * 3 + r] += w[i] * m[c * 4 + r];
+                wsum += w[i];
+            }
+        }
+        if (wsum == 0.0f) {
+            po[0] = p[0]; po[1] = p[1]; po[2] = p[2];
+            if (do_n) { no[0] = n[0]; no[1] = n[1]; no[2] = n[2]; }
+            continue;
+        }
+        xform_point(&b, p, po);
+        if (do_n) xform_normal(&b, n, no);
+    }
+}
+
+void kin_mesh_transform(const kin_mesh *mesh, const kin_mat4 *m, float *pos_out,
+                        float *nrm_out)
+{
+    if (!mesh || !m || !pos_out) return;
+    const int do_n = mesh->normals && nrm_out;
+    affine b;
+    affine_of(m, &b);
+    for (int v = 0; v < mesh->vertex_count; v++) {
+        xform_point(&b, mesh->positions + (size_t)v * 3, pos_out + (size_t)v * 3);
+        if (do_n)
+            xform_normal(&b, mesh->normals + (size_t)v * 3, nrm_out + (size_t)v * 3);
+    }
+}
