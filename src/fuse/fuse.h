@@ -19,17 +19,42 @@
  *   Resampling premultiplied colour keeps the background that the mask cut
  *   away from bleeding into the edge of the hand.
  *
- * NUMBERS (docs/rounding.md says it once for all paths)
+ * NUMBERS (docs/fuse.md states every rule once, with the exact float
+ * operation order; the fuse part of docs/rounding.md refers to it)
  *   Images are RGBA8, 4 bytes per pixel in memory order R G B A.
- *   fuse_light works in float: P/255, lighting, clamp to [0,1], then
- *   u8 = (int)(v * 255 + 0.5). Rgb of Q is rounded from M'*P' in float.
+ *   fuse_light works in float (IEEE single, no FMA, one fixed operation
+ *   order; u8/255 is computed as u8 * (1.0f/255.0f)): P/255, lighting,
+ *   clamp to [0,1], then u8 = (int)(v * 255 + 0.5).
+ *   Rgb of Q is rounded from M'*P' in float, alpha from M'. The specular
+ *   power x^s is not powf() but exp2(s log2 x) with fixed polynomials
+ *   (fuse_internal.h), so that every ISA gives the same bits.
+ *   The view vector of pixel (x, y) comes from the intrinsics (below);
+ *   N is normalised, and a normal of zero, huge or non-finite length
+ *   (|N|^2 outside (1e-30, 1e30)) is replaced by V. Pixels with M == 0
+ *   are (0,0,0,0) whatever N and P hold.
  *   fuse_composite is integer: the source coordinate of output pixel centre
- *   x is sx = (x + 0.5) * sw / vw - 0.5 in 16.16 fixed point, clamped to
- *   the edge pixels (edge pixels replicate); weights are the top 8 bits of
- *   the fraction; the four taps are blended as
+ *   x (counted from the viewport's left edge) is sx = (x + 0.5) sw / vw - 0.5
+ *   in 16.16 fixed point, computed exactly as
+ *     sx16 = floor(((2x + 1) sw - vw) 65536 / (2 vw)),
+ *   clamped to [0, (sw - 1) 65536] (edge pixels replicate: the taps beyond
+ *   the last pixel repeat it); the same for y with sh, vh. Weights are the
+ *   top 8 bits of the fraction, fx = (sx16 >> 8) & 255; the four taps are
+ *   blended as
  *     ((a(256-fx) + b fx)(256-fy) + (c(256-fx) + d fx) fy + 32768) >> 16
- *   and over is R = Q + div255((255 - Ma) V) with
+ *   and over is R = min(255, Q + div255((255 - Qa) V)) per colour, with
  *   div255(t) = (t + 128 + ((t + 128) >> 8)) >> 8 (exact rounding).
+ *
+ * ERRORS
+ *   Nothing is written unless the call returns FUSE_OK. FUSE_ERR_ARGS: a
+ *   NULL pointer, an image with NULL pixels, a width or height outside
+ *   1..FUSE_MAX_DIM, a stride below 4 * width (mask: width, normal:
+ *   3 * width floats, RGB24: 3 * width bytes), light_count outside
+ *   0..FUSE_MAX_LIGHTS, shininess outside [1, FUSE_PARAM_MAX], another
+ *   lighting float non-finite or beyond +-FUSE_PARAM_MAX, a light
+ *   direction of (near) zero length, intrinsics with fx or fy outside
+ *   [1e-3, 1e7] or |cx|, |cy| > 1e7, an empty viewport, or outputs that
+ *   overlap their inputs other than as allowed below. FUSE_ERR_SIZE: out
+ *   of another size than required, a viewport not inside V.
  *
  * WHAT IT DOES NOT
  *   No allocation, no threads, no global state, no file I/O.
@@ -50,6 +75,11 @@ extern "C" {
 #endif
 
 #define FUSE_MAX_LIGHTS 8
+/* Largest width or height of any image (keeps the 16.16 positions in
+ * int32 and every product in range). */
+#define FUSE_MAX_DIM 16384
+/* Bound on the magnitude of every float in fuse_lighting (no overflow). */
+#define FUSE_PARAM_MAX 1.0e6f
 
 typedef enum fuse_result {
     FUSE_OK = 0,
@@ -79,37 +109,51 @@ typedef struct fuse_lighting {
     float tone[3];                        /* colour tone multiplier */
 } fuse_lighting;
 
-/* Camera intrinsics of the image being lit: the view vector of pixel
- * (x, y) is V = -normalize(((x+.5-cx)/fx, -(y+.5-cy)/fy, -1)). */
+/* Camera intrinsics of the image being lit, in pixels of that image
+ * (after the crop: cy is relative to the crop's first row). The view
+ * vector of pixel (x, y), from the surface towards the camera, is
+ * V = -normalize(((x+.5-cx)/fx, -(y+.5-cy)/fy, -1)) (view space: x right,
+ * y up, the camera looks down -z). */
 typedef struct fuse_intrinsics { float fx, fy, cx, cy; } fuse_intrinsics;
 
-/* One light from above-front, ambient 0.35, kd 0.75, ks 0.15, s 16,
- * kf 0.6, tone 1: gentle shading, soft edges. */
+/* One white light from above-front (dir (0, 0.6, 0.8), colour 1),
+ * ambient 0.35, kd 0.75, ks 0.15, s 16, kf 0.6, tone 1: gentle shading,
+ * soft edges. */
 fuse_lighting fuse_lighting_default(void);
 
-/* A view of rows [y0, y0+h) of img (the crop of eq. 1 costs no copy). */
+/* A view of rows [y0, y0+h) of img (the crop of eq. 1 costs no copy).
+ * Returns a zeroed image (pixels NULL, which every call rejects) if img
+ * is NULL or the rows are not inside it (y0 < 0, h < 1, y0 + h > height). */
 fuse_image fuse_image_rows(const fuse_image *img, int y0, int h);
 
 /* The lighting layer (step 1). P, mask (u8, mask_stride bytes per row) and
  * normal (3 floats per pixel, normal_stride floats per row, need not be
  * unit length) have P's size; out (premultiplied RGBA8) too. Pixels with
- * M == 0 get (0,0,0,0). */
+ * M == 0 get (0,0,0,0). P's alpha is ignored. Light directions are
+ * normalised once per call. out may be P itself (same pixels and stride)
+ * and must not otherwise overlap P, mask or normal. Every written pixel
+ * has r, g, b <= a. */
 fuse_result fuse_light(const fuse_lighting *L, const fuse_intrinsics *K,
                        const fuse_image *P, const uint8_t *mask,
                        int mask_stride, const float *normal,
                        int normal_stride, fuse_image *out);
 
 /* Resample the premultiplied layer Q into the viewport (vp_x0, vp_y0,
- * vp_w, vp_h) of V and composite; out has V's size (out may be V itself).
- * The viewport must lie inside V. Alpha of out is 255. */
+ * vp_w, vp_h) of V and composite; out has V's size (out may be V itself,
+ * same pixels and stride; otherwise out overlaps neither V nor Q).
+ * The viewport must lie inside V. Outside it out = V byte for byte
+ * (alpha included); inside, alpha of out is 255. Q's rgb should not
+ * exceed its alpha (premultiplied); if it does the sum is clamped to 255. */
 fuse_result fuse_composite(const fuse_image *Q, const fuse_image *V,
                            int vp_x0, int vp_y0, int vp_w, int vp_h,
                            fuse_image *out);
 
-/* Fills an RGBA8 image from packed RGB24 (stride in bytes), alpha 255. */
+/* Fills an RGBA8 image from packed RGB24 (stride in bytes), alpha 255.
+ * out must have width x height pixels and must not overlap rgb. */
 fuse_result fuse_rgb24_to_rgba(const uint8_t *rgb, int stride, int width,
                                int height, fuse_image *out);
 
+/* A static English message for r (never NULL). */
 const char *fuse_result_str(fuse_result r);
 
 #ifdef __cplusplus

@@ -1,0 +1,216 @@
+/* fuse_internal.h - what the fuse kernels share: the arithmetic rules of
+ * docs/fuse.md written once (div255, the reproducible power, the exact
+ * source positions), the prepared lighting parameters and the scalar row
+ * kernels that define every output byte. A SIMD path includes this header,
+ * uses the same constants in the same operation order and must give the
+ * same bytes as the row kernels below (docs/fuse.md, "Rounding rules").
+ *
+ * Names shared across files use the fuse__ prefix; nothing here is public
+ * API. */
+#ifndef EGOFUSE_FUSE_INTERNAL_H
+#define EGOFUSE_FUSE_INTERNAL_H
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "fuse.h"
+
+/* ---- 8-bit integer rules -------------------------------------------- */
+
+/* round(t / 255) for 0 <= t <= 255 * 255, exact (no ties exist: 255 is
+ * odd). The pixman MUL_UN8 trick. */
+#define FUSE__DIV255(t) ((((t) + 128u) + (((t) + 128u) >> 8)) >> 8)
+/* round(a * b / 255) for 8-bit a, b. */
+#define FUSE__MUL_UN8(a, b) FUSE__DIV255((uint32_t)(a) * (uint32_t)(b))
+
+/* Bilinear blend of four 8-bit taps with 8-bit weights fx, fy in 0..255:
+ * a b on the upper row, c d on the lower one. Exact, rounds half up. The
+ * largest intermediate is 255 * 256 * 256 + 32768 < 2^25. */
+static inline uint32_t fuse__bilerp8(uint32_t a, uint32_t b, uint32_t c,
+                                     uint32_t d, uint32_t fx, uint32_t fy)
+{
+    uint32_t top = a * (256u - fx) + b * fx;
+    uint32_t bot = c * (256u - fx) + d * fx;
+    return (top * (256u - fy) + bot * fy + 32768u) >> 16;
+}
+
+/* ---- exact source positions ----------------------------------------- */
+
+/* Source coordinate of the centre of destination pixel i (0 <= i < dst)
+ * when src pixels are stretched over dst pixels, in 16.16 fixed point:
+ *   pos(i) = floor(((2i + 1) * src - dst) * 65536 / (2 * dst))
+ * which is floor(65536 * ((i + 0.5) * src / dst - 0.5)), exactly, then
+ * clamped to [0, (src - 1) * 65536]. fuse__axis walks i = 0, 1, 2, ...
+ * with an exact quotient/remainder step (no drift, no division per
+ * pixel). Needs src, dst in 1..FUSE_MAX_DIM. */
+typedef struct fuse__axis {
+    int64_t q, r;          /* floor quotient and remainder (0 <= r < den) */
+    int64_t den;           /* 2 * dst */
+    int64_t step_q, step_r;/* 2 * src * 65536 = step_q * den + step_r */
+    int32_t max;           /* (src - 1) << 16 */
+} fuse__axis;
+
+static inline void fuse__axis_init(fuse__axis *a, int src, int dst)
+{
+    int64_t num = ((int64_t)src - dst) * 65536;
+    a->den = 2 * (int64_t)dst;
+    a->q = num / a->den;
+    a->r = num % a->den;
+    if (a->r < 0) { a->r += a->den; a->q -= 1; }   /* floor, not trunc */
+    a->step_q = (2 * (int64_t)src * 65536) / a->den;
+    a->step_r = (2 * (int64_t)src * 65536) % a->den;
+    a->max = (int32_t)(src - 1) << 16;
+}
+
+/* Clamped 16.16 position of the current pixel. */
+static inline int32_t fuse__axis_pos(const fuse__axis *a)
+{
+    if (a->q < 0) return 0;
+    if (a->q > a->max) return a->max;
+    return (int32_t)a->q;
+}
+
+static inline void fuse__axis_next(fuse__axis *a)
+{
+    a->q += a->step_q;
+    a->r += a->step_r;
+    if (a->r >= a->den) { a->r -= a->den; a->q += 1; }
+}
+
+/* Direct form of the same position (one int64 division). */
+static inline int32_t fuse__src_pos(int i, int src, int dst)
+{
+    int64_t num = ((int64_t)2 * i + 1) * src - dst;
+    int64_t den = 2 * (int64_t)dst;
+    int64_t q, r;
+    num *= 65536;
+    q = num / den;
+    r = num % den;
+    if (r < 0) q -= 1;
+    if (q < 0) return 0;
+    if (q > ((int64_t)(src - 1) << 16)) return (int32_t)(src - 1) << 16;
+    return (int32_t)q;
+}
+
+/* ---- float rules ---------------------------------------------------- */
+
+static inline uint32_t fuse__f2u(float f) { uint32_t u; memcpy(&u, &f, 4); return u; }
+static inline float fuse__u2f(uint32_t u) { float f; memcpy(&f, &u, 4); return f; }
+
+/* max(0, v) and clamp to [0, 1]; written with ordered compares, so a NaN
+ * gives 0 (none can occur with validated parameters). */
+static inline float fuse__max0(float v) { return v > 0.0f ? v : 0.0f; }
+static inline float fuse__clamp01(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }
+
+/* 1/255 as a float (0x3B808081); u8 to [0, 1] is u * FUSE__INV255, a
+ * multiplication, not a division (255 * FUSE__INV255 rounds to 1.0f). */
+#define FUSE__INV255 (1.0f / 255.0f)
+
+/* float in [0, 1] to u8: (int)(v * 255 + 0.5), truncation. */
+static inline uint8_t fuse__unorm8(float v) { return (uint8_t)(int)(v * 255.0f + 0.5f); }
+
+/* log2 polynomial: log2(m) = t * (L1 + t2 (L3 + t2 (L5 + t2 (L7 + t2 L9))))
+ * with t = (m - 1) / (m + 1), m in [sqrt(1/2), sqrt(2)), Lk = 2 / (k ln 2)
+ * (the atanh series; |t| <= 0.1716, truncation error < 1e-9). */
+#define FUSE__LOG2_C1 2.88539008177792681472f
+#define FUSE__LOG2_C3 0.96179669392597560491f
+#define FUSE__LOG2_C5 0.57707801635558536294f
+#define FUSE__LOG2_C7 0.41219858311113240210f
+#define FUSE__LOG2_C9 0.32059889797532520163f
+#define FUSE__SQRT2   1.41421356237309504880f
+/* exp2 polynomial: 2^f = sum_{n=0..7} En f^n, En = ln2^n / n!, for f in
+ * [-0.5, 0.5] (truncation error < 3e-9), evaluated by Horner. */
+#define FUSE__EXP2_C0 1.0f
+#define FUSE__EXP2_C1 0.69314718055994530942f
+#define FUSE__EXP2_C2 0.24022650695910071233f
+#define FUSE__EXP2_C3 0.05550410866482157995f
+#define FUSE__EXP2_C4 0.00961812910762847716f
+#define FUSE__EXP2_C5 0.00133335581464284434f
+#define FUSE__EXP2_C6 0.00015403530393381609f
+#define FUSE__EXP2_C7 0.00001525273380405984f
+/* Below this N.H the specular term is 0 (x^s < 2^-100 for s >= 1). */
+#define FUSE__POW_MIN 7.88860905221011805412e-31f   /* 2^-100 */
+
+/* x^s for x in [0, 1] (larger x count as 1), s >= 1, in a fixed sequence
+ * of IEEE float operations and integer bit operations that every ISA can
+ * repeat exactly: x^s = exp2(s * log2(x)).
+ *   x <= 2^-100            -> 0
+ *   x = 2^e * m, m in [sqrt(1/2), sqrt(2)), e and m from the float's bits
+ *   l = (float)e + log2poly(m)          (log2poly above)
+ *   y = s * l;  y < -126   -> 0
+ *   k = floorf(y + 0.5f);  f = y - k    (exact, |f| <= 0.5)
+ *   result = exp2poly(f) * 2^k          (2^k built from bits)
+ * Relative error about 1e-6 against pow() for the s in use. */
+static inline float fuse__pow01(float x, float s)
+{
+    uint32_t bits;
+    int e;
+    float m, t, t2, p, l, y, k, f;
+    if (!(x > FUSE__POW_MIN)) return 0.0f;
+    if (x >= 1.0f) return 1.0f;
+    bits = fuse__f2u(x);
+    e = (int)(bits >> 23) - 127;
+    m = fuse__u2f((bits & 0x007fffffu) | 0x3f800000u);
+    if (m > FUSE__SQRT2) { m = m * 0.5f; e += 1; }
+    t = (m - 1.0f) / (m + 1.0f);
+    t2 = t * t;
+    p = FUSE__LOG2_C9;
+    p = p * t2 + FUSE__LOG2_C7;
+    p = p * t2 + FUSE__LOG2_C5;
+    p = p * t2 + FUSE__LOG2_C3;
+    p = p * t2 + FUSE__LOG2_C1;
+    l = (float)e + p * t;
+    y = s * l;
+    if (y < -126.0f) return 0.0f;
+    k = floorf(y + 0.5f);
+    f = y - k;
+    p = FUSE__EXP2_C7;
+    p = p * f + FUSE__EXP2_C6;
+    p = p * f + FUSE__EXP2_C5;
+    p = p * f + FUSE__EXP2_C4;
+    p = p * f + FUSE__EXP2_C3;
+    p = p * f + FUSE__EXP2_C2;
+    p = p * f + FUSE__EXP2_C1;
+    p = p * f + FUSE__EXP2_C0;
+    return p * fuse__u2f((uint32_t)((int)k + 127) << 23);
+}
+
+/* ---- prepared lighting ---------------------------------------------- */
+
+/* Lighting parameters after validation: light directions normalised once
+ * per call (dir / sqrtf(dot(dir, dir))), everything else copied. */
+typedef struct fuse__light_prep {
+    int light_count;
+    float dir[FUSE_MAX_LIGHTS][3];
+    float color[FUSE_MAX_LIGHTS][3];
+    float ambient[3];
+    float kd, ks, shininess, kf;
+    float tone[3];
+    float ifx, ify, cx, cy;   /* 1.0f / fx, 1.0f / fy (one IEEE division) */
+} fuse__light_prep;
+
+/* Validates L and K (docs/fuse.md) and fills *p. FUSE_OK or
+ * FUSE_ERR_ARGS. */
+fuse_result fuse__light_prepare(const fuse_lighting *L,
+                                const fuse_intrinsics *K,
+                                fuse__light_prep *p);
+
+/* ---- scalar row kernels (the reference) ------------------------------ */
+
+/* Lights row y of the image: width pixels of P (RGBA8), mask (u8),
+ * normal (3 floats each) into out (RGBA8, premultiplied). */
+void fuse__light_row_ref(const fuse__light_prep *p, int y, int width,
+                         const uint8_t *P, const uint8_t *mask,
+                         const float *normal, uint8_t *out);
+
+/* Resamples and composites one output row inside the viewport: q0/q1 are
+ * the two source rows (already chosen and clamped), fy the 8-bit row
+ * weight, ax the column walk positioned at viewport column 0, sw the
+ * source width; v and out point at the viewport's first pixel of the row
+ * (out may equal v). */
+void fuse__composite_row_ref(const uint8_t *q0, const uint8_t *q1,
+                             uint32_t fy, fuse__axis ax, int sw,
+                             const uint8_t *v, uint8_t *out, int vw);
+
+#endif

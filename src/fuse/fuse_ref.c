@@ -1,0 +1,346 @@
+/* fuse_ref.c - scalar reference of the fuse module: lighting layer,
+ * bilinear resampling into the viewport, "over" compositing, RGB24 to
+ * RGBA8. These loops define every output byte; the rules they follow are
+ * written in docs/fuse.md and the arithmetic itself sits in
+ * fuse_internal.h so that other paths share it. */
+#include "fuse_internal.h"
+
+#include <stddef.h>
+
+/* Every float parameter of fuse_lighting must lie in [-FUSE_PARAM_MAX,
+ * FUSE_PARAM_MAX] (fuse.h): with that bound no float in fuse_light can
+ * overflow, so no inf or NaN ever reaches a clamp. */
+#define PARAM_MAX FUSE_PARAM_MAX
+
+static int in_range(float v, float lo, float hi) { return v >= lo && v <= hi; }  /* NaN -> 0 */
+
+static int image_ok(const fuse_image *im)
+{
+    return im->pixels != NULL && im->width >= 1 && im->height >= 1 &&
+           im->width <= FUSE_MAX_DIM && im->height <= FUSE_MAX_DIM &&
+           im->stride >= 4 * im->width;
+}
+
+/* Bytes spanned by an image: [pixels, pixels + extent). */
+static size_t image_extent(const fuse_image *im)
+{
+    return (size_t)(im->height - 1) * (size_t)im->stride + 4u * (size_t)im->width;
+}
+
+static int overlap(const fuse_image *a, const fuse_image *b)
+{
+    uintptr_t a0 = (uintptr_t)a->pixels, a1 = a0 + image_extent(a);
+    uintptr_t b0 = (uintptr_t)b->pixels, b1 = b0 + image_extent(b);
+    return a0 < b1 && b0 < a1;
+}
+
+/* Same memory, same layout: processing pixel by pixel is safe in place. */
+static int same_image(const fuse_image *a, const fuse_image *b)
+{
+    return a->pixels == b->pixels && a->stride == b->stride &&
+           a->width == b->width && a->height == b->height;
+}
+
+static uint8_t *row_ptr(const fuse_image *im, int y)
+{
+    return im->pixels + (size_t)y * (size_t)im->stride;
+}
+
+fuse_lighting fuse_lighting_default(void)
+{
+    fuse_lighting L;
+    memset(&L, 0, sizeof L);
+    L.light_count = 1;
+    L.lights[0].dir[0] = 0.0f;   /* above (+y) and in front (+z, towards */
+    L.lights[0].dir[1] = 0.6f;   /* the viewer) of the surface           */
+    L.lights[0].dir[2] = 0.8f;
+    L.lights[0].color[0] = L.lights[0].color[1] = L.lights[0].color[2] = 1.0f;
+    L.ambient[0] = L.ambient[1] = L.ambient[2] = 0.35f;
+    L.kd = 0.75f;
+    L.ks = 0.15f;
+    L.shininess = 16.0f;
+    L.kf = 0.6f;
+    L.tone[0] = L.tone[1] = L.tone[2] = 1.0f;
+    return L;
+}
+
+fuse_image fuse_image_rows(const fuse_image *img, int y0, int h)
+{
+    fuse_image v;
+    memset(&v, 0, sizeof v);
+    if (img == NULL || img->pixels == NULL || img->stride < 0 || y0 < 0 ||
+        h < 1 || y0 > img->height - h)
+        return v;
+    v.pixels = row_ptr(img, y0);
+    v.width = img->width;
+    v.height = h;
+    v.stride = img->stride;
+    return v;
+}
+
+/* ---- lighting -------------------------------------------------------- */
+
+fuse_result fuse__light_prepare(const fuse_lighting *L,
+                                const fuse_intrinsics *K,
+                                fuse__light_prep *p)
+{
+    int i, c;
+    if (L->light_count < 0 || L->light_count > FUSE_MAX_LIGHTS)
+        return FUSE_ERR_ARGS;
+    if (!in_range(L->shininess, 1.0f, PARAM_MAX) ||
+        !in_range(L->kd, -PARAM_MAX, PARAM_MAX) ||
+        !in_range(L->ks, -PARAM_MAX, PARAM_MAX) ||
+        !in_range(L->kf, -PARAM_MAX, PARAM_MAX))
+        return FUSE_ERR_ARGS;
+    for (c = 0; c < 3; c++)
+        if (!in_range(L->ambient[c], -PARAM_MAX, PARAM_MAX) ||
+            !in_range(L->tone[c], -PARAM_MAX, PARAM_MAX))
+            return FUSE_ERR_ARGS;
+    if (!in_range(K->fx, 1.0e-3f, 1.0e7f) || !in_range(K->fy, 1.0e-3f, 1.0e7f) ||
+        !in_range(K->cx, -1.0e7f, 1.0e7f) || !in_range(K->cy, -1.0e7f, 1.0e7f))
+        return FUSE_ERR_ARGS;
+    memset(p, 0, sizeof *p);
+    for (i = 0; i < L->light_count; i++) {
+        const fuse_light_src *s = &L->lights[i];
+        float dd, inv;
+        for (c = 0; c < 3; c++)
+            if (!in_range(s->dir[c], -PARAM_MAX, PARAM_MAX) ||
+                !in_range(s->color[c], -PARAM_MAX, PARAM_MAX))
+                return FUSE_ERR_ARGS;
+        dd = (s->dir[0] * s->dir[0] + s->dir[1] * s->dir[1]) + s->dir[2] * s->dir[2];
+        if (!(dd > 1.0e-12f)) return FUSE_ERR_ARGS;   /* no direction */
+        inv = 1.0f / sqrtf(dd);
+        for (c = 0; c < 3; c++) {
+            p->dir[i][c] = s->dir[c] * inv;
+            p->color[i][c] = s->color[c];
+        }
+    }
+    p->light_count = L->light_count;
+    for (c = 0; c < 3; c++) {
+        p->ambient[c] = L->ambient[c];
+        p->tone[c] = L->tone[c];
+    }
+    p->kd = L->kd;
+    p->ks = L->ks;
+    p->shininess = L->shininess;
+    p->kf = L->kf;
+    p->ifx = 1.0f / K->fx;
+    p->ify = 1.0f / K->fy;
+    p->cx = K->cx;
+    p->cy = K->cy;
+    return FUSE_OK;
+}
+
+void fuse__light_row_ref(const fuse__light_prep *p, int y, int width,
+                         const uint8_t *P, const uint8_t *mask,
+                         const float *normal, uint8_t *out)
+{
+    /* View ray of the row; the image's y axis points down, view y up. */
+    const float py = (((float)y + 0.5f) - p->cy) * p->ify;
+    int x, i, c;
+    for (x = 0; x < width; x++, P += 4, normal += 3, out += 4) {
+        const unsigned M = mask[x];
+        float px, il, vx, vy, vz, nx, ny, nz, nn, ndv, t, fade, mp;
+        float C[3];
+        if (M == 0) {
+            out[0] = out[1] = out[2] = out[3] = 0;
+            continue;
+        }
+        /* V = -normalize(px, -py, -1) = (-px, py, 1) / |(px, py, 1)| */
+        px = (((float)x + 0.5f) - p->cx) * p->ifx;
+        il = 1.0f / sqrtf((px * px + py * py) + 1.0f);
+        vx = -(px * il);
+        vy = py * il;
+        vz = il;
+        /* N: normalised, or V when it has no usable length. */
+        nx = normal[0];
+        ny = normal[1];
+        nz = normal[2];
+        nn = (nx * nx + ny * ny) + nz * nz;
+        if (nn > 1.0e-30f && nn < 1.0e30f) {
+            float inv = 1.0f / sqrtf(nn);
+            nx = nx * inv;
+            ny = ny * inv;
+            nz = nz * inv;
+        } else {
+            nx = vx;
+            ny = vy;
+            nz = vz;
+        }
+        ndv = (nx * vx + ny * vy) + nz * vz;
+        C[0] = p->ambient[0];
+        C[1] = p->ambient[1];
+        C[2] = p->ambient[2];
+        for (i = 0; i < p->light_count; i++) {
+            const float lx = p->dir[i][0], ly = p->dir[i][1], lz = p->dir[i][2];
+            float w = p->kd * fuse__max0((nx * lx + ny * ly) + nz * lz);
+            if (p->ks != 0.0f) {           /* ks == 0: the term is +0 */
+                const float hx = lx + vx, hy = ly + vy, hz = lz + vz;
+                const float hh = (hx * hx + hy * hy) + hz * hz;
+                if (hh > 1.0e-12f) {        /* L == -V: no half vector */
+                    float ndh = ((nx * hx + ny * hy) + nz * hz) / sqrtf(hh);
+                    w = w + p->ks * fuse__pow01(ndh, p->shininess);
+                }
+            }
+            C[0] = C[0] + p->color[i][0] * w;
+            C[1] = C[1] + p->color[i][1] * w;
+            C[2] = C[2] + p->color[i][2] * w;
+        }
+        t = fuse__max0(1.0f - ndv);
+        fade = fuse__clamp01(1.0f - p->kf * (t * t));
+        mp = ((float)M * FUSE__INV255) * fade;
+        for (c = 0; c < 3; c++) {
+            float v = fuse__clamp01((((float)P[c] * FUSE__INV255) * C[c]) * p->tone[c]);
+            out[c] = fuse__unorm8(mp * v);
+        }
+        out[3] = fuse__unorm8(mp);
+    }
+}
+
+fuse_result fuse_light(const fuse_lighting *L, const fuse_intrinsics *K,
+                       const fuse_image *P, const uint8_t *mask,
+                       int mask_stride, const float *normal,
+                       int normal_stride, fuse_image *out)
+{
+    fuse__light_prep prep;
+    fuse_result r;
+    int y;
+    if (L == NULL || K == NULL || P == NULL || mask == NULL ||
+        normal == NULL || out == NULL)
+        return FUSE_ERR_ARGS;
+    if (!image_ok(P) || !image_ok(out) || mask_stride < P->width ||
+        normal_stride < 3 * P->width)
+        return FUSE_ERR_ARGS;
+    r = fuse__light_prepare(L, K, &prep);
+    if (r != FUSE_OK) return r;
+    if (out->width != P->width || out->height != P->height)
+        return FUSE_ERR_SIZE;
+    if (overlap(P, out) && !same_image(P, out))
+        return FUSE_ERR_ARGS;
+    for (y = 0; y < P->height; y++)
+        fuse__light_row_ref(&prep, y, P->width, row_ptr(P, y),
+                            mask + (size_t)y * (size_t)mask_stride,
+                            normal + (size_t)y * (size_t)normal_stride,
+                            row_ptr(out, y));
+    return FUSE_OK;
+}
+
+/* ---- resampling and compositing -------------------------------------- */
+
+void fuse__composite_row_ref(const uint8_t *q0, const uint8_t *q1,
+                             uint32_t fy, fuse__axis ax, int sw,
+                             const uint8_t *v, uint8_t *out, int vw)
+{
+    int i, c;
+    for (i = 0; i < vw; i++, v += 4, out += 4, fuse__axis_next(&ax)) {
+        const int32_t pos = fuse__axis_pos(&ax);
+        const int ix = pos >> 16;
+        const int ix1 = ix + 1 < sw ? ix + 1 : sw - 1;   /* edge replicates */
+        const uint32_t fx = ((uint32_t)pos >> 8) & 255u;
+        const uint8_t *a = q0 + 4 * ix, *b = q0 + 4 * ix1;
+        const uint8_t *cc = q1 + 4 * ix, *d = q1 + 4 * ix1;
+        uint32_t ta, tb, tc, td, inv;
+        memcpy(&ta, a, 4);
+        memcpy(&tb, b, 4);
+        memcpy(&tc, cc, 4);
+        memcpy(&td, d, 4);
+        if ((ta | tb | tc | td) == 0) {
+            /* All four taps zero: Q = 0 and R = div255(255 V) = V exactly. */
+            out[0] = v[0];
+            out[1] = v[1];
+            out[2] = v[2];
+            out[3] = 255;
+            continue;
+        }
+        inv = 255u - fuse__bilerp8(a[3], b[3], cc[3], d[3], fx, fy);
+        for (c = 0; c < 3; c++) {
+            uint32_t r = fuse__bilerp8(a[c], b[c], cc[c], d[c], fx, fy) +
+                         FUSE__DIV255(inv * v[c]);
+            out[c] = (uint8_t)(r < 255u ? r : 255u);
+        }
+        out[3] = 255;
+    }
+}
+
+fuse_result fuse_composite(const fuse_image *Q, const fuse_image *V,
+                           int vp_x0, int vp_y0, int vp_w, int vp_h,
+                           fuse_image *out)
+{
+    fuse__axis ax, ay;
+    int in_place, y;
+    size_t row_bytes;
+    if (Q == NULL || V == NULL || out == NULL)
+        return FUSE_ERR_ARGS;
+    if (!image_ok(Q) || !image_ok(V) || !image_ok(out) || vp_w < 1 || vp_h < 1)
+        return FUSE_ERR_ARGS;
+    if (out->width != V->width || out->height != V->height ||
+        vp_x0 < 0 || vp_y0 < 0 || vp_x0 > V->width - vp_w ||
+        vp_y0 > V->height - vp_h)
+        return FUSE_ERR_SIZE;
+    in_place = same_image(out, V);
+    if ((!in_place && overlap(out, V)) || overlap(out, Q))
+        return FUSE_ERR_ARGS;
+
+    row_bytes = 4u * (size_t)V->width;
+    fuse__axis_init(&ax, Q->width, vp_w);
+    fuse__axis_init(&ay, Q->height, vp_h);
+    for (y = 0; y < V->height; y++) {
+        const uint8_t *vrow = row_ptr(V, y);
+        uint8_t *orow = row_ptr(out, y);
+        int32_t pos;
+        int iy, iy1;
+        if (y < vp_y0 || y >= vp_y0 + vp_h) {
+            if (!in_place) memcpy(orow, vrow, row_bytes);
+            continue;
+        }
+        if (!in_place) {
+            memcpy(orow, vrow, 4u * (size_t)vp_x0);
+            memcpy(orow + 4 * (size_t)(vp_x0 + vp_w), vrow + 4 * (size_t)(vp_x0 + vp_w),
+                   4u * (size_t)(V->width - vp_x0 - vp_w));
+        }
+        pos = fuse__axis_pos(&ay);
+        iy = pos >> 16;
+        iy1 = iy + 1 < Q->height ? iy + 1 : Q->height - 1;
+        fuse__composite_row_ref(row_ptr(Q, iy), row_ptr(Q, iy1),
+                                ((uint32_t)pos >> 8) & 255u, ax, Q->width,
+                                vrow + 4 * (size_t)vp_x0,
+                                orow + 4 * (size_t)vp_x0, vp_w);
+        fuse__axis_next(&ay);
+    }
+    return FUSE_OK;
+}
+
+/* ---- conversion, messages -------------------------------------------- */
+
+fuse_result fuse_rgb24_to_rgba(const uint8_t *rgb, int stride, int width,
+                               int height, fuse_image *out)
+{
+    int x, y;
+    if (rgb == NULL || out == NULL || width < 1 || height < 1 ||
+        width > FUSE_MAX_DIM || height > FUSE_MAX_DIM || stride < 3 * width ||
+        !image_ok(out))
+        return FUSE_ERR_ARGS;
+    if (out->width != width || out->height != height)
+        return FUSE_ERR_SIZE;
+    for (y = 0; y < height; y++) {
+        const uint8_t *s = rgb + (size_t)y * (size_t)stride;
+        uint8_t *d = row_ptr(out, y);
+        for (x = 0; x < width; x++, s += 3, d += 4) {
+            d[0] = s[0];
+            d[1] = s[1];
+            d[2] = s[2];
+            d[3] = 255;
+        }
+    }
+    return FUSE_OK;
+}
+
+const char *fuse_result_str(fuse_result r)
+{
+    switch (r) {
+    case FUSE_OK:       return "ok";
+    case FUSE_ERR_ARGS: return "invalid argument (NULL pointer, bad stride or parameter)";
+    case FUSE_ERR_SIZE: return "image sizes do not fit together";
+    }
+    return "unknown fuse_result";
+}
