@@ -1,0 +1,66 @@
+/* cpu.c - CPU feature detection and the ISA cap. */
+#include "cpu.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const char *names[EF_ISA_COUNT] = {"default", "ref", "sse2", "avx2", "avx512"};
+
+static ef_isa detect(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_cpu_init();
+    if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+        __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl") &&
+        __builtin_cpu_supports("avx2"))
+        return EF_ISA_AVX512;
+    if (__builtin_cpu_supports("avx2")) return EF_ISA_AVX2;
+    if (__builtin_cpu_supports("sse2")) return EF_ISA_SSE2;
+    return EF_ISA_REF;
+#elif defined(__aarch64__)
+    return EF_ISA_SSE2; /* the portable path */
+#else
+    return EF_ISA_REF;
+#endif
+}
+
+ef_isa ef_cpu_best(void)
+{
+    static volatile int cached = -1; /* the one process-wide value */
+    if (cached < 0) cached = (int)detect();
+    return (ef_isa)cached;
+}
+
+int ef_cpu_has(ef_isa isa)
+{
+    return isa != EF_ISA_DEFAULT && isa < EF_ISA_COUNT && isa <= ef_cpu_best();
+}
+
+const char *ef_isa_name(ef_isa isa)
+{
+    return (unsigned)isa < EF_ISA_COUNT ? names[isa] : "unknown";
+}
+
+ef_isa ef_isa_parse(const char *name)
+{
+    if (!name) return EF_ISA_DEFAULT;
+    for (int i = 1; i < EF_ISA_COUNT; i++)
+        if (!strcmp(name, names[i])) return (ef_isa)i;
+    return EF_ISA_DEFAULT;
+}
+
+const char *ef_isa_env_error(void)
+{
+    const char *e = getenv("EGOFUSE_ISA");
+    if (!e || !*e) return NULL;
+    return ef_isa_parse(e) == EF_ISA_DEFAULT ? e : NULL;
+}
+
+ef_isa ef_isa_choose(ef_isa cap)
+{
+    ef_isa isa = ef_cpu_best();
+    if (cap != EF_ISA_DEFAULT && cap < isa) isa = cap;
+    ef_isa env = ef_isa_parse(getenv("EGOFUSE_ISA"));
+    if (env != EF_ISA_DEFAULT && env < isa) isa = env;
+    return isa;
+}
