@@ -22,7 +22,11 @@
  *        test LESS against the depth plane (if any), then write depth,
  *        mask = 255 and the perspective-correct attributes.
  *   Plane equations are evaluated in float with one fixed order of
- *   operations (docs/rounding.md), so SIMD paths can reproduce every byte.
+ *   operations (docs/raster.md, summarised in docs/rounding.md), so SIMD
+ *   paths can reproduce every byte. Attributes use perspective-correct
+ *   barycentrics, so a constant attribute comes out exactly constant.
+ *   Facing is decided per triangle after clipping and snapping, from the
+ *   sign of its snapped screen area (as GPUs do).
  *
  * WHAT IT DOES NOT
  *   No allocation, no threads, no global state: a target may be drawn by
@@ -87,10 +91,16 @@ typedef struct rast_mesh_desc {
     rast_cull cull;
 } rast_mesh_desc;
 
+/* Counters. tris_in and tris_nonfinite count submitted triangles; after
+ * clipping a triangle becomes a fan of up to 7, and the other counters
+ * count those fan triangles. */
 typedef struct rast_stats {
     long tris_in;             /* triangles submitted */
-    long tris_nonfinite;      /* dropped: NaN or infinite vertex */
-    long tris_clipped_away;   /* entirely outside after clipping */
+    long tris_nonfinite;      /* dropped: NaN or infinite vertex (also an
+                                 overflow to infinity inside the clipper) */
+    long tris_clipped_away;   /* entirely outside the clip volume, or a fan
+                                 triangle whose pixel box misses the target,
+                                 or touching the clip-space origin (w = 0) */
     long tris_degenerate;     /* zero area after snapping */
     long tris_culled;         /* removed by the cull mode */
     long tris_drawn;          /* set up and scanned (after clipping a
@@ -98,11 +108,23 @@ typedef struct rast_stats {
     long pixels_written;      /* depth-test passes */
 } rast_stats;
 
-/* Sets depth to 1.0, mask to 0 and attributes to 0. */
+/* Sets depth to 1.0, mask to 0 and attributes to 0 (the first width
+ * elements of each row; padding is left alone). NULL planes are skipped. */
 void rast_target_clear(const rast_target *t);
 
 /* Draws the mesh (see the steps above). Stats are added to *stats when it
- * is not NULL (zero it first). Validates everything before drawing. */
+ * is not NULL (zero it first). Validates everything before drawing; on an
+ * error nothing is drawn and *stats is untouched:
+ *   RAST_ERR_ARGS  t, mesh or t->mask NULL; mask/depth stride < width;
+ *                  attr stride < width*attr_count (when t->attr is set);
+ *                  attr_count outside 0..RAST_MAX_ATTRS or different in
+ *                  target and mesh; negative counts; clip/indices NULL with
+ *                  a count > 0; mesh->attr NULL with attr_count > 0; a cull
+ *                  value out of range.
+ *   RAST_ERR_SIZE  width or height <= 0 or > RAST_MAX_DIM.
+ *   RAST_ERR_INDEX an index >= vertex_count.
+ * With t->attr NULL the mesh attributes are ignored (attr_count must
+ * still match). */
 rast_result rast_draw(const rast_target *t, const rast_mesh_desc *mesh,
                       rast_stats *stats);
 
@@ -111,7 +133,9 @@ rast_result rast_draw(const rast_target *t, const rast_mesh_desc *mesh,
 void rast_transform_points(const float mvp[16], const float *pos, int n,
                            float *clip);
 /* out[i] = normalize(m3x3 * v[i]) where m3x3 is the upper 3x3 of the
- * column-major 4x4 m: for rotating normals into view space. */
+ * column-major 4x4 m: for rotating normals into view space. The length is
+ * taken in double (no underflow for tiny vectors); a zero vector stays
+ * zero. For non-uniform scale pass the inverse transpose. */
 void rast_transform_dirs(const float m[16], const float *v, int n, float *out);
 
 const char *rast_result_str(rast_result r);

@@ -1,0 +1,130 @@
+/* raster_internal.h - the parts of the rasterizer shared by the scalar
+ * reference (raster_ref.c) and any SIMD scan path (raster_<isa>.c).
+ *
+ * Split of the work (docs/raster.md has the full rules):
+ *   raster_setup.c  validation, clipping, perspective divide, viewport,
+ *                   sub-pixel snapping, culling, edge and plane setup, and
+ *                   the per-triangle driver rast__draw_with(). All of it is
+ *                   scalar and shared: a SIMD path never redoes setup.
+ *   raster_ref.c    rast__scan_ref(): the per-pixel loop over one set-up
+ *                   triangle. This is the only thing a SIMD path replaces,
+ *                   and it must give the same bytes (op order below).
+ *
+ * Per-pixel rule (rast__scan_ref; a SIMD scan must copy it exactly):
+ *   i = x - tri->x0, j = y - tri->y0 (pixel offsets inside the bounding box)
+ *   coverage: e_k = e_c[k] + j*e_dy[k] + i*e_dx[k] (int64, exact; any order)
+ *             covered iff e_0 >= 0 && e_1 >= 0 && e_2 >= 0
+ *   plane p : v = (p.c + p.dy * (float)j) + p.dx * (float)i   (float32)
+ *   depth   : z = min(max(v_z, 0), 1); pass iff depth == NULL || z < d[x]
+ *   attrs   : r = 1.0f / v_q;  b1 = v_b1 * r;  b2 = v_b2 * r;
+ *             a_k = (a0[k] + b1 * d1[k]) + b2 * d2[k]
+ */
+#ifndef EGOFUSE_RASTER_INTERNAL_H
+#define EGOFUSE_RASTER_INTERNAL_H
+
+#include <stdint.h>
+
+#include "raster.h"
+
+#define RAST__FIX_ONE (1 << RAST_SUBPIXEL_BITS)     /* 256: one pixel */
+#define RAST__FIX_HALF (1 << (RAST_SUBPIXEL_BITS - 1))
+/* Sutherland-Hodgman adds at most one vertex per plane: 3 + 6. */
+#define RAST__MAX_POLY 9
+#define RAST__PLANE_COUNT 6
+
+/* Clip planes, in the order they are applied (bit i of an outcode). */
+enum {
+    RAST__PLANE_NEAR = 0,   /* d = z + w        */
+    RAST__PLANE_FAR,        /* d = w - z        */
+    RAST__PLANE_LEFT,       /* d = gx*w + x     */
+    RAST__PLANE_RIGHT,      /* d = gx*w - x     */
+    RAST__PLANE_BOTTOM,     /* d = gy*w + y     */
+    RAST__PLANE_TOP         /* d = gy*w - y     */
+};
+
+/* A clip-space vertex with its attributes. */
+typedef struct rast__vert {
+    float x, y, z, w;
+    float a[RAST_MAX_ATTRS];
+} rast__vert;
+
+/* What does not change between triangles of one draw. */
+typedef struct rast__view {
+    int width, height;
+    float gx, gy;            /* guard-band factors: |x| <= gx*w, |y| <= gy*w */
+    int32_t min_x, max_x;    /* snapped x clamp: -G*256 .. (W+G)*256 */
+    int32_t min_y, max_y;
+    int attr_count;          /* attributes carried through clipping */
+} rast__view;
+
+/* A float plane: value at the centre of the bounding box's first pixel
+ * (x0, y0) and its change per pixel step in x and y. */
+typedef struct rast__plane {
+    float c, dx, dy;
+} rast__plane;
+
+/* One triangle ready to scan. Edge values are in 1/65536 pixel^2 units
+ * (fixed x fixed), already biased for the top-left rule, so a pixel is
+ * covered iff all three are >= 0. */
+typedef struct rast__tri {
+    int x0, y0, x1, y1;          /* inclusive pixel bounding box, clamped */
+    int64_t e_c[3];              /* edge values at the centre of (x0, y0) */
+    int64_t e_dx[3], e_dy[3];    /* change per pixel step */
+    rast__plane z;               /* window depth */
+    /* Perspective-correct barycentrics: q is 1/w scaled so that its
+     * largest vertex value is 1; b1, b2 are q times the screen-space
+     * barycentric weights of vertices 1 and 2 (vertex values (0, q1, 0)
+     * and (0, 0, q2)). At a pixel, b_i = v_bi / v_q. */
+    rast__plane q, b1, b2;
+    /* Attribute k = (a0 + b1 * d1) + b2 * d2, with d1 = a1 - a0 and
+     * d2 = a2 - a0 (float), vertices in the order after winding
+     * normalisation. A constant attribute is reproduced exactly. */
+    float a0[RAST_MAX_ATTRS], d1[RAST_MAX_ATTRS], d2[RAST_MAX_ATTRS];
+    int attr_count;
+} rast__tri;
+
+/* Result of rast__setup_tri. */
+enum {
+    RAST__SETUP_OK = 0,
+    RAST__SETUP_DEGENERATE,      /* zero area after snapping */
+    RAST__SETUP_CULLED,
+    RAST__SETUP_OFFSCREEN        /* bounding box misses the target */
+};
+
+/* Scans one triangle into t; returns the number of pixels written. */
+typedef long (*rast__scan_fn)(const rast_target *t, const rast__tri *tri);
+
+/* Fills the per-draw constants for target size w x h. */
+void rast__view_init(rast__view *v, int width, int height, int attr_count);
+
+/* Outcode of a vertex: bit i set when it is outside plane i. */
+unsigned rast__outcode(const rast__view *v, const rast__vert *p);
+
+/* Sutherland-Hodgman against the planes in `planes` (bit mask), in plane
+ * order. poly holds n vertices and room for RAST__MAX_POLY; tmp is scratch
+ * of the same size. Returns the vertex count left in poly (0..9). */
+int rast__clip_polygon(const rast__view *v, unsigned planes, rast__vert *poly,
+                       int n, rast__vert *tmp);
+
+/* Perspective divide, viewport and snapping of one vertex (w > 0, finite).
+ * Writes fixed-point screen coordinates (1/256 pixel). */
+void rast__snap(const rast__view *v, const rast__vert *p, int32_t *fx,
+                int32_t *fy);
+
+/* Sets up the triangle (p[0], p[1], p[2]) with snapped positions fx, fy.
+ * Returns RAST__SETUP_*; *tri is valid only for RAST__SETUP_OK. */
+int rast__setup_tri(const rast__view *v, const rast__vert *const p[3],
+                    const int32_t fx[3], const int32_t fy[3], rast_cull cull,
+                    rast__tri *tri);
+
+/* Checks the arguments (RAST_OK or the error of rast_draw). */
+rast_result rast__validate(const rast_target *t, const rast_mesh_desc *m);
+
+/* rast_draw with a given scan function (the reference or a SIMD one). */
+rast_result rast__draw_with(const rast_target *t, const rast_mesh_desc *m,
+                            rast_stats *stats, rast__scan_fn scan);
+
+/* The scalar reference scan. */
+long rast__scan_ref(const rast_target *t, const rast__tri *tri);
+
+#endif
