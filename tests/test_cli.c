@@ -293,8 +293,9 @@ static void render_end_to_end(void **state)
         assert_int_equal(r.height, 800);
         const uint8_t *p = r.data;
         /* Corners (outside the viewport and the quad) are the virtual scene. */
-        assert_memory_equal(p, (uint8_t[]){10, 40, 90}, 3);
-        assert_memory_equal(p + 3 * (1280 * 800 - 1), (uint8_t[]){10, 40, 90}, 3);
+        static const uint8_t virt_rgb[3] = {10, 40, 90};
+        assert_memory_equal(p, virt_rgb, 3);
+        assert_memory_equal(p + 3 * (1280 * 800 - 1), virt_rgb, 3);
         /* The quad is seen near the centre (shifted by the eye offset): the
          * camera's colour, lit, replaces the virtual scene there. */
         int hits = 0;
