@@ -1,0 +1,181 @@
+/* gen.h - internals of the sample-data generator (build/gen_samples).
+ *
+ * WHAT IT DOES
+ *   Builds, without downloading anything, everything `egofuse demo` needs:
+ *     gen_arms_build()   a skinned model of both arms and hands (skeleton,
+ *                        generalized-cylinder surfaces, smooth weights) and
+ *                        its "reach_grasp" animation, as a kin_model;
+ *     gen_glb_write()    that model as a binary glTF 2.0 file;
+ *     gen_scene_*()      the cockpit around the operator and the remote
+ *                        workshop, as flat-shaded triangle lists;
+ *     gen_render_*()     the stereo camera frames (640x480 sensor) and the
+ *                        virtual frames (1280x800 colour + depth) of one
+ *                        time step, through kin (FK, LBS, cameras) and
+ *                        raster (rast_draw).
+ *   samples/README.md describes the data; gen_main.c is the program.
+ *
+ * CONVENTIONS
+ *   World: metres, +Y up, the operator faces -Z, seated; the "body" node
+ *   (between the shoulders) is at GEN_BODY_POS. Everything is deterministic
+ *   for a given seed: no global state, no time, no rand().
+ */
+#ifndef EGOFUSE_GEN_H
+#define EGOFUSE_GEN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../../src/kin/kin.h"
+#include "../../src/raster/raster.h"
+
+#define GEN_FPS 60
+#define GEN_ANIM_KEYS 181               /* 0 .. 3 s every 1/60 s */
+#define GEN_ANIM_NAME "reach_grasp"
+#define GEN_CAM_W 640
+#define GEN_CAM_H 480
+#define GEN_VIRT_W 1280
+#define GEN_VIRT_H 800
+#define GEN_EYE_HALF_BASELINE 0.0325f
+#define GEN_HMD_HFOV_DEG 61.0f
+#define GEN_HMD_VFOV_DEG 40.0f
+#define GEN_VIRT_ZNEAR 0.05f
+#define GEN_VIRT_ZFAR 60.0f
+#define GEN_CAM_ZNEAR 0.02f
+#define GEN_CAM_ZFAR 30.0f
+
+/* Interpolated attributes of every rasterized vertex (both scenes and the
+ * arms share one layout so they can be drawn into one target). */
+enum {
+    GEN_A_NX, GEN_A_NY, GEN_A_NZ,   /* world-space normal */
+    GEN_A_R, GEN_A_G, GEN_A_B,      /* albedo, display space 0..1 */
+    GEN_A_U,                        /* pattern * GEN_PATTERN_STRIDE + u */
+    GEN_A_V,                        /* v, metres along the surface */
+    GEN_ATTRS
+};
+#define GEN_PATTERN_STRIDE 100.0f
+
+/* Surface patterns (procedural detail, see gen_render.c). */
+typedef enum gen_pattern {
+    GEN_PAT_SKIN = 0,      /* arms: fine skin mottling */
+    GEN_PAT_PLAIN,         /* painted metal / plastic */
+    GEN_PAT_TILES,         /* floor tiles */
+    GEN_PAT_SCREEN,        /* console display with bars */
+    GEN_PAT_WOOD,          /* wood grain */
+    GEN_PAT_BUTTONS,       /* panel with a grid of buttons */
+    GEN_PAT_WINDOW,        /* bright window panes */
+    GEN_PAT_FABRIC,        /* arms: sleeve weave */
+    GEN_PAT_COUNT
+} gen_pattern;
+
+/* ------------------------------------------------------------------ arms */
+
+/* Joints of one side, in skeleton order after the side's shoulder. */
+typedef enum gen_side_joint {
+    GEN_J_SHOULDER = 0, GEN_J_UPPER_ARM, GEN_J_FOREARM, GEN_J_HAND, GEN_J_PALM,
+    GEN_J_THUMB_1, GEN_J_THUMB_2, GEN_J_THUMB_3,
+    GEN_J_INDEX_1, GEN_J_INDEX_2, GEN_J_INDEX_3,
+    GEN_J_MIDDLE_1, GEN_J_MIDDLE_2, GEN_J_MIDDLE_3,
+    GEN_J_RING_1, GEN_J_RING_2, GEN_J_RING_3,
+    GEN_J_LITTLE_1, GEN_J_LITTLE_2, GEN_J_LITTLE_3,
+    GEN_SIDE_JOINTS                    /* 20 */
+} gen_side_joint;
+
+/* The generated model. Everything is owned by model.block. */
+typedef struct gen_arms {
+    kin_model model;        /* nodes, one mesh, one skin, one animation */
+    const float *albedo;    /* 3 per vertex (skin or sleeve colour) */
+    const float *uv;        /* 2 per vertex: pattern-coded u, v (GEN_A_U/V) */
+    int body, head, mesh_node;
+    int joint[2][GEN_SIDE_JOINTS];  /* node index, [0] = L_, [1] = R_ */
+    kin_vec3 grasp_point;   /* world point the right hand closes around */
+    float grasp_time;       /* seconds, when the grasp is complete */
+} gen_arms;
+
+/* Builds the model and its animation. Returns 0, or -1 when out of memory
+ * (the partial model is freed). */
+int  gen_arms_build(gen_arms *arms);
+void gen_arms_free(gen_arms *arms);
+/* Name of joint j of side (0 = "L_", 1 = "R_") into buf. */
+const char *gen_joint_name(int side, int j, char *buf, size_t n);
+
+/* Rotation whose matrix has the columns x, y, z (orthonormal, right-handed). */
+kin_quat gen_quat_from_axes(kin_vec3 x, kin_vec3 y, kin_vec3 z);
+
+/* Fills the animation channels of arms->model (called by gen_arms_build). */
+int  gen_anim_build(gen_arms *arms);
+
+/* Writes the model as binary glTF to path (atomically: path.tmp.<pid>,
+ * then rename). Returns 0, or -1 with a message naming the path in why. */
+int  gen_glb_write(const char *path, const gen_arms *arms, char *why,
+                   size_t why_size);
+
+/* ----------------------------------------------------------------- scenes */
+
+/* A static, flat-shaded triangle list with per-vertex attributes. */
+typedef struct gen_scene {
+    int vertex_count, vertex_cap;
+    float *pos;             /* 3 per vertex, world */
+    float *attr;            /* GEN_ATTRS per vertex */
+    int tri_count, tri_cap;
+    uint32_t *idx;
+    int failed;             /* an allocation failed */
+    /* lighting (world directions towards the lights) */
+    int light_count;
+    float light_dir[4][3], light_color[4][3];
+    float ambient[3];
+    float sky[3];           /* colour of anything not covered */
+} gen_scene;
+
+/* The operator's cockpit (seen by the cameras) and the remote workshop (the
+ * virtual scene, seen by the eyes). The workshop puts a cup at the arms'
+ * grasp point and a lamp post between the eyes and the reaching hand.
+ * Return 0, or -1 when out of memory. */
+int  gen_scene_cockpit(gen_scene *s);
+int  gen_scene_workshop(gen_scene *s, const gen_arms *arms);
+void gen_scene_free(gen_scene *s);
+
+/* ----------------------------------------------------------------- frames */
+
+/* Per-thread buffers for rendering one frame at a time. */
+typedef struct gen_frame_ctx {
+    const gen_arms *arms;
+    const gen_scene *cockpit, *workshop;
+    uint64_t seed;
+    /* pose */
+    kin_transform *locals;
+    kin_mat4 *world, *jm;
+    float *skin_pos, *skin_nrm, *arm_attr, *clip;
+    /* targets, sized for the larger of the two images */
+    float *depth, *tattr;
+    uint8_t *mask;
+    size_t clip_cap;
+} gen_frame_ctx;
+
+int  gen_frame_ctx_init(gen_frame_ctx *c, const gen_arms *arms,
+                        const gen_scene *cockpit, const gen_scene *workshop,
+                        uint64_t seed);
+void gen_frame_ctx_free(gen_frame_ctx *c);
+
+/* Poses the arms at time t (seconds): FK, LBS into c->skin_pos/skin_nrm;
+ * returns the head's world matrix in *world_from_head. */
+void gen_pose(gen_frame_ctx *c, float t, kin_mat4 *world_from_head);
+
+/* Renders the full 640x480 RGB sensor image of one camera (rgb: 3 bytes per
+ * pixel, 640*3 per row) for frame `frame`; *coverage gets the fraction of
+ * the cropped 640x400 part covered by the arms. Call gen_pose() first. */
+void gen_render_camera(gen_frame_ctx *c, const kin_mat4 *world_from_head,
+                       kin_eye eye, int frame, uint8_t *rgb, float *coverage);
+
+/* Renders the 1280x800 virtual image of one eye (rgb) and its depth
+ * (view-space depth -z in metres, 1 float per pixel). */
+void gen_render_virtual(gen_frame_ctx *c, const kin_mat4 *world_from_head,
+                        kin_eye eye, int frame, uint8_t *rgb, float *depth);
+
+/* Projection for a pinhole camera with intrinsics (pixels, the ray of pixel
+ * centre (x+.5, y+.5) is ((x+.5-cx)/fx, -(y+.5-cy)/fy, -1)) rendering a
+ * width x height image through rast_draw (OpenGL clip space). */
+kin_mat4 gen_proj_from_intrinsics(float fx, float fy, float cx, float cy,
+                                  int width, int height, float znear,
+                                  float zfar);
+
+#endif
