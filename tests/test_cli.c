@@ -340,6 +340,13 @@ static void render_bad_inputs(void **state)
     snprintf(png, sizeof png, "%s/left_0000.png", odir);
     assert_false(tu_exists(png));
 
+    /* The demo without generated samples says how to make them. */
+    char empty[600];
+    snprintf(empty, sizeof empty, "%s/no_samples", dir);
+    assert_int_equal(run("demo", "--samples", empty, "--out", odir, NULL), 1);
+    assert_non_null(strstr(out, "no_samples/scene.txt is missing"));
+    assert_non_null(strstr(out, "make demo"));
+
     /* Frames beyond the scene. */
     write_scene(dir, 640, 480);
     assert_int_equal(run("render", "--scene", scene, "--out", odir, "--first", "3", NULL), 1);
