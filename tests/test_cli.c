@@ -50,6 +50,8 @@ static void b64(const uint8_t *in, size_t n, char *o)
     *o = 0;
 }
 
+static double fin(float v) { return isfinite(v) ? v : 0.0; }
+
 /* A glTF with a node "head" and an unskinned quad [x0,x1]x[y0,y1] at depth
  * z facing +Z, normals +Z. */
 static void write_quad_gltf(const char *path, float x0, float x1, float y0, float y1, float z)
@@ -76,7 +78,7 @@ static void write_quad_gltf(const char *path, float x0, float x1, float y0, floa
             "\"min\":[%g,%g,%g],\"max\":[%g,%g,%g]},"
             "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
             "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}\n",
-            enc, x0, y0, z, x1, y1, z);
+            enc, fin(x0), fin(y0), fin(z), fin(x1), fin(y1), fin(z));
     fclose(f);
 }
 
@@ -159,6 +161,16 @@ static void mask_bad_models(void **state)
                          "--out", png, NULL), 1);
     assert_non_null(strstr(out, "0 animations"));
     assert_false(tu_exists(png));
+    /* A NaN in the model's data: rejected, named, nothing written. */
+    tu_tmp_path("nan.gltf", model, sizeof model);
+    write_quad_gltf(model, -1, NAN, -1, 1, 0);
+    assert_int_equal(run("mask", model, "--width", "32", "--height", "32", "--fov-y", "60",
+                         "--eye", "0,0,2", "--target", "0,0,0", "--out", png, NULL), 1);
+    assert_non_null(strstr(out, "nan.gltf"));
+    assert_non_null(strstr(out, "non-finite"));
+    assert_false(tu_exists(png));
+
+    tu_tmp_path("quad.gltf", model, sizeof model);
     /* Output folder that does not exist: an error naming it, nothing left. */
     char bad[600];
     snprintf(bad, sizeof bad, "%s.nodir/m.png", model);
