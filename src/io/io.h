@@ -67,6 +67,10 @@ io_result io_fail(io_error *err, io_result code, const char *fmt, ...)
 #endif
     ;
 
+/* IO_OK if path names an existing file that is not a folder, else
+ * IO_ERR_NOT_FOUND or IO_ERR_READ with "path: reason". */
+io_result io_check_file(const char *path, io_error *err);
+
 /* --------------------------------------------------------------- images */
 
 typedef enum io_type { IO_U8 = 0, IO_F32 = 1 } io_type;

@@ -1,8 +1,11 @@
 /* io_common.c - error helpers of the io module (see io.h, ERRORS). */
 #include "io.h"
 
+#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
 
 const char *io_result_str(io_result r)
 {
@@ -28,4 +31,18 @@ io_result io_fail(io_error *err, io_result code, const char *fmt, ...)
         }
     }
     return code;
+}
+
+io_result io_check_file(const char *path, io_error *err)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        int e = errno;
+        return io_fail(err, e == ENOENT || e == ENOTDIR ? IO_ERR_NOT_FOUND
+                                                        : IO_ERR_READ,
+                       "%s: %s", path, strerror(e));
+    }
+    if (S_ISDIR(st.st_mode))
+        return io_fail(err, IO_ERR_READ, "%s: is a directory", path);
+    return IO_OK;
 }

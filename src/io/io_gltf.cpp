@@ -892,15 +892,8 @@ io_result load_animations(Loader &L)
 io_result read_file(const char *path, std::vector<unsigned char> &bytes,
                     io_error *err)
 {
-    struct stat st;
-    if (stat(path, &st) != 0) {
-        int e = errno;
-        return io_fail(err, e == ENOENT || e == ENOTDIR ? IO_ERR_NOT_FOUND
-                                                        : IO_ERR_READ,
-                       "%s: %s", path, strerror(e));
-    }
-    if (S_ISDIR(st.st_mode))
-        return io_fail(err, IO_ERR_READ, "%s: is a directory", path);
+    io_result r0 = io_check_file(path, err);
+    if (r0 != IO_OK) return r0;
     FILE *f = fopen(path, "rb");
     if (!f) {
         int e = errno;

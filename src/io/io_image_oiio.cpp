@@ -63,15 +63,8 @@ std::string global_error(const char *fallback)
 io_result load(const char *path, io_type type, int want, io_image *out,
                io_error *err)
 {
-    struct stat st;
-    if (stat(path, &st) != 0) {
-        int e = errno;
-        return io_fail(err, e == ENOENT || e == ENOTDIR ? IO_ERR_NOT_FOUND
-                                                        : IO_ERR_READ,
-                       "%s: %s", path, strerror(e));
-    }
-    if (S_ISDIR(st.st_mode))
-        return io_fail(err, IO_ERR_READ, "%s: is a directory", path);
+    io_result r0 = io_check_file(path, err);
+    if (r0 != IO_OK) return r0;
 
     /* pixels exactly as stored: no premultiplication of PNG/TIFF alpha */
     OIIO::ImageSpec config;
