@@ -23,7 +23,7 @@ CFLAGS   += -std=c11 $(CFLAGS_COMMON)
 CXXFLAGS += -std=c++17 $(CFLAGS_COMMON)
 LDFLAGS  += $(SAN)
 
-CORE_SRC := $(wildcard src/cpu/*.c src/raster/*.c src/kin/*.c src/fuse/*.c)
+CORE_SRC := $(wildcard src/cpu/*.c src/pipe/*.c src/raster/*.c src/kin/*.c src/fuse/*.c)
 IO_SRC   := $(wildcard src/io/*.c)
 IO_CXX   := $(wildcard src/io/*.cpp)
 CLI_SRC  := $(wildcard src/cli/*.c)
@@ -115,7 +115,7 @@ test: deps
 	@sh tests/run_tests.sh $(BUILD)
 
 # Every public header compiles on its own as C and as C++ (sokol's rule).
-HEADERS := src/cpu/cpu.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h src/io/io.h
+HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h src/io/io.h
 check-headers:
 	@for h in $(HEADERS); do \
 	    echo "#include \"$$h\"" | $(CC) -std=c99 -Wall -Wextra -Werror -x c -fsyntax-only - || exit 1; \

@@ -7,6 +7,7 @@
 #include "../fuse/fuse.h"
 #include "../io/io.h"
 #include "../kin/kin.h"
+#include "../pipe/pipe.h"
 #include "../raster/raster.h"
 
 /* Exit codes of every subcommand. */
@@ -33,36 +34,6 @@ int cli_parse_vec3(const char *s, float out[3]);
 
 /* Creates a folder and its parents (like mkdir -p). 0 on success. */
 int cli_mkdirs(const char *path);
-
-/* ------------------------------------------------------------ posing */
-
-/* Per-frame state for posing and skinning a model: all buffers allocated
- * once by pose_init. Skinned meshes end up in world space; unskinned ones
- * are moved by their node's world matrix. */
-typedef struct pose_state {
-    const kin_model *model;
-    kin_transform *locals;    /* node_count */
-    kin_mat4 *world;          /* node_count */
-    kin_mat4 **joint_mats;    /* per skin, joint_count */
-    float **bind_normals;     /* per mesh: the file's normals, or smooth
-                                 ones computed when the file has none */
-    kin_mesh *meshes;         /* copies of the model's meshes pointing at
-                                 bind_normals */
-    float **pos;              /* per mesh, 3 per vertex, world space */
-    float **nrm;              /* per mesh, 3 per vertex, world space, unit */
-    float *clip;              /* 4 per vertex of the largest mesh */
-    float *vnrm;              /* 3 per vertex of the largest mesh */
-} pose_state;
-
-int  pose_init(pose_state *ps, const kin_model *m);
-void pose_free(pose_state *ps);
-/* Poses the model at time t of animation anim (NULL: rest pose), fills
- * world matrices and skinned world-space vertices and normals. */
-void pose_eval(pose_state *ps, const kin_animation *anim, float t);
-/* Draws every mesh of the posed model through the camera into target
- * (which must have attr_count 3 for view-space normals, or 0). */
-rast_result pose_draw(pose_state *ps, const kin_camera *cam,
-                      const rast_target *target, rast_stats *stats);
 
 /* Progress on a terminal (stderr), nothing otherwise. */
 typedef struct progress {

@@ -150,12 +150,21 @@ int cmd_mask(int argc, char **argv)
     }
 
     int rc = EXIT_FAIL;
-    pose_state ps;
+    pipe_pose ps;
+    float *clip = NULL, *vnrm = NULL;
     io_image mask = {0}, nimg = {0}, dimg = {0};
     size_t npx = (size_t)width * (size_t)height;
     float *depth = malloc(sizeof(float) * npx);
     float *nrm = malloc(sizeof(float) * 3 * npx);
-    if (pose_init(&ps, &model) != 0 || !depth || !nrm) {
+    if (pipe_pose_init(&ps, &model) != 0) {
+        free(depth);
+        free(nrm);
+        kin_model_free(&model);
+        return cli_fail("out of memory for %s", model_path);
+    }
+    clip = malloc(sizeof(float) * 4 * (size_t)ps.max_vertices);
+    vnrm = malloc(sizeof(float) * 3 * (size_t)ps.max_vertices);
+    if (!depth || !nrm || !clip || !vnrm) {
         cli_fail("out of memory for a %dx%d image of %s", width, height, model_path);
         goto done;
     }
@@ -166,8 +175,8 @@ int cmd_mask(int argc, char **argv)
     kin_camera cam = kin_camera_look_at(ve, vt, vu, fovy, width, height, znear, zfar);
     rast_target tg = {width, height, depth, width, mask.data, width, nrm, 3 * width, 3};
     rast_target_clear(&tg);
-    pose_eval(&ps, an, tsec);
-    rast_result rr = pose_draw(&ps, &cam, &tg, NULL);
+    pipe_pose_anim(&ps, an, tsec);
+    rast_result rr = pipe_pose_draw(&ps, &cam, &tg, clip, vnrm, NULL);
     if (rr != RAST_OK) {
         cli_fail("%s: cannot draw the model: %s", model_path, rast_result_str(rr));
         goto done;
@@ -203,7 +212,9 @@ done:
     io_image_free(&dimg);
     free(depth);
     free(nrm);
-    pose_free(&ps);
+    free(clip);
+    free(vnrm);
+    pipe_pose_free(&ps);
     kin_model_free(&model);
     return rc;
 }

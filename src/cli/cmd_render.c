@@ -11,7 +11,7 @@
 
 static const char *render_usage =
     "usage: egofuse render --scene FILE --out DIR [--first K] [--frames N]\n"
-    "                      [--masks] [--quiet]\n"
+    "                      [--masks] [--quiet] [--threads 1|2]\n"
     "\n"
     "Composites a recorded sequence (docs/scene.md): for each frame, poses the\n"
     "mask model at t = frame / fps, renders its mask and normals from both\n"
@@ -26,6 +26,7 @@ static const char *render_usage =
     "  --frames N     number of frames (default: all of the scene)\n"
     "  --masks        also write the masks, DIR/mask_left_NNNN.png ...\n"
     "  --quiet        no progress line\n"
+    "  --threads T    1, or 2 (default: one eye per thread; same bytes)\n"
     "  -h, --help     this text\n";
 
 static const char *demo_usage =
@@ -44,15 +45,8 @@ typedef struct render_opts {
     const char *out;
     int first, frames;
     int masks, quiet;
+    int threads;           /* 0 = 2 */
 } render_opts;
-
-/* Buffers of one eye. */
-typedef struct eye_buf {
-    float *depth, *nrm;
-    uint8_t *mask;
-    uint8_t *layer;          /* premultiplied lighting layer, RGBA8 */
-    io_image cam, virt, rgb; /* camera (RGBA8), virtual (RGBA8), output */
-} eye_buf;
 
 static int file_exists(const char *p)
 {
@@ -60,31 +54,28 @@ static int file_exists(const char *p)
     return stat(p, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-static fuse_lighting scene_lighting(const io_scene *s, const kin_camera *cam)
+/* The scene's lighting, directions in world space (pipe_frame turns them
+ * into each camera's view space). */
+static pipe_lighting scene_lighting(const io_scene *s)
 {
-    fuse_lighting L = fuse_lighting_default();
-    if (s->has_lighting) {
-        L.light_count = s->light_count;
-        for (int i = 0; i < 3; i++) {
-            L.ambient[i] = s->ambient[i];
-            L.tone[i] = s->tone[i];
-        }
-        L.kd = s->kd;
-        L.ks = s->ks;
-        L.shininess = s->shininess;
-        L.kf = s->kf;
-        for (int i = 0; i < s->light_count && i < FUSE_MAX_LIGHTS; i++) {
-            for (int k = 0; k < 3; k++) L.lights[i].color[k] = s->light_color[i][k];
-            kin_vec3 d = kin_v3(s->light_dir[i][0], s->light_dir[i][1], s->light_dir[i][2]);
-            d = kin_v3_norm(kin_mat4_mul_dir(&cam->view, d));
-            L.lights[i].dir[0] = d.x;
-            L.lights[i].dir[1] = d.y;
-            L.lights[i].dir[2] = d.z;
-        }
-    } else {
-        /* The default light is given in view space already. */
+    pipe_lighting pl = pipe_lighting_default();
+    if (!s->has_lighting) return pl;
+    fuse_lighting *L = &pl.light;
+    L->light_count = s->light_count;
+    for (int k = 0; k < 3; k++) {
+        L->ambient[k] = s->ambient[k];
+        L->tone[k] = s->tone[k];
     }
-    return L;
+    L->kd = s->kd;
+    L->ks = s->ks;
+    L->shininess = s->shininess;
+    L->kf = s->kf;
+    for (int i = 0; i < s->light_count && i < FUSE_MAX_LIGHTS; i++)
+        for (int k = 0; k < 3; k++) {
+            L->lights[i].dir[k] = s->light_dir[i][k];
+            L->lights[i].color[k] = s->light_color[i][k];
+        }
+    return pl;
 }
 
 static int load_rgba(const char *path, int w, int h, const char *what,
@@ -124,6 +115,12 @@ static int save_mask(const char *path, const uint8_t *mask, int w, int h)
     return EXIT_OK;
 }
 
+static fuse_image as_fuse(const io_image *img)
+{
+    fuse_image f = {img->data, img->width, img->height, (int)img->stride};
+    return f;
+}
+
 static int render(const render_opts *o)
 {
     io_error err;
@@ -153,7 +150,6 @@ static int render(const render_opts *o)
     io_scene_frame_path(&sc, sc.model, 0, model_path, sizeof model_path);
     if (io_gltf_load(model_path, &model, &err) != IO_OK) return cli_fail("%s", err.msg);
 
-    int rc = EXIT_FAIL;
     const kin_animation *anim = NULL;
     if (sc.animation[0]) {
         for (int i = 0; i < model.anim_count; i++)
@@ -167,33 +163,19 @@ static int render(const render_opts *o)
         anim = &model.anims[0];
     }
     int head = -1;
-    if (sc.head_node[0]) {
-        head = kin_model_find_node(&model, sc.head_node);
-        if (head < 0) {
-            cli_fail("%s: the scene's head node '%s' is not in %s", o->scene, sc.head_node, model_path);
-            kin_model_free(&model);
-            return EXIT_FAIL;
-        }
+    if (sc.head_node[0] && (head = kin_model_find_node(&model, sc.head_node)) < 0) {
+        cli_fail("%s: the scene's head node '%s' is not in %s", o->scene, sc.head_node, model_path);
+        kin_model_free(&model);
+        return EXIT_FAIL;
     }
 
+    int rc = EXIT_FAIL;
+    pipe_desc pd = {0};
+    pd.threads = o->threads;
+    pipe_ctx *pp = pipe_create(&pd, &model);
     kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
-    kin_sthmd_geometry g = kin_sthmd_geometry_of(NULL);
-    const int cw = g.crop_width, ch = g.crop_height;
-    const size_t cpx = (size_t)cw * (size_t)ch;
-
-    pose_state ps;
-    eye_buf eb[2];
-    memset(eb, 0, sizeof eb);
-    int ok = pose_init(&ps, &model) == 0;
-    for (int e = 0; e < 2 && ok; e++) {
-        eb[e].depth = malloc(sizeof(float) * cpx);
-        eb[e].nrm = malloc(sizeof(float) * 3 * cpx);
-        eb[e].mask = malloc(cpx);
-        eb[e].layer = malloc(4 * cpx);
-        ok = eb[e].depth && eb[e].nrm && eb[e].mask && eb[e].layer &&
-             io_image_alloc(&eb[e].rgb, hd.lcd_width, hd.lcd_height, 3, IO_U8, &err) == IO_OK;
-    }
-    if (!ok) {
+    io_image cam[2] = {{0}}, virt[2] = {{0}}, rgb = {0};
+    if (!pp || io_image_alloc(&rgb, hd.lcd_width, hd.lcd_height, 3, IO_U8, &err) != IO_OK) {
         cli_fail("out of memory");
         goto done;
     }
@@ -202,55 +184,46 @@ static int render(const render_opts *o)
         goto done;
     }
 
+    pipe_frame_in in = {0};
+    in.anim = anim;
+    in.head_node = head;
+    in.lighting = scene_lighting(&sc);
+    static const char *eye_name[2] = {"left", "right"};
+    pipe_frame_stats st, sum = {0};
     progress pr;
     progress_start(&pr, count);
     if (o->quiet) pr.enabled = 0;
-    static const char *eye_name[2] = {"left", "right"};
-    /* Seconds spent in each stage, summed over the frames. */
-    double t_pose = 0.0, t_raster = 0.0, t_fuse = 0.0, t0;
     for (int f = first; f < first + count; f++) {
-        float t = (float)f / sc.fps;
-        t0 = cli_now();
-        pose_eval(&ps, anim, t);
-        t_pose += cli_now() - t0;
-        kin_mat4 head_m = head >= 0 ? ps.world[head] : kin_mat4_identity();
         for (int e = 0; e < 2; e++) {
-            eye_buf *b = &eb[e];
-            kin_camera cam = kin_sthmd_camera(&hd, &head_m, (kin_eye)e);
-            rast_target tg = {cw, ch, b->depth, cw, b->mask, cw, b->nrm, 3 * cw, 3};
-            t0 = cli_now();
-            rast_target_clear(&tg);
-            rast_result rr = pose_draw(&ps, &cam, &tg, NULL);
-            t_raster += cli_now() - t0;
-            if (rr != RAST_OK) {
-                cli_fail("%s: frame %d: cannot draw the model: %s", model_path, f, rast_result_str(rr));
-                goto done;
-            }
-
             io_scene_frame_path(&sc, sc.camera[e], f, path, sizeof path);
-            if (load_rgba(path, hd.cam_width, hd.cam_height, "camera", &b->cam)) goto done;
+            if (load_rgba(path, hd.cam_width, hd.cam_height, "camera", &cam[e])) goto done;
             io_scene_frame_path(&sc, sc.virt[e], f, path, sizeof path);
-            if (load_rgba(path, hd.lcd_width, hd.lcd_height, "virtual scene", &b->virt)) goto done;
-
-            fuse_image full = {b->cam.data, b->cam.width, b->cam.height, (int)b->cam.stride};
-            fuse_image P = fuse_image_rows(&full, g.crop_y0, ch);
-            fuse_image Q = {b->layer, cw, ch, 4 * cw};
-            fuse_image V = {b->virt.data, b->virt.width, b->virt.height, (int)b->virt.stride};
-            fuse_lighting L = scene_lighting(&sc, &cam);
-            fuse_intrinsics K = {cam.fx, cam.fy, cam.cx, cam.cy};
-            t0 = cli_now();
-            fuse_result fr = fuse_light(&L, &K, &P, b->mask, cw, b->nrm, 3 * cw, &Q);
-            if (fr == FUSE_OK) fr = fuse_composite(&Q, &V, g.vp_x0, g.vp_y0, g.vp_width, g.vp_height, &V);
-            t_fuse += cli_now() - t0;
-            if (fr != FUSE_OK) {
-                cli_fail("%s: frame %d: %s", o->scene, f, fuse_result_str(fr));
-                goto done;
-            }
+            if (load_rgba(path, hd.lcd_width, hd.lcd_height, "virtual scene", &virt[e])) goto done;
+            in.camera[e] = as_fuse(&cam[e]);
+            in.virt[e] = as_fuse(&virt[e]);
+            in.out[e] = in.virt[e]; /* composite in place */
+        }
+        in.time = (float)f / sc.fps;
+        char why[256];
+        pipe_result pr_ = pipe_frame(pp, &in, &st, why, sizeof why);
+        if (pr_ != PIPE_OK) {
+            cli_fail("%s: frame %d: %s", o->scene, f, why);
+            goto done;
+        }
+        sum.ms_pose += st.ms_pose;
+        sum.ms_total += st.ms_total;
+        for (int e = 0; e < 2; e++) {
+            sum.ms_raster[e] += st.ms_raster[e];
+            sum.ms_fuse[e] += st.ms_fuse[e];
+        }
+        for (int e = 0; e < 2; e++) {
             snprintf(path, sizeof path, "%s/%s_%04d.png", o->out, eye_name[e], f);
-            if (save_rgb(path, &b->virt, &b->rgb)) goto done;
+            if (save_rgb(path, &virt[e], &rgb)) goto done;
             if (o->masks) {
+                int mw, mh;
+                const uint8_t *m = pipe_mask(pp, e, &mw, &mh);
                 snprintf(path, sizeof path, "%s/mask_%s_%04d.png", o->out, eye_name[e], f);
-                if (save_mask(path, b->mask, cw, ch)) goto done;
+                if (save_mask(path, m, mw, mh)) goto done;
             }
         }
         progress_step(&pr, f - first + 1, "frame");
@@ -259,29 +232,25 @@ static int render(const render_opts *o)
     if (!o->quiet) {
         double wall = cli_now() - pr.t0;
         printf("egofuse: wrote %d stereo frames (1280x800 per eye) to %s\n", count, o->out);
-        printf("egofuse: per stereo frame: pose+skin %.3f ms, raster %.3f ms, "
-               "lighting+composite %.3f ms (scalar reference, 1 thread); "
-               "with image files %.1f ms\n",
-               1e3 * t_pose / count, 1e3 * t_raster / count, 1e3 * t_fuse / count,
-               1e3 * wall / count);
+        printf("egofuse: per stereo frame, %d thread%s: %.3f ms (pose+skin %.3f ms; "
+               "per eye: raster %.3f ms, lighting+composite %.3f ms); with image files %.1f ms\n",
+               o->threads == 1 ? 1 : 2, o->threads == 1 ? "" : "s", sum.ms_total / count,
+               sum.ms_pose / count, (sum.ms_raster[0] + sum.ms_raster[1]) / (2.0 * count),
+               (sum.ms_fuse[0] + sum.ms_fuse[1]) / (2.0 * count), 1e3 * wall / count);
     }
     rc = EXIT_OK;
 done:
     for (int e = 0; e < 2; e++) {
-        free(eb[e].depth);
-        free(eb[e].nrm);
-        free(eb[e].mask);
-        free(eb[e].layer);
-        io_image_free(&eb[e].cam);
-        io_image_free(&eb[e].virt);
-        io_image_free(&eb[e].rgb);
+        io_image_free(&cam[e]);
+        io_image_free(&virt[e]);
     }
-    pose_free(&ps);
+    io_image_free(&rgb);
+    pipe_destroy(pp);
     kin_model_free(&model);
     return rc;
 }
 
-enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES };
+enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS };
 
 int cmd_render(int argc, char **argv)
 {
@@ -292,6 +261,7 @@ int cmd_render(int argc, char **argv)
         {"frames", required_argument, 0, O_FRAMES},
         {"masks", no_argument, 0, O_MASKS},
         {"quiet", no_argument, 0, O_QUIET},
+        {"threads", required_argument, 0, O_THREADS},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
@@ -314,6 +284,10 @@ int cmd_render(int argc, char **argv)
             break;
         case O_MASKS: o.masks = 1; break;
         case O_QUIET: o.quiet = 1; break;
+        case O_THREADS:
+            if (!cli_parse_int(optarg, 1, 2, &o.threads))
+                return cli_usage_error("render", "--threads '%s': 1 or 2", optarg);
+            break;
         case ':': return cli_usage_error("render", "option %s needs a value", argv[optind - 1]);
         default: return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);
         }

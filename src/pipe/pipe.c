@@ -1,0 +1,436 @@
+/* pipe.c - one stereo frame, end to end (see pipe.h). */
+#include "pipe.h"
+
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* ------------------------------------------------------------- posing */
+
+/* Area-weighted smooth vertex normals for meshes without NORMAL. (glTF
+ * asks for flat normals then; they matter only for lighting, and smooth
+ * ones shade a rounded model better.) */
+static void smooth_normals(const kin_mesh *m, float *out)
+{
+    memset(out, 0, sizeof(float) * 3 * (size_t)m->vertex_count);
+    for (int i = 0; i + 2 < m->index_count; i += 3) {
+        const uint32_t v[3] = {m->indices[i], m->indices[i + 1], m->indices[i + 2]};
+        const float *a = m->positions + 3 * v[0], *b = m->positions + 3 * v[1],
+                    *c = m->positions + 3 * v[2];
+        kin_vec3 n = kin_v3_cross(kin_v3(b[0] - a[0], b[1] - a[1], b[2] - a[2]),
+                                  kin_v3(c[0] - a[0], c[1] - a[1], c[2] - a[2]));
+        for (int k = 0; k < 3; k++) {
+            out[3 * v[k] + 0] += n.x;
+            out[3 * v[k] + 1] += n.y;
+            out[3 * v[k] + 2] += n.z;
+        }
+    }
+    for (int i = 0; i < m->vertex_count; i++) {
+        kin_vec3 n = kin_v3_norm(kin_v3(out[3 * i], out[3 * i + 1], out[3 * i + 2]));
+        out[3 * i + 0] = n.x;
+        out[3 * i + 1] = n.y;
+        out[3 * i + 2] = n.z;
+    }
+}
+
+int pipe_pose_init(pipe_pose *ps, const kin_model *m)
+{
+    memset(ps, 0, sizeof *ps);
+    ps->model = m;
+    size_t nn = (size_t)(m->node_count > 0 ? m->node_count : 1);
+    size_t nm = (size_t)m->mesh_count + 1;
+    ps->locals = calloc(nn, sizeof *ps->locals);
+    ps->world = calloc(nn, sizeof *ps->world);
+    ps->joint_mats = calloc((size_t)m->skin_count + 1, sizeof *ps->joint_mats);
+    ps->meshes = calloc(nm, sizeof *ps->meshes);
+    ps->own_normals = calloc(nm, sizeof(float *));
+    ps->pos = calloc(nm, sizeof(float *));
+    ps->nrm = calloc(nm, sizeof(float *));
+    if (!ps->locals || !ps->world || !ps->joint_mats || !ps->meshes ||
+        !ps->own_normals || !ps->pos || !ps->nrm)
+        goto oom;
+    for (int s = 0; s < m->skin_count; s++) {
+        ps->joint_mats[s] = calloc((size_t)m->skins[s].joint_count, sizeof(kin_mat4));
+        if (!ps->joint_mats[s]) goto oom;
+    }
+    ps->max_vertices = 1;
+    for (int i = 0; i < m->mesh_count; i++) {
+        const kin_mesh *me = &m->meshes[i];
+        size_t nv = (size_t)me->vertex_count;
+        if (me->vertex_count > ps->max_vertices) ps->max_vertices = me->vertex_count;
+        ps->meshes[i] = *me;
+        if (!me->normals) {
+            ps->own_normals[i] = malloc(sizeof(float) * 3 * nv);
+            if (!ps->own_normals[i]) goto oom;
+            smooth_normals(me, ps->own_normals[i]);
+            ps->meshes[i].normals = ps->own_normals[i];
+        }
+        ps->pos[i] = malloc(sizeof(float) * 3 * nv);
+        ps->nrm[i] = malloc(sizeof(float) * 3 * nv);
+        if (!ps->pos[i] || !ps->nrm[i]) goto oom;
+    }
+    return 0;
+oom:
+    pipe_pose_free(ps);
+    return -1;
+}
+
+void pipe_pose_free(pipe_pose *ps)
+{
+    const kin_model *m = ps->model;
+    if (m) {
+        for (int s = 0; ps->joint_mats && s < m->skin_count; s++)
+            free(ps->joint_mats[s]);
+        for (int i = 0; i < m->mesh_count; i++) {
+            if (ps->own_normals) free(ps->own_normals[i]);
+            if (ps->pos) free(ps->pos[i]);
+            if (ps->nrm) free(ps->nrm[i]);
+        }
+    }
+    free(ps->joint_mats);
+    free(ps->own_normals);
+    free(ps->meshes);
+    free(ps->pos);
+    free(ps->nrm);
+    free(ps->locals);
+    free(ps->world);
+    memset(ps, 0, sizeof *ps);
+}
+
+/* FK from ps->locals, then skinning of every mesh into world space. */
+static void pose_skin(pipe_pose *ps)
+{
+    const kin_model *m = ps->model;
+    kin_fk(m->parents, m->node_count, ps->locals, NULL, ps->world);
+    for (int s = 0; s < m->skin_count; s++)
+        kin_skin_joint_matrices(&m->skins[s], ps->world, ps->joint_mats[s]);
+    for (int i = 0; i < m->mesh_count; i++) {
+        const kin_mesh *me = &ps->meshes[i];
+        if (me->skin >= 0) {
+            /* glTF: a skinned mesh ignores its own node's transform. */
+            kin_skin_lbs(me, ps->joint_mats[me->skin], ps->pos[i], ps->nrm[i]);
+        } else {
+            kin_mat4 id = kin_mat4_identity();
+            kin_mesh_transform(me, me->node >= 0 ? &ps->world[me->node] : &id,
+                               ps->pos[i], ps->nrm[i]);
+        }
+    }
+}
+
+void pipe_pose_anim(pipe_pose *ps, const kin_animation *anim, float t)
+{
+    kin_pose_rest(ps->model, ps->locals);
+    if (anim) kin_anim_sample(anim, ps->model->node_count, t, ps->locals);
+    pose_skin(ps);
+}
+
+void pipe_pose_locals(pipe_pose *ps, const kin_transform *locals)
+{
+    memcpy(ps->locals, locals, sizeof *locals * (size_t)ps->model->node_count);
+    pose_skin(ps);
+}
+
+rast_result pipe_pose_draw(const pipe_pose *ps, const kin_camera *cam,
+                           const rast_target *target, float *clip,
+                           float *vnrm, rast_stats *stats)
+{
+    const int with_n = target->attr_count == 3;
+    for (int i = 0; i < ps->model->mesh_count; i++) {
+        const kin_mesh *me = &ps->meshes[i];
+        rast_transform_points(cam->view_proj.m, ps->pos[i], me->vertex_count, clip);
+        if (with_n) rast_transform_dirs(cam->view.m, ps->nrm[i], me->vertex_count, vnrm);
+        rast_mesh_desc d = {
+            .clip = clip,
+            .vertex_count = me->vertex_count,
+            .attr = with_n ? vnrm : NULL,
+            .attr_count = with_n ? 3 : 0,
+            .indices = me->indices,
+            .tri_count = me->index_count / 3,
+            .cull = RAST_CULL_NONE,
+        };
+        rast_result r = rast_draw(target, &d, stats);
+        if (r != RAST_OK) return r;
+    }
+    return RAST_OK;
+}
+
+/* ------------------------------------------------------------- frames */
+
+typedef struct eye_state {
+    int eye;
+    float *depth, *nrm, *clip, *vnrm;
+    uint8_t *mask, *layer;
+    kin_camera cam;
+    /* per-frame job */
+    const pipe_frame_in *in;
+    kin_mat4 head;
+    pipe_result result;
+    char why[160];
+    double ms_raster, ms_fuse, coverage;
+} eye_state;
+
+struct pipe_ctx {
+    pipe_desc desc;
+    kin_sthmd_desc hmd;
+    kin_sthmd_geometry geo;
+    pipe_pose pose;
+    eye_state eye[2];
+    /* the worker thread runs eye 1 when threads == 2 */
+    int threaded;
+    pthread_t worker;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    int job_seq, done_seq, quit;
+};
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+}
+
+/* 1 if im is a w x h RGBA8 image, else 0 with a sentence in why. */
+static int image_fits(const fuse_image *im, int w, int h, int eye,
+                      const char *what, char *why, int why_size)
+{
+    if (im->pixels && im->width == w && im->height == h && im->stride >= 4 * w)
+        return 1;
+    if (why && why_size > 0)
+        snprintf(why, (size_t)why_size,
+                 "%s eye: the %s image is %dx%d (stride %d), expected %dx%d RGBA8",
+                 eye ? "right" : "left", what, im->width, im->height, im->stride, w, h);
+    return 0;
+}
+
+static void run_eye(pipe_ctx *p, eye_state *e)
+{
+    const pipe_frame_in *in = e->in;
+    const int cw = p->geo.crop_width, ch = p->geo.crop_height;
+    double t0 = now_ms();
+    e->result = PIPE_OK;
+    e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
+    rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
+    rast_target_clear(&tg);
+    rast_result rr = pipe_pose_draw(&p->pose, &e->cam, &tg, e->clip, e->vnrm, NULL);
+    double t1 = now_ms();
+    e->ms_raster = t1 - t0;
+    if (rr != RAST_OK) {
+        e->result = PIPE_ERR_RASTER;
+        snprintf(e->why, sizeof e->why, "%s eye: rasterizer: %s",
+                 e->eye ? "right" : "left", rast_result_str(rr));
+        return;
+    }
+    long covered = 0;
+    for (int i = 0; i < cw * ch; i++) covered += e->mask[i] != 0;
+    e->coverage = (double)covered / (double)(cw * ch);
+
+    /* Lights from world space into this camera's view space. */
+    fuse_lighting L = in->lighting.light;
+    for (int i = 0; i < L.light_count && i < FUSE_MAX_LIGHTS; i++) {
+        kin_vec3 d = kin_v3(L.lights[i].dir[0], L.lights[i].dir[1], L.lights[i].dir[2]);
+        d = kin_v3_norm(kin_mat4_mul_dir(&e->cam.view, d));
+        L.lights[i].dir[0] = d.x;
+        L.lights[i].dir[1] = d.y;
+        L.lights[i].dir[2] = d.z;
+    }
+    fuse_intrinsics K = {e->cam.fx, e->cam.fy, e->cam.cx, e->cam.cy};
+    fuse_image P = fuse_image_rows(&in->camera[e->eye], p->geo.crop_y0, ch);
+    fuse_image Q = {e->layer, cw, ch, 4 * cw};
+    fuse_image out = in->out[e->eye];
+    fuse_result fr = fuse_light(&L, &K, &P, e->mask, cw, e->nrm, 3 * cw, &Q);
+    if (fr == FUSE_OK)
+        fr = fuse_composite(&Q, &in->virt[e->eye], p->geo.vp_x0, p->geo.vp_y0,
+                            p->geo.vp_width, p->geo.vp_height, &out);
+    e->ms_fuse = now_ms() - t1;
+    if (fr != FUSE_OK) {
+        e->result = PIPE_ERR_FUSE;
+        snprintf(e->why, sizeof e->why, "%s eye: lighting/composite: %s",
+                 e->eye ? "right" : "left", fuse_result_str(fr));
+    }
+}
+
+static void *worker_main(void *arg)
+{
+    pipe_ctx *p = arg;
+    int seen = 0;
+    pthread_mutex_lock(&p->mu);
+    for (;;) {
+        while (p->job_seq == seen && !p->quit) pthread_cond_wait(&p->cv, &p->mu);
+        if (p->quit) break;
+        seen = p->job_seq;
+        pthread_mutex_unlock(&p->mu);
+        run_eye(p, &p->eye[1]);
+        pthread_mutex_lock(&p->mu);
+        p->done_seq = seen;
+        pthread_cond_broadcast(&p->cv);
+    }
+    pthread_mutex_unlock(&p->mu);
+    return NULL;
+}
+
+pipe_lighting pipe_lighting_default(void)
+{
+    pipe_lighting l = {fuse_lighting_default()};
+    return l;
+}
+
+static void free_eyes(pipe_ctx *p)
+{
+    for (int e = 0; e < 2; e++) {
+        free(p->eye[e].depth);
+        free(p->eye[e].nrm);
+        free(p->eye[e].clip);
+        free(p->eye[e].vnrm);
+        free(p->eye[e].mask);
+        free(p->eye[e].layer);
+    }
+}
+
+pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
+{
+    if (!model) return NULL;
+    pipe_ctx *p = calloc(1, sizeof *p);
+    if (!p) return NULL;
+    if (desc) p->desc = *desc;
+    p->hmd = kin_sthmd_desc_resolved(&p->desc.hmd);
+    p->geo = kin_sthmd_geometry_of(&p->hmd);
+    if (pipe_pose_init(&p->pose, model) != 0) {
+        free(p);
+        return NULL;
+    }
+    size_t px = (size_t)p->geo.crop_width * (size_t)p->geo.crop_height;
+    size_t nv = (size_t)p->pose.max_vertices;
+    int ok = 1;
+    for (int e = 0; e < 2; e++) {
+        eye_state *s = &p->eye[e];
+        s->eye = e;
+        s->depth = malloc(sizeof(float) * px);
+        s->nrm = malloc(sizeof(float) * 3 * px);
+        s->mask = malloc(px);
+        s->layer = malloc(4 * px);
+        s->clip = malloc(sizeof(float) * 4 * nv);
+        s->vnrm = malloc(sizeof(float) * 3 * nv);
+        ok = ok && s->depth && s->nrm && s->mask && s->layer && s->clip && s->vnrm;
+    }
+    p->threaded = p->desc.threads != 1;
+    if (ok && p->threaded) {
+        pthread_mutex_init(&p->mu, NULL);
+        pthread_cond_init(&p->cv, NULL);
+        if (pthread_create(&p->worker, NULL, worker_main, p) != 0) {
+            pthread_mutex_destroy(&p->mu);
+            pthread_cond_destroy(&p->cv);
+            ok = 0;
+            p->threaded = 0;
+        }
+    }
+    if (!ok) {
+        free_eyes(p);
+        pipe_pose_free(&p->pose);
+        free(p);
+        return NULL;
+    }
+    return p;
+}
+
+void pipe_destroy(pipe_ctx *p)
+{
+    if (!p) return;
+    if (p->threaded) {
+        pthread_mutex_lock(&p->mu);
+        p->quit = 1;
+        pthread_cond_broadcast(&p->cv);
+        pthread_mutex_unlock(&p->mu);
+        pthread_join(p->worker, NULL);
+        pthread_mutex_destroy(&p->mu);
+        pthread_cond_destroy(&p->cv);
+    }
+    free_eyes(p);
+    pipe_pose_free(&p->pose);
+    free(p);
+}
+
+pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
+                       pipe_frame_stats *stats, char *why, int why_size)
+{
+    const int cam_w = p->hmd.cam_width, cam_h = p->hmd.cam_height;
+    const int lcd_w = p->hmd.lcd_width, lcd_h = p->hmd.lcd_height;
+    if (!in) return PIPE_ERR_ARGS;
+    for (int e = 0; e < 2; e++) {
+        if (!image_fits(&in->camera[e], cam_w, cam_h, e, "camera", why, why_size) ||
+            !image_fits(&in->virt[e], lcd_w, lcd_h, e, "virtual", why, why_size) ||
+            !image_fits(&in->out[e], lcd_w, lcd_h, e, "output", why, why_size))
+            return PIPE_ERR_ARGS;
+    }
+    if (in->head_node >= p->pose.model->node_count) {
+        if (why && why_size > 0)
+            snprintf(why, (size_t)why_size, "head node %d of %d", in->head_node,
+                     p->pose.model->node_count);
+        return PIPE_ERR_ARGS;
+    }
+
+    double t0 = now_ms();
+    if (in->locals) pipe_pose_locals(&p->pose, in->locals);
+    else pipe_pose_anim(&p->pose, in->anim, in->time);
+    kin_mat4 head = in->head_node >= 0 ? p->pose.world[in->head_node]
+                    : in->world_from_head ? *in->world_from_head
+                                          : kin_mat4_identity();
+    double t1 = now_ms();
+    for (int e = 0; e < 2; e++) {
+        p->eye[e].in = in;
+        p->eye[e].head = head;
+    }
+    if (p->threaded) {
+        pthread_mutex_lock(&p->mu);
+        int job = ++p->job_seq;
+        pthread_cond_broadcast(&p->cv);
+        pthread_mutex_unlock(&p->mu);
+        run_eye(p, &p->eye[0]);
+        pthread_mutex_lock(&p->mu);
+        while (p->done_seq != job) pthread_cond_wait(&p->cv, &p->mu);
+        pthread_mutex_unlock(&p->mu);
+    } else {
+        run_eye(p, &p->eye[0]);
+        run_eye(p, &p->eye[1]);
+    }
+    if (stats) {
+        stats->ms_pose = t1 - t0;
+        for (int e = 0; e < 2; e++) {
+            stats->ms_raster[e] = p->eye[e].ms_raster;
+            stats->ms_fuse[e] = p->eye[e].ms_fuse;
+            stats->coverage[e] = p->eye[e].coverage;
+        }
+        stats->ms_total = now_ms() - t0;
+    }
+    for (int e = 0; e < 2; e++) {
+        if (p->eye[e].result != PIPE_OK) {
+            if (why && why_size > 0) snprintf(why, (size_t)why_size, "%s", p->eye[e].why);
+            return p->eye[e].result;
+        }
+    }
+    return PIPE_OK;
+}
+
+const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
+{
+    if (width) *width = p->geo.crop_width;
+    if (height) *height = p->geo.crop_height;
+    return p->eye[eye ? 1 : 0].mask;
+}
+
+kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].cam; }
+
+kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }
+
+const char *pipe_result_str(pipe_result r)
+{
+    switch (r) {
+    case PIPE_OK: return "ok";
+    case PIPE_ERR_ARGS: return "invalid arguments";
+    case PIPE_ERR_RASTER: return "rasterizer error";
+    case PIPE_ERR_FUSE: return "lighting/composite error";
+    }
+    return "unknown error";
+}

@@ -1,0 +1,145 @@
+/* pipe.h - one stereo frame of egofuse, end to end: pose -> skin ->
+ * rasterize per eye -> lighting layer -> resample -> composite.
+ *
+ * WHAT IT DOES
+ *   pipe_pose_*: poses a kin_model (rest pose, an animation at time t, or
+ *   local transforms given by the caller, e.g. from IK) and skins every mesh
+ *   once per frame into world space (both eyes use the same skin).
+ *   pipe_frame(): for each eye, the STHMD camera from the head pose, the
+ *   G-buffer (depth, mask, view-space normals) at the cropped camera
+ *   resolution, the lighting layer on the camera image inside the mask, the
+ *   bilinear resampling into the viewport and the composite over the
+ *   virtual image. With threads = 2 the two eyes run on two threads; the
+ *   bytes do not depend on the thread count.
+ *
+ * WHAT IT DOES NOT
+ *   No file or device I/O (see src/io), no allocation per frame: buffers
+ *   and the worker thread are made by pipe_create. One pipe is used by one
+ *   caller thread at a time.
+ *
+ * USAGE
+ *   pipe_desc d = {0};                       // defaults: paper's HMD, 2 threads
+ *   pipe_ctx *p = pipe_create(&d, &model);
+ *   pipe_frame_in in = {0};
+ *   in.anim = &model.anims[0]; in.time = f / 60.0f; in.head_node = head;
+ *   in.camera[0] = left_640x480; in.virt[0] = left_1280x800; in.out[0] = ...;
+ *   in.lighting = pipe_lighting_default(); // lights in world space
+ *   pipe_frame(p, &in, &stats);
+ *   pipe_destroy(p);
+ */
+#ifndef EGOFUSE_PIPE_H
+#define EGOFUSE_PIPE_H
+
+#include "../fuse/fuse.h"
+#include "../kin/kin.h"
+#include "../raster/raster.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------- posing */
+
+/* Posing and skinning state of one model; buffers allocated once. */
+typedef struct pipe_pose {
+    const kin_model *model;
+    kin_transform *locals;    /* node_count: the pose being evaluated */
+    kin_mat4 *world;          /* node_count: world matrices after FK */
+    kin_mat4 **joint_mats;    /* per skin, joint_count */
+    kin_mesh *meshes;         /* the model's meshes; normals filled in
+                                 (smooth, area-weighted) where the file
+                                 has none */
+    float **own_normals;      /* per mesh: normals computed here, or NULL */
+    float **pos;              /* per mesh, 3 per vertex, world space */
+    float **nrm;              /* per mesh, 3 per vertex, world space, unit */
+    int max_vertices;         /* of the largest mesh */
+} pipe_pose;
+
+/* 0 on success, -1 when out of memory (nothing to free then). */
+int  pipe_pose_init(pipe_pose *ps, const kin_model *m);
+void pipe_pose_free(pipe_pose *ps);
+/* Poses at time t of anim (NULL: the rest pose), then skins. */
+void pipe_pose_anim(pipe_pose *ps, const kin_animation *anim, float t);
+/* Poses with the caller's local transforms (node_count), then skins. */
+void pipe_pose_locals(pipe_pose *ps, const kin_transform *locals);
+
+/* Draws every mesh of a posed model through cam into target (attr_count
+ * 3 receives view-space normals; 0 draws depth and mask only). clip and
+ * vnrm are scratch arrays of 4 and 3 floats per vertex of the largest
+ * mesh (ps->max_vertices). */
+rast_result pipe_pose_draw(const pipe_pose *ps, const kin_camera *cam,
+                           const rast_target *target, float *clip,
+                           float *vnrm, rast_stats *stats);
+
+/* ------------------------------------------------------------- frames */
+
+typedef struct pipe_desc {
+    kin_sthmd_desc hmd;       /* zero = the paper's HMD */
+    int threads;              /* 0 = 2 (one eye each); 1 = one thread */
+} pipe_desc;
+
+typedef struct pipe_ctx pipe_ctx;
+
+/* Lighting of the virtual scene. Directions are in WORLD space (towards
+ * the light); pipe_frame turns them into each camera's view space. */
+typedef struct pipe_lighting {
+    fuse_lighting light;      /* with light[i].dir in world space */
+} pipe_lighting;
+
+/* fuse_lighting_default() with its light direction taken as world space. */
+pipe_lighting pipe_lighting_default(void);
+
+typedef struct pipe_frame_in {
+    /* The pose: locals (node_count transforms) if not NULL, else anim at
+     * time (anim NULL = the rest pose). */
+    const kin_transform *locals;
+    const kin_animation *anim;
+    float time;
+    /* The head: world matrix of node head_node after posing, or
+     * *world_from_head when head_node < 0 (identity when that is NULL). */
+    int head_node;
+    const kin_mat4 *world_from_head;
+    /* Per eye (0 left, 1 right): the full camera image (hmd cam_width x
+     * cam_height, cropped here by eq. 1), the virtual image and the output
+     * (lcd_width x lcd_height; out may be the same memory as virt). */
+    fuse_image camera[2];
+    fuse_image virt[2];
+    fuse_image out[2];
+    pipe_lighting lighting;
+} pipe_frame_in;
+
+typedef struct pipe_frame_stats {
+    double ms_pose;           /* posing + skinning */
+    double ms_raster[2];      /* per eye: camera, G-buffer */
+    double ms_fuse[2];        /* per eye: lighting, resampling, composite */
+    double ms_total;          /* wall time of pipe_frame */
+    double coverage[2];       /* fraction of camera pixels in the mask */
+} pipe_frame_stats;
+
+typedef enum pipe_result {
+    PIPE_OK = 0,
+    PIPE_ERR_ARGS,            /* NULL pointers, image sizes that do not fit */
+    PIPE_ERR_RASTER,          /* the rasterizer refused the model */
+    PIPE_ERR_FUSE             /* the fuse stage refused its inputs */
+} pipe_result;
+
+/* NULL when out of memory or the thread cannot start. */
+pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model);
+void  pipe_destroy(pipe_ctx *p);
+/* One stereo frame. stats may be NULL. On error, why (if not NULL) gets a
+ * sentence naming the eye and the reason. */
+pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
+                       pipe_frame_stats *stats, char *why, int why_size);
+/* The last frame's G-buffer of one eye (valid until the next frame). */
+const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
+/* The camera of one eye in the last frame. */
+kin_camera pipe_camera(const pipe_ctx *p, int eye);
+/* The derived HMD numbers in use (crop, viewport). */
+kin_sthmd_geometry pipe_geometry(const pipe_ctx *p);
+
+const char *pipe_result_str(pipe_result r);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,223 @@
+/* test_pipe.c - one stereo frame end to end (src/pipe): the wiring of the
+ * stages (crop of eq. 1, camera per eye, lights into view space, viewport of
+ * eq. 4) against the same stages called one by one, thread-count
+ * independence, and bad inputs. */
+#include "support/testutil.h"
+
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/pipe/pipe.h"
+
+/* A model of one node ("head" at the origin) and one unskinned quad
+ * [-s,s]^2 at depth z (metres, in front of the head), normals +Z. */
+static void quad_model(kin_model *m, float s, float z)
+{
+    memset(m, 0, sizeof *m);
+    int16_t *parents = kin_block_alloc(&m->block, 2 * sizeof(int16_t));
+    kin_transform *rest = kin_block_alloc(&m->block, 2 * sizeof(kin_transform));
+    char(*names)[KIN_NAME_MAX] = kin_block_alloc(&m->block, 2 * KIN_NAME_MAX);
+    float *pos = kin_block_alloc(&m->block, 12 * sizeof(float));
+    float *nrm = kin_block_alloc(&m->block, 12 * sizeof(float));
+    uint32_t *idx = kin_block_alloc(&m->block, 6 * sizeof(uint32_t));
+    kin_mesh *mesh = kin_block_alloc(&m->block, sizeof(kin_mesh));
+    assert_non_null(mesh);
+    parents[0] = KIN_NO_PARENT;
+    parents[1] = 0;
+    rest[0] = rest[1] = kin_transform_identity();
+    strcpy(names[0], "head");
+    strcpy(names[1], "quad");
+    const float p[12] = {-s, -s, z, s, -s, z, s, s, z, -s, s, z};
+    memcpy(pos, p, sizeof p);
+    for (int i = 0; i < 4; i++) nrm[3 * i + 2] = 1.0f;
+    const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(idx, ix, sizeof ix);
+    *mesh = (kin_mesh){.vertex_count = 4, .positions = pos, .normals = nrm,
+                       .index_count = 6, .indices = idx, .node = 1, .skin = -1};
+    m->node_count = 2;
+    m->parents = parents;
+    m->rest = rest;
+    m->names = (const char(*)[KIN_NAME_MAX])names;
+    m->mesh_count = 1;
+    m->meshes = mesh;
+    char why[200];
+    assert_int_equal(kin_model_validate(m, why, sizeof why), 0);
+}
+
+typedef struct frame_bufs {
+    uint8_t *cam[2], *virt[2], *out[2];
+} frame_bufs;
+
+static void fill_random(uint8_t *p, size_t n, tu_rng *r)
+{
+    for (size_t i = 0; i < n; i++) p[i] = (uint8_t)tu_next(r);
+}
+
+static void make_frame(frame_bufs *b, pipe_frame_in *in, uint64_t seed)
+{
+    tu_rng r = {seed};
+    memset(in, 0, sizeof *in);
+    for (int e = 0; e < 2; e++) {
+        b->cam[e] = malloc(640 * 480 * 4);
+        b->virt[e] = malloc(1280 * 800 * 4);
+        b->out[e] = malloc(1280 * 800 * 4);
+        assert_non_null(b->out[e]);
+        fill_random(b->cam[e], 640 * 480 * 4, &r);
+        fill_random(b->virt[e], 1280 * 800 * 4, &r);
+        memset(b->out[e], 0xAB, 1280 * 800 * 4);
+        in->camera[e] = (fuse_image){b->cam[e], 640, 480, 640 * 4};
+        in->virt[e] = (fuse_image){b->virt[e], 1280, 800, 1280 * 4};
+        in->out[e] = (fuse_image){b->out[e], 1280, 800, 1280 * 4};
+    }
+    in->head_node = 0;
+    in->lighting = pipe_lighting_default();
+}
+
+static void free_frame(frame_bufs *b)
+{
+    for (int e = 0; e < 2; e++) {
+        free(b->cam[e]);
+        free(b->virt[e]);
+        free(b->out[e]);
+    }
+}
+
+/* The pipe equals the stages called by hand: camera of each eye, raster of
+ * the cropped 640x400 view, lights turned into view space, lighting of rows
+ * 40..439 of the sensor, composite into (43, 27, 1194, 746). */
+static void frame_equals_stages(void **state)
+{
+    (void)state;
+    kin_model m;
+    quad_model(&m, 0.08f, -0.5f);
+    pipe_desc d = {0};
+    d.threads = 1;
+    pipe_ctx *p = pipe_create(&d, &m);
+    assert_non_null(p);
+    frame_bufs b;
+    pipe_frame_in in;
+    make_frame(&b, &in, 7);
+    /* A head turned a little and moved: the cameras must follow it. */
+    kin_mat4 head = kin_mat4_from_tr(kin_v3(0.01f, -0.02f, 0.03f),
+                                     kin_quat_axis_angle(kin_v3(0, 1, 0), 0.1f));
+    in.head_node = -1;
+    in.world_from_head = &head;
+    pipe_frame_stats st;
+    char why[200] = "";
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    assert_true(st.coverage[0] > 0.01 && st.coverage[0] < 0.5);
+
+    kin_sthmd_geometry g = kin_sthmd_geometry_of(NULL);
+    assert_int_equal(g.crop_y0, 40);
+    static float depth[640 * 400], nrm[640 * 400 * 3];
+    static uint8_t mask[640 * 400], layer[640 * 400 * 4];
+    uint8_t *expect = malloc(1280 * 800 * 4);
+    for (int e = 0; e < 2; e++) {
+        kin_camera cam = kin_sthmd_camera(NULL, &head, (kin_eye)e);
+        kin_camera pc = pipe_camera(p, e);
+        assert_memory_equal(&cam.view_proj, &pc.view_proj, sizeof cam.view_proj);
+        rast_target t = {640, 400, depth, 640, mask, 640, nrm, 640 * 3, 3};
+        rast_target_clear(&t);
+        float clip[16], vn[12], wpos[12];
+        memcpy(wpos, m.meshes[0].positions, sizeof wpos);
+        rast_transform_points(cam.view_proj.m, wpos, 4, clip);
+        rast_transform_dirs(cam.view.m, m.meshes[0].normals, 4, vn);
+        rast_mesh_desc md = {clip, 4, vn, 3, m.meshes[0].indices, 2, RAST_CULL_NONE};
+        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
+        int mw, mh;
+        assert_memory_equal(pipe_mask(p, e, &mw, &mh), mask, sizeof mask);
+        fuse_lighting L = fuse_lighting_default();
+        kin_vec3 ld = kin_v3_norm(kin_mat4_mul_dir(
+            &cam.view, kin_v3(L.lights[0].dir[0], L.lights[0].dir[1], L.lights[0].dir[2])));
+        L.lights[0].dir[0] = ld.x;
+        L.lights[0].dir[1] = ld.y;
+        L.lights[0].dir[2] = ld.z;
+        fuse_intrinsics K = {cam.fx, cam.fy, cam.cx, cam.cy};
+        fuse_image P = {b.cam[e] + 40 * 640 * 4, 640, 400, 640 * 4};
+        fuse_image Q = {layer, 640, 400, 640 * 4};
+        fuse_image V = {b.virt[e], 1280, 800, 1280 * 4};
+        fuse_image R = {expect, 1280, 800, 1280 * 4};
+        assert_int_equal(fuse_light(&L, &K, &P, mask, 640, nrm, 640 * 3, &Q), FUSE_OK);
+        assert_int_equal(fuse_composite(&Q, &V, 43, 27, 1194, 746, &R), FUSE_OK);
+        assert_memory_equal(expect, b.out[e], 1280 * 800 * 4);
+    }
+    free(expect);
+    free_frame(&b);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
+/* One or two threads: the same bytes, frame after frame. */
+static void threads_same_bytes(void **state)
+{
+    (void)state;
+    kin_model m;
+    quad_model(&m, 0.1f, -0.4f);
+    uint32_t crc[2] = {0, 0};
+    for (int th = 1; th <= 2; th++) {
+        pipe_desc d = {0};
+        d.threads = th;
+        pipe_ctx *p = pipe_create(&d, &m);
+        assert_non_null(p);
+        for (int f = 0; f < 4; f++) {
+            frame_bufs b;
+            pipe_frame_in in;
+            make_frame(&b, &in, 100 + (uint64_t)f);
+            kin_mat4 head = kin_mat4_from_tr(kin_v3(0.02f * f, 0, 0), kin_quat_identity());
+            in.head_node = -1;
+            in.world_from_head = &head;
+            assert_int_equal(pipe_frame(p, &in, NULL, NULL, 0), PIPE_OK);
+            for (int e = 0; e < 2; e++) crc[th - 1] = tu_crc32(crc[th - 1], b.out[e], 1280 * 800 * 4);
+            free_frame(&b);
+        }
+        pipe_destroy(p);
+    }
+    assert_int_equal(crc[0], crc[1]);
+    kin_model_free(&m);
+}
+
+static void bad_inputs(void **state)
+{
+    (void)state;
+    kin_model m;
+    quad_model(&m, 0.1f, -0.4f);
+    pipe_ctx *p = pipe_create(NULL, &m);
+    assert_non_null(p);
+    assert_null(pipe_create(NULL, NULL));
+    frame_bufs b;
+    pipe_frame_in in;
+    make_frame(&b, &in, 3);
+    char why[200];
+    in.camera[1].height = 400; /* a cropped image where the sensor is due */
+    memset(b.out[0], 0x5A, 1280 * 800 * 4);
+    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_ERR_ARGS);
+    assert_non_null(strstr(why, "right eye"));
+    assert_non_null(strstr(why, "camera image is 640x400"));
+    /* Nothing was written. */
+    for (int i = 0; i < 1280 * 800 * 4; i++) assert_int_equal(b.out[0][i], 0x5A);
+    in.camera[1].height = 480;
+    in.virt[0].pixels = NULL;
+    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_ERR_ARGS);
+    assert_non_null(strstr(why, "left eye: the virtual image"));
+    in.virt[0].pixels = b.virt[0];
+    in.head_node = 5;
+    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_ERR_ARGS);
+    assert_non_null(strstr(why, "head node 5"));
+    in.head_node = 0;
+    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_OK);
+    free_frame(&b);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(frame_equals_stages),
+        cmocka_unit_test(threads_same_bytes),
+        cmocka_unit_test(bad_inputs),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
