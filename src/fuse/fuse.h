@@ -57,7 +57,9 @@
  *   of another size than required, a viewport not inside V.
  *
  * WHAT IT DOES NOT
- *   No allocation, no threads, no global state, no file I/O.
+ *   fuse_light, fuse_composite and the format, depth and tone calls: no
+ *   allocation, no threads, no global state, no file I/O. A fuse_context
+ *   (below) owns a thread pool, created once.
  *
  * USAGE
  *   fuse_lighting L = fuse_lighting_default();
@@ -68,7 +70,10 @@
 #ifndef EGOFUSE_FUSE_H
 #define EGOFUSE_FUSE_H
 
+#include <stddef.h>
 #include <stdint.h>
+
+#include "../cpu/cpu.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -152,6 +157,192 @@ fuse_result fuse_composite(const fuse_image *Q, const fuse_image *V,
  * out must have width x height pixels and must not overlap rgb. */
 fuse_result fuse_rgb24_to_rgba(const uint8_t *rgb, int stride, int width,
                                int height, fuse_image *out);
+
+/* ---- camera formats ----------------------------------------------------
+ *
+ * What V4L2 delivers, to RGBA8 (alpha 255), with the eq. 1 crop: rows
+ * [y0, y0 + out->height) of the frame become out (out->width = frame
+ * width). Integer arithmetic, the same bytes on every machine
+ * (docs/fuse.md, "Camera formats"):
+ *   YUYV, UYVY  4:2:2, BT.601 limited range (V4L2's default for them):
+ *               C = Y-16, D = U-128, E = V-128,
+ *               R = (298C + 409E + 128) >> 8, G = (298C - 100D - 208E + 128) >> 8,
+ *               B = (298C + 516D + 128) >> 8, each clamped to 0..255
+ *               (within 1 of the double-precision BT.601 matrix, tested);
+ *               both pixels of a pair use the pair's U, V. Width even.
+ *   GREY        R = G = B = Y (full range).
+ *   BAYER_*     8-bit raw Bayer, named by the colours of the top-left 2x2
+ *               (of the whole frame: the crop keeps the pattern's phase),
+ *               bilinear demosaic: a missing colour is the rounded mean of
+ *               its 2 or 4 nearest samples of that colour; beyond the frame
+ *               the samples mirror (x = -1 reads x = 1). Rows just outside
+ *               the crop are read when the frame has them. Width, height >= 2.
+ *   RGB24, BGR24 packed 3 bytes per pixel.
+ * FUSE_ERR_ARGS: NULL, unknown format, width/height outside
+ * 1..FUSE_MAX_DIM, stride below the row's bytes, odd width for YUYV/UYVY,
+ * Bayer narrower or lower than 2. FUSE_ERR_SIZE: size below
+ * (height - 1) * stride + row bytes, a crop outside the frame, out of
+ * another width. Nothing is written unless FUSE_OK. */
+typedef enum fuse_format {
+    FUSE_FMT_YUYV = 1,
+    FUSE_FMT_UYVY,
+    FUSE_FMT_GREY,
+    FUSE_FMT_BAYER_RGGB,
+    FUSE_FMT_BAYER_GRBG,
+    FUSE_FMT_BAYER_GBRG,
+    FUSE_FMT_BAYER_BGGR,
+    FUSE_FMT_RGB24,
+    FUSE_FMT_BGR24
+} fuse_format;
+
+typedef struct fuse_frame {
+    const uint8_t *data;
+    size_t size;              /* bytes available at data */
+    int width, height;        /* pixels */
+    int stride;               /* bytes per row */
+    fuse_format format;
+} fuse_frame;
+
+/* Bytes of one row of width pixels in format f (0 for an unknown f). */
+int fuse_format_row_bytes(fuse_format f, int width);
+fuse_result fuse_frame_to_rgba(const fuse_frame *src, int y0, fuse_image *out);
+
+/* ---- depth test against the virtual scene ------------------------------
+ *
+ * Conventions (docs/fuse.md, "Depth"):
+ *   hand   window depth z in [0, 1] per pixel of the lit layer Q (camera
+ *          resolution), as the rasterizer writes it (rast_target.depth,
+ *          z = z_ndc/2 + 1/2 of an OpenGL-style projection with znear,
+ *          zfar, e.g. kin_mat4_perspective). z >= 1 (the clear value) or
+ *          not finite: no depth known, the hand pixel is kept.
+ *          Its metric distance along the view axis is
+ *            d = 2 zfar znear / ((zfar + znear) - (2z - 1)(zfar - znear))
+ *          and offset is added (metres: e.g. D = 0.085 when the scene's
+ *          distances are measured from the eye and the camera sits D in
+ *          front of it; 0 when both are from the camera).
+ *   scene  per pixel of V (output resolution): the virtual scene's metric
+ *          distance along the view axis, metres. 0, negative, inf or NaN:
+ *          nothing there (the hand is in front).
+ * A pixel (x, y) of Q compares with the scene pixel its centre falls on,
+ *   ox = vp_x0 + floor((2x + 1) vp_w / (2 Q.width)), the same for y,
+ * and is set to (0, 0, 0, 0) when scene < d + offset (strictly): the
+ * virtual object in front hides the hand; the hand in front shows. The
+ * test runs at camera resolution before the composite, so the bilinear
+ * resampling softens the occlusion edge like the mask's edge. Float, in
+ * the operation order above; pixels of Q that are 0 are not looked at. */
+typedef struct fuse_depth {
+    const float *hand;        /* Q's size, hand_stride floats per row */
+    int hand_stride;
+    float znear, zfar;        /* 0 < znear < zfar <= 1e7 */
+    float offset;             /* metres added to the hand's distance */
+    const float *scene;       /* V's size, scene_stride floats per row */
+    int scene_stride;
+    int scene_width, scene_height;   /* V's size */
+} fuse_depth;
+
+/* Hides the pixels of the layer Q (in place) that the virtual scene
+ * covers; vp_* is the composite's viewport in V. FUSE_ERR_ARGS: NULL,
+ * strides below the widths, near/far out of range, offset not finite or
+ * beyond +-FUSE_PARAM_MAX. FUSE_ERR_SIZE: viewport not inside the scene. */
+fuse_result fuse_depth_test(const fuse_depth *d, fuse_image *Q, int vp_x0,
+                            int vp_y0, int vp_w, int vp_h);
+
+/* ---- colour tone matching ----------------------------------------------
+ *
+ * Gray-world statistics: the mean colour of the camera image where the
+ * mask is 0 (the real room, whose light also falls on the hands) and the
+ * mean colour of V inside the viewport (the virtual scene's light). The
+ * tone that carries one into the other is
+ *   t_c = (mean_V_c + 1) / (mean_P_c + 1),  clamped to [1/4, 4],
+ *   tone_c = t_c ^ strength           (strength 0: 1, no change; 1: full)
+ * which matches white balance and brightness at once. Every 4th pixel of
+ * every 4th row is sampled (x, y multiples of 4 from the image's or the
+ * viewport's corner); sums are exact integers, the rest in double, so the
+ * result is the same on every machine. A scene of one strong colour
+ * (a blue sky) tints the hands: lower strength for such scenes. Put
+ * tone into fuse_lighting.tone. FUSE_ERR_ARGS: NULL, bad image or mask
+ * stride, strength outside [0, 1]. FUSE_ERR_SIZE: viewport not in V. */
+fuse_result fuse_tone_match(const fuse_image *P, const uint8_t *mask,
+                            int mask_stride, const fuse_image *V, int vp_x0,
+                            int vp_y0, int vp_w, int vp_h, float strength,
+                            float tone[3]);
+
+/* ---- contexts: ISA choice and threads ---------------------------------
+ *
+ * fuse_light and fuse_composite above run on the calling thread with the
+ * best ISA that ef_isa_choose(EF_ISA_DEFAULT) allows (cpuid capped by
+ * EGOFUSE_ISA). A context lets the caller cap the ISA and use several
+ * threads. Every ISA and every thread count gives the same bytes as the
+ * scalar reference (EF_ISA_REF), which defines them (docs/fuse.md).
+ *
+ *   fuse_context_desc d = {0};
+ *   d.max_isa = EF_ISA_DEFAULT;   // or EF_ISA_REF .. EF_ISA_AVX512
+ *   d.threads = 2;
+ *   fuse_context *ctx = fuse_context_create(&d);
+ *   printf("fuse: %s\n", ef_isa_name(fuse_context_isa(ctx)));
+ *   fuse_eye eyes[2] = {...};
+ *   fuse_context_frame(ctx, eyes, 2);        // both eyes, every stage
+ *   fuse_context_destroy(ctx);
+ *
+ * fuse_context_create allocates the context and starts threads - 1 worker
+ * threads; the calls below allocate nothing. A context runs one call at a
+ * time (calls on one context from several threads must be serialised);
+ * different contexts are independent. */
+#define FUSE_MAX_THREADS 16
+
+typedef struct fuse_context fuse_context;
+
+typedef struct fuse_context_desc {
+    ef_isa max_isa;   /* cap: EF_ISA_DEFAULT (0) = the best the CPU has; */
+                      /* EGOFUSE_ISA caps further (ef_isa_choose)        */
+    int threads;      /* 0 or 1: the calling thread only; at most        */
+                      /* FUSE_MAX_THREADS (larger values are clamped)    */
+} fuse_context_desc;
+
+/* NULL desc = defaults. Returns NULL if out of memory or a thread could
+ * not start. */
+fuse_context *fuse_context_create(const fuse_context_desc *desc);
+/* Stops the workers and frees ctx (NULL is a no-op). */
+void fuse_context_destroy(fuse_context *ctx);
+/* The ISA in use (ref, sse2, avx2, avx512) and the thread count. */
+ef_isa fuse_context_isa(const fuse_context *ctx);
+int fuse_context_threads(const fuse_context *ctx);
+
+/* fuse_light and fuse_composite on ctx's ISA and threads (row bands).
+ * Same arguments, checks, errors and bytes; ctx NULL -> FUSE_ERR_ARGS. */
+fuse_result fuse_context_light(fuse_context *ctx, const fuse_lighting *L,
+                               const fuse_intrinsics *K, const fuse_image *P,
+                               const uint8_t *mask, int mask_stride,
+                               const float *normal, int normal_stride,
+                               fuse_image *out);
+fuse_result fuse_context_composite(fuse_context *ctx, const fuse_image *Q,
+                                   const fuse_image *V, int vp_x0, int vp_y0,
+                                   int vp_w, int vp_h, fuse_image *out);
+
+/* One eye of a stereo frame for fuse_context_frame: light P into Q (the
+ * caller's scratch layer, P's size), optionally hide what the virtual
+ * scene covers (depth, NULL: no depth test), composite Q into the viewport
+ * of V giving out (out may be V). Each field as in the calls above. */
+typedef struct fuse_eye {
+    const fuse_lighting *lighting;
+    const fuse_intrinsics *intrinsics;
+    fuse_image P;
+    const uint8_t *mask;
+    int mask_stride;
+    const float *normal;
+    int normal_stride;
+    fuse_image Q;
+    const fuse_depth *depth;
+    fuse_image V;
+    int vp_x0, vp_y0, vp_w, vp_h;
+    fuse_image out;
+} fuse_eye;
+
+/* Every stage of count eyes (1..FUSE_MAX_THREADS) on ctx's threads: with
+ * as many threads as eyes (or a multiple), each thread takes whole eyes;
+ * otherwise every stage is split into row bands. All eyes are checked
+ * before any is written; on an error nothing is written. */
+fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int count);
 
 /* A static English message for r (never NULL). */
 const char *fuse_result_str(fuse_result r);

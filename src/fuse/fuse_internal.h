@@ -203,6 +203,12 @@ fuse_result fuse__light_prepare(const fuse_lighting *L,
 void fuse__light_row_ref(const fuse__light_prep *p, int y, int width,
                          const uint8_t *P, const uint8_t *mask,
                          const float *normal, uint8_t *out);
+/* The same for pixels x0 <= x < x1 of the row only (P, mask, normal and
+ * out still point at the row's pixel 0). The SIMD paths finish their
+ * rows with it. */
+void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
+                          const uint8_t *P, const uint8_t *mask,
+                          const float *normal, uint8_t *out);
 
 /* Resamples and composites one output row inside the viewport: q0/q1 are
  * the two source rows (already chosen and clamped), fy the 8-bit row
@@ -212,5 +218,118 @@ void fuse__light_row_ref(const fuse__light_prep *p, int y, int width,
 void fuse__composite_row_ref(const uint8_t *q0, const uint8_t *q1,
                              uint32_t fy, fuse__axis ax, int sw,
                              const uint8_t *v, uint8_t *out, int vw);
+
+/* ---- table-driven composite (the SIMD paths) ------------------------- */
+
+/* Columns per tile of the column table: a viewport wider than this is done
+ * in column tiles (the bytes do not depend on the tiling). */
+#define FUSE__TILE 2048
+
+/* The column walk of fuse__axis written out for n columns: ix = pos >> 16,
+ * fx = (pos >> 8) & 255 of columns c0 .. c0 + n - 1. */
+typedef struct fuse__cols {
+    int32_t ix[FUSE__TILE];
+    int32_t fx[FUSE__TILE];
+} fuse__cols;
+
+/* Fills cols for viewport columns [c0, c0 + n), n <= FUSE__TILE. */
+static inline void fuse__cols_fill(fuse__cols *cols, int sw, int vw, int c0, int n)
+{
+    fuse__axis ax;
+    int64_t num;
+    int i;
+    fuse__axis_init(&ax, sw, vw);
+    /* start the walk at column c0: q = floor(((2 c0 + 1) sw - vw) 65536 / (2 vw)) */
+    num = (((int64_t)2 * c0 + 1) * sw - vw) * 65536;
+    ax.q = num / ax.den;
+    ax.r = num % ax.den;
+    if (ax.r < 0) { ax.r += ax.den; ax.q -= 1; }
+    for (i = 0; i < n; i++, fuse__axis_next(&ax)) {
+        const int32_t p = fuse__axis_pos(&ax);
+        cols->ix[i] = p >> 16;
+        cols->fx[i] = (int32_t)(((uint32_t)p >> 8) & 255u);
+    }
+}
+
+/* One output pixel of fuse__composite_row_ref from the table: the same
+ * bytes (the all-zero shortcut gives what the formula gives). */
+static inline void fuse__composite_px(const uint8_t *q0, const uint8_t *q1,
+                                      uint32_t fy, int ix, uint32_t fx, int sw,
+                                      const uint8_t *v, uint8_t *out)
+{
+    const int ix1 = ix + 1 < sw ? ix + 1 : sw - 1;
+    const uint8_t *a = q0 + 4 * ix, *b = q0 + 4 * ix1;
+    const uint8_t *c = q1 + 4 * ix, *d = q1 + 4 * ix1;
+    const uint32_t inv = 255u - fuse__bilerp8(a[3], b[3], c[3], d[3], fx, fy);
+    int k;
+    for (k = 0; k < 3; k++) {
+        uint32_t r = fuse__bilerp8(a[k], b[k], c[k], d[k], fx, fy) +
+                     FUSE__DIV255(inv * v[k]);
+        out[k] = (uint8_t)(r < 255u ? r : 255u);
+    }
+    out[3] = 255;
+}
+
+/* Composites n output pixels of one row from the table (columns c .. c+n-1
+ * of cols, i.e. cols->ix[c..]); v and out point at the first of them. */
+typedef void (*fuse__composite_fn)(const uint8_t *q0, const uint8_t *q1,
+                                   uint32_t fy, const fuse__cols *cols, int c,
+                                   int n, int sw, const uint8_t *v,
+                                   uint8_t *out);
+typedef void (*fuse__light_fn)(const fuse__light_prep *p, int y, int width,
+                               const uint8_t *P, const uint8_t *mask,
+                               const float *normal, uint8_t *out);
+
+void fuse__composite_cols_ref(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
+                              const fuse__cols *cols, int c, int n, int sw,
+                              const uint8_t *v, uint8_t *out);
+
+/* The ISA paths (fuse_sse2.c, fuse_avx2.c, fuse_avx512.c). Each gives the
+ * bytes of the reference kernels. */
+void fuse__light_row_sse2(const fuse__light_prep *p, int y, int width,
+                          const uint8_t *P, const uint8_t *mask,
+                          const float *normal, uint8_t *out);
+void fuse__light_row_avx2(const fuse__light_prep *p, int y, int width,
+                          const uint8_t *P, const uint8_t *mask,
+                          const float *normal, uint8_t *out);
+void fuse__light_row_avx512(const fuse__light_prep *p, int y, int width,
+                            const uint8_t *P, const uint8_t *mask,
+                            const float *normal, uint8_t *out);
+void fuse__composite_cols_sse2(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
+                               const fuse__cols *cols, int c, int n, int sw,
+                               const uint8_t *v, uint8_t *out);
+void fuse__composite_cols_avx2(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
+                               const fuse__cols *cols, int c, int n, int sw,
+                               const uint8_t *v, uint8_t *out);
+void fuse__composite_cols_avx512(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
+                                 const fuse__cols *cols, int c, int n, int sw,
+                                 const uint8_t *v, uint8_t *out);
+
+/* fuse__pow01 of the ISA paths over an array (for the tests):
+ * out[i] = pow01(x[i], s) computed in that path's lanes. */
+void fuse__pow01_row_sse2(const float *x, int n, float s, float *out);
+void fuse__pow01_row_avx2(const float *x, int n, float s, float *out);
+void fuse__pow01_row_avx512(const float *x, int n, float s, float *out);
+
+/* The depth test's checks and its rows [y0, y1) (fuse_depth.c). */
+fuse_result fuse__depth_check(const fuse_depth *d, const fuse_image *Q, int vp_x0,
+                              int vp_y0, int vp_w, int vp_h);
+void fuse__depth_rows(const fuse_depth *d, const fuse_image *Q, int vp_x0,
+                      int vp_y0, int vp_w, int vp_h, int y0, int y1);
+
+/* ---- validation shared by the drivers (fuse_ref.c) ------------------- */
+
+int fuse__image_ok(const fuse_image *im);
+int fuse__overlap(const fuse_image *a, const fuse_image *b);
+int fuse__same_image(const fuse_image *a, const fuse_image *b);
+/* Checks of fuse_light / fuse_composite (fuse.h ERRORS), prep filled. */
+fuse_result fuse__light_check(const fuse_lighting *L, const fuse_intrinsics *K,
+                              const fuse_image *P, const uint8_t *mask,
+                              int mask_stride, const float *normal,
+                              int normal_stride, const fuse_image *out,
+                              fuse__light_prep *prep);
+fuse_result fuse__composite_check(const fuse_image *Q, const fuse_image *V,
+                                  int vp_x0, int vp_y0, int vp_w, int vp_h,
+                                  const fuse_image *out);
 
 #endif

@@ -14,7 +14,7 @@
 
 static int in_range(float v, float lo, float hi) { return v >= lo && v <= hi; }  /* NaN -> 0 */
 
-static int image_ok(const fuse_image *im)
+int fuse__image_ok(const fuse_image *im)
 {
     return im->pixels != NULL && im->width >= 1 && im->height >= 1 &&
            im->width <= FUSE_MAX_DIM && im->height <= FUSE_MAX_DIM &&
@@ -27,7 +27,7 @@ static size_t image_extent(const fuse_image *im)
     return (size_t)(im->height - 1) * (size_t)im->stride + 4u * (size_t)im->width;
 }
 
-static int overlap(const fuse_image *a, const fuse_image *b)
+int fuse__overlap(const fuse_image *a, const fuse_image *b)
 {
     uintptr_t a0 = (uintptr_t)a->pixels, a1 = a0 + image_extent(a);
     uintptr_t b0 = (uintptr_t)b->pixels, b1 = b0 + image_extent(b);
@@ -35,7 +35,7 @@ static int overlap(const fuse_image *a, const fuse_image *b)
 }
 
 /* Same memory, same layout: processing pixel by pixel is safe in place. */
-static int same_image(const fuse_image *a, const fuse_image *b)
+int fuse__same_image(const fuse_image *a, const fuse_image *b)
 {
     return a->pixels == b->pixels && a->stride == b->stride &&
            a->width == b->width && a->height == b->height;
@@ -135,10 +135,20 @@ void fuse__light_row_ref(const fuse__light_prep *p, int y, int width,
                          const uint8_t *P, const uint8_t *mask,
                          const float *normal, uint8_t *out)
 {
+    fuse__light_span_ref(p, y, 0, width, P, mask, normal, out);
+}
+
+void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
+                          const uint8_t *P, const uint8_t *mask,
+                          const float *normal, uint8_t *out)
+{
     /* View ray of the row; the image's y axis points down, view y up. */
     const float py = (((float)y + 0.5f) - p->cy) * p->ify;
     int x, i, c;
-    for (x = 0; x < width; x++, P += 4, normal += 3, out += 4) {
+    P += 4 * (size_t)x0;
+    normal += 3 * (size_t)x0;
+    out += 4 * (size_t)x0;
+    for (x = x0; x < x1; x++, P += 4, normal += 3, out += 4) {
         const unsigned M = mask[x];
         float px, il, vx, vy, vz, nx, ny, nz, nn, ndv, t, fade, mp;
         float C[3];
@@ -197,31 +207,25 @@ void fuse__light_row_ref(const fuse__light_prep *p, int y, int width,
     }
 }
 
-fuse_result fuse_light(const fuse_lighting *L, const fuse_intrinsics *K,
-                       const fuse_image *P, const uint8_t *mask,
-                       int mask_stride, const float *normal,
-                       int normal_stride, fuse_image *out)
+fuse_result fuse__light_check(const fuse_lighting *L, const fuse_intrinsics *K,
+                              const fuse_image *P, const uint8_t *mask,
+                              int mask_stride, const float *normal,
+                              int normal_stride, const fuse_image *out,
+                              fuse__light_prep *prep)
 {
-    fuse__light_prep prep;
     fuse_result r;
-    int y;
     if (L == NULL || K == NULL || P == NULL || mask == NULL ||
         normal == NULL || out == NULL)
         return FUSE_ERR_ARGS;
-    if (!image_ok(P) || !image_ok(out) || mask_stride < P->width ||
+    if (!fuse__image_ok(P) || !fuse__image_ok(out) || mask_stride < P->width ||
         normal_stride < 3 * P->width)
         return FUSE_ERR_ARGS;
-    r = fuse__light_prepare(L, K, &prep);
+    r = fuse__light_prepare(L, K, prep);
     if (r != FUSE_OK) return r;
     if (out->width != P->width || out->height != P->height)
         return FUSE_ERR_SIZE;
-    if (overlap(P, out) && !same_image(P, out))
+    if (fuse__overlap(P, out) && !fuse__same_image(P, out))
         return FUSE_ERR_ARGS;
-    for (y = 0; y < P->height; y++)
-        fuse__light_row_ref(&prep, y, P->width, row_ptr(P, y),
-                            mask + (size_t)y * (size_t)mask_stride,
-                            normal + (size_t)y * (size_t)normal_stride,
-                            row_ptr(out, y));
     return FUSE_OK;
 }
 
@@ -262,51 +266,30 @@ void fuse__composite_row_ref(const uint8_t *q0, const uint8_t *q1,
     }
 }
 
-fuse_result fuse_composite(const fuse_image *Q, const fuse_image *V,
-                           int vp_x0, int vp_y0, int vp_w, int vp_h,
-                           fuse_image *out)
+void fuse__composite_cols_ref(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
+                              const fuse__cols *cols, int c, int n, int sw,
+                              const uint8_t *v, uint8_t *out)
 {
-    fuse__axis ax, ay;
-    int in_place, y;
-    size_t row_bytes;
+    int i;
+    for (i = 0; i < n; i++)
+        fuse__composite_px(q0, q1, fy, cols->ix[c + i], (uint32_t)cols->fx[c + i],
+                           sw, v + 4 * i, out + 4 * i);
+}
+
+fuse_result fuse__composite_check(const fuse_image *Q, const fuse_image *V,
+                                  int vp_x0, int vp_y0, int vp_w, int vp_h,
+                                  const fuse_image *out)
+{
     if (Q == NULL || V == NULL || out == NULL)
         return FUSE_ERR_ARGS;
-    if (!image_ok(Q) || !image_ok(V) || !image_ok(out) || vp_w < 1 || vp_h < 1)
+    if (!fuse__image_ok(Q) || !fuse__image_ok(V) || !fuse__image_ok(out) || vp_w < 1 || vp_h < 1)
         return FUSE_ERR_ARGS;
     if (out->width != V->width || out->height != V->height ||
         vp_x0 < 0 || vp_y0 < 0 || vp_x0 > V->width - vp_w ||
         vp_y0 > V->height - vp_h)
         return FUSE_ERR_SIZE;
-    in_place = same_image(out, V);
-    if ((!in_place && overlap(out, V)) || overlap(out, Q))
+    if ((!fuse__same_image(out, V) && fuse__overlap(out, V)) || fuse__overlap(out, Q))
         return FUSE_ERR_ARGS;
-
-    row_bytes = 4u * (size_t)V->width;
-    fuse__axis_init(&ax, Q->width, vp_w);
-    fuse__axis_init(&ay, Q->height, vp_h);
-    for (y = 0; y < V->height; y++) {
-        const uint8_t *vrow = row_ptr(V, y);
-        uint8_t *orow = row_ptr(out, y);
-        int32_t pos;
-        int iy, iy1;
-        if (y < vp_y0 || y >= vp_y0 + vp_h) {
-            if (!in_place) memcpy(orow, vrow, row_bytes);
-            continue;
-        }
-        if (!in_place) {
-            memcpy(orow, vrow, 4u * (size_t)vp_x0);
-            memcpy(orow + 4 * (size_t)(vp_x0 + vp_w), vrow + 4 * (size_t)(vp_x0 + vp_w),
-                   4u * (size_t)(V->width - vp_x0 - vp_w));
-        }
-        pos = fuse__axis_pos(&ay);
-        iy = pos >> 16;
-        iy1 = iy + 1 < Q->height ? iy + 1 : Q->height - 1;
-        fuse__composite_row_ref(row_ptr(Q, iy), row_ptr(Q, iy1),
-                                ((uint32_t)pos >> 8) & 255u, ax, Q->width,
-                                vrow + 4 * (size_t)vp_x0,
-                                orow + 4 * (size_t)vp_x0, vp_w);
-        fuse__axis_next(&ay);
-    }
     return FUSE_OK;
 }
 
@@ -318,7 +301,7 @@ fuse_result fuse_rgb24_to_rgba(const uint8_t *rgb, int stride, int width,
     int x, y;
     if (rgb == NULL || out == NULL || width < 1 || height < 1 ||
         width > FUSE_MAX_DIM || height > FUSE_MAX_DIM || stride < 3 * width ||
-        !image_ok(out))
+        !fuse__image_ok(out))
         return FUSE_ERR_ARGS;
     if (out->width != width || out->height != height)
         return FUSE_ERR_SIZE;

@@ -1,0 +1,192 @@
+/* fuse_avx512.c - AVX-512 (F, BW, DQ, VL) path of the fuse kernels, built
+ * with the flags of *_avx512.c and called only when cpuid reports them.
+ * The bytes are the reference's (docs/fuse.md, "Rounding rules");
+ * tests/test_fuse_isa.c checks it.
+ * Lighting: 16 pixels per vector (fuse_body.inl), lane masks in k
+ * registers. Composite: 16 output pixels per step from a window of 16
+ * source pixels per row (vpermd) when it holds every tap, else vpgatherdd;
+ * blend and over in 16-bit lanes as in fuse_avx2.c. */
+#include "fuse_internal.h"
+
+#if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512DQ__)
+#include <immintrin.h>
+
+#define LANES 16
+#define VF __m512
+#define VI __m512i
+#define VM __mmask16
+#define F1(c) _mm512_set1_ps(c)
+#define I1(c) _mm512_set1_epi32(c)
+#define FADD(a, b) _mm512_add_ps(a, b)
+#define FSUB(a, b) _mm512_sub_ps(a, b)
+#define FMUL(a, b) _mm512_mul_ps(a, b)
+#define FDIV(a, b) _mm512_div_ps(a, b)
+#define FSQRT(a) _mm512_sqrt_ps(a)
+#define FNEG(a) _mm512_xor_ps(a, _mm512_set1_ps(-0.0f))
+#define FMAX0(a) _mm512_max_ps(a, _mm512_setzero_ps())
+#define FMIN1(a) _mm512_min_ps(a, _mm512_set1_ps(1.0f))
+#define FGT(a, b) _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ)
+#define FGE(a, b) _mm512_cmp_ps_mask(a, b, _CMP_GE_OQ)
+#define FLT(a, b) _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ)
+#define MAND(a, b) ((__mmask16)((a) & (b)))
+#define FSEL(m, a, b) _mm512_mask_blend_ps(m, b, a)
+#define FZERO_UNLESS(m, a) _mm512_maskz_mov_ps(m, a)
+#define FFLOOR(a) _mm512_roundscale_ps(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)
+#define I2F(i) _mm512_cvtepi32_ps(i)
+#define F2I_TRUNC(f) _mm512_cvttps_epi32(f)
+#define FBITS(f) _mm512_castps_si512(f)
+#define IBITS(i) _mm512_castsi512_ps(i)
+#define IADD(a, b) _mm512_add_epi32(a, b)
+#define ISUB(a, b) _mm512_sub_epi32(a, b)
+#define IAND(a, b) _mm512_and_si512(a, b)
+#define IOR(a, b) _mm512_or_si512(a, b)
+#define ISRL(a, k) _mm512_srli_epi32(a, k)
+#define ISLL(a, k) _mm512_slli_epi32(a, k)
+#define LANE_INDEX _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
+#define MASK_ZERO(p) mask_zero16(p)
+#define LOAD_MASK(p) _mm512_cvtepu8_epi32(_mm_loadu_si128((const __m128i *)(const void *)(p)))
+#define LOAD_RGBA(p) _mm512_loadu_si512((const void *)(p))
+#define LOAD_NORMALS(p, x, y, z) load_normals(p, &(x), &(y), &(z))
+#define STORE_RGBA(p, v) _mm512_storeu_si512((void *)(p), v)
+#define STORE_ZERO(p) _mm512_storeu_si512((void *)(p), _mm512_setzero_si512())
+#define IZERO_IF_EQ0(m, v) _mm512_maskz_mov_epi32(_mm512_test_epi32_mask(m, m), v)
+#define LIGHT_ROW_NAME fuse__light_row_avx512
+#define POW_ROW_NAME fuse__pow01_row_avx512
+#define LOADF(p) _mm512_loadu_ps(p)
+#define STOREF(p, v) _mm512_storeu_ps(p, v)
+
+static inline int mask_zero16(const uint8_t *p)
+{
+    uint64_t a, b;
+    memcpy(&a, p, 8);
+    memcpy(&b, p + 8, 8);
+    return (a | b) == 0;
+}
+
+/* 16 interleaved xyz normals -> x, y, z: element k of component c is at
+ * g = 3k + c; two vpermt2ps pick g < 32 from the first two loads, then the
+ * rest from the third. */
+static inline void load_normals(const float *p, __m512 *x, __m512 *y, __m512 *z)
+{
+    const __m512 m0 = _mm512_loadu_ps(p), m1 = _mm512_loadu_ps(p + 16),
+                 m2 = _mm512_loadu_ps(p + 32);
+    const __m512i x1 = _mm512_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 0, 0, 0, 0, 0);
+    const __m512i x2 = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 17, 20, 23, 26, 29);
+    const __m512i y1 = _mm512_setr_epi32(1, 4, 7, 10, 13, 16, 19, 22, 25, 28, 31, 0, 0, 0, 0, 0);
+    const __m512i y2 = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 18, 21, 24, 27, 30);
+    const __m512i z1 = _mm512_setr_epi32(2, 5, 8, 11, 14, 17, 20, 23, 26, 29, 0, 0, 0, 0, 0, 0);
+    const __m512i z2 = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 16, 19, 22, 25, 28, 31);
+    *x = _mm512_permutex2var_ps(_mm512_permutex2var_ps(m0, x1, m1), x2, m2);
+    *y = _mm512_permutex2var_ps(_mm512_permutex2var_ps(m0, y1, m1), y2, m2);
+    *z = _mm512_permutex2var_ps(_mm512_permutex2var_ps(m0, z1, m1), z2, m2);
+}
+
+#include "fuse_body.inl"
+
+/* ---- composite (see blend16 in fuse_avx2.c for the exactness) ---------- */
+
+static inline __m512i blend16(__m512i a, __m512i b, __m512i c, __m512i d, __m512i v,
+                              __m512i wx0, __m512i wx1, __m512i wy0, __m512i wy1)
+{
+    const __m512i lo8 = _mm512_set1_epi16(255);
+    const __m512i col0 = _mm512_add_epi16(_mm512_mullo_epi16(a, wy0), _mm512_mullo_epi16(c, wy1));
+    const __m512i col1 = _mm512_add_epi16(_mm512_mullo_epi16(b, wy0), _mm512_mullo_epi16(d, wy1));
+    const __m512i H = _mm512_add_epi16(_mm512_mullo_epi16(_mm512_srli_epi16(col0, 8), wx0),
+                                       _mm512_mullo_epi16(_mm512_srli_epi16(col1, 8), wx1));
+    const __m512i L = _mm512_add_epi16(_mm512_mullo_epi16(_mm512_and_si512(col0, lo8), wx0),
+                                       _mm512_mullo_epi16(_mm512_and_si512(col1, lo8), wx1));
+    const __m512i q = _mm512_srli_epi16(
+        _mm512_add_epi16(_mm512_add_epi16(H, _mm512_srli_epi16(L, 8)), _mm512_set1_epi16(128)), 8);
+    const __m512i qa = _mm512_shufflehi_epi16(_mm512_shufflelo_epi16(q, 0xFF), 0xFF);
+    __m512i t = _mm512_mullo_epi16(_mm512_sub_epi16(lo8, qa), v);
+    t = _mm512_add_epi16(t, _mm512_set1_epi16(128));
+    t = _mm512_srli_epi16(_mm512_add_epi16(t, _mm512_srli_epi16(t, 8)), 8);
+    return _mm512_add_epi16(q, t);
+}
+
+static inline __m512i blend_px(__m512i a, __m512i b, __m512i c, __m512i d, __m512i v,
+                               __m512i fx, __m512i wy0, __m512i wy1)
+{
+    const __m512i z = _mm512_setzero_si512();
+    const __m512i plo = _mm512_set4_epi32((int)0x80048004u, (int)0x80048004u,
+                                          (int)0x80008000u, (int)0x80008000u);
+    const __m512i phi = _mm512_set4_epi32((int)0x800C800Cu, (int)0x800C800Cu,
+                                          (int)0x80088008u, (int)0x80088008u);
+    const __m512i w256 = _mm512_set1_epi16(256);
+    const __m512i fl = _mm512_shuffle_epi8(fx, plo), fh = _mm512_shuffle_epi8(fx, phi);
+    const __m512i rl = blend16(_mm512_unpacklo_epi8(a, z), _mm512_unpacklo_epi8(b, z),
+                               _mm512_unpacklo_epi8(c, z), _mm512_unpacklo_epi8(d, z),
+                               _mm512_unpacklo_epi8(v, z), _mm512_sub_epi16(w256, fl), fl, wy0, wy1);
+    const __m512i rh = blend16(_mm512_unpackhi_epi8(a, z), _mm512_unpackhi_epi8(b, z),
+                               _mm512_unpackhi_epi8(c, z), _mm512_unpackhi_epi8(d, z),
+                               _mm512_unpackhi_epi8(v, z), _mm512_sub_epi16(w256, fh), fh, wy0, wy1);
+    return _mm512_or_si512(_mm512_packus_epi16(rl, rh), _mm512_set1_epi32((int)0xFF000000u));
+}
+
+void fuse__composite_cols_avx512(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
+                                 const fuse__cols *cols, int c, int n, int sw,
+                                 const uint8_t *v, uint8_t *out)
+{
+    const __m512i wy0 = _mm512_set1_epi16((short)(256 - fy)), wy1 = _mm512_set1_epi16((short)fy);
+    const __m512i one = _mm512_set1_epi32(1), last = _mm512_set1_epi32(sw - 1);
+    const __m512i opaque = _mm512_set1_epi32((int)0xFF000000u);
+    const int32_t *ixs = cols->ix + c, *fxs = cols->fx + c;
+    int i = 0;
+    for (; i + 16 <= n; i += 16) {
+        const __m512i ix = _mm512_loadu_si512((const void *)(ixs + i));
+        const __m512i ix1 = _mm512_min_epi32(_mm512_add_epi32(ix, one), last);
+        const __m512i vv = _mm512_loadu_si512((const void *)(v + 4 * i));
+        __m512i a, b, cc, d;
+        int base = ixs[i];
+        const int hi = ixs[i + 15] + 1 < sw ? ixs[i + 15] + 1 : sw - 1;
+        if (base > sw - 16) base = sw - 16;
+        if (base >= 0 && hi - base < 16) {
+            const __m512i s0 = _mm512_loadu_si512((const void *)(q0 + 4 * base));
+            const __m512i s1 = _mm512_loadu_si512((const void *)(q1 + 4 * base));
+            const __m512i bb = _mm512_set1_epi32(base);
+            const __m512i r0 = _mm512_sub_epi32(ix, bb), r1 = _mm512_sub_epi32(ix1, bb);
+            const __m512i any = _mm512_or_si512(s0, s1);
+            if (_mm512_test_epi32_mask(any, any) == 0) {
+                /* every tap 0: R = V, alpha 255 */
+                _mm512_storeu_si512((void *)(out + 4 * i), _mm512_or_si512(vv, opaque));
+                continue;
+            }
+            a = _mm512_permutexvar_epi32(r0, s0);
+            b = _mm512_permutexvar_epi32(r1, s0);
+            cc = _mm512_permutexvar_epi32(r0, s1);
+            d = _mm512_permutexvar_epi32(r1, s1);
+        } else {
+            a = _mm512_i32gather_epi32(ix, (const void *)q0, 4);
+            b = _mm512_i32gather_epi32(ix1, (const void *)q0, 4);
+            cc = _mm512_i32gather_epi32(ix, (const void *)q1, 4);
+            d = _mm512_i32gather_epi32(ix1, (const void *)q1, 4);
+        }
+        _mm512_storeu_si512((void *)(out + 4 * i),
+                            blend_px(a, b, cc, d, vv, _mm512_loadu_si512((const void *)(fxs + i)),
+                                     wy0, wy1));
+    }
+    for (; i < n; i++)
+        fuse__composite_px(q0, q1, fy, ixs[i], (uint32_t)fxs[i], sw, v + 4 * i, out + 4 * i);
+}
+
+#else  /* not built for AVX-512: never chosen by cpuid, falls back */
+
+void fuse__light_row_avx512(const fuse__light_prep *p, int y, int width,
+                            const uint8_t *P, const uint8_t *mask,
+                            const float *normal, uint8_t *out)
+{
+    fuse__light_row_ref(p, y, width, P, mask, normal, out);
+}
+
+void fuse__composite_cols_avx512(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
+                                 const fuse__cols *cols, int c, int n, int sw,
+                                 const uint8_t *v, uint8_t *out)
+{
+    fuse__composite_cols_ref(q0, q1, fy, cols, c, n, sw, v, out);
+}
+void fuse__pow01_row_avx512(const float *x, int n, float s, float *out)
+{
+    int i;
+    for (i = 0; i < n; i++) out[i] = fuse__pow01(x[i], s);
+}
+#endif

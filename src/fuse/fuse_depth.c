@@ -1,0 +1,108 @@
+/* fuse_depth.c - the depth test of the lit layer against the virtual
+ * scene's depth, and gray-world colour tone matching. Conventions in
+ * fuse.h and docs/fuse.md ("Depth", "Tone matching"). */
+#include "fuse_internal.h"
+
+#include <math.h>
+#include <stddef.h>
+
+static int finite_in(float v, float lo, float hi) { return v >= lo && v <= hi; }   /* NaN -> 0 */
+
+fuse_result fuse__depth_check(const fuse_depth *d, const fuse_image *Q, int vp_x0,
+                              int vp_y0, int vp_w, int vp_h)
+{
+    if (d == NULL || Q == NULL || d->hand == NULL || d->scene == NULL ||
+        !fuse__image_ok(Q))
+        return FUSE_ERR_ARGS;
+    if (d->hand_stride < Q->width || d->scene_width < 1 || d->scene_height < 1 ||
+        d->scene_width > FUSE_MAX_DIM || d->scene_height > FUSE_MAX_DIM ||
+        d->scene_stride < d->scene_width || vp_w < 1 || vp_h < 1)
+        return FUSE_ERR_ARGS;
+    if (!finite_in(d->znear, 1.0e-7f, 1.0e7f) || !finite_in(d->zfar, 1.0e-7f, 1.0e7f) ||
+        !(d->zfar > d->znear) || !finite_in(d->offset, -FUSE_PARAM_MAX, FUSE_PARAM_MAX))
+        return FUSE_ERR_ARGS;
+    if (vp_x0 < 0 || vp_y0 < 0 || vp_x0 > d->scene_width - vp_w ||
+        vp_y0 > d->scene_height - vp_h)
+        return FUSE_ERR_SIZE;
+    return FUSE_OK;
+}
+
+void fuse__depth_rows(const fuse_depth *d, const fuse_image *Q, int vp_x0,
+                      int vp_y0, int vp_w, int vp_h, int y0, int y1)
+{
+    const float two_fn = (2.0f * d->zfar) * d->znear;
+    const float fpn = d->zfar + d->znear, fmn = d->zfar - d->znear;
+    const int sw = Q->width, sh = Q->height;
+    int x, y;
+    for (y = y0; y < y1; y++) {
+        const int oy = vp_y0 + (int)(((int64_t)2 * y + 1) * vp_h / (2 * (int64_t)sh));
+        const float *hz = d->hand + (size_t)y * (size_t)d->hand_stride;
+        const float *sc = d->scene + (size_t)oy * (size_t)d->scene_stride;
+        uint8_t *q = Q->pixels + (size_t)y * (size_t)Q->stride;
+        for (x = 0; x < sw; x++, q += 4) {
+            uint32_t w;
+            float z, dist, s;
+            memcpy(&w, q, 4);
+            if (w == 0) continue;
+            z = hz[x];
+            if (!(z >= 0.0f && z < 1.0f)) continue;          /* no depth: keep */
+            dist = two_fn / (fpn - ((2.0f * z) - 1.0f) * fmn) + d->offset;
+            s = sc[vp_x0 + (int)(((int64_t)2 * x + 1) * vp_w / (2 * (int64_t)sw))];
+            if (s > 0.0f && s < dist) memset(q, 0, 4);       /* scene in front */
+        }
+    }
+}
+
+fuse_result fuse_depth_test(const fuse_depth *d, fuse_image *Q, int vp_x0,
+                            int vp_y0, int vp_w, int vp_h)
+{
+    fuse_result r = fuse__depth_check(d, Q, vp_x0, vp_y0, vp_w, vp_h);
+    if (r != FUSE_OK) return r;
+    fuse__depth_rows(d, Q, vp_x0, vp_y0, vp_w, vp_h, 0, Q->height);
+    return FUSE_OK;
+}
+
+/* ---- tone matching ----------------------------------------------------- */
+
+#define TONE_STEP 4
+
+fuse_result fuse_tone_match(const fuse_image *P, const uint8_t *mask,
+                            int mask_stride, const fuse_image *V, int vp_x0,
+                            int vp_y0, int vp_w, int vp_h, float strength,
+                            float tone[3])
+{
+    uint64_t sp[3] = { 0, 0, 0 }, sv[3] = { 0, 0, 0 }, np = 0, nv = 0;
+    int x, y, c;
+    if (P == NULL || mask == NULL || V == NULL || tone == NULL ||
+        !fuse__image_ok(P) || !fuse__image_ok(V) || mask_stride < P->width ||
+        !(strength >= 0.0f && strength <= 1.0f) || vp_w < 1 || vp_h < 1)
+        return FUSE_ERR_ARGS;
+    if (vp_x0 < 0 || vp_y0 < 0 || vp_x0 > V->width - vp_w || vp_y0 > V->height - vp_h)
+        return FUSE_ERR_SIZE;
+    for (y = 0; y < P->height; y += TONE_STEP) {
+        const uint8_t *p = P->pixels + (size_t)y * (size_t)P->stride;
+        const uint8_t *m = mask + (size_t)y * (size_t)mask_stride;
+        for (x = 0; x < P->width; x += TONE_STEP)
+            if (m[x] == 0) {
+                for (c = 0; c < 3; c++) sp[c] += p[4 * x + c];
+                np++;
+            }
+    }
+    for (y = vp_y0; y < vp_y0 + vp_h; y += TONE_STEP) {
+        const uint8_t *v = V->pixels + (size_t)y * (size_t)V->stride;
+        for (x = vp_x0; x < vp_x0 + vp_w; x += TONE_STEP) {
+            for (c = 0; c < 3; c++) sv[c] += v[4 * x + c];
+            nv++;
+        }
+    }
+    for (c = 0; c < 3; c++) {
+        double t = 1.0;
+        if (np > 0) {   /* nv > 0 always: the viewport is not empty */
+            t = ((double)sv[c] / (double)nv + 1.0) / ((double)sp[c] / (double)np + 1.0);
+            if (t < 0.25) t = 0.25;
+            if (t > 4.0) t = 4.0;
+        }
+        tone[c] = (float)pow(t, (double)strength);
+    }
+    return FUSE_OK;
+}

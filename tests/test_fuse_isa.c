@@ -1,0 +1,535 @@
+/* test_fuse_isa.c - every ISA path of fuse_light and fuse_composite (SSE2,
+ * AVX2, AVX-512, with 1 and several threads) against the scalar reference,
+ * byte for byte (memcmp, padding included), over thousands of seeded cases:
+ * odd widths, padded strides, soft and empty masks, garbage normals,
+ * 0..8 lights, enlarging and reducing viewports, in-place composites,
+ * layers that are not premultiplied. The reference outputs of all cases
+ * fold into a CRC32 constant. An ISA the CPU (or EGOFUSE_ISA) does not
+ * allow is reported as SKIP, never as passed.
+ *
+ *   test_fuse_isa        the cmocka tests
+ *   test_fuse_isa N      reruns case N on every available ISA and prints
+ *                        the first differing pixel, if any */
+#include "support/testutil.h"
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/cpu/cpu.h"
+#include "../src/fuse/fuse.h"
+#include "../src/fuse/fuse_internal.h"
+
+/* CRC32 of the reference outputs of cases 0 .. CASES-1 (light, then
+ * composite, per case). Changes only with the rules of docs/fuse.md. */
+#define ISA_CRC 0x372C936Au
+#define CASES 3000
+
+static const ef_isa simd_isas[] = { EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512 };
+#define N_SIMD 3
+
+/* ---- one case ------------------------------------------------------------ */
+
+typedef struct buf { uint8_t *p; size_t n; } buf;
+
+static buf buf_new(size_t n, uint8_t fill)
+{
+    buf b;
+    b.n = n ? n : 1;
+    b.p = malloc(b.n);
+    assert_non_null(b.p);
+    memset(b.p, fill, b.n);
+    return b;
+}
+
+typedef struct light_case {
+    fuse_lighting L;
+    fuse_intrinsics K;
+    int w, h, pstride, mstride, nstride;
+    buf P, M, N;
+} light_case;
+
+typedef struct comp_case {
+    int qw, qh, qstride, vw_, vh_, vstride, x0, y0, w, h, in_place;
+    buf Q, V;
+} comp_case;
+
+static void make_lighting(tu_rng *r, fuse_lighting *L)
+{
+    static const float shin[] = { 1.0f, 1.37f, 2.0f, 5.5f, 16.0f, 64.0f, 200.0f, 1000.0f };
+    int i, c;
+    *L = fuse_lighting_default();
+    L->light_count = tu_int(r, FUSE_MAX_LIGHTS + 1);
+    for (i = 0; i < L->light_count; i++) {
+        const float sc = tu_range(r, 0.3f, 3.0f);
+        for (c = 0; c < 3; c++) {
+            L->lights[i].dir[c] = tu_range(r, -1, 1) * sc;
+            L->lights[i].color[c] = tu_range(r, -0.2f, 1.5f);
+        }
+        if (tu_int(r, 6) == 0) {   /* towards the camera's back: L = -V on axis */
+            L->lights[i].dir[0] = L->lights[i].dir[1] = 0.0f;
+            L->lights[i].dir[2] = -1.0f;
+        }
+    }
+    for (c = 0; c < 3; c++) {
+        L->ambient[c] = tu_range(r, -0.1f, 0.7f);
+        L->tone[c] = tu_range(r, 0.3f, 2.0f);
+    }
+    L->kd = tu_range(r, 0, 1.2f);
+    L->ks = tu_int(r, 5) == 0 ? 0.0f : tu_range(r, 0, 1.5f);
+    L->shininess = tu_int(r, 2) ? shin[tu_int(r, 8)] : tu_range(r, 1.0f, 300.0f);
+    L->kf = tu_range(r, -0.2f, 1.3f);
+}
+
+static void light_case_make(tu_rng *r, light_case *c)
+{
+    int x, y, style = tu_int(r, 5);
+    make_lighting(r, &c->L);
+    c->w = 1 + tu_int(r, tu_int(r, 4) ? 80 : 300);
+    c->h = 1 + tu_int(r, 6);
+    c->pstride = 4 * c->w + 4 * tu_int(r, 3);
+    c->mstride = c->w + tu_int(r, 9);
+    c->nstride = 3 * c->w + tu_int(r, 5);
+    /* odd w: the centre column has px = 0 exactly (V on the axis) */
+    c->K.fx = tu_range(r, 0.3f, 2.0f) * (float)c->w;
+    c->K.fy = c->K.fx * tu_range(r, 0.9f, 1.1f);
+    c->K.cx = tu_int(r, 2) ? 0.5f * (float)c->w : tu_range(r, -0.5f, 1.5f) * (float)c->w;
+    c->K.cy = tu_int(r, 2) ? 0.5f * (float)c->h : tu_range(r, -0.5f, 1.5f) * (float)c->h;
+    c->P = buf_new((size_t)c->pstride * c->h, 0);
+    c->M = buf_new((size_t)c->mstride * c->h, 0);
+    c->N = buf_new(sizeof(float) * (size_t)c->nstride * c->h, 0);
+    for (size_t i = 0; i < c->P.n; i++) c->P.p[i] = (uint8_t)tu_int(r, 256);
+    for (y = 0; y < c->h; y++)
+        for (x = 0; x < c->w; x++) {
+            uint8_t *m = c->M.p + (size_t)y * c->mstride + x;
+            float *n = (float *)(void *)c->N.p + (size_t)y * c->nstride + 3 * x;
+            int k = tu_int(r, 100);
+            /* mask styles: empty, sparse, runs, soft, full */
+            switch (style) {
+            case 0: *m = 0; break;
+            case 1: *m = k < 90 ? 0 : (uint8_t)(1 + tu_int(r, 255)); break;
+            case 2: *m = ((x / 13 + y) & 1) ? 255 : 0; break;
+            case 3: *m = (uint8_t)tu_int(r, 256); break;
+            default: *m = 255; break;
+            }
+            k = tu_int(r, 100);
+            if (k < 40) {            /* unit */
+                float a = tu_range(r, -1, 1), b = tu_range(r, -1, 1), cc = tu_range(r, 0, 1);
+                float l = sqrtf(a * a + b * b + cc * cc);
+                if (l < 1e-3f) l = 1.0f, a = 0, b = 0, cc = 1;
+                n[0] = a / l; n[1] = b / l; n[2] = cc / l;
+            } else if (k < 80) {     /* any length */
+                float s = tu_range(r, 0.01f, 100.0f);
+                n[0] = tu_range(r, -1, 1) * s;
+                n[1] = tu_range(r, -1, 1) * s;
+                n[2] = tu_range(r, -1, 1) * s;
+            } else if (k < 86) {     /* facing the camera exactly */
+                n[0] = 0; n[1] = 0; n[2] = 1;
+            } else if (k < 90) {
+                n[0] = n[1] = n[2] = 0;
+            } else if (k < 93) {
+                n[0] = NAN; n[1] = 0; n[2] = 1;
+            } else if (k < 96) {
+                n[0] = 0; n[1] = INFINITY; n[2] = 1;
+            } else if (k < 98) {     /* beyond the accepted length range */
+                n[0] = 1e20f; n[1] = 0; n[2] = 0;
+            } else {
+                n[0] = 1e-20f; n[1] = 0; n[2] = 0;
+            }
+        }
+    /* garbage in the normal padding: never read */
+    for (y = 0; y < c->h; y++)
+        for (x = 3 * c->w; x < c->nstride; x++)
+            ((float *)(void *)c->N.p)[(size_t)y * c->nstride + x] = NAN;
+}
+
+static void comp_case_make(tu_rng *r, comp_case *c)
+{
+    int style = tu_int(r, 4);
+    c->qw = 1 + tu_int(r, tu_int(r, 4) ? 70 : 300);
+    c->qh = 1 + tu_int(r, 12);
+    c->qstride = 4 * c->qw + 4 * tu_int(r, 3);
+    c->vw_ = 1 + tu_int(r, tu_int(r, 4) ? 120 : 400);
+    c->vh_ = 1 + tu_int(r, 16);
+    c->vstride = 4 * c->vw_ + 4 * tu_int(r, 3);
+    switch (tu_int(r, 4)) {
+    case 0: c->w = c->vw_; break;
+    case 1: c->w = c->qw <= c->vw_ ? c->qw : c->vw_; break;    /* 1:1 */
+    default: c->w = 1 + tu_int(r, c->vw_); break;
+    }
+    c->h = 1 + tu_int(r, c->vh_);
+    c->x0 = tu_int(r, c->vw_ - c->w + 1);
+    c->y0 = tu_int(r, c->vh_ - c->h + 1);
+    c->in_place = tu_int(r, 2);
+    c->Q = buf_new((size_t)c->qstride * c->qh, 0);
+    c->V = buf_new((size_t)c->vstride * c->vh_, 0);
+    for (size_t i = 0; i < c->V.n; i++) c->V.p[i] = (uint8_t)tu_int(r, 256);
+    for (int y = 0; y < c->qh; y++)
+        for (int x = 0; x < c->qw; x++) {
+            uint8_t *q = c->Q.p + (size_t)y * c->qstride + 4 * x;
+            int k = tu_int(r, 100), a;
+            if (style == 0 && k < 97) continue;               /* mostly empty */
+            if (style == 1 && ((x / 9 + y / 3) & 1)) continue; /* blocks */
+            a = k < 30 ? 255 : tu_int(r, 256);
+            if (style == 3) {                                  /* not premultiplied */
+                q[0] = (uint8_t)tu_int(r, 256); q[1] = (uint8_t)tu_int(r, 256);
+                q[2] = (uint8_t)tu_int(r, 256); q[3] = (uint8_t)a;
+            } else {
+                q[0] = (uint8_t)tu_int(r, a + 1); q[1] = (uint8_t)tu_int(r, a + 1);
+                q[2] = (uint8_t)tu_int(r, a + 1); q[3] = (uint8_t)a;
+            }
+        }
+}
+
+static uint64_t case_seed(int n) { return 0x15A0000000000000ull ^ ((uint64_t)n * 0x9E3779B97F4A7Cull); }
+
+/* Runs the light part of a case on ctx into a fresh output (filled 0xA5). */
+static buf run_light(fuse_context *ctx, const light_case *c)
+{
+    buf o = buf_new((size_t)c->pstride * c->h, 0xA5);
+    fuse_image P = { c->P.p, c->w, c->h, c->pstride }, O = { o.p, c->w, c->h, c->pstride };
+    assert_int_equal(fuse_context_light(ctx, &c->L, &c->K, &P, c->M.p, c->mstride,
+                                        (const float *)(const void *)c->N.p, c->nstride, &O),
+                     FUSE_OK);
+    return o;
+}
+
+static buf run_comp(fuse_context *ctx, const comp_case *c)
+{
+    buf o = buf_new(c->V.n, 0xA5);
+    fuse_image Q = { c->Q.p, c->qw, c->qh, c->qstride };
+    fuse_image V = { c->V.p, c->vw_, c->vh_, c->vstride };
+    fuse_image O = { o.p, c->vw_, c->vh_, c->vstride };
+    if (c->in_place) {
+        memcpy(o.p, c->V.p, c->V.n);
+        V.pixels = o.p;
+    }
+    assert_int_equal(fuse_context_composite(ctx, &Q, &V, c->x0, c->y0, c->w, c->h, &O), FUSE_OK);
+    return o;
+}
+
+/* First differing byte as a pixel; 0 if equal. */
+static int report_diff(const char *what, const char *isa, int n, const buf *ref,
+                       const buf *got, int stride)
+{
+    size_t i;
+    for (i = 0; i < ref->n; i++)
+        if (ref->p[i] != got->p[i]) {
+            size_t y = i / (size_t)stride, x = (i % (size_t)stride) / 4, b = i - i % 4;
+            printf("case %d %s %s: first difference at pixel (%zu, %zu) byte %zu: "
+                   "ref %u %u %u %u, got %u %u %u %u\n", n, what, isa, x, y, i % 4,
+                   ref->p[b], ref->p[b + 1], ref->p[b + 2], ref->p[b + 3],
+                   got->p[b], got->p[b + 1], got->p[b + 2], got->p[b + 3]);
+            return 1;
+        }
+    return 0;
+}
+
+typedef struct ctxs {
+    fuse_context *ref;
+    fuse_context *isa[N_SIMD][2];   /* 1 thread, 3 threads; NULL: missing */
+} ctxs;
+
+static void ctxs_make(ctxs *c)
+{
+    fuse_context_desc d = { EF_ISA_REF, 1 };
+    int i;
+    c->ref = fuse_context_create(&d);
+    assert_non_null(c->ref);
+    assert_int_equal(fuse_context_isa(c->ref), EF_ISA_REF);
+    for (i = 0; i < N_SIMD; i++) {
+        d.max_isa = simd_isas[i];
+        d.threads = 1;
+        c->isa[i][0] = fuse_context_create(&d);
+        d.threads = 3;
+        c->isa[i][1] = fuse_context_create(&d);
+        assert_non_null(c->isa[i][0]);
+        assert_non_null(c->isa[i][1]);
+        assert_int_equal(fuse_context_threads(c->isa[i][1]), 3);
+        if (fuse_context_isa(c->isa[i][0]) != simd_isas[i]) {
+            fuse_context_destroy(c->isa[i][0]);
+            fuse_context_destroy(c->isa[i][1]);
+            c->isa[i][0] = c->isa[i][1] = NULL;
+        }
+    }
+}
+
+static void ctxs_free(ctxs *c)
+{
+    int i;
+    fuse_context_destroy(c->ref);
+    for (i = 0; i < N_SIMD; i++) {
+        fuse_context_destroy(c->isa[i][0]);
+        fuse_context_destroy(c->isa[i][1]);
+    }
+}
+
+/* Runs case n on every available ISA; folds the reference into *crc.
+ * Returns the number of mismatches (each one printed). */
+static int run_case(const ctxs *cx, int n, uint32_t *crc)
+{
+    tu_rng r = { case_seed(n) };
+    light_case lc;
+    comp_case cc;
+    buf lref, cref;
+    int i, bad = 0;
+    light_case_make(&r, &lc);
+    comp_case_make(&r, &cc);
+    lref = run_light(cx->ref, &lc);
+    cref = run_comp(cx->ref, &cc);
+    if (crc) {
+        *crc = tu_crc32(*crc, lref.p, lref.n);
+        *crc = tu_crc32(*crc, cref.p, cref.n);
+    }
+    for (i = 0; i < N_SIMD; i++) {
+        fuse_context *ctx = cx->isa[i][n % 4 == 3];
+        buf lo, co;
+        if (ctx == NULL) continue;
+        lo = run_light(ctx, &lc);
+        co = run_comp(ctx, &cc);
+        bad += report_diff("light", ef_isa_name(simd_isas[i]), n, &lref, &lo, lc.pstride);
+        bad += report_diff("composite", ef_isa_name(simd_isas[i]), n, &cref, &co, cc.vstride);
+        free(lo.p);
+        free(co.p);
+    }
+    free(lref.p);
+    free(cref.p);
+    free(lc.P.p);
+    free(lc.M.p);
+    free(lc.N.p);
+    free(cc.Q.p);
+    free(cc.V.p);
+    return bad;
+}
+
+static int skip_missing(const ctxs *cx, int i)
+{
+    if (cx->isa[i][0] != NULL) return 0;
+    printf("SKIP %s: not available (cpu best %s, EGOFUSE_ISA %s)\n",
+           ef_isa_name(simd_isas[i]), ef_isa_name(ef_cpu_best()),
+           getenv("EGOFUSE_ISA") ? getenv("EGOFUSE_ISA") : "unset");
+    return 1;
+}
+
+/* ---- tests ---------------------------------------------------------------- */
+
+static void test_cases(void **state)
+{
+    ctxs cx;
+    uint32_t crc = 0;
+    int n, bad = 0, missing = 0, i;
+    (void)state;
+    ctxs_make(&cx);
+    for (i = 0; i < N_SIMD; i++) missing += skip_missing(&cx, i);
+    for (n = 0; n < CASES; n++) {
+        bad += run_case(&cx, n, &crc);
+        if (bad > 10) break;
+    }
+    ctxs_free(&cx);
+    printf("NOTE fuse ISA cases: %d, mismatches %d, reference CRC32 0x%08X (expected 0x%08X)\n",
+           n, bad, crc, ISA_CRC);
+    assert_int_equal(bad, 0);
+    assert_int_equal(crc, ISA_CRC);
+    if (missing) skip();
+}
+
+/* A soft elliptical "hand" mask with garbage normals outside it. */
+static void hand_scene(tu_rng *r, int w, int h, uint8_t *P, uint8_t *M, float *N, double cover)
+{
+    const double ax = 0.5 * w * sqrt(cover * 4 / 3.14159265), ay = 0.5 * h * sqrt(cover * 4 / 3.14159265);
+    int x, y;
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            const double dx = (x + 0.5 - 0.5 * w) / ax, dy = (y + 0.5 - 0.55 * h) / ay;
+            const double d = sqrt(dx * dx + dy * dy);
+            const size_t i = (size_t)y * w + x;
+            P[4 * i] = (uint8_t)tu_int(r, 256);
+            P[4 * i + 1] = (uint8_t)(x & 255);
+            P[4 * i + 2] = (uint8_t)(y & 255);
+            P[4 * i + 3] = 0;
+            M[i] = d < 0.97 ? 255 : d < 1.0 ? (uint8_t)(255 * (1.0 - d) / 0.03) : 0;
+            if (M[i]) {
+                N[3 * i] = (float)(dx * 0.8);
+                N[3 * i + 1] = (float)(-dy * 0.8);
+                N[3 * i + 2] = (float)sqrt(fmax(0.05, 1.0 - 0.64 * d * d));
+            } else {
+                N[3 * i] = N[3 * i + 1] = N[3 * i + 2] = NAN;
+            }
+        }
+}
+
+/* The paper's frame: 640x400 lit, composited into 1194x746 at (43, 27) of
+ * 1280x800, in place; every ISA with 1 and 2 threads. */
+static void test_paper_frame(void **state)
+{
+    enum { CW = 640, CH = 400, W = 1280, H = 800 };
+    ctxs cx;
+    tu_rng r = { 0xF00D5u };
+    uint8_t *P = malloc(CW * CH * 4), *M = malloc(CW * CH);
+    float *N = malloc(sizeof(float) * CW * CH * 3);
+    uint8_t *V0 = malloc(W * H * 4), *Qr = malloc(CW * CH * 4), *Vr = malloc(W * H * 4);
+    uint8_t *Q = malloc(CW * CH * 4), *Vo = malloc(W * H * 4);
+    fuse_lighting L = fuse_lighting_default();
+    fuse_intrinsics K = { 532.0f, 532.0f, 320.0f, 200.0f };
+    int i, t, missing = 0;
+    (void)state;
+    assert_true(P && M && N && V0 && Qr && Vr && Q && Vo);
+    hand_scene(&r, CW, CH, P, M, N, 0.3);
+    for (i = 0; i < W * H * 4; i++) V0[i] = (uint8_t)tu_int(&r, 256);
+    L.light_count = 2;
+    L.lights[1] = (fuse_light_src){ { -0.5f, 0.2f, 0.6f }, { 0.4f, 0.3f, 0.2f } };
+    ctxs_make(&cx);
+    {
+        fuse_image Pi = { P, CW, CH, 4 * CW }, Qi = { Qr, CW, CH, 4 * CW }, Vi = { Vr, W, H, 4 * W };
+        memcpy(Vr, V0, W * H * 4);
+        assert_int_equal(fuse_context_light(cx.ref, &L, &K, &Pi, M, CW, N, 3 * CW, &Qi), FUSE_OK);
+        assert_int_equal(fuse_context_composite(cx.ref, &Qi, &Vi, 43, 27, 1194, 746, &Vi), FUSE_OK);
+    }
+    for (i = 0; i < N_SIMD; i++) {
+        if (skip_missing(&cx, i)) { missing++; continue; }
+        for (t = 0; t < 2; t++) {
+            fuse_context_desc d = { simd_isas[i], t + 1 };
+            fuse_context *ctx = fuse_context_create(&d);
+            fuse_image Pi = { P, CW, CH, 4 * CW }, Qi = { Q, CW, CH, 4 * CW }, Vi = { Vo, W, H, 4 * W };
+            buf a = { Qr, CW * CH * 4 }, b = { Q, CW * CH * 4 }, c = { Vr, W * H * 4 }, e = { Vo, W * H * 4 };
+            assert_non_null(ctx);
+            memcpy(Vo, V0, W * H * 4);
+            memset(Q, 0x77, CW * CH * 4);
+            assert_int_equal(fuse_context_light(ctx, &L, &K, &Pi, M, CW, N, 3 * CW, &Qi), FUSE_OK);
+            assert_int_equal(fuse_context_composite(ctx, &Qi, &Vi, 43, 27, 1194, 746, &Vi), FUSE_OK);
+            assert_int_equal(report_diff("paper light", ef_isa_name(simd_isas[i]), -1, &a, &b, 4 * CW), 0);
+            assert_int_equal(report_diff("paper composite", ef_isa_name(simd_isas[i]), -1, &c, &e, 4 * W), 0);
+            fuse_context_destroy(ctx);
+        }
+    }
+    ctxs_free(&cx);
+    free(P); free(M); free(N); free(V0); free(Qr); free(Vr); free(Q); free(Vo);
+    if (missing) skip();
+}
+
+/* The public fuse_light / fuse_composite dispatch (EGOFUSE_ISA respected)
+ * and give the reference bytes; contexts report their ISA and reject NULL. */
+static void test_dispatch(void **state)
+{
+    ctxs cx;
+    tu_rng r = { case_seed(7) };
+    light_case lc;
+    comp_case cc;
+    buf lref, cref, lo, co;
+    fuse_context_desc d = { EF_ISA_DEFAULT, 0 };
+    fuse_context *ctx = fuse_context_create(&d);
+    (void)state;
+    assert_non_null(ctx);
+    assert_int_equal(fuse_context_isa(ctx), ef_isa_choose(EF_ISA_DEFAULT));
+    assert_int_equal(fuse_context_threads(ctx), 1);
+    fuse_context_destroy(ctx);
+    d.threads = 1000;
+    ctx = fuse_context_create(&d);
+    assert_int_equal(fuse_context_threads(ctx), FUSE_MAX_THREADS);
+    fuse_context_destroy(ctx);
+    fuse_context_destroy(NULL);
+    assert_int_equal(fuse_context_light(NULL, NULL, NULL, NULL, NULL, 0, NULL, 0, NULL), FUSE_ERR_ARGS);
+    assert_int_equal(fuse_context_composite(NULL, NULL, NULL, 0, 0, 1, 1, NULL), FUSE_ERR_ARGS);
+
+    ctxs_make(&cx);
+    light_case_make(&r, &lc);
+    comp_case_make(&r, &cc);
+    lref = run_light(cx.ref, &lc);
+    cref = run_comp(cx.ref, &cc);
+    lo = buf_new(lref.n, 0xA5);
+    co = buf_new(cref.n, 0xA5);
+    {
+        fuse_image P = { lc.P.p, lc.w, lc.h, lc.pstride }, O = { lo.p, lc.w, lc.h, lc.pstride };
+        fuse_image Q = { cc.Q.p, cc.qw, cc.qh, cc.qstride }, V = { cc.V.p, cc.vw_, cc.vh_, cc.vstride };
+        fuse_image VO = { co.p, cc.vw_, cc.vh_, cc.vstride };
+        assert_int_equal(fuse_light(&lc.L, &lc.K, &P, lc.M.p, lc.mstride,
+                                    (const float *)(const void *)lc.N.p, lc.nstride, &O), FUSE_OK);
+        if (cc.in_place) {
+            memcpy(co.p, cc.V.p, cc.V.n);
+            V.pixels = co.p;
+        }
+        assert_int_equal(fuse_composite(&Q, &V, cc.x0, cc.y0, cc.w, cc.h, &VO), FUSE_OK);
+    }
+    assert_memory_equal(lref.p, lo.p, lref.n);
+    assert_memory_equal(cref.p, co.p, cref.n);
+    free(lref.p); free(cref.p); free(lo.p); free(co.p);
+    free(lc.P.p); free(lc.M.p); free(lc.N.p); free(cc.Q.p); free(cc.V.p);
+    ctxs_free(&cx);
+}
+
+/* The lane power of every path against fuse__pow01, float bits, on
+ * boundary values (2^-k, the log2 reduction's sqrt(2) split, 1 - ulp,
+ * 2^-100, subnormals, rounding ties of y + 0.5) and random ones. Output
+ * bytes hide ulp differences of the power, so this checks it directly. */
+static void test_pow_bits(void **state)
+{
+    typedef void (*pow_fn)(const float *, int, float, float *);
+    static const pow_fn fns[N_SIMD] = { fuse__pow01_row_sse2, fuse__pow01_row_avx2,
+                                        fuse__pow01_row_avx512 };
+    static const float shin[] = { 1.0f, 1.5f, 2.0f, 2.5f, 3.0f, 7.3f, 16.0f, 64.0f,
+                                  200.0f, 1000.0f, 123456.7f, 1.0e6f };
+    enum { NX = 4096 };
+    float *x = malloc(NX * sizeof(float)), *ref = malloc(NX * sizeof(float)),
+          *got = malloc(NX * sizeof(float));
+    tu_rng r = { 0x9057u };
+    int i, n = 0, si, missing = 0;
+    (void)state;
+    assert_true(x && ref && got);
+    for (i = 0; i <= 130; i++) {
+        float p2 = ldexpf(1.0f, -i);
+        x[n++] = p2;
+        x[n++] = nextafterf(p2, 0.0f);
+        x[n++] = nextafterf(p2, 2.0f);
+        x[n++] = p2 * 0.70710678f;
+        x[n++] = p2 * 1.41421356f * 0.5f;
+    }
+    x[n++] = 0.0f; x[n++] = -0.0f; x[n++] = 1.0f; x[n++] = 1.5f; x[n++] = -0.5f;
+    x[n++] = FUSE__POW_MIN; x[n++] = nextafterf(FUSE__POW_MIN, 1.0f);
+    x[n++] = nextafterf(1.0f, 0.0f); x[n++] = NAN; x[n++] = 0.70710677f; x[n++] = 0.70710683f;
+    while (n < NX) {   /* log-uniform in (2^-40, 1), and near 1 */
+        float u = tu_unit(&r);
+        x[n++] = tu_int(&r, 4) ? exp2f(-40.0f * u) : 1.0f - 1e-4f * u;
+    }
+    for (i = 0; i < N_SIMD; i++) {
+        if (ef_isa_choose(simd_isas[i]) != simd_isas[i]) {
+            printf("SKIP pow01 %s: not available\n", ef_isa_name(simd_isas[i]));
+            missing++;
+            continue;
+        }
+        for (si = 0; si < (int)(sizeof shin / sizeof shin[0]); si++) {
+            int k;
+            for (k = 0; k < NX; k++) ref[k] = fuse__pow01(x[k], shin[si]);
+            fns[i](x, NX, shin[si], got);
+            for (k = 0; k < NX; k++)
+                if (memcmp(&ref[k], &got[k], 4) != 0) {
+                    print_error("pow01 %s: x %a s %g: ref %a got %a\n", ef_isa_name(simd_isas[i]),
+                                (double)x[k], (double)shin[si], (double)ref[k], (double)got[k]);
+                    fail();
+                }
+        }
+    }
+    free(x); free(ref); free(got);
+    if (missing) skip();
+}
+
+int main(int argc, char **argv)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cases),
+        cmocka_unit_test(test_pow_bits),
+        cmocka_unit_test(test_paper_frame),
+        cmocka_unit_test(test_dispatch),
+    };
+    if (argc > 1) {   /* rerun one case, print differences */
+        ctxs cx;
+        int n = atoi(argv[1]), bad;
+        ctxs_make(&cx);
+        for (int i = 0; i < N_SIMD; i++) skip_missing(&cx, i);
+        bad = run_case(&cx, n, NULL);
+        ctxs_free(&cx);
+        printf("case %d: %s\n", n, bad ? "DIFFERENT" : "identical on every available ISA");
+        return bad != 0;
+    }
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
