@@ -28,9 +28,19 @@
  *   Facing is decided per triangle after clipping and snapping, from the
  *   sign of its snapped screen area (as GPUs do).
  *
+ * SPEED
+ *   The per-pixel scan has SSE2, AVX2 and AVX-512 versions giving the same
+ *   bytes as the scalar reference (docs/raster.md section 9). rast_draw
+ *   uses the best one the CPU runs, capped by EGOFUSE_ISA (src/cpu/cpu.h).
+ *   A rast_context lets the caller cap the ISA, ask which one is used and
+ *   draw one target with several threads (row bands; the bytes do not
+ *   depend on the thread count).
+ *
  * WHAT IT DOES NOT
- *   No allocation, no threads, no global state: a target may be drawn by
- *   one thread at a time; different targets on different threads.
+ *   rast_draw: no allocation, no threads, no global state: a target may be
+ *   drawn by one thread at a time; different targets on different threads.
+ *   A context allocates and starts its threads once, in
+ *   rast_context_create; its draws allocate nothing.
  *   No textures, no blending, no anti-aliasing in the reference.
  *
  * USAGE
@@ -112,7 +122,8 @@ typedef struct rast_stats {
  * elements of each row; padding is left alone). NULL planes are skipped. */
 void rast_target_clear(const rast_target *t);
 
-/* Draws the mesh (see the steps above). Stats are added to *stats when it
+/* Draws the mesh (see the steps above) on the calling thread with the ISA
+ * of rast_draw_isa(). Stats are added to *stats when it
  * is not NULL (zero it first). Validates everything before drawing; on an
  * error nothing is drawn and *stats is untouched:
  *   RAST_ERR_ARGS  t, mesh or t->mask NULL; mask/depth stride < width;
@@ -127,6 +138,40 @@ void rast_target_clear(const rast_target *t);
  * still match). */
 rast_result rast_draw(const rast_target *t, const rast_mesh_desc *mesh,
                       rast_stats *stats);
+
+/* The ISA rast_draw uses now (an ef_isa value of src/cpu/cpu.h: the best
+ * the CPU runs, capped by EGOFUSE_ISA). */
+int rast_draw_isa(void);
+
+/* ---- contexts: ISA cap, threads ---------------------------------------- */
+
+#define RAST_MAX_THREADS 16
+
+typedef struct rast_context rast_context;
+
+typedef struct rast_context_desc {
+    int max_isa;   /* cap: an ef_isa value (src/cpu/cpu.h), 0 = no cap; the
+                      EGOFUSE_ISA variable caps further */
+    int threads;   /* 0 or 1: draw on the calling thread only;
+                      2..RAST_MAX_THREADS: the caller and threads-1 workers */
+} rast_context_desc;
+
+/* Creates a context (desc NULL: defaults). Chooses the ISA once and starts
+ * the workers. NULL on a bad desc (threads or max_isa out of range) or when
+ * memory or threads are not available. */
+rast_context *rast_context_create(const rast_context_desc *desc);
+/* Stops the workers and frees the context (NULL is fine). */
+void rast_context_destroy(rast_context *ctx);
+/* The ISA the context uses (an ef_isa value) and its thread count. */
+int rast_context_isa(const rast_context *ctx);
+int rast_context_threads(const rast_context *ctx);
+/* rast_draw through the context: same validation, errors, stats and bytes
+ * as rast_draw, for any ISA and any thread count. With threads > 1 the
+ * triangles are set up in parallel batches, then every thread scans all of
+ * them in submission order into its own interleaved 16-row bands. One
+ * draw per context at a time (ctx NULL: RAST_ERR_ARGS). Allocates nothing. */
+rast_result rast_context_draw(rast_context *ctx, const rast_target *t,
+                              const rast_mesh_desc *mesh, rast_stats *stats);
 
 /* clip[i] = mvp * (pos[i], 1) for n points (pos: 3 floats each, mvp a
  * column-major 4x4 matrix). */

@@ -93,6 +93,14 @@ enum {
 
 /* Scans one triangle into t; returns the number of pixels written. */
 typedef long (*rast__scan_fn)(const rast_target *t, const rast__tri *tri);
+/* The same, restricted to the rows ya..yb (inclusive; intersected with the
+ * triangle's box). Every pixel gets exactly the bytes of the full scan, so
+ * a target may be split into row bands drawn by different threads. */
+typedef long (*rast__scan_rows_fn)(const rast_target *t, const rast__tri *tri,
+                                   int ya, int yb);
+
+/* A triangle becomes at most RAST__MAX_POLY - 2 fan triangles. */
+#define RAST__MAX_FAN (RAST__MAX_POLY - 2)
 
 /* Fills the per-draw constants for target size w x h. */
 void rast__view_init(rast__view *v, int width, int height, int attr_count);
@@ -120,11 +128,38 @@ int rast__setup_tri(const rast__view *v, const rast__vert *const p[3],
 /* Checks the arguments (RAST_OK or the error of rast_draw). */
 rast_result rast__validate(const rast_target *t, const rast_mesh_desc *m);
 
-/* rast_draw with a given scan function (the reference or a SIMD one). */
+/* rast_draw on the calling thread with a given row scan (the reference
+ * or a SIMD one). */
 rast_result rast__draw_with(const rast_target *t, const rast_mesh_desc *m,
-                            rast_stats *stats, rast__scan_fn scan);
+                            rast_stats *stats, rast__scan_rows_fn scan);
+
+/* Fetch, clip, snap and set up submitted triangle ti of m (indices already
+ * validated): writes 0..RAST__MAX_FAN triangles to out, returns their
+ * count and adds every counter but tris_in and pixels_written to *st. */
+int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
+                  rast__tri *out, rast_stats *st);
+/* dst += s, every counter. */
+void rast__stats_add(rast_stats *dst, const rast_stats *s);
+/* Attribute count carried through clipping for this draw (0 unless both
+ * the target and the mesh have attributes). */
+int rast__draw_na(const rast_target *t, const rast_mesh_desc *m);
 
 /* The scalar reference scan. */
 long rast__scan_ref(const rast_target *t, const rast__tri *tri);
+long rast__scan_rows_ref(const rast_target *t, const rast__tri *tri, int ya,
+                         int yb);
+
+/* SIMD scans (raster_sse2.c, raster_avx2.c, raster_avx512.c; one body,
+ * raster_simd.inl). Each gives the bytes of rast__scan_ref. They may only
+ * be called when ef_cpu_has() says the CPU runs the ISA. */
+long rast__scan_rows_sse2(const rast_target *t, const rast__tri *tri, int ya,
+                          int yb);
+long rast__scan_rows_avx2(const rast_target *t, const rast__tri *tri, int ya,
+                          int yb);
+long rast__scan_rows_avx512(const rast_target *t, const rast__tri *tri,
+                            int ya, int yb);
+/* The row scan for an ISA (an ef_isa value); the reference for
+ * EF_ISA_REF, for an ISA not compiled in, and for unknown values. */
+rast__scan_rows_fn rast__scan_for_isa(int isa);
 
 #endif

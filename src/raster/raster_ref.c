@@ -6,13 +6,26 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 long rast__scan_ref(const rast_target *t, const rast__tri *tri)
 {
+    return rast__scan_rows_ref(t, tri, tri->y0, tri->y1);
+}
+
+long rast__scan_rows_ref(const rast_target *t, const rast__tri *tri, int ya,
+                         int yb)
+{
     const int na = t->attr ? tri->attr_count : 0;
     long written = 0;
-    int64_t er[3] = { tri->e_c[0], tri->e_c[1], tri->e_c[2] };
-    for (int y = tri->y0; y <= tri->y1; y++) {
+    const int ys = ya > tri->y0 ? ya : tri->y0;
+    const int ye = yb < tri->y1 ? yb : tri->y1;
+    if (ys > ye)
+        return 0;
+    int64_t er[3];
+    for (int k = 0; k < 3; k++)     /* exact: the same integers as stepping */
+        er[k] = tri->e_c[k] + (int64_t)(ys - tri->y0) * tri->e_dy[k];
+    for (int y = ys; y <= ye; y++) {
         const float fj = (float)(y - tri->y0);
         /* Row bases of every plane: c + dy * j. */
         const float zr = tri->z.c + tri->z.dy * fj;
@@ -55,12 +68,6 @@ long rast__scan_ref(const rast_target *t, const rast__tri *tri)
     return written;
 }
 
-rast_result rast_draw(const rast_target *t, const rast_mesh_desc *mesh,
-                      rast_stats *stats)
-{
-    return rast__draw_with(t, mesh, stats, rast__scan_ref);
-}
-
 void rast_target_clear(const rast_target *t)
 {
     if (!t || t->width <= 0 || t->height <= 0)
@@ -71,16 +78,11 @@ void rast_target_clear(const rast_target *t)
             for (int x = 0; x < t->width; x++)
                 d[x] = 1.0f;
         }
-        if (t->mask) {
-            uint8_t *m = t->mask + (size_t)y * (size_t)t->mask_stride;
-            for (int x = 0; x < t->width; x++)
-                m[x] = 0;
-        }
-        if (t->attr && t->attr_count > 0) {
-            float *a = t->attr + (size_t)y * (size_t)t->attr_stride;
-            for (int x = 0; x < t->width * t->attr_count; x++)
-                a[x] = 0.0f;
-        }
+        if (t->mask)
+            memset(t->mask + (size_t)y * (size_t)t->mask_stride, 0, (size_t)t->width);
+        if (t->attr && t->attr_count > 0)   /* all-zero bytes are 0.0f */
+            memset(t->attr + (size_t)y * (size_t)t->attr_stride, 0,
+                   (size_t)t->width * (size_t)t->attr_count * sizeof(float));
     }
 }
 

@@ -5,6 +5,9 @@
 
 #include <math.h>
 #include <stddef.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 /* ---- constants --------------------------------------------------------- */
 
@@ -115,7 +118,13 @@ static int32_t snap_axis(float s, int32_t lo, int32_t hi)
     float f = s * (float)RAST__FIX_ONE;
     if (f < (float)lo) f = (float)lo;
     if (f > (float)hi) f = (float)hi;
+#if defined(__SSE2__)
+    /* cvtss2si rounds in the current mode (half to even by default), as
+     * lrintf does, without a libm call. f is in range (clamped above). */
+    return (int32_t)_mm_cvtss_si32(_mm_set_ss(f));
+#else
     return (int32_t)lrintf(f);   /* round half to even (default mode) */
+#endif
 }
 
 void rast__snap(const rast__view *v, const rast__vert *p, int32_t *fx,
@@ -294,96 +303,113 @@ static int finite_vert(const rast__vert *p)
     return isfinite(p->x) && isfinite(p->y) && isfinite(p->z) && isfinite(p->w);
 }
 
+int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
+                  rast__tri *out, rast_stats *st)
+{
+    const int na = view->attr_count;
+    rast__vert poly[RAST__MAX_POLY], tmp[RAST__MAX_POLY];
+    int32_t fx[RAST__MAX_POLY], fy[RAST__MAX_POLY];
+    int bad = 0;
+    for (int i = 0; i < 3; i++) {
+        uint32_t idx = m->indices[3 * (size_t)ti + i];
+        const float *c = m->clip + 4 * (size_t)idx;
+        rast__vert *pv = &poly[i];
+        pv->x = c[0];
+        pv->y = c[1];
+        pv->z = c[2];
+        pv->w = c[3];
+        for (int k = 0; k < na; k++)
+            pv->a[k] = m->attr[(size_t)idx * m->attr_count + k];
+        bad |= !finite_vert(pv);
+    }
+    if (bad) {
+        st->tris_nonfinite++;
+        return 0;
+    }
+    unsigned c0 = rast__outcode(view, &poly[0]);
+    unsigned c1 = rast__outcode(view, &poly[1]);
+    unsigned c2 = rast__outcode(view, &poly[2]);
+    if (c0 & c1 & c2) {
+        st->tris_clipped_away++;
+        return 0;
+    }
+    int n = 3;
+    if (c0 | c1 | c2)
+        n = rast__clip_polygon(view, c0 | c1 | c2, poly, n, tmp);
+    /* After near and far, w >= |z| >= 0 for every vertex; w == 0 only
+     * at the clip-space origin (x = y = z = w = 0), which has no
+     * projection: such polygons are dropped here, before the divide.
+     * Overflow in the clipper (|coords| near FLT_MAX) is caught too. */
+    int state = n >= 3 ? 0 : 1;          /* 0 ok, 1 clipped, 2 nonfinite */
+    for (int i = 0; i < n && state == 0; i++) {
+        if (!finite_vert(&poly[i]))
+            state = 2;
+        else if (!(poly[i].w > 0.0f))
+            state = 1;
+    }
+    if (state == 1) {
+        st->tris_clipped_away++;
+        return 0;
+    }
+    if (state == 2) {
+        st->tris_nonfinite++;
+        return 0;
+    }
+    for (int i = 0; i < n; i++)
+        rast__snap(view, &poly[i], &fx[i], &fy[i]);
+    int made = 0;
+    for (int i = 1; i + 1 < n; i++) {
+        const rast__vert *pv[3] = { &poly[0], &poly[i], &poly[i + 1] };
+        int32_t tx[3] = { fx[0], fx[i], fx[i + 1] };
+        int32_t ty[3] = { fy[0], fy[i], fy[i + 1] };
+        switch (rast__setup_tri(view, pv, tx, ty, m->cull, &out[made])) {
+        case RAST__SETUP_OK:
+            st->tris_drawn++;
+            made++;
+            break;
+        case RAST__SETUP_DEGENERATE: st->tris_degenerate++; break;
+        case RAST__SETUP_CULLED:     st->tris_culled++; break;
+        default:                     st->tris_clipped_away++; break;
+        }
+    }
+    return made;
+}
+
+void rast__stats_add(rast_stats *dst, const rast_stats *s)
+{
+    dst->tris_in += s->tris_in;
+    dst->tris_nonfinite += s->tris_nonfinite;
+    dst->tris_clipped_away += s->tris_clipped_away;
+    dst->tris_degenerate += s->tris_degenerate;
+    dst->tris_culled += s->tris_culled;
+    dst->tris_drawn += s->tris_drawn;
+    dst->pixels_written += s->pixels_written;
+}
+
+int rast__draw_na(const rast_target *t, const rast_mesh_desc *m)
+{
+    /* Attributes go through clipping only if both sides have them. */
+    return (t->attr && m->attr) ? m->attr_count : 0;
+}
+
 rast_result rast__draw_with(const rast_target *t, const rast_mesh_desc *m,
-                            rast_stats *stats, rast__scan_fn scan)
+                            rast_stats *stats, rast__scan_rows_fn scan)
 {
     rast_result r = rast__validate(t, m);
     if (r != RAST_OK)
         return r;
 
-    /* Attributes go through clipping only if both sides have them. */
-    int na = (t->attr && m->attr) ? m->attr_count : 0;
     rast__view view;
-    rast__view_init(&view, t->width, t->height, na);
+    rast__view_init(&view, t->width, t->height, rast__draw_na(t, m));
     rast_stats st = { 0 };
     st.tris_in = m->tri_count;
-
-    rast__vert poly[RAST__MAX_POLY], tmp[RAST__MAX_POLY];
-    int32_t fx[RAST__MAX_POLY], fy[RAST__MAX_POLY];
-    rast__tri tri;
-
+    rast__tri tri[RAST__MAX_FAN];
     for (int ti = 0; ti < m->tri_count; ti++) {
-        int bad = 0;
-        for (int i = 0; i < 3; i++) {
-            uint32_t idx = m->indices[3 * ti + i];
-            const float *c = m->clip + 4 * (size_t)idx;
-            rast__vert *pv = &poly[i];
-            pv->x = c[0];
-            pv->y = c[1];
-            pv->z = c[2];
-            pv->w = c[3];
-            for (int k = 0; k < na; k++)
-                pv->a[k] = m->attr[(size_t)idx * m->attr_count + k];
-            bad |= !finite_vert(pv);
-        }
-        if (bad) {
-            st.tris_nonfinite++;
-            continue;
-        }
-        unsigned c0 = rast__outcode(&view, &poly[0]);
-        unsigned c1 = rast__outcode(&view, &poly[1]);
-        unsigned c2 = rast__outcode(&view, &poly[2]);
-        if (c0 & c1 & c2) {
-            st.tris_clipped_away++;
-            continue;
-        }
-        int n = 3;
-        if (c0 | c1 | c2)
-            n = rast__clip_polygon(&view, c0 | c1 | c2, poly, n, tmp);
-        /* After near and far, w >= |z| >= 0 for every vertex; w == 0 only
-         * at the clip-space origin (x = y = z = w = 0), which has no
-         * projection: such polygons are dropped here, before the divide.
-         * Overflow in the clipper (|coords| near FLT_MAX) is caught too. */
-        int state = n >= 3 ? 0 : 1;          /* 0 ok, 1 clipped, 2 nonfinite */
-        for (int i = 0; i < n && state == 0; i++) {
-            if (!finite_vert(&poly[i]))
-                state = 2;
-            else if (!(poly[i].w > 0.0f))
-                state = 1;
-        }
-        if (state == 1) {
-            st.tris_clipped_away++;
-            continue;
-        }
-        if (state == 2) {
-            st.tris_nonfinite++;
-            continue;
-        }
+        int n = rast__prepare(&view, m, ti, tri, &st);
         for (int i = 0; i < n; i++)
-            rast__snap(&view, &poly[i], &fx[i], &fy[i]);
-        for (int i = 1; i + 1 < n; i++) {
-            const rast__vert *pv[3] = { &poly[0], &poly[i], &poly[i + 1] };
-            int32_t tx[3] = { fx[0], fx[i], fx[i + 1] };
-            int32_t ty[3] = { fy[0], fy[i], fy[i + 1] };
-            switch (rast__setup_tri(&view, pv, tx, ty, m->cull, &tri)) {
-            case RAST__SETUP_OK:
-                st.tris_drawn++;
-                st.pixels_written += scan(t, &tri);
-                break;
-            case RAST__SETUP_DEGENERATE: st.tris_degenerate++; break;
-            case RAST__SETUP_CULLED:     st.tris_culled++; break;
-            default:                     st.tris_clipped_away++; break;
-            }
-        }
+            st.pixels_written += scan(t, &tri[i], tri[i].y0, tri[i].y1);
     }
-    if (stats) {
-        stats->tris_in += st.tris_in;
-        stats->tris_nonfinite += st.tris_nonfinite;
-        stats->tris_clipped_away += st.tris_clipped_away;
-        stats->tris_degenerate += st.tris_degenerate;
-        stats->tris_culled += st.tris_culled;
-        stats->tris_drawn += st.tris_drawn;
-        stats->pixels_written += st.pixels_written;
-    }
+    if (stats)
+        rast__stats_add(stats, &st);
     return RAST_OK;
 }

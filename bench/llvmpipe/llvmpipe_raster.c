@@ -1,0 +1,359 @@
+/* llvmpipe_raster.c - the bench scene (bench_mesh.h: two arms, both eyes,
+ * 640x400, depth + coverage + normals, back faces culled) rendered by Mesa
+ * llvmpipe (EGL surfaceless + OpenGL ES 3) and by egofuse in the same run:
+ * median times and their ratio, and the pixels where coverage differs,
+ * each classified by the distance of its centre to the nearest triangle
+ * edge (docs/raster.md section 10 explains the classes).
+ *
+ * Build (not in the Makefile: it needs EGL and GLES):
+ *   make build/libegofuse.a
+ *   gcc -std=c11 -O2 -D_GNU_SOURCE -o build/bench/llvmpipe_raster \
+ *       bench/llvmpipe/llvmpipe_raster.c build/libegofuse.a \
+ *       $(pkg-config --cflags --libs egl glesv2) -lm -lpthread
+ *   build/bench/llvmpipe_raster [--runs N] [--tris N,N,...]
+ *
+ * Exit status: 0 when llvmpipe ran and every coverage difference lies
+ * within snapping distance of an edge, 1 otherwise (2: usage, 3: no
+ * llvmpipe). */
+#define EGL_EGLEXT_PROTOTYPES
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GLES3/gl3.h>
+
+#include "../../src/cpu/cpu.h"
+#include "../../src/raster/raster.h"
+#include "../bench_mesh.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+enum { W = 640, H = 400 };
+/* A pixel centre closer than this to an edge (pixels) is "on the edge":
+ * each of the two rasterizers snaps vertices to 1/256 px, which moves an
+ * edge by up to sqrt(2)/512 px each. */
+#define EDGE_EPS (2.0 * 1.41421356 / 512.0)
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static GLuint compile(GLenum type, const char *src)
+{
+    GLuint s = glCreateShader(type);
+    glShaderSource(s, 1, &src, NULL);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[1024];
+        glGetShaderInfoLog(s, sizeof log, NULL, log);
+        fprintf(stderr, "shader: %s\n", log);
+        exit(3);
+    }
+    return s;
+}
+
+/* Distance (px) from (px, py) to segment a-b. */
+static double seg_dist(double px, double py, double ax, double ay, double bx, double by)
+{
+    double dx = bx - ax, dy = by - ay, l2 = dx * dx + dy * dy;
+    double t = l2 > 0 ? ((px - ax) * dx + (py - ay) * dy) / l2 : 0;
+    t = t < 0 ? 0 : t > 1 ? 1 : t;
+    double ex = ax + t * dx - px, ey = ay + t * dy - py;
+    return sqrt(ex * ex + ey * ey);
+}
+
+/* Smallest distance from pixel centre (x+.5, y+.5) to an edge of a
+ * triangle of the mesh, after near-plane clipping (double). */
+static double edge_distance(const float *clip, const uint32_t *idx, int nt, int x, int y)
+{
+    double px = x + 0.5, py = y + 0.5, best = 1e30;
+    for (int t = 0; t < nt; t++) {
+        double v[4][4], o[4][4];
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 4; k++)
+                v[i][k] = clip[4 * idx[3 * t + i] + k];
+        int n = 0;   /* clip against z >= -w */
+        for (int i = 0; i < 3; i++) {
+            const double *a = v[i], *b = v[(i + 1) % 3];
+            double da = a[2] + a[3], db = b[2] + b[3];
+            if (da >= 0)
+                memcpy(o[n++], a, sizeof o[0]);
+            if ((da >= 0) != (db >= 0)) {
+                double s = da / (da - db);
+                for (int k = 0; k < 4; k++)
+                    o[n][k] = a[k] + s * (b[k] - a[k]);
+                n++;
+            }
+        }
+        if (n < 3)
+            continue;
+        double sx[4], sy[4];
+        for (int i = 0; i < n; i++) {
+            double w = o[i][3] > 1e-12 ? o[i][3] : 1e-12;
+            sx[i] = (o[i][0] / w * 0.5 + 0.5) * W;
+            sy[i] = (0.5 - o[i][1] / w * 0.5) * H;
+        }
+        for (int i = 0; i < n; i++) {
+            int j = (i + 1) % n;
+            double d = seg_dist(px, py, sx[i], sy[i], sx[j], sy[j]);
+            if (d < best)
+                best = d;
+        }
+    }
+    return best;
+}
+
+int main(int argc, char **argv)
+{
+    int runs = 101;
+    int tris_list[8] = { 2000, 10000, 40000 }, ntl = 3;
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--runs") && i + 1 < argc)
+            runs = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--tris") && i + 1 < argc) {
+            ntl = 0;
+            for (char *s = strtok(argv[++i], ","); s && ntl < 8; s = strtok(NULL, ","))
+                tris_list[ntl++] = atoi(s);
+        } else {
+            fprintf(stderr, "usage: %s [--runs N] [--tris N,N,...]\n", argv[0]);
+            return 2;
+        }
+    }
+    if (runs < 1)
+        return 2;
+    setenv("EGL_PLATFORM", "surfaceless", 0);
+    setenv("GALLIUM_DRIVER", "llvmpipe", 0);
+    setenv("LIBGL_ALWAYS_SOFTWARE", "1", 0);
+
+    PFNEGLGETPLATFORMDISPLAYEXTPROC get_display =
+        (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+    EGLDisplay dpy = get_display ? get_display(EGL_PLATFORM_SURFACELESS_MESA,
+                                               EGL_DEFAULT_DISPLAY, NULL)
+                                 : eglGetDisplay(EGL_DEFAULT_DISPLAY);
+    EGLint major, minor;
+    if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, &major, &minor)) {
+        fprintf(stderr, "no surfaceless EGL display\n");
+        return 3;
+    }
+    eglBindAPI(EGL_OPENGL_ES_API);
+    const EGLint cattr[] = { EGL_CONTEXT_MAJOR_VERSION, 3, EGL_NONE };
+    EGLContext ctx = eglCreateContext(dpy, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, cattr);
+    if (ctx == EGL_NO_CONTEXT ||
+        !eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) {
+        fprintf(stderr, "cannot make a surfaceless GLES 3 context current\n");
+        return 3;
+    }
+    const char *renderer = (const char *)glGetString(GL_RENDERER);
+    printf("GL_RENDERER: %s\nGL_VERSION: %s\n", renderer, (const char *)glGetString(GL_VERSION));
+    if (!renderer || !strstr(renderer, "llvmpipe")) {
+        fprintf(stderr, "the renderer is not llvmpipe\n");
+        return 3;
+    }
+    printf("egofuse ISA: %s, scene: two arms, %dx%d per eye, depth + coverage + "
+           "normals, back faces culled, median of %d runs\n",
+           ef_isa_name((ef_isa)rast_draw_isa()), W, H, runs);
+
+    /* Framebuffer: RGBA8 (normal*0.5+0.5, alpha = coverage) + depth 24. */
+    GLuint fbo, rb[2];
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glGenRenderbuffers(2, rb);
+    glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, W, H);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
+    glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, W, H);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        fprintf(stderr, "incomplete framebuffer\n");
+        return 3;
+    }
+    const char *vs = "#version 300 es\n"
+                     "layout(location=0) in vec4 clip; layout(location=1) in vec3 nrm;\n"
+                     "out vec3 n;\n"
+                     "void main() { n = nrm; gl_Position = clip; }\n";
+    const char *fs = "#version 300 es\nprecision highp float;\n"
+                     "in vec3 n; out vec4 o;\n"
+                     "void main() { o = vec4(n * 0.5 + 0.5, 1.0); }\n";
+    GLuint prog = glCreateProgram();
+    glAttachShader(prog, compile(GL_VERTEX_SHADER, vs));
+    glAttachShader(prog, compile(GL_FRAGMENT_SHADER, fs));
+    glLinkProgram(prog);
+    glUseProgram(prog);
+    glViewport(0, 0, W, H);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW);
+    glClearColor(0, 0, 0, 0);
+    glClearDepthf(1.0f);
+
+    int bad_total = 0;
+    uint8_t *rgba = malloc((size_t)W * H * 4);
+    float *depth = malloc((size_t)W * H * 2 * sizeof(float));
+    uint8_t *mask = malloc((size_t)W * H * 2);
+    float *nrmp = malloc((size_t)W * H * 2 * 3 * sizeof(float));
+    double *tg = malloc((size_t)runs * sizeof(double)), *te = malloc((size_t)runs * sizeof(double));
+    rast_target tgt[2];
+    for (int e = 0; e < 2; e++) {
+        rast_target t = { W, H, depth + (size_t)e * W * H, W, mask + (size_t)e * W * H, W,
+                          nrmp + (size_t)e * W * H * 3, 3 * W, 3 };
+        tgt[e] = t;
+    }
+    for (int ti = 0; ti < ntl; ti++) {
+        bm_mesh m;
+        if (!bm_arms(&m, tris_list[ti]))
+            return 1;
+        float *clip[2];
+        float mvp[16];
+        for (int e = 0; e < 2; e++) {
+            clip[e] = malloc((size_t)m.vertex_count * 4 * sizeof(float));
+            bm_eye_mvp(e, W, H, mvp);
+            rast_transform_points(mvp, m.pos, m.vertex_count, clip[e]);
+        }
+        GLuint vbo[3], ibo;
+        glGenBuffers(3, vbo);
+        glGenBuffers(1, &ibo);
+        for (int e = 0; e < 2; e++) {
+            glBindBuffer(GL_ARRAY_BUFFER, vbo[e]);
+            glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)m.vertex_count * 16, clip[e], GL_STATIC_DRAW);
+        }
+        glBindBuffer(GL_ARRAY_BUFFER, vbo[2]);
+        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)m.vertex_count * 12, m.nrm, GL_STATIC_DRAW);
+        glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, 0);
+        glEnableVertexAttribArray(1);
+        glEnableVertexAttribArray(0);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo);
+        glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)m.tri_count * 12, m.idx, GL_STATIC_DRAW);
+
+        /* Timing, both eyes per run: llvmpipe clear + draw + glFinish (the
+         * clip coordinates are already in buffers, as egofuse gets them). */
+        for (int r = -5; r < runs; r++) {
+            double t0 = now_ms();
+            for (int e = 0; e < 2; e++) {
+                glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                glBindBuffer(GL_ARRAY_BUFFER, vbo[e]);
+                glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, 0, 0);
+                glDrawElements(GL_TRIANGLES, m.tri_count * 3, GL_UNSIGNED_INT, 0);
+                glFinish();
+            }
+            if (r >= 0)
+                tg[r] = now_ms() - t0;
+        }
+        double best_eg = 1e30;
+        int best_th = 1;
+        for (int th = 1; th <= 2; th++) {
+            rast_context_desc d = { 0, th };
+            rast_context *c = rast_context_create(&d);
+            if (!c)
+                return 1;
+            for (int r = -5; r < runs; r++) {
+                double t0 = now_ms();
+                for (int e = 0; e < 2; e++) {
+                    rast_target_clear(&tgt[e]);
+                    rast_mesh_desc md = { clip[e], m.vertex_count, m.nrm, 3, m.idx,
+                                          m.tri_count, RAST_CULL_BACK };
+                    rast_context_draw(c, &tgt[e], &md, NULL);
+                }
+                if (r >= 0)
+                    te[r] = now_ms() - t0;
+            }
+            double me = median(te, runs);
+            if (me < best_eg) {
+                best_eg = me;
+                best_th = th;
+            }
+            printf("%6d tris: egofuse %d thread(s) %.4f ms both eyes (clear + draw)\n",
+                   m.tri_count, th, me);
+            rast_context_destroy(c);
+        }
+        double mg = median(tg, runs);
+        printf("%6d tris: llvmpipe %.4f ms both eyes (clear + draw + finish); "
+               "llvmpipe / egofuse (%d thread(s)) = %.1fx\n", m.tri_count, mg, best_th,
+               mg / best_eg);
+
+        /* Coverage comparison per eye (the last renders of each). */
+        for (int e = 0; e < 2; e++) {
+            glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+            glBindBuffer(GL_ARRAY_BUFFER, vbo[e]);
+            glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, 0, 0);
+            glDrawElements(GL_TRIANGLES, m.tri_count * 3, GL_UNSIGNED_INT, 0);
+            glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, rgba);
+            long both = 0, only_gl = 0, only_eg = 0, on_edge = 0, off_edge = 0;
+            int maxn = 0;
+            double worst = 0;
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < W; x++) {
+                    const uint8_t *g = rgba + ((size_t)(H - 1 - y) * W + x) * 4; /* GL: bottom row first */
+                    int cg = g[3] != 0, ce = tgt[e].mask[(size_t)y * W + x] != 0;
+                    if (cg && ce) {
+                        both++;
+                        for (int k = 0; k < 3; k++) {
+                            float n = tgt[e].attr[((size_t)y * W + x) * 3 + k];
+                            int q = (int)lrintf((n * 0.5f + 0.5f) * 255.0f);
+                            int dd = abs(q - g[k]);
+                            if (dd > maxn)
+                                maxn = dd;
+                        }
+                        continue;
+                    }
+                    if (cg == ce)
+                        continue;
+                    only_gl += cg;
+                    only_eg += ce;
+                    double d = edge_distance(clip[e], m.idx, m.tri_count, x, y);
+                    if (d <= EDGE_EPS) {
+                        on_edge++;
+                    } else {
+                        off_edge++;
+                        if (d > worst)
+                            worst = d;
+                        if (off_edge <= 5)
+                            printf("    eye %d pixel (%d,%d): %s only, centre %.5f px from "
+                                   "the nearest edge\n", e, x, y, cg ? "llvmpipe" : "egofuse", d);
+                    }
+                }
+            printf("%6d tris eye %d: %ld pixels covered by both, %ld llvmpipe only, %ld "
+                   "egofuse only; of the %ld differences %ld lie within %.4f px of an edge, "
+                   "%ld do not (farthest %.4f px); normals max diff %d/255\n",
+                   m.tri_count, e, both, only_gl, only_eg, only_gl + only_eg, on_edge,
+                   EDGE_EPS, off_edge, worst, maxn);
+            bad_total += off_edge > 0;
+        }
+        glDeleteBuffers(3, vbo);
+        glDeleteBuffers(1, &ibo);
+        for (int e = 0; e < 2; e++)
+            free(clip[e]);
+        bm_free(&m);
+    }
+    eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(dpy, ctx);
+    eglTerminate(dpy);
+    free(rgba);
+    free(depth);
+    free(mask);
+    free(nrmp);
+    free(tg);
+    free(te);
+    return bad_total ? 1 : 0;
+}

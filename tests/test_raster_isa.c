@@ -1,0 +1,553 @@
+/* test_raster_isa.c - every SIMD scan against the scalar reference, byte
+ * for byte: seeded random triangle soups (slivers, huge, tiny, edge-on,
+ * behind the camera, across the near plane, shared edges, NaN vertices,
+ * attribute counts 0..8, odd target sizes and padded strides), a CRC over
+ * all cases against a recorded constant, the public dispatch (rast_draw,
+ * contexts, EGOFUSE_ISA) and band-parallel drawing with 1, 2, 3 and 4
+ * threads giving the same bytes.
+ *
+ * An ISA the CPU lacks is reported ("SKIP ...") and skipped, never passed.
+ *
+ *   test_raster_isa        run the tests
+ *   test_raster_isa N      rerun case N on every ISA and print the first
+ *                          differing pixel (exit 1 if any differs)
+ */
+#include "support/testutil.h"
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/cpu/cpu.h"
+#include "../src/raster/raster_internal.h"
+
+/* Recorded CRC32 of the reference output over all NCASES cases (update it
+ * together with SOUP_CRC of test_raster_basic.c when a rule changes). */
+#define ISA_CRC 0x554E1221u
+#define NCASES 4000
+
+typedef struct rcase {
+    rast_target t;
+    rast_mesh_desc m;
+    float *clip, *attr;
+    uint32_t *idx;
+    int attr_plane;       /* target has an attr plane */
+} rcase;
+
+static const int isas[] = { EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512 };
+
+/* ---- case generator ----------------------------------------------------- */
+
+static float pick_w(tu_rng *r)
+{
+    switch (tu_int(r, 6)) {
+    case 0: return tu_range(r, -2.0f, 0.05f);      /* behind / at the eye */
+    case 1: return tu_range(r, 0.01f, 0.2f);
+    default: return tu_range(r, 0.5f, 4.0f);
+    }
+}
+
+/* One vertex of kind k around NDC centre (cx, cy) with size s. */
+static void make_vertex(tu_rng *r, float cx, float cy, float s, float *c)
+{
+    float w = pick_w(r);
+    float aw = fabsf(w) > 1e-3f ? fabsf(w) : 1.0f;
+    c[0] = (cx + tu_range(r, -s, s)) * aw;
+    c[1] = (cy + tu_range(r, -s, s)) * aw;
+    c[2] = tu_range(r, -1.3f, 1.3f) * aw;
+    c[3] = w;
+}
+
+/* Builds case n (seeded by n alone). */
+static void make_case(int n, rcase *k)
+{
+    tu_rng r = { 0x15A0000ull + (uint64_t)n * 0x9E3779B97F4A7C15ull };
+    memset(k, 0, sizeof *k);
+    int big = tu_int(&r, 20) == 0;
+    int w = big ? 200 + tu_int(&r, 500) : 1 + tu_int(&r, 90);
+    int h = big ? 100 + tu_int(&r, 200) : 1 + tu_int(&r, 60);
+    int pad = tu_int(&r, 3) == 0 ? 0 : 1 + tu_int(&r, 17);
+    int na = tu_int(&r, 9);
+    k->attr_plane = tu_int(&r, 4) != 0;
+    rast_target *t = &k->t;
+    t->width = w;
+    t->height = h;
+    t->mask_stride = w + pad;
+    t->mask = malloc((size_t)t->mask_stride * h);
+    if (tu_int(&r, 5) != 0) {
+        t->depth_stride = w + tu_int(&r, 9);
+        t->depth = malloc((size_t)t->depth_stride * h * sizeof(float));
+    }
+    t->attr_count = na;
+    if (k->attr_plane && na > 0) {
+        t->attr_stride = w * na + tu_int(&r, 11);
+        t->attr = malloc((size_t)t->attr_stride * h * sizeof(float));
+    }
+
+    int ntri = big ? 1 + tu_int(&r, 12) : 1 + tu_int(&r, 40);
+    int nv = 3 * ntri + 16;
+    k->clip = malloc((size_t)nv * 4 * sizeof(float));
+    k->attr = na ? malloc((size_t)nv * na * sizeof(float)) : NULL;
+    k->idx = malloc((size_t)ntri * 3 * sizeof(uint32_t));
+    int v = 0, ti = 0;
+    while (ti < ntri) {
+        int kind = big && tu_int(&r, 2) ? 2 : tu_int(&r, 10);
+        float cx = tu_range(&r, -1.2f, 1.2f), cy = tu_range(&r, -1.2f, 1.2f);
+        float s = tu_range(&r, 0.01f, 0.6f);
+        if (kind == 0 && ti + 2 <= ntri && v + 4 <= nv) {
+            /* Shared edges: a quad as two triangles (same w, same depth
+             * plane), or a fan of four around a centre vertex. */
+            float wq = tu_range(&r, 0.5f, 3.0f);
+            for (int i = 0; i < 4; i++) {
+                float *c = k->clip + 4 * (v + i);
+                c[0] = (cx + ((i == 1 || i == 2) ? s : -s) + tu_range(&r, -0.1f, 0.1f) * s) * wq;
+                c[1] = (cy + (i >= 2 ? s : -s) + tu_range(&r, -0.1f, 0.1f) * s) * wq;
+                c[2] = tu_range(&r, -0.9f, 0.9f) * wq;
+                c[3] = wq;
+            }
+            uint32_t q[6] = { 0, 1, 2, 0, 2, 3 };
+            for (int i = 0; i < 6; i++)
+                k->idx[3 * ti + i] = (uint32_t)v + q[i];
+            v += 4;
+            ti += 2;
+            continue;
+        }
+        if (v + 3 > nv)
+            break;
+        float *c = k->clip + 4 * v;
+        for (int i = 0; i < 3; i++)
+            make_vertex(&r, cx, cy, s, c + 4 * i);
+        switch (kind) {
+        case 1:   /* sliver: third vertex near the line of the first two */
+        {
+            float f = tu_range(&r, -0.5f, 1.5f);
+            for (int q = 0; q < 4; q++)
+                c[8 + q] = c[q] + f * (c[4 + q] - c[q]);
+            c[8] += tu_range(&r, -1e-3f, 1e-3f) * fabsf(c[11]);
+            break;
+        }
+        case 2:   /* huge: around the view, up to far beyond the guard band
+                     (long edges far from the pixels: the int64 path) */
+            for (int i = 0; i < 3; i++) {
+                float a = tu_range(&r, 0.0f, 6.2831853f);
+                float rad = 1.5f * powf(8000.0f, tu_unit(&r));
+                float aw = fabsf(c[4 * i + 3]) > 1e-3f ? fabsf(c[4 * i + 3]) : 1.0f;
+                c[4 * i] = (cx + rad * cosf(a)) * aw;
+                c[4 * i + 1] = (cy + rad * sinf(a)) * aw;
+            }
+            break;
+        case 3:   /* tiny: within a pixel or two */
+            for (int i = 1; i < 3; i++) {
+                c[4 * i + 3] = c[3];
+                c[4 * i] = c[0] + tu_range(&r, -0.02f, 0.02f) * fabsf(c[3]);
+                c[4 * i + 1] = c[1] + tu_range(&r, -0.02f, 0.02f) * fabsf(c[3]);
+            }
+            break;
+        case 4:   /* edge-on: a plane through the eye (same x/w for all) */
+            for (int i = 1; i < 3; i++) {
+                c[4 * i] = c[0] / c[3] * c[4 * i + 3];
+            }
+            break;
+        case 5:   /* across the near plane */
+            c[2] = -2.0f * fabsf(c[3]);
+            c[6] = 0.5f * fabsf(c[7]);
+            break;
+        case 6:   /* rarely: a NaN or infinite coordinate */
+            if (tu_int(&r, 8) == 0)
+                c[tu_int(&r, 12)] = tu_int(&r, 2) ? NAN : INFINITY;
+            break;
+        default:
+            break;
+        }
+        for (int i = 0; i < 3; i++)
+            k->idx[3 * ti + i] = (uint32_t)(v + i);
+        v += 3;
+        ti++;
+    }
+    for (int i = 0; i < v * na; i++)
+        k->attr[i] = tu_int(&r, 16) == 0 ? 1e5f * tu_range(&r, -1, 1) : tu_range(&r, -1, 1);
+    rast_mesh_desc *m = &k->m;
+    m->clip = k->clip;
+    m->vertex_count = v;
+    m->attr = k->attr;
+    m->attr_count = na;
+    m->indices = k->idx;
+    m->tri_count = ti;
+    m->cull = (rast_cull)tu_int(&r, 3);
+}
+
+/* Fills every byte of the planes (padding included) with a pattern, then
+ * clears: padding must come out unchanged. */
+static void reset_target(const rast_target *t)
+{
+    memset(t->mask, 0x5A, (size_t)t->mask_stride * t->height);
+    if (t->depth)
+        memset(t->depth, 0x5A, (size_t)t->depth_stride * t->height * sizeof(float));
+    if (t->attr)
+        memset(t->attr, 0x5A, (size_t)t->attr_stride * t->height * sizeof(float));
+    rast_target_clear(t);
+}
+
+static void free_case(rcase *k)
+{
+    free(k->t.mask);
+    free(k->t.depth);
+    free(k->t.attr);
+    free(k->clip);
+    free(k->attr);
+    free(k->idx);
+}
+
+typedef struct snapshot {
+    uint8_t *mask;
+    float *depth, *attr;
+    rast_stats st;
+} snapshot;
+
+static size_t mask_bytes(const rast_target *t) { return (size_t)t->mask_stride * t->height; }
+static size_t depth_n(const rast_target *t) { return t->depth ? (size_t)t->depth_stride * t->height : 0; }
+static size_t attr_n(const rast_target *t) { return t->attr ? (size_t)t->attr_stride * t->height : 0; }
+
+static void take(const rast_target *t, const rast_stats *st, snapshot *s)
+{
+    s->mask = malloc(mask_bytes(t));
+    memcpy(s->mask, t->mask, mask_bytes(t));
+    s->depth = depth_n(t) ? malloc(depth_n(t) * sizeof(float)) : NULL;
+    if (s->depth) memcpy(s->depth, t->depth, depth_n(t) * sizeof(float));
+    s->attr = attr_n(t) ? malloc(attr_n(t) * sizeof(float)) : NULL;
+    if (s->attr) memcpy(s->attr, t->attr, attr_n(t) * sizeof(float));
+    s->st = *st;
+}
+
+static void drop(snapshot *s)
+{
+    free(s->mask);
+    free(s->depth);
+    free(s->attr);
+}
+
+/* 0 if t equals the snapshot; else prints (when verbose) the first
+ * differing element and returns 1. */
+static int differs(const rast_target *t, const rast_stats *st, const snapshot *s,
+                   const char *what, int verbose)
+{
+    if (!memcmp(t->mask, s->mask, mask_bytes(t)) &&
+        (!t->depth || !memcmp(t->depth, s->depth, depth_n(t) * sizeof(float))) &&
+        (!t->attr || !memcmp(t->attr, s->attr, attr_n(t) * sizeof(float))) &&
+        !memcmp(st, &s->st, sizeof *st))
+        return 0;
+    for (size_t i = 0; i < mask_bytes(t); i++)
+        if (t->mask[i] != s->mask[i]) {
+            if (verbose)
+                printf("%s: mask differs at x=%d y=%d: ref %d, got %d\n", what,
+                       (int)(i % t->mask_stride), (int)(i / t->mask_stride),
+                       s->mask[i], t->mask[i]);
+            return 1;
+        }
+    for (size_t i = 0; i < depth_n(t); i++)
+        if (memcmp(&t->depth[i], &s->depth[i], sizeof(float))) {
+            if (verbose)
+                printf("%s: depth differs at x=%d y=%d: ref %.9g, got %.9g\n", what,
+                       (int)(i % t->depth_stride), (int)(i / t->depth_stride),
+                       s->depth[i], t->depth[i]);
+            return 1;
+        }
+    for (size_t i = 0; i < attr_n(t); i++)
+        if (memcmp(&t->attr[i], &s->attr[i], sizeof(float))) {
+            if (verbose) {
+                size_t col = i % t->attr_stride;
+                printf("%s: attribute %d differs at x=%d y=%d: ref %.9g, got %.9g\n",
+                       what, (int)(col % t->attr_count), (int)(col / t->attr_count),
+                       (int)(i / t->attr_stride), s->attr[i], t->attr[i]);
+            }
+            return 1;
+        }
+    if (memcmp(st, &s->st, sizeof *st)) {
+        if (verbose)
+            printf("%s: stats differ: pixels ref %ld got %ld, drawn ref %ld got %ld\n",
+                   what, s->st.pixels_written, st->pixels_written, s->st.tris_drawn,
+                   st->tris_drawn);
+        return 1;
+    }
+    return 0;
+}
+
+/* 64-bit digest of a buffer (word-wise multiply-xorshift; tu_crc32 is
+ * bitwise and would dominate the run time on megabytes per case). */
+static uint64_t digest(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i += 8) {
+        uint64_t w = 0;
+        memcpy(&w, b + i, n - i < 8 ? n - i : 8);
+        h = (h ^ w) * 0x100000001B3ull;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+/* The CRC over all cases: CRC32 of the per-case digests of every plane
+ * (padding included) and the stats. */
+static uint32_t crc_target(uint32_t crc, const rast_target *t, const rast_stats *st)
+{
+    uint64_t h = digest(0xCBF29CE484222325ull, t->mask, mask_bytes(t));
+    if (t->depth) h = digest(h, t->depth, depth_n(t) * sizeof(float));
+    if (t->attr) h = digest(h, t->attr, attr_n(t) * sizeof(float));
+    long v[7] = { st->tris_in, st->tris_nonfinite, st->tris_clipped_away,
+                  st->tris_degenerate, st->tris_culled, st->tris_drawn,
+                  st->pixels_written };
+    h = digest(h, v, sizeof v);
+    return tu_crc32(crc, &h, sizeof h);
+}
+
+/* Draws case k with scan into a freshly reset target. */
+static void draw_case(rcase *k, rast__scan_rows_fn scan, rast_stats *st)
+{
+    reset_target(&k->t);
+    memset(st, 0, sizeof *st);
+    rast_target tt = k->t;
+    assert_int_equal(rast__draw_with(&tt, &k->m, st, scan), RAST_OK);
+}
+
+/* ---- tests ------------------------------------------------------------- */
+
+/* The soup on one ISA: every case equal to the reference. */
+static void soup_isa(int isa)
+{
+    if (!ef_cpu_has((ef_isa)isa)) {
+        print_message("SKIP raster isa %s: this CPU does not run it\n",
+                      ef_isa_name((ef_isa)isa));
+        skip();
+    }
+    rast__scan_rows_fn scan = rast__scan_for_isa(isa);
+    assert_true(scan != rast__scan_rows_ref);
+    uint32_t crc_ref = 0;
+    long pixels = 0, drawn = 0, clipped = 0, nonfinite = 0, degenerate = 0;
+    for (int n = 0; n < NCASES; n++) {
+        rcase k;
+        make_case(n, &k);
+        rast_stats st;
+        draw_case(&k, rast__scan_rows_ref, &st);
+        snapshot s;
+        take(&k.t, &st, &s);
+        crc_ref = crc_target(crc_ref, &k.t, &st);
+        pixels += st.pixels_written;
+        drawn += st.tris_drawn;
+        clipped += st.tris_clipped_away;
+        nonfinite += st.tris_nonfinite;
+        degenerate += st.tris_degenerate;
+        draw_case(&k, scan, &st);
+        if (differs(&k.t, &st, &s, ef_isa_name((ef_isa)isa), 1))
+            fail_msg("case %d: %s differs from the reference; rerun with "
+                     "test_raster_isa %d", n, ef_isa_name((ef_isa)isa), n);
+        drop(&s);
+        free_case(&k);
+    }
+    print_message("NOTE %s: %d cases, %ld triangles drawn, %ld pixels, %ld clipped "
+                  "away, %ld non-finite, %ld degenerate, all equal to the reference; "
+                  "CRC32 0x%08X (recorded 0x%08X)\n", ef_isa_name((ef_isa)isa), NCASES,
+                  drawn, pixels, clipped, nonfinite, degenerate, crc_ref, ISA_CRC);
+    /* The soup really exercises every path. */
+    assert_true(drawn > 20000 && pixels > 1000000 && clipped > 1000 &&
+                nonfinite > 50 && degenerate > 500);
+    assert_int_equal(crc_ref, ISA_CRC);
+}
+
+static void test_soup_sse2(void **state) { (void)state; soup_isa(EF_ISA_SSE2); }
+static void test_soup_avx2(void **state) { (void)state; soup_isa(EF_ISA_AVX2); }
+static void test_soup_avx512(void **state) { (void)state; soup_isa(EF_ISA_AVX512); }
+
+/* A scene bigger than one batch round: a perspective grid of 4000 quads
+ * (8000 triangles) with overlapping layers, drawn at 333 x 211 with 1, 2,
+ * 3 and 4 threads on every ISA: all equal to the single-thread reference. */
+static void test_threads_equal(void **state)
+{
+    (void)state;
+    enum { W = 333, H = 211, G = 40, L = 5 };   /* 40x20 grid, 5 layers */
+    const int nv = L * (G + 1) * (G / 2 + 1), nt = L * G * (G / 2) * 2;
+    float *clip = malloc((size_t)nv * 4 * sizeof(float));
+    float *attr = malloc((size_t)nv * 3 * sizeof(float));
+    uint32_t *idx = malloc((size_t)nt * 3 * sizeof(uint32_t));
+    tu_rng r = { 77 };
+    int v = 0, ti = 0;
+    for (int l = 0; l < L; l++) {
+        int base = v;
+        for (int j = 0; j <= G / 2; j++)
+            for (int i = 0; i <= G; i++) {
+                float w = tu_range(&r, 0.8f, 2.5f);
+                clip[4 * v + 0] = (-1.3f + 2.6f * i / G + tu_range(&r, -0.02f, 0.02f)) * w;
+                clip[4 * v + 1] = (-1.3f + 2.6f * j / (G / 2) + tu_range(&r, -0.02f, 0.02f)) * w;
+                clip[4 * v + 2] = tu_range(&r, -0.9f, 0.9f) * w;
+                clip[4 * v + 3] = w;
+                for (int a = 0; a < 3; a++)
+                    attr[3 * v + a] = tu_range(&r, -1, 1);
+                v++;
+            }
+        for (int j = 0; j < G / 2; j++)
+            for (int i = 0; i < G; i++) {
+                uint32_t a = (uint32_t)(base + j * (G + 1) + i);
+                uint32_t q[6] = { a, a + 1, a + G + 2, a, a + G + 2, a + G + 1 };
+                memcpy(idx + 3 * ti, q, sizeof q);
+                ti += 2;
+            }
+    }
+    assert_int_equal(v, nv);
+    assert_int_equal(ti, nt);
+    rast_mesh_desc m = { clip, nv, attr, 3, idx, nt, RAST_CULL_NONE };
+    rast_target t = { W, H, malloc((size_t)(W + 3) * H * sizeof(float)), W + 3,
+                      malloc((size_t)(W + 1) * H), W + 1,
+                      malloc((size_t)(W * 3 + 2) * H * sizeof(float)), W * 3 + 2, 3 };
+    rast_stats st;
+    memset(&st, 0, sizeof st);
+    reset_target(&t);
+    assert_int_equal(rast__draw_with(&t, &m, &st, rast__scan_rows_ref), RAST_OK);
+    snapshot s;
+    take(&t, &st, &s);
+    assert_true(st.pixels_written > 2 * W * H);
+    int runs = 0;
+    for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {
+        if (!ef_cpu_has((ef_isa)isa))
+            continue;
+        for (int th = 1; th <= 4; th++) {
+            rast_context_desc d = { isa, th };
+            rast_context *c = rast_context_create(&d);
+            assert_non_null(c);
+            assert_int_equal(rast_context_threads(c), th);
+            assert_true(rast_context_isa(c) <= isa);
+            for (int rep = 0; rep < 2; rep++) {   /* reuse of the pool */
+                reset_target(&t);
+                memset(&st, 0, sizeof st);
+                assert_int_equal(rast_context_draw(c, &t, &m, &st), RAST_OK);
+                char what[64];
+                snprintf(what, sizeof what, "%s, %d threads", ef_isa_name((ef_isa)isa), th);
+                if (differs(&t, &st, &s, what, 1))
+                    fail_msg("%s differs from the single-thread reference", what);
+                runs++;
+            }
+            rast_context_destroy(c);
+        }
+    }
+    print_message("NOTE threads: %d runs equal (pixels %ld)\n", runs, s.st.pixels_written);
+    drop(&s);
+    free(t.depth);
+    free(t.mask);
+    free(t.attr);
+    free(clip);
+    free(attr);
+    free(idx);
+}
+
+/* Contexts: bad descs, errors like rast_draw, the EGOFUSE_ISA cap. */
+static void test_context_api(void **state)
+{
+    (void)state;
+    rast_context_desc bad1 = { 0, -1 }, bad2 = { 0, RAST_MAX_THREADS + 1 },
+                      bad3 = { EF_ISA_COUNT, 1 };
+    assert_null(rast_context_create(&bad1));
+    assert_null(rast_context_create(&bad2));
+    assert_null(rast_context_create(&bad3));
+    rast_context_destroy(NULL);
+    assert_int_equal(rast_context_draw(NULL, NULL, NULL, NULL), RAST_ERR_ARGS);
+
+    rast_context *c = rast_context_create(NULL);
+    assert_non_null(c);
+    assert_int_equal(rast_context_threads(c), 1);
+    assert_int_equal(rast_context_isa(c), rast_draw_isa());
+    rast_context_destroy(c);
+
+    /* Errors through a threaded context: the same as rast_draw, stats
+     * untouched. */
+    rast_context_desc d2 = { 0, 2 };
+    c = rast_context_create(&d2);
+    assert_non_null(c);
+    uint8_t mask[4 * 4];
+    const float clip[12] = { -1, -1, 0, 1, 1, -1, 0, 1, -1, 1, 0, 1 };
+    const uint32_t bad_idx[3] = { 0, 1, 3 }, idx[3] = { 0, 1, 2 };
+    rast_target t = { 4, 4, NULL, 4, mask, 4, NULL, 0, 0 };
+    rast_mesh_desc m = { clip, 3, NULL, 0, bad_idx, 1, RAST_CULL_NONE };
+    rast_stats st;
+    memset(&st, 0, sizeof st);
+    assert_int_equal(rast_context_draw(c, &t, &m, &st), RAST_ERR_INDEX);
+    assert_int_equal(st.tris_in, 0);
+    t.width = 0;
+    m.indices = idx;
+    assert_int_equal(rast_context_draw(c, &t, &m, &st), RAST_ERR_SIZE);
+    t.width = 4;
+    assert_int_equal(rast_context_draw(c, NULL, &m, &st), RAST_ERR_ARGS);
+    rast_target_clear(&t);
+    assert_int_equal(rast_context_draw(c, &t, &m, &st), RAST_OK);
+    assert_int_equal(st.tris_in, 1);
+    assert_int_equal(st.pixels_written, 6);     /* below the diagonal; the
+                                                   diagonal is a right edge */
+    rast_context_destroy(c);
+
+    /* EGOFUSE_ISA caps both rast_draw and new contexts. */
+    const char *old = getenv("EGOFUSE_ISA");
+    char saved[32] = "";
+    if (old)
+        snprintf(saved, sizeof saved, "%s", old);
+    setenv("EGOFUSE_ISA", "ref", 1);
+    assert_int_equal(rast_draw_isa(), EF_ISA_REF);
+    c = rast_context_create(NULL);
+    assert_int_equal(rast_context_isa(c), EF_ISA_REF);
+    rast_context_destroy(c);
+    setenv("EGOFUSE_ISA", "sse2", 1);
+    assert_int_equal(rast_draw_isa(), ef_cpu_has(EF_ISA_SSE2) ? EF_ISA_SSE2 : EF_ISA_REF);
+    if (old)
+        setenv("EGOFUSE_ISA", saved, 1);
+    else
+        unsetenv("EGOFUSE_ISA");
+    /* A cap below the environment wins. */
+    rast_context_desc cap = { EF_ISA_REF, 1 };
+    c = rast_context_create(&cap);
+    assert_int_equal(rast_context_isa(c), EF_ISA_REF);
+    rast_context_destroy(c);
+    print_message("NOTE rast_draw uses %s\n", ef_isa_name((ef_isa)rast_draw_isa()));
+}
+
+/* ---- rerun of one case --------------------------------------------------- */
+
+static int rerun(int n)
+{
+    rcase k;
+    make_case(n, &k);
+    printf("case %d: %dx%d, strides mask %d depth %d attr %d, %d attributes%s, "
+           "%d triangles, cull %d\n", n, k.t.width, k.t.height, k.t.mask_stride,
+           k.t.depth_stride, k.t.attr_stride, k.t.attr_count,
+           k.t.attr ? "" : " (no plane)", k.m.tri_count, (int)k.m.cull);
+    rast_stats st;
+    draw_case(&k, rast__scan_rows_ref, &st);
+    snapshot s;
+    take(&k.t, &st, &s);
+    int bad = 0;
+    for (size_t i = 0; i < sizeof isas / sizeof isas[0]; i++) {
+        if (!ef_cpu_has((ef_isa)isas[i])) {
+            printf("SKIP %s: this CPU does not run it\n", ef_isa_name((ef_isa)isas[i]));
+            continue;
+        }
+        draw_case(&k, rast__scan_for_isa(isas[i]), &st);
+        if (differs(&k.t, &st, &s, ef_isa_name((ef_isa)isas[i]), 1))
+            bad = 1;
+        else
+            printf("%s: equal to the reference (%ld pixels)\n",
+                   ef_isa_name((ef_isa)isas[i]), st.pixels_written);
+    }
+    drop(&s);
+    free_case(&k);
+    return bad;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1)
+        return rerun(atoi(argv[1]));
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_soup_sse2),
+        cmocka_unit_test(test_soup_avx2),
+        cmocka_unit_test(test_soup_avx512),
+        cmocka_unit_test(test_threads_equal),
+        cmocka_unit_test(test_context_api),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
