@@ -141,6 +141,68 @@ io_result io_scene_load(const char *path, io_scene *out, io_error *err);
 void io_scene_frame_path(const io_scene *s, const char *pattern, int frame,
                          char *out, size_t out_size);
 
+/* ------------------------------------------------------------- tracking
+ * io_track.c: recorded tracking files ("egofuse-track 1"), per-user
+ * calibration files ("egofuse-calib 1") and the live UDP stream of
+ * KIN_TRACK_PACKET_SIZE-byte packets (formats: docs/tracking.md; parsing
+ * is kin's, see kin_track_parse / kin_track_packet_read). */
+
+/* Loads a whole recording; *out is allocated (free with io_track_free).
+ * Errors name the file and line: "rec.txt:12: SL needs 3 numbers, got 2". */
+io_result io_track_load(const char *path, kin_track_sample **out, int *count,
+                        io_error *err);
+void io_track_free(kin_track_sample *samples);
+/* Writes a recording (header + one line per sample), atomically. */
+io_result io_track_save(const char *path, const kin_track_sample *samples,
+                        int count, io_error *err);
+
+io_result io_user_calib_load(const char *path, kin_user_calib *out,
+                             io_error *err);
+io_result io_user_calib_save(const char *path, const kin_user_calib *c,
+                             io_error *err);
+
+/* One UDP endpoint: a receiver (io_track_udp_listen) or a sender
+ * (io_track_udp_connect). Plain data; close with io_track_udp_close. */
+typedef struct io_track_udp {
+    int fd;                      /* socket, -1 when closed */
+    int port;                    /* bound (receiver) or destination port */
+    uint32_t dest_addr;          /* sender: IPv4 address, network order */
+    /* receiver state */
+    uint64_t packets;            /* datagrams received */
+    uint64_t accepted;           /* valid and newer than the last */
+    uint64_t rejected;           /* malformed (size, magic, CRC, values) */
+    uint64_t stale;              /* valid but not newer (reordered, dup) */
+    uint32_t last_seq;           /* sequence of the last accepted packet */
+    int have_good;               /* 1 once a packet was accepted */
+    kin_track_sample last_good;  /* the newest accepted sample */
+    char status[512];            /* last report, e.g. "packet 17: CRC
+                                    mismatch (...); keeping the pose of
+                                    seq 15 (t = 1.250 s)" */
+} io_track_udp;
+
+/* Binds a receiver to addr (dotted IPv4, NULL = "127.0.0.1") and port
+ * (0 = any free port; read it back from u->port). Non-blocking. */
+io_result io_track_udp_listen(io_track_udp *u, const char *addr, int port,
+                              io_error *err);
+/* Reads every pending datagram, waiting up to timeout_ms (0 = not at all)
+ * for the first. Valid packets with a sequence newer than the last
+ * (serial-number arithmetic, so it wraps) are accepted; others are
+ * counted and described in u->status, never fatal. *out receives the
+ * newest good sample (the last good pose when nothing new came, valid = 0
+ * before the first), *fresh (may be NULL) the number accepted now.
+ * Returns IO_OK, or IO_ERR_DEVICE on a socket error (state kept). */
+io_result io_track_udp_poll(io_track_udp *u, int timeout_ms,
+                            kin_track_sample *out, int *fresh, io_error *err);
+/* A sender to addr:port. */
+io_result io_track_udp_connect(io_track_udp *u, const char *addr, int port,
+                               io_error *err);
+io_result io_track_udp_send(io_track_udp *u, const kin_track_sample *s,
+                            uint32_t seq, io_error *err);
+/* Sends arbitrary bytes (tests of malformed packets). */
+io_result io_track_udp_send_raw(io_track_udp *u, const void *bytes, size_t n,
+                                io_error *err);
+void io_track_udp_close(io_track_udp *u);
+
 #ifdef __cplusplus
 }
 #endif

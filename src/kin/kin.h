@@ -281,6 +281,396 @@ kin_camera kin_camera_look_at(kin_vec3 eye, kin_vec3 target, kin_vec3 up,
                               float fovy_deg, int width, int height,
                               float znear, float zfar);
 
+/* =====================================================================
+ * TRACKING, IK, HANDS, FILTERING, USER CALIBRATION, DQS  (issue 4)
+ * Files: kin_track.c, kin_ik.c, kin_hand.c, kin_filter.c, kin_calib.c,
+ * kin_dqs.c; formats and rules in docs/tracking.md.
+ *
+ * Per frame:  kin_filter_push(sample) -> kin_filter_output(display time)
+ *   -> kin_arm_rig_pose() (body, head, two-bone IK per arm, glove ->
+ *   fingers) -> kin_fk -> kin_skin_joint_matrices -> kin_skin_lbs or
+ *   kin_skin_dq_from_matrices + kin_skin_dqs. Nothing here allocates or
+ *   keeps hidden state; filter state lives in the caller's kin_filter.
+ * ===================================================================== */
+
+typedef enum kin_side { KIN_SIDE_LEFT = 0, KIN_SIDE_RIGHT = 1 } kin_side;
+
+/* Rotation whose matrix has the columns x, y, z (orthonormal,
+ * right-handed; Shepperd's method, w >= 0). */
+kin_quat kin_quat_from_axes(kin_vec3 x, kin_vec3 y, kin_vec3 z);
+/* (-x, -y, -z, w): the inverse of a unit quaternion. */
+kin_quat kin_quat_conjugate(kin_quat q);
+
+#define KIN_GLOVE_SENSORS 5        /* thumb, index, middle, ring, little */
+#define KIN_HAND_JOINTS 15         /* thumb_1..3, index_1..3, ..., little_1..3 */
+
+/* Parts of a tracking sample; a set bit in kin_track_sample.valid says the
+ * part holds a measurement (a cleared bit: the part is missing). */
+enum {
+    KIN_TRACK_HEAD       = 1 << 0,
+    KIN_TRACK_SHOULDER_L = 1 << 1,
+    KIN_TRACK_SHOULDER_R = 1 << 2,
+    KIN_TRACK_HAND_L     = 1 << 3,
+    KIN_TRACK_HAND_R     = 1 << 4,
+    KIN_TRACK_GLOVE_L    = 1 << 5,
+    KIN_TRACK_GLOVE_R    = 1 << 6,
+    KIN_TRACK_ALL        = 0x7F
+};
+
+/* One measurement of the five tracking points and both gloves (world
+ * space, metres). The hand pose is the wrist joint: its position is the
+ * wrist centre and its rotation the hand frame (-Z towards the fingers,
+ * +Y the back of the hand, as the model's hand joint). Values of a part
+ * whose valid bit is clear are undefined. */
+typedef struct kin_track_sample {
+    double t;                      /* capture time, seconds */
+    uint32_t valid;                /* KIN_TRACK_* bits */
+    kin_vec3 head_pos;             /* midpoint of the eyes */
+    kin_quat head_rot;             /* head frame: -Z forward, +X right eye */
+    kin_vec3 shoulder[2];          /* shoulder joint centres, [KIN_SIDE_*] */
+    kin_vec3 hand_pos[2];          /* wrist centres */
+    kin_quat hand_rot[2];          /* hand frames */
+    float glove[2][KIN_GLOVE_SENSORS]; /* flexure 0 (open) .. 1 (fist) */
+} kin_track_sample;
+
+/* Checks finiteness, unit quaternions (| |q| - 1 | <= 1e-3) and glove
+ * values in [0, 1] of the valid parts. Returns 0, or -1 with a reason. */
+int kin_track_sample_validate(const kin_track_sample *s, char *why,
+                              size_t why_size);
+
+/* Recorded text format "egofuse-track 1" (docs/tracking.md): a header,
+ * then one sample per line, e.g.
+ *   t 0.011 H 0 1.25 -0.08 0 0 0 1 SL -0.19 1 0 HR 0.2 1 -0.4 0 0 0 1 GR .1 .2 .2 .3 .3
+ * Parses a whole buffer (not NUL-terminated: text_len bytes). Call once
+ * with out == NULL to get the sample count in *count, then with out of
+ * capacity cap. Returns 0, or -1 with *err_line (1-based, 0 when the
+ * error is not on one line) and "reason" in why. Strict: unknown or
+ * repeated tags, wrong counts, trailing junk, non-finite numbers, glove
+ * values outside [0, 1], non-unit quaternions and time stamps that do not
+ * increase are errors. */
+int kin_track_parse(const char *text, size_t text_len, kin_track_sample *out,
+                    int cap, int *count, int *err_line, char *why,
+                    size_t why_size);
+/* Parses one data line (without the newline). Returns 1 for a sample, 0
+ * for a blank or comment line, -1 with a reason on error. */
+int kin_track_parse_line(const char *line, size_t len, kin_track_sample *out,
+                         char *why, size_t why_size);
+/* Writes one sample as a data line with '\n' (9 significant digits, so a
+ * float reads back exactly). Returns the length it needs (like snprintf);
+ * the text is complete only when that is < size. */
+int kin_track_format_line(const kin_track_sample *s, char *buf, size_t size);
+/* The header line of the format, with '\n'. */
+const char *kin_track_header(void);
+
+/* Live packets (UDP), little-endian, KIN_TRACK_PACKET_SIZE bytes:
+ *   0  "EGTK"  4  u16 version (1)  6  u16 valid bits  8  u32 sequence
+ *   12 f64 t   20  37 x f32: head pos(3) rot(4), shoulder L(3) R(3),
+ *   hand L pos(3) rot(4), hand R pos(3) rot(4), glove L(5) R(5)
+ *   168 u32 CRC-32 (IEEE) of bytes 0..167. */
+#define KIN_TRACK_PACKET_SIZE 172
+#define KIN_TRACK_PACKET_VERSION 1
+void kin_track_packet_write(const kin_track_sample *s, uint32_t seq,
+                            uint8_t out[KIN_TRACK_PACKET_SIZE]);
+/* Returns 0 and fills *out and *seq, or -1 with a reason (size, magic,
+ * version, CRC, unknown valid bits, and kin_track_sample_validate). */
+int kin_track_packet_read(const uint8_t *buf, size_t len,
+                          kin_track_sample *out, uint32_t *seq, char *why,
+                          size_t why_size);
+
+/* World rotation of the body frame from the shoulders: +X from the left
+ * to the right shoulder, +Y world up orthogonalised against X (the torso's
+ * pitch is not observable from two points; when the shoulder line is
+ * within ~6 degrees of vertical the direction to the head is used
+ * instead), +Z = X x Y (backwards; the body faces -Z). */
+kin_quat kin_body_frame(kin_vec3 shoulder_l, kin_vec3 shoulder_r,
+                        kin_vec3 head);
+
+/* ---------------------------------------------------------- arm IK job */
+
+/* Analytic two-bone IK shoulder -> elbow -> wrist (kin_ik.c, rules in
+ * docs/tracking.md). Zero means default for every float parameter.
+ *
+ * Reach: d = |wrist - shoulder| is softly limited to
+ *   [d_min, d_max], d_max = L1 + L2 (straight) and d_min the distance at
+ *   the maximum elbow flexion; above soft * d_max the distance follows
+ *   d_s + (d_max - d_s)(1 - exp(-(d - d_s)/(d_max - d_s))), so it is C1
+ *   and never reaches the straight-arm singularity; below d_min + the
+ *   same margin it is mirrored. The wrist is then pulled along the
+ *   shoulder-wrist line (reach_error reports by how much).
+ * Swivel: the elbow lies on the circle around that line (axis u). The
+ *   body's preferred direction b(u) is a dipole field on the sphere of arm
+ *   directions (body frame): A = down reflected in the plane normal to
+ *   u - Q, then projected: b = perp(A - 2 (A.w) w, u), w = (u-Q)/|u-Q|,
+ *   perp(v, u) = v - (v.u)u, Q = (-+0.707, 0, 0.707) (medially backwards
+ *   for the right / left arm). |b| = 1 everywhere but at u = Q (the arm
+ *   pointing into the back of the torso, outside its range), where it is
+ *   undefined. It gives "elbow down" for an arm forward, to the side or
+ *   back, "elbow back" for a hanging arm, "forward and out" for a raised
+ *   one. The hand turns it about u towards h = perp(-finger axis, u)
+ *   (where the forearm would point along the hand, i.e. least wrist bend)
+ *   by hand_gain * h.(u x b) radians:
+ *   linear in the hand's direction, so no flip when the hand points
+ *   against b. At the shoulder (d -> 0) u fades to the body's
+ *   forward-down direction F (singular only at D = -F d_min/4, behind and
+ *   above the shoulder, inside the body).
+ * Limits: elbow flexion <= elbow_max; the forearm takes twist_share of
+ *   the hand's roll about the forearm, clamped to +-twist_max. */
+typedef struct kin_arm_ik_job {
+    /* inputs */
+    kin_vec3 shoulder;        /* shoulder joint centre, world */
+    kin_vec3 wrist;           /* wrist target, world */
+    kin_quat hand_rot;        /* hand frame, world (unit) */
+    kin_quat body_rot;        /* kin_body_frame(), world (unit) */
+    kin_side side;
+    float upper_len, fore_len;/* bone lengths, metres, > 0 (required) */
+    float elbow_max_deg;      /* max flexion, default 150 */
+    float soft;               /* soft reach start, fraction of d_max,
+                                 default 0.97, in (0.5, 1) */
+    float hand_gain;          /* swivel towards the hand, radians per unit
+                                 of h.(u x b), default 1, in (0, 2] */
+    float twist_share;        /* default 0.5, in [0, 1] */
+    float twist_max_deg;      /* default 85 */
+    /* outputs (all written by kin_arm_ik_run) */
+    kin_vec3 elbow;           /* elbow position */
+    kin_vec3 wrist_out;       /* reached wrist position */
+    kin_quat upper_rot;       /* world rotations in the model's bone frame: */
+    kin_quat fore_rot;        /*  -Z along the bone, +X the elbow hinge */
+    float flexion;            /* elbow flexion, radians, 0 = straight */
+    float swivel;             /* the hand's turn of the elbow about the
+                                 line from b, radians, in [-hand_gain,
+                                 hand_gain] */
+    float reach_error;        /* |wrist_out - wrist|, metres */
+} kin_arm_ik_job;
+
+/* 1 if the inputs are valid (finite, unit quaternions, lengths > 0,
+ * parameters in range), else 0 with a reason. */
+int kin_arm_ik_validate(const kin_arm_ik_job *job, char *why, size_t why_size);
+/* Validates, then solves. Returns 1, or 0 (outputs untouched). */
+int kin_arm_ik_run(kin_arm_ik_job *job);
+
+/* ---------------------------------------------------------------- hands */
+
+/* Glove calibration: raw sensor readings -> flexure 0..1 per sensor,
+ * g = clamp((raw - raw_open) / (raw_fist - raw_open), 0, 1) (either order
+ * of the two readings works). */
+typedef struct kin_glove_calib {
+    float raw_open[KIN_GLOVE_SENSORS];
+    float raw_fist[KIN_GLOVE_SENSORS];
+} kin_glove_calib;
+
+/* Fits the calibration from n raw readings (5 floats each) taken while
+ * the user opens the hand flat and makes a fist: per sensor the 2nd and
+ * 98th percentile of the readings (robust to spikes) become open / fist
+ * (the lower is "open" unless invert_mask bit k says the sensor reads
+ * lower when bent). scratch: n floats. Returns 0, or -1 when n < 8, a
+ * reading is not finite or a sensor's range is below min_range. */
+int kin_glove_calib_fit(const float *raw, int n, unsigned invert_mask,
+                        float min_range, float *scratch,
+                        kin_glove_calib *out, char *why, size_t why_size);
+/* Applies it: out[k] in [0, 1]; a non-finite raw reading gives -1 and
+ * leaves out untouched, else 0. */
+int kin_glove_calib_apply(const kin_glove_calib *c,
+                          const float raw[KIN_GLOVE_SENSORS],
+                          float out[KIN_GLOVE_SENSORS]);
+
+/* Flexion (degrees) of the three joints of one finger at flexure 0 and 1.
+ * Thumb: joint 0 also takes opposition (about the palm's long axis). */
+typedef struct kin_hand_params {
+    float open_deg[5][3];     /* default: a relaxed open hand */
+    float fist_deg[5][3];     /* default: a loose fist */
+    float dip_coupling;       /* DIP = coupling * PIP when > 0 (overrides
+                                 the DIP table), default 2/3 */
+    float thumb_opp_deg[2];   /* opposition at 0 and 1, default 12, 40 */
+} kin_hand_params;
+
+/* Default parameters (the table in docs/tracking.md). */
+kin_hand_params kin_hand_params_default(void);
+
+/* Glove -> 15 finger joint rotations of one hand (kin_hand.c).
+ * Finger f (0 thumb .. 4 little), joint k (0 MCP/CMC, 1 PIP/MCP,
+ * 2 DIP/IP): angle a = open + g_f (fist - open) degrees (DIP: coupling *
+ * PIP), local rotation r = rest * Rx(-a) (flexion towards the palm, -Y),
+ * except the thumb's joint 0: Rz(s opp) * rest * Rx(-a), s = +1 right,
+ * -1 left. */
+typedef struct kin_hand_job {
+    const float *glove;           /* 5 values in [0, 1] (required) */
+    const kin_hand_params *params;/* NULL = kin_hand_params_default() */
+    const kin_quat *rest;         /* 15 rest rotations, or NULL = identity */
+    kin_side side;
+    kin_quat *out;                /* 15 local rotations (required) */
+    float *angles_deg;            /* 15 flexion angles, or NULL */
+} kin_hand_job;
+
+int kin_hand_validate(const kin_hand_job *job, char *why, size_t why_size);
+int kin_hand_run(const kin_hand_job *job);
+
+/* ------------------------------------------------------ arm rig (model) */
+
+/* Node names the rig needs: "body", "head" and per side ("L_", "R_")
+ * shoulder, upper_arm, forearm, hand, palm, thumb_1..3, index_1..3,
+ * middle_1..3, ring_1..3, little_1..3. */
+#define KIN_RIG_SIDE_JOINTS 20
+enum {
+    KIN_RIG_SHOULDER = 0, KIN_RIG_UPPER_ARM, KIN_RIG_FOREARM, KIN_RIG_HAND,
+    KIN_RIG_PALM, KIN_RIG_FINGER0    /* first of 15 finger joints */
+};
+
+typedef struct kin_arm_rig {
+    int body, head;
+    int joint[2][KIN_RIG_SIDE_JOINTS];   /* node indices, [side][KIN_RIG_*] */
+    float upper_len[2], fore_len[2];     /* model bone lengths, metres */
+    float shoulder_width;                /* model, between upper_arm nodes */
+} kin_arm_rig;
+
+/* Name of joint j (KIN_RIG_*) of a side into buf ("R_index_2"). */
+const char *kin_arm_rig_joint_name(kin_side side, int j, char *buf, size_t n);
+/* Finds the nodes by name. Returns 0, or -1 with every missing joint
+ * listed in why ("missing joints: L_thumb_3, R_palm") or another reason
+ * (parents not in chain order, zero bone length). */
+int kin_arm_rig_init(kin_arm_rig *rig, const kin_model *model, char *why,
+                     size_t why_size);
+
+/* Per-user calibration (kin_calib.c). */
+typedef struct kin_user_calib {
+    float arm_scale[2];       /* factor on upper arm and forearm length */
+    float hand_scale[2];      /* factor on palm and finger lengths */
+    float shoulder_scale;     /* factor on the shoulder offsets */
+    float arm_length[2];      /* measured shoulder-to-wrist, metres */
+    float shoulder_width;     /* measured, metres */
+    int has_glove[2];
+    kin_glove_calib glove[2];
+} kin_user_calib;
+
+/* Scale 1 everywhere, no glove calibration. */
+kin_user_calib kin_user_calib_identity(void);
+
+/* Poses the model from one (filtered) sample into locals (node_count,
+ * start from kin_pose_rest()): places "body" (a root) at the shoulders in
+ * kin_body_frame(), scales bone offsets by calib (NULL = identity), sets
+ * the head node from head_pos/head_rot, solves both arms with
+ * kin_arm_ik_run (ik_params: parameters only, NULL = defaults) and the
+ * fingers with kin_hand_run. Parts missing from sample->valid keep their
+ * locals. ik_out (2 jobs, or NULL) receives the solved jobs. Returns 1,
+ * or 0 when the sample or the model do not fit (then locals are left as
+ * far as they were written). */
+int kin_arm_rig_pose(const kin_arm_rig *rig, const kin_model *model,
+                     const kin_user_calib *calib,
+                     const kin_arm_ik_job *ik_params,
+                     const kin_track_sample *sample, kin_transform *locals,
+                     kin_arm_ik_job ik_out[2]);
+
+/* Estimates the calibration from a recording of the arms stretched
+ * forward and sideways (and the hands opened and closed, for gloves
+ * whose samples are raw readings: not done here): per side the 95th
+ * percentile of |hand - shoulder| over the valid samples is the arm
+ * length (the shoulder-wrist distance of the straight arm),
+ * arm_scale = length / (upper_len + fore_len) of the rig; hand_scale =
+ * arm_scale; shoulder width = median |R - L|. scratch: n floats. Needs
+ * >= 20 valid samples per side, else -1 with a reason. Scales outside
+ * [0.5, 2] are rejected as implausible. */
+int kin_user_calib_estimate(const kin_track_sample *samples, int n,
+                            const kin_arm_rig *rig, float *scratch,
+                            kin_user_calib *out, char *why, size_t why_size);
+/* Text file "egofuse-calib 1" (docs/tracking.md) into buf; returns the
+ * length needed (like snprintf). */
+int kin_user_calib_format(const kin_user_calib *c, char *buf, size_t size);
+/* Strict parse (missing or repeated keys, bad numbers, out-of-range
+ * scales are errors). Returns 0, or -1 with *err_line and a reason. */
+int kin_user_calib_parse(const char *text, size_t len, kin_user_calib *out,
+                         int *err_line, char *why, size_t why_size);
+
+/* ------------------------------------------------ filter and prediction */
+
+/* One Euro filter (Casiez et al. 2012) per part, constant-velocity
+ * prediction to the display time, and dropout handling. Zero = default. */
+typedef struct kin_filter_desc {
+    float min_cutoff_hz;      /* positions, default 1.5 */
+    float beta;               /* positions, s/m, default 4 */
+    float rot_min_cutoff_hz;  /* rotations, default 1.5 */
+    float rot_beta;           /* rotations, s/rad, default 0.5 */
+    float glove_min_cutoff_hz;/* gloves, default 3 */
+    float d_cutoff_hz;        /* derivative, default 1 */
+    float max_predict_s;      /* horizon limit, default 0.1 */
+    float hold_s;             /* dropout: hold the pose, default 0.15 */
+    float fade_s;             /* then fade confidence to 0, default 0.35 */
+    float reset_s;            /* a time stamp older than the last by more
+                                 than this restarts the filter, default 0.5 */
+    int no_lag_comp;          /* 1: predict x + dx h only (the output keeps
+                                 the low-pass's lag but less jitter); 0
+                                 (default): add the lag, see below */
+} kin_filter_desc;
+
+#define KIN_FILTER_PARTS 7    /* head, shoulder L/R, hand L/R, glove L/R */
+
+/* State of one part: filtered value, derivative (per second), last time. */
+typedef struct kin_filter_part {
+    int has;                  /* 0 until the first measurement */
+    double t;                 /* time of the last measurement */
+    kin_vec3 x, dx;           /* filtered position, velocity (m/s) */
+    kin_quat q;               /* filtered rotation */
+    kin_vec3 w;               /* angular velocity, world, rad/s */
+    float g[KIN_GLOVE_SENSORS], dg[KIN_GLOVE_SENSORS];
+    kin_vec3 z;               /* last raw measurement (velocities are */
+    kin_quat zq;              /*  taken from raw differences, unbiased */
+    float zg[KIN_GLOVE_SENSORS]; /* by the filter's lag) */
+    float lag, rot_lag;       /* ramp lag of the last update, seconds:
+                                 dt (1 - a) / a */
+} kin_filter_part;
+
+typedef struct kin_filter {
+    kin_filter_desc desc;     /* resolved */
+    double last_t;            /* newest accepted time stamp */
+    int started;
+    kin_filter_part part[KIN_FILTER_PARTS];
+    /* counters, for reporting */
+    uint32_t accepted, dropped_old, restarts, nonfinite_parts;
+} kin_filter;
+
+/* Result bits of kin_filter_push. */
+enum {
+    KIN_FILTER_ACCEPTED = 1,      /* the sample updated the filter */
+    KIN_FILTER_OLD      = 2,      /* dropped: not newer than the last */
+    KIN_FILTER_RESTART  = 4,      /* time went back by > reset_s: restarted */
+    KIN_FILTER_NONFINITE= 8       /* some part was not finite: treated as
+                                     missing */
+};
+
+kin_filter_desc kin_filter_desc_resolved(const kin_filter_desc *d);
+void kin_filter_init(kin_filter *f, const kin_filter_desc *desc);
+/* Feeds one measurement. Parts missing from valid (or not finite, or with
+ * bad quaternions / glove values) are skipped. Returns KIN_FILTER_* bits. */
+int kin_filter_push(kin_filter *f, const kin_track_sample *s);
+/* The pose predicted for display_t (seconds, on the sample clock): per
+ * part x + dx (h + lag) with h = clamp(display_t - t_part, 0,
+ * max_predict_s) and lag the low-pass's delay on a ramp (so a constant
+ * velocity is predicted exactly; velocity noise times lag adds jitter,
+ * desc.no_lag_comp = 1 sets lag = 0), rotations advanced by
+ * w (h + rot_lag). conf[part] (KIN_FILTER_PARTS, or NULL) is
+ * 1 while age = display_t - t_part <= hold_s, then falls linearly to 0 at
+ * hold_s + fade_s (the mask of that part fades with it); a part with
+ * conf 0 is cleared from out->valid. out->t = display_t. */
+void kin_filter_output(const kin_filter *f, double display_t,
+                       kin_track_sample *out, float *conf);
+
+/* --------------------------------------------- dual-quaternion skinning */
+
+/* Unit dual quaternion: real part r (rotation), dual part d = t r / 2. */
+typedef struct kin_dualquat { kin_quat r, d; } kin_dualquat;
+
+/* From a rigid matrix (rotation + translation; a scale in the matrix is
+ * removed by orthonormalising its columns). */
+kin_dualquat kin_dualquat_from_mat4(const kin_mat4 *m);
+kin_vec3 kin_dualquat_transform(const kin_dualquat *q, kin_vec3 p);
+/* dq[j] = kin_dualquat_from_mat4(&jm[j]) for j < count. */
+void kin_skin_dq_from_matrices(const kin_mat4 *jm, int count,
+                               kin_dualquat *dq);
+/* Dual-quaternion skinning (Kavan et al. 2008): b = sum w_i s_i dq_i with
+ * s_i = sign(r_i . r_0) (shortest path), then b / |b.r|; positions by b,
+ * normals by its rotation. Like kin_skin_lbs otherwise (zero weights keep
+ * the bind pose, outputs must not alias). */
+void kin_skin_dqs(const kin_mesh *mesh, const kin_dualquat *dq,
+                  float *pos_out, float *nrm_out);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,100 @@
+/* kin_dqs.c - dual-quaternion skinning (Kavan, Collins, Zara, O'Sullivan,
+ * "Geometric skinning with approximate dual quaternion blending", 2008),
+ * the scalar reference.
+ *
+ * A rigid transform (R, t) is the unit dual quaternion r + e d with r the
+ * rotation and d = (t, 0) r / 2. Per vertex: b = sum_i w_i s_i dq_i with
+ * s_i = +1 if r_i . r_first >= 0 else -1 (r_first: the first influence
+ * with w != 0), then b /= |b.r|; p' = b.r p b.r* + t(b),
+ * t(b) = 2 (b.r.w b.d.v - b.d.w b.r.v + b.r.v x b.d.v), n' = b.r n b.r*.
+ * Unlike LBS the blend of two rotations is a rotation, so a twisted wrist
+ * keeps its cross-section (LBS shrinks it by cos(angle/2)). Scale and
+ * mirroring are not representable: kin_dualquat_from_mat4 orthonormalises.
+ * No allocation. */
+#include "kin.h"
+
+#include <math.h>
+
+kin_dualquat kin_dualquat_from_mat4(const kin_mat4 *m)
+{
+    kin_vec3 c0 = kin_v3(m->m[0], m->m[1], m->m[2]);
+    kin_vec3 c1 = kin_v3(m->m[4], m->m[5], m->m[6]);
+    kin_vec3 x = kin_v3_norm(c0);
+    kin_vec3 y = kin_v3_norm(kin_v3_sub(c1, kin_v3_scale(x, kin_v3_dot(x, c1))));
+    kin_dualquat q;
+    if (kin_v3_len(x) == 0.0f || kin_v3_len(y) == 0.0f) {
+        q.r = kin_quat_identity();
+    } else {
+        kin_vec3 z = kin_v3_cross(x, y);
+        q.r = kin_quat_from_axes(x, y, z);
+    }
+    kin_quat t = { m->m[12], m->m[13], m->m[14], 0.0f };
+    kin_quat d = kin_quat_mul(t, q.r);
+    q.d = (kin_quat){ 0.5f * d.x, 0.5f * d.y, 0.5f * d.z, 0.5f * d.w };
+    return q;
+}
+
+/* Translation of a dual quaternion whose real part is unit. */
+static kin_vec3 dq_translation(const kin_dualquat *q)
+{
+    kin_vec3 rv = kin_v3(q->r.x, q->r.y, q->r.z), dv = kin_v3(q->d.x, q->d.y, q->d.z);
+    kin_vec3 t = kin_v3_add(kin_v3_sub(kin_v3_scale(dv, q->r.w), kin_v3_scale(rv, q->d.w)),
+                            kin_v3_cross(rv, dv));
+    return kin_v3_scale(t, 2.0f);
+}
+
+kin_vec3 kin_dualquat_transform(const kin_dualquat *q, kin_vec3 p)
+{
+    return kin_v3_add(kin_quat_rotate(q->r, p), dq_translation(q));
+}
+
+void kin_skin_dq_from_matrices(const kin_mat4 *jm, int count, kin_dualquat *dq)
+{
+    if (!jm || !dq) return;
+    for (int j = 0; j < count; j++) dq[j] = kin_dualquat_from_mat4(&jm[j]);
+}
+
+void kin_skin_dqs(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out, float *nrm_out)
+{
+    if (!mesh || !pos_out) return;
+    const int do_n = mesh->normals && nrm_out;
+    const int skinned = mesh->joints && mesh->weights && dq;
+    for (int v = 0; v < mesh->vertex_count; v++) {
+        const float *p = mesh->positions + (size_t)v * 3;
+        float *po = pos_out + (size_t)v * 3;
+        const float *n = do_n ? mesh->normals + (size_t)v * 3 : NULL;
+        float *no = do_n ? nrm_out + (size_t)v * 3 : NULL;
+        float b[8] = { 0 };
+        float wsum = 0.0f;
+        const kin_quat *r0 = NULL;
+        if (skinned) {
+            const uint16_t *j = mesh->joints + (size_t)v * 4;
+            const float *w = mesh->weights + (size_t)v * 4;
+            for (int i = 0; i < 4; i++) {
+                if (w[i] == 0.0f) continue;
+                const kin_dualquat *q = &dq[j[i]];
+                if (!r0) r0 = &q->r;
+                float dot = q->r.x * r0->x + q->r.y * r0->y + q->r.z * r0->z + q->r.w * r0->w;
+                float s = dot < 0.0f ? -w[i] : w[i];
+                b[0] += s * q->r.x; b[1] += s * q->r.y; b[2] += s * q->r.z; b[3] += s * q->r.w;
+                b[4] += s * q->d.x; b[5] += s * q->d.y; b[6] += s * q->d.z; b[7] += s * q->d.w;
+                wsum += w[i];
+            }
+        }
+        float len = sqrtf(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3]);
+        if (wsum == 0.0f || !(len > 0.0f)) {
+            po[0] = p[0]; po[1] = p[1]; po[2] = p[2];
+            if (do_n) { no[0] = n[0]; no[1] = n[1]; no[2] = n[2]; }
+            continue;
+        }
+        float inv = 1.0f / len;
+        kin_dualquat q = { { b[0] * inv, b[1] * inv, b[2] * inv, b[3] * inv },
+                           { b[4] * inv, b[5] * inv, b[6] * inv, b[7] * inv } };
+        kin_vec3 r = kin_dualquat_transform(&q, kin_v3(p[0], p[1], p[2]));
+        po[0] = r.x; po[1] = r.y; po[2] = r.z;
+        if (do_n) {
+            kin_vec3 nn = kin_v3_norm(kin_quat_rotate(q.r, kin_v3(n[0], n[1], n[2])));
+            no[0] = nn.x; no[1] = nn.y; no[2] = nn.z;
+        }
+    }
+}
