@@ -178,6 +178,43 @@ static void threads_same_bytes(void **state)
     kin_model_free(&m);
 }
 
+/* A virtual wall nearer than the hand hides it everywhere (out == V); a
+ * far one changes nothing. */
+static void virtual_depth(void **state)
+{
+    (void)state;
+    kin_model m;
+    quad_model(&m, 0.1f, -0.5f);
+    pipe_ctx *p = pipe_create(NULL, &m);
+    assert_non_null(p);
+    float *wall = malloc(sizeof(float) * 1280 * 800);
+    assert_non_null(wall);
+    frame_bufs b, c;
+    pipe_frame_in in, ref;
+    make_frame(&b, &in, 11);
+    make_frame(&c, &ref, 11);
+    assert_int_equal(pipe_frame(p, &ref, NULL, NULL, 0), PIPE_OK); /* no depth */
+    for (int i = 0; i < 1280 * 800; i++) wall[i] = 50.0f;
+    for (int e = 0; e < 2; e++) {
+        in.virt_depth[e] = wall;
+        in.virt_depth_stride[e] = 1280;
+    }
+    assert_int_equal(pipe_frame(p, &in, NULL, NULL, 0), PIPE_OK);
+    for (int e = 0; e < 2; e++) assert_memory_equal(b.out[e], c.out[e], 1280 * 800 * 4);
+    for (int i = 0; i < 1280 * 800; i++) wall[i] = 0.2f; /* nearer than the quad */
+    assert_int_equal(pipe_frame(p, &in, NULL, NULL, 0), PIPE_OK);
+    for (int e = 0; e < 2; e++) {
+        assert_memory_not_equal(b.out[e], c.out[e], 1280 * 800 * 4);
+        for (int i = 0; i < 1280 * 800 * 4; i++)
+            if ((i & 3) != 3) assert_int_equal(b.out[e][i], b.virt[e][i]);
+    }
+    free(wall);
+    free_frame(&b);
+    free_frame(&c);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
 static void bad_inputs(void **state)
 {
     (void)state;
@@ -217,6 +254,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(frame_equals_stages),
         cmocka_unit_test(threads_same_bytes),
+        cmocka_unit_test(virtual_depth),
         cmocka_unit_test(bad_inputs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

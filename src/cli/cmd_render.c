@@ -11,7 +11,8 @@
 
 static const char *render_usage =
     "usage: egofuse render --scene FILE --out DIR [--first K] [--frames N]\n"
-    "                      [--masks] [--quiet] [--threads 1|2]\n"
+    "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
+    "                      [--tone-match S]\n"
     "\n"
     "Composites a recorded sequence (docs/scene.md): for each frame, poses the\n"
     "mask model at t = frame / fps, renders its mask and normals from both\n"
@@ -27,6 +28,12 @@ static const char *render_usage =
     "  --masks        also write the masks, DIR/mask_left_NNNN.png ...\n"
     "  --quiet        no progress line\n"
     "  --threads T    1, or 2 (default: one eye per thread; same bytes)\n"
+    "  --no-depth     ignore the virtual scene's depth images (by default a\n"
+    "                 virtual object in front of the hand hides it)\n"
+    "  --tone-match S match the camera's colour tone to the virtual scene's,\n"
+    "                 strength S in [0, 1] (default 0: off)\n"
+    "\n"
+    "EGOFUSE_ISA=ref|sse2|avx2|avx512 caps the instruction set (same bytes).\n"
     "  -h, --help     this text\n";
 
 static const char *demo_usage =
@@ -46,6 +53,8 @@ typedef struct render_opts {
     int first, frames;
     int masks, quiet;
     int threads;           /* 0 = 2 */
+    int no_depth;          /* ignore the virtual scene's depth */
+    float tone_match;      /* 0 = off */
 } render_opts;
 
 static int file_exists(const char *p)
@@ -137,8 +146,9 @@ static int render(const render_opts *o)
     char path[IO_PATH_MAX + 64];
     for (int f = first; f < first + count; f++)
         for (int e = 0; e < 2; e++) {
-            const char *pat[2] = {sc.camera[e], sc.virt[e]};
-            for (int k = 0; k < 2; k++) {
+            const char *pat[3] = {sc.camera[e], sc.virt[e], sc.virt_depth[e]};
+            for (int k = 0; k < 3; k++) {
+                if (!pat[k][0]) continue; /* no depth for this scene */
                 io_scene_frame_path(&sc, pat[k], f, path, sizeof path);
                 if (!file_exists(path))
                     return cli_fail("%s: frame %d: %s is missing", o->scene, f, path);
@@ -172,9 +182,10 @@ static int render(const render_opts *o)
     int rc = EXIT_FAIL;
     pipe_desc pd = {0};
     pd.threads = o->threads;
+    pd.tone_match = o->tone_match;
     pipe_ctx *pp = pipe_create(&pd, &model);
     kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
-    io_image cam[2] = {{0}}, virt[2] = {{0}}, rgb = {0};
+    io_image cam[2] = {{0}}, virt[2] = {{0}}, vdepth[2] = {{0}}, rgb = {0};
     if (!pp || io_image_alloc(&rgb, hd.lcd_width, hd.lcd_height, 3, IO_U8, &err) != IO_OK) {
         cli_fail("out of memory");
         goto done;
@@ -199,6 +210,21 @@ static int render(const render_opts *o)
             if (load_rgba(path, hd.cam_width, hd.cam_height, "camera", &cam[e])) goto done;
             io_scene_frame_path(&sc, sc.virt[e], f, path, sizeof path);
             if (load_rgba(path, hd.lcd_width, hd.lcd_height, "virtual scene", &virt[e])) goto done;
+            if (sc.virt_depth[e][0] && !o->no_depth) {
+                io_scene_frame_path(&sc, sc.virt_depth[e], f, path, sizeof path);
+                io_image_free(&vdepth[e]);
+                if (io_image_load(path, IO_F32, 1, &vdepth[e], &err) != IO_OK) {
+                    cli_fail("%s", err.msg);
+                    goto done;
+                }
+                if (vdepth[e].width != hd.lcd_width || vdepth[e].height != hd.lcd_height) {
+                    cli_fail("%s: virtual depth image is %dx%d, expected %dx%d", path,
+                             vdepth[e].width, vdepth[e].height, hd.lcd_width, hd.lcd_height);
+                    goto done;
+                }
+                in.virt_depth[e] = vdepth[e].data;
+                in.virt_depth_stride[e] = (int)(vdepth[e].stride / sizeof(float));
+            }
             in.camera[e] = as_fuse(&cam[e]);
             in.virt[e] = as_fuse(&virt[e]);
             in.out[e] = in.virt[e]; /* composite in place */
@@ -232,8 +258,9 @@ static int render(const render_opts *o)
     if (!o->quiet) {
         double wall = cli_now() - pr.t0;
         printf("egofuse: wrote %d stereo frames (1280x800 per eye) to %s\n", count, o->out);
-        printf("egofuse: per stereo frame, %d thread%s: %.3f ms (pose+skin %.3f ms; "
+        printf("egofuse: per stereo frame, %s, %d thread%s: %.3f ms (pose+skin %.3f ms; "
                "per eye: raster %.3f ms, lighting+composite %.3f ms); with image files %.1f ms\n",
+               ef_isa_name((ef_isa)pipe_isa(pp)),
                o->threads == 1 ? 1 : 2, o->threads == 1 ? "" : "s", sum.ms_total / count,
                sum.ms_pose / count, (sum.ms_raster[0] + sum.ms_raster[1]) / (2.0 * count),
                (sum.ms_fuse[0] + sum.ms_fuse[1]) / (2.0 * count), 1e3 * wall / count);
@@ -243,6 +270,7 @@ done:
     for (int e = 0; e < 2; e++) {
         io_image_free(&cam[e]);
         io_image_free(&virt[e]);
+        io_image_free(&vdepth[e]);
     }
     io_image_free(&rgb);
     pipe_destroy(pp);
@@ -250,7 +278,8 @@ done:
     return rc;
 }
 
-enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS };
+enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
+       O_NO_DEPTH, O_TONE };
 
 int cmd_render(int argc, char **argv)
 {
@@ -262,6 +291,8 @@ int cmd_render(int argc, char **argv)
         {"masks", no_argument, 0, O_MASKS},
         {"quiet", no_argument, 0, O_QUIET},
         {"threads", required_argument, 0, O_THREADS},
+        {"no-depth", no_argument, 0, O_NO_DEPTH},
+        {"tone-match", required_argument, 0, O_TONE},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
@@ -287,6 +318,11 @@ int cmd_render(int argc, char **argv)
         case O_THREADS:
             if (!cli_parse_int(optarg, 1, 2, &o.threads))
                 return cli_usage_error("render", "--threads '%s': 1 or 2", optarg);
+            break;
+        case O_NO_DEPTH: o.no_depth = 1; break;
+        case O_TONE:
+            if (!cli_parse_float(optarg, &o.tone_match) || o.tone_match < 0.0f || o.tone_match > 1.0f)
+                return cli_usage_error("render", "--tone-match '%s': a strength in [0, 1]", optarg);
             break;
         case ':': return cli_usage_error("render", "option %s needs a value", argv[optind - 1]);
         default: return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);

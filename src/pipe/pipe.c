@@ -132,9 +132,9 @@ void pipe_pose_locals(pipe_pose *ps, const kin_transform *locals)
     pose_skin(ps);
 }
 
-rast_result pipe_pose_draw(const pipe_pose *ps, const kin_camera *cam,
-                           const rast_target *target, float *clip,
-                           float *vnrm, rast_stats *stats)
+rast_result pipe_pose_draw(const pipe_pose *ps, rast_context *ctx,
+                           const kin_camera *cam, const rast_target *target,
+                           float *clip, float *vnrm, rast_stats *stats)
 {
     const int with_n = target->attr_count == 3;
     for (int i = 0; i < ps->model->mesh_count; i++) {
@@ -150,7 +150,8 @@ rast_result pipe_pose_draw(const pipe_pose *ps, const kin_camera *cam,
             .tri_count = me->index_count / 3,
             .cull = RAST_CULL_NONE,
         };
-        rast_result r = rast_draw(target, &d, stats);
+        rast_result r = ctx ? rast_context_draw(ctx, target, &d, stats)
+                            : rast_draw(target, &d, stats);
         if (r != RAST_OK) return r;
     }
     return RAST_OK;
@@ -162,6 +163,8 @@ typedef struct eye_state {
     int eye;
     float *depth, *nrm, *clip, *vnrm;
     uint8_t *mask, *layer;
+    rast_context *rast;
+    fuse_context *fuse;
     kin_camera cam;
     /* per-frame job */
     const pipe_frame_in *in;
@@ -214,7 +217,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
     rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
     rast_target_clear(&tg);
-    rast_result rr = pipe_pose_draw(&p->pose, &e->cam, &tg, e->clip, e->vnrm, NULL);
+    rast_result rr = pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, e->clip, e->vnrm, NULL);
     double t1 = now_ms();
     e->ms_raster = t1 - t0;
     if (rr != RAST_OK) {
@@ -237,13 +240,36 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         L.lights[i].dir[2] = d.z;
     }
     fuse_intrinsics K = {e->cam.fx, e->cam.fy, e->cam.cx, e->cam.cy};
-    fuse_image P = fuse_image_rows(&in->camera[e->eye], p->geo.crop_y0, ch);
-    fuse_image Q = {e->layer, cw, ch, 4 * cw};
-    fuse_image out = in->out[e->eye];
-    fuse_result fr = fuse_light(&L, &K, &P, e->mask, cw, e->nrm, 3 * cw, &Q);
-    if (fr == FUSE_OK)
-        fr = fuse_composite(&Q, &in->virt[e->eye], p->geo.vp_x0, p->geo.vp_y0,
-                            p->geo.vp_width, p->geo.vp_height, &out);
+    fuse_eye fe = {0};
+    fe.lighting = &L;
+    fe.intrinsics = &K;
+    fe.P = fuse_image_rows(&in->camera[e->eye], p->geo.crop_y0, ch);
+    fe.mask = e->mask;
+    fe.mask_stride = cw;
+    fe.normal = e->nrm;
+    fe.normal_stride = 3 * cw;
+    fe.Q = (fuse_image){e->layer, cw, ch, 4 * cw};
+    fe.V = in->virt[e->eye];
+    fe.vp_x0 = p->geo.vp_x0;
+    fe.vp_y0 = p->geo.vp_y0;
+    fe.vp_w = p->geo.vp_width;
+    fe.vp_h = p->geo.vp_height;
+    fe.out = in->out[e->eye];
+    fuse_depth dt;
+    if (in->virt_depth[e->eye]) {
+        dt = (fuse_depth){e->depth, cw, p->hmd.znear, p->hmd.zfar, p->hmd.cam_offset_m,
+                          in->virt_depth[e->eye], in->virt_depth_stride[e->eye],
+                          fe.V.width, fe.V.height};
+        fe.depth = &dt;
+    }
+    fuse_result fr = FUSE_OK;
+    if (p->desc.tone_match > 0.0f) {
+        float tone[3];
+        fr = fuse_tone_match(&fe.P, e->mask, cw, &fe.V, fe.vp_x0, fe.vp_y0, fe.vp_w,
+                             fe.vp_h, p->desc.tone_match, tone);
+        for (int k = 0; k < 3; k++) L.tone[k] *= tone[k];
+    }
+    if (fr == FUSE_OK) fr = fuse_context_frame(e->fuse, &fe, 1);
     e->ms_fuse = now_ms() - t1;
     if (fr != FUSE_OK) {
         e->result = PIPE_ERR_FUSE;
@@ -286,6 +312,8 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].vnrm);
         free(p->eye[e].mask);
         free(p->eye[e].layer);
+        rast_context_destroy(p->eye[e].rast);
+        fuse_context_destroy(p->eye[e].fuse);
     }
 }
 
@@ -313,7 +341,12 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         s->layer = malloc(4 * px);
         s->clip = malloc(sizeof(float) * 4 * nv);
         s->vnrm = malloc(sizeof(float) * 3 * nv);
-        ok = ok && s->depth && s->nrm && s->mask && s->layer && s->clip && s->vnrm;
+        rast_context_desc rd = {p->desc.max_isa, 1};
+        fuse_context_desc fd = {(ef_isa)p->desc.max_isa, 1};
+        s->rast = rast_context_create(&rd);
+        s->fuse = fuse_context_create(&fd);
+        ok = ok && s->depth && s->nrm && s->mask && s->layer && s->clip && s->vnrm &&
+             s->rast && s->fuse;
     }
     p->threaded = p->desc.threads != 1;
     if (ok && p->threaded) {
@@ -423,6 +456,8 @@ const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
 kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].cam; }
 
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }
+
+int pipe_isa(const pipe_ctx *p) { return rast_context_isa(p->eye[0].rast); }
 
 const char *pipe_result_str(pipe_result r)
 {

@@ -64,18 +64,24 @@ void pipe_pose_anim(pipe_pose *ps, const kin_animation *anim, float t);
 void pipe_pose_locals(pipe_pose *ps, const kin_transform *locals);
 
 /* Draws every mesh of a posed model through cam into target (attr_count
- * 3 receives view-space normals; 0 draws depth and mask only). clip and
- * vnrm are scratch arrays of 4 and 3 floats per vertex of the largest
- * mesh (ps->max_vertices). */
-rast_result pipe_pose_draw(const pipe_pose *ps, const kin_camera *cam,
-                           const rast_target *target, float *clip,
-                           float *vnrm, rast_stats *stats);
+ * 3 receives view-space normals; 0 draws depth and mask only), with ctx
+ * (NULL: rast_draw, the best ISA on the calling thread). clip and vnrm are
+ * scratch arrays of 4 and 3 floats per vertex of the largest mesh
+ * (ps->max_vertices). */
+rast_result pipe_pose_draw(const pipe_pose *ps, rast_context *ctx,
+                           const kin_camera *cam, const rast_target *target,
+                           float *clip, float *vnrm, rast_stats *stats);
 
 /* ------------------------------------------------------------- frames */
 
 typedef struct pipe_desc {
     kin_sthmd_desc hmd;       /* zero = the paper's HMD */
     int threads;              /* 0 = 2 (one eye each); 1 = one thread */
+    int max_isa;              /* cap for raster and fuse: an ef_isa value
+                                 (src/cpu/cpu.h), 0 = the best the CPU has;
+                                 EGOFUSE_ISA caps further */
+    float tone_match;         /* 0 = off; (0,1]: strength of the gray-world
+                                 colour tone matching (fuse_tone_match) */
 } pipe_desc;
 
 typedef struct pipe_ctx pipe_ctx;
@@ -105,6 +111,11 @@ typedef struct pipe_frame_in {
     fuse_image camera[2];
     fuse_image virt[2];
     fuse_image out[2];
+    /* Optional depth of the virtual scene per eye (output resolution,
+     * metres along the eye's view axis; 0, inf or NaN = nothing there):
+     * a virtual object in front of the hand hides it (fuse_depth_test). */
+    const float *virt_depth[2];
+    int virt_depth_stride[2]; /* floats per row */
     pipe_lighting lighting;
 } pipe_frame_in;
 
@@ -134,6 +145,8 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The camera of one eye in the last frame. */
 kin_camera pipe_camera(const pipe_ctx *p, int eye);
+/* The ISA that raster and fuse use (an ef_isa value). */
+int pipe_isa(const pipe_ctx *p);
 /* The derived HMD numbers in use (crop, viewport). */
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p);
 
