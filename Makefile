@@ -31,6 +31,7 @@ GEN_SRC  := $(wildcard samples/gen/*.c)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_SHARED := $(wildcard tests/support/*.c)
 BENCH_SRC := $(wildcard bench/bench_*.c)
+LLVMPIPE_SRC := $(wildcard bench/llvmpipe/*.c)
 
 obj = $(patsubst %,$(BUILD)/obj/%.o,$(1))
 CORE_OBJ := $(call obj,$(CORE_SRC))
@@ -39,12 +40,18 @@ CLI_OBJ  := $(call obj,$(CLI_SRC))
 GEN_OBJ  := $(call obj,$(GEN_SRC))
 TEST_SHARED_OBJ := $(call obj,$(TEST_SHARED))
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
-BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
+BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC)) \
+             $(patsubst bench/llvmpipe/%.c,$(BUILD)/bench/%,$(LLVMPIPE_SRC))
 
 IO_PKGS  := OpenImageIO tinygltf libusb-1.0 libv4l2
 IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) 2>/dev/null)
 IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lstdc++
 SYS_LIBS := -lm -lpthread
+# Peers measured by the benchmarks: pixman (compositing), Mesa llvmpipe
+# through EGL + GLES (the same frame as GL shaders).
+BENCH_CFLAGS := $(shell pkg-config --cflags pixman-1 egl glesv2 2>/dev/null)
+BENCH_LIBS := $(shell pkg-config --libs pixman-1 2>/dev/null)
+GL_LIBS  := $(shell pkg-config --libs egl glesv2 2>/dev/null)
 
 LIB      := $(BUILD)/libegofuse.a
 IOLIB    := $(BUILD)/libegofuse_io.a
@@ -97,7 +104,13 @@ $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(IOLIB) $(LIB)
 
 $(BUILD)/bench/%: bench/%.c $(IOLIB) $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
+	$(CC) $(CFLAGS) $(IO_CFLAGS) $(BENCH_CFLAGS) -o $@ $< $(IOLIB) $(LIB) \
+	    $(BENCH_LIBS) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
+
+$(BUILD)/bench/%: bench/llvmpipe/%.c $(IOLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(IO_CFLAGS) $(BENCH_CFLAGS) -o $@ $< $(IOLIB) $(LIB) \
+	    $(GL_LIBS) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
 # Sample data: generated, never downloaded (samples/README.md).
 $(SAMPLES)/scene.txt: $(GEN)
