@@ -28,6 +28,7 @@ IO_SRC   := $(wildcard src/io/*.c)
 IO_CXX   := $(wildcard src/io/*.cpp)
 CLI_SRC  := $(wildcard src/cli/*.c)
 GEN_SRC  := $(wildcard samples/gen/*.c)
+GT_SRC   := $(wildcard samples/gt/*.c)
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_SHARED := $(wildcard tests/support/*.c)
 BENCH_SRC := $(wildcard bench/bench_*.c)
@@ -38,6 +39,9 @@ CORE_OBJ := $(call obj,$(CORE_SRC))
 IO_OBJ   := $(call obj,$(IO_SRC) $(IO_CXX))
 CLI_OBJ  := $(call obj,$(CLI_SRC))
 GEN_OBJ  := $(call obj,$(GEN_SRC))
+# The generator's scenes and the ground truth of `egofuse eval`, shared by
+# build/gen_samples and build/egofuse.
+SAMPLES_LIB_OBJ := $(filter-out %/gen_main.c.o,$(GEN_OBJ)) $(call obj,$(GT_SRC))
 TEST_SHARED_OBJ := $(call obj,$(TEST_SHARED))
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC)) \
@@ -55,11 +59,12 @@ GL_LIBS  := $(shell pkg-config --libs egl glesv2 2>/dev/null)
 
 LIB      := $(BUILD)/libegofuse.a
 IOLIB    := $(BUILD)/libegofuse_io.a
+SAMPLESLIB := $(BUILD)/libegofuse_samples.a
 EGOFUSE  := $(BUILD)/egofuse
 GEN      := $(BUILD)/gen_samples
 SAMPLES  := $(BUILD)/samples
 
-.PHONY: all deps demo test debug bench clean samples check-headers
+.PHONY: all deps demo test debug bench clean samples check-headers eval
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(IOLIB) $(EGOFUSE) $(GEN) $(TEST_BIN) $(BENCH_BIN)
@@ -91,11 +96,15 @@ $(IOLIB): $(IO_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
 
-$(EGOFUSE): $(CLI_OBJ) $(IOLIB) $(LIB)
-	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
+$(SAMPLESLIB): $(SAMPLES_LIB_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@ && ar rcs $@ $^
 
-$(GEN): $(GEN_OBJ) $(IOLIB) $(LIB)
-	$(CXX) $(LDFLAGS) -o $@ $(GEN_OBJ) $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
+$(EGOFUSE): $(CLI_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
+
+$(GEN): $(BUILD)/obj/samples/gen/gen_main.c.o $(SAMPLESLIB) $(IOLIB) $(LIB)
+	$(CXX) $(LDFLAGS) -o $@ $< $(SAMPLESLIB) $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
 
 $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(IOLIB) $(LIB)
 	@mkdir -p $(dir $@)
@@ -128,7 +137,8 @@ test: deps
 	@sh tests/run_tests.sh $(BUILD)
 
 # Every public header compiles on its own as C and as C++ (sokol's rule).
-HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h src/io/io.h
+HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
+           src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/io/io.h
 check-headers:
 	@for h in $(HEADERS); do \
 	    echo "#include \"$$h\"" | $(CC) -std=c99 -Wall -Wextra -Werror -x c -fsyntax-only - || exit 1; \
@@ -140,6 +150,11 @@ debug: deps
 	@$(MAKE) --no-print-directory BUILD=build-debug OPT=-O1 \
 	    SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" all
 	@ASAN_OPTIONS=detect_leaks=1 sh tests/run_tests.sh build-debug
+
+# The accuracy report (docs/accuracy.md): charts, table, summary.csv.
+eval: deps
+	@$(MAKE) --no-print-directory $(EGOFUSE)
+	$(EGOFUSE) eval --frames 180 --report out/eval
 
 bench: deps
 	@$(MAKE) --no-print-directory all

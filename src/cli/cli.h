@@ -20,6 +20,7 @@ enum {
 int cmd_mask(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_demo(int argc, char **argv);
+int cmd_eval(int argc, char **argv);   /* cmd_eval.c, docs/accuracy.md */
 
 /* Prints "egofuse: " + message to stderr; returns EXIT_FAIL. */
 int cli_fail(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -20,6 +20,7 @@ static const char *main_usage =
     "  demo     composite the bundled sample sequence (make demo runs it)\n"
     "  render   composite a recorded sequence described by a scene file\n"
     "  mask     render the coverage mask (and normals, depth) of a glTF model\n"
+    "  eval     measure the accuracy of each method against generated ground truth\n"
     "\n"
     "Run 'egofuse COMMAND --help' for the options of a command.\n";
 
@@ -42,6 +43,7 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "mask")) return cmd_mask(argc - 1, argv + 1);
     if (!strcmp(cmd, "render")) return cmd_render(argc - 1, argv + 1);
     if (!strcmp(cmd, "demo")) return cmd_demo(argc - 1, argv + 1);
+    if (!strcmp(cmd, "eval")) return cmd_eval(argc - 1, argv + 1);
     fprintf(stderr, "egofuse: unknown command '%s'\n\n%s", cmd, main_usage);
     return EXIT_USAGE;
 }

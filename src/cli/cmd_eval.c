@@ -1,0 +1,908 @@
+/* cmd_eval.c - `egofuse eval`: accuracy of the masks and composites of
+ * several methods against generated ground truth (samples/gt/, the
+ * definitions in src/fuse/fuse_metrics.h, the report in docs/accuracy.md).
+ *
+ * Per display frame (60 Hz): the true operator is posed and rendered into
+ * both camera images over the cockpit (with its exact silhouettes and the
+ * ideal composite); then every method configuration, with its own tracking
+ * stream (noise, latency, dropouts) and its own state (filter, last
+ * sample, previous masks), makes its masks and composites, which are timed
+ * and measured. */
+#include "cli.h"
+
+/* The ground truth comes from samples/gt/ and the sample generator
+ * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
+#include <getopt.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../fuse/fuse_metrics.h"
+#include "../fuse/fuse_refine.h"
+#include "../../samples/gt/gt.h"
+
+static const char *eval_usage =
+    "usage: egofuse eval [--frames N] [--noise MM] [--latency MS] [--dropout P]\n"
+    "                    [--calib-error E] [--speed S] [--seed S] [--per-frame]\n"
+    "                    [--csv FILE] [--report DIR] [--dump DIR] [--quiet]\n"
+    "\n"
+    "Generates ground truth (a true operator whose bones and limbs differ from\n"
+    "the mask model, filmed over a cockpit with skin-coloured objects, camera\n"
+    "noise and its own lighting; exact silhouettes; the ideal composite) and\n"
+    "measures the masks and composites of each method against it: mask IoU,\n"
+    "boundary F within 1 and 3 px, false-positive and false-negative area,\n"
+    "PSNR of the composite, temporal edge flicker, and the time per stereo\n"
+    "frame. Methods: kin (the paper: fixed-size model, IK from the tracked\n"
+    "hands, latest sample), kin-cal-pred (per-user calibration, One Euro\n"
+    "filter and prediction to the display time), skin (YCbCr skin-colour\n"
+    "key), refine (kin-cal-pred refined by colour in a band around its edge).\n"
+    "\n"
+    "  --frames N       display frames at 60 Hz (default 60; the motion is 3 s)\n"
+    "  --noise MM       RMS tracking position error (default 5)\n"
+    "  --latency MS     tracking latency (default 20)\n"
+    "  --dropout P      probability that a sample loses a hand (default 0.02)\n"
+    "  --calib-error E  relative error of the user calibration (default 0.02)\n"
+    "  --speed S        playback speed of the motion (default 1; 2 = fast moves)\n"
+    "  --seed S         seed of the camera and tracking noise (default 1)\n"
+    "  --per-frame      print every frame's figures per method\n"
+    "  --csv FILE       write the summary table as CSV\n"
+    "  --report DIR     run the sweeps (methods, band width, mask resolution,\n"
+    "                   triangles, LBS/DQS, tracking noise, latency, calibration\n"
+    "                   error) and write DIR/summary.csv, DIR/table.md, data files\n"
+    "                   and the charts (gnuplot, PNG)\n"
+    "  --dump DIR       write every mask: DIR/METHOD_SETTING_EYE_NNNN.png (red:\n"
+    "                   true silhouette, green: the method's mask)\n"
+    "  --quiet          no progress line\n"
+    "  -h, --help       this text\n";
+
+enum { CW = 640, CH = 400 };
+
+typedef enum method_kind { M_KIN, M_KIN_CAL, M_SKIN, M_REFINE } method_kind;
+static const char *kind_name[] = { "kin", "kin-cal-pred", "skin", "refine" };
+
+typedef struct method_cfg {
+    method_kind kind;
+    char setting[64];
+    char group[16];          /* methods, band, res, tris, skin, noise, ... */
+    float x;                 /* the swept value, for the charts */
+    int dqs;
+    int div;                 /* mask resolution divisor */
+    int fine;                /* 1: the subdivided (4x triangles) mask model */
+    int band;
+    gt_track_desc track;
+    float calib_error;
+} method_cfg;
+
+/* Per-configuration state and sums. */
+typedef struct method_run {
+    method_cfg cfg;
+    int next_k;              /* next tracking sample to deliver */
+    kin_track_sample last;   /* latest delivered parts (raw methods) */
+    int have_last;
+    kin_filter filter;
+    kin_transform *locals;
+    uint8_t *prev[2];        /* previous masks per eye */
+    int have_prev;
+    /* sums over frames and eyes */
+    double iou, bf1, bf3, fp, fn, mse, flicker, secs;
+    long n_eye, n_flicker, n_frames;
+} method_run;
+
+/* Shared per-frame buffers. */
+typedef struct eval_ctx {
+    gen_arms mask, mask_fine, truth;
+    gen_scene cockpit, workshop;
+    gen_frame_ctx gctx;
+    kin_arm_rig rig;
+    gt_operator_desc op;
+    kin_mat4 *world, *jm;
+    kin_transform *tlocals;
+    kin_mat4 *tworld;
+    kin_dualquat *dq;
+    float *pos, *nrm, *clip, *vnrm;
+    /* per eye */
+    uint8_t *cam_rgb;                       /* 640x480x3 */
+    uint8_t *P[2];                          /* 640x400 RGBA */
+    uint8_t *sil[2], *sil_prev[2];          /* true silhouettes, 640x400 */
+    int have_sil_prev;
+    float *tnrm[2];
+    uint8_t *V[2], *ideal[2];               /* 1280x800 RGBA */
+    float *vdepth;
+    uint8_t *vrgb;
+    fuse_lighting L[2];
+    kin_camera tcam[2];
+    /* method scratch */
+    uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
+    float *depth_lo, *nrm_lo, *mnrm;
+    void *refine_scratch;
+    size_t refine_scratch_size;
+    kin_sthmd_geometry g;
+} eval_ctx;
+
+typedef struct eval_opts {
+    int frames, per_frame, quiet;
+    float noise, latency, dropout, calib_error, speed;
+    int seed;
+    const char *csv, *report, *dump;
+} eval_opts;
+
+/* ------------------------------------------------------------ lighting */
+
+static fuse_lighting workshop_lighting(const gen_scene *ws, const kin_camera *cam)
+{
+    fuse_lighting L = fuse_lighting_default();
+    L.light_count = ws->light_count < FUSE_MAX_LIGHTS ? ws->light_count : FUSE_MAX_LIGHTS;
+    for (int i = 0; i < 3; i++) L.ambient[i] = ws->ambient[i];
+    L.kd = 0.80f;
+    L.ks = 0.12f;
+    L.shininess = 20.0f;
+    L.kf = 0.50f;
+    L.tone[0] = 1.0f;
+    L.tone[1] = 0.98f;
+    L.tone[2] = 0.96f;
+    for (int i = 0; i < L.light_count; i++) {
+        kin_vec3 d = kin_v3_norm(kin_mat4_mul_dir(
+            &cam->view, kin_v3(ws->light_dir[i][0], ws->light_dir[i][1], ws->light_dir[i][2])));
+        L.lights[i].dir[0] = d.x;
+        L.lights[i].dir[1] = d.y;
+        L.lights[i].dir[2] = d.z;
+        for (int k = 0; k < 3; k++) L.lights[i].color[k] = ws->light_color[i][k];
+    }
+    return L;
+}
+
+/* ------------------------------------------------------------- set-up */
+
+static void ctx_free(eval_ctx *c)
+{
+    gen_frame_ctx_free(&c->gctx);
+    gen_arms_free(&c->truth);
+    gen_arms_free(&c->mask_fine);
+    gen_arms_free(&c->mask);
+    gen_scene_free(&c->cockpit);
+    gen_scene_free(&c->workshop);
+    free(c->world); free(c->jm); free(c->tlocals); free(c->tworld); free(c->dq);
+    free(c->pos); free(c->nrm); free(c->clip); free(c->vnrm);
+    free(c->cam_rgb); free(c->vdepth); free(c->vrgb);
+    for (int e = 0; e < 2; e++) {
+        free(c->P[e]); free(c->sil[e]); free(c->sil_prev[e]); free(c->tnrm[e]); free(c->V[e]); free(c->ideal[e]);
+    }
+    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->layer); free(c->out);
+    free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
+    free(c->refine_scratch);
+    memset(c, 0, sizeof *c);
+}
+
+static int ctx_init(eval_ctx *c, uint64_t seed)
+{
+    memset(c, 0, sizeof *c);
+    c->g = kin_sthmd_geometry_of(NULL);
+    c->op = gt_operator_default();
+    gt_operator_desc same = { 1, 1, 1, 1, 1, 1, 1, 1 };
+    if (gen_arms_build(&c->mask) < 0 || gt_truth_build(&c->mask, &c->op, &c->truth) < 0 ||
+        gt_truth_build(&c->mask, &same, &c->mask_fine) < 0 ||
+        gt_cockpit_build(&c->cockpit) < 0 || gen_scene_workshop(&c->workshop, &c->mask) < 0 ||
+        gen_frame_ctx_init(&c->gctx, &c->truth, &c->cockpit, &c->workshop, seed) < 0)
+        return -1;
+    char why[256];
+    if (kin_arm_rig_init(&c->rig, &c->mask.model, why, sizeof why) < 0) {
+        cli_fail("mask model: %s", why);
+        return -1;
+    }
+    const kin_model *m = &c->mask.model;
+    size_t N = (size_t)m->node_count;
+    size_t V = (size_t)c->mask_fine.model.meshes[0].vertex_count;
+    size_t J = (size_t)m->skins[0].joint_count;
+    const size_t cp = (size_t)CW * CH, vp = (size_t)GEN_VIRT_W * GEN_VIRT_H;
+    c->world = malloc(sizeof *c->world * N);
+    c->tworld = malloc(sizeof *c->tworld * N);
+    c->tlocals = malloc(sizeof *c->tlocals * N);
+    c->jm = malloc(sizeof *c->jm * J);
+    c->dq = malloc(sizeof *c->dq * J);
+    c->pos = malloc(sizeof(float) * 3 * V);
+    c->nrm = malloc(sizeof(float) * 3 * V);
+    c->clip = malloc(sizeof(float) * 4 * V);
+    c->vnrm = malloc(sizeof(float) * 3 * V);
+    c->cam_rgb = malloc((size_t)GEN_CAM_W * GEN_CAM_H * 3);
+    c->vdepth = malloc(sizeof(float) * vp);
+    c->vrgb = malloc(vp * 3);
+    int ok = c->world && c->tworld && c->tlocals && c->jm && c->dq && c->pos && c->nrm &&
+             c->clip && c->vnrm && c->cam_rgb && c->vdepth && c->vrgb;
+    for (int e = 0; e < 2 && ok; e++) {
+        c->P[e] = malloc(cp * 4);
+        c->sil[e] = malloc(cp);
+        c->sil_prev[e] = malloc(cp);
+        c->tnrm[e] = malloc(sizeof(float) * 3 * cp);
+        c->V[e] = malloc(vp * 4);
+        c->ideal[e] = malloc(vp * 4);
+        ok = c->P[e] && c->sil[e] && c->sil_prev[e] && c->tnrm[e] && c->V[e] && c->ideal[e];
+    }
+    c->mask_lo = malloc(cp);
+    c->mask_up = malloc(cp);
+    c->refined = malloc(cp);
+    c->layer = malloc(cp * 4);
+    c->out = malloc(vp * 4);
+    c->depth_lo = malloc(sizeof(float) * cp);
+    c->nrm_lo = malloc(sizeof(float) * 3 * cp);
+    c->mnrm = malloc(sizeof(float) * 3 * cp);
+    fuse_refine_params rp = fuse_refine_params_default();
+    rp.band = 64;
+    rp.margin = 64;
+    c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
+    c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
+    ok = ok && c->mask_lo && c->mask_up && c->refined && c->layer && c->out && c->depth_lo &&
+         c->nrm_lo && c->mnrm && c->refine_scratch;
+    return ok ? 0 : -1;
+}
+
+/* ------------------------------------------------------- ground truth */
+
+static int make_truth(eval_ctx *c, int frame, float speed, int first)
+{
+    c->have_sil_prev = !first;
+    for (int e = 0; e < 2; e++) {
+        uint8_t *tmp = c->sil_prev[e];
+        c->sil_prev[e] = c->sil[e];
+        c->sil[e] = tmp;
+    }
+    float t = (float)frame / (float)GEN_FPS * speed;
+    kin_mat4 wfh;
+    gen_pose(&c->gctx, t, &wfh);
+    for (int e = 0; e < 2; e++) {
+        kin_camera cam = kin_sthmd_camera(NULL, &wfh, (kin_eye)e);
+        c->tcam[e] = cam;
+        gt_render_eye(&c->gctx, &wfh, (kin_eye)e, frame, c->cam_rgb, c->sil[e], c->tnrm[e]);
+        const uint8_t *src = c->cam_rgb + (size_t)c->g.crop_y0 * GEN_CAM_W * 3;
+        if (fuse_rgb24_to_rgba(src, GEN_CAM_W * 3, CW, CH,
+                               &(fuse_image){ c->P[e], CW, CH, 4 * CW }) != FUSE_OK)
+            return -1;
+        gen_render_virtual(&c->gctx, &wfh, (kin_eye)e, frame, c->vrgb, c->vdepth);
+        fuse_image V = { c->V[e], GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
+        if (fuse_rgb24_to_rgba(c->vrgb, GEN_VIRT_W * 3, GEN_VIRT_W, GEN_VIRT_H, &V) != FUSE_OK)
+            return -1;
+        c->L[e] = workshop_lighting(&c->workshop, &cam);
+        fuse_intrinsics K = { cam.fx, cam.fy, cam.cx, cam.cy };
+        fuse_image P = { c->P[e], CW, CH, 4 * CW }, Q = { c->layer, CW, CH, 4 * CW };
+        fuse_image I = { c->ideal[e], GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
+        if (fuse_light(&c->L[e], &K, &P, c->sil[e], CW, c->tnrm[e], 3 * CW, &Q) != FUSE_OK ||
+            fuse_composite(&Q, &V, c->g.vp_x0, c->g.vp_y0, c->g.vp_width, c->g.vp_height,
+                           &I) != FUSE_OK)
+            return -1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------ methods */
+
+static int run_init(method_run *r, const method_cfg *cfg, const eval_ctx *c)
+{
+    memset(r, 0, sizeof *r);
+    r->cfg = *cfg;
+    /* the tracker runs for a second before the first frame (the motion
+     * holds its first pose before t = 0) */
+    r->next_k = -(int)ceilf(cfg->track.rate_hz);
+    kin_filter_init(&r->filter, NULL);
+    r->locals = malloc(sizeof *r->locals * (size_t)c->mask.model.node_count);
+    r->prev[0] = malloc((size_t)CW * CH);
+    r->prev[1] = malloc((size_t)CW * CH);
+    if (!r->locals || !r->prev[0] || !r->prev[1]) return -1;
+    kin_pose_rest(&c->mask.model, r->locals);
+    return 0;
+}
+
+static void run_free(method_run *r)
+{
+    free(r->locals);
+    free(r->prev[0]);
+    free(r->prev[1]);
+}
+
+/* Copies the valid parts of s over *dst. */
+static void merge_sample(kin_track_sample *dst, const kin_track_sample *s)
+{
+    uint32_t v = s->valid;
+    dst->t = s->t;
+    if (v & KIN_TRACK_HEAD) { dst->head_pos = s->head_pos; dst->head_rot = s->head_rot; }
+    for (int k = 0; k < 2; k++) {
+        if (v & (KIN_TRACK_SHOULDER_L << k)) dst->shoulder[k] = s->shoulder[k];
+        if (v & (KIN_TRACK_HAND_L << k)) {
+            dst->hand_pos[k] = s->hand_pos[k];
+            dst->hand_rot[k] = s->hand_rot[k];
+        }
+        if (v & (KIN_TRACK_GLOVE_L << k)) memcpy(dst->glove[k], s->glove[k], sizeof s->glove[k]);
+    }
+    dst->valid |= v;
+}
+
+static kin_user_calib calib_of(const eval_ctx *c, float err)
+{
+    kin_user_calib u = kin_user_calib_identity();
+    float model = c->rig.upper_len[0] + c->rig.fore_len[0];
+    float truth = c->rig.upper_len[0] * c->op.upper_scale + c->rig.fore_len[0] * c->op.fore_scale;
+    for (int s = 0; s < 2; s++) {
+        u.arm_scale[s] = truth / model * (1.0f + err);
+        u.hand_scale[s] = c->op.hand_scale * (1.0f + err);
+    }
+    u.shoulder_scale = c->op.shoulder_scale * (1.0f + err);
+    return u;
+}
+
+/* Upsamples a w x h mask (nearest) to CW x CH, and normals likewise. */
+static void upsample(const uint8_t *lo, const float *nlo, int div, uint8_t *m, float *n)
+{
+    int w = CW / div;
+    for (int y = 0; y < CH; y++)
+        for (int x = 0; x < CW; x++) {
+            size_t s = (size_t)(y / div) * (size_t)w + (size_t)(x / div);
+            size_t d = (size_t)y * CW + (size_t)x;
+            m[d] = lo[s];
+            memcpy(&n[d * 3], &nlo[s * 3], sizeof(float) * 3);
+        }
+}
+
+/* One frame of one method: both eyes, measured. Returns -1 on failure. */
+/* DIR/<method>_<setting>_<eye>_NNNN.png: red = true silhouette, green =
+ * the method's mask, blue = the camera image's luma / 2. */
+static int dump_masks(const char *dir, const method_cfg *cfg, int frame, int eye,
+                      const uint8_t *mask, const uint8_t *sil, const uint8_t *P, uint8_t *rgb)
+{
+    for (size_t i = 0; i < (size_t)CW * CH; i++) {
+        rgb[i * 3 + 0] = sil[i];
+        rgb[i * 3 + 1] = mask[i] >= 128 ? 255 : 0;
+        rgb[i * 3 + 2] = (uint8_t)((P[i * 4] + 2 * P[i * 4 + 1] + P[i * 4 + 2]) / 8);
+    }
+    char path[IO_PATH_MAX + 128];
+    snprintf(path, sizeof path, "%s/%s_%s_%s_%04d.png", dir, kind_name[cfg->kind], cfg->setting,
+             eye ? "right" : "left", frame);
+    io_image img = { rgb, CW, CH, 3, IO_U8, (size_t)CW * 3 };
+    io_error err;
+    if (io_image_save(path, &img, &err) != IO_OK) return cli_fail("%s", err.msg);
+    return EXIT_OK;
+}
+
+static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const char *dump)
+{
+    const method_cfg *cfg = &r->cfg;
+    double T = (double)frame / GEN_FPS;
+    double t0 = cli_now();
+    /* tracking: every sample delivered by now */
+    const double lat = cfg->track.latency_ms * 1e-3;
+    for (;;) {
+        double tc = (double)r->next_k / cfg->track.rate_hz;
+        if (tc + lat > T + 1e-9) break;
+        kin_track_sample s;
+        gt_track_sample(&c->truth, &cfg->track, r->next_k, c->tlocals, c->tworld, &s);
+        r->next_k++;
+        if (cfg->kind == M_KIN) {
+            if (!r->have_last) { r->last = s; r->have_last = 1; }
+            else merge_sample(&r->last, &s);
+        } else if (cfg->kind != M_SKIN) {
+            kin_filter_push(&r->filter, &s);
+            r->have_last = 1;
+        }
+    }
+    t0 = cli_now();   /* the tracker's simulation is not the method's time */
+    const kin_model *m = cfg->fine ? &c->mask_fine.model : &c->mask.model;
+    const kin_mesh *me = &m->meshes[0];
+    int posed = 0;
+    if (cfg->kind != M_SKIN && r->have_last) {
+        kin_track_sample s;
+        kin_user_calib cal = calib_of(c, cfg->calib_error);
+        const kin_user_calib *cp = NULL;
+        if (cfg->kind == M_KIN) {
+            s = r->last;
+        } else {
+            kin_filter_output(&r->filter, T, &s, NULL);
+            cp = &cal;
+        }
+        posed = kin_arm_rig_pose(&c->rig, m, cp, NULL, &s, r->locals, NULL);
+        if (posed) {
+            kin_fk(m->parents, m->node_count, r->locals, NULL, c->world);
+            kin_skin_joint_matrices(&m->skins[0], c->world, c->jm);
+            if (cfg->dqs) {
+                kin_skin_dq_from_matrices(c->jm, m->skins[0].joint_count, c->dq);
+                kin_skin_dqs(me, c->dq, c->pos, c->nrm);
+            } else {
+                kin_skin_lbs(me, c->jm, c->pos, c->nrm);
+            }
+        }
+    }
+    double secs = cli_now() - t0;
+    for (int e = 0; e < 2; e++) {
+        t0 = cli_now();
+        kin_camera cam = c->tcam[e];
+        if (posed) {
+            kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
+            cam = kin_sthmd_camera(&hd, &c->world[c->rig.head], (kin_eye)e);
+        }
+        const uint8_t *mask = c->mask_up;
+        const float *nrm = c->mnrm;
+        if (cfg->kind == M_SKIN) {
+            fuse_image P = { c->P[e], CW, CH, 4 * CW };
+            fuse_skin_params sp = fuse_skin_params_default();
+            if (fuse_skin_key(&sp, &P, c->mask_up, CW) != FUSE_OK) return -1;
+            memset(c->mnrm, 0, sizeof(float) * 3 * CW * CH);
+        } else {
+            int div = cfg->div, w = CW / div, h = CH / div;
+            rast_target tg = { w, h, c->depth_lo, w, c->mask_lo, w, c->nrm_lo, 3 * w, 3 };
+            rast_target_clear(&tg);
+            if (posed) {
+                rast_transform_points(cam.view_proj.m, c->pos, me->vertex_count, c->clip);
+                rast_transform_dirs(cam.view.m, c->nrm, me->vertex_count, c->vnrm);
+                rast_mesh_desc d = { c->clip, me->vertex_count, c->vnrm, 3, me->indices,
+                                     me->index_count / 3, RAST_CULL_NONE };
+                if (rast_draw(&tg, &d, NULL) != RAST_OK) return -1;
+            }
+            if (div == 1) {
+                mask = c->mask_lo;
+                nrm = c->nrm_lo;
+            } else {
+                upsample(c->mask_lo, c->nrm_lo, div, c->mask_up, c->mnrm);
+            }
+            if (cfg->kind == M_REFINE) {
+                fuse_refine_params rp = fuse_refine_params_default();
+                rp.band = cfg->band;
+                fuse_image P = { c->P[e], CW, CH, 4 * CW };
+                if (fuse_refine_mask(&rp, &P, mask, CW, c->refined, CW, c->refine_scratch,
+                                     c->refine_scratch_size, NULL) != FUSE_OK)
+                    return -1;
+                mask = c->refined;
+            }
+        }
+        fuse_intrinsics K = { cam.fx, cam.fy, cam.cx, cam.cy };
+        fuse_image P = { c->P[e], CW, CH, 4 * CW }, Q = { c->layer, CW, CH, 4 * CW };
+        fuse_image V = { c->V[e], GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
+        fuse_image O = { c->out, GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
+        fuse_lighting L = workshop_lighting(&c->workshop, &cam);
+        if (fuse_light(&L, &K, &P, mask, CW, nrm, 3 * CW, &Q) != FUSE_OK ||
+            fuse_composite(&Q, &V, c->g.vp_x0, c->g.vp_y0, c->g.vp_width, c->g.vp_height,
+                           &O) != FUSE_OK)
+            return -1;
+        secs += cli_now() - t0;
+
+        /* measures */
+        fuse_confusion cf;
+        fuse_mask_confusion(mask, CW, c->sil[e], CW, CW, CH, &cf);
+        double iou = fuse_confusion_iou(&cf);
+        double bf1 = fuse_boundary_f(mask, CW, c->sil[e], CW, CW, CH, 1.0f, NULL, NULL);
+        double bf3 = fuse_boundary_f(mask, CW, c->sil[e], CW, CW, CH, 3.0f, NULL, NULL);
+        size_t off = (size_t)c->g.vp_y0 * 4 * GEN_VIRT_W + (size_t)c->g.vp_x0 * 4;
+        double mse = fuse_mse(c->out + off, 4 * GEN_VIRT_W, c->ideal[e] + off, 4 * GEN_VIRT_W,
+                              c->g.vp_width, c->g.vp_height, 4, 3);
+        r->iou += iou;
+        r->bf1 += bf1;
+        r->bf3 += bf3;
+        r->fp += (double)cf.fp;
+        r->fn += (double)cf.fn;
+        r->mse += mse;
+        r->n_eye++;
+        if (per_frame)
+            printf("%4d %-5s %-14s %-22s iou %.4f bf1 %.3f bf3 %.3f fp %6ld fn %6ld psnr %5.2f\n",
+                   frame, e ? "right" : "left", kind_name[cfg->kind], cfg->setting, iou, bf1,
+                   bf3, cf.fp, cf.fn, fuse_psnr_of_mse(mse));
+        if (dump && dump_masks(dump, cfg, frame, e, mask, c->sil[e], c->P[e], c->vrgb))
+            return -1;
+        if (r->have_prev && c->have_sil_prev) {
+            r->flicker += fuse_edge_flicker(r->prev[e], mask, c->sil_prev[e], c->sil[e], CW,
+                                            CW, CH);
+            r->n_flicker++;
+        }
+        memcpy(r->prev[e], mask, (size_t)CW * CH);
+    }
+    r->have_prev = 1;
+    r->secs += secs;
+    r->n_frames++;
+    return 0;
+}
+
+/* ------------------------------------------------------ configurations */
+
+static method_cfg base_cfg(const eval_opts *o, method_kind k)
+{
+    method_cfg c;
+    memset(&c, 0, sizeof c);
+    c.kind = k;
+    c.div = 1;
+    c.band = 16;
+    c.track = gt_track_default();
+    c.track.noise_mm = o->noise;
+    c.track.latency_ms = o->latency;
+    c.track.dropout = o->dropout;
+    c.track.speed = o->speed;
+    c.track.seed = (uint64_t)o->seed;
+    c.calib_error = o->calib_error;
+    snprintf(c.group, sizeof c.group, "methods");
+    snprintf(c.setting, sizeof c.setting, "default");
+    return c;
+}
+
+static int add_cfg(method_cfg *list, int n, int cap, method_cfg c)
+{
+    if (n < cap) list[n] = c;
+    return n + 1;
+}
+
+/* The methods at the given tracking; with sweeps, every knob. */
+static int make_configs(const eval_opts *o, int sweeps, method_cfg *L, int cap)
+{
+    int n = 0;
+    for (int k = 0; k < 4; k++) n = add_cfg(L, n, cap, base_cfg(o, (method_kind)k));
+    if (!sweeps) return n;
+    method_cfg c;
+    static const int bands[] = { 2, 3, 5, 8, 12, 24 };
+    for (int i = 0; i < 6; i++) {
+        c = base_cfg(o, M_REFINE);
+        c.band = bands[i];
+        c.x = (float)bands[i];
+        snprintf(c.group, sizeof c.group, "band");
+        snprintf(c.setting, sizeof c.setting, "band=%d", bands[i]);
+        n = add_cfg(L, n, cap, c);
+    }
+    for (int k = M_KIN_CAL; k <= M_REFINE; k += 2)
+        for (int div = 2; div <= 4; div *= 2) {
+            c = base_cfg(o, (method_kind)k);
+            c.div = div;
+            c.x = (float)div;
+            snprintf(c.group, sizeof c.group, "res");
+            snprintf(c.setting, sizeof c.setting, "mask=%dx%d", CW / div, CH / div);
+            n = add_cfg(L, n, cap, c);
+        }
+    for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
+        c = base_cfg(o, (method_kind)k);
+        c.fine = 1;
+        snprintf(c.group, sizeof c.group, "tris");
+        snprintf(c.setting, sizeof c.setting, "tris=4x");
+        n = add_cfg(L, n, cap, c);
+        c = base_cfg(o, (method_kind)k);
+        c.dqs = 1;
+        snprintf(c.group, sizeof c.group, "dqs");
+        snprintf(c.setting, sizeof c.setting, "dqs");
+        n = add_cfg(L, n, cap, c);
+    }
+    static const float noise[] = { 0, 2, 10, 20 };
+    static const float lat[] = { 0, 50, 100 };
+    static const float cal[] = { -0.10f, -0.05f, 0.0f, 0.05f, 0.10f };
+    for (int k = 0; k < 4; k++) {
+        if (k == M_SKIN) continue;
+        for (int i = 0; i < 4; i++) {
+            c = base_cfg(o, (method_kind)k);
+            c.track.noise_mm = noise[i];
+            c.x = noise[i];
+            snprintf(c.group, sizeof c.group, "noise");
+            snprintf(c.setting, sizeof c.setting, "noise=%gmm", (double)noise[i]);
+            n = add_cfg(L, n, cap, c);
+        }
+        for (int i = 0; i < 3; i++) {
+            c = base_cfg(o, (method_kind)k);
+            c.track.latency_ms = lat[i];
+            c.x = lat[i];
+            snprintf(c.group, sizeof c.group, "latency");
+            snprintf(c.setting, sizeof c.setting, "latency=%gms", (double)lat[i]);
+            n = add_cfg(L, n, cap, c);
+        }
+        if (k == M_KIN) continue;    /* the paper's method has no calibration */
+        for (int i = 0; i < 5; i++) {
+            c = base_cfg(o, (method_kind)k);
+            c.calib_error = cal[i];
+            c.x = 100.0f * cal[i];
+            snprintf(c.group, sizeof c.group, "calib");
+            snprintf(c.setting, sizeof c.setting, "calib=%+g%%", (double)(100.0f * cal[i]));
+            n = add_cfg(L, n, cap, c);
+        }
+    }
+    return n;
+}
+
+/* ---------------------------------------------------------- reporting */
+
+typedef struct summary {
+    double iou, bf1, bf3, fp, fn, psnr, ms, flicker;
+} summary;
+
+static summary summarise(const method_run *r)
+{
+    summary s;
+    double n = r->n_eye > 0 ? (double)r->n_eye : 1.0;
+    s.iou = r->iou / n;
+    s.bf1 = r->bf1 / n;
+    s.bf3 = r->bf3 / n;
+    s.fp = r->fp / n;
+    s.fn = r->fn / n;
+    s.psnr = fuse_psnr_of_mse(r->mse / n);
+    s.ms = 1e3 * r->secs / (r->n_frames > 0 ? (double)r->n_frames : 1.0);
+    s.flicker = r->n_flicker > 0 ? r->flicker / (double)r->n_flicker : 0.0;
+    return s;
+}
+
+static int write_csv(const char *path, const method_run *R, int n)
+{
+    char tmp[IO_PATH_MAX + 32];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    if (!f) return cli_fail("%s: cannot write", path);
+    fprintf(f, "method,setting,iou,bf1,bf3,fp_area,fn_area,psnr,ms_per_frame,flicker,group\n");
+    for (int i = 0; i < n; i++) {
+        summary s = summarise(&R[i]);
+        fprintf(f, "%s,%s,%.5f,%.5f,%.5f,%.1f,%.1f,%.3f,%.3f,%.4f,%s\n",
+                kind_name[R[i].cfg.kind], R[i].cfg.setting, s.iou, s.bf1, s.bf3, s.fp, s.fn,
+                s.psnr, s.ms, s.flicker, R[i].cfg.group);
+    }
+    if (fclose(f) != 0 || rename(tmp, path) != 0) {
+        remove(tmp);
+        return cli_fail("%s: cannot write", path);
+    }
+    return EXIT_OK;
+}
+
+static void print_table(FILE *f, const method_run *R, int n, int markdown)
+{
+    if (markdown)
+        fprintf(f, "| method | setting | IoU | BF 1px | BF 3px | FP px | FN px | PSNR dB | "
+                   "flicker px | ms/stereo frame |\n|---|---|---|---|---|---|---|---|---|---|\n");
+    else
+        fprintf(f, "%-13s %-16s %7s %6s %6s %8s %8s %6s %7s %8s\n", "method", "setting", "IoU",
+                "BF1", "BF3", "FP px", "FN px", "PSNR", "flicker", "ms/frame");
+    for (int i = 0; i < n; i++) {
+        summary s = summarise(&R[i]);
+        if (markdown)
+            fprintf(f, "| %s | %s | %.4f | %.3f | %.3f | %.0f | %.0f | %.2f | %.3f | %.2f |\n",
+                    kind_name[R[i].cfg.kind], R[i].cfg.setting, s.iou, s.bf1, s.bf3, s.fp,
+                    s.fn, s.psnr, s.flicker, s.ms);
+        else
+            fprintf(f, "%-13s %-16s %7.4f %6.3f %6.3f %8.0f %8.0f %6.2f %7.3f %8.2f\n",
+                    kind_name[R[i].cfg.kind], R[i].cfg.setting, s.iou, s.bf1, s.bf3, s.fp,
+                    s.fn, s.psnr, s.flicker, s.ms);
+    }
+}
+
+/* DIR/<group>.dat: one block per method (gnuplot index), x y columns. */
+static int write_group(const char *dir, const char *group, const method_run *R, int n,
+                       const eval_opts *o)
+{
+    char path[IO_PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/%s.dat", dir, group);
+    FILE *f = fopen(path, "w");
+    if (!f) return cli_fail("%s: cannot write", path);
+    for (int k = 0; k < 4; k++) {
+        fprintf(f, "# %s\n", kind_name[k]);
+        int any = 0;
+        /* the default configuration belongs on every tracking curve */
+        for (int pass = 0; pass < 2; pass++)
+            for (int i = 0; i < n; i++) {
+                const method_cfg *c = &R[i].cfg;
+                if ((int)c->kind != k) continue;
+                int is_default = !strcmp(c->group, "methods");
+                float x;
+                if (pass == 0 && is_default) {
+                    if (!strcmp(group, "noise")) x = o->noise;
+                    else if (!strcmp(group, "latency")) x = o->latency;
+                    else if (!strcmp(group, "calib")) x = 100.0f * o->calib_error;
+                    else if (!strcmp(group, "band") && k == M_REFINE) x = 16.0f;
+                    else continue;
+                    if (!strcmp(group, "calib") && k < M_KIN_CAL) continue;
+                } else if (pass == 1 && !strcmp(c->group, group)) {
+                    x = c->x;
+                } else {
+                    continue;
+                }
+                summary s = summarise(&R[i]);
+                fprintf(f, "%g %.5f %.5f %.3f %.3f\n", (double)x, s.iou, s.bf3, s.ms, s.psnr);
+                any = 1;
+            }
+        if (!any) fprintf(f, "nan nan nan nan nan\n");
+        fprintf(f, "\n\n");
+    }
+    fclose(f);
+    return EXIT_OK;
+}
+
+static int write_report(const char *dir, const method_run *R, int n, const eval_opts *o)
+{
+    char path[IO_PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/summary.csv", dir);
+    if (write_csv(path, R, n)) return EXIT_FAIL;
+    snprintf(path, sizeof path, "%s/table.md", dir);
+    FILE *f = fopen(path, "w");
+    if (!f) return cli_fail("%s: cannot write", path);
+    fprintf(f, "Ground truth: %d frames at 60 Hz, tracking noise %g mm, latency %g ms, dropout "
+               "%g, calibration error %g, speed %g, seed %d.\n\n",
+            o->frames, (double)o->noise, (double)o->latency, (double)o->dropout,
+            (double)o->calib_error, (double)o->speed, o->seed);
+    print_table(f, R, n, 1);
+    fclose(f);
+    /* speed-accuracy points: label, ms, iou, bf3 */
+    snprintf(path, sizeof path, "%s/speed.dat", dir);
+    f = fopen(path, "w");
+    if (!f) return cli_fail("%s: cannot write", path);
+    for (int k = 0; k < 4; k++) {
+        fprintf(f, "# %s\n", kind_name[k]);
+        for (int i = 0; i < n; i++) {
+            const method_cfg *c = &R[i].cfg;
+            if ((int)c->kind != k) continue;
+            if (strcmp(c->group, "methods") && strcmp(c->group, "band") &&
+                strcmp(c->group, "res") && strcmp(c->group, "tris") && strcmp(c->group, "dqs"))
+                continue;
+            summary s = summarise(&R[i]);
+            fprintf(f, "%.3f %.5f %.5f \"%s\"\n", s.ms, s.iou, s.bf3, c->setting);
+        }
+        fprintf(f, "\n\n");
+    }
+    fclose(f);
+    static const char *groups[] = { "noise", "latency", "calib", "band" };
+    for (int g = 0; g < 4; g++)
+        if (write_group(dir, groups[g], R, n, o)) return EXIT_FAIL;
+    snprintf(path, sizeof path, "%s/charts.gp", dir);
+    f = fopen(path, "w");
+    if (!f) return cli_fail("%s: cannot write", path);
+    fprintf(f,
+        "set terminal pngcairo size 900,600 font ',10'\n"
+        "set grid\nset key bottom right\n"
+        "titles = 'kin kin-cal-pred skin refine'\n"
+        "set output '%s/speed_iou.png'\n"
+        "set title 'Speed against accuracy: mask IoU (labels: setting)'\n"
+        "set xlabel 'ms per stereo frame (pose, skin, raster, refine, light, composite; 1 thread)'\n"
+        "set ylabel 'mask IoU'\nset logscale x\n"
+        "plot for [i=0:3] '%s/speed.dat' index i using 1:2 with points pt 7 ps 1.3 title word(titles, i+1), \\\n"
+        "     for [i=0:3] '%s/speed.dat' index i using 1:2:4 with labels offset 0,0.8 font ',7' notitle\n"
+        "set output '%s/speed_bf.png'\n"
+        "set title 'Speed against accuracy: boundary F-score within 3 px'\n"
+        "set ylabel 'BF (3 px)'\n"
+        "plot for [i=0:3] '%s/speed.dat' index i using 1:3 with points pt 7 ps 1.3 title word(titles, i+1), \\\n"
+        "     for [i=0:3] '%s/speed.dat' index i using 1:3:4 with labels offset 0,0.8 font ',7' notitle\n"
+        "unset logscale x\n"
+        "set output '%s/noise.png'\nset title 'Accuracy against tracking noise (latency %g ms)'\n"
+        "set xlabel 'RMS position noise, mm'\nset ylabel 'mask IoU'\n"
+        "plot for [i=0:3] '%s/noise.dat' index i using 1:2 with linespoints lw 2 title word(titles, i+1)\n"
+        "set output '%s/latency.png'\nset title 'Accuracy against tracking latency (noise %g mm)'\n"
+        "set xlabel 'latency, ms'\n"
+        "plot for [i=0:3] '%s/latency.dat' index i using 1:2 with linespoints lw 2 title word(titles, i+1)\n"
+        "set output '%s/calib.png'\nset title 'Accuracy against calibration error'\n"
+        "set xlabel 'error of the arm and hand scale, %%'\n"
+        "plot for [i=0:3] '%s/calib.dat' index i using 1:2 with linespoints lw 2 title word(titles, i+1)\n"
+        "set output '%s/band.png'\nset title 'Refinement band width'\n"
+        "set xlabel 'band half width, px'\nset ylabel 'IoU, BF(3 px)'\n"
+        "plot '%s/band.dat' index 3 using 1:2 with linespoints lw 2 title 'IoU', \\\n"
+        "     '%s/band.dat' index 3 using 1:3 with linespoints lw 2 title 'BF 3px'\n",
+        dir, dir, dir, dir, dir, dir, dir, (double)o->latency, dir, dir, (double)o->noise, dir,
+        dir, dir, dir, dir, dir);
+    fclose(f);
+    char cmd[3 * IO_PATH_MAX];
+    snprintf(cmd, sizeof cmd, "gnuplot '%s/charts.gp'", dir);
+    int rc = system(cmd);
+    if (rc != 0)
+        fprintf(stderr, "egofuse eval: gnuplot failed (status %d): the data files and "
+                        "%s/charts.gp are written, the PNG charts are not\n", rc, dir);
+    return EXIT_OK;
+}
+
+/* ---------------------------------------------------------------- run */
+
+static int eval_run(const eval_opts *o)
+{
+    eval_ctx c;
+    if (ctx_init(&c, (uint64_t)o->seed) < 0) {
+        ctx_free(&c);
+        return cli_fail("cannot build the ground truth (out of memory)");
+    }
+    if (o->dump && cli_mkdirs(o->dump) != 0) {
+        ctx_free(&c);
+        return cli_fail("%s: cannot create the folder", o->dump);
+    }
+    if (o->report && cli_mkdirs(o->report) != 0) {
+        ctx_free(&c);
+        return cli_fail("%s: cannot create the report folder", o->report);
+    }
+    enum { CAP = 96 };
+    method_cfg cfgs[CAP];
+    int n = make_configs(o, o->report != NULL, cfgs, CAP);
+    if (n > CAP) n = CAP;
+    method_run *R = calloc((size_t)n, sizeof *R);
+    int rc = EXIT_FAIL;
+    if (!R) { cli_fail("out of memory"); goto done; }
+    for (int i = 0; i < n; i++)
+        if (run_init(&R[i], &cfgs[i], &c) < 0) { cli_fail("out of memory"); goto done; }
+    progress pr;
+    progress_start(&pr, o->frames);
+    if (o->quiet) pr.enabled = 0;
+    for (int f = 0; f < o->frames; f++) {
+        if (make_truth(&c, f, o->speed, f == 0) < 0) { cli_fail("frame %d: ground truth", f); goto done; }
+        for (int i = 0; i < n; i++)
+            if (run_frame(&c, &R[i], f, o->per_frame, o->dump) < 0) {
+                cli_fail("frame %d: %s %s failed", f, kind_name[R[i].cfg.kind], R[i].cfg.setting);
+                goto done;
+            }
+        progress_step(&pr, f + 1, "eval frame");
+    }
+    progress_end(&pr);
+    printf("egofuse eval: %d frames, tracking noise %g mm, latency %g ms, dropout %g, "
+           "calibration error %g, speed %g; means per eye (640x400 masks)\n",
+           o->frames, (double)o->noise, (double)o->latency, (double)o->dropout,
+           (double)o->calib_error, (double)o->speed);
+    print_table(stdout, R, n, 0);
+    if (o->csv && write_csv(o->csv, R, n)) goto done;
+    if (o->report && write_report(o->report, R, n, o)) goto done;
+    if (o->report) printf("egofuse eval: report in %s (summary.csv, table.md, *.png)\n", o->report);
+    rc = EXIT_OK;
+done:
+    if (R)
+        for (int i = 0; i < n; i++) run_free(&R[i]);
+    free(R);
+    ctx_free(&c);
+    return rc;
+}
+
+enum { O_FRAMES = 256, O_NOISE, O_LATENCY, O_DROPOUT, O_CALIB, O_SPEED, O_SEED, O_PERFRAME,
+       O_CSV, O_REPORT, O_QUIET, O_DUMP };
+
+int cmd_eval(int argc, char **argv)
+{
+    static const struct option opts[] = {
+        {"frames", required_argument, 0, O_FRAMES},
+        {"noise", required_argument, 0, O_NOISE},
+        {"latency", required_argument, 0, O_LATENCY},
+        {"dropout", required_argument, 0, O_DROPOUT},
+        {"calib-error", required_argument, 0, O_CALIB},
+        {"speed", required_argument, 0, O_SPEED},
+        {"seed", required_argument, 0, O_SEED},
+        {"per-frame", no_argument, 0, O_PERFRAME},
+        {"csv", required_argument, 0, O_CSV},
+        {"report", required_argument, 0, O_REPORT},
+        {"quiet", no_argument, 0, O_QUIET},
+        {"dump", required_argument, 0, O_DUMP},
+        {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0},
+    };
+    eval_opts o = { 60, 0, 0, 5.0f, 20.0f, 0.02f, 0.02f, 1.0f, 1, NULL, NULL, NULL };
+    optind = 1;
+    opterr = 0;
+    int ch;
+    float v;
+    while ((ch = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+        switch (ch) {
+        case 'h': fputs(eval_usage, stdout); return EXIT_OK;
+        case O_FRAMES:
+            if (!cli_parse_int(optarg, 1, 100000, &o.frames))
+                return cli_usage_error("eval", "--frames '%s': not a positive count", optarg);
+            break;
+        case O_NOISE:
+            if (!cli_parse_float(optarg, &v) || v < 0.0f || v > 200.0f)
+                return cli_usage_error("eval", "--noise '%s': not in 0..200 mm", optarg);
+            o.noise = v;
+            break;
+        case O_LATENCY:
+            if (!cli_parse_float(optarg, &v) || v < 0.0f || v > 1000.0f)
+                return cli_usage_error("eval", "--latency '%s': not in 0..1000 ms", optarg);
+            o.latency = v;
+            break;
+        case O_DROPOUT:
+            if (!cli_parse_float(optarg, &v) || v < 0.0f || v > 1.0f)
+                return cli_usage_error("eval", "--dropout '%s': not in 0..1", optarg);
+            o.dropout = v;
+            break;
+        case O_CALIB:
+            if (!cli_parse_float(optarg, &v) || v < -0.4f || v > 0.4f)
+                return cli_usage_error("eval", "--calib-error '%s': not in -0.4..0.4", optarg);
+            o.calib_error = v;
+            break;
+        case O_SPEED:
+            if (!cli_parse_float(optarg, &v) || v < 0.1f || v > 10.0f)
+                return cli_usage_error("eval", "--speed '%s': not in 0.1..10", optarg);
+            o.speed = v;
+            break;
+        case O_SEED:
+            if (!cli_parse_int(optarg, 0, 1 << 30, &o.seed))
+                return cli_usage_error("eval", "--seed '%s': not a number", optarg);
+            break;
+        case O_PERFRAME: o.per_frame = 1; break;
+        case O_CSV: o.csv = optarg; break;
+        case O_REPORT: o.report = optarg; break;
+        case O_QUIET: o.quiet = 1; break;
+        case O_DUMP: o.dump = optarg; break;
+        case ':': return cli_usage_error("eval", "option %s needs a value", argv[optind - 1]);
+        default: return cli_usage_error("eval", "unknown option '%s'", argv[optind - 1]);
+        }
+    }
+    if (optind < argc) return cli_usage_error("eval", "unexpected argument '%s'", argv[optind]);
+    return eval_run(&o);
+}
+

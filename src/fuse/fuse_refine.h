@@ -1,0 +1,118 @@
+/* fuse_refine.h - masks from colour: the skin-colour key of the related
+ * work, and egofuse's edge-band refinement of the kinematic mask.
+ *
+ * WHAT IT DOES
+ *   fuse_skin_key(): a fixed chroma model. Each pixel of an RGBA8 image
+ *   is converted to YCbCr (BT.601, full range:
+ *     Y  =  0.299 R + 0.587 G + 0.114 B
+ *     Cb = 128 - 0.168736 R - 0.331264 G + 0.5 B
+ *     Cr = 128 + 0.5 R - 0.418688 G - 0.081312 B)
+ *   and is skin when its squared Mahalanobis distance in (Cb, Cr) to a
+ *   Gaussian skin model is <= max_dist2 and min_luma <= Y <= max_luma.
+ *   The default model is the widely used one of Hsu, Abdel-Mottaleb and
+ *   Jain (mean Cb 117.43, Cr 156.56, covariance [[160.13, 12.14],
+ *   [12.14, 299.46]]), max_dist2 = 2.5 (so that neutral grey, at 3.4,
+ *   is not skin) and luma 40..250.
+ *   Sleeves, shadows and skin-coloured objects defeat it: that is what the
+ *   accuracy report shows.
+ *
+ *   fuse_refine_mask(): the kinematic mask M (from the posed model) is
+ *   right except near its edge, where tracking noise, latency and the
+ *   model's shape put it a few pixels off. Per frame:
+ *     1. d(x) = chamfer (3-4) distance of every pixel to M's edge
+ *        (pixels with a 4-neighbour of the other class are at distance 1),
+ *        in pixels;
+ *     2. two colour histograms are learned from this frame: "hand" from
+ *        the pixels inside M with band < d <= band + margin, "background"
+ *        from those outside M at the same distances (the certain inside
+ *        and outside, near the edge where the colours that matter are);
+ *        colours are quantised to `bits` bits per channel of RGB;
+ *     3. every pixel with d <= band is decided again by the log-likelihood
+ *        ratio of its colour, log((h_fg + a)/(n_fg + a K)) -
+ *        log((h_bg + a)/(n_bg + a K)) (K bins, a K = 4 pseudo-samples),
+ *        plus a prior that trusts the model: +prior * (1 - 0.75 (d-1) /
+ *        band) inside M and the negative outside (strongest at the edge,
+ *        a quarter at the band's border); pixels beyond the band score
+ *        +4 inside M and -4 outside;
+ *     4. a band pixel is inside when the sum of the scores over the
+ *        (2 smooth + 1)^2 window around it (clipped to the image) is > 0:
+ *        camera noise and skin texture do not fray the edge.
+ *   Pixels farther than band from the edge keep M (binarised to 0/255).
+ *   When either histogram has fewer than min_samples pixels the colour
+ *   model is not trusted and the output is M.
+ *
+ * WHAT IT DOES NOT
+ *   No allocation (the caller gives the scratch memory), no threads, no
+ *   global state. Pure C, libc + libm.
+ */
+#ifndef EGOFUSE_FUSE_REFINE_H
+#define EGOFUSE_FUSE_REFINE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "fuse.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------- skin-colour key */
+
+typedef struct fuse_skin_params {
+    float mean_cb, mean_cr;
+    float cov[3];             /* var(Cb), cov(Cb, Cr), var(Cr) */
+    float max_dist2;          /* squared Mahalanobis distance, > 0 */
+    float min_luma, max_luma; /* 0..255 */
+} fuse_skin_params;
+
+fuse_skin_params fuse_skin_params_default(void);
+
+/* out[y * out_stride + x] = 255 for skin, 0 otherwise; P is RGBA8 (alpha
+ * ignored). FUSE_ERR_ARGS for NULL pointers, out_stride < width, a
+ * covariance that is not positive definite or max_dist2 <= 0. */
+fuse_result fuse_skin_key(const fuse_skin_params *p, const fuse_image *P,
+                          uint8_t *out, int out_stride);
+
+/* ------------------------------------------------- edge-band refinement */
+
+typedef struct fuse_refine_params {
+    int band;           /* uncertain half width, pixels, 1..64 (default 16) */
+    int margin;         /* learning ring beyond it, pixels, 1..64 (8) */
+    int bits;           /* colour bits per channel, 2..6 (4) */
+    float prior;        /* model trust at the edge, nats, >= 0 (1.0) */
+    int smooth;         /* decision window radius, 0..3 (default 1) */
+    int min_samples;    /* per histogram, >= 1 (64) */
+} fuse_refine_params;
+
+/* band 16, margin 8, bits 4, prior 1.0, smooth 1, min_samples 64. */
+fuse_refine_params fuse_refine_params_default(void);
+
+/* Bytes of scratch memory fuse_refine_mask needs for this size (0 when
+ * the size or the parameters are invalid). */
+size_t fuse_refine_scratch_size(const fuse_refine_params *p, int width,
+                                int height);
+
+typedef struct fuse_refine_stats {
+    long band_pixels;       /* pixels decided again */
+    long flipped_in;        /* outside M, now inside */
+    long flipped_out;       /* inside M, now outside */
+    long fg_samples, bg_samples;
+    int used_colour;        /* 0: the histograms were too small, out = M */
+} fuse_refine_stats;
+
+/* Refines mask (P's size, mask_stride bytes per row, inside = >= 128)
+ * with the colours of P (RGBA8) into out (0/255, out_stride bytes per
+ * row; out may not overlap mask or scratch). scratch: at least
+ * fuse_refine_scratch_size() bytes, 16-byte aligned. stats may be NULL.
+ * FUSE_ERR_ARGS on NULL pointers, bad strides, out-of-range parameters,
+ * or too little scratch. */
+fuse_result fuse_refine_mask(const fuse_refine_params *p, const fuse_image *P,
+                             const uint8_t *mask, int mask_stride,
+                             uint8_t *out, int out_stride, void *scratch,
+                             size_t scratch_size, fuse_refine_stats *stats);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
