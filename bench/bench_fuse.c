@@ -1,19 +1,34 @@
-/* bench_fuse.c - ms per stereo frame of the fuse stages (lighting at
- * 640x400, resampling + composite into 1194x746 of 1280x800, and the whole
- * fuse_context_frame), per ISA, 1 and 2 threads, for a typical hand (25%
- * of the view) and a worst case (70%). In the same run: memcpy of the
- * composite's bytes (V -> out, both eyes: the memory floor) and pixman
- * compositing the same camera image with an a8 mask, bilinear-scaled into
- * the same viewport (no lighting), as ratios. Medians over many runs.
+/* bench_fuse.c - ms per stereo frame of the fuse stages, per ISA, 1 and 2
+ * threads, for a typical hand (25% of the camera view) and a worst case
+ * (70%), against the memory floor and pixman measured in the same run.
  * Reports, never passes or fails.
  *
- *   bench_fuse [--csv] [--runs N]
+ *   bench_fuse [--csv] [--runs N] [--isa ref|sse2|avx2|avx512]
+ *              [--threads 1|2] [--case typical|worst] [--no-pixman] [--cpu-time]
  *
- * pixman is used when its header is found: the Makefile builds this file
- * without it; with it:
- *   gcc -std=c11 -O2 -ffp-contract=off -D_GNU_SOURCE $(pkg-config --cflags pixman-1) \
- *       bench/bench_fuse.c build/libegofuse.a $(pkg-config --libs pixman-1) -lm -lpthread */
+ * Per stereo frame (two eyes: 640x400 camera images lit, resampled into
+ * the 1194x746 viewport at (43, 27) of 1280x800, composited over V):
+ *   light      fuse_context_light, both eyes
+ *   comp       fuse_context_composite into a separate out (reads V, writes
+ *              out: the whole 1280x800 frame is written)
+ *   frame      fuse_context_frame, out separate from V
+ *   frame_ip   fuse_context_frame in place (out == V), what src/pipe does:
+ *              transparent spans of the layer cost a read of V and no write
+ *   memcpy     V -> out of both eyes (2 x 4.1 MB) with as many threads as
+ *              the row (one eye per thread with 2): the memory floor
+ *   pixman     single-threaded, in place on a copy of V (pixman's dst):
+ *     pm_blend   OVER of a 1194x746 premultiplied layer through a 1194x746
+ *                a8 mask, no scaling: the pure blend cost
+ *     pm_scaled  OVER of the 640x400 premultiplied layer Q, bilinear into
+ *                the viewport (PAD edges): what fuse_composite does
+ *     pm_scaled_mask  the camera image (x8r8g8b8) through the a8 mask, both
+ *                bilinear into the viewport (a composite without lighting)
+ * Every number is the median over --runs runs; the ratios are medians of
+ * the per-run ratios (each run times memcpy, then the stages, back to
+ * back), which cancels most of the noise of a shared machine. The scene V
+ * is opaque (alpha 255), as a rendered scene is. */
 #include <math.h>
+#include <pthread.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -33,14 +48,17 @@
 
 enum { CW = 640, CH = 400, W = 1280, H = 800, VX = 43, VY = 27, VW = 1194, VHH = 746 };
 
+/* --cpu-time: the calling thread's CPU time instead of the wall clock
+ * (insensitive to being descheduled on a loaded machine; meaningful for
+ * the 1-thread rows only, as the other threads' time is not counted). */
+static clockid_t clock_id = CLOCK_MONOTONIC;
+
 static double now_ms(void)
 {
     struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
+    clock_gettime(clock_id, &t);
     return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
 }
-
-static long sysconf_cpus(void) { return sysconf(_SC_NPROCESSORS_ONLN); }
 
 static int cmp_d(const void *a, const void *b)
 {
@@ -63,28 +81,39 @@ static uint32_t rnd(void)
     return (uint32_t)(z ^ (z >> 31));
 }
 
+static void *xmalloc(size_t n)
+{
+    void *p = malloc(n);
+    if (p == NULL) {
+        fprintf(stderr, "bench_fuse: out of memory\n");
+        exit(2);
+    }
+    return p;
+}
+
 typedef struct eye_buf {
-    uint8_t *P, *M, *Q, *V, *out;
+    uint8_t *P, *M, *Q, *V, *out, *Vip;   /* Vip: V for the in-place runs */
     float *N;
 } eye_buf;
 
 /* Two elliptical "hands" side by side covering about `cover` of the image,
- * with a soft edge of ~3 pixels. */
+ * with a soft edge of ~3 pixels. Returns the share of pixels with M > 0. */
 static double make_eye(eye_buf *e, double cover)
 {
-    const double a = 0.25 * CW * sqrt(cover * 8 / 3.14159265 / 1.6) * 1.0,
-                 b = a * 1.6 * CH / CW * 1.0;
+    const double a = 0.25 * CW * sqrt(cover * 8 / 3.14159265 / 1.6), b = a * 1.6 * CH / CW;
     long on = 0;
     int x, y, i;
-    e->P = malloc(CW * CH * 4);
-    e->M = malloc(CW * CH);
-    e->Q = malloc(CW * CH * 4);
-    e->N = malloc(sizeof(float) * CW * CH * 3);
-    e->V = malloc(W * H * 4);
-    e->out = malloc(W * H * 4);
-    if (!e->P || !e->M || !e->Q || !e->N || !e->V || !e->out) exit(2);
+    e->P = xmalloc(CW * CH * 4);
+    e->M = xmalloc(CW * CH);
+    e->Q = xmalloc(CW * CH * 4);
+    e->N = xmalloc(sizeof(float) * CW * CH * 3);
+    e->V = xmalloc(W * H * 4);
+    e->out = xmalloc(W * H * 4);
+    e->Vip = xmalloc(W * H * 4);
     for (i = 0; i < CW * CH * 4; i++) e->P[i] = (uint8_t)rnd();
-    for (i = 0; i < W * H * 4; i++) e->V[i] = (uint8_t)rnd();
+    for (i = 0; i < W * H * 4; i++) e->V[i] = (uint8_t)(i % 4 == 3 ? 255 : rnd());
+    memcpy(e->Vip, e->V, W * H * 4);
+    memcpy(e->out, e->V, W * H * 4);
     for (y = 0; y < CH; y++)
         for (x = 0; x < CW; x++) {
             const double cx = x < CW / 2 ? CW * 0.25 : CW * 0.75;
@@ -103,98 +132,198 @@ static double make_eye(eye_buf *e, double cover)
 
 static void free_eye(eye_buf *e)
 {
-    free(e->P); free(e->M); free(e->Q); free(e->N); free(e->V); free(e->out);
+    free(e->P); free(e->M); free(e->Q); free(e->N); free(e->V); free(e->out); free(e->Vip);
 }
 
-typedef struct result { double light, comp, frame; } result;
+/* ---- the memory floor: memcpy on 1 or 2 threads ------------------------- */
 
-static void run_stages(fuse_context *ctx, eye_buf e[2], int runs, result *r)
+typedef struct copier {
+    pthread_t th;
+    pthread_barrier_t start, done;
+    eye_buf *eye;      /* the eye the helper copies */
+    int quit;
+} copier;
+
+static void *copier_main(void *p)
+{
+    copier *c = p;
+    for (;;) {
+        pthread_barrier_wait(&c->start);
+        if (c->quit) break;
+        memcpy(c->eye->out, c->eye->V, (size_t)W * H * 4);
+        pthread_barrier_wait(&c->done);
+    }
+    return NULL;
+}
+
+static void copier_start(copier *c, eye_buf *second)
+{
+    c->eye = second;
+    c->quit = 0;
+    pthread_barrier_init(&c->start, NULL, 2);
+    pthread_barrier_init(&c->done, NULL, 2);
+    if (pthread_create(&c->th, NULL, copier_main, c) != 0) exit(2);
+}
+
+static void copier_stop(copier *c)
+{
+    c->quit = 1;
+    pthread_barrier_wait(&c->start);
+    pthread_join(c->th, NULL);
+    pthread_barrier_destroy(&c->start);
+    pthread_barrier_destroy(&c->done);
+}
+
+/* ms of memcpy V -> out of both eyes, on the calling thread or (c != NULL)
+ * one eye per thread. */
+static double time_memcpy(eye_buf e[2], copier *c)
+{
+    const double t0 = now_ms();
+    if (c != NULL) {
+        pthread_barrier_wait(&c->start);
+        memcpy(e[0].out, e[0].V, (size_t)W * H * 4);
+        pthread_barrier_wait(&c->done);
+    } else {
+        memcpy(e[0].out, e[0].V, (size_t)W * H * 4);
+        memcpy(e[1].out, e[1].V, (size_t)W * H * 4);
+    }
+    return now_ms() - t0;
+}
+
+/* ---- egofuse ------------------------------------------------------------ */
+
+typedef struct stats {
+    double light, comp, frame, frame_ip, memcpy;
+    double r_frame, r_frame_ip;   /* medians of frame / memcpy per run */
+} stats;
+
+static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, stats *s)
 {
     const fuse_lighting L = fuse_lighting_default();
     const fuse_intrinsics K = { 532.0f, 532.0f, CW / 2.0f, CH / 2.0f };
-    double *tl = malloc(sizeof(double) * runs), *tc = malloc(sizeof(double) * runs),
-           *tf = malloc(sizeof(double) * runs);
-    fuse_eye eyes[2];
+    double *t[7];
+    fuse_eye eyes[2], ip[2];
+    copier cp;
     int k, i;
-    for (i = 0; i < 2; i++)
+    for (i = 0; i < 7; i++) t[i] = xmalloc(sizeof(double) * (size_t)runs);
+    for (i = 0; i < 2; i++) {
         eyes[i] = (fuse_eye){ &L, &K, { e[i].P, CW, CH, 4 * CW }, e[i].M, CW, e[i].N, 3 * CW,
                               { e[i].Q, CW, CH, 4 * CW }, NULL, { e[i].V, W, H, 4 * W },
                               VX, VY, VW, VHH, { e[i].out, W, H, 4 * W } };
-    for (k = -2; k < runs; k++) {   /* 2 warm-up runs */
-        double t0 = now_ms(), t1, t2, t3;
+        ip[i] = eyes[i];
+        ip[i].V = ip[i].out = (fuse_image){ e[i].Vip, W, H, 4 * W };
+    }
+    if (threads > 1) copier_start(&cp, &e[1]);
+    for (k = -3; k < runs; k++) {   /* 3 warm-up runs */
+        double m, t0, t1, t2, t3, t4;
+        m = time_memcpy(e, threads > 1 ? &cp : NULL);
+        t0 = now_ms();
         for (i = 0; i < 2; i++)
-            fuse_context_light(ctx, &L, &K, &eyes[i].P, e[i].M, CW, e[i].N, 3 * CW, &eyes[i].Q);
+            if (fuse_context_light(ctx, &L, &K, &eyes[i].P, e[i].M, CW, e[i].N, 3 * CW,
+                                   &eyes[i].Q) != FUSE_OK) exit(3);
         t1 = now_ms();
         for (i = 0; i < 2; i++)
-            fuse_context_composite(ctx, &eyes[i].Q, &eyes[i].V, VX, VY, VW, VHH, &eyes[i].out);
+            if (fuse_context_composite(ctx, &eyes[i].Q, &eyes[i].V, VX, VY, VW, VHH,
+                                       &eyes[i].out) != FUSE_OK) exit(3);
         t2 = now_ms();
         if (fuse_context_frame(ctx, eyes, 2) != FUSE_OK) exit(3);
         t3 = now_ms();
-        if (k >= 0) {
-            tl[k] = t1 - t0;
-            tc[k] = t2 - t1;
-            tf[k] = t3 - t2;
-        }
+        if (fuse_context_frame(ctx, ip, 2) != FUSE_OK) exit(3);
+        t4 = now_ms();
+        if (k < 0) continue;
+        t[0][k] = t1 - t0;
+        t[1][k] = t2 - t1;
+        t[2][k] = t3 - t2;
+        t[3][k] = t4 - t3;
+        t[4][k] = m;
+        t[5][k] = (t3 - t2) / m;
+        t[6][k] = (t4 - t3) / m;
     }
-    r->light = median(tl, runs);
-    r->comp = median(tc, runs);
-    r->frame = median(tf, runs);
-    free(tl); free(tc); free(tf);
+    if (threads > 1) copier_stop(&cp);
+    s->light = median(t[0], runs);
+    s->comp = median(t[1], runs);
+    s->frame = median(t[2], runs);
+    s->frame_ip = median(t[3], runs);
+    s->memcpy = median(t[4], runs);
+    s->r_frame = median(t[5], runs);
+    s->r_frame_ip = median(t[6], runs);
+    for (i = 0; i < 7; i++) free(t[i]);
 }
 
-static double bench_memcpy(eye_buf e[2], int runs)
-{
-    double *t = malloc(sizeof(double) * runs), m;
-    int k, i;
-    for (k = -2; k < runs; k++) {
-        double t0 = now_ms();
-        for (i = 0; i < 2; i++) memcpy(e[i].out, e[i].V, (size_t)W * H * 4);
-        if (k >= 0) t[k] = now_ms() - t0;
-    }
-    m = median(t, runs);
-    free(t);
-    return m;
-}
+/* ---- pixman ------------------------------------------------------------- */
+
+typedef struct pm_stats { double blend, scaled, scaled_mask, memcpy; } pm_stats;
 
 #ifdef HAVE_PIXMAN
-/* OVER of the camera image (x8r8g8b8, 640x400) through the a8 mask, both
- * scaled bilinearly into the viewport of the 1280x800 a8r8g8b8 output:
- * the composite without lighting. */
-static double bench_pixman(eye_buf e[2], int runs)
+/* The three pixman composites of both eyes (see the top), each timed with a
+ * memcpy right before it; medians. dst is a copy of V per eye. */
+static void bench_pixman(eye_buf e[2], int runs, pm_stats *s)
 {
-    pixman_image_t *src[2], *msk[2], *dst[2];
+    pixman_image_t *lay[2], *lmask[2], *q[2], *cam[2], *msk[2], *dst[2];
+    uint8_t *big[2], *bigm[2], *dbuf[2];
     pixman_transform_t tr;
-    double *t = malloc(sizeof(double) * runs), m;
-    int k, i;
+    double *t[4];
+    int k, i, x, y;
+    const int mstride = (VW + 3) & ~3;
+    for (i = 0; i < 4; i++) t[i] = xmalloc(sizeof(double) * (size_t)runs);
     pixman_transform_init_scale(&tr, pixman_double_to_fixed((double)CW / VW),
                                 pixman_double_to_fixed((double)CH / VHH));
     for (i = 0; i < 2; i++) {
-        src[i] = pixman_image_create_bits(PIXMAN_x8r8g8b8, CW, CH, (uint32_t *)(void *)e[i].P, 4 * CW);
-        msk[i] = pixman_image_create_bits(PIXMAN_a8, CW, CH, (uint32_t *)(void *)e[i].M,
-                                          (CW + 3) & ~3);
-        dst[i] = pixman_image_create_bits(PIXMAN_a8r8g8b8, W, H, (uint32_t *)(void *)e[i].out, 4 * W);
-        pixman_image_set_transform(src[i], &tr);
+        /* the lit layer and the mask, nearest-upscaled to the viewport */
+        big[i] = xmalloc((size_t)VW * VHH * 4);
+        bigm[i] = xmalloc((size_t)mstride * VHH);
+        dbuf[i] = xmalloc((size_t)W * H * 4);
+        memcpy(dbuf[i], e[i].V, (size_t)W * H * 4);
+        for (y = 0; y < VHH; y++)
+            for (x = 0; x < VW; x++) {
+                const int sx = x * CW / VW, sy = y * CH / VHH;
+                memcpy(big[i] + 4 * ((size_t)y * VW + x), e[i].Q + 4 * ((size_t)sy * CW + sx), 4);
+                bigm[i][(size_t)y * mstride + x] = e[i].M[(size_t)sy * CW + sx];
+            }
+        lay[i] = pixman_image_create_bits(PIXMAN_a8r8g8b8, VW, VHH, (uint32_t *)(void *)big[i], 4 * VW);
+        lmask[i] = pixman_image_create_bits(PIXMAN_a8, VW, VHH, (uint32_t *)(void *)bigm[i], mstride);
+        q[i] = pixman_image_create_bits(PIXMAN_a8r8g8b8, CW, CH, (uint32_t *)(void *)e[i].Q, 4 * CW);
+        cam[i] = pixman_image_create_bits(PIXMAN_x8r8g8b8, CW, CH, (uint32_t *)(void *)e[i].P, 4 * CW);
+        msk[i] = pixman_image_create_bits(PIXMAN_a8, CW, CH, (uint32_t *)(void *)e[i].M, CW);
+        dst[i] = pixman_image_create_bits(PIXMAN_a8r8g8b8, W, H, (uint32_t *)(void *)dbuf[i], 4 * W);
+        pixman_image_set_transform(q[i], &tr);
+        pixman_image_set_transform(cam[i], &tr);
         pixman_image_set_transform(msk[i], &tr);
-        pixman_image_set_filter(src[i], PIXMAN_FILTER_BILINEAR, NULL, 0);
+        pixman_image_set_filter(q[i], PIXMAN_FILTER_BILINEAR, NULL, 0);
+        pixman_image_set_filter(cam[i], PIXMAN_FILTER_BILINEAR, NULL, 0);
         pixman_image_set_filter(msk[i], PIXMAN_FILTER_BILINEAR, NULL, 0);
-        pixman_image_set_repeat(src[i], PIXMAN_REPEAT_PAD);
+        pixman_image_set_repeat(q[i], PIXMAN_REPEAT_PAD);
+        pixman_image_set_repeat(cam[i], PIXMAN_REPEAT_PAD);
         pixman_image_set_repeat(msk[i], PIXMAN_REPEAT_PAD);
     }
     for (k = -2; k < runs; k++) {
-        double t0 = now_ms();
+        double m = time_memcpy(e, NULL), t0, t1, t2, t3;
+        t0 = now_ms();
         for (i = 0; i < 2; i++)
-            pixman_image_composite32(PIXMAN_OP_OVER, src[i], msk[i], dst[i], 0, 0, 0, 0,
-                                     VX, VY, VW, VHH);
-        if (k >= 0) t[k] = now_ms() - t0;
+            pixman_image_composite32(PIXMAN_OP_OVER, lay[i], lmask[i], dst[i], 0, 0, 0, 0, VX, VY, VW, VHH);
+        t1 = now_ms();
+        for (i = 0; i < 2; i++)
+            pixman_image_composite32(PIXMAN_OP_OVER, q[i], NULL, dst[i], 0, 0, 0, 0, VX, VY, VW, VHH);
+        t2 = now_ms();
+        for (i = 0; i < 2; i++)
+            pixman_image_composite32(PIXMAN_OP_OVER, cam[i], msk[i], dst[i], 0, 0, 0, 0, VX, VY, VW, VHH);
+        t3 = now_ms();
+        if (k < 0) continue;
+        t[0][k] = t1 - t0;
+        t[1][k] = t2 - t1;
+        t[2][k] = t3 - t2;
+        t[3][k] = m;
     }
-    m = median(t, runs);
+    s->blend = median(t[0], runs);
+    s->scaled = median(t[1], runs);
+    s->scaled_mask = median(t[2], runs);
+    s->memcpy = median(t[3], runs);
     for (i = 0; i < 2; i++) {
-        pixman_image_unref(src[i]);
-        pixman_image_unref(msk[i]);
-        pixman_image_unref(dst[i]);
+        pixman_image_unref(lay[i]); pixman_image_unref(lmask[i]); pixman_image_unref(q[i]);
+        pixman_image_unref(cam[i]); pixman_image_unref(msk[i]); pixman_image_unref(dst[i]);
+        free(big[i]); free(bigm[i]); free(dbuf[i]);
     }
-    free(t);
-    return m;
+    for (i = 0; i < 4; i++) free(t[i]);
 }
 #endif
 
@@ -217,24 +346,44 @@ static void machine(char *buf, size_t n)
     fclose(f);
 }
 
+static void usage(const char *argv0)
+{
+    fprintf(stderr, "usage: %s [--csv] [--runs N] [--isa ref|sse2|avx2|avx512] "
+            "[--threads 1|2] [--case typical|worst] [--no-pixman] [--cpu-time]\n", argv0);
+    exit(2);
+}
+
 int main(int argc, char **argv)
 {
     static const ef_isa isas[] = { EF_ISA_REF, EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512 };
     static const double covers[2] = { 0.25, 0.70 };
     static const char *cover_name[2] = { "typical", "worst" };
-    int csv = 0, runs = 51, a, c, i, t;
+    int csv = 0, runs = 51, a, c, i, t, only_threads = 0, only_case = -1, no_pixman = 0;
+    ef_isa only_isa = EF_ISA_DEFAULT;
     char cpu[256];
     for (a = 1; a < argc; a++) {
         if (!strcmp(argv[a], "--csv")) csv = 1;
         else if (!strcmp(argv[a], "--runs") && a + 1 < argc) runs = atoi(argv[++a]);
-        else {
-            fprintf(stderr, "usage: %s [--csv] [--runs N]\n", argv[0]);
-            return 2;
-        }
+        else if (!strcmp(argv[a], "--isa") && a + 1 < argc) {
+            only_isa = ef_isa_parse(argv[++a]);
+            if (only_isa == EF_ISA_DEFAULT) usage(argv[0]);
+        } else if (!strcmp(argv[a], "--threads") && a + 1 < argc) {
+            only_threads = atoi(argv[++a]);
+            if (only_threads < 1 || only_threads > 2) usage(argv[0]);
+        } else if (!strcmp(argv[a], "--case") && a + 1 < argc) {
+            a++;
+            only_case = !strcmp(argv[a], "typical") ? 0 : !strcmp(argv[a], "worst") ? 1 : -2;
+            if (only_case == -2) usage(argv[0]);
+        } else if (!strcmp(argv[a], "--no-pixman"))
+            no_pixman = 1;
+        else if (!strcmp(argv[a], "--cpu-time"))
+            clock_id = CLOCK_THREAD_CPUTIME_ID;
+        else
+            usage(argv[0]);
     }
     if (runs < 3) runs = 3;
     machine(cpu, sizeof cpu);
-    printf("%smachine: %s, %ld cpus\n", csv ? "# " : "", cpu, sysconf_cpus());
+    printf("%smachine: %s, %ld cpus\n", csv ? "# " : "", cpu, sysconf(_SC_NPROCESSORS_ONLN));
     printf("%scompiler: %s\n", csv ? "# " : "",
 #ifdef __VERSION__
            __VERSION__
@@ -242,58 +391,83 @@ int main(int argc, char **argv)
            "unknown"
 #endif
     );
-    printf("%sisa: best %s, EGOFUSE_ISA %s; pixman %s; medians of %d runs\n", csv ? "# " : "",
+    printf("%sisa: cpu best %s, EGOFUSE_ISA %s; pixman %s; medians of %d runs; %s\n",
+           csv ? "# " : "",
            ef_isa_name(ef_cpu_best()), getenv("EGOFUSE_ISA") ? getenv("EGOFUSE_ISA") : "unset",
 #ifdef HAVE_PIXMAN
            pixman_version_string(),
 #else
            "not built in",
 #endif
-           runs);
+           runs, clock_id == CLOCK_MONOTONIC ? "wall clock" : "CPU time of the calling thread");
     if (csv)
         printf("case,coverage,isa,threads,light_ms,composite_ms,light_plus_composite_ms,frame_ms,"
-               "memcpy_ms,pixman_ms,frame_over_memcpy,frame_over_pixman\n");
+               "frame_inplace_ms,memcpy_ms,frame_over_memcpy,frame_inplace_over_memcpy,"
+               "pixman_blend_ms,pixman_scaled_ms,pixman_scaled_mask_ms,pixman_memcpy_ms,"
+               "frame_inplace_over_pixman_blend,frame_inplace_over_pixman_scaled\n");
     for (c = 0; c < 2; c++) {
         eye_buf e[2];
-        double cov = 0, mc, px = NAN;
+        double cov = 0;
+        pm_stats pm = { NAN, NAN, NAN, NAN };
+        if (only_case >= 0 && only_case != c) continue;
         for (i = 0; i < 2; i++) cov += make_eye(&e[i], covers[c]) / 2;
-        mc = bench_memcpy(e, runs);
+        {   /* a lit layer for pixman's inputs */
+            const fuse_lighting L = fuse_lighting_default();
+            const fuse_intrinsics K = { 532.0f, 532.0f, CW / 2.0f, CH / 2.0f };
+            for (i = 0; i < 2; i++) {
+                fuse_image P = { e[i].P, CW, CH, 4 * CW }, Q = { e[i].Q, CW, CH, 4 * CW };
+                if (fuse_light(&L, &K, &P, e[i].M, CW, e[i].N, 3 * CW, &Q) != FUSE_OK) return 3;
+            }
+        }
 #ifdef HAVE_PIXMAN
-        px = bench_pixman(e, runs);
+        if (!no_pixman) bench_pixman(e, runs, &pm);
 #endif
         if (!csv)
-            printf("\n%s hand: %.1f%% of the camera pixels have M > 0; memcpy floor "
-                   "(V -> out, 2 x %.1f MB) %.3f ms; pixman over + a8 mask, bilinear %.3f ms\n"
-                   "  %-7s %3s %9s %9s %9s %9s %8s %8s\n", cover_name[c], 100 * cov,
-                   W * H * 4 / 1e6, mc, px, "isa", "thr", "light", "comp", "l+c", "frame",
-                   "/memcpy", "/pixman");
+            printf("\n%s hand: %.1f%% of the camera pixels have M > 0\n"
+                   "  pixman (1 thread, in place): blend 1:1 + a8 mask %.3f ms, layer bilinear "
+                   "%.3f ms, camera + a8 mask bilinear %.3f ms (memcpy 1 thread %.3f ms)\n"
+                   "  %-7s %3s %7s %7s %7s %7s %8s %7s %8s %8s %8s %8s\n",
+                   cover_name[c], 100 * cov, pm.blend, pm.scaled, pm.scaled_mask, pm.memcpy,
+                   "isa", "thr", "light", "comp", "frame", "frm_ip", "memcpy", "frm/mc",
+                   "frm_ip/mc", "ip/pm_bl", "ip/pm_sc", "ip/pm_sm");
         for (i = 0; i < 4; i++) {
+            if (only_isa != EF_ISA_DEFAULT && only_isa != isas[i]) continue;
             if (!ef_cpu_has(isas[i]) || ef_isa_choose(isas[i]) != isas[i]) {
                 if (!csv) printf("  %-7s SKIP: not available\n", ef_isa_name(isas[i]));
                 continue;
             }
             for (t = 1; t <= 2; t++) {
                 fuse_context_desc d = { isas[i], t };
-                fuse_context *ctx = fuse_context_create(&d);
-                result r;
+                fuse_context *ctx;
+                stats s;
                 const int n = isas[i] == EF_ISA_REF ? (runs < 7 ? runs : 7) : runs;
+                if (only_threads && t != only_threads) continue;
+                ctx = fuse_context_create(&d);
                 if (!ctx) return 2;
-                run_stages(ctx, e, n, &r);
+                run_stages(ctx, e, t, n, &s);
                 if (csv)
-                    printf("%s,%.4f,%s,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f\n", cover_name[c],
-                           cov, ef_isa_name(isas[i]), t, r.light, r.comp, r.light + r.comp, r.frame,
-                           mc, px, r.frame / mc, r.frame / px);
+                    printf("%s,%.4f,%s,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.4f,%.4f,%.4f,"
+                           "%.4f,%.3f,%.3f\n", cover_name[c], cov, ef_isa_name(isas[i]), t,
+                           s.light, s.comp, s.light + s.comp, s.frame, s.frame_ip, s.memcpy,
+                           s.r_frame, s.r_frame_ip, pm.blend, pm.scaled, pm.scaled_mask, pm.memcpy,
+                           s.frame_ip / pm.blend, s.frame_ip / pm.scaled);
                 else
-                    printf("  %-7s %3d %9.3f %9.3f %9.3f %9.3f %8.2f %8.2f\n", ef_isa_name(isas[i]),
-                           t, r.light, r.comp, r.light + r.comp, r.frame, r.frame / mc, r.frame / px);
+                    printf("  %-7s %3d %7.3f %7.3f %7.3f %7.3f %8.3f %7.2f %8.2f %8.2f %8.2f %8.3f\n",
+                           ef_isa_name(isas[i]), t, s.light, s.comp, s.frame, s.frame_ip, s.memcpy,
+                           s.r_frame, s.r_frame_ip, s.frame_ip / pm.blend, s.frame_ip / pm.scaled,
+                           s.frame_ip / pm.scaled_mask);
                 fuse_context_destroy(ctx);
             }
         }
         for (i = 0; i < 2; i++) free_eye(&e[i]);
     }
     if (!csv)
-        printf("\nms per stereo frame (two eyes). light, comp: the stages called one by one;\n"
-               "frame: fuse_context_frame (light + composite, one eye per thread with 2 threads).\n"
-               "/memcpy, /pixman: frame time over the memcpy floor and over pixman.\n");
+        printf("\nms per stereo frame (two eyes), medians. light, comp: the stages called one by\n"
+               "one (comp into a separate out); frame: fuse_context_frame (both stages, one eye per\n"
+               "thread with 2 threads), out separate; frm_ip: the same in place (out == V, as\n"
+               "src/pipe runs it). memcpy: V -> out of both eyes with the row's thread count (the\n"
+               "floor); frm/mc, frm_ip/mc: medians of the per-run ratios to it. ip/pm_*: frm_ip over\n"
+               "pixman's blend 1:1 + a8 mask, layer bilinear, camera + mask bilinear (below 1:\n"
+               "egofuse is faster). The machine is shared: compare ratios, not ms.\n");
     return 0;
 }

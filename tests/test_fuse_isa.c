@@ -312,6 +312,13 @@ static int skip_missing(const ctxs *cx, int i)
     return 1;
 }
 
+static int skip_missing_isa(ef_isa isa)
+{
+    printf("SKIP %s: not available (cpu best %s, EGOFUSE_ISA %s)\n", ef_isa_name(isa),
+           ef_isa_name(ef_cpu_best()), getenv("EGOFUSE_ISA") ? getenv("EGOFUSE_ISA") : "unset");
+    return 1;
+}
+
 /* ---- tests ---------------------------------------------------------------- */
 
 static void test_cases(void **state)
@@ -513,6 +520,219 @@ static void test_pow_bits(void **state)
     if (missing) skip();
 }
 
+/* ---- fuse_context_frame: the interleaved stages --------------------------- */
+
+/* One eye of a random frame: layer cw x ch, output W x H with a viewport
+ * (enlarging, reducing or 1:1), in place or not, with or without a depth
+ * test; all buffers owned here. */
+typedef struct frame_eye {
+    light_case lc;
+    int W, H, vx, vy, vw, vh, in_place, depth;
+    buf V, out, Q, hand, scene;
+    fuse_depth d;
+} frame_eye;
+
+static void frame_eye_make(tu_rng *r, frame_eye *e)
+{
+    int i;
+    light_case_make(r, &e->lc);
+    e->W = 1 + tu_int(r, tu_int(r, 3) ? 150 : 400);
+    e->H = 1 + tu_int(r, 50);
+    e->vw = tu_int(r, 3) == 0 ? (e->lc.w < e->W ? e->lc.w : e->W) : 1 + tu_int(r, e->W);
+    e->vh = 1 + tu_int(r, e->H);
+    e->vx = tu_int(r, e->W - e->vw + 1);
+    e->vy = tu_int(r, e->H - e->vh + 1);
+    e->in_place = tu_int(r, 2);
+    e->depth = tu_int(r, 3) == 0;
+    e->V = buf_new((size_t)e->W * e->H * 4, 0);
+    e->out = buf_new((size_t)e->W * e->H * 4, 0);
+    e->Q = buf_new((size_t)e->lc.pstride * e->lc.h, 0);
+    for (i = 0; i < (int)e->V.n; i++) e->V.p[i] = (uint8_t)tu_int(r, 256);
+    if (tu_int(r, 2))   /* an opaque scene (in place: no alpha to fix) */
+        for (i = 3; i < (int)e->V.n; i += 4) e->V.p[i] = 255;
+    e->hand = buf_new(sizeof(float) * (size_t)e->lc.w * e->lc.h, 0);
+    e->scene = buf_new(sizeof(float) * (size_t)e->W * e->H, 0);
+    for (i = 0; i < e->lc.w * e->lc.h; i++)
+        ((float *)(void *)e->hand.p)[i] = tu_range(r, 0.0f, 1.2f);
+    for (i = 0; i < e->W * e->H; i++)
+        ((float *)(void *)e->scene.p)[i] = tu_int(r, 2) ? tu_range(r, 0.0f, 3.0f) : 0.0f;
+    e->d = (fuse_depth){ (const float *)(const void *)e->hand.p, e->lc.w, 0.1f, 10.0f, 0.0f,
+                         (const float *)(const void *)e->scene.p, e->W, e->W, e->H };
+}
+
+static void frame_eye_free(frame_eye *e)
+{
+    free(e->lc.P.p); free(e->lc.M.p); free(e->lc.N.p);
+    free(e->V.p); free(e->out.p); free(e->Q.p); free(e->hand.p); free(e->scene.p);
+}
+
+/* The eye as fuse_context_frame takes it; out (and V in place) reset. */
+static fuse_eye frame_eye_bind(frame_eye *e)
+{
+    fuse_eye f;
+    memset(&f, 0, sizeof f);
+    memcpy(e->out.p, e->V.p, e->V.n);
+    memset(e->Q.p, 0x5A, e->Q.n);
+    f.lighting = &e->lc.L;
+    f.intrinsics = &e->lc.K;
+    f.P = (fuse_image){ e->lc.P.p, e->lc.w, e->lc.h, e->lc.pstride };
+    f.mask = e->lc.M.p;
+    f.mask_stride = e->lc.mstride;
+    f.normal = (const float *)(const void *)e->lc.N.p;
+    f.normal_stride = e->lc.nstride;
+    f.Q = (fuse_image){ e->Q.p, e->lc.w, e->lc.h, e->lc.pstride };
+    f.depth = e->depth ? &e->d : NULL;
+    f.V = (fuse_image){ e->in_place ? e->out.p : e->V.p, e->W, e->H, 4 * e->W };
+    f.vp_x0 = e->vx;
+    f.vp_y0 = e->vy;
+    f.vp_w = e->vw;
+    f.vp_h = e->vh;
+    f.out = (fuse_image){ e->out.p, e->W, e->H, 4 * e->W };
+    return f;
+}
+
+/* The stages one by one on the reference: *Q and *out (fresh buffers). */
+static void frame_eye_expect(fuse_context *ref, frame_eye *e, buf *Q, buf *out)
+{
+    fuse_eye f = frame_eye_bind(e);
+    *Q = buf_new(e->Q.n, 0);
+    *out = buf_new(e->out.n, 0);
+    assert_int_equal(fuse_context_light(ref, f.lighting, f.intrinsics, &f.P, f.mask, f.mask_stride,
+                                        f.normal, f.normal_stride, &f.Q), FUSE_OK);
+    if (f.depth)
+        assert_int_equal(fuse_depth_test(f.depth, &f.Q, f.vp_x0, f.vp_y0, f.vp_w, f.vp_h), FUSE_OK);
+    assert_int_equal(fuse_context_composite(ref, &f.Q, &f.V, f.vp_x0, f.vp_y0, f.vp_w, f.vp_h,
+                                            &f.out), FUSE_OK);
+    memcpy(Q->p, e->Q.p, e->Q.n);
+    memcpy(out->p, e->out.p, e->out.n);
+}
+
+/* fuse_context_frame on every ISA and 1..3 threads with 1..3 eyes equals
+ * the reference stages one by one: the composite and the layer Q. */
+static void test_frame_cases(void **state)
+{
+    enum { FRAMES = 150 };
+    fuse_context *ref, *ctx[N_SIMD + 1][3];
+    int n, i, t, missing = 0, bad = 0;
+    fuse_context_desc d = { EF_ISA_REF, 1 };
+    (void)state;
+    ref = fuse_context_create(&d);
+    assert_non_null(ref);
+    for (i = 0; i <= N_SIMD; i++)
+        for (t = 0; t < 3; t++) {
+            d.max_isa = i < N_SIMD ? simd_isas[i] : EF_ISA_REF;
+            d.threads = t + 1;
+            ctx[i][t] = fuse_context_create(&d);
+            assert_non_null(ctx[i][t]);
+        }
+    for (i = 0; i < N_SIMD; i++)
+        if (fuse_context_isa(ctx[i][0]) != simd_isas[i]) {
+            missing += skip_missing_isa(simd_isas[i]);
+            for (t = 0; t < 3; t++) {
+                fuse_context_destroy(ctx[i][t]);
+                ctx[i][t] = NULL;
+            }
+        }
+    for (n = 0; n < FRAMES && !bad; n++) {
+        tu_rng r = { case_seed(100000 + n) };
+        const int count = 1 + tu_int(&r, 3);
+        frame_eye e[3];
+        buf wq[3], wo[3];
+        fuse_eye f[3];
+        int k;
+        for (k = 0; k < count; k++) {
+            frame_eye_make(&r, &e[k]);
+            frame_eye_expect(ref, &e[k], &wq[k], &wo[k]);
+        }
+        for (i = 0; i <= N_SIMD; i++)
+            for (t = 0; t < 3; t++) {
+                if (ctx[i][t] == NULL) continue;
+                for (k = 0; k < count; k++) f[k] = frame_eye_bind(&e[k]);
+                assert_int_equal(fuse_context_frame(ctx[i][t], f, count), FUSE_OK);
+                for (k = 0; k < count; k++) {
+                    char what[64];
+                    snprintf(what, sizeof what, "frame %d eye %d threads %d out", n, k, t + 1);
+                    bad += report_diff(what, ef_isa_name(fuse_context_isa(ctx[i][t])), n,
+                                       &wo[k], &e[k].out, 4 * e[k].W);
+                    snprintf(what, sizeof what, "frame %d eye %d threads %d Q", n, k, t + 1);
+                    bad += report_diff(what, ef_isa_name(fuse_context_isa(ctx[i][t])), n,
+                                       &wq[k], &e[k].Q, e[k].lc.pstride);
+                }
+            }
+        for (k = 0; k < count; k++) {
+            free(wq[k].p);
+            free(wo[k].p);
+            frame_eye_free(&e[k]);
+        }
+    }
+    assert_int_equal(bad, 0);
+    fuse_context_destroy(ref);
+    for (i = 0; i <= N_SIMD; i++)
+        for (t = 0; t < 3; t++) fuse_context_destroy(ctx[i][t]);
+    if (missing) skip();
+}
+
+/* The camera image P inside the viewport of the in-place output: the
+ * stages one by one read all of P before the composite writes over it;
+ * fuse_context_frame must give the same bytes (it does not interleave). */
+static void test_frame_aliasing(void **state)
+{
+    enum { CW = 40, CH = 20, W = 100, H = 60 };
+    tu_rng r = { 0xA11A5u };
+    uint8_t *img = malloc(W * H * 4), *img0 = malloc(W * H * 4), *want = malloc(W * H * 4);
+    uint8_t *M = malloc(CW * CH), *Q = malloc(CW * CH * 4);
+    float *N = malloc(sizeof(float) * CW * CH * 3);
+    const fuse_lighting L = fuse_lighting_default();
+    const fuse_intrinsics K = { 40.0f, 40.0f, CW / 2.0f, CH / 2.0f };
+    fuse_context_desc d = { EF_ISA_REF, 1 };
+    fuse_context *ref = fuse_context_create(&d);
+    int i, t;
+    (void)state;
+    assert_true(img && img0 && want && M && Q && N && ref);
+    for (i = 0; i < W * H * 4; i++) img0[i] = (uint8_t)tu_int(&r, 256);
+    for (i = 0; i < CW * CH; i++) {
+        M[i] = (uint8_t)(tu_int(&r, 3) ? 255 : 0);
+        N[3 * i] = tu_range(&r, -1, 1);
+        N[3 * i + 1] = tu_range(&r, -1, 1);
+        N[3 * i + 2] = 1.0f;
+    }
+    {   /* P: rows 6..25 of the image, at the top of the viewport (rows 5..54) */
+        fuse_image I = { img, W, H, 4 * W };
+        fuse_image P = { img + 4 * (6 * W + 10), CW, CH, 4 * W }, Qi = { Q, CW, CH, 4 * CW };
+        memcpy(img, img0, W * H * 4);
+        assert_int_equal(fuse_context_light(ref, &L, &K, &P, M, CW, N, 3 * CW, &Qi), FUSE_OK);
+        assert_int_equal(fuse_context_composite(ref, &Qi, &I, 2, 5, 96, 50, &I), FUSE_OK);
+        memcpy(want, img, W * H * 4);
+    }
+    for (i = 0; i <= N_SIMD; i++)
+        for (t = 1; t <= 2; t++) {
+            fuse_context_desc cd = { i < N_SIMD ? simd_isas[i] : EF_ISA_REF, t };
+            fuse_context *ctx = fuse_context_create(&cd);
+            fuse_eye f;
+            assert_non_null(ctx);
+            memset(&f, 0, sizeof f);
+            memcpy(img, img0, W * H * 4);
+            f.lighting = &L;
+            f.intrinsics = &K;
+            f.P = (fuse_image){ img + 4 * (6 * W + 10), CW, CH, 4 * W };
+            f.mask = M;
+            f.mask_stride = CW;
+            f.normal = N;
+            f.normal_stride = 3 * CW;
+            f.Q = (fuse_image){ Q, CW, CH, 4 * CW };
+            f.V = f.out = (fuse_image){ img, W, H, 4 * W };
+            f.vp_x0 = 2;
+            f.vp_y0 = 5;
+            f.vp_w = 96;
+            f.vp_h = 50;
+            assert_int_equal(fuse_context_frame(ctx, &f, 1), FUSE_OK);
+            assert_memory_equal(img, want, W * H * 4);
+            fuse_context_destroy(ctx);
+        }
+    fuse_context_destroy(ref);
+    free(img); free(img0); free(want); free(M); free(Q); free(N);
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -520,6 +740,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_pow_bits),
         cmocka_unit_test(test_paper_frame),
         cmocka_unit_test(test_dispatch),
+        cmocka_unit_test(test_frame_cases),
+        cmocka_unit_test(test_frame_aliasing),
     };
     if (argc > 1) {   /* rerun one case, print differences */
         ctxs cx;

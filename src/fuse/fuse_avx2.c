@@ -181,6 +181,50 @@ void fuse__composite_cols_avx2(const uint8_t *q0, const uint8_t *q1, uint32_t fy
         fuse__composite_px(q0, q1, fy, ixs[i], (uint32_t)fxs[i], sw, v + 4 * i, out + 4 * i);
 }
 
+/* ---- coverage bits and opaque copies (fuse_internal.h) ----------------- */
+
+void fuse__cover_row_avx2(const uint8_t *q, int w, uint64_t *bits)
+{
+    const __m256i z = _mm256_setzero_si256();
+    const int nb = (w + 7) / 8, full = w / 8;
+    int b;
+    memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
+    for (b = 0; b < full; b++) {
+        const __m256i t = _mm256_loadu_si256((const __m256i *)(const void *)(q + 32 * (size_t)b));
+        bits[b >> 6] |= (uint64_t)(_mm256_movemask_epi8(_mm256_cmpeq_epi8(t, z)) != -1) << (b & 63);
+    }
+    if (full < nb) {
+        uint32_t acc = 0, t;
+        int x;
+        for (x = 8 * full; x < w; x++) {
+            memcpy(&t, q + 4 * (size_t)x, 4);
+            acc |= t;
+        }
+        if (acc) bits[full >> 6] |= (uint64_t)1 << (full & 63);
+    }
+}
+
+void fuse__opaque_avx2(const uint8_t *v, uint8_t *out, int n)
+{
+    const __m256i a = _mm256_set1_epi32((int)0xFF000000u);
+    int i = 0;
+    if (v == out) {
+        for (; i + 8 <= n; i += 8) {
+            const __m256i x = _mm256_loadu_si256((const __m256i *)(const void *)(v + 4 * (size_t)i));
+            if (!_mm256_testc_si256(x, a))   /* some alpha below 255 */
+                _mm256_storeu_si256((__m256i *)(void *)(out + 4 * (size_t)i), _mm256_or_si256(x, a));
+        }
+    } else {
+        for (; i + 16 <= n; i += 16) {
+            const __m256i x0 = _mm256_loadu_si256((const __m256i *)(const void *)(v + 4 * (size_t)i));
+            const __m256i x1 = _mm256_loadu_si256((const __m256i *)(const void *)(v + 4 * (size_t)i + 32));
+            _mm256_storeu_si256((__m256i *)(void *)(out + 4 * (size_t)i), _mm256_or_si256(x0, a));
+            _mm256_storeu_si256((__m256i *)(void *)(out + 4 * (size_t)i + 32), _mm256_or_si256(x1, a));
+        }
+    }
+    fuse__opaque_ref(v + 4 * (size_t)i, out + 4 * (size_t)i, n - i);
+}
+
 #else  /* not built for AVX2: never chosen by cpuid, falls back */
 
 void fuse__light_row_avx2(const fuse__light_prep *p, int y, int width,
@@ -200,5 +244,13 @@ void fuse__pow01_row_avx2(const float *x, int n, float s, float *out)
 {
     int i;
     for (i = 0; i < n; i++) out[i] = fuse__pow01(x[i], s);
+}
+void fuse__cover_row_avx2(const uint8_t *q, int w, uint64_t *bits)
+{
+    fuse__cover_row_ref(q, w, bits);
+}
+void fuse__opaque_avx2(const uint8_t *v, uint8_t *out, int n)
+{
+    fuse__opaque_ref(v, out, n);
 }
 #endif

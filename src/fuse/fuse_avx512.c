@@ -169,6 +169,53 @@ void fuse__composite_cols_avx512(const uint8_t *q0, const uint8_t *q1, uint32_t 
         fuse__composite_px(q0, q1, fy, ixs[i], (uint32_t)fxs[i], sw, v + 4 * i, out + 4 * i);
 }
 
+/* ---- coverage bits and opaque copies (fuse_internal.h) ----------------- */
+
+void fuse__cover_row_avx512(const uint8_t *q, int w, uint64_t *bits)
+{
+    const int nb = (w + 7) / 8, pairs = w / 16;
+    int k, b;
+    memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
+    for (k = 0; k < pairs; k++) {   /* blocks 2k and 2k + 1: qwords 0-3 and 4-7 */
+        const __m512i t = _mm512_loadu_si512((const void *)(q + 64 * (size_t)k));
+        const unsigned m = _mm512_test_epi64_mask(t, t);
+        const uint64_t two = (uint64_t)((m & 15u) != 0) | ((uint64_t)((m >> 4) != 0) << 1);
+        bits[k >> 5] |= two << (2 * (k & 31));
+    }
+    for (b = 2 * pairs; b < nb; b++) {
+        const int x1 = 8 * b + 8 < w ? 8 * b + 8 : w;
+        uint32_t acc = 0, t;
+        int x;
+        for (x = 8 * b; x < x1; x++) {
+            memcpy(&t, q + 4 * (size_t)x, 4);
+            acc |= t;
+        }
+        if (acc) bits[b >> 6] |= (uint64_t)1 << (b & 63);
+    }
+}
+
+void fuse__opaque_avx512(const uint8_t *v, uint8_t *out, int n)
+{
+    const __m512i a = _mm512_set1_epi32((int)0xFF000000u);
+    int i = 0;
+    if (v == out) {
+        for (; i + 16 <= n; i += 16) {
+            const __m512i x = _mm512_loadu_si512((const void *)(v + 4 * (size_t)i));
+            const __mmask16 low = _mm512_cmpneq_epi32_mask(_mm512_and_si512(x, a), a);
+            if (low)   /* some alpha below 255 */
+                _mm512_storeu_si512((void *)(out + 4 * (size_t)i), _mm512_or_si512(x, a));
+        }
+    } else {
+        for (; i + 32 <= n; i += 32) {
+            const __m512i x0 = _mm512_loadu_si512((const void *)(v + 4 * (size_t)i));
+            const __m512i x1 = _mm512_loadu_si512((const void *)(v + 4 * (size_t)i + 64));
+            _mm512_storeu_si512((void *)(out + 4 * (size_t)i), _mm512_or_si512(x0, a));
+            _mm512_storeu_si512((void *)(out + 4 * (size_t)i + 64), _mm512_or_si512(x1, a));
+        }
+    }
+    fuse__opaque_ref(v + 4 * (size_t)i, out + 4 * (size_t)i, n - i);
+}
+
 #else  /* not built for AVX-512: never chosen by cpuid, falls back */
 
 void fuse__light_row_avx512(const fuse__light_prep *p, int y, int width,
@@ -188,5 +235,13 @@ void fuse__pow01_row_avx512(const float *x, int n, float s, float *out)
 {
     int i;
     for (i = 0; i < n; i++) out[i] = fuse__pow01(x[i], s);
+}
+void fuse__cover_row_avx512(const uint8_t *q, int w, uint64_t *bits)
+{
+    fuse__cover_row_ref(q, w, bits);
+}
+void fuse__opaque_avx512(const uint8_t *v, uint8_t *out, int n)
+{
+    fuse__opaque_ref(v, out, n);
 }
 #endif

@@ -26,6 +26,8 @@ typedef struct kernels {
     ef_isa isa;
     fuse__light_fn light;
     fuse__composite_fn comp;   /* NULL: the reference axis walk */
+    fuse__cover_fn cover;      /* coverage bits of a layer row */
+    fuse__opaque_fn opaque;    /* R = V, alpha 255 (transparent spans) */
 } kernels;
 
 static kernels kernels_for(ef_isa isa)
@@ -36,19 +38,27 @@ static kernels kernels_for(ef_isa isa)
     case EF_ISA_AVX512:
         k.light = fuse__light_row_avx512;
         k.comp = fuse__composite_cols_avx512;
+        k.cover = fuse__cover_row_avx512;
+        k.opaque = fuse__opaque_avx512;
         break;
     case EF_ISA_AVX2:
         k.light = fuse__light_row_avx2;
         k.comp = fuse__composite_cols_avx2;
+        k.cover = fuse__cover_row_avx2;
+        k.opaque = fuse__opaque_avx2;
         break;
     case EF_ISA_SSE2:
         k.light = fuse__light_row_sse2;
         k.comp = fuse__composite_cols_sse2;
+        k.cover = fuse__cover_row_sse2;
+        k.opaque = fuse__opaque_sse2;
         break;
     default:
         k.isa = EF_ISA_REF;
         k.light = fuse__light_row_ref;
         k.comp = NULL;
+        k.cover = fuse__cover_row_ref;
+        k.opaque = fuse__opaque_ref;
         break;
     }
     return k;
@@ -258,29 +268,164 @@ typedef struct comp_job {
     int in_place;
 } comp_job;
 
-/* Rows [y0, y1) of the output. The ISA paths go through column tables of
- * FUSE__TILE columns; the reference walks fuse__axis as fuse_ref.c does. */
-static void comp_rows(const comp_job *j, int y0, int y1)
+/* Output pixels per transparency group: a group whose taps all lie in
+ * coverage blocks without a bit (both source rows) is a copy of V. */
+#define GROUP 16
+
+/* What the table-driven composite keeps between rows: the column table of
+ * one tile; for every coverage block b of the layer, the first and the
+ * last group of the tile whose taps can read it (gfirst[b] .. glast[b],
+ * empty when gfirst > glast); and the coverage bits of the last two layer
+ * rows. On the stack of the caller (about 26 KB); nothing is allocated. */
+#define NBLOCKS (FUSE_MAX_DIM / FUSE__COV_BLOCK)
+typedef struct comp_scratch {
+    fuse__cols cols;
+    int16_t gfirst[NBLOCKS], glast[NBLOCKS];
+    int tile_c0, tile_n;            /* the tile in cols; tile_n 0: none */
+    int cov_row[2];                 /* layer rows in cov, -1: none */
+    uint64_t cov[2][FUSE__COV_WORDS];
+} comp_scratch;
+
+static void scratch_init(comp_scratch *s)
+{
+    s->tile_c0 = 0;
+    s->tile_n = 0;
+    s->cov_row[0] = s->cov_row[1] = -1;
+}
+
+/* Group g (output columns [g GROUP, g GROUP + GROUP) of the tile) reads the
+ * source columns ix[first] .. min(ix[last] + 1, sw - 1), i.e. the blocks
+ * blo(g) .. bhi(g); both grow with g. */
+static void scratch_tile(comp_scratch *s, int sw, int vw, int c0, int n)
+{
+    const int ng = (n + GROUP - 1) / GROUP, nb = (sw + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
+    int g, b;
+    if (s->tile_n == n && s->tile_c0 == c0) return;
+    fuse__cols_fill(&s->cols, sw, vw, c0, n);
+    for (g = 0, b = 0; b < nb; b++) {    /* first g with bhi(g) >= b */
+        while (g < ng) {
+            const int last = g * GROUP + GROUP - 1 < n ? g * GROUP + GROUP - 1 : n - 1;
+            const int hi = s->cols.ix[last] + 1 < sw ? s->cols.ix[last] + 1 : sw - 1;
+            if (hi / FUSE__COV_BLOCK >= b) break;
+            g++;
+        }
+        s->gfirst[b] = (int16_t)g;
+    }
+    for (g = -1, b = 0; b < nb; b++) {   /* last g with blo(g) <= b */
+        while (g + 1 < ng && s->cols.ix[(g + 1) * GROUP] / FUSE__COV_BLOCK <= b) g++;
+        s->glast[b] = (int16_t)g;
+    }
+    s->tile_c0 = c0;
+    s->tile_n = n;
+}
+
+/* Coverage bits of layer row r, computed into the slot that does not hold
+ * row keep. */
+static const uint64_t *scratch_cover(comp_scratch *s, const comp_job *j, int r, int keep)
+{
+    int slot;
+    if (s->cov_row[0] == r) return s->cov[0];
+    if (s->cov_row[1] == r) return s->cov[1];
+    slot = s->cov_row[0] == keep ? 1 : 0;
+    j->k->cover(row_of(&j->Q, r), j->Q.width, s->cov[slot]);
+    s->cov_row[slot] = r;
+    return s->cov[slot];
+}
+
+/* The first bit >= b that is set (want 1) or clear (want 0) in the nb bits
+ * of a | c; nb if none. The bits at nb and above are 0. */
+static int next_bit(const uint64_t *a, const uint64_t *c, int nb, int b, int want)
+{
+    while (b < nb) {
+        uint64_t w = a[b >> 6] | c[b >> 6];
+        if (!want) w = ~w;
+        w &= ~(uint64_t)0 << (b & 63);
+        if (w) {
+            b = (b & ~63) + __builtin_ctzll(w);
+            return b < nb ? b : nb;
+        }
+        b = (b & ~63) + 64;
+    }
+    return nb;
+}
+
+/* The rows [y0, y1) outside the viewport and the columns left and right of
+ * it: a copy of V (nothing to do in place). */
+static void comp_border_rows(const comp_job *j, int y0, int y1)
 {
     const size_t row_bytes = 4u * (size_t)j->V.width;
-    const int sw = j->Q.width, sh = j->Q.height;
-    fuse__cols cols;
-    int y, c0;
-    /* rows outside the viewport and the columns left and right of it */
-    if (!j->in_place)
-        for (y = y0; y < y1; y++) {
-            const uint8_t *v = row_of(&j->V, y);
-            uint8_t *o = row_of(&j->out, y);
-            if (y < j->vy || y >= j->vy + j->vh) {
-                memcpy(o, v, row_bytes);
-                continue;
-            }
-            memcpy(o, v, 4u * (size_t)j->vx);
-            memcpy(o + 4 * (size_t)(j->vx + j->vw), v + 4 * (size_t)(j->vx + j->vw),
-                   4u * (size_t)(j->V.width - j->vx - j->vw));
+    int y;
+    if (j->in_place) return;
+    for (y = y0; y < y1; y++) {
+        const uint8_t *v = row_of(&j->V, y);
+        uint8_t *o = row_of(&j->out, y);
+        if (y < j->vy || y >= j->vy + j->vh) {
+            memcpy(o, v, row_bytes);
+            continue;
         }
-    if (y0 < j->vy) y0 = j->vy;
-    if (y1 > j->vy + j->vh) y1 = j->vy + j->vh;
+        memcpy(o, v, 4u * (size_t)j->vx);
+        memcpy(o + 4 * (size_t)(j->vx + j->vw), v + 4 * (size_t)(j->vx + j->vw),
+               4u * (size_t)(j->V.width - j->vx - j->vw));
+    }
+}
+
+/* n pixels from tile column c of row y: blended, or (transparent) V with
+ * alpha 255. */
+static void comp_span(const comp_job *j, const comp_scratch *s, const uint8_t *q0,
+                      const uint8_t *q1, uint32_t fy, const uint8_t *v, uint8_t *o, int c,
+                      int n, int covered)
+{
+    if (n <= 0) return;
+    if (covered)
+        j->k->comp(q0, q1, fy, &s->cols, c, n, j->Q.width, v + 4 * (size_t)c, o + 4 * (size_t)c);
+    else
+        j->k->opaque(v + 4 * (size_t)c, o + 4 * (size_t)c, n);
+}
+
+/* One output row y of the viewport, columns [c0, c0 + n) of the tile in s.
+ * The runs of covered blocks of the two layer rows give the groups that
+ * need the blend; every other group has four zero taps at every pixel and
+ * is a copy of V with alpha 255 (in place: a read, and a write only where
+ * V's alpha is not 255), the reference's bytes either way. */
+static void comp_row_tiled(const comp_job *j, comp_scratch *s, int y, int c0, int n)
+{
+    const int sw = j->Q.width, sh = j->Q.height;
+    const int nb = (sw + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
+    const int32_t pos = fuse__src_pos(y - j->vy, sh, j->vh);
+    const int iy = pos >> 16, iy1 = iy + 1 < sh ? iy + 1 : sh - 1;
+    const uint64_t *b0 = scratch_cover(s, j, iy, -1);
+    const uint64_t *b1 = iy1 == iy ? b0 : scratch_cover(s, j, iy1, iy);
+    const size_t off = 4 * ((size_t)j->vx + (size_t)c0);
+    const uint8_t *q0 = row_of(&j->Q, iy), *q1 = row_of(&j->Q, iy1);
+    const uint8_t *v = row_of(&j->V, y) + off;
+    uint8_t *o = row_of(&j->out, y) + off;
+    const uint32_t fy = ((uint32_t)pos >> 8) & 255u;
+    int done = 0, b = 0;   /* columns [0, done) written */
+    for (;;) {
+        int first, last, g0, g1, c;
+        first = next_bit(b0, b1, nb, b, 1);
+        if (first >= nb) break;
+        last = next_bit(b0, b1, nb, first, 0) - 1;
+        b = last + 1;
+        g0 = s->gfirst[first];
+        g1 = s->glast[last];
+        c = g0 * GROUP;
+        if (g0 > g1 || (g1 + 1) * GROUP <= done) continue;
+        if (c < done) c = done;
+        comp_span(j, s, q0, q1, fy, v, o, done, c - done, 0);
+        done = (g1 + 1) * GROUP < n ? (g1 + 1) * GROUP : n;
+        comp_span(j, s, q0, q1, fy, v, o, c, done - c, 1);
+    }
+    comp_span(j, s, q0, q1, fy, v, o, done, n - done, 0);
+}
+
+/* Viewport rows [y0, y1) (already clipped to the viewport). The ISA paths
+ * go through column tables of FUSE__TILE columns; the reference walks
+ * fuse__axis as fuse_ref.c does. */
+static void comp_vp_rows(const comp_job *j, comp_scratch *s, int y0, int y1)
+{
+    const int sw = j->Q.width, sh = j->Q.height;
+    int y, c0;
     if (j->k->comp == NULL) {
         fuse__axis ax;
         fuse__axis_init(&ax, sw, j->vw);
@@ -296,16 +441,22 @@ static void comp_rows(const comp_job *j, int y0, int y1)
     }
     for (c0 = 0; c0 < j->vw; c0 += FUSE__TILE) {
         const int n = j->vw - c0 < FUSE__TILE ? j->vw - c0 : FUSE__TILE;
-        const size_t off = 4 * ((size_t)j->vx + (size_t)c0);
-        fuse__cols_fill(&cols, sw, j->vw, c0, n);
-        for (y = y0; y < y1; y++) {
-            const int32_t pos = fuse__src_pos(y - j->vy, sh, j->vh);
-            const int iy = pos >> 16, iy1 = iy + 1 < sh ? iy + 1 : sh - 1;
-            j->k->comp(row_of(&j->Q, iy), row_of(&j->Q, iy1),
-                       ((uint32_t)pos >> 8) & 255u, &cols, 0, n, sw,
-                       row_of(&j->V, y) + off, row_of(&j->out, y) + off);
-        }
+        scratch_tile(s, sw, j->vw, c0, n);
+        for (y = y0; y < y1; y++)
+            comp_row_tiled(j, s, y, c0, n);
     }
+}
+
+/* Rows [y0, y1) of the output. */
+static void comp_rows(const comp_job *j, int y0, int y1)
+{
+    comp_scratch s;
+    comp_border_rows(j, y0, y1);
+    if (y0 < j->vy) y0 = j->vy;
+    if (y1 > j->vy + j->vh) y1 = j->vy + j->vh;
+    if (y0 >= y1) return;
+    scratch_init(&s);
+    comp_vp_rows(j, &s, y0, y1);
 }
 
 /* Band t of n over h rows: [h t / n, h (t + 1) / n). */
@@ -422,6 +573,7 @@ typedef struct eye_job {
 
 typedef struct frame_job {
     eye_job eyes[FUSE_MAX_THREADS];
+    int interleave[FUSE_MAX_THREADS];   /* eye_whole may interleave */
     int count;
 } frame_job;
 
@@ -433,15 +585,52 @@ static void eye_light_depth(const eye_job *e, int y0, int y1)
                          e->comp.vw, e->comp.vh, y0, y1);
 }
 
+/* Layer rows lit per step of the fused order: small enough that the rows
+ * (and their P, mask and normals) are still in L1/L2 when the composite
+ * reads them. */
+#define FUSE_CHUNK 8
+
+/* One whole eye on one thread. The ISA paths interleave the stages: layer
+ * rows are lit (and depth-tested) in chunks just before the output rows
+ * that read them are composited, so the layer is read back from cache,
+ * not from memory. Every row of the layer is final before any output row
+ * reads it, so the bytes are those of the stages one after the other. The
+ * reference path (and the rare cases where the interleaving does not
+ * apply: a viewport wider than one column tile, or inputs of the lighting
+ * that share memory with the output) runs the stages one after the other. */
+static void eye_whole(const eye_job *e, int interleave)
+{
+    const comp_job *j = &e->comp;
+    const int sh = e->light.P.height;
+    comp_scratch s;
+    int lit = 0, y;
+    if (!interleave || j->k->comp == NULL || j->vw > FUSE__TILE) {
+        eye_light_depth(e, 0, sh);
+        comp_rows(j, 0, j->V.height);
+        return;
+    }
+    scratch_init(&s);
+    comp_border_rows(j, 0, j->V.height);
+    for (y = j->vy; y < j->vy + j->vh; y++) {
+        const int32_t pos = fuse__src_pos(y - j->vy, sh, j->vh);
+        const int iy = pos >> 16, need = iy + 1 < sh ? iy + 1 : sh - 1;
+        while (lit <= need) {
+            const int n = sh - lit < FUSE_CHUNK ? sh - lit : FUSE_CHUNK;
+            eye_light_depth(e, lit, lit + n);
+            lit += n;
+        }
+        comp_vp_rows(j, &s, y, y + 1);
+    }
+    if (lit < sh) eye_light_depth(e, lit, sh);
+}
+
 /* count a multiple of n: thread t takes eyes t, t + n, ... whole */
 static void frame_whole_task(void *arg, int t, int n)
 {
     const frame_job *f = arg;
     int e;
-    for (e = t; e < f->count; e += n) {
-        eye_light_depth(&f->eyes[e], 0, f->eyes[e].light.P.height);
-        comp_rows(&f->eyes[e].comp, 0, f->eyes[e].comp.V.height);
-    }
+    for (e = t; e < f->count; e += n)
+        eye_whole(&f->eyes[e], f->interleave[e]);
 }
 
 static void frame_light_task(void *arg, int t, int n)
@@ -462,6 +651,46 @@ static void frame_comp_task(void *arg, int t, int n)
         band(f->eyes[e].comp.V.height, t, n, &y0, &y1);
         comp_rows(&f->eyes[e].comp, y0, y1);
     }
+}
+
+/* [p, p + n) and [q, q + m) share a byte. */
+static int bytes_overlap(const void *p, size_t n, const void *q, size_t m)
+{
+    const uintptr_t a = (uintptr_t)p, b = (uintptr_t)q;
+    return a < b + m && b < a + n;
+}
+
+static size_t image_bytes(const fuse_image *im)
+{
+    return (size_t)(im->height - 1) * (size_t)im->stride + 4u * (size_t)im->width;
+}
+
+/* The interleaved order of eye_whole reads V and the lighting's inputs
+ * while out is being written and writes Q while V is being read; it gives
+ * the stages' bytes when none of these share memory (the checks already
+ * keep out apart from Q, and V either equal to out or apart from it). */
+static int may_interleave(const fuse_eye *s)
+{
+    const size_t ob = image_bytes(&s->out);
+    const size_t mb = (size_t)(s->P.height - 1) * (size_t)s->mask_stride + (size_t)s->P.width;
+    const size_t nb = sizeof(float) * ((size_t)(s->P.height - 1) * (size_t)s->normal_stride +
+                                       3u * (size_t)s->P.width);
+    if (bytes_overlap(s->out.pixels, ob, s->P.pixels, image_bytes(&s->P)) ||
+        bytes_overlap(s->out.pixels, ob, s->mask, mb) ||
+        bytes_overlap(s->out.pixels, ob, s->normal, nb) ||
+        bytes_overlap(s->V.pixels, image_bytes(&s->V), s->Q.pixels, image_bytes(&s->Q)))
+        return 0;
+    if (s->depth != NULL) {
+        const fuse_depth *d = s->depth;
+        const size_t hb = sizeof(float) * ((size_t)(s->Q.height - 1) * (size_t)d->hand_stride +
+                                           (size_t)s->Q.width);
+        const size_t sb = sizeof(float) * ((size_t)(d->scene_height - 1) * (size_t)d->scene_stride +
+                                           (size_t)d->scene_width);
+        if (bytes_overlap(s->out.pixels, ob, d->hand, hb) ||
+            bytes_overlap(s->out.pixels, ob, d->scene, sb))
+            return 0;
+    }
+    return 1;
 }
 
 fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int count)
@@ -517,6 +746,8 @@ fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int coun
                 return FUSE_ERR_ARGS;
         }
     }
+    for (e = 0; e < count; e++)
+        f.interleave[e] = may_interleave(&eyes[e]);
     if (count % ctx->threads == 0) {
         run(ctx, frame_whole_task, &f);
     } else {

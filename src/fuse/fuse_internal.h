@@ -305,6 +305,32 @@ void fuse__composite_cols_avx512(const uint8_t *q0, const uint8_t *q1, uint32_t 
                                  const fuse__cols *cols, int c, int n, int sw,
                                  const uint8_t *v, uint8_t *out);
 
+/* ---- coverage and opaque copies (the composite driver, fuse_ctx.c) ---- */
+
+/* Source pixels per coverage bit. fuse__cover_row_* sets bit b of bits
+ * (bit b & 63 of word b >> 6) iff a byte of the pixels [8b, min(8b + 8, w))
+ * of the layer row q is non-zero, and clears the other bits of the
+ * (w + 511) / 512 words. A group of output pixels whose taps all lie in
+ * blocks without a bit is fully transparent: R = V with alpha 255, the
+ * reference's all-zero shortcut (docs/fuse.md, "Cost model"). */
+#define FUSE__COV_BLOCK 8
+#define FUSE__COV_WORDS ((FUSE_MAX_DIM / FUSE__COV_BLOCK + 63) / 64)
+typedef void (*fuse__cover_fn)(const uint8_t *q, int w, uint64_t *bits);
+/* out[i] = v[i] | 0xFF000000 (as RGBA8 pixels: alpha 255) for n pixels.
+ * out == v is allowed (in place): then only vectors holding an alpha other
+ * than 255 are stored, so an opaque V costs a read and no write. Otherwise
+ * out and v do not overlap. */
+typedef void (*fuse__opaque_fn)(const uint8_t *v, uint8_t *out, int n);
+
+void fuse__cover_row_ref(const uint8_t *q, int w, uint64_t *bits);
+void fuse__cover_row_sse2(const uint8_t *q, int w, uint64_t *bits);
+void fuse__cover_row_avx2(const uint8_t *q, int w, uint64_t *bits);
+void fuse__cover_row_avx512(const uint8_t *q, int w, uint64_t *bits);
+void fuse__opaque_ref(const uint8_t *v, uint8_t *out, int n);
+void fuse__opaque_sse2(const uint8_t *v, uint8_t *out, int n);
+void fuse__opaque_avx2(const uint8_t *v, uint8_t *out, int n);
+void fuse__opaque_avx512(const uint8_t *v, uint8_t *out, int n);
+
 /* fuse__pow01 of the ISA paths over an array (for the tests):
  * out[i] = pow01(x[i], s) computed in that path's lanes. */
 void fuse__pow01_row_sse2(const float *x, int n, float s, float *out);

@@ -276,6 +276,35 @@ void fuse__composite_cols_ref(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
                            sw, v + 4 * i, out + 4 * i);
 }
 
+/* Coverage bits of a layer row (fuse_internal.h). */
+void fuse__cover_row_ref(const uint8_t *q, int w, uint64_t *bits)
+{
+    const int nb = (w + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
+    int b;
+    memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
+    for (b = 0; b < nb; b++) {
+        const int x1 = 8 * b + 8 < w ? 8 * b + 8 : w;
+        uint32_t acc = 0, t;
+        int x;
+        for (x = 8 * b; x < x1; x++) {
+            memcpy(&t, q + 4 * (size_t)x, 4);
+            acc |= t;
+        }
+        if (acc != 0) bits[b >> 6] |= (uint64_t)1 << (b & 63);
+    }
+}
+
+void fuse__opaque_ref(const uint8_t *v, uint8_t *out, int n)
+{
+    int i;
+    for (i = 0; i < n; i++) {
+        out[4 * i] = v[4 * i];
+        out[4 * i + 1] = v[4 * i + 1];
+        out[4 * i + 2] = v[4 * i + 2];
+        out[4 * i + 3] = 255;
+    }
+}
+
 fuse_result fuse__composite_check(const fuse_image *Q, const fuse_image *V,
                                   int vp_x0, int vp_y0, int vp_w, int vp_h,
                                   const fuse_image *out)

@@ -150,6 +150,49 @@ void fuse__composite_cols_sse2(const uint8_t *q0, const uint8_t *q1, uint32_t fy
         fuse__composite_px(q0, q1, fy, ixs[i], (uint32_t)fxs[i], sw, v + 4 * i, out + 4 * i);
 }
 
+/* ---- coverage bits and opaque copies (fuse_internal.h) ----------------- */
+
+void fuse__cover_row_sse2(const uint8_t *q, int w, uint64_t *bits)
+{
+    const __m128i z = _mm_setzero_si128();
+    const int nb = (w + 7) / 8, full = w / 8;
+    int b;
+    memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
+    for (b = 0; b < full; b++) {
+        const __m128i t = _mm_or_si128(_mm_loadu_si128((const __m128i *)(const void *)(q + 32 * (size_t)b)),
+                                       _mm_loadu_si128((const __m128i *)(const void *)(q + 32 * (size_t)b + 16)));
+        bits[b >> 6] |= (uint64_t)(_mm_movemask_epi8(_mm_cmpeq_epi8(t, z)) != 0xFFFF) << (b & 63);
+    }
+    if (full < nb) {
+        uint32_t acc = 0;
+        int x;
+        for (x = 8 * full; x < w; x++) acc |= load_u32(q + 4 * (size_t)x);
+        if (acc) bits[full >> 6] |= (uint64_t)1 << (full & 63);
+    }
+}
+
+void fuse__opaque_sse2(const uint8_t *v, uint8_t *out, int n)
+{
+    const __m128i a = _mm_set1_epi32((int)0xFF000000u);
+    int i = 0;
+    if (v == out) {
+        for (; i + 4 <= n; i += 4) {
+            const __m128i x = _mm_loadu_si128((const __m128i *)(const void *)(v + 4 * (size_t)i));
+            const __m128i y = _mm_or_si128(x, a);
+            if (_mm_movemask_epi8(_mm_cmpeq_epi32(x, y)) != 0xFFFF)
+                _mm_storeu_si128((__m128i *)(void *)(out + 4 * (size_t)i), y);
+        }
+    } else {
+        for (; i + 8 <= n; i += 8) {
+            const __m128i x0 = _mm_loadu_si128((const __m128i *)(const void *)(v + 4 * (size_t)i));
+            const __m128i x1 = _mm_loadu_si128((const __m128i *)(const void *)(v + 4 * (size_t)i + 16));
+            _mm_storeu_si128((__m128i *)(void *)(out + 4 * (size_t)i), _mm_or_si128(x0, a));
+            _mm_storeu_si128((__m128i *)(void *)(out + 4 * (size_t)i + 16), _mm_or_si128(x1, a));
+        }
+    }
+    fuse__opaque_ref(v + 4 * (size_t)i, out + 4 * (size_t)i, n - i);
+}
+
 #else  /* no SSE2 (e.g. ARM): the reference kernels */
 
 void fuse__light_row_sse2(const fuse__light_prep *p, int y, int width,
@@ -169,5 +212,13 @@ void fuse__pow01_row_sse2(const float *x, int n, float s, float *out)
 {
     int i;
     for (i = 0; i < n; i++) out[i] = fuse__pow01(x[i], s);
+}
+void fuse__cover_row_sse2(const uint8_t *q, int w, uint64_t *bits)
+{
+    fuse__cover_row_ref(q, w, bits);
+}
+void fuse__opaque_sse2(const uint8_t *v, uint8_t *out, int n)
+{
+    fuse__opaque_ref(v, out, n);
 }
 #endif
