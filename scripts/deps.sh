@@ -1,5 +1,8 @@
 #!/bin/sh
-# Installs the Debian packages egofuse needs to build, test and run its demo.
+# Installs the Debian packages egofuse needs to build, test and run its demo
+# (the last line: the virtual machine that tests the camera, USB and glove
+# code against the Linux kernel's own drivers, tests/vm/; the kernel itself
+# is fetched by tests/vm/prepare.sh with apt-get download, not installed).
 # Called by `make demo`, `make test` and `make bench`; safe to run again (it
 # only installs what is missing). As a non-root user it prints the exact
 # apt-get line and stops.
@@ -12,7 +15,8 @@ libv4l-dev libusb-1.0-0-dev
 libcmocka-dev
 gnuplot-nox
 libpixman-1-dev
-libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri"
+libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
+qemu-system-x86 busybox-static cpio kmod xz-utils"
 
 missing=""
 for p in $PKGS; do

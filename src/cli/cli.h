@@ -21,6 +21,8 @@ int cmd_mask(int argc, char **argv);
 int cmd_render(int argc, char **argv);
 int cmd_demo(int argc, char **argv);
 int cmd_eval(int argc, char **argv);   /* cmd_eval.c, docs/accuracy.md */
+int cmd_run(int argc, char **argv);    /* cmd_run.c, docs/devices.md */
+int cmd_devices(int argc, char **argv);/* cmd_devices.c, docs/devices.md */
 
 /* Prints "egofuse: " + message to stderr; returns EXIT_FAIL. */
 int cli_fail(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -21,6 +21,8 @@ static const char *main_usage =
     "  render   composite a recorded sequence described by a scene file\n"
     "  mask     render the coverage mask (and normals, depth) of a glTF model\n"
     "  eval     measure the accuracy of each method against generated ground truth\n"
+    "  run      composite the live stereo cameras (V4L2), tracking and gloves\n"
+    "  devices  list the cameras, USB devices and data gloves found\n"
     "\n"
     "Run 'egofuse COMMAND --help' for the options of a command.\n";
 
@@ -44,6 +46,8 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "render")) return cmd_render(argc - 1, argv + 1);
     if (!strcmp(cmd, "demo")) return cmd_demo(argc - 1, argv + 1);
     if (!strcmp(cmd, "eval")) return cmd_eval(argc - 1, argv + 1);
+    if (!strcmp(cmd, "run")) return cmd_run(argc - 1, argv + 1);
+    if (!strcmp(cmd, "devices")) return cmd_devices(argc - 1, argv + 1);
     fprintf(stderr, "egofuse: unknown command '%s'\n\n%s", cmd, main_usage);
     return EXIT_USAGE;
 }

@@ -1,0 +1,87 @@
+#!/bin/sh
+# Runs inside the test VM (chrooted into the host's file system, see
+# tests/vm/init): device tests against vivid, qemu's USB devices and a fake
+# glove gadget, then `egofuse run` on the two vivid cameras. Lines starting
+# with VMTEST / VMMEASURE / VMSYNC are read by tests/test_vm.c.
+ROOT=$1
+OUT=$2
+VM=$(dirname "$OUT")
+BIN="$VM/vm_devices"
+cd "$ROOT" || exit 1
+fail=0
+step() { echo "VMSTEP $* at $(cut -d" " -f1 /proc/uptime) s"; }
+
+step capture
+"$BIN" capture || fail=1
+
+step usb
+# hotplug is seen by io_usb_watch's sysfs rescans (libusb's own events
+# would need a udev daemon, which this VM does not run)
+"$BIN" usb-list "$OUT/usb_before.txt" || fail=1
+sed 's/^/VMINFO usb /' "$OUT/usb_before.txt"
+"$BIN" usb-assign serial:CAM-L-0001 serial:CAM-R-0002 CAM-L-0001 CAM-R-0002 || fail=1
+# the host unplugs the right camera (QMP device_del) when it reads VMSYNC
+"$BIN" usb-watch 30000 usb-unplug || fail=1
+"$BIN" usb-assign serial:CAM-L-0001 serial:CAM-R-0002 CAM-L-0001 - || fail=1
+# ... and plugs it back into another port
+"$BIN" usb-watch 30000 usb-replug || fail=1
+"$BIN" usb-list "$OUT/usb_after.txt" || fail=1
+sed 's/^/VMINFO usb /' "$OUT/usb_after.txt"
+"$BIN" usb-assign serial:CAM-L-0001 serial:CAM-R-0002 CAM-L-0001 CAM-R-0002 || fail=1
+
+step glove
+# a fake 5DT Data Glove 5 Ultra (left, 5d70:0011): configfs HID gadget on dummy_hcd
+G=/sys/kernel/config/usb_gadget/glove
+if mkdir -p $G/strings/0x409 $G/configs/c.1 $G/functions/hid.usb0 2>/dev/null; then
+    echo 0x5d70 > $G/idVendor
+    echo 0x0011 > $G/idProduct
+    echo 0x0200 > $G/bcdUSB
+    echo GLOVE-L-0001 > $G/strings/0x409/serialnumber
+    echo 5DT > $G/strings/0x409/manufacturer
+    echo "Data Glove 5 Ultra (fake)" > $G/strings/0x409/product
+    echo 0 > $G/functions/hid.usb0/protocol
+    echo 0 > $G/functions/hid.usb0/subclass
+    echo 64 > $G/functions/hid.usb0/report_length
+    # vendor page, 64 input bytes and 64 output bytes
+    printf '\006\000\377\011\001\241\001\025\000\046\377\000\165\010\225\100\011\001\201\002\225\100\011\001\221\002\300' \
+        > $G/functions/hid.usb0/report_desc
+    ln -s $G/functions/hid.usb0 $G/configs/c.1/
+    ls /sys/class/udc | head -n1 > $G/UDC
+    i=0
+    while [ ! -e /dev/hidg0 ] && [ $i -lt 50 ]; do sleep 0.1; i=$((i + 1)); done
+    sleep 1
+    "$BIN" glove /dev/hidg0 serial:GLOVE-L-0001 || fail=1
+else
+    echo "VMTEST glove_gadget FAIL cannot create the configfs gadget"
+    fail=1
+fi
+
+step run
+# the live pipeline on both vivid cameras, HDMI input at 60 FPS
+EGOFUSE=${EGOFUSE_BIN:-$ROOT/build/egofuse}
+if [ ! -x "$EGOFUSE" ]; then
+    echo "VMTEST run_pipeline FAIL $EGOFUSE is not built"
+    fail=1
+elif [ ! -f "$ROOT/build/samples/scene.txt" ]; then
+    echo "VMTEST run_pipeline FAIL build/samples/scene.txt missing (make samples)"
+    fail=1
+else
+    # raw rgb24 stream, left above right (PNG encoding is slow under TCG)
+    "$EGOFUSE" run --scene "$ROOT/build/samples/scene.txt" --left /dev/video0 --right /dev/video1 \
+        --input 1 --dv --fps 60 --frames 8 --raw > "$OUT/run.rgb" 2> "$OUT/run.err"
+    rc=$?
+    tr '\r' '\n' < "$OUT/run.err" | grep . | tail -n 3 | sed 's/^/VMINFO run /'
+    bytes=$(wc -c < "$OUT/run.rgb")
+    want=$((8 * 1280 * 1600 * 3))
+    line=$(tr '\r' '\n' < "$OUT/run.err" | grep 'stereo frames' | tail -n 1)
+    if [ $rc -eq 0 ] && [ "$bytes" -eq $want ]; then
+        echo "VMTEST run_pipeline PASS $line; $bytes bytes = 8 composited 1280x1600 rgb24 frames"
+    else
+        echo "VMTEST run_pipeline FAIL exit $rc, $bytes of $want bytes: $line $(tail -c 300 "$OUT/run.err")"
+        fail=1
+    fi
+    rm -f "$OUT/run.rgb"
+fi
+
+step end
+exit $fail
