@@ -397,6 +397,84 @@ static void eval_small(void **state)
     assert_true(refine >= 1);
 }
 
+/* `render --pose tracking` and its options: every error case is named,
+ * and nothing is written. */
+static void render_pose_options(void **state)
+{
+    (void)state;
+    char dir[512], scene[600], odir[600], p[700], png[700];
+    tu_tmp_path("scene_pose", dir, sizeof dir);
+    char cmd[700];
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+    write_scene(dir, 640, 480);
+    snprintf(scene, sizeof scene, "%s/scene.txt", dir);
+    snprintf(odir, sizeof odir, "%s/out", dir);
+
+    /* usage errors (exit 2) */
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "bogus", NULL), 2);
+    assert_non_null(strstr(out, "--pose 'bogus'"));
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--calib", "c.txt", NULL), 2);
+    assert_non_null(strstr(out, "--calib needs --pose tracking"));
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "animation",
+                         "--no-filter", NULL), 2);
+    assert_non_null(strstr(out, "--no-filter needs --pose tracking"));
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",
+                         "--predict", "500", NULL), 2);
+    assert_non_null(strstr(out, "--predict '500'"));
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",
+                         "--predict", "nan", NULL), 2);
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", NULL), 2);
+
+    /* the scene names no tracking file */
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",
+                         "--quiet", NULL), 1);
+    assert_non_null(strstr(out, "no 'tracking' file"));
+
+    /* a tracking file that is missing, then malformed (file and line) */
+    snprintf(p, sizeof p, "%s/scene.txt", dir);
+    write_file(p, "egofuse-scene 1\n"
+                  "model = quad.gltf\n"
+                  "head_node = head\n"
+                  "frames = 1\n"
+                  "fps = 60\n"
+                  "camera_left = cam_l_%d.png\n"
+                  "camera_right = cam_r_%d.png\n"
+                  "virtual_left = virt_l_%d.png\n"
+                  "virtual_right = virt_r_%d.png\n"
+                  "tracking = track.txt\n");
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",
+                         "--quiet", NULL), 1);
+    assert_non_null(strstr(out, "track.txt"));
+    snprintf(p, sizeof p, "%s/track.txt", dir);
+    write_file(p, "egofuse-track 1\nt 0 SL 0 1\n");
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",
+                         "--quiet", NULL), 1);
+    assert_non_null(strstr(out, "track.txt:2:"));
+
+    /* a good recording, a missing calibration file */
+    write_file(p, "egofuse-track 1\nt 0 SL -0.2 1 0 SR 0.2 1 0\n");
+    char calib[700];
+    snprintf(calib, sizeof calib, "%s/no_calib.txt", dir);
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",
+                         "--calib", calib, "--quiet", NULL), 1);
+    assert_non_null(strstr(out, "no_calib.txt"));
+
+    /* a model without the arm rig's joints cannot be posed from tracking:
+     * the missing joints are listed */
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",
+                         "--quiet", NULL), 1);
+    assert_non_null(strstr(out, "quad.gltf"));
+    assert_non_null(strstr(out, "missing joints"));
+    assert_non_null(strstr(out, "R_palm"));
+    snprintf(png, sizeof png, "%s/left_0000.png", odir);
+    assert_false(tu_exists(png));
+
+    /* the same scene still renders from its animation */
+    assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "animation",
+                         "--quiet", NULL), 0);
+    assert_true(tu_exists(png));
+}
 
 int main(void)
 {
@@ -407,6 +485,7 @@ int main(void)
         cmocka_unit_test(mask_shared_models),
         cmocka_unit_test(render_end_to_end),
         cmocka_unit_test(render_bad_inputs),
+        cmocka_unit_test(render_pose_options),
         cmocka_unit_test(eval_small),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

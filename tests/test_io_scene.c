@@ -1,5 +1,6 @@
 /* test_io_scene.c - io_scene_load and io_scene_frame_path: a full file,
- * defaults, every class of error with its line number, path handling. */
+ * defaults, every class of error with its line number, path handling, the
+ * optional `tracking` key. */
 #include "support/testutil.h"
 #include <cmocka.h>
 
@@ -290,6 +291,68 @@ static void header_and_file_errors(void **state)
     assert_int_equal(io_scene_load(NULL, &s, &err), IO_ERR_ARGS);
 }
 
+/* The optional `tracking` key: a plain path, resolved like the model,
+ * absent = "", strictly parsed (once, not empty, no frame conversion). */
+static void tracking_key(void **state)
+{
+    (void)state;
+    char path[1024], text[2048], out[2200];
+    io_scene s;
+    io_error err;
+    tu_tmp_path("scene_track.txt", path, sizeof path);
+    const char *base =
+        "egofuse-scene 1\n"
+        "model = m.glb\n"
+        "frames = 2\n"
+        "fps = 60\n"
+        "camera_left = l%d.png\n"
+        "camera_right = r%d.png\n"
+        "virtual_left = vl%d.png\n"
+        "virtual_right = vr%d.png\n";
+    write_text(path, base);
+    assert_int_equal(io_scene_load(path, &s, &err), IO_OK);
+    assert_string_equal(s.tracking, "");
+
+    snprintf(text, sizeof text, "%stracking = rec/track.txt   # the true motion\n", base);
+    write_text(path, text);
+    io_result r = io_scene_load(path, &s, &err);
+    if (r != IO_OK) fprintf(stderr, "%s\n", err.msg);
+    assert_int_equal(r, IO_OK);
+    assert_string_equal(s.tracking, "rec/track.txt");
+    io_scene_frame_path(&s, s.tracking, 0, out, sizeof out);
+    char want[2200];
+    snprintf(want, sizeof want, "%s/rec/track.txt", s.dir);
+    assert_string_equal(out, want);
+
+    /* a literal percent sign */
+    snprintf(text, sizeof text, "%stracking = /abs/100%%%%.txt\n", base);
+    write_text(path, text);
+    assert_int_equal(io_scene_load(path, &s, &err), IO_OK);
+    assert_string_equal(s.tracking, "/abs/100%%.txt");
+    io_scene_frame_path(&s, s.tracking, 7, out, sizeof out);
+    assert_string_equal(out, "/abs/100%.txt");
+
+    static const struct { const char *line, *needle; io_result code; int line_no; } bad[] = {
+        { "tracking = a.txt\ntracking = b.txt\n", "duplicate key 'tracking' (first on line 9)", IO_ERR_FORMAT, 10 },
+        { "tracking =\n", "empty value", IO_ERR_FORMAT, 9 },
+        { "tracking = t_%04d.txt\n", "not a frame pattern", IO_ERR_FORMAT, 9 },
+        { "tracking = t%.txt\n", "not a frame pattern", IO_ERR_FORMAT, 9 },
+        { "tracking = t%\n", "not a frame pattern", IO_ERR_FORMAT, 9 },
+        { "Tracking = t.txt\n", "unknown key 'Tracking'", IO_ERR_FORMAT, 9 },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        snprintf(text, sizeof text, "%s%s", base, bad[i].line);
+        write_text(path, text);
+        r = io_scene_load(path, &s, &err);
+        if (r != bad[i].code || !strstr(err.msg, bad[i].needle))
+            fprintf(stderr, "case %zu: %s: %s\n", i, io_result_str(r), err.msg);
+        assert_int_equal(r, bad[i].code);
+        assert_non_null(strstr(err.msg, bad[i].needle));
+        snprintf(want, sizeof want, "scene_track.txt:%d: ", bad[i].line_no);
+        if (!strstr(err.msg, want)) fail_msg("case %zu: '%s' lacks '%s'", i, err.msg, want);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -299,6 +362,7 @@ int main(void)
         cmocka_unit_test(errors_name_file_and_line),
         cmocka_unit_test(frames_and_fps_checks),
         cmocka_unit_test(header_and_file_errors),
+        cmocka_unit_test(tracking_key),
     };
     return cmocka_run_group_tests_name("io_scene", tests, NULL, NULL);
 }

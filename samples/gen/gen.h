@@ -104,6 +104,13 @@ kin_quat gen_quat_from_axes(kin_vec3 x, kin_vec3 y, kin_vec3 z);
 /* Fills the animation channels of arms->model (called by gen_arms_build). */
 int  gen_anim_build(gen_arms *arms);
 
+/* Writes the recorded tracking of the first `frames` frames (t = f /
+ * GEN_FPS) of the animation to path ("egofuse-track 1", docs/tracking.md):
+ * head, shoulders, hands and glove values of the true motion
+ * (gen_track.c). Returns 0, or -1 with a message in why. */
+int  gen_track_write(const char *path, const gen_arms *arms, int frames,
+                     char *why, size_t why_size);
+
 /* Writes the model as binary glTF to path (atomically: path.tmp.<pid>,
  * then rename). Returns 0, or -1 with a message naming the path in why. */
 int  gen_glb_write(const char *path, const gen_arms *arms, char *why,

@@ -4,7 +4,8 @@
  *
  * DIR/model/arms.glb, DIR/cam/{left,right}_%04d.png (640x480 sensor),
  * DIR/virt/{left,right}_%04d.png (1280x800), DIR/virt/{left,right}_depth_
- * %04d.exr (view-space depth in metres) and DIR/scene.txt. See
+ * %04d.exr (view-space depth in metres), DIR/track.txt (the recorded
+ * tracking of the true motion) and DIR/scene.txt. See
  * samples/README.md. The output depends only on N and S (not on T). */
 #include "gen.h"
 #include "../../src/io/io.h"
@@ -157,6 +158,9 @@ static int write_scene(const char *dir, int frames, const gen_scene *ws,
                "virtual_right = virt/right_%%04d.png\n"
                "virtual_depth_left = virt/left_depth_%%04d.exr\n"
                "virtual_depth_right = virt/right_depth_%%04d.exr\n"
+               "# the true motion as a tracker and data gloves would record it\n"
+               "# (egofuse render --pose tracking)\n"
+               "tracking = track.txt\n"
                "# lighting layer: the workshop's own lights (world directions towards them)\n"
                "ambient = %.3f %.3f %.3f\n",
             (double)GEN_VIRT_ZFAR, GEN_ANIM_NAME, frames, GEN_FPS,
@@ -186,7 +190,7 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: gen_samples --out DIR [--frames N] [--seed S] [--threads T] [--only F]\n"
                "  writes the sample data of egofuse into DIR (samples/README.md):\n"
-               "  model/arms.glb, cam/, virt/, scene.txt. Defaults: 180 frames\n"
+               "  model/arms.glb, cam/, virt/, track.txt, scene.txt. Defaults: 180 frames\n"
                "  (3 s at 60 Hz), seed 1, 2 threads (the output does not depend\n"
                "  on the thread count). --only F renders frame F alone (previews).\n");
 }
@@ -327,6 +331,11 @@ int main(int argc, char **argv)
         fprintf(stderr, "gen_samples: %s\n", j.why);
         goto out;
     }
+    snprintf(path, sizeof path, "%s/track.txt", out);
+    if (gen_track_write(path, &arms, (int)frames, why, sizeof why) < 0) {
+        fprintf(stderr, "gen_samples: %s\n", why);
+        goto out;
+    }
     if (write_scene(out, (int)frames, &workshop, why, sizeof why) < 0) {
         fprintf(stderr, "gen_samples: %s\n", why);
         goto out;
@@ -343,7 +352,8 @@ int main(int argc, char **argv)
            "left %.4f right %.4f; min %.4f mean %.4f max %.4f\n",
            (double)j.coverage[0][0], (double)j.coverage[0][1], mn,
            sum / (2.0 * (double)frames), mx);
-    printf("gen_samples: wrote %s/scene.txt (%ld frames, seed %ld)\n", out, frames, seed);
+    printf("gen_samples: wrote %s/scene.txt and %s/track.txt (%ld frames, seed %ld)\n", out,
+           out, frames, seed);
     rc = 0;
 out:
     free(j.coverage);

@@ -12,7 +12,8 @@
 static const char *render_usage =
     "usage: egofuse render --scene FILE --out DIR [--first K] [--frames N]\n"
     "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
-    "                      [--tone-match S]\n"
+    "                      [--tone-match S] [--pose animation|tracking]\n"
+    "                      [--calib FILE] [--predict MS] [--no-filter]\n"
     "\n"
     "Composites a recorded sequence (docs/scene.md): for each frame, poses the\n"
     "mask model at t = frame / fps, renders its mask and normals from both\n"
@@ -32,6 +33,17 @@ static const char *render_usage =
     "                 virtual object in front of the hand hides it)\n"
     "  --tone-match S match the camera's colour tone to the virtual scene's,\n"
     "                 strength S in [0, 1] (default 0: off)\n"
+    "  --pose P       where the pose comes from: 'animation' (default: the\n"
+    "                 scene's animation at t) or 'tracking' (the scene's\n"
+    "                 recorded tracking file: head, shoulders, hands, gloves\n"
+    "                 -> One Euro filter + prediction -> two-bone arm IK and\n"
+    "                 glove mapping; docs/tracking.md)\n"
+    "  --calib FILE   with --pose tracking: per-user calibration\n"
+    "                 ('egofuse-calib 1': bone scales, glove ranges)\n"
+    "  --predict MS   with --pose tracking: predict the pose MS ms past the\n"
+    "                 camera frame's time (processing latency), 0..100,\n"
+    "                 default 0\n"
+    "  --no-filter    with --pose tracking: the newest raw sample, no filter\n"
     "\n"
     "EGOFUSE_ISA=ref|sse2|avx2|avx512 caps the instruction set (same bytes).\n"
     "  -h, --help     this text\n";
@@ -55,7 +67,86 @@ typedef struct render_opts {
     int threads;           /* 0 = 2 */
     int no_depth;          /* ignore the virtual scene's depth */
     float tone_match;      /* 0 = off */
+    int pose_tracking;     /* 1: pose from the scene's tracking file */
+    const char *calib;     /* per-user calibration file, or NULL */
+    float predict_ms;      /* display time past the frame time */
+    int no_filter;         /* raw samples instead of the One Euro filter */
 } render_opts;
+
+/* The pose from tracking: the recording, the rig, the filter and the
+ * locals handed to pipe_frame (docs/tracking.md). */
+typedef struct track_pose {
+    kin_track_sample *samples;
+    int count, next;           /* samples[next] is the first not yet used */
+    kin_arm_rig rig;
+    kin_user_calib calib;
+    kin_filter filter;
+    kin_transform *locals;
+    int rejected;              /* samples kin_arm_rig_pose could not use */
+} track_pose;
+
+static void track_pose_free(track_pose *tp)
+{
+    io_track_free(tp->samples);
+    free(tp->locals);
+    memset(tp, 0, sizeof *tp);
+}
+
+static int track_pose_init(track_pose *tp, const render_opts *o, const io_scene *sc,
+                           const kin_model *model, const char *model_path)
+{
+    io_error err;
+    char path[IO_PATH_MAX + 64], why[512];
+    memset(tp, 0, sizeof *tp);
+    if (!sc->tracking[0])
+        return cli_fail("%s: --pose tracking, but the scene has no 'tracking' file "
+                        "(docs/scene.md)", o->scene);
+    io_scene_frame_path(sc, sc->tracking, 0, path, sizeof path);
+    if (io_track_load(path, &tp->samples, &tp->count, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (tp->count < 1) {
+        track_pose_free(tp);
+        return cli_fail("%s: no tracking samples", path);
+    }
+    tp->calib = kin_user_calib_identity();
+    if (o->calib && io_user_calib_load(o->calib, &tp->calib, &err) != IO_OK) {
+        track_pose_free(tp);
+        return cli_fail("%s", err.msg);
+    }
+    if (kin_arm_rig_init(&tp->rig, model, why, sizeof why) != 0) {
+        track_pose_free(tp);
+        return cli_fail("%s: cannot pose it from tracking: %s", model_path, why);
+    }
+    kin_filter_init(&tp->filter, NULL);
+    tp->locals = malloc(sizeof *tp->locals * (size_t)model->node_count);
+    if (!tp->locals) {
+        track_pose_free(tp);
+        return cli_fail("out of memory");
+    }
+    return EXIT_OK;
+}
+
+/* The pose at frame time t: every sample up to t goes through the filter
+ * (or is taken raw), the output predicted to t + predict drives the rig. */
+static void track_pose_at(track_pose *tp, const render_opts *o, const kin_model *model,
+                          double t)
+{
+    kin_track_sample cur;
+    memset(&cur, 0, sizeof cur);   /* before the first sample: rest pose */
+    while (tp->next < tp->count && tp->samples[tp->next].t <= t + 1e-9) {
+        if (!o->no_filter) kin_filter_push(&tp->filter, &tp->samples[tp->next]);
+        tp->next++;
+    }
+    if (tp->next > 0) {
+        if (o->no_filter) cur = tp->samples[tp->next - 1];
+        else kin_filter_output(&tp->filter, t + 1e-3 * o->predict_ms, &cur, NULL);
+    }
+    kin_pose_rest(model, tp->locals);
+    if (!kin_arm_rig_pose(&tp->rig, model, &tp->calib, NULL, &cur, tp->locals, NULL)) {
+        /* a sample the model cannot take: keep the rest pose, count it */
+        kin_pose_rest(model, tp->locals);
+        tp->rejected++;
+    }
+}
 
 static int file_exists(const char *p)
 {
@@ -179,6 +270,13 @@ static int render(const render_opts *o)
         return EXIT_FAIL;
     }
 
+    track_pose tp;
+    memset(&tp, 0, sizeof tp);
+    if (o->pose_tracking && track_pose_init(&tp, o, &sc, &model, model_path) != EXIT_OK) {
+        kin_model_free(&model);
+        return EXIT_FAIL;
+    }
+
     int rc = EXIT_FAIL;
     pipe_desc pd = {0};
     pd.threads = o->threads;
@@ -230,6 +328,10 @@ static int render(const render_opts *o)
             in.out[e] = in.virt[e]; /* composite in place */
         }
         in.time = (float)f / sc.fps;
+        if (o->pose_tracking) {
+            track_pose_at(&tp, o, &model, (double)f / (double)sc.fps);
+            in.locals = tp.locals;
+        }
         char why[256];
         pipe_result pr_ = pipe_frame(pp, &in, &st, why, sizeof why);
         if (pr_ != PIPE_OK) {
@@ -264,6 +366,11 @@ static int render(const render_opts *o)
                o->threads == 1 ? 1 : 2, o->threads == 1 ? "" : "s", sum.ms_total / count,
                sum.ms_pose / count, (sum.ms_raster[0] + sum.ms_raster[1]) / (2.0 * count),
                (sum.ms_fuse[0] + sum.ms_fuse[1]) / (2.0 * count), 1e3 * wall / count);
+        if (o->pose_tracking)
+            printf("egofuse: pose from tracking (%d samples, %s, prediction %.0f ms%s%s)%s\n",
+                   tp.count, o->no_filter ? "raw" : "One Euro filter", (double)o->predict_ms,
+                   o->calib ? ", calibration " : "", o->calib ? o->calib : "",
+                   tp.rejected ? "; some samples did not fit the model (rest pose)" : "");
     }
     rc = EXIT_OK;
 done:
@@ -274,12 +381,13 @@ done:
     }
     io_image_free(&rgb);
     pipe_destroy(pp);
+    track_pose_free(&tp);
     kin_model_free(&model);
     return rc;
 }
 
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
-       O_NO_DEPTH, O_TONE };
+       O_NO_DEPTH, O_TONE, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER };
 
 int cmd_render(int argc, char **argv)
 {
@@ -293,10 +401,15 @@ int cmd_render(int argc, char **argv)
         {"threads", required_argument, 0, O_THREADS},
         {"no-depth", no_argument, 0, O_NO_DEPTH},
         {"tone-match", required_argument, 0, O_TONE},
+        {"pose", required_argument, 0, O_POSE},
+        {"calib", required_argument, 0, O_CALIB},
+        {"predict", required_argument, 0, O_PREDICT},
+        {"no-filter", no_argument, 0, O_NO_FILTER},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
     render_opts o = {0};
+    int tracking_only = 0;   /* an option that needs --pose tracking */
     optind = 1;
     opterr = 0;
     int c;
@@ -324,6 +437,19 @@ int cmd_render(int argc, char **argv)
             if (!cli_parse_float(optarg, &o.tone_match) || o.tone_match < 0.0f || o.tone_match > 1.0f)
                 return cli_usage_error("render", "--tone-match '%s': a strength in [0, 1]", optarg);
             break;
+        case O_POSE:
+            if (!strcmp(optarg, "tracking")) o.pose_tracking = 1;
+            else if (!strcmp(optarg, "animation")) o.pose_tracking = 0;
+            else return cli_usage_error("render", "--pose '%s': 'animation' or 'tracking'", optarg);
+            break;
+        case O_CALIB: o.calib = optarg; tracking_only = O_CALIB; break;
+        case O_PREDICT:
+            if (!cli_parse_float(optarg, &o.predict_ms) || !(o.predict_ms >= 0.0f) ||
+                o.predict_ms > 100.0f)
+                return cli_usage_error("render", "--predict '%s': milliseconds in [0, 100]", optarg);
+            tracking_only = O_PREDICT;
+            break;
+        case O_NO_FILTER: o.no_filter = 1; tracking_only = O_NO_FILTER; break;
         case ':': return cli_usage_error("render", "option %s needs a value", argv[optind - 1]);
         default: return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);
         }
@@ -331,6 +457,10 @@ int cmd_render(int argc, char **argv)
     if (optind < argc) return cli_usage_error("render", "unexpected argument '%s'", argv[optind]);
     if (!o.scene) return cli_usage_error("render", "--scene is required");
     if (!o.out) return cli_usage_error("render", "--out is required");
+    if (tracking_only && !o.pose_tracking)
+        return cli_usage_error("render", "%s needs --pose tracking",
+                               tracking_only == O_CALIB ? "--calib"
+                               : tracking_only == O_PREDICT ? "--predict" : "--no-filter");
     return render(&o);
 }
 

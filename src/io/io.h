@@ -134,6 +134,8 @@ typedef struct io_scene {
     float kd, ks, shininess, kf;
     float tone[3];
     int has_lighting;                 /* 0 = use fuse_lighting_default() */
+    char tracking[IO_PATH_MAX];       /* recorded tracking of the sequence
+                                         (docs/tracking.md), or "" */
 } io_scene;
 
 io_result io_scene_load(const char *path, io_scene *out, io_error *err);

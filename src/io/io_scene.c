@@ -28,6 +28,7 @@ typedef enum key_id {
     K_CAMERA_LEFT, K_CAMERA_RIGHT, K_VIRTUAL_LEFT, K_VIRTUAL_RIGHT,
     K_VIRTUAL_DEPTH_LEFT, K_VIRTUAL_DEPTH_RIGHT,
     K_AMBIENT, K_LIGHT, K_KD, K_KS, K_SHININESS, K_KF, K_TONE,
+    K_TRACKING,
     K_COUNT
 } key_id;
 
@@ -36,6 +37,7 @@ static const char *const key_names[K_COUNT] = {
     "camera_left", "camera_right", "virtual_left", "virtual_right",
     "virtual_depth_left", "virtual_depth_right",
     "ambient", "light", "kd", "ks", "shininess", "kf", "tone",
+    "tracking",
 };
 
 static const key_id required[] = {
@@ -248,6 +250,16 @@ static io_result set_key(const where *w, key_id k, char *value, io_scene *s)
         else s->kf = f[0];
         return IO_OK;
     }
+    case K_TRACKING:
+        /* a plain path: no frame conversion (io_scene_frame_path copies
+         * it unchanged, %% becoming %) */
+        for (const char *c = value; *c; c++) {
+            if (c[0] == '%' && c[1] == '%') { c++; continue; }
+            if (c[0] == '%')
+                return bad(w, IO_ERR_FORMAT, "tracking: '%s' is one file, not a frame "
+                                             "pattern (write %%%% for a %%)", value);
+        }
+        return copy_str(w, key, value, s->tracking, sizeof s->tracking);
     case K_COUNT: break;
     }
     return bad(w, IO_ERR_FORMAT, "internal: unhandled key");

@@ -671,6 +671,25 @@ void kin_skin_dq_from_matrices(const kin_mat4 *jm, int count,
 void kin_skin_dqs(const kin_mesh *mesh, const kin_dualquat *dq,
                   float *pos_out, float *nrm_out);
 
+/* ------------------------------------------------------ SIMD skinning */
+
+/* kin_skin_lbs and kin_skin_dqs run SIMD kernels (SSE2, AVX2, AVX-512;
+ * kin_skin_sse2.c, _avx2.c, _avx512.c) chosen at run time: the best ISA
+ * the CPU has, capped by EGOFUSE_ISA (src/cpu/cpu.h ef_isa_choose). The
+ * scalar reference defines the result: every path gives the same bytes
+ * (same operations in the same order per vertex, no FMA, exact sqrt and
+ * division; tests/test_kin_skin_isa.c). The ISA they use now (an ef_isa
+ * value of src/cpu/cpu.h): */
+int kin_skin_isa(void);
+/* The same with an explicit ISA (an ef_isa value: 1 ref, 2 sse2, 3 avx2,
+ * 4 avx512; 0 = as kin_skin_lbs). An ISA the CPU lacks runs the best one
+ * it has; EGOFUSE_ISA does not cap an explicit request. For tests and
+ * benchmarks. */
+void kin_skin_lbs_isa(const kin_mesh *mesh, const kin_mat4 *jm,
+                      float *pos_out, float *nrm_out, int isa);
+void kin_skin_dqs_isa(const kin_mesh *mesh, const kin_dualquat *dq,
+                      float *pos_out, float *nrm_out, int isa);
+
 #ifdef __cplusplus
 }
 #endif

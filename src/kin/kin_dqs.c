@@ -10,8 +10,12 @@
  * Unlike LBS the blend of two rotations is a rotation, so a twisted wrist
  * keeps its cross-section (LBS shrinks it by cos(angle/2)). Scale and
  * mirroring are not representable: kin_dualquat_from_mat4 orthonormalises.
- * No allocation. */
+ * No allocation. kin_skin_dqs runs the SIMD kernels (kin_skin_internal.h)
+ * on whole vectors of vertices and this reference on the rest (same
+ * bytes). */
 #include "kin.h"
+#include "kin_skin_internal.h"
+#include "../cpu/cpu.h"
 
 #include <math.h>
 
@@ -54,12 +58,12 @@ void kin_skin_dq_from_matrices(const kin_mat4 *jm, int count, kin_dualquat *dq)
     for (int j = 0; j < count; j++) dq[j] = kin_dualquat_from_mat4(&jm[j]);
 }
 
-void kin_skin_dqs(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out, float *nrm_out)
+void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
+                       float *pos_out, float *nrm_out, int v0, int v1)
 {
-    if (!mesh || !pos_out) return;
     const int do_n = mesh->normals && nrm_out;
     const int skinned = mesh->joints && mesh->weights && dq;
-    for (int v = 0; v < mesh->vertex_count; v++) {
+    for (int v = v0; v < v1; v++) {
         const float *p = mesh->positions + (size_t)v * 3;
         float *po = pos_out + (size_t)v * 3;
         const float *n = do_n ? mesh->normals + (size_t)v * 3 : NULL;
@@ -97,4 +101,30 @@ void kin_skin_dqs(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out, 
             no[0] = nn.x; no[1] = nn.y; no[2] = nn.z;
         }
     }
+}
+
+void kin_skin_dqs_isa(const kin_mesh *mesh, const kin_dualquat *dq,
+                      float *pos_out, float *nrm_out, int isa)
+{
+    if (!mesh || !pos_out) return;
+    int v = 0, n = mesh->vertex_count;
+    if (mesh->joints && mesh->weights && dq) {
+        ef_isa best = ef_cpu_best(), use = ef_isa_choose(EF_ISA_DEFAULT);
+        if (isa > (int)EF_ISA_DEFAULT && isa < (int)EF_ISA_COUNT)
+            use = (ef_isa)isa < best ? (ef_isa)isa : best;
+        switch (use) {
+#if defined(__x86_64__)
+        case EF_ISA_AVX512: v = kin__skin_dqs_avx512(mesh, dq, pos_out, nrm_out, 0, n); break;
+        case EF_ISA_AVX2: v = kin__skin_dqs_avx2(mesh, dq, pos_out, nrm_out, 0, n); break;
+        case EF_ISA_SSE2: v = kin__skin_dqs_sse2(mesh, dq, pos_out, nrm_out, 0, n); break;
+#endif
+        default: break;
+        }
+    }
+    kin__skin_dqs_ref(mesh, dq, pos_out, nrm_out, v, n);
+}
+
+void kin_skin_dqs(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out, float *nrm_out)
+{
+    kin_skin_dqs_isa(mesh, dq, pos_out, nrm_out, 0);
 }

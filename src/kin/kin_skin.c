@@ -5,8 +5,14 @@
  * A the upper 3x3 of B, cof(A) = det(A) A^-T its cofactor matrix, so C is
  * the inverse transpose times |det A| (a positive scale) and needs no
  * division; n' is then renormalised. A vertex whose weights sum to 0 keeps
- * its bind position and normal. No allocation. */
+ * its bind position and normal. No allocation.
+ *
+ * kin_skin_lbs runs the SIMD kernels (kin_skin_internal.h) on whole
+ * vectors of vertices and this reference on the rest; both give the same
+ * bytes. */
 #include "kin.h"
+#include "kin_skin_internal.h"
+#include "../cpu/cpu.h"
 
 #include <math.h>
 
@@ -55,13 +61,12 @@ static void xform_normal(const affine *b, const float *n, float *o)
     o[0] = r.x; o[1] = r.y; o[2] = r.z;
 }
 
-void kin_skin_lbs(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
-                  float *nrm_out)
+void kin__skin_lbs_ref(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
+                       float *nrm_out, int v0, int v1)
 {
-    if (!mesh || !pos_out) return;
     const int do_n = mesh->normals && nrm_out;
     const int skinned = mesh->joints && mesh->weights && jm;
-    for (int v = 0; v < mesh->vertex_count; v++) {
+    for (int v = v0; v < v1; v++) {
         const float *p = mesh->positions + (size_t)v * 3;
         float *po = pos_out + (size_t)v * 3;
         const float *n = do_n ? mesh->normals + (size_t)v * 3 : NULL;
@@ -88,6 +93,47 @@ void kin_skin_lbs(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
         xform_point(&b, p, po);
         if (do_n) xform_normal(&b, n, no);
     }
+}
+
+/* ------------------------------------------------------------ dispatch */
+
+int kin_skin_isa(void)
+{
+    return (int)ef_isa_choose(EF_ISA_DEFAULT);
+}
+
+/* The ISA a caller's request runs: 0 = kin_skin_isa(), else the request
+ * capped by what the CPU has (never by EGOFUSE_ISA: tests and benchmarks
+ * name the path they want). */
+static ef_isa isa_of(int isa)
+{
+    if (isa <= (int)EF_ISA_DEFAULT || isa >= (int)EF_ISA_COUNT) return ef_isa_choose(EF_ISA_DEFAULT);
+    ef_isa best = ef_cpu_best();
+    return (ef_isa)isa < best ? (ef_isa)isa : best;
+}
+
+void kin_skin_lbs_isa(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
+                      float *nrm_out, int isa)
+{
+    if (!mesh || !pos_out) return;
+    int v = 0, n = mesh->vertex_count;
+    if (mesh->joints && mesh->weights && jm) {
+        switch (isa_of(isa)) {
+#if defined(__x86_64__)
+        case EF_ISA_AVX512: v = kin__skin_lbs_avx512(mesh, jm, pos_out, nrm_out, 0, n); break;
+        case EF_ISA_AVX2: v = kin__skin_lbs_avx2(mesh, jm, pos_out, nrm_out, 0, n); break;
+        case EF_ISA_SSE2: v = kin__skin_lbs_sse2(mesh, jm, pos_out, nrm_out, 0, n); break;
+#endif
+        default: break;
+        }
+    }
+    kin__skin_lbs_ref(mesh, jm, pos_out, nrm_out, v, n);
+}
+
+void kin_skin_lbs(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
+                  float *nrm_out)
+{
+    kin_skin_lbs_isa(mesh, jm, pos_out, nrm_out, 0);
 }
 
 void kin_mesh_transform(const kin_mesh *mesh, const kin_mat4 *m, float *pos_out,

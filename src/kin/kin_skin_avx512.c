@@ -1,0 +1,366 @@
+/* kin_skin_avx512.c - skinning kernels, AVX-512 (16 vertices per vector)
+ * with kin_skin_simd.inl. A vertex's joint matrix is one zmm (LBS), its
+ * dual quaternion one ymm (DQS); 16 blended vertices are transposed with
+ * in-lane 4x4 transposes and 128-bit block shuffles. Bytes equal the
+ * reference (kin_skin.c, kin_dqs.c). Built with -mavx512f/bw/dq/vl. */
+#include "kin_skin_internal.h"
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#include <math.h>
+#include <string.h>
+
+#define W 16
+#define V __m512
+#define M __mmask16
+#define SIMD_LBS kin__skin_lbs_avx512
+#define SIMD_DQS kin__skin_dqs_avx512
+#define VSET1(x) _mm512_set1_ps(x)
+#define VADD(a, b) _mm512_add_ps(a, b)
+#define VSUB(a, b) _mm512_sub_ps(a, b)
+#define VMUL(a, b) _mm512_mul_ps(a, b)
+#define VDIV(a, b) _mm512_div_ps(a, b)
+#define VSQRT(a) _mm512_sqrt_ps(a)
+#define M_NE(a, b) _mm512_cmp_ps_mask(a, b, _CMP_NEQ_UQ)
+#define M_GT(a, b) _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ)
+#define M_LT(a, b) _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ)
+#define M_AND(a, b) ((__mmask16)((a) & (b)))
+#define SEL(m, t, f) _mm512_mask_blend_ps(m, f, t)
+#define SELZ(m, t) _mm512_maskz_mov_ps(m, t)
+#define NEG_IF(m, x) _mm512_mask_xor_ps(x, m, x, _mm512_set1_ps(-0.0f))
+#define M_ALL(m) ((m) == (__mmask16)0xFFFF)
+
+/* Bit i set when weight i is not 0 (NaN counts as not 0, as in the
+ * reference's "w == 0: skip"). */
+static inline unsigned nonzero4(const float *w)
+{
+    return (unsigned)_mm_movemask_ps(_mm_cmpneq_ps(_mm_loadu_ps(w), _mm_setzero_ps()));
+}
+
+/* In-lane 4x4 transposes of r0..r3: o[k] holds, in each 128-bit block,
+ * element k of that block of r0, r1, r2, r3. */
+static inline void tr4(__m512 r0, __m512 r1, __m512 r2, __m512 r3, __m512 o[4])
+{
+    __m512d t0 = _mm512_castps_pd(_mm512_unpacklo_ps(r0, r1));
+    __m512d t1 = _mm512_castps_pd(_mm512_unpacklo_ps(r2, r3));
+    __m512d t2 = _mm512_castps_pd(_mm512_unpackhi_ps(r0, r1));
+    __m512d t3 = _mm512_castps_pd(_mm512_unpackhi_ps(r2, r3));
+    o[0] = _mm512_castpd_ps(_mm512_unpacklo_pd(t0, t1));
+    o[1] = _mm512_castpd_ps(_mm512_unpackhi_pd(t0, t1));
+    o[2] = _mm512_castpd_ps(_mm512_unpacklo_pd(t2, t3));
+    o[3] = _mm512_castpd_ps(_mm512_unpackhi_pd(t2, t3));
+}
+
+static inline void lbs_rows(const kin_mesh *mesh, const kin_mat4 *jm, int v,
+                             __m512 a[12], __m512 *wsum)
+{
+    _Alignas(64) float ws[16];
+    __m512 r[16];
+    const uint16_t *j = mesh->joints + (size_t)v * 4;
+    const float *w = mesh->weights + (size_t)v * 4;
+    for (int l = 0; l < 16; l++, j += 4, w += 4) {
+        __m512 acc = _mm512_setzero_ps();
+        float s = 0.0f;
+        for (unsigned bits = nonzero4(w); bits; bits &= bits - 1) {
+            int i = __builtin_ctz(bits);
+            acc = _mm512_add_ps(acc, _mm512_mul_ps(_mm512_set1_ps(w[i]),
+                                                   _mm512_loadu_ps(jm[j[i]].m)));
+            s += w[i];
+        }
+        r[l] = acc;
+        ws[l] = s;
+    }
+    *wsum = _mm512_load_ps(ws);
+    /* s[I][rho], block J: column J, row rho of vertices 4I..4I+3 */
+    __m512 s[4][4];
+    for (int I = 0; I < 4; I++) tr4(r[4 * I], r[4 * I + 1], r[4 * I + 2], r[4 * I + 3], s[I]);
+    for (int rho = 0; rho < 3; rho++) {
+        __m512 abl = _mm512_shuffle_f32x4(s[0][rho], s[1][rho], 0x44);
+        __m512 cdl = _mm512_shuffle_f32x4(s[2][rho], s[3][rho], 0x44);
+        __m512 abh = _mm512_shuffle_f32x4(s[0][rho], s[1][rho], 0xEE);
+        __m512 cdh = _mm512_shuffle_f32x4(s[2][rho], s[3][rho], 0xEE);
+        a[0 * 3 + rho] = _mm512_shuffle_f32x4(abl, cdl, 0x88);
+        a[1 * 3 + rho] = _mm512_shuffle_f32x4(abl, cdl, 0xDD);
+        a[2 * 3 + rho] = _mm512_shuffle_f32x4(abh, cdh, 0x88);
+        a[3 * 3 + rho] = _mm512_shuffle_f32x4(abh, cdh, 0xDD);
+    }
+}
+
+static inline void dqs_rows(const kin_mesh *mesh, const kin_dualquat *dq, int v,
+                             __m512 b[8], __m512 *wsum)
+{
+    /* vertex l = 8I + 4h + i goes to slot 8I + 2i + h, so the in-lane
+     * transposes of slot pairs give 4 consecutive vertices per block */
+    _Alignas(64) float blk[16 * 8];
+    _Alignas(64) float ws[16];
+    const uint16_t *j = mesh->joints + (size_t)v * 4;
+    const float *w = mesh->weights + (size_t)v * 4;
+    for (int l = 0; l < 16; l++, j += 4, w += 4) {
+        __m256 acc = _mm256_setzero_ps();
+        float s = 0.0f;
+        const kin_quat *r0 = NULL;
+        for (unsigned bits = nonzero4(w); bits; bits &= bits - 1) {
+            int i = __builtin_ctz(bits);
+            const kin_dualquat *q = &dq[j[i]];
+            float sw = w[i];
+            if (!r0) {
+                r0 = &q->r;
+            } else {
+                float dot = q->r.x * r0->x + q->r.y * r0->y + q->r.z * r0->z + q->r.w * r0->w;
+                if (dot < 0.0f) sw = -w[i];
+            }
+            acc = _mm256_add_ps(acc, _mm256_mul_ps(_mm256_set1_ps(sw),
+                                                   _mm256_loadu_ps(&q->r.x)));
+            s += w[i];
+        }
+        int slot = (l & 8) + 2 * (l & 3) + ((l >> 2) & 1);
+        _mm256_store_ps(blk + 8 * slot, acc);
+        ws[l] = s;
+    }
+    *wsum = _mm512_load_ps(ws);
+    __m512 s[2][4];
+    for (int I = 0; I < 2; I++)
+        tr4(_mm512_load_ps(blk + 64 * I), _mm512_load_ps(blk + 64 * I + 16),
+            _mm512_load_ps(blk + 64 * I + 32), _mm512_load_ps(blk + 64 * I + 48), s[I]);
+    for (int rho = 0; rho < 4; rho++) {
+        b[rho] = _mm512_shuffle_f32x4(s[0][rho], s[1][rho], 0x88);
+        b[4 + rho] = _mm512_shuffle_f32x4(s[0][rho], s[1][rho], 0xDD);
+    }
+}
+
+/* ---- joint-table blend: no per-vertex loop --------------------------
+ * When every joint a block of 16 vertices reads (nonzero weight) is below
+ * 64, the blend runs in SoA: the needed elements of joints 0..63 sit
+ * transposed in a table (one 64-float row per element, built on demand
+ * from the joints the mesh reads, as the reference reads them), and
+ * per influence slot i one vpermt2ps (two and a blend above joint 31)
+ * looks up all 16 lanes at once. Lanes with w_i == 0 add +0 (masked
+ * product): the same sum as the reference's skip, since a sum started at
+ * +0 is never -0. The weight sum adds every w_i in order: adding a zero
+ * weight changes nothing either. Blocks reading joints >= 64 use the
+ * per-vertex rows path above. */
+typedef struct skin_tab {
+    _Alignas(64) float t[12][64];  /* [element][joint] */
+    int built;                     /* joints [0, built) are in t */
+    __m512i sel01, sel23;          /* word picks: slots 0|1 and 2|3 */
+    __m512i widx[4];               /* float picks: slot i of 8 vertices */
+} skin_tab;
+
+static inline void tab_init(skin_tab *T)
+{
+    T->built = 0;
+    _Alignas(64) short s01[32], s23[32];
+    _Alignas(64) int wi[4][16];
+    for (int l = 0; l < 32; l++) {
+        s01[l] = (short)(4 * (l & 15) + (l >> 4));
+        s23[l] = (short)(4 * (l & 15) + 2 + (l >> 4));
+    }
+    for (int i = 0; i < 4; i++)
+        for (int l = 0; l < 16; l++) wi[i][l] = 4 * (l & 7) + i;
+    T->sel01 = _mm512_load_si512(s01);
+    T->sel23 = _mm512_load_si512(s23);
+    for (int i = 0; i < 4; i++) T->widx[i] = _mm512_load_si512(wi[i]);
+}
+
+/* SoA weights, their nonzero masks, joint indices of 16 vertices, and
+ * the largest joint read with a nonzero weight (-1: none). */
+typedef struct blk16 {
+    __m512 w[4];
+    __mmask16 k[4];
+    __m512i j[4];
+    int maxj;
+} blk16;
+
+static inline void blk16_load(const skin_tab *T, const kin_mesh *mesh, int v, blk16 *b)
+{
+    const float *wp = mesh->weights + (size_t)v * 4;
+    const uint16_t *jp = mesh->joints + (size_t)v * 4;
+    const __m512 zero = _mm512_setzero_ps();
+    __m512 A = _mm512_loadu_ps(wp), B = _mm512_loadu_ps(wp + 16),
+           C = _mm512_loadu_ps(wp + 32), D = _mm512_loadu_ps(wp + 48);
+    __mmask32 kx = (__mmask32)_mm512_cmp_ps_mask(A, zero, _CMP_NEQ_UQ) |
+                   ((__mmask32)_mm512_cmp_ps_mask(B, zero, _CMP_NEQ_UQ) << 16);
+    __mmask32 ky = (__mmask32)_mm512_cmp_ps_mask(C, zero, _CMP_NEQ_UQ) |
+                   ((__mmask32)_mm512_cmp_ps_mask(D, zero, _CMP_NEQ_UQ) << 16);
+    __m512i X = _mm512_loadu_si512(jp), Y = _mm512_loadu_si512(jp + 32);
+    if (!(kx | ky)) {
+        b->maxj = -1;
+    } else {
+        __m512i mx = _mm512_max_epu16(_mm512_maskz_mov_epi16(kx, X), _mm512_maskz_mov_epi16(ky, Y));
+        __m256i m2 = _mm256_max_epu16(_mm512_castsi512_si256(mx), _mm512_extracti64x4_epi64(mx, 1));
+        __m128i m1 = _mm_max_epu16(_mm256_castsi256_si128(m2), _mm256_extracti128_si256(m2, 1));
+        m1 = _mm_minpos_epu16(_mm_xor_si128(m1, _mm_set1_epi32(-1)));
+        b->maxj = 0xFFFF - (_mm_cvtsi128_si32(m1) & 0xFFFF);
+    }
+    __m512i p01 = _mm512_permutex2var_epi16(X, T->sel01, Y);
+    __m512i p23 = _mm512_permutex2var_epi16(X, T->sel23, Y);
+    b->j[0] = _mm512_cvtepu16_epi32(_mm512_castsi512_si256(p01));
+    b->j[1] = _mm512_cvtepu16_epi32(_mm512_extracti64x4_epi64(p01, 1));
+    b->j[2] = _mm512_cvtepu16_epi32(_mm512_castsi512_si256(p23));
+    b->j[3] = _mm512_cvtepu16_epi32(_mm512_extracti64x4_epi64(p23, 1));
+    for (int i = 0; i < 4; i++) {
+        b->w[i] = _mm512_shuffle_f32x4(_mm512_permutex2var_ps(A, T->widx[i], B),
+                                       _mm512_permutex2var_ps(C, T->widx[i], D), 0x44);
+        b->k[i] = _mm512_cmp_ps_mask(b->w[i], zero, _CMP_NEQ_UQ);
+    }
+}
+
+/* Element e of joints j[] (lanes), from a table row of 64 joints. */
+static inline __m512 lookup(const float *row, __m512i j, int wide, __mmask16 hi)
+{
+    __m512 lo = _mm512_permutex2var_ps(_mm512_load_ps(row), j, _mm512_load_ps(row + 16));
+    if (!wide) return lo;
+    __m512 up = _mm512_permutex2var_ps(_mm512_load_ps(row + 32), j, _mm512_load_ps(row + 48));
+    return _mm512_mask_blend_ps(hi, lo, up);
+}
+
+/* The slots of one block; WIDE: joints up to 63 (else up to 31). */
+#define LBS_SLOTS(WIDE)                                                        \
+    {                                                                          \
+        for (int i = 0; i < 4; i++) {                                          \
+            ws = _mm512_add_ps(ws, b.w[i]);                                    \
+            if (!b.k[i]) continue;                                             \
+            __mmask16 hi = _mm512_test_epi32_mask(b.j[i], _mm512_set1_epi32(32)); \
+            _Pragma("GCC unroll 12")                                           \
+            for (int e = 0; e < 12; e++)                                       \
+                acc[e] = _mm512_add_ps(acc[e], _mm512_maskz_mul_ps(            \
+                    b.k[i], b.w[i], lookup(T->t[e], b.j[i], WIDE, hi)));       \
+        }                                                                      \
+    }
+
+static inline void lbs_block(skin_tab *T, const kin_mesh *mesh, const kin_mat4 *jm, int v,
+                             __m512 a[12], __m512 *wsum)
+{
+    blk16 b;
+    blk16_load(T, mesh, v, &b);
+    if (b.maxj >= 64) {
+        lbs_rows(mesh, jm, v, a, wsum);
+        return;
+    }
+    if (b.maxj >= T->built) {
+        if (T->built == 0) memset(T->t, 0, sizeof T->t);
+        for (int jj = T->built; jj <= b.maxj; jj++)
+            for (int c = 0; c < 4; c++)
+                for (int r = 0; r < 3; r++) T->t[c * 3 + r][jj] = jm[jj].m[c * 4 + r];
+        T->built = b.maxj + 1;
+    }
+    __m512 ws = _mm512_setzero_ps();
+    __m512 acc[12];
+#pragma GCC unroll 12
+    for (int e = 0; e < 12; e++) acc[e] = ws;
+    if (b.maxj >= 32) LBS_SLOTS(1) else LBS_SLOTS(0)
+#pragma GCC unroll 12
+    for (int e = 0; e < 12; e++) a[e] = acc[e];
+    *wsum = ws;
+}
+
+/* s_i = -w_i where r_i . r_first < 0, in lanes that had a first
+ * influence (the first one's own dot is >= 0: s = w, as the reference). */
+#define DQS_SLOTS(WIDE)                                                        \
+    {                                                                          \
+        for (int i = 0; i < 4; i++) {                                          \
+            ws = _mm512_add_ps(ws, b.w[i]);                                    \
+            __mmask16 k = b.k[i];                                              \
+            if (!k) continue;                                                  \
+            __mmask16 hi = _mm512_test_epi32_mask(b.j[i], _mm512_set1_epi32(32)); \
+            __m512 x[8];                                                       \
+            _Pragma("GCC unroll 8")                                            \
+            for (int e = 0; e < 8; e++) x[e] = lookup(T->t[e], b.j[i], WIDE, hi); \
+            __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_add_ps(            \
+                             _mm512_mul_ps(x[0], r0[0]), _mm512_mul_ps(x[1], r0[1])), \
+                             _mm512_mul_ps(x[2], r0[2])), _mm512_mul_ps(x[3], r0[3])); \
+            __mmask16 neg = _mm512_mask_cmp_ps_mask(have, dot, zero, _CMP_LT_OQ); \
+            __m512 sw = _mm512_mask_xor_ps(b.w[i], neg, b.w[i], _mm512_set1_ps(-0.0f)); \
+            __mmask16 first = (__mmask16)(k & ~have);                          \
+            _Pragma("GCC unroll 4")                                            \
+            for (int e = 0; e < 4; e++) r0[e] = _mm512_mask_mov_ps(r0[e], first, x[e]); \
+            have = (__mmask16)(have | k);                                      \
+            _Pragma("GCC unroll 8")                                            \
+            for (int e = 0; e < 8; e++)                                        \
+                acc[e] = _mm512_add_ps(acc[e], _mm512_maskz_mul_ps(k, sw, x[e])); \
+        }                                                                      \
+    }
+
+static inline void dqs_block(skin_tab *T, const kin_mesh *mesh, const kin_dualquat *dq, int v,
+                             __m512 q[8], __m512 *wsum)
+{
+    blk16 b;
+    blk16_load(T, mesh, v, &b);
+    if (b.maxj >= 64) {
+        dqs_rows(mesh, dq, v, q, wsum);
+        return;
+    }
+    if (b.maxj >= T->built) {
+        if (T->built == 0) memset(T->t, 0, sizeof T->t);
+        for (int jj = T->built; jj <= b.maxj; jj++) {
+            const float *src = &dq[jj].r.x;
+            for (int e = 0; e < 8; e++) T->t[e][jj] = src[e];
+        }
+        T->built = b.maxj + 1;
+    }
+    const __m512 zero = _mm512_setzero_ps();
+    __m512 ws = zero, r0[4] = { zero, zero, zero, zero }, acc[8];
+    __mmask16 have = 0;   /* lanes whose first influence is known */
+#pragma GCC unroll 8
+    for (int e = 0; e < 8; e++) acc[e] = zero;
+    if (b.maxj >= 32) DQS_SLOTS(1) else DQS_SLOTS(0)
+#pragma GCC unroll 8
+    for (int e = 0; e < 8; e++) q[e] = acc[e];
+    *wsum = ws;
+}
+
+/* x y z x y z ... (48 floats) <-> three SoA vectors. Component k of
+ * vertex v is float 3v + k: register (3v+k)/16, lane (3v+k)%16; the
+ * lanes of one component are distinct, so two blends gather them into
+ * one register and one permute puts them in vertex order. */
+typedef struct lay3 {
+    __m512i gidx[3], sidx[3];
+    __mmask16 mb[3], mc[3], sy[3], sz[3];
+} lay3;
+
+static inline void lay3_init(lay3 *L)
+{
+    for (int k = 0; k < 3; k++) {
+        _Alignas(64) int gi[16], si[16];
+        unsigned mb = 0, mc = 0, sy = 0, sz = 0;
+        for (int v = 0; v < 16; v++) {
+            int g = 3 * v + k, lane = g % 16;
+            gi[v] = lane;
+            si[lane] = v;
+            if (g >= 16 && g < 32) mb |= 1u << lane;
+            if (g >= 32) mc |= 1u << lane;
+        }
+        for (int lane = 0; lane < 16; lane++) {
+            int g = 16 * k + lane;
+            if (g % 3 == 1) sy |= 1u << lane;
+            if (g % 3 == 2) sz |= 1u << lane;
+        }
+        L->gidx[k] = _mm512_load_si512(gi);
+        L->sidx[k] = _mm512_load_si512(si);
+        L->mb[k] = (__mmask16)mb; L->mc[k] = (__mmask16)mc;
+        L->sy[k] = (__mmask16)sy; L->sz[k] = (__mmask16)sz;
+    }
+}
+
+static inline void deint3(const lay3 *L, const float *p, __m512 o[3])
+{
+    __m512 a = _mm512_loadu_ps(p), b = _mm512_loadu_ps(p + 16), c = _mm512_loadu_ps(p + 32);
+    for (int k = 0; k < 3; k++) {
+        __m512 t = _mm512_mask_blend_ps(L->mc[k], _mm512_mask_blend_ps(L->mb[k], a, b), c);
+        o[k] = _mm512_permutexvar_ps(L->gidx[k], t);
+    }
+}
+
+static inline void int3(const lay3 *L, float *p, const __m512 in[3])
+{
+    __m512 x = _mm512_permutexvar_ps(L->sidx[0], in[0]);
+    __m512 y = _mm512_permutexvar_ps(L->sidx[1], in[1]);
+    __m512 z = _mm512_permutexvar_ps(L->sidx[2], in[2]);
+    for (int r = 0; r < 3; r++)
+        _mm512_storeu_ps(p + 16 * r,
+                         _mm512_mask_blend_ps(L->sz[r], _mm512_mask_blend_ps(L->sy[r], x, y), z));
+}
+
+#include "kin_skin_simd.inl"
+
+#endif

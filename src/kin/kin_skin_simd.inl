@@ -1,0 +1,139 @@
+/* kin_skin_simd.inl - the one body of the SIMD skinning kernels, included
+ * by kin_skin_sse2.c, kin_skin_avx2.c and kin_skin_avx512.c.
+ *
+ * A vector holds W vertices (structure of arrays). Per block of W
+ * vertices the ISA file blends each vertex's joint matrices (LBS) or dual
+ * quaternions (DQS) in vector registers, one vertex at a time, exactly as
+ * the reference does (skipping zero weights, adding in influence order
+ * onto zero), and transposes the W blended results into SoA vectors; the
+ * rest is the reference's arithmetic, operation for operation, in lanes:
+ * the same IEEE results, so the output bytes equal kin__skin_*_ref.
+ *
+ * The ISA file defines: W, V (float vector), M (lane mask), VSET1, VADD,
+ * VSUB, VMUL, VDIV, VSQRT, M_NE (unordered or not equal), M_GT, M_LT
+ * (ordered), M_AND, M_ALL (every lane set), SEL(m, t, f) (t where m),
+ * SELZ(m, t) (t where m, else +0), NEG_IF(m, x) (sign flipped where m:
+ * the reference's x * -1; they differ only for a NaN, whose normal is 0
+ * either way), SIMD_LBS / SIMD_DQS (the
+ * kernel names), the type skin_tab (per-call state of the blend, e.g. a
+ * transposed joint table) and the static functions
+ *   tab_init(skin_tab *)
+ *   lbs_block(tab, mesh, jm, v, V a[12], V *wsum)  a[c*3+r]: column c, row r
+ *   dqs_block(tab, mesh, dq, v, V b[8], V *wsum)   b: r.xyzw, d.xyzw
+ *   lay3_init(lay3 *), deint3(const lay3 *, const float *, V o[3]),
+ *   int3(const lay3 *, float *, const V i[3])  (x y z x y z ... <-> SoA)
+ */
+
+/* cross(a, b), componentwise as kin_v3_cross. */
+#define CROSS(o, a, b)                                                   \
+    do {                                                                 \
+        o[0] = VSUB(VMUL(a[1], b[2]), VMUL(a[2], b[1]));                 \
+        o[1] = VSUB(VMUL(a[2], b[0]), VMUL(a[0], b[2]));                 \
+        o[2] = VSUB(VMUL(a[0], b[1]), VMUL(a[1], b[0]));                 \
+    } while (0)
+
+/* kin_v3_norm: r / |r|, or 0 when |r| is 0 or not finite. */
+static inline void norm3(V r[3], V zero, V inf)
+{
+    V l = VSQRT(VADD(VADD(VMUL(r[0], r[0]), VMUL(r[1], r[1])), VMUL(r[2], r[2])));
+    M ok = M_AND(M_GT(l, zero), M_LT(l, inf));
+    V inv = VDIV(VSET1(1.0f), l);
+    for (int k = 0; k < 3; k++) r[k] = SELZ(ok, VMUL(r[k], inv));
+}
+
+int SIMD_LBS(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
+             float *nrm_out, int v0, int v1)
+{
+    const int do_n = mesh->normals && nrm_out;
+    const V zero = VSET1(0.0f), inf = VSET1(INFINITY);
+    lay3 L;
+    lay3_init(&L);
+    skin_tab T;
+    tab_init(&T);
+    int v = v0;
+    for (; v1 - v >= W; v += W) {
+        V a[12], ws, p[3], o[3];
+        lbs_block(&T, mesh, jm, v, a, &ws);
+        M ok = M_NE(ws, zero);
+        const int all = M_ALL(ok);   /* no bind-pose lane: no selects */
+        deint3(&L, mesh->positions + (size_t)v * 3, p);
+        for (int r = 0; r < 3; r++) {
+            V t = VADD(VADD(VADD(VMUL(a[r], p[0]), VMUL(a[3 + r], p[1])),
+                            VMUL(a[6 + r], p[2])), a[9 + r]);
+            o[r] = all ? t : SEL(ok, t, p[r]);
+        }
+        int3(&L, pos_out + (size_t)v * 3, o);
+        if (!do_n) continue;
+        V n[3], c0[3], c1[3], c2[3], x[3];
+        const V a0[3] = { a[0], a[1], a[2] }, a1[3] = { a[3], a[4], a[5] },
+                a2[3] = { a[6], a[7], a[8] };
+        CROSS(c0, a1, a2);
+        CROSS(c1, a2, a0);
+        CROSS(c2, a0, a1);
+        V det = VADD(VADD(VMUL(a0[0], c0[0]), VMUL(a0[1], c0[1])), VMUL(a0[2], c0[2]));
+        M flip = M_LT(det, zero);
+        deint3(&L, mesh->normals + (size_t)v * 3, n);
+        for (int k = 0; k < 3; k++) {
+            x[k] = VADD(VADD(VMUL(c0[k], n[0]), VMUL(c1[k], n[1])), VMUL(c2[k], n[2]));
+            x[k] = NEG_IF(flip, x[k]);
+        }
+        norm3(x, zero, inf);
+        for (int k = 0; k < 3; k++) o[k] = all ? x[k] : SEL(ok, x[k], n[k]);
+        int3(&L, nrm_out + (size_t)v * 3, o);
+    }
+    return v;
+}
+
+/* kin_quat_rotate(u, w; x): x + 2 (u x x) w + u x (2 (u x x)). */
+static inline void qrot(const V u[3], V w, const V x[3], V out[3])
+{
+    V t[3], c[3];
+    CROSS(t, u, x);
+    const V two = VSET1(2.0f);
+    for (int k = 0; k < 3; k++) t[k] = VMUL(t[k], two);
+    CROSS(c, u, t);
+    for (int k = 0; k < 3; k++) out[k] = VADD(VADD(x[k], VMUL(t[k], w)), c[k]);
+}
+
+int SIMD_DQS(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out,
+             float *nrm_out, int v0, int v1)
+{
+    const int do_n = mesh->normals && nrm_out;
+    const V zero = VSET1(0.0f), inf = VSET1(INFINITY), two = VSET1(2.0f);
+    lay3 L;
+    lay3_init(&L);
+    skin_tab T;
+    tab_init(&T);
+    int v = v0;
+    for (; v1 - v >= W; v += W) {
+        V b[8], ws, p[3], o[3];
+        dqs_block(&T, mesh, dq, v, b, &ws);
+        V len = VSQRT(VADD(VADD(VADD(VMUL(b[0], b[0]), VMUL(b[1], b[1])),
+                                VMUL(b[2], b[2])), VMUL(b[3], b[3])));
+        M ok = M_AND(M_NE(ws, zero), M_GT(len, zero));
+        const int all = M_ALL(ok);
+        V inv = VDIV(VSET1(1.0f), len);
+        for (int k = 0; k < 8; k++) b[k] = VMUL(b[k], inv);
+        const V u[3] = { b[0], b[1], b[2] }, dv[3] = { b[4], b[5], b[6] };
+        deint3(&L, mesh->positions + (size_t)v * 3, p);
+        V rot[3], cr[3];
+        qrot(u, b[3], p, rot);
+        CROSS(cr, u, dv);
+        for (int k = 0; k < 3; k++) {
+            V t = VADD(VSUB(VMUL(dv[k], b[3]), VMUL(u[k], b[7])), cr[k]);
+            V y = VADD(rot[k], VMUL(t, two));
+            o[k] = all ? y : SEL(ok, y, p[k]);
+        }
+        int3(&L, pos_out + (size_t)v * 3, o);
+        if (!do_n) continue;
+        V n[3], x[3];
+        deint3(&L, mesh->normals + (size_t)v * 3, n);
+        qrot(u, b[3], n, x);
+        norm3(x, zero, inf);
+        for (int k = 0; k < 3; k++) o[k] = all ? x[k] : SEL(ok, x[k], n[k]);
+        int3(&L, nrm_out + (size_t)v * 3, o);
+    }
+    return v;
+}
+
+#undef CROSS
