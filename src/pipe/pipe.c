@@ -99,30 +99,61 @@ void pipe_pose_free(pipe_pose *ps)
     memset(ps, 0, sizeof *ps);
 }
 
-/* FK from ps->locals, then skinning of every mesh into world space. */
-static void pose_skin(pipe_pose *ps)
+/* FK from ps->locals and the joint matrices. */
+static void pose_fk(pipe_pose *ps)
 {
     const kin_model *m = ps->model;
     kin_fk(m->parents, m->node_count, ps->locals, NULL, ps->world);
     for (int s = 0; s < m->skin_count; s++)
         kin_skin_joint_matrices(&m->skins[s], ps->world, ps->joint_mats[s]);
+}
+
+/* Skins part `part` of `parts` of every mesh's vertices into world space.
+ * Every vertex is skinned on its own, so the bytes do not depend on how
+ * the vertices are split. Parts start on multiples of 16 vertices so that
+ * the SIMD paths run full blocks. */
+static void pose_skin_part(pipe_pose *ps, int part, int parts)
+{
+    const kin_model *m = ps->model;
     for (int i = 0; i < m->mesh_count; i++) {
         const kin_mesh *me = &ps->meshes[i];
+        int per = ((me->vertex_count + parts - 1) / parts + 15) & ~15;
+        int v0 = part * per, v1 = v0 + per < me->vertex_count ? v0 + per : me->vertex_count;
+        if (v0 >= v1) continue;
+        kin_mesh sub = *me; /* a view of vertices [v0, v1) */
+        sub.vertex_count = v1 - v0;
+        sub.positions += 3 * v0;
+        if (sub.normals) sub.normals += 3 * v0;
+        if (sub.joints) sub.joints += 4 * v0;
+        if (sub.weights) sub.weights += 4 * v0;
+        sub.indices = NULL;
+        sub.index_count = 0;
+        float *pos = ps->pos[i] + 3 * v0, *nrm = ps->nrm[i] + 3 * v0;
         if (me->skin >= 0) {
             /* glTF: a skinned mesh ignores its own node's transform. */
-            kin_skin_lbs(me, ps->joint_mats[me->skin], ps->pos[i], ps->nrm[i]);
+            kin_skin_lbs(&sub, ps->joint_mats[me->skin], pos, nrm);
         } else {
             kin_mat4 id = kin_mat4_identity();
-            kin_mesh_transform(me, me->node >= 0 ? &ps->world[me->node] : &id,
-                               ps->pos[i], ps->nrm[i]);
+            kin_mesh_transform(&sub, me->node >= 0 ? &ps->world[me->node] : &id, pos, nrm);
         }
     }
 }
 
-void pipe_pose_anim(pipe_pose *ps, const kin_animation *anim, float t)
+static void pose_skin(pipe_pose *ps)
+{
+    pose_fk(ps);
+    pose_skin_part(ps, 0, 1);
+}
+
+static void pose_locals_anim(pipe_pose *ps, const kin_animation *anim, float t)
 {
     kin_pose_rest(ps->model, ps->locals);
     if (anim) kin_anim_sample(anim, ps->model->node_count, t, ps->locals);
+}
+
+void pipe_pose_anim(pipe_pose *ps, const kin_animation *anim, float t)
+{
+    pose_locals_anim(ps, anim, t);
     pose_skin(ps);
 }
 
@@ -186,7 +217,14 @@ struct pipe_ctx {
     pthread_mutex_t mu;
     pthread_cond_t cv;
     int job_seq, done_seq, quit;
+    int job_kind;             /* JOB_SKIN or JOB_EYE */
+    int skin_split;           /* skin on both threads (large models) */
 };
+
+enum { JOB_SKIN, JOB_EYE };
+/* Below this many vertices, splitting the skinning costs more in the
+ * hand-over than it saves. */
+#define PIPE_SPLIT_SKIN_VERTICES 4096
 
 static double now_ms(void)
 {
@@ -287,14 +325,34 @@ static void *worker_main(void *arg)
         while (p->job_seq == seen && !p->quit) pthread_cond_wait(&p->cv, &p->mu);
         if (p->quit) break;
         seen = p->job_seq;
+        int kind = p->job_kind;
         pthread_mutex_unlock(&p->mu);
-        run_eye(p, &p->eye[1]);
+        if (kind == JOB_SKIN) pose_skin_part(&p->pose, 1, 2);
+        else run_eye(p, &p->eye[1]);
         pthread_mutex_lock(&p->mu);
         p->done_seq = seen;
         pthread_cond_broadcast(&p->cv);
     }
     pthread_mutex_unlock(&p->mu);
     return NULL;
+}
+
+/* Hands a job to the worker; returns its number for wait_job. */
+static int post_job(pipe_ctx *p, int kind)
+{
+    pthread_mutex_lock(&p->mu);
+    p->job_kind = kind;
+    int job = ++p->job_seq;
+    pthread_cond_broadcast(&p->cv);
+    pthread_mutex_unlock(&p->mu);
+    return job;
+}
+
+static void wait_job(pipe_ctx *p, int job)
+{
+    pthread_mutex_lock(&p->mu);
+    while (p->done_seq != job) pthread_cond_wait(&p->cv, &p->mu);
+    pthread_mutex_unlock(&p->mu);
 }
 
 pipe_lighting pipe_lighting_default(void)
@@ -349,6 +407,9 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
              s->rast && s->fuse;
     }
     p->threaded = p->desc.threads != 1;
+    long nv_all = 0;
+    for (int i = 0; i < model->mesh_count; i++) nv_all += model->meshes[i].vertex_count;
+    p->skin_split = nv_all >= PIPE_SPLIT_SKIN_VERTICES;
     if (ok && p->threaded) {
         pthread_mutex_init(&p->mu, NULL);
         pthread_cond_init(&p->cv, NULL);
@@ -405,8 +466,18 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
     }
 
     double t0 = now_ms();
-    if (in->locals) pipe_pose_locals(&p->pose, in->locals);
-    else pipe_pose_anim(&p->pose, in->anim, in->time);
+    if (in->locals)
+        memcpy(p->pose.locals, in->locals, sizeof *in->locals * (size_t)p->pose.model->node_count);
+    else
+        pose_locals_anim(&p->pose, in->anim, in->time);
+    pose_fk(&p->pose);
+    if (p->threaded && p->skin_split) {
+        int job = post_job(p, JOB_SKIN);
+        pose_skin_part(&p->pose, 0, 2);
+        wait_job(p, job);
+    } else {
+        pose_skin_part(&p->pose, 0, 1);
+    }
     kin_mat4 head = in->head_node >= 0 ? p->pose.world[in->head_node]
                     : in->world_from_head ? *in->world_from_head
                                           : kin_mat4_identity();
@@ -416,14 +487,9 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
         p->eye[e].head = head;
     }
     if (p->threaded) {
-        pthread_mutex_lock(&p->mu);
-        int job = ++p->job_seq;
-        pthread_cond_broadcast(&p->cv);
-        pthread_mutex_unlock(&p->mu);
+        int job = post_job(p, JOB_EYE);
         run_eye(p, &p->eye[0]);
-        pthread_mutex_lock(&p->mu);
-        while (p->done_seq != job) pthread_cond_wait(&p->cv, &p->mu);
-        pthread_mutex_unlock(&p->mu);
+        wait_job(p, job);
     } else {
         run_eye(p, &p->eye[0]);
         run_eye(p, &p->eye[1]);
