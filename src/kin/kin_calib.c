@@ -3,9 +3,9 @@
  * "egofuse-calib 1" (docs/tracking.md), formatted into and parsed from
  * caller buffers (the file itself is opened by src/io). No allocation. */
 #include "kin.h"
+#include "kin_internal.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,22 +14,7 @@
 #define SCALE_MIN 0.5f
 #define SCALE_MAX 2.0f
 
-static int fail(char *why, size_t n, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-
-static int fail(char *why, size_t n, const char *fmt, ...)
-{
-    if (why && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(why, n, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
+#define fail(why, n, ...) kin__fail(why, n, -1, __VA_ARGS__)
 
 kin_user_calib kin_user_calib_identity(void)
 {
@@ -103,24 +88,8 @@ int kin_user_calib_estimate(const kin_track_sample *samples, int n, const kin_ar
 
 /* ------------------------------------------------------------------- file */
 
-typedef struct sink { char *buf; size_t size, len; } sink;
-
-static void put(sink *k, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
-static void put(sink *k, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    char *dst = k->len < k->size ? k->buf + k->len : NULL;
-    size_t room = k->len < k->size ? k->size - k->len : 0;
-    int r = vsnprintf(dst, room, fmt, ap);
-    va_end(ap);
-    if (r > 0) k->len += (size_t)r;
-}
+typedef kin__sink sink;
+#define put kin__put
 
 int kin_user_calib_format(const kin_user_calib *c, char *buf, size_t size)
 {

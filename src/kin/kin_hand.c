@@ -4,9 +4,9 @@
  * to PIP; CMC with opposition, MCP and IP for the thumb). Table and rules:
  * docs/tracking.md. No allocation, no state. */
 #include "kin.h"
+#include "kin_internal.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,22 +14,7 @@
 #define PI_F 3.14159265358979f
 #define DEG2RAD(d) ((d) * (PI_F / 180.0f))
 
-static int fail(char *why, size_t n, int ret, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 4, 5)))
-#endif
-    ;
-
-static int fail(char *why, size_t n, int ret, const char *fmt, ...)
-{
-    if (why && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(why, n, fmt, ap);
-        va_end(ap);
-    }
-    return ret;
-}
+#define fail kin__fail
 
 /* ------------------------------------------------------------ calibration */
 

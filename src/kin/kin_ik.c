@@ -3,31 +3,16 @@
  * names from a tracking sample. Rules: kin.h (kin_arm_ik_job) and
  * docs/tracking.md. No allocation, no state. */
 #include "kin.h"
+#include "kin_internal.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
 #define PI_F 3.14159265358979f
 #define DEG2RAD(d) ((d) * (PI_F / 180.0f))
 
-static int fail(char *why, size_t n, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-
-static int fail(char *why, size_t n, const char *fmt, ...)
-{
-    if (why && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(why, n, fmt, ap);
-        va_end(ap);
-    }
-    return 0;
-}
+#define fail(why, n, ...) kin__fail(why, n, 0, __VA_ARGS__)
 
 /* ------------------------------------------------------------ quaternions */
 

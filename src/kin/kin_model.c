@@ -1,8 +1,8 @@
 /* kin_model.c - ownership and validation of kin_model. */
 #include "kin.h"
+#include "kin_internal.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,16 +44,7 @@ int kin_model_find_node(const kin_model *model, const char *name)
     return -1;
 }
 
-static int fail(char *why, size_t n, const char *fmt, ...)
-{
-    if (why && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(why, n, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
+#define fail(why, n, ...) kin__fail(why, n, -1, __VA_ARGS__)
 
 static int finite_all(const float *v, size_t n)
 {

@@ -7,9 +7,9 @@
  * exact count of numbers, quaternions must be unit within 1e-3 (they are
  * then renormalised), glove values in [0, 1]. No allocation. */
 #include "kin.h"
+#include "kin_internal.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,22 +17,7 @@
 #define LINE_CAP 1024
 #define QUAT_TOL 1e-3f
 
-static int fail(char *why, size_t n, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-
-static int fail(char *why, size_t n, const char *fmt, ...)
-{
-    if (why && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(why, n, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
+#define fail(why, n, ...) kin__fail(why, n, -1, __VA_ARGS__)
 
 static int finite3(kin_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 static int finite4(kin_quat q)
@@ -271,25 +256,8 @@ int kin_track_parse(const char *text, size_t text_len, kin_track_sample *out, in
     return 0;
 }
 
-/* Appends with snprintf semantics, tracking the total length needed. */
-typedef struct sink { char *buf; size_t size, len; } sink;
-
-static void put(sink *k, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
-static void put(sink *k, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    char *dst = k->len < k->size ? k->buf + k->len : NULL;
-    size_t room = k->len < k->size ? k->size - k->len : 0;
-    int r = vsnprintf(dst, room, fmt, ap);
-    va_end(ap);
-    if (r > 0) k->len += (size_t)r;
-}
+typedef kin__sink sink;
+#define put kin__put
 
 static void put_floats(sink *k, const float *v, int n)
 {
