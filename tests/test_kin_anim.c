@@ -9,17 +9,6 @@
 #include "../src/kin/kin.h"
 
 #define TOL 1e-5f
-#define PI_F 3.14159265358979f
-
-#define NEAR(a, b, tol)                                                       \
-    do {                                                                      \
-        double a_ = (a), b_ = (b);                                            \
-        if (!(fabs(a_ - b_) <= (tol)))                                        \
-            fail_msg("%s = %.9g, expected %s = %.9g (tol %g)", #a, a_, #b, b_, \
-                     (double)(tol));                                          \
-    } while (0)
-#define NEAR3(v, X, Y, Z, tol) \
-    do { NEAR((v).x, X, tol); NEAR((v).y, Y, tol); NEAR((v).z, Z, tol); } while (0)
 
 static kin_channel chan(int node, kin_path path, kin_interp in, int keys, int comps,
                         const float *times, const float *values)

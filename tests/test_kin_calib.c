@@ -12,14 +12,6 @@
 
 #include "../src/kin/kin.h"
 
-#define NEAR(a, b, tol)                                                       \
-    do {                                                                      \
-        double a_ = (a), b_ = (b);                                            \
-        if (!(fabs(a_ - b_) <= (tol)))                                        \
-            fail_msg("%s = %.9g, expected %s = %.9g (tol %g)", #a, a_, #b, b_, \
-                     (double)(tol));                                          \
-    } while (0)
-
 /* A rig as kin_arm_rig_init would give for the generated model. */
 static kin_arm_rig model_rig(void)
 {

@@ -16,16 +16,6 @@
  * rounding alone (2^-24 relative, a few operations) reaches ~1e-4 px. */
 #define PX_TOL 2e-3
 
-#define NEAR(a, b, tol)                                                       \
-    do {                                                                      \
-        double a_ = (a), b_ = (b);                                            \
-        if (!(fabs(a_ - b_) <= (tol)))                                        \
-            fail_msg("%s = %.9g, expected %s = %.9g (tol %g)", #a, a_, #b, b_, \
-                     (double)(tol));                                          \
-    } while (0)
-#define NEAR3(v, X, Y, Z, tol) \
-    do { NEAR((v).x, X, tol); NEAR((v).y, Y, tol); NEAR((v).z, Z, tol); } while (0)
-
 /* Projects a world point with view_proj and the viewport transform. */
 static void project(const kin_camera *c, kin_vec3 p, double *u, double *v, double *zndc)
 {

@@ -11,15 +11,6 @@
 
 #include "../src/kin/kin.h"
 
-#define PI_F 3.14159265358979f
-#define NEAR(a, b, tol)                                                       \
-    do {                                                                      \
-        double a_ = (a), b_ = (b);                                            \
-        if (!(fabs(a_ - b_) <= (tol)))                                        \
-            fail_msg("%s = %.9g, expected %s = %.9g (tol %g)", #a, a_, #b, b_, \
-                     (double)(tol));                                          \
-    } while (0)
-
 static kin_quat rand_q(tu_rng *g)
 {
     return kin_quat_normalize((kin_quat){ tu_range(g, -1, 1), tu_range(g, -1, 1),

@@ -12,13 +12,6 @@
 #include "../src/kin/kin.h"
 
 #define PI_D 3.14159265358979323846
-#define NEAR(a, b, tol)                                                       \
-    do {                                                                      \
-        double a_ = (a), b_ = (b);                                            \
-        if (!(fabs(a_ - b_) <= (tol)))                                        \
-            fail_msg("%s = %.9g, expected %s = %.9g (tol %g)", #a, a_, #b, b_, \
-                     (double)(tol));                                          \
-    } while (0)
 
 static kin_track_sample hand_at(double t, kin_vec3 p, kin_quat q)
 {

@@ -10,15 +10,6 @@
 
 #include "../src/kin/kin.h"
 
-#define PI_F 3.14159265358979f
-#define NEAR(a, b, tol)                                                       \
-    do {                                                                      \
-        double a_ = (a), b_ = (b);                                            \
-        if (!(fabs(a_ - b_) <= (tol)))                                        \
-            fail_msg("%s = %.9g, expected %s = %.9g (tol %g)", #a, a_, #b, b_, \
-                     (double)(tol));                                          \
-    } while (0)
-
 static void near_q(kin_quat a, kin_quat b, float tol)
 {
     float d = fabsf(a.x * b.x + a.y * b.y + a.z * b.z + a.w * b.w);

@@ -23,8 +23,6 @@
 #include "../src/io/io.h"
 #include "../src/kin/kin.h"
 
-#define PI_F 3.14159265358979f
-
 static kin_model g_model;
 static int g_loaded;
 static char g_skip[3000];

@@ -10,15 +10,7 @@
 #include "../src/kin/kin.h"
 
 #define TOL 1e-5f
-#define PI_F 3.14159265358979f
 
-#define NEAR(a, b, tol)                                                       \
-    do {                                                                      \
-        double a_ = (a), b_ = (b);                                            \
-        if (!(fabs(a_ - b_) <= (tol)))                                        \
-            fail_msg("%s = %.9g, expected %s = %.9g (tol %g)", #a, a_, #b, b_, \
-                     (double)(tol));                                          \
-    } while (0)
 #define NEAR3P(p, X, Y, Z, tol) \
     do { NEAR((p)[0], X, tol); NEAR((p)[1], Y, tol); NEAR((p)[2], Z, tol); } while (0)
 

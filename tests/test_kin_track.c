@@ -11,14 +11,6 @@
 
 #include "../src/kin/kin.h"
 
-#define NEAR(a, b, tol)                                                       \
-    do {                                                                      \
-        double a_ = (a), b_ = (b);                                            \
-        if (!(fabs(a_ - b_) <= (tol)))                                        \
-            fail_msg("%s = %.9g, expected %s = %.9g (tol %g)", #a, a_, #b, b_, \
-                     (double)(tol));                                          \
-    } while (0)
-
 /* Parses text; returns the result and fills line / why. */
 static int parse(const char *text, kin_track_sample *out, int cap, int *count, int *line,
                  char *why)

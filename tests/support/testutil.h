@@ -39,4 +39,17 @@ uint32_t tu_crc32(uint32_t crc, const void *data, size_t n);
  * died from a signal. */
 int tu_run(char *const argv[], char *out, size_t out_size);
 
+/* Float checks against analytic answers (cmocka's fail_msg at the use
+ * site): |a - b| <= tol, with both values in the message. */
+#define NEAR(a, b, tol)                                                       \
+    do {                                                                      \
+        double a_ = (a), b_ = (b);                                            \
+        if (!(fabs(a_ - b_) <= (tol)))                                        \
+            fail_msg("%s = %.9g, expected %s = %.9g (tol %g)", #a, a_, #b, b_, \
+                     (double)(tol));                                          \
+    } while (0)
+#define NEAR3(v, X, Y, Z, tol) \
+    do { NEAR((v).x, X, tol); NEAR((v).y, Y, tol); NEAR((v).z, Z, tol); } while (0)
+#define PI_F 3.14159265358979f
+
 #endif
