@@ -506,6 +506,234 @@ static void test_context_api(void **state)
     print_message("NOTE rast_draw uses %s\n", ef_isa_name((ef_isa)rast_draw_isa()));
 }
 
+/* The cached front end (trivial accept from per-vertex values) sets up
+ * exactly what the per-triangle clip path sets up: every triangle of the
+ * soup through rast__prepare_cached and rast__prepare, the fan triangles
+ * and the counters compared with memcmp. */
+static void test_prepare_cached_equal(void **state)
+{
+    (void)state;
+    long fast = 0, total = 0;
+    for (int n = 0; n < NCASES; n++) {
+        rcase k;
+        make_case(n, &k);
+        rast__view view;
+        rast__view_init(&view, k.t.width, k.t.height, rast__draw_na(&k.t, &k.m));
+        rast__vcache vc;
+        rast__vcache_reset(&vc);
+        for (int ti = 0; ti < k.m.tri_count; ti++) {
+            rast__tri a[RAST__MAX_FAN], b[RAST__MAX_FAN];
+            memset(a, 0, sizeof a);
+            memset(b, 0, sizeof b);
+            rast_stats sa, sb;
+            memset(&sa, 0, sizeof sa);
+            memset(&sb, 0, sizeof sb);
+            int na = rast__prepare_cached(&view, &k.m, ti, &vc, a, &sa);
+            int nb = rast__prepare(&view, &k.m, ti, b, &sb);
+            assert_int_equal(na, nb);
+            if (memcmp(a, b, sizeof a) || memcmp(&sa, &sb, sizeof sa))
+                fail_msg("case %d triangle %d: the cached front end differs", n, ti);
+            /* Count the triangles the trivial-accept path took. */
+            const uint32_t *ix = k.m.indices + 3 * (size_t)ti;
+            int inside = 1;
+            for (int i = 0; i < 3; i++) {
+                const rast__vc_entry *e = &vc.e[ix[i] & (RAST__VCACHE - 1)];
+                inside &= e->tag == ix[i] && e->flags == 0;
+            }
+            fast += inside;
+            total++;
+        }
+        free_case(&k);
+    }
+    print_message("NOTE cached front end: %ld of %ld triangles trivially accepted, all "
+                  "equal to the clip path\n", fast, total);
+    assert_true(fast > total / 4 && fast < total);
+}
+
+/* rast_context_draw_jobs: three jobs (two eyes and a small padded target,
+ * different meshes and attribute counts) with 1, 2 and 3 threads on every
+ * ISA, each job equal to rast_draw of it alone; bad jobs are rejected
+ * before anything is drawn; overlapping targets are rejected. */
+static void test_jobs_equal(void **state)
+{
+    (void)state;
+    /* The first three soup cases with attributes and a few hundred
+     * pixels. */
+    rcase k[3];
+    for (int j = 0, n = 0; j < 3; n++) {
+        make_case(n, &k[j]);
+        rast_stats st;
+        draw_case(&k[j], rast__scan_rows_ref, &st);
+        if (k[j].t.attr && st.pixels_written > 300)
+            j++;
+        else
+            free_case(&k[j]);
+    }
+    const rast_target *tp[3] = { &k[0].t, &k[1].t, &k[2].t };
+    const rast_mesh_desc *mp[3] = { &k[0].m, &k[1].m, &k[2].m };
+    snapshot ref[3];
+    rast_stats sum;
+    memset(&sum, 0, sizeof sum);
+    for (int j = 0; j < 3; j++) {
+        rast_stats st;
+        draw_case(&k[j], rast__scan_rows_ref, &st);
+        take(&k[j].t, &st, &ref[j]);
+        rast__stats_add(&sum, &st);
+    }
+    assert_true(sum.pixels_written > 100);
+    int runs = 0;
+    for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {
+        if (!ef_cpu_has((ef_isa)isa))
+            continue;
+        for (int th = 1; th <= 3; th++) {
+            rast_context_desc d = { isa, th };
+            rast_context *c = rast_context_create(&d);
+            assert_non_null(c);
+            for (int nj = 1; nj <= 3; nj++) {
+                for (int j = 0; j < 3; j++)
+                    reset_target(&k[j].t);
+                rast_stats st;
+                memset(&st, 0, sizeof st);
+                assert_int_equal(rast_context_draw_jobs(c, nj, tp, mp, &st), RAST_OK);
+                rast_stats want;
+                memset(&want, 0, sizeof want);
+                for (int j = 0; j < nj; j++) {
+                    char what[64];
+                    snprintf(what, sizeof what, "%s, %d threads, job %d of %d",
+                             ef_isa_name((ef_isa)isa), th, j, nj);
+                    if (differs(&k[j].t, &ref[j].st, &ref[j], what, 1))
+                        fail_msg("%s differs from rast_draw", what);
+                    rast__stats_add(&want, &ref[j].st);
+                }
+                assert_memory_equal(&st, &want, sizeof st);
+                runs++;
+            }
+            /* An invalid job: an error, nothing drawn, stats untouched. */
+            rast_mesh_desc bad = k[2].m;
+            bad.cull = (rast_cull)7;
+            const rast_mesh_desc *mb[3] = { &k[0].m, &k[1].m, &bad };
+            for (int j = 0; j < 3; j++)
+                reset_target(&k[j].t);
+            rast_stats st;
+            memset(&st, 0x11, sizeof st);
+            rast_stats st0 = st;
+            assert_int_equal(rast_context_draw_jobs(c, 3, tp, mb, &st), RAST_ERR_ARGS);
+            assert_memory_equal(&st, &st0, sizeof st);
+            for (int j = 0; j < 2; j++)
+                for (size_t i = 0; i < mask_bytes(&k[j].t); i++)
+                    if (k[j].t.mask[i] != 0 && (int)(i % k[j].t.mask_stride) < k[j].t.width)
+                        fail_msg("job %d drawn although job 2 is invalid", j);
+            /* The same target twice, or overlapping planes: rejected. */
+            const rast_target *same[2] = { &k[0].t, &k[0].t };
+            assert_int_equal(rast_context_draw_jobs(c, 2, same, mp, NULL), RAST_ERR_ARGS);
+            rast_target half = k[1].t;
+            /* The last pixel of k[0]'s mask plane is the first of half's. */
+            half.mask = k[0].t.mask + (size_t)(k[0].t.height - 1) * k[0].t.mask_stride +
+                        k[0].t.width - 1;
+            half.depth = NULL;
+            half.attr = NULL;
+            const rast_target *ov[2] = { &k[0].t, &half };
+            const rast_mesh_desc *mo[2] = { &k[0].m, &k[1].m };
+            assert_int_equal(rast_context_draw_jobs(c, 2, ov, mo, NULL), RAST_ERR_ARGS);
+            assert_int_equal(rast_context_draw_jobs(c, RAST_MAX_JOBS + 1, tp, mp, NULL),
+                             RAST_ERR_ARGS);
+            assert_int_equal(rast_context_draw_jobs(c, 0, NULL, NULL, NULL), RAST_OK);
+            rast_context_destroy(c);
+        }
+    }
+    assert_int_equal(rast_context_draw_jobs(NULL, 1, tp, mp, NULL), RAST_ERR_ARGS);
+    print_message("NOTE jobs: %d runs equal to rast_draw of each job\n", runs);
+    for (int j = 0; j < 3; j++) {
+        drop(&ref[j]);
+        free_case(&k[j]);
+    }
+}
+
+/* rast_context_clear: a sequence of frames (different soups into the same
+ * two targets, through jobs and single draws, 1 and 2 threads) cleared by
+ * the context gives, after every clear and every draw, the bytes of the
+ * same frames cleared with rast_target_clear (padding included, which
+ * neither may touch). A target the context does not know and a forgotten
+ * one are cleared whole. */
+static void test_context_clear(void **state)
+{
+    (void)state;
+    enum { W = 150, H = 70 };
+    int checked = 0;
+    for (int th = 1; th <= 2; th++) {
+        rast_context_desc d = { 0, th };
+        rast_context *c = rast_context_create(&d);
+        assert_non_null(c);
+        rast_target a[2], b[2];
+        for (int e = 0; e < 2; e++) {
+            rast_target t = { W, H, malloc((size_t)(W + 5) * H * sizeof(float)), W + 5,
+                              malloc((size_t)(W + 3) * H), W + 3,
+                              malloc((size_t)(3 * W + 2) * H * sizeof(float)), 3 * W + 2, 3 };
+            a[e] = t;
+            rast_target u = { W, H, malloc((size_t)(W + 5) * H * sizeof(float)), W + 5,
+                              malloc((size_t)(W + 3) * H), W + 3,
+                              malloc((size_t)(3 * W + 2) * H * sizeof(float)), 3 * W + 2, 3 };
+            b[e] = u;
+            reset_target(&a[e]);   /* pattern in the padding, then clear */
+            reset_target(&b[e]);
+            memset(a[e].mask, 0x77, (size_t)a[e].mask_stride * H);   /* garbage: the */
+            memset(a[e].depth, 0x77, (size_t)a[e].depth_stride * H * 4);  /* first clear */
+            memset(b[e].mask, 0x77, (size_t)b[e].mask_stride * H);   /* must be whole */
+            memset(b[e].depth, 0x77, (size_t)b[e].depth_stride * H * 4);
+        }
+        for (int frame = 0; frame < 12; frame++) {
+            if (frame == 8)
+                rast_context_forget(c);
+            for (int e = 0; e < 2; e++) {
+                if (frame == 8) {   /* written behind the context's back */
+                    memset(a[e].mask, 0x33, (size_t)W);
+                    memset(b[e].mask, 0x33, (size_t)W);
+                }
+                rast_context_clear(c, &a[e]);
+                rast_target_clear(&b[e]);
+                assert_memory_equal(a[e].mask, b[e].mask, (size_t)a[e].mask_stride * H);
+                assert_memory_equal(a[e].depth, b[e].depth, (size_t)a[e].depth_stride * H * 4);
+                assert_memory_equal(a[e].attr, b[e].attr, (size_t)a[e].attr_stride * H * 4);
+            }
+            rcase k[2];
+            rast_mesh_desc m[2];
+            for (int e = 0; e < 2; e++) {
+                /* A soup case with 3 attributes, drawn on this target. */
+                int n = 11 * frame + e;
+                do {
+                    make_case(n++, &k[e]);
+                    if (k[e].m.attr_count == 3)
+                        break;
+                    free_case(&k[e]);
+                } while (1);
+                m[e] = k[e].m;
+            }
+            const rast_target *tp[2] = { &a[0], &a[1] };
+            const rast_mesh_desc *mp[2] = { &m[0], &m[1] };
+            if (frame % 2)
+                assert_int_equal(rast_context_draw_jobs(c, 2, tp, mp, NULL), RAST_OK);
+            else
+                for (int e = 0; e < 2; e++)
+                    assert_int_equal(rast_context_draw(c, &a[e], &m[e], NULL), RAST_OK);
+            for (int e = 0; e < 2; e++) {
+                assert_int_equal(rast_draw(&b[e], &m[e], NULL), RAST_OK);
+                assert_memory_equal(a[e].mask, b[e].mask, (size_t)a[e].mask_stride * H);
+                assert_memory_equal(a[e].depth, b[e].depth, (size_t)a[e].depth_stride * H * 4);
+                assert_memory_equal(a[e].attr, b[e].attr, (size_t)a[e].attr_stride * H * 4);
+                free_case(&k[e]);
+                checked++;
+            }
+        }
+        for (int e = 0; e < 2; e++) {
+            free(a[e].depth); free(a[e].mask); free(a[e].attr);
+            free(b[e].depth); free(b[e].mask); free(b[e].attr);
+        }
+        rast_context_destroy(c);
+    }
+    rast_context_clear(NULL, NULL);      /* no crash */
+    print_message("NOTE context clear: %d frames equal to full clears\n", checked);
+}
+
 /* ---- rerun of one case --------------------------------------------------- */
 
 static int rerun(int n)
@@ -548,6 +776,9 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_soup_avx512),
         cmocka_unit_test(test_threads_equal),
         cmocka_unit_test(test_context_api),
+        cmocka_unit_test(test_prepare_cached_equal),
+        cmocka_unit_test(test_jobs_equal),
+        cmocka_unit_test(test_context_clear),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

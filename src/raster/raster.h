@@ -32,16 +32,18 @@
  *   The per-pixel scan has SSE2, AVX2 and AVX-512 versions giving the same
  *   bytes as the scalar reference (docs/raster.md section 9). rast_draw
  *   uses the best one the CPU runs, capped by EGOFUSE_ISA (src/cpu/cpu.h).
- *   A rast_context lets the caller cap the ISA, ask which one is used and
- *   draw one target with several threads (row bands; the bytes do not
- *   depend on the thread count).
+ *   A rast_context lets the caller cap the ISA, ask which one is used,
+ *   draw one target with several threads (row bands) or several targets
+ *   at once (e.g. one eye per thread; the bytes do not depend on the
+ *   thread count), and clear only what its draws touched.
  *
  * WHAT IT DOES NOT
  *   rast_draw: no allocation, no threads, no global state: a target may be
  *   drawn by one thread at a time; different targets on different threads.
  *   A context allocates and starts its threads once, in
  *   rast_context_create; its draws allocate nothing.
- *   No textures, no blending, no anti-aliasing in the reference.
+ *   No textures, no blending. Anti-aliased coverage (4/8/16 samples per
+ *   pixel, a fractional mask) is a separate, optional draw (below).
  *
  * USAGE
  *   float depth[W*H], nrm[W*H*3]; uint8_t mask[W*H];
@@ -172,6 +174,80 @@ int rast_context_threads(const rast_context *ctx);
  * draw per context at a time (ctx NULL: RAST_ERR_ARGS). Allocates nothing. */
 rast_result rast_context_draw(rast_context *ctx, const rast_target *t,
                               const rast_mesh_desc *mesh, rast_stats *stats);
+
+/* Several independent draws at once: job i draws mesh[i] into t[i]. With
+ * threads >= 2 and n >= 2 every job is drawn whole by one thread (job i
+ * by thread i % threads; e.g. the two eyes of a frame, one per thread,
+ * meeting only at the end); otherwise the jobs are drawn one after the
+ * other as by rast_context_draw. Bytes and stats (summed over the jobs)
+ * equal rast_draw of each job. Every job is validated first; on an error
+ * (the first job's in order) nothing is drawn and *stats is untouched.
+ * Errors: those of rast_draw, and RAST_ERR_ARGS for ctx, t or mesh NULL,
+ * n outside 0..RAST_MAX_JOBS, or two jobs whose target planes share
+ * memory. Allocates nothing. */
+#define RAST_MAX_JOBS 16
+rast_result rast_context_draw_jobs(rast_context *ctx, int n,
+                                   const rast_target *const t[],
+                                   const rast_mesh_desc *const mesh[],
+                                   rast_stats *stats);
+
+/* rast_target_clear that skips what is known to be clear. After a
+ * rast_context_clear of a target, the draws of that target through ctx
+ * (rast_context_draw, rast_context_draw_jobs) record the pixel box they
+ * may write, and the next rast_context_clear of the same target (same
+ * planes, size, strides and attribute count) clears only that box. A
+ * target the context does not know (it remembers the last
+ * RAST_CONTEXT_TARGETS) is cleared whole. The result equals
+ * rast_target_clear provided nothing else writes the planes in between
+ * (rast_draw, another context or the caller: then call rast_target_clear
+ * or rast_context_forget). ctx NULL: rast_target_clear. */
+#define RAST_CONTEXT_TARGETS 4
+void rast_context_clear(rast_context *ctx, const rast_target *t);
+/* Forgets every target: the next rast_context_clear clears whole. */
+void rast_context_forget(rast_context *ctx);
+
+/* ---- anti-aliased coverage ---------------------------------------------
+ *
+ * Optional soft edges for the mask: every pixel holds `count` samples at
+ * the standard Direct3D positions (4, 8 or 16 per pixel; offsets from the
+ * centre in 1/16 px, rast_aa_positions) and a bit per sample. A draw ORs
+ * in the samples each triangle covers, with the same clipping, snapping,
+ * culling and top-left rule as rast_draw (applied at the sample instead
+ * of the centre), so triangles sharing an edge cover each sample once.
+ * Depth: none. The coverage is the union of the drawn triangles (the
+ * silhouette of the mesh, independent of the order), which is what a soft
+ * hand mask needs; depth and normals come from rast_draw at the centres.
+ * rast_aa_resolve turns the bits into the 8-bit fractional mask
+ * round(255 * covered / count) (halves up). Error bound against the exact
+ * area of a pixel inside a straight edge: docs/raster.md section 12. */
+#define RAST_AA_MAX_SAMPLES 16
+
+typedef struct rast_aa_target {
+    int width, height;      /* 1..RAST_MAX_DIM */
+    uint32_t *samples;      /* per pixel: bit s set = sample s covered */
+    int stride;             /* elements per row, >= width */
+    int count;              /* samples per pixel: 4, 8 or 16 */
+} rast_aa_target;
+
+/* The offsets of the count samples (4, 8 or 16) from the pixel centre in
+ * 1/16 px (x right, y down), xy[2*s], xy[2*s+1]; 0 for another count. */
+int rast_aa_positions(int count, int xy[2 * RAST_AA_MAX_SAMPLES]);
+/* Clears the sample bits (first width elements of each row). */
+void rast_aa_clear(const rast_aa_target *t);
+/* ORs the samples covered by the mesh into t (mesh attributes are
+ * ignored; attr_count need not be 0). Validation and errors as rast_draw
+ * (RAST_ERR_ARGS also for a count other than 4, 8, 16 or samples NULL);
+ * stats count pixels with at least one covered sample per fan triangle in
+ * pixels_written. The ISA of rast_draw_isa(); same bits on every ISA. */
+rast_result rast_draw_aa(const rast_aa_target *t, const rast_mesh_desc *mesh,
+                         rast_stats *stats);
+/* The same with the context's ISA (on the calling thread). */
+rast_result rast_context_draw_aa(rast_context *ctx, const rast_aa_target *t,
+                                 const rast_mesh_desc *mesh, rast_stats *stats);
+/* mask[y*mask_stride + x] = (510 * covered + count) / (2 * count), i.e.
+ * round(255 * covered / count), halves up. RAST_ERR_ARGS / _SIZE as for
+ * a draw (mask NULL, mask_stride < width). */
+rast_result rast_aa_resolve(const rast_aa_target *t, uint8_t *mask, int mask_stride);
 
 /* clip[i] = mvp * (pos[i], 1) for n points (pos: 3 floats each, mvp a
  * column-major 4x4 matrix). */

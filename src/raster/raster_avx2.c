@@ -23,6 +23,8 @@ typedef __m256i vi;
 #define VI_ADD(a, b) _mm256_add_epi32(a, b)
 #define VI_OR(a, b) _mm256_or_si256(a, b)
 #define VI_LOADU(p) _mm256_loadu_si256((const __m256i *)(const void *)(p))
+#define VI_LANES() _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)
+#define VI_LANE_MUL(lanes, s) _mm256_mullo_epi32(lanes, _mm256_set1_epi32(s))
 #define VI_NEG_BITS(v) ((unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(v)))
 #define VF_LT_BITS(a, b) ((unsigned)_mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LT_OQ)))
 #define VF_STOREA(p, v) _mm256_store_ps(p, v)
@@ -54,8 +56,10 @@ static inline void mask_store(uint8_t *p, unsigned bits, int full)
 }
 #define MASK_STORE_M(p, bits, full) mask_store(p, bits, full)
 
-/* 8 pixels x 3 attributes, planar -> interleaved (x0 y0 z0 x1 y1 z1 ...). */
-static inline void attr3_store(float *p, __m256 a, __m256 b, __m256 c)
+/* 8 pixels x 3 attributes, planar -> interleaved (x0 y0 z0 x1 y1 z1 ...):
+ * r[0..2] are floats 0..11 (pixels 0..3) in their low halves and floats
+ * 12..23 (pixels 4..7) in their high halves. */
+static inline void attr3_interleave(__m256 a, __m256 b, __m256 c, __m256 r[3])
 {
     /* Per 128-bit half: lanes 0..3 of a, b, c -> 12 floats. */
     const __m256 ab_lo = _mm256_unpacklo_ps(a, b);   /* a0 b0 a1 b1 | a4 b4 a5 b5 */
@@ -75,17 +79,63 @@ static inline void attr3_store(float *p, __m256 a, __m256 b, __m256 c)
     r2 = _mm256_shuffle_ps(r2, c3, _MM_SHUFFLE(0, 0, 3, 2));            /* a3 b3 c3 c3 */
     r2 = _mm256_permute_ps(r2, _MM_SHUFFLE(2, 1, 0, 3));                /* c3 a3 b3 c3 */
     r2 = _mm256_blend_ps(r2, c2, 0x11);                                 /* c2 a3 b3 c3 */
-    /* Halves: low = pixels 0..3 (12 floats), high = pixels 4..7. */
-    _mm_storeu_ps(p + 0, _mm256_castps256_ps128(r0));
-    _mm_storeu_ps(p + 4, _mm256_castps256_ps128(r1));
-    _mm_storeu_ps(p + 8, _mm256_castps256_ps128(r2));
-    _mm_storeu_ps(p + 12, _mm256_extractf128_ps(r0, 1));
-    _mm_storeu_ps(p + 16, _mm256_extractf128_ps(r1, 1));
-    _mm_storeu_ps(p + 20, _mm256_extractf128_ps(r2, 1));
+    r[0] = r0;
+    r[1] = r1;
+    r[2] = r2;
 }
+
+static inline void attr3_store(float *p, __m256 a, __m256 b, __m256 c)
+{
+    __m256 r[3];
+    attr3_interleave(a, b, c, r);
+    /* Halves: low = pixels 0..3 (12 floats), high = pixels 4..7. */
+    _mm_storeu_ps(p + 0, _mm256_castps256_ps128(r[0]));
+    _mm_storeu_ps(p + 4, _mm256_castps256_ps128(r[1]));
+    _mm_storeu_ps(p + 8, _mm256_castps256_ps128(r[2]));
+    _mm_storeu_ps(p + 12, _mm256_extractf128_ps(r[0], 1));
+    _mm_storeu_ps(p + 16, _mm256_extractf128_ps(r[1], 1));
+    _mm_storeu_ps(p + 20, _mm256_extractf128_ps(r[2], 1));
+}
+
+/* Lane mask of 4 floats from 4 bits. */
+static inline __m128i bits_vec4(unsigned bits)
+{
+    const __m128i sel = _mm_setr_epi32(1, 2, 4, 8);
+    return _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32((int)bits), sel), sel);
+}
+
+/* Bit l of b -> bits 3l, 3l+1, 3l+2 (4 pixels -> 12 floats). */
+static const uint16_t spread3_4[16] = {
+    0x000, 0x007, 0x038, 0x03F, 0x1C0, 0x1C7, 0x1F8, 0x1FF,
+    0xE00, 0xE07, 0xE38, 0xE3F, 0xFC0, 0xFC7, 0xFF8, 0xFFF,
+};
+
+/* The pixels in bits only: masked stores never touch other floats. */
+static inline void attr3_store_m(float *p, unsigned bits, __m256 a, __m256 b, __m256 c)
+{
+    __m256 r[3];
+    attr3_interleave(a, b, c, r);
+    const unsigned lo = spread3_4[bits & 15u], hi = spread3_4[(bits >> 4) & 15u];
+    if (lo) {
+        _mm_maskstore_ps(p + 0, bits_vec4(lo & 15u), _mm256_castps256_ps128(r[0]));
+        _mm_maskstore_ps(p + 4, bits_vec4((lo >> 4) & 15u), _mm256_castps256_ps128(r[1]));
+        _mm_maskstore_ps(p + 8, bits_vec4(lo >> 8), _mm256_castps256_ps128(r[2]));
+    }
+    if (hi) {
+        _mm_maskstore_ps(p + 12, bits_vec4(hi & 15u), _mm256_extractf128_ps(r[0], 1));
+        _mm_maskstore_ps(p + 16, bits_vec4((hi >> 4) & 15u), _mm256_extractf128_ps(r[1], 1));
+        _mm_maskstore_ps(p + 20, bits_vec4(hi >> 8), _mm256_extractf128_ps(r[2], 1));
+    }
+}
+#define ATTR3_STORE_M(p, bits, a, b, c) attr3_store_m(p, bits, a, b, c)
 #define ATTR3_STORE_FULL(p, a, b, c) attr3_store(p, a, b, c)
 
 #include "raster_simd.inl"
+
+/* Anti-aliased coverage: 4 double lanes. */
+#define AA_V 4
+#define AA_FN rast__scan_aa_avx2
+#include "raster_aa.inl"
 
 #else
 typedef int rast__avx2_unused;   /* not an x86 build: the dispatcher skips it */

@@ -1,28 +1,35 @@
-/* raster_context.c - ISA dispatch, rast_draw, and the context: an ISA cap
- * and band-parallel drawing of one target with a small thread pool.
+/* raster_context.c - ISA dispatch, rast_draw, and the context: an ISA cap,
+ * parallel drawing with a small thread pool, and clearing only what the
+ * context's draws touched.
  *
- * Threads. A draw is cut into rounds of threads * BATCH submitted
- * triangles. In a round, thread k sets up triangles [base + k*BATCH,
- * base + (k+1)*BATCH) into its own buffer (clip, snap, setup: the shared
- * scalar code), then all threads meet at a barrier, then every thread scans
- * ALL set-up triangles of the round, in submission order, restricted to its
- * rows: 16-row bands, band b belonging to thread b % threads. Every pixel
- * thus sees the same triangles in the same order as on one thread, and a
- * scan restricted to rows writes exactly the bytes of the full scan, so the
- * result does not depend on the thread count. Buffers alternate between
- * two sets, so one barrier per round suffices: a thread refills set p in
- * round r+2 only after the barrier of round r+1, which no thread passes
- * before it has finished scanning round r.
+ * Two parallel modes (the bytes never depend on the thread count):
  *
- * Workers wait for a draw by spinning briefly (back-to-back draws, e.g. the
- * two eyes, then start without a system call) and then block on a
- * condition variable. */
+ * Jobs (rast_context_draw_jobs with n >= 2): job i is drawn whole by
+ * thread i % threads with the single-thread driver; the targets do not
+ * share memory, so the threads never meet before the end of the draw.
+ *
+ * Bands (rast_context_draw, or a single job). A draw is cut into rounds of
+ * threads * BATCH submitted triangles. In a round, thread k sets up
+ * triangles [base + k*BATCH, base + (k+1)*BATCH) into its own buffer
+ * (clip, snap, setup: the shared scalar code with its own vertex cache),
+ * then all threads meet at a barrier, then every thread scans ALL set-up
+ * triangles of the round, in submission order, restricted to its rows:
+ * 16-row bands, band b belonging to thread b % threads. Every pixel thus
+ * sees the same triangles in the same order as on one thread, and a scan
+ * restricted to rows writes exactly the bytes of the full scan. Buffers
+ * alternate between two sets, so one barrier per round suffices: a thread
+ * refills set p in round r+2 only after the barrier of round r+1, which no
+ * thread passes before it has finished scanning round r.
+ *
+ * Waiting. Workers wait for a draw, and threads for each other at a
+ * barrier, by spinning briefly (the partner is usually about to arrive)
+ * and then blocking on a condition variable, so a descheduled partner on
+ * a busy machine costs a wake-up, not a time slice of spinning. */
 #include "raster_internal.h"
 
 #include "../cpu/cpu.h"
 
 #include <pthread.h>
-#include <sched.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,10 +42,10 @@
 #endif
 
 enum {
-    BAND_ROWS = 16,     /* rows per band */
-    BATCH = 256,        /* submitted triangles per thread and round */
-    IDLE_SPINS = 20000, /* pause loops before a worker blocks */
-    BARRIER_SPINS = 4000 /* pause loops before a barrier yields */
+    BAND_ROWS = RAST__TILE, /* rows per band: one row of dirty tiles */
+    BATCH = 256,         /* submitted triangles per thread and round */
+    IDLE_SPINS = 20000,  /* pause loops before a worker blocks */
+    BARRIER_SPINS = 2000 /* pause loops before a barrier blocks */
 };
 
 /* ---- dispatch ----------------------------------------------------------- */
@@ -75,10 +82,18 @@ typedef struct slot {
     rast__tri *buf[2];          /* BATCH * RAST__MAX_FAN each */
     int count[2];
     rast_stats st;
-    unsigned sense;             /* barrier sense of this thread */
+    rast__vcache vc;
     unsigned gen;               /* last draw generation run (workers) */
     _Alignas(64) char pad[64];  /* keep slots on their own cache lines */
 } slot;
+
+/* A target whose planes the context knows to be clear except in the
+ * tiles marked in `dirty`. */
+typedef struct known_target {
+    rast_target t;
+    rast__tiles *dirty;
+    int used;
+} known_target;
 
 struct rast_context {
     int isa, threads;
@@ -86,16 +101,21 @@ struct rast_context {
     slot *slots;
     pthread_t th[RAST_MAX_THREADS];
     int started;
-    pthread_mutex_t mu;
+    pthread_mutex_t mu;         /* draw start (gen, quit) */
     pthread_cond_t cv;
+    pthread_mutex_t bar_mu;     /* barrier release */
+    pthread_cond_t bar_cv;
     _Alignas(64) atomic_uint gen;
     atomic_int quit;
     _Alignas(64) atomic_uint bar_count;
-    atomic_uint bar_sense;
+    atomic_uint bar_gen;
     /* The draw being run (written by the caller before gen changes). */
-    _Alignas(64) const rast_target *t;
-    const rast_mesh_desc *m;
-    rast__view view;
+    _Alignas(64) int njobs;
+    const rast_target *const *jt;
+    const rast_mesh_desc *const *jm;
+    rast__tiles *jtiles[RAST_MAX_JOBS]; /* per job: tiles to mark, or NULL */
+    known_target known[RAST_CONTEXT_TARGETS];
+    int known_next;
 };
 
 typedef struct worker_arg {
@@ -103,40 +123,59 @@ typedef struct worker_arg {
     int tid;
 } worker_arg;
 
-static void barrier(rast_context *c, slot *s)
+/* All threads meet: spin a little, then block. bar_gen changes only when
+ * the last thread arrives, so reading it before arriving is safe. */
+static void barrier(rast_context *c)
 {
-    const unsigned sense = s->sense ^ 1u;
-    s->sense = sense;
+    const unsigned g = atomic_load(&c->bar_gen);
     if (atomic_fetch_add(&c->bar_count, 1u) == (unsigned)c->threads - 1u) {
         atomic_store(&c->bar_count, 0u);
-        atomic_store(&c->bar_sense, sense);
+        pthread_mutex_lock(&c->bar_mu);
+        atomic_store(&c->bar_gen, g + 1u);
+        pthread_cond_broadcast(&c->bar_cv);
+        pthread_mutex_unlock(&c->bar_mu);
         return;
     }
-    for (int n = 0; atomic_load(&c->bar_sense) != sense; n++) {
-        if (n < BARRIER_SPINS)
-            cpu_relax();
-        else
-            sched_yield();
+    for (int n = 0; n < BARRIER_SPINS; n++) {
+        if (atomic_load(&c->bar_gen) != g)
+            return;
+        cpu_relax();
     }
+    pthread_mutex_lock(&c->bar_mu);
+    while (atomic_load(&c->bar_gen) == g)
+        pthread_cond_wait(&c->bar_cv, &c->bar_mu);
+    pthread_mutex_unlock(&c->bar_mu);
 }
 
-/* Scans tri into the bands of thread tid. */
-static long scan_bands(const rast_context *c, int tid, const rast__tri *tri)
+/* Scans tri into the bands of thread tid (and marks the tiles of those
+ * rows: a band is one row of tiles, which no other thread writes). */
+static long scan_bands(const rast_context *c, const rast_target *t, int tid,
+                       const rast__tri *tri, rast__tiles *tiles)
 {
     const int n = c->threads;
     const int b0 = tri->y0 / BAND_ROWS, b1 = tri->y1 / BAND_ROWS;
     long w = 0;
-    for (int b = b0 + ((tid - b0 % n) + n) % n; b <= b1; b += n)
-        w += c->scan(c->t, tri, b * BAND_ROWS, b * BAND_ROWS + BAND_ROWS - 1);
+    for (int b = b0 + ((tid - b0 % n) + n) % n; b <= b1; b += n) {
+        const int ya = b * BAND_ROWS, yb = ya + BAND_ROWS - 1;
+        w += c->scan(t, tri, ya, yb);
+        if (tiles)
+            rast__tiles_add(tiles, ya > tri->y0 ? ya : tri->y0, yb < tri->y1 ? yb : tri->y1,
+                            tri->x0, tri->x1);
+    }
     return w;
 }
 
-static void run_draw(rast_context *c, int tid)
+/* One job in band mode, run by every thread. */
+static void run_bands(rast_context *c, int tid, int job)
 {
     slot *me = &c->slots[tid];
-    const rast_mesh_desc *m = c->m;
+    const rast_target *t = c->jt[job];
+    const rast_mesh_desc *m = c->jm[job];
     const int n = c->threads;
-    memset(&me->st, 0, sizeof me->st);
+    rast__view view;
+    rast__view_init(&view, t->width, t->height, rast__draw_na(t, m));
+    rast__vcache_reset(&me->vc);
+    rast__tiles *tiles = c->jtiles[job];
     int par = 0;
     for (long base = 0; base < m->tri_count; base += (long)n * BATCH, par ^= 1) {
         long lo = base + (long)tid * BATCH, hi = lo + BATCH;
@@ -144,16 +183,37 @@ static void run_draw(rast_context *c, int tid)
             hi = m->tri_count;
         int cnt = 0;
         for (long ti = lo; ti < hi; ti++)
-            cnt += rast__prepare(&c->view, m, (int)ti, me->buf[par] + cnt, &me->st);
+            cnt += rast__prepare_cached(&view, m, (int)ti, &me->vc, me->buf[par] + cnt,
+                                        &me->st);
         me->count[par] = cnt;
-        barrier(c, me);
+        barrier(c);
         for (int s = 0; s < n; s++) {
             const slot *o = &c->slots[s];
-            for (int i = 0; i < o->count[par]; i++)
-                me->st.pixels_written += scan_bands(c, tid, &o->buf[par][i]);
+            for (int i = 0; i < o->count[par]; i++) {
+                const rast__tri *r = &o->buf[par][i];
+                me->st.pixels_written += scan_bands(c, t, tid, r, tiles);
+            }
         }
     }
-    barrier(c, me);
+    barrier(c);
+}
+
+static void run_draw(rast_context *c, int tid)
+{
+    slot *me = &c->slots[tid];
+    memset(&me->st, 0, sizeof me->st);
+    /* The draw's fields are read before this thread's last barrier: once
+     * it is passed, the caller may already be setting up the next draw. */
+    const int nj = c->njobs;
+    if (nj >= 2) {
+        for (int j = tid; j < nj; j += c->threads)
+            rast__draw_valid(c->jt[j], c->jm[j], &me->st, c->scan, c->jtiles[j]);
+        barrier(c);
+    } else if (nj == 1) {
+        run_bands(c, tid, 0);
+    } else {
+        barrier(c);
+    }
 }
 
 static void *worker_main(void *p)
@@ -197,6 +257,8 @@ void rast_context_destroy(rast_context *c)
     if (c->threads > 1) {
         pthread_cond_destroy(&c->cv);
         pthread_mutex_destroy(&c->mu);
+        pthread_cond_destroy(&c->bar_cv);
+        pthread_mutex_destroy(&c->bar_mu);
     }
     if (c->slots)
         for (int i = 0; i < c->threads; i++) {
@@ -204,6 +266,7 @@ void rast_context_destroy(rast_context *c)
             free(c->slots[i].buf[1]);
         }
     free(c->slots);
+    free(c->known[0].dirty);
     free(c);
 }
 
@@ -221,11 +284,21 @@ rast_context *rast_context_create(const rast_context_desc *desc)
     c->threads = d.threads > 1 ? d.threads : 1;
     c->isa = (int)ef_isa_choose((ef_isa)d.max_isa);
     c->scan = rast__scan_for_isa(c->isa);
+    /* Dirty tiles of the known targets, one block. */
+    c->known[0].dirty = malloc((size_t)RAST_CONTEXT_TARGETS * sizeof(rast__tiles));
+    if (!c->known[0].dirty) {
+        free(c);
+        return NULL;
+    }
+    for (int i = 1; i < RAST_CONTEXT_TARGETS; i++)
+        c->known[i].dirty = c->known[0].dirty + i;
     if (c->threads == 1)
         return c;
 
     pthread_mutex_init(&c->mu, NULL);
     pthread_cond_init(&c->cv, NULL);
+    pthread_mutex_init(&c->bar_mu, NULL);
+    pthread_cond_init(&c->bar_cv, NULL);
     c->slots = calloc((size_t)c->threads, sizeof *c->slots);
     if (!c->slots)
         goto fail;
@@ -263,30 +336,183 @@ int rast_context_threads(const rast_context *c)
     return c ? c->threads : 0;
 }
 
+/* ---- known targets (rast_context_clear) --------------------------------- */
+
+static int same_target(const rast_target *a, const rast_target *b)
+{
+    return a->width == b->width && a->height == b->height && a->depth == b->depth &&
+           a->mask == b->mask && a->attr == b->attr && a->attr_count == b->attr_count &&
+           (!a->depth || a->depth_stride == b->depth_stride) &&
+           a->mask_stride == b->mask_stride &&
+           (!a->attr || a->attr_stride == b->attr_stride);
+}
+
+static known_target *find_known(rast_context *c, const rast_target *t)
+{
+    for (int i = 0; i < RAST_CONTEXT_TARGETS; i++)
+        if (c->known[i].used && same_target(&c->known[i].t, t))
+            return &c->known[i];
+    return NULL;
+}
+
+/* Clears columns x0..x1 of row y of every plane (as rast_target_clear
+ * does for whole rows). */
+static void clear_span(const rast_target *t, int y, int x0, int x1)
+{
+    const size_t n = (size_t)(x1 - x0 + 1);
+    if (t->depth) {
+        float *d = t->depth + (size_t)y * (size_t)t->depth_stride + x0;
+        for (size_t x = 0; x < n; x++)
+            d[x] = 1.0f;
+    }
+    memset(t->mask + (size_t)y * (size_t)t->mask_stride + x0, 0, n);
+    if (t->attr && t->attr_count > 0)
+        memset(t->attr + (size_t)y * (size_t)t->attr_stride +
+                   (size_t)x0 * (size_t)t->attr_count,
+               0, n * (size_t)t->attr_count * sizeof(float));
+}
+
+void rast_context_clear(rast_context *c, const rast_target *t)
+{
+    if (!c || !t || !t->mask || t->width <= 0 || t->height <= 0 ||
+        t->width > RAST_MAX_DIM || t->height > RAST_MAX_DIM) {
+        rast_target_clear(t);
+        return;
+    }
+    const int tw = (t->width + RAST__TILE - 1) / RAST__TILE;
+    const int th = (t->height + RAST__TILE - 1) / RAST__TILE;
+    known_target *k = find_known(c, t);
+    if (k) {
+        /* Runs of marked tiles of each tile row, row by row. */
+        for (int ty = 0; ty < th; ty++) {
+            const int ya = ty * RAST__TILE;
+            const int yb = ya + RAST__TILE - 1 < t->height - 1 ? ya + RAST__TILE - 1
+                                                              : t->height - 1;
+            for (int tx = 0; tx < tw;) {
+                if (!((k->dirty->bits[ty][tx / 64] >> (tx % 64)) & 1u)) {
+                    tx++;
+                    continue;
+                }
+                int te = tx;
+                while (te + 1 < tw && ((k->dirty->bits[ty][(te + 1) / 64] >> ((te + 1) % 64)) & 1u))
+                    te++;
+                const int x1 = (te + 1) * RAST__TILE - 1 < t->width - 1
+                                   ? (te + 1) * RAST__TILE - 1 : t->width - 1;
+                for (int y = ya; y <= yb; y++)
+                    clear_span(t, y, tx * RAST__TILE, x1);
+                tx = te + 1;
+            }
+        }
+    } else {
+        rast_target_clear(t);
+        k = &c->known[c->known_next];
+        c->known_next = (c->known_next + 1) % RAST_CONTEXT_TARGETS;
+        k->t = *t;
+        k->used = 1;
+    }
+    for (int ty = 0; ty < th; ty++)
+        memset(k->dirty->bits[ty], 0, sizeof k->dirty->bits[ty]);
+}
+
+void rast_context_forget(rast_context *c)
+{
+    if (!c)
+        return;
+    for (int i = 0; i < RAST_CONTEXT_TARGETS; i++)
+        c->known[i].used = 0;
+    c->known_next = 0;
+}
+
+/* ---- draws -------------------------------------------------------------- */
+
+/* Byte range [lo, hi) of a plane of h rows. */
+static int ranges_overlap(const void *a, size_t sa, const void *b, size_t sb)
+{
+    const char *pa = a, *pb = b;
+    return a && b && pa < pb + sb && pb < pa + sa;
+}
+
+static size_t plane_bytes(int h, int stride, size_t row, size_t elem)
+{
+    return ((size_t)(h - 1) * (size_t)stride + row) * elem;
+}
+
+/* 1 when two valid targets share memory (any plane with any plane). */
+static int targets_overlap(const rast_target *a, const rast_target *b)
+{
+    const void *pa[3] = { a->depth, a->mask, a->attr_count > 0 ? a->attr : NULL };
+    const void *pb[3] = { b->depth, b->mask, b->attr_count > 0 ? b->attr : NULL };
+    size_t sa[3] = { a->depth ? plane_bytes(a->height, a->depth_stride, (size_t)a->width, 4) : 0,
+                     plane_bytes(a->height, a->mask_stride, (size_t)a->width, 1),
+                     pa[2] ? plane_bytes(a->height, a->attr_stride,
+                                         (size_t)a->width * (size_t)a->attr_count, 4) : 0 };
+    size_t sb[3] = { b->depth ? plane_bytes(b->height, b->depth_stride, (size_t)b->width, 4) : 0,
+                     plane_bytes(b->height, b->mask_stride, (size_t)b->width, 1),
+                     pb[2] ? plane_bytes(b->height, b->attr_stride,
+                                         (size_t)b->width * (size_t)b->attr_count, 4) : 0 };
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (ranges_overlap(pa[i], sa[i], pb[j], sb[j]))
+                return 1;
+    return 0;
+}
+
+rast_result rast_context_draw_jobs(rast_context *c, int n, const rast_target *const t[],
+                                   const rast_mesh_desc *const mesh[], rast_stats *stats)
+{
+    if (!c || n < 0 || n > RAST_MAX_JOBS || (n > 0 && (!t || !mesh)))
+        return RAST_ERR_ARGS;
+    for (int i = 0; i < n; i++) {
+        rast_result r = rast__validate(t[i], mesh[i]);
+        if (r != RAST_OK)
+            return r;
+    }
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < i; j++)
+            if (targets_overlap(t[i], t[j]))
+                return RAST_ERR_ARGS;
+    rast_stats st = { 0 };
+    for (int i = 0; i < n; i++) {
+        known_target *k = find_known(c, t[i]);
+        c->jtiles[i] = k ? k->dirty : NULL;
+    }
+    if (c->threads == 1 || n == 0) {
+        for (int i = 0; i < n; i++)
+            rast__draw_valid(t[i], mesh[i], &st, c->scan, c->jtiles[i]);
+    } else {
+        c->njobs = n;
+        c->jt = t;
+        c->jm = mesh;
+        pthread_mutex_lock(&c->mu);
+        atomic_fetch_add(&c->gen, 1u);
+        pthread_cond_broadcast(&c->cv);
+        pthread_mutex_unlock(&c->mu);
+        run_draw(c, 0);
+        for (int k = 0; k < c->threads; k++)
+            rast__stats_add(&st, &c->slots[k].st);
+        st.tris_in = 0;
+        for (int i = 0; i < n; i++)
+            st.tris_in += mesh[i]->tri_count;
+    }
+    if (stats)
+        rast__stats_add(stats, &st);
+    return RAST_OK;
+}
+
 rast_result rast_context_draw(rast_context *c, const rast_target *t,
                               const rast_mesh_desc *m, rast_stats *stats)
 {
     if (!c)
         return RAST_ERR_ARGS;
-    if (c->threads == 1)
-        return rast__draw_with(t, m, stats, c->scan);
-    rast_result r = rast__validate(t, m);
-    if (r != RAST_OK)
-        return r;
-    c->t = t;
-    c->m = m;
-    rast__view_init(&c->view, t->width, t->height, rast__draw_na(t, m));
-    pthread_mutex_lock(&c->mu);
-    atomic_fetch_add(&c->gen, 1u);
-    pthread_cond_broadcast(&c->cv);
-    pthread_mutex_unlock(&c->mu);
-    run_draw(c, 0);
-    if (stats) {
-        rast_stats st = { 0 };
-        st.tris_in = m->tri_count;
-        for (int i = 0; i < c->threads; i++)
-            rast__stats_add(&st, &c->slots[i].st);
-        rast__stats_add(stats, &st);
-    }
-    return RAST_OK;
+    const rast_target *const tt[1] = { t };
+    const rast_mesh_desc *const mm[1] = { m };
+    return rast_context_draw_jobs(c, 1, tt, mm, stats);
+}
+
+rast_result rast_context_draw_aa(rast_context *c, const rast_aa_target *t,
+                                 const rast_mesh_desc *m, rast_stats *stats)
+{
+    if (!c)
+        return RAST_ERR_ARGS;
+    return rast__draw_aa_with(t, m, stats, rast__scan_aa_for_isa(c->isa));
 }

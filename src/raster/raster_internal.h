@@ -133,11 +133,89 @@ rast_result rast__validate(const rast_target *t, const rast_mesh_desc *m);
 rast_result rast__draw_with(const rast_target *t, const rast_mesh_desc *m,
                             rast_stats *stats, rast__scan_rows_fn scan);
 
+/* Tiles of 16x16 pixels a draw may have written, one bit per tile:
+ * bit (tx % 64) of bits[ty][tx / 64]. */
+#define RAST__TILE 16
+#define RAST__TILE_ROWS (RAST_MAX_DIM / RAST__TILE)
+#define RAST__TILE_WORDS (RAST_MAX_DIM / RAST__TILE / 64)
+typedef struct rast__tiles {
+    uint64_t bits[RAST__TILE_ROWS][RAST__TILE_WORDS];
+} rast__tiles;
+/* Marks the tiles of pixels x0..x1 x ya..yb (inclusive, not empty). */
+void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1);
+
+/* The body of rast__draw_with for validated arguments. When tiles is not
+ * NULL, the pixel box of every scanned triangle is marked in it (every
+ * pixel the draw may have written lies in a marked tile). */
+void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
+                      rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles);
+
 /* Fetch, clip, snap and set up submitted triangle ti of m (indices already
  * validated): writes 0..RAST__MAX_FAN triangles to out, returns their
  * count and adds every counter but tris_in and pixels_written to *st. */
 int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
                   rast__tri *out, rast_stats *st);
+/* Per-vertex results of the front end for one draw, in a small
+ * direct-mapped cache keyed by vertex index (RAST__VCACHE entries). Every
+ * value is a pure function of the vertex, so a cached value is the bit
+ * the scalar per-triangle path computes (docs/raster.md section 11):
+ * flags (RAST__VF_*), the outcode, the snapped position and the double
+ * per-vertex plane inputs zw = (z/w)*0.5+0.5 and iw = 1/w. */
+#define RAST__VCACHE 256
+enum {
+    RAST__VF_NONFINITE = 1 << 6,   /* a NaN or infinite coordinate */
+    RAST__VF_SLOW = 1 << 7         /* outcode != 0 or w <= 0: clip path */
+};
+typedef struct rast__vc_entry {
+    uint32_t tag;                  /* vertex index, UINT32_MAX = empty */
+    uint32_t flags;                /* outcode (bits 0..5) | RAST__VF_* */
+    int32_t X, Y;                  /* snapped (valid when flags == 0) */
+    double zw, iw;
+} rast__vc_entry;
+typedef struct rast__vcache {
+    rast__vc_entry e[RAST__VCACHE];
+} rast__vcache;
+
+/* Empties the cache (once per draw: clip data may change between draws). */
+void rast__vcache_reset(rast__vcache *c);
+
+/* rast__prepare with the vertex cache: triangles whose three vertices are
+ * finite and inside every clip plane (the usual case) are set up from the
+ * cached per-vertex values; the others go through rast__prepare. Same
+ * triangles, bytes and counters as rast__prepare. */
+int rast__prepare_cached(const rast__view *view, const rast_mesh_desc *m, int ti,
+                         rast__vcache *vc, rast__tri *out, rast_stats *st);
+
+/* ---- anti-aliased coverage (raster_aa.c, raster_aa.inl) ---------------- */
+
+/* rast__prepare for anti-aliased coverage: the same fetch, clip, snap,
+ * culling and counters, then edges only (planes and attributes left
+ * zero) and the pixel box of the samples instead of the centres. */
+int rast__prepare_aa(const rast__view *view, const rast_mesh_desc *m, int ti,
+                     rast__tri *out, rast_stats *st);
+
+/* Sample offsets from the pixel centre in 1/16 px (D3D standard
+ * patterns), count = 4, 8 or 16; NULL otherwise. */
+const int8_t (*rast__aa_pattern(int count))[2];
+
+/* ORs the samples of tri covered in each pixel into t (rows ya..yb of the
+ * box); returns the number of pixels with at least one covered sample.
+ * Sample s of pixel (x, y) is covered iff every edge value at
+ * p = centre + 16 * offset_s (1/256 px units) is >= 0 (int64, the biased
+ * edges of the tri: the top-left rule for samples):
+ *   E_k(p) = e_c[k] + i * e_dx[k] + j * e_dy[k] + dx_k * 16*oy_s - dy_k * 16*ox_s
+ * with dx_k = e_dy[k] / 256, dy_k = -e_dx[k] / 256. */
+typedef long (*rast__scan_aa_fn)(const rast_aa_target *t, const rast__tri *tri,
+                                 int ya, int yb);
+long rast__scan_aa_ref(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
+long rast__scan_aa_sse2(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
+long rast__scan_aa_avx2(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
+long rast__scan_aa_avx512(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
+rast__scan_aa_fn rast__scan_aa_for_isa(int isa);
+/* rast_draw_aa with a given scan. */
+rast_result rast__draw_aa_with(const rast_aa_target *t, const rast_mesh_desc *m,
+                               rast_stats *stats, rast__scan_aa_fn scan);
+
 /* dst += s, every counter. */
 void rast__stats_add(rast_stats *dst, const rast_stats *s);
 /* Attribute count carried through clipping for this draw (0 unless both

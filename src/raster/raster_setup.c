@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -140,17 +141,56 @@ void rast__snap(const rast__view *v, const rast__vert *p, int32_t *fx,
 
 /* ---- triangle setup ---------------------------------------------------- */
 
-/* floor(a / 256) for any sign. */
-static int64_t floor_fix(int64_t a)
-{
-    int64_t q = a / RAST__FIX_ONE;
-    if (a % RAST__FIX_ONE != 0 && a < 0)
-        q--;
-    return q;
-}
+#if defined(__GNUC__) || defined(__clang__)
+#define RAST__NOINLINE __attribute__((noinline))
+#else
+#define RAST__NOINLINE
+#endif
 
-/* Plane through (X_i, Y_i, f_i) in pixel units, in double, stored as
- * float: value at (cx, cy) and the gradient. area = ex1*ey2 - ex2*ey1. */
+/* The four planes of a triangle (z, q, b1, b2) in double, stored as
+ * float: value at (cx, cy) and the gradient, area = ex1*ey2 - ex2*ey1.
+ * Per plane, with vertex values f0, f1, f2 (docs/raster.md section 6.1):
+ *   df1 = f1 - f0; df2 = f2 - f0;
+ *   gx = (df1*ey2 - df2*ey1) / area;  gy = (df2*ex1 - df1*ex2) / area;
+ *   c  = (f0 + gx*(cx - X0)) + gy*(cy - Y0)
+ * The four planes share the geometry, so they are computed as the four
+ * lanes of one vector: every lane runs exactly these IEEE double
+ * operations (no contraction: -ffp-contract=off), so the result is the
+ * bits of four scalar evaluations, with two vector divisions instead of
+ * eight scalar ones. */
+#if defined(__GNUC__) || defined(__clang__)
+typedef double v4d __attribute__((vector_size(32)));
+typedef float v4f __attribute__((vector_size(16)));
+
+static void planes_setup(const double X[3], const double Y[3], double area,
+                         const v4d *pf0, const v4d *pf1, const v4d *pf2, double cx,
+                         double cy, rast__tri *tri)
+{
+    const v4d f0 = *pf0, f1 = *pf1, f2 = *pf2;
+    const double ex1 = X[1] - X[0], ey1 = Y[1] - Y[0];
+    const double ex2 = X[2] - X[0], ey2 = Y[2] - Y[0];
+    const double ox = cx - X[0], oy = cy - Y[0];
+    const v4d df1 = f1 - f0, df2 = f2 - f0;
+    const v4d gx = (df1 * ey2 - df2 * ey1) / area;
+    const v4d gy = (df2 * ex1 - df1 * ex2) / area;
+    const v4d c = (f0 + gx * ox) + gy * oy;
+    const v4f fc = __builtin_convertvector(c, v4f);
+    const v4f fgx = __builtin_convertvector(gx, v4f);
+    const v4f fgy = __builtin_convertvector(gy, v4f);
+    rast__plane *pl[4] = { &tri->z, &tri->q, &tri->b1, &tri->b2 };
+    for (int i = 0; i < 4; i++) {
+        pl[i]->c = fc[i];
+        pl[i]->dx = fgx[i];
+        pl[i]->dy = fgy[i];
+    }
+}
+#define PLANES_SETUP(X, Y, area, zw, q, cx, cy, tri)                           \
+    do {                                                                      \
+        const v4d f0_ = { zw[0], q[0], 0.0, 0.0 }, f1_ = { zw[1], q[1], q[1], 0.0 }, \
+                  f2_ = { zw[2], q[2], 0.0, q[2] };                           \
+        planes_setup(X, Y, area, &f0_, &f1_, &f2_, cx, cy, tri);              \
+    } while (0)
+#else
 static void plane_setup(const double X[3], const double Y[3], double area,
                         double f0, double f1, double f2, double cx, double cy,
                         rast__plane *pl)
@@ -165,74 +205,87 @@ static void plane_setup(const double X[3], const double Y[3], double area,
     pl->dx = (float)gx;
     pl->dy = (float)gy;
 }
+#define PLANES_SETUP(X, Y, area, zw, q, cx, cy, tri)                           \
+    do {                                                                      \
+        plane_setup(X, Y, area, zw[0], zw[1], zw[2], cx, cy, &(tri)->z);      \
+        plane_setup(X, Y, area, q[0], q[1], q[2], cx, cy, &(tri)->q);         \
+        plane_setup(X, Y, area, 0.0, q[1], 0.0, cx, cy, &(tri)->b1);          \
+        plane_setup(X, Y, area, 0.0, 0.0, q[2], cx, cy, &(tri)->b2);          \
+    } while (0)
+#endif
 
-int rast__setup_tri(const rast__view *v, const rast__vert *const p[3],
-                    const int32_t fx[3], const int32_t fy[3], rast_cull cull,
-                    rast__tri *tri)
+/* Twice the signed area of the snapped triangle in 1/65536 pixel^2; every
+ * coordinate lies in [-2^21, 2^22], so each product is below 2^46
+ * (docs/raster.md). The viewport flips y, so a triangle counter-clockwise
+ * in NDC (front, as OpenGL) has a negative area (y down). */
+static inline int64_t snapped_area(int32_t x0, int32_t y0, int32_t x1, int32_t y1,
+                                   int32_t x2, int32_t y2)
 {
-    /* Twice the signed area in 1/65536 pixel^2; every coordinate lies in
-     * [-2^21, 2^22], so each product is below 2^46 (docs/raster.md). */
-    int64_t area = (int64_t)(fx[1] - fx[0]) * (fy[2] - fy[0]) -
-                   (int64_t)(fy[1] - fy[0]) * (fx[2] - fx[0]);
+    return (int64_t)(x1 - x0) * (y2 - y0) - (int64_t)(y1 - y0) * (x2 - x0);
+}
+
+/* RAST__SETUP_OK, _DEGENERATE or _CULLED for a signed snapped area. */
+static inline int area_test(int64_t area, rast_cull cull)
+{
     if (area == 0)
         return RAST__SETUP_DEGENERATE;
-    /* The viewport flips y, so a triangle counter-clockwise in NDC (front,
-     * as OpenGL) has a negative area in screen coordinates (y down). */
-    int front = area < 0;
+    const int front = area < 0;
     if ((cull == RAST_CULL_BACK && !front) || (cull == RAST_CULL_FRONT && front))
         return RAST__SETUP_CULLED;
+    return RAST__SETUP_OK;
+}
 
-    /* Normalise to area > 0 (clockwise on the screen, y down): then the
-     * interior is where every edge function is positive. */
-    int o[3] = { 0, 1, 2 };
-    if (area < 0) {
-        o[1] = 2;
-        o[2] = 1;
-        area = -area;
-    }
-    int64_t X[3], Y[3];
-    for (int i = 0; i < 3; i++) {
-        X[i] = fx[o[i]];
-        Y[i] = fy[o[i]];
-    }
-
-    /* Pixel bounding box: pixel x is a candidate iff xmin <= 256x+128 <= xmax. */
-    int64_t xmin = X[0], xmax = X[0], ymin = Y[0], ymax = Y[0];
+/* The rest of the setup for a triangle already normalised to area > 0
+ * (clockwise on the screen, y down: the interior is where every edge
+ * function is positive): snapped positions X, Y, per-vertex plane inputs
+ * zw_i = (z/w)*0.5+0.5 and iw_i = 1/w (double) and attributes
+ * (attr_count floats per vertex, unused when 0), all in that order. */
+static int setup_oriented(const rast__view *v, const int32_t X[3], const int32_t Y[3],
+                          int64_t area, const double zwv[3], const double iwv[3],
+                          const float *const attr[3], rast__tri *tri)
+{
+    /* Pixel bounding box: pixel x is a candidate iff xmin <= 256x+128 <= xmax,
+     * i.e. x0 = floor((xmin - 128 + 255) / 256), x1 = floor((xmax - 128) / 256)
+     * (|X| < 2^23: int32, and >> is a floor division for the arithmetic
+     * shift of gcc, clang and msvc). */
+    int32_t xmin = X[0], xmax = X[0], ymin = Y[0], ymax = Y[0];
     for (int i = 1; i < 3; i++) {
-        if (X[i] < xmin) xmin = X[i];
-        if (X[i] > xmax) xmax = X[i];
-        if (Y[i] < ymin) ymin = Y[i];
-        if (Y[i] > ymax) ymax = Y[i];
+        xmin = X[i] < xmin ? X[i] : xmin;
+        xmax = X[i] > xmax ? X[i] : xmax;
+        ymin = Y[i] < ymin ? Y[i] : ymin;
+        ymax = Y[i] > ymax ? Y[i] : ymax;
     }
-    int64_t bx0 = floor_fix(xmin - RAST__FIX_HALF + RAST__FIX_ONE - 1);
-    int64_t bx1 = floor_fix(xmax - RAST__FIX_HALF);
-    int64_t by0 = floor_fix(ymin - RAST__FIX_HALF + RAST__FIX_ONE - 1);
-    int64_t by1 = floor_fix(ymax - RAST__FIX_HALF);
-    if (bx0 < 0) bx0 = 0;
-    if (by0 < 0) by0 = 0;
-    if (bx1 > v->width - 1) bx1 = v->width - 1;
-    if (by1 > v->height - 1) by1 = v->height - 1;
+    int32_t bx0 = (xmin - RAST__FIX_HALF + RAST__FIX_ONE - 1) >> RAST_SUBPIXEL_BITS;
+    int32_t bx1 = (xmax - RAST__FIX_HALF) >> RAST_SUBPIXEL_BITS;
+    int32_t by0 = (ymin - RAST__FIX_HALF + RAST__FIX_ONE - 1) >> RAST_SUBPIXEL_BITS;
+    int32_t by1 = (ymax - RAST__FIX_HALF) >> RAST_SUBPIXEL_BITS;
+    bx0 = bx0 < 0 ? 0 : bx0;
+    by0 = by0 < 0 ? 0 : by0;
+    bx1 = bx1 > v->width - 1 ? v->width - 1 : bx1;
+    by1 = by1 > v->height - 1 ? v->height - 1 : by1;
     if (bx0 > bx1 || by0 > by1)
         return RAST__SETUP_OFFSCREEN;
-    tri->x0 = (int)bx0;
-    tri->y0 = (int)by0;
-    tri->x1 = (int)bx1;
-    tri->y1 = (int)by1;
+    tri->x0 = bx0;
+    tri->y0 = by0;
+    tri->x1 = bx1;
+    tri->y1 = by1;
 
     /* Edge k runs from vertex k+1 to vertex k+2 (opposite vertex k):
      * E(p) = dx*(py - ya) - dy*(px - xa), positive inside. Top-left rule:
      * with this winding an edge is top (dy == 0, dx > 0) or left (dy < 0);
      * those keep E == 0, the others get a -1 bias so that E == 0 fails the
-     * sign test. */
-    int64_t cx = bx0 * RAST__FIX_ONE + RAST__FIX_HALF;
-    int64_t cy = by0 * RAST__FIX_ONE + RAST__FIX_HALF;
+     * sign test. Deltas and offsets are below 2^24, products below 2^47. */
+    const int32_t cx = bx0 * RAST__FIX_ONE + RAST__FIX_HALF;
+    const int32_t cy = by0 * RAST__FIX_ONE + RAST__FIX_HALF;
+    static const int ea[3] = { 1, 2, 0 }, eb[3] = { 2, 0, 1 };
     for (int k = 0; k < 3; k++) {
-        int a = (k + 1) % 3, b = (k + 2) % 3;
-        int64_t dx = X[b] - X[a], dy = Y[b] - Y[a];
-        int top_left = dy < 0 || (dy == 0 && dx > 0);
-        tri->e_c[k] = dx * (cy - Y[a]) - dy * (cx - X[a]) - (top_left ? 0 : 1);
-        tri->e_dx[k] = -dy * RAST__FIX_ONE;
-        tri->e_dy[k] = dx * RAST__FIX_ONE;
+        const int a = ea[k], b = eb[k];
+        const int32_t dx = X[b] - X[a], dy = Y[b] - Y[a];
+        const int top_left = dy < 0 || (dy == 0 && dx > 0);
+        tri->e_c[k] = (int64_t)dx * (cy - Y[a]) - (int64_t)dy * (cx - X[a]) -
+                      (top_left ? 0 : 1);
+        tri->e_dx[k] = -(int64_t)dy * RAST__FIX_ONE;
+        tri->e_dy[k] = (int64_t)dx * RAST__FIX_ONE;
     }
 
     /* Float planes, set up in double from the snapped positions (exact in
@@ -242,29 +295,63 @@ int rast__setup_tri(const rast__view *v, const rast__vert *const p[3],
         Xd[i] = (double)X[i] / RAST__FIX_ONE;
         Yd[i] = (double)Y[i] / RAST__FIX_ONE;
     }
-    double aread = (double)area / ((double)RAST__FIX_ONE * RAST__FIX_ONE);
-    double ocx = (double)bx0 + 0.5, ocy = (double)by0 + 0.5;
-    double zw[3], q[3], qmax = 0.0;
-    for (int i = 0; i < 3; i++) {
-        const rast__vert *pv = p[o[i]];
-        zw[i] = ((double)pv->z / (double)pv->w) * 0.5 + 0.5;
-        q[i] = 1.0 / (double)pv->w;
-        if (q[i] > qmax) qmax = q[i];
-    }
+    const double aread = (double)area / ((double)RAST__FIX_ONE * RAST__FIX_ONE);
+    const double ocx = (double)bx0 + 0.5, ocy = (double)by0 + 0.5;
+    double qmax = 0.0;
     for (int i = 0; i < 3; i++)
-        q[i] = q[i] / qmax;
-    plane_setup(Xd, Yd, aread, zw[0], zw[1], zw[2], ocx, ocy, &tri->z);
-    plane_setup(Xd, Yd, aread, q[0], q[1], q[2], ocx, ocy, &tri->q);
-    plane_setup(Xd, Yd, aread, 0.0, q[1], 0.0, ocx, ocy, &tri->b1);
-    plane_setup(Xd, Yd, aread, 0.0, 0.0, q[2], ocx, ocy, &tri->b2);
+        if (iwv[i] > qmax) qmax = iwv[i];
+    const double q[3] = { iwv[0] / qmax, iwv[1] / qmax, iwv[2] / qmax };
+    PLANES_SETUP(Xd, Yd, aread, zwv, q, ocx, ocy, tri);
     tri->attr_count = v->attr_count;
     for (int k = 0; k < v->attr_count; k++) {
-        const float a0 = p[o[0]]->a[k];
+        const float a0 = attr[0][k];
         tri->a0[k] = a0;
-        tri->d1[k] = p[o[1]]->a[k] - a0;
-        tri->d2[k] = p[o[2]]->a[k] - a0;
+        tri->d1[k] = attr[1][k] - a0;
+        tri->d2[k] = attr[2][k] - a0;
     }
     return RAST__SETUP_OK;
+}
+
+/* The whole setup of one triangle in submission order. */
+static int setup_core(const rast__view *v, const int32_t fx[3], const int32_t fy[3],
+                      const double zwv[3], const double iwv[3],
+                      const float *const attr[3], rast_cull cull, rast__tri *tri)
+{
+    int64_t area = snapped_area(fx[0], fy[0], fx[1], fy[1], fx[2], fy[2]);
+    const int r = area_test(area, cull);
+    if (r != RAST__SETUP_OK)
+        return r;
+    /* Normalise to area > 0 by swapping vertices 1 and 2. */
+    const int s1 = area < 0 ? 2 : 1, s2 = area < 0 ? 1 : 2;
+    const int32_t X[3] = { fx[0], fx[s1], fx[s2] }, Y[3] = { fy[0], fy[s1], fy[s2] };
+    const double zw[3] = { zwv[0], zwv[s1], zwv[s2] }, iw[3] = { iwv[0], iwv[s1], iwv[s2] };
+    const float *const at[3] = { attr[0], attr[s1], attr[s2] };
+    return setup_oriented(v, X, Y, area < 0 ? -area : area, zw, iw, at, tri);
+}
+
+/* Per-vertex plane inputs (docs/raster.md section 6.1). */
+static double vert_zw(const rast__vert *p)
+{
+    return ((double)p->z / (double)p->w) * 0.5 + 0.5;
+}
+
+static double vert_iw(const rast__vert *p)
+{
+    return 1.0 / (double)p->w;
+}
+
+int rast__setup_tri(const rast__view *v, const rast__vert *const p[3],
+                    const int32_t fx[3], const int32_t fy[3], rast_cull cull,
+                    rast__tri *tri)
+{
+    double zw[3], iw[3];
+    const float *attr[3];
+    for (int i = 0; i < 3; i++) {
+        zw[i] = vert_zw(p[i]);
+        iw[i] = vert_iw(p[i]);
+        attr[i] = p[i]->a;
+    }
+    return setup_core(v, fx, fy, zw, iw, attr, cull, tri);
 }
 
 /* ---- validation and the driver ----------------------------------------- */
@@ -303,12 +390,14 @@ static int finite_vert(const rast__vert *p)
     return isfinite(p->x) && isfinite(p->y) && isfinite(p->z) && isfinite(p->w);
 }
 
-int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
-                  rast__tri *out, rast_stats *st)
+/* Fetch, clip and snap submitted triangle ti: the snapped polygon (fx, fy;
+ * vertices in poly) and its vertex count, or 0 when the triangle is
+ * dropped (counted in *st). */
+static int clip_snap(const rast__view *view, const rast_mesh_desc *m, int ti,
+                     rast__vert *poly, int32_t *fx, int32_t *fy, rast_stats *st)
 {
     const int na = view->attr_count;
-    rast__vert poly[RAST__MAX_POLY], tmp[RAST__MAX_POLY];
-    int32_t fx[RAST__MAX_POLY], fy[RAST__MAX_POLY];
+    rast__vert tmp[RAST__MAX_POLY];
     int bad = 0;
     for (int i = 0; i < 3; i++) {
         uint32_t idx = m->indices[3 * (size_t)ti + i];
@@ -357,6 +446,15 @@ int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
     }
     for (int i = 0; i < n; i++)
         rast__snap(view, &poly[i], &fx[i], &fy[i]);
+    return n;
+}
+
+int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
+                  rast__tri *out, rast_stats *st)
+{
+    rast__vert poly[RAST__MAX_POLY];
+    int32_t fx[RAST__MAX_POLY], fy[RAST__MAX_POLY];
+    const int n = clip_snap(view, m, ti, poly, fx, fy, st);
     int made = 0;
     for (int i = 1; i + 1 < n; i++) {
         const rast__vert *pv[3] = { &poly[0], &poly[i], &poly[i + 1] };
@@ -371,6 +469,173 @@ int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
         case RAST__SETUP_CULLED:     st->tris_culled++; break;
         default:                     st->tris_clipped_away++; break;
         }
+    }
+    return made;
+}
+
+void rast__vcache_reset(rast__vcache *c)
+{
+    for (int i = 0; i < RAST__VCACHE; i++)
+        c->e[i].tag = UINT32_MAX;
+}
+
+/* Fills the cache entry of vertex idx (a miss). */
+static RAST__NOINLINE void vc_fill(const rast__view *view,
+                                              const rast_mesh_desc *m,
+                                              rast__vc_entry *e, uint32_t idx)
+{
+    const float *c = m->clip + 4 * (size_t)idx;
+    rast__vert p;
+    p.x = c[0];
+    p.y = c[1];
+    p.z = c[2];
+    p.w = c[3];
+    e->tag = idx;
+    if (!finite_vert(&p)) {
+        e->flags = RAST__VF_NONFINITE;
+        return;
+    }
+    const unsigned oc = rast__outcode(view, &p);
+    /* w <= 0 inside every plane: only the clip-space origin, which the
+     * clip path drops (docs/raster.md section 3.3). */
+    if (oc || !(p.w > 0.0f)) {
+        e->flags = oc | RAST__VF_SLOW;
+        return;
+    }
+    e->flags = 0;
+    rast__snap(view, &p, &e->X, &e->Y);
+    e->zw = vert_zw(&p);
+    e->iw = vert_iw(&p);
+}
+
+static inline const rast__vc_entry *vc_get(const rast__view *view,
+                                           const rast_mesh_desc *m, rast__vcache *vc,
+                                           uint32_t idx)
+{
+    rast__vc_entry *e = &vc->e[idx & (RAST__VCACHE - 1)];
+    if (e->tag != idx)
+        vc_fill(view, m, e, idx);
+    return e;
+}
+
+static int count_setup(int r, rast_stats *st)
+{
+    switch (r) {
+    case RAST__SETUP_OK:         st->tris_drawn++; return 1;
+    case RAST__SETUP_DEGENERATE: st->tris_degenerate++; return 0;
+    case RAST__SETUP_CULLED:     st->tris_culled++; return 0;
+    default:                     st->tris_clipped_away++; return 0;
+    }
+}
+
+int rast__prepare_cached(const rast__view *view, const rast_mesh_desc *m, int ti,
+                         rast__vcache *vc, rast__tri *out, rast_stats *st)
+{
+    const uint32_t *ix = m->indices + 3 * (size_t)ti;
+    const rast__vc_entry *e0 = vc_get(view, m, vc, ix[0]);
+    const rast__vc_entry *e1 = vc_get(view, m, vc, ix[1]);
+    const rast__vc_entry *e2 = vc_get(view, m, vc, ix[2]);
+    /* Two indices of one triangle in the same cache slot: the later
+     * lookup evicted the earlier one; take the uncached path (the same
+     * result, computed again). */
+    if (e0->tag != ix[0] || e1->tag != ix[1])
+        return rast__prepare(view, m, ti, out, st);
+    const unsigned fa = e0->flags | e1->flags | e2->flags;
+    if (fa) {
+        /* The order of rast__prepare: non-finite, all outside one plane,
+         * then clipping (which also drops w <= 0). */
+        if (fa & RAST__VF_NONFINITE) {
+            st->tris_nonfinite++;
+            return 0;
+        }
+        if (e0->flags & e1->flags & e2->flags & ((1u << RAST__PLANE_COUNT) - 1u)) {
+            st->tris_clipped_away++;
+            return 0;
+        }
+        return rast__prepare(view, m, ti, out, st);
+    }
+    /* Trivial accept: no clipping, one fan triangle. Area and culling
+     * first (half of a closed mesh faces away). */
+    const int64_t area = snapped_area(e0->X, e0->Y, e1->X, e1->Y, e2->X, e2->Y);
+    const int r = area_test(area, m->cull);
+    if (r != RAST__SETUP_OK)
+        return count_setup(r, st);
+    const rast__vc_entry *v1 = area < 0 ? e2 : e1, *v2 = area < 0 ? e1 : e2;
+    const uint32_t i1 = area < 0 ? ix[2] : ix[1], i2 = area < 0 ? ix[1] : ix[2];
+    const int32_t X[3] = { e0->X, v1->X, v2->X }, Y[3] = { e0->Y, v1->Y, v2->Y };
+    const double zw[3] = { e0->zw, v1->zw, v2->zw }, iw[3] = { e0->iw, v1->iw, v2->iw };
+    const float *attr[3] = { NULL, NULL, NULL };
+    if (view->attr_count > 0) {
+        const size_t ac = (size_t)m->attr_count;
+        attr[0] = m->attr + (size_t)ix[0] * ac;
+        attr[1] = m->attr + (size_t)i1 * ac;
+        attr[2] = m->attr + (size_t)i2 * ac;
+    }
+    return count_setup(setup_oriented(view, X, Y, area < 0 ? -area : area, zw, iw,
+                                      attr, out), st);
+}
+
+
+/* Anti-aliased coverage: the setup of one fan triangle (edges only, pixel
+ * box of the samples). Samples lie at the pixel centre plus offsets in
+ * [-8, 7]/16 px, i.e. within [x, x + 15/16] of pixel x, so pixel x may
+ * hold a covered sample only if 256x <= Xmax and 256x + 240 >= Xmin:
+ * x0 = ceil((Xmin - 240) / 256) = (Xmin + 15) >> 8, x1 = Xmax >> 8. */
+static int setup_aa(const rast__view *v, const int32_t fx[3], const int32_t fy[3],
+                    rast_cull cull, rast__tri *tri)
+{
+    int64_t area = snapped_area(fx[0], fy[0], fx[1], fy[1], fx[2], fy[2]);
+    const int r = area_test(area, cull);
+    if (r != RAST__SETUP_OK)
+        return r;
+    const int s1 = area < 0 ? 2 : 1, s2 = area < 0 ? 1 : 2;
+    const int32_t X[3] = { fx[0], fx[s1], fx[s2] }, Y[3] = { fy[0], fy[s1], fy[s2] };
+    int32_t xmin = X[0], xmax = X[0], ymin = Y[0], ymax = Y[0];
+    for (int i = 1; i < 3; i++) {
+        xmin = X[i] < xmin ? X[i] : xmin;
+        xmax = X[i] > xmax ? X[i] : xmax;
+        ymin = Y[i] < ymin ? Y[i] : ymin;
+        ymax = Y[i] > ymax ? Y[i] : ymax;
+    }
+    int32_t bx0 = (xmin + 15) >> RAST_SUBPIXEL_BITS, bx1 = xmax >> RAST_SUBPIXEL_BITS;
+    int32_t by0 = (ymin + 15) >> RAST_SUBPIXEL_BITS, by1 = ymax >> RAST_SUBPIXEL_BITS;
+    bx0 = bx0 < 0 ? 0 : bx0;
+    by0 = by0 < 0 ? 0 : by0;
+    bx1 = bx1 > v->width - 1 ? v->width - 1 : bx1;
+    by1 = by1 > v->height - 1 ? v->height - 1 : by1;
+    if (bx0 > bx1 || by0 > by1)
+        return RAST__SETUP_OFFSCREEN;
+    memset(tri, 0, sizeof *tri);
+    tri->x0 = bx0;
+    tri->y0 = by0;
+    tri->x1 = bx1;
+    tri->y1 = by1;
+    const int32_t cx = bx0 * RAST__FIX_ONE + RAST__FIX_HALF;
+    const int32_t cy = by0 * RAST__FIX_ONE + RAST__FIX_HALF;
+    static const int ea[3] = { 1, 2, 0 }, eb[3] = { 2, 0, 1 };
+    for (int k = 0; k < 3; k++) {
+        const int a = ea[k], b = eb[k];
+        const int32_t dx = X[b] - X[a], dy = Y[b] - Y[a];
+        const int top_left = dy < 0 || (dy == 0 && dx > 0);
+        tri->e_c[k] = (int64_t)dx * (cy - Y[a]) - (int64_t)dy * (cx - X[a]) -
+                      (top_left ? 0 : 1);
+        tri->e_dx[k] = -(int64_t)dy * RAST__FIX_ONE;
+        tri->e_dy[k] = (int64_t)dx * RAST__FIX_ONE;
+    }
+    return RAST__SETUP_OK;
+}
+
+int rast__prepare_aa(const rast__view *view, const rast_mesh_desc *m, int ti,
+                     rast__tri *out, rast_stats *st)
+{
+    rast__vert poly[RAST__MAX_POLY];
+    int32_t fx[RAST__MAX_POLY], fy[RAST__MAX_POLY];
+    const int n = clip_snap(view, m, ti, poly, fx, fy, st);
+    int made = 0;
+    for (int i = 1; i + 1 < n; i++) {
+        const int32_t tx[3] = { fx[0], fx[i], fx[i + 1] };
+        const int32_t ty[3] = { fy[0], fy[i], fy[i + 1] };
+        made += count_setup(setup_aa(view, tx, ty, m->cull, &out[made]), st);
     }
     return made;
 }
@@ -392,24 +657,55 @@ int rast__draw_na(const rast_target *t, const rast_mesh_desc *m)
     return (t->attr && m->attr) ? m->attr_count : 0;
 }
 
+void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1)
+{
+    const int t0 = x0 / RAST__TILE, t1 = x1 / RAST__TILE;
+    if (t0 / 64 == t1 / 64) {   /* the usual case: one word per tile row */
+        const int w = t0 / 64, lo = t0 % 64, hi = t1 % 64;
+        const uint64_t bits = (hi == 63 ? ~(uint64_t)0 : ((uint64_t)1 << (hi + 1)) - 1u) &
+                              ~(((uint64_t)1 << lo) - 1u);
+        for (int ty = ya / RAST__TILE; ty <= yb / RAST__TILE; ty++)
+            tl->bits[ty][w] |= bits;
+        return;
+    }
+    for (int ty = ya / RAST__TILE; ty <= yb / RAST__TILE; ty++)
+        for (int w = t0 / 64; w <= t1 / 64; w++) {
+            const int lo = w * 64 > t0 ? 0 : t0 - w * 64;
+            const int hi = w * 64 + 63 < t1 ? 63 : t1 - w * 64;
+            const uint64_t upto = hi == 63 ? ~(uint64_t)0 : ((uint64_t)1 << (hi + 1)) - 1u;
+            tl->bits[ty][w] |= upto & ~(((uint64_t)1 << lo) - 1u);
+        }
+}
+
+void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
+                      rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles)
+{
+    rast__view view;
+    rast__view_init(&view, t->width, t->height, rast__draw_na(t, m));
+    rast_stats st = { 0 };
+    st.tris_in = m->tri_count;
+    rast__tri tri[RAST__MAX_FAN];
+    rast__vcache vc;
+    rast__vcache_reset(&vc);
+    for (int ti = 0; ti < m->tri_count; ti++) {
+        int n = rast__prepare_cached(&view, m, ti, &vc, tri, &st);
+        for (int i = 0; i < n; i++) {
+            const rast__tri *r = &tri[i];
+            st.pixels_written += scan(t, r, r->y0, r->y1);
+            if (tiles)
+                rast__tiles_add(tiles, r->y0, r->y1, r->x0, r->x1);
+        }
+    }
+    if (stats)
+        rast__stats_add(stats, &st);
+}
+
 rast_result rast__draw_with(const rast_target *t, const rast_mesh_desc *m,
                             rast_stats *stats, rast__scan_rows_fn scan)
 {
     rast_result r = rast__validate(t, m);
     if (r != RAST_OK)
         return r;
-
-    rast__view view;
-    rast__view_init(&view, t->width, t->height, rast__draw_na(t, m));
-    rast_stats st = { 0 };
-    st.tris_in = m->tri_count;
-    rast__tri tri[RAST__MAX_FAN];
-    for (int ti = 0; ti < m->tri_count; ti++) {
-        int n = rast__prepare(&view, m, ti, tri, &st);
-        for (int i = 0; i < n; i++)
-            st.pixels_written += scan(t, &tri[i], tri[i].y0, tri[i].y1);
-    }
-    if (stats)
-        rast__stats_add(stats, &st);
+    rast__draw_valid(t, m, stats, scan, NULL);
     return RAST_OK;
 }

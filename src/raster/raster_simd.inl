@@ -15,6 +15,8 @@
  *                          NaN included)
  *   VF_CVT(vi)             int32 -> float (exact here: |i| < 2^24)
  *   VI_SET1 VI_ADD VI_OR VI_LOADU(p)
+ *   VI_LANES()             the vector 0, 1, ..., SIMD_V-1
+ *   VI_LANE_MUL(lanes, s)  lane l = l * s (int32; |l*s| < 2^27 here)
  *   VI_NEG_BITS(v)         lanes whose sign bit is set
  *   VF_LT_BITS(a, b)       lanes with a < b (ordered)
  *   VF_LOAD_M(p, bits, full)       load the lanes in bits (full: all);
@@ -25,16 +27,21 @@
  * Optional:
  *   ATTR3_STORE_FULL(p, a0, a1, a2)  interleave three attribute vectors of
  *                          SIMD_V pixels into p[3*SIMD_V] (all lanes).
+ *   ATTR3_STORE_M(p, bits, a0, a1, a2)  the same for the pixels in bits
+ *                          only (no other float is accessed).
  *
  * COVERAGE. The reference tests E >= 0 with int64 E stepped by multiples of
  * 256 (e_dx = -dy*256, e_dy = dx*256). Since floor((E + 256k)/256) =
  * floor(E/256) + k and E >= 0 <=> floor(E/256) >= 0, the body tests the
  * reduced value E' = floor(E/256) stepped by -dy and dx, the same sign for
  * every pixel. Bounds: |dx|, |dy| < 2^23 (docs/raster.md section 2).
- *   * Fast path (int32 throughout): when E' at the four corners of the
- *     scanned rows x [0, nvec*SIMD_V) lies in (-2^30, 2^30), every value
- *     in that rectangle does (E' is affine), and so does every difference
- *     used as a step (< 2^31): int32 adds give the exact integers.
+ *   * Fast path (int32 throughout): when the bound |c| + rows*|sy| +
+ *     cols*|sx| of |E'| over the scanned rows x [0, nvec*SIMD_V) (at least
+ *     the largest corner value, E' being affine) lies below 2^30, every
+ *     value and every step difference fits int32: int32 adds give the
+ *     exact integers. Triangles one vector wide (most of a fine mesh)
+ *     take a loop that tests coverage first and computes the float row
+ *     values only for rows with covered pixels.
  *   * Otherwise (huge triangles, vertices far in the guard band): E' of the
  *     first lane of each vector is computed in int64 and clamped to
  *     [-2^29, 2^29] before adding the lane offsets l*(-dy), |l*dy| <
@@ -46,16 +53,46 @@
 #define SIMD_LIM30 ((int64_t)(1 << 30) - 1)
 #define SIMD_LIM29 ((int64_t)1 << 29)
 
-/* floor(a / 256) for any sign (no reliance on >> of negative values). */
+/* floor(a / 256) for any sign: an arithmetic shift (gcc, clang and msvc
+ * shift signed values arithmetically; checked by the soup test, where
+ * half of the edge values are negative). */
 static inline int64_t simd_floor256(int64_t a)
 {
-    int64_t q = a / 256;
-    return (a % 256 != 0 && a < 0) ? q - 1 : q;
+    return a >> 8;
 }
 
 static inline int32_t simd_clamp29(int64_t a)
 {
     return (int32_t)(a < -SIMD_LIM29 ? -SIMD_LIM29 : a > SIMD_LIM29 ? SIMD_LIM29 : a);
+}
+
+static inline int64_t simd_abs64(int64_t a)
+{
+    return a < 0 ? -a : a;
+}
+
+/* The attributes of the lanes in pass, written interleaved to dst. */
+static inline void simd_attr_store(float *dst, int na, unsigned pass, vf b1, vf b2,
+                                   const vf *av0, const vf *av1, const vf *av2)
+{
+#ifdef ATTR3_STORE_M
+    if (na == 3) {
+        ATTR3_STORE_M(dst, pass,
+            VF_ADD(VF_ADD(av0[0], VF_MUL(b1, av1[0])), VF_MUL(b2, av2[0])),
+            VF_ADD(VF_ADD(av0[1], VF_MUL(b1, av1[1])), VF_MUL(b2, av2[1])),
+            VF_ADD(VF_ADD(av0[2], VF_MUL(b1, av1[2])), VF_MUL(b2, av2[2])));
+        return;
+    }
+#endif
+    _Alignas(64) float a[RAST_MAX_ATTRS][SIMD_V];
+    for (int k = 0; k < na; k++)
+        VF_STOREA(a[k], VF_ADD(VF_ADD(av0[k], VF_MUL(b1, av1[k])), VF_MUL(b2, av2[k])));
+    for (unsigned bits = pass; bits; bits &= bits - 1) {
+        const int l = __builtin_ctz(bits);
+        float *p = dst + (size_t)l * (size_t)na;
+        for (int k = 0; k < na; k++)
+            p[k] = a[k][l];
+    }
 }
 
 long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
@@ -69,37 +106,27 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
     const int nvec = (nx + SIMD_V - 1) / SIMD_V;
     const int64_t rows = ye - ys;
 
-    /* Reduced edges, relative to (x0, ys). */
-    int64_t c[3], sx[3], sy[3];
+    /* Reduced edges, relative to (x0, ys). sx, sy are the snapped edge
+     * deltas (|dx|, |dy| < 2^23). The int32 path is taken when a bound
+     * of |E'| over the scanned rectangle (|c| + rows*|sy| + cols*|sx|,
+     * at least the largest corner value) stays below 2^30. */
+    int64_t c[3];
+    int32_t sx[3], sy[3];
     int fits = 1;
+    const int64_t cols = (int64_t)nvec * SIMD_V - 1;
     for (int k = 0; k < 3; k++) {
         c[k] = simd_floor256(tri->e_c[k] + (int64_t)(ys - tri->y0) * tri->e_dy[k]);
-        sx[k] = tri->e_dx[k] / 256;     /* exact: multiples of 256 */
-        sy[k] = tri->e_dy[k] / 256;
-        for (int cj = 0; cj < 2; cj++)
-            for (int ci = 0; ci < 2; ci++) {
-                int64_t v = c[k] + cj * rows * sy[k] +
-                            ci * ((int64_t)nvec * SIMD_V - 1) * sx[k];
-                if (v < -SIMD_LIM30 || v > SIMD_LIM30)
-                    fits = 0;
-            }
+        sx[k] = (int32_t)(tri->e_dx[k] / 256);     /* exact: multiples of 256 */
+        sy[k] = (int32_t)(tri->e_dy[k] / 256);
+        fits &= simd_abs64(c[k]) + rows * simd_abs64(sy[k]) + cols * simd_abs64(sx[k]) <=
+                SIMD_LIM30;
     }
-    _Alignas(64) int32_t off[3][SIMD_V], lane[SIMD_V];
-    for (int l = 0; l < SIMD_V; l++) {
-        lane[l] = l;
-        for (int k = 0; k < 3; k++)
-            off[k][l] = (int32_t)(l * sx[k]);
-    }
-    const vi lanev = VI_LOADU(lane);
-    const vi off0 = VI_LOADU(off[0]), off1 = VI_LOADU(off[1]), off2 = VI_LOADU(off[2]);
-    /* Vector step; only used (and only in range) when nvec > 1. */
-    const vi st0 = VI_SET1(fits && nvec > 1 ? (int32_t)(SIMD_V * sx[0]) : 0);
-    const vi st1 = VI_SET1(fits && nvec > 1 ? (int32_t)(SIMD_V * sx[1]) : 0);
-    const vi st2 = VI_SET1(fits && nvec > 1 ? (int32_t)(SIMD_V * sx[2]) : 0);
+    const vi lanev = VI_LANES();
+    const vi off0 = VI_LANE_MUL(lanev, sx[0]), off1 = VI_LANE_MUL(lanev, sx[1]),
+             off2 = VI_LANE_MUL(lanev, sx[2]);
 
     const vf zero = VF_SET1(0.0f), one = VF_SET1(1.0f);
-    const vf zdx = VF_SET1(tri->z.dx), qdx = VF_SET1(tri->q.dx);
-    const vf b1dx = VF_SET1(tri->b1.dx), b2dx = VF_SET1(tri->b2.dx);
+    const vf zdx = VF_SET1(tri->z.dx);
     vf av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
     for (int k = 0; k < na; k++) {
         av0[k] = VF_SET1(tri->a0[k]);
@@ -108,8 +135,67 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
     }
 
     long written = 0;
+    uint8_t *mrow = t->mask + (size_t)ys * (size_t)t->mask_stride + tri->x0;
+    float *drow = t->depth ? t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0
+                           : NULL;
+    float *arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride +
+                           (size_t)tri->x0 * (size_t)na
+                     : NULL;
+    if (fits && nvec == 1) {
+        /* One vector per row (most triangles of a fine mesh): coverage
+         * first, the float work only for rows with covered pixels. */
+        const unsigned valid = nx >= SIMD_V ? SIMD_FULL : (1u << nx) - 1u;
+        vi e0 = VI_ADD(VI_SET1((int32_t)c[0]), off0);
+        vi e1 = VI_ADD(VI_SET1((int32_t)c[1]), off1);
+        vi e2 = VI_ADD(VI_SET1((int32_t)c[2]), off2);
+        const vi sy0 = VI_SET1(sy[0]), sy1 = VI_SET1(sy[1]), sy2 = VI_SET1(sy[2]);
+        const vf fi = VF_CVT(lanev);
+        for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
+                 drow = drow ? drow + t->depth_stride : NULL,
+                 arow = arow ? arow + t->attr_stride : NULL) {
+            const unsigned cov = ~VI_NEG_BITS(VI_OR(VI_OR(e0, e1), e2)) & valid;
+            e0 = VI_ADD(e0, sy0);
+            e1 = VI_ADD(e1, sy1);
+            e2 = VI_ADD(e2, sy2);
+            if (!cov)
+                continue;
+            const float fj = (float)(y - tri->y0);
+            const float zr = tri->z.c + tri->z.dy * fj;
+            vf z = VF_ADD(VF_SET1(zr), VF_MUL(zdx, fi));
+            z = VF_MAX(zero, z);
+            z = VF_MIN(one, z);
+            unsigned pass = cov;
+            if (drow) {
+                const vf d = VF_LOAD_M(drow, cov, cov == SIMD_FULL);
+                pass = cov & VF_LT_BITS(z, d);
+                if (!pass)
+                    continue;
+                VF_STORE_M(drow, pass, pass == SIMD_FULL, z);
+            }
+            MASK_STORE_M(mrow, pass, pass == SIMD_FULL);
+            written += __builtin_popcount(pass);
+            if (!na)
+                continue;
+            const float qr = tri->q.c + tri->q.dy * fj;
+            const float b1r = tri->b1.c + tri->b1.dy * fj;
+            const float b2r = tri->b2.c + tri->b2.dy * fj;
+            const vf r = VF_DIV(one, VF_ADD(VF_SET1(qr), VF_MUL(VF_SET1(tri->q.dx), fi)));
+            const vf b1 = VF_MUL(VF_ADD(VF_SET1(b1r), VF_MUL(VF_SET1(tri->b1.dx), fi)), r);
+            const vf b2 = VF_MUL(VF_ADD(VF_SET1(b2r), VF_MUL(VF_SET1(tri->b2.dx), fi)), r);
+            simd_attr_store(arow, na, pass, b1, b2, av0, av1, av2);
+        }
+        return written;
+    }
+
+    const vi st0 = VI_SET1(fits ? (int32_t)(SIMD_V * sx[0]) : 0);
+    const vi st1 = VI_SET1(fits ? (int32_t)(SIMD_V * sx[1]) : 0);
+    const vi st2 = VI_SET1(fits ? (int32_t)(SIMD_V * sx[2]) : 0);
+    const vf qdx = VF_SET1(tri->q.dx);
+    const vf b1dx = VF_SET1(tri->b1.dx), b2dx = VF_SET1(tri->b2.dx);
     int64_t rb[3] = { c[0], c[1], c[2] };
-    for (int y = ys; y <= ye; y++) {
+    for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
+             drow = drow ? drow + t->depth_stride : NULL,
+             arow = arow ? arow + t->attr_stride : NULL) {
         /* Row bases: the reference's scalar expressions. */
         const float fj = (float)(y - tri->y0);
         const float zr = tri->z.c + tri->z.dy * fj;
@@ -117,10 +203,6 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
         const float b1r = tri->b1.c + tri->b1.dy * fj;
         const float b2r = tri->b2.c + tri->b2.dy * fj;
         const vf zrv = VF_SET1(zr);
-        uint8_t *mrow = t->mask + (size_t)y * (size_t)t->mask_stride;
-        float *drow = t->depth ? t->depth + (size_t)y * (size_t)t->depth_stride
-                               : NULL;
-        float *arow = na ? t->attr + (size_t)y * (size_t)t->attr_stride : NULL;
         vi e0 = lanev, e1 = lanev, e2 = lanev;
         if (fits) {
             e0 = VI_ADD(VI_SET1((int32_t)rb[0]), off0);
@@ -130,7 +212,6 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
         int64_t eb0 = rb[0], eb1 = rb[1], eb2 = rb[2];
         for (int v = 0; v < nvec; v++) {
             const int i0 = v * SIMD_V;
-            const int x = tri->x0 + i0;
             const int rem = nx - i0;
             const unsigned valid = rem >= SIMD_V ? SIMD_FULL : (1u << rem) - 1u;
             unsigned neg;
@@ -144,9 +225,9 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
                 const vi t1 = VI_ADD(VI_SET1(simd_clamp29(eb1)), off1);
                 const vi t2 = VI_ADD(VI_SET1(simd_clamp29(eb2)), off2);
                 neg = VI_NEG_BITS(VI_OR(VI_OR(t0, t1), t2));
-                eb0 += SIMD_V * sx[0];
-                eb1 += SIMD_V * sx[1];
-                eb2 += SIMD_V * sx[2];
+                eb0 += SIMD_V * (int64_t)sx[0];
+                eb1 += SIMD_V * (int64_t)sx[1];
+                eb2 += SIMD_V * (int64_t)sx[2];
             }
             const unsigned cov = ~neg & valid;
             if (!cov)
@@ -157,20 +238,20 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
             z = VF_MIN(one, z);
             unsigned pass = cov;
             if (drow) {
-                const vf d = VF_LOAD_M(drow + x, cov, cov == SIMD_FULL);
+                const vf d = VF_LOAD_M(drow + i0, cov, cov == SIMD_FULL);
                 pass = cov & VF_LT_BITS(z, d);
                 if (!pass)
                     continue;
-                VF_STORE_M(drow + x, pass, pass == SIMD_FULL, z);
+                VF_STORE_M(drow + i0, pass, pass == SIMD_FULL, z);
             }
-            MASK_STORE_M(mrow + x, pass, pass == SIMD_FULL);
+            MASK_STORE_M(mrow + i0, pass, pass == SIMD_FULL);
             written += __builtin_popcount(pass);
             if (!na)
                 continue;
             const vf r = VF_DIV(one, VF_ADD(VF_SET1(qr), VF_MUL(qdx, fi)));
             const vf b1 = VF_MUL(VF_ADD(VF_SET1(b1r), VF_MUL(b1dx, fi)), r);
             const vf b2 = VF_MUL(VF_ADD(VF_SET1(b2r), VF_MUL(b2dx, fi)), r);
-            float *dst = arow + (size_t)x * (size_t)na;
+            float *dst = arow + (size_t)i0 * (size_t)na;
 #ifdef ATTR3_STORE_FULL
             if (na == 3 && pass == SIMD_FULL) {
                 ATTR3_STORE_FULL(dst,
@@ -180,16 +261,7 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
                 continue;
             }
 #endif
-            _Alignas(64) float a[RAST_MAX_ATTRS][SIMD_V];
-            for (int k = 0; k < na; k++)
-                VF_STOREA(a[k], VF_ADD(VF_ADD(av0[k], VF_MUL(b1, av1[k])),
-                                       VF_MUL(b2, av2[k])));
-            for (unsigned bits = pass; bits; bits &= bits - 1) {
-                const int l = __builtin_ctz(bits);
-                float *p = dst + (size_t)l * (size_t)na;
-                for (int k = 0; k < na; k++)
-                    p[k] = a[k][l];
-            }
+            simd_attr_store(dst, na, pass, b1, b2, av0, av1, av2);
         }
         rb[0] += sy[0];
         rb[1] += sy[1];

@@ -24,6 +24,9 @@ typedef __m128i vi;
 #define VI_ADD(a, b) _mm_add_epi32(a, b)
 #define VI_OR(a, b) _mm_or_si128(a, b)
 #define VI_LOADU(p) _mm_loadu_si128((const __m128i *)(const void *)(p))
+#define VI_LANES() _mm_setr_epi32(0, 1, 2, 3)
+/* No 32-bit multiply in SSE2: the products in scalar (|3*s| < 2^27). */
+#define VI_LANE_MUL(lanes, s) _mm_setr_epi32(0, (s), 2 * (s), 3 * (s))
 #define VI_NEG_BITS(v) ((unsigned)_mm_movemask_ps(_mm_castsi128_ps(v)))
 #define VF_LT_BITS(a, b) ((unsigned)_mm_movemask_ps(_mm_cmplt_ps(a, b)))
 #define VF_STOREA(p, v) _mm_store_ps(p, v)
@@ -84,6 +87,11 @@ static inline void attr3_store(float *p, __m128 a, __m128 b, __m128 c)
 #define ATTR3_STORE_FULL(p, a, b, c) attr3_store(p, a, b, c)
 
 #include "raster_simd.inl"
+
+/* Anti-aliased coverage: 2 double lanes. */
+#define AA_V 2
+#define AA_FN rast__scan_aa_sse2
+#include "raster_aa.inl"
 
 #else
 typedef int rast__sse2_unused;   /* not x86: the dispatcher uses the reference */
