@@ -254,7 +254,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     e->result = PIPE_OK;
     e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
     rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
-    rast_target_clear(&tg);
+    rast_context_clear(e->rast, &tg); /* only what the last frame drew */
     rast_result rr = pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, e->clip, e->vnrm, NULL);
     double t1 = now_ms();
     e->ms_raster = t1 - t0;
