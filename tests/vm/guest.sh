@@ -62,12 +62,12 @@ EGOFUSE=${EGOFUSE_BIN:-$ROOT/build/egofuse}
 if [ ! -x "$EGOFUSE" ]; then
     echo "VMTEST run_pipeline FAIL $EGOFUSE is not built"
     fail=1
-elif [ ! -f "$ROOT/build/samples/scene.txt" ]; then
-    echo "VMTEST run_pipeline FAIL build/samples/scene.txt missing (make samples)"
+elif [ ! -f "$(dirname "$OUT")/samples/scene.txt" ]; then
+    echo "VMTEST run_pipeline FAIL $(dirname "$OUT")/samples/scene.txt missing (tests/vm/prepare.sh makes it)"
     fail=1
 else
     # raw rgb24 stream, left above right (PNG encoding is slow under TCG)
-    "$EGOFUSE" run --scene "$ROOT/build/samples/scene.txt" --left /dev/video0 --right /dev/video1 \
+    "$EGOFUSE" run --scene "$(dirname "$OUT")/samples/scene.txt" --left /dev/video0 --right /dev/video1 \
         --input 1 --dv --fps 60 --frames 8 --raw > "$OUT/run.rgb" 2> "$OUT/run.err"
     rc=$?
     tr '\r' '\n' < "$OUT/run.err" | grep . | tail -n 3 | sed 's/^/VMINFO run /'

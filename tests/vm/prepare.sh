@@ -49,6 +49,14 @@ if [ ! -s "$VM/vmlinux" ] || [ ! -d "$VM/kernel/lib/modules/$KV" ]; then
     rm -f "$deb"
 fi
 
+# ---- a short sample sequence for `egofuse run` in the guest (the scene's
+# model, animation, lighting and virtual images; the cameras are vivid's)
+if [ ! -s "$VM/samples/scene.txt" ]; then
+    [ -x "$ROOT/$BUILD/gen_samples" ] || skip "$BUILD/gen_samples is not built"
+    "$ROOT/$BUILD/gen_samples" --out "$VM/samples" --frames 2 >/dev/null ||
+        skip "cannot generate the samples for the guest"
+fi
+
 # ---- initramfs
 IR="$VM/initramfs"
 rm -rf "$IR"
