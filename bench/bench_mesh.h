@@ -40,7 +40,9 @@ static void bm_capsule(bm_mesh *m, const float a[3], const float b[3], float r,
     for (int i = 0; i <= R; i++) {
         float t = (float)i / (float)R;
         float s = 0.5f - 0.5f * cosf(3.14159265f * t);       /* along */
-        float pr = sqrtf(sinf(3.14159265f * t));             /* profile */
+        /* profile; sinf(3.14159265f) < 0 (the float is above pi): clamp,
+         * or the far pole of every capsule would be NaN */
+        float pr = sqrtf(fmaxf(0.0f, sinf(3.14159265f * t)));
         int ring = (i == 0 || i == R) ? 1 : S;
         for (int j = 0; j < ring; j++) {
             float ph = 6.2831853f * (float)j / (float)S;

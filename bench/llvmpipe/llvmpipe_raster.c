@@ -5,20 +5,15 @@
  * each classified by the distance of its centre to the nearest triangle
  * edge (docs/raster.md section 10 explains the classes).
  *
- * Build (not in the Makefile: it needs EGL and GLES):
- *   make build/libegofuse.a
- *   gcc -std=c11 -O2 -D_GNU_SOURCE -o build/bench/llvmpipe_raster \
- *       bench/llvmpipe/llvmpipe_raster.c build/libegofuse.a \
- *       $(pkg-config --cflags --libs egl glesv2) -lm -lpthread
+ * The EGL/GLES setup is bench/llvmpipe/egl_harness.h, shared with
+ * llvmpipe_frame.c (the whole stereo frame). `make build/bench/llvmpipe_raster`
+ * builds it (the Makefile links EGL and GLESv2):
  *   build/bench/llvmpipe_raster [--runs N] [--tris N,N,...]
  *
  * Exit status: 0 when llvmpipe ran and every coverage difference lies
  * within snapping distance of an edge, 1 otherwise (2: usage, 3: no
  * llvmpipe). */
-#define EGL_EGLEXT_PROTOTYPES
-#include <EGL/egl.h>
-#include <EGL/eglext.h>
-#include <GLES3/gl3.h>
+#include "egl_harness.h"
 
 #include "../../src/cpu/cpu.h"
 #include "../../src/raster/raster.h"
@@ -35,41 +30,6 @@ enum { W = 640, H = 400 };
  * each of the two rasterizers snaps vertices to 1/256 px, which moves an
  * edge by up to sqrt(2)/512 px each. */
 #define EDGE_EPS (2.0 * 1.41421356 / 512.0)
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-static GLuint compile(GLenum type, const char *src)
-{
-    GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &src, NULL);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[1024];
-        glGetShaderInfoLog(s, sizeof log, NULL, log);
-        fprintf(stderr, "shader: %s\n", log);
-        exit(3);
-    }
-    return s;
-}
 
 /* Distance (px) from (px, py) to segment a-b. */
 static double seg_dist(double px, double py, double ax, double ay, double bx, double by)
@@ -140,34 +100,9 @@ int main(int argc, char **argv)
     }
     if (runs < 1)
         return 2;
-    setenv("EGL_PLATFORM", "surfaceless", 0);
-    setenv("GALLIUM_DRIVER", "llvmpipe", 0);
-    setenv("LIBGL_ALWAYS_SOFTWARE", "1", 0);
-
-    PFNEGLGETPLATFORMDISPLAYEXTPROC get_display =
-        (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
-    EGLDisplay dpy = get_display ? get_display(EGL_PLATFORM_SURFACELESS_MESA,
-                                               EGL_DEFAULT_DISPLAY, NULL)
-                                 : eglGetDisplay(EGL_DEFAULT_DISPLAY);
-    EGLint major, minor;
-    if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, &major, &minor)) {
-        fprintf(stderr, "no surfaceless EGL display\n");
+    eh_gl gl;
+    if (eh_open(&gl, -1) != 0)
         return 3;
-    }
-    eglBindAPI(EGL_OPENGL_ES_API);
-    const EGLint cattr[] = { EGL_CONTEXT_MAJOR_VERSION, 3, EGL_NONE };
-    EGLContext ctx = eglCreateContext(dpy, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, cattr);
-    if (ctx == EGL_NO_CONTEXT ||
-        !eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) {
-        fprintf(stderr, "cannot make a surfaceless GLES 3 context current\n");
-        return 3;
-    }
-    const char *renderer = (const char *)glGetString(GL_RENDERER);
-    printf("GL_RENDERER: %s\nGL_VERSION: %s\n", renderer, (const char *)glGetString(GL_VERSION));
-    if (!renderer || !strstr(renderer, "llvmpipe")) {
-        fprintf(stderr, "the renderer is not llvmpipe\n");
-        return 3;
-    }
     printf("egofuse ISA: %s, scene: two arms, %dx%d per eye, depth + coverage + "
            "normals, back faces culled, median of %d runs\n",
            ef_isa_name((ef_isa)rast_draw_isa()), W, H, runs);
@@ -194,10 +129,7 @@ int main(int argc, char **argv)
     const char *fs = "#version 300 es\nprecision highp float;\n"
                      "in vec3 n; out vec4 o;\n"
                      "void main() { o = vec4(n * 0.5 + 0.5, 1.0); }\n";
-    GLuint prog = glCreateProgram();
-    glAttachShader(prog, compile(GL_VERTEX_SHADER, vs));
-    glAttachShader(prog, compile(GL_FRAGMENT_SHADER, fs));
-    glLinkProgram(prog);
+    GLuint prog = eh_program(vs, fs);
     glUseProgram(prog);
     glViewport(0, 0, W, H);
     glEnable(GL_DEPTH_TEST);
@@ -249,7 +181,7 @@ int main(int argc, char **argv)
         /* Timing, both eyes per run: llvmpipe clear + draw + glFinish (the
          * clip coordinates are already in buffers, as egofuse gets them). */
         for (int r = -5; r < runs; r++) {
-            double t0 = now_ms();
+            double t0 = eh_now_ms();
             for (int e = 0; e < 2; e++) {
                 glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
                 glBindBuffer(GL_ARRAY_BUFFER, vbo[e]);
@@ -258,7 +190,7 @@ int main(int argc, char **argv)
                 glFinish();
             }
             if (r >= 0)
-                tg[r] = now_ms() - t0;
+                tg[r] = eh_now_ms() - t0;
         }
         double best_eg = 1e30;
         int best_th = 1;
@@ -267,18 +199,24 @@ int main(int argc, char **argv)
             rast_context *c = rast_context_create(&d);
             if (!c)
                 return 1;
-            for (int r = -5; r < runs; r++) {
-                double t0 = now_ms();
-                for (int e = 0; e < 2; e++) {
-                    rast_target_clear(&tgt[e]);
-                    rast_mesh_desc md = { clip[e], m.vertex_count, m.nrm, 3, m.idx,
-                                          m.tri_count, RAST_CULL_BACK };
-                    rast_context_draw(c, &tgt[e], &md, NULL);
-                }
-                if (r >= 0)
-                    te[r] = now_ms() - t0;
+            rast_mesh_desc md[2];
+            for (int e = 0; e < 2; e++) {
+                rast_mesh_desc m1 = { clip[e], m.vertex_count, m.nrm, 3, m.idx,
+                                      m.tri_count, RAST_CULL_BACK };
+                md[e] = m1;
             }
-            double me = median(te, runs);
+            const rast_target *tp[2] = { &tgt[0], &tgt[1] };
+            const rast_mesh_desc *mp[2] = { &md[0], &md[1] };
+            for (int r = -5; r < runs; r++) {
+                double t0 = eh_now_ms();
+                /* Both eyes in one call: with 2 threads, one eye each. */
+                rast_target_clear(&tgt[0]);
+                rast_target_clear(&tgt[1]);
+                rast_context_draw_jobs(c, 2, tp, mp, NULL);
+                if (r >= 0)
+                    te[r] = eh_now_ms() - t0;
+            }
+            double me = eh_median(te, runs);
             if (me < best_eg) {
                 best_eg = me;
                 best_th = th;
@@ -287,7 +225,7 @@ int main(int argc, char **argv)
                    m.tri_count, th, me);
             rast_context_destroy(c);
         }
-        double mg = median(tg, runs);
+        double mg = eh_median(tg, runs);
         printf("%6d tris: llvmpipe %.4f ms both eyes (clear + draw + finish); "
                "llvmpipe / egofuse (%d thread(s)) = %.1fx\n", m.tri_count, mg, best_th,
                mg / best_eg);
@@ -346,9 +284,7 @@ int main(int argc, char **argv)
             free(clip[e]);
         bm_free(&m);
     }
-    eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    eglDestroyContext(dpy, ctx);
-    eglTerminate(dpy);
+    eh_close(&gl);
     free(rgba);
     free(depth);
     free(mask);
