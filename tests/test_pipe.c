@@ -261,6 +261,82 @@ static void virtual_depth(void **state)
     kin_model_free(&m);
 }
 
+/* A closed, outward-wound box: culling back faces leaves the mask as it
+ * is from every viewpoint; an open quad seen from behind disappears. */
+static void cull_back_faces(void **state)
+{
+    (void)state;
+    kin_model m;
+    quad_model(&m, 0.05f, -0.4f); /* reuse its arrays for a box */
+    static float pos[24], nrm[24];
+    static uint32_t idx[36];
+    static const uint32_t faces[36] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                                       2, 3, 7, 2, 7, 6, 1, 2, 6, 1, 6, 5, 0, 4, 7, 0, 7, 3};
+    for (int i = 0; i < 8; i++) {
+        pos[3 * i + 0] = (i & 1) ^ ((i >> 1) & 1) ? 0.05f : -0.05f;
+        pos[3 * i + 1] = (i & 2) ? 0.05f : -0.05f;
+        pos[3 * i + 2] = (i & 4) ? -0.35f : -0.45f;
+        nrm[3 * i + 2] = 1.0f;
+    }
+    memcpy(idx, faces, sizeof faces);
+    kin_mesh box = m.meshes[0];
+    box.vertex_count = 8;
+    box.positions = pos;
+    box.normals = nrm;
+    box.index_count = 36;
+    box.indices = idx;
+    kin_model bm = m;
+    bm.meshes = &box;
+    for (int v = 0; v < 6; v++) {
+        uint8_t *masks[2];
+        for (int c = 0; c < 2; c++) {
+            pipe_desc d = {0};
+            d.threads = 1;
+            d.cull = c ? RAST_CULL_BACK : RAST_CULL_NONE;
+            pipe_ctx *p = pipe_create(&d, &bm);
+            assert_non_null(p);
+            frame_bufs b;
+            pipe_frame_in in;
+            make_frame(&b, &in, 5);
+            kin_mat4 head = kin_mat4_from_tr(kin_v3(0.03f * (v - 3), 0.02f * (v % 3), 0.0f),
+                                             kin_quat_axis_angle(kin_v3(0, 1, 0), 0.15f * (v - 3)));
+            in.head_node = -1;
+            in.world_from_head = &head;
+            assert_int_equal(pipe_frame(p, &in, NULL, NULL, 0), PIPE_OK);
+            int w, h;
+            masks[c] = malloc(640 * 400);
+            memcpy(masks[c], pipe_mask(p, 0, &w, &h), 640 * 400);
+            free_frame(&b);
+            pipe_destroy(p);
+        }
+        int on = 0;
+        for (int i = 0; i < 640 * 400; i++) on += masks[0][i] != 0;
+        assert_true(on > 1000);
+        assert_memory_equal(masks[0], masks[1], 640 * 400);
+        free(masks[0]);
+        free(masks[1]);
+    }
+    /* The quad faces +Z, towards the head: turned around, it is culled. */
+    static uint32_t flipped[6] = {0, 2, 1, 0, 3, 2};
+    kin_mesh q = m.meshes[0];
+    q.indices = flipped;
+    kin_model qm = m;
+    qm.meshes = &q;
+    pipe_desc d = {0};
+    d.cull = RAST_CULL_BACK;
+    pipe_ctx *p = pipe_create(&d, &qm);
+    frame_bufs b;
+    pipe_frame_in in;
+    make_frame(&b, &in, 6);
+    assert_int_equal(pipe_frame(p, &in, NULL, NULL, 0), PIPE_OK);
+    int w, h;
+    const uint8_t *mk = pipe_mask(p, 0, &w, &h);
+    for (int i = 0; i < w * h; i++) assert_int_equal(mk[i], 0);
+    free_frame(&b);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
 static void bad_inputs(void **state)
 {
     (void)state;
@@ -302,6 +378,7 @@ int main(void)
         cmocka_unit_test_prestate(threads_same_bytes, NULL),
         cmocka_unit_test_prestate(threads_same_bytes, (void *)1),
         cmocka_unit_test(virtual_depth),
+        cmocka_unit_test(cull_back_faces),
         cmocka_unit_test(bad_inputs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -176,7 +176,7 @@ int cmd_mask(int argc, char **argv)
     rast_target tg = {width, height, depth, width, mask.data, width, nrm, 3 * width, 3};
     rast_target_clear(&tg);
     pipe_pose_anim(&ps, an, tsec);
-    rast_result rr = pipe_pose_draw(&ps, NULL, &cam, &tg, clip, vnrm, NULL);
+    rast_result rr = pipe_pose_draw(&ps, NULL, &cam, &tg, RAST_CULL_NONE, clip, vnrm, NULL);
     if (rr != RAST_OK) {
         cli_fail("%s: cannot draw the model: %s", model_path, rast_result_str(rr));
         goto done;

@@ -165,7 +165,8 @@ void pipe_pose_locals(pipe_pose *ps, const kin_transform *locals)
 
 rast_result pipe_pose_draw(const pipe_pose *ps, rast_context *ctx,
                            const kin_camera *cam, const rast_target *target,
-                           float *clip, float *vnrm, rast_stats *stats)
+                           rast_cull cull, float *clip, float *vnrm,
+                           rast_stats *stats)
 {
     const int with_n = target->attr_count == 3;
     for (int i = 0; i < ps->model->mesh_count; i++) {
@@ -179,7 +180,7 @@ rast_result pipe_pose_draw(const pipe_pose *ps, rast_context *ctx,
             .attr_count = with_n ? 3 : 0,
             .indices = me->indices,
             .tri_count = me->index_count / 3,
-            .cull = RAST_CULL_NONE,
+            .cull = cull,
         };
         rast_result r = ctx ? rast_context_draw(ctx, target, &d, stats)
                             : rast_draw(target, &d, stats);
@@ -255,7 +256,8 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
     rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
     rast_context_clear(e->rast, &tg); /* only what the last frame drew */
-    rast_result rr = pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, e->clip, e->vnrm, NULL);
+    rast_result rr = pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, p->desc.cull, e->clip,
+                                    e->vnrm, NULL);
     double t1 = now_ms();
     e->ms_raster = t1 - t0;
     if (rr != RAST_OK) {

@@ -64,13 +64,15 @@ void pipe_pose_anim(pipe_pose *ps, const kin_animation *anim, float t);
 void pipe_pose_locals(pipe_pose *ps, const kin_transform *locals);
 
 /* Draws every mesh of a posed model through cam into target (attr_count
- * 3 receives view-space normals; 0 draws depth and mask only), with ctx
+ * 3 receives view-space normals; 0 draws depth and mask only), culling
+ * as cull says, with ctx
  * (NULL: rast_draw, the best ISA on the calling thread). clip and vnrm are
  * scratch arrays of 4 and 3 floats per vertex of the largest mesh
  * (ps->max_vertices). */
 rast_result pipe_pose_draw(const pipe_pose *ps, rast_context *ctx,
                            const kin_camera *cam, const rast_target *target,
-                           float *clip, float *vnrm, rast_stats *stats);
+                           rast_cull cull, float *clip, float *vnrm,
+                           rast_stats *stats);
 
 /* ------------------------------------------------------------- frames */
 
@@ -82,6 +84,11 @@ typedef struct pipe_desc {
                                  EGOFUSE_ISA caps further */
     float tone_match;         /* 0 = off; (0,1]: strength of the gray-world
                                  colour tone matching (fuse_tone_match) */
+    rast_cull cull;           /* RAST_CULL_NONE (default): both faces, right
+                                 for any model; RAST_CULL_BACK: about half
+                                 the triangle setups, right for closed,
+                                 consistently wound meshes (the samples'
+                                 arms: the masks are identical) */
 } pipe_desc;
 
 typedef struct pipe_ctx pipe_ctx;
