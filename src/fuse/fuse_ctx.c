@@ -28,6 +28,8 @@ typedef struct kernels {
     fuse__composite_fn comp;   /* NULL: the reference axis walk */
     fuse__cover_fn cover;      /* coverage bits of a layer row */
     fuse__opaque_fn opaque;    /* R = V, alpha 255 (transparent spans) */
+    fuse__hrow_fn hrow;        /* NULL: no row cache, comp per output row */
+    fuse__vrow_fn vrow;
 } kernels;
 
 static kernels kernels_for(ef_isa isa)
@@ -40,18 +42,24 @@ static kernels kernels_for(ef_isa isa)
         k.comp = fuse__composite_cols_avx512;
         k.cover = fuse__cover_row_avx512;
         k.opaque = fuse__opaque_avx512;
+        k.hrow = fuse__hrow_avx512;
+        k.vrow = fuse__vrow_avx512;
         break;
     case EF_ISA_AVX2:
         k.light = fuse__light_row_avx2;
         k.comp = fuse__composite_cols_avx2;
         k.cover = fuse__cover_row_avx2;
         k.opaque = fuse__opaque_avx2;
+        k.hrow = fuse__hrow_avx2;
+        k.vrow = fuse__vrow_avx2;
         break;
     case EF_ISA_SSE2:
         k.light = fuse__light_row_sse2;
         k.comp = fuse__composite_cols_sse2;
         k.cover = fuse__cover_row_sse2;
         k.opaque = fuse__opaque_sse2;
+        k.hrow = NULL;
+        k.vrow = NULL;
         break;
     default:
         k.isa = EF_ISA_REF;
@@ -59,6 +67,8 @@ static kernels kernels_for(ef_isa isa)
         k.comp = NULL;
         k.cover = fuse__cover_row_ref;
         k.opaque = fuse__opaque_ref;
+        k.hrow = NULL;
+        k.vrow = NULL;
         break;
     }
     return k;
@@ -276,14 +286,21 @@ typedef struct comp_job {
  * one tile; for every coverage block b of the layer, the first and the
  * last group of the tile whose taps can read it (gfirst[b] .. glast[b],
  * empty when gfirst > glast); and the coverage bits of the last two layer
- * rows. On the stack of the caller (about 26 KB); nothing is allocated. */
+ * rows. With a row cache (kernels.hrow), also the horizontal taps h of
+ * those two rows (fuse_internal.h) over the groups their coverage reaches
+ * (bit g of grp; a group without its bit has all taps of that row zero).
+ * On the stack of the caller (about 75 KB); nothing is allocated. */
 #define NBLOCKS (FUSE_MAX_DIM / FUSE__COV_BLOCK)
+#define GWORDS ((FUSE__TILE / GROUP + 63) / 64)
 typedef struct comp_scratch {
     fuse__cols cols;
     int16_t gfirst[NBLOCKS], glast[NBLOCKS];
     int tile_c0, tile_n;            /* the tile in cols; tile_n 0: none */
     int cov_row[2];                 /* layer rows in cov, -1: none */
     uint64_t cov[2][FUSE__COV_WORDS];
+    uint64_t grp[2][GWORDS];        /* groups with h computed */
+    uint16_t h[2][4 * FUSE__TILE];  /* 4 channels per tile column */
+    uint16_t h_zero[4 * FUSE__TILE];/* h = 0 (stored FUSE__H_BIAS), set with the tile */
 } comp_scratch;
 
 static void scratch_init(comp_scratch *s)
@@ -301,6 +318,11 @@ static void scratch_tile(comp_scratch *s, int sw, int vw, int c0, int n)
     const int ng = (n + GROUP - 1) / GROUP, nb = (sw + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
     int g, b;
     if (s->tile_n == n && s->tile_c0 == c0) return;
+    s->cov_row[0] = s->cov_row[1] = -1;   /* h depends on the tile */
+    if (s->tile_n == 0) {
+        int i;
+        for (i = 0; i < 4 * FUSE__TILE; i++) s->h_zero[i] = (uint16_t)FUSE__H_BIAS;
+    }
     fuse__cols_fill(&s->cols, sw, vw, c0, n);
     for (g = 0, b = 0; b < nb; b++) {    /* first g with bhi(g) >= b */
         while (g < ng) {
@@ -321,14 +343,52 @@ static void scratch_tile(comp_scratch *s, int sw, int vw, int c0, int n)
 
 /* Coverage bits of layer row r, computed into the slot that does not hold
  * row keep. */
-static const uint64_t *scratch_cover(comp_scratch *s, const comp_job *j, int r, int keep)
+static int next_bit(const uint64_t *a, const uint64_t *c, int nb, int b, int want);
+
+/* h of layer row r into slot (kernels.hrow): over the groups that the runs
+ * of its coverage bits reach (gfirst/glast), each group once. Any group
+ * with a non-zero tap in row r reads a covered block, so it is one of
+ * them; the others keep no bit in grp and count as h = 0. */
+static void scratch_hrow(comp_scratch *s, const comp_job *j, int r, int slot)
+{
+    const int sw = j->Q.width, n = s->tile_n;
+    const int nb = (sw + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
+    const uint64_t *bits = s->cov[slot];
+    const uint8_t *q = row_of(&j->Q, r);
+    int b = 0, done = 0;   /* groups [0, done) handled */
+    memset(s->grp[slot], 0, sizeof s->grp[slot]);
+    for (;;) {
+        const int first = next_bit(bits, bits, nb, b, 1);
+        int last, g0, g1, c, e, g;
+        if (first >= nb) break;
+        last = next_bit(bits, bits, nb, first, 0) - 1;
+        b = last + 1;
+        g0 = s->gfirst[first] > done ? s->gfirst[first] : done;
+        g1 = s->glast[last];
+        if (g0 > g1) continue;
+        c = g0 * GROUP;
+        e = (g1 + 1) * GROUP < n ? (g1 + 1) * GROUP : n;
+        j->k->hrow(q, &s->cols, c, e - c, sw, s->h[slot] + 4 * (size_t)c);
+        for (g = g0; g <= g1; g++) s->grp[slot][g >> 6] |= (uint64_t)1 << (g & 63);
+        done = g1 + 1;
+    }
+}
+
+/* Coverage bits (and with a row cache, h) of layer row r, computed into
+ * the slot that does not hold row keep; *slot_out: the slot. */
+static const uint64_t *scratch_cover(comp_scratch *s, const comp_job *j, int r, int keep,
+                                     int *slot_out)
 {
     int slot;
-    if (s->cov_row[0] == r) return s->cov[0];
-    if (s->cov_row[1] == r) return s->cov[1];
-    slot = s->cov_row[0] == keep ? 1 : 0;
-    j->k->cover(row_of(&j->Q, r), j->Q.width, s->cov[slot]);
-    s->cov_row[slot] = r;
+    if (s->cov_row[0] == r) slot = 0;
+    else if (s->cov_row[1] == r) slot = 1;
+    else {
+        slot = s->cov_row[0] == keep ? 1 : 0;
+        j->k->cover(row_of(&j->Q, r), j->Q.width, s->cov[slot]);
+        if (j->k->hrow != NULL) scratch_hrow(s, j, r, slot);
+        s->cov_row[slot] = r;
+    }
+    *slot_out = slot;
     return s->cov[slot];
 }
 
@@ -382,6 +442,55 @@ static void comp_span(const comp_job *j, const comp_scratch *s, const uint8_t *q
         j->k->opaque(v + 4 * (size_t)c, o + 4 * (size_t)c, n);
 }
 
+/* Bits of the groups whose class (1: h only in the upper row, 2: only in
+ * the lower one, 3: in both) is cls, word w. */
+static uint64_t class_word(const uint64_t *g0, const uint64_t *g1, int w, int cls)
+{
+    return cls == 3 ? g0[w] & g1[w] : cls == 1 ? g0[w] & ~g1[w] : ~g0[w] & g1[w];
+}
+
+/* The first group >= g (of ng) whose class is not cls; ng if none. */
+static int class_end(const uint64_t *g0, const uint64_t *g1, int ng, int g, int cls)
+{
+    while (g < ng) {
+        const uint64_t w = ~class_word(g0, g1, g >> 6, cls) & (~(uint64_t)0 << (g & 63));
+        if (w) {
+            g = (g & ~63) + __builtin_ctzll(w);
+            return g < ng ? g : ng;
+        }
+        g = (g & ~63) + 64;
+    }
+    return ng;
+}
+
+/* An output row from the row cache: slots r0 (upper layer row) and r1
+ * (lower). Groups with h in either row go through kernels.vrow in runs of
+ * one class, a row without h reading h_zero (its taps there are all 0);
+ * the other groups have four zero taps at every pixel: V, alpha 255. */
+static void comp_row_cached(const comp_job *j, const comp_scratch *s, int r0, int r1,
+                            uint32_t fy, const uint8_t *v, uint8_t *o, int n)
+{
+    const int ng = (n + GROUP - 1) / GROUP;
+    const uint64_t *g0 = s->grp[r0], *g1 = s->grp[r1];
+    const uint16_t *h0 = s->h[r0], *h1 = s->h[r1];
+    int g = 0, done = 0;   /* columns [0, done) written */
+    for (;;) {
+        const int gs = next_bit(g0, g1, ng, g, 1);
+        int cls, ge, c, e;
+        if (gs >= ng) break;
+        cls = (int)((g0[gs >> 6] >> (gs & 63)) & 1u) | (int)(((g1[gs >> 6] >> (gs & 63)) & 1u) << 1);
+        ge = class_end(g0, g1, ng, gs, cls);
+        c = gs * GROUP;
+        e = ge * GROUP < n ? ge * GROUP : n;
+        if (c > done) j->k->opaque(v + 4 * (size_t)done, o + 4 * (size_t)done, c - done);
+        j->k->vrow((cls & 1) ? h0 + 4 * (size_t)c : s->h_zero, (cls & 2) ? h1 + 4 * (size_t)c : s->h_zero,
+                   fy, v + 4 * (size_t)c, o + 4 * (size_t)c, e - c);
+        done = e;
+        g = ge;
+    }
+    if (n > done) j->k->opaque(v + 4 * (size_t)done, o + 4 * (size_t)done, n - done);
+}
+
 /* One output row y of the viewport, columns [c0, c0 + n) of the tile in s.
  * The runs of covered blocks of the two layer rows give the groups that
  * need the blend; every other group has four zero taps at every pixel and
@@ -393,14 +502,20 @@ static void comp_row_tiled(const comp_job *j, comp_scratch *s, int y, int c0, in
     const int nb = (sw + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
     const int32_t pos = fuse__src_pos(y - j->vy, sh, j->vh);
     const int iy = pos >> 16, iy1 = iy + 1 < sh ? iy + 1 : sh - 1;
-    const uint64_t *b0 = scratch_cover(s, j, iy, -1);
-    const uint64_t *b1 = iy1 == iy ? b0 : scratch_cover(s, j, iy1, iy);
+    int s0, s1;
+    const uint64_t *b0 = scratch_cover(s, j, iy, -1, &s0);
+    const uint64_t *b1 = iy1 == iy ? b0 : scratch_cover(s, j, iy1, iy, &s1);
     const size_t off = 4 * ((size_t)j->vx + (size_t)c0);
     const uint8_t *q0 = row_of(&j->Q, iy), *q1 = row_of(&j->Q, iy1);
     const uint8_t *v = row_of(&j->V, y) + off;
     uint8_t *o = row_of(&j->out, y) + off;
     const uint32_t fy = ((uint32_t)pos >> 8) & 255u;
     int done = 0, b = 0;   /* columns [0, done) written */
+    if (iy1 == iy) s1 = s0;
+    if (j->k->vrow != NULL) {
+        comp_row_cached(j, s, s0, s1, fy, v, o, n);
+        return;
+    }
     for (;;) {
         int first, last, g0, g1, c;
         first = next_bit(b0, b1, nb, b, 1);

@@ -305,6 +305,65 @@ void fuse__composite_cols_avx512(const uint8_t *q0, const uint8_t *q1, uint32_t 
                                  const fuse__cols *cols, int c, int n, int sw,
                                  const uint8_t *v, uint8_t *out);
 
+/* ---- row-cached composite (AVX2, AVX-512) ----------------------------- */
+
+/* The bilinear sum regrouped by rows: with the horizontal taps of layer row
+ * r at output column i, h_r = a (256 - fx) + b fx (per channel, <= 65280),
+ * the reference's q is (h_iy (256 - fy) + h_iy1 fy + 32768) >> 16, the same
+ * exact integer sum. A layer row is read by ~1.9 output rows when the
+ * layer is enlarged, so the driver computes h once per layer row (only for
+ * the groups that its coverage can reach) and keeps the last two.
+ * Stored: h - 32768 as an int16 (h ^ FUSE__H_BIAS as a u16), so that the
+ * vertical sum is one signed 16x16 -> 32-bit multiply-add per pair
+ * (pmaddwd): (h0 - 32768) w0 + (h1 - 32768) w1 + 32768 * 256 + 32768, with
+ * w0 + w1 = 256; every term fits an int32. 4 values per output column in
+ * the pixel's channel order (r, g, b, a), 4 * i + k for column i. A layer
+ * row without taps there (h = 0) holds FUSE__H_BIAS. */
+#define FUSE__H_BIAS 0x8000u
+
+/* h of columns c .. c + n - 1 of cols from layer row q (h points at column
+ * c's entry). */
+typedef void (*fuse__hrow_fn)(const uint8_t *q, const fuse__cols *cols, int c,
+                              int n, int sw, uint16_t *h);
+/* The vertical blend of h0 (upper row) and h1 (lower row) with weight fy
+ * and the over onto n pixels of V: the bytes of fuse__composite_px. */
+typedef void (*fuse__vrow_fn)(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
+                              const uint8_t *v, uint8_t *out, int n);
+
+/* One column of fuse__hrow_fn. */
+static inline void fuse__hpx(const uint8_t *q, int ix, uint32_t fx, int sw, uint16_t *h)
+{
+    const int ix1 = ix + 1 < sw ? ix + 1 : sw - 1;
+    int k;
+    for (k = 0; k < 4; k++)
+        h[k] = (uint16_t)((q[4 * ix + k] * (256u - fx) + q[4 * ix1 + k] * fx) ^ FUSE__H_BIAS);
+}
+
+/* One pixel of fuse__vrow_fn. */
+static inline void fuse__vpx(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
+                             const uint8_t *v, uint8_t *out)
+{
+    const uint32_t inv = 255u - (((h0[3] ^ FUSE__H_BIAS) * (256u - fy) +
+                                  (h1[3] ^ FUSE__H_BIAS) * fy + 32768u) >> 16);
+    int k;
+    for (k = 0; k < 3; k++) {
+        const uint32_t r = (((h0[k] ^ FUSE__H_BIAS) * (256u - fy) +
+                             (h1[k] ^ FUSE__H_BIAS) * fy + 32768u) >> 16) +
+                           FUSE__DIV255(inv * v[k]);
+        out[k] = (uint8_t)(r < 255u ? r : 255u);
+    }
+    out[3] = 255;
+}
+
+void fuse__hrow_avx2(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
+                     uint16_t *h);
+void fuse__hrow_avx512(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
+                       uint16_t *h);
+void fuse__vrow_avx2(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
+                     const uint8_t *v, uint8_t *out, int n);
+void fuse__vrow_avx512(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
+                       const uint8_t *v, uint8_t *out, int n);
+
 /* ---- coverage and opaque copies (the composite driver, fuse_ctx.c) ---- */
 
 /* Source pixels per coverage bit. fuse__cover_row_* sets bit b of bits
