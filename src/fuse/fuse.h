@@ -206,6 +206,10 @@ typedef struct fuse_frame {
 /* Bytes of one row of width pixels in format f (0 for an unknown f). */
 int fuse_format_row_bytes(fuse_format f, int width);
 fuse_result fuse_frame_to_rgba(const fuse_frame *src, int y0, fuse_image *out);
+/* The same on at most ISA cap (EF_ISA_DEFAULT: the best; EGOFUSE_ISA caps
+ * further). YUYV and UYVY have an AVX2 path; the bytes never differ. */
+fuse_result fuse_frame_to_rgba_isa(const fuse_frame *src, int y0, fuse_image *out,
+                                   ef_isa cap);
 
 /* ---- depth test against the virtual scene ------------------------------
  *

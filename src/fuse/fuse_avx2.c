@@ -322,6 +322,12 @@ void fuse__opaque_avx2(const uint8_t *v, uint8_t *out, int n)
 
 #else  /* not built for AVX2: never chosen by cpuid, falls back */
 
+int fuse__yuv422_row_avx2(const uint8_t *src, int width, int uyvy, uint8_t *dst)
+{
+    (void)src, (void)width, (void)uyvy, (void)dst;
+    return 0; /* the caller converts the whole row */
+}
+
 void fuse__light_row_avx2(const fuse__light_prep *p, int y, int width,
                           const uint8_t *P, const uint8_t *mask,
                           const float *normal, uint8_t *out)
@@ -360,4 +366,61 @@ void fuse__opaque_avx2(const uint8_t *v, uint8_t *out, int n)
 {
     fuse__opaque_ref(v, out, n);
 }
+
 #endif
+
+#if defined(__AVX2__)
+/* ---- camera formats: YUYV / UYVY rows (fuse_formats.c, yuv_px) ---------
+ *
+ * 16 pixels a step, the reference's integer formula exactly: with
+ * C = Y-16, D = U-128, E = V-128 every channel is base + a pair product,
+ *   base = 298 C + 128 (one madd of (C, 1) by (298, 128)),
+ *   R = base + 409 E, G = base - 100 D - 208 E, B = base + 516 D
+ * (madd of (D, E) by (0, 409), (-100, -208), (516, 0)), all in int32;
+ * then v >> 8 (arithmetic) and the unsigned saturating packs give exactly
+ * clamp255: a negative v has a negative v >> 8, packed to 0, and v >> 8 is
+ * at most 534, which packs to 255. */
+static inline __m256i yuv_channel(__m256i base_lo, __m256i base_hi, __m256i de_lo,
+                                  __m256i de_hi, __m256i k)
+{
+    __m256i lo = _mm256_srai_epi32(_mm256_add_epi32(base_lo, _mm256_madd_epi16(de_lo, k)), 8);
+    __m256i hi = _mm256_srai_epi32(_mm256_add_epi32(base_hi, _mm256_madd_epi16(de_hi, k)), 8);
+    return _mm256_packs_epi32(lo, hi); /* int16, pixel order kept per lane */
+}
+
+int fuse__yuv422_row_avx2(const uint8_t *src, int width, int uyvy, uint8_t *dst)
+{
+    const __m256i lo8 = _mm256_set1_epi16(0x00FF);
+    const __m256i c16 = _mm256_set1_epi16(16), c128 = _mm256_set1_epi16(128);
+    const __m256i one = _mm256_set1_epi16(1), alpha = _mm256_set1_epi16(255);
+    const __m256i kbase = _mm256_set1_epi32((128 << 16) | 298);
+    const __m256i kr = _mm256_set1_epi32(409 << 16);
+    const __m256i kg = _mm256_set1_epi32((int)(((uint32_t)(uint16_t)-208 << 16) | (uint16_t)-100));
+    const __m256i kb = _mm256_set1_epi32(516);
+    int x = 0;
+    for (; x + 16 <= width; x += 16) {
+        __m256i v = _mm256_loadu_si256((const __m256i *)(const void *)(src + 2 * x));
+        __m256i yw = uyvy ? _mm256_srli_epi16(v, 8) : _mm256_and_si256(v, lo8);
+        __m256i cw = uyvy ? _mm256_and_si256(v, lo8) : _mm256_srli_epi16(v, 8);
+        __m256i c = _mm256_sub_epi16(yw, c16);
+        __m256i ch = _mm256_sub_epi16(cw, c128);           /* D0 E0 D1 E1 ... */
+        __m256i d = _mm256_shufflehi_epi16(_mm256_shufflelo_epi16(ch, 0xA0), 0xA0);
+        __m256i e = _mm256_shufflehi_epi16(_mm256_shufflelo_epi16(ch, 0xF5), 0xF5);
+        __m256i base_lo = _mm256_madd_epi16(_mm256_unpacklo_epi16(c, one), kbase);
+        __m256i base_hi = _mm256_madd_epi16(_mm256_unpackhi_epi16(c, one), kbase);
+        __m256i de_lo = _mm256_unpacklo_epi16(d, e), de_hi = _mm256_unpackhi_epi16(d, e);
+        __m256i r = yuv_channel(base_lo, base_hi, de_lo, de_hi, kr);
+        __m256i g = yuv_channel(base_lo, base_hi, de_lo, de_hi, kg);
+        __m256i b = yuv_channel(base_lo, base_hi, de_lo, de_hi, kb);
+        __m256i rg = _mm256_packus_epi16(r, g);             /* R0-7 G0-7 | R8-15 G8-15 */
+        __m256i ba = _mm256_packus_epi16(b, alpha);         /* B0-7 A    | B8-15 A */
+        __m256i rb = _mm256_unpacklo_epi8(rg, ba);          /* R0 B0 R1 B1 ... */
+        __m256i ga = _mm256_unpackhi_epi8(rg, ba);          /* G0 A  G1 A  ... */
+        __m256i p0 = _mm256_unpacklo_epi8(rb, ga);          /* px 0-3 | 8-11 */
+        __m256i p1 = _mm256_unpackhi_epi8(rb, ga);          /* px 4-7 | 12-15 */
+        _mm256_storeu_si256((__m256i *)(void *)(dst + 4 * x), _mm256_permute2x128_si256(p0, p1, 0x20));
+        _mm256_storeu_si256((__m256i *)(void *)(dst + 4 * x + 32), _mm256_permute2x128_si256(p0, p1, 0x31));
+    }
+    return x; /* pixels done; the caller finishes the row */
+}
+#endif /* __AVX2__ */

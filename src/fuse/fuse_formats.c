@@ -84,8 +84,25 @@ static void demosaic_row(const fuse_frame *s, const int pat[4], int y, uint8_t *
     }
 }
 
+/* The AVX2 part of a YUYV/UYVY row where the CPU has it; returns the
+ * pixels done (the scalar loop does the rest). */
+static int yuv_row_fast(int avx2, const uint8_t *r, int width, int uyvy, uint8_t *d)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    if (avx2) return fuse__yuv422_row_avx2(r, width, uyvy, d);
+#endif
+    (void)avx2, (void)r, (void)width, (void)uyvy, (void)d;
+    return 0;
+}
+
 fuse_result fuse_frame_to_rgba(const fuse_frame *s, int y0, fuse_image *out)
 {
+    return fuse_frame_to_rgba_isa(s, y0, out, EF_ISA_DEFAULT);
+}
+
+fuse_result fuse_frame_to_rgba_isa(const fuse_frame *s, int y0, fuse_image *out, ef_isa cap)
+{
+    const int yuv_avx2 = ef_isa_choose(cap) >= EF_ISA_AVX2;
     static const int pats[4][4] = {
         { 0, 1, 1, 2 },   /* RGGB */
         { 1, 0, 2, 1 },   /* GRBG */
@@ -120,13 +137,15 @@ fuse_result fuse_frame_to_rgba(const fuse_frame *s, int y0, fuse_image *out)
         uint8_t *d = out->pixels + (size_t)y * (size_t)out->stride;
         switch (s->format) {
         case FUSE_FMT_YUYV:
-            for (x = 0; x < s->width; x += 2, r += 4, d += 8) {
+            x = yuv_row_fast(yuv_avx2, r, s->width, 0, d);
+            for (r += 2 * x, d += 4 * x; x < s->width; x += 2, r += 4, d += 8) {
                 yuv_px(r[0], r[1], r[3], d);
                 yuv_px(r[2], r[1], r[3], d + 4);
             }
             break;
         case FUSE_FMT_UYVY:
-            for (x = 0; x < s->width; x += 2, r += 4, d += 8) {
+            x = yuv_row_fast(yuv_avx2, r, s->width, 1, d);
+            for (r += 2 * x, d += 4 * x; x < s->width; x += 2, r += 4, d += 8) {
                 yuv_px(r[1], r[0], r[2], d);
                 yuv_px(r[3], r[0], r[2], d + 4);
             }

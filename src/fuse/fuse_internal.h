@@ -417,4 +417,10 @@ fuse_result fuse__composite_check(const fuse_image *Q, const fuse_image *V,
                                   int vp_x0, int vp_y0, int vp_w, int vp_h,
                                   const fuse_image *out);
 
+/* Camera formats (fuse_formats.c): converts the first pixels of a YUYV
+ * (uyvy 0) or UYVY (uyvy 1) row of width pixels to RGBA8, byte-exact with
+ * the reference, and returns how many it did (a multiple of 16); the
+ * caller converts the rest. */
+int fuse__yuv422_row_avx2(const uint8_t *src, int width, int uyvy, uint8_t *dst);
+
 #endif
