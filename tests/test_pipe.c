@@ -337,6 +337,50 @@ static void cull_back_faces(void **state)
     kin_model_free(&m);
 }
 
+/* Camera frames given as YUYV: the same bytes as converting them first and
+ * giving RGBA; a frame of the wrong size is refused. */
+static void raw_camera_frames(void **state)
+{
+    (void)state;
+    kin_model m;
+    quad_model(&m, 0.1f, -0.4f);
+    pipe_ctx *p = pipe_create(NULL, &m);
+    assert_non_null(p);
+    frame_bufs b, c;
+    pipe_frame_in in, ref;
+    make_frame(&b, &in, 21);
+    make_frame(&c, &ref, 21);
+    tu_rng r = {5};
+    uint8_t *yuyv[2];
+    for (int e = 0; e < 2; e++) {
+        yuyv[e] = malloc(640 * 480 * 2);
+        for (int i = 0; i < 640 * 480 * 2; i++) yuyv[e][i] = (uint8_t)tu_next(&r);
+        in.camera_raw[e] = (fuse_frame){yuyv[e], 640 * 480 * 2, 640, 480, 1280, FUSE_FMT_YUYV};
+        fuse_image full = {c.cam[e], 640, 480, 640 * 4};
+        assert_int_equal(fuse_frame_to_rgba(&in.camera_raw[e], 0, &full), FUSE_OK);
+    }
+    pipe_frame_stats st;
+    assert_int_equal(pipe_frame(p, &ref, NULL, NULL, 0), PIPE_OK);
+    assert_int_equal(pipe_frame(p, &in, &st, NULL, 0), PIPE_OK);
+    for (int e = 0; e < 2; e++) assert_memory_equal(b.out[e], c.out[e], 1280 * 800 * 4);
+    char why[200];
+    in.camera_raw[1].height = 400;
+    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_ERR_ARGS);
+    assert_non_null(strstr(why, "right eye: camera frame 640x400"));
+    assert_non_null(strstr(why, "bad size"));
+    in.camera_raw[1].height = 480;
+    in.camera_raw[1].size = 1000; /* a short buffer: refused before any output */
+    memset(b.out[0], 0x3C, 1280 * 800 * 4);
+    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_ERR_ARGS);
+    assert_non_null(strstr(why, "bad buffer"));
+    for (int i = 0; i < 1280 * 800 * 4; i++) assert_int_equal(b.out[0][i], 0x3C);
+    for (int e = 0; e < 2; e++) free(yuyv[e]);
+    free_frame(&b);
+    free_frame(&c);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
 static void bad_inputs(void **state)
 {
     (void)state;
@@ -379,6 +423,7 @@ int main(void)
         cmocka_unit_test_prestate(threads_same_bytes, (void *)1),
         cmocka_unit_test(virtual_depth),
         cmocka_unit_test(cull_back_faces),
+        cmocka_unit_test(raw_camera_frames),
         cmocka_unit_test(bad_inputs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

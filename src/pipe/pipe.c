@@ -195,6 +195,7 @@ typedef struct eye_state {
     int eye;
     float *depth, *nrm, *clip, *vnrm;
     uint8_t *mask, *layer;
+    uint8_t *cam_rgba;        /* the cropped camera image, when given raw */
     rast_context *rast;
     fuse_context *fuse;
     kin_camera cam;
@@ -203,7 +204,7 @@ typedef struct eye_state {
     kin_mat4 head;
     pipe_result result;
     char why[160];
-    double ms_raster, ms_fuse, coverage;
+    double ms_raster, ms_convert, ms_fuse, coverage;
 } eye_state;
 
 struct pipe_ctx {
@@ -283,7 +284,21 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     fuse_eye fe = {0};
     fe.lighting = &L;
     fe.intrinsics = &K;
-    fe.P = fuse_image_rows(&in->camera[e->eye], p->geo.crop_y0, ch);
+    e->ms_convert = 0.0;
+    if (in->camera_raw[e->eye].data) {
+        double tc = now_ms();
+        fe.P = (fuse_image){e->cam_rgba, cw, ch, 4 * cw};
+        fuse_result cr = fuse_frame_to_rgba(&in->camera_raw[e->eye], p->geo.crop_y0, &fe.P);
+        e->ms_convert = now_ms() - tc;
+        if (cr != FUSE_OK) {
+            e->result = PIPE_ERR_ARGS;
+            snprintf(e->why, sizeof e->why, "%s eye: camera frame: %s",
+                     e->eye ? "right" : "left", fuse_result_str(cr));
+            return;
+        }
+    } else {
+        fe.P = fuse_image_rows(&in->camera[e->eye], p->geo.crop_y0, ch);
+    }
     fe.mask = e->mask;
     fe.mask_stride = cw;
     fe.normal = e->nrm;
@@ -310,7 +325,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         for (int k = 0; k < 3; k++) L.tone[k] *= tone[k];
     }
     if (fr == FUSE_OK) fr = fuse_context_frame(e->fuse, &fe, 1);
-    e->ms_fuse = now_ms() - t1;
+    e->ms_fuse = now_ms() - t1 - e->ms_convert;
     if (fr != FUSE_OK) {
         e->result = PIPE_ERR_FUSE;
         snprintf(e->why, sizeof e->why, "%s eye: lighting/composite: %s",
@@ -372,6 +387,7 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].vnrm);
         free(p->eye[e].mask);
         free(p->eye[e].layer);
+        free(p->eye[e].cam_rgba);
         rast_context_destroy(p->eye[e].rast);
         fuse_context_destroy(p->eye[e].fuse);
     }
@@ -399,13 +415,14 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         s->nrm = malloc(sizeof(float) * 3 * px);
         s->mask = malloc(px);
         s->layer = malloc(4 * px);
+        s->cam_rgba = malloc(4 * px);
         s->clip = malloc(sizeof(float) * 4 * nv);
         s->vnrm = malloc(sizeof(float) * 3 * nv);
         rast_context_desc rd = {p->desc.max_isa, 1};
         fuse_context_desc fd = {(ef_isa)p->desc.max_isa, 1};
         s->rast = rast_context_create(&rd);
         s->fuse = fuse_context_create(&fd);
-        ok = ok && s->depth && s->nrm && s->mask && s->layer && s->clip && s->vnrm &&
+        ok = ok && s->depth && s->nrm && s->mask && s->layer && s->cam_rgba && s->clip && s->vnrm &&
              s->rast && s->fuse;
     }
     p->threaded = p->desc.threads != 1;
@@ -455,7 +472,27 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
     const int lcd_w = p->hmd.lcd_width, lcd_h = p->hmd.lcd_height;
     if (!in) return PIPE_ERR_ARGS;
     for (int e = 0; e < 2; e++) {
-        if (!image_fits(&in->camera[e], cam_w, cam_h, e, "camera", why, why_size) ||
+        const fuse_frame *raw = &in->camera_raw[e];
+        if (raw->data) {
+            /* Checked here, before any eye writes its output. */
+            int rb = fuse_format_row_bytes(raw->format, raw->width);
+            const char *bad = NULL;
+            if (raw->width != cam_w || raw->height != cam_h) bad = "size";
+            else if (rb == 0) bad = "format";
+            else if (raw->stride < rb ||
+                     raw->size < (size_t)(raw->height - 1) * (size_t)raw->stride + (size_t)rb)
+                bad = "buffer";
+            if (bad) {
+                if (why && why_size > 0)
+                    snprintf(why, (size_t)why_size,
+                             "%s eye: camera frame %dx%d, format %d, stride %d, %zu bytes: "
+                             "bad %s (expected %dx%d)", e ? "right" : "left", raw->width,
+                             raw->height, (int)raw->format, raw->stride, raw->size, bad,
+                             cam_w, cam_h);
+                return PIPE_ERR_ARGS;
+            }
+        }
+        if ((!raw->data && !image_fits(&in->camera[e], cam_w, cam_h, e, "camera", why, why_size)) ||
             !image_fits(&in->virt[e], lcd_w, lcd_h, e, "virtual", why, why_size) ||
             !image_fits(&in->out[e], lcd_w, lcd_h, e, "output", why, why_size))
             return PIPE_ERR_ARGS;
@@ -500,6 +537,7 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
         stats->ms_pose = t1 - t0;
         for (int e = 0; e < 2; e++) {
             stats->ms_raster[e] = p->eye[e].ms_raster;
+            stats->ms_convert[e] = p->eye[e].ms_convert;
             stats->ms_fuse[e] = p->eye[e].ms_fuse;
             stats->coverage[e] = p->eye[e].coverage;
         }

@@ -118,6 +118,11 @@ typedef struct pipe_frame_in {
     fuse_image camera[2];
     fuse_image virt[2];
     fuse_image out[2];
+    /* Optional: the camera frames as the camera delivers them (YUYV, UYVY,
+     * GREY, Bayer, RGB24: fuse_frame_to_rgba). When camera_raw[e].data is
+     * set, the eye's thread converts only the cropped rows itself and
+     * camera[e] is not used. */
+    fuse_frame camera_raw[2];
     /* Optional depth of the virtual scene per eye (output resolution,
      * metres along the eye's view axis; 0, inf or NaN = nothing there):
      * a virtual object in front of the hand hides it (fuse_depth_test). */
@@ -129,6 +134,7 @@ typedef struct pipe_frame_in {
 typedef struct pipe_frame_stats {
     double ms_pose;           /* posing + skinning */
     double ms_raster[2];      /* per eye: camera, G-buffer */
+    double ms_convert[2];     /* per eye: camera format conversion (raw) */
     double ms_fuse[2];        /* per eye: lighting, resampling, composite */
     double ms_total;          /* wall time of pipe_frame */
     double coverage[2];       /* fraction of camera pixels in the mask */
