@@ -224,19 +224,6 @@ static void rgba_to_yuyv(const uint8_t *rgba, int w, int h, size_t stride, uint8
     }
 }
 
-typedef struct conv_job {
-    fuse_frame frame;
-    int y0;
-    fuse_image out;   /* the crop's rows of the 640x480 RGBA buffer */
-    fuse_result r;
-} conv_job;
-
-static void conv_run(void *p)
-{
-    conv_job *j = p;
-    j->r = fuse_frame_to_rgba(&j->frame, j->y0, &j->out);
-}
-
 /* ------------------------------------------------------------- the bench */
 
 /* Virtual images of one output resolution: a window of frames. */
@@ -484,27 +471,11 @@ static void times_init(times *t, int cap)
 /* One whole stereo frame i: convert, track, pipe_frame. Fills slot k of
  * the times (k < 0: not recorded). Returns 0 on a pipe error. */
 static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *src, long i,
-                      int threads, int k)
+                      int k)
 {
     const int w = (int)(i % is->n);
     const int cw = b->hmd.cam_width, ch = b->hmd.cam_height;
     double t0 = now_ms();
-    conv_job job[2];
-    for (int e = 0; e < 2; e++) {
-        fuse_image full = img_of(b->cam_rgba[e], cw, ch);
-        job[e].frame = (fuse_frame){b->yuyv[w % b->window][e], b->yuyv_size, cw, ch, 2 * cw,
-                                    FUSE_FMT_YUYV};
-        job[e].y0 = b->geo.crop_y0;
-        job[e].out = fuse_image_rows(&full, b->geo.crop_y0, b->geo.crop_height);
-    }
-    if (threads == 2) {
-        helper_start(&b->help, conv_run, &job[1]);
-        conv_run(&job[0]);
-        helper_wait(&b->help);
-    } else {
-        conv_run(&job[0]);
-        conv_run(&job[1]);
-    }
     double t1 = now_ms();
     pipe_frame_in in = {0};
     if (!src->rest) {
@@ -520,7 +491,9 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
     in.head_node = src->head || src->rest ? -1 : b->rig.head;
     in.world_from_head = src->head;
     for (int e = 0; e < 2; e++) {
-        in.camera[e] = img_of(b->cam_rgba[e], cw, ch);
+        /* As the camera delivers it: each eye's thread converts its crop. */
+        in.camera_raw[e] = (fuse_frame){b->yuyv[w % b->window][e], b->yuyv_size, cw, ch,
+                                        2 * cw, FUSE_FMT_YUYV};
         in.virt[e] = img_of(is->virt[w][e], is->w, is->h);
         in.out[e] = img_of(b->out[e], is->w, is->h);
         in.virt_depth[e] = is->depth[w][e];
@@ -531,14 +504,13 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
     char why[256];
     pipe_result r = pipe_frame(p, &in, &st, why, sizeof why);
     double t3 = now_ms();
-    if (r != PIPE_OK || job[0].r != FUSE_OK || job[1].r != FUSE_OK) {
-        fprintf(stderr, "bench_frame: frame %ld: %s\n", i,
-                r != PIPE_OK ? why : "camera conversion failed");
+    if (r != PIPE_OK) {
+        fprintf(stderr, "bench_frame: frame %ld: %s\n", i, why);
         return 0;
     }
     if (k >= 0 && k < b->tm.cap) {
         b->tm.total[k] = t3 - t0;
-        b->tm.convert[k] = t1 - t0;
+        b->tm.convert[k] = st.ms_convert[0] + st.ms_convert[1];
         b->tm.track[k] = t2 - t1;
         b->tm.skin[k] = st.ms_pose;
         b->tm.raster[k] = st.ms_raster[0] + st.ms_raster[1];
@@ -551,18 +523,18 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
 /* Warm-up frames, then n measured frames on p, or fewer when max_s
  * seconds have passed (but at least min(n, 100)): the time box keeps
  * `make bench` to a few minutes on a loaded machine. */
-static int measure(bench *b, pipe_ctx *p, const imgset *is, const posesrc *src, int threads,
-                   int n, double max_s, result *r)
+static int measure(bench *b, pipe_ctx *p, const imgset *is, const posesrc *src, int n,
+                   double max_s, result *r)
 {
     if (n > b->tm.cap) n = b->tm.cap;
     kin_filter_init(&b->filt, NULL);   /* every case starts from its first sample */
     long i0 = b->tick;
     for (int k = -8; k < 0; k++)
-        if (!frame_step(b, p, is, src, i0 + 8 + k, threads, -1)) return 0;
+        if (!frame_step(b, p, is, src, i0 + 8 + k, -1)) return 0;
     double t0 = now_ms();
     const int n_min = n < 100 ? n : 100;
     for (int k = 0; k < n; k++) {
-        if (!frame_step(b, p, is, src, i0 + 8 + k, threads, k)) return 0;
+        if (!frame_step(b, p, is, src, i0 + 8 + k, k)) return 0;
         if (k + 1 >= n_min && now_ms() - t0 > 1e3 * max_s) {
             n = k + 1;
             break;
@@ -633,7 +605,7 @@ static double coverage_at(bench *b, pipe_ctx *p, const posesrc *src0, double d)
     posesrc src = *src0;
     src.head = &h;
     kin_filter_init(&b->filt, NULL);   /* the pose at once, no filter lag */
-    if (!frame_step(b, p, &b->base, &src, b->tick, 2, 0)) return 0;
+    if (!frame_step(b, p, &b->base, &src, b->tick, 0)) return 0;
     return b->tm.cover[0];
 }
 
@@ -745,7 +717,7 @@ static void run_grid(bench *b, const budget *bu)
                 double s = isas[i] == EF_ISA_REF ? bu->s_ref
                            : isas[i] == best     ? bu->s_best
                                                  : bu->s_other;
-                if (measure(b, p, &b->base, c ? &worst : &typical, t, n, s, &r)) {
+                if (measure(b, p, &b->base, c ? &worst : &typical, n, s, &r)) {
                     print_row(c ? "worst" : "typical", ef_isa_name(isas[i]), t, &r);
                     if (isas[i] == best) b->lat[c][t - 1] = r;
                     csv_row(b, c ? "frame_worst" : "frame_typical", "egofuse", ef_isa_name(isas[i]),
@@ -1045,7 +1017,7 @@ static void scale_tris(bench *b, int n, double max_s, ef_isa isa)
         for (int t = 1; t <= 2; t++) {
             pipe_ctx *p = make_pipe(b, &mm.m, isa, t, NULL);
             result r;
-            if (p && measure(b, p, &b->base, &rest, t, n, max_s, &r)) {
+            if (p && measure(b, p, &b->base, &rest, n, max_s, &r)) {
                 med[t - 1] = r.total.median;
                 cov = r.coverage;
                 csv_row(b, "scale_tris", "egofuse", ef_isa_name(isa), t, &r, mm.bm.tri_count,
@@ -1078,7 +1050,7 @@ static void scale_cover(bench *b, int n, double max_s, ef_isa isa)
         for (int t = 1; t <= 2; t++) {
             pipe_ctx *p = make_pipe(b, &b->model, isa, t, NULL);
             result r;
-            if (p && measure(b, p, &b->base, &src, t, n, max_s, &r)) {
+            if (p && measure(b, p, &b->base, &src, n, max_s, &r)) {
                 med[t - 1] = r.total.median;
                 cov = r.coverage;
                 csv_row(b, "scale_cover", "egofuse", ef_isa_name(isa), t, &r, -1, b->base.w,
@@ -1146,7 +1118,7 @@ static void scale_res(bench *b, int n, double max_s, ef_isa isa)
         for (int t = 1; t <= 2; t++) {
             pipe_ctx *p = make_pipe(b, &b->model, isa, t, &hd);
             result r;
-            if (p && measure(b, p, &is, &typical, t, n, max_s, &r)) {
+            if (p && measure(b, p, &is, &typical, n, max_s, &r)) {
                 med[t - 1] = r.total.median;
                 csv_row(b, "scale_res", "egofuse", ef_isa_name(isa), t, &r, -1, sizes[i][0],
                         sizes[i][1]);

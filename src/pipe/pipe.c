@@ -288,7 +288,8 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     if (in->camera_raw[e->eye].data) {
         double tc = now_ms();
         fe.P = (fuse_image){e->cam_rgba, cw, ch, 4 * cw};
-        fuse_result cr = fuse_frame_to_rgba(&in->camera_raw[e->eye], p->geo.crop_y0, &fe.P);
+        fuse_result cr = fuse_frame_to_rgba_isa(&in->camera_raw[e->eye], p->geo.crop_y0, &fe.P,
+                                                (ef_isa)p->desc.max_isa);
         e->ms_convert = now_ms() - tc;
         if (cr != FUSE_OK) {
             e->result = PIPE_ERR_ARGS;
