@@ -122,6 +122,35 @@ static void test_validation(void **state)
     rt_free(&t);
 }
 
+/* One bad index at every position of a longer index list (the check
+ * runs 4 indices at a time plus a scalar tail), for the smallest bad
+ * value, one with the top bit set and the largest. */
+static void test_index_every_position(void **state)
+{
+    (void)state;
+    rast_target t = rt_make(16, 16, 1, 2, 1);
+    rast_mesh_desc d = valid_mesh();
+    enum { NT = 11 };
+    uint32_t idx[3 * NT];
+    const uint32_t bad[3] = { 4, 0x80000000u, 0xFFFFFFFFu };
+    d.indices = idx;
+    d.tri_count = NT;
+    for (int pos = 0; pos < 3 * NT; pos++)
+        for (int b = 0; b < 3; b++) {
+            for (int i = 0; i < 3 * NT; i++)
+                idx[i] = (uint32_t)(i % 4);
+            assert_int_equal(rast_draw(&t, &d, NULL), RAST_OK);
+            idx[pos] = bad[b];
+            assert_int_equal(rast_draw(&t, &d, NULL), RAST_ERR_INDEX);
+        }
+    d.vertex_count = 0;   /* no vertex: every index is out of range */
+    idx[0] = 0;
+    assert_int_equal(rast_draw(&t, &d, NULL), RAST_ERR_INDEX);
+    d.tri_count = 0;
+    assert_int_equal(rast_draw(&t, &d, NULL), RAST_OK);
+    rt_free(&t);
+}
+
 static void test_index_out_of_range(void **state)
 {
     (void)state;
@@ -418,6 +447,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_validation),
         cmocka_unit_test(test_index_out_of_range),
+        cmocka_unit_test(test_index_every_position),
         cmocka_unit_test(test_zero_size_and_empty),
         cmocka_unit_test(test_clear_keeps_padding),
         cmocka_unit_test(test_result_str),

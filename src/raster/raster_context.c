@@ -181,11 +181,9 @@ static void run_bands(rast_context *c, int tid, int job)
         long lo = base + (long)tid * BATCH, hi = lo + BATCH;
         if (hi > m->tri_count)
             hi = m->tri_count;
-        int cnt = 0;
-        for (long ti = lo; ti < hi; ti++)
-            cnt += rast__prepare_cached(&view, m, (int)ti, &me->vc, me->buf[par] + cnt,
-                                        &me->st);
-        me->count[par] = cnt;
+        me->count[par] = lo < hi ? rast__prepare_range(&view, m, (int)lo, (int)hi, &me->vc,
+                                                       me->buf[par], &me->st)
+                                 : 0;
         barrier(c);
         for (int s = 0; s < n; s++) {
             const slot *o = &c->slots[s];

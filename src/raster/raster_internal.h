@@ -88,7 +88,12 @@ enum {
     RAST__SETUP_OK = 0,
     RAST__SETUP_DEGENERATE,      /* zero area after snapping */
     RAST__SETUP_CULLED,
-    RAST__SETUP_OFFSCREEN        /* bounding box misses the target */
+    RAST__SETUP_OFFSCREEN,       /* bounding box misses the target */
+    /* Set up (counted as drawn) but provably writes no pixel: a box of
+     * one pixel whose centre fails the edge test. rast__prepare and the
+     * cached path count it as drawn and emit no triangle (its scan would
+     * write nothing); *tri has the box and edges but no planes. */
+    RAST__SETUP_EMPTY
 };
 
 /* Scans one triangle into t; returns the number of pixels written. */
@@ -185,6 +190,14 @@ void rast__vcache_reset(rast__vcache *c);
  * triangles, bytes and counters as rast__prepare. */
 int rast__prepare_cached(const rast__view *view, const rast_mesh_desc *m, int ti,
                          rast__vcache *vc, rast__tri *out, rast_stats *st);
+
+/* rast__prepare_cached for submitted triangles ti0 .. ti1-1 in order,
+ * writing their fan triangles one after the other to out (room for
+ * (ti1 - ti0) * RAST__MAX_FAN); returns their count. The same triangles,
+ * bytes and counters as rast__prepare_cached per triangle, without a call
+ * per triangle for the common rejections. */
+int rast__prepare_range(const rast__view *view, const rast_mesh_desc *m, int ti0,
+                        int ti1, rast__vcache *vc, rast__tri *out, rast_stats *st);
 
 /* ---- anti-aliased coverage (raster_aa.c, raster_aa.inl) ---------------- */
 

@@ -3,6 +3,7 @@
  * The rules and their bounds are written down in docs/raster.md. */
 #include "raster_internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
@@ -45,13 +46,23 @@ static float plane_dist(const rast__view *v, const rast__vert *p, int i)
     }
 }
 
+static inline unsigned outcode_inl(const rast__view *v, const rast__vert *p)
+{
+    /* The six distances of plane_dist (the same float expressions, so the
+     * same bits), tested without branches. */
+    const float x = p->x, y = p->y, z = p->z, w = p->w;
+    const float gxw = v->gx * w, gyw = v->gy * w;
+    return (unsigned)((z + w) < 0.0f) << RAST__PLANE_NEAR |
+           (unsigned)((w - z) < 0.0f) << RAST__PLANE_FAR |
+           (unsigned)((gxw + x) < 0.0f) << RAST__PLANE_LEFT |
+           (unsigned)((gxw - x) < 0.0f) << RAST__PLANE_RIGHT |
+           (unsigned)((gyw + y) < 0.0f) << RAST__PLANE_BOTTOM |
+           (unsigned)((gyw - y) < 0.0f) << RAST__PLANE_TOP;
+}
+
 unsigned rast__outcode(const rast__view *v, const rast__vert *p)
 {
-    unsigned code = 0;
-    for (int i = 0; i < RAST__PLANE_COUNT; i++)
-        if (plane_dist(v, p, i) < 0.0f)
-            code |= 1u << i;
-    return code;
+    return outcode_inl(v, p);
 }
 
 /* The point where edge (in, out) crosses the plane. Always computed from
@@ -128,8 +139,8 @@ static int32_t snap_axis(float s, int32_t lo, int32_t hi)
 #endif
 }
 
-void rast__snap(const rast__view *v, const rast__vert *p, int32_t *fx,
-                int32_t *fy)
+static inline void snap_inl(const rast__view *v, const rast__vert *p, int32_t *fx,
+                            int32_t *fy)
 {
     float nx = p->x / p->w;
     float ny = p->y / p->w;
@@ -137,6 +148,12 @@ void rast__snap(const rast__view *v, const rast__vert *p, int32_t *fx,
     float sy = (0.5f - ny * 0.5f) * (float)v->height;
     *fx = snap_axis(sx, v->min_x, v->max_x);
     *fy = snap_axis(sy, v->min_y, v->max_y);
+}
+
+void rast__snap(const rast__view *v, const rast__vert *p, int32_t *fx,
+                int32_t *fy)
+{
+    snap_inl(v, p, fx, fy);
 }
 
 /* ---- triangle setup ---------------------------------------------------- */
@@ -287,6 +304,13 @@ static int setup_oriented(const rast__view *v, const int32_t X[3], const int32_t
         tri->e_dx[k] = -(int64_t)dy * RAST__FIX_ONE;
         tri->e_dy[k] = (int64_t)dx * RAST__FIX_ONE;
     }
+    /* A box of one pixel whose centre is outside (20% of the scanned
+     * triangles of the 10k bench model, 55% at 41k): the scan would write
+     * nothing, so the planes
+     * are not set up and the triangle is not scanned; it still counts as
+     * drawn (the counters of the full path). */
+    if (bx0 == bx1 && by0 == by1 && (tri->e_c[0] | tri->e_c[1] | tri->e_c[2]) < 0)
+        return RAST__SETUP_EMPTY;
 
     /* Float planes, set up in double from the snapped positions (exact in
      * double) and stored as float. The origin is the centre of (x0, y0). */
@@ -379,15 +403,38 @@ rast_result rast__validate(const rast_target *t, const rast_mesh_desc *m)
     if (m->cull != RAST_CULL_NONE && m->cull != RAST_CULL_BACK &&
         m->cull != RAST_CULL_FRONT)
         return RAST_ERR_ARGS;
-    for (long i = 0; i < 3L * m->tri_count; i++)
-        if (m->indices[i] >= (uint32_t)m->vertex_count)
-            return RAST_ERR_INDEX;
-    return RAST_OK;
+    /* Every index below the vertex count, without a branch per index
+     * (4 at a time with SSE2: unsigned idx > nv - 1 as a signed compare
+     * of both sides biased by 2^31). */
+    const size_t ni = 3 * (size_t)m->tri_count;
+    if (ni == 0)
+        return RAST_OK;
+    if (m->vertex_count == 0)
+        return RAST_ERR_INDEX;
+    const uint32_t last = (uint32_t)m->vertex_count - 1u;
+    uint32_t bad = 0;
+    size_t i = 0;
+#if defined(__SSE2__)
+    const __m128i bias = _mm_set1_epi32(INT32_MIN);
+    const __m128i lim = _mm_set1_epi32((int32_t)(last ^ 0x80000000u));
+    __m128i acc = _mm_setzero_si128();
+    for (; i + 4 <= ni; i += 4) {
+        const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)(m->indices + i));
+        acc = _mm_or_si128(acc, _mm_cmpgt_epi32(_mm_xor_si128(v, bias), lim));
+    }
+    bad = (uint32_t)_mm_movemask_epi8(acc);
+#endif
+    for (; i < ni; i++)
+        bad |= (uint32_t)(m->indices[i] > last);
+    return bad ? RAST_ERR_INDEX : RAST_OK;
 }
 
 static int finite_vert(const rast__vert *p)
 {
-    return isfinite(p->x) && isfinite(p->y) && isfinite(p->z) && isfinite(p->w);
+    /* isfinite of each coordinate (|c| <= FLT_MAX is false for NaN and
+     * infinities), without a branch per coordinate. */
+    return (fabsf(p->x) <= FLT_MAX) & (fabsf(p->y) <= FLT_MAX) & (fabsf(p->z) <= FLT_MAX) &
+           (fabsf(p->w) <= FLT_MAX);
 }
 
 /* Fetch, clip and snap submitted triangle ti: the snapped polygon (fx, fy;
@@ -465,6 +512,7 @@ int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
             st->tris_drawn++;
             made++;
             break;
+        case RAST__SETUP_EMPTY:      st->tris_drawn++; break;
         case RAST__SETUP_DEGENERATE: st->tris_degenerate++; break;
         case RAST__SETUP_CULLED:     st->tris_culled++; break;
         default:                     st->tris_clipped_away++; break;
@@ -495,7 +543,7 @@ static RAST__NOINLINE void vc_fill(const rast__view *view,
         e->flags = RAST__VF_NONFINITE;
         return;
     }
-    const unsigned oc = rast__outcode(view, &p);
+    const unsigned oc = outcode_inl(view, &p);
     /* w <= 0 inside every plane: only the clip-space origin, which the
      * clip path drops (docs/raster.md section 3.3). */
     if (oc || !(p.w > 0.0f)) {
@@ -503,7 +551,7 @@ static RAST__NOINLINE void vc_fill(const rast__view *view,
         return;
     }
     e->flags = 0;
-    rast__snap(view, &p, &e->X, &e->Y);
+    snap_inl(view, &p, &e->X, &e->Y);
     e->zw = vert_zw(&p);
     e->iw = vert_iw(&p);
 }
@@ -522,14 +570,26 @@ static int count_setup(int r, rast_stats *st)
 {
     switch (r) {
     case RAST__SETUP_OK:         st->tris_drawn++; return 1;
+    case RAST__SETUP_EMPTY:      st->tris_drawn++; return 0;
     case RAST__SETUP_DEGENERATE: st->tris_degenerate++; return 0;
     case RAST__SETUP_CULLED:     st->tris_culled++; return 0;
     default:                     st->tris_clipped_away++; return 0;
     }
 }
 
-int rast__prepare_cached(const rast__view *view, const rast_mesh_desc *m, int ti,
-                         rast__vcache *vc, rast__tri *out, rast_stats *st)
+#if defined(__GNUC__) || defined(__clang__)
+#define RAST__INLINE inline __attribute__((always_inline))
+#else
+#define RAST__INLINE inline
+#endif
+
+/* The body of rast__prepare_cached, inlined into the range loop of
+ * rast__prepare_range so that the common rejections (back faces, tiny
+ * and off-screen triangles: 75-85% of the bench model) cost no call. */
+static RAST__INLINE int prepare_cached_one(const rast__view *view,
+                                           const rast_mesh_desc *m, int ti,
+                                           rast__vcache *vc, rast__tri *out,
+                                           rast_stats *st)
 {
     const uint32_t *ix = m->indices + 3 * (size_t)ti;
     const rast__vc_entry *e0 = vc_get(view, m, vc, ix[0]);
@@ -573,6 +633,26 @@ int rast__prepare_cached(const rast__view *view, const rast_mesh_desc *m, int ti
     }
     return count_setup(setup_oriented(view, X, Y, area < 0 ? -area : area, zw, iw,
                                       attr, out), st);
+}
+
+int rast__prepare_cached(const rast__view *view, const rast_mesh_desc *m, int ti,
+                         rast__vcache *vc, rast__tri *out, rast_stats *st)
+{
+    return prepare_cached_one(view, m, ti, vc, out, st);
+}
+
+int rast__prepare_range(const rast__view *view, const rast_mesh_desc *m, int ti0,
+                        int ti1, rast__vcache *vc, rast__tri *out, rast_stats *st)
+{
+    /* Counters in a local copy: built with -fno-strict-aliasing, the
+     * compiler would otherwise store and reload them around every write
+     * to out. */
+    rast_stats ls = *st;
+    int n = 0;
+    for (int ti = ti0; ti < ti1; ti++)
+        n += prepare_cached_one(view, m, ti, vc, out + n, &ls);
+    *st = ls;
+    return n;
 }
 
 
@@ -684,16 +764,33 @@ void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
     rast__view_init(&view, t->width, t->height, rast__draw_na(t, m));
     rast_stats st = { 0 };
     st.tris_in = m->tri_count;
-    rast__tri tri[RAST__MAX_FAN];
+    /* Front end over chunks of submitted triangles, then the scans of
+     * the chunk's triangles in submission order. */
+    enum { CHUNK = 16 };
+    rast__tri tri[CHUNK * RAST__MAX_FAN];
     rast__vcache vc;
     rast__vcache_reset(&vc);
-    for (int ti = 0; ti < m->tri_count; ti++) {
-        int n = rast__prepare_cached(&view, m, ti, &vc, tri, &st);
+    int last[4] = { 1, 0, 1, 0 };   /* tiles marked last: x0, x1, y0, y1 (none) */
+    for (int ti = 0; ti < m->tri_count; ti += CHUNK) {
+        const int te = m->tri_count - ti > CHUNK ? ti + CHUNK : m->tri_count;
+        const int n = rast__prepare_range(&view, m, ti, te, &vc, tri, &st);
         for (int i = 0; i < n; i++) {
             const rast__tri *r = &tri[i];
             st.pixels_written += scan(t, r, r->y0, r->y1);
-            if (tiles)
-                rast__tiles_add(tiles, r->y0, r->y1, r->x0, r->x1);
+            if (!tiles)
+                continue;
+            /* Neighbouring triangles mostly lie in the tiles just marked:
+             * skip the marking when the tile rectangle is inside the last
+             * one marked (those bits are set already). */
+            const int tx0 = r->x0 / RAST__TILE, tx1 = r->x1 / RAST__TILE;
+            const int ty0 = r->y0 / RAST__TILE, ty1 = r->y1 / RAST__TILE;
+            if (tx0 >= last[0] && tx1 <= last[1] && ty0 >= last[2] && ty1 <= last[3])
+                continue;
+            rast__tiles_add(tiles, r->y0, r->y1, r->x0, r->x1);
+            last[0] = tx0;
+            last[1] = tx1;
+            last[2] = ty0;
+            last[3] = ty1;
         }
     }
     if (stats)

@@ -95,12 +95,48 @@ static inline void simd_attr_store(float *dst, int na, unsigned pass, vf b1, vf 
     }
 }
 
+/* A box of one pixel (x0, y), the commonest box of a fine mesh far away:
+ * the reference's scalar expressions for that pixel (fi = 0 and fj are
+ * the same floats, every op the same IEEE op), without the vector
+ * set-up of SIMD_FN. */
+static long simd_scan_pixel(const rast_target *t, const rast__tri *tri, int y)
+{
+    const int64_t j = y - tri->y0;
+    if (((tri->e_c[0] + j * tri->e_dy[0]) | (tri->e_c[1] + j * tri->e_dy[1]) |
+         (tri->e_c[2] + j * tri->e_dy[2])) < 0)
+        return 0;
+    const float fj = (float)j, fi = 0.0f;
+    float z = (tri->z.c + tri->z.dy * fj) + tri->z.dx * fi;
+    z = z < 0.0f ? 0.0f : z;
+    z = z > 1.0f ? 1.0f : z;
+    const int x = tri->x0;
+    if (t->depth) {
+        float *d = t->depth + (size_t)y * (size_t)t->depth_stride + x;
+        if (!(z < *d))
+            return 0;
+        *d = z;
+    }
+    t->mask[(size_t)y * (size_t)t->mask_stride + x] = 255;
+    const int na = t->attr ? tri->attr_count : 0;
+    if (na) {
+        const float r = 1.0f / ((tri->q.c + tri->q.dy * fj) + tri->q.dx * fi);
+        const float b1 = ((tri->b1.c + tri->b1.dy * fj) + tri->b1.dx * fi) * r;
+        const float b2 = ((tri->b2.c + tri->b2.dy * fj) + tri->b2.dx * fi) * r;
+        float *a = t->attr + (size_t)y * (size_t)t->attr_stride + (size_t)x * (size_t)na;
+        for (int k = 0; k < na; k++)
+            a[k] = (tri->a0[k] + b1 * tri->d1[k]) + b2 * tri->d2[k];
+    }
+    return 1;
+}
+
 long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
 {
     const int ys = ya > tri->y0 ? ya : tri->y0;
     const int ye = yb < tri->y1 ? yb : tri->y1;
     if (ys > ye)
         return 0;
+    if (tri->x0 == tri->x1 && ys == ye)
+        return simd_scan_pixel(t, tri, ys);
     const int na = t->attr ? tri->attr_count : 0;
     const int nx = tri->x1 - tri->x0 + 1;
     const int nvec = (nx + SIMD_V - 1) / SIMD_V;
@@ -116,8 +152,8 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
     const int64_t cols = (int64_t)nvec * SIMD_V - 1;
     for (int k = 0; k < 3; k++) {
         c[k] = simd_floor256(tri->e_c[k] + (int64_t)(ys - tri->y0) * tri->e_dy[k]);
-        sx[k] = (int32_t)(tri->e_dx[k] / 256);     /* exact: multiples of 256 */
-        sy[k] = (int32_t)(tri->e_dy[k] / 256);
+        sx[k] = (int32_t)(tri->e_dx[k] >> 8);      /* exact: multiples of 256 */
+        sy[k] = (int32_t)(tri->e_dy[k] >> 8);
         fits &= simd_abs64(c[k]) + rows * simd_abs64(sy[k]) + cols * simd_abs64(sx[k]) <=
                 SIMD_LIM30;
     }
