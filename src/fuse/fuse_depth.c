@@ -39,15 +39,27 @@ void fuse__depth_rows(const fuse_depth *d, const fuse_image *Q, int vp_x0,
         const float *hz = d->hand + (size_t)y * (size_t)d->hand_stride;
         const float *sc = d->scene + (size_t)oy * (size_t)d->scene_stride;
         uint8_t *q = Q->pixels + (size_t)y * (size_t)Q->stride;
+        /* ox = floor((2x + 1) vp_w / (2 sw)) kept as quotient and
+         * remainder and stepped by 2 vp_w per pixel: exact, no division */
+        int64_t ox = (int64_t)vp_w / (2 * (int64_t)sw), rem = (int64_t)vp_w % (2 * (int64_t)sw);
+        const int64_t den = 2 * (int64_t)sw, step = 2 * (int64_t)vp_w;
+        const int64_t step_q = step / den, step_r = step % den;
         for (x = 0; x < sw; x++, q += 4) {
             uint32_t w;
             float z, dist, s;
+            const int64_t cx = ox;
+            ox += step_q;
+            rem += step_r;
+            if (rem >= den) {
+                rem -= den;
+                ox++;
+            }
             memcpy(&w, q, 4);
             if (w == 0) continue;
             z = hz[x];
             if (!(z >= 0.0f && z < 1.0f)) continue;          /* no depth: keep */
             dist = two_fn / (fpn - ((2.0f * z) - 1.0f) * fmn) + d->offset;
-            s = sc[vp_x0 + (int)(((int64_t)2 * x + 1) * vp_w / (2 * (int64_t)sw))];
+            s = sc[vp_x0 + (int)cx];
             if (s > 0.0f && s < dist) memset(q, 0, 4);       /* scene in front */
         }
     }
