@@ -384,24 +384,7 @@ static int preload(bench *b, const char *samples_dir, int window)
     b->seq_frames = sc.frames;
     b->hmd = kin_sthmd_desc_resolved(NULL);
     b->geo = kin_sthmd_geometry_of(&b->hmd);
-    b->lighting = pipe_lighting_default();
-    if (sc.has_lighting) {
-        fuse_lighting *L = &b->lighting.light;
-        L->light_count = sc.light_count;
-        for (int k = 0; k < 3; k++) {
-            L->ambient[k] = sc.ambient[k];
-            L->tone[k] = sc.tone[k];
-        }
-        L->kd = sc.kd;
-        L->ks = sc.ks;
-        L->shininess = sc.shininess;
-        L->kf = sc.kf;
-        for (int i = 0; i < sc.light_count && i < FUSE_MAX_LIGHTS; i++)
-            for (int k = 0; k < 3; k++) {
-                L->lights[i].dir[k] = sc.light_dir[i][k];
-                L->lights[i].color[k] = sc.light_color[i][k];
-            }
-    }
+    b->lighting.light = io_scene_lighting(&sc);
     make_samples(b);
 
     const int cw = b->hmd.cam_width, ch = b->hmd.cam_height;

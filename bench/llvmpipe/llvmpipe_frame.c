@@ -229,24 +229,7 @@ static int load(inputs *in, const char *dir, int window)
     in->seq_frames = sc.frames;
     in->hmd = kin_sthmd_desc_resolved(NULL);
     in->geo = kin_sthmd_geometry_of(&in->hmd);
-    in->lighting = pipe_lighting_default();
-    if (sc.has_lighting) {
-        fuse_lighting *L = &in->lighting.light;
-        L->light_count = sc.light_count;
-        for (int k = 0; k < 3; k++) {
-            L->ambient[k] = sc.ambient[k];
-            L->tone[k] = sc.tone[k];
-        }
-        L->kd = sc.kd;
-        L->ks = sc.ks;
-        L->shininess = sc.shininess;
-        L->kf = sc.kf;
-        for (int i = 0; i < sc.light_count && i < FUSE_MAX_LIGHTS; i++)
-            for (int k = 0; k < 3; k++) {
-                L->lights[i].dir[k] = sc.light_dir[i][k];
-                L->lights[i].color[k] = sc.light_color[i][k];
-            }
-    }
+    in->lighting.light = io_scene_lighting(&sc);
     const int cw = in->hmd.cam_width, ch = in->hmd.cam_height;
     const int lw = in->hmd.lcd_width, lh = in->hmd.lcd_height;
     in->window = window < sc.frames ? window : sc.frames;

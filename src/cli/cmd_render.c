@@ -158,30 +158,6 @@ static int file_exists(const char *p)
     return stat(p, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-/* The scene's lighting, directions in world space (pipe_frame turns them
- * into each camera's view space). */
-static pipe_lighting scene_lighting(const io_scene *s)
-{
-    pipe_lighting pl = pipe_lighting_default();
-    if (!s->has_lighting) return pl;
-    fuse_lighting *L = &pl.light;
-    L->light_count = s->light_count;
-    for (int k = 0; k < 3; k++) {
-        L->ambient[k] = s->ambient[k];
-        L->tone[k] = s->tone[k];
-    }
-    L->kd = s->kd;
-    L->ks = s->ks;
-    L->shininess = s->shininess;
-    L->kf = s->kf;
-    for (int i = 0; i < s->light_count && i < FUSE_MAX_LIGHTS; i++)
-        for (int k = 0; k < 3; k++) {
-            L->lights[i].dir[k] = s->light_dir[i][k];
-            L->lights[i].color[k] = s->light_color[i][k];
-        }
-    return pl;
-}
-
 static int load_rgba(const char *path, int w, int h, const char *what,
                      io_image *img)
 {
@@ -301,7 +277,7 @@ static int render(const render_opts *o)
     pipe_frame_in in = {0};
     in.anim = anim;
     in.head_node = head;
-    in.lighting = scene_lighting(&sc);
+    in.lighting.light = io_scene_lighting(&sc);
     static const char *eye_name[2] = {"left", "right"};
     pipe_frame_stats st, sum = {0};
     progress pr;

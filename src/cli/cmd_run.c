@@ -286,6 +286,7 @@ static int run(const run_opts *o)
     pipe_frame_in in;
     memset(&in, 0, sizeof in);
     in.lighting = pipe_lighting_default();
+    if (have_scene) in.lighting.light = io_scene_lighting(&sc); /* the scene's lights */
     in.head_node = head;
     kin_mat4 ident = kin_mat4_identity();
     in.world_from_head = &ident;

@@ -28,6 +28,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include "../fuse/fuse.h"
 #include "../kin/kin.h"
 
 #ifdef __cplusplus
@@ -139,6 +140,10 @@ typedef struct io_scene {
 } io_scene;
 
 io_result io_scene_load(const char *path, io_scene *out, io_error *err);
+/* The scene's lighting for the fuse stage, light directions in WORLD space
+ * (src/pipe turns them into each camera's view space); the defaults of
+ * fuse_lighting_default() when the file sets none. */
+fuse_lighting io_scene_lighting(const io_scene *s);
 /* Expands a frame pattern of the scene into an absolute-or-relative path. */
 void io_scene_frame_path(const io_scene *s, const char *pattern, int frame,
                          char *out, size_t out_size);

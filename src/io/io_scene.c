@@ -271,24 +271,41 @@ static int is_lighting_key(key_id k)
            k == K_SHININESS || k == K_KF || k == K_TONE;
 }
 
-/* The values of fuse_lighting_default() (src/fuse/fuse.h, fuse_ref.c),
- * copied because io may not call fuse: ambient 0.35, kd 0.75, ks 0.15,
- * s 16, kf 0.6, tone 1, one white light from (0, 0.6, 0.8). */
+/* Lighting fields the file does not set take fuse_lighting_default(). */
 static void lighting_defaults(io_scene *s, const int *seen)
 {
-    if (!seen[K_AMBIENT]) s->ambient[0] = s->ambient[1] = s->ambient[2] = 0.35f;
-    if (!seen[K_KD]) s->kd = 0.75f;
-    if (!seen[K_KS]) s->ks = 0.15f;
-    if (!seen[K_SHININESS]) s->shininess = 16.0f;
-    if (!seen[K_KF]) s->kf = 0.6f;
-    if (!seen[K_TONE]) s->tone[0] = s->tone[1] = s->tone[2] = 1.0f;
+    const fuse_lighting d = fuse_lighting_default();
+    if (!seen[K_AMBIENT]) memcpy(s->ambient, d.ambient, sizeof s->ambient);
+    if (!seen[K_KD]) s->kd = d.kd;
+    if (!seen[K_KS]) s->ks = d.ks;
+    if (!seen[K_SHININESS]) s->shininess = d.shininess;
+    if (!seen[K_KF]) s->kf = d.kf;
+    if (!seen[K_TONE]) memcpy(s->tone, d.tone, sizeof s->tone);
     if (!seen[K_LIGHT]) {
-        s->light_count = 1;
-        s->light_dir[0][0] = 0.0f;
-        s->light_dir[0][1] = 0.6f;
-        s->light_dir[0][2] = 0.8f;
-        s->light_color[0][0] = s->light_color[0][1] = s->light_color[0][2] = 1.0f;
+        s->light_count = d.light_count;
+        for (int i = 0; i < d.light_count; i++) {
+            memcpy(s->light_dir[i], d.lights[i].dir, sizeof s->light_dir[i]);
+            memcpy(s->light_color[i], d.lights[i].color, sizeof s->light_color[i]);
+        }
     }
+}
+
+fuse_lighting io_scene_lighting(const io_scene *s)
+{
+    fuse_lighting L = fuse_lighting_default();
+    if (!s->has_lighting) return L;
+    L.light_count = s->light_count < FUSE_MAX_LIGHTS ? s->light_count : FUSE_MAX_LIGHTS;
+    memcpy(L.ambient, s->ambient, sizeof L.ambient);
+    memcpy(L.tone, s->tone, sizeof L.tone);
+    L.kd = s->kd;
+    L.ks = s->ks;
+    L.shininess = s->shininess;
+    L.kf = s->kf;
+    for (int i = 0; i < L.light_count; i++) {
+        memcpy(L.lights[i].dir, s->light_dir[i], sizeof L.lights[i].dir);
+        memcpy(L.lights[i].color, s->light_color[i], sizeof L.lights[i].color);
+    }
+    return L;
 }
 
 /* One line (without its newline) after the header. */

@@ -118,28 +118,11 @@ static const char *const keys[K_COUNT] = { "arm_scale", "hand_scale", "shoulder_
 static const int key_count[K_COUNT] = { 2, 2, 1, 2, 1, 10, 10 };
 #define REQUIRED_KEYS 5 /* the first five */
 
-/* Strict decimal number (see kin_track.c). */
+/* Strict decimal number (kin__parse_number), at most 1e30 in magnitude. */
 static int number(const char *tok, float *out)
 {
-    const char *p = tok;
-    int digits = 0;
-    if (*p == '+' || *p == '-') p++;
-    while (*p >= '0' && *p <= '9') { p++; digits++; }
-    if (*p == '.') {
-        p++;
-        while (*p >= '0' && *p <= '9') { p++; digits++; }
-    }
-    if (!digits) return -1;
-    if (*p == 'e' || *p == 'E') {
-        p++;
-        if (*p == '+' || *p == '-') p++;
-        int ed = 0;
-        while (*p >= '0' && *p <= '9') { p++; ed++; }
-        if (!ed) return -1;
-    }
-    if (*p) return -1;
-    double v = strtod(tok, NULL);
-    if (!isfinite(v) || fabs(v) > 1e30) return -1;
+    double v;
+    if (kin__parse_number(tok, &v) != 0 || fabs(v) > 1e30) return -1;
     *out = (float)v;
     return 0;
 }

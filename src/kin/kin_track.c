@@ -67,33 +67,7 @@ int kin_track_sample_validate(const kin_track_sample *s, char *why, size_t why_s
 
 const char *kin_track_header(void) { return "egofuse-track 1\n"; }
 
-/* A strict decimal number: [+-]digits[.digits] or [+-].digits, optional
- * exponent. Returns 0 and the value, or -1. */
-static int parse_number(const char *tok, double *out)
-{
-    const char *p = tok;
-    if (*p == '+' || *p == '-') p++;
-    int digits = 0;
-    while (*p >= '0' && *p <= '9') { p++; digits++; }
-    if (*p == '.') {
-        p++;
-        while (*p >= '0' && *p <= '9') { p++; digits++; }
-    }
-    if (!digits) return -1;
-    if (*p == 'e' || *p == 'E') {
-        p++;
-        if (*p == '+' || *p == '-') p++;
-        int ed = 0;
-        while (*p >= '0' && *p <= '9') { p++; ed++; }
-        if (!ed) return -1;
-    }
-    if (*p) return -1;
-    char *end = NULL;
-    double v = strtod(tok, &end);
-    if (!end || *end || !isfinite(v)) return -1;
-    *out = v;
-    return 0;
-}
+#define parse_number kin__parse_number
 
 typedef struct tag_info { const char *name; int count; uint32_t bit; } tag_info;
 

@@ -1,8 +1,10 @@
 /* kin_util.c - helpers shared by the kin sources (kin_internal.h). */
 #include "kin_internal.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 int kin__fail(char *why, size_t n, int ret, const char *fmt, ...)
 {
@@ -24,4 +26,30 @@ void kin__put(kin__sink *k, const char *fmt, ...)
     int r = vsnprintf(dst, room, fmt, ap);
     va_end(ap);
     if (r > 0) k->len += (size_t)r;
+}
+
+int kin__parse_number(const char *tok, double *out)
+{
+    const char *p = tok;
+    if (*p == '+' || *p == '-') p++;
+    int digits = 0;
+    while (*p >= '0' && *p <= '9') { p++; digits++; }
+    if (*p == '.') {
+        p++;
+        while (*p >= '0' && *p <= '9') { p++; digits++; }
+    }
+    if (!digits) return -1;
+    if (*p == 'e' || *p == 'E') {
+        p++;
+        if (*p == '+' || *p == '-') p++;
+        int ed = 0;
+        while (*p >= '0' && *p <= '9') { p++; ed++; }
+        if (!ed) return -1;
+    }
+    if (*p) return -1;
+    char *end = NULL;
+    double v = strtod(tok, &end);
+    if (!end || *end || !isfinite(v)) return -1;
+    *out = v;
+    return 0;
 }
