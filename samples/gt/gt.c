@@ -4,6 +4,7 @@
 #include "gt.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -432,18 +433,33 @@ int gt_cockpit_build(gen_scene *s)
 
 void gt_render_eye(gen_frame_ctx *c, const kin_mat4 *world_from_head,
                    kin_eye eye, int frame, uint8_t *rgb, uint8_t *sil,
-                   float *nrm)
+                   float *nrm, float *scratch_depth, uint8_t *scratch_mask)
 {
     gen_render_camera(c, world_from_head, eye, frame, rgb, NULL);
     kin_camera cam = kin_sthmd_camera(NULL, world_from_head, eye);
     kin_sthmd_geometry g = kin_sthmd_geometry_of(NULL);
+    /* The arms alone, with the camera's projection: a pixel is arm when
+     * they cover its centre and their depth is the scene's (nothing of the
+     * cockpit in front). Not from the render's pattern codes: those are
+     * interpolated across the triangles where skin meets sleeve, and the
+     * cuff would fall out of the silhouette. */
+    kin_mat4 proj = gen_proj_from_intrinsics(cam.fx, cam.fy, cam.cx, cam.cy + (float)g.crop_y0,
+                                             GEN_CAM_W, GEN_CAM_H, GEN_CAM_ZNEAR, GEN_CAM_ZFAR);
+    kin_mat4 vp = kin_mat4_mul(&proj, &cam.view);
+    const kin_mesh *me = &c->arms->model.meshes[0];
+    rast_target t = { GEN_CAM_W, GEN_CAM_H, scratch_depth, GEN_CAM_W, scratch_mask, GEN_CAM_W,
+                      NULL, 0, 0 };
+    rast_target_clear(&t);
+    rast_transform_points(vp.m, c->skin_pos, me->vertex_count, c->clip);
+    rast_mesh_desc d = { c->clip, me->vertex_count, NULL, 0, me->indices, me->index_count / 3,
+                         RAST_CULL_NONE };
+    rast_draw(&t, &d, NULL);
     for (int y = 0; y < g.crop_height; y++)
         for (int x = 0; x < g.crop_width; x++) {
             size_t i = (size_t)(y + g.crop_y0) * GEN_CAM_W + (size_t)x;
             size_t o = (size_t)y * (size_t)g.crop_width + (size_t)x;
             const float *a = &c->tattr[i * GEN_ATTRS];
-            int pat = pattern_of(a[GEN_A_U]);
-            int arm = c->mask[i] && (pat == GEN_PAT_SKIN || pat == GEN_PAT_FABRIC);
+            int arm = scratch_mask[i] && c->mask[i] && scratch_depth[i] <= c->depth[i];
             sil[o] = arm ? 255 : 0;
             if (!nrm) continue;
             kin_vec3 n = kin_v3(0, 0, 0);
@@ -545,4 +561,284 @@ void gt_track_sample(const gen_arms *truth, const gt_track_desc *d, int k,
         if (unit(&r) < d->dropout)
             out->valid &= ~(uint32_t)((KIN_TRACK_HAND_L | KIN_TRACK_GLOVE_L) << s);
     }
+}
+
+/* ---------------------------------------------------------- sequences */
+
+/* Key postures per side: wrist xyz, finger direction xyz, back-of-hand
+ * direction xyz, grip (-0.3 open .. 0 relaxed .. 1 closed), in the world
+ * of samples/gen (eyes at (0, 1.25, -0.08) looking 27 deg down, shoulders
+ * at (+-0.19, 0.97, 0)); joined by minimum-jerk blends (rest at each key),
+ * as the generator's reach_grasp. */
+#define SEQ_DIM 10
+#define SEQ_MAX_KEYS 12
+
+typedef struct seq_side {
+    int n;
+    float t[SEQ_MAX_KEYS];
+    float v[SEQ_MAX_KEYS][SEQ_DIM];
+} seq_side;
+
+typedef struct seq_desc {
+    const char *name;
+    float duration;
+    seq_side side[2];          /* [0] left, [1] right */
+    int nh;
+    float ht[SEQ_MAX_KEYS];
+    float hv[SEQ_MAX_KEYS][2]; /* head yaw (+ left), pitch (- down), deg */
+} seq_desc;
+
+#define RREST 0.130f, 1.075f, -0.320f, -0.25f, -0.12f, -1.0f, 0.35f, 1.0f, 0.0f
+#define LREST -0.120f, 1.070f, -0.310f, 0.25f, -0.12f, -1.0f, -0.35f, 1.0f, 0.0f
+#define HEAD0 { 0.0f, -27.0f }
+
+static const seq_desc sequences[] = {
+    /* the hands cross: the right hand reaches to the left in front of the
+     * left hand, which goes to the right, nearer the eyes; then back */
+    { "cross", 3.0f,
+      { { 5, { 0.0f, 0.4f, 1.3f, 2.1f, 3.0f },
+          { { LREST, 0.1f }, { LREST, 0.1f },
+            { 0.100f, 1.080f, -0.280f, 0.70f, 0.05f, -1.0f, -0.2f, 1.0f, 0.1f, 0.2f },
+            { 0.060f, 1.090f, -0.270f, 0.60f, 0.05f, -1.0f, -0.2f, 1.0f, 0.1f, 0.0f },
+            { LREST, 0.1f } } },
+        { 5, { 0.0f, 0.3f, 1.2f, 2.0f, 3.0f },
+          { { RREST, 0.0f }, { RREST, 0.0f },
+            { -0.120f, 1.030f, -0.440f, -0.70f, -0.15f, -1.0f, 0.2f, 1.0f, 0.0f, -0.2f },
+            { -0.080f, 1.020f, -0.460f, -0.60f, -0.15f, -1.0f, 0.2f, 1.0f, 0.0f, 0.6f },
+            { RREST, 0.0f } } } },
+      4, { 0.0f, 0.8f, 2.0f, 3.0f }, { HEAD0, { 3.0f, -28.0f }, { 2.0f, -28.0f }, HEAD0 } },
+    /* the hands come up to 15 cm in front of the eyes (the right one
+     * first, as if looking at the palm), then go back to 40 cm */
+    { "near", 3.0f,
+      { { 4, { 0.0f, 1.0f, 1.9f, 3.0f },
+          { { LREST, 0.1f },
+            { -0.050f, 1.160f, -0.230f, 0.20f, 0.45f, -1.0f, -0.6f, 0.6f, 0.6f, -0.2f },
+            { -0.060f, 1.140f, -0.250f, 0.20f, 0.45f, -1.0f, -0.6f, 0.6f, 0.6f, 0.3f },
+            { -0.100f, 1.040f, -0.420f, 0.25f, -0.12f, -1.0f, -0.35f, 1.0f, 0.0f, 0.1f } } },
+        { 5, { 0.0f, 0.7f, 1.4f, 2.2f, 3.0f },
+          { { RREST, 0.0f },
+            { 0.040f, 1.170f, -0.220f, -0.20f, 0.50f, -1.0f, 0.6f, 0.5f, 0.6f, -0.3f },
+            { 0.045f, 1.175f, -0.215f, -0.20f, 0.50f, -1.0f, 0.6f, 0.5f, 0.6f, 0.5f },
+            { 0.100f, 1.060f, -0.400f, -0.25f, -0.12f, -1.0f, 0.35f, 1.0f, 0.0f, 0.0f },
+            { 0.110f, 1.050f, -0.430f, -0.25f, -0.12f, -1.0f, 0.35f, 1.0f, 0.0f, 0.0f } } } },
+      3, { 0.0f, 1.2f, 3.0f }, { HEAD0, { 0.0f, -20.0f }, { 0.0f, -26.0f } } },
+    /* the hands go out to the image edges (left hand beyond the left
+     * border, right hand to the right and the bottom), partly out of view */
+    { "edge", 3.0f,
+      { { 4, { 0.0f, 0.9f, 1.8f, 3.0f },
+          { { LREST, 0.1f },
+            { -0.300f, 1.060f, -0.400f, -0.30f, -0.10f, -1.0f, -0.35f, 1.0f, 0.0f, -0.1f },
+            { -0.320f, 1.080f, -0.380f, -0.30f, -0.10f, -1.0f, -0.35f, 1.0f, 0.0f, 0.4f },
+            { LREST, 0.1f } } },
+        { 5, { 0.0f, 0.6f, 1.3f, 2.2f, 3.0f },
+          { { RREST, 0.0f },
+            { 0.300f, 1.040f, -0.420f, 0.30f, -0.10f, -1.0f, 0.35f, 1.0f, 0.0f, 0.0f },
+            { 0.260f, 0.960f, -0.300f, 0.20f, -0.30f, -1.0f, 0.35f, 1.0f, 0.0f, 0.3f },
+            { 0.150f, 0.950f, -0.280f, 0.00f, -0.30f, -1.0f, 0.35f, 1.0f, 0.0f, 0.0f },
+            { RREST, 0.0f } } } },
+      3, { 0.0f, 1.5f, 3.0f }, { HEAD0, { -2.0f, -25.0f }, HEAD0 } },
+    /* fast moves: reaches of 0.25-0.3 s (up to ~2 m/s at the wrist),
+     * both hands, out and back twice */
+    { "fast", 3.0f,
+      { { 9, { 0.0f, 0.3f, 0.55f, 0.85f, 1.1f, 1.6f, 1.85f, 2.15f, 3.0f },
+          { { LREST, 0.1f }, { LREST, 0.1f },
+            { -0.200f, 1.000f, -0.520f, 0.10f, -0.20f, -1.0f, -0.4f, 1.0f, 0.0f, 0.5f },
+            { -0.200f, 1.000f, -0.520f, 0.10f, -0.20f, -1.0f, -0.4f, 1.0f, 0.0f, 0.5f },
+            { LREST, 0.1f }, { LREST, 0.1f },
+            { 0.020f, 1.020f, -0.480f, 0.30f, -0.20f, -1.0f, -0.4f, 1.0f, 0.0f, -0.2f },
+            { LREST, 0.1f }, { LREST, 0.1f } } },
+        { 9, { 0.0f, 0.2f, 0.45f, 0.75f, 1.0f, 1.4f, 1.65f, 1.95f, 3.0f },
+          { { RREST, 0.0f }, { RREST, 0.0f },
+            { 0.220f, 0.990f, -0.530f, -0.10f, -0.20f, -1.0f, 0.4f, 1.0f, 0.0f, 0.8f },
+            { 0.220f, 0.990f, -0.530f, -0.10f, -0.20f, -1.0f, 0.4f, 1.0f, 0.0f, 0.8f },
+            { RREST, 0.0f }, { RREST, 0.0f },
+            { -0.040f, 1.010f, -0.500f, -0.30f, -0.20f, -1.0f, 0.4f, 1.0f, 0.0f, -0.2f },
+            { RREST, 0.0f }, { RREST, 0.0f } } } },
+      4, { 0.0f, 0.5f, 1.5f, 3.0f }, { HEAD0, { -6.0f, -30.0f }, { 5.0f, -28.0f }, HEAD0 } },
+    /* calibration: both arms stretched forward, then sideways, then up
+     * forward (kin_user_calib_estimate takes the 95th percentile of the
+     * shoulder-hand distance); not rendered */
+    { "calib", 4.0f,
+      { { 6, { 0.0f, 0.6f, 1.4f, 2.2f, 3.0f, 4.0f },
+          { { LREST, 0.0f },
+            { -0.190f, 0.970f, -0.700f, 0.0f, 0.0f, -1.0f, 0.0f, 1.0f, 0.0f, -0.3f },
+            { -0.190f, 0.970f, -0.700f, 0.0f, 0.0f, -1.0f, 0.0f, 1.0f, 0.0f, -0.3f },
+            { -0.890f, 0.970f, 0.000f, -1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, -0.3f },
+            { -0.890f, 0.970f, 0.000f, -1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, -0.3f },
+            { LREST, 0.0f } } },
+        { 6, { 0.0f, 0.6f, 1.4f, 2.2f, 3.0f, 4.0f },
+          { { RREST, 0.0f },
+            { 0.190f, 0.970f, -0.700f, 0.0f, 0.0f, -1.0f, 0.0f, 1.0f, 0.0f, -0.3f },
+            { 0.190f, 0.970f, -0.700f, 0.0f, 0.0f, -1.0f, 0.0f, 1.0f, 0.0f, -0.3f },
+            { 0.890f, 0.970f, 0.000f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, -0.3f },
+            { 0.890f, 0.970f, 0.000f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, -0.3f },
+            { RREST, 0.0f } } } },
+      2, { 0.0f, 4.0f }, { HEAD0, HEAD0 } },
+};
+
+const char *gt_sequence_name(int i)
+{
+    if (i == 0) return GEN_ANIM_NAME;
+    int n = (int)(sizeof sequences / sizeof sequences[0]);
+    return i >= 1 && i <= n ? sequences[i - 1].name : NULL;
+}
+
+static float minjerk(float u)
+{
+    if (u <= 0.0f) return 0.0f;
+    if (u >= 1.0f) return 1.0f;
+    return u * u * u * (10.0f + u * (-15.0f + 6.0f * u));
+}
+
+static void keys_eval(int n, const float *t, const float *v, int dim, float x, float *out)
+{
+    int i = 0;
+    if (x <= t[0]) { memcpy(out, v, sizeof(float) * (size_t)dim); return; }
+    while (i + 1 < n && t[i + 1] <= x) i++;
+    if (i + 1 >= n) { memcpy(out, v + (size_t)(n - 1) * (size_t)dim, sizeof(float) * (size_t)dim); return; }
+    float u = minjerk((x - t[i]) / (t[i + 1] - t[i]));
+    const float *a = v + (size_t)i * (size_t)dim, *b = a + dim;
+    for (int k = 0; k < dim; k++) out[k] = a[k] + (b[k] - a[k]) * u;
+}
+
+/* World rotations of upper arm, forearm and hand of one side (the
+ * generator's rule: elbow in the plane of the pole (0.45 s, -1, 0.25),
+ * the forearm takes half of the hand's roll). */
+static void seq_arm(kin_vec3 S, float L1, float L2, const float *c, float s, kin_quat out[3])
+{
+    kin_vec3 W = kin_v3(c[0], c[1], c[2]), pole = kin_v3(0.45f * s, -1.0f, 0.25f);
+    kin_vec3 d = kin_v3_sub(W, S);
+    float L = kin_v3_len(d), maxl = 0.985f * (L1 + L2), minl = fmaxf(L2 - L1 + 0.05f, 0.05f);
+    kin_vec3 u = kin_v3_norm(d);
+    if (L > maxl) L = maxl;
+    if (L < minl) L = minl;
+    W = kin_v3_add(S, kin_v3_scale(u, L));
+    float ca = (L1 * L1 + L * L - L2 * L2) / (2.0f * L1 * L);
+    ca = ca > 1.0f ? 1.0f : ca;
+    float sa = sqrtf(fmaxf(0.0f, 1.0f - ca * ca));
+    kin_vec3 p = kin_v3_norm(kin_v3_sub(pole, kin_v3_scale(u, kin_v3_dot(pole, u))));
+    kin_vec3 E = kin_v3_add(S, kin_v3_scale(kin_v3_add(kin_v3_scale(u, ca), kin_v3_scale(p, sa)), L1));
+    kin_vec3 du = kin_v3_norm(kin_v3_sub(E, S)), df = kin_v3_norm(kin_v3_sub(W, E));
+    kin_vec3 n = kin_v3_cross(du, df);
+    if (kin_v3_len(n) < 1e-4f) n = kin_v3_cross(du, pole);
+    n = kin_v3_norm(n);
+    kin_vec3 zu = kin_v3_scale(du, -1.0f);
+    out[0] = gen_quat_from_axes(n, kin_v3_cross(zu, n), zu);
+    kin_vec3 zh = kin_v3_scale(kin_v3_norm(kin_v3(c[3], c[4], c[5])), -1.0f);
+    kin_vec3 dors = kin_v3(c[6], c[7], c[8]);
+    kin_vec3 yh = kin_v3_norm(kin_v3_sub(dors, kin_v3_scale(zh, kin_v3_dot(dors, zh))));
+    out[2] = gen_quat_from_axes(kin_v3_cross(yh, zh), yh, zh);
+    kin_vec3 zf = kin_v3_scale(df, -1.0f), yf = kin_v3_cross(zf, n);
+    kin_vec3 yp = kin_v3_sub(yh, kin_v3_scale(zf, kin_v3_dot(yh, zf)));
+    float roll = 0.5f * atan2f(kin_v3_dot(kin_v3_cross(yf, yp), zf), kin_v3_dot(yf, yp));
+    kin_quat rr = kin_quat_axis_angle(zf, roll);
+    out[1] = gen_quat_from_axes(kin_quat_rotate(rr, n), kin_quat_rotate(rr, yf), zf);
+}
+
+static kin_quat qconj(kin_quat q) { kin_quat c = { -q.x, -q.y, -q.z, q.w }; return c; }
+
+int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
+{
+    if (!strcmp(name, GEN_ANIM_NAME)) {
+        truth->model.anim_count = mask->model.anim_count;
+        truth->model.anims = mask->model.anims;
+        return 0;
+    }
+    const seq_desc *sq = NULL;
+    for (size_t i = 0; i < sizeof sequences / sizeof sequences[0]; i++)
+        if (!strcmp(sequences[i].name, name)) sq = &sequences[i];
+    if (!sq) return -1;
+    const kin_model *m = &mask->model;
+    kin_model *t = &truth->model;
+    const int keys = (int)lroundf(sq->duration * GEN_FPS) + 1;
+    /* channels: head, per side upper arm, forearm, hand, 15 finger joints */
+    int nodes[1 + 2 * 18], nch = 0;
+    nodes[nch++] = mask->head;
+    for (int s = 0; s < 2; s++) {
+        nodes[nch++] = mask->joint[s][GEN_J_UPPER_ARM];
+        nodes[nch++] = mask->joint[s][GEN_J_FOREARM];
+        nodes[nch++] = mask->joint[s][GEN_J_HAND];
+        for (int j = GEN_J_THUMB_1; j < GEN_SIDE_JOINTS; j++) nodes[nch++] = mask->joint[s][j];
+    }
+    float *times;
+    kin_channel *ch;
+    kin_animation *an;
+    kin_quat *q;
+    kin_mat4 *w;
+    ALLOC(times, keys);
+    ALLOC(ch, nch);
+    ALLOC(an, 1);
+    ALLOC(q, m->node_count);
+    ALLOC(w, m->node_count);
+    for (int k = 0; k < keys; k++) times[k] = (float)k / (float)GEN_FPS;
+    for (int c = 0; c < nch; c++) {
+        float *v;
+        ALLOC(v, keys * 4);
+        ch[c] = (kin_channel){ nodes[c], KIN_PATH_ROTATION, KIN_INTERP_LINEAR, keys, 4, times, v };
+    }
+    /* the mask model's shoulders and bone lengths (the angles are then
+     * given to the true operator, as the generator does) */
+    kin_fk(m->parents, m->node_count, m->rest, NULL, w);
+    kin_vec3 S[2];
+    float L1[2], L2[2];
+    for (int s = 0; s < 2; s++) {
+        const int *J = mask->joint[s];
+        S[s] = mat_t(&w[J[GEN_J_UPPER_ARM]]);
+        L1[s] = kin_v3_len(kin_v3_sub(mat_t(&w[J[GEN_J_FOREARM]]), S[s]));
+        L2[s] = kin_v3_len(kin_v3_sub(mat_t(&w[J[GEN_J_HAND]]), mat_t(&w[J[GEN_J_FOREARM]])));
+    }
+    static const float relax[4][3] = { { 10, 18, 8 }, { 14, 22, 10 }, { 18, 26, 12 }, { 22, 30, 14 } };
+    static const float grasp[4][3] = { { 42, 62, 30 }, { 48, 66, 32 }, { 54, 70, 34 }, { 60, 72, 36 } };
+    const float D = PI_F / 180.0f;
+    const kin_vec3 X = kin_v3(1, 0, 0);
+    for (int k = 0; k < keys; k++) {
+        float tk = times[k], hv[2];
+        for (int i = 0; i < m->node_count; i++) q[i] = m->rest[i].r;
+        keys_eval(sq->nh, sq->ht, &sq->hv[0][0], 2, tk, hv);
+        q[mask->head] = kin_quat_mul(kin_quat_axis_angle(kin_v3(0, 1, 0), hv[0] * D),
+                                     kin_quat_axis_angle(X, hv[1] * D));
+        for (int s = 0; s < 2; s++) {
+            const int *J = mask->joint[s];
+            float sg = s ? 1.0f : -1.0f, c[SEQ_DIM];
+            keys_eval(sq->side[s].n, sq->side[s].t, &sq->side[s].v[0][0], SEQ_DIM, tk, c);
+            kin_quat wr[3];
+            seq_arm(S[s], L1[s], L2[s], c, sg, wr);
+            kin_quat pw = kin_quat_mul(m->rest[mask->body].r, m->rest[J[GEN_J_SHOULDER]].r);
+            q[J[GEN_J_UPPER_ARM]] = kin_quat_normalize(kin_quat_mul(qconj(pw), wr[0]));
+            q[J[GEN_J_FOREARM]] = kin_quat_normalize(kin_quat_mul(qconj(wr[0]), wr[1]));
+            q[J[GEN_J_HAND]] = kin_quat_normalize(kin_quat_mul(qconj(wr[1]), wr[2]));
+            float g = c[9];
+            for (int f = 1; f < 5; f++) {
+                int j1 = GEN_J_THUMB_1 + 3 * f;
+                for (int j = 0; j < 3; j++) {
+                    float fl = relax[f - 1][j] + g * (grasp[f - 1][j] - relax[f - 1][j]);
+                    kin_quat r = kin_quat_axis_angle(X, -fl * D);
+                    q[J[j1 + j]] = j == 0 ? kin_quat_mul(m->rest[J[j1]].r, r) : r;
+                }
+            }
+            q[J[GEN_J_THUMB_1]] = kin_quat_mul(
+                kin_quat_axis_angle(kin_v3(0, 0, 1), (12.0f + 28.0f * g) * D * sg),
+                kin_quat_mul(m->rest[J[GEN_J_THUMB_1]].r,
+                             kin_quat_axis_angle(X, -(6.0f + 10.0f * g) * D)));
+            q[J[GEN_J_THUMB_2]] = kin_quat_axis_angle(X, -(10.0f + 22.0f * g) * D);
+            q[J[GEN_J_THUMB_3]] = kin_quat_axis_angle(X, -(12.0f + 30.0f * g) * D);
+        }
+        for (int c = 0; c < nch; c++) {
+            kin_quat r = q[nodes[c]];
+            float *v = (float *)ch[c].values;
+            if (k > 0 && v[(k - 1) * 4] * r.x + v[(k - 1) * 4 + 1] * r.y +
+                                 v[(k - 1) * 4 + 2] * r.z + v[(k - 1) * 4 + 3] * r.w < 0.0f)
+                r = (kin_quat){ -r.x, -r.y, -r.z, -r.w };
+            memcpy(&v[k * 4], &r, sizeof r);
+        }
+    }
+    snprintf(an->name, KIN_NAME_MAX, "%s", sq->name);
+    an->channel_count = nch;
+    an->channels = ch;
+    an->duration = times[keys - 1];
+    t->anim_count = 1;
+    t->anims = an;
+    return 0;
+oom:
+    return -1;
 }

@@ -58,16 +58,34 @@ gt_operator_desc gt_operator_default(void);
 int gt_truth_build(const gen_arms *mask, const gt_operator_desc *d,
                    gen_arms *truth);
 
+/* Motion sequences of the true operator (docs/accuracy.md): index 0 is
+ * the generator's "reach_grasp", then "cross" (the hands cross, one in
+ * front of the other), "near" (the hands 15 cm from the eyes), "edge"
+ * (the hands at and beyond the image borders), "fast" (reaches of
+ * 0.25-0.3 s) and "calib" (the arms stretched forward and sideways: the
+ * calibration motion of kin_user_calib_estimate, not meant to be
+ * rendered). NULL past the last. */
+const char *gt_sequence_name(int i);
+
+/* Makes truth move through sequence `name`: its animation (joint angles
+ * solved for the mask model's bones, as the generator does) is allocated
+ * in truth->model's memory block and becomes truth->model.anims[0]
+ * ("reach_grasp": the mask model's own animation). Returns 0, or -1 for
+ * an unknown name or when out of memory. */
+int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth);
+
 /* The cockpit with skin-coloured objects. 0, or -1 when out of memory. */
 int gt_cockpit_build(gen_scene *s);
 
 /* Renders eye `eye` of frame `frame` of the true operator posed by
  * gen_pose(c, ...) (c built on the truth): rgb (640x480x3 sensor image),
- * sil (640x400, 255 on the true arms), nrm (640x400x3 view-space unit
- * normals of the arms, 0 elsewhere; may be NULL). */
+ * sil (640x400, 255 on the true arms: the pixel centres they cover where
+ * nothing of the cockpit is in front), nrm (640x400x3 view-space unit
+ * normals of the arms, 0 elsewhere; may be NULL). scratch_depth and
+ * scratch_mask: 640x480 floats and bytes. */
 void gt_render_eye(gen_frame_ctx *c, const kin_mat4 *world_from_head,
                    kin_eye eye, int frame, uint8_t *rgb, uint8_t *sil,
-                   float *nrm);
+                   float *nrm, float *scratch_depth, uint8_t *scratch_mask);
 
 /* The true sample at animation time t (seconds). locals and world:
  * scratch of truth->model.node_count entries. All parts valid. */

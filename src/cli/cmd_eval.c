@@ -6,8 +6,9 @@
  * both camera images over the cockpit (with its exact silhouettes and the
  * ideal composite); then every method configuration, with its own tracking
  * stream (noise, latency, dropouts) and its own state (filter, last
- * sample, previous masks), makes its masks and composites, which are timed
- * and measured. */
+ * sample, previous masks, elbow fit), makes its masks and composites, which
+ * are timed and measured. A report runs several such batches (methods,
+ * knobs, tracking sweeps, other sequences), each on its own ground truth. */
 #include "cli.h"
 
 /* The ground truth comes from samples/gt/ and the sample generator
@@ -22,9 +23,11 @@
 #include "../../samples/gt/gt.h"
 
 static const char *eval_usage =
-    "usage: egofuse eval [--frames N] [--noise MM] [--latency MS] [--dropout P]\n"
-    "                    [--calib-error E] [--speed S] [--seed S] [--per-frame]\n"
-    "                    [--csv FILE] [--report DIR] [--dump DIR] [--quiet]\n"
+    "usage: egofuse eval [--sequence NAME] [--frames N] [--noise MM] [--latency MS]\n"
+    "                    [--dropout P] [--calib-error E] [--speed S] [--seed S]\n"
+    "                    [--methods LIST] [--band PX] [--global W] [--per-frame]\n"
+    "                    [--csv FILE] [--report DIR] [--sweep-frames N]\n"
+    "                    [--seq-frames N] [--dump DIR] [--quiet]\n"
     "\n"
     "Generates ground truth (a true operator whose bones and limbs differ from\n"
     "the mask model, filmed over a cockpit with skin-coloured objects, camera\n"
@@ -33,23 +36,38 @@ static const char *eval_usage =
     "boundary F within 1 and 3 px, false-positive and false-negative area,\n"
     "PSNR of the composite, temporal edge flicker, and the time per stereo\n"
     "frame. Methods: kin (the paper: fixed-size model, IK from the tracked\n"
-    "hands, latest sample), kin-cal-pred (per-user calibration, One Euro\n"
-    "filter and prediction to the display time), skin (YCbCr skin-colour\n"
-    "key), refine (kin-cal-pred refined by colour in a band around its edge).\n"
+    "hands, latest sample), kin-cal-pred (user calibration estimated from a\n"
+    "calibration motion, One Euro filter and prediction to the camera frame's\n"
+    "time), skin (YCbCr skin-colour key), refine (kin-cal-pred with the elbows\n"
+    "fitted to the images, refined by colour in a band around its edge).\n"
     "\n"
-    "  --frames N       display frames at 60 Hz (default 60; the motion is 3 s)\n"
+    "  --sequence NAME  reach_grasp (default), cross (hands crossing), near\n"
+    "                   (hands 15 cm from the eyes), edge (hands at the image\n"
+    "                   borders), fast (0.25 s reaches)\n"
+    "  --frames N       display frames at 60 Hz (default 60; sequences are 3 s)\n"
     "  --noise MM       RMS tracking position error (default 5)\n"
     "  --latency MS     tracking latency (default 20)\n"
     "  --dropout P      probability that a sample loses a hand (default 0.02)\n"
-    "  --calib-error E  relative error of the user calibration (default 0.02)\n"
-    "  --speed S        playback speed of the motion (default 1; 2 = fast moves)\n"
+    "  --calib-error E  relative error added to the estimated user calibration\n"
+    "                   (default 0)\n"
+    "  --speed S        playback speed of the motion (default 1)\n"
     "  --seed S         seed of the camera and tracking noise (default 1)\n"
+    "  --methods LIST   comma-separated subset of kin,kin-cal-pred,skin,refine\n"
+    "                   (default: all four)\n"
+    "  --band PX        refinement band half width, 1..64 (default 16)\n"
+    "  --global W       refine: weight of the image-wide colour model against\n"
+    "                   the band's local one, 0..1 (default 0.5)\n"
     "  --per-frame      print every frame's figures per method\n"
     "  --csv FILE       write the summary table as CSV\n"
-    "  --report DIR     run the sweeps (methods, band width, mask resolution,\n"
-    "                   triangles, LBS/DQS, tracking noise, latency, calibration\n"
-    "                   error) and write DIR/summary.csv, DIR/table.md, data files\n"
+    "  --report DIR     also run the speed knobs (band width, elbow fit, global\n"
+    "                   colour model, filter lag compensation, mask resolution,\n"
+    "                   triangles, LBS/DQS) and the tracking sweeps (noise,\n"
+    "                   latency, calibration error) on --sweep-frames frames, and\n"
+    "                   the methods on every other sequence on --seq-frames\n"
+    "                   frames; write DIR/summary.csv, DIR/table.md, data files\n"
     "                   and the charts (gnuplot, PNG)\n"
+    "  --sweep-frames N frames of the knobs and tracking sweeps (default 60)\n"
+    "  --seq-frames N   frames of each other sequence in a report (default 90)\n"
     "  --dump DIR       write every mask: DIR/METHOD_SETTING_EYE_NNNN.png (red:\n"
     "                   true silhouette, green: the method's mask)\n"
     "  --quiet          no progress line\n"
@@ -69,6 +87,9 @@ typedef struct method_cfg {
     int div;                 /* mask resolution divisor */
     int fine;                /* 1: the subdivided (4x triangles) mask model */
     int band;
+    int fit;                 /* refine: 1 = fit the elbows to the image */
+    float global;            /* refine: weight of the global colour model */
+    int lag_comp;            /* 1: the One Euro filter's ramp-lag compensation */
     gt_track_desc track;
     float calib_error;
 } method_cfg;
@@ -83,8 +104,9 @@ typedef struct method_run {
     kin_transform *locals;
     uint8_t *prev[2];        /* previous masks per eye */
     int have_prev;
+    float swivel[2];         /* elbow fit of the last frame, radians */
     /* sums over frames and eyes */
-    double iou, bf1, bf3, fp, fn, mse, flicker, secs;
+    double iou, bf1, bf3, fp, fn, mse, flicker, flicker_den, secs;
     long n_eye, n_flicker, n_frames;
 } method_run;
 
@@ -117,6 +139,17 @@ typedef struct eval_ctx {
     void *refine_scratch;
     size_t refine_scratch_size;
     kin_sthmd_geometry g;
+    /* elbow fit: colour model per eye, arm vertices per model and side */
+    float *llr[2];
+    void *cm_scratch;
+    size_t cm_scratch_size;
+    int *fitv[2][2];          /* [fine][side] vertex indices */
+    int fitn[2][2];
+    uint8_t *learn;           /* the colour model's learning mask */
+    float *gt_depth;          /* gt_render_eye scratch, 640x480 */
+    uint8_t *gt_mask;
+    kin_user_calib calib;     /* estimated from the calibration motion */
+    char calib_why[256];
 } eval_ctx;
 
 typedef struct eval_opts {
@@ -124,6 +157,11 @@ typedef struct eval_opts {
     float noise, latency, dropout, calib_error, speed;
     int seed;
     const char *csv, *report, *dump;
+    unsigned methods;        /* bit k: method_kind k is run */
+    const char *sequence;    /* gt_sequence_name() */
+    int sweep_frames, seq_frames; /* report: tracking sweeps, other sequences */
+    float global;            /* refine: weight of the global colour model */
+    int band;                /* refinement band of the default refine */
 } eval_opts;
 
 /* ------------------------------------------------------------ lighting */
@@ -151,6 +189,150 @@ static fuse_lighting workshop_lighting(const gen_scene *ws, const kin_camera *ca
     return L;
 }
 
+/* ----------------------------------------------------------- elbow fit */
+
+/* The IK places the elbow by a rule (kin_arm_ik_job: a swivel about the
+ * shoulder-wrist line); a real operator's elbow is elsewhere on that circle
+ * (the paper's "mismatch posture of elbows"). The refine method turns each
+ * arm (upper arm and forearm, the wrist and hand fixed) about that line to
+ * the swivel whose surface points fall on the most arm-coloured pixels of
+ * both camera images: the colour model (fuse_colour_model_learn) is learned
+ * from the previous frame's refined mask (the first frame: the kinematic
+ * mask). Candidates every FIT_STEP within +-FIT_RANGE of the IK's elbow,
+ * then +-FIT_STEP/2 around the best in 1 degree steps; a swivel changes by
+ * at most FIT_RATE per frame. */
+#define FIT_BITS 4
+#define FIT_POINTS 400
+#define FIT_RANGE_DEG 60.0f
+#define FIT_STEP_DEG 5.0f
+#define FIT_RATE_DEG 12.0f
+#define FIT_PRIOR 0.05f       /* nats per point at 30 degrees from the IK */
+#define DEG2RAD 0.01745329252f
+
+/* Vertices bound (weight >= 0.9) to the upper arm or forearm of a side,
+ * at most FIT_POINTS, evenly picked. */
+static int fit_vertices(const kin_model *m, const kin_arm_rig *rig, int *out[2], int n[2])
+{
+    const kin_mesh *me = &m->meshes[0];
+    const kin_skin *sk = &m->skins[0];
+    for (int s = 0; s < 2; s++) {
+        int ua = rig->joint[s][KIN_RIG_UPPER_ARM], fa = rig->joint[s][KIN_RIG_FOREARM];
+        int count = 0;
+        for (int pass = 0; pass < 2; pass++) {
+            int k = 0;
+            for (int v = 0; v < me->vertex_count; v++) {
+                float w = 0.0f;
+                for (int j = 0; j < 4; j++) {
+                    int node = sk->joints[me->joints[v * 4 + j]];
+                    if (node == ua || node == fa) w += me->weights[v * 4 + j];
+                }
+                if (w < 0.9f) continue;
+                if (pass == 1) {
+                    /* every (count / FIT_POINTS)-th */
+                    long lo = (long)k * FIT_POINTS / count, hi = (long)(k + 1) * FIT_POINTS / count;
+                    if (hi > lo && n[s] < FIT_POINTS) out[s][n[s]++] = v;
+                }
+                k++;
+            }
+            if (pass == 0) {
+                count = k;
+                n[s] = 0;
+                out[s] = malloc(sizeof(int) * FIT_POINTS);
+                if (!out[s] || count == 0) return -1;
+            }
+        }
+    }
+    return 0;
+}
+
+static kin_vec3 node_pos(const kin_mat4 *m) { return kin_v3(m->m[12], m->m[13], m->m[14]); }
+
+static kin_quat node_rot(const kin_mat4 *m)
+{
+    kin_vec3 x = kin_v3_norm(kin_v3(m->m[0], m->m[1], m->m[2]));
+    kin_vec3 y = kin_v3_norm(kin_v3(m->m[4], m->m[5], m->m[6]));
+    kin_vec3 z = kin_v3_norm(kin_v3_cross(x, y));
+    y = kin_v3_cross(z, x);
+    return kin_quat_normalize(kin_quat_from_axes(x, y, z));
+}
+
+/* Colour score of one side's arm turned by phi about S + t u: the clamped
+ * log-likelihood ratios of the pixels its points project to, both eyes. */
+static float fit_score(const eval_ctx *c, const int *v, int n, const float *pos, kin_vec3 S,
+                       kin_vec3 u, float phi, const kin_camera cam[2])
+{
+    kin_quat q = kin_quat_axis_angle(u, phi);
+    float score = 0.0f;
+    for (int e = 0; e < 2; e++) {
+        const float *M = cam[e].view_proj.m;
+        const uint8_t *P = c->P[e];
+        const float *llr = c->llr[e];
+        for (int i = 0; i < n; i++) {
+            const float *p = &pos[(size_t)v[i] * 3];
+            kin_vec3 r = kin_v3_add(S, kin_quat_rotate(q, kin_v3(p[0] - S.x, p[1] - S.y, p[2] - S.z)));
+            float w = M[3] * r.x + M[7] * r.y + M[11] * r.z + M[15];
+            if (!(w > 1e-3f)) continue;
+            float x = (M[0] * r.x + M[4] * r.y + M[8] * r.z + M[12]) / w;
+            float y = (M[1] * r.x + M[5] * r.y + M[9] * r.z + M[13]) / w;
+            int px = (int)floorf((x * 0.5f + 0.5f) * CW), py = (int)floorf((0.5f - y * 0.5f) * CH);
+            if (px < 0 || py < 0 || px >= CW || py >= CH) continue;
+            score += llr[fuse_colour_bin(P + ((size_t)py * CW + (size_t)px) * 4, FIT_BITS)];
+        }
+    }
+    return score;
+}
+
+/* Turns the arm of side s by phi about its shoulder-wrist line in locals
+ * (world = FK of locals; the hand keeps its world rotation). */
+static void apply_swivel(const kin_arm_rig *rig, const kin_model *m, const kin_mat4 *world,
+                         int s, float phi, kin_transform *locals)
+{
+    int ua = rig->joint[s][KIN_RIG_UPPER_ARM], fa = rig->joint[s][KIN_RIG_FOREARM];
+    int hd = rig->joint[s][KIN_RIG_HAND];
+    kin_vec3 u = kin_v3_norm(kin_v3_sub(node_pos(&world[hd]), node_pos(&world[ua])));
+    int par = m->parents[ua];
+    kin_quat qp = par >= 0 ? node_rot(&world[par]) : kin_quat_identity();
+    kin_quat qf = node_rot(&world[fa]);
+    kin_vec3 ap = kin_quat_rotate(kin_quat_conjugate(qp), u);
+    kin_vec3 af = kin_quat_rotate(kin_quat_conjugate(qf), u);
+    locals[ua].r = kin_quat_normalize(kin_quat_mul(kin_quat_axis_angle(ap, phi), locals[ua].r));
+    locals[hd].r = kin_quat_normalize(kin_quat_mul(kin_quat_axis_angle(af, -phi), locals[hd].r));
+}
+
+/* The best swivel of each side (radians, relative to the IK's elbow) for
+ * the skinned positions pos, searched around prev (NULL: the whole
+ * range). */
+static void fit_swivels(const eval_ctx *c, int fine, const kin_mat4 *world, const float *pos,
+                        const kin_camera cam[2], const float prev[2], float best[2])
+{
+    for (int s = 0; s < 2; s++) {
+        int ua = c->rig.joint[s][KIN_RIG_UPPER_ARM], hd = c->rig.joint[s][KIN_RIG_HAND];
+        kin_vec3 S = node_pos(&world[ua]);
+        kin_vec3 u = kin_v3_norm(kin_v3_sub(node_pos(&world[hd]), S));
+        const float range = FIT_RANGE_DEG * DEG2RAD, rate = FIT_RATE_DEG * DEG2RAD;
+        float p0 = prev ? prev[s] : 0.0f;
+        float lo = prev ? p0 - rate : -range, hi = prev ? p0 + rate : range;
+        if (lo < -range) lo = -range;
+        if (hi > range) hi = range;
+        float bphi = p0 < lo ? lo : p0 > hi ? hi : p0;
+        const float pk = FIT_PRIOR * 2.0f * (float)c->fitn[fine][s] / (30.0f * 30.0f * DEG2RAD * DEG2RAD);
+        float bsc = fit_score(c, c->fitv[fine][s], c->fitn[fine][s], pos, S, u, bphi, cam) -
+                    pk * bphi * bphi;
+        for (int pass = 0; pass < 2; pass++) {
+            float step = (pass ? 1.0f : FIT_STEP_DEG) * DEG2RAD;
+            float a = pass ? bphi - 0.5f * FIT_STEP_DEG * DEG2RAD : lo;
+            float b = pass ? bphi + 0.5f * FIT_STEP_DEG * DEG2RAD : hi;
+            for (float phi = a; phi <= b + 1e-6f; phi += step) {
+                if (phi < lo || phi > hi) continue;
+                float sc = fit_score(c, c->fitv[fine][s], c->fitn[fine][s], pos, S, u, phi, cam) -
+                           pk * phi * phi;
+                if (sc > bsc) { bsc = sc; bphi = phi; }
+            }
+        }
+        best[s] = bphi;
+    }
+}
+
 /* ------------------------------------------------------------- set-up */
 
 static void ctx_free(eval_ctx *c)
@@ -170,10 +352,38 @@ static void ctx_free(eval_ctx *c)
     free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->layer); free(c->out);
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
+    free(c->llr[0]); free(c->llr[1]); free(c->cm_scratch); free(c->learn);
+    free(c->gt_depth); free(c->gt_mask);
+    for (int f = 0; f < 2; f++)
+        for (int s = 0; s < 2; s++) free(c->fitv[f][s]);
     memset(c, 0, sizeof *c);
 }
 
-static int ctx_init(eval_ctx *c, uint64_t seed)
+/* The user calibration as a cockpit would make it: the true operator
+ * stretches the arms forward and sideways (gt sequence "calib", 4 s), the
+ * tracker records it (noise, dropouts) and kin_user_calib_estimate turns it
+ * into scales. */
+static int estimate_calib(eval_ctx *c, const gt_track_desc *track)
+{
+    gen_arms cal = c->truth;
+    if (gt_sequence_build(&c->mask, "calib", &cal) < 0) return -1;
+    c->truth.model.block = cal.model.block;   /* the same block, maybe moved */
+    int n = (int)(4.0f * track->rate_hz);
+    kin_track_sample *S = malloc(sizeof *S * (size_t)n);
+    float *scratch = malloc(sizeof(float) * (size_t)n);
+    int rc = -1;
+    if (S && scratch) {
+        for (int k = 0; k < n; k++)
+            gt_track_sample(&cal, track, k, c->tlocals, c->tworld, &S[k]);
+        rc = kin_user_calib_estimate(S, n, &c->rig, scratch, &c->calib, c->calib_why,
+                                     sizeof c->calib_why);
+    }
+    free(S);
+    free(scratch);
+    return rc;
+}
+
+static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_track_desc *track)
 {
     memset(c, 0, sizeof *c);
     c->g = kin_sthmd_geometry_of(NULL);
@@ -232,7 +442,24 @@ static int ctx_init(eval_ctx *c, uint64_t seed)
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
     ok = ok && c->mask_lo && c->mask_up && c->refined && c->layer && c->out && c->depth_lo &&
          c->nrm_lo && c->mnrm && c->refine_scratch;
-    return ok ? 0 : -1;
+    c->cm_scratch_size = fuse_colour_model_scratch_size(FIT_BITS);
+    c->cm_scratch = malloc(c->cm_scratch_size);
+    c->learn = malloc(cp);
+    c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
+    c->gt_mask = malloc((size_t)GEN_CAM_W * GEN_CAM_H);
+    for (int e = 0; e < 2; e++) c->llr[e] = malloc(sizeof(float) << (3 * FIT_BITS));
+    ok = ok && c->cm_scratch && c->learn && c->gt_depth && c->gt_mask && c->llr[0] &&
+         c->llr[1];
+    for (int f = 0; f < 2 && ok; f++)
+        ok = fit_vertices(f ? &c->mask_fine.model : &c->mask.model, &c->rig, c->fitv[f],
+                          c->fitn[f]) == 0;
+    if (!ok) return -1;
+    if (estimate_calib(c, track) < 0) {
+        cli_fail("user calibration from the calibration motion: %s", c->calib_why);
+        return -2;
+    }
+    if (gt_sequence_build(&c->mask, sequence, &c->truth) < 0) return -1;
+    return 0;
 }
 
 /* ------------------------------------------------------- ground truth */
@@ -251,7 +478,8 @@ static int make_truth(eval_ctx *c, int frame, float speed, int first)
     for (int e = 0; e < 2; e++) {
         kin_camera cam = kin_sthmd_camera(NULL, &wfh, (kin_eye)e);
         c->tcam[e] = cam;
-        gt_render_eye(&c->gctx, &wfh, (kin_eye)e, frame, c->cam_rgb, c->sil[e], c->tnrm[e]);
+        gt_render_eye(&c->gctx, &wfh, (kin_eye)e, frame, c->cam_rgb, c->sil[e], c->tnrm[e],
+                      c->gt_depth, c->gt_mask);
         const uint8_t *src = c->cam_rgb + (size_t)c->g.crop_y0 * GEN_CAM_W * 3;
         if (fuse_rgb24_to_rgba(src, GEN_CAM_W * 3, CW, CH,
                                &(fuse_image){ c->P[e], CW, CH, 4 * CW }) != FUSE_OK)
@@ -281,7 +509,14 @@ static int run_init(method_run *r, const method_cfg *cfg, const eval_ctx *c)
     /* the tracker runs for a second before the first frame (the motion
      * holds its first pose before t = 0) */
     r->next_k = -(int)ceilf(cfg->track.rate_hz);
-    kin_filter_init(&r->filter, NULL);
+    /* The filter as egofuse configures it: kin's defaults without the
+     * ramp-lag compensation (it adds the low-pass's lag times a noisy
+     * velocity: on 5 mm noise it costs IoU and triples the edge flicker,
+     * see the "lagcomp" row of the report) */
+    kin_filter_desc fd;
+    memset(&fd, 0, sizeof fd);
+    fd.no_lag_comp = !cfg->lag_comp;
+    kin_filter_init(&r->filter, &fd);
     r->locals = malloc(sizeof *r->locals * (size_t)c->mask.model.node_count);
     r->prev[0] = malloc((size_t)CW * CH);
     r->prev[1] = malloc((size_t)CW * CH);
@@ -314,17 +549,26 @@ static void merge_sample(kin_track_sample *dst, const kin_track_sample *s)
     dst->valid |= v;
 }
 
+/* The estimated calibration (estimate_calib) with every scale times
+ * (1 + err): the calibration-error sweep. */
 static kin_user_calib calib_of(const eval_ctx *c, float err)
 {
-    kin_user_calib u = kin_user_calib_identity();
-    float model = c->rig.upper_len[0] + c->rig.fore_len[0];
-    float truth = c->rig.upper_len[0] * c->op.upper_scale + c->rig.fore_len[0] * c->op.fore_scale;
+    kin_user_calib u = c->calib;
     for (int s = 0; s < 2; s++) {
-        u.arm_scale[s] = truth / model * (1.0f + err);
-        u.hand_scale[s] = c->op.hand_scale * (1.0f + err);
+        u.arm_scale[s] *= 1.0f + err;
+        u.hand_scale[s] *= 1.0f + err;
     }
-    u.shoulder_scale = c->op.shoulder_scale * (1.0f + err);
+    u.shoulder_scale *= 1.0f + err;
     return u;
+}
+
+/* The true proportions the calibration should find (for the report). */
+static void true_scales(const eval_ctx *c, float *arm, float *hand, float *shoulder)
+{
+    float model = c->rig.upper_len[0] + c->rig.fore_len[0];
+    *arm = (c->rig.upper_len[0] * c->op.upper_scale + c->rig.fore_len[0] * c->op.fore_scale) / model;
+    *hand = c->op.hand_scale;
+    *shoulder = c->op.shoulder_scale;
 }
 
 /* Upsamples a w x h mask (nearest) to CW x CH, and normals likewise. */
@@ -358,6 +602,89 @@ static int dump_masks(const char *dir, const method_cfg *cfg, int frame, int eye
     io_error err;
     if (io_image_save(path, &img, &err) != IO_OK) return cli_fail("%s", err.msg);
     return EXIT_OK;
+}
+
+/* FK and skinning of locals into c->world, c->pos, c->nrm. */
+static void pose_skin(eval_ctx *c, const method_cfg *cfg, const kin_model *m,
+                      const kin_transform *locals)
+{
+    const kin_mesh *me = &m->meshes[0];
+    kin_fk(m->parents, m->node_count, locals, NULL, c->world);
+    kin_skin_joint_matrices(&m->skins[0], c->world, c->jm);
+    if (cfg->dqs) {
+        kin_skin_dq_from_matrices(c->jm, m->skins[0].joint_count, c->dq);
+        kin_skin_dqs(me, c->dq, c->pos, c->nrm);
+    } else {
+        kin_skin_lbs(me, c->jm, c->pos, c->nrm);
+    }
+}
+
+/* Mask (and normals) of the posed model through cam at the method's
+ * resolution; *mask, *nrm point at the full-resolution result. */
+static int draw_mask(eval_ctx *c, const method_cfg *cfg, const kin_mesh *me, int posed,
+                     const kin_camera *cam, const uint8_t **mask, const float **nrm)
+{
+    int div = cfg->div, w = CW / div, h = CH / div;
+    rast_target tg = { w, h, c->depth_lo, w, c->mask_lo, w, c->nrm_lo, 3 * w, 3 };
+    rast_target_clear(&tg);
+    if (posed) {
+        rast_transform_points(cam->view_proj.m, c->pos, me->vertex_count, c->clip);
+        rast_transform_dirs(cam->view.m, c->nrm, me->vertex_count, c->vnrm);
+        rast_mesh_desc d = { c->clip, me->vertex_count, c->vnrm, 3, me->indices,
+                             me->index_count / 3, RAST_CULL_NONE };
+        if (rast_draw(&tg, &d, NULL) != RAST_OK) return -1;
+    }
+    if (div == 1) {
+        *mask = c->mask_lo;
+        *nrm = c->nrm_lo;
+    } else {
+        upsample(c->mask_lo, c->nrm_lo, div, c->mask_up, c->mnrm);
+        *mask = c->mask_up;
+        *nrm = c->mnrm;
+    }
+    return 0;
+}
+
+static kin_camera eye_camera(const eval_ctx *c, int e)
+{
+    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
+    return kin_sthmd_camera(&hd, &c->world[c->rig.head], (kin_eye)e);
+}
+
+/* The elbow fit of the refine method (see fit_swivels): learns the colour
+ * models, finds the swivels, turns the arms in r->locals. */
+static int fit_elbows(eval_ctx *c, method_run *r, const kin_model *m, uint32_t valid)
+{
+    const kin_mesh *me = &m->meshes[0];
+    kin_camera cam[2];
+    for (int e = 0; e < 2; e++) {
+        cam[e] = eye_camera(c, e);
+        /* learn where the kinematic mask and the last refined mask agree */
+        const uint8_t *m0;
+        const float *nrm;
+        if (draw_mask(c, &r->cfg, me, 1, &cam[e], &m0, &nrm) < 0) return -1;
+        const uint8_t *learn = m0;
+        if (r->have_prev) {
+            for (size_t i = 0; i < (size_t)CW * CH; i++) {
+                int a = m0[i] >= 128, b = r->prev[e][i] >= 128;
+                c->learn[i] = a && b ? 255 : !a && !b ? 0 : 128;
+            }
+            learn = c->learn;
+        }
+        fuse_colour_model cm = { FIT_BITS, 0, 0, c->llr[e] };
+        fuse_image P = { c->P[e], CW, CH, 4 * CW };
+        if (fuse_colour_model_learn(&cm, &P, learn, CW, 4, 2, 3.0f, 64, c->cm_scratch,
+                                    c->cm_scratch_size) != FUSE_OK)
+            return -1;
+    }
+    float best[2];
+    fit_swivels(c, r->cfg.fine, c->world, c->pos, cam, r->have_prev ? r->swivel : NULL, best);
+    for (int s = 0; s < 2; s++) {
+        if (!(valid & (KIN_TRACK_HAND_L << s))) continue;
+        apply_swivel(&c->rig, m, c->world, s, best[s], r->locals);
+        r->swivel[s] = best[s];
+    }
+    return 0;
 }
 
 static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const char *dump)
@@ -396,25 +723,16 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             cp = &cal;
         }
         posed = kin_arm_rig_pose(&c->rig, m, cp, NULL, &s, r->locals, NULL);
-        if (posed) {
-            kin_fk(m->parents, m->node_count, r->locals, NULL, c->world);
-            kin_skin_joint_matrices(&m->skins[0], c->world, c->jm);
-            if (cfg->dqs) {
-                kin_skin_dq_from_matrices(c->jm, m->skins[0].joint_count, c->dq);
-                kin_skin_dqs(me, c->dq, c->pos, c->nrm);
-            } else {
-                kin_skin_lbs(me, c->jm, c->pos, c->nrm);
-            }
+        if (posed) pose_skin(c, cfg, m, r->locals);
+        if (posed && cfg->kind == M_REFINE && cfg->fit) {
+            if (fit_elbows(c, r, m, s.valid) < 0) return -1;
+            pose_skin(c, cfg, m, r->locals);
         }
     }
     double secs = cli_now() - t0;
     for (int e = 0; e < 2; e++) {
         t0 = cli_now();
-        kin_camera cam = c->tcam[e];
-        if (posed) {
-            kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
-            cam = kin_sthmd_camera(&hd, &c->world[c->rig.head], (kin_eye)e);
-        }
+        kin_camera cam = posed ? eye_camera(c, e) : c->tcam[e];
         const uint8_t *mask = c->mask_up;
         const float *nrm = c->mnrm;
         if (cfg->kind == M_SKIN) {
@@ -423,29 +741,20 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             if (fuse_skin_key(&sp, &P, c->mask_up, CW) != FUSE_OK) return -1;
             memset(c->mnrm, 0, sizeof(float) * 3 * CW * CH);
         } else {
-            int div = cfg->div, w = CW / div, h = CH / div;
-            rast_target tg = { w, h, c->depth_lo, w, c->mask_lo, w, c->nrm_lo, 3 * w, 3 };
-            rast_target_clear(&tg);
-            if (posed) {
-                rast_transform_points(cam.view_proj.m, c->pos, me->vertex_count, c->clip);
-                rast_transform_dirs(cam.view.m, c->nrm, me->vertex_count, c->vnrm);
-                rast_mesh_desc d = { c->clip, me->vertex_count, c->vnrm, 3, me->indices,
-                                     me->index_count / 3, RAST_CULL_NONE };
-                if (rast_draw(&tg, &d, NULL) != RAST_OK) return -1;
-            }
-            if (div == 1) {
-                mask = c->mask_lo;
-                nrm = c->nrm_lo;
-            } else {
-                upsample(c->mask_lo, c->nrm_lo, div, c->mask_up, c->mnrm);
-            }
+            if (draw_mask(c, cfg, me, posed, &cam, &mask, &nrm) < 0) return -1;
             if (cfg->kind == M_REFINE) {
                 fuse_refine_params rp = fuse_refine_params_default();
                 rp.band = cfg->band;
                 fuse_image P = { c->P[e], CW, CH, 4 * CW };
-                if (fuse_refine_mask(&rp, &P, mask, CW, c->refined, CW, c->refine_scratch,
-                                     c->refine_scratch_size, NULL) != FUSE_OK)
-                    return -1;
+                fuse_colour_model g = { FIT_BITS, 0, 0, c->llr[e] };
+                fuse_result fr =
+                    cfg->fit && cfg->global > 0.0f
+                        ? fuse_refine_mask_global(&rp, &g, cfg->global, &P, mask, CW, c->refined,
+                                                  CW, c->refine_scratch, c->refine_scratch_size,
+                                                  NULL)
+                        : fuse_refine_mask(&rp, &P, mask, CW, c->refined, CW, c->refine_scratch,
+                                           c->refine_scratch_size, NULL);
+                if (fr != FUSE_OK) return -1;
                 mask = c->refined;
             }
         }
@@ -477,14 +786,22 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         r->mse += mse;
         r->n_eye++;
         if (per_frame)
-            printf("%4d %-5s %-14s %-22s iou %.4f bf1 %.3f bf3 %.3f fp %6ld fn %6ld psnr %5.2f\n",
+            printf("%4d %-5s %-14s %-22s iou %.4f bf1 %.3f bf3 %.3f fp %6ld fn %6ld psnr %5.2f"
+                   " swivel %+.0f %+.0f deg\n",
                    frame, e ? "right" : "left", kind_name[cfg->kind], cfg->setting, iou, bf1,
-                   bf3, cf.fp, cf.fn, fuse_psnr_of_mse(mse));
+                   bf3, cf.fp, cf.fn, fuse_psnr_of_mse(mse), (double)(r->swivel[0] / DEG2RAD),
+                   (double)(r->swivel[1] / DEG2RAD));
         if (dump && dump_masks(dump, cfg, frame, e, mask, c->sil[e], c->P[e], c->vrgb))
             return -1;
         if (r->have_prev && c->have_sil_prev) {
-            r->flicker += fuse_edge_flicker(r->prev[e], mask, c->sil_prev[e], c->sil[e], CW,
-                                            CW, CH);
+            /* summed as numerator and denominator (spurious swept area over
+             * true edge length), so frames where the hand leaves the view
+             * (a few edge pixels) do not dominate the mean */
+            double fl = fuse_edge_flicker(r->prev[e], mask, c->sil_prev[e], c->sil[e], CW, CW, CH);
+            long edge = fuse_boundary_count(c->sil[e], CW, CW, CH);
+            double den = edge > 1 ? (double)edge : 1.0;
+            r->flicker += fl * den;
+            r->flicker_den += den;
             r->n_flicker++;
         }
         memcpy(r->prev[e], mask, (size_t)CW * CH);
@@ -503,7 +820,9 @@ static method_cfg base_cfg(const eval_opts *o, method_kind k)
     memset(&c, 0, sizeof c);
     c.kind = k;
     c.div = 1;
-    c.band = 16;
+    c.band = o->band;
+    c.fit = k == M_REFINE;
+    c.global = o->global;
     c.track = gt_track_default();
     c.track.noise_mm = o->noise;
     c.track.latency_ms = o->latency;
@@ -522,72 +841,100 @@ static int add_cfg(method_cfg *list, int n, int cap, method_cfg c)
     return n + 1;
 }
 
-/* The methods at the given tracking; with sweeps, every knob. */
-static int make_configs(const eval_opts *o, int sweeps, method_cfg *L, int cap)
+/* Phases of a report (each on its own ground truth and frame count). */
+enum { PH_METHODS, PH_KNOBS, PH_TRACK, PH_SEQ };
+
+/* A configuration of a sweep: group, swept value and setting "name=" x
+ * (x as %g) followed by unit. */
+static method_cfg named_cfg(const eval_opts *o, method_kind k, const char *group, float x,
+                            const char *name, const char *unit)
+{
+    method_cfg c = base_cfg(o, k);
+    c.x = x;
+    snprintf(c.group, sizeof c.group, "%s", group);
+    snprintf(c.setting, sizeof c.setting, "%s=%g%s", name, (double)x, unit);
+    return c;
+}
+
+/* PH_METHODS: the selected methods at the given tracking; PH_KNOBS: the
+ * same (group "knobs") with every speed knob; PH_TRACK: the tracking sweeps (and the methods at the
+ * given tracking, group "track"); PH_SEQ: the methods on sequence seq. */
+static int make_configs(const eval_opts *o, int phase, const char *seq, method_cfg *L, int cap)
 {
     int n = 0;
-    for (int k = 0; k < 4; k++) n = add_cfg(L, n, cap, base_cfg(o, (method_kind)k));
-    if (!sweeps) return n;
     method_cfg c;
-    static const int bands[] = { 2, 3, 5, 8, 12, 24 };
-    for (int i = 0; i < 6; i++) {
-        c = base_cfg(o, M_REFINE);
-        c.band = bands[i];
-        c.x = (float)bands[i];
-        snprintf(c.group, sizeof c.group, "band");
-        snprintf(c.setting, sizeof c.setting, "band=%d", bands[i]);
-        n = add_cfg(L, n, cap, c);
-    }
-    for (int k = M_KIN_CAL; k <= M_REFINE; k += 2)
-        for (int div = 2; div <= 4; div *= 2) {
+    if (phase == PH_METHODS || phase == PH_KNOBS || phase == PH_SEQ)
+        for (int k = 0; k < 4; k++) {
+            if (!(o->methods & (1u << k))) continue;
             c = base_cfg(o, (method_kind)k);
-            c.div = div;
-            c.x = (float)div;
-            snprintf(c.group, sizeof c.group, "res");
-            snprintf(c.setting, sizeof c.setting, "mask=%dx%d", CW / div, CH / div);
+            if (phase == PH_SEQ) {
+                snprintf(c.group, sizeof c.group, "sequence");
+                snprintf(c.setting, sizeof c.setting, "seq=%s", seq);
+            } else if (phase == PH_KNOBS) {
+                snprintf(c.group, sizeof c.group, "knobs");
+            }
             n = add_cfg(L, n, cap, c);
         }
-    for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
-        c = base_cfg(o, (method_kind)k);
-        c.fine = 1;
-        snprintf(c.group, sizeof c.group, "tris");
-        snprintf(c.setting, sizeof c.setting, "tris=4x");
-        n = add_cfg(L, n, cap, c);
-        c = base_cfg(o, (method_kind)k);
-        c.dqs = 1;
-        snprintf(c.group, sizeof c.group, "dqs");
-        snprintf(c.setting, sizeof c.setting, "dqs");
-        n = add_cfg(L, n, cap, c);
-    }
-    static const float noise[] = { 0, 2, 10, 20 };
-    static const float lat[] = { 0, 50, 100 };
-    static const float cal[] = { -0.10f, -0.05f, 0.0f, 0.05f, 0.10f };
-    for (int k = 0; k < 4; k++) {
-        if (k == M_SKIN) continue;
-        for (int i = 0; i < 4; i++) {
-            c = base_cfg(o, (method_kind)k);
-            c.track.noise_mm = noise[i];
-            c.x = noise[i];
-            snprintf(c.group, sizeof c.group, "noise");
-            snprintf(c.setting, sizeof c.setting, "noise=%gmm", (double)noise[i]);
-            n = add_cfg(L, n, cap, c);
-        }
-        for (int i = 0; i < 3; i++) {
-            c = base_cfg(o, (method_kind)k);
-            c.track.latency_ms = lat[i];
-            c.x = lat[i];
-            snprintf(c.group, sizeof c.group, "latency");
-            snprintf(c.setting, sizeof c.setting, "latency=%gms", (double)lat[i]);
-            n = add_cfg(L, n, cap, c);
-        }
-        if (k == M_KIN) continue;    /* the paper's method has no calibration */
+    if (phase == PH_KNOBS) {
+        static const int bands[] = { 4, 8, 12, 24, 32 };
         for (int i = 0; i < 5; i++) {
-            c = base_cfg(o, (method_kind)k);
-            c.calib_error = cal[i];
-            c.x = 100.0f * cal[i];
-            snprintf(c.group, sizeof c.group, "calib");
-            snprintf(c.setting, sizeof c.setting, "calib=%+g%%", (double)(100.0f * cal[i]));
+            c = named_cfg(o, M_REFINE, "band", (float)bands[i], "band", "");
+            c.band = bands[i];
             n = add_cfg(L, n, cap, c);
+        }
+        c = named_cfg(o, M_REFINE, "fit", 0.0f, "fit", "");
+        c.fit = 0;
+        n = add_cfg(L, n, cap, c);
+        c = named_cfg(o, M_REFINE, "global", 0.0f, "global", "");
+        c.global = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
+            c = named_cfg(o, (method_kind)k, "lagcomp", 1.0f, "lagcomp", "");
+            c.lag_comp = 1;
+            n = add_cfg(L, n, cap, c);
+        }
+        for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
+            for (int div = 2; div <= 4; div *= 2) {
+                c = named_cfg(o, (method_kind)k, "res", (float)div, "div", "");
+                snprintf(c.setting, sizeof c.setting, "mask=%dx%d", CW / div, CH / div);
+                c.div = div;
+                n = add_cfg(L, n, cap, c);
+            }
+            c = named_cfg(o, (method_kind)k, "tris", 4.0f, "tris", "x");
+            c.fine = 1;
+            n = add_cfg(L, n, cap, c);
+            c = named_cfg(o, (method_kind)k, "dqs", 1.0f, "dqs", "");
+            snprintf(c.setting, sizeof c.setting, "dqs");
+            c.dqs = 1;
+            n = add_cfg(L, n, cap, c);
+        }
+    }
+    if (phase == PH_TRACK) {
+        static const float noise[] = { 0, 10, 20 };
+        static const float lat[] = { 0, 50, 100 };
+        static const float cal[] = { -0.10f, -0.05f, 0.05f, 0.10f };
+        for (int k = 0; k < 4; k++) {
+            if (k == M_SKIN || !(o->methods & (1u << k))) continue;
+            c = base_cfg(o, (method_kind)k);
+            snprintf(c.group, sizeof c.group, "track");
+            n = add_cfg(L, n, cap, c);
+            for (int i = 0; i < 3; i++) {
+                c = named_cfg(o, (method_kind)k, "noise", noise[i], "noise", "mm");
+                c.track.noise_mm = noise[i];
+                n = add_cfg(L, n, cap, c);
+            }
+            for (int i = 0; i < 3; i++) {
+                c = named_cfg(o, (method_kind)k, "latency", lat[i], "latency", "ms");
+                c.track.latency_ms = lat[i];
+                n = add_cfg(L, n, cap, c);
+            }
+            if (k == M_KIN) continue;    /* the paper's method has no calibration */
+            for (int i = 0; i < 4; i++) {
+                c = named_cfg(o, (method_kind)k, "calib", 100.0f * (o->calib_error + cal[i]),
+                              "calib", "%");
+                c.calib_error = o->calib_error + cal[i];
+                n = add_cfg(L, n, cap, c);
+            }
         }
     }
     return n;
@@ -610,8 +957,18 @@ static summary summarise(const method_run *r)
     s.fn = r->fn / n;
     s.psnr = fuse_psnr_of_mse(r->mse / n);
     s.ms = 1e3 * r->secs / (r->n_frames > 0 ? (double)r->n_frames : 1.0);
-    s.flicker = r->n_flicker > 0 ? r->flicker / (double)r->n_flicker : 0.0;
+    s.flicker = r->flicker_den > 0.0 ? r->flicker / r->flicker_den : 0.0;
     return s;
+}
+
+static void print_calib(FILE *f, const eval_ctx *c)
+{
+    float arm, hand, sh;
+    true_scales(c, &arm, &hand, &sh);
+    fprintf(f, "calibration (kin_user_calib_estimate on the calibration motion): arm x%.3f "
+               "(true %.3f), hand x%.3f (true %.3f), shoulders x%.3f (true %.3f)\n",
+            (double)c->calib.arm_scale[1], (double)arm, (double)c->calib.hand_scale[1],
+            (double)hand, (double)c->calib.shoulder_scale, (double)sh);
 }
 
 static int write_csv(const char *path, const method_run *R, int n)
@@ -655,7 +1012,10 @@ static void print_table(FILE *f, const method_run *R, int n, int markdown)
     }
 }
 
-/* DIR/<group>.dat: one block per method (gnuplot index), x y columns. */
+/* DIR/<group>.dat: one block per method (gnuplot index), x y columns,
+ * sorted by x; the method at the given tracking (group "track") is the
+ * point at the given value of a tracking curve, the default refine (group
+ * "knobs") the default band's point. */
 static int write_group(const char *dir, const char *group, const method_run *R, int n,
                        const eval_opts *o)
 {
@@ -665,38 +1025,76 @@ static int write_group(const char *dir, const char *group, const method_run *R, 
     if (!f) return cli_fail("%s: cannot write", path);
     for (int k = 0; k < 4; k++) {
         fprintf(f, "# %s\n", kind_name[k]);
-        int any = 0;
-        /* the default configuration belongs on every tracking curve */
-        for (int pass = 0; pass < 2; pass++)
-            for (int i = 0; i < n; i++) {
-                const method_cfg *c = &R[i].cfg;
-                if ((int)c->kind != k) continue;
-                int is_default = !strcmp(c->group, "methods");
-                float x;
-                if (pass == 0 && is_default) {
-                    if (!strcmp(group, "noise")) x = o->noise;
-                    else if (!strcmp(group, "latency")) x = o->latency;
-                    else if (!strcmp(group, "calib")) x = 100.0f * o->calib_error;
-                    else if (!strcmp(group, "band") && k == M_REFINE) x = 16.0f;
-                    else continue;
-                    if (!strcmp(group, "calib") && k < M_KIN_CAL) continue;
-                } else if (pass == 1 && !strcmp(c->group, group)) {
-                    x = c->x;
-                } else {
-                    continue;
-                }
-                summary s = summarise(&R[i]);
-                fprintf(f, "%g %.5f %.5f %.3f %.3f\n", (double)x, s.iou, s.bf3, s.ms, s.psnr);
-                any = 1;
-            }
-        if (!any) fprintf(f, "nan nan nan nan nan\n");
+        float xs[64];
+        int idx[64], m = 0;
+        for (int i = 0; i < n && m < 64; i++) {
+            const method_cfg *c = &R[i].cfg;
+            if ((int)c->kind != k) continue;
+            float x;
+            if (!strcmp(c->group, group)) x = c->x;
+            else if (!strcmp(c->group, "track") && !strcmp(group, "noise")) x = o->noise;
+            else if (!strcmp(c->group, "track") && !strcmp(group, "latency")) x = o->latency;
+            else if (!strcmp(c->group, "track") && !strcmp(group, "calib") && k != M_KIN)
+                x = 100.0f * o->calib_error;
+            else if (!strcmp(c->group, "knobs") && !strcmp(group, "band") && k == M_REFINE)
+                x = (float)o->band;
+            else continue;
+            int j = m++;
+            while (j > 0 && xs[j - 1] > x) { xs[j] = xs[j - 1]; idx[j] = idx[j - 1]; j--; }
+            xs[j] = x;
+            idx[j] = i;
+        }
+        for (int j = 0; j < m; j++) {
+            summary s = summarise(&R[idx[j]]);
+            fprintf(f, "%g %.5f %.5f %.3f %.3f\n", (double)xs[j], s.iou, s.bf3, s.ms, s.psnr);
+        }
+        if (!m) fprintf(f, "nan nan nan nan nan\n");
         fprintf(f, "\n\n");
     }
     fclose(f);
     return EXIT_OK;
 }
 
-static int write_report(const char *dir, const method_run *R, int n, const eval_opts *o)
+/* DIR/sequences.dat: per sequence, IoU then BF(3 px) of the four methods. */
+static int write_sequences(const char *dir, const method_run *R, int n, const eval_opts *o)
+{
+    char path[IO_PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/sequences.dat", dir);
+    FILE *f = fopen(path, "w");
+    if (!f) return cli_fail("%s: cannot write", path);
+    fprintf(f, "# sequence iou(kin kin-cal-pred skin refine) bf3(same)\n");
+    for (int q = 0; gt_sequence_name(q); q++) {
+        const char *name = gt_sequence_name(q);
+        char want[64];
+        snprintf(want, sizeof want, "seq=%s", name);
+        double iou[4], bf3[4];
+        int any = 0;
+        for (int k = 0; k < 4; k++) {
+            iou[k] = bf3[k] = NAN;
+            for (int i = 0; i < n; i++) {
+                const method_cfg *c = &R[i].cfg;
+                if ((int)c->kind != k) continue;
+                int hit = !strcmp(name, o->sequence) ? !strcmp(c->group, "methods")
+                                                     : !strcmp(c->setting, want);
+                if (!hit) continue;
+                summary s = summarise(&R[i]);
+                iou[k] = s.iou;
+                bf3[k] = s.bf3;
+                any = 1;
+            }
+        }
+        if (!any) continue;
+        fprintf(f, "%s", name);
+        for (int k = 0; k < 4; k++) fprintf(f, " %.5f", iou[k]);
+        for (int k = 0; k < 4; k++) fprintf(f, " %.5f", bf3[k]);
+        fprintf(f, "\n");
+    }
+    fclose(f);
+    return EXIT_OK;
+}
+
+static int write_report(const char *dir, const method_run *R, int n, const eval_opts *o,
+                        const eval_ctx *c)
 {
     char path[IO_PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/summary.csv", dir);
@@ -704,10 +1102,16 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
     snprintf(path, sizeof path, "%s/table.md", dir);
     FILE *f = fopen(path, "w");
     if (!f) return cli_fail("%s: cannot write", path);
-    fprintf(f, "Ground truth: %d frames at 60 Hz, tracking noise %g mm, latency %g ms, dropout "
-               "%g, calibration error %g, speed %g, seed %d.\n\n",
-            o->frames, (double)o->noise, (double)o->latency, (double)o->dropout,
-            (double)o->calib_error, (double)o->speed, o->seed);
+    fprintf(f, "Ground truth: sequence %s, tracking noise %g mm, latency %g ms, dropout %g, "
+               "calibration error %g, speed %g, seed %d. Frames: %d for the methods (group "
+               "methods), %d for the speed knobs (groups knobs, band, fit, global, lagcomp, "
+               "res, tris, dqs) and the tracking sweeps (groups track, noise, latency, calib), "
+               "%d per other sequence (group sequence).\n\n",
+            o->sequence, (double)o->noise, (double)o->latency, (double)o->dropout,
+            (double)o->calib_error, (double)o->speed, o->seed, o->frames, o->sweep_frames,
+            o->seq_frames);
+    print_calib(f, c);
+    fprintf(f, "\n");
     print_table(f, R, n, 1);
     fclose(f);
     /* speed-accuracy points: label, ms, iou, bf3 */
@@ -717,13 +1121,15 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
     for (int k = 0; k < 4; k++) {
         fprintf(f, "# %s\n", kind_name[k]);
         for (int i = 0; i < n; i++) {
-            const method_cfg *c = &R[i].cfg;
-            if ((int)c->kind != k) continue;
-            if (strcmp(c->group, "methods") && strcmp(c->group, "band") &&
-                strcmp(c->group, "res") && strcmp(c->group, "tris") && strcmp(c->group, "dqs"))
+            const method_cfg *cf = &R[i].cfg;
+            if ((int)cf->kind != k) continue;
+            if (strcmp(cf->group, "knobs") && strcmp(cf->group, "band") &&
+                strcmp(cf->group, "res") && strcmp(cf->group, "tris") &&
+                strcmp(cf->group, "dqs") && strcmp(cf->group, "fit") &&
+                strcmp(cf->group, "global") && strcmp(cf->group, "lagcomp"))
                 continue;
             summary s = summarise(&R[i]);
-            fprintf(f, "%.3f %.5f %.5f \"%s\"\n", s.ms, s.iou, s.bf3, c->setting);
+            fprintf(f, "%.3f %.5f %.5f \"%s\"\n", s.ms, s.iou, s.bf3, cf->setting);
         }
         fprintf(f, "\n\n");
     }
@@ -731,11 +1137,12 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
     static const char *groups[] = { "noise", "latency", "calib", "band" };
     for (int g = 0; g < 4; g++)
         if (write_group(dir, groups[g], R, n, o)) return EXIT_FAIL;
+    if (write_sequences(dir, R, n, o)) return EXIT_FAIL;
     snprintf(path, sizeof path, "%s/charts.gp", dir);
     f = fopen(path, "w");
     if (!f) return cli_fail("%s: cannot write", path);
     fprintf(f,
-        "set terminal pngcairo size 900,600 font ',10'\n"
+        "set terminal pngcairo noenhanced size 900,600 font ',10'\n"
         "set grid\nset key bottom right\n"
         "titles = 'kin kin-cal-pred skin refine'\n"
         "set output '%s/speed_iou.png'\n"
@@ -756,15 +1163,21 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
         "set output '%s/latency.png'\nset title 'Accuracy against tracking latency (noise %g mm)'\n"
         "set xlabel 'latency, ms'\n"
         "plot for [i=0:3] '%s/latency.dat' index i using 1:2 with linespoints lw 2 title word(titles, i+1)\n"
-        "set output '%s/calib.png'\nset title 'Accuracy against calibration error'\n"
-        "set xlabel 'error of the arm and hand scale, %%'\n"
+        "set output '%s/calib.png'\nset title 'Accuracy against calibration error (on top of the estimate)'\n"
+        "set xlabel 'error of the arm, hand and shoulder scales, %%'\n"
         "plot for [i=0:3] '%s/calib.dat' index i using 1:2 with linespoints lw 2 title word(titles, i+1)\n"
         "set output '%s/band.png'\nset title 'Refinement band width'\n"
         "set xlabel 'band half width, px'\nset ylabel 'IoU, BF(3 px)'\n"
         "plot '%s/band.dat' index 3 using 1:2 with linespoints lw 2 title 'IoU', \\\n"
-        "     '%s/band.dat' index 3 using 1:3 with linespoints lw 2 title 'BF 3px'\n",
+        "     '%s/band.dat' index 3 using 1:3 with linespoints lw 2 title 'BF 3px'\n"
+        "set output '%s/sequences.png'\nset title 'Mask IoU per sequence and method'\n"
+        "set style data histograms\nset style histogram clustered gap 1\n"
+        "set style fill solid 0.8 border -1\nset yrange [0:1.15]\nset key top center horizontal\n"
+        "set xlabel 'sequence'\nset ylabel 'mask IoU'\n"
+        "plot '%s/sequences.dat' using 2:xtic(1) title 'kin', '' using 3 title 'kin-cal-pred', "
+        "'' using 4 title 'skin', '' using 5 title 'refine'\n",
         dir, dir, dir, dir, dir, dir, dir, (double)o->latency, dir, dir, (double)o->noise, dir,
-        dir, dir, dir, dir, dir);
+        dir, dir, dir, dir, dir, dir, dir);
     fclose(f);
     char cmd[3 * IO_PATH_MAX];
     snprintf(cmd, sizeof cmd, "gnuplot '%s/charts.gp'", dir);
@@ -777,62 +1190,116 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
 
 /* ---------------------------------------------------------------- run */
 
-static int eval_run(const eval_opts *o)
+/* Runs configurations cfgs[0..n) into R on `frames` frames of sequence
+ * seq (one ground truth). The context is left in *c for the caller to
+ * free. */
+static int run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames,
+                     const method_cfg *cfgs, method_run *R, int n)
 {
-    eval_ctx c;
-    if (ctx_init(&c, (uint64_t)o->seed) < 0) {
-        ctx_free(&c);
-        return cli_fail("cannot build the ground truth (out of memory)");
-    }
-    if (o->dump && cli_mkdirs(o->dump) != 0) {
-        ctx_free(&c);
-        return cli_fail("%s: cannot create the folder", o->dump);
-    }
-    if (o->report && cli_mkdirs(o->report) != 0) {
-        ctx_free(&c);
-        return cli_fail("%s: cannot create the report folder", o->report);
-    }
-    enum { CAP = 96 };
-    method_cfg cfgs[CAP];
-    int n = make_configs(o, o->report != NULL, cfgs, CAP);
-    if (n > CAP) n = CAP;
-    method_run *R = calloc((size_t)n, sizeof *R);
+    method_cfg base = base_cfg(o, M_KIN_CAL);
+    int irc = ctx_init(c, (uint64_t)o->seed, seq, &base.track);
+    if (irc < 0)
+        return irc == -2 ? EXIT_FAIL : cli_fail("cannot build the ground truth (out of memory)");
     int rc = EXIT_FAIL;
-    if (!R) { cli_fail("out of memory"); goto done; }
-    for (int i = 0; i < n; i++)
-        if (run_init(&R[i], &cfgs[i], &c) < 0) { cli_fail("out of memory"); goto done; }
+    int inited = 0;
+    for (; inited < n; inited++)
+        if (run_init(&R[inited], &cfgs[inited], c) < 0) { cli_fail("out of memory"); goto done; }
     progress pr;
-    progress_start(&pr, o->frames);
+    progress_start(&pr, frames);
     if (o->quiet) pr.enabled = 0;
-    for (int f = 0; f < o->frames; f++) {
-        if (make_truth(&c, f, o->speed, f == 0) < 0) { cli_fail("frame %d: ground truth", f); goto done; }
+    for (int f = 0; f < frames; f++) {
+        if (make_truth(c, f, o->speed, f == 0) < 0) { cli_fail("frame %d: ground truth", f); goto done; }
         for (int i = 0; i < n; i++)
-            if (run_frame(&c, &R[i], f, o->per_frame, o->dump) < 0) {
+            if (run_frame(c, &R[i], f, o->per_frame, o->dump) < 0) {
                 cli_fail("frame %d: %s %s failed", f, kind_name[R[i].cfg.kind], R[i].cfg.setting);
                 goto done;
             }
-        progress_step(&pr, f + 1, "eval frame");
+        char what[64];
+        snprintf(what, sizeof what, "eval %s frame", seq);
+        progress_step(&pr, f + 1, what);
     }
     progress_end(&pr);
-    printf("egofuse eval: %d frames, tracking noise %g mm, latency %g ms, dropout %g, "
-           "calibration error %g, speed %g; means per eye (640x400 masks)\n",
-           o->frames, (double)o->noise, (double)o->latency, (double)o->dropout,
-           (double)o->calib_error, (double)o->speed);
-    print_table(stdout, R, n, 0);
+    rc = EXIT_OK;
+done:
+    for (int i = 0; i < inited; i++) run_free(&R[i]);
+    return rc;
+}
+
+static int eval_run(const eval_opts *o)
+{
+    if (o->dump && cli_mkdirs(o->dump) != 0)
+        return cli_fail("%s: cannot create the folder", o->dump);
+    if (o->report && cli_mkdirs(o->report) != 0)
+        return cli_fail("%s: cannot create the report folder", o->report);
+    enum { CAP = 160 };
+    method_cfg *cfgs = calloc(CAP, sizeof *cfgs);
+    method_run *R = calloc(CAP, sizeof *R);
+    eval_ctx c;
+    memset(&c, 0, sizeof c);
+    int n = 0, rc = EXIT_FAIL;
+    if (!cfgs || !R) { cli_fail("out of memory"); goto done; }
+    /* batches: (sequence, frames, phase) */
+    const char *bseq[8];
+    int bframes[8], bphase[8], nb = 0;
+    bseq[nb] = o->sequence; bframes[nb] = o->frames; bphase[nb++] = PH_METHODS;
+    if (o->report) {
+        bseq[nb] = o->sequence; bframes[nb] = o->sweep_frames; bphase[nb++] = PH_KNOBS;
+        bseq[nb] = o->sequence; bframes[nb] = o->sweep_frames; bphase[nb++] = PH_TRACK;
+        for (int q = 0; gt_sequence_name(q) && nb < 8; q++) {
+            const char *name = gt_sequence_name(q);
+            if (!strcmp(name, o->sequence) || !strcmp(name, "calib")) continue;
+            bseq[nb] = name; bframes[nb] = o->seq_frames; bphase[nb++] = PH_SEQ;
+        }
+    }
+    for (int b = 0; b < nb; b++) {
+        int m = make_configs(o, bphase[b], bseq[b], cfgs + n, CAP - n);
+        if (n + m > CAP) { cli_fail("too many configurations"); goto done; }
+        ctx_free(&c);
+        if (run_batch(o, &c, bseq[b], bframes[b], cfgs + n, R + n, m)) goto done;
+        if (b == 0 || !o->quiet) {
+            printf("egofuse eval: sequence %s, %d frames, tracking noise %g mm, latency %g ms, "
+                   "dropout %g, calibration error %g, speed %g; means per eye (640x400 masks)\n",
+                   bseq[b], bframes[b], (double)o->noise, (double)o->latency,
+                   (double)o->dropout, (double)o->calib_error, (double)o->speed);
+            if (b == 0) print_calib(stdout, &c);
+            print_table(stdout, R + n, m, 0);
+        }
+        n += m;
+    }
     if (o->csv && write_csv(o->csv, R, n)) goto done;
-    if (o->report && write_report(o->report, R, n, o)) goto done;
+    if (o->report && write_report(o->report, R, n, o, &c)) goto done;
     if (o->report) printf("egofuse eval: report in %s (summary.csv, table.md, *.png)\n", o->report);
     rc = EXIT_OK;
 done:
-    if (R)
-        for (int i = 0; i < n; i++) run_free(&R[i]);
-    free(R);
     ctx_free(&c);
+    free(R);
+    free(cfgs);
     return rc;
 }
 
 enum { O_FRAMES = 256, O_NOISE, O_LATENCY, O_DROPOUT, O_CALIB, O_SPEED, O_SEED, O_PERFRAME,
-       O_CSV, O_REPORT, O_QUIET, O_DUMP };
+       O_CSV, O_REPORT, O_QUIET, O_DUMP, O_METHODS, O_BAND, O_SEQUENCE, O_SWEEP_FRAMES,
+       O_SEQ_FRAMES, O_GLOBAL };
+
+/* "kin,refine" -> bits of method_kind; 0 when a name is unknown. */
+static unsigned parse_methods(const char *list)
+{
+    unsigned bits = 0;
+    const char *p = list;
+    while (*p) {
+        size_t n = strcspn(p, ",");
+        int found = 0;
+        for (int k = 0; k < 4; k++)
+            if (strlen(kind_name[k]) == n && !strncmp(p, kind_name[k], n)) {
+                bits |= 1u << k;
+                found = 1;
+            }
+        if (!found) return 0;
+        p += n;
+        if (*p == ',') p++;
+    }
+    return bits;
+}
 
 int cmd_eval(int argc, char **argv)
 {
@@ -849,10 +1316,17 @@ int cmd_eval(int argc, char **argv)
         {"report", required_argument, 0, O_REPORT},
         {"quiet", no_argument, 0, O_QUIET},
         {"dump", required_argument, 0, O_DUMP},
+        {"methods", required_argument, 0, O_METHODS},
+        {"band", required_argument, 0, O_BAND},
+        {"sequence", required_argument, 0, O_SEQUENCE},
+        {"sweep-frames", required_argument, 0, O_SWEEP_FRAMES},
+        {"seq-frames", required_argument, 0, O_SEQ_FRAMES},
+        {"global", required_argument, 0, O_GLOBAL},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
-    eval_opts o = { 60, 0, 0, 5.0f, 20.0f, 0.02f, 0.02f, 1.0f, 1, NULL, NULL, NULL };
+    eval_opts o = { 60, 0, 0, 5.0f, 20.0f, 0.02f, 0.0f, 1.0f, 1, NULL, NULL, NULL, 15u,
+                    GEN_ANIM_NAME, 60, 90, 0.5f, 16 };
     optind = 1;
     opterr = 0;
     int ch;
@@ -880,8 +1354,8 @@ int cmd_eval(int argc, char **argv)
             o.dropout = v;
             break;
         case O_CALIB:
-            if (!cli_parse_float(optarg, &v) || v < -0.4f || v > 0.4f)
-                return cli_usage_error("eval", "--calib-error '%s': not in -0.4..0.4", optarg);
+            if (!cli_parse_float(optarg, &v) || v < -0.3f || v > 0.3f)
+                return cli_usage_error("eval", "--calib-error '%s': not in -0.3..0.3", optarg);
             o.calib_error = v;
             break;
         case O_SPEED:
@@ -898,6 +1372,39 @@ int cmd_eval(int argc, char **argv)
         case O_REPORT: o.report = optarg; break;
         case O_QUIET: o.quiet = 1; break;
         case O_DUMP: o.dump = optarg; break;
+        case O_METHODS:
+            o.methods = parse_methods(optarg);
+            if (!o.methods)
+                return cli_usage_error("eval", "--methods '%s': not a list of kin, "
+                                       "kin-cal-pred, skin, refine", optarg);
+            break;
+        case O_SEQUENCE: {
+            int known = 0;
+            for (int i = 0; gt_sequence_name(i); i++)
+                known |= !strcmp(optarg, gt_sequence_name(i)) && strcmp(optarg, "calib");
+            if (!known)
+                return cli_usage_error("eval", "--sequence '%s': not one of reach_grasp, cross, "
+                                       "near, edge, fast", optarg);
+            o.sequence = optarg;
+            break;
+        }
+        case O_SWEEP_FRAMES:
+            if (!cli_parse_int(optarg, 1, 100000, &o.sweep_frames))
+                return cli_usage_error("eval", "--sweep-frames '%s': not a positive count", optarg);
+            break;
+        case O_GLOBAL:
+            if (!cli_parse_float(optarg, &v) || v < 0.0f || v > 1.0f)
+                return cli_usage_error("eval", "--global '%s': not in 0..1", optarg);
+            o.global = v;
+            break;
+        case O_SEQ_FRAMES:
+            if (!cli_parse_int(optarg, 1, 100000, &o.seq_frames))
+                return cli_usage_error("eval", "--seq-frames '%s': not a positive count", optarg);
+            break;
+        case O_BAND:
+            if (!cli_parse_int(optarg, 1, 64, &o.band))
+                return cli_usage_error("eval", "--band '%s': not in 1..64 px", optarg);
+            break;
         case ':': return cli_usage_error("eval", "option %s needs a value", argv[optind - 1]);
         default: return cli_usage_error("eval", "unknown option '%s'", argv[optind - 1]);
         }

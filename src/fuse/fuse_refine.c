@@ -162,12 +162,14 @@ static unsigned bin_of(const uint8_t *px, int bits)
            ((unsigned)(px[1] >> s) << bits) | (unsigned)(px[2] >> s);
 }
 
-fuse_result fuse_refine_mask(const fuse_refine_params *p, const fuse_image *P,
-                             const uint8_t *mask, int mask_stride,
-                             uint8_t *out, int out_stride, void *scratch,
-                             size_t scratch_size, fuse_refine_stats *stats)
+static fuse_result refine(const fuse_refine_params *p, const fuse_colour_model *g, float gw,
+                          const fuse_image *P, const uint8_t *mask, int mask_stride,
+                          uint8_t *out, int out_stride, void *scratch, size_t scratch_size,
+                          fuse_refine_stats *stats)
 {
     layout L;
+    if (g && (!g->llr || g->bits < 2 || g->bits > 6 || !(gw >= 0.0f) || !(gw <= 1.0f)))
+        return FUSE_ERR_ARGS;
     if (!image_ok(P) || !mask || !out || !scratch ||
         mask_stride < P->width || out_stride < P->width ||
         ((uintptr_t)scratch & 15u) != 0 ||
@@ -228,7 +230,9 @@ fuse_result fuse_refine_mask(const fuse_refine_params *p, const fuse_image *P,
             st.band_pixels++;
             float pr = p->prior *
                        (1.0f - 0.75f * ((float)d[x] - 3.0f) / (float)band3);
-            o[x] = llr[bin_of(s + 4 * x, p->bits)] + (in ? pr : -pr);
+            float c = llr[bin_of(s + 4 * x, p->bits)];
+            if (g) c = (1.0f - gw) * c + gw * g->llr[bin_of(s + 4 * x, g->bits)];
+            o[x] = c + (in ? pr : -pr);
         }
     }
     /* 4. decision: the sign of the score summed over a (2r+1)^2 window,
@@ -259,5 +263,86 @@ fuse_result fuse_refine_mask(const fuse_refine_params *p, const fuse_image *P,
         }
     }
     if (stats) *stats = st;
+    return FUSE_OK;
+}
+
+fuse_result fuse_refine_mask(const fuse_refine_params *p, const fuse_image *P,
+                             const uint8_t *mask, int mask_stride,
+                             uint8_t *out, int out_stride, void *scratch,
+                             size_t scratch_size, fuse_refine_stats *stats)
+{
+    return refine(p, NULL, 0.0f, P, mask, mask_stride, out, out_stride, scratch, scratch_size,
+                  stats);
+}
+
+fuse_result fuse_refine_mask_global(const fuse_refine_params *p, const fuse_colour_model *g,
+                                    float weight, const fuse_image *P, const uint8_t *mask,
+                                    int mask_stride, uint8_t *out, int out_stride,
+                                    void *scratch, size_t scratch_size,
+                                    fuse_refine_stats *stats)
+{
+    if (!g) return FUSE_ERR_ARGS;
+    return refine(p, g, weight, P, mask, mask_stride, out, out_stride, scratch, scratch_size,
+                  stats);
+}
+
+/* ----------------------------------------------- global colour model */
+
+size_t fuse_colour_model_scratch_size(int bits)
+{
+    if (bits < 2 || bits > 6) return 0;
+    return 2u * ((size_t)1 << (3 * bits)) * sizeof(uint32_t);
+}
+
+unsigned fuse_colour_bin(const uint8_t *rgb, int bits)
+{
+    return bin_of(rgb, bits);
+}
+
+fuse_result fuse_colour_model_learn(fuse_colour_model *cm, const fuse_image *P,
+                                    const uint8_t *mask, int mask_stride,
+                                    int margin, int step, float clamp,
+                                    long min_samples, void *scratch,
+                                    size_t scratch_size)
+{
+    if (!cm || !cm->llr || cm->bits < 2 || cm->bits > 6 || !image_ok(P) || !mask ||
+        mask_stride < P->width || margin < 0 || margin > 64 || step < 1 || step > 8 ||
+        !(clamp > 0.0f) || min_samples < 1 || !scratch ||
+        ((uintptr_t)scratch & 3u) != 0 || scratch_size < fuse_colour_model_scratch_size(cm->bits))
+        return FUSE_ERR_ARGS;
+    const int w = P->width, h = P->height, bins = 1 << (3 * cm->bits);
+    uint32_t *hf = scratch, *hb = hf + bins;
+    memset(hf, 0, 2u * (size_t)bins * sizeof(uint32_t));
+    long nf = 0, nb = 0;
+    for (int y = 0; y < h; y += step) {
+        const uint8_t *m = mask + (size_t)y * (size_t)mask_stride;
+        const uint8_t *s = P->pixels + (size_t)y * (size_t)P->stride;
+        for (int x = 0; x < w; x += step) {
+            const uint8_t v = m[x];
+            if (v != 0 && v != 255) continue;
+            int in = v == 255;
+            /* the four neighbours at the margin (clipped to the image) */
+            int xl = x - margin < 0 ? 0 : x - margin, xr = x + margin >= w ? w - 1 : x + margin;
+            int yu = y - margin < 0 ? 0 : y - margin, yd = y + margin >= h ? h - 1 : y + margin;
+            if (m[xl] != v || m[xr] != v || mask[(size_t)yu * (size_t)mask_stride + (size_t)x] != v ||
+                mask[(size_t)yd * (size_t)mask_stride + (size_t)x] != v)
+                continue;
+            unsigned b = bin_of(s + 4 * x, cm->bits);
+            if (in) { hf[b]++; nf++; }
+            else { hb[b]++; nb++; }
+        }
+    }
+    cm->fg_samples = nf;
+    cm->bg_samples = nb;
+    if (nf < min_samples || nb < min_samples) {
+        memset(cm->llr, 0, (size_t)bins * sizeof(float));
+        return FUSE_OK;
+    }
+    const float a = 4.0f / (float)bins;
+    float off = logf((float)nb + 4.0f) - logf((float)nf + 4.0f);
+    for (int b = 0; b < bins; b++) {
+        float v = logf(((float)hf[b] + a) / ((float)hb[b] + a)) + off;
+        cm->llr[b] = v > clamp ? clamp : v < -clamp ? -clamp : v;
+    }
     return FUSE_OK;
 }

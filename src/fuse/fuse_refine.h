@@ -112,6 +112,55 @@ fuse_result fuse_refine_mask(const fuse_refine_params *p, const fuse_image *P,
                              uint8_t *out, int out_stride, void *scratch,
                              size_t scratch_size, fuse_refine_stats *stats);
 
+/* ----------------------------------------------- global colour model */
+
+/* A two-class colour model of a whole image (arm against background),
+ * learned from a rough mask: a 3-D histogram of RGB quantised to `bits`
+ * bits per channel (2..6) per class, turned into a log-likelihood ratio
+ * per bin, llr = log((h_fg + a) / (n_fg + a K)) - log((h_bg + a) /
+ * (n_bg + a K)) (K bins, a K = 4 pseudo-samples), clamped to +-clamp.
+ * Only pixels whose four neighbours at distance `margin` (pixels, 0..64)
+ * have the same value are learned (the mask's edge, which may be off by
+ * a few pixels, is left out); every `step`-th pixel (1..8) in x and y.
+ * Used by `egofuse eval` to score where an arm lies in the image (its
+ * elbow, which the IK can only guess, docs/accuracy.md). */
+typedef struct fuse_colour_model {
+    int bits;                 /* 2..6 */
+    long fg_samples, bg_samples;
+    float *llr;               /* 1 << (3 bits) floats, caller-owned */
+} fuse_colour_model;
+
+/* Bytes of scratch for fuse_colour_model_learn (the two histograms). */
+size_t fuse_colour_model_scratch_size(int bits);
+/* The bin of an RGB pixel: (r >> (8-bits)) << 2 bits | (g >> (8-bits))
+ * << bits | (b >> (8-bits)). */
+unsigned fuse_colour_bin(const uint8_t *rgb, int bits);
+/* Learns cm->llr (cm->bits and cm->llr set by the caller) from P (RGBA8)
+ * and mask: 255 = arm, 0 = background, any other value = not learned
+ * (e.g. where two estimates disagree). scratch: fuse_colour_model_scratch_size()
+ * bytes, 4-byte aligned. When either class has fewer than min_samples
+ * pixels, llr is all 0 and FUSE_OK is still returned (check the counts).
+ * FUSE_ERR_ARGS on NULL pointers, bad sizes or parameters. */
+fuse_result fuse_colour_model_learn(fuse_colour_model *cm, const fuse_image *P,
+                                    const uint8_t *mask, int mask_stride,
+                                    int margin, int step, float clamp,
+                                    long min_samples, void *scratch,
+                                    size_t scratch_size);
+
+/* fuse_refine_mask with the band's colour term mixed from the frame's
+ * local histograms (weight 1 - weight) and a global colour model g
+ * (fuse_colour_model_learn, e.g. learned where two estimates of the mask
+ * agree; weight in [0, 1], 1 = g alone). The local histograms must still
+ * have min_samples pixels, else out = M as before. FUSE_ERR_ARGS also for
+ * a NULL or invalid g. */
+fuse_result fuse_refine_mask_global(const fuse_refine_params *p,
+                                    const fuse_colour_model *g, float weight,
+                                    const fuse_image *P, const uint8_t *mask,
+                                    int mask_stride, uint8_t *out,
+                                    int out_stride, void *scratch,
+                                    size_t scratch_size,
+                                    fuse_refine_stats *stats);
+
 #ifdef __cplusplus
 }
 #endif
