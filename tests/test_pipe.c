@@ -199,7 +199,7 @@ static void frame_equals_stages(void **state)
 static void threads_same_bytes(void **state)
 {
     kin_model m;
-    if (*state) grid_model(&m, 80, 0.12f, -0.4f); /* 6400 vertices: split skinning */
+    if (*state) grid_model(&m, 260, 0.12f, -0.4f); /* 67600 vertices: split skinning */
     else quad_model(&m, 0.1f, -0.4f);
     uint32_t crc[2] = {0, 0};
     for (int th = 1; th <= 2; th++) {
