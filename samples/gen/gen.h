@@ -98,9 +98,6 @@ void gen_arms_free(gen_arms *arms);
 /* Name of joint j of side (0 = "L_", 1 = "R_") into buf. */
 const char *gen_joint_name(int side, int j, char *buf, size_t n);
 
-/* Rotation whose matrix has the columns x, y, z (orthonormal, right-handed). */
-kin_quat gen_quat_from_axes(kin_vec3 x, kin_vec3 y, kin_vec3 z);
-
 /* Fills the animation channels of arms->model (called by gen_arms_build). */
 int  gen_anim_build(gen_arms *arms);
 

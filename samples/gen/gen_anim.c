@@ -20,38 +20,6 @@
 
 /* -------------------------------------------------------------- helpers */
 
-/* Rotation whose matrix has columns x, y, z (orthonormal, right-handed). */
-kin_quat gen_quat_from_axes(kin_vec3 x, kin_vec3 y, kin_vec3 z)
-{
-    float tr = x.x + y.y + z.z;
-    kin_quat q;
-    if (tr > 0.0f) {
-        float r = sqrtf(1.0f + tr) * 2.0f;
-        q.w = 0.25f * r;
-        q.x = (y.z - z.y) / r;
-        q.y = (z.x - x.z) / r;
-        q.z = (x.y - y.x) / r;
-    } else if (x.x > y.y && x.x > z.z) {
-        float r = sqrtf(1.0f + x.x - y.y - z.z) * 2.0f;
-        q.w = (y.z - z.y) / r;
-        q.x = 0.25f * r;
-        q.y = (y.x + x.y) / r;
-        q.z = (z.x + x.z) / r;
-    } else if (y.y > z.z) {
-        float r = sqrtf(1.0f + y.y - x.x - z.z) * 2.0f;
-        q.w = (z.x - x.z) / r;
-        q.x = (y.x + x.y) / r;
-        q.y = 0.25f * r;
-        q.z = (z.y + y.z) / r;
-    } else {
-        float r = sqrtf(1.0f + z.z - x.x - y.y) * 2.0f;
-        q.w = (x.y - y.x) / r;
-        q.x = (z.x + x.z) / r;
-        q.y = (z.y + y.z) / r;
-        q.z = 0.25f * r;
-    }
-    return kin_quat_normalize(q);
-}
 
 static kin_quat qconj(kin_quat q)
 {
@@ -178,13 +146,13 @@ static void solve_arm(kin_vec3 S, const float *c, float s, kin_quat out[3])
     /* upper arm: -Z along the bone, X the elbow hinge */
     kin_vec3 zu = kin_v3_scale(du, -1.0f);
     kin_vec3 yu = kin_v3_cross(zu, n);
-    out[0] = gen_quat_from_axes(n, yu, zu);
+    out[0] = kin_quat_from_axes(n, yu, zu);
     /* hand */
     kin_vec3 zh = kin_v3_scale(kin_v3_norm(kin_v3(c[3], c[4], c[5])), -1.0f);
     kin_vec3 dors = kin_v3(c[6], c[7], c[8]);
     kin_vec3 yh = kin_v3_norm(kin_v3_sub(dors, kin_v3_scale(zh, kin_v3_dot(dors, zh))));
     kin_vec3 xh = kin_v3_cross(yh, zh);
-    out[2] = gen_quat_from_axes(xh, yh, zh);
+    out[2] = kin_quat_from_axes(xh, yh, zh);
     /* forearm: hinge frame, rolled by half of the hand's roll about it */
     kin_vec3 zf = kin_v3_scale(df, -1.0f);
     kin_vec3 yf = kin_v3_cross(zf, n);
@@ -192,7 +160,7 @@ static void solve_arm(kin_vec3 S, const float *c, float s, kin_quat out[3])
     float roll = atan2f(kin_v3_dot(kin_v3_cross(yf, yp), zf), kin_v3_dot(yf, yp));
     kin_vec3 xf = rot_about(n, zf, 0.5f * roll);
     yf = rot_about(yf, zf, 0.5f * roll);
-    out[1] = gen_quat_from_axes(xf, yf, zf);
+    out[1] = kin_quat_from_axes(xf, yf, zf);
 }
 
 /* Local rotations of every animated node at time t into q[node]. */

@@ -61,7 +61,7 @@ static kin_quat thumb_rest_rotation(float s)
     kin_vec3 yh = kin_v3_norm(kin_v3(-0.75f * s, 0.65f, 0.0f));
     kin_vec3 x = kin_v3_norm(kin_v3_cross(yh, z));
     kin_vec3 y = kin_v3_cross(z, x);
-    return gen_quat_from_axes(x, y, z);
+    return kin_quat_from_axes(x, y, z);
 }
 
 /* ---------------------------------------------------------------- builder */

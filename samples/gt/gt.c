@@ -52,7 +52,7 @@ static kin_quat mat_q(const kin_mat4 *m)
     kin_vec3 y = kin_v3_norm(kin_v3(m->m[4], m->m[5], m->m[6]));
     kin_vec3 z = kin_v3_norm(kin_v3_cross(x, y));
     y = kin_v3_cross(z, x);
-    return kin_quat_normalize(gen_quat_from_axes(x, y, z));
+    return kin_quat_normalize(kin_quat_from_axes(x, y, z));
 }
 
 /* Area-weighted smooth normals. */
@@ -723,16 +723,16 @@ static void seq_arm(kin_vec3 S, float L1, float L2, const float *c, float s, kin
     if (kin_v3_len(n) < 1e-4f) n = kin_v3_cross(du, pole);
     n = kin_v3_norm(n);
     kin_vec3 zu = kin_v3_scale(du, -1.0f);
-    out[0] = gen_quat_from_axes(n, kin_v3_cross(zu, n), zu);
+    out[0] = kin_quat_from_axes(n, kin_v3_cross(zu, n), zu);
     kin_vec3 zh = kin_v3_scale(kin_v3_norm(kin_v3(c[3], c[4], c[5])), -1.0f);
     kin_vec3 dors = kin_v3(c[6], c[7], c[8]);
     kin_vec3 yh = kin_v3_norm(kin_v3_sub(dors, kin_v3_scale(zh, kin_v3_dot(dors, zh))));
-    out[2] = gen_quat_from_axes(kin_v3_cross(yh, zh), yh, zh);
+    out[2] = kin_quat_from_axes(kin_v3_cross(yh, zh), yh, zh);
     kin_vec3 zf = kin_v3_scale(df, -1.0f), yf = kin_v3_cross(zf, n);
     kin_vec3 yp = kin_v3_sub(yh, kin_v3_scale(zf, kin_v3_dot(yh, zf)));
     float roll = 0.5f * atan2f(kin_v3_dot(kin_v3_cross(yf, yp), zf), kin_v3_dot(yf, yp));
     kin_quat rr = kin_quat_axis_angle(zf, roll);
-    out[1] = gen_quat_from_axes(kin_quat_rotate(rr, n), kin_quat_rotate(rr, yf), zf);
+    out[1] = kin_quat_from_axes(kin_quat_rotate(rr, n), kin_quat_rotate(rr, yf), zf);
 }
 
 static kin_quat qconj(kin_quat q) { kin_quat c = { -q.x, -q.y, -q.z, q.w }; return c; }
