@@ -66,6 +66,8 @@ SAMPLES  := $(BUILD)/samples
 
 .PHONY: all deps demo test debug bench clean samples check-headers eval
 .DEFAULT_GOAL := all
+# Keep intermediate objects (tests/support/*.o), so a second make rebuilds nothing.
+.SECONDARY:
 
 all: $(LIB) $(IOLIB) $(EGOFUSE) $(GEN) $(TEST_BIN) $(BENCH_BIN)
 
