@@ -51,6 +51,7 @@
 #include "../src/io/io.h"
 #include "../src/pipe/pipe.h"
 #include "bench_mesh.h"
+#include "bench_util.h"
 
 #if defined(__has_include)
 #if __has_include(<pixman.h>)
@@ -108,25 +109,6 @@ static void *xmalloc(size_t n)
         exit(1);
     }
     return p;
-}
-
-static void cpu_name(char *buf, size_t n)
-{
-    snprintf(buf, n, "unknown");
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (!f) return;
-    char line[512];
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, "model name", 10)) {
-            char *c = strchr(line, ':');
-            if (c) {
-                c += 2;
-                c[strcspn(c, "\n")] = 0;
-                snprintf(buf, n, "%s", c);
-            }
-            break;
-        }
-    fclose(f);
 }
 
 /* A helper thread that runs one job at a time (the second eye's camera
@@ -199,30 +181,6 @@ static void helper_stop(helper *h)
 
 /* --------------------------------------------------------- camera YUYV */
 
-static uint8_t clamp_u8(int v) { return (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v); }
-
-/* RGBA8 -> YUYV (BT.601 limited range, the inverse of fuse's conversion;
- * U and V are the pair's mean): what a V4L2 camera delivers. */
-static void rgba_to_yuyv(const uint8_t *rgba, int w, int h, size_t stride, uint8_t *out)
-{
-    for (int y = 0; y < h; y++) {
-        const uint8_t *s = rgba + (size_t)y * stride;
-        uint8_t *d = out + (size_t)y * 2 * (size_t)w;
-        for (int x = 0; x + 1 < w; x += 2) {
-            int yy[2], uu = 0, vv = 0;
-            for (int k = 0; k < 2; k++) {
-                const int r = s[4 * (x + k)], g = s[4 * (x + k) + 1], b = s[4 * (x + k) + 2];
-                yy[k] = 16 + ((66 * r + 129 * g + 25 * b + 128) >> 8);
-                uu += (-38 * r - 74 * g + 112 * b + 128) >> 8;
-                vv += (112 * r - 94 * g - 18 * b + 128) >> 8;
-            }
-            d[2 * x + 0] = clamp_u8(yy[0]);
-            d[2 * x + 1] = clamp_u8(128 + (uu >> 1));
-            d[2 * x + 2] = clamp_u8(yy[1]);
-            d[2 * x + 3] = clamp_u8(128 + (vv >> 1));
-        }
-    }
-}
 
 /* ------------------------------------------------------------- the bench */
 
@@ -403,7 +361,7 @@ static int preload(bench *b, const char *samples_dir, int window)
             io_scene_frame_path(&sc, sc.camera[e], fr, path, sizeof path);
             if (!load_rgba(path, cw, ch, &img)) return 0;
             b->yuyv[f][e] = xmalloc(b->yuyv_size);
-            rgba_to_yuyv(img.data, cw, ch, img.stride, b->yuyv[f][e]);
+            bench_rgba_to_yuyv(img.data, cw, ch, img.stride, b->yuyv[f][e]);
             io_image_free(&img);
             io_scene_frame_path(&sc, sc.virt[e], fr, path, sizeof path);
             if (!load_rgba(path, lw, lh, &img)) return 0;
@@ -1171,7 +1129,7 @@ int main(int argc, char **argv)
     b.outdir = outdir;
     mkdir(outdir, 0755);
     char cpu[256];
-    cpu_name(cpu, sizeof cpu);
+    bench_cpu_name(cpu, sizeof cpu);
     printf("machine: %s, %ld cpus online\n", cpu, sysconf(_SC_NPROCESSORS_ONLN));
 #if defined(__clang__)
     printf("compiler: clang %s, -O2 -ffp-contract=off\n", __clang_version__);

@@ -38,6 +38,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/fuse/fuse.h"
+#include "bench_util.h"
 
 #if defined(__has_include)
 #if __has_include(<pixman.h>)
@@ -327,25 +328,6 @@ static void bench_pixman(eye_buf e[2], int runs, pm_stats *s)
 }
 #endif
 
-static void machine(char *buf, size_t n)
-{
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    char line[512];
-    snprintf(buf, n, "unknown");
-    if (!f) return;
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, "model name", 10)) {
-            char *c = strchr(line, ':');
-            if (c) {
-                c += 2;
-                c[strcspn(c, "\n")] = 0;
-                snprintf(buf, n, "%s", c);
-            }
-            break;
-        }
-    fclose(f);
-}
-
 static void usage(const char *argv0)
 {
     fprintf(stderr, "usage: %s [--csv] [--runs N] [--isa ref|sse2|avx2|avx512] "
@@ -382,7 +364,7 @@ int main(int argc, char **argv)
             usage(argv[0]);
     }
     if (runs < 3) runs = 3;
-    machine(cpu, sizeof cpu);
+    bench_cpu_name(cpu, sizeof cpu);
     printf("%smachine: %s, %ld cpus\n", csv ? "# " : "", cpu, sysconf(_SC_NPROCESSORS_ONLN));
     printf("%scompiler: %s\n", csv ? "# " : "",
 #ifdef __VERSION__

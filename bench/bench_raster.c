@@ -13,6 +13,7 @@
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster.h"
 #include "bench_mesh.h"
+#include "bench_util.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,26 +38,6 @@ static double median(double *v, int n)
 {
     qsort(v, (size_t)n, sizeof *v, cmp_double);
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-static void cpu_name(char *buf, size_t n)
-{
-    snprintf(buf, n, "unknown");
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (!f)
-        return;
-    char line[256];
-    while (fgets(line, sizeof line, f))
-        if (!strncmp(line, "model name", 10)) {
-            char *c = strchr(line, ':');
-            if (c) {
-                c += 2;
-                c[strcspn(c, "\n")] = 0;
-                snprintf(buf, n, "%s", c);
-            }
-            break;
-        }
-    fclose(f);
 }
 
 int main(int argc, char **argv)
@@ -91,7 +72,7 @@ int main(int argc, char **argv)
         return 2;
     }
     char cpu[128];
-    cpu_name(cpu, sizeof cpu);
+    bench_cpu_name(cpu, sizeof cpu);
     const char *p = csv ? "# " : "";
     printf("%smachine: %s, %ld online cpus\n", p, cpu, sysconf(_SC_NPROCESSORS_ONLN));
     printf("%scompiler: %s (" __VERSION__ "), flags -O2 -ffp-contract=off\n", p,

@@ -43,6 +43,7 @@
  * Exit status: 0 (benchmarks report, they do not judge), 1 the samples
  * cannot be read, 2 usage, 3 llvmpipe unavailable. */
 #include "egl_harness.h"
+#include "../bench_util.h"
 
 #include "../../src/cpu/cpu.h"
 #include "../../src/io/io.h"
@@ -173,29 +174,6 @@ typedef struct inputs {
     float *depth[MAX_WINDOW][2];       /* 1280x800, or NULL */
 } inputs;
 
-static uint8_t clamp_u8(int v) { return (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v); }
-
-/* RGBA -> YUYV, BT.601 limited range (as bench_frame.c). */
-static void rgba_to_yuyv(const uint8_t *rgba, int w, int h, size_t stride, uint8_t *out)
-{
-    for (int y = 0; y < h; y++) {
-        const uint8_t *s = rgba + (size_t)y * stride;
-        uint8_t *d = out + (size_t)y * 2 * (size_t)w;
-        for (int x = 0; x + 1 < w; x += 2) {
-            int yy[2], uu = 0, vv = 0;
-            for (int k = 0; k < 2; k++) {
-                const int r = s[4 * (x + k)], g = s[4 * (x + k) + 1], b = s[4 * (x + k) + 2];
-                yy[k] = 16 + ((66 * r + 129 * g + 25 * b + 128) >> 8);
-                uu += (-38 * r - 74 * g + 112 * b + 128) >> 8;
-                vv += (112 * r - 94 * g - 18 * b + 128) >> 8;
-            }
-            d[2 * x + 0] = clamp_u8(yy[0]);
-            d[2 * x + 1] = clamp_u8(128 + (uu >> 1));
-            d[2 * x + 2] = clamp_u8(yy[1]);
-            d[2 * x + 3] = clamp_u8(128 + (vv >> 1));
-        }
-    }
-}
 
 static int load(inputs *in, const char *dir, int window)
 {
@@ -245,7 +223,7 @@ static int load(inputs *in, const char *dir, int window)
                 return 0;
             }
             in->yuyv[f][e] = xmalloc((size_t)cw * ch * 2);
-            rgba_to_yuyv(img.data, cw, ch, img.stride, in->yuyv[f][e]);
+            bench_rgba_to_yuyv(img.data, cw, ch, img.stride, in->yuyv[f][e]);
             io_image_free(&img);
             io_scene_frame_path(&sc, sc.virt[e], fr, path, sizeof path);
             if (io_image_load(path, IO_U8, 4, &img, &err) != IO_OK || img.width != lw ||
