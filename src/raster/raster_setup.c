@@ -252,6 +252,48 @@ static inline int area_test(int64_t area, rast_cull cull)
     return RAST__SETUP_OK;
 }
 
+/* Bounds of the snapped vertices. */
+static inline void snapped_bounds(const int32_t X[3], const int32_t Y[3], int32_t *xmin,
+                                  int32_t *xmax, int32_t *ymin, int32_t *ymax)
+{
+    *xmin = *xmax = X[0];
+    *ymin = *ymax = Y[0];
+    for (int i = 1; i < 3; i++) {
+        *xmin = X[i] < *xmin ? X[i] : *xmin;
+        *xmax = X[i] > *xmax ? X[i] : *xmax;
+        *ymin = Y[i] < *ymin ? Y[i] : *ymin;
+        *ymax = Y[i] > *ymax ? Y[i] : *ymax;
+    }
+}
+
+/* The pixel box and the edge functions of a triangle of positive area.
+ * Edge k runs from vertex k+1 to vertex k+2 (opposite vertex k):
+ * E(p) = dx*(py - ya) - dy*(px - xa), positive inside, evaluated at the
+ * centre of the box's first pixel. Top-left rule: with this winding an
+ * edge is top (dy == 0, dx > 0) or left (dy < 0); those keep E == 0, the
+ * others get a -1 bias so that E == 0 fails the sign test. Deltas and
+ * offsets are below 2^24, products below 2^47. */
+static inline void setup_edges(rast__tri *tri, const int32_t X[3], const int32_t Y[3],
+                               int32_t bx0, int32_t by0, int32_t bx1, int32_t by1)
+{
+    tri->x0 = bx0;
+    tri->y0 = by0;
+    tri->x1 = bx1;
+    tri->y1 = by1;
+    const int32_t cx = bx0 * RAST__FIX_ONE + RAST__FIX_HALF;
+    const int32_t cy = by0 * RAST__FIX_ONE + RAST__FIX_HALF;
+    static const int ea[3] = { 1, 2, 0 }, eb[3] = { 2, 0, 1 };
+    for (int k = 0; k < 3; k++) {
+        const int a = ea[k], b = eb[k];
+        const int32_t dx = X[b] - X[a], dy = Y[b] - Y[a];
+        const int top_left = dy < 0 || (dy == 0 && dx > 0);
+        tri->e_c[k] = (int64_t)dx * (cy - Y[a]) - (int64_t)dy * (cx - X[a]) -
+                      (top_left ? 0 : 1);
+        tri->e_dx[k] = -(int64_t)dy * RAST__FIX_ONE;
+        tri->e_dy[k] = (int64_t)dx * RAST__FIX_ONE;
+    }
+}
+
 /* The rest of the setup for a triangle already normalised to area > 0
  * (clockwise on the screen, y down: the interior is where every edge
  * function is positive): snapped positions X, Y, per-vertex plane inputs
@@ -265,13 +307,8 @@ static int setup_oriented(const rast__view *v, const int32_t X[3], const int32_t
      * i.e. x0 = floor((xmin - 128 + 255) / 256), x1 = floor((xmax - 128) / 256)
      * (|X| < 2^23: int32, and >> is a floor division for the arithmetic
      * shift of gcc, clang and msvc). */
-    int32_t xmin = X[0], xmax = X[0], ymin = Y[0], ymax = Y[0];
-    for (int i = 1; i < 3; i++) {
-        xmin = X[i] < xmin ? X[i] : xmin;
-        xmax = X[i] > xmax ? X[i] : xmax;
-        ymin = Y[i] < ymin ? Y[i] : ymin;
-        ymax = Y[i] > ymax ? Y[i] : ymax;
-    }
+    int32_t xmin, xmax, ymin, ymax;
+    snapped_bounds(X, Y, &xmin, &xmax, &ymin, &ymax);
     int32_t bx0 = (xmin - RAST__FIX_HALF + RAST__FIX_ONE - 1) >> RAST_SUBPIXEL_BITS;
     int32_t bx1 = (xmax - RAST__FIX_HALF) >> RAST_SUBPIXEL_BITS;
     int32_t by0 = (ymin - RAST__FIX_HALF + RAST__FIX_ONE - 1) >> RAST_SUBPIXEL_BITS;
@@ -282,28 +319,7 @@ static int setup_oriented(const rast__view *v, const int32_t X[3], const int32_t
     by1 = by1 > v->height - 1 ? v->height - 1 : by1;
     if (bx0 > bx1 || by0 > by1)
         return RAST__SETUP_OFFSCREEN;
-    tri->x0 = bx0;
-    tri->y0 = by0;
-    tri->x1 = bx1;
-    tri->y1 = by1;
-
-    /* Edge k runs from vertex k+1 to vertex k+2 (opposite vertex k):
-     * E(p) = dx*(py - ya) - dy*(px - xa), positive inside. Top-left rule:
-     * with this winding an edge is top (dy == 0, dx > 0) or left (dy < 0);
-     * those keep E == 0, the others get a -1 bias so that E == 0 fails the
-     * sign test. Deltas and offsets are below 2^24, products below 2^47. */
-    const int32_t cx = bx0 * RAST__FIX_ONE + RAST__FIX_HALF;
-    const int32_t cy = by0 * RAST__FIX_ONE + RAST__FIX_HALF;
-    static const int ea[3] = { 1, 2, 0 }, eb[3] = { 2, 0, 1 };
-    for (int k = 0; k < 3; k++) {
-        const int a = ea[k], b = eb[k];
-        const int32_t dx = X[b] - X[a], dy = Y[b] - Y[a];
-        const int top_left = dy < 0 || (dy == 0 && dx > 0);
-        tri->e_c[k] = (int64_t)dx * (cy - Y[a]) - (int64_t)dy * (cx - X[a]) -
-                      (top_left ? 0 : 1);
-        tri->e_dx[k] = -(int64_t)dy * RAST__FIX_ONE;
-        tri->e_dy[k] = (int64_t)dx * RAST__FIX_ONE;
-    }
+    setup_edges(tri, X, Y, bx0, by0, bx1, by1);
     /* A box of one pixel whose centre is outside (20% of the scanned
      * triangles of the 10k bench model, 55% at 41k): the scan would write
      * nothing, so the planes
@@ -670,13 +686,8 @@ static int setup_aa(const rast__view *v, const int32_t fx[3], const int32_t fy[3
         return r;
     const int s1 = area < 0 ? 2 : 1, s2 = area < 0 ? 1 : 2;
     const int32_t X[3] = { fx[0], fx[s1], fx[s2] }, Y[3] = { fy[0], fy[s1], fy[s2] };
-    int32_t xmin = X[0], xmax = X[0], ymin = Y[0], ymax = Y[0];
-    for (int i = 1; i < 3; i++) {
-        xmin = X[i] < xmin ? X[i] : xmin;
-        xmax = X[i] > xmax ? X[i] : xmax;
-        ymin = Y[i] < ymin ? Y[i] : ymin;
-        ymax = Y[i] > ymax ? Y[i] : ymax;
-    }
+    int32_t xmin, xmax, ymin, ymax;
+    snapped_bounds(X, Y, &xmin, &xmax, &ymin, &ymax);
     int32_t bx0 = (xmin + 15) >> RAST_SUBPIXEL_BITS, bx1 = xmax >> RAST_SUBPIXEL_BITS;
     int32_t by0 = (ymin + 15) >> RAST_SUBPIXEL_BITS, by1 = ymax >> RAST_SUBPIXEL_BITS;
     bx0 = bx0 < 0 ? 0 : bx0;
@@ -686,22 +697,7 @@ static int setup_aa(const rast__view *v, const int32_t fx[3], const int32_t fy[3
     if (bx0 > bx1 || by0 > by1)
         return RAST__SETUP_OFFSCREEN;
     memset(tri, 0, sizeof *tri);
-    tri->x0 = bx0;
-    tri->y0 = by0;
-    tri->x1 = bx1;
-    tri->y1 = by1;
-    const int32_t cx = bx0 * RAST__FIX_ONE + RAST__FIX_HALF;
-    const int32_t cy = by0 * RAST__FIX_ONE + RAST__FIX_HALF;
-    static const int ea[3] = { 1, 2, 0 }, eb[3] = { 2, 0, 1 };
-    for (int k = 0; k < 3; k++) {
-        const int a = ea[k], b = eb[k];
-        const int32_t dx = X[b] - X[a], dy = Y[b] - Y[a];
-        const int top_left = dy < 0 || (dy == 0 && dx > 0);
-        tri->e_c[k] = (int64_t)dx * (cy - Y[a]) - (int64_t)dy * (cx - X[a]) -
-                      (top_left ? 0 : 1);
-        tri->e_dx[k] = -(int64_t)dy * RAST__FIX_ONE;
-        tri->e_dy[k] = (int64_t)dx * RAST__FIX_ONE;
-    }
+    setup_edges(tri, X, Y, bx0, by0, bx1, by1);
     return RAST__SETUP_OK;
 }
 
