@@ -11,7 +11,9 @@
  *   twist.csv/.png         wrist ring radius error, LBS vs DQS, -180..180
  *   predict.csv/.png       hand position error vs prediction horizon
  * and prints the time of filter + IK + FK + skinning of a 10k-vertex arm
- * per frame (LBS and DQS, on every ISA the CPU runs; medians of batches).
+ * per frame (LBS and DQS, each straight from the mesh and through a skin
+ * plan built once, on every ISA the CPU runs, all in the same run; medians
+ * of batches).
  * `--timing-only` (last argument) prints only the timing. Ground truth:
  * an arm of other proportions than the model's, driven by joint angles
  * (not by this IK), seeded noise.
@@ -377,6 +379,21 @@ static void timing(void)
     kin_mesh m;
     memset(&m, 0, sizeof m);
     m.vertex_count = NV; m.positions = pos; m.normals = nrm; m.joints = jt; m.weights = wt;
+    /* the skin plan: built once per mesh (not timed) */
+    size_t ns = kin_skin_plan_scratch_size(&m);
+    void *scratch = malloc(ns);
+    size_t plan_bytes = scratch ? kin_skin_plan_size(&m, scratch) : 0;
+    void *plan_mem = plan_bytes ? aligned_alloc(64, (plan_bytes + 63) & ~(size_t)63) : NULL;
+    kin_skin_plan plan;
+    if (!plan_mem || kin_skin_plan_init(&plan, &m, scratch, plan_mem, plan_bytes)) {
+        printf("skin plan: out of memory\n");
+        free(scratch);
+        free(plan_mem);
+        return;
+    }
+    free(scratch);
+    printf("skin plan: %d joint lists, %d batches of 16 (%.0f%% lanes used), %zu bytes\n",
+           plan.group_count, plan.batch_count, 100.0 * NV / (16.0 * plan.batch_count), plan_bytes);
     kin_filter f;
     kin_filter_init(&f, NULL);
     /* per configuration: 21 batches of 100 frames, the median batch (the
@@ -385,7 +402,8 @@ static void timing(void)
     printf("per frame (median of %d batches of %d frames), %d vertices, %d nodes:\n",
            BATCHES, FRAMES, NV, nn);
     int frame_no = 0;
-    for (int mode = 0; mode < 3; mode++) {
+    /* modes: no skinning, LBS, LBS with the plan, DQS, DQS with the plan */
+    for (int mode = 0; mode < 5; mode++) {
         for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {
             if (mode == 0 && isa > EF_ISA_REF) break;
             if (!ef_cpu_has((ef_isa)isa)) continue;
@@ -410,21 +428,25 @@ static void timing(void)
                     kin_fk(b.m.parents, nn, loc, NULL, world);
                     kin_skin_joint_matrices(&b.skin, world, jm);
                     if (mode == 1) kin_skin_lbs_isa(&m, jm, po, no, isa);
-                    else if (mode == 2) {
+                    else if (mode == 2) kin_skin_lbs_plan_part(&plan, jm, po, no, 0, 1, isa);
+                    else if (mode >= 3) {
                         kin_skin_dq_from_matrices(jm, nn, dq);
-                        kin_skin_dqs_isa(&m, dq, po, no, isa);
+                        if (mode == 3) kin_skin_dqs_isa(&m, dq, po, no, isa);
+                        else kin_skin_dqs_plan_part(&plan, dq, po, no, 0, 1, isa);
                     }
                 }
                 batch[bi] = (now_s() - t0) * 1e3 / FRAMES;
             }
             qsort(batch, BATCHES, sizeof batch[0], cmp_double);
-            static const char *const what[3] = { "no skinning", "LBS", "DQS" };
+            static const char *const what[5] = { "no skinning", "LBS", "LBS plan", "DQS",
+                                                 "DQS plan" };
             printf("  filter + rig IK + hands + FK + joint matrices + %-11s %-6s "
                    "%.4f ms/frame (min %.4f)\n", what[mode],
                    mode ? ef_isa_name((ef_isa)isa) : "", batch[BATCHES / 2], batch[0]);
         }
     }
     printf("  skinning uses %s by default (kin_skin_isa)\n", ef_isa_name((ef_isa)kin_skin_isa()));
+    free(plan_mem);
 }
 
 int main(int argc, char **argv)

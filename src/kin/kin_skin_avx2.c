@@ -14,6 +14,10 @@
 #define V __m256
 #define M __m256
 #define SIMD_LBS kin__skin_lbs_avx2
+#define SIMD_LBS_PLAN kin__skin_lbs_plan_avx2
+#define SIMD_DQS_PLAN kin__skin_dqs_plan_avx2
+#define VLOAD(p) _mm256_load_ps(p)
+#define VNEG(x) _mm256_xor_ps(x, _mm256_set1_ps(-0.0f))
 #define SIMD_DQS kin__skin_dqs_avx2
 #define VSET1(x) _mm256_set1_ps(x)
 #define VADD(a, b) _mm256_add_ps(a, b)
@@ -163,6 +167,25 @@ static inline void int3(const lay3 *L, float *p, const __m256 in[3])
     _mm256_storeu_ps(p, _mm256_blend_ps(_mm256_blend_ps(x, y, 0x92), z, 0x24));
     _mm256_storeu_ps(p + 8, _mm256_blend_ps(_mm256_blend_ps(x, y, 0x24), z, 0x49));
     _mm256_storeu_ps(p + 16, _mm256_blend_ps(_mm256_blend_ps(x, y, 0x49), z, 0x92));
+}
+
+/* One vertex's x y z (lanes 0-2 of x) to p: 8 bytes and 4 bytes. */
+static inline __attribute__((always_inline)) void store3(float *p, __m128 x)
+{
+    _mm_storel_pi((__m64 *)p, x);
+    _mm_store_ss(p + 2, _mm_movehl_ps(x, x));
+}
+
+/* Three SoA vectors (8 lanes) to out + 3 dest[l], via in-lane transposes. */
+static inline __attribute__((always_inline)) void scat3(float *out, const int32_t *dest, const __m256 o[3])
+{
+    __m256 t[4];
+    tr4(o[0], o[1], o[2], o[2], t);   /* t[k], lane J: vertex 4J + k */
+#pragma GCC unroll 4
+    for (int k = 0; k < 4; k++) {
+        store3(out + 3 * (size_t)dest[k], _mm256_castps256_ps128(t[k]));
+        store3(out + 3 * (size_t)dest[4 + k], _mm256_extractf128_ps(t[k], 1));
+    }
 }
 
 #include "kin_skin_simd.inl"

@@ -14,6 +14,10 @@
 #define V __m512
 #define M __mmask16
 #define SIMD_LBS kin__skin_lbs_avx512
+#define SIMD_LBS_PLAN kin__skin_lbs_plan_avx512
+#define SIMD_DQS_PLAN kin__skin_dqs_plan_avx512
+#define VLOAD(p) _mm512_load_ps(p)
+#define VNEG(x) _mm512_xor_ps(x, _mm512_set1_ps(-0.0f))
 #define SIMD_DQS kin__skin_dqs_avx512
 #define VSET1(x) _mm512_set1_ps(x)
 #define VADD(a, b) _mm512_add_ps(a, b)
@@ -359,6 +363,25 @@ static inline void int3(const lay3 *L, float *p, const __m512 in[3])
     for (int r = 0; r < 3; r++)
         _mm512_storeu_ps(p + 16 * r,
                          _mm512_mask_blend_ps(L->sz[r], _mm512_mask_blend_ps(L->sy[r], x, y), z));
+}
+
+/* Three SoA vectors (x, y, z of 16 lanes) to out + 3 dest[l]: an in-lane
+ * transpose gives each vertex's x y z (and a spare) in one 128-bit block,
+ * stored with a 3-float mask. */
+static inline __attribute__((always_inline)) void scat3(float *out, const int32_t *dest, const __m512 o[3])
+{
+    __m512 t[4];
+    tr4(o[0], o[1], o[2], o[2], t);   /* t[k], block J: vertex 4J + k */
+#define KIN_SCAT(J, k)                                                             \
+    _mm_mask_storeu_ps(out + 3 * (size_t)dest[4 * (J) + (k)], 0x7,                 \
+                       _mm512_extractf32x4_ps(t[k], J));
+#define KIN_SCAT_BLOCK(J) KIN_SCAT(J, 0) KIN_SCAT(J, 1) KIN_SCAT(J, 2) KIN_SCAT(J, 3)
+    KIN_SCAT_BLOCK(0)
+    KIN_SCAT_BLOCK(1)
+    KIN_SCAT_BLOCK(2)
+    KIN_SCAT_BLOCK(3)
+#undef KIN_SCAT_BLOCK
+#undef KIN_SCAT
 }
 
 #include "kin_skin_simd.inl"

@@ -8,7 +8,8 @@
  * memcmp-equal. A kernel skins the vertices [v0, v1) of a skinned mesh
  * (joints, weights and matrices present) and returns the first vertex it
  * did not do (it only does whole vectors); the dispatcher finishes the
- * rest with the reference. */
+ * rest with the reference. The plan kernels (kin_skin_plan.c, same .inl)
+ * do whole batches of a skin plan instead. */
 #ifndef EGOFUSE_KIN_SKIN_INTERNAL_H
 #define EGOFUSE_KIN_SKIN_INTERNAL_H
 
@@ -31,5 +32,36 @@ int kin__skin_dqs_avx2(const kin_mesh *mesh, const kin_dualquat *dq,
                        float *pos_out, float *nrm_out, int v0, int v1);
 int kin__skin_dqs_avx512(const kin_mesh *mesh, const kin_dualquat *dq,
                          float *pos_out, float *nrm_out, int v0, int v1);
+
+/* ---- skin plan (kin_skin_plan.c) -----------------------------------
+ * One batch: up to KIN__PLAN_W vertices that read the same joints with
+ * nonzero weight, in the same influence order (n of them; n = 0: vertices
+ * whose reference weight sum is 0, which keep their bind pose). Lanes past
+ * `lanes` repeat lane 0 (same vertex, same bytes written twice). When
+ * contiguous, dest[l] = first + l for all 16 lanes. */
+#define KIN__PLAN_W 16
+typedef struct kin__plan_batch {
+    int32_t n, lanes, contiguous, first;
+    int32_t joint[4];
+    int32_t pad[8];
+    int32_t dest[KIN__PLAN_W];
+    float w[4][KIN__PLAN_W];    /* nonzero weights, influence order */
+    float p[3][KIN__PLAN_W];    /* bind positions, SoA */
+    float nrm[3][KIN__PLAN_W];  /* bind normals, SoA (when the plan has them) */
+} kin__plan_batch;
+
+/* Batches [b0, b1) of a plan; they do every batch (no scalar tail). */
+void kin__skin_lbs_plan_sse2(const kin__plan_batch *bt, int b0, int b1,
+                             const kin_mat4 *jm, float *pos_out, float *nrm_out);
+void kin__skin_lbs_plan_avx2(const kin__plan_batch *bt, int b0, int b1,
+                             const kin_mat4 *jm, float *pos_out, float *nrm_out);
+void kin__skin_lbs_plan_avx512(const kin__plan_batch *bt, int b0, int b1,
+                               const kin_mat4 *jm, float *pos_out, float *nrm_out);
+void kin__skin_dqs_plan_sse2(const kin__plan_batch *bt, int b0, int b1,
+                             const kin_dualquat *dq, float *pos_out, float *nrm_out);
+void kin__skin_dqs_plan_avx2(const kin__plan_batch *bt, int b0, int b1,
+                             const kin_dualquat *dq, float *pos_out, float *nrm_out);
+void kin__skin_dqs_plan_avx512(const kin__plan_batch *bt, int b0, int b1,
+                               const kin_dualquat *dq, float *pos_out, float *nrm_out);
 
 #endif

@@ -136,4 +136,171 @@ int SIMD_DQS(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out,
     return v;
 }
 
+/* ---- skin plan kernels (kin_skin_plan.c) ----------------------------
+ * A batch of KIN__PLAN_W vertices reads the same joints: each element of
+ * a joint's matrix (dual quaternion) is broadcast and multiplied by the
+ * lanes' weights, summed onto +0 in influence order like the reference.
+ * Inputs are SoA in the batch (aligned loads); outputs go to the vertices'
+ * places: int3 when the batch is contiguous, else scat3 (the ISA file's
+ * scatter of three SoA vectors to the lanes' dest indices). The ISA file
+ * also defines VLOAD (aligned load), VNEG (sign flip, the reference's
+ * -w), SIMD_LBS_PLAN and SIMD_DQS_PLAN. */
+
+static inline __attribute__((always_inline)) void plan_store(const lay3 *L, const kin__plan_batch *B, int h, float *out,
+                              const V o[3])
+{
+    if (B->contiguous) int3(L, out + 3 * (size_t)(B->first + h), o);
+    else scat3(out, B->dest + h, o);
+}
+
+/* n == 0: the bind pose. */
+static inline __attribute__((always_inline)) void plan_copy(const lay3 *L, const kin__plan_batch *B, float *pos_out,
+                             float *nrm_out)
+{
+    for (int h = 0; h < KIN__PLAN_W; h += W) {
+        V o[3];
+        for (int k = 0; k < 3; k++) o[k] = VLOAD(B->p[k] + h);
+        plan_store(L, B, h, pos_out, o);
+        if (!nrm_out) continue;
+        for (int k = 0; k < 3; k++) o[k] = VLOAD(B->nrm[k] + h);
+        plan_store(L, B, h, nrm_out, o);
+    }
+}
+
+/* Lanes [h, h + W) of an LBS batch with n influences (n a constant
+ * where it is inlined, so the loops unroll and a[] stays in registers;
+ * forced inline: a call would pass the vectors through memory). */
+static inline __attribute__((always_inline)) void lbs_plan_lanes(const kin__plan_batch *B, const int n, int h,
+                                  const kin_mat4 *jm, const lay3 *L, float *pos_out,
+                                  float *nrm_out)
+{
+    const V zero = VSET1(0.0f), inf = VSET1(INFINITY);
+    V a[12], p[3], o[3];
+    {
+        const float *m = jm[B->joint[0]].m;
+        const V w = VLOAD(B->w[0] + h);
+#pragma GCC unroll 12
+        for (int e = 0; e < 12; e++)
+            a[e] = VADD(zero, VMUL(w, VSET1(m[(e / 3) * 4 + e % 3])));
+    }
+#pragma GCC unroll 4
+    for (int i = 1; i < n; i++) {
+        const float *m = jm[B->joint[i]].m;
+        const V w = VLOAD(B->w[i] + h);
+#pragma GCC unroll 12
+        for (int e = 0; e < 12; e++)
+            a[e] = VADD(a[e], VMUL(w, VSET1(m[(e / 3) * 4 + e % 3])));
+    }
+    for (int k = 0; k < 3; k++) p[k] = VLOAD(B->p[k] + h);
+    for (int r = 0; r < 3; r++)
+        o[r] = VADD(VADD(VADD(VMUL(a[r], p[0]), VMUL(a[3 + r], p[1])),
+                         VMUL(a[6 + r], p[2])), a[9 + r]);
+    plan_store(L, B, h, pos_out, o);
+    if (!nrm_out) return;
+    V nn[3], c0[3], c1[3], c2[3], x[3];
+    const V a0[3] = { a[0], a[1], a[2] }, a1[3] = { a[3], a[4], a[5] },
+            a2[3] = { a[6], a[7], a[8] };
+    CROSS(c0, a1, a2);
+    CROSS(c1, a2, a0);
+    CROSS(c2, a0, a1);
+    V det = VADD(VADD(VMUL(a0[0], c0[0]), VMUL(a0[1], c0[1])), VMUL(a0[2], c0[2]));
+    M flip = M_LT(det, zero);
+    for (int k = 0; k < 3; k++) nn[k] = VLOAD(B->nrm[k] + h);
+    for (int k = 0; k < 3; k++) {
+        x[k] = VADD(VADD(VMUL(c0[k], nn[0]), VMUL(c1[k], nn[1])), VMUL(c2[k], nn[2]));
+        x[k] = NEG_IF(flip, x[k]);
+    }
+    norm3(x, zero, inf);
+    plan_store(L, B, h, nrm_out, x);
+}
+
+void SIMD_LBS_PLAN(const kin__plan_batch *bt, int b0, int b1, const kin_mat4 *jm,
+                   float *pos_out, float *nrm_out)
+{
+    lay3 L;
+    lay3_init(&L);
+    for (int b = b0; b < b1; b++) {
+        const kin__plan_batch *B = &bt[b];
+        switch (B->n) {
+        case 1: for (int h = 0; h < KIN__PLAN_W; h += W) lbs_plan_lanes(B, 1, h, jm, &L, pos_out, nrm_out); break;
+        case 2: for (int h = 0; h < KIN__PLAN_W; h += W) lbs_plan_lanes(B, 2, h, jm, &L, pos_out, nrm_out); break;
+        case 3: for (int h = 0; h < KIN__PLAN_W; h += W) lbs_plan_lanes(B, 3, h, jm, &L, pos_out, nrm_out); break;
+        case 4: for (int h = 0; h < KIN__PLAN_W; h += W) lbs_plan_lanes(B, 4, h, jm, &L, pos_out, nrm_out); break;
+        default: plan_copy(&L, B, pos_out, nrm_out); break;
+        }
+    }
+}
+
+/* Lanes [h, h + W) of a DQS batch with n influences, neg[i]: the sign
+ * flip of influence i (inlined with a constant n, like lbs_plan_lanes). */
+static inline __attribute__((always_inline)) void dqs_plan_lanes(
+    const kin__plan_batch *B, const int n, const int neg[4], int h, const kin_dualquat *dq,
+    const lay3 *L, float *pos_out, float *nrm_out)
+{
+    const V zero = VSET1(0.0f), inf = VSET1(INFINITY), two = VSET1(2.0f);
+    V q[8], p[3], o[3];
+#pragma GCC unroll 8
+    for (int e = 0; e < 8; e++) q[e] = zero;
+#pragma GCC unroll 4
+    for (int i = 0; i < n; i++) {
+        const float *d = &dq[B->joint[i]].r.x;
+        V w = VLOAD(B->w[i] + h);
+        if (neg[i]) w = VNEG(w);
+#pragma GCC unroll 8
+        for (int e = 0; e < 8; e++) q[e] = VADD(q[e], VMUL(w, VSET1(d[e])));
+    }
+    V len = VSQRT(VADD(VADD(VADD(VMUL(q[0], q[0]), VMUL(q[1], q[1])),
+                            VMUL(q[2], q[2])), VMUL(q[3], q[3])));
+    M ok = M_GT(len, zero);
+    const int all = M_ALL(ok);
+    V inv = VDIV(VSET1(1.0f), len);
+#pragma GCC unroll 8
+    for (int e = 0; e < 8; e++) q[e] = VMUL(q[e], inv);
+    const V u[3] = { q[0], q[1], q[2] }, dv[3] = { q[4], q[5], q[6] };
+    for (int k = 0; k < 3; k++) p[k] = VLOAD(B->p[k] + h);
+    V rot[3], cr[3];
+    qrot(u, q[3], p, rot);
+    CROSS(cr, u, dv);
+    for (int k = 0; k < 3; k++) {
+        V t = VADD(VSUB(VMUL(dv[k], q[3]), VMUL(u[k], q[7])), cr[k]);
+        V y = VADD(rot[k], VMUL(t, two));
+        o[k] = all ? y : SEL(ok, y, p[k]);
+    }
+    plan_store(L, B, h, pos_out, o);
+    if (!nrm_out) return;
+    V nn[3], x[3];
+    for (int k = 0; k < 3; k++) nn[k] = VLOAD(B->nrm[k] + h);
+    qrot(u, q[3], nn, x);
+    norm3(x, zero, inf);
+    for (int k = 0; k < 3; k++) o[k] = all ? x[k] : SEL(ok, x[k], nn[k]);
+    plan_store(L, B, h, nrm_out, o);
+}
+
+void SIMD_DQS_PLAN(const kin__plan_batch *bt, int b0, int b1, const kin_dualquat *dq,
+                   float *pos_out, float *nrm_out)
+{
+    lay3 L;
+    lay3_init(&L);
+    for (int b = b0; b < b1; b++) {
+        const kin__plan_batch *B = &bt[b];
+        const int n = B->n;
+        if (n == 0) { plan_copy(&L, B, pos_out, nrm_out); continue; }
+        /* the reference's signs: s_i = -w_i when r_i . r_first < 0 (the
+         * same for every lane: the same joints) */
+        int neg[4] = { 0, 0, 0, 0 };
+        const kin_quat *r0 = &dq[B->joint[0]].r;
+        for (int i = 0; i < n; i++) {
+            const kin_quat *q = &dq[B->joint[i]].r;
+            float dot = q->x * r0->x + q->y * r0->y + q->z * r0->z + q->w * r0->w;
+            neg[i] = dot < 0.0f;
+        }
+        switch (n) {
+        case 1: for (int h = 0; h < KIN__PLAN_W; h += W) dqs_plan_lanes(B, 1, neg, h, dq, &L, pos_out, nrm_out); break;
+        case 2: for (int h = 0; h < KIN__PLAN_W; h += W) dqs_plan_lanes(B, 2, neg, h, dq, &L, pos_out, nrm_out); break;
+        case 3: for (int h = 0; h < KIN__PLAN_W; h += W) dqs_plan_lanes(B, 3, neg, h, dq, &L, pos_out, nrm_out); break;
+        default: for (int h = 0; h < KIN__PLAN_W; h += W) dqs_plan_lanes(B, 4, neg, h, dq, &L, pos_out, nrm_out); break;
+        }
+    }
+}
+
 #undef CROSS

@@ -15,6 +15,10 @@
 #define V __m128
 #define M __m128
 #define SIMD_LBS kin__skin_lbs_sse2
+#define SIMD_LBS_PLAN kin__skin_lbs_plan_sse2
+#define SIMD_DQS_PLAN kin__skin_dqs_plan_sse2
+#define VLOAD(p) _mm_load_ps(p)
+#define VNEG(x) _mm_xor_ps(x, _mm_set1_ps(-0.0f))
 #define SIMD_DQS kin__skin_dqs_sse2
 #define VSET1(x) _mm_set1_ps(x)
 #define VADD(a, b) _mm_add_ps(a, b)
@@ -131,6 +135,20 @@ static inline void int3(const lay3 *L, float *p, const __m128 in[3])
     for (int k = 0; k < 3; k++) _mm_store_ps(t[k], in[k]);
     for (int v = 0; v < 4; v++)
         for (int k = 0; k < 3; k++) p[3 * v + k] = t[k][v];
+}
+
+/* Three SoA vectors (4 lanes) to out + 3 dest[l]. */
+static inline __attribute__((always_inline)) void scat3(float *out, const int32_t *dest, const __m128 o[3])
+{
+    __m128 x = o[0], y = o[1], z = o[2], w = o[2];
+    _MM_TRANSPOSE4_PS(x, y, z, w);
+    const __m128 r[4] = { x, y, z, w };
+#pragma GCC unroll 4
+    for (int k = 0; k < 4; k++) {
+        float *p = out + 3 * (size_t)dest[k];
+        _mm_storel_pi((__m64 *)p, r[k]);
+        _mm_store_ss(p + 2, _mm_movehl_ps(r[k], r[k]));
+    }
 }
 
 #include "kin_skin_simd.inl"
