@@ -550,6 +550,203 @@ static void test_prepare_cached_equal(void **state)
     assert_true(fast > total / 4 && fast < total);
 }
 
+/* The batched (SIMD) plane set-up equals the scalar one bit for bit.
+ * 1. Raw batches: random snapped triangles from sub-pixel slivers to
+ *    guard-band size (|X|, |Y| up to 2^22 / 256 px), 1/w spread over 2^-40
+ *    .. 2^40 (near and far vertices of one triangle), depth in and out of
+ *    [0, 1], every batch length 1..16: rast__planes_avx2/avx512 against
+ *    rast__planes_ref with memcmp, and a CRC over the reference planes.
+ * 2. Front end: every soup case (NaN, huge, behind the camera, slivers,
+ *    culling) through rast__prepare_range with no set-up ISA (one by
+ *    one), the scalar one and each SIMD one (batched planes, block vertex
+ *    fills, AVX-512 rejection of 16 triangles at once), in chunks of
+ *    1..40 triangles: the same set-up triangles (memcmp) and counters.
+ * 3. Vertex block fills against the scalar fill (below). */
+#define SETUP_CRC 0xFA07FF57u
+static void test_setup_isa_equal(void **state)
+{
+    (void)state;
+    static const int simd[2] = { EF_ISA_AVX2, EF_ISA_AVX512 };
+    const rast__planes_fn fns[2] = { rast__planes_avx2, rast__planes_avx512 };
+    int have[2], nhave = 0;
+    for (int i = 0; i < 2; i++) {
+        have[i] = ef_cpu_has((ef_isa)simd[i]);
+        nhave += have[i];
+        if (!have[i])
+            print_message("SKIP setup isa %s: this CPU does not run it\n",
+                          ef_isa_name((ef_isa)simd[i]));
+    }
+    if (!nhave)
+        skip();
+    tu_rng r = { 0x5E7u };
+    uint32_t crc = 0;
+    long lanes = 0;
+    static rast__tri ta[RAST__PBATCH], tb[RAST__PBATCH];
+    for (int it = 0; it < 3000; it++) {
+        rast__pbatch a, b;
+        a.n = 1 + tu_int(&r, RAST__PBATCH);
+        for (int l = 0; l < a.n; l++) {
+            int32_t X[3], Y[3];
+            int64_t area;
+            do {
+                const int scale = 1 << tu_int(&r, 23);   /* 1 .. 2^22 sub-pixels */
+                const int32_t ox = tu_int(&r, 1 << 21) - (1 << 20);
+                const int32_t oy = tu_int(&r, 1 << 21) - (1 << 20);
+                for (int i = 0; i < 3; i++) {
+                    X[i] = ox + tu_int(&r, 2 * scale + 1) - scale;
+                    Y[i] = oy + tu_int(&r, 2 * scale + 1) - scale;
+                }
+                area = (int64_t)(X[1] - X[0]) * (Y[2] - Y[0]) -
+                       (int64_t)(Y[1] - Y[0]) * (X[2] - X[0]);
+            } while (area == 0);
+            if (area < 0) {   /* winding normalised as the set-up does */
+                int32_t tx = X[1], ty = Y[1];
+                X[1] = X[2]; Y[1] = Y[2]; X[2] = tx; Y[2] = ty;
+                area = -area;
+            }
+            int32_t xmin = X[0], ymin = Y[0];
+            for (int i = 0; i < 3; i++) {
+                a.X[i][l] = (double)X[i] / 256.0;
+                a.Y[i][l] = (double)Y[i] / 256.0;
+                a.zw[i][l] = tu_int(&r, 8) ? tu_unit(&r) : tu_range(&r, -3.0f, 3.0f);
+                a.iw[i][l] = ldexp(0.5 + tu_unit(&r), tu_int(&r, 81) - 40);
+                xmin = X[i] < xmin ? X[i] : xmin;
+                ymin = Y[i] < ymin ? Y[i] : ymin;
+            }
+            a.area[l] = (double)area / 65536.0;
+            a.cx[l] = (double)((xmin + 127) >> 8) + 0.5;
+            a.cy[l] = (double)((ymin + 127) >> 8) + 0.5;
+            a.tri[l] = &ta[l];
+        }
+        memset(ta, 0, sizeof ta);
+        b = a;
+        rast__planes_ref(&a);
+        assert_int_equal(a.n, 0);
+        for (int l = 0; l < b.n; l++)
+            crc = tu_crc32(crc, &ta[l].z, 4 * sizeof(rast__plane));
+        lanes += b.n;
+        for (int i = 0; i < 2; i++) {
+            if (!have[i])
+                continue;
+            rast__pbatch c = b;
+            memset(tb, 0, sizeof tb);
+            for (int l = 0; l < c.n; l++)
+                c.tri[l] = &tb[l];
+            fns[i](&c);
+            assert_int_equal(c.n, 0);
+            if (memcmp(ta, tb, sizeof ta))
+                fail_msg("batch %d: %s planes differ from the reference", it,
+                         ef_isa_name((ef_isa)simd[i]));
+        }
+    }
+    print_message("NOTE planes: %ld random triangles, SIMD equal to the reference; "
+                  "CRC32 0x%08X (recorded 0x%08X)\n", lanes, crc, SETUP_CRC);
+    assert_int_equal(crc, SETUP_CRC);
+
+    /* 2. The front end with every planes function. */
+    const int nf = 4;
+    const rast__setup_isa *pf[4] = { NULL, &rast__setup_isa_ref, &rast__setup_isa_avx2,
+                                     &rast__setup_isa_avx512 };
+    long batched = 0;
+    for (int n = 0; n < NCASES; n++) {
+        rcase k;
+        make_case(n, &k);
+        rast__view view;
+        rast__view_init(&view, k.t.width, k.t.height, rast__draw_na(&k.t, &k.m));
+        const size_t cap = (size_t)k.m.tri_count * RAST__MAX_FAN;
+        rast__tri *out[4];
+        rast_stats st[4];
+        int cnt[4];
+        const int chunk = 1 + tu_int(&r, 40);
+        for (int f = 0; f < nf; f++) {
+            out[f] = calloc(cap, sizeof(rast__tri));
+            memset(&st[f], 0, sizeof st[f]);
+            cnt[f] = 0;
+            if (f >= 2 && !have[f - 2])
+                continue;
+            rast__vcache vc;
+            rast__vcache_reset(&vc);
+            for (int ti = 0; ti < k.m.tri_count; ti += chunk) {
+                const int te = ti + chunk < k.m.tri_count ? ti + chunk : k.m.tri_count;
+                cnt[f] += rast__prepare_range(&view, &k.m, ti, te, &vc, out[f] + cnt[f],
+                                              &st[f], pf[f]);
+            }
+            /* The triangles made (slots past them are scratch). */
+            if (f == 0 || (cnt[f] == cnt[0] && !memcmp(&st[f], &st[0], sizeof st[0]) &&
+                           !memcmp(out[f], out[0], (size_t)cnt[0] * sizeof(rast__tri))))
+                continue;
+            fail_msg("case %d: the front end with set-up ISA %d differs (count %d vs %d; "
+                     "drawn %ld vs %ld, culled %ld vs %ld, degenerate %ld vs %ld, clipped "
+                     "%ld vs %ld)", n, f, cnt[f], cnt[0], st[f].tris_drawn, st[0].tris_drawn,
+                     st[f].tris_culled, st[0].tris_culled, st[f].tris_degenerate,
+                     st[0].tris_degenerate, st[f].tris_clipped_away, st[0].tris_clipped_away);
+        }
+        batched += cnt[0];
+        for (int f = 0; f < nf; f++)
+            free(out[f]);
+        free_case(&k);
+    }
+    print_message("NOTE front end: %d soup cases, %ld set-up triangles, equal with every "
+                  "set-up ISA\n", NCASES, batched);
+    assert_true(batched > 20000);
+
+    /* 3. Vertex block fills: random vertices (inside, beyond the guard
+     * band, behind the eye, w = 0, at the clip-space origin, tiny and huge
+     * w, NaN and infinities), every block length, SIMD entries equal to
+     * the scalar ones (tag and flags always, the values where valid). */
+    static const rast__vfill_fn vf[2] = { rast__vfill_avx2, rast__vfill_avx512 };
+    long valid = 0, slow = 0, bad = 0;
+    for (int it = 0; it < 4000; it++) {
+        rast__view view;
+        rast__view_init(&view, 1 + tu_int(&r, 800), 1 + tu_int(&r, 600), 0);
+        float clip[4 * RAST__VBLOCK];
+        for (int i = 0; i < 4 * RAST__VBLOCK; i += 4) {
+            const float wv = tu_int(&r, 10) == 0 ? tu_range(&r, -1.0f, 0.01f)
+                             : tu_int(&r, 10) == 0 ? ldexpf(tu_unit(&r), -tu_int(&r, 140))
+                             : tu_int(&r, 20) == 0 ? ldexpf(1.0f + tu_unit(&r), tu_int(&r, 127))
+                                                   : tu_range(&r, 0.05f, 5.0f);
+            const float reach = tu_int(&r, 4) == 0 ? 2e4f : 1.3f;
+            clip[i] = tu_range(&r, -reach, reach) * wv;
+            clip[i + 1] = tu_range(&r, -reach, reach) * wv;
+            clip[i + 2] = tu_range(&r, -1.2f, 1.2f) * wv;
+            clip[i + 3] = wv;
+            if (tu_int(&r, 50) == 0)
+                clip[i] = clip[i + 1] = clip[i + 2] = clip[i + 3] = 0.0f;
+            if (tu_int(&r, 40) == 0)
+                clip[i + tu_int(&r, 4)] = tu_int(&r, 3) == 0 ? NAN
+                                          : tu_int(&r, 2) ? INFINITY : -INFINITY;
+        }
+        const int count = 1 + tu_int(&r, RAST__VBLOCK);
+        const uint32_t base = (uint32_t)tu_int(&r, 1 << 20) * RAST__VBLOCK;
+        rast__vc_entry want[RAST__VBLOCK], got[RAST__VBLOCK];
+        rast__vfill_ref(&view, clip - 4 * (size_t)base, base, count, want);
+        for (int l = 0; l < count; l++) {
+            valid += want[l].flags == 0;
+            slow += (want[l].flags & RAST__VF_SLOW) != 0;
+            bad += (want[l].flags & RAST__VF_NONFINITE) != 0;
+        }
+        for (int i = 0; i < 2; i++) {
+            if (!have[i])
+                continue;
+            memset(got, 0xA5, sizeof got);
+            vf[i](&view, clip - 4 * (size_t)base, base, count, got);
+            for (int l = 0; l < count; l++) {
+                const rast__vc_entry *a = &want[l], *b = &got[l];
+                if (a->tag != b->tag || a->flags != b->flags ||
+                    (a->flags == 0 && (a->X != b->X || a->Y != b->Y ||
+                                       memcmp(&a->zw, &b->zw, sizeof a->zw) ||
+                                       memcmp(&a->iw, &b->iw, sizeof a->iw))))
+                    fail_msg("vertex fill %d lane %d: %s differs from the scalar fill "
+                             "(flags %u vs %u)", it, l, ef_isa_name((ef_isa)simd[i]),
+                             a->flags, b->flags);
+            }
+        }
+    }
+    print_message("NOTE vertex fills: %ld valid, %ld to clip, %ld non-finite vertices, "
+                  "SIMD equal to the scalar fill\n", valid, slow, bad);
+    assert_true(valid > 10000 && slow > 5000 && bad > 500);
+}
+
 /* rast_context_draw_jobs: three jobs (two eyes and a small padded target,
  * different meshes and attribute counts) with 1, 2 and 3 threads on every
  * ISA, each job equal to rast_draw of it alone; bad jobs are rejected
@@ -777,6 +974,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_threads_equal),
         cmocka_unit_test(test_context_api),
         cmocka_unit_test(test_prepare_cached_equal),
+        cmocka_unit_test(test_setup_isa_equal),
         cmocka_unit_test(test_jobs_equal),
         cmocka_unit_test(test_context_clear),
     };

@@ -4,6 +4,7 @@
 #include "raster_internal.h"
 
 #if defined(__x86_64__) || defined(__i386__)
+#include <float.h>
 #include <immintrin.h>
 #include <string.h>
 
@@ -136,6 +137,38 @@ static inline void attr3_store_m(float *p, unsigned bits, __m256 a, __m256 b, __
 #define AA_V 4
 #define AA_FN rast__scan_aa_avx2
 #include "raster_aa.inl"
+
+/* Batched set-up (raster_planes.inl): planes in 4 double lanes, vertex fills. */
+#define PD_V 4
+#define PLANES_FN rast__planes_avx2
+typedef __m256d vd;
+#define PD_LOAD(p) _mm256_load_pd(p)
+#define PD_SET1(x) _mm256_set1_pd(x)
+#define PD_ADD(a, b) _mm256_add_pd(a, b)
+#define PD_SUB(a, b) _mm256_sub_pd(a, b)
+#define PD_MUL(a, b) _mm256_mul_pd(a, b)
+#define PD_DIV(a, b) _mm256_div_pd(a, b)
+#define PD_MAX(a, b) _mm256_max_pd(a, b)
+#define PD_STORE_F(p, v) _mm_storeu_ps(p, _mm256_cvtpd_ps(v))
+#define PS_V 8
+#define VFILL_FN rast__vfill_avx2
+#define SETUP_ISA rast__setup_isa_avx2
+typedef __m256 vs;
+#define PS_LOAD(p) _mm256_load_ps(p)
+#define PS_SET1(x) _mm256_set1_ps(x)
+#define PS_ADD(a, b) _mm256_add_ps(a, b)
+#define PS_SUB(a, b) _mm256_sub_ps(a, b)
+#define PS_MUL(a, b) _mm256_mul_ps(a, b)
+#define PS_DIV(a, b) _mm256_div_ps(a, b)
+#define PS_MAX(a, b) _mm256_max_ps(a, b)
+#define PS_MIN(a, b) _mm256_min_ps(a, b)
+#define PS_LT_BITS(a, b) ((unsigned)_mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LT_OQ)))
+#define PS_LE_BITS(a, b) ((unsigned)_mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LE_OQ)))
+#define PS_GT_BITS(a, b) ((unsigned)_mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_GT_OQ)))
+#define PS_CVT_STORE(p, v) _mm256_store_si256((__m256i *)(void *)(p), _mm256_cvtps_epi32(v))
+#define PD_LOAD_F(p) _mm256_cvtps_pd(_mm_load_ps(p))
+#define PD_STORE(p, v) _mm256_store_pd(p, v)
+#include "raster_planes.inl"
 
 #else
 typedef int rast__avx2_unused;   /* not an x86 build: the dispatcher skips it */

@@ -5,6 +5,7 @@
 #include "raster_internal.h"
 
 #if defined(__x86_64__) || defined(__i386__)
+#include <float.h>
 #include <immintrin.h>
 
 #define SIMD_V 16
@@ -95,6 +96,212 @@ static inline void attr3_store_m(float *p, unsigned bits, __m512 a, __m512 b, __
 #define AA_V 8
 #define AA_FN rast__scan_aa_avx512
 #include "raster_aa.inl"
+
+/* Batched set-up (raster_planes.inl): planes in 8 double lanes, vertex fills. */
+#define PD_V 8
+#define PLANES_FN rast__planes_avx512
+typedef __m512d vd;
+#define PD_LOAD(p) _mm512_load_pd(p)
+#define PD_SET1(x) _mm512_set1_pd(x)
+#define PD_ADD(a, b) _mm512_add_pd(a, b)
+#define PD_SUB(a, b) _mm512_sub_pd(a, b)
+#define PD_MUL(a, b) _mm512_mul_pd(a, b)
+#define PD_DIV(a, b) _mm512_div_pd(a, b)
+#define PD_MAX(a, b) _mm512_max_pd(a, b)
+#define PD_STORE_F(p, v) _mm256_storeu_ps(p, _mm512_cvtpd_ps(v))
+#define PS_V 16
+#define VFILL_FN rast__vfill_avx512
+#define SETUP_ISA rast__setup_isa_avx512
+typedef __m512 vs;
+#define PS_LOAD(p) _mm512_load_ps(p)
+#define PS_SET1(x) _mm512_set1_ps(x)
+#define PS_ADD(a, b) _mm512_add_ps(a, b)
+#define PS_SUB(a, b) _mm512_sub_ps(a, b)
+#define PS_MUL(a, b) _mm512_mul_ps(a, b)
+#define PS_DIV(a, b) _mm512_div_ps(a, b)
+#define PS_MAX(a, b) _mm512_max_ps(a, b)
+#define PS_MIN(a, b) _mm512_min_ps(a, b)
+#define PS_LT_BITS(a, b) ((unsigned)_mm512_cmp_ps_mask(a, b, _CMP_LT_OQ))
+#define PS_LE_BITS(a, b) ((unsigned)_mm512_cmp_ps_mask(a, b, _CMP_LE_OQ))
+#define PS_GT_BITS(a, b) ((unsigned)_mm512_cmp_ps_mask(a, b, _CMP_GT_OQ))
+#define PS_CVT_STORE(p, v) _mm512_store_si512((void *)(p), _mm512_cvtps_epi32(v))
+#define PD_LOAD_F(p) _mm512_cvtps_pd(_mm256_load_ps(p))
+#define PD_STORE(p, v) _mm512_store_pd(p, v)
+/* 16 vertices xyzw: per pair of input vectors one two-source permute puts
+ * x (low half) and y (high half), another z and w; 128-bit shuffles join
+ * the halves of the two pairs. */
+static inline void load_block_xyzw(const float *c, float *x, float *y, float *z, float *w)
+{
+    const __m512 v0 = _mm512_loadu_ps(c), v1 = _mm512_loadu_ps(c + 16);
+    const __m512 v2 = _mm512_loadu_ps(c + 32), v3 = _mm512_loadu_ps(c + 48);
+    const __m512i ixy = _mm512_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28, 1, 5, 9, 13, 17, 21,
+                                          25, 29);
+    const __m512i izw = _mm512_add_epi32(ixy, _mm512_set1_epi32(2));
+    const __m512 xy01 = _mm512_permutex2var_ps(v0, ixy, v1);
+    const __m512 xy23 = _mm512_permutex2var_ps(v2, ixy, v3);
+    const __m512 zw01 = _mm512_permutex2var_ps(v0, izw, v1);
+    const __m512 zw23 = _mm512_permutex2var_ps(v2, izw, v3);
+    _mm512_store_ps(x, _mm512_shuffle_f32x4(xy01, xy23, 0x44));
+    _mm512_store_ps(y, _mm512_shuffle_f32x4(xy01, xy23, 0xEE));
+    _mm512_store_ps(z, _mm512_shuffle_f32x4(zw01, zw23, 0x44));
+    _mm512_store_ps(w, _mm512_shuffle_f32x4(zw01, zw23, 0xEE));
+}
+#define LOAD_BLOCK_XYZW(c, x, y, z, w) load_block_xyzw(c, x, y, z, w)
+
+/* Trivial rejection of 16 submitted triangles (rast__front_fn, see
+ * raster_internal.h). Per lane, the decisions of the scalar front end
+ * (prepare_cached_one and setup_box_edges in raster_setup.c):
+ *   area sign: p1 = dx1*dy2 and p2 = dy1*dx2 in double (|d| < 2^23, so
+ *     both products and their order are exact), area = p1 - p2;
+ *   degenerate (area 0), culled (back: area > 0, front: area < 0);
+ *   box: x0 = max((xmin + 127) >> 8, 0), x1 = min((xmax - 128) >> 8, W-1)
+ *     (y alike), off screen when empty;
+ *   one-pixel box (before clamping too, so every coordinate difference is
+ *     below 512 and the int32 products below 2^18): the three biased edge
+ *     values at the centre, winding normalised, all >= 0 or empty. */
+static inline __m512i front_deint(__m512i a, __m512i b, __m512i c, __m512i idx)
+{
+    /* lane l = element idx[l] of the 48 indices a | b | c (idx < 48). */
+    const __mmask16 hi = _mm512_cmpge_epi32_mask(idx, _mm512_set1_epi32(32));
+    return _mm512_mask_permutexvar_epi32(_mm512_permutex2var_epi32(a, idx, b), hi, idx, c);
+}
+
+static inline unsigned front_area_bits(__m512i a, __m512i b, __m512i c, __m512i d,
+                                       int cmp)
+{
+    /* Lanes with a*b <cmp> c*d (exact in double). */
+    const __m512d alo = _mm512_cvtepi32_pd(_mm512_castsi512_si256(a));
+    const __m512d ahi = _mm512_cvtepi32_pd(_mm512_extracti32x8_epi32(a, 1));
+    const __m512d blo = _mm512_cvtepi32_pd(_mm512_castsi512_si256(b));
+    const __m512d bhi = _mm512_cvtepi32_pd(_mm512_extracti32x8_epi32(b, 1));
+    const __m512d clo = _mm512_cvtepi32_pd(_mm512_castsi512_si256(c));
+    const __m512d chi = _mm512_cvtepi32_pd(_mm512_extracti32x8_epi32(c, 1));
+    const __m512d dlo = _mm512_cvtepi32_pd(_mm512_castsi512_si256(d));
+    const __m512d dhi = _mm512_cvtepi32_pd(_mm512_extracti32x8_epi32(d, 1));
+    const __m512d p1lo = _mm512_mul_pd(alo, blo), p2lo = _mm512_mul_pd(clo, dlo);
+    const __m512d p1hi = _mm512_mul_pd(ahi, bhi), p2hi = _mm512_mul_pd(chi, dhi);
+    if (cmp > 0)
+        return (unsigned)_mm512_cmp_pd_mask(p1lo, p2lo, _CMP_GT_OQ) |
+               (unsigned)_mm512_cmp_pd_mask(p1hi, p2hi, _CMP_GT_OQ) << 8;
+    return (unsigned)_mm512_cmp_pd_mask(p1lo, p2lo, _CMP_LT_OQ) |
+           (unsigned)_mm512_cmp_pd_mask(p1hi, p2hi, _CMP_LT_OQ) << 8;
+}
+
+/* Biased edge value from a to b at (cx, cy) (int32: small boxes only). */
+static inline __m512i front_edge(__m512i xa, __m512i ya, __m512i xb, __m512i yb,
+                                 __m512i cx, __m512i cy)
+{
+    const __m512i dx = _mm512_sub_epi32(xb, xa), dy = _mm512_sub_epi32(yb, ya);
+    const __m512i zero = _mm512_setzero_si512();
+    const __mmask16 tl = _mm512_cmplt_epi32_mask(dy, zero) |
+                         (_mm512_cmpeq_epi32_mask(dy, zero) & _mm512_cmpgt_epi32_mask(dx, zero));
+    const __m512i e = _mm512_sub_epi32(_mm512_mullo_epi32(dx, _mm512_sub_epi32(cy, ya)),
+                                       _mm512_mullo_epi32(dy, _mm512_sub_epi32(cx, xa)));
+    return _mm512_mask_sub_epi32(e, (__mmask16)~tl, e, _mm512_set1_epi32(1));
+}
+
+unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__vcache *vc,
+                            int ti, rast_stats *st, rast__vfill_fn vfill)
+{
+    const uint32_t *ix = m->indices + 3 * (size_t)ti;
+    const __m512i a = _mm512_loadu_si512(ix), b = _mm512_loadu_si512(ix + 16),
+                  c = _mm512_loadu_si512(ix + 32);
+    const __m512i l3 = _mm512_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 33, 36, 39,
+                                         42, 45);
+    const __m512i one = _mm512_set1_epi32(1);
+    __m512i iv[3];
+    iv[0] = front_deint(a, b, c, l3);
+    iv[1] = front_deint(a, b, c, _mm512_add_epi32(l3, one));
+    iv[2] = front_deint(a, b, c, _mm512_add_epi32(l3, _mm512_set1_epi32(2)));
+    /* Entry k of slot s is at int offset 8*s (32-byte entries). */
+    const int *eb = (const int *)(const void *)vc->e;
+    const __m512i smask = _mm512_set1_epi32(RAST__VCACHE - 1);
+    __m512i so[3];
+    unsigned miss = 0;
+    for (int k = 0; k < 3; k++) {
+        so[k] = _mm512_slli_epi32(_mm512_and_si512(iv[k], smask), 3);
+        miss |= _mm512_cmpneq_epi32_mask(_mm512_i32gather_epi32(so[k], eb, 4), iv[k]);
+    }
+    if (miss) {
+        _Alignas(64) uint32_t idx[3][16];
+        for (int k = 0; k < 3; k++)
+            _mm512_store_si512(idx[k], iv[k]);
+        for (unsigned bits = miss; bits; bits &= bits - 1) {
+            const int l = __builtin_ctz(bits);
+            for (int k = 0; k < 3; k++) {
+                const uint32_t i = idx[k][l];
+                if (vc->e[i & (RAST__VCACHE - 1)].tag == i)
+                    continue;
+                const uint32_t base = i & ~(uint32_t)(RAST__VBLOCK - 1);
+                const uint32_t left = (uint32_t)m->vertex_count - base;
+                vfill(v, m->clip, base, left < RAST__VBLOCK ? (int)left : RAST__VBLOCK,
+                      &vc->e[base & (RAST__VCACHE - 1)]);
+            }
+        }
+        unsigned still = 0;
+        for (int k = 0; k < 3; k++)
+            still |= _mm512_cmpneq_epi32_mask(_mm512_i32gather_epi32(so[k], eb, 4), iv[k]);
+        if (still)   /* slots shared inside the group: the scalar path */
+            return 0xFFFFu;
+    }
+    __m512i X[3], Y[3], fl = _mm512_setzero_si512();
+    for (int k = 0; k < 3; k++) {
+        fl = _mm512_or_si512(fl, _mm512_i32gather_epi32(_mm512_add_epi32(so[k], one), eb, 4));
+        X[k] = _mm512_i32gather_epi32(_mm512_add_epi32(so[k], _mm512_set1_epi32(2)), eb, 4);
+        Y[k] = _mm512_i32gather_epi32(_mm512_add_epi32(so[k], _mm512_set1_epi32(3)), eb, 4);
+    }
+    const unsigned special = _mm512_test_epi32_mask(fl, fl);
+    const __m512i dx1 = _mm512_sub_epi32(X[1], X[0]), dy1 = _mm512_sub_epi32(Y[1], Y[0]);
+    const __m512i dx2 = _mm512_sub_epi32(X[2], X[0]), dy2 = _mm512_sub_epi32(Y[2], Y[0]);
+    const unsigned pos = front_area_bits(dx1, dy2, dy1, dx2, 1);
+    const unsigned neg = front_area_bits(dx1, dy2, dy1, dx2, -1);
+    const unsigned valid = ~special & 0xFFFFu;
+    const unsigned degen = valid & ~(pos | neg);
+    const unsigned cullm = m->cull == RAST_CULL_BACK ? pos : m->cull == RAST_CULL_FRONT ? neg : 0u;
+    const unsigned culled = valid & cullm & (pos | neg);
+    const unsigned live = valid & (pos | neg) & ~cullm;
+
+    const __m512i xmin = _mm512_min_epi32(X[0], _mm512_min_epi32(X[1], X[2]));
+    const __m512i xmax = _mm512_max_epi32(X[0], _mm512_max_epi32(X[1], X[2]));
+    const __m512i ymin = _mm512_min_epi32(Y[0], _mm512_min_epi32(Y[1], Y[2]));
+    const __m512i ymax = _mm512_max_epi32(Y[0], _mm512_max_epi32(Y[1], Y[2]));
+    const __m512i c127 = _mm512_set1_epi32(RAST__FIX_ONE - 1 - RAST__FIX_HALF);
+    const __m512i c128 = _mm512_set1_epi32(RAST__FIX_HALF);
+    const __m512i rx0 = _mm512_srai_epi32(_mm512_add_epi32(xmin, c127), RAST_SUBPIXEL_BITS);
+    const __m512i rx1 = _mm512_srai_epi32(_mm512_sub_epi32(xmax, c128), RAST_SUBPIXEL_BITS);
+    const __m512i ry0 = _mm512_srai_epi32(_mm512_add_epi32(ymin, c127), RAST_SUBPIXEL_BITS);
+    const __m512i ry1 = _mm512_srai_epi32(_mm512_sub_epi32(ymax, c128), RAST_SUBPIXEL_BITS);
+    const __m512i zero = _mm512_setzero_si512();
+    const __m512i bx0 = _mm512_max_epi32(rx0, zero), by0 = _mm512_max_epi32(ry0, zero);
+    const __m512i bx1 = _mm512_min_epi32(rx1, _mm512_set1_epi32(v->width - 1));
+    const __m512i by1 = _mm512_min_epi32(ry1, _mm512_set1_epi32(v->height - 1));
+    const unsigned off = _mm512_cmpgt_epi32_mask(bx0, bx1) | _mm512_cmpgt_epi32_mask(by0, by1);
+    const unsigned offs = live & off;
+    const unsigned live2 = live & ~off;
+    unsigned empty = 0;
+    const unsigned single = live2 & _mm512_cmpeq_epi32_mask(rx0, rx1) &
+                            _mm512_cmpeq_epi32_mask(ry0, ry1);
+    if (single) {
+        const __mmask16 sw = (__mmask16)neg;   /* normalise: swap 1 and 2 */
+        const __m512i x1 = _mm512_mask_blend_epi32(sw, X[1], X[2]);
+        const __m512i x2 = _mm512_mask_blend_epi32(sw, X[2], X[1]);
+        const __m512i y1 = _mm512_mask_blend_epi32(sw, Y[1], Y[2]);
+        const __m512i y2 = _mm512_mask_blend_epi32(sw, Y[2], Y[1]);
+        const __m512i cx = _mm512_add_epi32(_mm512_slli_epi32(bx0, RAST_SUBPIXEL_BITS), c128);
+        const __m512i cy = _mm512_add_epi32(_mm512_slli_epi32(by0, RAST_SUBPIXEL_BITS), c128);
+        const __m512i e0 = front_edge(x1, y1, x2, y2, cx, cy);
+        const __m512i e1 = front_edge(x2, y2, X[0], Y[0], cx, cy);
+        const __m512i e2 = front_edge(X[0], Y[0], x1, y1, cx, cy);
+        empty = single & _mm512_movepi32_mask(_mm512_or_si512(_mm512_or_si512(e0, e1), e2));
+    }
+    st->tris_degenerate += __builtin_popcount(degen);
+    st->tris_culled += __builtin_popcount(culled);
+    st->tris_clipped_away += __builtin_popcount(offs);
+    st->tris_drawn += __builtin_popcount(empty);
+    return special | (live2 & ~empty);
+}
+#define FRONT_FN rast__front_avx512
+#include "raster_planes.inl"
 
 #else
 typedef int rast__avx512_unused;   /* not an x86 build: the dispatcher skips it */

@@ -65,6 +65,19 @@ rast__scan_rows_fn rast__scan_for_isa(int isa)
     return rast__scan_rows_ref;
 }
 
+const rast__setup_isa *rast__setup_for_scan(rast__scan_rows_fn scan)
+{
+#if defined(__x86_64__)
+    if (scan == rast__scan_rows_avx512)
+        return &rast__setup_isa_avx512;
+    if (scan == rast__scan_rows_avx2)
+        return &rast__setup_isa_avx2;
+#else
+    (void)scan;
+#endif
+    return &rast__setup_isa_ref;
+}
+
 int rast_draw_isa(void)
 {
     return (int)ef_isa_choose(EF_ISA_DEFAULT);
@@ -98,6 +111,7 @@ typedef struct known_target {
 struct rast_context {
     int isa, threads;
     rast__scan_rows_fn scan;
+    const rast__setup_isa *setup; /* the set-up kernels of the ISA */
     slot *slots;
     pthread_t th[RAST_MAX_THREADS];
     int started;
@@ -182,7 +196,7 @@ static void run_bands(rast_context *c, int tid, int job)
         if (hi > m->tri_count)
             hi = m->tri_count;
         me->count[par] = lo < hi ? rast__prepare_range(&view, m, (int)lo, (int)hi, &me->vc,
-                                                       me->buf[par], &me->st)
+                                                       me->buf[par], &me->st, c->setup)
                                  : 0;
         barrier(c);
         for (int s = 0; s < n; s++) {
@@ -282,6 +296,7 @@ rast_context *rast_context_create(const rast_context_desc *desc)
     c->threads = d.threads > 1 ? d.threads : 1;
     c->isa = (int)ef_isa_choose((ef_isa)d.max_isa);
     c->scan = rast__scan_for_isa(c->isa);
+    c->setup = rast__setup_for_scan(c->scan);
     /* Dirty tiles of the known targets, one block. */
     c->known[0].dirty = malloc((size_t)RAST_CONTEXT_TARGETS * sizeof(rast__tiles));
     if (!c->known[0].dirty) {

@@ -4,8 +4,13 @@
  * Split of the work (docs/raster.md has the full rules):
  *   raster_setup.c  validation, clipping, perspective divide, viewport,
  *                   sub-pixel snapping, culling, edge and plane setup, and
- *                   the per-triangle driver rast__draw_with(). All of it is
- *                   scalar and shared: a SIMD path never redoes setup.
+ *                   the per-triangle driver rast__draw_with(). Scalar; it
+ *                   defines the set-up's bits. Three parts of it have SIMD
+ *                   versions that give the same bits (rast__setup_isa:
+ *                   raster_planes.inl, raster_avx2.c, raster_avx512.c):
+ *                   the float planes of 4/8 triangles per vector, vertex
+ *                   cache fills of 16 vertices, and (AVX-512) the trivial
+ *                   rejection of 16 triangles at once.
  *   raster_ref.c    rast__scan_ref(): the per-pixel loop over one set-up
  *                   triangle. This is the only thing a SIMD path replaces,
  *                   and it must give the same bytes (op order below).
@@ -166,7 +171,7 @@ int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
  * the scalar per-triangle path computes (docs/raster.md section 11):
  * flags (RAST__VF_*), the outcode, the snapped position and the double
  * per-vertex plane inputs zw = (z/w)*0.5+0.5 and iw = 1/w. */
-#define RAST__VCACHE 256
+#define RAST__VCACHE 1024
 enum {
     RAST__VF_NONFINITE = 1 << 6,   /* a NaN or infinite coordinate */
     RAST__VF_SLOW = 1 << 7         /* outcode != 0 or w <= 0: clip path */
@@ -191,13 +196,89 @@ void rast__vcache_reset(rast__vcache *c);
 int rast__prepare_cached(const rast__view *view, const rast_mesh_desc *m, int ti,
                          rast__vcache *vc, rast__tri *out, rast_stats *st);
 
+/* Deferred plane set-up. The float planes (z, q, b1, b2) of a triangle
+ * are the division-bound part of its set-up (docs/raster.md section 6.1).
+ * The front end queues the inputs of trivially accepted triangles here
+ * (structure of arrays, values already in double) and a planes function
+ * computes RAST__PBATCH of them at once, one triangle per SIMD lane, with
+ * the scalar set-up's IEEE double operations in its order per lane: the
+ * same bits as rast__planes_ref.
+ *   X, Y  vertex positions in pixels ((double)fixed / 256, exact), after
+ *         winding normalisation; area = snapped area / 65536 (> 0, exact);
+ *   cx, cy  the centre of the box's first pixel; zw, iw per vertex. */
+#define RAST__PBATCH 16
+typedef struct rast__pbatch {
+    int n;
+    rast__tri *tri[RAST__PBATCH];
+    _Alignas(64) double X[3][RAST__PBATCH];
+    _Alignas(64) double Y[3][RAST__PBATCH];
+    _Alignas(64) double zw[3][RAST__PBATCH];
+    _Alignas(64) double iw[3][RAST__PBATCH];
+    _Alignas(64) double area[RAST__PBATCH];
+    _Alignas(64) double cx[RAST__PBATCH];
+    _Alignas(64) double cy[RAST__PBATCH];
+} rast__pbatch;
+/* Writes the z, q, b1, b2 planes of b->tri[0 .. b->n-1] and sets b->n = 0.
+ * Lanes n .. RAST__PBATCH-1 may be overwritten with harmless values. */
+typedef void (*rast__planes_fn)(rast__pbatch *b);
+void rast__planes_ref(rast__pbatch *b);
+void rast__planes_avx2(rast__pbatch *b);
+void rast__planes_avx512(rast__pbatch *b);
+
+/* Vertex cache fill of a block: e[l] = the entry of vertex base + l for
+ * l < count (count 1..RAST__VBLOCK; clip: the mesh's clip coordinates),
+ * the bits the scalar fill gives (tag, flags and, when flags == 0, the
+ * snapped position, zw and iw; other fields are unspecified). */
+#define RAST__VBLOCK 16
+typedef void (*rast__vfill_fn)(const rast__view *v, const float *clip, uint32_t base,
+                               int count, rast__vc_entry *e);
+void rast__vfill_ref(const rast__view *v, const float *clip, uint32_t base, int count,
+                     rast__vc_entry *e);
+void rast__vfill_avx2(const rast__view *v, const float *clip, uint32_t base, int count,
+                      rast__vc_entry *e);
+void rast__vfill_avx512(const rast__view *v, const float *clip, uint32_t base, int count,
+                        rast__vc_entry *e);
+
+/* The set-up kernels of an ISA for rast__prepare_range: planes in
+ * batches, and vertex cache misses filled RAST__VBLOCK aligned vertices
+ * at a time (meshes index nearby vertices together). */
+/* Trivial rejection of RAST__FRONT_GROUP submitted triangles ti .. ti+15
+ * at once (one per lane): for triangles whose three vertices are cached
+ * and valid (flags 0), the area, culling, pixel box and, for one-pixel
+ * boxes, the empty-centre test of the scalar set-up; those rejected (and
+ * empty ones) are counted in *st exactly as the scalar path counts them.
+ * Returns the lanes the scalar path must still run (survivors, vertices
+ * not cached or needing clipping), bit l for triangle ti + l. May fill
+ * cache entries (as a lookup does). */
+#define RAST__FRONT_GROUP 16
+typedef unsigned (*rast__front_fn)(const rast__view *v, const rast_mesh_desc *m,
+                                   rast__vcache *vc, int ti, rast_stats *st,
+                                   rast__vfill_fn vfill);
+unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__vcache *vc,
+                            int ti, rast_stats *st, rast__vfill_fn vfill);
+
+typedef struct rast__setup_isa {
+    rast__planes_fn planes;
+    rast__vfill_fn vfill;
+    rast__front_fn front;     /* NULL: every triangle through the scalar path */
+} rast__setup_isa;
+extern const rast__setup_isa rast__setup_isa_ref, rast__setup_isa_avx2,
+    rast__setup_isa_avx512;
+/* The set-up kernels that go with a row scan (those of the scan's ISA;
+ * the scalar ones for the reference and SSE2). */
+const rast__setup_isa *rast__setup_for_scan(rast__scan_rows_fn scan);
+
 /* rast__prepare_cached for submitted triangles ti0 .. ti1-1 in order,
  * writing their fan triangles one after the other to out (room for
  * (ti1 - ti0) * RAST__MAX_FAN); returns their count. The same triangles,
  * bytes and counters as rast__prepare_cached per triangle, without a call
- * per triangle for the common rejections. */
+ * per triangle for the common rejections. With isa not NULL, the planes
+ * of trivially accepted triangles are computed in batches by isa->planes
+ * (before the function returns) and cache misses filled in blocks by
+ * isa->vfill; NULL: one by one as rast__prepare_cached. */
 int rast__prepare_range(const rast__view *view, const rast_mesh_desc *m, int ti0,
-                        int ti1, rast__vcache *vc, rast__tri *out, rast_stats *st);
+                        int ti1, rast__vcache *vc, rast__tri *out, rast_stats *st,
+                        const rast__setup_isa *isa);
 
 /* ---- anti-aliased coverage (raster_aa.c, raster_aa.inl) ---------------- */
 

@@ -294,14 +294,12 @@ static inline void setup_edges(rast__tri *tri, const int32_t X[3], const int32_t
     }
 }
 
-/* The rest of the setup for a triangle already normalised to area > 0
- * (clockwise on the screen, y down: the interior is where every edge
- * function is positive): snapped positions X, Y, per-vertex plane inputs
- * zw_i = (z/w)*0.5+0.5 and iw_i = 1/w (double) and attributes
- * (attr_count floats per vertex, unused when 0), all in that order. */
-static int setup_oriented(const rast__view *v, const int32_t X[3], const int32_t Y[3],
-                          int64_t area, const double zwv[3], const double iwv[3],
-                          const float *const attr[3], rast__tri *tri)
+/* The pixel box and the edges of a triangle already normalised to area
+ * > 0 (clockwise on the screen, y down: the interior is where every edge
+ * function is positive) with snapped positions X, Y: RAST__SETUP_OK,
+ * _OFFSCREEN or _EMPTY. */
+static inline int setup_box_edges(const rast__view *v, const int32_t X[3],
+                                  const int32_t Y[3], rast__tri *tri)
 {
     /* Pixel bounding box: pixel x is a candidate iff xmin <= 256x+128 <= xmax,
      * i.e. x0 = floor((xmin - 128 + 255) / 256), x1 = floor((xmax - 128) / 256)
@@ -327,21 +325,41 @@ static int setup_oriented(const rast__view *v, const int32_t X[3], const int32_t
      * drawn (the counters of the full path). */
     if (bx0 == bx1 && by0 == by1 && (tri->e_c[0] | tri->e_c[1] | tri->e_c[2]) < 0)
         return RAST__SETUP_EMPTY;
+    return RAST__SETUP_OK;
+}
 
-    /* Float planes, set up in double from the snapped positions (exact in
-     * double) and stored as float. The origin is the centre of (x0, y0). */
-    double Xd[3], Yd[3];
-    for (int i = 0; i < 3; i++) {
-        Xd[i] = (double)X[i] / RAST__FIX_ONE;
-        Yd[i] = (double)Y[i] / RAST__FIX_ONE;
-    }
-    const double aread = (double)area / ((double)RAST__FIX_ONE * RAST__FIX_ONE);
-    const double ocx = (double)bx0 + 0.5, ocy = (double)by0 + 0.5;
+/* The float planes of one triangle from the double inputs of
+ * rast__pbatch (docs/raster.md section 6.1). The one definition of the
+ * planes' bits: rast__planes_ref runs it per triangle, the SIMD planes
+ * functions per lane. */
+static void planes_one(const double Xd[3], const double Yd[3], double aread,
+                       const double zwv[3], const double iwv[3], double ocx,
+                       double ocy, rast__tri *tri)
+{
     double qmax = 0.0;
     for (int i = 0; i < 3; i++)
         if (iwv[i] > qmax) qmax = iwv[i];
     const double q[3] = { iwv[0] / qmax, iwv[1] / qmax, iwv[2] / qmax };
     PLANES_SETUP(Xd, Yd, aread, zwv, q, ocx, ocy, tri);
+}
+
+/* The plane inputs in double (exact conversions of the snapped values). */
+static inline void plane_inputs(const int32_t X[3], const int32_t Y[3], int64_t area,
+                                const rast__tri *tri, double Xd[3], double Yd[3],
+                                double *aread, double *ocx, double *ocy)
+{
+    for (int i = 0; i < 3; i++) {
+        Xd[i] = (double)X[i] / RAST__FIX_ONE;
+        Yd[i] = (double)Y[i] / RAST__FIX_ONE;
+    }
+    *aread = (double)area / ((double)RAST__FIX_ONE * RAST__FIX_ONE);
+    *ocx = (double)tri->x0 + 0.5;
+    *ocy = (double)tri->y0 + 0.5;
+}
+
+static inline void setup_attrs(const rast__view *v, const float *const attr[3],
+                               rast__tri *tri)
+{
     tri->attr_count = v->attr_count;
     for (int k = 0; k < v->attr_count; k++) {
         const float a0 = attr[0][k];
@@ -349,7 +367,40 @@ static int setup_oriented(const rast__view *v, const int32_t X[3], const int32_t
         tri->d1[k] = attr[1][k] - a0;
         tri->d2[k] = attr[2][k] - a0;
     }
+}
+
+/* The rest of the setup for a triangle already normalised to area > 0:
+ * snapped positions X, Y, per-vertex plane inputs zw_i = (z/w)*0.5+0.5
+ * and iw_i = 1/w (double) and attributes (attr_count floats per vertex,
+ * unused when 0), all in that order. */
+static int setup_oriented(const rast__view *v, const int32_t X[3], const int32_t Y[3],
+                          int64_t area, const double zwv[3], const double iwv[3],
+                          const float *const attr[3], rast__tri *tri)
+{
+    const int r = setup_box_edges(v, X, Y, tri);
+    if (r != RAST__SETUP_OK)
+        return r;
+    /* Float planes, set up in double from the snapped positions (exact in
+     * double) and stored as float. The origin is the centre of (x0, y0). */
+    double Xd[3], Yd[3], aread, ocx, ocy;
+    plane_inputs(X, Y, area, tri, Xd, Yd, &aread, &ocx, &ocy);
+    planes_one(Xd, Yd, aread, zwv, iwv, ocx, ocy, tri);
+    setup_attrs(v, attr, tri);
     return RAST__SETUP_OK;
+}
+
+const rast__setup_isa rast__setup_isa_ref = { rast__planes_ref, rast__vfill_ref, NULL };
+
+void rast__planes_ref(rast__pbatch *b)
+{
+    for (int i = 0; i < b->n; i++) {
+        const double X[3] = { b->X[0][i], b->X[1][i], b->X[2][i] };
+        const double Y[3] = { b->Y[0][i], b->Y[1][i], b->Y[2][i] };
+        const double zw[3] = { b->zw[0][i], b->zw[1][i], b->zw[2][i] };
+        const double iw[3] = { b->iw[0][i], b->iw[1][i], b->iw[2][i] };
+        planes_one(X, Y, b->area[i], zw, iw, b->cx[i], b->cy[i], b->tri[i]);
+    }
+    b->n = 0;
 }
 
 /* The whole setup of one triangle in submission order. */
@@ -543,12 +594,10 @@ void rast__vcache_reset(rast__vcache *c)
         c->e[i].tag = UINT32_MAX;
 }
 
-/* Fills the cache entry of vertex idx (a miss). */
-static RAST__NOINLINE void vc_fill(const rast__view *view,
-                                              const rast_mesh_desc *m,
-                                              rast__vc_entry *e, uint32_t idx)
+/* The cache entry of the vertex at c (index idx). */
+static inline void vc_fill_one(const rast__view *view, const float *c, uint32_t idx,
+                               rast__vc_entry *e)
 {
-    const float *c = m->clip + 4 * (size_t)idx;
     rast__vert p;
     p.x = c[0];
     p.y = c[1];
@@ -572,13 +621,43 @@ static RAST__NOINLINE void vc_fill(const rast__view *view,
     e->iw = vert_iw(&p);
 }
 
+/* Fills the cache entry of vertex idx (a miss). */
+static RAST__NOINLINE void vc_fill(const rast__view *view, const rast_mesh_desc *m,
+                                   rast__vc_entry *e, uint32_t idx)
+{
+    vc_fill_one(view, m->clip + 4 * (size_t)idx, idx, e);
+}
+
+void rast__vfill_ref(const rast__view *v, const float *clip, uint32_t base, int count,
+                     rast__vc_entry *e)
+{
+    for (int l = 0; l < count; l++)
+        vc_fill_one(v, clip + 4 * ((size_t)base + (size_t)l), base + (uint32_t)l, &e[l]);
+}
+
+/* A miss with block fills: the aligned block of RAST__VBLOCK vertices
+ * around idx (its slots are consecutive: RAST__VCACHE is a multiple). */
+static RAST__NOINLINE void vc_fill_block(const rast__view *view, const rast_mesh_desc *m,
+                                         rast__vcache *vc, uint32_t idx,
+                                         rast__vfill_fn vfill)
+{
+    const uint32_t base = idx & ~(uint32_t)(RAST__VBLOCK - 1);
+    const uint32_t left = (uint32_t)m->vertex_count - base;
+    const int count = left < RAST__VBLOCK ? (int)left : RAST__VBLOCK;
+    vfill(view, m->clip, base, count, &vc->e[base & (RAST__VCACHE - 1)]);
+}
+
 static inline const rast__vc_entry *vc_get(const rast__view *view,
                                            const rast_mesh_desc *m, rast__vcache *vc,
-                                           uint32_t idx)
+                                           uint32_t idx, rast__vfill_fn vfill)
 {
     rast__vc_entry *e = &vc->e[idx & (RAST__VCACHE - 1)];
-    if (e->tag != idx)
-        vc_fill(view, m, e, idx);
+    if (e->tag != idx) {
+        if (vfill)
+            vc_fill_block(view, m, vc, idx, vfill);
+        else
+            vc_fill(view, m, e, idx);
+    }
     return e;
 }
 
@@ -605,12 +684,14 @@ static int count_setup(int r, rast_stats *st)
 static RAST__INLINE int prepare_cached_one(const rast__view *view,
                                            const rast_mesh_desc *m, int ti,
                                            rast__vcache *vc, rast__tri *out,
-                                           rast_stats *st)
+                                           rast_stats *st, rast__pbatch *pb,
+                                           const rast__setup_isa *isa)
 {
     const uint32_t *ix = m->indices + 3 * (size_t)ti;
-    const rast__vc_entry *e0 = vc_get(view, m, vc, ix[0]);
-    const rast__vc_entry *e1 = vc_get(view, m, vc, ix[1]);
-    const rast__vc_entry *e2 = vc_get(view, m, vc, ix[2]);
+    const rast__vfill_fn vfill = isa ? isa->vfill : NULL;
+    const rast__vc_entry *e0 = vc_get(view, m, vc, ix[0], vfill);
+    const rast__vc_entry *e1 = vc_get(view, m, vc, ix[1], vfill);
+    const rast__vc_entry *e2 = vc_get(view, m, vc, ix[2], vfill);
     /* Two indices of one triangle in the same cache slot: the later
      * lookup evicted the earlier one; take the uncached path (the same
      * result, computed again). */
@@ -647,26 +728,65 @@ static RAST__INLINE int prepare_cached_one(const rast__view *view,
         attr[1] = m->attr + (size_t)i1 * ac;
         attr[2] = m->attr + (size_t)i2 * ac;
     }
-    return count_setup(setup_oriented(view, X, Y, area < 0 ? -area : area, zw, iw,
-                                      attr, out), st);
+    if (!pb)
+        return count_setup(setup_oriented(view, X, Y, area < 0 ? -area : area, zw, iw,
+                                          attr, out), st);
+    /* Batched planes: box, edges and attributes now, the planes queued. */
+    const int r2 = setup_box_edges(view, X, Y, out);
+    if (r2 != RAST__SETUP_OK)
+        return count_setup(r2, st);
+    setup_attrs(view, attr, out);
+    const int k = pb->n;
+    double Xd[3], Yd[3];
+    plane_inputs(X, Y, area < 0 ? -area : area, out, Xd, Yd, &pb->area[k], &pb->cx[k],
+                 &pb->cy[k]);
+    for (int i = 0; i < 3; i++) {
+        pb->X[i][k] = Xd[i];
+        pb->Y[i][k] = Yd[i];
+        pb->zw[i][k] = zw[i];
+        pb->iw[i][k] = iw[i];
+    }
+    pb->tri[k] = out;
+    pb->n = k + 1;
+    if (pb->n == RAST__PBATCH)
+        isa->planes(pb);
+    st->tris_drawn++;
+    return 1;
 }
 
 int rast__prepare_cached(const rast__view *view, const rast_mesh_desc *m, int ti,
                          rast__vcache *vc, rast__tri *out, rast_stats *st)
 {
-    return prepare_cached_one(view, m, ti, vc, out, st);
+    return prepare_cached_one(view, m, ti, vc, out, st, NULL, NULL);
 }
 
 int rast__prepare_range(const rast__view *view, const rast_mesh_desc *m, int ti0,
-                        int ti1, rast__vcache *vc, rast__tri *out, rast_stats *st)
+                        int ti1, rast__vcache *vc, rast__tri *out, rast_stats *st,
+                        const rast__setup_isa *isa)
 {
     /* Counters in a local copy: built with -fno-strict-aliasing, the
      * compiler would otherwise store and reload them around every write
      * to out. */
     rast_stats ls = *st;
     int n = 0;
-    for (int ti = ti0; ti < ti1; ti++)
-        n += prepare_cached_one(view, m, ti, vc, out + n, &ls);
+    if (isa) {
+        rast__pbatch pb;
+        pb.n = 0;
+        int ti = ti0;
+        if (isa->front)
+            for (; ti + RAST__FRONT_GROUP <= ti1; ti += RAST__FRONT_GROUP)
+                for (unsigned rest = isa->front(view, m, vc, ti, &ls, isa->vfill); rest;
+                     rest &= rest - 1)
+                    n += prepare_cached_one(view, m, ti + __builtin_ctz(rest), vc, out + n,
+                                            &ls, &pb, isa);
+        for (; ti < ti1; ti++)
+            n += prepare_cached_one(view, m, ti, vc, out + n, &ls, &pb, isa);
+        if (pb.n)
+            isa->planes(&pb);
+    } else {
+        for (int ti = ti0; ti < ti1; ti++)
+            n += prepare_cached_one(view, m, ti, vc, out + n, &ls, NULL, NULL);
+    }
     *st = ls;
     return n;
 }
@@ -766,10 +886,11 @@ void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
     rast__tri tri[CHUNK * RAST__MAX_FAN];
     rast__vcache vc;
     rast__vcache_reset(&vc);
+    const rast__setup_isa *isa = rast__setup_for_scan(scan);
     int last[4] = { 1, 0, 1, 0 };   /* tiles marked last: x0, x1, y0, y1 (none) */
     for (int ti = 0; ti < m->tri_count; ti += CHUNK) {
         const int te = m->tri_count - ti > CHUNK ? ti + CHUNK : m->tri_count;
-        const int n = rast__prepare_range(&view, m, ti, te, &vc, tri, &st);
+        const int n = rast__prepare_range(&view, m, ti, te, &vc, tri, &st, isa);
         for (int i = 0; i < n; i++) {
             const rast__tri *r = &tri[i];
             st.pixels_written += scan(t, r, r->y0, r->y1);
