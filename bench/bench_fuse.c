@@ -14,6 +14,9 @@
  *   frame      fuse_context_frame, out separate from V
  *   frame_ip   fuse_context_frame in place (out == V), what src/pipe does:
  *              transparent spans of the layer cost a read of V and no write
+ *   frame_dp   frame_ip with the depth test against the virtual scene's
+ *              depth (a "bottle" at 0.38 m over a tenth of the width, in
+ *              front of part of the hands at 0.33-0.45 m)
  *   memcpy     V -> out of both eyes (2 x 4.1 MB) with as many threads as
  *              the row (one eye per thread with 2): the memory floor
  *   pixman     single-threaded, in place on a copy of V (pixman's dst):
@@ -95,7 +98,19 @@ static void *xmalloc(size_t n)
 typedef struct eye_buf {
     uint8_t *P, *M, *Q, *V, *out, *Vip;   /* Vip: V for the in-place runs */
     float *N;
+    float *hz, *sd;                       /* hand window depth, scene metres */
 } eye_buf;
+
+/* the depth test's projection */
+#define ZNEAR 0.05f
+#define ZFAR 10.0f
+
+/* window depth of metric distance d (fuse.h, "depth test", inverted) */
+static float window_z(double d)
+{
+    const double fpn = ZFAR + ZNEAR, fmn = ZFAR - ZNEAR, two_fn = 2.0 * ZFAR * ZNEAR;
+    return (float)(((fpn - two_fn / d) / fmn + 1.0) * 0.5);
+}
 
 /* Two elliptical "hands" side by side covering about `cover` of the image,
  * with a soft edge of ~3 pixels. Returns the share of pixels with M > 0. */
@@ -111,6 +126,10 @@ static double make_eye(eye_buf *e, double cover)
     e->V = xmalloc(W * H * 4);
     e->out = xmalloc(W * H * 4);
     e->Vip = xmalloc(W * H * 4);
+    e->hz = xmalloc(sizeof(float) * CW * CH);
+    e->sd = xmalloc(sizeof(float) * W * H);
+    for (i = 0; i < W * H; i++)
+        e->sd[i] = (i % W) >= W * 45 / 100 && (i % W) < W * 55 / 100 ? 0.38f : 0.0f;
     for (i = 0; i < CW * CH * 4; i++) e->P[i] = (uint8_t)rnd();
     for (i = 0; i < W * H * 4; i++) e->V[i] = (uint8_t)(i % 4 == 3 ? 255 : rnd());
     memcpy(e->Vip, e->V, W * H * 4);
@@ -126,6 +145,7 @@ static double make_eye(eye_buf *e, double cover)
             e->N[3 * k] = (float)dx;
             e->N[3 * k + 1] = (float)-dy;
             e->N[3 * k + 2] = (float)sqrt(fmax(0.05, 1 - d * d));
+            e->hz[k] = d < 1 ? window_z(0.45 - 0.12 * sqrt(1 - d * d)) : 1.0f;
             on += e->M[k] != 0;
         }
     return (double)on / (CW * CH);
@@ -134,6 +154,7 @@ static double make_eye(eye_buf *e, double cover)
 static void free_eye(eye_buf *e)
 {
     free(e->P); free(e->M); free(e->Q); free(e->N); free(e->V); free(e->out); free(e->Vip);
+    free(e->hz); free(e->sd);
 }
 
 /* ---- the memory floor: memcpy on 1 or 2 threads ------------------------- */
@@ -194,29 +215,33 @@ static double time_memcpy(eye_buf e[2], copier *c)
 /* ---- egofuse ------------------------------------------------------------ */
 
 typedef struct stats {
-    double light, comp, frame, frame_ip, memcpy;
-    double r_frame, r_frame_ip;   /* medians of frame / memcpy per run */
+    double light, comp, frame, frame_ip, frame_dp, memcpy;
+    double r_frame, r_frame_ip, r_frame_dp;   /* medians of frame / memcpy per run */
 } stats;
 
 static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, stats *s)
 {
     const fuse_lighting L = fuse_lighting_default();
     const fuse_intrinsics K = { 532.0f, 532.0f, CW / 2.0f, CH / 2.0f };
-    double *t[7];
-    fuse_eye eyes[2], ip[2];
+    double *t[9];
+    fuse_eye eyes[2], ip[2], dp[2];
+    fuse_depth depth[2];
     copier cp;
     int k, i;
-    for (i = 0; i < 7; i++) t[i] = xmalloc(sizeof(double) * (size_t)runs);
+    for (i = 0; i < 9; i++) t[i] = xmalloc(sizeof(double) * (size_t)runs);
     for (i = 0; i < 2; i++) {
         eyes[i] = (fuse_eye){ &L, &K, { e[i].P, CW, CH, 4 * CW }, e[i].M, CW, e[i].N, 3 * CW,
                               { e[i].Q, CW, CH, 4 * CW }, NULL, { e[i].V, W, H, 4 * W },
                               VX, VY, VW, VHH, { e[i].out, W, H, 4 * W } };
         ip[i] = eyes[i];
         ip[i].V = ip[i].out = (fuse_image){ e[i].Vip, W, H, 4 * W };
+        depth[i] = (fuse_depth){ e[i].hz, CW, ZNEAR, ZFAR, 0.0f, e[i].sd, W, W, H };
+        dp[i] = ip[i];
+        dp[i].depth = &depth[i];
     }
     if (threads > 1) copier_start(&cp, &e[1]);
     for (k = -3; k < runs; k++) {   /* 3 warm-up runs */
-        double m, t0, t1, t2, t3, t4;
+        double m, t0, t1, t2, t3, t4, t5;
         m = time_memcpy(e, threads > 1 ? &cp : NULL);
         t0 = now_ms();
         for (i = 0; i < 2; i++)
@@ -231,6 +256,8 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
         t3 = now_ms();
         if (fuse_context_frame(ctx, ip, 2) != FUSE_OK) exit(3);
         t4 = now_ms();
+        if (fuse_context_frame(ctx, dp, 2) != FUSE_OK) exit(3);
+        t5 = now_ms();
         if (k < 0) continue;
         t[0][k] = t1 - t0;
         t[1][k] = t2 - t1;
@@ -239,6 +266,8 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
         t[4][k] = m;
         t[5][k] = (t3 - t2) / m;
         t[6][k] = (t4 - t3) / m;
+        t[7][k] = t5 - t4;
+        t[8][k] = (t5 - t4) / m;
     }
     if (threads > 1) copier_stop(&cp);
     s->light = median(t[0], runs);
@@ -248,7 +277,9 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
     s->memcpy = median(t[4], runs);
     s->r_frame = median(t[5], runs);
     s->r_frame_ip = median(t[6], runs);
-    for (i = 0; i < 7; i++) free(t[i]);
+    s->frame_dp = median(t[7], runs);
+    s->r_frame_dp = median(t[8], runs);
+    for (i = 0; i < 9; i++) free(t[i]);
 }
 
 /* ---- pixman ------------------------------------------------------------- */
@@ -386,7 +417,8 @@ int main(int argc, char **argv)
         printf("case,coverage,isa,threads,light_ms,composite_ms,light_plus_composite_ms,frame_ms,"
                "frame_inplace_ms,memcpy_ms,frame_over_memcpy,frame_inplace_over_memcpy,"
                "pixman_blend_ms,pixman_scaled_ms,pixman_scaled_mask_ms,pixman_memcpy_ms,"
-               "frame_inplace_over_pixman_blend,frame_inplace_over_pixman_scaled\n");
+               "frame_inplace_over_pixman_blend,frame_inplace_over_pixman_scaled,"
+               "frame_depth_ms,frame_depth_over_memcpy\n");
     for (c = 0; c < 2; c++) {
         eye_buf e[2];
         double cov = 0;
@@ -408,10 +440,10 @@ int main(int argc, char **argv)
             printf("\n%s hand: %.1f%% of the camera pixels have M > 0\n"
                    "  pixman (1 thread, in place): blend 1:1 + a8 mask %.3f ms, layer bilinear "
                    "%.3f ms, camera + a8 mask bilinear %.3f ms (memcpy 1 thread %.3f ms)\n"
-                   "  %-7s %3s %7s %7s %7s %7s %8s %7s %8s %8s %8s %8s\n",
+                   "  %-7s %3s %7s %7s %7s %7s %7s %8s %7s %8s %7s %8s %8s %8s\n",
                    cover_name[c], 100 * cov, pm.blend, pm.scaled, pm.scaled_mask, pm.memcpy,
-                   "isa", "thr", "light", "comp", "frame", "frm_ip", "memcpy", "frm/mc",
-                   "frm_ip/mc", "ip/pm_bl", "ip/pm_sc", "ip/pm_sm");
+                   "isa", "thr", "light", "comp", "frame", "frm_ip", "frm_dp", "memcpy", "frm/mc",
+                   "frm_ip/mc", "dp/mc", "ip/pm_bl", "ip/pm_sc", "ip/pm_sm");
         for (i = 0; i < 4; i++) {
             if (only_isa != EF_ISA_DEFAULT && only_isa != isas[i]) continue;
             if (!ef_cpu_has(isas[i]) || ef_isa_choose(isas[i]) != isas[i]) {
@@ -429,15 +461,15 @@ int main(int argc, char **argv)
                 run_stages(ctx, e, t, n, &s);
                 if (csv)
                     printf("%s,%.4f,%s,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.4f,%.4f,%.4f,"
-                           "%.4f,%.3f,%.3f\n", cover_name[c], cov, ef_isa_name(isas[i]), t,
+                           "%.4f,%.3f,%.3f,%.4f,%.3f\n", cover_name[c], cov, ef_isa_name(isas[i]), t,
                            s.light, s.comp, s.light + s.comp, s.frame, s.frame_ip, s.memcpy,
                            s.r_frame, s.r_frame_ip, pm.blend, pm.scaled, pm.scaled_mask, pm.memcpy,
-                           s.frame_ip / pm.blend, s.frame_ip / pm.scaled);
+                           s.frame_ip / pm.blend, s.frame_ip / pm.scaled, s.frame_dp, s.r_frame_dp);
                 else
-                    printf("  %-7s %3d %7.3f %7.3f %7.3f %7.3f %8.3f %7.2f %8.2f %8.2f %8.2f %8.3f\n",
-                           ef_isa_name(isas[i]), t, s.light, s.comp, s.frame, s.frame_ip, s.memcpy,
-                           s.r_frame, s.r_frame_ip, s.frame_ip / pm.blend, s.frame_ip / pm.scaled,
-                           s.frame_ip / pm.scaled_mask);
+                    printf("  %-7s %3d %7.3f %7.3f %7.3f %7.3f %7.3f %8.3f %7.2f %8.2f %7.2f %8.2f %8.2f %8.3f\n",
+                           ef_isa_name(isas[i]), t, s.light, s.comp, s.frame, s.frame_ip, s.frame_dp,
+                           s.memcpy, s.r_frame, s.r_frame_ip, s.r_frame_dp, s.frame_ip / pm.blend,
+                           s.frame_ip / pm.scaled, s.frame_ip / pm.scaled_mask);
                 fuse_context_destroy(ctx);
             }
         }
@@ -447,8 +479,9 @@ int main(int argc, char **argv)
         printf("\nms per stereo frame (two eyes), medians. light, comp: the stages called one by\n"
                "one (comp into a separate out); frame: fuse_context_frame (both stages, one eye per\n"
                "thread with 2 threads), out separate; frm_ip: the same in place (out == V, as\n"
-               "src/pipe runs it). memcpy: V -> out of both eyes with the row's thread count (the\n"
-               "floor); frm/mc, frm_ip/mc: medians of the per-run ratios to it. ip/pm_*: frm_ip over\n"
+               "src/pipe runs it); frm_dp: frm_ip with the depth test. memcpy: V -> out of both eyes\n"
+               "with the row's thread count (the floor); frm/mc, frm_ip/mc, dp/mc: medians of the\n"
+               "per-run ratios to it. ip/pm_*: frm_ip over\n"
                "pixman's blend 1:1 + a8 mask, layer bilinear, camera + mask bilinear (below 1:\n"
                "egofuse is faster). The machine is shared: compare ratios, not ms.\n");
     return 0;

@@ -3,8 +3,9 @@
  * byte for byte (memcmp, padding included), over thousands of seeded cases:
  * odd widths, padded strides, soft and empty masks, garbage normals,
  * 0..8 lights, enlarging and reducing viewports, in-place composites,
- * layers that are not premultiplied. The reference outputs of all cases
- * fold into a CRC32 constant. An ISA the CPU (or EGOFUSE_ISA) does not
+ * layers that are not premultiplied; and the depth test (test_depth_isa:
+ * NaN, inf, equal depths). The reference outputs of all cases fold into
+ * CRC32 constants. An ISA the CPU (or EGOFUSE_ISA) does not
  * allow is reported as SKIP, never as passed.
  *
  *   test_fuse_isa        the cmocka tests
@@ -600,7 +601,8 @@ static void frame_eye_expect(fuse_context *ref, frame_eye *e, buf *Q, buf *out)
     assert_int_equal(fuse_context_light(ref, f.lighting, f.intrinsics, &f.P, f.mask, f.mask_stride,
                                         f.normal, f.normal_stride, &f.Q), FUSE_OK);
     if (f.depth)
-        assert_int_equal(fuse_depth_test(f.depth, &f.Q, f.vp_x0, f.vp_y0, f.vp_w, f.vp_h), FUSE_OK);
+        assert_int_equal(fuse_context_depth_test(ref, f.depth, &f.Q, f.vp_x0, f.vp_y0, f.vp_w, f.vp_h),
+                         FUSE_OK);
     assert_int_equal(fuse_context_composite(ref, &f.Q, &f.V, f.vp_x0, f.vp_y0, f.vp_w, f.vp_h,
                                             &f.out), FUSE_OK);
     memcpy(Q->p, e->Q.p, e->Q.n);
@@ -733,6 +735,149 @@ static void test_frame_aliasing(void **state)
     free(img); free(img0); free(want); free(M); free(Q); free(N);
 }
 
+/* ---- the depth test -------------------------------------------------------- */
+
+/* CRC32 of the reference's layers of depth cases 0 .. DEPTH_CASES-1. */
+#define DEPTH_CRC 0xA0E7730Au
+#define DEPTH_CASES 400
+
+static float depth_special(tu_rng *r)
+{
+    static const float v[] = { NAN, -NAN, INFINITY, -INFINITY, 0.0f, -0.0f, 1.0f,
+                               0.99999994f, -1e-30f, 1e-45f, 2.0f, -3.0f };
+    return v[tu_int(r, (int)(sizeof v / sizeof v[0]))];
+}
+
+typedef struct depth_case {
+    int qw, qh, qstride, hstride, W, H, sstride, vx, vy, vw, vh;
+    buf Q, hand, scene;
+    fuse_depth d;
+} depth_case;
+
+/* A random layer (40% of the pixels 0), hand depths (30% special: NaN,
+ * +-inf, +-0, 1, 1 - ulp, negative, subnormal, beyond 1), a scene with
+ * "nothing there" values (0, negative, NaN, inf) and, at about a third
+ * of the layer pixels, the scene pixel they read set to exactly the
+ * hand's distance (an equal depth keeps the hand) or one ulp either side. */
+static void depth_case_make(tu_rng *r, depth_case *c, int *ties)
+{
+    float *hz, *sc;
+    int x, y, i;
+    c->qw = 1 + tu_int(r, tu_int(r, 3) ? 70 : 700);
+    c->qh = 1 + tu_int(r, 12);
+    c->qstride = 4 * c->qw + 4 * tu_int(r, 3);
+    c->hstride = c->qw + tu_int(r, 5);
+    c->vw = tu_int(r, 3) == 0 ? c->qw : 1 + tu_int(r, 3 * c->qw);   /* 1:1, enlarge, reduce */
+    c->vh = 1 + tu_int(r, 3 * c->qh);
+    c->W = c->vw + tu_int(r, 20);
+    c->H = c->vh + tu_int(r, 5);
+    c->sstride = c->W + tu_int(r, 4);
+    c->vx = tu_int(r, c->W - c->vw + 1);
+    c->vy = tu_int(r, c->H - c->vh + 1);
+    c->Q = buf_new((size_t)c->qstride * c->qh, 0);
+    c->hand = buf_new(sizeof(float) * (size_t)c->hstride * c->qh, 0);
+    c->scene = buf_new(sizeof(float) * (size_t)c->sstride * c->H, 0);
+    hz = (float *)(void *)c->hand.p;
+    sc = (float *)(void *)c->scene.p;
+    c->d.znear = tu_range(r, 0.001f, 1.0f);
+    c->d.zfar = c->d.znear * tu_range(r, 1.5f, 1e4f);
+    c->d.offset = tu_int(r, 2) ? 0.0f : tu_range(r, -0.2f, 0.2f);
+    for (i = 0; i < (int)c->Q.n; i++) c->Q.p[i] = (uint8_t)tu_int(r, 256);
+    for (y = 0; y < c->qh; y++)
+        for (x = 0; x < c->qw; x++)
+            if (tu_int(r, 5) < 2) memset(c->Q.p + (size_t)y * c->qstride + 4 * x, 0, 4);
+    for (i = 0; i < c->hstride * c->qh; i++)
+        hz[i] = tu_int(r, 10) < 3 ? depth_special(r) : tu_unit(r);
+    for (i = 0; i < c->sstride * c->H; i++)
+        sc[i] = tu_int(r, 4) == 0 ? depth_special(r)
+                                  : tu_range(r, 0.0f, 1.2f) * (c->d.zfar + c->d.offset);
+    {
+        const float two_fn = (2.0f * c->d.zfar) * c->d.znear;
+        const float fpn = c->d.zfar + c->d.znear, fmn = c->d.zfar - c->d.znear;
+        for (y = 0; y < c->qh; y++)
+            for (x = 0; x < c->qw; x++) {
+                const int ox = c->vx + (int)(((int64_t)2 * x + 1) * c->vw / (2 * (int64_t)c->qw));
+                const int oy = c->vy + (int)(((int64_t)2 * y + 1) * c->vh / (2 * (int64_t)c->qh));
+                const float z = hz[(size_t)y * c->hstride + x];
+                float dist;
+                const int k = tu_int(r, 9);
+                if (k >= 3 || !(z >= 0.0f && z < 1.0f)) continue;
+                dist = two_fn / (fpn - ((2.0f * z) - 1.0f) * fmn) + c->d.offset;
+                sc[(size_t)oy * c->sstride + ox] =
+                    k == 0 ? dist : nextafterf(dist, k == 1 ? INFINITY : -INFINITY);
+                *ties += k == 0;
+            }
+    }
+    c->d.hand = hz;
+    c->d.hand_stride = c->hstride;
+    c->d.scene = sc;
+    c->d.scene_stride = c->sstride;
+    c->d.scene_width = c->W;
+    c->d.scene_height = c->H;
+}
+
+/* Every ISA's depth test, 1 and 3 threads, and the public dispatch, byte
+ * for byte against the reference (padding included); the reference's
+ * layers fold into DEPTH_CRC. The cases must hide some pixels, keep some
+ * and hold exact ties. */
+static void test_depth_isa(void **state)
+{
+    ctxs cx;
+    uint32_t crc = 0;
+    long hidden = 0, kept = 0;
+    int n, i, t, bad = 0, missing = 0, ties = 0;
+    (void)state;
+    ctxs_make(&cx);
+    for (i = 0; i < N_SIMD; i++) missing += skip_missing(&cx, i);
+    for (n = 0; n < DEPTH_CASES && !bad; n++) {
+        tu_rng r = { case_seed(200000 + n) };
+        depth_case c;
+        buf want, got;
+        fuse_image Q;
+        size_t k;
+        depth_case_make(&r, &c, &ties);
+        want = buf_new(c.Q.n, 0);
+        got = buf_new(c.Q.n, 0);
+        memcpy(want.p, c.Q.p, c.Q.n);
+        Q = (fuse_image){ want.p, c.qw, c.qh, c.qstride };
+        assert_int_equal(fuse_context_depth_test(cx.ref, &c.d, &Q, c.vx, c.vy, c.vw, c.vh), FUSE_OK);
+        crc = tu_crc32(crc, want.p, want.n);
+        for (k = 0; k + 4 <= c.Q.n; k += 4) {
+            uint32_t a, b;
+            memcpy(&a, c.Q.p + k, 4);
+            memcpy(&b, want.p + k, 4);
+            hidden += a != 0 && b == 0;
+            kept += a != 0 && b != 0;
+        }
+        for (i = 0; i <= N_SIMD; i++)
+            for (t = 0; t < 2; t++) {
+                fuse_context *ctx = i < N_SIMD ? cx.isa[i][t] : NULL;
+                char what[64];
+                if (i < N_SIMD && ctx == NULL) continue;
+                if (i == N_SIMD && t == 1) continue;
+                memcpy(got.p, c.Q.p, c.Q.n);
+                Q.pixels = got.p;
+                if (ctx != NULL)
+                    assert_int_equal(fuse_context_depth_test(ctx, &c.d, &Q, c.vx, c.vy, c.vw, c.vh),
+                                     FUSE_OK);
+                else   /* the public entry: the best ISA allowed */
+                    assert_int_equal(fuse_depth_test(&c.d, &Q, c.vx, c.vy, c.vw, c.vh), FUSE_OK);
+                snprintf(what, sizeof what, "depth (threads %d)", t ? 3 : 1);
+                bad += report_diff(what, ctx ? ef_isa_name(fuse_context_isa(ctx)) : "dispatch", n,
+                                   &want, &got, c.qstride);
+            }
+        free(want.p); free(got.p); free(c.Q.p); free(c.hand.p); free(c.scene.p);
+    }
+    ctxs_free(&cx);
+    printf("NOTE fuse depth cases: %d, hidden %ld, kept %ld, exact ties %d, mismatches %d, "
+           "reference CRC32 0x%08X (expected 0x%08X)\n", n, hidden, kept, ties, bad, crc, DEPTH_CRC);
+    assert_int_equal(bad, 0);
+    assert_true(hidden > 1000 && kept > 1000 && ties > 100);
+    assert_int_equal(crc, DEPTH_CRC);
+    assert_int_equal(fuse_context_depth_test(NULL, NULL, NULL, 0, 0, 1, 1), FUSE_ERR_ARGS);
+    if (missing) skip();
+}
+
 int main(int argc, char **argv)
 {
     const struct CMUnitTest tests[] = {
@@ -742,6 +887,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_dispatch),
         cmocka_unit_test(test_frame_cases),
         cmocka_unit_test(test_frame_aliasing),
+        cmocka_unit_test(test_depth_isa),
     };
     if (argc > 1) {   /* rerun one case, print differences */
         ctxs cx;

@@ -247,7 +247,9 @@ typedef struct fuse_depth {
 /* Hides the pixels of the layer Q (in place) that the virtual scene
  * covers; vp_* is the composite's viewport in V. FUSE_ERR_ARGS: NULL,
  * strides below the widths, near/far out of range, offset not finite or
- * beyond +-FUSE_PARAM_MAX. FUSE_ERR_SIZE: viewport not inside the scene. */
+ * beyond +-FUSE_PARAM_MAX. FUSE_ERR_SIZE: viewport not inside the scene.
+ * Runs on the best ISA allowed (as fuse_light); every ISA gives the
+ * bytes of the scalar reference (fuse_context_depth_test below). */
 fuse_result fuse_depth_test(const fuse_depth *d, fuse_image *Q, int vp_x0,
                             int vp_y0, int vp_w, int vp_h);
 
@@ -322,6 +324,9 @@ fuse_result fuse_context_light(fuse_context *ctx, const fuse_lighting *L,
 fuse_result fuse_context_composite(fuse_context *ctx, const fuse_image *Q,
                                    const fuse_image *V, int vp_x0, int vp_y0,
                                    int vp_w, int vp_h, fuse_image *out);
+/* fuse_depth_test on ctx's ISA and threads; ctx NULL -> FUSE_ERR_ARGS. */
+fuse_result fuse_context_depth_test(fuse_context *ctx, const fuse_depth *d, fuse_image *Q,
+                                    int vp_x0, int vp_y0, int vp_w, int vp_h);
 
 /* One eye of a stereo frame for fuse_context_frame: light P into Q (the
  * caller's scratch layer, P's size), optionally hide what the virtual

@@ -3,14 +3,12 @@
  * (docs/fuse.md, "Rounding rules"); tests/test_fuse_isa.c checks it.
  *
  * Lighting: 8 pixels per vector, fuse_body.inl.
- * Composite: 8 output pixels per step. The taps of 8 consecutive output
- * pixels lie in a window of 8 source pixels when the layer is enlarged
- * (640 -> 1194: at most 5), so one load per source row and vpermd give the
- * four taps; otherwise (reductions, narrow layers) vpgatherdd. Blend and
- * over in 16-bit lanes, exact (see the comment at blend8). The drivers use
- * the row cache instead (fuse__hrow_avx2 once per layer row, then
- * fuse__vrow_avx2 per output row; fuse_internal.h); the per-row kernel
- * stays for fuse__composite_fn. */
+ * Composite through the row cache (fuse_internal.h): fuse__hrow_avx2 once
+ * per layer row, fuse__vrow_avx2 per output row. The taps of 8 consecutive
+ * output pixels lie in a window of 8 source pixels when the layer is
+ * enlarged (640 -> 1194: at most 5), so one load and vpermd give them;
+ * otherwise (reductions, narrow layers) vpgatherdd. Depth test: 8 pixels
+ * a step, the scene gathered. */
 #include "fuse_internal.h"
 
 #if defined(__AVX2__)
@@ -83,106 +81,6 @@ static inline void load_normals(const float *p, __m256 *x, __m256 *y, __m256 *z)
 }
 
 #include "fuse_body.inl"
-
-/* ---- composite ---------------------------------------------------------- */
-
-/* Bilinear blend + over of 4 pixels in 16-bit lanes (a, b, c, d, v: the
- * taps and V widened to u16; wx0/wx1: 256 - fx and fx per channel; wy0/wy1
- * the same for the row). The reference's
- *   q = ((a wx0 + b wx1) wy0 + (c wx0 + d wx1) wy1 + 32768) >> 16
- * is a sum of exact integer products, so it may be grouped by columns:
- *   col0 = a wy0 + c wy1,  col1 = b wy0 + d wy1      (<= 65280: u16)
- *   S = col0 wx0 + col1 wx1 = 256 H + Lo with
- *   H = hi0 wx0 + hi1 wx1, Lo = lo0 wx0 + lo1 wx1 (hi = col >> 8, lo = col & 255)
- *   q = floor((S + 32768) / 65536) = (H + (Lo >> 8) + 128) >> 8
- * where H + (Lo >> 8) <= S / 256 <= 65280, so every step fits in u16. Over:
- *   r = q + div255((255 - qa) v),  div255(t) = (t + 128 + ((t + 128) >> 8)) >> 8
- * with t <= 65025; the final min(255, .) is the saturating pack. */
-static inline __m256i blend16(__m256i a, __m256i b, __m256i c, __m256i d, __m256i v,
-                              __m256i wx0, __m256i wx1, __m256i wy0, __m256i wy1)
-{
-    const __m256i lo8 = _mm256_set1_epi16(255);
-    const __m256i col0 = _mm256_add_epi16(_mm256_mullo_epi16(a, wy0), _mm256_mullo_epi16(c, wy1));
-    const __m256i col1 = _mm256_add_epi16(_mm256_mullo_epi16(b, wy0), _mm256_mullo_epi16(d, wy1));
-    const __m256i H = _mm256_add_epi16(_mm256_mullo_epi16(_mm256_srli_epi16(col0, 8), wx0),
-                                       _mm256_mullo_epi16(_mm256_srli_epi16(col1, 8), wx1));
-    const __m256i L = _mm256_add_epi16(_mm256_mullo_epi16(_mm256_and_si256(col0, lo8), wx0),
-                                       _mm256_mullo_epi16(_mm256_and_si256(col1, lo8), wx1));
-    const __m256i q = _mm256_srli_epi16(
-        _mm256_add_epi16(_mm256_add_epi16(H, _mm256_srli_epi16(L, 8)), _mm256_set1_epi16(128)), 8);
-    const __m256i qa = _mm256_shufflehi_epi16(_mm256_shufflelo_epi16(q, 0xFF), 0xFF);
-    __m256i t = _mm256_mullo_epi16(_mm256_sub_epi16(lo8, qa), v);
-    t = _mm256_add_epi16(t, _mm256_set1_epi16(128));
-    t = _mm256_srli_epi16(_mm256_add_epi16(t, _mm256_srli_epi16(t, 8)), 8);
-    return _mm256_add_epi16(q, t);
-}
-
-/* 8 pixels: taps a b c d (RGBA8 per 32-bit lane), V, fx per lane. */
-static inline __m256i blend8(__m256i a, __m256i b, __m256i c, __m256i d, __m256i v,
-                             __m256i fx, __m256i wy0, __m256i wy1)
-{
-    const __m256i z = _mm256_setzero_si256();
-    /* fx of pixels 0,1 | 4,5 and 2,3 | 6,7 in each pixel's 4 u16 lanes */
-    const __m256i plo = _mm256_setr_epi8(0, -128, 0, -128, 0, -128, 0, -128, 4, -128, 4, -128, 4, -128, 4, -128,
-                                         0, -128, 0, -128, 0, -128, 0, -128, 4, -128, 4, -128, 4, -128, 4, -128);
-    const __m256i phi = _mm256_setr_epi8(8, -128, 8, -128, 8, -128, 8, -128, 12, -128, 12, -128, 12, -128, 12, -128,
-                                         8, -128, 8, -128, 8, -128, 8, -128, 12, -128, 12, -128, 12, -128, 12, -128);
-    const __m256i w256 = _mm256_set1_epi16(256);
-    const __m256i fl = _mm256_shuffle_epi8(fx, plo), fh = _mm256_shuffle_epi8(fx, phi);
-    const __m256i rl = blend16(_mm256_unpacklo_epi8(a, z), _mm256_unpacklo_epi8(b, z),
-                               _mm256_unpacklo_epi8(c, z), _mm256_unpacklo_epi8(d, z),
-                               _mm256_unpacklo_epi8(v, z), _mm256_sub_epi16(w256, fl), fl, wy0, wy1);
-    const __m256i rh = blend16(_mm256_unpackhi_epi8(a, z), _mm256_unpackhi_epi8(b, z),
-                               _mm256_unpackhi_epi8(c, z), _mm256_unpackhi_epi8(d, z),
-                               _mm256_unpackhi_epi8(v, z), _mm256_sub_epi16(w256, fh), fh, wy0, wy1);
-    return _mm256_or_si256(_mm256_packus_epi16(rl, rh), _mm256_set1_epi32((int)0xFF000000u));
-}
-
-void fuse__composite_cols_avx2(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
-                               const fuse__cols *cols, int c, int n, int sw,
-                               const uint8_t *v, uint8_t *out)
-{
-    const __m256i wy0 = _mm256_set1_epi16((short)(256 - fy)), wy1 = _mm256_set1_epi16((short)fy);
-    const __m256i one = _mm256_set1_epi32(1), last = _mm256_set1_epi32(sw - 1);
-    const __m256i opaque = _mm256_set1_epi32((int)0xFF000000u);
-    const int32_t *ixs = cols->ix + c, *fxs = cols->fx + c;
-    int i = 0;
-    for (; i + 8 <= n; i += 8) {
-        const __m256i ix = _mm256_loadu_si256((const __m256i *)(const void *)(ixs + i));
-        const __m256i ix1 = _mm256_min_epi32(_mm256_add_epi32(ix, one), last);
-        const __m256i vv = _mm256_loadu_si256((const __m256i *)(const void *)(v + 4 * i));
-        __m256i a, b, cc, d;
-        int base = ixs[i];
-        const int hi = ixs[i + 7] + 1 < sw ? ixs[i + 7] + 1 : sw - 1;
-        if (base > sw - 8) base = sw - 8;
-        if (base >= 0 && hi - base < 8) {
-            const __m256i s0 = _mm256_loadu_si256((const __m256i *)(const void *)(q0 + 4 * base));
-            const __m256i s1 = _mm256_loadu_si256((const __m256i *)(const void *)(q1 + 4 * base));
-            const __m256i bb = _mm256_set1_epi32(base);
-            const __m256i r0 = _mm256_sub_epi32(ix, bb), r1 = _mm256_sub_epi32(ix1, bb);
-            if (_mm256_testz_si256(_mm256_or_si256(s0, s1), _mm256_or_si256(s0, s1))) {
-                /* every tap 0: R = V, alpha 255 */
-                _mm256_storeu_si256((__m256i *)(void *)(out + 4 * i), _mm256_or_si256(vv, opaque));
-                continue;
-            }
-            a = _mm256_permutevar8x32_epi32(s0, r0);
-            b = _mm256_permutevar8x32_epi32(s0, r1);
-            cc = _mm256_permutevar8x32_epi32(s1, r0);
-            d = _mm256_permutevar8x32_epi32(s1, r1);
-        } else {
-            a = _mm256_i32gather_epi32((const int *)(const void *)q0, ix, 4);
-            b = _mm256_i32gather_epi32((const int *)(const void *)q0, ix1, 4);
-            cc = _mm256_i32gather_epi32((const int *)(const void *)q1, ix, 4);
-            d = _mm256_i32gather_epi32((const int *)(const void *)q1, ix1, 4);
-        }
-        _mm256_storeu_si256((__m256i *)(void *)(out + 4 * i),
-                            blend8(a, b, cc, d, vv,
-                                   _mm256_loadu_si256((const __m256i *)(const void *)(fxs + i)),
-                                   wy0, wy1));
-    }
-    for (; i < n; i++)
-        fuse__composite_px(q0, q1, fy, ixs[i], (uint32_t)fxs[i], sw, v + 4 * i, out + 4 * i);
-}
 
 /* ---- row-cached composite (fuse_internal.h, fuse__hrow_fn) ------------- */
 
@@ -320,6 +218,58 @@ void fuse__opaque_avx2(const uint8_t *v, uint8_t *out, int n)
     fuse__opaque_ref(v + 4 * (size_t)i, out + 4 * (size_t)i, n - i);
 }
 
+/* ---- depth test (fuse__depth_span_ref, 8 pixels a step) ----------------- */
+
+void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int w)
+{
+    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
+    const __m256 two_fn = _mm256_set1_ps(p->two_fn), fpn = _mm256_set1_ps(p->fpn);
+    const __m256 fmn = _mm256_set1_ps(p->fmn), off = _mm256_set1_ps(p->offset);
+    /* the column walk of 8 lanes, stepped by 8 pixels: 16 vw = sq den + sr */
+    const int32_t step = 16 * p->vw;
+    const __m256i den = _mm256_set1_epi32(p->den), den1 = _mm256_set1_epi32(p->den - 1);
+    const __m256i sq = _mm256_set1_epi32(step / p->den), sr = _mm256_set1_epi32(step % p->den);
+    int32_t ox0[8], rem0[8];
+    __m256i ox, rem;
+    int x, k;
+    if (w < 8) {
+        fuse__depth_span_ref(p, q, hz, sc, 0, w);
+        return;
+    }
+    for (k = 0; k < 8; k++) fuse__depth_col(p, k, &ox0[k], &rem0[k]);
+    ox = _mm256_loadu_si256((const __m256i *)(const void *)ox0);
+    rem = _mm256_loadu_si256((const __m256i *)(const void *)rem0);
+    for (x = 0; x + 8 <= w; x += 8) {
+        __m256i *qp = (__m256i *)(void *)(q + 4 * (size_t)x);
+        const __m256i qq = _mm256_loadu_si256(qp);
+        if (!_mm256_testz_si256(qq, qq)) {
+            const __m256 nz = _mm256_castsi256_ps(
+                _mm256_xor_si256(_mm256_cmpeq_epi32(qq, _mm256_setzero_si256()), _mm256_set1_epi32(-1)));
+            const __m256 z = _mm256_loadu_ps(hz + x);
+            const __m256 has = _mm256_and_ps(nz, _mm256_and_ps(_mm256_cmp_ps(z, zero, _CMP_GE_OQ),
+                                                               _mm256_cmp_ps(z, one, _CMP_LT_OQ)));
+            if (_mm256_movemask_ps(has)) {
+                const __m256 s = _mm256_mask_i32gather_ps(zero, sc, ox, has, 4);
+                const __m256 dist = _mm256_add_ps(
+                    _mm256_div_ps(two_fn, _mm256_sub_ps(fpn, _mm256_mul_ps(_mm256_sub_ps(_mm256_mul_ps(two, z), one), fmn))),
+                    off);
+                const __m256 kill = _mm256_and_ps(has, _mm256_and_ps(_mm256_cmp_ps(s, zero, _CMP_GT_OQ),
+                                                                     _mm256_cmp_ps(s, dist, _CMP_LT_OQ)));
+                if (_mm256_movemask_ps(kill))   /* the row is this thread's: rewrite the rest */
+                    _mm256_storeu_si256(qp, _mm256_andnot_si256(_mm256_castps_si256(kill), qq));
+            }
+        }
+        rem = _mm256_add_epi32(rem, sr);
+        {
+            const __m256i carry = _mm256_cmpgt_epi32(rem, den1);   /* rem >= den: -1 */
+            rem = _mm256_sub_epi32(rem, _mm256_and_si256(carry, den));
+            ox = _mm256_sub_epi32(_mm256_add_epi32(ox, sq), carry);
+        }
+    }
+    fuse__depth_span_ref(p, q, hz, sc, x, w);
+}
+
 #else  /* not built for AVX2: never chosen by cpuid, falls back */
 
 int fuse__yuv422_row_avx2(const uint8_t *src, int width, int uyvy, uint8_t *dst)
@@ -335,11 +285,10 @@ void fuse__light_row_avx2(const fuse__light_prep *p, int y, int width,
     fuse__light_row_ref(p, y, width, P, mask, normal, out);
 }
 
-void fuse__composite_cols_avx2(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
-                               const fuse__cols *cols, int c, int n, int sw,
-                               const uint8_t *v, uint8_t *out)
+void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int w)
 {
-    fuse__composite_cols_ref(q0, q1, fy, cols, c, n, sw, v, out);
+    fuse__depth_row_ref(p, q, hz, sc, w);
 }
 void fuse__pow01_row_avx2(const float *x, int n, float s, float *out)
 {

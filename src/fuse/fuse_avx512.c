@@ -3,10 +3,10 @@
  * The bytes are the reference's (docs/fuse.md, "Rounding rules");
  * tests/test_fuse_isa.c checks it.
  * Lighting: 16 pixels per vector (fuse_body.inl), lane masks in k
- * registers. Composite: 16 output pixels per step from a window of 16
- * source pixels per row (vpermd) when it holds every tap, else vpgatherdd;
- * blend and over in 16-bit lanes as in fuse_avx2.c. The drivers use the
- * row cache (fuse__hrow_avx512 / fuse__vrow_avx512, fuse_internal.h). */
+ * registers. Composite through the row cache (fuse__hrow_avx512 once per
+ * layer row, fuse__vrow_avx512 per output row; fuse_internal.h): taps from
+ * a window of 16 source pixels per row (vpermd) when it holds them all,
+ * else vpgatherdd. Depth test: 16 pixels a step, the scene gathered. */
 #include "fuse_internal.h"
 
 #if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512DQ__)
@@ -83,92 +83,6 @@ static inline void load_normals(const float *p, __m512 *x, __m512 *y, __m512 *z)
 }
 
 #include "fuse_body.inl"
-
-/* ---- composite (see blend16 in fuse_avx2.c for the exactness) ---------- */
-
-static inline __m512i blend16(__m512i a, __m512i b, __m512i c, __m512i d, __m512i v,
-                              __m512i wx0, __m512i wx1, __m512i wy0, __m512i wy1)
-{
-    const __m512i lo8 = _mm512_set1_epi16(255);
-    const __m512i col0 = _mm512_add_epi16(_mm512_mullo_epi16(a, wy0), _mm512_mullo_epi16(c, wy1));
-    const __m512i col1 = _mm512_add_epi16(_mm512_mullo_epi16(b, wy0), _mm512_mullo_epi16(d, wy1));
-    const __m512i H = _mm512_add_epi16(_mm512_mullo_epi16(_mm512_srli_epi16(col0, 8), wx0),
-                                       _mm512_mullo_epi16(_mm512_srli_epi16(col1, 8), wx1));
-    const __m512i L = _mm512_add_epi16(_mm512_mullo_epi16(_mm512_and_si512(col0, lo8), wx0),
-                                       _mm512_mullo_epi16(_mm512_and_si512(col1, lo8), wx1));
-    const __m512i q = _mm512_srli_epi16(
-        _mm512_add_epi16(_mm512_add_epi16(H, _mm512_srli_epi16(L, 8)), _mm512_set1_epi16(128)), 8);
-    const __m512i qa = _mm512_shufflehi_epi16(_mm512_shufflelo_epi16(q, 0xFF), 0xFF);
-    __m512i t = _mm512_mullo_epi16(_mm512_sub_epi16(lo8, qa), v);
-    t = _mm512_add_epi16(t, _mm512_set1_epi16(128));
-    t = _mm512_srli_epi16(_mm512_add_epi16(t, _mm512_srli_epi16(t, 8)), 8);
-    return _mm512_add_epi16(q, t);
-}
-
-static inline __m512i blend_px(__m512i a, __m512i b, __m512i c, __m512i d, __m512i v,
-                               __m512i fx, __m512i wy0, __m512i wy1)
-{
-    const __m512i z = _mm512_setzero_si512();
-    const __m512i plo = _mm512_set4_epi32((int)0x80048004u, (int)0x80048004u,
-                                          (int)0x80008000u, (int)0x80008000u);
-    const __m512i phi = _mm512_set4_epi32((int)0x800C800Cu, (int)0x800C800Cu,
-                                          (int)0x80088008u, (int)0x80088008u);
-    const __m512i w256 = _mm512_set1_epi16(256);
-    const __m512i fl = _mm512_shuffle_epi8(fx, plo), fh = _mm512_shuffle_epi8(fx, phi);
-    const __m512i rl = blend16(_mm512_unpacklo_epi8(a, z), _mm512_unpacklo_epi8(b, z),
-                               _mm512_unpacklo_epi8(c, z), _mm512_unpacklo_epi8(d, z),
-                               _mm512_unpacklo_epi8(v, z), _mm512_sub_epi16(w256, fl), fl, wy0, wy1);
-    const __m512i rh = blend16(_mm512_unpackhi_epi8(a, z), _mm512_unpackhi_epi8(b, z),
-                               _mm512_unpackhi_epi8(c, z), _mm512_unpackhi_epi8(d, z),
-                               _mm512_unpackhi_epi8(v, z), _mm512_sub_epi16(w256, fh), fh, wy0, wy1);
-    return _mm512_or_si512(_mm512_packus_epi16(rl, rh), _mm512_set1_epi32((int)0xFF000000u));
-}
-
-void fuse__composite_cols_avx512(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
-                                 const fuse__cols *cols, int c, int n, int sw,
-                                 const uint8_t *v, uint8_t *out)
-{
-    const __m512i wy0 = _mm512_set1_epi16((short)(256 - fy)), wy1 = _mm512_set1_epi16((short)fy);
-    const __m512i one = _mm512_set1_epi32(1), last = _mm512_set1_epi32(sw - 1);
-    const __m512i opaque = _mm512_set1_epi32((int)0xFF000000u);
-    const int32_t *ixs = cols->ix + c, *fxs = cols->fx + c;
-    int i = 0;
-    for (; i + 16 <= n; i += 16) {
-        const __m512i ix = _mm512_loadu_si512((const void *)(ixs + i));
-        const __m512i ix1 = _mm512_min_epi32(_mm512_add_epi32(ix, one), last);
-        const __m512i vv = _mm512_loadu_si512((const void *)(v + 4 * i));
-        __m512i a, b, cc, d;
-        int base = ixs[i];
-        const int hi = ixs[i + 15] + 1 < sw ? ixs[i + 15] + 1 : sw - 1;
-        if (base > sw - 16) base = sw - 16;
-        if (base >= 0 && hi - base < 16) {
-            const __m512i s0 = _mm512_loadu_si512((const void *)(q0 + 4 * base));
-            const __m512i s1 = _mm512_loadu_si512((const void *)(q1 + 4 * base));
-            const __m512i bb = _mm512_set1_epi32(base);
-            const __m512i r0 = _mm512_sub_epi32(ix, bb), r1 = _mm512_sub_epi32(ix1, bb);
-            const __m512i any = _mm512_or_si512(s0, s1);
-            if (_mm512_test_epi32_mask(any, any) == 0) {
-                /* every tap 0: R = V, alpha 255 */
-                _mm512_storeu_si512((void *)(out + 4 * i), _mm512_or_si512(vv, opaque));
-                continue;
-            }
-            a = _mm512_permutexvar_epi32(r0, s0);
-            b = _mm512_permutexvar_epi32(r1, s0);
-            cc = _mm512_permutexvar_epi32(r0, s1);
-            d = _mm512_permutexvar_epi32(r1, s1);
-        } else {
-            a = _mm512_i32gather_epi32(ix, (const void *)q0, 4);
-            b = _mm512_i32gather_epi32(ix1, (const void *)q0, 4);
-            cc = _mm512_i32gather_epi32(ix, (const void *)q1, 4);
-            d = _mm512_i32gather_epi32(ix1, (const void *)q1, 4);
-        }
-        _mm512_storeu_si512((void *)(out + 4 * i),
-                            blend_px(a, b, cc, d, vv, _mm512_loadu_si512((const void *)(fxs + i)),
-                                     wy0, wy1));
-    }
-    for (; i < n; i++)
-        fuse__composite_px(q0, q1, fy, ixs[i], (uint32_t)fxs[i], sw, v + 4 * i, out + 4 * i);
-}
 
 /* ---- row-cached composite (fuse_internal.h, fuse__hrow_fn) ------------- */
 
@@ -323,6 +237,56 @@ void fuse__opaque_avx512(const uint8_t *v, uint8_t *out, int n)
     fuse__opaque_ref(v + 4 * (size_t)i, out + 4 * (size_t)i, n - i);
 }
 
+/* ---- depth test (fuse__depth_span_ref, 16 pixels a step) ---------------- */
+
+void fuse__depth_row_avx512(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                            const float *sc, int w)
+{
+    const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f), two = _mm512_set1_ps(2.0f);
+    const __m512 two_fn = _mm512_set1_ps(p->two_fn), fpn = _mm512_set1_ps(p->fpn);
+    const __m512 fmn = _mm512_set1_ps(p->fmn), off = _mm512_set1_ps(p->offset);
+    /* the column walk of 16 lanes, stepped by 16 pixels: 32 vw = sq den + sr */
+    const int32_t step = 32 * p->vw;
+    const __m512i den = _mm512_set1_epi32(p->den), sq = _mm512_set1_epi32(step / p->den);
+    const __m512i sr = _mm512_set1_epi32(step % p->den), one_i = _mm512_set1_epi32(1);
+    int32_t ox0[16], rem0[16];
+    __m512i ox, rem;
+    int x, k;
+    if (w < 16) {
+        fuse__depth_span_ref(p, q, hz, sc, 0, w);
+        return;
+    }
+    for (k = 0; k < 16; k++) fuse__depth_col(p, k, &ox0[k], &rem0[k]);
+    ox = _mm512_loadu_si512((const void *)ox0);
+    rem = _mm512_loadu_si512((const void *)rem0);
+    for (x = 0; x + 16 <= w; x += 16) {
+        const __m512i qq = _mm512_loadu_si512((const void *)(q + 4 * (size_t)x));
+        const __mmask16 nz = _mm512_test_epi32_mask(qq, qq);
+        if (nz) {
+            const __m512 z = _mm512_loadu_ps(hz + x);
+            const __mmask16 has = _mm512_mask_cmp_ps_mask(_mm512_mask_cmp_ps_mask(nz, z, zero, _CMP_GE_OQ),
+                                                          z, one, _CMP_LT_OQ);
+            if (has) {
+                const __m512 s = _mm512_mask_i32gather_ps(zero, has, ox, sc, 4);
+                const __m512 dist = _mm512_add_ps(
+                    _mm512_div_ps(two_fn, _mm512_sub_ps(fpn, _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(two, z), one), fmn))),
+                    off);
+                const __mmask16 kill = _mm512_mask_cmp_ps_mask(_mm512_mask_cmp_ps_mask(has, s, zero, _CMP_GT_OQ),
+                                                               s, dist, _CMP_LT_OQ);
+                if (kill) _mm512_mask_storeu_epi32((void *)(q + 4 * (size_t)x), kill, _mm512_setzero_si512());
+            }
+        }
+        rem = _mm512_add_epi32(rem, sr);
+        {
+            const __mmask16 carry = _mm512_cmpge_epi32_mask(rem, den);
+            rem = _mm512_mask_sub_epi32(rem, carry, rem, den);
+            ox = _mm512_add_epi32(ox, sq);
+            ox = _mm512_mask_add_epi32(ox, carry, ox, one_i);
+        }
+    }
+    fuse__depth_span_ref(p, q, hz, sc, x, w);
+}
+
 #else  /* not built for AVX-512: never chosen by cpuid, falls back */
 
 void fuse__light_row_avx512(const fuse__light_prep *p, int y, int width,
@@ -332,11 +296,10 @@ void fuse__light_row_avx512(const fuse__light_prep *p, int y, int width,
     fuse__light_row_ref(p, y, width, P, mask, normal, out);
 }
 
-void fuse__composite_cols_avx512(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
-                                 const fuse__cols *cols, int c, int n, int sw,
-                                 const uint8_t *v, uint8_t *out)
+void fuse__depth_row_avx512(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                            const float *sc, int w)
 {
-    fuse__composite_cols_ref(q0, q1, fy, cols, c, n, sw, v, out);
+    fuse__depth_row_ref(p, q, hz, sc, w);
 }
 void fuse__pow01_row_avx512(const float *x, int n, float s, float *out)
 {

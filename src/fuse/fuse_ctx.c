@@ -24,8 +24,10 @@
 
 typedef struct kernels {
     ef_isa isa;
+    int ref;                   /* the reference: axis walk, stages in order */
     fuse__light_fn light;
-    fuse__composite_fn comp;   /* NULL: the reference axis walk */
+    fuse__depth_fn depth;
+    fuse__composite_fn comp;   /* SSE2: table-driven, per output row */
     fuse__cover_fn cover;      /* coverage bits of a layer row */
     fuse__opaque_fn opaque;    /* R = V, alpha 255 (transparent spans) */
     fuse__hrow_fn hrow;        /* NULL: no row cache, comp per output row */
@@ -38,23 +40,29 @@ static kernels kernels_for(ef_isa isa)
     k.isa = isa;
     switch (isa) {
     case EF_ISA_AVX512:
+        k.ref = 0;
         k.light = fuse__light_row_avx512;
-        k.comp = fuse__composite_cols_avx512;
+        k.depth = fuse__depth_row_avx512;
+        k.comp = NULL;
         k.cover = fuse__cover_row_avx512;
         k.opaque = fuse__opaque_avx512;
         k.hrow = fuse__hrow_avx512;
         k.vrow = fuse__vrow_avx512;
         break;
     case EF_ISA_AVX2:
+        k.ref = 0;
         k.light = fuse__light_row_avx2;
-        k.comp = fuse__composite_cols_avx2;
+        k.depth = fuse__depth_row_avx2;
+        k.comp = NULL;
         k.cover = fuse__cover_row_avx2;
         k.opaque = fuse__opaque_avx2;
         k.hrow = fuse__hrow_avx2;
         k.vrow = fuse__vrow_avx2;
         break;
     case EF_ISA_SSE2:
+        k.ref = 0;
         k.light = fuse__light_row_sse2;
+        k.depth = fuse__depth_row_sse2;
         k.comp = fuse__composite_cols_sse2;
         k.cover = fuse__cover_row_sse2;
         k.opaque = fuse__opaque_sse2;
@@ -63,7 +71,9 @@ static kernels kernels_for(ef_isa isa)
         break;
     default:
         k.isa = EF_ISA_REF;
+        k.ref = 1;
         k.light = fuse__light_row_ref;
+        k.depth = fuse__depth_row_ref;
         k.comp = NULL;
         k.cover = fuse__cover_row_ref;
         k.opaque = fuse__opaque_ref;
@@ -541,7 +551,7 @@ static void comp_vp_rows(const comp_job *j, comp_scratch *s, int y0, int y1)
 {
     const int sw = j->Q.width, sh = j->Q.height;
     int y, c0;
-    if (j->k->comp == NULL) {
+    if (j->k->ref) {
         fuse__axis ax;
         fuse__axis_init(&ax, sw, j->vw);
         for (y = y0; y < y1; y++) {
@@ -678,6 +688,52 @@ fuse_result fuse_context_composite(fuse_context *ctx, const fuse_image *Q,
     return comp_with(ctx, &ctx->k, Q, V, vp_x0, vp_y0, vp_w, vp_h, out);
 }
 
+typedef struct depth_job {
+    const kernels *k;
+    const fuse_depth *d;
+    fuse_image Q;
+    int vx, vy, vw, vh;
+} depth_job;
+
+static void depth_task(void *arg, int t, int n)
+{
+    const depth_job *j = arg;
+    int y0, y1;
+    band(j->Q.height, t, n, &y0, &y1);
+    fuse__depth_rows(j->d, &j->Q, j->vx, j->vy, j->vw, j->vh, y0, y1, j->k->depth);
+}
+
+static fuse_result depth_with(fuse_context *ctx, const kernels *k, const fuse_depth *d,
+                              fuse_image *Q, int vp_x0, int vp_y0, int vp_w, int vp_h)
+{
+    depth_job j;
+    fuse_result r = fuse__depth_check(d, Q, vp_x0, vp_y0, vp_w, vp_h);
+    if (r != FUSE_OK) return r;
+    j.k = k;
+    j.d = d;
+    j.Q = *Q;
+    j.vx = vp_x0;
+    j.vy = vp_y0;
+    j.vw = vp_w;
+    j.vh = vp_h;
+    run(ctx, depth_task, &j);
+    return FUSE_OK;
+}
+
+fuse_result fuse_depth_test(const fuse_depth *d, fuse_image *Q, int vp_x0,
+                            int vp_y0, int vp_w, int vp_h)
+{
+    const kernels k = kernels_for(ef_isa_choose(EF_ISA_DEFAULT));
+    return depth_with(NULL, &k, d, Q, vp_x0, vp_y0, vp_w, vp_h);
+}
+
+fuse_result fuse_context_depth_test(fuse_context *ctx, const fuse_depth *d, fuse_image *Q,
+                                    int vp_x0, int vp_y0, int vp_w, int vp_h)
+{
+    if (ctx == NULL) return FUSE_ERR_ARGS;
+    return depth_with(ctx, &ctx->k, d, Q, vp_x0, vp_y0, vp_w, vp_h);
+}
+
 /* ---- a whole frame ------------------------------------------------------- */
 
 typedef struct eye_job {
@@ -697,7 +753,7 @@ static void eye_light_depth(const eye_job *e, int y0, int y1)
     light_rows(&e->light, y0, y1);
     if (e->depth != NULL)
         fuse__depth_rows(e->depth, &e->light.out, e->comp.vx, e->comp.vy,
-                         e->comp.vw, e->comp.vh, y0, y1);
+                         e->comp.vw, e->comp.vh, y0, y1, e->light.k->depth);
 }
 
 /* Layer rows lit per step of the fused order: small enough that the rows
@@ -719,7 +775,7 @@ static void eye_whole(const eye_job *e, int interleave)
     const int sh = e->light.P.height;
     comp_scratch s;
     int lit = 0, y;
-    if (!interleave || j->k->comp == NULL || j->vw > FUSE__TILE) {
+    if (!interleave || j->k->ref || j->vw > FUSE__TILE) {
         eye_light_depth(e, 0, sh);
         comp_rows(j, 0, j->V.height);
         return;

@@ -27,51 +27,68 @@ fuse_result fuse__depth_check(const fuse_depth *d, const fuse_image *Q, int vp_x
     return FUSE_OK;
 }
 
-void fuse__depth_rows(const fuse_depth *d, const fuse_image *Q, int vp_x0,
-                      int vp_y0, int vp_w, int vp_h, int y0, int y1)
+void fuse__depth_prepare(const fuse_depth *d, int qw, int vp_w, fuse__depth_prep *p)
 {
-    const float two_fn = (2.0f * d->zfar) * d->znear;
-    const float fpn = d->zfar + d->znear, fmn = d->zfar - d->znear;
-    const int sw = Q->width, sh = Q->height;
-    int x, y;
-    for (y = y0; y < y1; y++) {
-        const int oy = vp_y0 + (int)(((int64_t)2 * y + 1) * vp_h / (2 * (int64_t)sh));
-        const float *hz = d->hand + (size_t)y * (size_t)d->hand_stride;
-        const float *sc = d->scene + (size_t)oy * (size_t)d->scene_stride;
-        uint8_t *q = Q->pixels + (size_t)y * (size_t)Q->stride;
-        /* ox = floor((2x + 1) vp_w / (2 sw)) kept as quotient and
-         * remainder and stepped by 2 vp_w per pixel: exact, no division */
-        int64_t ox = (int64_t)vp_w / (2 * (int64_t)sw), rem = (int64_t)vp_w % (2 * (int64_t)sw);
-        const int64_t den = 2 * (int64_t)sw, step = 2 * (int64_t)vp_w;
-        const int64_t step_q = step / den, step_r = step % den;
-        for (x = 0; x < sw; x++, q += 4) {
-            uint32_t w;
-            float z, dist, s;
-            const int64_t cx = ox;
-            ox += step_q;
-            rem += step_r;
-            if (rem >= den) {
-                rem -= den;
-                ox++;
-            }
-            memcpy(&w, q, 4);
-            if (w == 0) continue;
-            z = hz[x];
-            if (!(z >= 0.0f && z < 1.0f)) continue;          /* no depth: keep */
-            dist = two_fn / (fpn - ((2.0f * z) - 1.0f) * fmn) + d->offset;
-            s = sc[vp_x0 + (int)cx];
-            if (s > 0.0f && s < dist) memset(q, 0, 4);       /* scene in front */
+    p->two_fn = (2.0f * d->zfar) * d->znear;
+    p->fpn = d->zfar + d->znear;
+    p->fmn = d->zfar - d->znear;
+    p->offset = d->offset;
+    p->vw = vp_w;
+    p->den = 2 * qw;
+    p->step_q = (2 * vp_w) / p->den;
+    p->step_r = (2 * vp_w) % p->den;
+}
+
+/* The reference: for every pixel that is not (0,0,0,0) and has a hand
+ * depth z in [0, 1), dist = two_fn / (fpn - (2z - 1) fmn) + offset (this
+ * order, IEEE single), and the pixel is zeroed when 0 < scene < dist.
+ * NaN fails every compare: a NaN depth keeps the pixel, a NaN scene too. */
+void fuse__depth_span_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int x0, int x1)
+{
+    int32_t ox, rem;
+    int x;
+    if (x0 >= x1) return;
+    fuse__depth_col(p, x0, &ox, &rem);
+    for (x = x0; x < x1; x++) {
+        uint32_t w;
+        float z, dist, s;
+        const int32_t cx = ox;
+        ox += p->step_q;
+        rem += p->step_r;
+        if (rem >= p->den) {
+            rem -= p->den;
+            ox++;
         }
+        memcpy(&w, q + 4 * (size_t)x, 4);
+        if (w == 0) continue;
+        z = hz[x];
+        if (!(z >= 0.0f && z < 1.0f)) continue;          /* no depth: keep */
+        dist = p->two_fn / (p->fpn - ((2.0f * z) - 1.0f) * p->fmn) + p->offset;
+        s = sc[cx];
+        if (s > 0.0f && s < dist) memset(q + 4 * (size_t)x, 0, 4);   /* scene in front */
     }
 }
 
-fuse_result fuse_depth_test(const fuse_depth *d, fuse_image *Q, int vp_x0,
-                            int vp_y0, int vp_w, int vp_h)
+void fuse__depth_row_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                         const float *sc, int w)
 {
-    fuse_result r = fuse__depth_check(d, Q, vp_x0, vp_y0, vp_w, vp_h);
-    if (r != FUSE_OK) return r;
-    fuse__depth_rows(d, Q, vp_x0, vp_y0, vp_w, vp_h, 0, Q->height);
-    return FUSE_OK;
+    fuse__depth_span_ref(p, q, hz, sc, 0, w);
+}
+
+void fuse__depth_rows(const fuse_depth *d, const fuse_image *Q, int vp_x0,
+                      int vp_y0, int vp_w, int vp_h, int y0, int y1, fuse__depth_fn fn)
+{
+    const int sh = Q->height;
+    fuse__depth_prep p;
+    int y;
+    fuse__depth_prepare(d, Q->width, vp_w, &p);
+    for (y = y0; y < y1; y++) {
+        const int oy = vp_y0 + (int)(((int64_t)2 * y + 1) * vp_h / (2 * (int64_t)sh));
+        fn(&p, Q->pixels + (size_t)y * (size_t)Q->stride,
+           d->hand + (size_t)y * (size_t)d->hand_stride,
+           d->scene + (size_t)oy * (size_t)d->scene_stride + vp_x0, Q->width);
+    }
 }
 
 /* ---- tone matching ----------------------------------------------------- */

@@ -285,7 +285,8 @@ void fuse__composite_cols_ref(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
                               const uint8_t *v, uint8_t *out);
 
 /* The ISA paths (fuse_sse2.c, fuse_avx2.c, fuse_avx512.c). Each gives the
- * bytes of the reference kernels. */
+ * bytes of the reference kernels. The table-driven composite per output
+ * row is SSE2's; AVX2 and AVX-512 composite through the row cache below. */
 void fuse__light_row_sse2(const fuse__light_prep *p, int y, int width,
                           const uint8_t *P, const uint8_t *mask,
                           const float *normal, uint8_t *out);
@@ -298,12 +299,6 @@ void fuse__light_row_avx512(const fuse__light_prep *p, int y, int width,
 void fuse__composite_cols_sse2(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
                                const fuse__cols *cols, int c, int n, int sw,
                                const uint8_t *v, uint8_t *out);
-void fuse__composite_cols_avx2(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
-                               const fuse__cols *cols, int c, int n, int sw,
-                               const uint8_t *v, uint8_t *out);
-void fuse__composite_cols_avx512(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
-                                 const fuse__cols *cols, int c, int n, int sw,
-                                 const uint8_t *v, uint8_t *out);
 
 /* ---- row-cached composite (AVX2, AVX-512) ----------------------------- */
 
@@ -396,11 +391,53 @@ void fuse__pow01_row_sse2(const float *x, int n, float s, float *out);
 void fuse__pow01_row_avx2(const float *x, int n, float s, float *out);
 void fuse__pow01_row_avx512(const float *x, int n, float s, float *out);
 
-/* The depth test's checks and its rows [y0, y1) (fuse_depth.c). */
+/* ---- depth test (fuse_depth.c; the rule in fuse.h, "depth test") ----- */
+
+/* The depth test's constants and the exact walk of the scene column
+ *   ox(x) = floor((2x + 1) vw / (2 sw))        (from the viewport's left)
+ * as quotient and remainder: ox(x + 1) = ox(x) + step_q, rem += step_r,
+ * one more when rem reaches den. Every value fits an int32 (vw, sw <=
+ * FUSE_MAX_DIM, so (2x + 1) vw < 2^30). */
+typedef struct fuse__depth_prep {
+    float two_fn, fpn, fmn, offset;   /* (2 zfar) znear, zfar + znear, zfar - znear */
+    int32_t vw, den;                  /* vp_w, 2 Q.width */
+    int32_t step_q, step_r;           /* 2 vp_w = step_q den + step_r */
+} fuse__depth_prep;
+
+void fuse__depth_prepare(const fuse_depth *d, int qw, int vp_w, fuse__depth_prep *p);
+
+/* Column of pixel x: *ox = ox(x), *rem the remainder. */
+static inline void fuse__depth_col(const fuse__depth_prep *p, int x, int32_t *ox, int32_t *rem)
+{
+    const int64_t num = ((int64_t)2 * x + 1) * p->vw;
+    *ox = (int32_t)(num / p->den);
+    *rem = (int32_t)(num % p->den);
+}
+
+/* The depth test of one layer row: q its w RGBA8 pixels (zeroed where the
+ * scene is in front), hz the hand's window depths of the row, sc the
+ * scene row's distances from the viewport's left edge (scene + oy stride
+ * + vp_x0). The ISA paths give the bytes of fuse__depth_row_ref: the same
+ * IEEE operations in the same order, ordered compares. */
+typedef void (*fuse__depth_fn)(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                               const float *sc, int w);
+/* Pixels x0 <= x < x1 of the row only (q, hz, sc still at pixel 0). */
+void fuse__depth_span_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int x0, int x1);
+void fuse__depth_row_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                         const float *sc, int w);
+void fuse__depth_row_sse2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int w);
+void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int w);
+void fuse__depth_row_avx512(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                            const float *sc, int w);
+
+/* The depth test's checks, and its rows [y0, y1) with the row kernel fn. */
 fuse_result fuse__depth_check(const fuse_depth *d, const fuse_image *Q, int vp_x0,
                               int vp_y0, int vp_w, int vp_h);
 void fuse__depth_rows(const fuse_depth *d, const fuse_image *Q, int vp_x0,
-                      int vp_y0, int vp_w, int vp_h, int y0, int y1);
+                      int vp_y0, int vp_w, int vp_h, int y0, int y1, fuse__depth_fn fn);
 
 /* ---- validation shared by the drivers (fuse_ref.c) ------------------- */
 

@@ -4,7 +4,8 @@
  * Lighting: 4 pixels per vector (fuse_body.inl); SSE2 has no floor
  * instruction, so floorf is the exact truncate-and-correct below.
  * Composite: 4 output pixels per step, taps loaded one by one, blend and
- * over in 16-bit lanes (the same exact decomposition as fuse_avx2.c).
+ * over in 16-bit lanes (the exact decomposition at blend16). Depth test:
+ * 4 pixels a step, the scene loaded lane by lane (no gather in SSE2).
  * On a machine without SSE2 (ARM) the reference kernels stand in. */
 #include "fuse_internal.h"
 
@@ -82,7 +83,20 @@ static inline uint32_t load_u32(const uint8_t *p)
 
 #include "fuse_body.inl"
 
-/* ---- composite (see blend16 in fuse_avx2.c for the exactness) ---------- */
+/* ---- composite ---------------------------------------------------------- */
+
+/* Bilinear blend + over of 2 pixels in 16-bit lanes (a, b, c, d, v: the
+ * taps and V widened to u16; wx0/wx1: 256 - fx and fx per channel; wy0/wy1
+ * the same for the row). The reference's
+ *   q = ((a wx0 + b wx1) wy0 + (c wx0 + d wx1) wy1 + 32768) >> 16
+ * is a sum of exact integer products, so it may be grouped by columns:
+ *   col0 = a wy0 + c wy1,  col1 = b wy0 + d wy1      (<= 65280: u16)
+ *   S = col0 wx0 + col1 wx1 = 256 H + Lo with
+ *   H = hi0 wx0 + hi1 wx1, Lo = lo0 wx0 + lo1 wx1 (hi = col >> 8, lo = col & 255)
+ *   q = floor((S + 32768) / 65536) = (H + (Lo >> 8) + 128) >> 8
+ * where H + (Lo >> 8) <= S / 256 <= 65280, so every step fits in u16. Over:
+ *   r = q + div255((255 - qa) v),  div255(t) = (t + 128 + ((t + 128) >> 8)) >> 8
+ * with t <= 65025; the final min(255, .) is the saturating pack. */
 
 static inline __m128i blend16(__m128i a, __m128i b, __m128i c, __m128i d, __m128i v,
                               __m128i wx0, __m128i wx1, __m128i wy0, __m128i wy1)
@@ -193,6 +207,51 @@ void fuse__opaque_sse2(const uint8_t *v, uint8_t *out, int n)
     fuse__opaque_ref(v + 4 * (size_t)i, out + 4 * (size_t)i, n - i);
 }
 
+/* ---- depth test (fuse__depth_span_ref, 4 pixels a step) ----------------- */
+
+void fuse__depth_row_sse2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int w)
+{
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
+    const __m128 two_fn = _mm_set1_ps(p->two_fn), fpn = _mm_set1_ps(p->fpn);
+    const __m128 fmn = _mm_set1_ps(p->fmn), off = _mm_set1_ps(p->offset);
+    const __m128i zi = _mm_setzero_si128();
+    int32_t ox, rem;   /* column of pixel x */
+    int x = 0, k;
+    fuse__depth_col(p, 0, &ox, &rem);
+    for (; x + 4 <= w; x += 4) {
+        __m128i *qp = (__m128i *)(void *)(q + 4 * (size_t)x);
+        const __m128i qq = _mm_loadu_si128(qp);
+        int32_t c[4];
+        for (k = 0; k < 4; k++) {   /* the columns of the 4 pixels, and on */
+            c[k] = ox;
+            ox += p->step_q;
+            rem += p->step_r;
+            if (rem >= p->den) {
+                rem -= p->den;
+                ox++;
+            }
+        }
+        if (_mm_movemask_epi8(_mm_cmpeq_epi32(qq, zi)) != 0xFFFF) {
+            const __m128 nz = _mm_castsi128_ps(_mm_xor_si128(_mm_cmpeq_epi32(qq, zi), _mm_set1_epi32(-1)));
+            const __m128 z = _mm_loadu_ps(hz + x);
+            const __m128 has = _mm_and_ps(nz, _mm_and_ps(_mm_cmpge_ps(z, zero), _mm_cmplt_ps(z, one)));
+            const int hm = _mm_movemask_ps(has);
+            if (hm) {
+                const __m128 s = _mm_setr_ps((hm & 1) ? sc[c[0]] : 0.0f, (hm & 2) ? sc[c[1]] : 0.0f,
+                                             (hm & 4) ? sc[c[2]] : 0.0f, (hm & 8) ? sc[c[3]] : 0.0f);
+                const __m128 dist = _mm_add_ps(
+                    _mm_div_ps(two_fn, _mm_sub_ps(fpn, _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(two, z), one), fmn))),
+                    off);
+                const __m128 kill = _mm_and_ps(has, _mm_and_ps(_mm_cmpgt_ps(s, zero), _mm_cmplt_ps(s, dist)));
+                if (_mm_movemask_ps(kill))   /* the row is this thread's: rewrite the rest */
+                    _mm_storeu_si128(qp, _mm_andnot_si128(_mm_castps_si128(kill), qq));
+            }
+        }
+    }
+    fuse__depth_span_ref(p, q, hz, sc, x, w);
+}
+
 #else  /* no SSE2 (e.g. ARM): the reference kernels */
 
 void fuse__light_row_sse2(const fuse__light_prep *p, int y, int width,
@@ -207,6 +266,11 @@ void fuse__composite_cols_sse2(const uint8_t *q0, const uint8_t *q1, uint32_t fy
                                const uint8_t *v, uint8_t *out)
 {
     fuse__composite_cols_ref(q0, q1, fy, cols, c, n, sw, v, out);
+}
+void fuse__depth_row_sse2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int w)
+{
+    fuse__depth_row_ref(p, q, hz, sc, w);
 }
 void fuse__pow01_row_sse2(const float *x, int n, float s, float *out)
 {
