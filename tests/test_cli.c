@@ -131,6 +131,17 @@ static void usage_errors(void **state)
     assert_int_equal(run("render", "--scene", "s.txt", NULL), 2);
     assert_non_null(strstr(out, "--out is required"));
     assert_int_equal(run("render", "--bogus", NULL), 2);
+    /* --refine BAND: 1..64 px */
+    assert_int_equal(run("render", "--help", NULL), 0);
+    assert_non_null(strstr(out, "--refine BAND"));
+    assert_int_equal(run("render", "--scene", "s.txt", "--out", "o", "--refine", "0", NULL), 2);
+    assert_non_null(strstr(out, "--refine '0'"));
+    assert_int_equal(run("render", "--scene", "s.txt", "--out", "o", "--refine", "65", NULL), 2);
+    assert_non_null(strstr(out, "--refine '65'"));
+    assert_int_equal(run("run", "--help", NULL), 0);
+    assert_non_null(strstr(out, "--refine BAND"));
+    assert_int_equal(run("run", "--refine", "x", NULL), 2);
+    assert_non_null(strstr(out, "--refine 'x'"));
 }
 
 /* ------------------------------------------------------------- mask */

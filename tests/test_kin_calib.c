@@ -1,7 +1,11 @@
 /* test_kin_calib.c - per-user calibration (kin_calib.c): bone scales
  * estimated from a synthetic recording of a user 1.1x the model's size,
- * the file format (exact round trip, strict errors with line numbers),
- * and the effect: the calibrated rig reaches targets the model's own
+ * the hand scale from the fingertip gesture (exact on exact samples,
+ * robust to the approach, within the noise on noisy ones, the fallback to
+ * the arm scale when the gesture is missing), the model's fingertip
+ * reference on a hand-built model, the file format (exact round trip, old
+ * files without hand_length, strict errors with line numbers), and the
+ * effect: the calibrated rig reaches targets the model's own
  * arm cannot. */
 #include "support/testutil.h"
 #include <cmocka.h>
@@ -52,6 +56,46 @@ static int record(kin_track_sample *s, int n, float arm_len, float width, tu_rng
     return n;
 }
 
+/* The model's middle fingertips in the hand frames (left mirrored). */
+static const kin_vec3 TIP_L = { 0.008f, -0.004f, -0.195f };
+static const kin_vec3 TIP_R = { -0.008f, -0.004f, -0.195f };
+
+/* Appends n samples of the fingertip gesture of a user whose hands are
+ * `scale` times the model's: the middle fingertips pressed together at
+ * C, the left hand's fingers pointing to +X, the right hand's to -X,
+ * the pair turning up to 25 deg about Y and tilting 15 deg about Z; the
+ * fingertips `gap` metres apart along the fingers (0: touching); wrist
+ * noise `noise` (uniform per axis, metres). */
+static int gesture(kin_track_sample *s, int n, float scale, float gap, float noise, tu_rng *g)
+{
+    for (int i = 0; i < n; i++) {
+        memset(&s[i], 0, sizeof s[i]);
+        s[i].t = 0.01 * i;
+        s[i].valid = KIN_TRACK_ALL & ~(uint32_t)(KIN_TRACK_GLOVE_L | KIN_TRACK_GLOVE_R);
+        s[i].head_rot = kin_quat_identity();
+        s[i].head_pos = kin_v3(0, 1.3f, -0.08f);
+        s[i].shoulder[0] = kin_v3(-0.21f, 1.0f, 0.0f);
+        s[i].shoulder[1] = kin_v3(0.21f, 1.0f, 0.0f);
+        float yaw = 0.44f * sinf(0.05f * (float)i), tilt = 0.26f * cosf(0.03f * (float)i);
+        kin_quat pair = kin_quat_mul(kin_quat_axis_angle(kin_v3(0, 1, 0), yaw),
+                                     kin_quat_axis_angle(kin_v3(0, 0, 1), tilt));
+        /* -Z (the fingers) to +X for the left hand, to -X for the right */
+        s[i].hand_rot[0] = kin_quat_mul(pair, kin_quat_axis_angle(kin_v3(0, 1, 0), -1.5707963f));
+        s[i].hand_rot[1] = kin_quat_mul(pair, kin_quat_axis_angle(kin_v3(0, 1, 0), 1.5707963f));
+        kin_vec3 C = kin_v3(0.01f, 1.02f, -0.38f);
+        kin_vec3 x = kin_quat_rotate(pair, kin_v3(1, 0, 0));
+        kin_vec3 tl = kin_quat_rotate(s[i].hand_rot[0], kin_v3_scale(TIP_L, scale));
+        kin_vec3 tr = kin_quat_rotate(s[i].hand_rot[1], kin_v3_scale(TIP_R, scale));
+        s[i].hand_pos[0] = kin_v3_sub(kin_v3_sub(C, tl), kin_v3_scale(x, 0.5f * gap));
+        s[i].hand_pos[1] = kin_v3_add(kin_v3_sub(C, tr), kin_v3_scale(x, 0.5f * gap));
+        for (int k = 0; k < 2; k++)
+            s[i].hand_pos[k] = kin_v3_add(s[i].hand_pos[k],
+                                          kin_v3(noise * tu_range(g, -1, 1), noise * tu_range(g, -1, 1),
+                                                 noise * tu_range(g, -1, 1)));
+    }
+    return n;
+}
+
 /* ------------------------------------------------------------ validity */
 
 static void validity_estimate_rejects(void **state)
@@ -72,6 +116,39 @@ static void validity_estimate_rejects(void **state)
     record(s, 500, 0.2f, 0.42f, &g);            /* never stretched */
     assert_int_equal(kin_user_calib_estimate(s, 500, &rig, scratch, &c, why, sizeof why), -1);
     assert_non_null(strstr(why, "were the arms stretched"));
+}
+
+/* Without the gesture (or without a fingertip reference) the hand scale
+ * falls back to the arm scale, with the reason. */
+static void validity_gesture_missing_falls_back(void **state)
+{
+    (void)state;
+    static kin_track_sample s[700];
+    float scratch[700];
+    tu_rng g = { 0x63616c33 };
+    kin_arm_rig rig = model_rig();
+    const kin_vec3 tips[2] = { TIP_L, TIP_R };
+    kin_user_calib c;
+    char why[256];
+    record(s, 500, 0.616f, 0.42f, &g);
+    assert_int_equal(kin_user_calib_estimate_tips(s, 500, &rig, tips, scratch, &c, why, sizeof why), 1);
+    assert_non_null(strstr(why, "fingertip gesture: 0 samples"));
+    assert_non_null(strstr(why, "hand scale = arm scale"));
+    NEAR(c.hand_scale[0], c.arm_scale[0], 0);
+    NEAR(c.hand_scale[1], c.arm_scale[1], 0);
+    NEAR(c.hand_length[0], 0, 0);
+    assert_int_equal(kin_user_calib_estimate_tips(s, 500, &rig, NULL, scratch, &c, why, sizeof why), 1);
+    assert_non_null(strstr(why, "no fingertip reference"));
+    /* 19 gesture samples are too few; the hands 4 cm apart are no touch */
+    gesture(s + 500, 19, 1.05f, 0.0f, 0.0f, &g);
+    assert_int_equal(kin_user_calib_estimate_tips(s, 519, &rig, tips, scratch, &c, why, sizeof why), 1);
+    assert_non_null(strstr(why, "19 samples"));
+    gesture(s + 500, 200, 1.05f, 0.04f, 0.0f, &g);
+    for (int i = 500; i < 700; i++) s[i].hand_pos[1].y += 0.03f;   /* 3 cm off the line */
+    assert_int_equal(kin_user_calib_estimate_tips(s, 700, &rig, tips, scratch, &c, why, sizeof why), 1);
+    NEAR(c.hand_scale[1], c.arm_scale[1], 0);
+    /* a failing arm estimate still fails */
+    assert_int_equal(kin_user_calib_estimate_tips(s, 19, &rig, tips, scratch, &c, why, sizeof why), -1);
 }
 
 static void expect_parse_error(const char *text, int line, const char *in_why)
@@ -108,6 +185,98 @@ static void validity_file_errors(void **state)
 
 /* -------------------------------------------------------------- results */
 
+/* Exact gesture samples of hands 1.05x the model's: the scale comes back
+ * to float rounding, whatever the arms say (1.1x); 60 samples of the
+ * approach (the fingertips 1-5 cm apart: s up to 1.05 + 0.05 / 0.39) do
+ * not move it. */
+static void result_hand_scale_from_gesture(void **state)
+{
+    (void)state;
+    static kin_track_sample s[800];
+    float scratch[800];
+    tu_rng g = { 0x63616c34 };
+    kin_arm_rig rig = model_rig();
+    const kin_vec3 tips[2] = { TIP_L, TIP_R };
+    record(s, 500, 0.616f, 0.42f, &g);
+    gesture(s + 500, 240, 1.05f, 0.0f, 0.0f, &g);
+    for (int i = 0; i < 60; i++)
+        gesture(s + 740 + i, 1, 1.05f, 0.01f + 0.04f * (float)i / 59.0f, 0.0f, &g);
+    kin_user_calib c;
+    char why[256];
+    int rc = kin_user_calib_estimate_tips(s, 800, &rig, tips, scratch, &c, why, sizeof why);
+    if (rc != 0) fail_msg("%d: %s", rc, why);
+    NEAR(c.hand_scale[0], 1.05, 2e-6);
+    NEAR(c.hand_scale[1], 1.05, 2e-6);
+    NEAR(c.arm_scale[1], 1.1, 0.006);
+    NEAR(c.hand_length[0], 1.05 * sqrt(0.008 * 0.008 + 0.004 * 0.004 + 0.195 * 0.195), 1e-6);
+    NEAR(c.hand_length[1], c.hand_length[0], 1e-7);
+    /* hands 0.92x, 3 mm wrist noise per axis: each sample's s is off by
+     * about 3 mm * 1.4 / 0.39 m; the shortest half of 240 within 0.005 */
+    gesture(s + 500, 240, 0.92f, 0.0f, 0.003f, &g);
+    for (int i = 0; i < 60; i++)
+        gesture(s + 740 + i, 1, 0.92f, 0.01f + 0.04f * (float)i / 59.0f, 0.003f, &g);
+    rc = kin_user_calib_estimate_tips(s, 800, &rig, tips, scratch, &c, why, sizeof why);
+    if (rc != 0) fail_msg("%d: %s", rc, why);
+    NEAR(c.hand_scale[0], 0.92, 0.005);
+}
+
+/* The fingertip reference of a hand-built model: hand joint at
+ * (0.1, 1, -0.3) turned 90 deg about Y, middle_3 at (0.01, 0, -0.15) in
+ * it; vertices bound to middle_3 at 0.005 and 0.02 beyond it along its
+ * bone (-Z) and one 0.05 beyond with weight 0.4 (not bound): the tip is
+ * (0.01, 0, -0.17) in the hand frame, on both sides. */
+static void result_hand_tips_of_a_model(void **state)
+{
+    (void)state;
+    int16_t parents[2] = { KIN_NO_PARENT, 0 };
+    kin_transform rest[2];
+    rest[0].t = kin_v3(0.1f, 1.0f, -0.3f);
+    rest[0].r = kin_quat_axis_angle(kin_v3(0, 1, 0), 1.5707963f);
+    rest[0].s = kin_v3(1, 1, 1);
+    rest[1].t = kin_v3(0.01f, 0.0f, -0.15f);
+    rest[1].r = kin_quat_axis_angle(kin_v3(1, 0, 0), 0.3f);
+    rest[1].s = kin_v3(1, 1, 1);
+    kin_mat4 w0 = kin_mat4_from_transform(&rest[0]), l1 = kin_mat4_from_transform(&rest[1]);
+    kin_mat4 w1 = kin_mat4_mul(&w0, &l1), ibm[2];
+    assert_true(kin_mat4_inverse(&w0, &ibm[0]));
+    assert_true(kin_mat4_inverse(&w1, &ibm[1]));
+    /* bind-space positions: world(1) * local offsets along -Z */
+    float pos[9];
+    const float along[3] = { 0.005f, 0.02f, 0.05f };
+    for (int v = 0; v < 3; v++) {
+        kin_vec3 p = kin_mat4_mul_point(&w1, kin_v3(0.001f, 0.002f, -along[v]));
+        pos[v * 3] = p.x; pos[v * 3 + 1] = p.y; pos[v * 3 + 2] = p.z;
+    }
+    uint16_t joints[12] = { 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0 };
+    float weights[12] = { 1, 0, 0, 0, 0.7f, 0.3f, 0, 0, 0.4f, 0.6f, 0, 0 };
+    uint32_t idx[3] = { 0, 1, 2 };
+    const int jn[2] = { 0, 1 };
+    kin_skin sk = { 2, jn, ibm };
+    kin_mesh me;
+    memset(&me, 0, sizeof me);
+    me.vertex_count = 3; me.positions = pos; me.joints = joints; me.weights = weights;
+    me.index_count = 3; me.indices = idx; me.node = -1; me.skin = 0;
+    kin_model m;
+    memset(&m, 0, sizeof m);
+    m.node_count = 2; m.parents = parents; m.rest = rest;
+    m.mesh_count = 1; m.meshes = &me; m.skin_count = 1; m.skins = &sk;
+    kin_arm_rig rig = model_rig();
+    for (int s = 0; s < 2; s++) {
+        rig.joint[s][KIN_RIG_HAND] = 0;
+        rig.joint[s][KIN_RIG_FINGER0 + 8] = 1;   /* middle_3 */
+    }
+    kin_vec3 tip[2];
+    char why[128];
+    if (kin_user_calib_hand_tips(&rig, &m, tip, why, sizeof why)) fail_msg("%s", why);
+    /* middle_3's -Z in the hand frame: Rx(0.3) (0, 0, -1) */
+    double ez = 0.02 * cos(0.3), ey = 0.02 * sin(0.3);
+    NEAR3(tip[0], 0.01, ey, -0.15 - ez, 1e-6);
+    NEAR3(tip[1], 0.01, ey, -0.15 - ez, 1e-6);
+    m.mesh_count = 0;
+    assert_int_equal(kin_user_calib_hand_tips(&rig, &m, tip, why, sizeof why), -1);
+    assert_non_null(strstr(why, "no skinned mesh"));
+}
+
 static void result_estimate_user_size(void **state)
 {
     (void)state;
@@ -139,6 +308,7 @@ static void result_file_round_trip(void **state)
     c.arm_length[0] = 0.6153f; c.arm_length[1] = 0.511f;
     c.shoulder_width = 0.42f;
     c.has_glove[0] = 1;
+    c.hand_length[0] = 0.203125f; c.hand_length[1] = 0.1875f;
     for (int i = 0; i < 5; i++) { c.glove[0].raw_open[i] = 0.1f * i; c.glove[0].raw_fist[i] = 3.0f - i; }
     char buf[1024];
     int n = kin_user_calib_format(&c, buf, sizeof buf);
@@ -149,6 +319,18 @@ static void result_file_round_trip(void **state)
     char why[256];
     if (kin_user_calib_parse(buf, (size_t)n, &back, &line, why, sizeof why)) fail_msg("%s", why);
     assert_memory_equal(&back, &c, sizeof c);
+    assert_non_null(strstr(buf, "\nhand_length 0.203125 0.1875\n"));
+    /* a file of the arms-only estimate has no hand_length line, and an old
+     * file without it reads back with hand_length 0 */
+    c.hand_length[0] = c.hand_length[1] = 0.0f;
+    n = kin_user_calib_format(&c, buf, sizeof buf);
+    assert_null(strstr(buf, "hand_length"));
+    const char *old = "egofuse-calib 1\narm_scale 1.1 1.1\nhand_scale 1.1 1.1\n"
+                      "shoulder_scale 1\narm_length 0.6 0.6\nshoulder_width 0.4\n";
+    if (kin_user_calib_parse(old, strlen(old), &back, &line, why, sizeof why)) fail_msg("%s", why);
+    NEAR(back.hand_scale[1], 1.1f, 0);
+    NEAR(back.hand_length[0], 0, 0);
+    NEAR(back.hand_length[1], 0, 0);
 }
 
 /* The calibrated rig reaches a stretched-arm target of the bigger user;
@@ -181,9 +363,12 @@ int main(void)
     const struct CMUnitTest validity[] = {
         cmocka_unit_test(validity_estimate_rejects),
         cmocka_unit_test(validity_file_errors),
+        cmocka_unit_test(validity_gesture_missing_falls_back),
     };
     const struct CMUnitTest results[] = {
         cmocka_unit_test(result_estimate_user_size),
+        cmocka_unit_test(result_hand_scale_from_gesture),
+        cmocka_unit_test(result_hand_tips_of_a_model),
         cmocka_unit_test(result_file_round_trip),
         cmocka_unit_test(result_calibration_lets_the_arm_reach),
     };

@@ -1,7 +1,9 @@
 /* test_pipe.c - one stereo frame end to end (src/pipe): the wiring of the
  * stages (crop of eq. 1, camera per eye, lights into view space, viewport of
  * eq. 4) against the same stages called one by one, thread-count
- * independence, and bad inputs. */
+ * independence, the mask refinement (pipe_desc.refine_band: the same
+ * bytes as fuse_refine_mask by hand, and it follows the camera's arm
+ * colour beyond the model's edge), and bad inputs. */
 #include "support/testutil.h"
 
 #include <cmocka.h>
@@ -415,6 +417,80 @@ static void bad_inputs(void **state)
     kin_model_free(&m);
 }
 
+/* refine_band: the eye's mask is fuse_refine_mask of the G-buffer mask
+ * with the cropped camera image; on a camera image whose skin colour
+ * reaches 4 px beyond the model's edge, the refined mask takes it. */
+static void refine_band_mask(void **state)
+{
+    (void)state;
+    kin_model m;
+    quad_model(&m, 0.05f, -0.4f);
+    frame_bufs b;
+    pipe_frame_in in;
+    make_frame(&b, &in, 77);
+    pipe_desc d = {0};
+    d.threads = 1;
+    pipe_ctx *p0 = pipe_create(&d, &m);
+    d.refine_band = 8;
+    pipe_ctx *p1 = pipe_create(&d, &m);
+    assert_non_null(p0);
+    assert_non_null(p1);
+    char why[200];
+    assert_int_equal(pipe_frame(p0, &in, NULL, why, sizeof why), PIPE_OK);
+    int w, h;
+    const uint8_t *kin_mask = pipe_mask(p0, 0, &w, &h);
+    assert_int_equal(w, 640);
+    assert_int_equal(h, 400);
+    /* skin within 4 px (Chebyshev) of the model's mask, blue-grey
+     * elsewhere, +-4 of noise; rows 40..439 of the sensor are the crop */
+    tu_rng r = {78};
+    long kin_area = 0, skin_area = 0;
+    for (int y = 0; y < 400; y++)
+        for (int x = 0; x < 640; x++) {
+            int near = 0;
+            for (int dy = -4; dy <= 4 && !near; dy++)
+                for (int dx = -4; dx <= 4 && !near; dx++) {
+                    int yy = y + dy, xx = x + dx;
+                    near = yy >= 0 && yy < 400 && xx >= 0 && xx < 640 && kin_mask[yy * 640 + xx];
+                }
+            kin_area += kin_mask[y * 640 + x] != 0;
+            skin_area += near;
+            for (int e = 0; e < 2; e++) {
+                uint8_t *px = &b.cam[e][((y + 40) * 640 + x) * 4];
+                int n = (int)(tu_next(&r) % 9) - 4;
+                px[0] = (uint8_t)((near ? 205 : 70) + n);
+                px[1] = (uint8_t)((near ? 140 : 95) + n);
+                px[2] = (uint8_t)((near ? 115 : 150) + n);
+            }
+        }
+    assert_true(kin_area > 2000);
+    assert_int_equal(pipe_frame(p1, &in, NULL, why, sizeof why), PIPE_OK);
+    const uint8_t *refined = pipe_mask(p1, 0, NULL, NULL);
+    /* by hand */
+    fuse_refine_params rp = fuse_refine_params_default();
+    rp.band = 8;
+    size_t ss = fuse_refine_scratch_size(&rp, 640, 400);
+    void *scratch = aligned_alloc(16, (ss + 15) & ~(size_t)15);
+    uint8_t *want = malloc(640 * 400);
+    assert_non_null(scratch);
+    assert_non_null(want);
+    fuse_image P = {b.cam[0] + 40 * 640 * 4, 640, 400, 640 * 4};
+    assert_int_equal(fuse_refine_mask(&rp, &P, kin_mask, 640, want, 640, scratch, ss, NULL),
+                     FUSE_OK);
+    assert_memory_equal(refined, want, 640 * 400);
+    long area = 0;
+    for (int i = 0; i < 640 * 400; i++) area += refined[i] >= 128;
+    /* the 4 px ring is taken (up to the corners the smoothing rounds) */
+    assert_true(area > kin_area + (skin_area - kin_area) * 9 / 10);
+    assert_true(area <= skin_area);
+    free(want);
+    free(scratch);
+    pipe_destroy(p0);
+    pipe_destroy(p1);
+    free_frame(&b);
+    kin_model_free(&m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -425,6 +501,7 @@ int main(void)
         cmocka_unit_test(cull_back_faces),
         cmocka_unit_test(raw_camera_frames),
         cmocka_unit_test(bad_inputs),
+        cmocka_unit_test(refine_band_mask),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

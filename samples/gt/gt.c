@@ -577,6 +577,7 @@ typedef struct seq_side {
     int n;
     float t[SEQ_MAX_KEYS];
     float v[SEQ_MAX_KEYS][SEQ_DIM];
+    int tip[SEQ_MAX_KEYS];     /* 1: xyz is the middle fingertip, not the wrist */
 } seq_side;
 
 typedef struct seq_desc {
@@ -586,6 +587,9 @@ typedef struct seq_desc {
     int nh;
     float ht[SEQ_MAX_KEYS];
     float hv[SEQ_MAX_KEYS][2]; /* head yaw (+ left), pitch (- down), deg */
+    int true_bones;            /* 1: the angles are solved for the true
+                                  operator's bones (its wrists and
+                                  fingertips go where the keys say) */
 } seq_desc;
 
 #define RREST 0.130f, 1.075f, -0.320f, -0.25f, -0.12f, -1.0f, 0.35f, 1.0f, 0.0f
@@ -600,13 +604,13 @@ static const seq_desc sequences[] = {
           { { LREST, 0.1f }, { LREST, 0.1f },
             { 0.100f, 1.080f, -0.280f, 0.70f, 0.05f, -1.0f, -0.2f, 1.0f, 0.1f, 0.2f },
             { 0.060f, 1.090f, -0.270f, 0.60f, 0.05f, -1.0f, -0.2f, 1.0f, 0.1f, 0.0f },
-            { LREST, 0.1f } } },
+            { LREST, 0.1f } }, { 0 } },
         { 5, { 0.0f, 0.3f, 1.2f, 2.0f, 3.0f },
           { { RREST, 0.0f }, { RREST, 0.0f },
             { -0.120f, 1.030f, -0.440f, -0.70f, -0.15f, -1.0f, 0.2f, 1.0f, 0.0f, -0.2f },
             { -0.080f, 1.020f, -0.460f, -0.60f, -0.15f, -1.0f, 0.2f, 1.0f, 0.0f, 0.6f },
-            { RREST, 0.0f } } } },
-      4, { 0.0f, 0.8f, 2.0f, 3.0f }, { HEAD0, { 3.0f, -28.0f }, { 2.0f, -28.0f }, HEAD0 } },
+            { RREST, 0.0f } }, { 0 } } },
+      4, { 0.0f, 0.8f, 2.0f, 3.0f }, { HEAD0, { 3.0f, -28.0f }, { 2.0f, -28.0f }, HEAD0 }, 0 },
     /* the hands come up to 15 cm in front of the eyes (the right one
      * first, as if looking at the palm), then go back to 40 cm */
     { "near", 3.0f,
@@ -614,14 +618,14 @@ static const seq_desc sequences[] = {
           { { LREST, 0.1f },
             { -0.050f, 1.160f, -0.230f, 0.20f, 0.45f, -1.0f, -0.6f, 0.6f, 0.6f, -0.2f },
             { -0.060f, 1.140f, -0.250f, 0.20f, 0.45f, -1.0f, -0.6f, 0.6f, 0.6f, 0.3f },
-            { -0.100f, 1.040f, -0.420f, 0.25f, -0.12f, -1.0f, -0.35f, 1.0f, 0.0f, 0.1f } } },
+            { -0.100f, 1.040f, -0.420f, 0.25f, -0.12f, -1.0f, -0.35f, 1.0f, 0.0f, 0.1f } }, { 0 } },
         { 5, { 0.0f, 0.7f, 1.4f, 2.2f, 3.0f },
           { { RREST, 0.0f },
             { 0.040f, 1.170f, -0.220f, -0.20f, 0.50f, -1.0f, 0.6f, 0.5f, 0.6f, -0.3f },
             { 0.045f, 1.175f, -0.215f, -0.20f, 0.50f, -1.0f, 0.6f, 0.5f, 0.6f, 0.5f },
             { 0.100f, 1.060f, -0.400f, -0.25f, -0.12f, -1.0f, 0.35f, 1.0f, 0.0f, 0.0f },
-            { 0.110f, 1.050f, -0.430f, -0.25f, -0.12f, -1.0f, 0.35f, 1.0f, 0.0f, 0.0f } } } },
-      3, { 0.0f, 1.2f, 3.0f }, { HEAD0, { 0.0f, -20.0f }, { 0.0f, -26.0f } } },
+            { 0.110f, 1.050f, -0.430f, -0.25f, -0.12f, -1.0f, 0.35f, 1.0f, 0.0f, 0.0f } }, { 0 } } },
+      3, { 0.0f, 1.2f, 3.0f }, { HEAD0, { 0.0f, -20.0f }, { 0.0f, -26.0f } }, 0 },
     /* the hands go out to the image edges (left hand beyond the left
      * border, right hand to the right and the bottom), partly out of view */
     { "edge", 3.0f,
@@ -629,14 +633,14 @@ static const seq_desc sequences[] = {
           { { LREST, 0.1f },
             { -0.300f, 1.060f, -0.400f, -0.30f, -0.10f, -1.0f, -0.35f, 1.0f, 0.0f, -0.1f },
             { -0.320f, 1.080f, -0.380f, -0.30f, -0.10f, -1.0f, -0.35f, 1.0f, 0.0f, 0.4f },
-            { LREST, 0.1f } } },
+            { LREST, 0.1f } }, { 0 } },
         { 5, { 0.0f, 0.6f, 1.3f, 2.2f, 3.0f },
           { { RREST, 0.0f },
             { 0.300f, 1.040f, -0.420f, 0.30f, -0.10f, -1.0f, 0.35f, 1.0f, 0.0f, 0.0f },
             { 0.260f, 0.960f, -0.300f, 0.20f, -0.30f, -1.0f, 0.35f, 1.0f, 0.0f, 0.3f },
             { 0.150f, 0.950f, -0.280f, 0.00f, -0.30f, -1.0f, 0.35f, 1.0f, 0.0f, 0.0f },
-            { RREST, 0.0f } } } },
-      3, { 0.0f, 1.5f, 3.0f }, { HEAD0, { -2.0f, -25.0f }, HEAD0 } },
+            { RREST, 0.0f } }, { 0 } } },
+      3, { 0.0f, 1.5f, 3.0f }, { HEAD0, { -2.0f, -25.0f }, HEAD0 }, 0 },
     /* fast moves: reaches of 0.25-0.3 s (up to ~2 m/s at the wrist),
      * both hands, out and back twice */
     { "fast", 3.0f,
@@ -646,34 +650,53 @@ static const seq_desc sequences[] = {
             { -0.200f, 1.000f, -0.520f, 0.10f, -0.20f, -1.0f, -0.4f, 1.0f, 0.0f, 0.5f },
             { LREST, 0.1f }, { LREST, 0.1f },
             { 0.020f, 1.020f, -0.480f, 0.30f, -0.20f, -1.0f, -0.4f, 1.0f, 0.0f, -0.2f },
-            { LREST, 0.1f }, { LREST, 0.1f } } },
+            { LREST, 0.1f }, { LREST, 0.1f } }, { 0 } },
         { 9, { 0.0f, 0.2f, 0.45f, 0.75f, 1.0f, 1.4f, 1.65f, 1.95f, 3.0f },
           { { RREST, 0.0f }, { RREST, 0.0f },
             { 0.220f, 0.990f, -0.530f, -0.10f, -0.20f, -1.0f, 0.4f, 1.0f, 0.0f, 0.8f },
             { 0.220f, 0.990f, -0.530f, -0.10f, -0.20f, -1.0f, 0.4f, 1.0f, 0.0f, 0.8f },
             { RREST, 0.0f }, { RREST, 0.0f },
             { -0.040f, 1.010f, -0.500f, -0.30f, -0.20f, -1.0f, 0.4f, 1.0f, 0.0f, -0.2f },
-            { RREST, 0.0f }, { RREST, 0.0f } } } },
-      4, { 0.0f, 0.5f, 1.5f, 3.0f }, { HEAD0, { -6.0f, -30.0f }, { 5.0f, -28.0f }, HEAD0 } },
-    /* calibration: both arms stretched forward, then sideways, then up
-     * forward (kin_user_calib_estimate takes the 95th percentile of the
-     * shoulder-hand distance); not rendered */
-    { "calib", 4.0f,
-      { { 6, { 0.0f, 0.6f, 1.4f, 2.2f, 3.0f, 4.0f },
+            { RREST, 0.0f }, { RREST, 0.0f } }, { 0 } } },
+      4, { 0.0f, 0.5f, 1.5f, 3.0f }, { HEAD0, { -6.0f, -30.0f }, { 5.0f, -28.0f }, HEAD0 }, 0 },
+    /* calibration: both arms stretched forward, then sideways
+     * (kin_user_calib_estimate takes the 95th percentile of the
+     * shoulder-hand distance); then the fingertip gesture of
+     * kin_user_calib_estimate_tips: the middle fingertips of both hands
+     * pressed together in front of the chest, fingers as straight as they
+     * go (grip -0.3), the pair turning 20 deg left, tilting 20 deg and
+     * turning 15 deg right, 2.1 s; the angles are solved for the true
+     * operator's own bones, so that its fingertips touch. Not rendered. */
+#define CTIP(x, y, z, fx, fy, fz, bx, by, bz) { x, y, z, fx, fy, fz, bx, by, bz, -0.3f }
+    { "calib", 7.7f,
+      { { 11, { 0.0f, 0.6f, 1.4f, 2.2f, 3.0f, 4.0f, 4.8f, 5.5f, 6.2f, 6.9f, 7.7f },
           { { LREST, 0.0f },
             { -0.190f, 0.970f, -0.700f, 0.0f, 0.0f, -1.0f, 0.0f, 1.0f, 0.0f, -0.3f },
             { -0.190f, 0.970f, -0.700f, 0.0f, 0.0f, -1.0f, 0.0f, 1.0f, 0.0f, -0.3f },
             { -0.890f, 0.970f, 0.000f, -1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, -0.3f },
             { -0.890f, 0.970f, 0.000f, -1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, -0.3f },
-            { LREST, 0.0f } } },
-        { 6, { 0.0f, 0.6f, 1.4f, 2.2f, 3.0f, 4.0f },
+            { LREST, 0.0f },
+            CTIP(0.000f, 1.000f, -0.360f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f),
+            CTIP(0.020f, 1.020f, -0.370f, 0.94f, 0.0f, -0.342f, 0.0f, 1.0f, 0.0f),
+            CTIP(0.000f, 1.030f, -0.350f, 0.94f, 0.342f, 0.0f, -0.342f, 0.94f, 0.0f),
+            CTIP(-0.010f, 1.000f, -0.380f, 0.966f, 0.0f, 0.259f, 0.0f, 1.0f, 0.0f),
+            { LREST, 0.0f } },
+          { 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 0 } },
+        { 11, { 0.0f, 0.6f, 1.4f, 2.2f, 3.0f, 4.0f, 4.8f, 5.5f, 6.2f, 6.9f, 7.7f },
           { { RREST, 0.0f },
             { 0.190f, 0.970f, -0.700f, 0.0f, 0.0f, -1.0f, 0.0f, 1.0f, 0.0f, -0.3f },
             { 0.190f, 0.970f, -0.700f, 0.0f, 0.0f, -1.0f, 0.0f, 1.0f, 0.0f, -0.3f },
             { 0.890f, 0.970f, 0.000f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, -0.3f },
             { 0.890f, 0.970f, 0.000f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, -0.3f },
-            { RREST, 0.0f } } } },
-      2, { 0.0f, 4.0f }, { HEAD0, HEAD0 } },
+            { RREST, 0.0f },
+            CTIP(0.000f, 1.000f, -0.360f, -1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f),
+            CTIP(0.020f, 1.020f, -0.370f, -0.94f, 0.0f, 0.342f, 0.0f, 1.0f, 0.0f),
+            CTIP(0.000f, 1.030f, -0.350f, -0.94f, -0.342f, 0.0f, -0.342f, 0.94f, 0.0f),
+            CTIP(-0.010f, 1.000f, -0.380f, -0.966f, 0.0f, -0.259f, 0.0f, 1.0f, 0.0f),
+            { RREST, 0.0f } },
+          { 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 0 } } },
+      2, { 0.0f, 7.7f }, { HEAD0, HEAD0 }, 1 },
+#undef CTIP
 };
 
 const char *gt_sequence_name(int i)
@@ -699,6 +722,86 @@ static void keys_eval(int n, const float *t, const float *v, int dim, float x, f
     float u = minjerk((x - t[i]) / (t[i + 1] - t[i]));
     const float *a = v + (size_t)i * (size_t)dim, *b = a + dim;
     for (int k = 0; k < dim; k++) out[k] = a[k] + (b[k] - a[k]) * u;
+}
+
+/* Finger flexion (degrees) of fingers 1..4 (index..little), joints 0..2,
+ * relaxed (grip 0) and grasping (grip 1). */
+static const float relax[4][3] = { { 10, 18, 8 }, { 14, 22, 10 }, { 18, 26, 12 }, { 22, 30, 14 } };
+static const float grasp[4][3] = { { 42, 62, 30 }, { 48, 66, 32 }, { 54, 70, 34 }, { 60, 72, 36 } };
+
+/* Local rotation of joint j (0..2) of finger f (1..4) at grip g. */
+static kin_quat finger_rot(const kin_model *m, const int *J, int f, int j, float g)
+{
+    int j1 = GEN_J_THUMB_1 + 3 * f;
+    float fl = relax[f - 1][j] + g * (grasp[f - 1][j] - relax[f - 1][j]);
+    kin_quat r = kin_quat_axis_angle(kin_v3(1, 0, 0), -fl * (PI_F / 180.0f));
+    return j == 0 ? kin_quat_mul(m->rest[J[j1]].r, r) : r;
+}
+
+/* The hand's world rotation of a key (-Z along the fingers c[3..5], +Y
+ * towards the back of the hand c[6..8]). */
+static kin_quat key_hand_rot(const float *c)
+{
+    kin_vec3 zh = kin_v3_scale(kin_v3_norm(kin_v3(c[3], c[4], c[5])), -1.0f);
+    kin_vec3 dors = kin_v3(c[6], c[7], c[8]);
+    kin_vec3 yh = kin_v3_norm(kin_v3_sub(dors, kin_v3_scale(zh, kin_v3_dot(dors, zh))));
+    return kin_quat_from_axes(kin_v3_cross(yh, zh), yh, zh);
+}
+
+/* What turns fingertip keys into wrist keys: the operator whose
+ * fingertips they are, and per side how far its middle fingertip's
+ * surface reaches beyond the middle_3 joint. */
+typedef struct tipper {
+    const kin_model *m;
+    const int *J[2];
+    float ext[2];
+} tipper;
+
+/* The middle fingertip in the hand joint's frame at grip g. */
+static kin_vec3 tip_in_hand(const tipper *tp, int s, float g)
+{
+    const kin_model *m = tp->m;
+    const int *J = tp->J[s];
+    kin_vec3 p = kin_v3(0.0f, 0.0f, -tp->ext[s]);
+    for (int j = 2; j >= 0; j--)
+        p = kin_v3_add(m->rest[J[GEN_J_MIDDLE_1 + j]].t, kin_quat_rotate(finger_rot(m, J, 2, j, g), p));
+    return kin_v3_add(m->rest[J[GEN_J_PALM]].t, kin_quat_rotate(m->rest[J[GEN_J_PALM]].r, p));
+}
+
+/* Key values c (xyz the middle fingertip) into a wrist key. */
+static void tip_to_wrist(const tipper *tp, int s, float *c)
+{
+    kin_vec3 t = kin_quat_rotate(key_hand_rot(c), tip_in_hand(tp, s, c[9]));
+    c[0] -= t.x;
+    c[1] -= t.y;
+    c[2] -= t.z;
+}
+
+/* The keys of one side at time x, as wrist keys: between two fingertip
+ * keys the fingertip is interpolated (it stays where the keys put it),
+ * else the wrists. Without fingertip keys this is keys_eval. */
+static void side_eval(const seq_side *sd, const tipper *tp, int s, float x, float *out)
+{
+    int n = sd->n, i = 0;
+    while (i + 1 < n && sd->t[i + 1] <= x) i++;
+    if (x <= sd->t[0] || i + 1 >= n) {
+        int k = x <= sd->t[0] ? 0 : n - 1;
+        memcpy(out, sd->v[k], sizeof(float) * SEQ_DIM);
+        if (sd->tip[k]) tip_to_wrist(tp, s, out);
+        return;
+    }
+    if (sd->tip[i] && sd->tip[i + 1]) {
+        keys_eval(n, sd->t, &sd->v[0][0], SEQ_DIM, x, out);
+        tip_to_wrist(tp, s, out);
+        return;
+    }
+    float a[SEQ_DIM], b[SEQ_DIM];
+    memcpy(a, sd->v[i], sizeof a);
+    memcpy(b, sd->v[i + 1], sizeof b);
+    if (sd->tip[i]) tip_to_wrist(tp, s, a);
+    if (sd->tip[i + 1]) tip_to_wrist(tp, s, b);
+    float u = minjerk((x - sd->t[i]) / (sd->t[i + 1] - sd->t[i]));
+    for (int k = 0; k < SEQ_DIM; k++) out[k] = a[k] + (b[k] - a[k]) * u;
 }
 
 /* World rotations of upper arm, forearm and hand of one side (the
@@ -727,7 +830,7 @@ static void seq_arm(kin_vec3 S, float L1, float L2, const float *c, float s, kin
     kin_vec3 zh = kin_v3_scale(kin_v3_norm(kin_v3(c[3], c[4], c[5])), -1.0f);
     kin_vec3 dors = kin_v3(c[6], c[7], c[8]);
     kin_vec3 yh = kin_v3_norm(kin_v3_sub(dors, kin_v3_scale(zh, kin_v3_dot(dors, zh))));
-    out[2] = kin_quat_from_axes(kin_v3_cross(yh, zh), yh, zh);
+    out[2] = kin_quat_from_axes(kin_v3_cross(yh, zh), yh, zh);   /* key_hand_rot(c) */
     kin_vec3 zf = kin_v3_scale(df, -1.0f), yf = kin_v3_cross(zf, n);
     kin_vec3 yp = kin_v3_sub(yh, kin_v3_scale(zf, kin_v3_dot(yh, zf)));
     float roll = 0.5f * atan2f(kin_v3_dot(kin_v3_cross(yf, yp), zf), kin_v3_dot(yf, yp));
@@ -777,8 +880,29 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
         ch[c] = (kin_channel){ nodes[c], KIN_PATH_ROTATION, KIN_INTERP_LINEAR, keys, 4, times, v };
     }
     /* the mask model's shoulders and bone lengths (the angles are then
-     * given to the true operator, as the generator does) */
-    kin_fk(m->parents, m->node_count, m->rest, NULL, w);
+     * given to the true operator, as the generator does), or for a
+     * true_bones sequence the true operator's own */
+    const kin_model *bones = sq->true_bones ? t : m;
+    kin_fk(bones->parents, bones->node_count, bones->rest, NULL, w);
+    tipper tp = { bones, { mask->joint[0], mask->joint[1] }, { 0.0f, 0.0f } };
+    const kin_mesh *bm = &bones->meshes[0];
+    const kin_skin *bs = &bones->skins[0];
+    for (int s = 0; s < 2; s++) {
+        /* the middle fingertip's surface beyond middle_3, along its bone
+         * (the mesh is in the bind pose, which is the rest pose) */
+        int m3 = mask->joint[s][GEN_J_MIDDLE_3];
+        kin_vec3 o = mat_t(&w[m3]);
+        kin_vec3 ax = kin_v3_norm(kin_v3(-w[m3].m[8], -w[m3].m[9], -w[m3].m[10]));
+        for (int v = 0; v < bm->vertex_count; v++) {
+            float wt = 0.0f;
+            for (int k = 0; k < 4; k++)
+                if (bs->joints[bm->joints[v * 4 + k]] == m3) wt += bm->weights[v * 4 + k];
+            if (wt < 0.5f) continue;
+            const float *p = &bm->positions[v * 3];
+            float e = kin_v3_dot(kin_v3_sub(kin_v3(p[0], p[1], p[2]), o), ax);
+            if (e > tp.ext[s]) tp.ext[s] = e;
+        }
+    }
     kin_vec3 S[2];
     float L1[2], L2[2];
     for (int s = 0; s < 2; s++) {
@@ -787,8 +911,6 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
         L1[s] = kin_v3_len(kin_v3_sub(mat_t(&w[J[GEN_J_FOREARM]]), S[s]));
         L2[s] = kin_v3_len(kin_v3_sub(mat_t(&w[J[GEN_J_HAND]]), mat_t(&w[J[GEN_J_FOREARM]])));
     }
-    static const float relax[4][3] = { { 10, 18, 8 }, { 14, 22, 10 }, { 18, 26, 12 }, { 22, 30, 14 } };
-    static const float grasp[4][3] = { { 42, 62, 30 }, { 48, 66, 32 }, { 54, 70, 34 }, { 60, 72, 36 } };
     const float D = PI_F / 180.0f;
     const kin_vec3 X = kin_v3(1, 0, 0);
     for (int k = 0; k < keys; k++) {
@@ -800,7 +922,7 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
         for (int s = 0; s < 2; s++) {
             const int *J = mask->joint[s];
             float sg = s ? 1.0f : -1.0f, c[SEQ_DIM];
-            keys_eval(sq->side[s].n, sq->side[s].t, &sq->side[s].v[0][0], SEQ_DIM, tk, c);
+            side_eval(&sq->side[s], &tp, s, tk, c);
             kin_quat wr[3];
             seq_arm(S[s], L1[s], L2[s], c, sg, wr);
             kin_quat pw = kin_quat_mul(m->rest[mask->body].r, m->rest[J[GEN_J_SHOULDER]].r);

@@ -62,9 +62,12 @@ int gt_truth_build(const gen_arms *mask, const gt_operator_desc *d,
  * the generator's "reach_grasp", then "cross" (the hands cross, one in
  * front of the other), "near" (the hands 15 cm from the eyes), "edge"
  * (the hands at and beyond the image borders), "fast" (reaches of
- * 0.25-0.3 s) and "calib" (the arms stretched forward and sideways: the
- * calibration motion of kin_user_calib_estimate, not meant to be
- * rendered). NULL past the last. */
+ * 0.25-0.3 s) and "calib" (7.7 s: the arms stretched forward and
+ * sideways, then the fingertip gesture, the middle fingertips of both
+ * hands pressed together: the calibration motion of
+ * kin_user_calib_estimate_tips, solved for the true operator's own bones
+ * so that its fingertips touch; not meant to be rendered). NULL past the
+ * last. */
 const char *gt_sequence_name(int i);
 
 /* Makes truth move through sequence `name`: its animation (joint angles

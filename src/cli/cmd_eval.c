@@ -20,6 +20,7 @@
 
 #include "../fuse/fuse_metrics.h"
 #include "../fuse/fuse_refine.h"
+#include "../pipe/pipe.h"
 #include "../../samples/gt/gt.h"
 
 static const char *eval_usage =
@@ -61,8 +62,9 @@ static const char *eval_usage =
     "  --csv FILE       write the summary table as CSV\n"
     "  --report DIR     also run the speed knobs (band width, elbow fit, global\n"
     "                   colour model, filter lag compensation, mask resolution,\n"
-    "                   triangles, LBS/DQS) and the tracking sweeps (noise,\n"
-    "                   latency, calibration error) on --sweep-frames frames, and\n"
+    "                   coverage samples per pixel (aa 4/8/16), triangles,\n"
+    "                   LBS/DQS) and the tracking sweeps (noise, latency,\n"
+    "                   calibration error) on --sweep-frames frames, and\n"
     "                   the methods on every other sequence on --seq-frames\n"
     "                   frames; write DIR/summary.csv, DIR/table.md, data files\n"
     "                   and the charts (gnuplot, PNG)\n"
@@ -84,6 +86,7 @@ typedef struct method_cfg {
     char group[16];          /* methods, band, res, tris, skin, noise, ... */
     float x;                 /* the swept value, for the charts */
     int dqs;
+    int aa;                  /* coverage samples per pixel: 1, 4, 8, 16 */
     int div;                 /* mask resolution divisor */
     int fine;                /* 1: the subdivided (4x triangles) mask model */
     int band;
@@ -105,6 +108,7 @@ typedef struct method_run {
     uint8_t *prev[2];        /* previous masks per eye */
     int have_prev;
     float swivel[2];         /* elbow fit of the last frame, radians */
+    pipe_fit *fit;           /* refine: the elbow fit and colour models */
     /* sums over frames and eyes */
     double iou, bf1, bf3, fp, fn, mse, flicker, flicker_den, secs;
     long n_eye, n_flicker, n_frames;
@@ -135,21 +139,16 @@ typedef struct eval_ctx {
     kin_camera tcam[2];
     /* method scratch */
     uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
+    uint32_t *aa_samples;    /* anti-aliased coverage, 640x400 */
     float *depth_lo, *nrm_lo, *mnrm;
     void *refine_scratch;
     size_t refine_scratch_size;
     kin_sthmd_geometry g;
-    /* elbow fit: colour model per eye, arm vertices per model and side */
-    float *llr[2];
-    void *cm_scratch;
-    size_t cm_scratch_size;
-    int *fitv[2][2];          /* [fine][side] vertex indices */
-    int fitn[2][2];
-    uint8_t *learn;           /* the colour model's learning mask */
     float *gt_depth;          /* gt_render_eye scratch, 640x480 */
     uint8_t *gt_mask;
     kin_user_calib calib;     /* estimated from the calibration motion */
     char calib_why[256];
+    int calib_hand_fallback;  /* 1: no fingertip gesture, hand = arm scale */
 } eval_ctx;
 
 typedef struct eval_opts {
@@ -191,147 +190,11 @@ static fuse_lighting workshop_lighting(const gen_scene *ws, const kin_camera *ca
 
 /* ----------------------------------------------------------- elbow fit */
 
-/* The IK places the elbow by a rule (kin_arm_ik_job: a swivel about the
- * shoulder-wrist line); a real operator's elbow is elsewhere on that circle
- * (the paper's "mismatch posture of elbows"). The refine method turns each
- * arm (upper arm and forearm, the wrist and hand fixed) about that line to
- * the swivel whose surface points fall on the most arm-coloured pixels of
- * both camera images: the colour model (fuse_colour_model_learn) is learned
- * from the previous frame's refined mask (the first frame: the kinematic
- * mask). Candidates every FIT_STEP within +-FIT_RANGE of the IK's elbow,
- * then +-FIT_STEP/2 around the best in 1 degree steps; a swivel changes by
- * at most FIT_RATE per frame. */
-#define FIT_BITS 4
-#define FIT_POINTS 400
-#define FIT_RANGE_DEG 60.0f
-#define FIT_STEP_DEG 5.0f
-#define FIT_RATE_DEG 12.0f
-#define FIT_PRIOR 0.05f       /* nats per point at 30 degrees from the IK */
+/* The refine method fits the elbows to the images with the library's
+ * pipe_fit (src/pipe/pipe.h: the swivel of each arm about its
+ * shoulder-wrist line whose surface falls on the most arm-coloured
+ * pixels), the same code as `egofuse render/run --refine`. */
 #define DEG2RAD 0.01745329252f
-
-/* Vertices bound (weight >= 0.9) to the upper arm or forearm of a side,
- * at most FIT_POINTS, evenly picked. */
-static int fit_vertices(const kin_model *m, const kin_arm_rig *rig, int *out[2], int n[2])
-{
-    const kin_mesh *me = &m->meshes[0];
-    const kin_skin *sk = &m->skins[0];
-    for (int s = 0; s < 2; s++) {
-        int ua = rig->joint[s][KIN_RIG_UPPER_ARM], fa = rig->joint[s][KIN_RIG_FOREARM];
-        int count = 0;
-        for (int pass = 0; pass < 2; pass++) {
-            int k = 0;
-            for (int v = 0; v < me->vertex_count; v++) {
-                float w = 0.0f;
-                for (int j = 0; j < 4; j++) {
-                    int node = sk->joints[me->joints[v * 4 + j]];
-                    if (node == ua || node == fa) w += me->weights[v * 4 + j];
-                }
-                if (w < 0.9f) continue;
-                if (pass == 1) {
-                    /* every (count / FIT_POINTS)-th */
-                    long lo = (long)k * FIT_POINTS / count, hi = (long)(k + 1) * FIT_POINTS / count;
-                    if (hi > lo && n[s] < FIT_POINTS) out[s][n[s]++] = v;
-                }
-                k++;
-            }
-            if (pass == 0) {
-                count = k;
-                n[s] = 0;
-                out[s] = malloc(sizeof(int) * FIT_POINTS);
-                if (!out[s] || count == 0) return -1;
-            }
-        }
-    }
-    return 0;
-}
-
-static kin_vec3 node_pos(const kin_mat4 *m) { return kin_v3(m->m[12], m->m[13], m->m[14]); }
-
-static kin_quat node_rot(const kin_mat4 *m)
-{
-    kin_vec3 x = kin_v3_norm(kin_v3(m->m[0], m->m[1], m->m[2]));
-    kin_vec3 y = kin_v3_norm(kin_v3(m->m[4], m->m[5], m->m[6]));
-    kin_vec3 z = kin_v3_norm(kin_v3_cross(x, y));
-    y = kin_v3_cross(z, x);
-    return kin_quat_normalize(kin_quat_from_axes(x, y, z));
-}
-
-/* Colour score of one side's arm turned by phi about S + t u: the clamped
- * log-likelihood ratios of the pixels its points project to, both eyes. */
-static float fit_score(const eval_ctx *c, const int *v, int n, const float *pos, kin_vec3 S,
-                       kin_vec3 u, float phi, const kin_camera cam[2])
-{
-    kin_quat q = kin_quat_axis_angle(u, phi);
-    float score = 0.0f;
-    for (int e = 0; e < 2; e++) {
-        const float *M = cam[e].view_proj.m;
-        const uint8_t *P = c->P[e];
-        const float *llr = c->llr[e];
-        for (int i = 0; i < n; i++) {
-            const float *p = &pos[(size_t)v[i] * 3];
-            kin_vec3 r = kin_v3_add(S, kin_quat_rotate(q, kin_v3(p[0] - S.x, p[1] - S.y, p[2] - S.z)));
-            float w = M[3] * r.x + M[7] * r.y + M[11] * r.z + M[15];
-            if (!(w > 1e-3f)) continue;
-            float x = (M[0] * r.x + M[4] * r.y + M[8] * r.z + M[12]) / w;
-            float y = (M[1] * r.x + M[5] * r.y + M[9] * r.z + M[13]) / w;
-            int px = (int)floorf((x * 0.5f + 0.5f) * CW), py = (int)floorf((0.5f - y * 0.5f) * CH);
-            if (px < 0 || py < 0 || px >= CW || py >= CH) continue;
-            score += llr[fuse_colour_bin(P + ((size_t)py * CW + (size_t)px) * 4, FIT_BITS)];
-        }
-    }
-    return score;
-}
-
-/* Turns the arm of side s by phi about its shoulder-wrist line in locals
- * (world = FK of locals; the hand keeps its world rotation). */
-static void apply_swivel(const kin_arm_rig *rig, const kin_model *m, const kin_mat4 *world,
-                         int s, float phi, kin_transform *locals)
-{
-    int ua = rig->joint[s][KIN_RIG_UPPER_ARM], fa = rig->joint[s][KIN_RIG_FOREARM];
-    int hd = rig->joint[s][KIN_RIG_HAND];
-    kin_vec3 u = kin_v3_norm(kin_v3_sub(node_pos(&world[hd]), node_pos(&world[ua])));
-    int par = m->parents[ua];
-    kin_quat qp = par >= 0 ? node_rot(&world[par]) : kin_quat_identity();
-    kin_quat qf = node_rot(&world[fa]);
-    kin_vec3 ap = kin_quat_rotate(kin_quat_conjugate(qp), u);
-    kin_vec3 af = kin_quat_rotate(kin_quat_conjugate(qf), u);
-    locals[ua].r = kin_quat_normalize(kin_quat_mul(kin_quat_axis_angle(ap, phi), locals[ua].r));
-    locals[hd].r = kin_quat_normalize(kin_quat_mul(kin_quat_axis_angle(af, -phi), locals[hd].r));
-}
-
-/* The best swivel of each side (radians, relative to the IK's elbow) for
- * the skinned positions pos, searched around prev (NULL: the whole
- * range). */
-static void fit_swivels(const eval_ctx *c, int fine, const kin_mat4 *world, const float *pos,
-                        const kin_camera cam[2], const float prev[2], float best[2])
-{
-    for (int s = 0; s < 2; s++) {
-        int ua = c->rig.joint[s][KIN_RIG_UPPER_ARM], hd = c->rig.joint[s][KIN_RIG_HAND];
-        kin_vec3 S = node_pos(&world[ua]);
-        kin_vec3 u = kin_v3_norm(kin_v3_sub(node_pos(&world[hd]), S));
-        const float range = FIT_RANGE_DEG * DEG2RAD, rate = FIT_RATE_DEG * DEG2RAD;
-        float p0 = prev ? prev[s] : 0.0f;
-        float lo = prev ? p0 - rate : -range, hi = prev ? p0 + rate : range;
-        if (lo < -range) lo = -range;
-        if (hi > range) hi = range;
-        float bphi = p0 < lo ? lo : p0 > hi ? hi : p0;
-        const float pk = FIT_PRIOR * 2.0f * (float)c->fitn[fine][s] / (30.0f * 30.0f * DEG2RAD * DEG2RAD);
-        float bsc = fit_score(c, c->fitv[fine][s], c->fitn[fine][s], pos, S, u, bphi, cam) -
-                    pk * bphi * bphi;
-        for (int pass = 0; pass < 2; pass++) {
-            float step = (pass ? 1.0f : FIT_STEP_DEG) * DEG2RAD;
-            float a = pass ? bphi - 0.5f * FIT_STEP_DEG * DEG2RAD : lo;
-            float b = pass ? bphi + 0.5f * FIT_STEP_DEG * DEG2RAD : hi;
-            for (float phi = a; phi <= b + 1e-6f; phi += step) {
-                if (phi < lo || phi > hi) continue;
-                float sc = fit_score(c, c->fitv[fine][s], c->fitn[fine][s], pos, S, u, phi, cam) -
-                           pk * phi * phi;
-                if (sc > bsc) { bsc = sc; bphi = phi; }
-            }
-        }
-        best[s] = bphi;
-    }
-}
 
 /* ------------------------------------------------------------- set-up */
 
@@ -349,34 +212,39 @@ static void ctx_free(eval_ctx *c)
     for (int e = 0; e < 2; e++) {
         free(c->P[e]); free(c->sil[e]); free(c->sil_prev[e]); free(c->tnrm[e]); free(c->V[e]); free(c->ideal[e]);
     }
+    free(c->aa_samples);
     free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->layer); free(c->out);
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
-    free(c->llr[0]); free(c->llr[1]); free(c->cm_scratch); free(c->learn);
     free(c->gt_depth); free(c->gt_mask);
-    for (int f = 0; f < 2; f++)
-        for (int s = 0; s < 2; s++) free(c->fitv[f][s]);
     memset(c, 0, sizeof *c);
 }
 
 /* The user calibration as a cockpit would make it: the true operator
- * stretches the arms forward and sideways (gt sequence "calib", 4 s), the
- * tracker records it (noise, dropouts) and kin_user_calib_estimate turns it
- * into scales. */
+ * stretches the arms forward and sideways, then presses the middle
+ * fingertips of both hands together (gt sequence "calib", 7.7 s), the
+ * tracker records it (noise, dropouts) and kin_user_calib_estimate_tips
+ * turns it into scales: the hands' from the gesture and the mask model's
+ * fingertips (kin_user_calib_hand_tips), never from the truth's. */
 static int estimate_calib(eval_ctx *c, const gt_track_desc *track)
 {
     gen_arms cal = c->truth;
     if (gt_sequence_build(&c->mask, "calib", &cal) < 0) return -1;
     c->truth.model.block = cal.model.block;   /* the same block, maybe moved */
-    int n = (int)(4.0f * track->rate_hz);
+    int n = (int)(cal.model.anims[0].duration * track->rate_hz) + 1;
     kin_track_sample *S = malloc(sizeof *S * (size_t)n);
     float *scratch = malloc(sizeof(float) * (size_t)n);
     int rc = -1;
+    kin_vec3 tips[2];
     if (S && scratch) {
         for (int k = 0; k < n; k++)
             gt_track_sample(&cal, track, k, c->tlocals, c->tworld, &S[k]);
-        rc = kin_user_calib_estimate(S, n, &c->rig, scratch, &c->calib, c->calib_why,
-                                     sizeof c->calib_why);
+        int have_tips = kin_user_calib_hand_tips(&c->rig, &c->mask.model, tips, c->calib_why,
+                                                 sizeof c->calib_why) == 0;
+        rc = kin_user_calib_estimate_tips(S, n, &c->rig, have_tips ? tips : NULL, scratch,
+                                          &c->calib, c->calib_why, sizeof c->calib_why);
+        c->calib_hand_fallback = rc == 1;
+        if (rc == 1) rc = 0;
     }
     free(S);
     free(scratch);
@@ -428,6 +296,7 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
         ok = c->P[e] && c->sil[e] && c->sil_prev[e] && c->tnrm[e] && c->V[e] && c->ideal[e];
     }
     c->mask_lo = malloc(cp);
+    c->aa_samples = malloc(sizeof(uint32_t) * cp);
     c->mask_up = malloc(cp);
     c->refined = malloc(cp);
     c->layer = malloc(cp * 4);
@@ -440,19 +309,11 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     rp.margin = 64;
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
-    ok = ok && c->mask_lo && c->mask_up && c->refined && c->layer && c->out && c->depth_lo &&
+    ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && c->layer && c->out && c->depth_lo &&
          c->nrm_lo && c->mnrm && c->refine_scratch;
-    c->cm_scratch_size = fuse_colour_model_scratch_size(FIT_BITS);
-    c->cm_scratch = malloc(c->cm_scratch_size);
-    c->learn = malloc(cp);
     c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
     c->gt_mask = malloc((size_t)GEN_CAM_W * GEN_CAM_H);
-    for (int e = 0; e < 2; e++) c->llr[e] = malloc(sizeof(float) << (3 * FIT_BITS));
-    ok = ok && c->cm_scratch && c->learn && c->gt_depth && c->gt_mask && c->llr[0] &&
-         c->llr[1];
-    for (int f = 0; f < 2 && ok; f++)
-        ok = fit_vertices(f ? &c->mask_fine.model : &c->mask.model, &c->rig, c->fitv[f],
-                          c->fitn[f]) == 0;
+    ok = ok && c->gt_depth && c->gt_mask;
     if (!ok) return -1;
     if (estimate_calib(c, track) < 0) {
         cli_fail("user calibration from the calibration motion: %s", c->calib_why);
@@ -521,6 +382,11 @@ static int run_init(method_run *r, const method_cfg *cfg, const eval_ctx *c)
     r->prev[0] = malloc((size_t)CW * CH);
     r->prev[1] = malloc((size_t)CW * CH);
     if (!r->locals || !r->prev[0] || !r->prev[1]) return -1;
+    if (cfg->kind == M_REFINE) {
+        r->fit = pipe_fit_create(NULL, cfg->fine ? &c->mask_fine.model : &c->mask.model,
+                                 &c->rig, CW, CH);
+        if (!r->fit) return -1;
+    }
     kin_pose_rest(&c->mask.model, r->locals);
     return 0;
 }
@@ -530,6 +396,7 @@ static void run_free(method_run *r)
     free(r->locals);
     free(r->prev[0]);
     free(r->prev[1]);
+    pipe_fit_destroy(r->fit);
 }
 
 /* Copies the valid parts of s over *dst. */
@@ -633,6 +500,15 @@ static int draw_mask(eval_ctx *c, const method_cfg *cfg, const kin_mesh *me, int
         rast_mesh_desc d = { c->clip, me->vertex_count, c->vnrm, 3, me->indices,
                              me->index_count / 3, RAST_CULL_NONE };
         if (rast_draw(&tg, &d, NULL) != RAST_OK) return -1;
+        if (cfg->aa > 1) {
+            /* the mask from cfg->aa coverage samples per pixel (depth and
+             * normals stay those of the centres) */
+            rast_aa_target at = { w, h, c->aa_samples, w, cfg->aa };
+            rast_aa_clear(&at);
+            if (rast_draw_aa(&at, &d, NULL) != RAST_OK ||
+                rast_aa_resolve(&at, c->mask_lo, w) != RAST_OK)
+                return -1;
+        }
     }
     if (div == 1) {
         *mask = c->mask_lo;
@@ -651,39 +527,26 @@ static kin_camera eye_camera(const eval_ctx *c, int e)
     return kin_sthmd_camera(&hd, &c->world[c->rig.head], (kin_eye)e);
 }
 
-/* The elbow fit of the refine method (see fit_swivels): learns the colour
- * models, finds the swivels, turns the arms in r->locals. */
+/* The elbow fit of the refine method (pipe_fit): learns the colour
+ * models where the kinematic mask and the last refined mask agree, finds
+ * the swivels, turns the arms in r->locals. */
 static int fit_elbows(eval_ctx *c, method_run *r, const kin_model *m, uint32_t valid)
 {
     const kin_mesh *me = &m->meshes[0];
     kin_camera cam[2];
+    fuse_image P[2];
     for (int e = 0; e < 2; e++) {
         cam[e] = eye_camera(c, e);
-        /* learn where the kinematic mask and the last refined mask agree */
+        P[e] = (fuse_image){ c->P[e], CW, CH, 4 * CW };
         const uint8_t *m0;
         const float *nrm;
         if (draw_mask(c, &r->cfg, me, 1, &cam[e], &m0, &nrm) < 0) return -1;
-        const uint8_t *learn = m0;
-        if (r->have_prev) {
-            for (size_t i = 0; i < (size_t)CW * CH; i++) {
-                int a = m0[i] >= 128, b = r->prev[e][i] >= 128;
-                c->learn[i] = a && b ? 255 : !a && !b ? 0 : 128;
-            }
-            learn = c->learn;
-        }
-        fuse_colour_model cm = { FIT_BITS, 0, 0, c->llr[e] };
-        fuse_image P = { c->P[e], CW, CH, 4 * CW };
-        if (fuse_colour_model_learn(&cm, &P, learn, CW, 4, 2, 3.0f, 64, c->cm_scratch,
-                                    c->cm_scratch_size) != FUSE_OK)
+        if (pipe_fit_learn(r->fit, e, &P[e], m0, CW, r->have_prev ? r->prev[e] : NULL, CW) !=
+            FUSE_OK)
             return -1;
     }
-    float best[2];
-    fit_swivels(c, r->cfg.fine, c->world, c->pos, cam, r->have_prev ? r->swivel : NULL, best);
-    for (int s = 0; s < 2; s++) {
-        if (!(valid & (KIN_TRACK_HAND_L << s))) continue;
-        apply_swivel(&c->rig, m, c->world, s, best[s], r->locals);
-        r->swivel[s] = best[s];
-    }
+    unsigned sides = ((valid & KIN_TRACK_HAND_L) ? 1u : 0u) | ((valid & KIN_TRACK_HAND_R) ? 2u : 0u);
+    pipe_fit_elbows(r->fit, c->world, c->pos, cam, P, sides, r->locals, r->swivel);
     return 0;
 }
 
@@ -746,10 +609,9 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 fuse_refine_params rp = fuse_refine_params_default();
                 rp.band = cfg->band;
                 fuse_image P = { c->P[e], CW, CH, 4 * CW };
-                fuse_colour_model g = { FIT_BITS, 0, 0, c->llr[e] };
                 fuse_result fr =
                     cfg->fit && cfg->global > 0.0f
-                        ? fuse_refine_mask_global(&rp, &g, cfg->global, &P, mask, CW, c->refined,
+                        ? fuse_refine_mask_global(&rp, pipe_fit_colour(r->fit, e), cfg->global, &P, mask, CW, c->refined,
                                                   CW, c->refine_scratch, c->refine_scratch_size,
                                                   NULL)
                         : fuse_refine_mask(&rp, &P, mask, CW, c->refined, CW, c->refine_scratch,
@@ -820,6 +682,7 @@ static method_cfg base_cfg(const eval_opts *o, method_kind k)
     memset(&c, 0, sizeof c);
     c.kind = k;
     c.div = 1;
+    c.aa = 1;
     c.band = o->band;
     c.fit = k == M_REFINE;
     c.global = o->global;
@@ -900,6 +763,11 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, method_c
                 c.div = div;
                 n = add_cfg(L, n, cap, c);
             }
+            for (int aa = 4; aa <= 16; aa *= 2) {
+                c = named_cfg(o, (method_kind)k, "aa", (float)aa, "aa", "");
+                c.aa = aa;
+                n = add_cfg(L, n, cap, c);
+            }
             c = named_cfg(o, (method_kind)k, "tris", 4.0f, "tris", "x");
             c.fine = 1;
             n = add_cfg(L, n, cap, c);
@@ -965,10 +833,11 @@ static void print_calib(FILE *f, const eval_ctx *c)
 {
     float arm, hand, sh;
     true_scales(c, &arm, &hand, &sh);
-    fprintf(f, "calibration (kin_user_calib_estimate on the calibration motion): arm x%.3f "
-               "(true %.3f), hand x%.3f (true %.3f), shoulders x%.3f (true %.3f)\n",
+    fprintf(f, "calibration (kin_user_calib_estimate_tips on the calibration motion): arm "
+               "x%.3f (true %.3f), hand x%.3f (true %.3f, %s), shoulders x%.3f (true %.3f)\n",
             (double)c->calib.arm_scale[1], (double)arm, (double)c->calib.hand_scale[1],
-            (double)hand, (double)c->calib.shoulder_scale, (double)sh);
+            (double)hand, c->calib_hand_fallback ? c->calib_why : "fingertip gesture",
+            (double)c->calib.shoulder_scale, (double)sh);
 }
 
 static int write_csv(const char *path, const method_run *R, int n)
@@ -1105,7 +974,7 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
     fprintf(f, "Ground truth: sequence %s, tracking noise %g mm, latency %g ms, dropout %g, "
                "calibration error %g, speed %g, seed %d. Frames: %d for the methods (group "
                "methods), %d for the speed knobs (groups knobs, band, fit, global, lagcomp, "
-               "res, tris, dqs) and the tracking sweeps (groups track, noise, latency, calib), "
+               "res, aa, tris, dqs) and the tracking sweeps (groups track, noise, latency, calib), "
                "%d per other sequence (group sequence).\n\n",
             o->sequence, (double)o->noise, (double)o->latency, (double)o->dropout,
             (double)o->calib_error, (double)o->speed, o->seed, o->frames, o->sweep_frames,
@@ -1125,7 +994,7 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
             if ((int)cf->kind != k) continue;
             if (strcmp(cf->group, "knobs") && strcmp(cf->group, "band") &&
                 strcmp(cf->group, "res") && strcmp(cf->group, "tris") &&
-                strcmp(cf->group, "dqs") && strcmp(cf->group, "fit") &&
+                strcmp(cf->group, "dqs") && strcmp(cf->group, "fit") && strcmp(cf->group, "aa") &&
                 strcmp(cf->group, "global") && strcmp(cf->group, "lagcomp"))
                 continue;
             summary s = summarise(&R[i]);

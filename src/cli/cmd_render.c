@@ -14,6 +14,7 @@ static const char *render_usage =
     "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
     "                      [--tone-match S] [--pose animation|tracking]\n"
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
+    "                      [--refine BAND]\n"
     "\n"
     "Composites a recorded sequence (docs/scene.md): for each frame, poses the\n"
     "mask model at t = frame / fps, renders its mask and normals from both\n"
@@ -48,6 +49,10 @@ static const char *render_usage =
     "  --no-filter    with --pose tracking: the newest raw sample, no filter\n"
     "\n"
     "EGOFUSE_ISA=ref|sse2|avx2|avx512 caps the instruction set (same bytes).\n"
+    "  --refine BAND  refine the masks by colour in a band of BAND px (1..64,\n"
+    "                 16 is `egofuse eval`'s default) around their edges; with\n"
+    "                 --pose tracking the elbows are first fitted to the camera\n"
+    "                 images (pipe_fit): eval's method refine\n"
     "  -h, --help     this text\n";
 
 static const char *demo_usage =
@@ -75,6 +80,7 @@ typedef struct render_opts {
     float predict_ms;      /* display time past the frame time */
     int no_filter;         /* raw samples instead of the One Euro filter */
     int cull_back;         /* cull back faces (closed models) */
+    int refine;            /* refinement band, px; 0 = off */
 } render_opts;
 
 /* The pose from tracking: the recording, the rig, the filter and the
@@ -87,6 +93,7 @@ typedef struct track_pose {
     kin_filter filter;
     kin_transform *locals;
     int rejected;              /* samples kin_arm_rig_pose could not use */
+    unsigned fit_skip;         /* pipe_frame_in.fit_skip: untracked hands */
 } track_pose;
 
 static void track_pose_free(track_pose *tp)
@@ -145,6 +152,7 @@ static void track_pose_at(track_pose *tp, const render_opts *o, const kin_model 
         else kin_filter_output(&tp->filter, t + 1e-3 * o->predict_ms, &cur, NULL);
     }
     kin_pose_rest(model, tp->locals);
+    tp->fit_skip = ((cur.valid & KIN_TRACK_HAND_L) ? 0u : 1u) | ((cur.valid & KIN_TRACK_HAND_R) ? 0u : 2u);
     if (!kin_arm_rig_pose(&tp->rig, model, &tp->calib, NULL, &cur, tp->locals, NULL)) {
         /* a sample the model cannot take: keep the rest pose, count it */
         kin_pose_rest(model, tp->locals);
@@ -262,6 +270,8 @@ static int render(const render_opts *o)
     pd.threads = o->threads;
     pd.tone_match = o->tone_match;
     pd.cull = o->cull_back ? RAST_CULL_BACK : RAST_CULL_NONE;
+    pd.refine_band = o->refine;
+    pd.fit_rig = o->refine && o->pose_tracking ? &tp.rig : NULL;
     pipe_ctx *pp = pipe_create(&pd, &model);
     kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
     io_image cam[2] = {{0}}, virt[2] = {{0}}, vdepth[2] = {{0}}, rgb = {0};
@@ -312,6 +322,7 @@ static int render(const render_opts *o)
         if (o->pose_tracking) {
             track_pose_at(&tp, o, &model, (double)f / (double)sc.fps);
             in.locals = tp.locals;
+            in.fit_skip = tp.fit_skip;
         }
         char why[256];
         pipe_result pr_ = pipe_frame(pp, &in, &st, why, sizeof why);
@@ -368,7 +379,7 @@ done:
 }
 
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
-       O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER };
+       O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE };
 
 int cmd_render(int argc, char **argv)
 {
@@ -382,6 +393,7 @@ int cmd_render(int argc, char **argv)
         {"threads", required_argument, 0, O_THREADS},
         {"no-depth", no_argument, 0, O_NO_DEPTH},
         {"cull-back", no_argument, 0, O_CULL},
+        {"refine", required_argument, 0, O_REFINE},
         {"tone-match", required_argument, 0, O_TONE},
         {"pose", required_argument, 0, O_POSE},
         {"calib", required_argument, 0, O_CALIB},
@@ -416,6 +428,10 @@ int cmd_render(int argc, char **argv)
             break;
         case O_NO_DEPTH: o.no_depth = 1; break;
         case O_CULL: o.cull_back = 1; break;
+        case O_REFINE:
+            if (!cli_parse_int(optarg, 1, 64, &o.refine))
+                return cli_usage_error("render", "--refine '%s': a band of 1..64 px", optarg);
+            break;
         case O_TONE:
             if (!cli_parse_float(optarg, &o.tone_match) || o.tone_match < 0.0f || o.tone_match > 1.0f)
                 return cli_usage_error("render", "--tone-match '%s': a strength in [0, 1]", optarg);

@@ -46,6 +46,10 @@ static const char *run_usage =
     "                   stdout: | ffplay -f rawvideo -pixel_format rgb24\n"
     "                   -video_size 1280x1600 -\n"
     "  --frames N       stop after N stereo frames (default: until Ctrl-C)\n"
+    "  --refine BAND    refine the masks by colour in a band of BAND px (1..64,\n"
+    "                   16 in `egofuse eval`) around their edges; with\n"
+    "                   --track-port the elbows are first fitted to the\n"
+    "                   camera images (eval's method refine)\n"
     "  --quiet          no status line\n"
     "  -h, --help       this text\n"
     "\n"
@@ -56,6 +60,7 @@ typedef struct run_opts {
     const char *scene, *model, *virt[2], *sel[2], *glove_sel[2], *calib, *out;
     uint32_t fourcc;
     int fps, input, dv, buffers, track_port, raw, frames, quiet;
+    int refine;             /* refinement band, px; 0 = off */
 } run_opts;
 
 static volatile sig_atomic_t stop_flag;
@@ -263,6 +268,8 @@ static int run(const run_opts *o)
             goto done;
         }
     }
+    pd.refine_band = o->refine;
+    pd.fit_rig = o->refine && o->track_port ? &rig : NULL;
     if (!(pipe = pipe_create(&pd, &model))) {
         cli_fail("cannot start the pipeline (out of memory or no thread)");
         goto done;
@@ -365,6 +372,8 @@ static int run(const run_opts *o)
                 kin_pose_rest(&model, locals);
                 if (kin_arm_rig_pose(&rig, &model, &ucal, NULL, &sample, locals, NULL))
                     in.locals = locals;
+                in.fit_skip = ((sample.valid & KIN_TRACK_HAND_L) ? 0u : 1u) |
+                              ((sample.valid & KIN_TRACK_HAND_R) ? 0u : 2u);
             }
         }
         char why[256];
@@ -450,7 +459,7 @@ done:
 }
 
 enum { O_SCENE = 256, O_MODEL, O_VIRT, O_LEFT, O_RIGHT, O_FORMAT, O_FPS, O_INPUT, O_DV, O_BUFFERS,
-       O_TRACK, O_GLOVE_L, O_GLOVE_R, O_CALIB, O_OUT, O_RAW, O_FRAMES, O_QUIET };
+       O_TRACK, O_GLOVE_L, O_GLOVE_R, O_CALIB, O_OUT, O_RAW, O_FRAMES, O_QUIET, O_REFINE };
 
 int cmd_run(int argc, char **argv)
 {
@@ -466,6 +475,7 @@ int cmd_run(int argc, char **argv)
         {"calib", required_argument, 0, O_CALIB},   {"out", required_argument, 0, O_OUT},
         {"raw", no_argument, 0, O_RAW},             {"frames", required_argument, 0, O_FRAMES},
         {"quiet", no_argument, 0, O_QUIET},         {"help", no_argument, 0, 'h'},
+        {"refine", required_argument, 0, O_REFINE},
         {0, 0, 0, 0},
     };
     run_opts o;
@@ -525,6 +535,10 @@ int cmd_run(int argc, char **argv)
                 return cli_usage_error("run", "--frames '%s': not a positive count", optarg);
             break;
         case O_QUIET: o.quiet = 1; break;
+        case O_REFINE:
+            if (!cli_parse_int(optarg, 1, 64, &o.refine))
+                return cli_usage_error("run", "--refine '%s': a band of 1..64 px", optarg);
+            break;
         case ':': return cli_usage_error("run", "option %s needs a value", argv[optind - 1]);
         default: return cli_usage_error("run", "unknown option '%s'", argv[optind - 1]);
         }

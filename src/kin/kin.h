@@ -541,6 +541,9 @@ typedef struct kin_user_calib {
     float shoulder_width;     /* measured, metres */
     int has_glove[2];
     kin_glove_calib glove[2];
+    float hand_length[2];     /* measured wrist to middle fingertip (the
+                                 fingertip gesture), metres; 0 = not
+                                 measured (hand_scale = arm_scale) */
 } kin_user_calib;
 
 /* Scale 1 everywhere, no glove calibration. */
@@ -573,6 +576,35 @@ int kin_arm_rig_pose(const kin_arm_rig *rig, const kin_model *model,
 int kin_user_calib_estimate(const kin_track_sample *samples, int n,
                             const kin_arm_rig *rig, float *scratch,
                             kin_user_calib *out, char *why, size_t why_size);
+
+/* The middle fingertip of each hand in its hand joint's frame (the frame
+ * of kin_track_sample.hand_rot), metres, for the model's rest pose of the
+ * fingers: the middle_3 joint moved along its bone (-Z) to the farthest
+ * surface point of the vertices bound to it (weight >= 0.5, mesh 0 posed
+ * by its skin at rest); the joint itself when no vertex is bound to it.
+ * Returns 0, or -1 with a reason (no skinned mesh, bad rig). */
+int kin_user_calib_hand_tips(const kin_arm_rig *rig, const kin_model *model,
+                             kin_vec3 tip[2], char *why, size_t why_size);
+
+/* kin_user_calib_estimate, and the hand scale measured on its own from the
+ * fingertip gesture of the recording (docs/tracking.md): the hands held
+ * with the fingers straight and the middle fingertips of both hands
+ * pressed together (the hands may turn). A sample with both hands is
+ * taken as the gesture when, with a = rot_L tip[0], b = rot_R tip[1],
+ * d = a - b, g = hand_pos[1] - hand_pos[0] (touch: g = s d):
+ *   |d| >= 0.75 (|tip[0]| + |tip[1]|)   (fingers roughly opposed),
+ *   s = g.d / d.d in [0.5, 2] and |g - s d| <= 2 cm;
+ * with >= 20 such samples, hand_scale (both sides) is the midpoint of the
+ * shortest interval holding half of their s (robust to the approach,
+ * where the gap between the fingertips makes s larger), hand_length[k] =
+ * hand_scale |tip[k]|. tip == NULL or too few gesture samples: hand_scale
+ * = arm_scale, hand_length 0, the reason in why, and the return value 1.
+ * Returns 0 (everything measured), 1 (hand scale from the arms) or -1 as
+ * kin_user_calib_estimate. scratch: n floats. */
+int kin_user_calib_estimate_tips(const kin_track_sample *samples, int n,
+                                 const kin_arm_rig *rig, const kin_vec3 tip[2],
+                                 float *scratch, kin_user_calib *out,
+                                 char *why, size_t why_size);
 /* Text file "egofuse-calib 1" (docs/tracking.md) into buf; returns the
  * length needed (like snprintf). */
 int kin_user_calib_format(const kin_user_calib *c, char *buf, size_t size);

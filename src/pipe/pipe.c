@@ -1,6 +1,7 @@
 /* pipe.c - one stereo frame, end to end (see pipe.h). */
 #include "pipe.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -111,12 +112,19 @@ static void pose_fk(pipe_pose *ps)
 /* Skins part `part` of `parts` of every mesh's vertices into world space.
  * Every vertex is skinned on its own, so the bytes do not depend on how
  * the vertices are split. Parts start on multiples of 16 vertices so that
- * the SIMD paths run full blocks. */
-static void pose_skin_part(pipe_pose *ps, int part, int parts)
+ * the SIMD paths run full blocks. plans (per mesh, or NULL): skin plans of
+ * the skinned meshes (kin_skin_lbs_plan: the same bytes as kin_skin_lbs,
+ * about 2x faster; parts are runs of its batches). */
+static void pose_skin_part(pipe_pose *ps, const kin_skin_plan *plans, int part, int parts)
 {
     const kin_model *m = ps->model;
     for (int i = 0; i < m->mesh_count; i++) {
         const kin_mesh *me = &ps->meshes[i];
+        if (me->skin >= 0 && plans && plans[i].batches) {
+            kin_skin_lbs_plan_part(&plans[i], ps->joint_mats[me->skin], ps->pos[i], ps->nrm[i],
+                                   part, parts, 0);
+            continue;
+        }
         int per = ((me->vertex_count + parts - 1) / parts + 15) & ~15;
         int v0 = part * per, v1 = v0 + per < me->vertex_count ? v0 + per : me->vertex_count;
         if (v0 >= v1) continue;
@@ -142,7 +150,7 @@ static void pose_skin_part(pipe_pose *ps, int part, int parts)
 static void pose_skin(pipe_pose *ps)
 {
     pose_fk(ps);
-    pose_skin_part(ps, 0, 1);
+    pose_skin_part(ps, NULL, 0, 1);
 }
 
 static void pose_locals_anim(pipe_pose *ps, const kin_animation *anim, float t)
@@ -196,6 +204,11 @@ typedef struct eye_state {
     float *depth, *nrm, *clip, *vnrm;
     uint8_t *mask, *layer;
     uint8_t *cam_rgba;        /* the cropped camera image, when given raw */
+    uint8_t *refined;         /* the refined mask (refine_band) */
+    void *refine_scratch;
+    size_t refine_scratch_size;
+    int have_refined;         /* refined holds the last frame's mask */
+    int converted;            /* cam_rgba already holds this frame's crop */
     rast_context *rast;
     fuse_context *fuse;
     kin_camera cam;
@@ -221,6 +234,10 @@ struct pipe_ctx {
     int job_seq, done_seq, quit;
     int job_kind;             /* JOB_SKIN or JOB_EYE */
     int skin_split;           /* skin on both threads (large models) */
+    kin_skin_plan *plans;     /* per mesh: the skin plan of a skinned mesh */
+    void **plan_mem;          /* per mesh: its memory, or NULL */
+    pipe_fit *fit;            /* elbow fit (refine_band and fit_rig) */
+    kin_arm_rig fit_rig;
 };
 
 enum { JOB_SKIN, JOB_EYE };
@@ -287,7 +304,9 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     fe.lighting = &L;
     fe.intrinsics = &K;
     e->ms_convert = 0.0;
-    if (in->camera_raw[e->eye].data) {
+    if (e->converted) {
+        fe.P = (fuse_image){e->cam_rgba, cw, ch, 4 * cw};
+    } else if (in->camera_raw[e->eye].data) {
         double tc = now_ms();
         fe.P = (fuse_image){e->cam_rgba, cw, ch, 4 * cw};
         fuse_result cr = fuse_frame_to_rgba_isa(&in->camera_raw[e->eye], p->geo.crop_y0, &fe.P,
@@ -304,6 +323,24 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     }
     fe.mask = e->mask;
     fe.mask_stride = cw;
+    if (p->desc.refine_band > 0) {
+        fuse_refine_params rp = fuse_refine_params_default();
+        rp.band = p->desc.refine_band;
+        fuse_result rr2 =
+            p->fit ? fuse_refine_mask_global(&rp, pipe_fit_colour(p->fit, e->eye), 0.5f, &fe.P,
+                                             e->mask, cw, e->refined, cw, e->refine_scratch,
+                                             e->refine_scratch_size, NULL)
+                   : fuse_refine_mask(&rp, &fe.P, e->mask, cw, e->refined, cw,
+                                      e->refine_scratch, e->refine_scratch_size, NULL);
+        if (rr2 != FUSE_OK) {
+            e->result = PIPE_ERR_FUSE;
+            snprintf(e->why, sizeof e->why, "%s eye: mask refinement: %s",
+                     e->eye ? "right" : "left", fuse_result_str(rr2));
+            return;
+        }
+        e->have_refined = 1;
+        fe.mask = e->refined;
+    }
     fe.normal = e->nrm;
     fe.normal_stride = 3 * cw;
     fe.Q = (fuse_image){e->layer, cw, ch, 4 * cw};
@@ -347,7 +384,7 @@ static void *worker_main(void *arg)
         seen = p->job_seq;
         int kind = p->job_kind;
         pthread_mutex_unlock(&p->mu);
-        if (kind == JOB_SKIN) pose_skin_part(&p->pose, 1, 2);
+        if (kind == JOB_SKIN) pose_skin_part(&p->pose, p->plans, 1, 2);
         else run_eye(p, &p->eye[1]);
         pthread_mutex_lock(&p->mu);
         p->done_seq = seen;
@@ -391,9 +428,43 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].mask);
         free(p->eye[e].layer);
         free(p->eye[e].cam_rgba);
+        free(p->eye[e].refined);
+        free(p->eye[e].refine_scratch);
         rast_context_destroy(p->eye[e].rast);
         fuse_context_destroy(p->eye[e].fuse);
     }
+    pipe_fit_destroy(p->fit);
+    p->fit = NULL;
+}
+
+static void skin_plans_free(pipe_ctx *p)
+{
+    for (int i = 0; p->plan_mem && i < p->pose.model->mesh_count; i++) free(p->plan_mem[i]);
+    free(p->plan_mem);
+    free(p->plans);
+    p->plan_mem = NULL;
+    p->plans = NULL;
+}
+
+/* A skin plan per skinned mesh (of pose.meshes, whose normals are filled
+ * in), built once. Returns 0, or -1 when out of memory. */
+static int skin_plans_build(pipe_ctx *p)
+{
+    const int nm = p->pose.model->mesh_count;
+    p->plans = calloc((size_t)nm + 1, sizeof *p->plans);
+    p->plan_mem = calloc((size_t)nm + 1, sizeof *p->plan_mem);
+    if (!p->plans || !p->plan_mem) return -1;
+    for (int i = 0; i < nm; i++) {
+        const kin_mesh *me = &p->pose.meshes[i];
+        if (me->skin < 0) continue;
+        void *scratch = malloc(kin_skin_plan_scratch_size(me) + 16);
+        size_t bytes = scratch ? kin_skin_plan_size(me, scratch) : 0;
+        p->plan_mem[i] = bytes ? aligned_alloc(64, (bytes + 63) & ~(size_t)63) : NULL;
+        int rc = p->plan_mem[i] ? kin_skin_plan_init(&p->plans[i], me, scratch, p->plan_mem[i], bytes) : -1;
+        free(scratch);
+        if (rc != 0) return -1;
+    }
+    return 0;
 }
 
 pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
@@ -427,7 +498,25 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         s->fuse = fuse_context_create(&fd);
         ok = ok && s->depth && s->nrm && s->mask && s->layer && s->cam_rgba && s->clip && s->vnrm &&
              s->rast && s->fuse;
+        if (ok && p->desc.refine_band > 0) {
+            fuse_refine_params rp = fuse_refine_params_default();
+            rp.band = p->desc.refine_band;
+            s->refine_scratch_size =
+                fuse_refine_scratch_size(&rp, p->geo.crop_width, p->geo.crop_height);
+            s->refined = malloc(px);
+            s->refine_scratch = s->refine_scratch_size
+                                    ? aligned_alloc(16, (s->refine_scratch_size + 15) & ~(size_t)15)
+                                    : NULL;
+            ok = s->refined && s->refine_scratch;
+        }
     }
+    if (ok && p->desc.refine_band > 0 && p->desc.fit_rig) {
+        p->fit_rig = *p->desc.fit_rig;
+        p->desc.fit_rig = &p->fit_rig;
+        p->fit = pipe_fit_create(NULL, model, &p->fit_rig, p->geo.crop_width, p->geo.crop_height);
+        ok = p->fit != NULL;
+    }
+    ok = ok && skin_plans_build(p) == 0;
     p->threaded = p->desc.threads != 1;
     long nv_all = 0;
     for (int i = 0; i < model->mesh_count; i++) nv_all += model->meshes[i].vertex_count;
@@ -444,6 +533,7 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
     }
     if (!ok) {
         free_eyes(p);
+        skin_plans_free(p);
         pipe_pose_free(&p->pose);
         free(p);
         return NULL;
@@ -464,8 +554,57 @@ void pipe_destroy(pipe_ctx *p)
         pthread_cond_destroy(&p->cv);
     }
     free_eyes(p);
+    skin_plans_free(p);
     pipe_pose_free(&p->pose);
     free(p);
+}
+
+/* The elbow fit (pipe_fit) on the caller's thread: each eye's cropped
+ * camera image (converted here when raw: the eye's thread then uses it)
+ * and kinematic mask, the colour models, the swivels; then the pose is
+ * skinned again. */
+static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_mat4 *head,
+                              char *why, int why_size)
+{
+    const int cw = p->geo.crop_width, ch = p->geo.crop_height;
+    kin_camera cam[2];
+    fuse_image P[2];
+    for (int e = 0; e < 2; e++) {
+        eye_state *s = &p->eye[e];
+        cam[e] = kin_sthmd_camera(&p->hmd, head, (kin_eye)e);
+        if (in->camera_raw[e].data) {
+            P[e] = (fuse_image){s->cam_rgba, cw, ch, 4 * cw};
+            fuse_result cr = fuse_frame_to_rgba_isa(&in->camera_raw[e], p->geo.crop_y0, &P[e],
+                                                    (ef_isa)p->desc.max_isa);
+            if (cr != FUSE_OK) {
+                if (why && why_size > 0)
+                    snprintf(why, (size_t)why_size, "%s eye: camera frame: %s",
+                             e ? "right" : "left", fuse_result_str(cr));
+                return PIPE_ERR_ARGS;
+            }
+            s->converted = 1;
+        } else {
+            P[e] = fuse_image_rows(&in->camera[e], p->geo.crop_y0, ch);
+        }
+        rast_target tg = {cw, ch, s->depth, cw, s->mask, cw, s->nrm, 3 * cw, 3};
+        rast_context_clear(s->rast, &tg);
+        rast_result rr = pipe_pose_draw(&p->pose, s->rast, &cam[e], &tg, p->desc.cull, s->clip,
+                                        s->vnrm, NULL);
+        fuse_result lr = rr == RAST_OK ? pipe_fit_learn(p->fit, e, &P[e], s->mask, cw,
+                                                        s->have_refined ? s->refined : NULL, cw)
+                                       : FUSE_OK;
+        if (rr != RAST_OK || lr != FUSE_OK) {
+            if (why && why_size > 0)
+                snprintf(why, (size_t)why_size, "%s eye: elbow fit: %s", e ? "right" : "left",
+                         rr != RAST_OK ? rast_result_str(rr) : fuse_result_str(lr));
+            return rr != RAST_OK ? PIPE_ERR_RASTER : PIPE_ERR_FUSE;
+        }
+    }
+    pipe_fit_elbows(p->fit, p->pose.world, p->pose.pos[0], cam, P, 3u & ~in->fit_skip,
+                    p->pose.locals, NULL);
+    pose_fk(&p->pose);
+    pose_skin_part(&p->pose, p->plans, 0, 1);
+    return PIPE_OK;
 }
 
 pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
@@ -515,14 +654,19 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
     pose_fk(&p->pose);
     if (p->threaded && p->skin_split) {
         int job = post_job(p, JOB_SKIN);
-        pose_skin_part(&p->pose, 0, 2);
+        pose_skin_part(&p->pose, p->plans, 0, 2);
         wait_job(p, job);
     } else {
-        pose_skin_part(&p->pose, 0, 1);
+        pose_skin_part(&p->pose, p->plans, 0, 1);
     }
     kin_mat4 head = in->head_node >= 0 ? p->pose.world[in->head_node]
                     : in->world_from_head ? *in->world_from_head
                                           : kin_mat4_identity();
+    for (int e = 0; e < 2; e++) p->eye[e].converted = 0;
+    if (p->fit && in->locals) {
+        pipe_result fr = fit_elbows(p, in, &head, why, why_size);
+        if (fr != PIPE_OK) return fr;
+    }
     double t1 = now_ms();
     for (int e = 0; e < 2; e++) {
         p->eye[e].in = in;
@@ -559,7 +703,8 @@ const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
 {
     if (width) *width = p->geo.crop_width;
     if (height) *height = p->geo.crop_height;
-    return p->eye[eye ? 1 : 0].mask;
+    const eye_state *e = &p->eye[eye ? 1 : 0];
+    return e->have_refined ? e->refined : e->mask;
 }
 
 kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].cam; }
@@ -577,4 +722,238 @@ const char *pipe_result_str(pipe_result r)
     case PIPE_ERR_FUSE: return "lighting/composite error";
     }
     return "unknown error";
+}
+
+/* ------------------------------------------------------- elbow fit */
+
+#define FIT_DEG2RAD 0.01745329252f
+
+struct pipe_fit {
+    pipe_fit_desc d;
+    const kin_model *model;
+    kin_arm_rig rig;
+    int width, height;
+    int *v[2];                /* vertex indices per side */
+    int n[2];
+    float swivel[2];
+    int have_prev;
+    float *llr[2];            /* colour model per eye */
+    fuse_colour_model cm[2];
+    uint8_t *learn;           /* width x height */
+    void *scratch;
+    size_t scratch_size;
+};
+
+/* Vertices bound (weight >= 0.9) to the upper arm or forearm of a side,
+ * at most d.points, evenly picked. -1 when a side has none. */
+static int fit_vertices(pipe_fit *f)
+{
+    const kin_mesh *me = &f->model->meshes[0];
+    const kin_skin *sk = &f->model->skins[0];
+    const int P = f->d.points;
+    for (int s = 0; s < 2; s++) {
+        int ua = f->rig.joint[s][KIN_RIG_UPPER_ARM], fa = f->rig.joint[s][KIN_RIG_FOREARM];
+        int count = 0;
+        f->n[s] = 0;
+        for (int pass = 0; pass < 2; pass++) {
+            int k = 0;
+            for (int v = 0; v < me->vertex_count; v++) {
+                float w = 0.0f;
+                for (int j = 0; j < 4; j++) {
+                    int node = sk->joints[me->joints[v * 4 + j]];
+                    if (node == ua || node == fa) w += me->weights[v * 4 + j];
+                }
+                if (w < 0.9f) continue;
+                if (pass == 1) {
+                    long lo = (long)k * P / count, hi = (long)(k + 1) * P / count;
+                    if (hi > lo && f->n[s] < P) f->v[s][f->n[s]++] = v;
+                }
+                k++;
+            }
+            if (pass == 0) {
+                count = k;
+                if (count == 0) return -1;
+            }
+        }
+    }
+    return 0;
+}
+
+pipe_fit *pipe_fit_create(const pipe_fit_desc *desc, const kin_model *model,
+                          const kin_arm_rig *rig, int width, int height)
+{
+    if (!model || !rig || width < 1 || height < 1 || model->mesh_count < 1 ||
+        model->skin_count < 1 || !model->meshes[0].joints || !model->meshes[0].weights)
+        return NULL;
+    pipe_fit *f = calloc(1, sizeof *f);
+    if (!f) return NULL;
+    if (desc) f->d = *desc;
+    if (!(f->d.range_deg > 0.0f)) f->d.range_deg = 60.0f;
+    if (!(f->d.step_deg > 0.0f)) f->d.step_deg = 5.0f;
+    if (!(f->d.rate_deg > 0.0f)) f->d.rate_deg = 12.0f;
+    if (!(f->d.prior > 0.0f)) f->d.prior = 0.05f;
+    if (f->d.points <= 0) f->d.points = 400;
+    f->model = model;
+    f->rig = *rig;
+    f->width = width;
+    f->height = height;
+    f->scratch_size = fuse_colour_model_scratch_size(PIPE_FIT_BITS);
+    f->scratch = malloc(f->scratch_size);
+    f->learn = malloc((size_t)width * (size_t)height);
+    int ok = f->scratch && f->learn;
+    for (int e = 0; e < 2; e++) {
+        f->llr[e] = calloc((size_t)1 << (3 * PIPE_FIT_BITS), sizeof(float));
+        f->cm[e] = (fuse_colour_model){ PIPE_FIT_BITS, 0, 0, f->llr[e] };
+        f->v[e] = malloc(sizeof(int) * (size_t)f->d.points);
+        ok = ok && f->llr[e] && f->v[e];
+    }
+    if (!ok || fit_vertices(f) < 0) {
+        pipe_fit_destroy(f);
+        return NULL;
+    }
+    return f;
+}
+
+void pipe_fit_destroy(pipe_fit *f)
+{
+    if (!f) return;
+    for (int e = 0; e < 2; e++) {
+        free(f->llr[e]);
+        free(f->v[e]);
+    }
+    free(f->learn);
+    free(f->scratch);
+    free(f);
+}
+
+void pipe_fit_reset(pipe_fit *f)
+{
+    f->have_prev = 0;
+    f->swivel[0] = f->swivel[1] = 0.0f;
+}
+
+const fuse_colour_model *pipe_fit_colour(const pipe_fit *f, int eye)
+{
+    return &f->cm[eye ? 1 : 0];
+}
+
+fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint8_t *mask,
+                           int mask_stride, const uint8_t *prev, int prev_stride)
+{
+    if (!f || !P || !mask || eye < 0 || eye > 1 || P->width != f->width ||
+        P->height != f->height || mask_stride < f->width || (prev && prev_stride < f->width))
+        return FUSE_ERR_ARGS;
+    const uint8_t *learn = mask;
+    int stride = mask_stride;
+    if (prev) {
+        for (int y = 0; y < f->height; y++)
+            for (int x = 0; x < f->width; x++) {
+                int a = mask[(size_t)y * (size_t)mask_stride + (size_t)x] >= 128;
+                int b = prev[(size_t)y * (size_t)prev_stride + (size_t)x] >= 128;
+                f->learn[(size_t)y * (size_t)f->width + (size_t)x] =
+                    a && b ? 255 : !a && !b ? 0 : 128;
+            }
+        learn = f->learn;
+        stride = f->width;
+    }
+    return fuse_colour_model_learn(&f->cm[eye], P, learn, stride, 4, 2, 3.0f, 64, f->scratch,
+                                   f->scratch_size);
+}
+
+static kin_vec3 fit_node_pos(const kin_mat4 *m) { return kin_v3(m->m[12], m->m[13], m->m[14]); }
+
+static kin_quat fit_node_rot(const kin_mat4 *m)
+{
+    kin_vec3 x = kin_v3_norm(kin_v3(m->m[0], m->m[1], m->m[2]));
+    kin_vec3 y = kin_v3_norm(kin_v3(m->m[4], m->m[5], m->m[6]));
+    kin_vec3 z = kin_v3_norm(kin_v3_cross(x, y));
+    y = kin_v3_cross(z, x);
+    return kin_quat_normalize(kin_quat_from_axes(x, y, z));
+}
+
+/* Colour score of side s's arm turned by phi about S + t u. */
+static float fit_score(const pipe_fit *f, int s, const float *pos, kin_vec3 S, kin_vec3 u,
+                       float phi, const kin_camera cam[2], const fuse_image P[2])
+{
+    kin_quat q = kin_quat_axis_angle(u, phi);
+    const int W = f->width, H = f->height;
+    float score = 0.0f;
+    for (int e = 0; e < 2; e++) {
+        const float *M = cam[e].view_proj.m;
+        const float *llr = f->llr[e];
+        for (int i = 0; i < f->n[s]; i++) {
+            const float *p = &pos[(size_t)f->v[s][i] * 3];
+            kin_vec3 r = kin_v3_add(S, kin_quat_rotate(q, kin_v3(p[0] - S.x, p[1] - S.y, p[2] - S.z)));
+            float w = M[3] * r.x + M[7] * r.y + M[11] * r.z + M[15];
+            if (!(w > 1e-3f)) continue;
+            float x = (M[0] * r.x + M[4] * r.y + M[8] * r.z + M[12]) / w;
+            float y = (M[1] * r.x + M[5] * r.y + M[9] * r.z + M[13]) / w;
+            int px = (int)floorf((x * 0.5f + 0.5f) * (float)W);
+            int py = (int)floorf((0.5f - y * 0.5f) * (float)H);
+            if (px < 0 || py < 0 || px >= W || py >= H) continue;
+            const uint8_t *rgb = P[e].pixels + (size_t)py * (size_t)P[e].stride + (size_t)px * 4;
+            score += llr[fuse_colour_bin(rgb, PIPE_FIT_BITS)];
+        }
+    }
+    return score;
+}
+
+/* Turns the arm of side s by phi about its shoulder-wrist line in locals
+ * (world = FK of locals; the hand keeps its world rotation). */
+static void fit_apply(const pipe_fit *f, const kin_mat4 *world, int s, float phi,
+                      kin_transform *locals)
+{
+    const kin_model *m = f->model;
+    int ua = f->rig.joint[s][KIN_RIG_UPPER_ARM], fa = f->rig.joint[s][KIN_RIG_FOREARM];
+    int hd = f->rig.joint[s][KIN_RIG_HAND];
+    kin_vec3 u = kin_v3_norm(kin_v3_sub(fit_node_pos(&world[hd]), fit_node_pos(&world[ua])));
+    int par = m->parents[ua];
+    kin_quat qp = par >= 0 ? fit_node_rot(&world[par]) : kin_quat_identity();
+    kin_quat qf = fit_node_rot(&world[fa]);
+    kin_vec3 ap = kin_quat_rotate(kin_quat_conjugate(qp), u);
+    kin_vec3 af = kin_quat_rotate(kin_quat_conjugate(qf), u);
+    locals[ua].r = kin_quat_normalize(kin_quat_mul(kin_quat_axis_angle(ap, phi), locals[ua].r));
+    locals[hd].r = kin_quat_normalize(kin_quat_mul(kin_quat_axis_angle(af, -phi), locals[hd].r));
+}
+
+void pipe_fit_elbows(pipe_fit *f, const kin_mat4 *world, const float *pos,
+                     const kin_camera cam[2], const fuse_image P[2], unsigned sides,
+                     kin_transform *locals, float swivel[2])
+{
+    const float D = FIT_DEG2RAD;
+    float best[2];
+    for (int s = 0; s < 2; s++) {
+        int ua = f->rig.joint[s][KIN_RIG_UPPER_ARM], hd = f->rig.joint[s][KIN_RIG_HAND];
+        kin_vec3 S = fit_node_pos(&world[ua]);
+        kin_vec3 u = kin_v3_norm(kin_v3_sub(fit_node_pos(&world[hd]), S));
+        const float range = f->d.range_deg * D, rate = f->d.rate_deg * D;
+        float p0 = f->have_prev ? f->swivel[s] : 0.0f;
+        float lo = f->have_prev ? p0 - rate : -range, hi = f->have_prev ? p0 + rate : range;
+        if (lo < -range) lo = -range;
+        if (hi > range) hi = range;
+        float bphi = p0 < lo ? lo : p0 > hi ? hi : p0;
+        const float pk = f->d.prior * 2.0f * (float)f->n[s] / (30.0f * 30.0f * D * D);
+        float bsc = fit_score(f, s, pos, S, u, bphi, cam, P) - pk * bphi * bphi;
+        for (int pass = 0; pass < 2; pass++) {
+            float step = (pass ? 1.0f : f->d.step_deg) * D;
+            float a = pass ? bphi - 0.5f * f->d.step_deg * D : lo;
+            float b = pass ? bphi + 0.5f * f->d.step_deg * D : hi;
+            for (float phi = a; phi <= b + 1e-6f; phi += step) {
+                if (phi < lo || phi > hi) continue;
+                float sc = fit_score(f, s, pos, S, u, phi, cam, P) - pk * phi * phi;
+                if (sc > bsc) { bsc = sc; bphi = phi; }
+            }
+        }
+        best[s] = bphi;
+    }
+    for (int s = 0; s < 2; s++) {
+        if (!(sides & (1u << s))) continue;
+        fit_apply(f, world, s, best[s], locals);
+        f->swivel[s] = best[s];
+    }
+    f->have_prev = 1;
+    if (swivel) {
+        swivel[0] = best[0];
+        swivel[1] = best[1];
+    }
 }

@@ -31,6 +31,7 @@
 #define EGOFUSE_PIPE_H
 
 #include "../fuse/fuse.h"
+#include "../fuse/fuse_refine.h"
 #include "../kin/kin.h"
 #include "../raster/raster.h"
 
@@ -89,6 +90,16 @@ typedef struct pipe_desc {
                                  the triangle setups, right for closed,
                                  consistently wound meshes (the samples'
                                  arms: the masks are identical) */
+    int refine_band;          /* 0 = off; 1..64: each eye's mask is refined
+                                 by colour in a band of this half width
+                                 around its edge (fuse_refine_mask; with
+                                 fit_rig, fuse_refine_mask_global with the
+                                 elbow fit's colour model, weight 0.5:
+                                 `egofuse eval`'s refine method) */
+    const kin_arm_rig *fit_rig; /* with refine_band, and frames posed by
+                                 pipe_frame_in.locals: fit the elbows to the
+                                 camera images (pipe_fit) before the eyes
+                                 are drawn; NULL = no fit. Copied. */
 } pipe_desc;
 
 typedef struct pipe_ctx pipe_ctx;
@@ -129,6 +140,9 @@ typedef struct pipe_frame_in {
     const float *virt_depth[2];
     int virt_depth_stride[2]; /* floats per row */
     pipe_lighting lighting;
+    /* With an elbow fit (pipe_desc.fit_rig): bit 0 / bit 1 = do not turn
+     * the left / right arm (its hand is not tracked this frame). */
+    unsigned fit_skip;
 } pipe_frame_in;
 
 typedef struct pipe_frame_stats {
@@ -154,7 +168,8 @@ void  pipe_destroy(pipe_ctx *p);
  * sentence naming the eye and the reason. */
 pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
                        pipe_frame_stats *stats, char *why, int why_size);
-/* The last frame's G-buffer of one eye (valid until the next frame). */
+/* The last frame's mask of one eye (valid until the next frame): the
+ * refined one with pipe_desc.refine_band, else the G-buffer's. */
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The camera of one eye in the last frame. */
 kin_camera pipe_camera(const pipe_ctx *p, int eye);
@@ -164,6 +179,66 @@ int pipe_isa(const pipe_ctx *p);
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p);
 
 const char *pipe_result_str(pipe_result r);
+
+/* ------------------------------------------------------- elbow fit
+ *
+ * The IK places each elbow by a rule (kin_arm_ik_job: a swivel about the
+ * shoulder-wrist line); a real operator's elbow is elsewhere on that
+ * circle (the paper's "mismatch posture of elbows"). pipe_fit turns each
+ * arm (upper arm and forearm; the wrist and the hand keep their world
+ * pose) about that line to the swivel whose surface points (up to
+ * `points` vertices bound to the upper arm or forearm with weight >= 0.9,
+ * evenly picked) fall on the most arm-coloured pixels of both camera
+ * images: the sum over both eyes of the clamped log-likelihood ratio of
+ * the colour model (fuse_colour_model_learn, PIPE_FIT_BITS bits per
+ * channel) at the pixel each point projects to, minus a prior
+ * prior * points * (phi / 30 deg)^2 that trusts the IK. Search: every
+ * step_deg within +-range_deg of the IK's elbow on the first frame after
+ * a reset, then within +-rate_deg of the last swivel; then 1-degree steps
+ * within +-step_deg/2 of the best. The colour model of each eye is learned
+ * from the camera image where this frame's kinematic mask and the last
+ * refined mask agree (the first frame: the kinematic mask alone; learning
+ * margin 4 px, every 2nd pixel, clamp 3 nats, >= 64 samples per class).
+ * Used by `egofuse eval` (method refine), and by pipe_frame when
+ * pipe_desc.refine_band and fit_rig are set (docs/accuracy.md). No
+ * allocation after pipe_fit_create. */
+#define PIPE_FIT_BITS 4
+
+typedef struct pipe_fit_desc {
+    float range_deg;          /* default 60 */
+    float step_deg;           /* default 5 */
+    float rate_deg;           /* per frame, default 12 */
+    float prior;              /* nats per point at 30 deg, default 0.05 */
+    int points;               /* per arm, default 400 */
+} pipe_fit_desc;
+
+typedef struct pipe_fit pipe_fit;
+
+/* For mesh 0 of model (skinned by skin 0) and the rig's joints; images of
+ * width x height. desc NULL or zero fields = defaults. NULL when out of
+ * memory or the model has no vertex bound to an arm. */
+pipe_fit *pipe_fit_create(const pipe_fit_desc *desc, const kin_model *model,
+                          const kin_arm_rig *rig, int width, int height);
+void pipe_fit_destroy(pipe_fit *f);
+/* Forgets the last swivels (the next fit searches the whole range). */
+void pipe_fit_reset(pipe_fit *f);
+/* Learns eye's colour model from P (RGBA8, width x height) and this
+ * frame's kinematic mask (inside = >= 128), with the last refined mask
+ * prev (NULL: none). FUSE_ERR_ARGS for bad arguments. */
+fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P,
+                           const uint8_t *mask, int mask_stride,
+                           const uint8_t *prev, int prev_stride);
+/* Fits both swivels for the posed model (world: FK of locals, pos: mesh
+ * 0 skinned to world space) seen by cam[0], cam[1] (view_proj maps onto
+ * the images P[0], P[1], width x height), turns the arms of the sides
+ * whose bit is set in `sides` (bit 0 left, bit 1 right: those whose hand
+ * is tracked) in locals and remembers their swivels. swivel (NULL or 2
+ * floats) receives the swivels of this frame, radians from the IK's. */
+void pipe_fit_elbows(pipe_fit *f, const kin_mat4 *world, const float *pos,
+                     const kin_camera cam[2], const fuse_image P[2],
+                     unsigned sides, kin_transform *locals, float swivel[2]);
+/* The colour model eye learned last (for fuse_refine_mask_global). */
+const fuse_colour_model *pipe_fit_colour(const pipe_fit *f, int eye);
 
 #ifdef __cplusplus
 }
