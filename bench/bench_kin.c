@@ -11,9 +11,11 @@
  *   twist.csv/.png         wrist ring radius error, LBS vs DQS, -180..180
  *   predict.csv/.png       hand position error vs prediction horizon
  * and prints the time of filter + IK + FK + skinning of a 10k-vertex arm
- * per frame (LBS and DQS, each straight from the mesh and through a skin
- * plan built once, on every ISA the CPU runs, all in the same run; medians
- * of batches).
+ * per frame: LBS and DQS, each straight from the mesh and through a skin
+ * plan built once, side by side on every ISA the CPU runs, for two meshes
+ * (joints drawn at random per vertex, the plan's worst case, and a
+ * rig-like mesh with vertices in rings along the bones), all in the same
+ * run; medians of batches.
  * `--timing-only` (last argument) prints only the timing. Ground truth:
  * an arm of other proportions than the model's, driven by joint angles
  * (not by this IK), seeded noise.
@@ -324,6 +326,73 @@ static int add_node(bench_model *b, const char *name, int parent, kin_vec3 t)
     return i;
 }
 
+/* The two timed meshes of NV vertices on the bench rig (world: its rest
+ * pose). m[0] "random": each vertex 2 cm around a joint drawn at random,
+ * influences (joint, parent) with a random split: the skin plan's worst
+ * case (every batch scattered). m[1] "rig": as a real rig, the vertices
+ * of each bone in rings along it, in vertex order (bone by bone), radius
+ * 2-3 cm, weights by the position t along the bone: (parent 1-t, joint t)
+ * listed by decreasing weight, the parent alone over the first 10%. */
+static void bench_meshes(const bench_model *b, const kin_mat4 *world, float *pos, float *nrm,
+                         uint16_t *jt, float *wt, float *pos2, float *nrm2, uint16_t *jt2,
+                         float *wt2, int nv, kin_mesh m[2])
+{
+    const int nn = b->m.node_count;
+    rng r = { 5 };
+    for (int v = 0; v < nv; v++) {
+        int j = 2 + (int)(unit(&r) * (nn - 2));
+        int p = b->parents[j] >= 0 ? b->parents[j] : j;
+        kin_vec3 c = kin_v3(world[j].m[12], world[j].m[13], world[j].m[14]);
+        kin_vec3 n = kin_v3_norm(noise3(&r, 1.0f));
+        kin_vec3 x = kin_v3_add(c, kin_v3_scale(n, 0.02f));
+        memcpy(pos + 3 * v, &x, 12);
+        memcpy(nrm + 3 * v, &n, 12);
+        float a = (float)unit(&r);
+        jt[4 * v] = (uint16_t)j; jt[4 * v + 1] = (uint16_t)p; jt[4 * v + 2] = jt[4 * v + 3] = 0;
+        wt[4 * v] = a; wt[4 * v + 1] = 1 - a; wt[4 * v + 2] = wt[4 * v + 3] = 0;
+    }
+    /* bones: nodes 2.. with a parent (the arm and finger joints) */
+    const int bones = nn - 2;
+    for (int v = 0; v < nv; v++) {
+        int bi = (int)((long long)v * bones / nv);
+        int v0 = (int)(((long long)bi * nv + bones - 1) / bones);
+        int v1 = (int)(((long long)(bi + 1) * nv + bones - 1) / bones);
+        int j = 2 + bi, p = b->parents[j] >= 0 ? b->parents[j] : j;
+        float t = (float)(v - v0) / (float)(v1 - v0);
+        kin_vec3 P = kin_v3(world[p].m[12], world[p].m[13], world[p].m[14]);
+        kin_vec3 C = kin_v3(world[j].m[12], world[j].m[13], world[j].m[14]);
+        kin_vec3 ax = kin_v3_sub(C, P);
+        if (kin_v3_len(ax) == 0.0f) ax = kin_v3(0, 0, -1);
+        kin_vec3 e1 = kin_v3_norm(kin_v3_cross(ax, fabsf(ax.y) < 0.9f * kin_v3_len(ax)
+                                                       ? kin_v3(0, 1, 0) : kin_v3(1, 0, 0)));
+        kin_vec3 e2 = kin_v3_norm(kin_v3_cross(ax, e1));
+        float ang = 2.0f * PI_F * (float)((v - v0) % 16) / 16.0f;
+        kin_vec3 n = kin_v3_add(kin_v3_scale(e1, cosf(ang)), kin_v3_scale(e2, sinf(ang)));
+        float rad = 0.02f + 0.01f * (float)unit(&r);
+        kin_vec3 x = kin_v3_add(kin_v3_add(P, kin_v3_scale(ax, t)), kin_v3_scale(n, rad));
+        memcpy(pos2 + 3 * v, &x, 12);
+        memcpy(nrm2 + 3 * v, &n, 12);
+        uint16_t *J = jt2 + 4 * v;
+        float *w = wt2 + 4 * v;
+        J[2] = J[3] = 0; w[2] = w[3] = 0;
+        if (t < 0.1f) {
+            J[0] = (uint16_t)p; J[1] = (uint16_t)j; w[0] = 1; w[1] = 0;
+        } else if (t < 0.5f) {
+            J[0] = (uint16_t)p; J[1] = (uint16_t)j; w[0] = 1 - t; w[1] = t;
+        } else {
+            J[0] = (uint16_t)j; J[1] = (uint16_t)p; w[0] = t; w[1] = 1 - t;
+        }
+    }
+    for (int k = 0; k < 2; k++) {
+        memset(&m[k], 0, sizeof m[k]);
+        m[k].vertex_count = nv;
+        m[k].positions = k ? pos2 : pos;
+        m[k].normals = k ? nrm2 : nrm;
+        m[k].joints = k ? jt2 : jt;
+        m[k].weights = k ? wt2 : wt;
+    }
+}
+
 static void timing(void)
 {
     static bench_model b;
@@ -363,90 +432,100 @@ static void timing(void)
     enum { NV = 10000 };
     static float pos[NV * 3], nrm[NV * 3], wt[NV * 4], po[NV * 3], no[NV * 3];
     static uint16_t jt[NV * 4];
-    rng r = { 5 };
-    for (int v = 0; v < NV; v++) {
-        int j = 2 + (int)(unit(&r) * (nn - 2));
-        int p = b.parents[j] >= 0 ? b.parents[j] : j;
-        kin_vec3 c = kin_v3(world[j].m[12], world[j].m[13], world[j].m[14]);
-        kin_vec3 n = kin_v3_norm(noise3(&r, 1.0f));
-        kin_vec3 x = kin_v3_add(c, kin_v3_scale(n, 0.02f));
-        memcpy(pos + 3 * v, &x, 12);
-        memcpy(nrm + 3 * v, &n, 12);
-        float a = (float)unit(&r);
-        jt[4 * v] = (uint16_t)j; jt[4 * v + 1] = (uint16_t)p; jt[4 * v + 2] = jt[4 * v + 3] = 0;
-        wt[4 * v] = a; wt[4 * v + 1] = 1 - a; wt[4 * v + 2] = wt[4 * v + 3] = 0;
-    }
-    kin_mesh m;
-    memset(&m, 0, sizeof m);
-    m.vertex_count = NV; m.positions = pos; m.normals = nrm; m.joints = jt; m.weights = wt;
-    /* the skin plan: built once per mesh (not timed) */
-    size_t ns = kin_skin_plan_scratch_size(&m);
-    void *scratch = malloc(ns);
-    size_t plan_bytes = scratch ? kin_skin_plan_size(&m, scratch) : 0;
-    void *plan_mem = plan_bytes ? aligned_alloc(64, (plan_bytes + 63) & ~(size_t)63) : NULL;
-    kin_skin_plan plan;
-    if (!plan_mem || kin_skin_plan_init(&plan, &m, scratch, plan_mem, plan_bytes)) {
-        printf("skin plan: out of memory\n");
+    /* the skin plans: built once per mesh (not timed) */
+    kin_skin_plan plan[2];
+    void *plan_mem[2] = { NULL, NULL };
+    kin_mesh m[2];
+    static float pos2[NV * 3], nrm2[NV * 3], wt2[NV * 4];
+    static uint16_t jt2[NV * 4];
+    bench_meshes(&b, world, pos, nrm, jt, wt, pos2, nrm2, jt2, wt2, NV, m);
+    static const char *const mesh_name[2] = {
+        "random: each vertex near a random joint, 2 influences drawn per vertex",
+        "rig: vertices in rings along the bones in vertex order, weights by position"
+    };
+    for (int k = 0; k < 2; k++) {
+        size_t ns = kin_skin_plan_scratch_size(&m[k]);
+        void *scratch = malloc(ns);
+        size_t plan_bytes = scratch ? kin_skin_plan_size(&m[k], scratch) : 0;
+        plan_mem[k] = plan_bytes ? aligned_alloc(64, (plan_bytes + 63) & ~(size_t)63) : NULL;
+        int rc = plan_mem[k] ? kin_skin_plan_init(&plan[k], &m[k], scratch, plan_mem[k], plan_bytes) : -1;
         free(scratch);
-        free(plan_mem);
-        return;
+        if (rc) {
+            printf("skin plan: out of memory\n");
+            free(plan_mem[0]);
+            free(plan_mem[1]);
+            return;
+        }
+        printf("mesh %s:\n  skin plan: %d joint lists, %d batches of 16 (%.0f%% lanes used, "
+               "%d contiguous), %zu bytes\n", mesh_name[k], plan[k].group_count,
+               plan[k].batch_count, 100.0 * NV / (16.0 * plan[k].batch_count),
+               kin_skin_plan_contiguous(&plan[k]), plan_bytes);
     }
-    free(scratch);
-    printf("skin plan: %d joint lists, %d batches of 16 (%.0f%% lanes used), %zu bytes\n",
-           plan.group_count, plan.batch_count, 100.0 * NV / (16.0 * plan.batch_count), plan_bytes);
     kin_filter f;
     kin_filter_init(&f, NULL);
-    /* per configuration: 21 batches of 100 frames, the median batch (the
-     * machine is shared: medians, not means) */
+    /* per configuration: 21 batches of 100 frames (10 for the scalar
+     * reference), the median batch (the machine is shared: medians, not
+     * means); every configuration in the same run */
     enum { BATCHES = 21, FRAMES = 100 };
-    printf("per frame (median of %d batches of %d frames), %d vertices, %d nodes:\n",
-           BATCHES, FRAMES, NV, nn);
+    printf("per frame, filter + rig IK + hands + FK + joint matrices + skinning, %d vertices "
+           "with normals, %d nodes; ms, median (min) of %d batches:\n", NV, nn, BATCHES);
     int frame_no = 0;
-    /* modes: no skinning, LBS, LBS with the plan, DQS, DQS with the plan */
-    for (int mode = 0; mode < 5; mode++) {
-        for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {
-            if (mode == 0 && isa > EF_ISA_REF) break;
-            if (!ef_cpu_has((ef_isa)isa)) continue;
-            double batch[BATCHES];
-            for (int bi = 0; bi < BATCHES; bi++) {
-                double t0 = now_s();
-                for (int i = 0; i < FRAMES; i++, frame_no++) {
-                    double t = frame_no / 90.0;
-                    truth a = true_arm(t);
-                    kin_track_sample s = sample_of(&a, t);
-                    s.valid = KIN_TRACK_ALL;
-                    s.shoulder[0] = kin_v3(-0.2f, 1.0f, 0.0f);
-                    s.hand_pos[0] = kin_v3(-0.25f, 0.9f, -0.35f);
-                    s.hand_rot[0] = kin_quat_identity();
-                    s.head_pos = kin_v3(0, 1.25f, -0.08f);
-                    s.head_rot = kin_quat_identity();
-                    for (int g = 0; g < 5; g++) s.glove[0][g] = s.glove[1][g] = 0.5f;
-                    kin_filter_push(&f, &s);
-                    kin_track_sample o;
-                    kin_filter_output(&f, t + 0.02, &o, NULL);
-                    kin_arm_rig_pose(&rig, &b.m, NULL, NULL, &o, loc, NULL);
-                    kin_fk(b.m.parents, nn, loc, NULL, world);
-                    kin_skin_joint_matrices(&b.skin, world, jm);
-                    if (mode == 1) kin_skin_lbs_isa(&m, jm, po, no, isa);
-                    else if (mode == 2) kin_skin_lbs_plan_part(&plan, jm, po, no, 0, 1, isa);
-                    else if (mode >= 3) {
-                        kin_skin_dq_from_matrices(jm, nn, dq);
-                        if (mode == 3) kin_skin_dqs_isa(&m, dq, po, no, isa);
-                        else kin_skin_dqs_plan_part(&plan, dq, po, no, 0, 1, isa);
+    static const char *const what[5] = { "no skinning", "LBS from the mesh", "LBS plan",
+                                         "DQS from the mesh", "DQS plan" };
+    for (int k = 0; k < 2; k++) {
+        printf("  %-24s", k ? "rig mesh" : "random mesh");
+        for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++)
+            if (ef_cpu_has((ef_isa)isa)) printf(" %-17s", ef_isa_name((ef_isa)isa));
+        printf("\n");
+        /* modes: no skinning, LBS, LBS with the plan, DQS, DQS with the plan */
+        for (int mode = k ? 1 : 0; mode < 5; mode++) {
+            printf("    %-22s", what[mode]);
+            for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {
+                if (mode == 0 && isa > EF_ISA_REF) break;
+                if (!ef_cpu_has((ef_isa)isa)) continue;
+                const int frames = isa == EF_ISA_REF && mode ? FRAMES / 10 : FRAMES;
+                double batch[BATCHES];
+                for (int bi = 0; bi < BATCHES; bi++) {
+                    double t0 = now_s();
+                    for (int i = 0; i < frames; i++, frame_no++) {
+                        double t = frame_no / 90.0;
+                        truth a = true_arm(t);
+                        kin_track_sample s = sample_of(&a, t);
+                        s.valid = KIN_TRACK_ALL;
+                        s.shoulder[0] = kin_v3(-0.2f, 1.0f, 0.0f);
+                        s.hand_pos[0] = kin_v3(-0.25f, 0.9f, -0.35f);
+                        s.hand_rot[0] = kin_quat_identity();
+                        s.head_pos = kin_v3(0, 1.25f, -0.08f);
+                        s.head_rot = kin_quat_identity();
+                        for (int g = 0; g < 5; g++) s.glove[0][g] = s.glove[1][g] = 0.5f;
+                        kin_filter_push(&f, &s);
+                        kin_track_sample o;
+                        kin_filter_output(&f, t + 0.02, &o, NULL);
+                        kin_arm_rig_pose(&rig, &b.m, NULL, NULL, &o, loc, NULL);
+                        kin_fk(b.m.parents, nn, loc, NULL, world);
+                        kin_skin_joint_matrices(&b.skin, world, jm);
+                        if (mode == 1) kin_skin_lbs_isa(&m[k], jm, po, no, isa);
+                        else if (mode == 2) kin_skin_lbs_plan_part(&plan[k], jm, po, no, 0, 1, isa);
+                        else if (mode >= 3) {
+                            kin_skin_dq_from_matrices(jm, nn, dq);
+                            if (mode == 3) kin_skin_dqs_isa(&m[k], dq, po, no, isa);
+                            else kin_skin_dqs_plan_part(&plan[k], dq, po, no, 0, 1, isa);
+                        }
                     }
+                    batch[bi] = (now_s() - t0) * 1e3 / frames;
                 }
-                batch[bi] = (now_s() - t0) * 1e3 / FRAMES;
+                qsort(batch, BATCHES, sizeof batch[0], cmp_double);
+                char cell[40];
+                snprintf(cell, sizeof cell, "%.4f (%.4f)", batch[BATCHES / 2], batch[0]);
+                printf(" %-17s", cell);
+                fflush(stdout);
             }
-            qsort(batch, BATCHES, sizeof batch[0], cmp_double);
-            static const char *const what[5] = { "no skinning", "LBS", "LBS plan", "DQS",
-                                                 "DQS plan" };
-            printf("  filter + rig IK + hands + FK + joint matrices + %-11s %-6s "
-                   "%.4f ms/frame (min %.4f)\n", what[mode],
-                   mode ? ef_isa_name((ef_isa)isa) : "", batch[BATCHES / 2], batch[0]);
+            printf("\n");
         }
     }
     printf("  skinning uses %s by default (kin_skin_isa)\n", ef_isa_name((ef_isa)kin_skin_isa()));
-    free(plan_mem);
+    free(plan_mem[0]);
+    free(plan_mem[1]);
 }
 
 int main(int argc, char **argv)

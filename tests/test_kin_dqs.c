@@ -2,7 +2,9 @@
  * hand-worked answers: matrix <-> dual quaternion, agreement with LBS for
  * rigid single-joint vertices, antipodal quaternions, a pure translation
  * blend, and the wrist-twist sweep -180..180 degrees where the LBS
- * cross-section shrinks by |1 - w + w e^(i theta)|^2 and DQS keeps it. */
+ * cross-section shrinks by |1 - w + w e^(i theta)|^2 and DQS keeps it;
+ * the reference's division-only formula against Kavan's normalised dual
+ * quaternion evaluated in double (positions, normals, their lengths). */
 #include "support/testutil.h"
 #include <cmocka.h>
 
@@ -127,6 +129,82 @@ static void result_translation_blend(void **state)
     NEAR(po[0], sqrtf(0.5f), 1e-6); NEAR(po[1], sqrtf(0.5f), 1e-6);
 }
 
+/* kin_dqs.c skips Kavan's b / |b.r| and the normal's renormalisation
+ * (one division per vertex): over seeded blends of 1..4 joints (antipodal
+ * signs, unnormalised weights, non-unit normals) the result equals
+ * R(b^) p + t(b^) and R(b^) n, b^ = b / |b.r|, evaluated in double from
+ * the same blend, and a unit normal stays unit. */
+static void result_matches_normalised_kavan_in_double(void **state)
+{
+    (void)state;
+    tu_rng g = { 0x64717333 };
+    enum { N = 500, J = 6 };
+    static float pos[N * 3], nrm[N * 3], w[N * 4], po[N * 3], no[N * 3];
+    static uint16_t jt[N * 4];
+    kin_dualquat dq[J];
+    for (int j = 0; j < J; j++) {
+        kin_mat4 m = kin_mat4_from_tr(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1),
+                                             tu_range(&g, -1, 1)), rand_q(&g));
+        dq[j] = kin_dualquat_from_mat4(&m);
+        if (j % 2) { /* the antipodal form of the same transform */
+            float *f = &dq[j].r.x;
+            for (int e = 0; e < 8; e++) f[e] = -f[e];
+        }
+    }
+    for (int v = 0; v < N; v++) {
+        float len = v % 5 == 0 ? 2.5f : 1.0f;      /* some non-unit normals */
+        kin_vec3 n = kin_v3_scale(kin_v3_norm(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1),
+                                                     tu_range(&g, -1, 1))), len);
+        memcpy(nrm + 3 * v, &n, sizeof n);
+        for (int c = 0; c < 3; c++) pos[3 * v + c] = tu_range(&g, -1, 1);
+        int k = 1 + tu_int(&g, 4);
+        for (int i = 0; i < 4; i++) {
+            jt[4 * v + i] = (uint16_t)tu_int(&g, J);
+            w[4 * v + i] = i < k ? tu_range(&g, 0.1f, 1.0f) : 0.0f;  /* unnormalised */
+        }
+    }
+    kin_mesh m = mesh_of(N, pos, nrm, jt, w);
+    kin_skin_dqs(&m, dq, po, no);
+    for (int v = 0; v < N; v++) {
+        double b[8] = { 0 };
+        const float *r0 = NULL;
+        for (int i = 0; i < 4; i++) {
+            if (w[4 * v + i] == 0.0f) continue;
+            const float *q = &dq[jt[4 * v + i]].r.x;
+            if (!r0) r0 = q;
+            double dot = 0, s = w[4 * v + i];
+            for (int e = 0; e < 4; e++) dot += (double)q[e] * r0[e];
+            if (dot < 0) s = -s;
+            for (int e = 0; e < 8; e++) b[e] += s * q[e];
+        }
+        double l = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3]);
+        for (int e = 0; e < 8; e++) b[e] /= l;
+        /* R v = v + 2w (u x v) + 2 u x (u x v); t = 2 (w d.v - d.w u + u x d.v) */
+        double u[3] = { b[0], b[1], b[2] }, dv[3] = { b[4], b[5], b[6] }, wr = b[3], dw = b[7];
+        double in[2][3], out[2][3];
+        for (int c = 0; c < 3; c++) { in[0][c] = pos[3 * v + c]; in[1][c] = nrm[3 * v + c]; }
+        for (int s = 0; s < 2; s++) {
+            const double *x = in[s];
+            double t[3] = { 2 * (u[1] * x[2] - u[2] * x[1]), 2 * (u[2] * x[0] - u[0] * x[2]),
+                            2 * (u[0] * x[1] - u[1] * x[0]) };
+            double c2[3] = { u[1] * t[2] - u[2] * t[1], u[2] * t[0] - u[0] * t[2],
+                             u[0] * t[1] - u[1] * t[0] };
+            for (int c = 0; c < 3; c++) out[s][c] = x[c] + wr * t[c] + c2[c];
+        }
+        double cr[3] = { u[1] * dv[2] - u[2] * dv[1], u[2] * dv[0] - u[0] * dv[2],
+                         u[0] * dv[1] - u[1] * dv[0] };
+        double nl = 0, nw = 0;
+        for (int c = 0; c < 3; c++) {
+            double want = out[0][c] + 2 * (wr * dv[c] - dw * u[c] + cr[c]);
+            NEAR(po[3 * v + c], want, 4e-6);
+            NEAR(no[3 * v + c], out[1][c], 4e-6);
+            nl += (double)no[3 * v + c] * no[3 * v + c];
+            nw += (double)nrm[3 * v + c] * nrm[3 * v + c];
+        }
+        NEAR(sqrt(nl), sqrt(nw), 2e-6 * sqrt(nw));   /* rotated, length kept */
+    }
+}
+
 /* Ring area (shoelace, in its z plane) of K points. */
 static double ring_area(const float *p, int k)
 {
@@ -206,6 +284,7 @@ int main(void)
         cmocka_unit_test(result_dualquat_matches_matrix),
         cmocka_unit_test(result_rigid_vertices_equal_lbs),
         cmocka_unit_test(result_translation_blend),
+        cmocka_unit_test(result_matches_normalised_kavan_in_double),
         cmocka_unit_test(sweep_wrist_twist_volume),
     };
     int f = cmocka_run_group_tests_name("kin_dqs validity", validity, NULL, NULL);

@@ -20,7 +20,7 @@
 
 /* CRC32 of the reference's positions and normals (LBS then DQS) over all
  * NCASES cases; update it (and docs/kin.md) when the reference changes. */
-#define SKIN_CRC 0xD0EF5DC4u
+#define SKIN_CRC 0x09D4160Au
 #define NCASES 60
 #define NJOINTS 80   /* capacity; a case uses 24, 48 or 80 */
 

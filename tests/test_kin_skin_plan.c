@@ -234,6 +234,9 @@ static void test_structure(void **state)
     assert_int_equal(plan.batch_count, 6);
     assert_int_equal(plan.max_joint, 3);   /* 7 and 9 are in a zero-sum vertex */
     assert_int_equal(plan.normals, 0);
+    /* 16 consecutive vertices: the first batch of {3} and of {1,2} */
+    assert_int_equal(kin_skin_plan_contiguous(&plan), 2);
+    assert_int_equal(kin_skin_plan_contiguous(NULL), 0);
     kin_mat4 jm[4];
     for (int j = 0; j < 4; j++) jm[j] = kin_mat4_from_tr(kin_v3((float)j, 0, 0), kin_quat_identity());
     for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {

@@ -699,9 +699,11 @@ kin_vec3 kin_dualquat_transform(const kin_dualquat *q, kin_vec3 p);
 void kin_skin_dq_from_matrices(const kin_mat4 *jm, int count,
                                kin_dualquat *dq);
 /* Dual-quaternion skinning (Kavan et al. 2008): b = sum w_i s_i dq_i with
- * s_i = sign(r_i . r_0) (shortest path), then b / |b.r|; positions by b,
- * normals by its rotation. Like kin_skin_lbs otherwise (zero weights keep
- * the bind pose, outputs must not alias). */
+ * s_i = sign(r_i . r_0) (shortest path); positions by b / |b.r|, normals
+ * by its rotation (not renormalised: a unit normal stays unit to a few
+ * ulp), computed with one division and no square root per vertex
+ * (kin_dqs.c). Like kin_skin_lbs otherwise (zero weights keep the bind
+ * pose, outputs must not alias). */
 void kin_skin_dqs(const kin_mesh *mesh, const kin_dualquat *dq,
                   float *pos_out, float *nrm_out);
 
@@ -781,6 +783,9 @@ void kin_skin_lbs_plan_part(const kin_skin_plan *plan, const kin_mat4 *jm,
 void kin_skin_dqs_plan_part(const kin_skin_plan *plan, const kin_dualquat *dq,
                             float *pos_out, float *nrm_out, int part, int parts,
                             int isa);
+/* Batches of the plan whose 16 vertices are consecutive in the mesh
+ * (stored without a scatter), for reports; 0 for NULL. */
+int kin_skin_plan_contiguous(const kin_skin_plan *plan);
 
 #ifdef __cplusplus
 }

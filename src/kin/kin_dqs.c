@@ -5,14 +5,22 @@
  * A rigid transform (R, t) is the unit dual quaternion r + e d with r the
  * rotation and d = (t, 0) r / 2. Per vertex: b = sum_i w_i s_i dq_i with
  * s_i = +1 if r_i . r_first >= 0 else -1 (r_first: the first influence
- * with w != 0), then b /= |b.r|; p' = b.r p b.r* + t(b),
- * t(b) = 2 (b.r.w b.d.v - b.d.w b.r.v + b.r.v x b.d.v), n' = b.r n b.r*.
- * Unlike LBS the blend of two rotations is a rotation, so a twisted wrist
- * keeps its cross-section (LBS shrinks it by cos(angle/2)). Scale and
- * mirroring are not representable: kin_dualquat_from_mat4 orthonormalises.
- * No allocation. kin_skin_dqs runs the SIMD kernels (kin_skin_internal.h)
- * on whole vectors of vertices and this reference on the rest (same
- * bytes). */
+ * with w != 0). Kavan's b / |b.r| is not formed: with u = b.r.v,
+ * w = b.r.w, d = b.d and k = 2 / |b.r|^2 (one division, no square root)
+ *   p' = p + k (w e + u x e - d.w u),   e = u x p + d.v
+ *   n' = n + k (w f + u x f),           f = u x n
+ * which is, in exact arithmetic, R(b / |b.r|) p + t(b / |b.r|) and
+ * R(b / |b.r|) n (q v q* = |q|^2 v + 2w (u x v) + 2 u x (u x v) for any
+ * q; t(q) = 2 (q.r.w q.d.v - q.d.w q.r.v + q.r.v x q.d.v), and
+ * e collects both cross products with u). The normal is rotated, not
+ * renormalised: a unit normal stays unit to a few ulp, and the length of
+ * any other is kept. A vertex whose weights sum to 0, or whose |b.r|^2 is
+ * not > 0, keeps its bind pose. Unlike LBS the blend of two rotations is
+ * a rotation, so a twisted wrist keeps its cross-section (LBS shrinks it
+ * by cos(angle/2)). Scale and mirroring are not representable:
+ * kin_dualquat_from_mat4 orthonormalises. No allocation. kin_skin_dqs
+ * runs the SIMD kernels (kin_skin_internal.h) on whole vectors of
+ * vertices and this reference on the rest (same bytes). */
 #include "kin.h"
 #include "kin_skin_internal.h"
 #include "../cpu/cpu.h"
@@ -58,6 +66,14 @@ void kin_skin_dq_from_matrices(const kin_mat4 *jm, int count, kin_dualquat *dq)
     for (int j = 0; j < count; j++) dq[j] = kin_dualquat_from_mat4(&jm[j]);
 }
 
+/* o = a x b, componentwise as kin_v3_cross (o must not alias). */
+static void cross3(const float *a, const float *b, float *o)
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
                        float *pos_out, float *nrm_out, int v0, int v1)
 {
@@ -85,20 +101,24 @@ void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
                 wsum += w[i];
             }
         }
-        float len = sqrtf(b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3]);
-        if (wsum == 0.0f || !(len > 0.0f)) {
+        float sq = b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3];
+        if (wsum == 0.0f || !(sq > 0.0f)) {
             po[0] = p[0]; po[1] = p[1]; po[2] = p[2];
             if (do_n) { no[0] = n[0]; no[1] = n[1]; no[2] = n[2]; }
             continue;
         }
-        float inv = 1.0f / len;
-        kin_dualquat q = { { b[0] * inv, b[1] * inv, b[2] * inv, b[3] * inv },
-                           { b[4] * inv, b[5] * inv, b[6] * inv, b[7] * inv } };
-        kin_vec3 r = kin_dualquat_transform(&q, kin_v3(p[0], p[1], p[2]));
-        po[0] = r.x; po[1] = r.y; po[2] = r.z;
+        const float k = 2.0f / sq, w = b[3], dw = b[7];
+        const float u[3] = { b[0], b[1], b[2] };
+        float e[3], g[3];
+        cross3(u, p, e);
+        for (int c = 0; c < 3; c++) e[c] = e[c] + b[4 + c];
+        cross3(u, e, g);
+        for (int c = 0; c < 3; c++) po[c] = p[c] + k * ((w * e[c] + g[c]) - dw * u[c]);
         if (do_n) {
-            kin_vec3 nn = kin_v3_norm(kin_quat_rotate(q.r, kin_v3(n[0], n[1], n[2])));
-            no[0] = nn.x; no[1] = nn.y; no[2] = nn.z;
+            float f[3];
+            cross3(u, n, f);
+            cross3(u, f, g);
+            for (int c = 0; c < 3; c++) no[c] = n[c] + k * (w * f[c] + g[c]);
         }
     }
 }

@@ -151,6 +151,15 @@ int kin_skin_plan_init(kin_skin_plan *plan, const kin_mesh *mesh, void *scratch,
     return 0;
 }
 
+int kin_skin_plan_contiguous(const kin_skin_plan *plan)
+{
+    if (!plan || !plan->batches) return 0;
+    const kin__plan_batch *bt = plan->batches;
+    int c = 0;
+    for (int b = 0; b < plan->batch_count; b++) c += bt[b].contiguous != 0;
+    return c;
+}
+
 /* ------------------------------------------------------------ per frame */
 
 /* 0 = kin_skin_isa(), else the request capped by the CPU (as kin_skin.c). */

@@ -33,19 +33,52 @@
     } while (0)
 
 /* kin_v3_norm: r / |r|, or 0 when |r| is 0 or not finite. */
-static inline void norm3(V r[3], V zero, V inf)
+static inline __attribute__((always_inline)) void norm3(V r[3], V zero, V inf)
 {
     V l = VSQRT(VADD(VADD(VMUL(r[0], r[0]), VMUL(r[1], r[1])), VMUL(r[2], r[2])));
     M ok = M_AND(M_GT(l, zero), M_LT(l, inf));
     V inv = VDIV(VSET1(1.0f), l);
+#pragma GCC unroll 3
     for (int k = 0; k < 3; k++) r[k] = SELZ(ok, VMUL(r[k], inv));
+}
+
+/* LBS of W lanes, the reference's operations (kin_skin.c): p' = A p + t
+ * with a[c*3+r] column c, row r of the blended matrix; the normal
+ * n' = normalize(sign(det A) cof(A) n). Forced inline with unrolled
+ * loops: a call or a loop over a small array would pass the vectors
+ * through memory. */
+static inline __attribute__((always_inline)) void lbs_pos(const V a[12], const V p[3], V o[3])
+{
+#pragma GCC unroll 3
+    for (int r = 0; r < 3; r++)
+        o[r] = VADD(VADD(VADD(VMUL(a[r], p[0]), VMUL(a[3 + r], p[1])),
+                         VMUL(a[6 + r], p[2])), a[9 + r]);
+}
+
+static inline __attribute__((always_inline)) void lbs_nrm(const V a[12], const V n[3], V x[3])
+{
+    const V zero = VSET1(0.0f), inf = VSET1(INFINITY);
+    V c0[3], c1[3], c2[3];
+    const V a0[3] = { a[0], a[1], a[2] }, a1[3] = { a[3], a[4], a[5] },
+            a2[3] = { a[6], a[7], a[8] };
+    CROSS(c0, a1, a2);
+    CROSS(c1, a2, a0);
+    CROSS(c2, a0, a1);
+    V det = VADD(VADD(VMUL(a0[0], c0[0]), VMUL(a0[1], c0[1])), VMUL(a0[2], c0[2]));
+    M flip = M_LT(det, zero);
+#pragma GCC unroll 3
+    for (int k = 0; k < 3; k++) {
+        x[k] = VADD(VADD(VMUL(c0[k], n[0]), VMUL(c1[k], n[1])), VMUL(c2[k], n[2]));
+        x[k] = NEG_IF(flip, x[k]);
+    }
+    norm3(x, zero, inf);
 }
 
 int SIMD_LBS(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
              float *nrm_out, int v0, int v1)
 {
     const int do_n = mesh->normals && nrm_out;
-    const V zero = VSET1(0.0f), inf = VSET1(INFINITY);
+    const V zero = VSET1(0.0f);
     lay3 L;
     lay3_init(&L);
     skin_tab T;
@@ -57,49 +90,67 @@ int SIMD_LBS(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
         M ok = M_NE(ws, zero);
         const int all = M_ALL(ok);   /* no bind-pose lane: no selects */
         deint3(&L, mesh->positions + (size_t)v * 3, p);
-        for (int r = 0; r < 3; r++) {
-            V t = VADD(VADD(VADD(VMUL(a[r], p[0]), VMUL(a[3 + r], p[1])),
-                            VMUL(a[6 + r], p[2])), a[9 + r]);
-            o[r] = all ? t : SEL(ok, t, p[r]);
+        lbs_pos(a, p, o);
+        if (!all) {
+#pragma GCC unroll 3
+            for (int r = 0; r < 3; r++) o[r] = SEL(ok, o[r], p[r]);
         }
         int3(&L, pos_out + (size_t)v * 3, o);
         if (!do_n) continue;
-        V n[3], c0[3], c1[3], c2[3], x[3];
-        const V a0[3] = { a[0], a[1], a[2] }, a1[3] = { a[3], a[4], a[5] },
-                a2[3] = { a[6], a[7], a[8] };
-        CROSS(c0, a1, a2);
-        CROSS(c1, a2, a0);
-        CROSS(c2, a0, a1);
-        V det = VADD(VADD(VMUL(a0[0], c0[0]), VMUL(a0[1], c0[1])), VMUL(a0[2], c0[2]));
-        M flip = M_LT(det, zero);
+        V n[3];
         deint3(&L, mesh->normals + (size_t)v * 3, n);
-        for (int k = 0; k < 3; k++) {
-            x[k] = VADD(VADD(VMUL(c0[k], n[0]), VMUL(c1[k], n[1])), VMUL(c2[k], n[2]));
-            x[k] = NEG_IF(flip, x[k]);
+        lbs_nrm(a, n, o);
+        if (!all) {
+#pragma GCC unroll 3
+            for (int k = 0; k < 3; k++) o[k] = SEL(ok, o[k], n[k]);
         }
-        norm3(x, zero, inf);
-        for (int k = 0; k < 3; k++) o[k] = all ? x[k] : SEL(ok, x[k], n[k]);
         int3(&L, nrm_out + (size_t)v * 3, o);
     }
     return v;
 }
 
-/* kin_quat_rotate(u, w; x): x + 2 (u x x) w + u x (2 (u x x)). */
-static inline void qrot(const V u[3], V w, const V x[3], V out[3])
+/* The DQS of W lanes (kin_dqs.c): q the blended dual quaternion (r.xyzw,
+ * d.xyzw), k = 2 / |q.r|^2, u = q.r.xyz:
+ *   p' = p + k (w e + u x e - d.w u),  e = u x p + d.v
+ *   n' = n + k (w f + u x f),          f = u x n
+ * in the reference's order of operations. */
+static inline __attribute__((always_inline)) void dqs_pos(const V q[8], V k, const V p[3],
+                                                          V o[3])
 {
-    V t[3], c[3];
-    CROSS(t, u, x);
-    const V two = VSET1(2.0f);
-    for (int k = 0; k < 3; k++) t[k] = VMUL(t[k], two);
-    CROSS(c, u, t);
-    for (int k = 0; k < 3; k++) out[k] = VADD(VADD(x[k], VMUL(t[k], w)), c[k]);
+    const V u[3] = { q[0], q[1], q[2] };
+    V e[3], g[3];
+    CROSS(e, u, p);
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; c++) e[c] = VADD(e[c], q[4 + c]);
+    CROSS(g, u, e);
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; c++)
+        o[c] = VADD(p[c], VMUL(k, VSUB(VADD(VMUL(q[3], e[c]), g[c]), VMUL(q[7], u[c]))));
+}
+
+static inline __attribute__((always_inline)) void dqs_nrm(const V q[8], V k, const V n[3],
+                                                          V o[3])
+{
+    const V u[3] = { q[0], q[1], q[2] };
+    V f[3], g[3];
+    CROSS(f, u, n);
+    CROSS(g, u, f);
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; c++) o[c] = VADD(n[c], VMUL(k, VADD(VMUL(q[3], f[c]), g[c])));
+}
+
+/* |q.r|^2 in the reference's order. */
+static inline __attribute__((always_inline)) V dqs_sq(const V q[8])
+{
+    return VADD(VADD(VADD(VMUL(q[0], q[0]), VMUL(q[1], q[1])), VMUL(q[2], q[2])),
+                VMUL(q[3], q[3]));
 }
 
 int SIMD_DQS(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out,
              float *nrm_out, int v0, int v1)
 {
     const int do_n = mesh->normals && nrm_out;
-    const V zero = VSET1(0.0f), inf = VSET1(INFINITY), two = VSET1(2.0f);
+    const V zero = VSET1(0.0f), two = VSET1(2.0f);
     lay3 L;
     lay3_init(&L);
     skin_tab T;
@@ -108,29 +159,25 @@ int SIMD_DQS(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out,
     for (; v1 - v >= W; v += W) {
         V b[8], ws, p[3], o[3];
         dqs_block(&T, mesh, dq, v, b, &ws);
-        V len = VSQRT(VADD(VADD(VADD(VMUL(b[0], b[0]), VMUL(b[1], b[1])),
-                                VMUL(b[2], b[2])), VMUL(b[3], b[3])));
-        M ok = M_AND(M_NE(ws, zero), M_GT(len, zero));
+        V sq = dqs_sq(b);
+        M ok = M_AND(M_NE(ws, zero), M_GT(sq, zero));
         const int all = M_ALL(ok);
-        V inv = VDIV(VSET1(1.0f), len);
-        for (int k = 0; k < 8; k++) b[k] = VMUL(b[k], inv);
-        const V u[3] = { b[0], b[1], b[2] }, dv[3] = { b[4], b[5], b[6] };
+        V k = VDIV(two, sq);
         deint3(&L, mesh->positions + (size_t)v * 3, p);
-        V rot[3], cr[3];
-        qrot(u, b[3], p, rot);
-        CROSS(cr, u, dv);
-        for (int k = 0; k < 3; k++) {
-            V t = VADD(VSUB(VMUL(dv[k], b[3]), VMUL(u[k], b[7])), cr[k]);
-            V y = VADD(rot[k], VMUL(t, two));
-            o[k] = all ? y : SEL(ok, y, p[k]);
+        dqs_pos(b, k, p, o);
+        if (!all) {
+#pragma GCC unroll 3
+            for (int c = 0; c < 3; c++) o[c] = SEL(ok, o[c], p[c]);
         }
         int3(&L, pos_out + (size_t)v * 3, o);
         if (!do_n) continue;
-        V n[3], x[3];
+        V n[3];
         deint3(&L, mesh->normals + (size_t)v * 3, n);
-        qrot(u, b[3], n, x);
-        norm3(x, zero, inf);
-        for (int k = 0; k < 3; k++) o[k] = all ? x[k] : SEL(ok, x[k], n[k]);
+        dqs_nrm(b, k, n, o);
+        if (!all) {
+#pragma GCC unroll 3
+            for (int c = 0; c < 3; c++) o[c] = SEL(ok, o[c], n[c]);
+        }
         int3(&L, nrm_out + (size_t)v * 3, o);
     }
     return v;
@@ -174,7 +221,7 @@ static inline __attribute__((always_inline)) void lbs_plan_lanes(const kin__plan
                                   const kin_mat4 *jm, const lay3 *L, float *pos_out,
                                   float *nrm_out)
 {
-    const V zero = VSET1(0.0f), inf = VSET1(INFINITY);
+    const V zero = VSET1(0.0f);
     V a[12], p[3], o[3];
     {
         const float *m = jm[B->joint[0]].m;
@@ -191,27 +238,19 @@ static inline __attribute__((always_inline)) void lbs_plan_lanes(const kin__plan
         for (int e = 0; e < 12; e++)
             a[e] = VADD(a[e], VMUL(w, VSET1(m[(e / 3) * 4 + e % 3])));
     }
-    for (int k = 0; k < 3; k++) p[k] = VLOAD(B->p[k] + h);
-    for (int r = 0; r < 3; r++)
-        o[r] = VADD(VADD(VADD(VMUL(a[r], p[0]), VMUL(a[3 + r], p[1])),
-                         VMUL(a[6 + r], p[2])), a[9 + r]);
-    plan_store(L, B, h, pos_out, o);
-    if (!nrm_out) return;
-    V nn[3], c0[3], c1[3], c2[3], x[3];
-    const V a0[3] = { a[0], a[1], a[2] }, a1[3] = { a[3], a[4], a[5] },
-            a2[3] = { a[6], a[7], a[8] };
-    CROSS(c0, a1, a2);
-    CROSS(c1, a2, a0);
-    CROSS(c2, a0, a1);
-    V det = VADD(VADD(VMUL(a0[0], c0[0]), VMUL(a0[1], c0[1])), VMUL(a0[2], c0[2]));
-    M flip = M_LT(det, zero);
-    for (int k = 0; k < 3; k++) nn[k] = VLOAD(B->nrm[k] + h);
-    for (int k = 0; k < 3; k++) {
-        x[k] = VADD(VADD(VMUL(c0[k], nn[0]), VMUL(c1[k], nn[1])), VMUL(c2[k], nn[2]));
-        x[k] = NEG_IF(flip, x[k]);
+    /* the normal first: its square root and division are the longest
+     * chain, and the position's work and stores fill their latency */
+    V x[3];
+    if (nrm_out) {
+#pragma GCC unroll 3
+        for (int k = 0; k < 3; k++) p[k] = VLOAD(B->nrm[k] + h);
+        lbs_nrm(a, p, x);
     }
-    norm3(x, zero, inf);
-    plan_store(L, B, h, nrm_out, x);
+#pragma GCC unroll 3
+    for (int k = 0; k < 3; k++) p[k] = VLOAD(B->p[k] + h);
+    lbs_pos(a, p, o);
+    plan_store(L, B, h, pos_out, o);
+    if (nrm_out) plan_store(L, B, h, nrm_out, x);
 }
 
 void SIMD_LBS_PLAN(const kin__plan_batch *bt, int b0, int b1, const kin_mat4 *jm,
@@ -237,7 +276,7 @@ static inline __attribute__((always_inline)) void dqs_plan_lanes(
     const kin__plan_batch *B, const int n, const int neg[4], int h, const kin_dualquat *dq,
     const lay3 *L, float *pos_out, float *nrm_out)
 {
-    const V zero = VSET1(0.0f), inf = VSET1(INFINITY), two = VSET1(2.0f);
+    const V zero = VSET1(0.0f);
     V q[8], p[3], o[3];
 #pragma GCC unroll 8
     for (int e = 0; e < 8; e++) q[e] = zero;
@@ -249,30 +288,27 @@ static inline __attribute__((always_inline)) void dqs_plan_lanes(
 #pragma GCC unroll 8
         for (int e = 0; e < 8; e++) q[e] = VADD(q[e], VMUL(w, VSET1(d[e])));
     }
-    V len = VSQRT(VADD(VADD(VADD(VMUL(q[0], q[0]), VMUL(q[1], q[1])),
-                            VMUL(q[2], q[2])), VMUL(q[3], q[3])));
-    M ok = M_GT(len, zero);
+    V sq = dqs_sq(q);
+    M ok = M_GT(sq, zero);
     const int all = M_ALL(ok);
-    V inv = VDIV(VSET1(1.0f), len);
-#pragma GCC unroll 8
-    for (int e = 0; e < 8; e++) q[e] = VMUL(q[e], inv);
-    const V u[3] = { q[0], q[1], q[2] }, dv[3] = { q[4], q[5], q[6] };
-    for (int k = 0; k < 3; k++) p[k] = VLOAD(B->p[k] + h);
-    V rot[3], cr[3];
-    qrot(u, q[3], p, rot);
-    CROSS(cr, u, dv);
-    for (int k = 0; k < 3; k++) {
-        V t = VADD(VSUB(VMUL(dv[k], q[3]), VMUL(u[k], q[7])), cr[k]);
-        V y = VADD(rot[k], VMUL(t, two));
-        o[k] = all ? y : SEL(ok, y, p[k]);
+    V k = VDIV(VSET1(2.0f), sq);
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; c++) p[c] = VLOAD(B->p[c] + h);
+    dqs_pos(q, k, p, o);
+    if (!all) {
+#pragma GCC unroll 3
+        for (int c = 0; c < 3; c++) o[c] = SEL(ok, o[c], p[c]);
     }
     plan_store(L, B, h, pos_out, o);
     if (!nrm_out) return;
-    V nn[3], x[3];
-    for (int k = 0; k < 3; k++) nn[k] = VLOAD(B->nrm[k] + h);
-    qrot(u, q[3], nn, x);
-    norm3(x, zero, inf);
-    for (int k = 0; k < 3; k++) o[k] = all ? x[k] : SEL(ok, x[k], nn[k]);
+    V nn[3];
+#pragma GCC unroll 3
+    for (int c = 0; c < 3; c++) nn[c] = VLOAD(B->nrm[c] + h);
+    dqs_nrm(q, k, nn, o);
+    if (!all) {
+#pragma GCC unroll 3
+        for (int c = 0; c < 3; c++) o[c] = SEL(ok, o[c], nn[c]);
+    }
     plan_store(L, B, h, nrm_out, o);
 }
 
