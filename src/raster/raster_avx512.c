@@ -7,6 +7,7 @@
 #if defined(__x86_64__) || defined(__i386__)
 #include <float.h>
 #include <immintrin.h>
+#include <stddef.h>
 
 #define SIMD_V 16
 #define SIMD_FN rast__scan_rows_avx512
@@ -200,6 +201,33 @@ static inline __m512i front_edge(__m512i xa, __m512i ya, __m512i xb, __m512i yb,
     return _mm512_mask_sub_epi32(e, (__mmask16)~tl, e, _mm512_set1_epi32(1));
 }
 
+_Static_assert(sizeof(rast__vc_entry) == 32 && offsetof(rast__vc_entry, flags) == 4 &&
+                   offsetof(rast__vc_entry, X) == 8 && offsetof(rast__vc_entry, Y) == 12,
+               "rast__front_avx512 gathers (tag, flags) and (X, Y) as qwords 4s, 4s+1");
+
+/* The qwords eb[q_l] for the 16 lanes l of q: lanes 0..7 in p[0], 8..15
+ * in p[1]. */
+static inline void front_gather_pairs(const long long *eb, __m512i q, __m512i p[2])
+{
+    p[0] = _mm512_i32gather_epi64(_mm512_castsi512_si256(q), eb, 8);
+    p[1] = _mm512_i32gather_epi64(_mm512_extracti32x8_epi32(q, 1), eb, 8);
+}
+
+/* The low (even) and high (odd) dwords of the 16 qwords p[0], p[1]. */
+static inline __m512i front_even(const __m512i p[2])
+{
+    const __m512i ie = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26,
+                                         28, 30);
+    return _mm512_permutex2var_epi32(p[0], ie, p[1]);
+}
+
+static inline __m512i front_odd(const __m512i p[2])
+{
+    const __m512i io = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27,
+                                         29, 31);
+    return _mm512_permutex2var_epi32(p[0], io, p[1]);
+}
+
 unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__vcache *vc,
                             int ti, rast_stats *st, rast__vfill_fn vfill)
 {
@@ -213,14 +241,18 @@ unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__
     iv[0] = front_deint(a, b, c, l3);
     iv[1] = front_deint(a, b, c, _mm512_add_epi32(l3, one));
     iv[2] = front_deint(a, b, c, _mm512_add_epi32(l3, _mm512_set1_epi32(2)));
-    /* Entry k of slot s is at int offset 8*s (32-byte entries). */
-    const int *eb = (const int *)(const void *)vc->e;
+    /* Cache entries are 32 bytes: qword 4s of slot s holds (tag, flags),
+     * qword 4s + 1 the snapped (X, Y). Each pair comes with one 64-bit
+     * gather element (8 lanes per gather, half the element loads of
+     * 32-bit gathers) and is split into 16-lane vectors by permutes. */
+    const long long *eb = (const long long *)(const void *)vc->e;
     const __m512i smask = _mm512_set1_epi32(RAST__VCACHE - 1);
-    __m512i so[3];
+    __m512i so[3], tf[3][2];
     unsigned miss = 0;
     for (int k = 0; k < 3; k++) {
-        so[k] = _mm512_slli_epi32(_mm512_and_si512(iv[k], smask), 3);
-        miss |= _mm512_cmpneq_epi32_mask(_mm512_i32gather_epi32(so[k], eb, 4), iv[k]);
+        so[k] = _mm512_slli_epi32(_mm512_and_si512(iv[k], smask), 2);
+        front_gather_pairs(eb, so[k], tf[k]);
+        miss |= _mm512_cmpneq_epi32_mask(front_even(tf[k]), iv[k]);
     }
     if (miss) {
         _Alignas(64) uint32_t idx[3][16];
@@ -239,16 +271,20 @@ unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__
             }
         }
         unsigned still = 0;
-        for (int k = 0; k < 3; k++)
-            still |= _mm512_cmpneq_epi32_mask(_mm512_i32gather_epi32(so[k], eb, 4), iv[k]);
+        for (int k = 0; k < 3; k++) {
+            front_gather_pairs(eb, so[k], tf[k]);
+            still |= _mm512_cmpneq_epi32_mask(front_even(tf[k]), iv[k]);
+        }
         if (still)   /* slots shared inside the group: the scalar path */
             return 0xFFFFu;
     }
     __m512i X[3], Y[3], fl = _mm512_setzero_si512();
     for (int k = 0; k < 3; k++) {
-        fl = _mm512_or_si512(fl, _mm512_i32gather_epi32(_mm512_add_epi32(so[k], one), eb, 4));
-        X[k] = _mm512_i32gather_epi32(_mm512_add_epi32(so[k], _mm512_set1_epi32(2)), eb, 4);
-        Y[k] = _mm512_i32gather_epi32(_mm512_add_epi32(so[k], _mm512_set1_epi32(3)), eb, 4);
+        __m512i xy[2];
+        fl = _mm512_or_si512(fl, front_odd(tf[k]));
+        front_gather_pairs(eb, _mm512_add_epi32(so[k], one), xy);
+        X[k] = front_even(xy);
+        Y[k] = front_odd(xy);
     }
     const unsigned special = _mm512_test_epi32_mask(fl, fl);
     const __m512i dx1 = _mm512_sub_epi32(X[1], X[0]), dy1 = _mm512_sub_epi32(Y[1], Y[0]);

@@ -95,21 +95,22 @@ static inline void simd_attr_store(float *dst, int na, unsigned pass, vf b1, vf 
     }
 }
 
-/* A box of one pixel (x0, y), the commonest box of a fine mesh far away:
- * the reference's scalar expressions for that pixel (fi = 0 and fj are
- * the same floats, every op the same IEEE op), without the vector
- * set-up of SIMD_FN. */
-static long simd_scan_pixel(const rast_target *t, const rast__tri *tri, int y)
+/* One pixel (x, y) of the box: the reference's scalar expressions for
+ * that pixel (fi, fj are the same floats, every op the same IEEE op),
+ * without the vector set-up of SIMD_FN. Used for boxes of one or two
+ * pixels (1x1, 2x1, 1x2: two thirds of the scanned triangles of the 10k
+ * bench model), whose vector set-up costs more than their pixels. */
+static inline long simd_scan_pixel(const rast_target *t, const rast__tri *tri, int x, int y)
 {
-    const int64_t j = y - tri->y0;
-    if (((tri->e_c[0] + j * tri->e_dy[0]) | (tri->e_c[1] + j * tri->e_dy[1]) |
-         (tri->e_c[2] + j * tri->e_dy[2])) < 0)
+    const int64_t i = x - tri->x0, j = y - tri->y0;
+    if (((tri->e_c[0] + j * tri->e_dy[0] + i * tri->e_dx[0]) |
+         (tri->e_c[1] + j * tri->e_dy[1] + i * tri->e_dx[1]) |
+         (tri->e_c[2] + j * tri->e_dy[2] + i * tri->e_dx[2])) < 0)
         return 0;
-    const float fj = (float)j, fi = 0.0f;
+    const float fj = (float)j, fi = (float)i;
     float z = (tri->z.c + tri->z.dy * fj) + tri->z.dx * fi;
     z = z < 0.0f ? 0.0f : z;
     z = z > 1.0f ? 1.0f : z;
-    const int x = tri->x0;
     if (t->depth) {
         float *d = t->depth + (size_t)y * (size_t)t->depth_stride + x;
         if (!(z < *d))
@@ -135,8 +136,14 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
     const int ye = yb < tri->y1 ? yb : tri->y1;
     if (ys > ye)
         return 0;
-    if (tri->x0 == tri->x1 && ys == ye)
-        return simd_scan_pixel(t, tri, ys);
+    if (tri->x0 == tri->x1) {
+        if (ys == ye)
+            return simd_scan_pixel(t, tri, tri->x0, ys);
+        if (ys + 1 == ye)
+            return simd_scan_pixel(t, tri, tri->x0, ys) + simd_scan_pixel(t, tri, tri->x0, ye);
+    } else if (tri->x0 + 1 == tri->x1 && ys == ye) {
+        return simd_scan_pixel(t, tri, tri->x0, ys) + simd_scan_pixel(t, tri, tri->x1, ys);
+    }
     const int na = t->attr ? tri->attr_count : 0;
     const int nx = tri->x1 - tri->x0 + 1;
     const int nvec = (nx + SIMD_V - 1) / SIMD_V;
