@@ -7,7 +7,10 @@
  * alone when the colours cannot tell hand from background; the global
  * colour model (fuse_colour_model_learn): its log-likelihood ratios on
  * colours whose counts are known, the pixels it leaves out, and the
- * refinement that mixes it in. */
+ * refinement that mixes it in; the band-only paths (portable, AVX2,
+ * AVX-512: fuse_refine_mask_isa) byte for byte and stat for stat against
+ * the scalar reference on 400 seeded random cases each (skipped where the
+ * CPU lacks the ISA), and the reference's CRC on the disc scene. */
 #include "support/testutil.h"
 #include <cmocka.h>
 
@@ -19,6 +22,9 @@
 #include "../src/fuse/fuse_refine.h"
 
 enum { W = 160, H = 120 };
+/* CRC-32 of the reference's output in test_refine_crc */
+#define CRC_BAND5 0x6c9574c7u
+#define CRC_BAND16 0x3f86ac59u
 
 static void set_px(uint8_t *img, int x, int y, int r, int g, int b)
 {
@@ -323,6 +329,205 @@ static void test_refine_global(void **state)
     free(llr); free(cscr); free(scratch);
 }
 
+/* ------------------------------------------ fast paths against the reference */
+
+/* A random case: odd sizes, padded strides, a mask of random discs (or
+ * empty, full, pixel noise, touching the border), grey values around 128
+ * in the mask, two colour clusters plus noise in P, random parameters
+ * (band 1..64, margin, bits, smooth, prior incl. 0), sometimes a global
+ * model of the same or other bits. */
+typedef struct rcase {
+    int w, h, ms, os, ps;
+    uint8_t *img, *mask;
+    fuse_refine_params rp;
+    fuse_colour_model g;
+    int use_g;
+    float weight;
+} rcase;
+
+static void make_case(rcase *c, tu_rng *r, int k)
+{
+    c->w = 1 + tu_int(r, k < 8 ? 9 : 97);
+    c->h = 1 + tu_int(r, k < 8 ? 9 : 71);
+    if (k % 13 == 5) { c->w = 129 + tu_int(r, 64); c->h = 97 + tu_int(r, 40); }
+    c->ms = c->w + tu_int(r, 5);
+    c->os = c->w + tu_int(r, 5);
+    c->ps = 4 * c->w + 4 * tu_int(r, 3);
+    c->img = malloc((size_t)c->ps * (size_t)c->h);
+    c->mask = malloc((size_t)c->ms * (size_t)c->h);
+    const int kind = k % 7;   /* 0 empty, 1 full, 2 noise, else discs */
+    const int nd = 1 + tu_int(r, 4);
+    float cx[4], cy[4], rr[4];
+    for (int i = 0; i < nd; i++) {
+        cx[i] = tu_range(r, -0.2f, 1.2f) * (float)c->w;
+        cy[i] = tu_range(r, -0.2f, 1.2f) * (float)c->h;
+        rr[i] = tu_range(r, 0.5f, 0.6f * (float)(c->w > c->h ? c->w : c->h));
+    }
+    for (int y = 0; y < c->h; y++)
+        for (int x = 0; x < c->w; x++) {
+            int in = 0;
+            if (kind == 1) in = 1;
+            else if (kind == 2) in = tu_int(r, 3) == 0;
+            else if (kind > 2)
+                for (int i = 0; i < nd; i++) {
+                    float dx = (float)x + 0.5f - cx[i], dy = (float)y + 0.5f - cy[i];
+                    in |= dx * dx + dy * dy <= rr[i] * rr[i];
+                }
+            c->mask[(size_t)y * (size_t)c->ms + (size_t)x] =
+                (uint8_t)(in ? 128 + tu_int(r, 128) : tu_int(r, 128));
+            /* the colour follows the mask (noisily), sometimes it lies */
+            int skin = tu_int(r, 8) == 0 ? !in : in;
+            int n = tu_int(r, 41) - 20;
+            uint8_t *p = c->img + (size_t)y * (size_t)c->ps + 4 * (size_t)x;
+            int rgb[3] = { skin ? 200 : 60, skin ? 140 : 90, skin ? 110 : 120 };
+            for (int j = 0; j < 3; j++) {
+                int v = rgb[j] + n + tu_int(r, 31) - 15;
+                p[j] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
+            }
+            p[3] = (uint8_t)tu_int(r, 256);
+        }
+    for (int y = 0; y < c->h; y++)   /* padding bytes: garbage */
+        for (int x = c->w; x < c->ms; x++) c->mask[(size_t)y * (size_t)c->ms + (size_t)x] = 200;
+    c->rp = fuse_refine_params_default();
+    c->rp.band = k % 11 == 0 ? 64 : 1 + tu_int(r, k % 3 ? 12 : 64);
+    c->rp.margin = 1 + tu_int(r, k % 4 ? 10 : 64);
+    c->rp.bits = k % 29 == 3 ? 6 : 2 + tu_int(r, 4);
+    c->rp.smooth = tu_int(r, 4);
+    c->rp.prior = k % 5 == 0 ? 0.0f : tu_range(r, 0.0f, 3.0f);
+    c->rp.min_samples = k % 17 == 1 ? 100000 : 1 + tu_int(r, 20);
+    c->use_g = tu_int(r, 3) == 0;
+    c->g.bits = tu_int(r, 2) ? c->rp.bits : 2 + tu_int(r, 4);
+    c->g.fg_samples = c->g.bg_samples = 0;
+    size_t gb = (size_t)1 << (3 * c->g.bits);
+    c->g.llr = malloc(gb * sizeof(float));
+    for (size_t i = 0; i < gb; i++) c->g.llr[i] = tu_range(r, -3.0f, 3.0f);
+    c->weight = tu_int(r, 4) == 0 ? (float)tu_int(r, 2) : tu_unit(r);
+}
+
+static void free_case(rcase *c)
+{
+    free(c->img);
+    free(c->mask);
+    free(c->g.llr);
+}
+
+/* Runs a case on the reference and on isa; fails on any byte or stat that
+ * differs. Returns the CRC of the reference output. */
+static uint32_t check_case(const rcase *c, ef_isa isa, int k)
+{
+    fuse_image P = { c->img, c->w, c->h, c->ps };
+    size_t ss = fuse_refine_scratch_size(&c->rp, c->w, c->h);
+    assert_true(ss > 0);
+    void *s1 = aligned_alloc(64, (ss + 63) & ~(size_t)63);
+    void *s2 = aligned_alloc(64, (ss + 63) & ~(size_t)63);
+    size_t on = (size_t)c->os * (size_t)c->h;
+    uint8_t *o1 = malloc(on), *o2 = malloc(on);
+    memset(o1, 0x5a, on);
+    memset(o2, 0x5a, on);
+    memset(s2, 0xa5, ss);   /* the fast path must not read stale scratch */
+    fuse_refine_stats t1, t2;
+    const fuse_colour_model *g = c->use_g ? &c->g : NULL;
+    assert_int_equal(fuse_refine_mask_isa(&c->rp, g, c->weight, &P, c->mask, c->ms, o1, c->os,
+                                          s1, ss, &t1, EF_ISA_REF), FUSE_OK);
+    assert_int_equal(fuse_refine_mask_isa(&c->rp, g, c->weight, &P, c->mask, c->ms, o2, c->os,
+                                          s2, ss, &t2, isa), FUSE_OK);
+    if (memcmp(o1, o2, on) != 0) {
+        for (size_t i = 0; i < on; i++)
+            if (o1[i] != o2[i]) {
+                print_error("case %d (%dx%d band %d margin %d bits %d smooth %d g %d): "
+                            "byte %zu (x %zu, y %zu) ref %d %s %d\n", k, c->w, c->h,
+                            c->rp.band, c->rp.margin, c->rp.bits, c->rp.smooth, c->use_g, i,
+                            i % (size_t)c->os, i / (size_t)c->os, o1[i], ef_isa_name(isa),
+                            o2[i]);
+                break;
+            }
+        fail();
+    }
+    assert_int_equal(t1.band_pixels, t2.band_pixels);
+    assert_int_equal(t1.flipped_in, t2.flipped_in);
+    assert_int_equal(t1.flipped_out, t2.flipped_out);
+    assert_int_equal(t1.fg_samples, t2.fg_samples);
+    assert_int_equal(t1.bg_samples, t2.bg_samples);
+    assert_int_equal(t1.used_colour, t2.used_colour);
+    uint32_t crc = tu_crc32(0, o1, on);
+    free(s1); free(s2); free(o1); free(o2);
+    return crc;
+}
+
+static void check_isa(ef_isa isa)
+{
+    if (!ef_cpu_has(isa) || ef_isa_choose(isa) != isa) {
+        print_message("%s: not available here (or capped by EGOFUSE_ISA)\n", ef_isa_name(isa));
+        skip();
+    }
+    assert_int_equal(fuse_refine_isa(isa), isa);
+    tu_rng r = { 0x5eed0007u };
+    long used = 0, flips = 0;
+    for (int k = 0; k < 400; k++) {
+        rcase c;
+        make_case(&c, &r, k);
+        check_case(&c, isa, k);
+        fuse_refine_stats st;
+        fuse_image P = { c.img, c.w, c.h, c.ps };
+        size_t ss = fuse_refine_scratch_size(&c.rp, c.w, c.h);
+        void *s = aligned_alloc(64, (ss + 63) & ~(size_t)63);
+        uint8_t *o = malloc((size_t)c.os * (size_t)c.h);
+        assert_int_equal(fuse_refine_mask_isa(&c.rp, NULL, 0.0f, &P, c.mask, c.ms, o, c.os, s, ss,
+                                              &st, isa), FUSE_OK);
+        used += st.used_colour;
+        flips += st.flipped_in + st.flipped_out;
+        free(s);
+        free(o);
+        free_case(&c);
+    }
+    /* the cases exercise the colour decision, not only the copy of M */
+    print_message("%s: 400 cases, colour used in %ld, %ld pixels flipped\n", ef_isa_name(isa),
+                  used, flips);
+    assert_true(used > 80);
+    assert_true(flips > 1000);
+}
+
+static void test_fast_c(void **state) { (void)state; check_isa(EF_ISA_SSE2); }
+static void test_fast_avx2(void **state) { (void)state; check_isa(EF_ISA_AVX2); }
+static void test_fast_avx512(void **state) { (void)state; check_isa(EF_ISA_AVX512); }
+
+/* The disc scene with a shifted kinematic mask (defaults, band 5 and 16):
+ * the reference's bytes as a constant (the result of the whole-image
+ * implementation this path replaced), and every path available gives them. */
+static void test_refine_crc(void **state)
+{
+    (void)state;
+    uint8_t *img = malloc(4 * W * H), *truth = malloc(W * H), *km = malloc(W * H);
+    uint8_t *out = malloc(W * H);
+    const uint32_t expect[2] = { CRC_BAND5, CRC_BAND16 };
+    const int bands[2] = { 5, 16 };
+    scene(img, truth, 80.3f, 61.7f, 30.0f, 77u);
+    disc(km, 82.3f, 60.2f, 28.5f);
+    fuse_image P = { img, W, H, 4 * W };
+    for (int b = 0; b < 2; b++) {
+        fuse_refine_params rp = fuse_refine_params_default();
+        rp.band = bands[b];
+        size_t ss = fuse_refine_scratch_size(&rp, W, H);
+        void *scratch = aligned_alloc(64, (ss + 63) & ~(size_t)63);
+        for (int i = EF_ISA_REF; i < EF_ISA_COUNT; i++) {
+            if (i != EF_ISA_REF && (!ef_cpu_has((ef_isa)i) || (int)fuse_refine_isa((ef_isa)i) != i))
+                continue;
+            fuse_refine_stats st;
+            memset(out, 0, W * H);
+            assert_int_equal(fuse_refine_mask_isa(&rp, NULL, 0.0f, &P, km, W, out, W, scratch,
+                                                  ss, &st, (ef_isa)i), FUSE_OK);
+            uint32_t crc = tu_crc32(0, out, W * H);
+            print_message("band %d %s: crc 0x%08x, band pixels %ld, flipped %ld/%ld\n",
+                          bands[b], ef_isa_name((ef_isa)i), (unsigned)crc, st.band_pixels,
+                          st.flipped_in, st.flipped_out);
+            assert_int_equal(st.used_colour, 1);
+            assert_int_equal(crc, expect[b]);
+        }
+        free(scratch);
+    }
+    free(img); free(truth); free(km); free(out);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -331,6 +536,10 @@ int main(void)
         cmocka_unit_test(test_refine_keeps_mask),
         cmocka_unit_test(test_colour_model_counts),
         cmocka_unit_test(test_refine_global),
+        cmocka_unit_test(test_fast_c),
+        cmocka_unit_test(test_fast_avx2),
+        cmocka_unit_test(test_fast_avx512),
+        cmocka_unit_test(test_refine_crc),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

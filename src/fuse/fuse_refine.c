@@ -1,6 +1,7 @@
 /* fuse_refine.c - skin-colour key and edge-band colour refinement of the
  * kinematic mask (fuse_refine.h). */
 #include "fuse_refine.h"
+#include "fuse_refine_kern.h"
 
 #include <math.h>
 #include <string.h>
@@ -104,7 +105,9 @@ size_t fuse_refine_scratch_size(const fuse_refine_params *p, int width,
                                 int height)
 {
     layout L;
-    return layout_of(p, width, height, &L) ? L.total : 0;
+    if (!layout_of(p, width, height, &L)) return 0;
+    size_t f = fuse__refine_fast_scratch(p, width, height);
+    return f > L.total ? f : L.total;
 }
 
 static uint16_t min16(uint16_t a, unsigned b)
@@ -162,19 +165,28 @@ static unsigned bin_of(const uint8_t *px, int bits)
            ((unsigned)(px[1] >> s) << bits) | (unsigned)(px[2] >> s);
 }
 
+/* The argument checks of every path. */
+static int refine_args_ok(const fuse_refine_params *p, const fuse_colour_model *g, float gw,
+                          const fuse_image *P, const uint8_t *mask, int mask_stride,
+                          const uint8_t *out, int out_stride, const void *scratch,
+                          size_t scratch_size)
+{
+    if (g && (!g->llr || g->bits < 2 || g->bits > 6 || !(gw >= 0.0f) || !(gw <= 1.0f)))
+        return 0;
+    return image_ok(P) && mask && out && scratch && mask_stride >= P->width &&
+           out_stride >= P->width && ((uintptr_t)scratch & 15u) == 0 && params_ok(p) &&
+           scratch_size >= fuse_refine_scratch_size(p, P->width, P->height);
+}
+
+/* The scalar reference: whole-image passes, the definition of the result
+ * (arguments checked by the caller). */
 static fuse_result refine(const fuse_refine_params *p, const fuse_colour_model *g, float gw,
                           const fuse_image *P, const uint8_t *mask, int mask_stride,
-                          uint8_t *out, int out_stride, void *scratch, size_t scratch_size,
+                          uint8_t *out, int out_stride, void *scratch,
                           fuse_refine_stats *stats)
 {
     layout L;
-    if (g && (!g->llr || g->bits < 2 || g->bits > 6 || !(gw >= 0.0f) || !(gw <= 1.0f)))
-        return FUSE_ERR_ARGS;
-    if (!image_ok(P) || !mask || !out || !scratch ||
-        mask_stride < P->width || out_stride < P->width ||
-        ((uintptr_t)scratch & 15u) != 0 ||
-        !layout_of(p, P->width, P->height, &L) || scratch_size < L.total)
-        return FUSE_ERR_ARGS;
+    if (!layout_of(p, P->width, P->height, &L)) return FUSE_ERR_ARGS;
     const int w = P->width, h = P->height;
     uint8_t *base = scratch;
     uint16_t *dist = (uint16_t *)(void *)(base + L.dist);
@@ -266,13 +278,44 @@ static fuse_result refine(const fuse_refine_params *p, const fuse_colour_model *
     return FUSE_OK;
 }
 
+ef_isa fuse_refine_isa(ef_isa isa)
+{
+    if (isa == EF_ISA_REF) return EF_ISA_REF;
+    if ((unsigned)isa >= EF_ISA_COUNT) isa = EF_ISA_DEFAULT;
+    ef_isa c = ef_isa_choose(isa);
+    if (c == EF_ISA_AVX512 && !fuse__refine_kern_avx512()) c = EF_ISA_AVX2;
+    if (c == EF_ISA_AVX2 && !fuse__refine_kern_avx2()) c = EF_ISA_SSE2;
+    return c;
+}
+
+fuse_result fuse_refine_mask_isa(const fuse_refine_params *p, const fuse_colour_model *g,
+                                 float weight, const fuse_image *P, const uint8_t *mask,
+                                 int mask_stride, uint8_t *out, int out_stride, void *scratch,
+                                 size_t scratch_size, fuse_refine_stats *stats, ef_isa isa)
+{
+    if (!refine_args_ok(p, g, weight, P, mask, mask_stride, out, out_stride, scratch,
+                        scratch_size))
+        return FUSE_ERR_ARGS;
+    if (!g) weight = 0.0f;
+    const fuse__refine_kern *k;
+    switch (fuse_refine_isa(isa)) {
+    case EF_ISA_REF:
+        return refine(p, g, weight, P, mask, mask_stride, out, out_stride, scratch, stats);
+    case EF_ISA_AVX512: k = fuse__refine_kern_avx512(); break;
+    case EF_ISA_AVX2: k = fuse__refine_kern_avx2(); break;
+    default: k = &fuse__refine_kern_c; break;
+    }
+    return fuse__refine_fast(k, p, g, weight, P, mask, mask_stride, out, out_stride, scratch,
+                             stats);
+}
+
 fuse_result fuse_refine_mask(const fuse_refine_params *p, const fuse_image *P,
                              const uint8_t *mask, int mask_stride,
                              uint8_t *out, int out_stride, void *scratch,
                              size_t scratch_size, fuse_refine_stats *stats)
 {
-    return refine(p, NULL, 0.0f, P, mask, mask_stride, out, out_stride, scratch, scratch_size,
-                  stats);
+    return fuse_refine_mask_isa(p, NULL, 0.0f, P, mask, mask_stride, out, out_stride, scratch,
+                                scratch_size, stats, EF_ISA_DEFAULT);
 }
 
 fuse_result fuse_refine_mask_global(const fuse_refine_params *p, const fuse_colour_model *g,
@@ -282,8 +325,8 @@ fuse_result fuse_refine_mask_global(const fuse_refine_params *p, const fuse_colo
                                     fuse_refine_stats *stats)
 {
     if (!g) return FUSE_ERR_ARGS;
-    return refine(p, g, weight, P, mask, mask_stride, out, out_stride, scratch, scratch_size,
-                  stats);
+    return fuse_refine_mask_isa(p, g, weight, P, mask, mask_stride, out, out_stride, scratch,
+                                scratch_size, stats, EF_ISA_DEFAULT);
 }
 
 /* ----------------------------------------------- global colour model */

@@ -41,6 +41,11 @@
  *   When either histogram has fewer than min_samples pixels the colour
  *   model is not trusted and the output is M.
  *
+ *   The result is defined by the scalar reference (whole-image passes,
+ *   fuse_refine_mask_isa with EF_ISA_REF); the default path does the same
+ *   work only where it can change a byte (rows and columns within band +
+ *   margin of the edge) with SIMD row kernels, and gives the same bytes.
+ *
  * WHAT IT DOES NOT
  *   No allocation (the caller gives the scratch memory), no threads, no
  *   global state. Pure C, libc + libm.
@@ -160,6 +165,28 @@ fuse_result fuse_refine_mask_global(const fuse_refine_params *p,
                                     int out_stride, void *scratch,
                                     size_t scratch_size,
                                     fuse_refine_stats *stats);
+
+/* ------------------------------------------------- paths */
+
+/* The refinement (fuse_refine_mask_global with g, fuse_refine_mask when g
+ * is NULL: weight is then ignored) on a chosen path:
+ *   EF_ISA_REF      the scalar reference above, whole-image passes: the
+ *                   definition of every output byte;
+ *   anything else   the band-only path (fuse_refine_fast.c: work only in
+ *                   per-row ranges around the mask's edge, integer
+ *                   histograms, tables, SIMD row kernels) of the ISA
+ *                   fuse_refine_isa(isa) names.
+ * Every path gives the same bytes and the same stats.
+ * fuse_refine_mask and fuse_refine_mask_global run EF_ISA_DEFAULT (the
+ * best the CPU has, capped by EGOFUSE_ISA). Same errors as those two. */
+fuse_result fuse_refine_mask_isa(const fuse_refine_params *p, const fuse_colour_model *g,
+                                 float weight, const fuse_image *P, const uint8_t *mask,
+                                 int mask_stride, uint8_t *out, int out_stride, void *scratch,
+                                 size_t scratch_size, fuse_refine_stats *stats, ef_isa isa);
+/* The path fuse_refine_mask_isa takes for isa: EF_ISA_REF for EF_ISA_REF,
+ * else ef_isa_choose(isa) (EF_ISA_DEFAULT: no cap) limited to the paths
+ * this build has; EF_ISA_SSE2 names the portable band-only kernels. */
+ef_isa fuse_refine_isa(ef_isa isa);
 
 #ifdef __cplusplus
 }
