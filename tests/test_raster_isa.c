@@ -931,6 +931,256 @@ static void test_context_clear(void **state)
     print_message("NOTE context clear: %d frames equal to full clears\n", checked);
 }
 
+/* ---- the vector front end (rast__vpass_*, rast__frontv_*) --------------- */
+
+/* Case n of the mesh generator: a jittered grid of shared vertices (2x2
+ * to 61x61) over a window of NDC from a few pixels to far beyond the
+ * view, both windings, w from behind the eye to far (a tilted w plane
+ * crossing 0 in a quarter of the cases, so triangles straddle the near
+ * plane), depth in and out of the clip volume, rare NaN / infinite
+ * vertices, repeated indices (degenerate), triangles between random far
+ * vertices, a shuffled order in half the cases, every cull mode,
+ * 0..8 attributes, odd target sizes and padded strides. */
+static void make_mesh(int n, rcase *k)
+{
+    tu_rng r = { 0xF0E7000ull + (uint64_t)n * 0x9E3779B97F4A7C15ull };
+    memset(k, 0, sizeof *k);
+    const int w = tu_int(&r, 8) == 0 ? 1 + tu_int(&r, 20) : 16 + tu_int(&r, 700);
+    const int h = tu_int(&r, 8) == 0 ? 1 + tu_int(&r, 20) : 16 + tu_int(&r, 400);
+    const int na = tu_int(&r, 2) ? 3 : tu_int(&r, 9);
+    rast_target *t = &k->t;
+    t->width = w;
+    t->height = h;
+    t->mask_stride = w + tu_int(&r, 5);
+    t->mask = malloc((size_t)t->mask_stride * h);
+    if (tu_int(&r, 5) != 0) {
+        t->depth_stride = w + tu_int(&r, 5);
+        t->depth = malloc((size_t)t->depth_stride * h * sizeof(float));
+    }
+    t->attr_count = na;
+    k->attr_plane = tu_int(&r, 4) != 0;
+    if (k->attr_plane && na > 0) {
+        t->attr_stride = w * na + tu_int(&r, 7);
+        t->attr = malloc((size_t)t->attr_stride * h * sizeof(float));
+    }
+    const int G = 2 + tu_int(&r, 60);
+    const int nv = G * G;
+    const float ext = powf(2.0f, tu_range(&r, -7.0f, 2.0f));   /* grid size in NDC */
+    const float cx = tu_range(&r, -0.8f, 0.8f), cy = tu_range(&r, -0.8f, 0.8f);
+    const float jit = tu_int(&r, 3) == 0 ? 0.0f : tu_range(&r, 0.0f, 0.45f);
+    const int tilt = tu_int(&r, 4) == 0;
+    const float w0 = tu_range(&r, 0.2f, 3.0f), wx = tilt ? tu_range(&r, -3.0f, 3.0f) : 0.0f;
+    const float zlo = tu_int(&r, 4) == 0 ? -1.5f : -0.9f, zhi = tu_int(&r, 4) == 0 ? 1.5f : 0.9f;
+    k->clip = malloc((size_t)nv * 4 * sizeof(float));
+    k->attr = na ? malloc((size_t)nv * na * sizeof(float)) : NULL;
+    for (int j = 0; j < G; j++)
+        for (int i = 0; i < G; i++) {
+            float *c = k->clip + 4 * (j * G + i);
+            const float u = ((float)i + tu_range(&r, -jit, jit)) / (float)(G - 1) - 0.5f;
+            const float v = ((float)j + tu_range(&r, -jit, jit)) / (float)(G - 1) - 0.5f;
+            const float wv = w0 + wx * u + tu_range(&r, -0.01f, 0.01f);
+            const float aw = fabsf(wv) > 1e-3f ? fabsf(wv) : 1.0f;
+            c[0] = (cx + ext * u) * aw;
+            c[1] = (cy + ext * v) * aw;
+            c[2] = tu_range(&r, zlo, zhi) * aw;
+            c[3] = wv;
+            if (tu_int(&r, 400) == 0)
+                c[tu_int(&r, 4)] = tu_int(&r, 2) ? NAN : -INFINITY;
+        }
+    for (int i = 0; i < nv * na; i++)
+        k->attr[i] = tu_range(&r, -1.0f, 1.0f);
+    const int nt = 2 * (G - 1) * (G - 1);
+    k->idx = malloc((size_t)nt * 3 * sizeof(uint32_t));
+    const int flip_all = tu_int(&r, 2);
+    for (int q = 0; q < (G - 1) * (G - 1); q++) {
+        const uint32_t a = (uint32_t)(q / (G - 1) * G + q % (G - 1));
+        const uint32_t quad[6] = { a, a + 1, a + (uint32_t)G + 1, a, a + (uint32_t)G + 1,
+                                   a + (uint32_t)G };
+        for (int i = 0; i < 6; i++)
+            k->idx[6 * q + i] = quad[i];
+    }
+    for (int ti = 0; ti < nt; ti++) {
+        uint32_t *x = k->idx + 3 * ti;
+        if (flip_all ^ (tu_int(&r, 10) == 0)) {
+            const uint32_t s = x[1];
+            x[1] = x[2];
+            x[2] = s;
+        }
+        if (tu_int(&r, 50) == 0)
+            x[tu_int(&r, 3)] = x[tu_int(&r, 3)];
+        if (tu_int(&r, 40) == 0)
+            x[tu_int(&r, 3)] = (uint32_t)tu_int(&r, nv);
+    }
+    if (tu_int(&r, 2))
+        for (int ti = nt - 1; ti > 0; ti--) {
+            const int o = tu_int(&r, ti + 1);
+            uint32_t s[3];
+            memcpy(s, k->idx + 3 * ti, sizeof s);
+            memcpy(k->idx + 3 * ti, k->idx + 3 * o, sizeof s);
+            memcpy(k->idx + 3 * o, s, sizeof s);
+        }
+    rast_mesh_desc *m = &k->m;
+    m->clip = k->clip;
+    m->vertex_count = nv;
+    m->attr = k->attr;
+    m->attr_count = na;
+    m->indices = k->idx;
+    m->tri_count = nt;
+    m->cull = (rast_cull)tu_int(&r, 3);
+}
+
+/* One case through the vector front end of an ISA against the scalar
+ * path: the vertex pass against the scalar vertex fill (every vertex),
+ * then the front end in random chunks of 1..300 submitted triangles
+ * against rast__prepare_range with the scalar set-up (memcmp of the
+ * records, counters). Adds the reference records and counters to *crc
+ * and counts the set-up triangles and those of special vertices. */
+static void frontv_case(const rcase *k, const rast__setup_isa *isa, tu_rng *r, uint32_t *crc,
+                        long *made, long *clipped, const char *what)
+{
+    rast__view view;
+    rast__view_init(&view, k->t.width, k->t.height, rast__draw_na(&k->t, &k->m));
+    const rast_mesh_desc *m = &k->m;
+    rast__vbuf *vb = rast__vbuf_alloc(m->vertex_count);
+    assert_non_null(vb);
+    isa->vpass(&view, m->clip, m->vertex_count, vb);
+    for (int i = 0; i < m->vertex_count; i++) {
+        rast__vc_entry e;
+        rast__vfill_ref(&view, m->clip, (uint32_t)i, 1, &e);
+        const int mark = vb->xy[2 * i] == RAST__VX_SPECIAL;
+        if (mark != (e.flags != 0) ||
+            (!mark && (vb->xy[2 * i] != e.X || vb->xy[2 * i + 1] != e.Y ||
+                       memcmp(&vb->zw[i], &e.zw, sizeof e.zw) ||
+                       memcmp(&vb->iw[i], &e.iw, sizeof e.iw))))
+            fail_msg("%s: vertex %d of the vertex pass differs from the scalar fill "
+                     "(flags %u)", what, i, e.flags);
+    }
+    const size_t cap = (size_t)m->tri_count * RAST__MAX_FAN + 1;
+    rast__tri *a = calloc(cap, sizeof *a), *b = calloc(cap, sizeof *b);
+    rast_stats sa, sb;
+    memset(&sa, 0, sizeof sa);
+    memset(&sb, 0, sizeof sb);
+    rast__vcache vc;
+    rast__vcache_reset(&vc);
+    const int na = rast__prepare_range(&view, m, 0, m->tri_count, &vc, a, &sa,
+                                       &rast__setup_isa_ref);
+    int nb = 0;
+    for (int ti = 0; ti < m->tri_count;) {
+        const int len = tu_int(r, 4) == 0 ? 1 + tu_int(r, 16) : 1 + tu_int(r, 300);
+        const int te = m->tri_count - ti > len ? ti + len : m->tri_count;
+        nb += isa->frontv(&view, m, vb, ti, te, b + nb, &sb);
+        ti = te;
+    }
+    if (na != nb || memcmp(&sa, &sb, sizeof sa))
+        fail_msg("%s: %d vs %d records; drawn %ld vs %ld, culled %ld vs %ld, degenerate "
+                 "%ld vs %ld, clipped %ld vs %ld, non-finite %ld vs %ld", what, nb, na,
+                 sb.tris_drawn, sa.tris_drawn, sb.tris_culled, sa.tris_culled,
+                 sb.tris_degenerate, sa.tris_degenerate, sb.tris_clipped_away,
+                 sa.tris_clipped_away, sb.tris_nonfinite, sa.tris_nonfinite);
+    for (int i = 0; i < na; i++)
+        if (memcmp(&a[i], &b[i], sizeof a[i]))
+            fail_msg("%s: record %d of %d differs (box %d %d %d %d vs %d %d %d %d, e_c0 "
+                     "%lld vs %lld, z.c %.9g vs %.9g)", what, i, na, b[i].x0, b[i].y0,
+                     b[i].x1, b[i].y1, a[i].x0, a[i].y0, a[i].x1, a[i].y1,
+                     (long long)b[i].e_c[0], (long long)a[i].e_c[0], b[i].z.c, a[i].z.c);
+    *crc = tu_crc32(*crc, a, (size_t)na * sizeof *a);
+    const long cnt[5] = { sa.tris_nonfinite, sa.tris_clipped_away, sa.tris_degenerate,
+                          sa.tris_culled, sa.tris_drawn };
+    *crc = tu_crc32(*crc, cnt, sizeof cnt);
+    *made += na;
+    *clipped += sa.tris_clipped_away + sa.tris_nonfinite;
+    free(a);
+    free(b);
+    rast__vbuf_free(vb);
+}
+
+/* The vector front end equals the scalar set-up: every soup case and
+ * 300 grid meshes (shared vertices, slivers, huge, behind the eye, NaN,
+ * culling, degenerate) record for record, a CRC of the reference records
+ * and counters against a recorded constant, and whole draws of the
+ * meshes through a context (which takes the vector front end) against
+ * rast_draw with the reference scan, byte for byte; an index out of
+ * range is still RAST_ERR_INDEX with nothing drawn. */
+#define FRONTV_CRC 0x79E6CFE7u
+static void test_frontv_equal(void **state)
+{
+    (void)state;
+    static const int simd[2] = { EF_ISA_AVX2, EF_ISA_AVX512 };
+    const rast__setup_isa *isas_v[2] = { &rast__setup_isa_avx2, &rast__setup_isa_avx512 };
+    int nhave = 0;
+    for (int i = 0; i < 2; i++) {
+        if (ef_cpu_has((ef_isa)simd[i]) && isas_v[i]->vpass)
+            nhave++;
+        else
+            print_message("SKIP vector front end %s: this CPU does not run it\n",
+                          ef_isa_name((ef_isa)simd[i]));
+    }
+    if (!nhave)
+        skip();
+    tu_rng r = { 0xF70u };
+    for (int i = 0; i < 2; i++) {
+        if (!ef_cpu_has((ef_isa)simd[i]))
+            continue;
+        uint32_t crc = 0;
+        long made = 0, clipped = 0, made_soup = 0, clipped_soup = 0, tris = 0;
+        for (int n = 0; n < NCASES; n++) {
+            rcase k;
+            make_case(n, &k);
+            char what[64];
+            snprintf(what, sizeof what, "%s soup case %d", ef_isa_name((ef_isa)simd[i]), n);
+            frontv_case(&k, isas_v[i], &r, &crc, &made_soup, &clipped_soup, what);
+            free_case(&k);
+        }
+        rast_context_desc d = { simd[i], 1 };
+        rast_context *c = rast_context_create(&d);
+        assert_non_null(c);
+        assert_int_equal(rast_context_isa(c), simd[i]);
+        for (int n = 0; n < 300; n++) {
+            rcase k;
+            make_mesh(n, &k);
+            char what[64];
+            snprintf(what, sizeof what, "%s mesh %d", ef_isa_name((ef_isa)simd[i]), n);
+            frontv_case(&k, isas_v[i], &r, &crc, &made, &clipped, what);
+            tris += k.m.tri_count;
+            /* The whole draw through the context. */
+            rast_stats st;
+            draw_case(&k, rast__scan_rows_ref, &st);
+            snapshot ref;
+            take(&k.t, &st, &ref);
+            reset_target(&k.t);
+            memset(&st, 0, sizeof st);
+            assert_int_equal(rast_context_draw(c, &k.t, &k.m, &st), RAST_OK);
+            if (differs(&k.t, &st, &ref, what, 1))
+                fail_msg("%s: the context draw differs from the reference", what);
+            drop(&ref);
+            if (n % 50 == 0) {
+                /* A bad index anywhere: an error, nothing drawn. */
+                const int at = tu_int(&r, 3 * k.m.tri_count);
+                const uint32_t keep = k.idx[at];
+                k.idx[at] = (uint32_t)k.m.vertex_count + (uint32_t)tu_int(&r, 3);
+                reset_target(&k.t);
+                memset(&st, 0x33, sizeof st);
+                const rast_stats st0 = st;
+                assert_int_equal(rast_context_draw(c, &k.t, &k.m, &st), RAST_ERR_INDEX);
+                assert_memory_equal(&st, &st0, sizeof st);
+                for (int y = 0; y < k.t.height; y++)
+                    for (int x = 0; x < k.t.width; x++)
+                        assert_int_equal(k.t.mask[(size_t)y * k.t.mask_stride + x], 0);
+                k.idx[at] = keep;
+            }
+            free_case(&k);
+        }
+        rast_context_destroy(c);
+        print_message("NOTE vector front end %s: soup %ld records (%ld clipped or "
+                      "non-finite triangles), meshes %ld triangles, %ld records (%ld "
+                      "clipped or non-finite), equal to the scalar set-up and the reference "
+                      "draw; CRC32 0x%08X (recorded 0x%08X)\n", ef_isa_name((ef_isa)simd[i]),
+                      made_soup, clipped_soup, tris, made, clipped, crc, FRONTV_CRC);
+        assert_true(made > 100000 && clipped > 1000 && made_soup > 20000);
+        assert_int_equal(crc, FRONTV_CRC);
+    }
+}
+
 /* ---- rerun of one case --------------------------------------------------- */
 
 static int rerun(int n)
@@ -977,6 +1227,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_setup_isa_equal),
         cmocka_unit_test(test_jobs_equal),
         cmocka_unit_test(test_context_clear),
+        cmocka_unit_test(test_frontv_equal),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -168,6 +168,9 @@ typedef __m256 vs;
 #define PS_CVT_STORE(p, v) _mm256_store_si256((__m256i *)(void *)(p), _mm256_cvtps_epi32(v))
 #define PD_LOAD_F(p) _mm256_cvtps_pd(_mm_load_ps(p))
 #define PD_STORE(p, v) _mm256_store_pd(p, v)
+/* The vector front end: raster_front_avx2.c. */
+#define VPASS_FN rast__vpass_avx2
+#define FRONTV_FN rast__frontv_avx2
 #include "raster_planes.inl"
 
 #else

@@ -337,6 +337,9 @@ unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__
     return special | (live2 & ~empty);
 }
 #define FRONT_FN rast__front_avx512
+/* The vector front end: raster_front_avx512.c. */
+#define VPASS_FN rast__vpass_avx512
+#define FRONTV_FN rast__frontv_avx512
 #include "raster_planes.inl"
 
 #else

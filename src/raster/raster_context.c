@@ -112,6 +112,9 @@ struct rast_context {
     int isa, threads;
     rast__scan_rows_fn scan;
     const rast__setup_isa *setup; /* the set-up kernels of the ISA */
+    /* Per thread: the vertex buffer of the vector front end (NULL when
+     * the ISA has none). Whole-job draws use it. */
+    rast__vbuf *vb[RAST_MAX_THREADS];
     slot *slots;
     pthread_t th[RAST_MAX_THREADS];
     int started;
@@ -219,7 +222,8 @@ static void run_draw(rast_context *c, int tid)
     const int nj = c->njobs;
     if (nj >= 2) {
         for (int j = tid; j < nj; j += c->threads)
-            rast__draw_valid(c->jt[j], c->jm[j], &me->st, c->scan, c->jtiles[j]);
+            rast__draw_valid_vb(c->jt[j], c->jm[j], &me->st, c->scan, c->jtiles[j],
+                                c->vb[tid]);
         barrier(c);
     } else if (nj == 1) {
         run_bands(c, tid, 0);
@@ -278,6 +282,8 @@ void rast_context_destroy(rast_context *c)
             free(c->slots[i].buf[1]);
         }
     free(c->slots);
+    for (int i = 0; i < c->threads; i++)
+        rast__vbuf_free(c->vb[i]);
     free(c->known[0].dirty);
     free(c);
 }
@@ -305,14 +311,22 @@ rast_context *rast_context_create(const rast_context_desc *desc)
     }
     for (int i = 1; i < RAST_CONTEXT_TARGETS; i++)
         c->known[i].dirty = c->known[0].dirty + i;
+    if (c->threads > 1) {
+        pthread_mutex_init(&c->mu, NULL);
+        pthread_cond_init(&c->cv, NULL);
+        pthread_mutex_init(&c->bar_mu, NULL);
+        pthread_cond_init(&c->bar_cv, NULL);
+    }
+    /* Vertex buffers (address space for RAST__VX_CAP vertices; only the
+     * pages a draw uses are touched). */
+    if (c->setup->vpass)
+        for (int i = 0; i < c->threads; i++)
+            if (!(c->vb[i] = rast__vbuf_alloc(RAST__VX_CAP)))
+                goto fail;
     if (c->threads == 1)
         return c;
 
-    pthread_mutex_init(&c->mu, NULL);
-    pthread_cond_init(&c->cv, NULL);
-    pthread_mutex_init(&c->bar_mu, NULL);
-    pthread_cond_init(&c->bar_cv, NULL);
-    c->slots = calloc((size_t)c->threads, sizeof *c->slots);
+    c->slots = calloc((size_t)(unsigned)c->threads, sizeof *c->slots);
     if (!c->slots)
         goto fail;
     for (int i = 0; i < c->threads; i++)
@@ -491,7 +505,7 @@ rast_result rast_context_draw_jobs(rast_context *c, int n, const rast_target *co
     }
     if (c->threads == 1 || n == 0) {
         for (int i = 0; i < n; i++)
-            rast__draw_valid(t[i], mesh[i], &st, c->scan, c->jtiles[i]);
+            rast__draw_valid_vb(t[i], mesh[i], &st, c->scan, c->jtiles[i], c->vb[0]);
     } else {
         c->njobs = n;
         c->jt = t;

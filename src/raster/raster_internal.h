@@ -11,6 +11,10 @@
  *                   the float planes of 4/8 triangles per vector, vertex
  *                   cache fills of 16 vertices, and (AVX-512) the trivial
  *                   rejection of 16 triangles at once.
+ *   raster_front_avx512.c, raster_front_avx2.c
+ *                   the vector front end (below: rast__vbuf): vertex pass,
+ *                   rejection and set-up in lanes, for whole-job draws
+ *                   through a context; same records as the scalar set-up.
  *   raster_ref.c    rast__scan_ref(): the per-pixel loop over one set-up
  *                   triangle. This is the only thing a SIMD path replaces,
  *                   and it must give the same bytes (op order below).
@@ -159,6 +163,13 @@ void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1);
  * pixel the draw may have written lies in a marked tile). */
 void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
                       rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles);
+/* The same with a vertex buffer: when the scan's set-up ISA has a vector
+ * front end and the mesh fits (vertex_count <= vb->cap), the draw runs
+ * it (same bytes and counters); otherwise (or vb NULL) rast__draw_valid. */
+struct rast__vbuf;
+void rast__draw_valid_vb(const rast_target *t, const rast_mesh_desc *m,
+                         rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles,
+                         struct rast__vbuf *vb);
 
 /* Fetch, clip, snap and set up submitted triangle ti of m (indices already
  * validated): writes 0..RAST__MAX_FAN triangles to out, returns their
@@ -257,10 +268,57 @@ typedef unsigned (*rast__front_fn)(const rast__view *v, const rast_mesh_desc *m,
 unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__vcache *vc,
                             int ti, rast_stats *st, rast__vfill_fn vfill);
 
+/* ---- the vector front end (sixth round, docs/raster.md section 11) ------
+ *
+ * Per draw, every vertex is transformed once into a vertex buffer owned by
+ * the context (no tags, no misses): the snapped position as one 64-bit
+ * pair (X low, Y high; X = RAST__VX_SPECIAL when the vertex is not finite,
+ * outside a clip plane or at w <= 0, i.e. when the vertex cache would give
+ * it flags != 0) and the double plane inputs zw, iw (valid when X is not
+ * the marker). Then groups of RAST__FRONT_GROUP submitted triangles are
+ * rejected in lanes (area, culling, box, empty one-pixel boxes), the
+ * survivors queued (compressed) and set up RAST__FRONT_GROUP at a time in
+ * lanes straight into their scan-ready records: box, biased int64 edges,
+ * planes (the double operations of planes_one per lane) and attributes.
+ * Triangles with a marked vertex go through rast__prepare in order. The
+ * records and counters are those of rast__prepare_range. */
+#define RAST__VX_SPECIAL INT32_MIN
+#define RAST__VX_CHUNK 128                        /* submitted triangles per chunk */
+#define RAST__VX_CAP (1 << 17)                    /* vertices per buffer */
+typedef struct rast__vbuf {
+    int cap;                  /* vertices (a multiple of 16) */
+    int32_t *xy;              /* 2 per vertex: X, Y */
+    double *zw, *iw;          /* 1 per vertex */
+    rast__tri *out;           /* RAST__VX_CHUNK * RAST__MAX_FAN records */
+} rast__vbuf;
+/* A buffer for cap vertices (rounded up to 16) in one 64-byte aligned
+ * block, or NULL; rast__vbuf_free(NULL) is fine. */
+rast__vbuf *rast__vbuf_alloc(int cap);
+void rast__vbuf_free(rast__vbuf *vb);
+/* Fills vb for the count vertices at clip (count <= vb->cap). */
+typedef void (*rast__vpass_fn)(const rast__view *v, const float *clip, int count,
+                               rast__vbuf *vb);
+/* The set-up of submitted triangles ti0 .. ti1-1 (indices validated, vb
+ * filled by the vpass of the same ISA for m's clip coordinates) into out
+ * (room for (ti1 - ti0) * RAST__MAX_FAN): returns the record count; adds
+ * the counters but tris_in and pixels_written to *st. Records and
+ * counters equal rast__prepare_range's (bytes of the fields it writes). */
+typedef int (*rast__frontv_fn)(const rast__view *v, const rast_mesh_desc *m,
+                               const rast__vbuf *vb, int ti0, int ti1, rast__tri *out,
+                               rast_stats *st);
+void rast__vpass_avx2(const rast__view *v, const float *clip, int count, rast__vbuf *vb);
+int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
+                      int ti0, int ti1, rast__tri *out, rast_stats *st);
+void rast__vpass_avx512(const rast__view *v, const float *clip, int count, rast__vbuf *vb);
+int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
+                        int ti0, int ti1, rast__tri *out, rast_stats *st);
+
 typedef struct rast__setup_isa {
     rast__planes_fn planes;
     rast__vfill_fn vfill;
     rast__front_fn front;     /* NULL: every triangle through the scalar path */
+    rast__vpass_fn vpass;     /* NULL (with frontv): no vector front end */
+    rast__frontv_fn frontv;
 } rast__setup_isa;
 extern const rast__setup_isa rast__setup_isa_ref, rast__setup_isa_avx2,
     rast__setup_isa_avx512;

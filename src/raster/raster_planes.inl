@@ -196,4 +196,8 @@ void VFILL_FN(const rast__view *v, const float *clip, uint32_t base, int count,
 #ifndef FRONT_FN
 #define FRONT_FN NULL
 #endif
-const rast__setup_isa SETUP_ISA = { PLANES_FN, VFILL_FN, FRONT_FN };
+#ifndef VPASS_FN
+#define VPASS_FN NULL
+#define FRONTV_FN NULL
+#endif
+const rast__setup_isa SETUP_ISA = { PLANES_FN, VFILL_FN, FRONT_FN, VPASS_FN, FRONTV_FN };

@@ -6,6 +6,7 @@
 #include <float.h>
 #include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
 #include <string.h>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -389,7 +390,8 @@ static int setup_oriented(const rast__view *v, const int32_t X[3], const int32_t
     return RAST__SETUP_OK;
 }
 
-const rast__setup_isa rast__setup_isa_ref = { rast__planes_ref, rast__vfill_ref, NULL };
+const rast__setup_isa rast__setup_isa_ref = { rast__planes_ref, rast__vfill_ref, NULL, NULL,
+                                               NULL };
 
 void rast__planes_ref(rast__pbatch *b)
 {
@@ -873,6 +875,33 @@ void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1)
         }
 }
 
+/* Scans the n set-up triangles tri in order; marks their tiles (last:
+ * the tile rectangle marked last, x0, x1, y0, y1). */
+static long scan_list(const rast_target *t, const rast__tri *tri, int n,
+                      rast__scan_rows_fn scan, rast__tiles *tiles, int last[4])
+{
+    long px = 0;
+    for (int i = 0; i < n; i++) {
+        const rast__tri *r = &tri[i];
+        px += scan(t, r, r->y0, r->y1);
+        if (!tiles)
+            continue;
+        /* Neighbouring triangles mostly lie in the tiles just marked:
+         * skip the marking when the tile rectangle is inside the last
+         * one marked (those bits are set already). */
+        const int tx0 = r->x0 / RAST__TILE, tx1 = r->x1 / RAST__TILE;
+        const int ty0 = r->y0 / RAST__TILE, ty1 = r->y1 / RAST__TILE;
+        if (tx0 >= last[0] && tx1 <= last[1] && ty0 >= last[2] && ty1 <= last[3])
+            continue;
+        rast__tiles_add(tiles, r->y0, r->y1, r->x0, r->x1);
+        last[0] = tx0;
+        last[1] = tx1;
+        last[2] = ty0;
+        last[3] = ty1;
+    }
+    return px;
+}
+
 void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
                       rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles)
 {
@@ -891,27 +920,59 @@ void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
     for (int ti = 0; ti < m->tri_count; ti += CHUNK) {
         const int te = m->tri_count - ti > CHUNK ? ti + CHUNK : m->tri_count;
         const int n = rast__prepare_range(&view, m, ti, te, &vc, tri, &st, isa);
-        for (int i = 0; i < n; i++) {
-            const rast__tri *r = &tri[i];
-            st.pixels_written += scan(t, r, r->y0, r->y1);
-            if (!tiles)
-                continue;
-            /* Neighbouring triangles mostly lie in the tiles just marked:
-             * skip the marking when the tile rectangle is inside the last
-             * one marked (those bits are set already). */
-            const int tx0 = r->x0 / RAST__TILE, tx1 = r->x1 / RAST__TILE;
-            const int ty0 = r->y0 / RAST__TILE, ty1 = r->y1 / RAST__TILE;
-            if (tx0 >= last[0] && tx1 <= last[1] && ty0 >= last[2] && ty1 <= last[3])
-                continue;
-            rast__tiles_add(tiles, r->y0, r->y1, r->x0, r->x1);
-            last[0] = tx0;
-            last[1] = tx1;
-            last[2] = ty0;
-            last[3] = ty1;
-        }
+        st.pixels_written += scan_list(t, tri, n, scan, tiles, last);
     }
     if (stats)
         rast__stats_add(stats, &st);
+}
+
+void rast__draw_valid_vb(const rast_target *t, const rast_mesh_desc *m,
+                         rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles,
+                         rast__vbuf *vb)
+{
+    const rast__setup_isa *isa = rast__setup_for_scan(scan);
+    if (!vb || !isa->vpass || !isa->frontv || m->vertex_count > vb->cap) {
+        rast__draw_valid(t, m, stats, scan, tiles);
+        return;
+    }
+    rast__view view;
+    rast__view_init(&view, t->width, t->height, rast__draw_na(t, m));
+    rast_stats st = { 0 };
+    st.tris_in = m->tri_count;
+    isa->vpass(&view, m->clip, m->vertex_count, vb);
+    int last[4] = { 1, 0, 1, 0 };
+    for (int ti = 0; ti < m->tri_count; ti += RAST__VX_CHUNK) {
+        const int te = m->tri_count - ti > RAST__VX_CHUNK ? ti + RAST__VX_CHUNK : m->tri_count;
+        const int n = isa->frontv(&view, m, vb, ti, te, vb->out, &st);
+        st.pixels_written += scan_list(t, vb->out, n, scan, tiles, last);
+    }
+    if (stats)
+        rast__stats_add(stats, &st);
+}
+
+rast__vbuf *rast__vbuf_alloc(int cap)
+{
+    if (cap < 0 || cap > (1 << 24))
+        return NULL;
+    const size_t c = ((size_t)cap + 15u) & ~(size_t)15u;
+    const size_t head = 64, nout = (size_t)RAST__VX_CHUNK * RAST__MAX_FAN;
+    const size_t size = head + c * (2 * sizeof(int32_t) + 2 * sizeof(double)) +
+                        ((nout * sizeof(rast__tri) + 63u) & ~(size_t)63u);
+    char *p = aligned_alloc(64, (size + 63u) & ~(size_t)63u);
+    if (!p)
+        return NULL;
+    rast__vbuf *vb = (rast__vbuf *)(void *)p;
+    vb->cap = (int)c;
+    vb->xy = (int32_t *)(void *)(p + head);
+    vb->zw = (double *)(void *)(p + head + c * 2 * sizeof(int32_t));
+    vb->iw = vb->zw + c;
+    vb->out = (rast__tri *)(void *)(vb->iw + c);
+    return vb;
+}
+
+void rast__vbuf_free(rast__vbuf *vb)
+{
+    free(vb);
 }
 
 rast_result rast__draw_with(const rast_target *t, const rast_mesh_desc *m,

@@ -1,0 +1,449 @@
+/* raster_front_avx2.c - the vector front end with AVX2 (8 lanes): the
+ * port of raster_front_avx512.c (same steps, same operations per lane,
+ * same bytes as rast__prepare_range with the scalar set-up; docs/raster.md
+ * section 11, sixth round). Groups of 8 submitted triangles; survivors
+ * are compressed into the queue through a permutation table and set up
+ * 8 at a time (edges in 4 int64 lanes, planes in 4 double lanes). Built
+ * with -mavx2 -mf16c; called only when cpuid reports AVX2. */
+#include "raster_internal.h"
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <float.h>
+#include <immintrin.h>
+#include <stddef.h>
+
+/* ---- vertex pass -------------------------------------------------------- */
+
+void rast__vpass_avx2(const rast__view *v, const float *clip, int count, rast__vbuf *vb)
+{
+    const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f);
+    const __m256 fix = _mm256_set1_ps((float)RAST__FIX_ONE);
+    const __m256 big = _mm256_set1_ps(FLT_MAX), nbig = _mm256_set1_ps(-FLT_MAX);
+    const __m256 gx = _mm256_set1_ps(v->gx), gy = _mm256_set1_ps(v->gy);
+    const __m256 fw = _mm256_set1_ps((float)v->width), fh = _mm256_set1_ps((float)v->height);
+    const __m256 lox = _mm256_set1_ps((float)v->min_x), hix = _mm256_set1_ps((float)v->max_x);
+    const __m256 loy = _mm256_set1_ps((float)v->min_y), hiy = _mm256_set1_ps((float)v->max_y);
+    const __m256i mark = _mm256_set1_epi32(RAST__VX_SPECIAL);
+    const __m256i lane4 = _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28);
+    const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256d dhalf = _mm256_set1_pd(0.5), done = _mm256_set1_pd(1.0);
+    for (int base = 0; base < count; base += 8) {
+        const int cnt = count - base < 8 ? count - base : 8;
+        const float *c = clip + 4 * (size_t)base;
+        __m256 x, y, z, w;
+        if (cnt == 8) {
+            x = _mm256_i32gather_ps(c, lane4, 4);
+            y = _mm256_i32gather_ps(c + 1, lane4, 4);
+            z = _mm256_i32gather_ps(c + 2, lane4, 4);
+            w = _mm256_i32gather_ps(c + 3, lane4, 4);
+        } else {
+            const __m256 lm = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(cnt), iota));
+            x = _mm256_mask_i32gather_ps(zero, c, lane4, lm, 4);
+            y = _mm256_mask_i32gather_ps(zero, c + 1, lane4, lm, 4);
+            z = _mm256_mask_i32gather_ps(zero, c + 2, lane4, lm, 4);
+            w = _mm256_mask_i32gather_ps(zero, c + 3, lane4, lm, 4);
+        }
+        const __m256 fin = _mm256_and_ps(
+            _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(x, big, _CMP_LE_OQ),
+                                        _mm256_cmp_ps(nbig, x, _CMP_LE_OQ)),
+                          _mm256_and_ps(_mm256_cmp_ps(y, big, _CMP_LE_OQ),
+                                        _mm256_cmp_ps(nbig, y, _CMP_LE_OQ))),
+            _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(z, big, _CMP_LE_OQ),
+                                        _mm256_cmp_ps(nbig, z, _CMP_LE_OQ)),
+                          _mm256_and_ps(_mm256_cmp_ps(w, big, _CMP_LE_OQ),
+                                        _mm256_cmp_ps(nbig, w, _CMP_LE_OQ))));
+        const __m256 gxw = _mm256_mul_ps(gx, w), gyw = _mm256_mul_ps(gy, w);
+        const __m256 out = _mm256_or_ps(
+            _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(_mm256_add_ps(z, w), zero, _CMP_LT_OQ),
+                                      _mm256_cmp_ps(_mm256_sub_ps(w, z), zero, _CMP_LT_OQ)),
+                         _mm256_or_ps(_mm256_cmp_ps(_mm256_add_ps(gxw, x), zero, _CMP_LT_OQ),
+                                      _mm256_cmp_ps(_mm256_sub_ps(gxw, x), zero, _CMP_LT_OQ))),
+            _mm256_or_ps(_mm256_cmp_ps(_mm256_add_ps(gyw, y), zero, _CMP_LT_OQ),
+                         _mm256_cmp_ps(_mm256_sub_ps(gyw, y), zero, _CMP_LT_OQ)));
+        const __m256 wpos = _mm256_cmp_ps(w, zero, _CMP_GT_OQ);
+        /* special = !fin | out | !(w > 0) */
+        const __m256 ok = _mm256_andnot_ps(out, _mm256_and_ps(fin, wpos));
+        const __m256 nx = _mm256_div_ps(x, w), ny = _mm256_div_ps(y, w);
+        const __m256 sx = _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(nx, half), half), fw);
+        const __m256 sy = _mm256_mul_ps(_mm256_sub_ps(half, _mm256_mul_ps(ny, half)), fh);
+        __m256i X = _mm256_cvtps_epi32(_mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(sx, fix), lox), hix));
+        const __m256i Y =
+            _mm256_cvtps_epi32(_mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(sy, fix), loy), hiy));
+        X = _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(mark),
+                                                 _mm256_castsi256_ps(X), ok));
+        const __m256i lo = _mm256_unpacklo_epi32(X, Y), hi = _mm256_unpackhi_epi32(X, Y);
+        int32_t *xy = vb->xy + 2 * (size_t)base;
+        _mm256_store_si256((__m256i *)(void *)xy, _mm256_permute2x128_si256(lo, hi, 0x20));
+        _mm256_store_si256((__m256i *)(void *)(xy + 8), _mm256_permute2x128_si256(lo, hi, 0x31));
+        for (int h = 0; h < 2; h++) {
+            const __m256d dz = _mm256_cvtps_pd(h ? _mm256_extractf128_ps(z, 1)
+                                                 : _mm256_castps256_ps128(z));
+            const __m256d dw = _mm256_cvtps_pd(h ? _mm256_extractf128_ps(w, 1)
+                                                 : _mm256_castps256_ps128(w));
+            _mm256_store_pd(vb->zw + base + 4 * h,
+                            _mm256_add_pd(_mm256_mul_pd(_mm256_div_pd(dz, dw), dhalf), dhalf));
+            _mm256_store_pd(vb->iw + base + 4 * h, _mm256_div_pd(done, dw));
+        }
+    }
+}
+
+/* ---- helpers ------------------------------------------------------------ */
+
+static inline unsigned bits8(__m256i m)
+{
+    return (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(m));
+}
+
+static inline __m128i half4(__m256i v, int h)
+{
+    return h ? _mm256_extracti128_si256(v, 1) : _mm256_castsi256_si128(v);
+}
+
+/* Lanes with a*b > c*d (gt) or a*b < c*d (!gt), exact in double. */
+static inline unsigned prod_cmp(__m256i a, __m256i b, __m256i c, __m256i d, int gt)
+{
+    unsigned r = 0;
+    for (int h = 0; h < 2; h++) {
+        const __m256d p1 = _mm256_mul_pd(_mm256_cvtepi32_pd(half4(a, h)),
+                                         _mm256_cvtepi32_pd(half4(b, h)));
+        const __m256d p2 = _mm256_mul_pd(_mm256_cvtepi32_pd(half4(c, h)),
+                                         _mm256_cvtepi32_pd(half4(d, h)));
+        r |= (unsigned)_mm256_movemask_pd(_mm256_cmp_pd(p1, p2, gt ? _CMP_GT_OQ : _CMP_LT_OQ))
+             << (4 * h);
+    }
+    return r;
+}
+
+/* All ones in the lanes whose edge keeps E == 0 (top-left rule). */
+static inline __m256i top_left(__m256i dx, __m256i dy)
+{
+    const __m256i zero = _mm256_setzero_si256();
+    return _mm256_or_si256(_mm256_cmpgt_epi32(zero, dy),
+                           _mm256_and_si256(_mm256_cmpeq_epi32(dy, zero),
+                                            _mm256_cmpgt_epi32(dx, zero)));
+}
+
+/* Biased edge value in int32 (one-pixel boxes only). */
+static inline __m256i edge32(__m256i xa, __m256i ya, __m256i xb, __m256i yb, __m256i cx,
+                             __m256i cy)
+{
+    const __m256i dx = _mm256_sub_epi32(xb, xa), dy = _mm256_sub_epi32(yb, ya);
+    const __m256i e = _mm256_sub_epi32(_mm256_mullo_epi32(dx, _mm256_sub_epi32(cy, ya)),
+                                       _mm256_mullo_epi32(dy, _mm256_sub_epi32(cx, xa)));
+    /* e - 1 where not top-left: e + (tl ? 0 : -1) = e + ~tl */
+    return _mm256_add_epi32(e, _mm256_xor_si256(top_left(dx, dy), _mm256_set1_epi32(-1)));
+}
+
+static inline __m256i blend8(__m256i a, __m256i b, __m256i m)
+{
+    return _mm256_castps_si256(
+        _mm256_blendv_ps(_mm256_castsi256_ps(a), _mm256_castsi256_ps(b), _mm256_castsi256_ps(m)));
+}
+
+/* Lane mask vector of bits. */
+static inline __m256i vmask(unsigned bits)
+{
+    const __m256i sel = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    return _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32((int)bits), sel), sel);
+}
+
+/* Permutation of the set lanes of b to the front: 8 3-bit lane numbers. */
+static inline __m256i compress_idx(unsigned b)
+{
+    uint32_t p = 0;
+    int k = 0;
+    for (unsigned x = b; x; x &= x - 1, k++)
+        p |= (uint32_t)__builtin_ctz(x) << (3 * k);
+    const __m256i sh = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
+    return _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32((int)p), sh),
+                            _mm256_set1_epi32(7));
+}
+
+/* ---- survivor queue and set-up ------------------------------------------ */
+
+enum { Q_X0, Q_X1, Q_X2, Q_Y0, Q_Y1, Q_Y2, Q_V0, Q_V1, Q_V2, Q_BX0, Q_BY0, Q_BX1, Q_BY1,
+       Q_SLOT, Q_FIELDS };
+typedef struct squeue {
+    int n;
+    _Alignas(32) int32_t f[Q_FIELDS][16];
+} squeue;
+
+static inline void plane4(__m256d f0, __m256d f1, __m256d f2, __m256d ex1, __m256d ey1,
+                          __m256d ex2, __m256d ey2, __m256d ox, __m256d oy, __m256d area,
+                          float *c, float *gxo, float *gyo)
+{
+    const __m256d df1 = _mm256_sub_pd(f1, f0), df2 = _mm256_sub_pd(f2, f0);
+    const __m256d gx = _mm256_div_pd(
+        _mm256_sub_pd(_mm256_mul_pd(df1, ey2), _mm256_mul_pd(df2, ey1)), area);
+    const __m256d gy = _mm256_div_pd(
+        _mm256_sub_pd(_mm256_mul_pd(df2, ex1), _mm256_mul_pd(df1, ex2)), area);
+    const __m256d cc = _mm256_add_pd(_mm256_add_pd(f0, _mm256_mul_pd(gx, ox)),
+                                     _mm256_mul_pd(gy, oy));
+    _mm_store_ps(c, _mm256_cvtpd_ps(cc));
+    _mm_store_ps(gxo, _mm256_cvtpd_ps(gx));
+    _mm_store_ps(gyo, _mm256_cvtpd_ps(gy));
+}
+
+/* Sets up queue lanes 0 .. k-1 (k = 1..8) into their records. */
+static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
+                  const squeue *q, int k, rast__tri *out)
+{
+    const __m256i L = _mm256_cmpgt_epi32(_mm256_set1_epi32(k),
+                                         _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    __m256i X[3], Y[3], V[3];
+    for (int i = 0; i < 3; i++) {
+        X[i] = _mm256_load_si256((const __m256i *)(const void *)q->f[Q_X0 + i]);
+        Y[i] = _mm256_load_si256((const __m256i *)(const void *)q->f[Q_Y0 + i]);
+        V[i] = _mm256_and_si256(L, _mm256_load_si256((const __m256i *)(const void *)q->f[Q_V0 + i]));
+    }
+    const __m256i bx0 = _mm256_load_si256((const __m256i *)(const void *)q->f[Q_BX0]);
+    const __m256i by0 = _mm256_load_si256((const __m256i *)(const void *)q->f[Q_BY0]);
+    const __m256i c128 = _mm256_set1_epi32(RAST__FIX_HALF);
+    const __m256i cx = _mm256_add_epi32(_mm256_slli_epi32(bx0, RAST_SUBPIXEL_BITS), c128);
+    const __m256i cy = _mm256_add_epi32(_mm256_slli_epi32(by0, RAST_SUBPIXEL_BITS), c128);
+
+    _Alignas(32) int64_t ec[3][8], edx[3][8], edy[3][8];
+    static const int ea[3] = { 1, 2, 0 }, eb[3] = { 2, 0, 1 };
+    const __m256i zero = _mm256_setzero_si256(), one = _mm256_set1_epi32(1);
+    for (int e = 0; e < 3; e++) {
+        const int a = ea[e], b = eb[e];
+        const __m256i dx = _mm256_sub_epi32(X[b], X[a]), dy = _mm256_sub_epi32(Y[b], Y[a]);
+        const __m256i bias = _mm256_andnot_si256(top_left(dx, dy), one);
+        const __m256i oy = _mm256_sub_epi32(cy, Y[a]), ox = _mm256_sub_epi32(cx, X[a]);
+        for (int h = 0; h < 2; h++) {
+            const __m256i dx64 = _mm256_cvtepi32_epi64(half4(dx, h));
+            const __m256i dy64 = _mm256_cvtepi32_epi64(half4(dy, h));
+            const __m256i p1 = _mm256_mul_epi32(dx64, _mm256_cvtepi32_epi64(half4(oy, h)));
+            const __m256i p2 = _mm256_mul_epi32(dy64, _mm256_cvtepi32_epi64(half4(ox, h)));
+            const __m256i r = _mm256_sub_epi64(_mm256_sub_epi64(p1, p2),
+                                               _mm256_cvtepi32_epi64(half4(bias, h)));
+            _mm256_store_si256((__m256i *)(void *)&ec[e][4 * h], r);
+            _mm256_store_si256((__m256i *)(void *)&edx[e][4 * h],
+                               _mm256_sub_epi64(zero, _mm256_slli_epi64(dy64, RAST_SUBPIXEL_BITS)));
+            _mm256_store_si256((__m256i *)(void *)&edy[e][4 * h],
+                               _mm256_slli_epi64(dx64, RAST_SUBPIXEL_BITS));
+        }
+    }
+
+    _Alignas(32) float pl[12][8];
+    const __m256d inv256 = _mm256_set1_pd(1.0 / RAST__FIX_ONE), dzero = _mm256_setzero_pd();
+    const __m256d dhalf = _mm256_set1_pd(0.5), done = _mm256_set1_pd(1.0);
+    for (int h = 0; h < 2; h++) {
+        const __m256d lh = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(half4(L, h)));
+        __m256d Xd[3], Yd[3], zw[3], iw[3];
+        for (int i = 0; i < 3; i++) {
+            Xd[i] = _mm256_mul_pd(_mm256_cvtepi32_pd(half4(X[i], h)), inv256);
+            Yd[i] = _mm256_mul_pd(_mm256_cvtepi32_pd(half4(Y[i], h)), inv256);
+            const __m128i vi = half4(V[i], h);
+            zw[i] = _mm256_mask_i32gather_pd(dzero, vb->zw, vi, lh, 8);
+            iw[i] = _mm256_mask_i32gather_pd(done, vb->iw, vi, lh, 8);
+        }
+        const __m256d ex1 = _mm256_sub_pd(Xd[1], Xd[0]), ey1 = _mm256_sub_pd(Yd[1], Yd[0]);
+        const __m256d ex2 = _mm256_sub_pd(Xd[2], Xd[0]), ey2 = _mm256_sub_pd(Yd[2], Yd[0]);
+        const __m256d area = _mm256_blendv_pd(
+            done, _mm256_sub_pd(_mm256_mul_pd(ex1, ey2), _mm256_mul_pd(ey1, ex2)), lh);
+        const __m256d ocx = _mm256_add_pd(_mm256_cvtepi32_pd(half4(bx0, h)), dhalf);
+        const __m256d ocy = _mm256_add_pd(_mm256_cvtepi32_pd(half4(by0, h)), dhalf);
+        const __m256d ox = _mm256_sub_pd(ocx, Xd[0]), oy = _mm256_sub_pd(ocy, Yd[0]);
+        /* max(a, b) = a > b ? a : b, as the scalar loop */
+        const __m256d qmax =
+            _mm256_max_pd(iw[2], _mm256_max_pd(iw[1], _mm256_max_pd(iw[0], dzero)));
+        const __m256d q0 = _mm256_div_pd(iw[0], qmax), q1 = _mm256_div_pd(iw[1], qmax),
+                      q2 = _mm256_div_pd(iw[2], qmax);
+        const int o = 4 * h;
+        plane4(zw[0], zw[1], zw[2], ex1, ey1, ex2, ey2, ox, oy, area, pl[0] + o, pl[1] + o,
+               pl[2] + o);
+        plane4(q0, q1, q2, ex1, ey1, ex2, ey2, ox, oy, area, pl[3] + o, pl[4] + o, pl[5] + o);
+        plane4(dzero, q1, dzero, ex1, ey1, ex2, ey2, ox, oy, area, pl[6] + o, pl[7] + o,
+               pl[8] + o);
+        plane4(dzero, dzero, q2, ex1, ey1, ex2, ey2, ox, oy, area, pl[9] + o, pl[10] + o,
+               pl[11] + o);
+    }
+
+    const int ac = v->attr_count;
+    _Alignas(32) float at[3][RAST_MAX_ATTRS][8];
+    if (ac > 0) {
+        const __m256i vac = _mm256_set1_epi32(ac);
+        const __m256i b0 = _mm256_mullo_epi32(V[0], vac), b1 = _mm256_mullo_epi32(V[1], vac),
+                      b2 = _mm256_mullo_epi32(V[2], vac);
+        const __m256 fz = _mm256_setzero_ps(), lm = _mm256_castsi256_ps(L);
+        for (int a = 0; a < ac; a++) {
+            const __m256i ka = _mm256_set1_epi32(a);
+            const __m256 a0 =
+                _mm256_mask_i32gather_ps(fz, m->attr, _mm256_add_epi32(b0, ka), lm, 4);
+            const __m256 a1 =
+                _mm256_mask_i32gather_ps(fz, m->attr, _mm256_add_epi32(b1, ka), lm, 4);
+            const __m256 a2 =
+                _mm256_mask_i32gather_ps(fz, m->attr, _mm256_add_epi32(b2, ka), lm, 4);
+            _mm256_store_ps(at[0][a], a0);
+            _mm256_store_ps(at[1][a], _mm256_sub_ps(a1, a0));
+            _mm256_store_ps(at[2][a], _mm256_sub_ps(a2, a0));
+        }
+    }
+
+    for (int l = 0; l < k; l++) {
+        rast__tri *t = out + q->f[Q_SLOT][l];
+        t->x0 = q->f[Q_BX0][l];
+        t->y0 = q->f[Q_BY0][l];
+        t->x1 = q->f[Q_BX1][l];
+        t->y1 = q->f[Q_BY1][l];
+        for (int e = 0; e < 3; e++) {
+            t->e_c[e] = ec[e][l];
+            t->e_dx[e] = edx[e][l];
+            t->e_dy[e] = edy[e][l];
+        }
+        t->z.c = pl[0][l];
+        t->z.dx = pl[1][l];
+        t->z.dy = pl[2][l];
+        t->q.c = pl[3][l];
+        t->q.dx = pl[4][l];
+        t->q.dy = pl[5][l];
+        t->b1.c = pl[6][l];
+        t->b1.dx = pl[7][l];
+        t->b1.dy = pl[8][l];
+        t->b2.c = pl[9][l];
+        t->b2.dx = pl[10][l];
+        t->b2.dy = pl[11][l];
+        t->attr_count = ac;
+        for (int a = 0; a < ac; a++) {
+            t->a0[a] = at[0][a][l];
+            t->d1[a] = at[1][a][l];
+            t->d2[a] = at[2][a][l];
+        }
+    }
+}
+
+int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
+                      int ti0, int ti1, rast__tri *out, rast_stats *st)
+{
+    rast_stats ls = *st;
+    squeue q;
+    q.n = 0;
+    int n = 0;
+    const long long *xyb = (const long long *)(const void *)vb->xy;
+    const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256i mark = _mm256_set1_epi32(RAST__VX_SPECIAL);
+    const __m256i zero = _mm256_setzero_si256();
+    const __m256i c127 = _mm256_set1_epi32(RAST__FIX_ONE - 1 - RAST__FIX_HALF);
+    const __m256i c128 = _mm256_set1_epi32(RAST__FIX_HALF);
+    const __m256i wmax = _mm256_set1_epi32(v->width - 1), hmax = _mm256_set1_epi32(v->height - 1);
+    for (int ti = ti0; ti < ti1; ti += 8) {
+        const int cnt = ti1 - ti < 8 ? ti1 - ti : 8;
+        const unsigned L = (1u << cnt) - 1u;
+        /* Indices, de-interleaved (lanes past cnt: vertex 0). */
+        const uint32_t *ix = m->indices + 3 * (size_t)ti;
+        _Alignas(32) int32_t ib[3][8] = { { 0 } };
+        for (int l = 0; l < cnt; l++) {
+            ib[0][l] = (int32_t)ix[3 * l];
+            ib[1][l] = (int32_t)ix[3 * l + 1];
+            ib[2][l] = (int32_t)ix[3 * l + 2];
+        }
+        __m256i iv[3], X[3], Y[3], spec = zero;
+        for (int k = 0; k < 3; k++) {
+            iv[k] = _mm256_load_si256((const __m256i *)(const void *)ib[k]);
+            const __m256i p0 = _mm256_i32gather_epi64(xyb, half4(iv[k], 0), 8);
+            const __m256i p1 = _mm256_i32gather_epi64(xyb, half4(iv[k], 1), 8);
+            const __m256 s0 = _mm256_castsi256_ps(p0), s1 = _mm256_castsi256_ps(p1);
+            X[k] = _mm256_permute4x64_epi64(
+                _mm256_castps_si256(_mm256_shuffle_ps(s0, s1, _MM_SHUFFLE(2, 0, 2, 0))),
+                _MM_SHUFFLE(3, 1, 2, 0));
+            Y[k] = _mm256_permute4x64_epi64(
+                _mm256_castps_si256(_mm256_shuffle_ps(s0, s1, _MM_SHUFFLE(3, 1, 3, 1))),
+                _MM_SHUFFLE(3, 1, 2, 0));
+            spec = _mm256_or_si256(spec, _mm256_cmpeq_epi32(X[k], mark));
+        }
+        const unsigned special0 = bits8(spec) & L;
+        const unsigned valid = L & ~special0;
+        const __m256i dx1 = _mm256_sub_epi32(X[1], X[0]), dy1 = _mm256_sub_epi32(Y[1], Y[0]);
+        const __m256i dx2 = _mm256_sub_epi32(X[2], X[0]), dy2 = _mm256_sub_epi32(Y[2], Y[0]);
+        const unsigned pos = prod_cmp(dx1, dy2, dy1, dx2, 1);
+        const unsigned neg = prod_cmp(dx1, dy2, dy1, dx2, 0);
+        const unsigned cullm =
+            m->cull == RAST_CULL_BACK ? pos : m->cull == RAST_CULL_FRONT ? neg : 0u;
+        const unsigned degen = valid & ~(pos | neg);
+        const unsigned culled = valid & cullm & (pos | neg);
+        const unsigned live = valid & (pos | neg) & ~cullm;
+        const __m256i xmin = _mm256_min_epi32(X[0], _mm256_min_epi32(X[1], X[2]));
+        const __m256i xmax = _mm256_max_epi32(X[0], _mm256_max_epi32(X[1], X[2]));
+        const __m256i ymin = _mm256_min_epi32(Y[0], _mm256_min_epi32(Y[1], Y[2]));
+        const __m256i ymax = _mm256_max_epi32(Y[0], _mm256_max_epi32(Y[1], Y[2]));
+        const __m256i rx0 = _mm256_srai_epi32(_mm256_add_epi32(xmin, c127), RAST_SUBPIXEL_BITS);
+        const __m256i rx1 = _mm256_srai_epi32(_mm256_sub_epi32(xmax, c128), RAST_SUBPIXEL_BITS);
+        const __m256i ry0 = _mm256_srai_epi32(_mm256_add_epi32(ymin, c127), RAST_SUBPIXEL_BITS);
+        const __m256i ry1 = _mm256_srai_epi32(_mm256_sub_epi32(ymax, c128), RAST_SUBPIXEL_BITS);
+        const __m256i bx0 = _mm256_max_epi32(rx0, zero), by0 = _mm256_max_epi32(ry0, zero);
+        const __m256i bx1 = _mm256_min_epi32(rx1, wmax), by1 = _mm256_min_epi32(ry1, hmax);
+        const unsigned off =
+            bits8(_mm256_or_si256(_mm256_cmpgt_epi32(bx0, bx1), _mm256_cmpgt_epi32(by0, by1)));
+        const unsigned csingle =
+            live & ~off &
+            bits8(_mm256_and_si256(_mm256_cmpeq_epi32(bx0, bx1), _mm256_cmpeq_epi32(by0, by1)));
+        const unsigned usingle =
+            bits8(_mm256_and_si256(_mm256_cmpeq_epi32(rx0, rx1), _mm256_cmpeq_epi32(ry0, ry1)));
+        const unsigned odd = csingle & ~usingle;
+        const unsigned special = special0 | odd;
+        const unsigned live2 = live & ~off & ~odd;
+        const __m256i sw = vmask(neg);
+        const __m256i x1 = blend8(X[1], X[2], sw), x2 = blend8(X[2], X[1], sw);
+        const __m256i y1 = blend8(Y[1], Y[2], sw), y2 = blend8(Y[2], Y[1], sw);
+        unsigned empty = 0;
+        const unsigned single = csingle & usingle;
+        if (single) {
+            const __m256i cx = _mm256_add_epi32(_mm256_slli_epi32(bx0, RAST_SUBPIXEL_BITS), c128);
+            const __m256i cy = _mm256_add_epi32(_mm256_slli_epi32(by0, RAST_SUBPIXEL_BITS), c128);
+            const __m256i e0 = edge32(x1, y1, x2, y2, cx, cy);
+            const __m256i e1 = edge32(x2, y2, X[0], Y[0], cx, cy);
+            const __m256i e2 = edge32(X[0], Y[0], x1, y1, cx, cy);
+            empty = single & bits8(_mm256_or_si256(_mm256_or_si256(e0, e1), e2));
+        }
+        const unsigned surv = live2 & ~empty;
+        ls.tris_degenerate += __builtin_popcount(degen);
+        ls.tris_culled += __builtin_popcount(culled);
+        ls.tris_clipped_away += __builtin_popcount(live & off);
+        ls.tris_drawn += __builtin_popcount(live2);
+        if (!surv && !special)
+            continue;
+        __m256i slot;
+        const __m256i perm = compress_idx(surv);
+        if (special) {
+            _Alignas(32) int32_t sl[8] = { 0 };
+            for (unsigned bits = special | surv; bits; bits &= bits - 1) {
+                const int l = __builtin_ctz(bits);
+                if ((special >> l) & 1u)
+                    n += rast__prepare(v, m, ti + l, out + n, &ls);
+                else
+                    sl[l] = n++;
+            }
+            slot = _mm256_permutevar8x32_epi32(
+                _mm256_load_si256((const __m256i *)(const void *)sl), perm);
+        } else {
+            slot = _mm256_add_epi32(_mm256_set1_epi32(n), iota);
+            n += __builtin_popcount(surv);
+        }
+        if (!surv)
+            continue;
+        const __m256i vi1 = blend8(iv[1], iv[2], sw), vi2 = blend8(iv[2], iv[1], sw);
+        const __m256i fld[Q_SLOT] = { X[0], x1, x2, Y[0], y1, y2, iv[0], vi1, vi2,
+                                      bx0, by0, bx1, by1 };
+        for (int f = 0; f < Q_SLOT; f++)
+            _mm256_storeu_si256((__m256i *)(void *)(q.f[f] + q.n),
+                                _mm256_permutevar8x32_epi32(fld[f], perm));
+        _mm256_storeu_si256((__m256i *)(void *)(q.f[Q_SLOT] + q.n), slot);
+        q.n += __builtin_popcount(surv);
+        if (q.n >= 8) {
+            flush(v, m, vb, &q, 8, out);
+            q.n -= 8;
+            for (int f = 0; f < Q_FIELDS; f++)
+                _mm256_store_si256((__m256i *)(void *)q.f[f],
+                                   _mm256_load_si256((const __m256i *)(const void *)(q.f[f] + 8)));
+        }
+    }
+    if (q.n)
+        flush(v, m, vb, &q, q.n, out);
+    *st = ls;
+    return n;
+}
+
+#else
+typedef int rast__front_avx2_unused;   /* not an x86 build */
+#endif
