@@ -17,6 +17,9 @@
  *   frame_dp   frame_ip with the depth test against the virtual scene's
  *              depth (a "bottle" at 0.38 m over a tenth of the width, in
  *              front of part of the hands at 0.33-0.45 m)
+ *   frame_op   frame_ip with fuse_eye.v_opaque = 1 (V is opaque: the spans
+ *              the layer does not reach are neither read nor written)
+ *   frame_dop  frame_dp with v_opaque = 1
  *   memcpy     V -> out of both eyes (2 x 4.1 MB) with as many threads as
  *              the row (one eye per thread with 2): the memory floor
  *   pixman     single-threaded, in place on a copy of V (pixman's dst):
@@ -215,33 +218,37 @@ static double time_memcpy(eye_buf e[2], copier *c)
 /* ---- egofuse ------------------------------------------------------------ */
 
 typedef struct stats {
-    double light, comp, frame, frame_ip, frame_dp, memcpy;
-    double r_frame, r_frame_ip, r_frame_dp;   /* medians of frame / memcpy per run */
+    double light, comp, frame, frame_ip, frame_dp, frame_op, frame_dop, memcpy;
+    double r_frame, r_frame_ip, r_frame_dp, r_frame_op, r_frame_dop;   /* medians of x / memcpy per run */
 } stats;
 
 static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, stats *s)
 {
     const fuse_lighting L = fuse_lighting_default();
     const fuse_intrinsics K = { 532.0f, 532.0f, CW / 2.0f, CH / 2.0f };
-    double *t[9];
-    fuse_eye eyes[2], ip[2], dp[2];
+    double *t[13];
+    fuse_eye eyes[2], ip[2], dp[2], op[2], dop[2];
     fuse_depth depth[2];
     copier cp;
     int k, i;
-    for (i = 0; i < 9; i++) t[i] = xmalloc(sizeof(double) * (size_t)runs);
+    for (i = 0; i < 13; i++) t[i] = xmalloc(sizeof(double) * (size_t)runs);
     for (i = 0; i < 2; i++) {
         eyes[i] = (fuse_eye){ &L, &K, { e[i].P, CW, CH, 4 * CW }, e[i].M, CW, e[i].N, 3 * CW,
                               { e[i].Q, CW, CH, 4 * CW }, NULL, { e[i].V, W, H, 4 * W },
-                              VX, VY, VW, VHH, { e[i].out, W, H, 4 * W } };
+                              VX, VY, VW, VHH, { e[i].out, W, H, 4 * W }, 0 };
         ip[i] = eyes[i];
         ip[i].V = ip[i].out = (fuse_image){ e[i].Vip, W, H, 4 * W };
         depth[i] = (fuse_depth){ e[i].hz, CW, ZNEAR, ZFAR, 0.0f, e[i].sd, W, W, H };
         dp[i] = ip[i];
         dp[i].depth = &depth[i];
+        op[i] = ip[i];
+        op[i].v_opaque = 1;
+        dop[i] = dp[i];
+        dop[i].v_opaque = 1;
     }
     if (threads > 1) copier_start(&cp, &e[1]);
     for (k = -3; k < runs; k++) {   /* 3 warm-up runs */
-        double m, t0, t1, t2, t3, t4, t5;
+        double m, t0, t1, t2, t3, t4, t5, t6, t7;
         m = time_memcpy(e, threads > 1 ? &cp : NULL);
         t0 = now_ms();
         for (i = 0; i < 2; i++)
@@ -258,6 +265,10 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
         t4 = now_ms();
         if (fuse_context_frame(ctx, dp, 2) != FUSE_OK) exit(3);
         t5 = now_ms();
+        if (fuse_context_frame(ctx, op, 2) != FUSE_OK) exit(3);
+        t6 = now_ms();
+        if (fuse_context_frame(ctx, dop, 2) != FUSE_OK) exit(3);
+        t7 = now_ms();
         if (k < 0) continue;
         t[0][k] = t1 - t0;
         t[1][k] = t2 - t1;
@@ -268,6 +279,10 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
         t[6][k] = (t4 - t3) / m;
         t[7][k] = t5 - t4;
         t[8][k] = (t5 - t4) / m;
+        t[9][k] = t6 - t5;
+        t[10][k] = (t6 - t5) / m;
+        t[11][k] = t7 - t6;
+        t[12][k] = (t7 - t6) / m;
     }
     if (threads > 1) copier_stop(&cp);
     s->light = median(t[0], runs);
@@ -279,7 +294,11 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
     s->r_frame_ip = median(t[6], runs);
     s->frame_dp = median(t[7], runs);
     s->r_frame_dp = median(t[8], runs);
-    for (i = 0; i < 9; i++) free(t[i]);
+    s->frame_op = median(t[9], runs);
+    s->r_frame_op = median(t[10], runs);
+    s->frame_dop = median(t[11], runs);
+    s->r_frame_dop = median(t[12], runs);
+    for (i = 0; i < 13; i++) free(t[i]);
 }
 
 /* ---- pixman ------------------------------------------------------------- */
@@ -418,7 +437,8 @@ int main(int argc, char **argv)
                "frame_inplace_ms,memcpy_ms,frame_over_memcpy,frame_inplace_over_memcpy,"
                "pixman_blend_ms,pixman_scaled_ms,pixman_scaled_mask_ms,pixman_memcpy_ms,"
                "frame_inplace_over_pixman_blend,frame_inplace_over_pixman_scaled,"
-               "frame_depth_ms,frame_depth_over_memcpy\n");
+               "frame_depth_ms,frame_depth_over_memcpy,frame_opaque_ms,frame_opaque_over_memcpy,"
+               "frame_opaque_depth_ms,frame_opaque_depth_over_memcpy\n");
     for (c = 0; c < 2; c++) {
         eye_buf e[2];
         double cov = 0;
@@ -440,10 +460,11 @@ int main(int argc, char **argv)
             printf("\n%s hand: %.1f%% of the camera pixels have M > 0\n"
                    "  pixman (1 thread, in place): blend 1:1 + a8 mask %.3f ms, layer bilinear "
                    "%.3f ms, camera + a8 mask bilinear %.3f ms (memcpy 1 thread %.3f ms)\n"
-                   "  %-7s %3s %7s %7s %7s %7s %7s %8s %7s %8s %7s %8s %8s %8s\n",
+                   "  %-7s %3s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %8s %8s %8s\n",
                    cover_name[c], 100 * cov, pm.blend, pm.scaled, pm.scaled_mask, pm.memcpy,
-                   "isa", "thr", "light", "comp", "frame", "frm_ip", "frm_dp", "memcpy", "frm/mc",
-                   "frm_ip/mc", "dp/mc", "ip/pm_bl", "ip/pm_sc", "ip/pm_sm");
+                   "isa", "thr", "light", "comp", "frame", "frm_ip", "frm_dp", "frm_op", "frm_dop",
+                   "memcpy", "frm/mc", "ip/mc", "dp/mc", "op/mc", "dop/mc", "ip/pm_bl", "ip/pm_sc",
+                   "ip/pm_sm");
         for (i = 0; i < 4; i++) {
             if (only_isa != EF_ISA_DEFAULT && only_isa != isas[i]) continue;
             if (!ef_cpu_has(isas[i]) || ef_isa_choose(isas[i]) != isas[i]) {
@@ -461,14 +482,18 @@ int main(int argc, char **argv)
                 run_stages(ctx, e, t, n, &s);
                 if (csv)
                     printf("%s,%.4f,%s,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.4f,%.4f,%.4f,"
-                           "%.4f,%.3f,%.3f,%.4f,%.3f\n", cover_name[c], cov, ef_isa_name(isas[i]), t,
+                           "%.4f,%.3f,%.3f,%.4f,%.3f,%.4f,%.3f,%.4f,%.3f\n", cover_name[c], cov,
+                           ef_isa_name(isas[i]), t,
                            s.light, s.comp, s.light + s.comp, s.frame, s.frame_ip, s.memcpy,
                            s.r_frame, s.r_frame_ip, pm.blend, pm.scaled, pm.scaled_mask, pm.memcpy,
-                           s.frame_ip / pm.blend, s.frame_ip / pm.scaled, s.frame_dp, s.r_frame_dp);
+                           s.frame_ip / pm.blend, s.frame_ip / pm.scaled, s.frame_dp, s.r_frame_dp,
+                           s.frame_op, s.r_frame_op, s.frame_dop, s.r_frame_dop);
                 else
-                    printf("  %-7s %3d %7.3f %7.3f %7.3f %7.3f %7.3f %8.3f %7.2f %8.2f %7.2f %8.2f %8.2f %8.3f\n",
+                    printf("  %-7s %3d %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %7.2f %7.2f %7.2f "
+                           "%7.2f %7.2f %8.2f %8.2f %8.3f\n",
                            ef_isa_name(isas[i]), t, s.light, s.comp, s.frame, s.frame_ip, s.frame_dp,
-                           s.memcpy, s.r_frame, s.r_frame_ip, s.r_frame_dp, s.frame_ip / pm.blend,
+                           s.frame_op, s.frame_dop, s.memcpy, s.r_frame, s.r_frame_ip, s.r_frame_dp,
+                           s.r_frame_op, s.r_frame_dop, s.frame_ip / pm.blend,
                            s.frame_ip / pm.scaled, s.frame_ip / pm.scaled_mask);
                 fuse_context_destroy(ctx);
             }
@@ -479,8 +504,9 @@ int main(int argc, char **argv)
         printf("\nms per stereo frame (two eyes), medians. light, comp: the stages called one by\n"
                "one (comp into a separate out); frame: fuse_context_frame (both stages, one eye per\n"
                "thread with 2 threads), out separate; frm_ip: the same in place (out == V, as\n"
-               "src/pipe runs it); frm_dp: frm_ip with the depth test. memcpy: V -> out of both eyes\n"
-               "with the row's thread count (the floor); frm/mc, frm_ip/mc, dp/mc: medians of the\n"
+               "src/pipe runs it); frm_dp: frm_ip with the depth test; frm_op, frm_dop: frm_ip,\n"
+               "frm_dp with fuse_eye.v_opaque = 1. memcpy: V -> out of both eyes with the row's\n"
+               "thread count (the floor); frm/mc, ip/mc, dp/mc, op/mc, dop/mc: medians of the\n"
                "per-run ratios to it. ip/pm_*: frm_ip over\n"
                "pixman's blend 1:1 + a8 mask, layer bilinear, camera + mask bilinear (below 1:\n"
                "egofuse is faster). The machine is shared: compare ratios, not ms.\n");

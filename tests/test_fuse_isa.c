@@ -572,7 +572,8 @@ static fuse_eye frame_eye_bind(frame_eye *e)
 {
     fuse_eye f;
     memset(&f, 0, sizeof f);
-    memcpy(e->out.p, e->V.p, e->V.n);
+    if (e->in_place) memcpy(e->out.p, e->V.p, e->V.n);
+    else memset(e->out.p, 0x77, e->out.n);   /* every byte must be written */
     memset(e->Q.p, 0x5A, e->Q.n);
     f.lighting = &e->lc.L;
     f.intrinsics = &e->lc.K;
@@ -609,13 +610,38 @@ static void frame_eye_expect(fuse_context *ref, frame_eye *e, buf *Q, buf *out)
     memcpy(out->p, e->out.p, e->out.n);
 }
 
+/* The output with fuse_eye.v_opaque = 1 against the reference stages
+ * (want): V opaque everywhere, the same bytes; otherwise (the promise
+ * broken) the same rgb, and an alpha that is the reference's or, where the
+ * reference has 255, V's own. Returns 1 (and prints) on a difference. */
+static int opaque_diff(const char *what, const char *isa, int n, const frame_eye *e,
+                       const buf *want, const buf *got)
+{
+    int opaque = 1;
+    size_t i;
+    for (i = 3; i < e->V.n; i += 4) opaque &= e->V.p[i] == 255;
+    if (opaque) return report_diff(what, isa, n, want, got, 4 * e->W);
+    for (i = 0; i < want->n; i++) {
+        const int ok = i % 4 != 3 ? got->p[i] == want->p[i]
+                                  : got->p[i] == want->p[i] || (want->p[i] == 255 && got->p[i] == e->V.p[i]);
+        if (!ok) {
+            print_error("%s %s case %d: byte %zu (pixel %zu, %zu channel %zu) is %d, want %d (V %d)\n",
+                        what, isa, n, i, (i / 4) % (size_t)e->W, (i / 4) / (size_t)e->W, i % 4,
+                        got->p[i], want->p[i], e->V.p[i]);
+            return 1;
+        }
+    }
+    return 0;
+}
+
 /* fuse_context_frame on every ISA and 1..3 threads with 1..3 eyes equals
- * the reference stages one by one: the composite and the layer Q. */
+ * the reference stages one by one: the composite and the layer Q; also with
+ * v_opaque = 1 (opaque_diff: half the cases have an opaque V). */
 static void test_frame_cases(void **state)
 {
     enum { FRAMES = 150 };
     fuse_context *ref, *ctx[N_SIMD + 1][3];
-    int n, i, t, missing = 0, bad = 0;
+    int n, i, t, op, missing = 0, bad = 0;
     fuse_context_desc d = { EF_ISA_REF, 1 };
     (void)state;
     ref = fuse_context_create(&d);
@@ -647,16 +673,26 @@ static void test_frame_cases(void **state)
             frame_eye_expect(ref, &e[k], &wq[k], &wo[k]);
         }
         for (i = 0; i <= N_SIMD; i++)
-            for (t = 0; t < 3; t++) {
+            for (t = 0; t < 3; t++)
+            for (op = 0; op < 2; op++) {
                 if (ctx[i][t] == NULL) continue;
-                for (k = 0; k < count; k++) f[k] = frame_eye_bind(&e[k]);
+                for (k = 0; k < count; k++) {
+                    f[k] = frame_eye_bind(&e[k]);
+                    f[k].v_opaque = op;
+                }
                 assert_int_equal(fuse_context_frame(ctx[i][t], f, count), FUSE_OK);
                 for (k = 0; k < count; k++) {
-                    char what[64];
-                    snprintf(what, sizeof what, "frame %d eye %d threads %d out", n, k, t + 1);
-                    bad += report_diff(what, ef_isa_name(fuse_context_isa(ctx[i][t])), n,
-                                       &wo[k], &e[k].out, 4 * e[k].W);
-                    snprintf(what, sizeof what, "frame %d eye %d threads %d Q", n, k, t + 1);
+                    char what[80];
+                    snprintf(what, sizeof what, "frame %d eye %d threads %d v_opaque %d out", n, k,
+                             t + 1, op);
+                    if (op)
+                        bad += opaque_diff(what, ef_isa_name(fuse_context_isa(ctx[i][t])), n, &e[k],
+                                           &wo[k], &e[k].out);
+                    else
+                        bad += report_diff(what, ef_isa_name(fuse_context_isa(ctx[i][t])), n,
+                                           &wo[k], &e[k].out, 4 * e[k].W);
+                    snprintf(what, sizeof what, "frame %d eye %d threads %d v_opaque %d Q", n, k,
+                             t + 1, op);
                     bad += report_diff(what, ef_isa_name(fuse_context_isa(ctx[i][t])), n,
                                        &wq[k], &e[k].Q, e[k].lc.pstride);
                 }
@@ -820,6 +856,51 @@ static void depth_case_make(tu_rng *r, depth_case *c, int *ties)
  * for byte against the reference (padding included); the reference's
  * layers fold into DEPTH_CRC. The cases must hide some pixels, keep some
  * and hold exact ties. */
+/* The depth test on mask bytes (fuse__depth_mrow_*, what fuse_context_frame
+ * runs before lighting) against the layer's test: a mask byte (non-zero
+ * where the layer pixel is) must become 0 exactly where the pixel was
+ * hidden and keep its value elsewhere. want: the layer after the
+ * reference's test. Returns the number of kernels that differ. */
+static int depth_mask_check(const depth_case *c, const buf *want, int n)
+{
+    static const fuse__depth_mask_fn fns[N_SIMD + 1] = { fuse__depth_mrow_sse2, fuse__depth_mrow_avx2,
+                                                         fuse__depth_mrow_avx512, fuse__depth_mrow_ref };
+    uint8_t *m0 = malloc((size_t)c->qw * c->qh), *m = malloc((size_t)c->qw * c->qh);
+    fuse__depth_prep p;
+    int i, x, y, bad = 0;
+    assert_true(m0 && m);
+    for (y = 0; y < c->qh; y++)
+        for (x = 0; x < c->qw; x++) {
+            uint32_t a;
+            memcpy(&a, c->Q.p + (size_t)y * c->qstride + 4 * (size_t)x, 4);
+            m0[(size_t)y * c->qw + x] = (uint8_t)(a ? 1 + a % 255 : 0);
+        }
+    fuse__depth_prepare(&c->d, c->qw, c->vw, &p);
+    for (i = 0; i <= N_SIMD; i++) {
+        if (i < N_SIMD && ef_isa_choose(simd_isas[i]) != simd_isas[i]) continue;
+        memcpy(m, m0, (size_t)c->qw * c->qh);
+        for (y = 0; y < c->qh; y++)
+            fns[i](&p, m + (size_t)y * c->qw, c->d.hand + (size_t)y * c->d.hand_stride,
+                   fuse__depth_scene_row(&c->d, y, c->qh, c->vx, c->vy, c->vh), c->qw);
+        for (y = 0; y < c->qh; y++)
+            for (x = 0; x < c->qw; x++) {
+                const size_t k = (size_t)y * c->qw + x;
+                uint32_t a;
+                memcpy(&a, want->p + (size_t)y * c->qstride + 4 * (size_t)x, 4);
+                if (m[k] != (a ? m0[k] : 0)) {
+                    printf("case %d depth on the mask %s: pixel (%d, %d) mask %d -> %d, layer %08X\n",
+                           n, i < N_SIMD ? ef_isa_name(simd_isas[i]) : "ref", x, y, m0[k], m[k], a);
+                    bad++;
+                    x = c->qw;
+                    y = c->qh;
+                }
+            }
+    }
+    free(m0);
+    free(m);
+    return bad;
+}
+
 static void test_depth_isa(void **state)
 {
     ctxs cx;
@@ -842,6 +923,7 @@ static void test_depth_isa(void **state)
         Q = (fuse_image){ want.p, c.qw, c.qh, c.qstride };
         assert_int_equal(fuse_context_depth_test(cx.ref, &c.d, &Q, c.vx, c.vy, c.vw, c.vh), FUSE_OK);
         crc = tu_crc32(crc, want.p, want.n);
+        bad += depth_mask_check(&c, &want, n);
         for (k = 0; k + 4 <= c.Q.n; k += 4) {
             uint32_t a, b;
             memcpy(&a, c.Q.p + k, 4);

@@ -228,13 +228,17 @@ static void test_light_vs_double(void **state)
     assert_true(max_err < 1.0);
 }
 
-/* x^s of fuse__pow01 against pow(): the reproducible power is accurate. */
+/* x^s of fuse__pow01 against pow(): the reproducible power is accurate.
+ * Integer s up to FUSE__POW_INT_MAX go by squaring (relative error below
+ * (s - 1) 2^-24), the others by exp2/log2 (1.3e-7 (1 + |s log2 x|)). */
 static void test_pow01(void **state)
 {
-    static const float shin[] = { 1.0f, 1.5f, 2.0f, 3.7f, 16.0f, 64.0f, 128.0f, 1000.0f };
+    static const float shin[] = { 1.0f, 1.5f, 2.0f, 3.7f, 5.0f, 16.0f, 63.0f, 64.0f, 65.0f,
+                                  128.0f, 1000.0f };
+    enum { NS = sizeof shin / sizeof shin[0] };
     tu_rng r = { 0x5EED0002u };
-    double worst = 0;
-    int i, k;
+    double worst = 0, worst_int = 0;
+    int i, k, ints = 0;
     (void)state;
     assert_true(fuse__pow01(1.0f, 16.0f) == 1.0f);
     assert_true(fuse__pow01(1.5f, 16.0f) == 1.0f);
@@ -242,23 +246,46 @@ static void test_pow01(void **state)
     assert_true(fuse__pow01(-0.5f, 2.0f) == 0.0f);
     assert_true(fuse__pow01(0.5f, 1.0f) == 0.5f);
     assert_true(fuse__pow01(0.25f, 2.0f) == 0.0625f);
-    for (k = 0; k < 8; k++)
+    assert_true(fuse__pow01(0.5f, 16.0f) == 1.0f / 65536.0f);   /* squarings of a power of 2: exact */
+    assert_true(fuse__pow01(0.75f, 3.0f) == 0.421875f);          /* 27/64, exact in float */
+    assert_int_equal(fuse__pow_int(16.0f), 16);
+    assert_int_equal(fuse__pow_int(64.0f), 64);
+    assert_int_equal(fuse__pow_int(65.0f), 0);
+    assert_int_equal(fuse__pow_int(2.5f), 0);
+    assert_int_equal(fuse__pow_int(1.0f), 1);
+    /* the order is fixed: x^3 = x * (x * x), x^5 = x * ((x x)(x x)) */
+    {
+        const float x = 0.9f, x2 = x * x, x4 = x2 * x2;
+        assert_true(fuse__pow01(x, 3.0f) == x * x2);
+        assert_true(fuse__pow01(x, 5.0f) == x * x4);
+    }
+    for (k = 0; k < NS; k++)
         for (i = 0; i < 20000; i++) {
             float x = i < 10000 ? tu_unit(&r) : 1.0f - tu_unit(&r) * 0.01f;
             double ref = pow(x, shin[k]);
             double got = fuse__pow01(x, shin[k]);
             if (ref > 1e-30) {
-                /* The float y = s log2(x) alone carries a relative error
-                 * of 2^-24 |y| ln 2 into the result: scale by 1 + |y|. */
-                double y = fabs(shin[k] * log2((double)x));
-                double e = fabs(got - ref) / ref / (1.0 + y);
-                if (e > worst) worst = e;
+                if (fuse__pow_int(shin[k])) {
+                    /* (s - 1) roundings, each at most 2^-24 relative */
+                    double e = fabs(got - ref) / ref / ((shin[k] - 1.0) * 0x1p-24 + 0x1p-40);
+                    if (e > worst_int) worst_int = e;
+                    ints++;
+                } else {
+                    /* The float y = s log2(x) alone carries a relative error
+                     * of 2^-24 |y| ln 2 into the result: scale by 1 + |y|. */
+                    double y = fabs(shin[k] * log2((double)x));
+                    double e = fabs(got - ref) / ref / (1.0 + y);
+                    if (e > worst) worst = e;
+                }
             } else {
                 assert_true(got < 1e-30);
             }
         }
-    printf("NOTE pow01: max relative error / (1 + |s log2 x|) %.3g\n", worst);
+    printf("NOTE pow01: max relative error / (1 + |s log2 x|) %.3g (exp2/log2); "
+           "/ ((s - 1) 2^-24) %.3g (squaring, %d values)\n", worst, worst_int, ints);
     assert_true(worst < 1e-6);
+    assert_true(worst_int <= 1.0);
+    assert_true(ints > 50000);
 }
 
 /* ---- hand-worked single pixels --------------------------------------- */

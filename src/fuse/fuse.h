@@ -26,7 +26,8 @@
  *   order; u8/255 is computed as u8 * (1.0f/255.0f)): P/255, lighting,
  *   clamp to [0,1], then u8 = (int)(v * 255 + 0.5).
  *   Rgb of Q is rounded from M'*P' in float, alpha from M'. The specular
- *   power x^s is not powf() but exp2(s log2 x) with fixed polynomials
+ *   power x^s is not powf(): an integer s up to 64 by squaring in a fixed
+ *   order, any other s as exp2(s log2 x) with fixed polynomials
  *   (fuse_internal.h), so that every ISA gives the same bits.
  *   The view vector of pixel (x, y) comes from the intrinsics (below);
  *   N is normalised, and a normal of zero, huge or non-finite length
@@ -345,6 +346,16 @@ typedef struct fuse_eye {
     fuse_image V;
     int vp_x0, vp_y0, vp_w, vp_h;
     fuse_image out;
+    /* 1: the caller promises that every pixel of V inside the viewport has
+     * alpha 255 (a rendered scene, a frame already composited once). The
+     * pixels that the layer does not reach (four zero taps) are then out = V
+     * without a look at V: in place (out == V) they are neither read nor
+     * written, out of place they are copied. With an opaque V the bytes are
+     * those of v_opaque = 0. If the promise is broken, rgb is still exact
+     * and the alpha of those pixels is V's or 255 (which one is not
+     * specified). 0 (the default): no promise, alpha 255 everywhere in the
+     * viewport (an in-place composite reads all of V to check it). */
+    int v_opaque;
 } fuse_eye;
 
 /* Every stage of count eyes (1..FUSE_MAX_THREADS) on ctx's threads: with

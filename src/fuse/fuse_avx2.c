@@ -148,8 +148,10 @@ static inline __m256i vblend4_256(__m256i a, __m256i b, __m256i vw, __m256i w)
     const __m256i q = _mm256_packus_epi32(sl, sh);
     const __m256i qa = _mm256_shufflehi_epi16(_mm256_shufflelo_epi16(q, 0xFF), 0xFF);
     __m256i t = _mm256_mullo_epi16(_mm256_sub_epi16(lo8, qa), vw);
-    t = _mm256_add_epi16(t, r128);
-    t = _mm256_srli_epi16(_mm256_add_epi16(t, _mm256_srli_epi16(t, 8)), 8);
+    /* div255: ((t + 128) + ((t + 128) >> 8)) >> 8 is ((t + 128) 257) >> 16 (the
+     * inner floor cannot move the outer one: an integer plus a fraction
+     * below 1 never crosses a multiple of 256), one vpmulhuw */
+    t = _mm256_mulhi_epu16(_mm256_add_epi16(t, r128), _mm256_set1_epi16(257));
     return _mm256_add_epi16(q, t);
 }
 
@@ -220,8 +222,11 @@ void fuse__opaque_avx2(const uint8_t *v, uint8_t *out, int n)
 
 /* ---- depth test (fuse__depth_span_ref, 8 pixels a step) ----------------- */
 
-void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                          const float *sc, int w)
+/* The row on the layer (bpp 4: a pixel is looked at when it is not 0) or
+ * on mask bytes (bpp 1: when its byte is not 0); hidden pixels are zeroed. */
+static inline __attribute__((always_inline)) void depth_row(const fuse__depth_prep *p, uint8_t *q,
+                                                            const float *hz, const float *sc,
+                                                            int w, int bpp)
 {
     const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
     const __m256 two_fn = _mm256_set1_ps(p->two_fn), fpn = _mm256_set1_ps(p->fpn);
@@ -234,30 +239,65 @@ void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz
     __m256i ox, rem;
     int x, k;
     if (w < 8) {
-        fuse__depth_span_ref(p, q, hz, sc, 0, w);
+        if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, 0, w);
+        else fuse__depth_mspan_ref(p, q, hz, sc, 0, w);
         return;
     }
     for (k = 0; k < 8; k++) fuse__depth_col(p, k, &ox0[k], &rem0[k]);
     ox = _mm256_loadu_si256((const __m256i *)(const void *)ox0);
     rem = _mm256_loadu_si256((const __m256i *)(const void *)rem0);
     for (x = 0; x + 8 <= w; x += 8) {
-        __m256i *qp = (__m256i *)(void *)(q + 4 * (size_t)x);
-        const __m256i qq = _mm256_loadu_si256(qp);
-        if (!_mm256_testz_si256(qq, qq)) {
+        __m256i qq;
+        uint64_t m8 = 0;
+        int any;
+        if (bpp == 4) {
+            qq = _mm256_loadu_si256((const __m256i *)(const void *)(q + 4 * (size_t)x));
+            any = !_mm256_testz_si256(qq, qq);
+        } else {
+            memcpy(&m8, q + x, 8);
+            qq = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128((long long)m8));
+            any = m8 != 0;
+        }
+        if (any) {
             const __m256 nz = _mm256_castsi256_ps(
                 _mm256_xor_si256(_mm256_cmpeq_epi32(qq, _mm256_setzero_si256()), _mm256_set1_epi32(-1)));
             const __m256 z = _mm256_loadu_ps(hz + x);
             const __m256 has = _mm256_and_ps(nz, _mm256_and_ps(_mm256_cmp_ps(z, zero, _CMP_GE_OQ),
                                                                _mm256_cmp_ps(z, one, _CMP_LT_OQ)));
             if (_mm256_movemask_ps(has)) {
-                const __m256 s = _mm256_mask_i32gather_ps(zero, sc, ox, has, 4);
+                /* the scene values: when the 8 columns lie in a window of 16
+                 * (always when the layer is enlarged), two loads of the window
+                 * (masked to the viewport's width: nothing beyond it is read),
+                 * two vpermps and a blend; otherwise a gather. Lanes outside
+                 * has are never used. */
+                const int32_t c0 = _mm_cvtsi128_si32(_mm256_castsi256_si128(ox));
+                const int32_t c7 = _mm_extract_epi32(_mm256_extracti128_si256(ox, 1), 3);
+                __m256 s;
+                if (c7 - c0 < 16) {
+                    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+                    const __m256i left = _mm256_set1_epi32(p->vw - c0);
+                    const __m256 lo = _mm256_maskload_ps(sc + c0, _mm256_cmpgt_epi32(left, lane));
+                    const __m256 hi = _mm256_maskload_ps(sc + c0 + 8, _mm256_cmpgt_epi32(
+                        left, _mm256_add_epi32(lane, _mm256_set1_epi32(8))));
+                    const __m256i idx = _mm256_sub_epi32(ox, _mm256_set1_epi32(c0));
+                    s = _mm256_blendv_ps(_mm256_permutevar8x32_ps(lo, idx), _mm256_permutevar8x32_ps(hi, idx),
+                                         _mm256_castsi256_ps(_mm256_cmpgt_epi32(idx, _mm256_set1_epi32(7))));
+                } else {
+                    s = _mm256_mask_i32gather_ps(zero, sc, ox, has, 4);
+                }
                 const __m256 dist = _mm256_add_ps(
                     _mm256_div_ps(two_fn, _mm256_sub_ps(fpn, _mm256_mul_ps(_mm256_sub_ps(_mm256_mul_ps(two, z), one), fmn))),
                     off);
                 const __m256 kill = _mm256_and_ps(has, _mm256_and_ps(_mm256_cmp_ps(s, zero, _CMP_GT_OQ),
                                                                      _mm256_cmp_ps(s, dist, _CMP_LT_OQ)));
-                if (_mm256_movemask_ps(kill))   /* the row is this thread's: rewrite the rest */
-                    _mm256_storeu_si256(qp, _mm256_andnot_si256(_mm256_castps_si256(kill), qq));
+                const int km = _mm256_movemask_ps(kill);
+                if (km && bpp == 4)   /* the row is this thread's: rewrite the rest */
+                    _mm256_storeu_si256((__m256i *)(void *)(q + 4 * (size_t)x),
+                                        _mm256_andnot_si256(_mm256_castps_si256(kill), qq));
+                else if (km) {
+                    for (k = 0; k < 8; k++)
+                        if (km >> k & 1) q[x + k] = 0;
+                }
             }
         }
         rem = _mm256_add_epi32(rem, sr);
@@ -267,7 +307,20 @@ void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz
             ox = _mm256_sub_epi32(_mm256_add_epi32(ox, sq), carry);
         }
     }
-    fuse__depth_span_ref(p, q, hz, sc, x, w);
+    if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, x, w);
+    else fuse__depth_mspan_ref(p, q, hz, sc, x, w);
+}
+
+void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int w)
+{
+    depth_row(p, q, hz, sc, w, 4);
+}
+
+void fuse__depth_mrow_avx2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                           const float *sc, int w)
+{
+    depth_row(p, m, hz, sc, w, 1);
 }
 
 #else  /* not built for AVX2: never chosen by cpuid, falls back */
@@ -289,6 +342,11 @@ void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz
                           const float *sc, int w)
 {
     fuse__depth_row_ref(p, q, hz, sc, w);
+}
+void fuse__depth_mrow_avx2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                           const float *sc, int w)
+{
+    fuse__depth_mrow_ref(p, m, hz, sc, w);
 }
 void fuse__pow01_row_avx2(const float *x, int n, float s, float *out)
 {

@@ -155,8 +155,10 @@ static inline __m512i vblend8_512(__m512i a, __m512i b, __m512i vw, __m512i w)
     const __m512i q = _mm512_packus_epi32(sl, sh);
     const __m512i qa = _mm512_shufflehi_epi16(_mm512_shufflelo_epi16(q, 0xFF), 0xFF);
     __m512i t = _mm512_mullo_epi16(_mm512_sub_epi16(lo8, qa), vw);
-    t = _mm512_add_epi16(t, r128);
-    t = _mm512_srli_epi16(_mm512_add_epi16(t, _mm512_srli_epi16(t, 8)), 8);
+    /* div255: ((t + 128) + ((t + 128) >> 8)) >> 8 is ((t + 128) 257) >> 16 (the
+     * inner floor cannot move the outer one: an integer plus a fraction
+     * below 1 never crosses a multiple of 256), one vpmulhuw */
+    t = _mm512_mulhi_epu16(_mm512_add_epi16(t, r128), _mm512_set1_epi16(257));
     return _mm512_add_epi16(q, t);
 }
 
@@ -239,8 +241,11 @@ void fuse__opaque_avx512(const uint8_t *v, uint8_t *out, int n)
 
 /* ---- depth test (fuse__depth_span_ref, 16 pixels a step) ---------------- */
 
-void fuse__depth_row_avx512(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                            const float *sc, int w)
+/* The row on the layer (bpp 4: a pixel is looked at when it is not 0) or
+ * on mask bytes (bpp 1: when its byte is not 0); hidden pixels are zeroed. */
+static inline __attribute__((always_inline)) void depth_row(const fuse__depth_prep *p, uint8_t *q,
+                                                            const float *hz, const float *sc,
+                                                            int w, int bpp)
 {
     const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f), two = _mm512_set1_ps(2.0f);
     const __m512 two_fn = _mm512_set1_ps(p->two_fn), fpn = _mm512_set1_ps(p->fpn);
@@ -253,27 +258,57 @@ void fuse__depth_row_avx512(const fuse__depth_prep *p, uint8_t *q, const float *
     __m512i ox, rem;
     int x, k;
     if (w < 16) {
-        fuse__depth_span_ref(p, q, hz, sc, 0, w);
+        if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, 0, w);
+        else fuse__depth_mspan_ref(p, q, hz, sc, 0, w);
         return;
     }
     for (k = 0; k < 16; k++) fuse__depth_col(p, k, &ox0[k], &rem0[k]);
     ox = _mm512_loadu_si512((const void *)ox0);
     rem = _mm512_loadu_si512((const void *)rem0);
     for (x = 0; x + 16 <= w; x += 16) {
-        const __m512i qq = _mm512_loadu_si512((const void *)(q + 4 * (size_t)x));
-        const __mmask16 nz = _mm512_test_epi32_mask(qq, qq);
+        __mmask16 nz;
+        if (bpp == 4) {
+            const __m512i qq = _mm512_loadu_si512((const void *)(q + 4 * (size_t)x));
+            nz = _mm512_test_epi32_mask(qq, qq);
+        } else {
+            const __m128i mm = _mm_loadu_si128((const __m128i *)(const void *)(q + x));
+            nz = _mm_test_epi8_mask(mm, mm);
+        }
         if (nz) {
             const __m512 z = _mm512_loadu_ps(hz + x);
             const __mmask16 has = _mm512_mask_cmp_ps_mask(_mm512_mask_cmp_ps_mask(nz, z, zero, _CMP_GE_OQ),
                                                           z, one, _CMP_LT_OQ);
             if (has) {
-                const __m512 s = _mm512_mask_i32gather_ps(zero, has, ox, sc, 4);
+                /* the scene values: when the 16 columns lie in a window of 32
+                 * (always when the layer is enlarged), two loads of the window
+                 * (masked to the viewport's width: nothing beyond it is read)
+                 * and vpermt2ps; otherwise a gather. Lanes outside has are
+                 * never used. */
+                const int32_t c0 = _mm_cvtsi128_si32(_mm512_castsi512_si128(ox));
+                const int32_t c15 = _mm_extract_epi32(_mm512_extracti32x4_epi32(ox, 3), 3);
+                __m512 s;
+                if (c15 - c0 < 32) {
+                    const int32_t left = p->vw - c0;
+                    const __mmask16 k0 = left >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << left) - 1u);
+                    const __mmask16 k1 = left >= 32 ? (__mmask16)0xFFFF
+                                         : left <= 16 ? (__mmask16)0 : (__mmask16)((1u << (left - 16)) - 1u);
+                    const __m512 lo = _mm512_maskz_loadu_ps(k0, sc + c0);
+                    const __m512 hi = _mm512_maskz_loadu_ps(k1, sc + c0 + 16);
+                    s = _mm512_permutex2var_ps(lo, _mm512_sub_epi32(ox, _mm512_set1_epi32(c0)), hi);
+                } else {
+                    s = _mm512_mask_i32gather_ps(zero, has, ox, sc, 4);
+                }
                 const __m512 dist = _mm512_add_ps(
                     _mm512_div_ps(two_fn, _mm512_sub_ps(fpn, _mm512_mul_ps(_mm512_sub_ps(_mm512_mul_ps(two, z), one), fmn))),
                     off);
                 const __mmask16 kill = _mm512_mask_cmp_ps_mask(_mm512_mask_cmp_ps_mask(has, s, zero, _CMP_GT_OQ),
                                                                s, dist, _CMP_LT_OQ);
-                if (kill) _mm512_mask_storeu_epi32((void *)(q + 4 * (size_t)x), kill, _mm512_setzero_si512());
+                if (kill) {
+                    if (bpp == 4)
+                        _mm512_mask_storeu_epi32((void *)(q + 4 * (size_t)x), kill, _mm512_setzero_si512());
+                    else
+                        _mm_mask_storeu_epi8((void *)(q + x), kill, _mm_setzero_si128());
+                }
             }
         }
         rem = _mm512_add_epi32(rem, sr);
@@ -284,7 +319,20 @@ void fuse__depth_row_avx512(const fuse__depth_prep *p, uint8_t *q, const float *
             ox = _mm512_mask_add_epi32(ox, carry, ox, one_i);
         }
     }
-    fuse__depth_span_ref(p, q, hz, sc, x, w);
+    if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, x, w);
+    else fuse__depth_mspan_ref(p, q, hz, sc, x, w);
+}
+
+void fuse__depth_row_avx512(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                            const float *sc, int w)
+{
+    depth_row(p, q, hz, sc, w, 4);
+}
+
+void fuse__depth_mrow_avx512(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                             const float *sc, int w)
+{
+    depth_row(p, m, hz, sc, w, 1);
 }
 
 #else  /* not built for AVX-512: never chosen by cpuid, falls back */
@@ -300,6 +348,11 @@ void fuse__depth_row_avx512(const fuse__depth_prep *p, uint8_t *q, const float *
                             const float *sc, int w)
 {
     fuse__depth_row_ref(p, q, hz, sc, w);
+}
+void fuse__depth_mrow_avx512(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                             const float *sc, int w)
+{
+    fuse__depth_mrow_ref(p, m, hz, sc, w);
 }
 void fuse__pow01_row_avx512(const float *x, int n, float s, float *out)
 {

@@ -40,13 +40,33 @@
 #define U_MAX 2
 #define EACH _Pragma("GCC unroll 2") for (u = 0; u < nu; u++)
 
-/* fuse__pow01 in lanes, for nu vectors x[u]; s broadcast. */
-static inline __attribute__((always_inline)) void pow01_lanes(const VF *x, VF s, int nu, VF *r)
+/* fuse__pow01 in lanes, for nu vectors x[u]; s broadcast, n =
+ * fuse__pow_int(s) (uniform: the squarings of fuse__powi01 when n > 0). */
+static inline __attribute__((always_inline)) void pow01_lanes(const VF *x, VF s, int n, int nu, VF *r)
 {
     VI e[U_MAX];
     VF m[U_MAX], ef[U_MAX], t[U_MAX], t2[U_MAX], p[U_MAX], y[U_MAX], k[U_MAX], f[U_MAX];
     VM big[U_MAX];
     int u;
+    if (n > 0) {
+        VF b[U_MAX];
+        int k = n;
+        EACH {
+            b[u] = x[u];
+            p[u] = F1(1.0f);
+        }
+        for (;;) {
+            if (k & 1) EACH p[u] = FMUL(p[u], b[u]);
+            k >>= 1;
+            if (k == 0) break;
+            EACH b[u] = FMUL(b[u], b[u]);
+        }
+        EACH {   /* the early returns of fuse__pow01 */
+            const VF q = FSEL(FGE(x[u], F1(1.0f)), F1(1.0f), p[u]);
+            r[u] = FZERO_UNLESS(FGT(x[u], F1(FUSE__POW_MIN)), q);
+        }
+        return;
+    }
     EACH {
         const VI bits = FBITS(x[u]);
         e[u] = ISUB(ISRL(bits, 23), I1(127));
@@ -145,7 +165,7 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
                 ndh[u] = FADD(FADD(FMUL(nx[u], hx), FMUL(ny[u], hy)), FMUL(nz[u], hz));
             }
             EACH ndh[u] = FDIV(ndh[u], FSQRT(hh[u]));
-            pow01_lanes(ndh, F1(p->shininess), nu, sp);
+            pow01_lanes(ndh, F1(p->shininess), p->ipow, nu, sp);
             EACH w[u] = FSEL(FGT(hh[u], F1(1.0e-12f)), FADD(w[u], FMUL(F1(p->ks), sp[u])), w[u]);
         }
         EACH {
@@ -208,7 +228,7 @@ void POW_ROW_NAME(const float *x, int n, float s, float *out)
         VF v;
         memcpy(tmp, x + i, sizeof tmp);
         v = LOADF(tmp);
-        pow01_lanes(&v, F1(s), 1, &r);
+        pow01_lanes(&v, F1(s), fuse__pow_int(s), 1, &r);
         STOREF(tmp, r);
         memcpy(out + i, tmp, sizeof tmp);
     }

@@ -27,6 +27,7 @@ typedef struct kernels {
     int ref;                   /* the reference: axis walk, stages in order */
     fuse__light_fn light;
     fuse__depth_fn depth;
+    fuse__depth_mask_fn depth_mask;   /* the depth test on mask bytes */
     fuse__composite_fn comp;   /* SSE2: table-driven, per output row */
     fuse__cover_fn cover;      /* coverage bits of a layer row */
     fuse__opaque_fn opaque;    /* R = V, alpha 255 (transparent spans) */
@@ -43,6 +44,7 @@ static kernels kernels_for(ef_isa isa)
         k.ref = 0;
         k.light = fuse__light_row_avx512;
         k.depth = fuse__depth_row_avx512;
+        k.depth_mask = fuse__depth_mrow_avx512;
         k.comp = NULL;
         k.cover = fuse__cover_row_avx512;
         k.opaque = fuse__opaque_avx512;
@@ -53,6 +55,7 @@ static kernels kernels_for(ef_isa isa)
         k.ref = 0;
         k.light = fuse__light_row_avx2;
         k.depth = fuse__depth_row_avx2;
+        k.depth_mask = fuse__depth_mrow_avx2;
         k.comp = NULL;
         k.cover = fuse__cover_row_avx2;
         k.opaque = fuse__opaque_avx2;
@@ -63,6 +66,7 @@ static kernels kernels_for(ef_isa isa)
         k.ref = 0;
         k.light = fuse__light_row_sse2;
         k.depth = fuse__depth_row_sse2;
+        k.depth_mask = fuse__depth_mrow_sse2;
         k.comp = fuse__composite_cols_sse2;
         k.cover = fuse__cover_row_sse2;
         k.opaque = fuse__opaque_sse2;
@@ -74,6 +78,7 @@ static kernels kernels_for(ef_isa isa)
         k.ref = 1;
         k.light = fuse__light_row_ref;
         k.depth = fuse__depth_row_ref;
+        k.depth_mask = fuse__depth_mrow_ref;
         k.comp = NULL;
         k.cover = fuse__cover_row_ref;
         k.opaque = fuse__opaque_ref;
@@ -252,17 +257,53 @@ typedef struct light_job {
     int mask_stride, normal_stride;
 } light_job;
 
-static int mask_row_empty(const uint8_t *m, int w)
+/* Asks for the bytes [p, p + n) in cache (a hint: no fault, no effect on
+ * the result). The lit and blended spans of a row start in its middle, where
+ * the hardware prefetcher has not yet seen a stream; asking for the next
+ * row's span while this one is computed hides the memory latency. */
+static void prefetch(const void *p, size_t n, int write)
 {
-    uint64_t acc = 0;
-    int x = 0;
-    for (; x + 8 <= w; x += 8) {
-        uint64_t t;
-        memcpy(&t, m + x, 8);
-        acc |= t;
+    const uintptr_t a = (uintptr_t)p & ~(uintptr_t)63, e = (uintptr_t)p + n;
+    uintptr_t q;
+    if (write)
+        for (q = a; q < e; q += 64) __builtin_prefetch((const void *)q, 1, 3);
+    else
+        for (q = a; q < e; q += 64) __builtin_prefetch((const void *)q, 0, 3);
+}
+
+/* [*x0, *x1): a span of the mask row (w bytes) that holds every non-zero
+ * byte (found 8 bytes at a time, so it may reach up to 7 zero bytes beyond
+ * them); *x0 == *x1 == 0 when every byte is 0. */
+static void mask_span(const uint8_t *m, int w, int *x0, int *x1)
+{
+    int a = 0, b = w;
+    uint64_t t;
+    for (; a + 8 <= w; a += 8) {
+        memcpy(&t, m + a, 8);
+        if (t) break;
     }
-    for (; x < w; x++) acc |= m[x];
-    return acc == 0;
+    if (a + 8 > w)   /* no word set: the last w % 8 bytes */
+        while (a < w && m[a] == 0) a++;
+    if (a >= w) {
+        *x0 = *x1 = 0;
+        return;
+    }
+    for (; b - 8 >= a; b -= 8) {   /* every byte at b and beyond is 0 */
+        memcpy(&t, m + b - 8, 8);
+        if (t) break;
+    }
+    *x0 = a;
+    *x1 = b;
+}
+
+/* Prefetches the inputs of layer row y over [x0, x1) (the span of the row
+ * before it: the hand moves little from row to row). */
+static void light_prefetch(const light_job *j, int y, int x0, int x1)
+{
+    if (y >= j->P.height || x0 >= x1) return;
+    prefetch(j->normal + (size_t)y * (size_t)j->normal_stride + 3 * (size_t)x0,
+             12u * (size_t)(x1 - x0), 0);
+    prefetch(row_of(&j->P, y) + 4 * (size_t)x0, 4u * (size_t)(x1 - x0), 0);
 }
 
 static void light_rows(const light_job *j, int y0, int y1)
@@ -272,10 +313,13 @@ static void light_rows(const light_job *j, int y0, int y1)
     for (y = y0; y < y1; y++) {
         const uint8_t *m = j->mask + (size_t)y * (size_t)j->mask_stride;
         uint8_t *o = row_of(&j->out, y);
-        if (mask_row_empty(m, w)) {     /* the rows above and below the hand */
+        int x0, x1;
+        mask_span(m, w, &x0, &x1);
+        if (x0 >= x1) {     /* the rows above and below the hand */
             memset(o, 0, 4u * (size_t)w);
             continue;
         }
+        light_prefetch(j, y + 1, x0, x1);
         j->k->light(&j->prep, y, w, row_of(&j->P, y), m,
                     j->normal + (size_t)y * (size_t)j->normal_stride, o);
     }
@@ -286,7 +330,17 @@ typedef struct comp_job {
     fuse_image Q, V, out;
     int vx, vy, vw, vh;
     int in_place;
+    int v_opaque;       /* fuse_eye.v_opaque: transparent spans are out = V */
 } comp_job;
+
+/* n pixels that the layer does not reach: out = V with alpha 255. With the
+ * caller's promise that V is opaque that is V itself: nothing to do in
+ * place, a copy otherwise. */
+static void transparent(const comp_job *j, const uint8_t *v, uint8_t *o, int n)
+{
+    if (!j->v_opaque) j->k->opaque(v, o, n);
+    else if (!j->in_place) memcpy(o, v, 4u * (size_t)n);
+}
 
 /* Output pixels per transparency group: a group whose taps all lie in
  * coverage blocks without a bit (both source rows) is a copy of V. */
@@ -449,7 +503,7 @@ static void comp_span(const comp_job *j, const comp_scratch *s, const uint8_t *q
     if (covered)
         j->k->comp(q0, q1, fy, &s->cols, c, n, j->Q.width, v + 4 * (size_t)c, o + 4 * (size_t)c);
     else
-        j->k->opaque(v + 4 * (size_t)c, o + 4 * (size_t)c, n);
+        transparent(j, v + 4 * (size_t)c, o + 4 * (size_t)c, n);
 }
 
 /* Bits of the groups whose class (1: h only in the upper row, 2: only in
@@ -476,9 +530,12 @@ static int class_end(const uint64_t *g0, const uint64_t *g1, int ng, int g, int 
 /* An output row from the row cache: slots r0 (upper layer row) and r1
  * (lower). Groups with h in either row go through kernels.vrow in runs of
  * one class, a row without h reading h_zero (its taps there are all 0);
- * the other groups have four zero taps at every pixel: V, alpha 255. */
+ * the other groups have four zero taps at every pixel: V, alpha 255.
+ * next: prefetch the next output row's pixels over the blended runs (in
+ * place with an opaque V, where nothing else reads the row: otherwise the
+ * rows are read from end to end and the hardware prefetcher streams them). */
 static void comp_row_cached(const comp_job *j, const comp_scratch *s, int r0, int r1,
-                            uint32_t fy, const uint8_t *v, uint8_t *o, int n)
+                            uint32_t fy, const uint8_t *v, uint8_t *o, int n, int next)
 {
     const int ng = (n + GROUP - 1) / GROUP;
     const uint64_t *g0 = s->grp[r0], *g1 = s->grp[r1];
@@ -492,13 +549,15 @@ static void comp_row_cached(const comp_job *j, const comp_scratch *s, int r0, in
         ge = class_end(g0, g1, ng, gs, cls);
         c = gs * GROUP;
         e = ge * GROUP < n ? ge * GROUP : n;
-        if (c > done) j->k->opaque(v + 4 * (size_t)done, o + 4 * (size_t)done, c - done);
+        if (c > done) transparent(j, v + 4 * (size_t)done, o + 4 * (size_t)done, c - done);
+        if (next)   /* the same span of the next output row (prefetch above) */
+            prefetch(v + (size_t)j->V.stride + 4 * (size_t)c, 4u * (size_t)(e - c), 1);
         j->k->vrow((cls & 1) ? h0 + 4 * (size_t)c : s->h_zero, (cls & 2) ? h1 + 4 * (size_t)c : s->h_zero,
                    fy, v + 4 * (size_t)c, o + 4 * (size_t)c, e - c);
         done = e;
         g = ge;
     }
-    if (n > done) j->k->opaque(v + 4 * (size_t)done, o + 4 * (size_t)done, n - done);
+    if (n > done) transparent(j, v + 4 * (size_t)done, o + 4 * (size_t)done, n - done);
 }
 
 /* One output row y of the viewport, columns [c0, c0 + n) of the tile in s.
@@ -523,7 +582,8 @@ static void comp_row_tiled(const comp_job *j, comp_scratch *s, int y, int c0, in
     int done = 0, b = 0;   /* columns [0, done) written */
     if (iy1 == iy) s1 = s0;
     if (j->k->vrow != NULL) {
-        comp_row_cached(j, s, s0, s1, fy, v, o, n);
+        comp_row_cached(j, s, s0, s1, fy, v, o, n,
+                        j->in_place && j->v_opaque && y + 1 < j->vy + j->vh);
         return;
     }
     for (;;) {
@@ -647,6 +707,7 @@ static fuse_result comp_with(fuse_context *ctx, const kernels *k,
     j.vw = vp_w;
     j.vh = vp_h;
     j.in_place = fuse__same_image(out, V);
+    j.v_opaque = 0;
     run(ctx, comp_task, &j);
     return FUSE_OK;
 }
@@ -748,12 +809,51 @@ typedef struct frame_job {
     int count;
 } frame_job;
 
+/* Layer rows [y0, y1) of an eye: lit, and with a depth test hidden where
+ * the scene is in front. The ISA paths test the mask (a copy of each row)
+ * before lighting, so hidden pixels are never lit; the bytes are those of
+ * lighting and then testing the layer (fuse_internal.h,
+ * fuse__depth_mask_fn), which the reference does. */
 static void eye_light_depth(const eye_job *e, int y0, int y1)
 {
-    light_rows(&e->light, y0, y1);
-    if (e->depth != NULL)
-        fuse__depth_rows(e->depth, &e->light.out, e->comp.vx, e->comp.vy,
-                         e->comp.vw, e->comp.vh, y0, y1, e->light.k->depth);
+    const light_job *j = &e->light;
+    const int w = j->P.width, sh = j->P.height;
+    const fuse_depth *d = e->depth;
+    fuse__depth_prep dp;
+    uint8_t m[FUSE_MAX_DIM];
+    int y;
+    if (d == NULL || j->k->ref) {
+        light_rows(j, y0, y1);
+        if (d != NULL)
+            fuse__depth_rows(d, &j->out, e->comp.vx, e->comp.vy, e->comp.vw, e->comp.vh, y0, y1,
+                             j->k->depth);
+        return;
+    }
+    fuse__depth_prepare(d, w, e->comp.vw, &dp);
+    for (y = y0; y < y1; y++) {
+        const uint8_t *m0 = j->mask + (size_t)y * (size_t)j->mask_stride;
+        uint8_t *o = row_of(&j->out, y);
+        int x0, x1;
+        mask_span(m0, w, &x0, &x1);
+        if (x0 >= x1) {
+            memset(o, 0, 4u * (size_t)w);
+            continue;
+        }
+        light_prefetch(j, y + 1, x0, x1);
+        if (y + 1 < sh) {   /* and the next row's depths, hand and scene */
+            const int32_t c0 = (int32_t)(((int64_t)2 * x0 + 1) * dp.vw / dp.den);
+            const int32_t c1 = (int32_t)(((int64_t)2 * (x1 - 1) + 1) * dp.vw / dp.den);
+            prefetch(d->hand + (size_t)(y + 1) * (size_t)d->hand_stride + x0,
+                     sizeof(float) * (size_t)(x1 - x0), 0);
+            prefetch(fuse__depth_scene_row(d, y + 1, sh, e->comp.vx, e->comp.vy, e->comp.vh) + c0,
+                     sizeof(float) * (size_t)(c1 - c0 + 1), 0);
+        }
+        memcpy(m, m0, (size_t)w);
+        j->k->depth_mask(&dp, m, d->hand + (size_t)y * (size_t)d->hand_stride,
+                         fuse__depth_scene_row(d, y, sh, e->comp.vx, e->comp.vy, e->comp.vh), w);
+        j->k->light(&j->prep, y, w, row_of(&j->P, y), m,
+                    j->normal + (size_t)y * (size_t)j->normal_stride, o);
+    }
 }
 
 /* Layer rows lit per step of the fused order: small enough that the rows
@@ -904,6 +1004,7 @@ fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int coun
         j->comp.vw = s->vp_w;
         j->comp.vh = s->vp_h;
         j->comp.in_place = fuse__same_image(&s->out, &s->V);
+        j->comp.v_opaque = s->v_opaque != 0;
         j->depth = s->depth;
     }
     /* one eye's writes must not land in another eye's inputs */

@@ -76,6 +76,39 @@ void fuse__depth_row_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
     fuse__depth_span_ref(p, q, hz, sc, 0, w);
 }
 
+/* The same rule on mask bytes (fuse_internal.h): m != 0 instead of a pixel
+ * that is not (0,0,0,0). */
+void fuse__depth_mspan_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                           const float *sc, int x0, int x1)
+{
+    int32_t ox, rem;
+    int x;
+    if (x0 >= x1) return;
+    fuse__depth_col(p, x0, &ox, &rem);
+    for (x = x0; x < x1; x++) {
+        float z, dist, s;
+        const int32_t cx = ox;
+        ox += p->step_q;
+        rem += p->step_r;
+        if (rem >= p->den) {
+            rem -= p->den;
+            ox++;
+        }
+        if (m[x] == 0) continue;
+        z = hz[x];
+        if (!(z >= 0.0f && z < 1.0f)) continue;
+        dist = p->two_fn / (p->fpn - ((2.0f * z) - 1.0f) * p->fmn) + p->offset;
+        s = sc[cx];
+        if (s > 0.0f && s < dist) m[x] = 0;
+    }
+}
+
+void fuse__depth_mrow_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                          const float *sc, int w)
+{
+    fuse__depth_mspan_ref(p, m, hz, sc, 0, w);
+}
+
 void fuse__depth_rows(const fuse_depth *d, const fuse_image *Q, int vp_x0,
                       int vp_y0, int vp_w, int vp_h, int y0, int y1, fuse__depth_fn fn)
 {
@@ -83,12 +116,10 @@ void fuse__depth_rows(const fuse_depth *d, const fuse_image *Q, int vp_x0,
     fuse__depth_prep p;
     int y;
     fuse__depth_prepare(d, Q->width, vp_w, &p);
-    for (y = y0; y < y1; y++) {
-        const int oy = vp_y0 + (int)(((int64_t)2 * y + 1) * vp_h / (2 * (int64_t)sh));
+    for (y = y0; y < y1; y++)
         fn(&p, Q->pixels + (size_t)y * (size_t)Q->stride,
            d->hand + (size_t)y * (size_t)d->hand_stride,
-           d->scene + (size_t)oy * (size_t)d->scene_stride + vp_x0, Q->width);
-    }
+           fuse__depth_scene_row(d, y, sh, vp_x0, vp_y0, vp_h), Q->width);
 }
 
 /* ---- tone matching ----------------------------------------------------- */

@@ -132,16 +132,46 @@ static inline uint8_t fuse__unorm8(float v) { return (uint8_t)(int)(v * 255.0f +
 /* Below this N.H the specular term is 0 (x^s < 2^-100 for s >= 1). */
 #define FUSE__POW_MIN 7.88860905221011805412e-31f   /* 2^-100 */
 
+/* Integer exponents up to this are powers by squaring (fuse__powi01). */
+#define FUSE__POW_INT_MAX 64
+
+/* s as the integer exponent of fuse__powi01 when s is an integer in
+ * [1, FUSE__POW_INT_MAX], else 0 (the exp2/log2 path). */
+static inline int fuse__pow_int(float s)
+{
+    return s >= 1.0f && s <= (float)FUSE__POW_INT_MAX && s == floorf(s) ? (int)s : 0;
+}
+
+/* x^n, n >= 1, by squaring from the lowest bit of n up, in this order:
+ *   r = 1, b = x; for each bit of n: if set, r = r * b; b = b * b
+ * (the last squaring is not done). IEEE single, correctly rounded
+ * multiplies (subnormal results included), so every ISA repeats it. The
+ * relative error is below (n - 1) 2^-24 (first order). */
+static inline float fuse__powi01(float x, int n)
+{
+    float r = 1.0f, b = x;
+    for (;;) {
+        if (n & 1) r = r * b;
+        n >>= 1;
+        if (n == 0) return r;
+        b = b * b;
+    }
+}
+
 /* x^s for x in [0, 1] (larger x count as 1), s >= 1, in a fixed sequence
  * of IEEE float operations and integer bit operations that every ISA can
- * repeat exactly: x^s = exp2(s * log2(x)).
+ * repeat exactly: an integer s in [1, FUSE__POW_INT_MAX] by squaring
+ * (fuse__powi01), any other s as x^s = exp2(s * log2(x)).
  *   x <= 2^-100            -> 0
+ *   x >= 1                 -> 1
+ *   integer s <= 64        -> fuse__powi01(x, s)
  *   x = 2^e * m, m in [sqrt(1/2), sqrt(2)), e and m from the float's bits
  *   l = (float)e + log2poly(m)          (log2poly above)
  *   y = s * l;  y < -126   -> 0
  *   k = floorf(y + 0.5f);  f = y - k    (exact, |f| <= 0.5)
  *   result = exp2poly(f) * 2^k          (2^k built from bits)
- * Relative error about 1e-6 against pow() for the s in use. */
+ * Relative error about 1e-6 against pow() for the s in use (the
+ * exp2/log2 path: 1.3e-7 (1 + |s log2 x|); squaring: (s - 1) 2^-24). */
 static inline float fuse__pow01(float x, float s)
 {
     uint32_t bits;
@@ -149,6 +179,7 @@ static inline float fuse__pow01(float x, float s)
     float m, t, t2, p, l, y, k, f;
     if (!(x > FUSE__POW_MIN)) return 0.0f;
     if (x >= 1.0f) return 1.0f;
+    if (fuse__pow_int(s)) return fuse__powi01(x, fuse__pow_int(s));
     bits = fuse__f2u(x);
     e = (int)(bits >> 23) - 127;
     m = fuse__u2f((bits & 0x007fffffu) | 0x3f800000u);
@@ -186,6 +217,7 @@ typedef struct fuse__light_prep {
     float color[FUSE_MAX_LIGHTS][3];
     float ambient[3];
     float kd, ks, shininess, kf;
+    int ipow;                 /* fuse__pow_int(shininess) */
     float tone[3];
     float ifx, ify, cx, cy;   /* 1.0f / fx, 1.0f / fy (one IEEE division) */
 } fuse__light_prep;
@@ -432,6 +464,36 @@ void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz
                           const float *sc, int w);
 void fuse__depth_row_avx512(const fuse__depth_prep *p, uint8_t *q, const float *hz,
                             const float *sc, int w);
+
+/* The same test on a row of the coverage mask before lighting (what
+ * fuse_context_frame runs): m holds the w mask bytes of a layer row (a
+ * copy: it is written), and every pixel with m != 0 that the scene hides
+ * by the rule above gets m = 0. Lighting the result gives the bytes of
+ * lighting the mask and then running fuse__depth_row_* on the layer: a
+ * hidden pixel is 0 either way, a pixel with M = 0 is 0 and not looked at
+ * either way, and the others are lit the same (docs/fuse.md, "Depth"). The
+ * ISA paths give the bytes of fuse__depth_mrow_ref. */
+typedef void (*fuse__depth_mask_fn)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                                    const float *sc, int w);
+void fuse__depth_mspan_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                           const float *sc, int x0, int x1);
+void fuse__depth_mrow_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                          const float *sc, int w);
+void fuse__depth_mrow_sse2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                           const float *sc, int w);
+void fuse__depth_mrow_avx2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                           const float *sc, int w);
+void fuse__depth_mrow_avx512(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                             const float *sc, int w);
+
+/* The scene row (from the viewport's left edge) that layer row y of a
+ * layer sh rows high reads: oy = vp_y0 + floor((2y + 1) vp_h / (2 sh)). */
+static inline const float *fuse__depth_scene_row(const fuse_depth *d, int y, int sh, int vp_x0,
+                                                 int vp_y0, int vp_h)
+{
+    const int oy = vp_y0 + (int)(((int64_t)2 * y + 1) * vp_h / (2 * (int64_t)sh));
+    return d->scene + (size_t)oy * (size_t)d->scene_stride + vp_x0;
+}
 
 /* The depth test's checks, and its rows [y0, y1) with the row kernel fn. */
 fuse_result fuse__depth_check(const fuse_depth *d, const fuse_image *Q, int vp_x0,

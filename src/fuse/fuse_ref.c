@@ -123,6 +123,7 @@ fuse_result fuse__light_prepare(const fuse_lighting *L,
     p->kd = L->kd;
     p->ks = L->ks;
     p->shininess = L->shininess;
+    p->ipow = fuse__pow_int(L->shininess);
     p->kf = L->kf;
     p->ifx = 1.0f / K->fx;
     p->ify = 1.0f / K->fy;

@@ -209,8 +209,11 @@ void fuse__opaque_sse2(const uint8_t *v, uint8_t *out, int n)
 
 /* ---- depth test (fuse__depth_span_ref, 4 pixels a step) ----------------- */
 
-void fuse__depth_row_sse2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                          const float *sc, int w)
+/* The row on the layer (bpp 4: a pixel is looked at when it is not 0) or
+ * on mask bytes (bpp 1: when its byte is not 0); hidden pixels are zeroed. */
+static inline __attribute__((always_inline)) void depth_row(const fuse__depth_prep *p, uint8_t *q,
+                                                            const float *hz, const float *sc,
+                                                            int w, int bpp)
 {
     const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f);
     const __m128 two_fn = _mm_set1_ps(p->two_fn), fpn = _mm_set1_ps(p->fpn);
@@ -220,8 +223,7 @@ void fuse__depth_row_sse2(const fuse__depth_prep *p, uint8_t *q, const float *hz
     int x = 0, k;
     fuse__depth_col(p, 0, &ox, &rem);
     for (; x + 4 <= w; x += 4) {
-        __m128i *qp = (__m128i *)(void *)(q + 4 * (size_t)x);
-        const __m128i qq = _mm_loadu_si128(qp);
+        __m128i qq;
         int32_t c[4];
         for (k = 0; k < 4; k++) {   /* the columns of the 4 pixels, and on */
             c[k] = ox;
@@ -232,6 +234,10 @@ void fuse__depth_row_sse2(const fuse__depth_prep *p, uint8_t *q, const float *hz
                 ox++;
             }
         }
+        if (bpp == 4)
+            qq = _mm_loadu_si128((const __m128i *)(const void *)(q + 4 * (size_t)x));
+        else
+            qq = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128((int)load_u32(q + x)), zi), zi);
         if (_mm_movemask_epi8(_mm_cmpeq_epi32(qq, zi)) != 0xFFFF) {
             const __m128 nz = _mm_castsi128_ps(_mm_xor_si128(_mm_cmpeq_epi32(qq, zi), _mm_set1_epi32(-1)));
             const __m128 z = _mm_loadu_ps(hz + x);
@@ -244,12 +250,31 @@ void fuse__depth_row_sse2(const fuse__depth_prep *p, uint8_t *q, const float *hz
                     _mm_div_ps(two_fn, _mm_sub_ps(fpn, _mm_mul_ps(_mm_sub_ps(_mm_mul_ps(two, z), one), fmn))),
                     off);
                 const __m128 kill = _mm_and_ps(has, _mm_and_ps(_mm_cmpgt_ps(s, zero), _mm_cmplt_ps(s, dist)));
-                if (_mm_movemask_ps(kill))   /* the row is this thread's: rewrite the rest */
-                    _mm_storeu_si128(qp, _mm_andnot_si128(_mm_castps_si128(kill), qq));
+                const int km = _mm_movemask_ps(kill);
+                if (km && bpp == 4)   /* the row is this thread's: rewrite the rest */
+                    _mm_storeu_si128((__m128i *)(void *)(q + 4 * (size_t)x),
+                                     _mm_andnot_si128(_mm_castps_si128(kill), qq));
+                else if (km) {
+                    for (k = 0; k < 4; k++)
+                        if (km >> k & 1) q[x + k] = 0;
+                }
             }
         }
     }
-    fuse__depth_span_ref(p, q, hz, sc, x, w);
+    if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, x, w);
+    else fuse__depth_mspan_ref(p, q, hz, sc, x, w);
+}
+
+void fuse__depth_row_sse2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int w)
+{
+    depth_row(p, q, hz, sc, w, 4);
+}
+
+void fuse__depth_mrow_sse2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                           const float *sc, int w)
+{
+    depth_row(p, m, hz, sc, w, 1);
 }
 
 #else  /* no SSE2 (e.g. ARM): the reference kernels */
@@ -271,6 +296,11 @@ void fuse__depth_row_sse2(const fuse__depth_prep *p, uint8_t *q, const float *hz
                           const float *sc, int w)
 {
     fuse__depth_row_ref(p, q, hz, sc, w);
+}
+void fuse__depth_mrow_sse2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                           const float *sc, int w)
+{
+    fuse__depth_mrow_ref(p, m, hz, sc, w);
 }
 void fuse__pow01_row_sse2(const float *x, int n, float s, float *out)
 {
