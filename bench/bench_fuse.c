@@ -60,43 +60,12 @@ enum { CW = 640, CH = 400, W = 1280, H = 800, VX = 43, VY = 27, VW = 1194, VHH =
  * the 1-thread rows only, as the other threads' time is not counted). */
 static clockid_t clock_id = CLOCK_MONOTONIC;
 
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(clock_id, &t);
-    return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
-
-static int cmp_d(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+static double now_ms(void) { return bench_now_ms(clock_id); }
 
 static uint64_t rng = 0x1234567u;
-static uint32_t rnd(void)
-{
-    uint64_t z = (rng += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return (uint32_t)(z ^ (z >> 31));
-}
+static uint32_t rnd(void) { return bench_rand(&rng); }
 
-static void *xmalloc(size_t n)
-{
-    void *p = malloc(n);
-    if (p == NULL) {
-        fprintf(stderr, "bench_fuse: out of memory\n");
-        exit(2);
-    }
-    return p;
-}
+static void *xmalloc(size_t n) { return bench_xmalloc(n, "bench_fuse"); }
 
 typedef struct eye_buf {
     uint8_t *P, *M, *Q, *V, *out, *Vip;   /* Vip: V for the in-place runs */
@@ -285,20 +254,15 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
         t[12][k] = (t7 - t6) / m;
     }
     if (threads > 1) copier_stop(&cp);
-    s->light = median(t[0], runs);
-    s->comp = median(t[1], runs);
-    s->frame = median(t[2], runs);
-    s->frame_ip = median(t[3], runs);
-    s->memcpy = median(t[4], runs);
-    s->r_frame = median(t[5], runs);
-    s->r_frame_ip = median(t[6], runs);
-    s->frame_dp = median(t[7], runs);
-    s->r_frame_dp = median(t[8], runs);
-    s->frame_op = median(t[9], runs);
-    s->r_frame_op = median(t[10], runs);
-    s->frame_dop = median(t[11], runs);
-    s->r_frame_dop = median(t[12], runs);
-    for (i = 0; i < 13; i++) free(t[i]);
+    {   /* t[i] -> its field */
+        double *const dst[13] = { &s->light, &s->comp, &s->frame, &s->frame_ip, &s->memcpy,
+                                  &s->r_frame, &s->r_frame_ip, &s->frame_dp, &s->r_frame_dp,
+                                  &s->frame_op, &s->r_frame_op, &s->frame_dop, &s->r_frame_dop };
+        for (i = 0; i < 13; i++) {
+            *dst[i] = bench_median(t[i], runs);
+            free(t[i]);
+        }
+    }
 }
 
 /* ---- pixman ------------------------------------------------------------- */
@@ -365,10 +329,10 @@ static void bench_pixman(eye_buf e[2], int runs, pm_stats *s)
         t[2][k] = t3 - t2;
         t[3][k] = m;
     }
-    s->blend = median(t[0], runs);
-    s->scaled = median(t[1], runs);
-    s->scaled_mask = median(t[2], runs);
-    s->memcpy = median(t[3], runs);
+    s->blend = bench_median(t[0], runs);
+    s->scaled = bench_median(t[1], runs);
+    s->scaled_mask = bench_median(t[2], runs);
+    s->memcpy = bench_median(t[3], runs);
     for (i = 0; i < 2; i++) {
         pixman_image_unref(lay[i]); pixman_image_unref(lmask[i]); pixman_image_unref(q[i]);
         pixman_image_unref(cam[i]); pixman_image_unref(msk[i]); pixman_image_unref(dst[i]);

@@ -39,43 +39,12 @@
 
 enum { CW = 640, CH = 400, CROP_Y0 = 40, MAX_CASES = 64 };
 
-static double now_ms(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
-}
-
-static int cmp_d(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_d);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+static double now_ms(void) { return bench_now_ms(CLOCK_MONOTONIC); }
 
 static uint64_t rng = 0x7e57ab1eu;
-static uint32_t rnd(void)
-{
-    uint64_t z = (rng += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return (uint32_t)(z ^ (z >> 31));
-}
+static uint32_t rnd(void) { return bench_rand(&rng); }
 
-static void *xmalloc(size_t n)
-{
-    void *p = malloc(n);
-    if (!p) {
-        fprintf(stderr, "bench_refine: out of memory\n");
-        exit(2);
-    }
-    return p;
-}
+static void *xmalloc(size_t n) { return bench_xmalloc(n, "bench_refine"); }
 
 typedef struct ecase {
     char name[64];
@@ -310,11 +279,11 @@ int main(int argc, char **argv)
                 double sp = 1.0;
                 if (k >= 0) {
                     for (int r = 0; r < runs; r++) ratio[r] = t_ref[r] / t[r];
-                    sp = median(ratio, runs);
+                    sp = bench_median(ratio, runs);
                 }
                 double *tc = xmalloc(sizeof(double) * (size_t)runs);
                 memcpy(tc, t, sizeof(double) * (size_t)runs);
-                double ms = median(tc, runs);
+                double ms = bench_median(tc, runs);
                 free(tc);
                 const char *pn = k < 0 ? "ref" : ef_isa_name(paths[k]);
                 if (k < 0) sum_ref[mode] += ms;

@@ -5,7 +5,51 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
+
+/* Milliseconds on clock clk (CLOCK_MONOTONIC: the wall clock;
+ * CLOCK_THREAD_CPUTIME_ID: the calling thread's CPU time). */
+static inline double bench_now_ms(clockid_t clk)
+{
+    struct timespec t;
+    clock_gettime(clk, &t);
+    return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
+static inline int bench_cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The median of v[0..n-1], n >= 1 (sorts v). */
+static inline double bench_median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, bench_cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* splitmix64 on *state: the benchmarks' seeded pseudo-random numbers. */
+static inline uint32_t bench_rand(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return (uint32_t)(z ^ (z >> 31));
+}
+
+/* malloc that exits (status 2, "who: out of memory") when it fails. */
+static inline void *bench_xmalloc(size_t n, const char *who)
+{
+    void *p = malloc(n);
+    if (p == NULL) {
+        fprintf(stderr, "%s: out of memory\n", who);
+        exit(2);
+    }
+    return p;
+}
 
 /* The CPU's model name from /proc/cpuinfo, or "unknown". */
 static inline void bench_cpu_name(char *buf, size_t n)

@@ -39,19 +39,21 @@ void fuse__depth_prepare(const fuse_depth *d, int qw, int vp_w, fuse__depth_prep
     p->step_r = (2 * vp_w) % p->den;
 }
 
-/* The reference: for every pixel that is not (0,0,0,0) and has a hand
- * depth z in [0, 1), dist = two_fn / (fpn - (2z - 1) fmn) + offset (this
- * order, IEEE single), and the pixel is zeroed when 0 < scene < dist.
- * NaN fails every compare: a NaN depth keeps the pixel, a NaN scene too. */
-void fuse__depth_span_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                          const float *sc, int x0, int x1)
+/* The reference: for every pixel that is set and has a hand depth z in
+ * [0, 1), dist = two_fn / (fpn - (2z - 1) fmn) + offset (this order, IEEE
+ * single), and the pixel is zeroed when 0 < scene < dist. NaN fails every
+ * compare: a NaN depth keeps the pixel, a NaN scene too. bpp 4: q holds
+ * RGBA8 pixels, set when not (0,0,0,0); bpp 1: mask bytes
+ * (fuse_internal.h), set when not 0. Callers pass a constant bpp. */
+static inline void depth_span(const fuse__depth_prep *p, uint8_t *q, int bpp,
+                              const float *hz, const float *sc, int x0, int x1)
 {
     int32_t ox, rem;
     int x;
     if (x0 >= x1) return;
     fuse__depth_col(p, x0, &ox, &rem);
     for (x = x0; x < x1; x++) {
-        uint32_t w;
+        uint8_t *px = q + (size_t)bpp * (size_t)x;
         float z, dist, s;
         const int32_t cx = ox;
         ox += p->step_q;
@@ -60,53 +62,45 @@ void fuse__depth_span_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz
             rem -= p->den;
             ox++;
         }
-        memcpy(&w, q + 4 * (size_t)x, 4);
-        if (w == 0) continue;
+        if (bpp == 4) {
+            uint32_t w;
+            memcpy(&w, px, 4);
+            if (w == 0) continue;
+        } else if (px[0] == 0) {
+            continue;
+        }
         z = hz[x];
         if (!(z >= 0.0f && z < 1.0f)) continue;          /* no depth: keep */
         dist = p->two_fn / (p->fpn - ((2.0f * z) - 1.0f) * p->fmn) + p->offset;
         s = sc[cx];
-        if (s > 0.0f && s < dist) memset(q + 4 * (size_t)x, 0, 4);   /* scene in front */
+        if (s > 0.0f && s < dist) memset(px, 0, (size_t)bpp);   /* scene in front */
     }
+}
+
+void fuse__depth_span_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int x0, int x1)
+{
+    depth_span(p, q, 4, hz, sc, x0, x1);
 }
 
 void fuse__depth_row_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
                          const float *sc, int w)
 {
-    fuse__depth_span_ref(p, q, hz, sc, 0, w);
+    depth_span(p, q, 4, hz, sc, 0, w);
 }
 
-/* The same rule on mask bytes (fuse_internal.h): m != 0 instead of a pixel
- * that is not (0,0,0,0). */
+/* The same rule on mask bytes: m != 0 instead of a pixel that is not
+ * (0,0,0,0). */
 void fuse__depth_mspan_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
                            const float *sc, int x0, int x1)
 {
-    int32_t ox, rem;
-    int x;
-    if (x0 >= x1) return;
-    fuse__depth_col(p, x0, &ox, &rem);
-    for (x = x0; x < x1; x++) {
-        float z, dist, s;
-        const int32_t cx = ox;
-        ox += p->step_q;
-        rem += p->step_r;
-        if (rem >= p->den) {
-            rem -= p->den;
-            ox++;
-        }
-        if (m[x] == 0) continue;
-        z = hz[x];
-        if (!(z >= 0.0f && z < 1.0f)) continue;
-        dist = p->two_fn / (p->fpn - ((2.0f * z) - 1.0f) * p->fmn) + p->offset;
-        s = sc[cx];
-        if (s > 0.0f && s < dist) m[x] = 0;
-    }
+    depth_span(p, m, 1, hz, sc, x0, x1);
 }
 
 void fuse__depth_mrow_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
                           const float *sc, int w)
 {
-    fuse__depth_mspan_ref(p, m, hz, sc, 0, w);
+    depth_span(p, m, 1, hz, sc, 0, w);
 }
 
 void fuse__depth_rows(const fuse_depth *d, const fuse_image *Q, int vp_x0,
