@@ -4,13 +4,17 @@
  * blend, and the wrist-twist sweep -180..180 degrees where the LBS
  * cross-section shrinks by |1 - w + w e^(i theta)|^2 and DQS keeps it;
  * the reference's division-only formula against Kavan's normalised dual
- * quaternion evaluated in double (positions, normals, their lengths). */
+ * quaternion evaluated in double (positions, normals, their lengths) on
+ * every ISA, with weight sums from 1e-30 to 1e30; b.r = 0 with a nonzero
+ * weight sum keeps the bind pose. */
 #include "support/testutil.h"
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "../src/cpu/cpu.h"
 #include "../src/kin/kin.h"
 
 static kin_quat rand_q(tu_rng *g)
@@ -46,6 +50,54 @@ static void validity_zero_weights_and_no_skin(void **state)
     NEAR(po[3], 5, 1e-6); NEAR(po[4], 6, 1e-6); NEAR(po[5], 7, 1e-6);
     kin_skin_dqs(&m, NULL, po, no);                              /* no joints */
     assert_memory_equal(po, pos, sizeof pos);
+}
+
+/* b.r exactly 0 with a nonzero weight sum: r1 = (0,0,0,1), r2 =
+ * (0,0,1,0), r3 = (0,0,0.25,0.25) (not unit: the blend does not care),
+ * weights 0.25, 0.25, -1 (sum -0.5; no sign flips, r2.r1 = 0 and
+ * r3.r1 > 0) give b.r = 0 in exact float arithmetic: the bind pose, on
+ * every ISA, from the mesh and with a skin plan, also with the weights
+ * scaled by 1e-30 (b.r stays 0 through the range rescaling). 37 vertices:
+ * whole vectors and a tail on every ISA. */
+static void validity_zero_real_part_keeps_bind_pose(void **state)
+{
+    (void)state;
+    enum { N = 37 };
+    float pos[N * 3], nrm[N * 3], w[N * 4], po[N * 3], no[N * 3];
+    uint16_t jt[N * 4];
+    for (int v = 0; v < N; v++) {
+        const float s = v % 2 ? 1e-30f : 1.0f;
+        for (int c = 0; c < 3; c++) { pos[3 * v + c] = (float)(v + c); nrm[3 * v + c] = c == 1; }
+        jt[4 * v] = 0; jt[4 * v + 1] = 1; jt[4 * v + 2] = 2; jt[4 * v + 3] = 0;
+        w[4 * v] = 0.25f * s; w[4 * v + 1] = 0.25f * s; w[4 * v + 2] = -s; w[4 * v + 3] = 0;
+    }
+    kin_dualquat dq[3] = { { { 0, 0, 0, 1 }, { 0.5f, 0, 0, 0 } },
+                           { { 0, 0, 1, 0 }, { 0, 0.5f, 0, 0 } },
+                           { { 0, 0, 0.25f, 0.25f }, { 0, 0, 0.5f, 0 } } };
+    kin_mesh m = mesh_of(N, pos, nrm, jt, w);
+    size_t ns = kin_skin_plan_scratch_size(&m);
+    void *scratch = malloc(ns);
+    size_t bytes = kin_skin_plan_size(&m, scratch);
+    void *mem = aligned_alloc(64, (bytes + 63) & ~(size_t)63);
+    kin_skin_plan plan;
+    assert_int_equal(kin_skin_plan_init(&plan, &m, scratch, mem, bytes), 0);
+    for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {
+        if (!ef_cpu_has((ef_isa)isa)) continue;
+        for (int with_plan = 0; with_plan < 2; with_plan++) {
+            memset(po, 0xFF, sizeof po);
+            memset(no, 0xFF, sizeof no);
+            if (with_plan) kin_skin_dqs_plan_part(&plan, dq, po, no, 0, 1, isa);
+            else kin_skin_dqs_isa(&m, dq, po, no, isa);
+            assert_memory_equal(po, pos, sizeof pos);
+            assert_memory_equal(no, nrm, sizeof nrm);
+        }
+    }
+    /* the same joints with weights 0.25, 0.25, -0.75 move the vertex */
+    w[2] = -0.75f;
+    kin_skin_dqs_isa(&m, dq, po, no, EF_ISA_REF);
+    assert_true(memcmp(po, pos, 3 * sizeof(float)) != 0);
+    free(mem);
+    free(scratch);
 }
 
 /* -------------------------------------------------------------- results */
@@ -129,43 +181,12 @@ static void result_translation_blend(void **state)
     NEAR(po[0], sqrtf(0.5f), 1e-6); NEAR(po[1], sqrtf(0.5f), 1e-6);
 }
 
-/* kin_dqs.c skips Kavan's b / |b.r| and the normal's renormalisation
- * (one division per vertex): over seeded blends of 1..4 joints (antipodal
- * signs, unnormalised weights, non-unit normals) the result equals
- * R(b^) p + t(b^) and R(b^) n, b^ = b / |b.r|, evaluated in double from
- * the same blend, and a unit normal stays unit. */
-static void result_matches_normalised_kavan_in_double(void **state)
+/* po, no (n vertices) against Kavan's normalised blend in double. */
+static void check_kavan(int n, const float *pos, const float *nrm, const uint16_t *jt,
+                        const float *w, const kin_dualquat *dq, const float *po,
+                        const float *no)
 {
-    (void)state;
-    tu_rng g = { 0x64717333 };
-    enum { N = 500, J = 6 };
-    static float pos[N * 3], nrm[N * 3], w[N * 4], po[N * 3], no[N * 3];
-    static uint16_t jt[N * 4];
-    kin_dualquat dq[J];
-    for (int j = 0; j < J; j++) {
-        kin_mat4 m = kin_mat4_from_tr(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1),
-                                             tu_range(&g, -1, 1)), rand_q(&g));
-        dq[j] = kin_dualquat_from_mat4(&m);
-        if (j % 2) { /* the antipodal form of the same transform */
-            float *f = &dq[j].r.x;
-            for (int e = 0; e < 8; e++) f[e] = -f[e];
-        }
-    }
-    for (int v = 0; v < N; v++) {
-        float len = v % 5 == 0 ? 2.5f : 1.0f;      /* some non-unit normals */
-        kin_vec3 n = kin_v3_scale(kin_v3_norm(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1),
-                                                     tu_range(&g, -1, 1))), len);
-        memcpy(nrm + 3 * v, &n, sizeof n);
-        for (int c = 0; c < 3; c++) pos[3 * v + c] = tu_range(&g, -1, 1);
-        int k = 1 + tu_int(&g, 4);
-        for (int i = 0; i < 4; i++) {
-            jt[4 * v + i] = (uint16_t)tu_int(&g, J);
-            w[4 * v + i] = i < k ? tu_range(&g, 0.1f, 1.0f) : 0.0f;  /* unnormalised */
-        }
-    }
-    kin_mesh m = mesh_of(N, pos, nrm, jt, w);
-    kin_skin_dqs(&m, dq, po, no);
-    for (int v = 0; v < N; v++) {
+    for (int v = 0; v < n; v++) {
         double b[8] = { 0 };
         const float *r0 = NULL;
         for (int i = 0; i < 4; i++) {
@@ -204,6 +225,60 @@ static void result_matches_normalised_kavan_in_double(void **state)
         NEAR(sqrt(nl), sqrt(nw), 2e-6 * sqrt(nw));   /* rotated, length kept */
     }
 }
+
+/* kin_dqs.c skips Kavan's b / |b.r| and the normal's renormalisation
+ * (one division per vertex): over seeded blends of 1..4 joints (antipodal
+ * signs, unnormalised weights, non-unit normals) the result equals
+ * R(b^) p + t(b^) and R(b^) n, b^ = b / |b.r|, evaluated in double from
+ * the same blend, and a unit normal stays unit. The weights of a vertex
+ * are scaled by one of 1, 1e-10, 1e-19, 3e-20, 1e-21, 1e-23, 1e-30, 2e19,
+ * 1e30: k = 2 / |b.r|^2 overflows (or |b.r|^2 under- or overflows) at the
+ * ends of that range unless b is rescaled first, and the result must still
+ * be the rigid one. On every ISA (the reference and the SIMD kernels). */
+static void result_matches_normalised_kavan_in_double(void **state)
+{
+    (void)state;
+    tu_rng g = { 0x64717333 };
+    enum { N = 500, J = 6 };
+    static float pos[N * 3], nrm[N * 3], w[N * 4], po[N * 3], no[N * 3];
+    static uint16_t jt[N * 4];
+    kin_dualquat dq[J];
+    for (int j = 0; j < J; j++) {
+        kin_mat4 m = kin_mat4_from_tr(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1),
+                                             tu_range(&g, -1, 1)), rand_q(&g));
+        dq[j] = kin_dualquat_from_mat4(&m);
+        if (j % 2) { /* the antipodal form of the same transform */
+            float *f = &dq[j].r.x;
+            for (int e = 0; e < 8; e++) f[e] = -f[e];
+        }
+    }
+    for (int v = 0; v < N; v++) {
+        float len = v % 5 == 0 ? 2.5f : 1.0f;      /* some non-unit normals */
+        kin_vec3 n = kin_v3_scale(kin_v3_norm(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1),
+                                                     tu_range(&g, -1, 1))), len);
+        memcpy(nrm + 3 * v, &n, sizeof n);
+        for (int c = 0; c < 3; c++) pos[3 * v + c] = tu_range(&g, -1, 1);
+        int k = 1 + tu_int(&g, 4);
+        for (int i = 0; i < 4; i++) {
+            jt[4 * v + i] = (uint16_t)tu_int(&g, J);
+            w[4 * v + i] = i < k ? tu_range(&g, 0.1f, 1.0f) : 0.0f;  /* unnormalised */
+        }
+    }
+    static const float scale[] = { 1.0f, 1e-10f, 1e-19f, 3e-20f, 1e-21f, 1e-23f, 1e-30f,
+                                   2e19f, 1e30f };
+    enum { NS = (int)(sizeof scale / sizeof scale[0]) };
+    for (int v = 0; v < N; v++)
+        for (int i = 0; i < 4; i++) w[4 * v + i] *= scale[(v / 2) % NS];
+    kin_mesh m = mesh_of(N, pos, nrm, jt, w);
+    for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {
+        if (!ef_cpu_has((ef_isa)isa)) continue;
+        memset(po, 0xFF, sizeof po);
+        memset(no, 0xFF, sizeof no);
+        kin_skin_dqs_isa(&m, dq, po, no, isa);
+        check_kavan(N, pos, nrm, jt, w, dq, po, no);
+    }
+}
+
 
 /* Ring area (shoelace, in its z plane) of K points. */
 static double ring_area(const float *p, int k)
@@ -279,6 +354,7 @@ int main(void)
 {
     const struct CMUnitTest validity[] = {
         cmocka_unit_test(validity_zero_weights_and_no_skin),
+        cmocka_unit_test(validity_zero_real_part_keeps_bind_pose),
     };
     const struct CMUnitTest results[] = {
         cmocka_unit_test(result_dualquat_matches_matrix),

@@ -17,58 +17,23 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/kin/kin.h"
+#include "support/kin_testmesh.h"
 
 /* CRC32 of the reference's positions and normals (LBS then DQS) over all
  * NCASES cases; update it (and docs/kin.md) when the reference changes. */
 #define SKIN_CRC 0x09D4160Au
 #define NCASES 60
-#define NJOINTS 80   /* capacity; a case uses 24, 48 or 80 */
 
-typedef struct skcase {
-    kin_mesh mesh;
-    float *pos, *nrm, *w;
-    uint16_t *jt;
-    kin_mat4 jm[NJOINTS];
-    kin_dualquat dq[NJOINTS];
-    int nj;
-} skcase;
-
-static kin_quat rand_quat(tu_rng *r)
-{
-    kin_quat q = { tu_range(r, -1, 1), tu_range(r, -1, 1), tu_range(r, -1, 1),
-                   tu_range(r, -1, 1) };
-    return kin_quat_normalize(q);
-}
-
-static void make_case(int n, skcase *k)
+static void make_case(int n, tu_skin_case *k)
 {
     tu_rng r = { 0x736b696e0000ull + (uint64_t)n };
     static const int counts[] = { 1, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 32, 33, 63, 100, 257, 1000 };
     int nv = counts[n % (int)(sizeof counts / sizeof counts[0])];
     if (n >= 34) nv = 1 + tu_int(&r, 3000);
-    k->pos = malloc((size_t)nv * 3 * sizeof(float));
-    k->nrm = malloc((size_t)nv * 3 * sizeof(float));
-    k->w = malloc((size_t)nv * 4 * sizeof(float));
-    k->jt = malloc((size_t)nv * 4 * sizeof(uint16_t));
     /* joint counts below 32, below 64 and above (the AVX-512 table paths
      * and its per-vertex fallback) */
-    const int nj = k->nj = n % 3 == 0 ? 24 : n % 3 == 1 ? 48 : NJOINTS;
-    for (int j = 0; j < nj; j++) {
-        kin_vec3 t = kin_v3(tu_range(&r, -2, 2), tu_range(&r, -2, 2), tu_range(&r, -2, 2));
-        k->jm[j] = kin_mat4_from_tr(t, rand_quat(&r));
-        k->dq[j] = kin_dualquat_from_mat4(&k->jm[j]);
-        if (j % 3 == 1) k->dq[j].r = (kin_quat){ -k->dq[j].r.x, -k->dq[j].r.y, -k->dq[j].r.z, -k->dq[j].r.w };
-        if (j % 3 == 1) k->dq[j].d = (kin_quat){ -k->dq[j].d.x, -k->dq[j].d.y, -k->dq[j].d.z, -k->dq[j].d.w };
-        if (j % 4 == 2) { /* scale, shear */
-            for (int e = 0; e < 12; e++) k->jm[j].m[e] *= tu_range(&r, 0.5f, 1.5f);
-            k->jm[j].m[4] += tu_range(&r, -0.3f, 0.3f);
-        }
-        if (j % 5 == 3) /* mirrored */
-            for (int e = 0; e < 3; e++) k->jm[j].m[e] = -k->jm[j].m[e];
-    }
-    k->jm[nj - 2] = (kin_mat4){ { 0 } };                 /* singular */
-    k->jm[nj - 1].m[0] = NAN;                            /* read with w = 0 only */
-    k->dq[nj - 1].r.x = NAN;
+    const int nj = n % 3 == 0 ? 24 : n % 3 == 1 ? 48 : TU_SKIN_JOINTS;
+    tu_skin_case_begin(k, &r, nv, nj);
     for (int v = 0; v < nv; v++) {
         for (int c = 0; c < 3; c++) k->pos[3 * v + c] = tu_range(&r, -1, 1);
         kin_vec3 nn = kin_v3_norm(kin_v3(tu_range(&r, -1, 1), tu_range(&r, -1, 1), tu_range(&r, -1, 1)));
@@ -88,43 +53,19 @@ static void make_case(int n, skcase *k)
         }
         if (kind != 2 && s > 0)
             for (int i = 0; i < 4; i++) k->w[4 * v + i] /= s;  /* kind 2: unnormalised */
-        if (kind == 3) { k->w[4 * v] = 0.5f; k->w[4 * v + 1] = -0.5f; k->w[4 * v + 2] = k->w[4 * v + 3] = 0; }
-        if (kind == 4) for (int i = 0; i < 4; i++) k->w[4 * v + i] = 0.0f;
-        if (kind == 5) k->w[4 * v + 3] = -0.25f;               /* negative */
-        if (kind == 6) { k->jt[4 * v + 3] = (uint16_t)(nj - 1); k->w[4 * v + 3] = 0.0f; }
-        if (kind == 8) { k->jt[4 * v + 2] = 60000; k->w[4 * v + 2] = 0.0f; } /* never read */
-        if (kind == 7) { k->jt[4 * v] = (uint16_t)(nj - 2); }   /* singular joint */
+        tu_skin_weight_kind(k, v, kind);
     }
-    memset(&k->mesh, 0, sizeof k->mesh);
-    k->mesh.vertex_count = nv;
-    k->mesh.positions = k->pos;
-    k->mesh.normals = (n % 7 == 6) ? NULL : k->nrm;
-    k->mesh.joints = k->jt;
-    k->mesh.weights = k->w;
-}
-
-static void free_case(skcase *k)
-{
-    free(k->pos); free(k->nrm); free(k->w); free(k->jt);
+    tu_skin_case_end(k, nv, n % 7 != 6);
 }
 
 /* Runs one skinning (dqs = 0 LBS, 1 DQS) on isa into fresh buffers. */
-static void run(const skcase *k, int dqs, int isa, float *po, float *no)
+static void run(const tu_skin_case *k, int dqs, int isa, float *po, float *no)
 {
     size_t n = (size_t)k->mesh.vertex_count * 3 * sizeof(float);
     memset(po, 0xA5, n);
     memset(no, 0xA5, n);
     if (dqs) kin_skin_dqs_isa(&k->mesh, k->dq, po, no, isa);
     else kin_skin_lbs_isa(&k->mesh, k->jm, po, no, isa);
-}
-
-static void first_diff(const float *a, const float *b, int n, const char *what, int c,
-                       const char *isa)
-{
-    for (int i = 0; i < n; i++)
-        if (memcmp(&a[i], &b[i], sizeof(float)))
-            fail_msg("case %d: %s %s vertex %d comp %d: %.9g (ref %.9g)", c, isa, what,
-                     i / 3, i % 3, (double)b[i], (double)a[i]);
 }
 
 static void isa_equal(int isa)
@@ -137,7 +78,7 @@ static void isa_equal(int isa)
     uint32_t crc = 0;
     long verts = 0, kept = 0;
     for (int c = 0; c < NCASES; c++) {
-        skcase k;
+        tu_skin_case k;
         make_case(c, &k);
         int n3 = k.mesh.vertex_count * 3;
         float *rp = malloc((size_t)n3 * 4), *rn = malloc((size_t)n3 * 4);
@@ -148,14 +89,14 @@ static void isa_equal(int isa)
             if (k.mesh.normals) crc = tu_crc32(crc, rn, (size_t)n3 * 4);
             for (int i = 0; i < n3; i++) kept += rp[i] == k.pos[i];
             run(&k, dqs, isa, sp, sn);
-            first_diff(rp, sp, n3, dqs ? "DQS position" : "LBS position", c,
+            tu_skin_first_diff(rp, sp, n3, dqs ? "DQS position" : "LBS position", c,
                        ef_isa_name((ef_isa)isa));
-            first_diff(rn, sn, n3, dqs ? "DQS normal" : "LBS normal", c,
+            tu_skin_first_diff(rn, sn, n3, dqs ? "DQS normal" : "LBS normal", c,
                        ef_isa_name((ef_isa)isa));
             verts += k.mesh.vertex_count;
         }
         free(rp); free(rn); free(sp); free(sn);
-        free_case(&k);
+        tu_skin_case_free(&k);
     }
     print_message("NOTE kin skin %s: %d cases, %ld vertex skins equal to the reference, "
                   "CRC32 0x%08X (recorded 0x%08X)\n", ef_isa_name((ef_isa)isa), NCASES,
@@ -178,7 +119,7 @@ static void test_dispatch_equal(void **state)
     assert_true(isa >= EF_ISA_REF && isa < EF_ISA_COUNT);
     assert_true(ef_cpu_has((ef_isa)isa));
     for (int c = 0; c < 20; c++) {
-        skcase k;
+        tu_skin_case k;
         make_case(c, &k);
         int n3 = k.mesh.vertex_count * 3;
         float *rp = malloc((size_t)n3 * 4), *rn = malloc((size_t)n3 * 4);
@@ -189,11 +130,11 @@ static void test_dispatch_equal(void **state)
             memset(sn, 0xA5, (size_t)n3 * 4);
             if (dqs) kin_skin_dqs(&k.mesh, k.dq, sp, sn);
             else kin_skin_lbs(&k.mesh, k.jm, sp, sn);
-            first_diff(rp, sp, n3, "position", c, "dispatch");
-            first_diff(rn, sn, n3, "normal", c, "dispatch");
+            tu_skin_first_diff(rp, sp, n3, "position", c, "dispatch");
+            tu_skin_first_diff(rn, sn, n3, "normal", c, "dispatch");
         }
         free(rp); free(rn); free(sp); free(sn);
-        free_case(&k);
+        tu_skin_case_free(&k);
     }
 }
 
@@ -201,7 +142,7 @@ static void test_dispatch_equal(void **state)
 static void test_no_normal_output(void **state)
 {
     (void)state;
-    skcase k;
+    tu_skin_case k;
     make_case(16, &k);   /* 1000 vertices */
     int n3 = k.mesh.vertex_count * 3;
     float *po = malloc((size_t)n3 * 4), *ref = malloc((size_t)n3 * 4), *tmp = malloc((size_t)n3 * 4);
@@ -210,10 +151,67 @@ static void test_no_normal_output(void **state)
         if (!ef_cpu_has((ef_isa)isa)) continue;
         memset(po, 0, (size_t)n3 * 4);
         kin_skin_lbs_isa(&k.mesh, k.jm, po, NULL, isa);
-        first_diff(ref, po, n3, "LBS position without normals", 16, ef_isa_name((ef_isa)isa));
+        tu_skin_first_diff(ref, po, n3, "LBS position without normals", 16, ef_isa_name((ef_isa)isa));
     }
     free(po); free(ref); free(tmp);
-    free_case(&k);
+    tu_skin_case_free(&k);
+}
+
+/* DQS with the weight sums at the ends of the float range (vertex v's
+ * weights scaled by tu_skin_weight_scale(v): 2^-64, 2^64, 3e-20, 1e-30,
+ * 2e19, 1e30, 1e-21, 1e-23 or 1, mixed within every vector): every ISA
+ * gives the reference's bytes; the reference's result does not change by
+ * a byte for a power-of-two factor (the blend and the rescaling are exact
+ * there, and the formula does not depend on a positive scale of b) and
+ * stays within 1e-5 of the unscaled result for the others (never the bind
+ * pose, inf or NaN where the unscaled vertex moved). */
+static void test_dqs_weight_scale(void **state)
+{
+    (void)state;
+    long exact = 0, near = 0, isas = 0;
+    for (int c = 0; c < NCASES; c += 3) {
+        tu_skin_case k;
+        make_case(c, &k);
+        const int nv = k.mesh.vertex_count, n3 = nv * 3, do_n = k.mesh.normals != NULL;
+        float *up = malloc((size_t)n3 * 4), *un = malloc((size_t)n3 * 4);
+        float *rp = malloc((size_t)n3 * 4), *rn = malloc((size_t)n3 * 4);
+        float *sp = malloc((size_t)n3 * 4), *sn = malloc((size_t)n3 * 4);
+        run(&k, 1, EF_ISA_REF, up, un);
+        float *w = tu_skin_scaled_weights(&k);
+        tu_skin_case ks = k;
+        ks.mesh.weights = w;
+        run(&ks, 1, EF_ISA_REF, rp, rn);
+        for (int v = 0; v < nv; v++) {
+            const int pow2 = v % TU_SKIN_SCALES < 3;   /* 1, 2^-64, 2^64 */
+            for (int i = 3 * v; i < 3 * v + 3; i++) {
+                if (pow2) {
+                    if (memcmp(&rp[i], &up[i], 4) || (do_n && memcmp(&rn[i], &un[i], 4)))
+                        fail_msg("case %d vertex %d (weights x %g): %.9g %.9g, unscaled %.9g %.9g",
+                                 c, v, (double)tu_skin_weight_scale(v), (double)rp[i],
+                                 (double)rn[i], (double)up[i], (double)un[i]);
+                    exact++;
+                } else {
+                    if (!(fabsf(rp[i] - up[i]) <= 1e-5f) || (do_n && !(fabsf(rn[i] - un[i]) <= 1e-5f)))
+                        fail_msg("case %d vertex %d (weights x %g): %.9g %.9g, unscaled %.9g %.9g",
+                                 c, v, (double)tu_skin_weight_scale(v), (double)rp[i],
+                                 (double)rn[i], (double)up[i], (double)un[i]);
+                    near++;
+                }
+            }
+        }
+        for (int isa = EF_ISA_SSE2; isa < EF_ISA_COUNT; isa++) {
+            if (!ef_cpu_has((ef_isa)isa)) continue;
+            run(&ks, 1, isa, sp, sn);
+            tu_skin_first_diff(rp, sp, n3, "DQS position, scaled weights", c, ef_isa_name((ef_isa)isa));
+            tu_skin_first_diff(rn, sn, n3, "DQS normal, scaled weights", c, ef_isa_name((ef_isa)isa));
+            isas++;
+        }
+        free(w); free(up); free(un); free(rp); free(rn); free(sp); free(sn);
+        tu_skin_case_free(&k);
+    }
+    print_message("NOTE kin dqs scaled weights: %ld coordinates byte-equal to the unscaled, "
+                  "%ld within 1e-5, %ld ISA runs equal to the reference\n", exact, near, isas);
+    assert_true(exact > 1000 && near > 1000);
 }
 
 int main(void)
@@ -224,6 +222,7 @@ int main(void)
         cmocka_unit_test(test_avx512),
         cmocka_unit_test(test_dispatch_equal),
         cmocka_unit_test(test_no_normal_output),
+        cmocka_unit_test(test_dqs_weight_scale),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

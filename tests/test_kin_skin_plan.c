@@ -20,56 +20,18 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/kin/kin.h"
+#include "support/kin_testmesh.h"
 
 #define NCASES 40
-#define NJOINTS 80
 
-typedef struct pcase {
-    kin_mesh mesh;
-    float *pos, *nrm, *w;
-    uint16_t *jt;
-    kin_mat4 jm[NJOINTS];
-    kin_dualquat dq[NJOINTS];
-    int nj;
-} pcase;
-
-static kin_quat rand_quat(tu_rng *r)
-{
-    kin_quat q = { tu_range(r, -1, 1), tu_range(r, -1, 1), tu_range(r, -1, 1),
-                   tu_range(r, -1, 1) };
-    return kin_quat_normalize(q);
-}
-
-static void make_case(int n, pcase *k)
+static void make_case(int n, tu_skin_case *k)
 {
     tu_rng r = { 0x706c616e0000ull + (uint64_t)n };
     static const int counts[] = { 1, 5, 15, 16, 17, 32, 33, 100, 257, 1000 };
     int nv = counts[n % (int)(sizeof counts / sizeof counts[0])];
     if (n >= 20) nv = 1 + tu_int(&r, 4000);
-    k->pos = malloc((size_t)nv * 3 * sizeof(float));
-    k->nrm = malloc((size_t)nv * 3 * sizeof(float));
-    k->w = malloc((size_t)nv * 4 * sizeof(float));
-    k->jt = malloc((size_t)nv * 4 * sizeof(uint16_t));
-    const int nj = k->nj = n % 3 == 0 ? 24 : n % 3 == 1 ? 48 : NJOINTS;
-    for (int j = 0; j < nj; j++) {
-        kin_vec3 t = kin_v3(tu_range(&r, -2, 2), tu_range(&r, -2, 2), tu_range(&r, -2, 2));
-        k->jm[j] = kin_mat4_from_tr(t, rand_quat(&r));
-        k->dq[j] = kin_dualquat_from_mat4(&k->jm[j]);
-        if (j % 3 == 1) { /* the other sign of the same transform */
-            kin_quat *q = &k->dq[j].r, *d = &k->dq[j].d;
-            *q = (kin_quat){ -q->x, -q->y, -q->z, -q->w };
-            *d = (kin_quat){ -d->x, -d->y, -d->z, -d->w };
-        }
-        if (j % 4 == 2) { /* scale, shear */
-            for (int e = 0; e < 12; e++) k->jm[j].m[e] *= tu_range(&r, 0.5f, 1.5f);
-            k->jm[j].m[4] += tu_range(&r, -0.3f, 0.3f);
-        }
-        if (j % 5 == 3) /* mirrored */
-            for (int e = 0; e < 3; e++) k->jm[j].m[e] = -k->jm[j].m[e];
-    }
-    k->jm[nj - 2] = (kin_mat4){ { 0 } };                 /* singular */
-    k->jm[nj - 1].m[0] = NAN;                            /* read with w = 0 only */
-    k->dq[nj - 1].r.x = NAN;
+    const int nj = n % 3 == 0 ? 24 : n % 3 == 1 ? 48 : TU_SKIN_JOINTS;
+    tu_skin_case_begin(k, &r, nv, nj);
     /* grouped cases: runs of vertices share a joint list (contiguous
      * batches); the others draw joints per vertex (scattered batches) */
     const int grouped = n % 2 == 0;
@@ -95,26 +57,11 @@ static void make_case(int n, pcase *k)
         }
         if (kind != 2)
             for (int i = 0; i < 4; i++) k->w[4 * v + i] /= s;  /* kind 2: unnormalised */
-        if (kind == 3) { k->w[4 * v] = 0.5f; k->w[4 * v + 1] = -0.5f; k->w[4 * v + 2] = k->w[4 * v + 3] = 0; }
-        if (kind == 4) for (int i = 0; i < 4; i++) k->w[4 * v + i] = 0.0f;
-        if (kind == 5) k->w[4 * v + 3] = -0.25f;               /* negative */
-        if (kind == 6) { k->jt[4 * v + 3] = (uint16_t)(nj - 1); k->w[4 * v + 3] = 0.0f; }
-        if (kind == 8) { k->jt[4 * v + 2] = 60000; k->w[4 * v + 2] = 0.0f; } /* never read */
-        if (kind == 7 && !grouped) k->jt[4 * v] = (uint16_t)(nj - 2);       /* singular */
+        /* the special kinds; the singular joint only where joints are
+         * drawn per vertex */
+        tu_skin_weight_kind(k, v, kind == 7 && grouped ? -1 : kind);
     }
-    memset(&k->mesh, 0, sizeof k->mesh);
-    k->mesh.vertex_count = nv;
-    k->mesh.positions = k->pos;
-    k->mesh.normals = (n % 7 == 6) ? NULL : k->nrm;
-    k->mesh.joints = k->jt;
-    k->mesh.weights = k->w;
-    k->mesh.skin = 0;
-    k->mesh.node = -1;
-}
-
-static void free_case(pcase *k)
-{
-    free(k->pos); free(k->nrm); free(k->w); free(k->jt);
+    tu_skin_case_end(k, nv, n % 7 != 6);
 }
 
 /* A plan of k's mesh in fresh memory (*mem to free). */
@@ -131,15 +78,6 @@ static void build_plan(const kin_mesh *m, kin_skin_plan *plan, void **mem)
     free(scratch);
 }
 
-static void first_diff(const float *ref, const float *got, int n, const char *what, int c,
-                       const char *isa)
-{
-    for (int i = 0; i < n; i++)
-        if (memcmp(&ref[i], &got[i], sizeof(float)))
-            fail_msg("case %d: %s %s vertex %d comp %d: %.9g (ref %.9g)", c, isa, what,
-                     i / 3, i % 3, (double)got[i], (double)ref[i]);
-}
-
 static void plan_equal(int isa)
 {
     if (!ef_cpu_has((ef_isa)isa)) {
@@ -149,7 +87,7 @@ static void plan_equal(int isa)
     }
     long verts = 0, contiguous = 0, batches = 0, kept = 0;
     for (int c = 0; c < NCASES; c++) {
-        pcase k;
+        tu_skin_case k;
         make_case(c, &k);
         kin_skin_plan plan;
         void *mem;
@@ -173,8 +111,8 @@ static void plan_equal(int isa)
                 kin_skin_lbs_plan_part(&plan, k.jm, sp, sn, 0, 1, isa);
             }
             const char *nm = ef_isa_name((ef_isa)isa);
-            first_diff(rp, sp, n3, dqs ? "DQS plan position" : "LBS plan position", c, nm);
-            first_diff(rn, sn, n3, dqs ? "DQS plan normal" : "LBS plan normal", c, nm);
+            tu_skin_first_diff(rp, sp, n3, dqs ? "DQS plan position" : "LBS plan position", c, nm);
+            tu_skin_first_diff(rn, sn, n3, dqs ? "DQS plan normal" : "LBS plan normal", c, nm);
             /* NaN-free: the NaN joint is only read with weight 0 */
             for (int i = 0; i < n3; i++) {
                 if (!isfinite(sp[i])) fail_msg("case %d: position %d not finite", c, i / 3);
@@ -190,7 +128,7 @@ static void plan_equal(int isa)
             contiguous += plan.batch_count < k.mesh.vertex_count / 8;
         free(rp); free(rn); free(sp); free(sn);
         free(mem);
-        free_case(&k);
+        tu_skin_case_free(&k);
     }
     print_message("NOTE kin skin plan %s: %d cases, %ld vertex skins equal to the reference, "
                   "%ld batches\n", ef_isa_name((ef_isa)isa), NCASES, verts, batches);
@@ -202,6 +140,58 @@ static void test_ref(void **state) { (void)state; plan_equal(EF_ISA_REF); }
 static void test_sse2(void **state) { (void)state; plan_equal(EF_ISA_SSE2); }
 static void test_avx2(void **state) { (void)state; plan_equal(EF_ISA_AVX2); }
 static void test_avx512(void **state) { (void)state; plan_equal(EF_ISA_AVX512); }
+
+/* DQS with the weight sums at the ends of the float range (vertex v's
+ * weights scaled by tu_skin_weight_scale(v), mixed within every batch):
+ * the plan on every ISA gives the bytes of kin_skin_dqs (EF_ISA_REF) of
+ * the same weights, and every coordinate that moves without the scaling
+ * moves the same with it (within 1e-5: not the bind pose, inf or NaN). */
+static void test_dqs_weight_scale(void **state)
+{
+    (void)state;
+    long runs = 0, moved = 0;
+    for (int c = 0; c < NCASES; c += 3) {
+        tu_skin_case k;
+        make_case(c, &k);
+        float *w = tu_skin_scaled_weights(&k);
+        kin_mesh m = k.mesh;
+        m.weights = w;
+        kin_skin_plan plan;
+        void *mem;
+        build_plan(&m, &plan, &mem);
+        const int n3 = m.vertex_count * 3;
+        const size_t bytes = (size_t)n3 * sizeof(float);
+        float *up = malloc(bytes), *un = malloc(bytes), *rp = malloc(bytes), *rn = malloc(bytes),
+              *sp = malloc(bytes), *sn = malloc(bytes);
+        memset(rn, 0xA5, bytes);
+        kin_skin_dqs_isa(&k.mesh, k.dq, up, un, EF_ISA_REF);
+        kin_skin_dqs_isa(&m, k.dq, rp, rn, EF_ISA_REF);
+        for (int i = 0; i < n3; i++) {
+            if (up[i] == k.pos[i]) continue;
+            if (!(fabsf(rp[i] - up[i]) <= 1e-5f))
+                fail_msg("case %d vertex %d (weights x %g): %.9g, unscaled %.9g", c, i / 3,
+                         (double)tu_skin_weight_scale(i / 3), (double)rp[i], (double)up[i]);
+            moved++;
+        }
+        for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {
+            if (!ef_cpu_has((ef_isa)isa)) continue;
+            memset(sp, 0x5A, bytes);
+            memset(sn, 0xA5, bytes);
+            kin_skin_dqs_plan_part(&plan, k.dq, sp, sn, 0, 1, isa);
+            const char *nm = ef_isa_name((ef_isa)isa);
+            tu_skin_first_diff(rp, sp, n3, "DQS plan position, scaled weights", c, nm);
+            tu_skin_first_diff(rn, sn, n3, "DQS plan normal, scaled weights", c, nm);
+            runs++;
+        }
+        free(up); free(un); free(rp); free(rn); free(sp); free(sn);
+        free(mem);
+        free(w);
+        tu_skin_case_free(&k);
+    }
+    print_message("NOTE kin dqs plan, scaled weights: %ld ISA runs equal to the reference, "
+                  "%ld moved coordinates still moved\n", runs, moved);
+    assert_true(moved > 10000);
+}
 
 /* A hand-built mesh: 20 vertices on joint 3 alone (weight 1), 20 on joints
  * 1 then 2 (0.25, 0.75), 5 on 2 then 1 (another order: another group), 3
@@ -260,7 +250,7 @@ static void test_structure(void **state)
 static void test_parts(void **state)
 {
     (void)state;
-    pcase k;
+    tu_skin_case k;
     make_case(21, &k);
     kin_skin_plan plan;
     void *mem;
@@ -291,8 +281,8 @@ static void test_parts(void **state)
             }
         }
         assert_int_equal(written, k.mesh.vertex_count);
-        first_diff(whole, acc, n3, "parts position", 21, "default");
-        first_diff(wn, an, n3, "parts normal", 21, "default");
+        tu_skin_first_diff(whole, acc, n3, "parts position", 21, "default");
+        tu_skin_first_diff(wn, an, n3, "parts normal", 21, "default");
     }
     /* a part outside [0, parts) writes nothing */
     memset(one, 0xFF, bytes);
@@ -305,7 +295,7 @@ static void test_parts(void **state)
     }
     free(whole); free(wn); free(acc); free(an); free(one); free(on);
     free(mem);
-    free_case(&k);
+    tu_skin_case_free(&k);
 }
 
 /* NULL joint matrices / dual quaternions: the bind pose, as the reference;
@@ -313,7 +303,7 @@ static void test_parts(void **state)
 static void test_bind_pose(void **state)
 {
     (void)state;
-    pcase k;
+    tu_skin_case k;
     make_case(7, &k);   /* 100 vertices */
     kin_skin_plan plan;
     void *mem;
@@ -321,11 +311,11 @@ static void test_bind_pose(void **state)
     const int n3 = k.mesh.vertex_count * 3;
     float po[300], no[300];
     kin_skin_lbs_plan(&plan, NULL, po, no);
-    first_diff(k.pos, po, n3, "LBS without matrices", 7, "default");
-    first_diff(k.nrm, no, n3, "LBS normals without matrices", 7, "default");
+    tu_skin_first_diff(k.pos, po, n3, "LBS without matrices", 7, "default");
+    tu_skin_first_diff(k.nrm, no, n3, "LBS normals without matrices", 7, "default");
     memset(po, 0, sizeof po);
     kin_skin_dqs_plan(&plan, NULL, po, no);
-    first_diff(k.pos, po, n3, "DQS without dual quaternions", 7, "default");
+    tu_skin_first_diff(k.pos, po, n3, "DQS without dual quaternions", 7, "default");
     free(mem);
     kin_mesh bare = k.mesh;
     bare.joints = NULL;
@@ -335,9 +325,9 @@ static void test_bind_pose(void **state)
     assert_int_equal(plan.group_count, 1);
     memset(po, 0, sizeof po);
     kin_skin_lbs_plan(&plan, k.jm, po, no);
-    first_diff(k.pos, po, n3, "unskinned mesh", 7, "default");
+    tu_skin_first_diff(k.pos, po, n3, "unskinned mesh", 7, "default");
     free(mem);
-    free_case(&k);
+    tu_skin_case_free(&k);
 }
 
 static void test_invalid(void **state)
@@ -348,7 +338,7 @@ static void test_invalid(void **state)
     assert_int_equal(kin_skin_plan_size(NULL, NULL), 0);
     assert_int_equal(kin_skin_plan_init(&plan, NULL, NULL, NULL, 0), -1);
     assert_null(plan.batches);
-    pcase k;
+    tu_skin_case k;
     make_case(5, &k);   /* 32 vertices: 2..32 batches */
     void *scratch = malloc(kin_skin_plan_scratch_size(&k.mesh));
     size_t bytes = kin_skin_plan_size(&k.mesh, scratch);
@@ -371,7 +361,7 @@ static void test_invalid(void **state)
     kin_skin_dqs_plan(NULL, k.dq, NULL, NULL);
     free(mem);
     free(scratch);
-    free_case(&k);
+    tu_skin_case_free(&k);
 }
 
 int main(void)
@@ -381,6 +371,7 @@ int main(void)
         cmocka_unit_test(test_sse2),
         cmocka_unit_test(test_avx2),
         cmocka_unit_test(test_avx512),
+        cmocka_unit_test(test_dqs_weight_scale),
         cmocka_unit_test(test_structure),
         cmocka_unit_test(test_parts),
         cmocka_unit_test(test_bind_pose),

@@ -702,8 +702,11 @@ void kin_skin_dq_from_matrices(const kin_mat4 *jm, int count,
  * s_i = sign(r_i . r_0) (shortest path); positions by b / |b.r|, normals
  * by its rotation (not renormalised: a unit normal stays unit to a few
  * ulp), computed with one division and no square root per vertex
- * (kin_dqs.c). Like kin_skin_lbs otherwise (zero weights keep the bind
- * pose, outputs must not alias). */
+ * (kin_dqs.c). The result does not depend on the scale of the weights:
+ * a b whose |b.r|^2 is outside (2^-100, 2^100) is first scaled by an
+ * exact power of two (weights summing to 1e-30 or 1e30 give the same
+ * rigid transform as 1). Like kin_skin_lbs otherwise (weights summing to
+ * exactly 0, or b.r = 0, keep the bind pose; outputs must not alias). */
 void kin_skin_dqs(const kin_mesh *mesh, const kin_dualquat *dq,
                   float *pos_out, float *nrm_out);
 

@@ -14,8 +14,15 @@
  * q; t(q) = 2 (q.r.w q.d.v - q.d.w q.r.v + q.r.v x q.d.v), and
  * e collects both cross products with u). The normal is rotated, not
  * renormalised: a unit normal stays unit to a few ulp, and the length of
- * any other is kept. A vertex whose weights sum to 0, or whose |b.r|^2 is
- * not > 0, keeps its bind pose. Unlike LBS the blend of two rotations is
+ * any other is kept. The result does not change when b is scaled by a
+ * positive factor, so when |b.r|^2 is outside (2^-100, 2^100) (a tiny or
+ * huge weight sum: 2 / |b.r|^2 would overflow, or |b.r|^2 under- or
+ * overflow) b is first scaled by the power of two that brings its largest
+ * |b.r| component to [1, 2) (dq_fit: exact); inside that range nothing is
+ * scaled. So weights summing to 1e-30 or 1e30 give the rigid transform
+ * (not inf/NaN, not the bind pose). A vertex whose weights sum to exactly
+ * 0, or whose b.r is 0 (|b.r|^2 still not > 0 after the scaling), keeps
+ * its bind pose. Unlike LBS the blend of two rotations is
  * a rotation, so a twisted wrist keeps its cross-section (LBS shrinks it
  * by cos(angle/2)). Scale and mirroring are not representable:
  * kin_dualquat_from_mat4 orthonormalises. No allocation. kin_skin_dqs
@@ -26,6 +33,8 @@
 #include "../cpu/cpu.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 kin_dualquat kin_dualquat_from_mat4(const kin_mat4 *m)
 {
@@ -74,6 +83,35 @@ static void cross3(const float *a, const float *b, float *o)
     o[2] = a[0] * b[1] - a[1] * b[0];
 }
 
+/* |b.r|^2 in the kernels' order. */
+static float dq_sq(const float b[8])
+{
+    return b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3];
+}
+
+/* maxps / minps: a > b ? a : b and a < b ? a : b (the second operand when
+ * either is NaN), as the SIMD kernels' VMAX / VMIN. */
+static float maxps(float a, float b) { return a > b ? a : b; }
+static float minps(float a, float b) { return a < b ? a : b; }
+
+/* b * 2^-E with 2^E the power of two of m = max |b.r component| (its
+ * exponent bits), m clamped to [2^-126, 2^126]: the largest |b.r|
+ * component lands in [1, 2) (for m in range), so |b.r|^2 is in [1, 8).
+ * Exact (a power of two, results normal), and the skinned vertex does not
+ * depend on a positive scale of b, so only the range of k changes. m = 0
+ * (b.r = 0) keeps b.r = 0; a NaN stays NaN; an inf stays inf. */
+static void dq_fit(float b[8])
+{
+    float m = maxps(maxps(maxps(fabsf(b[0]), fabsf(b[1])), fabsf(b[2])), fabsf(b[3]));
+    m = minps(maxps(m, KIN__DQS_FIT_LO), KIN__DQS_FIT_HI);
+    uint32_t u;
+    memcpy(&u, &m, sizeof u);
+    u &= 0x7F800000u;             /* 2^floor(log2 m) */
+    memcpy(&m, &u, sizeof m);
+    const float s = 1.0f / m;      /* exact: 2^-E, normal */
+    for (int e = 0; e < 8; e++) b[e] *= s;
+}
+
 void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
                        float *pos_out, float *nrm_out, int v0, int v1)
 {
@@ -101,7 +139,11 @@ void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
                 wsum += w[i];
             }
         }
-        float sq = b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + b[3] * b[3];
+        float sq = dq_sq(b);
+        if (!(sq > KIN__DQS_SQ_MIN && sq < KIN__DQS_SQ_MAX)) {
+            dq_fit(b);
+            sq = dq_sq(b);
+        }
         if (wsum == 0.0f || !(sq > 0.0f)) {
             po[0] = p[0]; po[1] = p[1]; po[2] = p[2];
             if (do_n) { no[0] = n[0]; no[1] = n[1]; no[2] = n[2]; }
@@ -129,10 +171,7 @@ void kin_skin_dqs_isa(const kin_mesh *mesh, const kin_dualquat *dq,
     if (!mesh || !pos_out) return;
     int v = 0, n = mesh->vertex_count;
     if (mesh->joints && mesh->weights && dq) {
-        ef_isa best = ef_cpu_best(), use = ef_isa_choose(EF_ISA_DEFAULT);
-        if (isa > (int)EF_ISA_DEFAULT && isa < (int)EF_ISA_COUNT)
-            use = (ef_isa)isa < best ? (ef_isa)isa : best;
-        switch (use) {
+        switch ((ef_isa)kin__skin_isa_of(isa)) {
 #if defined(__x86_64__)
         case EF_ISA_AVX512: v = kin__skin_dqs_avx512(mesh, dq, pos_out, nrm_out, 0, n); break;
         case EF_ISA_AVX2: v = kin__skin_dqs_avx2(mesh, dq, pos_out, nrm_out, 0, n); break;

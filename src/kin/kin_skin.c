@@ -102,14 +102,13 @@ int kin_skin_isa(void)
     return (int)ef_isa_choose(EF_ISA_DEFAULT);
 }
 
-/* The ISA a caller's request runs: 0 = kin_skin_isa(), else the request
- * capped by what the CPU has (never by EGOFUSE_ISA: tests and benchmarks
- * name the path they want). */
-static ef_isa isa_of(int isa)
+/* Never capped by EGOFUSE_ISA: tests and benchmarks name the path they
+ * want. */
+int kin__skin_isa_of(int isa)
 {
-    if (isa <= (int)EF_ISA_DEFAULT || isa >= (int)EF_ISA_COUNT) return ef_isa_choose(EF_ISA_DEFAULT);
+    if (isa <= (int)EF_ISA_DEFAULT || isa >= (int)EF_ISA_COUNT) return (int)ef_isa_choose(EF_ISA_DEFAULT);
     ef_isa best = ef_cpu_best();
-    return (ef_isa)isa < best ? (ef_isa)isa : best;
+    return (int)((ef_isa)isa < best ? (ef_isa)isa : best);
 }
 
 void kin_skin_lbs_isa(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
@@ -118,7 +117,7 @@ void kin_skin_lbs_isa(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
     if (!mesh || !pos_out) return;
     int v = 0, n = mesh->vertex_count;
     if (mesh->joints && mesh->weights && jm) {
-        switch (isa_of(isa)) {
+        switch ((ef_isa)kin__skin_isa_of(isa)) {
 #if defined(__x86_64__)
         case EF_ISA_AVX512: v = kin__skin_lbs_avx512(mesh, jm, pos_out, nrm_out, 0, n); break;
         case EF_ISA_AVX2: v = kin__skin_lbs_avx2(mesh, jm, pos_out, nrm_out, 0, n); break;

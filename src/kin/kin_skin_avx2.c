@@ -33,6 +33,10 @@
 #define SELZ(m, t) _mm256_and_ps(m, t)
 #define NEG_IF(m, x) _mm256_xor_ps(x, _mm256_and_ps(m, _mm256_set1_ps(-0.0f)))
 #define M_ALL(m) (_mm256_movemask_ps(m) == 0xFF)
+#define VMAX(a, b) _mm256_max_ps(a, b)
+#define VMIN(a, b) _mm256_min_ps(a, b)
+#define VABS(x) _mm256_and_ps(x, _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF)))
+#define VEXP2(x) _mm256_and_ps(x, _mm256_castsi256_ps(_mm256_set1_epi32(0x7F800000)))
 
 static inline unsigned nonzero4(const float *w)
 {

@@ -33,6 +33,10 @@
 #define SELZ(m, t) _mm512_maskz_mov_ps(m, t)
 #define NEG_IF(m, x) _mm512_mask_xor_ps(x, m, x, _mm512_set1_ps(-0.0f))
 #define M_ALL(m) ((m) == (__mmask16)0xFFFF)
+#define VMAX(a, b) _mm512_max_ps(a, b)
+#define VMIN(a, b) _mm512_min_ps(a, b)
+#define VABS(x) _mm512_and_ps(x, _mm512_castsi512_ps(_mm512_set1_epi32(0x7FFFFFFF)))
+#define VEXP2(x) _mm512_and_ps(x, _mm512_castsi512_ps(_mm512_set1_epi32(0x7F800000)))
 
 /* Bit i set when weight i is not 0 (NaN counts as not 0, as in the
  * reference's "w == 0: skip"). */

@@ -15,6 +15,23 @@
 
 #include "kin.h"
 
+/* DQS range rule (kin_dqs.c dq_fit, kin_skin_simd.inl dqs_fit): when
+ * |b.r|^2 is not in (KIN__DQS_SQ_MIN, KIN__DQS_SQ_MAX) (a tiny or huge
+ * weight sum: k = 2 / |b.r|^2 would overflow, or |b.r|^2 under- or
+ * overflow), b is first scaled by the power of two that brings its
+ * largest |b.r| component to [1, 2) (that component clamped to
+ * [KIN__DQS_FIT_LO, KIN__DQS_FIT_HI] first). Inside the range nothing is
+ * scaled, so those bytes are the unscaled formula's. */
+#define KIN__DQS_SQ_MIN 0x1p-100f
+#define KIN__DQS_SQ_MAX 0x1p100f
+#define KIN__DQS_FIT_LO 0x1p-126f
+#define KIN__DQS_FIT_HI 0x1p126f
+
+/* The ISA (an ef_isa value) a request of kin_skin_lbs_isa & co. runs:
+ * 0 (or out of range) = kin_skin_isa(), else the request capped by what
+ * the CPU has (never by EGOFUSE_ISA). */
+int kin__skin_isa_of(int isa);
+
 void kin__skin_lbs_ref(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
                        float *nrm_out, int v0, int v1);
 void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
@@ -50,18 +67,14 @@ typedef struct kin__plan_batch {
     float nrm[3][KIN__PLAN_W];  /* bind normals, SoA (when the plan has them) */
 } kin__plan_batch;
 
-/* Batches [b0, b1) of a plan; they do every batch (no scalar tail). */
-void kin__skin_lbs_plan_sse2(const kin__plan_batch *bt, int b0, int b1,
-                             const kin_mat4 *jm, float *pos_out, float *nrm_out);
-void kin__skin_lbs_plan_avx2(const kin__plan_batch *bt, int b0, int b1,
-                             const kin_mat4 *jm, float *pos_out, float *nrm_out);
-void kin__skin_lbs_plan_avx512(const kin__plan_batch *bt, int b0, int b1,
-                               const kin_mat4 *jm, float *pos_out, float *nrm_out);
-void kin__skin_dqs_plan_sse2(const kin__plan_batch *bt, int b0, int b1,
-                             const kin_dualquat *dq, float *pos_out, float *nrm_out);
-void kin__skin_dqs_plan_avx2(const kin__plan_batch *bt, int b0, int b1,
-                             const kin_dualquat *dq, float *pos_out, float *nrm_out);
-void kin__skin_dqs_plan_avx512(const kin__plan_batch *bt, int b0, int b1,
-                               const kin_dualquat *dq, float *pos_out, float *nrm_out);
+/* Batches [b0, b1) of a plan; they do every batch (no scalar tail). xf:
+ * the joint matrices (kin_mat4, LBS) or dual quaternions (kin_dualquat,
+ * DQS), not NULL; one function type, so kin_skin_plan.c picks them from
+ * a table. */
+typedef void kin__plan_fn(const kin__plan_batch *bt, int b0, int b1, const void *xf,
+                          float *pos_out, float *nrm_out);
+typedef kin__plan_fn *kin__plan_kernel;
+kin__plan_fn kin__skin_lbs_plan_sse2, kin__skin_lbs_plan_avx2, kin__skin_lbs_plan_avx512;
+kin__plan_fn kin__skin_dqs_plan_sse2, kin__skin_dqs_plan_avx2, kin__skin_dqs_plan_avx512;
 
 #endif

@@ -162,14 +162,6 @@ int kin_skin_plan_contiguous(const kin_skin_plan *plan)
 
 /* ------------------------------------------------------------ per frame */
 
-/* 0 = kin_skin_isa(), else the request capped by the CPU (as kin_skin.c). */
-static ef_isa plan_isa(int isa)
-{
-    if (isa <= (int)EF_ISA_DEFAULT || isa >= (int)EF_ISA_COUNT) return ef_isa_choose(EF_ISA_DEFAULT);
-    ef_isa best = ef_cpu_best();
-    return (ef_isa)isa < best ? (ef_isa)isa : best;
-}
-
 /* Lane l of batch B as a one-vertex mesh for the reference. */
 typedef struct lane_mesh {
     kin_mesh m;
@@ -205,64 +197,69 @@ static void range_of(const kin_skin_plan *plan, int part, int parts, int *b0, in
     *b1 = (int)(nb * (part + 1) / parts);
 }
 
-void kin_skin_lbs_plan_part(const kin_skin_plan *plan, const kin_mat4 *jm, float *pos_out,
-                            float *nrm_out, int part, int parts, int isa)
+/* One skinning method: its plan kernel per ISA (NULL: none, the
+ * reference per lane) and its reference on a one-vertex mesh. */
+typedef struct plan_method {
+    kin__plan_kernel simd[EF_ISA_COUNT];
+    void (*ref)(const kin_mesh *m, const void *xf, float *pos_out, float *nrm_out);
+} plan_method;
+
+static void lbs_ref(const kin_mesh *m, const void *xf, float *pos_out, float *nrm_out)
+{
+    kin__skin_lbs_ref(m, xf, pos_out, nrm_out, 0, 1);
+}
+
+static void dqs_ref(const kin_mesh *m, const void *xf, float *pos_out, float *nrm_out)
+{
+    kin__skin_dqs_ref(m, xf, pos_out, nrm_out, 0, 1);
+}
+
+#if defined(__x86_64__)
+#define PLAN_SIMD(kind)                                                                   \
+    { [EF_ISA_SSE2] = kin__skin_##kind##_plan_sse2, [EF_ISA_AVX2] = kin__skin_##kind##_plan_avx2, \
+      [EF_ISA_AVX512] = kin__skin_##kind##_plan_avx512 }
+#else
+#define PLAN_SIMD(kind) { 0 }
+#endif
+static const plan_method lbs_method = { PLAN_SIMD(lbs), lbs_ref };
+static const plan_method dqs_method = { PLAN_SIMD(dqs), dqs_ref };
+#undef PLAN_SIMD
+
+/* Part `part` of `parts` of the plan with method pm. xf NULL: the
+ * reference, which keeps the bind pose without transforms. */
+static void plan_run(const plan_method *pm, const kin_skin_plan *plan, const void *xf,
+                     float *pos_out, float *nrm_out, int part, int parts, int isa)
 {
     if (!plan || !plan->batches || !pos_out) return;
     if (!plan->normals) nrm_out = NULL;
     int b0, b1;
     range_of(plan, part, parts, &b0, &b1);
     const kin__plan_batch *bt = plan->batches;
-    static const kin_mat4 none = { { 0 } };
-    ef_isa use = plan_isa(isa);
-    if (!jm) use = EF_ISA_REF;   /* every vertex keeps its bind pose */
-    switch (use) {
-#if defined(__x86_64__)
-    case EF_ISA_AVX512: kin__skin_lbs_plan_avx512(bt, b0, b1, jm, pos_out, nrm_out); return;
-    case EF_ISA_AVX2: kin__skin_lbs_plan_avx2(bt, b0, b1, jm, pos_out, nrm_out); return;
-    case EF_ISA_SSE2: kin__skin_lbs_plan_sse2(bt, b0, b1, jm, pos_out, nrm_out); return;
-#endif
-    default: break;
+    const kin__plan_kernel k = xf ? pm->simd[kin__skin_isa_of(isa)] : NULL;
+    if (k) {
+        k(bt, b0, b1, xf, pos_out, nrm_out);
+        return;
     }
     for (int b = b0; b < b1; b++)
         for (int l = 0; l < bt[b].lanes; l++) {
             lane_mesh lm;
             float r[6];
             lane_of(&bt[b], l, nrm_out != NULL, &lm);
-            if (!jm) lm.m.weights = NULL;
-            kin__skin_lbs_ref(&lm.m, jm ? jm : &none, r, r + 3, 0, 1);
+            pm->ref(&lm.m, xf, r, r + 3);
             out_lane(r, bt[b].dest[l], pos_out, nrm_out);
         }
+}
+
+void kin_skin_lbs_plan_part(const kin_skin_plan *plan, const kin_mat4 *jm, float *pos_out,
+                            float *nrm_out, int part, int parts, int isa)
+{
+    plan_run(&lbs_method, plan, jm, pos_out, nrm_out, part, parts, isa);
 }
 
 void kin_skin_dqs_plan_part(const kin_skin_plan *plan, const kin_dualquat *dq, float *pos_out,
                             float *nrm_out, int part, int parts, int isa)
 {
-    if (!plan || !plan->batches || !pos_out) return;
-    if (!plan->normals) nrm_out = NULL;
-    int b0, b1;
-    range_of(plan, part, parts, &b0, &b1);
-    const kin__plan_batch *bt = plan->batches;
-    static const kin_dualquat none = { { 0, 0, 0, 1 }, { 0, 0, 0, 0 } };
-    ef_isa use = plan_isa(isa);
-    if (!dq) use = EF_ISA_REF;
-    switch (use) {
-#if defined(__x86_64__)
-    case EF_ISA_AVX512: kin__skin_dqs_plan_avx512(bt, b0, b1, dq, pos_out, nrm_out); return;
-    case EF_ISA_AVX2: kin__skin_dqs_plan_avx2(bt, b0, b1, dq, pos_out, nrm_out); return;
-    case EF_ISA_SSE2: kin__skin_dqs_plan_sse2(bt, b0, b1, dq, pos_out, nrm_out); return;
-#endif
-    default: break;
-    }
-    for (int b = b0; b < b1; b++)
-        for (int l = 0; l < bt[b].lanes; l++) {
-            lane_mesh lm;
-            float r[6];
-            lane_of(&bt[b], l, nrm_out != NULL, &lm);
-            if (!dq) lm.m.weights = NULL;
-            kin__skin_dqs_ref(&lm.m, dq ? dq : &none, r, r + 3, 0, 1);
-            out_lane(r, bt[b].dest[l], pos_out, nrm_out);
-        }
+    plan_run(&dqs_method, plan, dq, pos_out, nrm_out, part, parts, isa);
 }
 
 void kin_skin_lbs_plan(const kin_skin_plan *plan, const kin_mat4 *jm, float *pos_out,

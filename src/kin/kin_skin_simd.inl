@@ -12,7 +12,10 @@
  * The ISA file defines: W, V (float vector), M (lane mask), VSET1, VADD,
  * VSUB, VMUL, VDIV, VSQRT, M_NE (unordered or not equal), M_GT, M_LT
  * (ordered), M_AND, M_ALL (every lane set), SEL(m, t, f) (t where m),
- * SELZ(m, t) (t where m, else +0), NEG_IF(m, x) (sign flipped where m:
+ * SELZ(m, t) (t where m, else +0), VMAX / VMIN (maxps / minps: the
+ * second operand when either is NaN), VABS (sign bit cleared), VEXP2
+ * (only the exponent bits kept: 2^floor(log2 x) for a normal x > 0),
+ * NEG_IF(m, x) (sign flipped where m:
  * the reference's x * -1; they differ only for a NaN, whose normal is 0
  * either way), SIMD_LBS / SIMD_DQS (the
  * kernel names), the type skin_tab (per-call state of the blend, e.g. a
@@ -146,6 +149,24 @@ static inline __attribute__((always_inline)) V dqs_sq(const V q[8])
                 VMUL(q[3], q[3]));
 }
 
+/* The range rule of kin_dqs.c (dq_fit): lanes whose |q.r|^2 is outside
+ * (KIN__DQS_SQ_MIN, KIN__DQS_SQ_MAX) are scaled by 2^-E, 2^E the power of
+ * two (exponent bits, VEXP2) of their largest |q.r| component clamped to
+ * [KIN__DQS_FIT_LO, KIN__DQS_FIT_HI]; the other lanes keep their bits.
+ * Updates *sq. Branch-free per lane; a vector with every lane in range
+ * (the normal case) skips it. */
+static inline __attribute__((always_inline)) void dqs_fit(V q[8], V *sq)
+{
+    const M in = M_AND(M_GT(*sq, VSET1(KIN__DQS_SQ_MIN)), M_LT(*sq, VSET1(KIN__DQS_SQ_MAX)));
+    if (M_ALL(in)) return;
+    V m = VMAX(VMAX(VMAX(VABS(q[0]), VABS(q[1])), VABS(q[2])), VABS(q[3]));
+    m = VMIN(VMAX(m, VSET1(KIN__DQS_FIT_LO)), VSET1(KIN__DQS_FIT_HI));
+    const V s = VDIV(VSET1(1.0f), VEXP2(m));
+#pragma GCC unroll 8
+    for (int e = 0; e < 8; e++) q[e] = SEL(in, q[e], VMUL(q[e], s));
+    *sq = dqs_sq(q);
+}
+
 int SIMD_DQS(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out,
              float *nrm_out, int v0, int v1)
 {
@@ -160,6 +181,7 @@ int SIMD_DQS(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out,
         V b[8], ws, p[3], o[3];
         dqs_block(&T, mesh, dq, v, b, &ws);
         V sq = dqs_sq(b);
+        dqs_fit(b, &sq);
         M ok = M_AND(M_NE(ws, zero), M_GT(sq, zero));
         const int all = M_ALL(ok);
         V k = VDIV(two, sq);
@@ -253,9 +275,10 @@ static inline __attribute__((always_inline)) void lbs_plan_lanes(const kin__plan
     if (nrm_out) plan_store(L, B, h, nrm_out, x);
 }
 
-void SIMD_LBS_PLAN(const kin__plan_batch *bt, int b0, int b1, const kin_mat4 *jm,
+void SIMD_LBS_PLAN(const kin__plan_batch *bt, int b0, int b1, const void *xf,
                    float *pos_out, float *nrm_out)
 {
+    const kin_mat4 *jm = xf;
     lay3 L;
     lay3_init(&L);
     for (int b = b0; b < b1; b++) {
@@ -289,6 +312,7 @@ static inline __attribute__((always_inline)) void dqs_plan_lanes(
         for (int e = 0; e < 8; e++) q[e] = VADD(q[e], VMUL(w, VSET1(d[e])));
     }
     V sq = dqs_sq(q);
+    dqs_fit(q, &sq);
     M ok = M_GT(sq, zero);
     const int all = M_ALL(ok);
     V k = VDIV(VSET1(2.0f), sq);
@@ -312,9 +336,10 @@ static inline __attribute__((always_inline)) void dqs_plan_lanes(
     plan_store(L, B, h, nrm_out, o);
 }
 
-void SIMD_DQS_PLAN(const kin__plan_batch *bt, int b0, int b1, const kin_dualquat *dq,
+void SIMD_DQS_PLAN(const kin__plan_batch *bt, int b0, int b1, const void *xf,
                    float *pos_out, float *nrm_out)
 {
+    const kin_dualquat *dq = xf;
     lay3 L;
     lay3_init(&L);
     for (int b = b0; b < b1; b++) {

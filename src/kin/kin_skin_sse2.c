@@ -34,6 +34,10 @@
 #define SELZ(m, t) _mm_and_ps(m, t)
 #define NEG_IF(m, x) _mm_xor_ps(x, _mm_and_ps(m, _mm_set1_ps(-0.0f)))
 #define M_ALL(m) (_mm_movemask_ps(m) == 0xF)
+#define VMAX(a, b) _mm_max_ps(a, b)
+#define VMIN(a, b) _mm_min_ps(a, b)
+#define VABS(x) _mm_and_ps(x, _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF)))
+#define VEXP2(x) _mm_and_ps(x, _mm_castsi128_ps(_mm_set1_epi32(0x7F800000)))
 
 /* Bit i set when weight i is not 0 (NaN counts as not 0, as in the
  * reference's "w == 0: skip"). */
