@@ -634,7 +634,9 @@ static void run_grid(bench *b, const budget *bu)
     posesrc typical = {b->samples, b->seq_frames, NULL, 0};
     posesrc worst = {&b->samples[b->worst_frame], 1, &b->worst_head, 0};
     printf("\nWhole stereo frame (ms; stage columns are medians, raster and fuse summed over\n"
-           "both eyes, which run in parallel with 2 threads; headroom = 16.67 - p99):\n");
+           "both eyes, which run in parallel with 2 threads; raster = context clear + vertex\n"
+           "transforms + draw with normals, back faces culled, as bench_raster's \"pipe\" rows;\n"
+           "headroom = 16.67 - p99):\n");
     print_head();
     for (int c = 0; c < 2; c++) {
         for (int i = 0; i < 4; i++) {

@@ -5,12 +5,32 @@
  * ms per eye and for both eyes (draw only; clear and vertex transform
  * reported apart), and triangles per second. Reports, never fails.
  *
+ * Then the pipeline's configuration ("pipe" rows): the raster stage of
+ * src/pipe run_eye as it runs per eye (each eye its own 1-thread
+ * context: rast_context_clear, then per mesh rast_transform_points +
+ * rast_transform_dirs and rast_context_draw with the view-space normals as
+ * 3 attributes), cull back (bench_frame, `egofuse demo`, --cull-back) and
+ * cull none (the pipe's default), with the cache cold as in a frame (the
+ * lighting and composite stage write about 24 MB between two raster
+ * stages; --cold MB, 0 = hot): for the bench scene at each --tris count
+ * (which covers ~8% of the view) and for the sample model at 12 poses
+ * over its animation (--samples DIR, default build/samples: 15.6k
+ * triangles, ~20% of the view, about 3x the pixels and 1.7x the scanned
+ * triangles of the bench scene at 16k; --samples none skips it). Columns: ms per eye of
+ * the stage and of its parts, pixels written and triangles scanned per
+ * eye. The stage of the last pose is checked against pipe_pose_draw
+ * (same bytes). The transforms run with rast_draw_isa() (capped by
+ * EGOFUSE_ISA, not by the row's ISA), as in the pipe.
+ *
  *   bench_raster [--csv] [--runs N] [--tris N,N,...] [--size WxH]
  *                [--isa ref|sse2|avx2|avx512] [--threads 1|2]
+ *                [--samples DIR|none] [--cold MB] [--no-pipe]
  *
  * The same scene through Mesa llvmpipe, with the ratio, is
  * bench/llvmpipe/llvmpipe_raster (built separately: it needs EGL/GLES). */
 #include "../src/cpu/cpu.h"
+#include "../src/io/io.h"
+#include "../src/pipe/pipe.h"
 #include "../src/raster/raster.h"
 #include "bench_mesh.h"
 #include "bench_util.h"
@@ -40,14 +60,309 @@ static double median(double *v, int n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+
+/* ---- the pipeline's configuration ------------------------------------- */
+
+/* One posed frame of a model: meshes (positions, normals in the head's
+ * world), indices, and the two eyes' matrices. */
+typedef struct pipe_scene {
+    int meshes;
+    const int *vcount, *icount;
+    const float *const *pos, *const *nrm;
+    const uint32_t *const *idx;
+} pipe_scene;
+
+typedef struct pipe_eye {
+    rast_context *ctx;
+    rast_target tg;
+    float *clip, *vn;
+} pipe_eye;
+
+/* The raster stage of run_eye for one eye: context clear, then per mesh
+ * the two transforms and the draw. Adds the parts' times to t[3] (clear,
+ * transforms, draw) and the stats to *st. */
+static void pipe_stage(pipe_eye *e, const pipe_scene *sc, const float vp[16],
+                       const float view[16], rast_cull cull, double t[3], rast_stats *st)
+{
+    double t0 = now_ms();
+    rast_context_clear(e->ctx, &e->tg);
+    t[0] += now_ms() - t0;
+    for (int i = 0; i < sc->meshes; i++) {
+        double a = now_ms();
+        rast_transform_points(vp, sc->pos[i], sc->vcount[i], e->clip);
+        rast_transform_dirs(view, sc->nrm[i], sc->vcount[i], e->vn);
+        double b = now_ms();
+        rast_mesh_desc d = { e->clip, sc->vcount[i], e->vn, 3, sc->idx[i], sc->icount[i] / 3,
+                             cull };
+        rast_context_draw(e->ctx, &e->tg, &d, st);
+        t[1] += b - a;
+        t[2] += now_ms() - b;
+    }
+}
+
+/* Stands for the rest of a frame between two raster stages: updates mb MB
+ * with plain stores (a memset this large may use non-temporal stores,
+ * which leave the caches, and so the target planes, alone). */
+static void evict(uint8_t *junk, int mb, int r)
+{
+    if (!junk || mb <= 0)
+        return;
+    uint64_t *q = (uint64_t *)(void *)junk;
+    const size_t n = ((size_t)mb << 20) / sizeof *q;
+    for (size_t i = 0; i < n; i++)
+        q[i] += (uint64_t)(unsigned)r;
+}
+
+static const char *cull_name(rast_cull c)
+{
+    return c == RAST_CULL_BACK ? "back" : c == RAST_CULL_FRONT ? "front" : "none";
+}
+
+static void pipe_print_head(int csv)
+{
+    if (csv)
+        printf("pipe,model,tris,isa,cull,ms_stage_per_eye,ms_clear_per_eye,ms_xform_per_eye,"
+               "ms_draw_per_eye,pixels_per_eye,scanned_per_eye,cold_mb\n");
+    else
+        printf("%-6s %7s %-7s %-4s %9s %8s %8s %8s %7s %7s\n", "model", "tris", "isa", "cull",
+               "stage/eye", "clear", "xform", "draw", "px/eye", "scanned");
+}
+
+static void pipe_print_row(int csv, const char *model, int tris, int isa, rast_cull cull,
+                           double stage, double clr, double xf, double draw, long px,
+                           long scanned, int cold)
+{
+    if (csv)
+        printf("pipe,%s,%d,%s,%s,%.4f,%.4f,%.4f,%.4f,%ld,%ld,%d\n", model, tris,
+               ef_isa_name((ef_isa)isa), cull_name(cull), stage, clr, xf, draw, px, scanned,
+               cold);
+    else
+        printf("%-6s %7d %-7s %-4s %9.4f %8.4f %8.4f %8.4f %7ld %7ld\n", model, tris,
+               ef_isa_name((ef_isa)isa), cull_name(cull), stage, clr, xf, draw, px, scanned);
+    fflush(stdout);
+}
+
+/* The pipe rows of one scene: poses[p] (np of them) are the per-pose
+ * scenes, vp[p][e] / view[p][e] the eyes' matrices. Medians over runs of
+ * whole passes through the poses (ms per eye: the pass time / (2 np)). */
+static void pipe_rows(int csv, const char *model, int tris, const pipe_scene *poses, int np,
+                      float (*vp)[2][16], float (*view)[2][16], int W, int H, int runs,
+                      int only_isa, int cold, uint8_t *junk)
+{
+    int maxv = 0;
+    for (int p = 0; p < np; p++)
+        for (int i = 0; i < poses[p].meshes; i++)
+            maxv = poses[p].vcount[i] > maxv ? poses[p].vcount[i] : maxv;
+    pipe_eye eye[2];
+    float *planes[2];
+    for (int e = 0; e < 2; e++) {
+        planes[e] = malloc((size_t)W * H * 16 + (size_t)W * H);
+        eye[e].clip = malloc((size_t)maxv * 4 * sizeof(float));
+        eye[e].vn = malloc((size_t)maxv * 3 * sizeof(float));
+        if (!planes[e] || !eye[e].clip || !eye[e].vn) {
+            fprintf(stderr, "out of memory\n");
+            exit(1);
+        }
+        rast_target t = { W, H, planes[e], W, (uint8_t *)(planes[e] + (size_t)W * H * 4), W,
+                          planes[e] + (size_t)W * H, 3 * W, 3 };
+        eye[e].tg = t;
+    }
+    double *ts = malloc((size_t)runs * 4 * sizeof(double));
+    if (!ts)
+        exit(1);
+    static const rast_cull culls[2] = { RAST_CULL_BACK, RAST_CULL_NONE };
+    for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {
+        if (!ef_cpu_has((ef_isa)isa) || (only_isa && isa != only_isa))
+            continue;
+        for (int ci = 0; ci < 2; ci++) {
+            rast_context_desc d = { isa, 1 };
+            for (int e = 0; e < 2; e++)
+                if (!(eye[e].ctx = rast_context_create(&d)))
+                    exit(1);
+            long px = 0, scanned = 0;
+            for (int r = -2; r < runs; r++) {   /* 2 warm-up passes */
+                double t[3] = { 0, 0, 0 };
+                rast_stats st = { 0 };
+                for (int p = 0; p < np; p++) {
+                    evict(junk, cold, r * np + p);
+                    for (int e = 0; e < 2; e++)
+                        pipe_stage(&eye[e], &poses[p], vp[p][e], view[p][e], culls[ci], t, &st);
+                }
+                if (r >= 0) {
+                    for (int k = 0; k < 3; k++)
+                        ts[(size_t)runs * (size_t)(k + 1) + (size_t)r] = t[k] / (2.0 * np);
+                    ts[r] = (t[0] + t[1] + t[2]) / (2.0 * np);
+                }
+                px = st.pixels_written / (2 * np);
+                scanned = st.tris_drawn / (2 * np);
+            }
+            double m[4];
+            for (int k = 0; k < 4; k++)
+                m[k] = median(ts + (size_t)runs * (size_t)k, runs);
+            pipe_print_row(csv, model, tris, rast_context_isa(eye[0].ctx), culls[ci], m[0],
+                           m[1], m[2], m[3], px, scanned, cold);
+            for (int e = 0; e < 2; e++)
+                rast_context_destroy(eye[e].ctx);
+        }
+    }
+    free(ts);
+    for (int e = 0; e < 2; e++) {
+        free(planes[e]);
+        free(eye[e].clip);
+        free(eye[e].vn);
+    }
+}
+
+/* The sample model (DIR/scene.txt) posed at np times evenly over its
+ * animation, both eyes of the STHMD cameras at the crop resolution, as
+ * pipe_frame draws them. Returns 0 (and prints why) when it cannot. */
+static int pipe_samples(int csv, const char *dir, int np, int runs, int only_isa, int cold,
+                        uint8_t *junk)
+{
+    char path[IO_PATH_MAX + 64];
+    io_scene sc;
+    io_error err;
+    kin_model model;
+    snprintf(path, sizeof path, "%s/scene.txt", dir);
+    if (io_scene_load(path, &sc, &err) != IO_OK) {
+        printf("%ssample model: skipped (%s; build/gen_samples --out %s)\n", csv ? "# " : "",
+               err.msg, dir);
+        return 0;
+    }
+    io_scene_frame_path(&sc, sc.model, 0, path, sizeof path);
+    if (io_gltf_load(path, &model, &err) != IO_OK) {
+        printf("%ssample model: skipped (%s)\n", csv ? "# " : "", err.msg);
+        return 0;
+    }
+    const kin_animation *anim = NULL;
+    for (int i = 0; i < model.anim_count; i++)
+        if (!sc.animation[0] || !strcmp(model.anims[i].name, sc.animation)) {
+            anim = &model.anims[i];
+            break;
+        }
+    const int head = kin_model_find_node(&model, sc.head_node[0] ? sc.head_node : "head");
+    pipe_pose ps;
+    if (head < 0 || pipe_pose_init(&ps, &model) != 0) {
+        printf("%ssample model: skipped (no head node '%s')\n", csv ? "# " : "", sc.head_node);
+        kin_model_free(&model);
+        return 0;
+    }
+    const kin_sthmd_desc hmd = kin_sthmd_desc_resolved(NULL);
+    const kin_sthmd_geometry geo = kin_sthmd_geometry_of(&hmd);
+    const int W = geo.crop_width, H = geo.crop_height, nm = model.mesh_count;
+    /* Every pose's skinned meshes, copied (pipe_pose holds one pose). */
+    pipe_scene *poses = calloc((size_t)np, sizeof *poses);
+    float(*vp)[2][16] = malloc((size_t)np * sizeof *vp);
+    float(*view)[2][16] = malloc((size_t)np * sizeof *view);
+    int *vcount = malloc((size_t)nm * sizeof(int)), *icount = malloc((size_t)nm * sizeof(int));
+    const uint32_t **idx = malloc((size_t)nm * sizeof *idx);
+    float **pos = malloc((size_t)np * nm * sizeof *pos);
+    float **nrm = malloc((size_t)np * nm * sizeof *nrm);
+    if (!poses || !vp || !view || !vcount || !icount || !idx || !pos || !nrm)
+        exit(1);
+    long tris = 0;
+    for (int i = 0; i < nm; i++) {
+        vcount[i] = ps.meshes[i].vertex_count;
+        icount[i] = ps.meshes[i].index_count;
+        idx[i] = ps.meshes[i].indices;
+        tris += icount[i] / 3;
+    }
+    for (int p = 0; p < np; p++) {
+        const float tp = anim ? anim->duration * (float)p / (float)np : 0.0f;
+        pipe_pose_anim(&ps, anim, tp);
+        for (int i = 0; i < nm; i++) {
+            const size_t n = (size_t)vcount[i] * 3;
+            pos[(size_t)p * nm + i] = malloc(n * sizeof(float));
+            nrm[(size_t)p * nm + i] = malloc(n * sizeof(float));
+            if (!pos[(size_t)p * nm + i] || !nrm[(size_t)p * nm + i])
+                exit(1);
+            memcpy(pos[(size_t)p * nm + i], ps.pos[i], n * sizeof(float));
+            memcpy(nrm[(size_t)p * nm + i], ps.nrm[i], n * sizeof(float));
+        }
+        for (int e = 0; e < 2; e++) {
+            const kin_camera cam = kin_sthmd_camera(&hmd, &ps.world[head], (kin_eye)e);
+            memcpy(vp[p][e], cam.view_proj.m, sizeof vp[p][e]);
+            memcpy(view[p][e], cam.view.m, sizeof view[p][e]);
+        }
+        pipe_scene s = { nm, vcount, icount, (const float *const *)(pos + (size_t)p * nm),
+                         (const float *const *)(nrm + (size_t)p * nm), idx };
+        poses[p] = s;
+    }
+    /* The stage here equals the pipe's: the last pose through
+     * pipe_pose_draw and through pipe_stage, both cull modes. */
+    int same = 1;
+    {
+        rast_context *c = rast_context_create(NULL);
+        size_t plane = (size_t)W * H * 17;
+        uint8_t *a = malloc(plane), *b = malloc(plane);
+        float *clip = malloc((size_t)ps.max_vertices * 4 * sizeof(float));
+        float *vn = malloc((size_t)ps.max_vertices * 3 * sizeof(float));
+        if (!c || !a || !b || !clip || !vn)
+            exit(1);
+        for (int ci = 0; ci < 2; ci++) {
+            const rast_cull cull = ci ? RAST_CULL_NONE : RAST_CULL_BACK;
+            for (int k = 0; k < 2; k++) {
+                uint8_t *m = k ? b : a;
+                rast_target t = { W, H, (float *)(void *)m, W, m + (size_t)W * H * 16, W,
+                                  (float *)(void *)(m + (size_t)W * H * 4), 3 * W, 3 };
+                if (k == 0) {
+                    kin_camera cam = kin_sthmd_camera(&hmd, &ps.world[head], KIN_EYE_LEFT);
+                    rast_target_clear(&t);
+                    pipe_pose_draw(&ps, c, &cam, &t, cull, clip, vn, NULL);
+                } else {
+                    pipe_eye e = { c, t, clip, vn };
+                    double tt[3] = { 0, 0, 0 };
+                    rast_target_clear(&t);
+                    rast_context_forget(c);
+                    pipe_stage(&e, &poses[np - 1], vp[np - 1][0], view[np - 1][0], cull, tt,
+                               NULL);
+                }
+            }
+            same &= memcmp(a, b, plane) == 0;
+        }
+        rast_context_destroy(c);
+        free(a);
+        free(b);
+        free(clip);
+        free(vn);
+    }
+    printf("%ssample model %s: %ld triangles in %d mesh%s, %d poses over '%s', %dx%d per eye; "
+           "stage equal to pipe_pose_draw: %s\n",
+           csv ? "# " : "", path, tris, nm, nm == 1 ? "" : "es", np, anim ? anim->name : "rest",
+           W, H, same ? "yes" : "NO");
+    pipe_rows(csv, "sample", (int)tris, poses, np, vp, view, W, H, runs, only_isa, cold, junk);
+    for (int i = 0; i < np * nm; i++) {
+        free(pos[i]);
+        free(nrm[i]);
+    }
+    free(pos);
+    free(nrm);
+    free(idx);
+    free(vcount);
+    free(icount);
+    free(vp);
+    free(view);
+    free(poses);
+    pipe_pose_free(&ps);
+    kin_model_free(&model);
+    return 1;
+}
+
 int main(int argc, char **argv)
 {
     int csv = 0, runs = 301, W = 640, H = 400;
     int tris_list[8] = { 2000, 10000, 40000 }, ntl = 3;
-    int only_isa = 0, only_threads = 0;
+    int only_isa = 0, only_threads = 0, pipe = 1, cold = 24;
+    const char *samples = "build/samples";
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--csv"))
             csv = 1;
+        else if (!strcmp(argv[i], "--no-pipe"))
+            pipe = 0;
+        else if (!strcmp(argv[i], "--samples") && i + 1 < argc)
+            samples = argv[++i];
+        else if (!strcmp(argv[i], "--cold") && i + 1 < argc)
+            cold = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--runs") && i + 1 < argc)
             runs = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--isa") && i + 1 < argc)
@@ -62,12 +377,14 @@ int main(int argc, char **argv)
                 tris_list[ntl++] = atoi(s);
         } else {
             fprintf(stderr, "usage: %s [--csv] [--runs N] [--tris N,N,...] [--size WxH] "
-                            "[--isa NAME] [--threads N]\n",
+                            "[--isa NAME] [--threads N] [--samples DIR|none] [--cold MB] "
+                            "[--no-pipe]\n",
                     argv[0]);
             return 2;
         }
     }
-    if (runs < 1 || W < 1 || H < 1 || W > RAST_MAX_DIM || H > RAST_MAX_DIM) {
+    if (runs < 1 || W < 1 || H < 1 || W > RAST_MAX_DIM || H > RAST_MAX_DIM || cold < 0 ||
+        cold > 1024) {
         fprintf(stderr, "bad --runs or --size\n");
         return 2;
     }
@@ -206,5 +523,37 @@ int main(int argc, char **argv)
     free(t_clear);
     free(t_xf);
     free(t_cclear);
+    if (!pipe || only_threads > 1)
+        return 0;
+
+    /* The pipeline's configuration (see the top of the file). */
+    uint8_t *junk = cold > 0 ? calloc((size_t)cold << 20, 1) : NULL;
+    printf("\n%spipeline configuration: the raster stage of run_eye per eye (1-thread "
+           "context per eye, context clear + transforms + draw, normals as 3 attributes), "
+           "%d MB written between stages (--cold), medians of up to 31 passes (bench scene) "
+           "and 9 passes over 12 poses (sample model), ms per eye\n",
+           p, junk ? cold : 0);
+    pipe_print_head(csv);
+    for (int ti = 0; ti < ntl; ti++) {
+        bm_mesh mesh;
+        if (!bm_arms(&mesh, tris_list[ti]))
+            return 1;
+        float vp[1][2][16], view[1][2][16];
+        for (int e = 0; e < 2; e++) {
+            bm_eye_mvp(e, W, H, vp[0][e]);
+            for (int k = 0; k < 16; k++)
+                view[0][e][k] = k % 5 == 0 ? 1.0f : 0.0f;
+        }
+        const int vc = mesh.vertex_count, ic = 3 * mesh.tri_count;
+        const float *pp = mesh.pos, *np = mesh.nrm;
+        const uint32_t *ip = mesh.idx;
+        pipe_scene sc = { 1, &vc, &ic, &pp, &np, &ip };
+        pipe_rows(csv, "bench", mesh.tri_count, &sc, 1, vp, view, W, H, runs < 31 ? runs : 31,
+                  only_isa, junk ? cold : 0, junk);
+        bm_free(&mesh);
+    }
+    if (strcmp(samples, "none") != 0)
+        pipe_samples(csv, samples, 12, runs < 9 ? runs : 9, only_isa, junk ? cold : 0, junk);
+    free(junk);
     return 0;
 }

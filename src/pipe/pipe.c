@@ -286,8 +286,8 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                  e->eye ? "right" : "left", rast_result_str(rr));
         return;
     }
-    long covered = 0;
-    for (int i = 0; i < cw * ch; i++) covered += e->mask[i] != 0;
+    /* Only the tiles the draws marked are read (the rest is clear). */
+    const long covered = rast_context_count(e->rast, &tg);
     e->coverage = (double)covered / (double)(cw * ch);
 
     /* Lights from world space into this camera's view space. */

@@ -205,6 +205,14 @@ rast_result rast_context_draw_jobs(rast_context *ctx, int n,
 void rast_context_clear(rast_context *ctx, const rast_target *t);
 /* Forgets every target: the next rast_context_clear clears whole. */
 void rast_context_forget(rast_context *ctx);
+/* The number of nonzero bytes of t's mask (the first width bytes of each
+ * row). For a target the context knows (rast_context_clear above), only
+ * the tiles its draws marked since that clear are read: the rest is clear
+ * under the same condition (nothing else wrote the planes). Otherwise, or
+ * with ctx NULL, every row. 16 bytes per SSE2 step. 0 for a target
+ * without a mask, with a size out of range or a mask stride below the
+ * width. */
+long rast_context_count(rast_context *ctx, const rast_target *t);
 
 /* ---- anti-aliased coverage ---------------------------------------------
  *
@@ -250,7 +258,10 @@ rast_result rast_context_draw_aa(rast_context *ctx, const rast_aa_target *t,
 rast_result rast_aa_resolve(const rast_aa_target *t, uint8_t *mask, int mask_stride);
 
 /* clip[i] = mvp * (pos[i], 1) for n points (pos: 3 floats each, mvp a
- * column-major 4x4 matrix). */
+ * column-major 4x4 matrix), each row as ((m0*x + m4*y) + m8*z) + m12.
+ * Both transforms run 16 vertices per step with AVX-512 when
+ * rast_draw_isa() allows it (EGOFUSE_ISA caps it; a context's cap does
+ * not apply), with the same bytes as the scalar code on every ISA. */
 void rast_transform_points(const float mvp[16], const float *pos, int n,
                            float *clip);
 /* out[i] = normalize(m3x3 * v[i]) where m3x3 is the upper 3x3 of the

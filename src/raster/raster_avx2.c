@@ -128,7 +128,7 @@ static inline void attr3_store_m(float *p, unsigned bits, __m256 a, __m256 b, __
         _mm_maskstore_ps(p + 20, bits_vec4(hi >> 8), _mm256_extractf128_ps(r[2], 1));
     }
 }
-#define ATTR3_STORE_M(p, bits, a, b, c) attr3_store_m(p, bits, a, b, c)
+#define ATTR3_STORE_M(p, bits, lanes, a, b, c) attr3_store_m(p, bits, a, b, c)
 #define ATTR3_STORE_FULL(p, a, b, c) attr3_store(p, a, b, c)
 
 #include "raster_simd.inl"

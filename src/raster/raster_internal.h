@@ -388,6 +388,14 @@ long rast__scan_rows_avx2(const rast_target *t, const rast__tri *tri, int ya,
                           int yb);
 long rast__scan_rows_avx512(const rast_target *t, const rast__tri *tri,
                             int ya, int yb);
+/* The vertex transforms of raster.h: the scalar reference (raster_ref.c)
+ * and the AVX-512 version (raster_avx512.c, same bytes; call only when the
+ * CPU runs AVX-512). rast_transform_points / _dirs use the AVX-512 one when
+ * rast_draw_isa() allows it. */
+void rast__transform_points_ref(const float mvp[16], const float *pos, int n, float *clip);
+void rast__transform_dirs_ref(const float m[16], const float *v, int n, float *out);
+void rast__transform_points_avx512(const float mvp[16], const float *pos, int n, float *clip);
+void rast__transform_dirs_avx512(const float m[16], const float *v, int n, float *out);
 /* The row scan for an ISA (an ef_isa value); the reference for
  * EF_ISA_REF, for an ISA not compiled in, and for unknown values. */
 rast__scan_rows_fn rast__scan_for_isa(int isa);

@@ -27,8 +27,11 @@
  * Optional:
  *   ATTR3_STORE_FULL(p, a0, a1, a2)  interleave three attribute vectors of
  *                          SIMD_V pixels into p[3*SIMD_V] (all lanes).
- *   ATTR3_STORE_M(p, bits, a0, a1, a2)  the same for the pixels in bits
- *                          only (no other float is accessed).
+ *   ATTR3_STORE_M(p, bits, lanes, a0, a1, a2)  the same for the pixels in
+ *                          bits only (no other float is accessed); bits lie
+ *                          in the first `lanes` lanes (the box width of a
+ *                          one-vector row, the lanes left in a wider one),
+ *                          so the outputs needed are known per triangle.
  *
  * COVERAGE. The reference tests E >= 0 with int64 E stepped by multiples of
  * 256 (e_dx = -dy*256, e_dy = dx*256). Since floor((E + 256k)/256) =
@@ -72,12 +75,13 @@ static inline int64_t simd_abs64(int64_t a)
 }
 
 /* The attributes of the lanes in pass, written interleaved to dst. */
-static inline void simd_attr_store(float *dst, int na, unsigned pass, vf b1, vf b2,
-                                   const vf *av0, const vf *av1, const vf *av2)
+static inline void simd_attr_store(float *dst, int na, unsigned pass, int lanes, vf b1,
+                                   vf b2, const vf *av0, const vf *av1, const vf *av2)
 {
+    (void)lanes;
 #ifdef ATTR3_STORE_M
     if (na == 3) {
-        ATTR3_STORE_M(dst, pass,
+        ATTR3_STORE_M(dst, pass, lanes,
             VF_ADD(VF_ADD(av0[0], VF_MUL(b1, av1[0])), VF_MUL(b2, av2[0])),
             VF_ADD(VF_ADD(av0[1], VF_MUL(b1, av1[1])), VF_MUL(b2, av2[1])),
             VF_ADD(VF_ADD(av0[2], VF_MUL(b1, av1[2])), VF_MUL(b2, av2[2])));
@@ -225,7 +229,7 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
             const vf r = VF_DIV(one, VF_ADD(VF_SET1(qr), VF_MUL(VF_SET1(tri->q.dx), fi)));
             const vf b1 = VF_MUL(VF_ADD(VF_SET1(b1r), VF_MUL(VF_SET1(tri->b1.dx), fi)), r);
             const vf b2 = VF_MUL(VF_ADD(VF_SET1(b2r), VF_MUL(VF_SET1(tri->b2.dx), fi)), r);
-            simd_attr_store(arow, na, pass, b1, b2, av0, av1, av2);
+            simd_attr_store(arow, na, pass, nx, b1, b2, av0, av1, av2);
         }
         return written;
     }
@@ -304,7 +308,7 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
                 continue;
             }
 #endif
-            simd_attr_store(dst, na, pass, b1, b2, av0, av1, av2);
+            simd_attr_store(dst, na, pass, rem, b1, b2, av0, av1, av2);
         }
         rb[0] += sy[0];
         rb[1] += sy[1];
