@@ -40,7 +40,8 @@ static const char *eval_usage =
     "hands, latest sample), kin-cal-pred (user calibration estimated from a\n"
     "calibration motion, One Euro filter and prediction to the camera frame's\n"
     "time), skin (YCbCr skin-colour key), refine (kin-cal-pred with the elbows\n"
-    "fitted to the images, refined by colour in a band around its edge).\n"
+    "fitted to the images and the limbs thinned to them, refined by colour in a\n"
+    "band around its edge).\n"
     "\n"
     "  --sequence NAME  reach_grasp (default), cross (hands crossing), near\n"
     "                   (hands 15 cm from the eyes), edge (hands at the image\n"
@@ -109,6 +110,8 @@ typedef struct method_run {
     int have_prev;
     float swivel[2];         /* elbow fit of the last frame, radians */
     pipe_fit *fit;           /* refine: the elbow fit and colour models */
+    float thick[2][2];       /* refine: limb thickness measured by the fit */
+    int have_thick;
     /* sums over frames and eyes */
     double iou, bf1, bf3, fp, fn, mse, flicker, flicker_den, secs;
     long n_eye, n_flicker, n_frames;
@@ -538,6 +541,9 @@ static int fit_elbows(eval_ctx *c, method_run *r, const kin_model *m, uint32_t v
     for (int e = 0; e < 2; e++) {
         cam[e] = eye_camera(c, e);
         P[e] = (fuse_image){ c->P[e], CW, CH, 4 * CW };
+        /* the colour model learned after the last frame's refinement
+         * (run_frame); only without one is the kinematic mask drawn here */
+        if (pipe_fit_learned(r->fit, e)) continue;
         const uint8_t *m0;
         const float *nrm;
         if (draw_mask(c, &r->cfg, me, 1, &cam[e], &m0, &nrm) < 0) return -1;
@@ -588,8 +594,10 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         posed = kin_arm_rig_pose(&c->rig, m, cp, NULL, &s, r->locals, NULL);
         if (posed) pose_skin(c, cfg, m, r->locals);
         if (posed && cfg->kind == M_REFINE && cfg->fit) {
+            pipe_fit_shape(r->fit, c->world, c->pos);
             if (fit_elbows(c, r, m, s.valid) < 0) return -1;
             pose_skin(c, cfg, m, r->locals);
+            pipe_fit_shape(r->fit, c->world, c->pos);
         }
     }
     double secs = cli_now() - t0;
@@ -617,6 +625,14 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                         : fuse_refine_mask(&rp, &P, mask, CW, c->refined, CW, c->refine_scratch,
                                            c->refine_scratch_size, NULL);
                 if (fr != FUSE_OK) return -1;
+                if (cfg->fit && posed) {
+                    /* the next frame's fit: the colour model from this
+                     * frame's kinematic and refined masks (no extra
+                     * raster), and the limb widths (self-calibration) */
+                    if (pipe_fit_learn(r->fit, e, &P, mask, CW, c->refined, CW) != FUSE_OK)
+                        return -1;
+                    pipe_fit_measure(r->fit, e, &cam, c->world, mask, CW, c->refined, CW);
+                }
                 mask = c->refined;
             }
         }
@@ -647,12 +663,16 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         r->fn += (double)cf.fn;
         r->mse += mse;
         r->n_eye++;
-        if (per_frame)
+        if (per_frame) {
+            float th[2][2] = { { 1, 1 }, { 1, 1 } };
+            if (r->fit) pipe_fit_thickness(r->fit, th, NULL);
             printf("%4d %-5s %-14s %-22s iou %.4f bf1 %.3f bf3 %.3f fp %6ld fn %6ld psnr %5.2f"
-                   " swivel %+.0f %+.0f deg\n",
+                   " swivel %+.0f %+.0f deg thick %.3f %.3f %.3f %.3f\n",
                    frame, e ? "right" : "left", kind_name[cfg->kind], cfg->setting, iou, bf1,
                    bf3, cf.fp, cf.fn, fuse_psnr_of_mse(mse), (double)(r->swivel[0] / DEG2RAD),
-                   (double)(r->swivel[1] / DEG2RAD));
+                   (double)(r->swivel[1] / DEG2RAD), (double)th[0][0], (double)th[0][1],
+                   (double)th[1][0], (double)th[1][1]);
+        }
         if (dump && dump_masks(dump, cfg, frame, e, mask, c->sil[e], c->P[e], c->vrgb))
             return -1;
         if (r->have_prev && c->have_sil_prev) {
@@ -671,6 +691,10 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
     r->have_prev = 1;
     r->secs += secs;
     r->n_frames++;
+    if (r->fit && cfg->fit) {
+        pipe_fit_thickness(r->fit, r->thick, NULL);
+        r->have_thick = 1;
+    }
     return 0;
 }
 
@@ -860,6 +884,21 @@ static int write_csv(const char *path, const method_run *R, int n)
     return EXIT_OK;
 }
 
+/* The limb thickness the first refine run with the elbow fit measured
+ * from the images (pipe_fit_measure), against the truth's. */
+static void print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int n)
+{
+    for (int i = 0; i < n; i++) {
+        if (R[i].cfg.kind != M_REFINE || !R[i].have_thick) continue;
+        fprintf(f, "refine's limb thickness from the images (pipe_fit, only thinner is "
+                   "measured): forearm x%.3f x%.3f (true %.2f), upper arm x%.3f x%.3f "
+                   "(true %.2f)\n",
+                (double)R[i].thick[0][1], (double)R[i].thick[1][1], (double)c->op.fore_thick,
+                (double)R[i].thick[0][0], (double)R[i].thick[1][0], (double)c->op.upper_thick);
+        return;
+    }
+}
+
 static void print_table(FILE *f, const method_run *R, int n, int markdown)
 {
     if (markdown)
@@ -980,6 +1019,7 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
             (double)o->calib_error, (double)o->speed, o->seed, o->frames, o->sweep_frames,
             o->seq_frames);
     print_calib(f, c);
+    print_thickness(f, c, R, n);
     fprintf(f, "\n");
     print_table(f, R, n, 1);
     fclose(f);
@@ -1132,6 +1172,7 @@ static int eval_run(const eval_opts *o)
                    (double)o->dropout, (double)o->calib_error, (double)o->speed);
             if (b == 0) print_calib(stdout, &c);
             print_table(stdout, R + n, m, 0);
+            print_thickness(stdout, &c, R + n, m);
         }
         n += m;
     }
