@@ -189,7 +189,21 @@ typedef struct imgset {
     int n, w, h;
     uint8_t *virt[MAX_WINDOW][2];
     float *depth[MAX_WINDOW][2];
+    int opaque;               /* every image has alpha 255 everywhere:
+                                 pipe_frame_in.virt_opaque is set */
 } imgset;
+
+/* 1 when every virtual image of the set is opaque (pipe_image_opaque
+ * over the whole image, so over any viewport). */
+static int imgset_opaque(const imgset *is)
+{
+    for (int f = 0; f < is->n; f++)
+        for (int e = 0; e < 2; e++) {
+            fuse_image im = {is->virt[f][e], is->w, is->h, 4 * is->w};
+            if (!pipe_image_opaque(&im, 0, 0, is->w, is->h)) return 0;
+        }
+    return 1;
+}
 
 /* Where the pose of frame i comes from. */
 typedef struct posesrc {
@@ -386,6 +400,7 @@ static int preload(bench *b, const char *samples_dir, int window)
             }
         }
     }
+    b->base.opaque = imgset_opaque(&b->base);
     for (int e = 0; e < 2; e++) b->cam_rgba[e] = xmalloc((size_t)cw * ch * 4);
     b->out_bytes = (size_t)2560 * 1600 * 4;
     for (int e = 0; e < 2; e++) {
@@ -440,6 +455,7 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
         in.virt_depth[e] = is->depth[w][e];
         in.virt_depth_stride[e] = is->w;
     }
+    in.virt_opaque = is->opaque;
     in.lighting = b->lighting;
     pipe_frame_stats st;
     char why[256];
@@ -1030,6 +1046,7 @@ static void imgset_resized(const bench *b, imgset *o, int w, int h, int frames)
                 }
             }
         }
+    o->opaque = imgset_opaque(o);
 }
 
 static void imgset_free(imgset *o)
@@ -1159,6 +1176,10 @@ int main(int argc, char **argv)
            samples, b.seq_frames, b.fps, b.model.node_count, tris, b.window,
            b.window * 2 * (b.yuyv_size + (size_t)b.base.w * b.base.h * 8) / 1e6,
            (now_ms() - t_load) / 1e3);
+    printf("virtual images: %s\n",
+           b.base.opaque ? "opaque (alpha 255 everywhere, checked at load): pipe_frame_in.virt_opaque "
+                           "= 1, the composite copies V where the hand is not without reading alpha"
+                         : "not opaque: pipe_frame_in.virt_opaque = 0");
     printf("frames per case: up to %d for the best ISA (%s), %d for the other SIMD paths, %d for "
            "the scalar reference,\n%d per scaling point, each case also stopped after %.1f / %.1f / "
            "%.1f / %.1f s (at least 100 frames); poses cycle through the %d-frame sequence, images "

@@ -4,8 +4,9 @@
  * independence, the mask refinement (pipe_desc.refine_band: the same
  * bytes as fuse_refine_mask by hand, and it follows the camera's arm
  * colour beyond the model's edge), the elbow fit in pipe_frame
- * (pipe_desc.fit_rig: arms turned in the camera images are found), and
- * bad inputs. */
+ * (pipe_desc.fit_rig: arms turned in the camera images are found),
+ * pipe_frame_in.virt_opaque (same bytes on opaque virtual images; the
+ * flag reaches the composite) and pipe_image_opaque, and bad inputs. */
 #include "support/testutil.h"
 
 #include <cmocka.h>
@@ -226,6 +227,127 @@ static void threads_same_bytes(void **state)
     }
     assert_int_equal(crc[0], crc[1]);
     kin_model_free(&m);
+}
+
+/* Alpha of the viewport (43, 27, 1194, 746) of an eye's virtual image
+ * set to a (the rest stays random). */
+static void viewport_alpha(uint8_t *virt, uint8_t a)
+{
+    for (int y = 27; y < 27 + 746; y++)
+        for (int x = 43; x < 43 + 1194; x++) virt[((size_t)y * 1280 + (size_t)x) * 4 + 3] = a;
+}
+
+/* pipe_frame_in.virt_opaque: on virtual images opaque in the viewport
+ * (random outside it) the same bytes as without the promise, out of
+ * place and in place, with 1 and 2 threads. In place with a broken
+ * promise (alpha 7 in the viewport) the rgb is still that of no promise,
+ * and a viewport corner far from the hand keeps alpha 7: the composite
+ * did not touch it, so the flag reached it (without: alpha 255). */
+static void virt_opaque_same_bytes(void **state)
+{
+    (void)state;
+    kin_model m;
+    quad_model(&m, 0.1f, -0.4f);
+    const size_t n = 1280 * 800 * 4;
+    for (int th = 1; th <= 2; th++) {
+        pipe_desc d = {0};
+        d.threads = th;
+        pipe_ctx *p = pipe_create(&d, &m);
+        assert_non_null(p);
+        kin_sthmd_geometry g = pipe_geometry(p);
+        assert_int_equal(g.vp_x0, 43);
+        assert_int_equal(g.vp_width, 1194);
+        frame_bufs b;
+        pipe_frame_in in;
+        make_frame(&b, &in, 300 + (uint64_t)th);
+        for (int e = 0; e < 2; e++) {
+            viewport_alpha(b.virt[e], 255);
+            assert_true(pipe_image_opaque(&in.virt[e], g.vp_x0, g.vp_y0, g.vp_width, g.vp_height));
+            assert_false(pipe_image_opaque(&in.virt[e], 0, 0, 1280, 800));
+        }
+        /* out of place */
+        uint8_t *ref[2], *ip[2][2];
+        assert_int_equal(pipe_frame(p, &in, NULL, NULL, 0), PIPE_OK);
+        for (int e = 0; e < 2; e++) {
+            ref[e] = malloc(n);
+            assert_non_null(ref[e]);
+            memcpy(ref[e], b.out[e], n);
+            memset(b.out[e], 0xAB, n);
+        }
+        in.virt_opaque = 1;
+        assert_int_equal(pipe_frame(p, &in, NULL, NULL, 0), PIPE_OK);
+        for (int e = 0; e < 2; e++) assert_memory_equal(ref[e], b.out[e], n);
+        /* in place: [0] without the promise, [1] with it */
+        for (int k = 0; k < 2; k++) {
+            pipe_frame_in ii = in;
+            ii.virt_opaque = k;
+            for (int e = 0; e < 2; e++) {
+                ip[k][e] = malloc(n);
+                assert_non_null(ip[k][e]);
+                memcpy(ip[k][e], b.virt[e], n);
+                ii.virt[e].pixels = ip[k][e];
+                ii.out[e] = ii.virt[e];
+            }
+            assert_int_equal(pipe_frame(p, &ii, NULL, NULL, 0), PIPE_OK);
+        }
+        for (int e = 0; e < 2; e++) {
+            assert_memory_equal(ip[0][e], ip[1][e], n);
+            assert_memory_equal(ip[0][e], ref[e], n);
+        }
+        /* in place, promise broken */
+        for (int k = 0; k < 2; k++) {
+            pipe_frame_in ii = in;
+            ii.virt_opaque = k;
+            for (int e = 0; e < 2; e++) {
+                memcpy(ip[k][e], b.virt[e], n);
+                viewport_alpha(ip[k][e], 7);
+                ii.virt[e].pixels = ip[k][e];
+                ii.out[e] = ii.virt[e];
+            }
+            assert_int_equal(pipe_frame(p, &ii, NULL, NULL, 0), PIPE_OK);
+        }
+        for (int e = 0; e < 2; e++) {
+            for (size_t i = 0; i < n; i++)
+                if ((i & 3) != 3 && ip[0][e][i] != ip[1][e][i])
+                    fail_msg("eye %d byte %zu: rgb %d, expected %d", e, i, ip[1][e][i], ip[0][e][i]);
+            const size_t corner = ((size_t)27 * 1280 + 43) * 4 + 3;
+            assert_int_equal(ip[0][e][corner], 255);
+            assert_int_equal(ip[1][e][corner], 7);
+            free(ip[0][e]);
+            free(ip[1][e]);
+            free(ref[e]);
+        }
+        free_frame(&b);
+        pipe_destroy(p);
+    }
+    kin_model_free(&m);
+}
+
+/* pipe_image_opaque: alpha 255 over the rectangle, not elsewhere; empty,
+ * outside or NULL: 0. */
+static void image_opaque(void **state)
+{
+    (void)state;
+    enum { w = 37, h = 11, stride = 4 * w + 12 };
+    uint8_t px[stride * h];
+    tu_rng r = {5};
+    fill_random(px, sizeof px, &r);
+    for (int y = 2; y < 9; y++)
+        for (int x = 3; x < 30; x++) px[y * stride + 4 * x + 3] = 255;
+    fuse_image im = {px, w, h, stride};
+    assert_true(pipe_image_opaque(&im, 3, 2, 27, 7));
+    assert_true(pipe_image_opaque(&im, 29, 8, 1, 1));
+    assert_false(pipe_image_opaque(&im, 2, 2, 28, 7));   /* a column more */
+    assert_false(pipe_image_opaque(&im, 3, 2, 27, 8));   /* a row more */
+    px[5 * stride + 4 * 17 + 3] = 254;
+    assert_false(pipe_image_opaque(&im, 3, 2, 27, 7));
+    assert_true(pipe_image_opaque(&im, 18, 2, 12, 7));
+    assert_false(pipe_image_opaque(&im, 0, 0, 0, 1));
+    assert_false(pipe_image_opaque(&im, 30, 0, 8, 1));   /* past the right edge */
+    assert_false(pipe_image_opaque(&im, -1, 2, 5, 5));
+    assert_false(pipe_image_opaque(NULL, 3, 2, 1, 1));
+    fuse_image none = {NULL, w, h, stride};
+    assert_false(pipe_image_opaque(&none, 3, 2, 1, 1));
 }
 
 /* A virtual wall nearer than the hand hides it everywhere (out == V); a
@@ -709,6 +831,8 @@ int main(void)
         cmocka_unit_test(bad_inputs),
         cmocka_unit_test(refine_band_mask),
         cmocka_unit_test(fit_in_pipe_frame),
+        cmocka_unit_test(virt_opaque_same_bytes),
+        cmocka_unit_test(image_opaque),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -275,7 +275,15 @@ static int render(const render_opts *o)
     pipe_ctx *pp = pipe_create(&pd, &model);
     kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
     io_image cam[2] = {{0}}, virt[2] = {{0}}, vdepth[2] = {{0}}, rgb = {0};
-    if (!pp || io_image_alloc(&rgb, hd.lcd_width, hd.lcd_height, 3, IO_U8, &err) != IO_OK) {
+    if (!pp) {
+        if (pd.fit_rig)
+            cli_fail("cannot start the pipeline: out of memory, no thread, or the elbow fit "
+                     "cannot use %s (mesh 0's skin, the arms' node chains)", model_path);
+        else
+            cli_fail("cannot start the pipeline: out of memory or no thread");
+        goto done;
+    }
+    if (io_image_alloc(&rgb, hd.lcd_width, hd.lcd_height, 3, IO_U8, &err) != IO_OK) {
         cli_fail("out of memory");
         goto done;
     }
@@ -284,6 +292,7 @@ static int render(const render_opts *o)
         goto done;
     }
 
+    const kin_sthmd_geometry geo = pipe_geometry(pp);
     pipe_frame_in in = {0};
     in.anim = anim;
     in.head_node = head;
@@ -318,6 +327,13 @@ static int render(const render_opts *o)
             in.virt[e] = as_fuse(&virt[e]);
             in.out[e] = in.virt[e]; /* composite in place */
         }
+        /* Opaque virtual images (checked once per frame; decoding the PNGs
+         * costs far more): the in-place composite then leaves V alone
+         * where the hand is not. Same bytes either way. */
+        in.virt_opaque = pipe_image_opaque(&in.virt[0], geo.vp_x0, geo.vp_y0, geo.vp_width,
+                                           geo.vp_height) &&
+                         pipe_image_opaque(&in.virt[1], geo.vp_x0, geo.vp_y0, geo.vp_width,
+                                           geo.vp_height);
         in.time = (float)f / sc.fps;
         if (o->pose_tracking) {
             track_pose_at(&tp, o, &model, (double)f / (double)sc.fps);

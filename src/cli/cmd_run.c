@@ -206,7 +206,14 @@ static int run(const run_opts *o)
         if (vpath) {
             if (load_virt(vpath, W, H, &virt[e])) goto done;
         } else if (io_image_alloc(&virt[e], W, H, 4, IO_U8, &err) == IO_OK) {
-            memset(virt[e].data, 96, virt[e].stride * (size_t)H); /* plain grey */
+            /* plain grey, opaque */
+            for (int y = 0; y < H; y++) {
+                uint8_t *row = (uint8_t *)virt[e].data + (size_t)y * virt[e].stride;
+                for (int x = 0; x < W; x++) {
+                    row[4 * x + 0] = row[4 * x + 1] = row[4 * x + 2] = 96;
+                    row[4 * x + 3] = 255;
+                }
+            }
         } else {
             cli_fail("%s", err.msg);
             goto done;
@@ -271,7 +278,9 @@ static int run(const run_opts *o)
     pd.refine_band = o->refine;
     pd.fit_rig = o->refine && o->track_port ? &rig : NULL;
     if (!(pipe = pipe_create(&pd, &model))) {
-        cli_fail("cannot start the pipeline (out of memory or no thread)");
+        cli_fail(pd.fit_rig ? "cannot start the pipeline (out of memory, no thread, or the elbow "
+                              "fit cannot use the model: mesh 0's skin, the arms' node chains)"
+                            : "cannot start the pipeline (out of memory or no thread)");
         goto done;
     }
     if (o->out && cli_mkdirs(o->out) != 0) {
@@ -303,6 +312,14 @@ static int run(const run_opts *o)
         in.virt[e] = (fuse_image){virt[e].data, W, H, (int)virt[e].stride};
         in.out[e] = (fuse_image){outimg[e].data, W, H, (int)outimg[e].stride};
     }
+    /* The virtual images do not change: checked once. Opaque (the grey
+     * fallback is), the composite copies V where the hand is not without
+     * looking at its alpha. */
+    const kin_sthmd_geometry geo = pipe_geometry(pipe);
+    in.virt_opaque = pipe_image_opaque(&in.virt[0], geo.vp_x0, geo.vp_y0, geo.vp_width,
+                                       geo.vp_height) &&
+                     pipe_image_opaque(&in.virt[1], geo.vp_x0, geo.vp_y0, geo.vp_width,
+                                       geo.vp_height);
     kin_track_sample sample;
     memset(&sample, 0, sizeof sample);
     int have_pose = 0, have_img[2] = {0, 0};

@@ -361,6 +361,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     fe.vp_w = p->geo.vp_width;
     fe.vp_h = p->geo.vp_height;
     fe.out = in->out[e->eye];
+    fe.v_opaque = in->virt_opaque != 0;
     fuse_depth dt;
     if (in->virt_depth[e->eye]) {
         dt = (fuse_depth){e->depth, cw, p->hmd.znear, p->hmd.zfar, p->hmd.cam_offset_m,
@@ -727,6 +728,20 @@ kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].
 
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }
 
+int pipe_image_opaque(const fuse_image *im, int x0, int y0, int w, int h)
+{
+    if (!im || !im->pixels || w < 1 || h < 1 || x0 < 0 || y0 < 0 || x0 > im->width - w ||
+        y0 > im->height - h || im->stride < 4 * im->width)
+        return 0;
+    for (int y = y0; y < y0 + h; y++) {
+        const uint8_t *a = im->pixels + (size_t)y * (size_t)im->stride + (size_t)x0 * 4 + 3;
+        unsigned all = 255;
+        for (int x = 0; x < w; x++) all &= a[(size_t)x * 4];
+        if (all != 255) return 0;
+    }
+    return 1;
+}
+
 int pipe_isa(const pipe_ctx *p) { return rast_context_isa(p->eye[0].rast); }
 
 const char *pipe_result_str(pipe_result r)
@@ -746,6 +761,8 @@ const char *pipe_result_str(pipe_result r)
 #define FIT_STATIONS 6            /* width stations per segment and eye */
 #define FIT_MAX_WALK 160          /* px: longest half width measured */
 #define FIT_MIN_SAMPLES 12        /* widths before a thickness is used */
+#define FIT_WINDOW_GEOS 14        /* poses checking the points in view: every
+                                     30 deg over up to 360 deg, and its end */
 
 struct pipe_fit {
     pipe_fit_desc d;
@@ -786,7 +803,7 @@ struct pipe_fit {
 static int fit_vertices(pipe_fit *f)
 {
     const kin_mesh *me = &f->model->meshes[0];
-    const kin_skin *sk = &f->model->skins[0];
+    const kin_skin *sk = &f->model->skins[me->skin];
     const int P = f->d.points;
     for (int s = 0; s < 2; s++) {
         int ua = f->rig.joint[s][KIN_RIG_UPPER_ARM], fa = f->rig.joint[s][KIN_RIG_FOREARM];
@@ -830,7 +847,7 @@ static int fit_vertices(pipe_fit *f)
 static void fit_radii(pipe_fit *f)
 {
     const kin_mesh *me = &f->model->meshes[0];
-    const kin_skin *sk = &f->model->skins[0];
+    const kin_skin *sk = &f->model->skins[me->skin];
     for (int s = 0; s < 2; s++)
         for (int g = 0; g < 2; g++) {
             int j0 = f->rig.joint[s][g ? KIN_RIG_FOREARM : KIN_RIG_UPPER_ARM];
@@ -868,21 +885,88 @@ static void fit_radii(pipe_fit *f)
         }
 }
 
+/* One setting of pipe_fit_desc: 0 = def, else it must lie in (0, hi] and
+ * be >= lo (NaN fails). */
+static int fit_setting(float *v, float def, float lo, float hi)
+{
+    if (*v == 0.0f) {
+        *v = def;
+        return 1;
+    }
+    return *v > 0.0f && *v >= lo && *v <= hi;
+}
+
+/* The settings with defaults filled in; 0 when one is out of bounds. */
+static int fit_settings(pipe_fit_desc *d)
+{
+    if (!fit_setting(&d->range_deg, 60.0f, 0.0f, PIPE_FIT_MAX_RANGE_DEG) ||
+        !fit_setting(&d->step_deg, 5.0f, PIPE_FIT_MIN_STEP_DEG, PIPE_FIT_MAX_STEP_DEG) ||
+        !fit_setting(&d->rate_deg, 12.0f, 0.0f, PIPE_FIT_MAX_RANGE_DEG) ||
+        !fit_setting(&d->prior, 0.05f, 0.0f, PIPE_FIT_MAX_PRIOR))
+        return 0;
+    if (d->points == 0) d->points = 400;
+    if (d->shape_samples == 0) d->shape_samples = 48;
+    return d->points >= 1 && d->points <= PIPE_FIT_MAX_POINTS &&
+           d->shape_samples <= PIPE_FIT_MAX_SHAPE_SAMPLES;
+}
+
+/* 1 when mesh 0 is skinned by one of the model's skins, whose joints are
+ * nodes, and every joint index of its vertices names one of them. */
+static int fit_mesh_ok(const kin_model *m)
+{
+    const kin_mesh *me = &m->meshes[0];
+    if (me->skin < 0 || me->skin >= m->skin_count || !me->joints || !me->weights ||
+        !me->positions || me->vertex_count < 1)
+        return 0;
+    const kin_skin *sk = &m->skins[me->skin];
+    if (sk->joint_count < 1 || !sk->joints) return 0;
+    for (int k = 0; k < sk->joint_count; k++)
+        if (sk->joints[k] < 0 || sk->joints[k] >= m->node_count) return 0;
+    for (size_t i = 0; i < 4 * (size_t)me->vertex_count; i++)
+        if (me->joints[i] >= sk->joint_count) return 0;
+    return 1;
+}
+
+/* 1 when node a is a proper ancestor of node d. */
+static int fit_ancestor(const kin_model *m, int a, int d)
+{
+    for (int k = 0, n = d; k < m->node_count; k++) {
+        n = m->parents[n];
+        if (n < 0 || n >= m->node_count) return 0;
+        if (n == a) return 1;
+    }
+    return 0;
+}
+
+/* 1 when each side's upper arm, forearm and hand are nodes, each a proper
+ * descendant of the one before: turning the upper arm then moves the
+ * forearm and the hand, and the hand's correction (fit_apply) is taken in
+ * its parent's frame, whichever node that is. */
+static int fit_rig_ok(const kin_model *m, const kin_arm_rig *rig)
+{
+    if (!m->parents) return 0;
+    for (int s = 0; s < 2; s++) {
+        const int j[3] = { rig->joint[s][KIN_RIG_UPPER_ARM], rig->joint[s][KIN_RIG_FOREARM],
+                           rig->joint[s][KIN_RIG_HAND] };
+        for (int k = 0; k < 3; k++)
+            if (j[k] < 0 || j[k] >= m->node_count) return 0;
+        if (!fit_ancestor(m, j[0], j[1]) || !fit_ancestor(m, j[1], j[2])) return 0;
+    }
+    return 1;
+}
+
 pipe_fit *pipe_fit_create(const pipe_fit_desc *desc, const kin_model *model,
                           const kin_arm_rig *rig, int width, int height)
 {
     if (!model || !rig || width < 1 || height < 1 || model->mesh_count < 1 ||
-        model->skin_count < 1 || !model->meshes[0].joints || !model->meshes[0].weights)
+        !model->meshes || !model->skins || !fit_mesh_ok(model) || !fit_rig_ok(model, rig))
         return NULL;
+    pipe_fit_desc d = {0};
+    if (desc) d = *desc;
+    if (!fit_settings(&d)) return NULL;
     pipe_fit *f = calloc(1, sizeof *f);
     if (!f) return NULL;
-    if (desc) f->d = *desc;
-    if (!(f->d.range_deg > 0.0f)) f->d.range_deg = 60.0f;
-    if (!(f->d.step_deg > 0.0f)) f->d.step_deg = 5.0f;
-    if (!(f->d.rate_deg > 0.0f)) f->d.rate_deg = 12.0f;
-    if (!(f->d.prior > 0.0f)) f->d.prior = 0.05f;
-    if (f->d.points <= 0) f->d.points = 400;
-    if (f->d.shape_samples == 0) f->d.shape_samples = 48;
+    f->d = d;
     f->model = model;
     f->rig = *rig;
     f->width = width;
@@ -1086,17 +1170,20 @@ static float fit_score(const pipe_fit *f, int s, const float *pos, const fit_geo
 }
 
 /* Turns the arm of side s by phi about its shoulder-wrist line in locals
- * (world = FK of locals; the hand keeps its world rotation). */
+ * (world = FK of locals; the hand keeps its world rotation). Turning the
+ * upper arm's local by phi about u turns every node below it, the hand's
+ * parent hp included, by phi about u in world space; the hand's local
+ * then turns by -phi about u seen in hp's frame (the forearm, or a wrist
+ * or twist node between them: pipe_fit_create checked the chain). */
 static void fit_apply(const pipe_fit *f, const kin_mat4 *world, int s, float phi,
                       kin_transform *locals)
 {
     const kin_model *m = f->model;
-    int ua = f->rig.joint[s][KIN_RIG_UPPER_ARM], fa = f->rig.joint[s][KIN_RIG_FOREARM];
-    int hd = f->rig.joint[s][KIN_RIG_HAND];
+    int ua = f->rig.joint[s][KIN_RIG_UPPER_ARM], hd = f->rig.joint[s][KIN_RIG_HAND];
     kin_vec3 u = kin_v3_norm(kin_v3_sub(fit_node_pos(&world[hd]), fit_node_pos(&world[ua])));
-    int par = m->parents[ua];
+    int par = m->parents[ua], hp = m->parents[hd];
     kin_quat qp = par >= 0 ? fit_node_rot(&world[par]) : kin_quat_identity();
-    kin_quat qf = fit_node_rot(&world[fa]);
+    kin_quat qf = fit_node_rot(&world[hp]);
     kin_vec3 ap = kin_quat_rotate(kin_quat_conjugate(qp), u);
     kin_vec3 af = kin_quat_rotate(kin_quat_conjugate(qf), u);
     locals[ua].r = kin_quat_normalize(kin_quat_mul(kin_quat_axis_angle(ap, phi), locals[ua].r));
@@ -1156,9 +1243,10 @@ void pipe_fit_elbows(pipe_fit *f, const kin_mat4 *world, const float *pos,
         const float pk = f->d.prior * 2.0f * (float)f->n[s] / (30.0f * 30.0f * D * D);
         /* the points in view over the whole window: at its ends and every
          * 30 degrees between (the projections move smoothly with phi) */
-        fit_geo gw[8];
+        fit_geo gw[FIT_WINDOW_GEOS];
         int nw = 0;
-        for (float phi = lo; nw < 7 && phi < hi; phi += 30.0f * D) fit_geo_of(S, u, phi, &gw[nw++]);
+        for (float phi = lo; nw < FIT_WINDOW_GEOS - 1 && phi < hi; phi += 30.0f * D)
+            fit_geo_of(S, u, phi, &gw[nw++]);
         fit_geo_of(S, u, hi, &gw[nw++]);
         fit_common(f, s, pos, gw, nw, cam);
         fit_geo g;
@@ -1168,7 +1256,16 @@ void pipe_fit_elbows(pipe_fit *f, const kin_mat4 *world, const float *pos,
             float step = (pass ? 1.0f : f->d.step_deg) * D;
             float lo2 = pass ? bphi - 0.5f * f->d.step_deg * D : lo;
             float hi2 = pass ? bphi + 0.5f * f->d.step_deg * D : hi;
-            for (float phi = lo2; phi <= hi2 + 1e-6f; phi += step) {
+            /* The candidates of phi += step (bit for bit those of the
+             * first version: `egofuse eval` and render --refine keep their
+             * bytes), bounded by an index: phi += step alone never ended
+             * for a step too small to move phi; with the desc's bounds
+             * (step >= 0.1 deg) every addition moves it and at most
+             * 2 * 180 / 0.1 + 2 candidates run. */
+            const float span = (hi2 + 1e-6f - lo2) / step;
+            const int nc = span >= 0.0f && span < 8192.0f ? (int)span + 1 : -1;
+            float phi = lo2;
+            for (int i = 0; i <= nc && phi <= hi2 + 1e-6f; i++, phi += step) {
                 if (phi < lo || phi > hi) continue;
                 fit_geo_of(S, u, phi, &g);
                 float sc = fit_score(f, s, pos, &g, cam, P) - pk * phi * phi;

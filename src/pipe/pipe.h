@@ -143,6 +143,15 @@ typedef struct pipe_frame_in {
     /* With an elbow fit (pipe_desc.fit_rig): bit 0 / bit 1 = do not turn
      * the left / right arm (its hand is not tracked this frame). */
     unsigned fit_skip;
+    /* 1: the caller promises that both virtual images have alpha 255 at
+     * every pixel of the viewport (pipe_geometry: vp_x0, vp_y0, vp_width,
+     * vp_height), e.g. checked once with pipe_image_opaque. The composite
+     * then skips V wherever the hand is not (fuse_eye.v_opaque: in place,
+     * out == virt, those pixels are neither read nor written; ~0.4x a
+     * memcpy of the output per frame); the bytes are those of 0. A broken
+     * promise keeps rgb exact, but the alpha of those pixels may be V's
+     * instead of 255. 0 (the default): no promise. */
+    int virt_opaque;
 } pipe_frame_in;
 
 typedef struct pipe_frame_stats {
@@ -161,7 +170,9 @@ typedef enum pipe_result {
     PIPE_ERR_FUSE             /* the fuse stage refused its inputs */
 } pipe_result;
 
-/* NULL when out of memory or the thread cannot start. */
+/* NULL when out of memory or the thread cannot start, or with
+ * refine_band and fit_rig when pipe_fit_create refuses the model or the
+ * rig (mesh 0's skin, the arms' node chains). */
 pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model);
 void  pipe_destroy(pipe_ctx *p);
 /* One stereo frame. stats may be NULL. On error, why (if not NULL) gets a
@@ -177,6 +188,11 @@ kin_camera pipe_camera(const pipe_ctx *p, int eye);
 int pipe_isa(const pipe_ctx *p);
 /* The derived HMD numbers in use (crop, viewport). */
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p);
+/* 1 when every pixel of the rectangle (x0, y0, w, h) of the RGBA8 image
+ * im has alpha 255 (for pipe_frame_in.virt_opaque: the viewport of
+ * pipe_geometry), else 0; 0 as well for NULL pixels, an empty rectangle
+ * or one not inside the image. Reads the rectangle's alpha bytes once. */
+int pipe_image_opaque(const fuse_image *im, int x0, int y0, int w, int h);
 
 const char *pipe_result_str(pipe_result r);
 
@@ -219,23 +235,41 @@ const char *pipe_result_str(pipe_result r);
  * allocation after pipe_fit_create. */
 #define PIPE_FIT_BITS 5
 
+/* Bounds of pipe_fit_desc (pipe_fit_create refuses a setting outside
+ * them: the search must end and its buffers stay small). */
+#define PIPE_FIT_MIN_STEP_DEG 0.1f
+#define PIPE_FIT_MAX_STEP_DEG 45.0f
+#define PIPE_FIT_MAX_RANGE_DEG 180.0f   /* range_deg and rate_deg */
+#define PIPE_FIT_MAX_PRIOR 100.0f
+#define PIPE_FIT_MAX_POINTS 4096
+#define PIPE_FIT_MAX_SHAPE_SAMPLES 4096
+
 typedef struct pipe_fit_desc {
-    float range_deg;          /* default 60 */
-    float step_deg;           /* default 5 */
-    float rate_deg;           /* per frame, default 12 */
-    float prior;              /* nats per point at 30 deg, default 0.05 */
-    int points;               /* per arm, default 400 */
+    float range_deg;          /* default 60; (0, PIPE_FIT_MAX_RANGE_DEG] */
+    float step_deg;           /* default 5; [PIPE_FIT_MIN_STEP_DEG,
+                                 PIPE_FIT_MAX_STEP_DEG] */
+    float rate_deg;           /* per frame, default 12; (0, 180] */
+    float prior;              /* nats per point at 30 deg, default 0.05;
+                                 (0, PIPE_FIT_MAX_PRIOR] */
+    int points;               /* per arm, default 400; 1..PIPE_FIT_MAX_POINTS */
     int shape_samples;        /* limb widths measured per segment (both
                                  eyes) before its thickness is frozen
-                                 (pipe_fit_measure), default 48; < 0 = no
+                                 (pipe_fit_measure), default 48, at most
+                                 PIPE_FIT_MAX_SHAPE_SAMPLES; < 0 = no
                                  thickness calibration (factors stay 1) */
 } pipe_fit_desc;
 
 typedef struct pipe_fit pipe_fit;
 
-/* For mesh 0 of model (skinned by skin 0) and the rig's joints; images of
- * width x height. desc NULL or zero fields = defaults. NULL when out of
- * memory or the model has no vertex bound to an arm. */
+/* For mesh 0 of model (skinned by its own skin, meshes[0].skin) and the
+ * rig's joints; images of width x height. desc NULL or zero fields =
+ * defaults. NULL when out of memory, for a setting outside the bounds
+ * above (NaN, infinite and negative included; zero = the default), when
+ * mesh 0 has no valid skin (its skin index or a joint index out of
+ * range), when a side's rig joints are not a chain upper arm -> forearm
+ * -> hand (each a descendant of the one before: nodes between them, e.g.
+ * a twist or wrist node, are fine) or the model has no vertex bound to an
+ * arm. */
 pipe_fit *pipe_fit_create(const pipe_fit_desc *desc, const kin_model *model,
                           const kin_arm_rig *rig, int width, int height);
 void pipe_fit_destroy(pipe_fit *f);
