@@ -5,14 +5,25 @@
  * each classified by the distance of its centre to the nearest triangle
  * edge (docs/raster.md section 10 explains the classes).
  *
+ * egofuse is timed as the pipeline draws (one context per thread count,
+ * workers started once: rast_context_clear of what the last frame drew +
+ * rast_context_draw_jobs, both eyes, with 2 threads one eye per thread)
+ * and, as an extra line, with a full rast_target_clear of both targets
+ * (the figure of earlier rounds); clear and draw are also shown apart,
+ * and the 2-thread dispatch of two empty jobs with the worker spinning
+ * and asleep. The ratio to llvmpipe uses the better thread count of the
+ * pipeline line. The pipeline's frame is checked equal (memcmp of every
+ * plane) to rast_target_clear + rast_draw, which is what is compared with
+ * llvmpipe.
+ *
  * The EGL/GLES setup is bench/llvmpipe/egl_harness.h, shared with
  * llvmpipe_frame.c (the whole stereo frame). `make build/bench/llvmpipe_raster`
  * builds it (the Makefile links EGL and GLESv2):
  *   build/bench/llvmpipe_raster [--runs N] [--tris N,N,...]
  *
  * Exit status: 0 when llvmpipe ran and every coverage difference lies
- * within snapping distance of an edge, 1 otherwise (2: usage, 3: no
- * llvmpipe). */
+ * within snapping distance of an edge and the pipeline's frame equals the
+ * reference's, 1 otherwise (2: usage, 3: no llvmpipe). */
 #include "egl_harness.h"
 
 #include "../../src/cpu/cpu.h"
@@ -146,6 +157,9 @@ int main(int argc, char **argv)
     uint8_t *mask = malloc((size_t)W * H * 2);
     float *nrmp = malloc((size_t)W * H * 2 * 3 * sizeof(float));
     double *tg = malloc((size_t)runs * sizeof(double)), *te = malloc((size_t)runs * sizeof(double));
+    double *tc = malloc((size_t)runs * sizeof(double)), *td = malloc((size_t)runs * sizeof(double));
+    if (!rgba || !depth || !mask || !nrmp || !tg || !te || !tc || !td)
+        return 1;
     rast_target tgt[2];
     for (int e = 0; e < 2; e++) {
         rast_target t = { W, H, depth + (size_t)e * W * H, W, mask + (size_t)e * W * H, W,
@@ -192,8 +206,19 @@ int main(int argc, char **argv)
             if (r >= 0)
                 tg[r] = eh_now_ms() - t0;
         }
-        double best_eg = 1e30;
-        int best_th = 1;
+        /* egofuse, both eyes per run, one context per thread count (its
+         * workers started once, in rast_context_create, not per call):
+         *   pipe: rast_context_clear of both targets (only the tiles the
+         *         previous frame drew) + rast_context_draw_jobs (with 2
+         *         threads one eye per thread), as the pipeline draws;
+         *   full: rast_target_clear of both targets (4.4 MB) + the same
+         *         draw (the measurement of earlier rounds, kept);
+         *   jobs of 0 triangles: the 2-thread dispatch alone (wake the
+         *         worker, meet at the end), the worker hot (spinning) and
+         *         asleep (blocked after its idle spins), to show what the
+         *         second thread costs per call. */
+        double best_eg = 1e30, best_full = 1e30;
+        int best_th = 1, best_full_th = 1;
         for (int th = 1; th <= 2; th++) {
             rast_context_desc d = { 0, th };
             rast_context *c = rast_context_create(&d);
@@ -207,28 +232,127 @@ int main(int argc, char **argv)
             }
             const rast_target *tp[2] = { &tgt[0], &tgt[1] };
             const rast_mesh_desc *mp[2] = { &md[0], &md[1] };
-            for (int r = -5; r < runs; r++) {
-                double t0 = eh_now_ms();
-                /* Both eyes in one call: with 2 threads, one eye each. */
-                rast_target_clear(&tgt[0]);
-                rast_target_clear(&tgt[1]);
+            for (int mode = 0; mode < 2; mode++) {
+                rast_context_forget(c);
+                for (int r = -5; r < runs; r++) {
+                    double t0 = eh_now_ms();
+                    for (int e = 0; e < 2; e++) {
+                        if (mode == 0)
+                            rast_context_clear(c, &tgt[e]);
+                        else
+                            rast_target_clear(&tgt[e]);
+                    }
+                    double t1 = eh_now_ms();
+                    rast_context_draw_jobs(c, 2, tp, mp, NULL);
+                    double t2 = eh_now_ms();
+                    if (r >= 0) {
+                        te[r] = t2 - t0;
+                        tc[r] = t1 - t0;
+                        td[r] = t2 - t1;
+                    }
+                }
+                double me = eh_median(te, runs), mc = eh_median(tc, runs),
+                       md2 = eh_median(td, runs);
+                if (mode == 0 && me < best_eg) {
+                    best_eg = me;
+                    best_th = th;
+                }
+                if (mode == 1 && me < best_full) {
+                    best_full = me;
+                    best_full_th = th;
+                }
+                printf("%6d tris: egofuse %d thread(s) %.4f ms both eyes (%s: clear %.4f + "
+                       "draw %.4f)\n", m.tri_count, th, me,
+                       mode == 0 ? "pipe, context clear + draw" : "full clear + draw", mc,
+                       md2);
+            }
+            /* The pipe mode's last frame equals a full clear + draw. */
+            {
+                size_t np = (size_t)W * H;
+                uint8_t *m0 = malloc(np * 2);
+                float *d0 = malloc(np * 2 * sizeof(float)), *n0 = malloc(np * 6 * sizeof(float));
+                if (!m0 || !d0 || !n0)
+                    return 1;
+                for (int e = 0; e < 2; e++)
+                    rast_context_clear(c, &tgt[e]);
                 rast_context_draw_jobs(c, 2, tp, mp, NULL);
-                if (r >= 0)
-                    te[r] = eh_now_ms() - t0;
+                rast_context_draw_jobs(c, 2, tp, mp, NULL); /* dirty the planes twice */
+                for (int e = 0; e < 2; e++)
+                    rast_context_clear(c, &tgt[e]);
+                rast_context_draw_jobs(c, 2, tp, mp, NULL);
+                memcpy(m0, mask, np * 2);
+                memcpy(d0, depth, np * 2 * sizeof(float));
+                memcpy(n0, nrmp, np * 6 * sizeof(float));
+                for (int e = 0; e < 2; e++)
+                    rast_target_clear(&tgt[e]);
+                rast_draw(&tgt[0], &md[0], NULL);
+                rast_draw(&tgt[1], &md[1], NULL);
+                int same = !memcmp(m0, mask, np * 2) &&
+                           !memcmp(d0, depth, np * 2 * sizeof(float)) &&
+                           !memcmp(n0, nrmp, np * 6 * sizeof(float));
+                if (!same) {
+                    printf("%6d tris: egofuse %d thread(s): context clear + draw DIFFERS from "
+                           "rast_target_clear + rast_draw\n", m.tri_count, th);
+                    bad_total++;
+                }
+                free(m0);
+                free(d0);
+                free(n0);
+                rast_context_forget(c);
             }
-            double me = eh_median(te, runs);
-            if (me < best_eg) {
-                best_eg = me;
-                best_th = th;
+            if (th == 2) {
+                static const rast_target empty_t[2] = { { 1, 1, NULL, 1, NULL, 1, NULL, 0, 0 },
+                                                        { 1, 1, NULL, 1, NULL, 1, NULL, 0, 0 } };
+                static uint8_t em[2];
+                rast_target et[2] = { empty_t[0], empty_t[1] };
+                et[0].mask = &em[0];
+                et[1].mask = &em[1];
+                rast_mesh_desc z = { clip[0], 0, NULL, 0, m.idx, 0, RAST_CULL_BACK };
+                const rast_target *ep[2] = { &et[0], &et[1] };
+                const rast_mesh_desc *zp[2] = { &z, &z };
+                double hot = 0, cold = 0;
+                for (int k = 0; k < 2; k++) {
+                    for (int r = -5; r < runs; r++) {
+                        if (k == 1) { /* let the worker block: 20 ms busy on this thread */
+                            double w0 = eh_now_ms();
+                            while (eh_now_ms() - w0 < 20.0)
+                                ;
+                        }
+                        double t0 = eh_now_ms();
+                        rast_context_draw_jobs(c, 2, ep, zp, NULL);
+                        if (r >= 0)
+                            te[r] = eh_now_ms() - t0;
+                        if (k == 1 && r >= 20)
+                            break;
+                    }
+                    if (k == 0)
+                        hot = eh_median(te, runs);
+                    else
+                        cold = eh_median(te, runs < 21 ? runs : 21);
+                }
+                printf("%6d tris: egofuse 2 threads, two jobs of 0 triangles (dispatch only): "
+                       "%.4f ms worker spinning, %.4f ms worker asleep\n", m.tri_count, hot,
+                       cold);
             }
-            printf("%6d tris: egofuse %d thread(s) %.4f ms both eyes (clear + draw)\n",
-                   m.tri_count, th, me);
             rast_context_destroy(c);
         }
         double mg = eh_median(tg, runs);
         printf("%6d tris: llvmpipe %.4f ms both eyes (clear + draw + finish); "
-               "llvmpipe / egofuse (%d thread(s)) = %.1fx\n", m.tri_count, mg, best_th,
-               mg / best_eg);
+               "llvmpipe / egofuse pipe (%d thread(s)) = %.1fx; "
+               "llvmpipe / egofuse full clear (%d thread(s)) = %.1fx\n", m.tri_count, mg,
+               best_th, mg / best_eg, best_full_th, mg / best_full);
+
+        /* The planes for the comparison: a full clear + draw. */
+        for (int e = 0; e < 2; e++)
+            rast_target_clear(&tgt[e]);
+        {
+            rast_mesh_desc m0 = { clip[0], m.vertex_count, m.nrm, 3, m.idx, m.tri_count,
+                                  RAST_CULL_BACK };
+            rast_mesh_desc m1 = { clip[1], m.vertex_count, m.nrm, 3, m.idx, m.tri_count,
+                                  RAST_CULL_BACK };
+            rast_draw(&tgt[0], &m0, NULL);
+            rast_draw(&tgt[1], &m1, NULL);
+        }
 
         /* Coverage comparison per eye (the last renders of each). */
         for (int e = 0; e < 2; e++) {
@@ -291,5 +415,7 @@ int main(int argc, char **argv)
     free(nrmp);
     free(tg);
     free(te);
+    free(tc);
+    free(td);
     return bad_total ? 1 : 0;
 }

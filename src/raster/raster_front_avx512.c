@@ -268,29 +268,9 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
                pl[11] + o);
     }
 
-    /* setup_attrs: a0 = attribute of vertex 0, d1 = a1 - a0, d2 = a2 - a0. */
-    const int ac = v->attr_count;
-    _Alignas(64) float at[3][RAST_MAX_ATTRS][16];
-    if (ac > 0) {
-        const __m512i vac = _mm512_set1_epi32(ac);
-        const __m512i b0 = _mm512_mullo_epi32(V[0], vac), b1 = _mm512_mullo_epi32(V[1], vac),
-                      b2 = _mm512_mullo_epi32(V[2], vac);
-        const __m512 fz = _mm512_setzero_ps();
-        for (int a = 0; a < ac; a++) {
-            const __m512i ka = _mm512_set1_epi32(a);
-            const __m512 a0 =
-                _mm512_mask_i32gather_ps(fz, L, _mm512_add_epi32(b0, ka), m->attr, 4);
-            const __m512 a1 =
-                _mm512_mask_i32gather_ps(fz, L, _mm512_add_epi32(b1, ka), m->attr, 4);
-            const __m512 a2 =
-                _mm512_mask_i32gather_ps(fz, L, _mm512_add_epi32(b2, ka), m->attr, 4);
-            _mm512_store_ps(at[0][a], a0);
-            _mm512_store_ps(at[1][a], _mm512_sub_ps(a1, a0));
-            _mm512_store_ps(at[2][a], _mm512_sub_ps(a2, a0));
-        }
-    }
-
     /* The records: lane l -> out[slot l]. */
+    const int ac = v->attr_count;
+    const __mmask8 AM = (__mmask8)((1u << ac) - 1u);
     for (int l = 0; l < k; l++) {
         rast__tri *t = out + q->f[Q_SLOT][l];
         t->x0 = q->f[Q_BX0][l];
@@ -315,15 +295,26 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
         t->b2.dx = pl[10][l];
         t->b2.dy = pl[11][l];
         t->attr_count = ac;
-        for (int a = 0; a < ac; a++) {
-            t->a0[a] = at[0][a][l];
-            t->d1[a] = at[1][a][l];
-            t->d2[a] = at[2][a][l];
+        /* setup_attrs: a0 = attribute of vertex 0, d1 = a1 - a0,
+         * d2 = a2 - a0, per record by masked loads (no byte past the
+         * vertex's ac floats is read) and masked stores (no byte past
+         * a0[ac - 1], d1[ac - 1], d2[ac - 1] is written). */
+        if (ac > 0) {
+            const float *a0p = m->attr + (size_t)q->f[Q_V0][l] * (size_t)ac;
+            const float *a1p = m->attr + (size_t)q->f[Q_V1][l] * (size_t)ac;
+            const float *a2p = m->attr + (size_t)q->f[Q_V2][l] * (size_t)ac;
+            const __m256 a0 = _mm256_maskz_loadu_ps(AM, a0p);
+            const __m256 a1 = _mm256_maskz_loadu_ps(AM, a1p);
+            const __m256 a2 = _mm256_maskz_loadu_ps(AM, a2p);
+            _mm256_mask_storeu_ps(t->a0, AM, a0);
+            _mm256_mask_storeu_ps(t->d1, AM, _mm256_sub_ps(a1, a0));
+            _mm256_mask_storeu_ps(t->d2, AM, _mm256_sub_ps(a2, a0));
         }
     }
 }
 
 _Static_assert(RAST__FRONT_GROUP == 16, "one group per 16-lane vector");
+_Static_assert(RAST_MAX_ATTRS <= 8, "attributes by 8-lane masked loads and stores");
 
 int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
                         int ti0, int ti1, rast__tri *out, rast_stats *st)
