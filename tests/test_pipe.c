@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "../src/pipe/pipe.h"
+#include "support/pipe_testrig.h"
 
 /* A model of one node ("head" at the origin) and one unskinned quad
  * [-s,s]^2 at depth z (metres, in front of the head), normals +Z. */
@@ -617,7 +618,7 @@ static void refine_band_mask(void **state)
 
 /* ------------------------------------------- elbow fit in pipe_frame */
 
-enum { RINGS = 12, AROUND = 10, ARM_NODES = 7 };
+enum { ARM_NODES = 7 };
 
 /* Two arms below the head (world_from_head = identity, the cameras look
  * down -Z): nodes 0 body; per side s: 1 + 3 s upper arm at the shoulder
@@ -634,40 +635,16 @@ typedef struct fit_arms {
     int joints[ARM_NODES];
     kin_skin skin;
     kin_mesh mesh;
-    float pos[6 * RINGS * AROUND * 3];
-    uint16_t jnt[6 * RINGS * AROUND * 4];
-    float wgt[6 * RINGS * AROUND * 4];
-    uint32_t idx[6 * (RINGS - 1) * AROUND * 2 * 3];
+    float pos[6 * TU_TUBE_VERTS * 3];
+    uint16_t jnt[6 * TU_TUBE_VERTS * 4];
+    float wgt[6 * TU_TUBE_VERTS * 4];
+    uint32_t idx[6 * TU_TUBE_TRIS * 3];
     int nv, nt;
 } fit_arms;
 
 static void arm_tube(fit_arms *A, kin_vec3 a, kin_vec3 b, float r, int j)
 {
-    kin_vec3 d = kin_v3_norm(kin_v3_sub(b, a));
-    kin_vec3 e1 = kin_v3_norm(kin_v3_cross(d, kin_v3(0, 1, 0)));
-    kin_vec3 e2 = kin_v3_cross(d, e1);
-    int v0 = A->nv;
-    for (int i = 0; i < RINGS; i++) {
-        kin_vec3 c = kin_v3_add(a, kin_v3_scale(kin_v3_sub(b, a), (float)i / (RINGS - 1)));
-        for (int k = 0; k < AROUND; k++) {
-            float t = 6.2831853f * (float)k / AROUND;
-            kin_vec3 p = kin_v3_add(c, kin_v3_add(kin_v3_scale(e1, r * cosf(t)),
-                                                  kin_v3_scale(e2, r * sinf(t))));
-            memcpy(&A->pos[A->nv * 3], &p, sizeof p);
-            A->jnt[A->nv * 4] = (uint16_t)j;
-            A->wgt[A->nv * 4] = 1.0f;
-            A->nv++;
-        }
-    }
-    for (int i = 0; i + 1 < RINGS; i++)
-        for (int k = 0; k < AROUND; k++) {
-            uint32_t a0 = (uint32_t)(v0 + i * AROUND + k);
-            uint32_t a1 = (uint32_t)(v0 + i * AROUND + (k + 1) % AROUND);
-            uint32_t *t = &A->idx[A->nt * 3];
-            t[0] = a0; t[1] = a0 + AROUND; t[2] = a1;
-            t[3] = a1; t[4] = a0 + AROUND; t[5] = a1 + AROUND;
-            A->nt += 2;
-        }
+    tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, a, b, r, j);
 }
 
 static void fit_arms_build(fit_arms *A)
@@ -693,23 +670,10 @@ static void fit_arms_build(fit_arms *A)
         A->rig.joint[s][KIN_RIG_FOREARM] = u + 1;
         A->rig.joint[s][KIN_RIG_HAND] = u + 2;
     }
-    kin_mat4 world[ARM_NODES];
-    kin_fk(A->parents, ARM_NODES, A->rest, NULL, world);
-    for (int j = 0; j < ARM_NODES; j++) {
-        A->joints[j] = j;
-        assert_true(kin_mat4_inverse(&world[j], &A->ibm[j]));
-    }
-    A->skin = (kin_skin){ ARM_NODES, A->joints, A->ibm };
     A->mesh = (kin_mesh){ .vertex_count = A->nv, .positions = A->pos, .joints = A->jnt,
                           .weights = A->wgt, .index_count = A->nt * 3, .indices = A->idx,
                           .node = -1, .skin = 0 };
-    A->m.node_count = ARM_NODES;
-    A->m.parents = A->parents;
-    A->m.rest = A->rest;
-    A->m.mesh_count = 1;
-    A->m.meshes = &A->mesh;
-    A->m.skin_count = 1;
-    A->m.skins = &A->skin;
+    tu_rig_bind(&A->m, &A->skin, &A->mesh, ARM_NODES, A->parents, A->rest, A->ibm, A->joints);
 }
 
 /* IoU of two 640x400 masks (inside = >= 128). */

@@ -24,8 +24,9 @@
 #include <string.h>
 
 #include "../src/pipe/pipe.h"
+#include "support/pipe_testrig.h"
 
-enum { W = 320, H = 240, RINGS = 12, AROUND = 10 };
+enum { W = 320, H = 240 };
 #define D2R 0.01745329252f
 
 /* Nodes: 0 body; per side s: 1 + 3 s upper arm (at the shoulder), 2 + 3 s
@@ -54,38 +55,16 @@ typedef struct arms {
     int nv, nt;
 } arms;
 
-/* A tube of RINGS x AROUND vertices from a to b, radius r, bound to joint
- * j, part `part` of side s; appended to A's arrays. */
+/* A tube (tu_tube) from a to b, radius r, bound to joint j, part `part`
+ * of side s; appended to A's arrays. */
 static void tube(arms *A, kin_vec3 a, kin_vec3 b, float r, int j, int s, int part)
 {
-    kin_vec3 d = kin_v3_norm(kin_v3_sub(b, a));
-    kin_vec3 e1 = kin_v3_norm(kin_v3_cross(d, fabsf(d.y) < 0.9f ? kin_v3(0, 1, 0) : kin_v3(1, 0, 0)));
-    kin_vec3 e2 = kin_v3_cross(d, e1);
-    int v0 = A->nv;
-    for (int i = 0; i < RINGS; i++) {
-        kin_vec3 c = kin_v3_add(a, kin_v3_scale(kin_v3_sub(b, a), (float)i / (RINGS - 1)));
-        for (int k = 0; k < AROUND; k++) {
-            float t = 6.2831853f * (float)k / AROUND;
-            kin_vec3 p = kin_v3_add(c, kin_v3_add(kin_v3_scale(e1, r * cosf(t)),
-                                                  kin_v3_scale(e2, r * sinf(t))));
-            float *o = &A->pos[A->nv * 3];
-            o[0] = p.x; o[1] = p.y; o[2] = p.z;
-            A->jnt[A->nv * 4] = (uint16_t)j;
-            A->wgt[A->nv * 4] = 1.0f;
-            A->side[A->nv] = (uint8_t)s;
-            A->part[A->nv] = (uint8_t)part;
-            A->nv++;
-        }
+    const int v0 = A->nv;
+    tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, a, b, r, j);
+    for (int v = v0; v < A->nv; v++) {
+        A->side[v] = (uint8_t)s;
+        A->part[v] = (uint8_t)part;
     }
-    for (int i = 0; i + 1 < RINGS; i++)
-        for (int k = 0; k < AROUND; k++) {
-            uint32_t a0 = (uint32_t)(v0 + i * AROUND + k), a1 = (uint32_t)(v0 + i * AROUND + (k + 1) % AROUND);
-            uint32_t b0 = a0 + AROUND, b1 = a1 + AROUND;
-            uint32_t *t = &A->idx[A->nt * 3];
-            t[0] = a0; t[1] = b0; t[2] = a1;
-            t[3] = a1; t[4] = b0; t[5] = b1;
-            A->nt += 2;
-        }
 }
 
 /* The arms with the upper arm's and forearm's tube radii times ku, kf;
@@ -99,7 +78,7 @@ static void arms_build_wrist(arms *A) { arms_build_opt(A, 1.0f, 1.0f, 1); }
 static void arms_build_opt(arms *A, float ku, float kf, int wrist)
 {
     memset(A, 0, sizeof *A);
-    const int nv = 6 * RINGS * AROUND, nt = 6 * (RINGS - 1) * AROUND * 2;
+    const int nv = 6 * TU_TUBE_VERTS, nt = 6 * TU_TUBE_TRIS;
     const int per = wrist ? 4 : 3;
     A->nodes = 1 + 2 * per;
     A->pos = calloc((size_t)nv * 3, sizeof(float));
@@ -138,28 +117,10 @@ static void arms_build_opt(arms *A, float ku, float kf, int wrist)
         A->rig.joint[s][KIN_RIG_FOREARM] = u + 1;
         A->rig.joint[s][KIN_RIG_HAND] = hand;
     }
-    kin_mat4 world[MAX_NODES];
-    kin_fk(A->parents, A->nodes, A->rest, NULL, world);
-    for (int j = 0; j < A->nodes; j++) {
-        A->joints[j] = j;
-        assert_true(kin_mat4_inverse(&world[j], &A->ibm[j]));
-    }
-    A->skin = (kin_skin){ A->nodes, A->joints, A->ibm };
-    A->mesh.vertex_count = A->nv;
-    A->mesh.positions = A->pos;
-    A->mesh.joints = A->jnt;
-    A->mesh.weights = A->wgt;
-    A->mesh.index_count = A->nt * 3;
-    A->mesh.indices = A->idx;
-    A->mesh.node = -1;
-    A->mesh.skin = 0;
-    A->m.node_count = A->nodes;
-    A->m.parents = A->parents;
-    A->m.rest = A->rest;
-    A->m.mesh_count = 1;
-    A->m.meshes = &A->mesh;
-    A->m.skin_count = 1;
-    A->m.skins = &A->skin;
+    A->mesh = (kin_mesh){ .vertex_count = A->nv, .positions = A->pos, .joints = A->jnt,
+                          .weights = A->wgt, .index_count = A->nt * 3, .indices = A->idx,
+                          .node = -1, .skin = 0 };
+    tu_rig_bind(&A->m, &A->skin, &A->mesh, A->nodes, A->parents, A->rest, A->ibm, A->joints);
 }
 
 static void arms_free(arms *A)
@@ -291,19 +252,22 @@ static void fit_case_opt(const float true_phi[2], float found[2], uint64_t seed,
     arms_free(&A);
 }
 
-static void fit_case(const float true_phi[2], float found[2], uint64_t seed)
+/* The fit of `variant` (desc: NULL for the defaults) finds elbows turned
+ * by +20 and -15 degrees within 3 degrees (fit_case_opt checks the pose
+ * it leaves). */
+static void finds_20_m15(uint64_t seed, int variant, const pipe_fit_desc *desc)
 {
-    fit_case_opt(true_phi, found, seed, PLAIN, NULL);
+    const float phi[2] = { 20.0f * D2R, -15.0f * D2R };
+    float found[2];
+    fit_case_opt(phi, found, seed, variant, desc);
+    NEAR(found[0] / D2R, 20.0, 3.0);
+    NEAR(found[1] / D2R, -15.0, 3.0);
 }
 
 static void finds_turned_elbows(void **state)
 {
     (void)state;
-    const float phi[2] = { 20.0f * D2R, -15.0f * D2R };
-    float found[2];
-    fit_case(phi, found, 0x666974);
-    NEAR(found[0] / D2R, 20.0, 3.0);
-    NEAR(found[1] / D2R, -15.0, 3.0);
+    finds_20_m15(0x666974, PLAIN, NULL);
 }
 
 static void stays_when_right(void **state)
@@ -311,7 +275,7 @@ static void stays_when_right(void **state)
     (void)state;
     const float phi[2] = { 0.0f, 0.0f };
     float found[2];
-    fit_case(phi, found, 0x666975);
+    fit_case_opt(phi, found, 0x666975, PLAIN, NULL);
     NEAR(found[0] / D2R, 0.0, 3.0);
     NEAR(found[1] / D2R, 0.0, 3.0);
 }
@@ -343,12 +307,12 @@ static void draw_some(const arms *A, const float *pos, const kin_camera *cam, ui
 }
 
 /* The skin of the sleeved arms: the wrist third of each forearm tube (its
- * rings 2 RINGS / 3 and beyond) and the hand; the rest is sleeve. */
+ * rings 2 TU_TUBE_RINGS / 3 and beyond) and the hand; the rest is sleeve. */
 static int is_skin(const arms *A, int v)
 {
     int k = A->part[v];
-    int ring = (v % (RINGS * AROUND)) / AROUND;
-    return k == 2 || (k == 1 && ring >= 2 * RINGS / 3);
+    int ring = (v % TU_TUBE_VERTS) / TU_TUBE_AROUND;
+    return k == 2 || (k == 1 && ring >= 2 * TU_TUBE_RINGS / 3);
 }
 
 /* The forearms leave the image at its bottom (the elbows are 50-80 px
@@ -516,6 +480,20 @@ static void thickness_from_masks(void **state)
     arms_free(&T);
 }
 
+/* A W x H camera image and mask split down the middle: the left half
+ * inside M and skin-red, the right half outside and blue-grey. */
+static void half_image(uint8_t *rgba, uint8_t *m)
+{
+    for (int i = 0; i < W * H; i++) {
+        int in = (i % W) < W / 2;
+        m[i] = in ? 255 : 0;
+        rgba[i * 4 + 0] = in ? 200 : 60;
+        rgba[i * 4 + 1] = in ? 120 : 90;
+        rgba[i * 4 + 2] = in ? 100 : 150;
+        rgba[i * 4 + 3] = 255;
+    }
+}
+
 /* pipe_fit_learned: no model before learning or when a class is empty,
  * one after. */
 static void learned_flag(void **state)
@@ -527,14 +505,7 @@ static void learned_flag(void **state)
     assert_non_null(f);
     uint8_t *rgba = malloc(4 * W * H), *m = malloc(W * H);
     assert_true(rgba && m);
-    for (int i = 0; i < W * H; i++) {
-        int in = (i % W) < W / 2;
-        m[i] = in ? 255 : 0;
-        rgba[i * 4 + 0] = in ? 200 : 60;
-        rgba[i * 4 + 1] = in ? 120 : 90;
-        rgba[i * 4 + 2] = in ? 100 : 150;
-        rgba[i * 4 + 3] = 255;
-    }
+    half_image(rgba, m);
     fuse_image P = { rgba, W, H, 4 * W };
     assert_false(pipe_fit_learned(f, 0));
     assert_false(pipe_fit_learned(f, 1));
@@ -588,11 +559,7 @@ static void bad_arguments(void **state)
 static void fit_through_wrist_node(void **state)
 {
     (void)state;
-    const float phi[2] = { 20.0f * D2R, -15.0f * D2R };
-    float found[2];
-    fit_case_opt(phi, found, 0x777269, WRIST, NULL);
-    NEAR(found[0] / D2R, 20.0, 3.0);
-    NEAR(found[1] / D2R, -15.0, 3.0);
+    finds_20_m15(0x777269, WRIST, NULL);
 }
 
 /* Mesh 0 skinned by skin 1 while skin 0 names the nodes in reverse: the
@@ -602,11 +569,7 @@ static void fit_through_wrist_node(void **state)
 static void fit_uses_mesh_skin(void **state)
 {
     (void)state;
-    const float phi[2] = { 20.0f * D2R, -15.0f * D2R };
-    float found[2];
-    fit_case_opt(phi, found, 0x736b31, SKIN1, NULL);
-    NEAR(found[0] / D2R, 20.0, 3.0);
-    NEAR(found[1] / D2R, -15.0, 3.0);
+    finds_20_m15(0x736b31, SKIN1, NULL);
 }
 
 /* Settings outside the documented bounds are refused: a step that
@@ -642,11 +605,7 @@ static void settings_bounded(void **state)
         pipe_fit *f = pipe_fit_create(&edge[i], &A.m, &A.rig, W, H);
         assert_non_null(f);
         pipe_fit_destroy(f);
-        const float phi[2] = { 20.0f * D2R, -15.0f * D2R };
-        float found[2];
-        fit_case_opt(phi, found, 0x65646765 + i, PLAIN, &edge[i]);
-        NEAR(found[0] / D2R, 20.0, 3.0);
-        NEAR(found[1] / D2R, -15.0, 3.0);
+        finds_20_m15(0x65646765 + i, PLAIN, &edge[i]);
     }
     arms_free(&A);
 }
@@ -703,14 +662,7 @@ static void huge_projections(void **state)
     }
     uint8_t *rgba = malloc(4 * W * H), *m = malloc(W * H);
     assert_true(rgba && m);
-    for (int i = 0; i < W * H; i++) {
-        int in = (i % W) < W / 2;
-        m[i] = in ? 255 : 0;
-        rgba[i * 4 + 0] = in ? 200 : 60;
-        rgba[i * 4 + 1] = in ? 120 : 90;
-        rgba[i * 4 + 2] = in ? 100 : 150;
-        rgba[i * 4 + 3] = 255;
-    }
+    half_image(rgba, m);
     const fuse_image P[2] = { { rgba, W, H, 4 * W }, { rgba, W, H, 4 * W } };
     pipe_fit *f = pipe_fit_create(NULL, &A.m, &A.rig, W, H);
     assert_non_null(f);

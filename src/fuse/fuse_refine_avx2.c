@@ -30,16 +30,6 @@ static inline uint32_t edge_bits(const uint8_t *up, const uint8_t *row, const ui
     return (m ^ l) | (m ^ r) | (m ^ u) | (m ^ d);
 }
 
-static int is_in(uint8_t v) { return v >= 128; }
-
-/* The portable edge test of one pixel. */
-static int edge_at(const uint8_t *up, const uint8_t *row, const uint8_t *dn, int w, int x)
-{
-    const int in = is_in(row[x]);
-    return (x > 0 && is_in(row[x - 1]) != in) || (x + 1 < w && is_in(row[x + 1]) != in) ||
-           is_in(up[x]) != in || is_in(dn[x]) != in;
-}
-
 static int edge_span_avx2(const uint8_t *up, const uint8_t *row, const uint8_t *dn, int w,
                           int *x0, int *x1)
 {
@@ -50,7 +40,7 @@ static int edge_span_avx2(const uint8_t *up, const uint8_t *row, const uint8_t *
             if (e) { a = x + __builtin_ctz(e); break; }
             x += 32;
         } else {
-            if (edge_at(up, row, dn, w, x)) { a = x; break; }
+            if (fuse__refine_edge_at(up, row, dn, w, x)) { a = x; break; }
             x++;
         }
     }
@@ -61,7 +51,7 @@ static int edge_span_avx2(const uint8_t *up, const uint8_t *row, const uint8_t *
             if (e) { b = x - __builtin_clz(e); break; }
             x -= 32;
         } else {
-            if (edge_at(up, row, dn, w, x)) { b = x; break; }
+            if (fuse__refine_edge_at(up, row, dn, w, x)) { b = x; break; }
             x--;
         }
     }
@@ -107,24 +97,13 @@ static inline void vert16(uint16_t *r, const uint16_t *v, int x)
     _mm256_storeu_si256((__m256i *)(void *)(r + x), m);
 }
 
-static uint16_t min16(uint16_t a, unsigned b) { return b < a ? (uint16_t)b : a; }
-
 /* the vertical part on [a, b]: vectors inside, the portable rule at the ends */
 static void vert_row(uint16_t *r, const uint16_t *v, int w, int a, int b)
 {
     int x = a;
-    for (; x <= b && x < 1; x++) {   /* pixel 0: no left neighbour */
-        uint16_t m = min16(r[x], (unsigned)v[x] + 3u);
-        if (x + 1 < w) m = min16(m, (unsigned)v[x + 1] + 4u);
-        r[x] = m;
-    }
+    for (; x <= b && x < 1; x++) r[x] = fuse__refine_vert_px(r, v, w, x);
     for (; x + 15 <= b && x + 16 < w; x += 16) vert16(r, v, x);
-    for (; x <= b; x++) {
-        uint16_t m = min16(r[x], (unsigned)v[x] + 3u);
-        if (x > 0) m = min16(m, (unsigned)v[x - 1] + 4u);
-        if (x + 1 < w) m = min16(m, (unsigned)v[x + 1] + 4u);
-        r[x] = m;
-    }
+    for (; x <= b; x++) r[x] = fuse__refine_vert_px(r, v, w, x);
 }
 
 static void dt_fwd_avx2(uint16_t *r, const uint16_t *u, int w, int a, int b)

@@ -120,59 +120,81 @@ static inline __m512i vert_min(__m512i cur, const uint16_t *v, int w, int x, __m
     return _mm512_min_epu16(m, _mm512_adds_epu16(rv, four));
 }
 
-static void dt_fwd_avx512(uint16_t *r, const uint16_t *u, int w, int a, int b)
+/* 3 * lane: 0, 3, ..., 93 */
+static inline __m512i lane3(void)
 {
     short l3[32];
     for (int j = 0; j < 32; j++) l3[j] = (short)(3 * j);
-    const __m512i lane3 = _mm512_loadu_si512(l3), big = _mm512_set1_epi16(BIG);
-    const __m512i s1 = shift_idx(1), s2 = shift_idx(2), s4 = shift_idx(4), s8 = shift_idx(8),
-                  s16 = shift_idx(16);
+    return _mm512_loadu_si512(l3);
+}
+
+/* One step of run_min: lane j takes min(t[j], t[j - k]) (fwd) or
+ * min(t[j], t[j + k]), through s = shift_idx(k) / shift_idx(-k); lanes
+ * j - k < 0 / j + k > 31 take `big` (the masks are constants once
+ * inlined). */
+static inline __m512i run_step(__m512i t, __m512i big, __m512i s, int k, int fwd)
+{
+    const __mmask32 take = fwd ? (__mmask32)(0xFFFFFFFFu << k) : (__mmask32)(0xFFFFFFFFu >> k);
+    return _mm512_min_epi16(t, _mm512_mask_permutexvar_epi16(big, take, s, t));
+}
+
+/* The inclusive running minimum over the 32 lanes of t, from lane 0 up
+ * (fwd: lane j = min of lanes 0..j) or from lane 31 down (lane j = min of
+ * lanes j..31), as a log-step scan in five steps k = 1, 2, 4, 8, 16;
+ * s[i] = shift_idx(k) forward, shift_idx(-k) backward. Shared by both
+ * chamfer passes (the same machine code as the two unrolled scans). */
+static inline __m512i run_min(__m512i t, __m512i big, const __m512i s[5], int fwd)
+{
+    t = run_step(t, big, s[0], 1, fwd);
+    t = run_step(t, big, s[1], 2, fwd);
+    t = run_step(t, big, s[2], 4, fwd);
+    t = run_step(t, big, s[3], 8, fwd);
+    return run_step(t, big, s[4], 16, fwd);
+}
+
+/* The 32 lanes of row r at x after the vertical part of a pass (v: the
+ * row above or below, NULL: none), lanes outside ld `big`. */
+static inline __m512i pass_in(const uint16_t *r, const uint16_t *v, int w, int x, __mmask32 ld,
+                              __m512i big)
+{
+    __m512i c = _mm512_mask_loadu_epi16(big, ld, r + x);
+    if (v) c = vert_min(c, v, w, x, ld);
+    return _mm512_mask_blend_epi16(ld, big, c);
+}
+
+static void dt_fwd_avx512(uint16_t *r, const uint16_t *u, int w, int a, int b)
+{
+    const __m512i l3 = lane3(), big = _mm512_set1_epi16(BIG);
+    const __m512i s[5] = {shift_idx(1), shift_idx(2), shift_idx(4), shift_idx(8),
+                          shift_idx(16)};
     int carry = BIG - 3;   /* r[a - 1] is the cap (or absent) */
     for (int x = a; x <= b; x += 32) {
         const __mmask32 ld = lanes32(b + 1 - x);
-        __m512i v = _mm512_mask_loadu_epi16(big, ld, r + x);
-        if (u) v = vert_min(v, u, w, x, ld);
-        v = _mm512_mask_blend_epi16(ld, big, v);
+        const __m512i v = pass_in(r, u, w, x, ld, big);
         /* t = v - 3 lane; prefix minimum; the carry enters as r[x-1] + 3 */
-        __m512i t = _mm512_sub_epi16(v, lane3);
-        t = _mm512_min_epi16(t, _mm512_mask_permutexvar_epi16(big, 0xFFFFFFFEu, s1, t));
-        t = _mm512_min_epi16(t, _mm512_mask_permutexvar_epi16(big, 0xFFFFFFFCu, s2, t));
-        t = _mm512_min_epi16(t, _mm512_mask_permutexvar_epi16(big, 0xFFFFFFF0u, s4, t));
-        t = _mm512_min_epi16(t, _mm512_mask_permutexvar_epi16(big, 0xFFFFFF00u, s8, t));
-        t = _mm512_min_epi16(t, _mm512_mask_permutexvar_epi16(big, 0xFFFF0000u, s16, t));
+        __m512i t = run_min(_mm512_sub_epi16(v, l3), big, s, 1);
         t = _mm512_min_epi16(t, _mm512_set1_epi16((short)(carry + 3)));
-        const __m512i o = _mm512_add_epi16(t, lane3);
-        _mm512_mask_storeu_epi16(r + x, ld, o);
+        _mm512_mask_storeu_epi16(r + x, ld, _mm512_add_epi16(t, l3));
         carry = (uint16_t)r[x + 31 < b ? x + 31 : b];
     }
 }
 
 static void dt_bwd_avx512(uint16_t *r, const uint16_t *dn, int w, int a, int b)
 {
-    short l3[32];
-    for (int j = 0; j < 32; j++) l3[j] = (short)(3 * j);
-    const __m512i lane3 = _mm512_loadu_si512(l3), big = _mm512_set1_epi16(BIG);
-    const __m512i s1 = shift_idx(-1), s2 = shift_idx(-2), s4 = shift_idx(-4),
-                  s8 = shift_idx(-8), s16 = shift_idx(-16);
+    const __m512i l3 = lane3(), big = _mm512_set1_epi16(BIG);
+    const __m512i s[5] = {shift_idx(-1), shift_idx(-2), shift_idx(-4), shift_idx(-8),
+                          shift_idx(-16)};
     const int n = (b - a) / 32;
     int carry = BIG - 96;   /* r[b + 1] is the cap (or absent) */
     for (int i = n; i >= 0; i--) {
         const int x = a + 32 * i;
         const __mmask32 ld = lanes32(b + 1 - x);
-        __m512i v = _mm512_mask_loadu_epi16(big, ld, r + x);
-        if (dn) v = vert_min(v, dn, w, x, ld);
-        v = _mm512_mask_blend_epi16(ld, big, v);
+        const __m512i v = pass_in(r, dn, w, x, ld, big);
         /* t = v + 3 lane; suffix minimum; the carry at lane 32 enters as
          * r[x + 32] + 3 (32 - j) = (r[x + 32] + 96) - 3 j */
-        __m512i t = _mm512_add_epi16(v, lane3);
-        t = _mm512_min_epi16(t, _mm512_mask_permutexvar_epi16(big, 0x7FFFFFFFu, s1, t));
-        t = _mm512_min_epi16(t, _mm512_mask_permutexvar_epi16(big, 0x3FFFFFFFu, s2, t));
-        t = _mm512_min_epi16(t, _mm512_mask_permutexvar_epi16(big, 0x0FFFFFFFu, s4, t));
-        t = _mm512_min_epi16(t, _mm512_mask_permutexvar_epi16(big, 0x00FFFFFFu, s8, t));
-        t = _mm512_min_epi16(t, _mm512_mask_permutexvar_epi16(big, 0x0000FFFFu, s16, t));
+        __m512i t = run_min(_mm512_add_epi16(v, l3), big, s, 0);
         t = _mm512_min_epi16(t, _mm512_set1_epi16((short)(carry + 96)));
-        const __m512i o = _mm512_sub_epi16(t, lane3);
-        _mm512_mask_storeu_epi16(r + x, ld, o);
+        _mm512_mask_storeu_epi16(r + x, ld, _mm512_sub_epi16(t, l3));
         carry = r[x];
     }
 }

@@ -33,27 +33,18 @@
 
 /* ---------------------------------------------------- portable kernels */
 
-static int is_in(uint8_t v) { return v >= 128; }
-
-static int edge_at(const uint8_t *up, const uint8_t *row, const uint8_t *dn, int w, int x)
-{
-    const int in = is_in(row[x]);
-    return (x > 0 && is_in(row[x - 1]) != in) || (x + 1 < w && is_in(row[x + 1]) != in) ||
-           is_in(up[x]) != in || is_in(dn[x]) != in;
-}
-
 static int edge_span_c(const uint8_t *up, const uint8_t *row, const uint8_t *dn, int w,
                        int *x0, int *x1)
 {
     int a = -1, b = -1;
     for (int x = 0; x < w; x++)
-        if (edge_at(up, row, dn, w, x)) {
+        if (fuse__refine_edge_at(up, row, dn, w, x)) {
             a = x;
             break;
         }
     if (a < 0) return 0;
     for (int x = w - 1; x >= a; x--)
-        if (edge_at(up, row, dn, w, x)) {
+        if (fuse__refine_edge_at(up, row, dn, w, x)) {
             b = x;
             break;
         }
@@ -65,33 +56,23 @@ static int edge_span_c(const uint8_t *up, const uint8_t *row, const uint8_t *dn,
 static void dt_init_c(const uint8_t *up, const uint8_t *row, const uint8_t *dn, int w, int a,
                       int b, uint16_t cap, uint16_t *d)
 {
-    for (int x = a; x <= b; x++) d[x] = edge_at(up, row, dn, w, x) ? 3 : cap;
+    for (int x = a; x <= b; x++) d[x] = fuse__refine_edge_at(up, row, dn, w, x) ? 3 : cap;
 }
-
-static uint16_t min16(uint16_t a, unsigned b) { return b < a ? (uint16_t)b : a; }
 
 static void dt_fwd_c(uint16_t *r, const uint16_t *u, int w, int a, int b)
 {
     if (u)
-        for (int x = a; x <= b; x++) {
-            uint16_t v = min16(r[x], (unsigned)u[x] + 3u);
-            if (x > 0) v = min16(v, (unsigned)u[x - 1] + 4u);
-            if (x + 1 < w) v = min16(v, (unsigned)u[x + 1] + 4u);
-            r[x] = v;
-        }
-    for (int x = a > 0 ? a : 1; x <= b; x++) r[x] = min16(r[x], (unsigned)r[x - 1] + 3u);
+        for (int x = a; x <= b; x++) r[x] = fuse__refine_vert_px(r, u, w, x);
+    for (int x = a > 0 ? a : 1; x <= b; x++)
+        r[x] = fuse__refine_min16(r[x], (unsigned)r[x - 1] + 3u);
 }
 
 static void dt_bwd_c(uint16_t *r, const uint16_t *dn, int w, int a, int b)
 {
     if (dn)
-        for (int x = a; x <= b; x++) {
-            uint16_t v = min16(r[x], (unsigned)dn[x] + 3u);
-            if (x + 1 < w) v = min16(v, (unsigned)dn[x + 1] + 4u);
-            if (x > 0) v = min16(v, (unsigned)dn[x - 1] + 4u);
-            r[x] = v;
-        }
-    for (int x = b + 1 < w ? b : w - 2; x >= a; x--) r[x] = min16(r[x], (unsigned)r[x + 1] + 3u);
+        for (int x = a; x <= b; x++) r[x] = fuse__refine_vert_px(r, dn, w, x);
+    for (int x = b + 1 < w ? b : w - 2; x >= a; x--)
+        r[x] = fuse__refine_min16(r[x], (unsigned)r[x + 1] + 3u);
 }
 
 static unsigned bin_of(const uint8_t *px, int bits)
@@ -109,7 +90,7 @@ static void hist_row_c(const uint8_t *px, const uint8_t *m, const uint16_t *d, i
     for (int x = a; x <= b; x++) {
         if (d[x] <= band3 || d[x] > outer3) continue;
         unsigned bin = bin_of(px + 4 * x, bits);
-        if (is_in(m[x])) { hf[bin]++; f++; }
+        if (fuse__refine_in(m[x])) { hf[bin]++; f++; }
         else { hb[bin]++; g++; }
     }
     *nf += f;
@@ -120,7 +101,7 @@ static void score_row_c(const fuse__refine_tabs *t, const uint8_t *px, const uin
                         const uint16_t *d, float *s, int a, int b)
 {
     for (int x = a; x <= b; x++) {
-        const int in = is_in(m[x]);
+        const int in = fuse__refine_in(m[x]);
         if (d[x] > t->band3) {
             s[x] = in ? 4.0f : -4.0f;
             continue;
@@ -136,7 +117,7 @@ static void decide_row_c(const float *s, ptrdiff_t ss, int rad, const uint8_t *m
                          long cnt[3])
 {
     for (int x = a; x <= b; x++) {
-        const int in = is_in(m[x]);
+        const int in = fuse__refine_in(m[x]);
         uint8_t v;
         if (d[x] > band3) {
             v = in ? 255 : 0;
@@ -157,7 +138,7 @@ static void decide_row_c(const float *s, ptrdiff_t ss, int rad, const uint8_t *m
 
 static void binarise_c(const uint8_t *m, uint8_t *out, int a, int b)
 {
-    for (int x = a; x <= b; x++) out[x] = is_in(m[x]) ? 255 : 0;
+    for (int x = a; x <= b; x++) out[x] = fuse__refine_in(m[x]) ? 255 : 0;
 }
 
 const fuse__refine_kern fuse__refine_kern_c = {

@@ -62,6 +62,40 @@ typedef struct fuse__refine_kern {
     void (*binarise)(const uint8_t *m, uint8_t *out, int a, int b);
 } fuse__refine_kern;
 
+/* Scalar rules shared by the portable kernels and the SIMD files' row
+ * ends (the reference's, fuse_refine.c). */
+
+/* A mask byte is inside when >= 128. */
+static inline int fuse__refine_in(uint8_t v) { return v >= 128; }
+
+/* Pixel x is an edge pixel: a 4-neighbour of the other class (none left
+ * of x = 0 or right of x = w - 1; up / dn are the row itself at the
+ * image border). */
+static inline int fuse__refine_edge_at(const uint8_t *up, const uint8_t *row,
+                                       const uint8_t *dn, int w, int x)
+{
+    const int in = fuse__refine_in(row[x]);
+    return (x > 0 && fuse__refine_in(row[x - 1]) != in) ||
+           (x + 1 < w && fuse__refine_in(row[x + 1]) != in) ||
+           fuse__refine_in(up[x]) != in || fuse__refine_in(dn[x]) != in;
+}
+
+static inline uint16_t fuse__refine_min16(uint16_t a, unsigned b)
+{
+    return b < a ? (uint16_t)b : a;
+}
+
+/* The vertical part of a chamfer row pass at x: min(r[x], v[x] + 3,
+ * v[x - 1] + 4, v[x + 1] + 4), v the row above (forward) or below
+ * (backward), the neighbours only inside [0, w). */
+static inline uint16_t fuse__refine_vert_px(const uint16_t *r, const uint16_t *v, int w, int x)
+{
+    uint16_t m = fuse__refine_min16(r[x], (unsigned)v[x] + 3u);
+    if (x > 0) m = fuse__refine_min16(m, (unsigned)v[x - 1] + 4u);
+    if (x + 1 < w) m = fuse__refine_min16(m, (unsigned)v[x + 1] + 4u);
+    return m;
+}
+
 /* The portable C kernels (every machine); the SIMD files call them for
  * the parts of a row their vectors do not cover. */
 extern const fuse__refine_kern fuse__refine_kern_c;
