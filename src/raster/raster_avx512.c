@@ -274,6 +274,13 @@ static inline void load_block_xyzw(const float *c, float *x, float *y, float *z,
 }
 #define LOAD_BLOCK_XYZW(c, x, y, z, w) load_block_xyzw(c, x, y, z, w)
 
+/* Lane macros, the rejection helpers and raster_front.inl. */
+#include "raster_front_avx512.inl"
+
+_Static_assert(sizeof(rast__vc_entry) == 32 && offsetof(rast__vc_entry, flags) == 4 &&
+                   offsetof(rast__vc_entry, X) == 8 && offsetof(rast__vc_entry, Y) == 12,
+               "rast__front_avx512 gathers (tag, flags) and (X, Y) as qwords 4s, 4s+1");
+
 /* Trivial rejection of 16 submitted triangles (rast__front_fn, see
  * raster_internal.h). Per lane, the decisions of the scalar front end
  * (prepare_cached_one and setup_box_edges in raster_setup.c):
@@ -285,87 +292,15 @@ static inline void load_block_xyzw(const float *c, float *x, float *y, float *z,
  *   one-pixel box (before clamping too, so every coordinate difference is
  *     below 512 and the int32 products below 2^18): the three biased edge
  *     values at the centre, winding normalised, all >= 0 or empty. */
-static inline __m512i front_deint(__m512i a, __m512i b, __m512i c, __m512i idx)
-{
-    /* lane l = element idx[l] of the 48 indices a | b | c (idx < 48). */
-    const __mmask16 hi = _mm512_cmpge_epi32_mask(idx, _mm512_set1_epi32(32));
-    return _mm512_mask_permutexvar_epi32(_mm512_permutex2var_epi32(a, idx, b), hi, idx, c);
-}
-
-static inline unsigned front_area_bits(__m512i a, __m512i b, __m512i c, __m512i d,
-                                       int cmp)
-{
-    /* Lanes with a*b <cmp> c*d (exact in double). */
-    const __m512d alo = _mm512_cvtepi32_pd(_mm512_castsi512_si256(a));
-    const __m512d ahi = _mm512_cvtepi32_pd(_mm512_extracti32x8_epi32(a, 1));
-    const __m512d blo = _mm512_cvtepi32_pd(_mm512_castsi512_si256(b));
-    const __m512d bhi = _mm512_cvtepi32_pd(_mm512_extracti32x8_epi32(b, 1));
-    const __m512d clo = _mm512_cvtepi32_pd(_mm512_castsi512_si256(c));
-    const __m512d chi = _mm512_cvtepi32_pd(_mm512_extracti32x8_epi32(c, 1));
-    const __m512d dlo = _mm512_cvtepi32_pd(_mm512_castsi512_si256(d));
-    const __m512d dhi = _mm512_cvtepi32_pd(_mm512_extracti32x8_epi32(d, 1));
-    const __m512d p1lo = _mm512_mul_pd(alo, blo), p2lo = _mm512_mul_pd(clo, dlo);
-    const __m512d p1hi = _mm512_mul_pd(ahi, bhi), p2hi = _mm512_mul_pd(chi, dhi);
-    if (cmp > 0)
-        return (unsigned)_mm512_cmp_pd_mask(p1lo, p2lo, _CMP_GT_OQ) |
-               (unsigned)_mm512_cmp_pd_mask(p1hi, p2hi, _CMP_GT_OQ) << 8;
-    return (unsigned)_mm512_cmp_pd_mask(p1lo, p2lo, _CMP_LT_OQ) |
-           (unsigned)_mm512_cmp_pd_mask(p1hi, p2hi, _CMP_LT_OQ) << 8;
-}
-
-/* Biased edge value from a to b at (cx, cy) (int32: small boxes only). */
-static inline __m512i front_edge(__m512i xa, __m512i ya, __m512i xb, __m512i yb,
-                                 __m512i cx, __m512i cy)
-{
-    const __m512i dx = _mm512_sub_epi32(xb, xa), dy = _mm512_sub_epi32(yb, ya);
-    const __m512i zero = _mm512_setzero_si512();
-    const __mmask16 tl = _mm512_cmplt_epi32_mask(dy, zero) |
-                         (_mm512_cmpeq_epi32_mask(dy, zero) & _mm512_cmpgt_epi32_mask(dx, zero));
-    const __m512i e = _mm512_sub_epi32(_mm512_mullo_epi32(dx, _mm512_sub_epi32(cy, ya)),
-                                       _mm512_mullo_epi32(dy, _mm512_sub_epi32(cx, xa)));
-    return _mm512_mask_sub_epi32(e, (__mmask16)~tl, e, _mm512_set1_epi32(1));
-}
-
-_Static_assert(sizeof(rast__vc_entry) == 32 && offsetof(rast__vc_entry, flags) == 4 &&
-                   offsetof(rast__vc_entry, X) == 8 && offsetof(rast__vc_entry, Y) == 12,
-               "rast__front_avx512 gathers (tag, flags) and (X, Y) as qwords 4s, 4s+1");
-
-/* The qwords eb[q_l] for the 16 lanes l of q: lanes 0..7 in p[0], 8..15
- * in p[1]. */
-static inline void front_gather_pairs(const long long *eb, __m512i q, __m512i p[2])
-{
-    p[0] = _mm512_i32gather_epi64(_mm512_castsi512_si256(q), eb, 8);
-    p[1] = _mm512_i32gather_epi64(_mm512_extracti32x8_epi32(q, 1), eb, 8);
-}
-
-/* The low (even) and high (odd) dwords of the 16 qwords p[0], p[1]. */
-static inline __m512i front_even(const __m512i p[2])
-{
-    const __m512i ie = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26,
-                                         28, 30);
-    return _mm512_permutex2var_epi32(p[0], ie, p[1]);
-}
-
-static inline __m512i front_odd(const __m512i p[2])
-{
-    const __m512i io = _mm512_setr_epi32(1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 23, 25, 27,
-                                         29, 31);
-    return _mm512_permutex2var_epi32(p[0], io, p[1]);
-}
-
 unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__vcache *vc,
                             int ti, rast_stats *st, rast__vfill_fn vfill)
 {
     const uint32_t *ix = m->indices + 3 * (size_t)ti;
     const __m512i a = _mm512_loadu_si512(ix), b = _mm512_loadu_si512(ix + 16),
                   c = _mm512_loadu_si512(ix + 32);
-    const __m512i l3 = _mm512_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 33, 36, 39,
-                                         42, 45);
     const __m512i one = _mm512_set1_epi32(1);
     __m512i iv[3];
-    iv[0] = front_deint(a, b, c, l3);
-    iv[1] = front_deint(a, b, c, _mm512_add_epi32(l3, one));
-    iv[2] = front_deint(a, b, c, _mm512_add_epi32(l3, _mm512_set1_epi32(2)));
+    deint_tris(a, b, c, iv);
     /* Cache entries are 32 bytes: qword 4s of slot s holds (tag, flags),
      * qword 4s + 1 the snapped (X, Y). Each pair comes with one 64-bit
      * gather element (8 lanes per gather, half the element loads of
@@ -376,8 +311,8 @@ unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__
     unsigned miss = 0;
     for (int k = 0; k < 3; k++) {
         so[k] = _mm512_slli_epi32(_mm512_and_si512(iv[k], smask), 2);
-        front_gather_pairs(eb, so[k], tf[k]);
-        miss |= _mm512_cmpneq_epi32_mask(front_even(tf[k]), iv[k]);
+        gather_pairs(eb, so[k], tf[k]);
+        miss |= _mm512_cmpneq_epi32_mask(pairs_lo(tf[k]), iv[k]);
     }
     if (miss) {
         _Alignas(64) uint32_t idx[3][16];
@@ -397,8 +332,8 @@ unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__
         }
         unsigned still = 0;
         for (int k = 0; k < 3; k++) {
-            front_gather_pairs(eb, so[k], tf[k]);
-            still |= _mm512_cmpneq_epi32_mask(front_even(tf[k]), iv[k]);
+            gather_pairs(eb, so[k], tf[k]);
+            still |= _mm512_cmpneq_epi32_mask(pairs_lo(tf[k]), iv[k]);
         }
         if (still)   /* slots shared inside the group: the scalar path */
             return 0xFFFFu;
@@ -406,59 +341,28 @@ unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__
     __m512i X[3], Y[3], fl = _mm512_setzero_si512();
     for (int k = 0; k < 3; k++) {
         __m512i xy[2];
-        fl = _mm512_or_si512(fl, front_odd(tf[k]));
-        front_gather_pairs(eb, _mm512_add_epi32(so[k], one), xy);
-        X[k] = front_even(xy);
-        Y[k] = front_odd(xy);
+        fl = _mm512_or_si512(fl, pairs_hi(tf[k]));
+        gather_pairs(eb, _mm512_add_epi32(so[k], one), xy);
+        X[k] = pairs_lo(xy);
+        Y[k] = pairs_hi(xy);
     }
     const unsigned special = _mm512_test_epi32_mask(fl, fl);
-    const __m512i dx1 = _mm512_sub_epi32(X[1], X[0]), dy1 = _mm512_sub_epi32(Y[1], Y[0]);
-    const __m512i dx2 = _mm512_sub_epi32(X[2], X[0]), dy2 = _mm512_sub_epi32(Y[2], Y[0]);
-    const unsigned pos = front_area_bits(dx1, dy2, dy1, dx2, 1);
-    const unsigned neg = front_area_bits(dx1, dy2, dy1, dx2, -1);
-    const unsigned valid = ~special & 0xFFFFu;
-    const unsigned degen = valid & ~(pos | neg);
-    const unsigned cullm = m->cull == RAST_CULL_BACK ? pos : m->cull == RAST_CULL_FRONT ? neg : 0u;
-    const unsigned culled = valid & cullm & (pos | neg);
-    const unsigned live = valid & (pos | neg) & ~cullm;
-
-    const __m512i xmin = _mm512_min_epi32(X[0], _mm512_min_epi32(X[1], X[2]));
-    const __m512i xmax = _mm512_max_epi32(X[0], _mm512_max_epi32(X[1], X[2]));
-    const __m512i ymin = _mm512_min_epi32(Y[0], _mm512_min_epi32(Y[1], Y[2]));
-    const __m512i ymax = _mm512_max_epi32(Y[0], _mm512_max_epi32(Y[1], Y[2]));
-    const __m512i c127 = _mm512_set1_epi32(RAST__FIX_ONE - 1 - RAST__FIX_HALF);
-    const __m512i c128 = _mm512_set1_epi32(RAST__FIX_HALF);
-    const __m512i rx0 = _mm512_srai_epi32(_mm512_add_epi32(xmin, c127), RAST_SUBPIXEL_BITS);
-    const __m512i rx1 = _mm512_srai_epi32(_mm512_sub_epi32(xmax, c128), RAST_SUBPIXEL_BITS);
-    const __m512i ry0 = _mm512_srai_epi32(_mm512_add_epi32(ymin, c127), RAST_SUBPIXEL_BITS);
-    const __m512i ry1 = _mm512_srai_epi32(_mm512_sub_epi32(ymax, c128), RAST_SUBPIXEL_BITS);
-    const __m512i zero = _mm512_setzero_si512();
-    const __m512i bx0 = _mm512_max_epi32(rx0, zero), by0 = _mm512_max_epi32(ry0, zero);
-    const __m512i bx1 = _mm512_min_epi32(rx1, _mm512_set1_epi32(v->width - 1));
-    const __m512i by1 = _mm512_min_epi32(ry1, _mm512_set1_epi32(v->height - 1));
-    const unsigned off = _mm512_cmpgt_epi32_mask(bx0, bx1) | _mm512_cmpgt_epi32_mask(by0, by1);
-    const unsigned offs = live & off;
-    const unsigned live2 = live & ~off;
+    unsigned pos, neg;
+    front_area_signs(X, Y, &pos, &neg);
+    const front_class cl = front_classify(m->cull, ~special & 0xFFFFu, pos, neg);
+    const front_box bx = front_box_of(X, Y, v->width, v->height);
+    const unsigned live2 = cl.live & ~bx.off;
     unsigned empty = 0;
-    const unsigned single = live2 & _mm512_cmpeq_epi32_mask(rx0, rx1) &
-                            _mm512_cmpeq_epi32_mask(ry0, ry1);
+    const unsigned single = live2 & bx.uone;
     if (single) {
         const __mmask16 sw = (__mmask16)neg;   /* normalise: swap 1 and 2 */
         const __m512i x1 = _mm512_mask_blend_epi32(sw, X[1], X[2]);
         const __m512i x2 = _mm512_mask_blend_epi32(sw, X[2], X[1]);
         const __m512i y1 = _mm512_mask_blend_epi32(sw, Y[1], Y[2]);
         const __m512i y2 = _mm512_mask_blend_epi32(sw, Y[2], Y[1]);
-        const __m512i cx = _mm512_add_epi32(_mm512_slli_epi32(bx0, RAST_SUBPIXEL_BITS), c128);
-        const __m512i cy = _mm512_add_epi32(_mm512_slli_epi32(by0, RAST_SUBPIXEL_BITS), c128);
-        const __m512i e0 = front_edge(x1, y1, x2, y2, cx, cy);
-        const __m512i e1 = front_edge(x2, y2, X[0], Y[0], cx, cy);
-        const __m512i e2 = front_edge(X[0], Y[0], x1, y1, cx, cy);
-        empty = single & _mm512_movepi32_mask(_mm512_or_si512(_mm512_or_si512(e0, e1), e2));
+        empty = single & front_empty_bits(X[0], Y[0], x1, y1, x2, y2, bx.bx0, bx.by0);
     }
-    st->tris_degenerate += __builtin_popcount(degen);
-    st->tris_culled += __builtin_popcount(culled);
-    st->tris_clipped_away += __builtin_popcount(offs);
-    st->tris_drawn += __builtin_popcount(empty);
+    front_count(st, cl.degen, cl.culled, cl.live & bx.off, empty);
     return special | (live2 & ~empty);
 }
 #define FRONT_FN rast__front_avx512

@@ -124,8 +124,8 @@ static inline __m256i top_left(__m256i dx, __m256i dy)
 }
 
 /* Biased edge value in int32 (one-pixel boxes only). */
-static inline __m256i edge32(__m256i xa, __m256i ya, __m256i xb, __m256i yb, __m256i cx,
-                             __m256i cy)
+static inline __m256i front_edge32(__m256i xa, __m256i ya, __m256i xb, __m256i yb,
+                                   __m256i cx, __m256i cy)
 {
     const __m256i dx = _mm256_sub_epi32(xb, xa), dy = _mm256_sub_epi32(yb, ya);
     const __m256i e = _mm256_sub_epi32(_mm256_mullo_epi32(dx, _mm256_sub_epi32(cy, ya)),
@@ -159,30 +159,40 @@ static inline __m256i compress_idx(unsigned b)
                             _mm256_set1_epi32(7));
 }
 
-/* ---- survivor queue and set-up ------------------------------------------ */
+/* Lane macros of raster_front.inl (8 int32 lanes, 4 double lanes). */
+#define FRONT_V 8
+typedef __m256i fvi;
+#define FI_ZERO() _mm256_setzero_si256()
+#define FI_SET1(x) _mm256_set1_epi32(x)
+#define FI_ADD(a, b) _mm256_add_epi32(a, b)
+#define FI_SUB(a, b) _mm256_sub_epi32(a, b)
+#define FI_OR(a, b) _mm256_or_si256(a, b)
+#define FI_MIN(a, b) _mm256_min_epi32(a, b)
+#define FI_MAX(a, b) _mm256_max_epi32(a, b)
+#define FI_SRAI(v, n) _mm256_srai_epi32(v, n)
+#define FI_SLLI(v, n) _mm256_slli_epi32(v, n)
+typedef __m256i fvm;
+#define FI_GT(a, b) _mm256_cmpgt_epi32(a, b)
+#define FI_EQ(a, b) _mm256_cmpeq_epi32(a, b)
+#define FM_OR(a, b) _mm256_or_si256(a, b)
+#define FM_AND(a, b) _mm256_and_si256(a, b)
+#define FM_BITS(m) bits8(m)
+#define FI_NEG_BITS(v) bits8(v)
+typedef __m256d fvd;
+typedef __m256d fdm;
+#define FD_SET1(x) _mm256_set1_pd(x)
+#define FD_ADD(a, b) _mm256_add_pd(a, b)
+#define FD_SUB(a, b) _mm256_sub_pd(a, b)
+#define FD_MUL(a, b) _mm256_mul_pd(a, b)
+#define FD_DIV(a, b) _mm256_div_pd(a, b)
+#define FD_MAX(a, b) _mm256_max_pd(a, b)
+#define FD_HALF_CVT(v, h) _mm256_cvtepi32_pd(half4(v, h))
+#define FD_GATHER(d, p, v, h, lh) _mm256_mask_i32gather_pd(d, p, half4(v, h), lh, 8)
+#define FD_KEEP(lh, a, b) _mm256_blendv_pd(b, a, lh)
+#define FD_STORE_F(p, v) _mm_store_ps(p, _mm256_cvtpd_ps(v))
+#include "raster_front.inl"
 
-enum { Q_X0, Q_X1, Q_X2, Q_Y0, Q_Y1, Q_Y2, Q_V0, Q_V1, Q_V2, Q_BX0, Q_BY0, Q_BX1, Q_BY1,
-       Q_SLOT, Q_FIELDS };
-typedef struct squeue {
-    int n;
-    _Alignas(32) int32_t f[Q_FIELDS][16];
-} squeue;
-
-static inline void plane4(__m256d f0, __m256d f1, __m256d f2, __m256d ex1, __m256d ey1,
-                          __m256d ex2, __m256d ey2, __m256d ox, __m256d oy, __m256d area,
-                          float *c, float *gxo, float *gyo)
-{
-    const __m256d df1 = _mm256_sub_pd(f1, f0), df2 = _mm256_sub_pd(f2, f0);
-    const __m256d gx = _mm256_div_pd(
-        _mm256_sub_pd(_mm256_mul_pd(df1, ey2), _mm256_mul_pd(df2, ey1)), area);
-    const __m256d gy = _mm256_div_pd(
-        _mm256_sub_pd(_mm256_mul_pd(df2, ex1), _mm256_mul_pd(df1, ex2)), area);
-    const __m256d cc = _mm256_add_pd(_mm256_add_pd(f0, _mm256_mul_pd(gx, ox)),
-                                     _mm256_mul_pd(gy, oy));
-    _mm_store_ps(c, _mm256_cvtpd_ps(cc));
-    _mm_store_ps(gxo, _mm256_cvtpd_ps(gx));
-    _mm_store_ps(gyo, _mm256_cvtpd_ps(gy));
-}
+/* ---- survivor set-up ---------------------------------------------------- */
 
 /* Sets up queue lanes 0 .. k-1 (k = 1..8) into their records. */
 static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
@@ -225,40 +235,11 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
         }
     }
 
+    /* planes_one per lane. */
     _Alignas(32) float pl[12][8];
-    const __m256d inv256 = _mm256_set1_pd(1.0 / RAST__FIX_ONE), dzero = _mm256_setzero_pd();
-    const __m256d dhalf = _mm256_set1_pd(0.5), done = _mm256_set1_pd(1.0);
-    for (int h = 0; h < 2; h++) {
-        const __m256d lh = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(half4(L, h)));
-        __m256d Xd[3], Yd[3], zw[3], iw[3];
-        for (int i = 0; i < 3; i++) {
-            Xd[i] = _mm256_mul_pd(_mm256_cvtepi32_pd(half4(X[i], h)), inv256);
-            Yd[i] = _mm256_mul_pd(_mm256_cvtepi32_pd(half4(Y[i], h)), inv256);
-            const __m128i vi = half4(V[i], h);
-            zw[i] = _mm256_mask_i32gather_pd(dzero, vb->zw, vi, lh, 8);
-            iw[i] = _mm256_mask_i32gather_pd(done, vb->iw, vi, lh, 8);
-        }
-        const __m256d ex1 = _mm256_sub_pd(Xd[1], Xd[0]), ey1 = _mm256_sub_pd(Yd[1], Yd[0]);
-        const __m256d ex2 = _mm256_sub_pd(Xd[2], Xd[0]), ey2 = _mm256_sub_pd(Yd[2], Yd[0]);
-        const __m256d area = _mm256_blendv_pd(
-            done, _mm256_sub_pd(_mm256_mul_pd(ex1, ey2), _mm256_mul_pd(ey1, ex2)), lh);
-        const __m256d ocx = _mm256_add_pd(_mm256_cvtepi32_pd(half4(bx0, h)), dhalf);
-        const __m256d ocy = _mm256_add_pd(_mm256_cvtepi32_pd(half4(by0, h)), dhalf);
-        const __m256d ox = _mm256_sub_pd(ocx, Xd[0]), oy = _mm256_sub_pd(ocy, Yd[0]);
-        /* max(a, b) = a > b ? a : b, as the scalar loop */
-        const __m256d qmax =
-            _mm256_max_pd(iw[2], _mm256_max_pd(iw[1], _mm256_max_pd(iw[0], dzero)));
-        const __m256d q0 = _mm256_div_pd(iw[0], qmax), q1 = _mm256_div_pd(iw[1], qmax),
-                      q2 = _mm256_div_pd(iw[2], qmax);
-        const int o = 4 * h;
-        plane4(zw[0], zw[1], zw[2], ex1, ey1, ex2, ey2, ox, oy, area, pl[0] + o, pl[1] + o,
-               pl[2] + o);
-        plane4(q0, q1, q2, ex1, ey1, ex2, ey2, ox, oy, area, pl[3] + o, pl[4] + o, pl[5] + o);
-        plane4(dzero, q1, dzero, ex1, ey1, ex2, ey2, ox, oy, area, pl[6] + o, pl[7] + o,
-               pl[8] + o);
-        plane4(dzero, dzero, q2, ex1, ey1, ex2, ey2, ox, oy, area, pl[9] + o, pl[10] + o,
-               pl[11] + o);
-    }
+    for (int h = 0; h < 2; h++)
+        front_planes_half(X, Y, V, bx0, by0,
+                          _mm256_castsi256_pd(_mm256_cvtepi32_epi64(half4(L, h))), h, vb, pl);
 
     const int ac = v->attr_count;
     _Alignas(32) float at[3][RAST_MAX_ATTRS][8];
@@ -282,29 +263,7 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
     }
 
     for (int l = 0; l < k; l++) {
-        rast__tri *t = out + q->f[Q_SLOT][l];
-        t->x0 = q->f[Q_BX0][l];
-        t->y0 = q->f[Q_BY0][l];
-        t->x1 = q->f[Q_BX1][l];
-        t->y1 = q->f[Q_BY1][l];
-        for (int e = 0; e < 3; e++) {
-            t->e_c[e] = ec[e][l];
-            t->e_dx[e] = edx[e][l];
-            t->e_dy[e] = edy[e][l];
-        }
-        t->z.c = pl[0][l];
-        t->z.dx = pl[1][l];
-        t->z.dy = pl[2][l];
-        t->q.c = pl[3][l];
-        t->q.dx = pl[4][l];
-        t->q.dy = pl[5][l];
-        t->b1.c = pl[6][l];
-        t->b1.dx = pl[7][l];
-        t->b1.dy = pl[8][l];
-        t->b2.c = pl[9][l];
-        t->b2.dx = pl[10][l];
-        t->b2.dy = pl[11][l];
-        t->attr_count = ac;
+        rast__tri *t = front_record(q, l, ec, edx, edy, pl, ac, out);
         for (int a = 0; a < ac; a++) {
             t->a0[a] = at[0][a][l];
             t->d1[a] = at[1][a][l];
@@ -324,9 +283,7 @@ int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__
     const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     const __m256i mark = _mm256_set1_epi32(RAST__VX_SPECIAL);
     const __m256i zero = _mm256_setzero_si256();
-    const __m256i c127 = _mm256_set1_epi32(RAST__FIX_ONE - 1 - RAST__FIX_HALF);
-    const __m256i c128 = _mm256_set1_epi32(RAST__FIX_HALF);
-    const __m256i wmax = _mm256_set1_epi32(v->width - 1), hmax = _mm256_set1_epi32(v->height - 1);
+    const int vw = v->width, vh = v->height;   /* kept in registers */
     for (int ti = ti0; ti < ti1; ti += 8) {
         const int cnt = ti1 - ti < 8 ? ti1 - ti : 8;
         const unsigned L = (1u << cnt) - 1u;
@@ -353,67 +310,33 @@ int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__
             spec = _mm256_or_si256(spec, _mm256_cmpeq_epi32(X[k], mark));
         }
         const unsigned special0 = bits8(spec) & L;
-        const unsigned valid = L & ~special0;
-        const __m256i dx1 = _mm256_sub_epi32(X[1], X[0]), dy1 = _mm256_sub_epi32(Y[1], Y[0]);
-        const __m256i dx2 = _mm256_sub_epi32(X[2], X[0]), dy2 = _mm256_sub_epi32(Y[2], Y[0]);
-        const unsigned pos = prod_cmp(dx1, dy2, dy1, dx2, 1);
-        const unsigned neg = prod_cmp(dx1, dy2, dy1, dx2, 0);
-        const unsigned cullm =
-            m->cull == RAST_CULL_BACK ? pos : m->cull == RAST_CULL_FRONT ? neg : 0u;
-        const unsigned degen = valid & ~(pos | neg);
-        const unsigned culled = valid & cullm & (pos | neg);
-        const unsigned live = valid & (pos | neg) & ~cullm;
-        const __m256i xmin = _mm256_min_epi32(X[0], _mm256_min_epi32(X[1], X[2]));
-        const __m256i xmax = _mm256_max_epi32(X[0], _mm256_max_epi32(X[1], X[2]));
-        const __m256i ymin = _mm256_min_epi32(Y[0], _mm256_min_epi32(Y[1], Y[2]));
-        const __m256i ymax = _mm256_max_epi32(Y[0], _mm256_max_epi32(Y[1], Y[2]));
-        const __m256i rx0 = _mm256_srai_epi32(_mm256_add_epi32(xmin, c127), RAST_SUBPIXEL_BITS);
-        const __m256i rx1 = _mm256_srai_epi32(_mm256_sub_epi32(xmax, c128), RAST_SUBPIXEL_BITS);
-        const __m256i ry0 = _mm256_srai_epi32(_mm256_add_epi32(ymin, c127), RAST_SUBPIXEL_BITS);
-        const __m256i ry1 = _mm256_srai_epi32(_mm256_sub_epi32(ymax, c128), RAST_SUBPIXEL_BITS);
-        const __m256i bx0 = _mm256_max_epi32(rx0, zero), by0 = _mm256_max_epi32(ry0, zero);
-        const __m256i bx1 = _mm256_min_epi32(rx1, wmax), by1 = _mm256_min_epi32(ry1, hmax);
-        const unsigned off =
-            bits8(_mm256_or_si256(_mm256_cmpgt_epi32(bx0, bx1), _mm256_cmpgt_epi32(by0, by1)));
-        const unsigned csingle =
-            live & ~off &
-            bits8(_mm256_and_si256(_mm256_cmpeq_epi32(bx0, bx1), _mm256_cmpeq_epi32(by0, by1)));
-        const unsigned usingle =
-            bits8(_mm256_and_si256(_mm256_cmpeq_epi32(rx0, rx1), _mm256_cmpeq_epi32(ry0, ry1)));
-        const unsigned odd = csingle & ~usingle;
+        /* prepare_cached_one: area sign, degenerate, culling. */
+        unsigned pos, neg;
+        front_area_signs(X, Y, &pos, &neg);
+        const front_class c = front_classify(m->cull, L & ~special0, pos, neg);
+        /* setup_box_edges: the clamped pixel box, off screen, empty (as
+         * raster_front_avx512.c). */
+        const front_box b = front_box_of(X, Y, vw, vh);
+        const unsigned csingle = c.live & ~b.off & b.one;
+        const unsigned odd = csingle & ~b.uone;
         const unsigned special = special0 | odd;
-        const unsigned live2 = live & ~off & ~odd;
+        const unsigned live2 = c.live & ~b.off & ~odd;
         const __m256i sw = vmask(neg);
         const __m256i x1 = blend8(X[1], X[2], sw), x2 = blend8(X[2], X[1], sw);
         const __m256i y1 = blend8(Y[1], Y[2], sw), y2 = blend8(Y[2], Y[1], sw);
+        const unsigned single = csingle & b.uone;
         unsigned empty = 0;
-        const unsigned single = csingle & usingle;
-        if (single) {
-            const __m256i cx = _mm256_add_epi32(_mm256_slli_epi32(bx0, RAST_SUBPIXEL_BITS), c128);
-            const __m256i cy = _mm256_add_epi32(_mm256_slli_epi32(by0, RAST_SUBPIXEL_BITS), c128);
-            const __m256i e0 = edge32(x1, y1, x2, y2, cx, cy);
-            const __m256i e1 = edge32(x2, y2, X[0], Y[0], cx, cy);
-            const __m256i e2 = edge32(X[0], Y[0], x1, y1, cx, cy);
-            empty = single & bits8(_mm256_or_si256(_mm256_or_si256(e0, e1), e2));
-        }
+        if (single)
+            empty = single & front_empty_bits(X[0], Y[0], x1, y1, x2, y2, b.bx0, b.by0);
         const unsigned surv = live2 & ~empty;
-        ls.tris_degenerate += __builtin_popcount(degen);
-        ls.tris_culled += __builtin_popcount(culled);
-        ls.tris_clipped_away += __builtin_popcount(live & off);
-        ls.tris_drawn += __builtin_popcount(live2);
+        front_count(&ls, c.degen, c.culled, c.live & b.off, live2);
         if (!surv && !special)
             continue;
         __m256i slot;
         const __m256i perm = compress_idx(surv);
         if (special) {
             _Alignas(32) int32_t sl[8] = { 0 };
-            for (unsigned bits = special | surv; bits; bits &= bits - 1) {
-                const int l = __builtin_ctz(bits);
-                if ((special >> l) & 1u)
-                    n += rast__prepare(v, m, ti + l, out + n, &ls);
-                else
-                    sl[l] = n++;
-            }
+            n = front_slots(v, m, ti, special, surv, out, n, &ls, sl);
             slot = _mm256_permutevar8x32_epi32(
                 _mm256_load_si256((const __m256i *)(const void *)sl), perm);
         } else {
@@ -424,7 +347,7 @@ int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__
             continue;
         const __m256i vi1 = blend8(iv[1], iv[2], sw), vi2 = blend8(iv[2], iv[1], sw);
         const __m256i fld[Q_SLOT] = { X[0], x1, x2, Y[0], y1, y2, iv[0], vi1, vi2,
-                                      bx0, by0, bx1, by1 };
+                                      b.bx0, b.by0, b.bx1, b.by1 };
         for (int f = 0; f < Q_SLOT; f++)
             _mm256_storeu_si256((__m256i *)(void *)(q.f[f] + q.n),
                                 _mm256_permutevar8x32_epi32(fld[f], perm));
