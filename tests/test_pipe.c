@@ -6,7 +6,10 @@
  * colour beyond the model's edge), the elbow fit in pipe_frame
  * (pipe_desc.fit_rig: arms turned in the camera images are found),
  * pipe_frame_in.virt_opaque (same bytes on opaque virtual images; the
- * flag reaches the composite) and pipe_image_opaque, and bad inputs. */
+ * flag reaches the composite) and pipe_image_opaque, and bad inputs.
+ * Review fixes of the fit in pipe_frame: animation-posed frames with a
+ * fit rig give the bytes of none, the measured thickness applies to
+ * animation frames too, pipe_reset_fit. */
 #include "support/testutil.h"
 
 #include <cmocka.h>
@@ -783,6 +786,203 @@ static void fit_in_pipe_frame(void **state)
     free(T);
 }
 
+/* The camera images of both eyes (b->cam, 640x480) for the arms T seen
+ * from head: skin-red arms over blue-grey, noise +-4 (seeded). */
+static void paint_arms(const fit_arms *T, const kin_mat4 *head, kin_sthmd_geometry g,
+                       frame_bufs *b, uint64_t seed)
+{
+    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
+    uint8_t *sil = malloc(640 * 400);
+    float *clip = malloc(sizeof(float) * 4 * (size_t)T->nv), *depth = malloc(sizeof(float) * 640 * 400);
+    assert_true(sil && clip && depth);
+    tu_rng r = {seed};
+    for (int e = 0; e < 2; e++) {
+        kin_camera cam = kin_sthmd_camera(&hd, head, (kin_eye)e);
+        rast_target t = { 640, 400, depth, 640, sil, 640, NULL, 0, 0 };
+        rast_target_clear(&t);
+        rast_transform_points(cam.view_proj.m, T->pos, T->nv, clip);
+        rast_mesh_desc md = { clip, T->nv, NULL, 0, T->idx, T->nt, RAST_CULL_NONE };
+        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
+        for (int y = 0; y < 480; y++)
+            for (int x = 0; x < 640; x++) {
+                int yy = y - g.crop_y0;
+                int in_arm = yy >= 0 && yy < 400 && sil[yy * 640 + x];
+                uint8_t *px = &b->cam[e][(y * 640 + x) * 4];
+                int n = (int)(tu_next(&r) % 9) - 4;
+                px[0] = (uint8_t)((in_arm ? 200 : 70) + n);
+                px[1] = (uint8_t)((in_arm ? 120 : 90) + n);
+                px[2] = (uint8_t)((in_arm ? 100 : 150) + n);
+                px[3] = 255;
+            }
+    }
+    free(sil);
+    free(clip);
+    free(depth);
+}
+
+/* One frame of each pipe (pf, then pr) on `in`; pf's outputs are kept in
+ * keep[e] (1280x800 RGBA8 each), its masks in kmask[e] (640x400). */
+static void frame_pair(pipe_ctx *pf, pipe_ctx *pr, const pipe_frame_in *in, uint8_t *keep[2],
+                       uint8_t *kmask[2])
+{
+    char why[200];
+    assert_int_equal(pipe_frame(pf, in, NULL, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) {
+        memcpy(keep[e], in->out[e].pixels, 1280 * 800 * 4);
+        memcpy(kmask[e], pipe_mask(pf, e, NULL, NULL), 640 * 400);
+    }
+    assert_int_equal(pipe_frame(pr, in, NULL, why, sizeof why), PIPE_OK);
+}
+
+/* Review fix: frames posed by the animation (in.locals NULL, as `egofuse
+ * run` before its first tracking sample) with a fit rig give the bytes of
+ * no fit rig: the fit has no colour model yet, so the refinement is
+ * fuse_refine_mask's (it was fuse_refine_mask_global with the all-zero
+ * model, weight 0.5: the local term halved, IoU 0.9241 -> 0.9175 on
+ * fit_in_pipe_frame's scene). Outputs and masks compared, 2 frames. */
+static void fit_anim_same_bytes(void **state)
+{
+    (void)state;
+    fit_arms *A = malloc(sizeof *A), *T = malloc(sizeof *T);
+    assert_true(A && T);
+    fit_arms_build(A);
+    fit_arms_build(T);
+    for (int v = 0; v < T->nv; v++) {   /* the truth's arms turned +-20 deg */
+        int j = T->jnt[v * 4], s = j >= 4, k = j - 1 - 3 * s;
+        if (k > 1) continue;
+        float x = s ? 0.2f : -0.2f;
+        kin_vec3 S = kin_v3(x, -0.1f, 0), u = kin_v3_norm(kin_v3(0, 0.05f, -0.6f));
+        kin_quat q = kin_quat_axis_angle(u, (s ? -20.0f : 20.0f) * 0.01745329f);
+        kin_vec3 p;
+        memcpy(&p, &T->pos[v * 3], sizeof p);
+        p = kin_v3_add(S, kin_quat_rotate(q, kin_v3_sub(p, S)));
+        memcpy(&T->pos[v * 3], &p, sizeof p);
+    }
+    frame_bufs b;
+    pipe_frame_in in;
+    make_frame(&b, &in, 93);
+    kin_mat4 head = kin_mat4_identity();
+    in.head_node = -1;
+    in.world_from_head = &head;
+    in.locals = NULL;
+    in.anim = NULL;                     /* the rest pose: the model's */
+    pipe_desc d = {0};
+    d.threads = 2;
+    d.refine_band = 16;
+    pipe_ctx *pr = pipe_create(&d, &A->m);
+    d.fit_rig = &A->rig;
+    pipe_ctx *pf = pipe_create(&d, &A->m);
+    assert_true(pr && pf);
+    paint_arms(T, &head, pipe_geometry(pf), &b, 94);
+    uint8_t *keep[2], *km[2];
+    for (int e = 0; e < 2; e++) {
+        keep[e] = malloc(1280 * 800 * 4);
+        km[e] = malloc(640 * 400);
+        assert_true(keep[e] && km[e]);
+    }
+    for (int f = 0; f < 2; f++) {
+        frame_pair(pf, pr, &in, keep, km);
+        for (int e = 0; e < 2; e++) {
+            assert_memory_equal(keep[e], b.out[e], 1280 * 800 * 4);
+            assert_memory_equal(km[e], pipe_mask(pr, e, NULL, NULL), 640 * 400);
+        }
+    }
+    pipe_destroy(pf);
+    pipe_destroy(pr);
+    for (int e = 0; e < 2; e++) {
+        free(keep[e]);
+        free(km[e]);
+    }
+    free_frame(&b);
+    free(A);
+    free(T);
+}
+
+/* Review fixes of the fit's state across frames. The truth's forearms
+ * are 0.7x the model's. (a) Tracked frames: the measured forearms shrink
+ * the kinematic mask (pipe_frame_stats.coverage falls). (b) An
+ * animation-posed frame of the same pose draws the same thickness as a
+ * tracked one (equal coverage; it was the model's, 1, before). (c)
+ * pipe_reset_fit forgets it all: the next animation frame gives the bytes
+ * of a pipe without fit and the first near frame's coverage. */
+static void fit_state_across_frames(void **state)
+{
+    (void)state;
+    fit_arms *A = malloc(sizeof *A), *T = malloc(sizeof *T);
+    assert_true(A && T);
+    fit_arms_build(A);
+    fit_arms_build(T);
+    for (int s = 0; s < 2; s++) {       /* the truth's forearms thinner */
+        float x = s ? 0.2f : -0.2f, in = s ? -0.12f : 0.12f;
+        kin_vec3 E = kin_v3(x + in, -0.1f, -0.3f), Wr = kin_v3(x, -0.05f, -0.6f);
+        kin_vec3 dd = kin_v3_sub(Wr, E);
+        for (int v = 0; v < T->nv; v++) {
+            if (T->jnt[v * 4] != 2 + 3 * s) continue;
+            kin_vec3 p;
+            memcpy(&p, &T->pos[v * 3], sizeof p);
+            float t = kin_v3_dot(kin_v3_sub(p, E), dd) / kin_v3_dot(dd, dd);
+            kin_vec3 c = kin_v3_add(E, kin_v3_scale(dd, t));
+            p = kin_v3_add(c, kin_v3_scale(kin_v3_sub(p, c), 0.7f));
+            memcpy(&T->pos[v * 3], &p, sizeof p);
+        }
+    }
+    frame_bufs b;
+    pipe_frame_in in;
+    make_frame(&b, &in, 95);
+    kin_mat4 head = kin_mat4_identity();
+    in.head_node = -1;
+    in.locals = A->rest;
+    pipe_desc d = {0};
+    d.threads = 2;
+    d.refine_band = 16;
+    pipe_ctx *pr = pipe_create(&d, &A->m);
+    d.fit_rig = &A->rig;
+    pipe_ctx *pf = pipe_create(&d, &A->m);
+    assert_true(pr && pf);
+    char why[200];
+    pipe_frame_stats st;
+    /* (a) tracked */
+    in.world_from_head = &head;
+    paint_arms(T, &head, pipe_geometry(pf), &b, 97);
+    in.fit_skip = 3;                    /* the pose stays the model's */
+    double c1[2], c4[2];
+    for (int f = 0; f < 4; f++) {
+        assert_int_equal(pipe_frame(pf, &in, &st, why, sizeof why), PIPE_OK);
+        for (int e = 0; e < 2; e++) (f ? c4 : c1)[e] = st.coverage[e];
+    }
+    for (int e = 0; e < 2; e++) assert_true(c4[e] < 0.97 * c1[e]);
+    /* (b) animation frame of the same pose: the same thickness */
+    in.locals = NULL;
+    in.anim = NULL;
+    assert_int_equal(pipe_frame(pf, &in, &st, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) assert_true(st.coverage[e] == c4[e]);
+    /* (c) forgotten: the bytes of no fit */
+    pipe_reset_fit(pf);
+    uint8_t *keep[2], *km[2];
+    for (int e = 0; e < 2; e++) {
+        keep[e] = malloc(1280 * 800 * 4);
+        km[e] = malloc(640 * 400);
+        assert_true(keep[e] && km[e]);
+    }
+    frame_pair(pf, pr, &in, keep, km);
+    for (int e = 0; e < 2; e++) {
+        assert_memory_equal(keep[e], b.out[e], 1280 * 800 * 4);
+        assert_memory_equal(km[e], pipe_mask(pr, e, NULL, NULL), 640 * 400);
+    }
+    assert_int_equal(pipe_frame(pf, &in, &st, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) assert_true(st.coverage[e] == c1[e]);
+    pipe_reset_fit(NULL);
+    pipe_destroy(pf);
+    pipe_destroy(pr);
+    for (int e = 0; e < 2; e++) {
+        free(keep[e]);
+        free(km[e]);
+    }
+    free_frame(&b);
+    free(A);
+    free(T);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -795,6 +995,8 @@ int main(void)
         cmocka_unit_test(bad_inputs),
         cmocka_unit_test(refine_band_mask),
         cmocka_unit_test(fit_in_pipe_frame),
+        cmocka_unit_test(fit_anim_same_bytes),
+        cmocka_unit_test(fit_state_across_frames),
         cmocka_unit_test(virt_opaque_same_bytes),
         cmocka_unit_test(image_opaque),
     };

@@ -15,7 +15,10 @@
  * hand (the hand is corrected in its parent's frame), the mesh's own skin
  * (not skin 0), settings outside their bounds refused (a 1e-9 degree step
  * never ended), models and rigs the fit cannot use refused, projections
- * far outside the image compared as floats. */
+ * far outside the image compared as floats. Second review: left and
+ * right chains that share nodes refused, pipe_fit_learn binarises a mask
+ * without refined mask, pipe_fit_measure refuses short strides, NULL
+ * guards, pipe_fit_forget. */
 #include "support/testutil.h"
 
 #include <cmocka.h>
@@ -638,6 +641,13 @@ static void bad_models(void **state)
     r = A.rig; /* the other side's hand */
     r.joint[0][KIN_RIG_HAND] = A.rig.joint[1][KIN_RIG_HAND];
     assert_null(pipe_fit_create(NULL, &A.m, &r, W, H));
+    r = A.rig; /* both sides the same arm: turned and thickened twice */
+    for (int k = 0; k < 3; k++) r.joint[1][k] = A.rig.joint[0][k];
+    assert_null(pipe_fit_create(NULL, &A.m, &r, W, H));
+    r = A.rig; /* the right arm hanging below the left hand */
+    A.parents[A.rig.joint[1][KIN_RIG_UPPER_ARM]] = (int16_t)A.rig.joint[0][KIN_RIG_HAND];
+    assert_null(pipe_fit_create(NULL, &A.m, &r, W, H));
+    A.parents[A.rig.joint[1][KIN_RIG_UPPER_ARM]] = 0;
     pipe_fit *f = pipe_fit_create(NULL, &A.m, &A.rig, W, H);
     assert_non_null(f);
     pipe_fit_destroy(f);
@@ -692,6 +702,93 @@ static void huge_projections(void **state)
     arms_free(&A);
 }
 
+/* Review fixes: pipe_fit_learn without a refined mask takes inside as
+ * >= 128 (a mask of 200 and 50 learns the model of 255 and 0; it learned
+ * nothing before); pipe_fit_measure refuses strides below the width (a
+ * bottom-up mask, stride -W, measured the same widths as top-down before:
+ * the thickness froze; now nothing is measured); the small calls take
+ * f NULL; pipe_fit_forget drops the colour models. */
+static void review_arguments(void **state)
+{
+    (void)state;
+    arms A, T;
+    arms_build(&A);
+    arms_build_r(&T, 1.0f, 0.85f);
+    pipe_fit *f = pipe_fit_create(NULL, &A.m, &A.rig, W, H);
+    assert_non_null(f);
+    uint8_t *rgba = malloc(4 * W * H), *m = malloc(W * H), *g = malloc(W * H);
+    assert_true(rgba && m && g);
+    half_image(rgba, m);
+    for (int i = 0; i < W * H; i++) g[i] = m[i] ? 200 : 50;
+    fuse_image P = { rgba, W, H, 4 * W };
+    assert_int_equal(pipe_fit_learn(f, 0, &P, m, W, NULL, 0), FUSE_OK);
+    assert_int_equal(pipe_fit_learn(f, 1, &P, g, W, NULL, 0), FUSE_OK);
+    assert_true(pipe_fit_learned(f, 1));
+    assert_int_equal(pipe_fit_colour(f, 1)->fg_samples, pipe_fit_colour(f, 0)->fg_samples);
+    assert_memory_equal(pipe_fit_colour(f, 1)->llr, pipe_fit_colour(f, 0)->llr,
+                        sizeof(float) << (3 * PIPE_FIT_BITS));
+    pipe_fit_forget(f);
+    assert_false(pipe_fit_learned(f, 0));
+    assert_false(pipe_fit_learned(f, 1));
+    /* bottom-up masks (pointer to the last row, stride -W) */
+    kin_camera cam[2];
+    for (int e = 0; e < 2; e++)
+        cam[e] = kin_camera_look_at(kin_v3(e ? 0.03f : -0.03f, 0.25f, 0.25f), kin_v3(0, -0.1f, -0.35f),
+                                    kin_v3(0, 1, 0), 75.0f, W, H, 0.05f, 10.0f);
+    uint8_t *kin = malloc(W * H), *sil = malloc(W * H), *kb = malloc(W * H), *sb = malloc(W * H);
+    assert_true(kin && sil && kb && sb);
+    kin_mat4 world[MAX_NODES];
+    kin_fk(A.parents, A.nodes, A.rest, NULL, world);
+    const fuse_image P2[2] = { P, P };
+    float th[2][2];
+    int frozen = 1;
+    for (int frame = 0; frame < 6; frame++) {
+        for (int e = 0; e < 2; e++) {
+            draw(&A, A.pos, &cam[e], kin);
+            draw(&T, T.pos, &cam[e], sil);
+            for (int y = 0; y < H; y++) {
+                memcpy(kb + (size_t)(H - 1 - y) * W, kin + (size_t)y * W, W);
+                memcpy(sb + (size_t)(H - 1 - y) * W, sil + (size_t)y * W, W);
+            }
+            pipe_fit_measure(f, e, &cam[e], world, kb + (size_t)(H - 1) * W, -W,
+                             sb + (size_t)(H - 1) * W, -W);
+            pipe_fit_measure(f, e, &cam[e], world, kin, W - 1, sil, W - 1);
+        }
+        kin_transform locals[MAX_NODES];
+        memcpy(locals, A.rest, sizeof locals);
+        pipe_fit_elbows(f, world, A.pos, cam, P2, 0u, locals, NULL);
+    }
+    pipe_fit_thickness(f, th, &frozen);
+    assert_false(frozen);
+    for (int s = 0; s < 2; s++) {
+        NEAR(th[s][0], 1.0, 0.0);
+        NEAR(th[s][1], 1.0, 0.0);
+    }
+    /* f NULL */
+    pipe_fit_reset(NULL);
+    pipe_fit_reset_shape(NULL);
+    pipe_fit_forget(NULL);
+    assert_null(pipe_fit_colour(NULL, 0));
+    assert_false(pipe_fit_learned(NULL, 0));
+    pipe_fit_shape(NULL, world, T.pos);
+    th[0][0] = 0.5f;
+    frozen = 1;
+    pipe_fit_thickness(NULL, th, &frozen);
+    assert_false(frozen);
+    NEAR(th[0][0], 1.0, 0.0);
+    pipe_fit_measure(NULL, 0, &cam[0], world, kin, W, sil, W);
+    pipe_fit_destroy(f);
+    free(rgba);
+    free(m);
+    free(g);
+    free(kin);
+    free(sil);
+    free(kb);
+    free(sb);
+    arms_free(&A);
+    arms_free(&T);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -706,6 +803,7 @@ int main(void)
         cmocka_unit_test(settings_bounded),
         cmocka_unit_test(bad_models),
         cmocka_unit_test(huge_projections),
+        cmocka_unit_test(review_arguments),
     };
     return cmocka_run_group_tests_name("pipe_fit", tests, NULL, NULL);
 }

@@ -617,15 +617,21 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 fuse_refine_params rp = fuse_refine_params_default();
                 rp.band = cfg->band;
                 fuse_image P = { c->P[e], CW, CH, 4 * CW };
+                /* the global term only once the fit has a colour model
+                 * (as pipe_frame): an all-zero one would halve the local
+                 * term */
+                fuse_refine_stats rs;
                 fuse_result fr =
-                    cfg->fit && cfg->global > 0.0f
+                    cfg->fit && cfg->global > 0.0f && pipe_fit_learned(r->fit, e)
                         ? fuse_refine_mask_global(&rp, pipe_fit_colour(r->fit, e), cfg->global, &P, mask, CW, c->refined,
                                                   CW, c->refine_scratch, c->refine_scratch_size,
-                                                  NULL)
+                                                  &rs)
                         : fuse_refine_mask(&rp, &P, mask, CW, c->refined, CW, c->refine_scratch,
-                                           c->refine_scratch_size, NULL);
+                                           c->refine_scratch_size, &rs);
                 if (fr != FUSE_OK) return -1;
-                if (cfg->fit && posed) {
+                /* not from a fallback (out = M): its widths are the
+                 * model's own (as pipe_frame) */
+                if (cfg->fit && posed && rs.used_colour) {
                     /* the next frame's fit: the colour model from this
                      * frame's kinematic and refined masks (no extra
                      * raster), and the limb widths (self-calibration) */

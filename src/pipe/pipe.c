@@ -238,6 +238,8 @@ struct pipe_ctx {
     void **plan_mem;          /* per mesh: its memory, or NULL */
     pipe_fit *fit;            /* elbow fit (refine_band and fit_rig) */
     kin_arm_rig fit_rig;
+    int fit_no_prev;          /* pipe_reset_fit: the refined masks are of
+                                 before it, not to be learned from */
 };
 
 enum { JOB_SKIN, JOB_EYE };
@@ -326,12 +328,17 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     if (p->desc.refine_band > 0) {
         fuse_refine_params rp = fuse_refine_params_default();
         rp.band = p->desc.refine_band;
+        /* the elbow fit's colour model as the global term only once it
+         * has one: before that (or when the last learning found too few
+         * samples) its all-zero model would only halve the local term */
+        fuse_refine_stats rs;
         fuse_result rr2 =
-            p->fit ? fuse_refine_mask_global(&rp, pipe_fit_colour(p->fit, e->eye), 0.5f, &fe.P,
-                                             e->mask, cw, e->refined, cw, e->refine_scratch,
-                                             e->refine_scratch_size, NULL)
-                   : fuse_refine_mask(&rp, &fe.P, e->mask, cw, e->refined, cw,
-                                      e->refine_scratch, e->refine_scratch_size, NULL);
+            p->fit && pipe_fit_learned(p->fit, e->eye)
+                ? fuse_refine_mask_global(&rp, pipe_fit_colour(p->fit, e->eye), 0.5f, &fe.P,
+                                          e->mask, cw, e->refined, cw, e->refine_scratch,
+                                          e->refine_scratch_size, &rs)
+                : fuse_refine_mask(&rp, &fe.P, e->mask, cw, e->refined, cw, e->refine_scratch,
+                                   e->refine_scratch_size, &rs);
         if (rr2 != FUSE_OK) {
             e->result = PIPE_ERR_FUSE;
             snprintf(e->why, sizeof e->why, "%s eye: mask refinement: %s",
@@ -340,9 +347,12 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         }
         e->have_refined = 1;
         fe.mask = e->refined;
-        if (p->fit && in->locals) {
+        if (p->fit && in->locals && rs.used_colour) {
             /* the next frame's fit: its colour model from this frame's
-             * kinematic and refined masks, and the limb widths */
+             * kinematic and refined masks, and the limb widths; not when
+             * the refinement fell back to the kinematic mask (out = M):
+             * its widths would be the model's own, samples equal to the
+             * factor in use */
             if (pipe_fit_learn(p->fit, e->eye, &fe.P, e->mask, cw, e->refined, cw) != FUSE_OK) {
                 e->result = PIPE_ERR_FUSE;
                 snprintf(e->why, sizeof e->why, "%s eye: elbow fit: colour model",
@@ -605,9 +615,9 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
         rast_context_clear(s->rast, &tg);
         rast_result rr = pipe_pose_draw(&p->pose, s->rast, &cam[e], &tg, p->desc.cull, s->clip,
                                         s->vnrm, NULL);
-        fuse_result lr = rr == RAST_OK ? pipe_fit_learn(p->fit, e, &P[e], s->mask, cw,
-                                                        s->have_refined ? s->refined : NULL, cw)
-                                       : FUSE_OK;
+        const uint8_t *prev = s->have_refined && !p->fit_no_prev ? s->refined : NULL;
+        fuse_result lr =
+            rr == RAST_OK ? pipe_fit_learn(p->fit, e, &P[e], s->mask, cw, prev, cw) : FUSE_OK;
         if (rr != RAST_OK || lr != FUSE_OK) {
             if (why && why_size > 0)
                 snprintf(why, (size_t)why_size, "%s eye: elbow fit: %s", e ? "right" : "left",
@@ -679,8 +689,11 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
                     : in->world_from_head ? *in->world_from_head
                                           : kin_mat4_identity();
     for (int e = 0; e < 2; e++) p->eye[e].converted = 0;
+    /* the measured thickness on every frame, animation-posed ones too: the
+     * arm drawn does not switch between the calibrated and the model's
+     * thickness when tracked and animated frames mix */
+    if (p->fit) pipe_fit_shape(p->fit, p->pose.world, p->pose.pos[0]);
     if (p->fit && in->locals) {
-        pipe_fit_shape(p->fit, p->pose.world, p->pose.pos[0]);
         pipe_result fr = fit_elbows(p, in, &head, why, why_size);
         if (fr != PIPE_OK) return fr;
     }
@@ -713,7 +726,15 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
             return p->eye[e].result;
         }
     }
+    p->fit_no_prev = 0;
     return PIPE_OK;
+}
+
+void pipe_reset_fit(pipe_ctx *p)
+{
+    if (!p || !p->fit) return;
+    pipe_fit_forget(p->fit);
+    p->fit_no_prev = 1;
 }
 
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
@@ -952,7 +973,11 @@ static int fit_rig_ok(const kin_model *m, const kin_arm_rig *rig)
             if (j[k] < 0 || j[k] >= m->node_count) return 0;
         if (!fit_ancestor(m, j[0], j[1]) || !fit_ancestor(m, j[1], j[2])) return 0;
     }
-    return 1;
+    /* the arms apart: two chains that share a node (or one hanging below
+     * the other's upper arm) have one upper arm at or below the other's,
+     * and would turn and thicken the same limb twice */
+    const int a = rig->joint[0][KIN_RIG_UPPER_ARM], b = rig->joint[1][KIN_RIG_UPPER_ARM];
+    return a != b && !fit_ancestor(m, a, b) && !fit_ancestor(m, b, a);
 }
 
 pipe_fit *pipe_fit_create(const pipe_fit_desc *desc, const kin_model *model,
@@ -1022,12 +1047,14 @@ void pipe_fit_destroy(pipe_fit *f)
 
 void pipe_fit_reset(pipe_fit *f)
 {
+    if (!f) return;
     f->have_prev = 0;
     f->swivel[0] = f->swivel[1] = 0.0f;
 }
 
 void pipe_fit_reset_shape(pipe_fit *f)
 {
+    if (!f) return;
     for (int s = 0; s < 2; s++)
         for (int g = 0; g < 2; g++) {
             f->thick[s][g] = 1.0f;
@@ -1037,14 +1064,26 @@ void pipe_fit_reset_shape(pipe_fit *f)
     f->frozen = f->d.shape_samples < 0;
 }
 
+void pipe_fit_forget(pipe_fit *f)
+{
+    if (!f) return;
+    pipe_fit_reset(f);
+    pipe_fit_reset_shape(f);
+    for (int e = 0; e < 2; e++) {
+        f->learned[e] = 0;
+        f->cm[e].fg_samples = f->cm[e].bg_samples = 0;
+        memset(f->llr[e], 0, sizeof(float) << (3 * PIPE_FIT_BITS));
+    }
+}
+
 const fuse_colour_model *pipe_fit_colour(const pipe_fit *f, int eye)
 {
-    return &f->cm[eye ? 1 : 0];
+    return f ? &f->cm[eye ? 1 : 0] : NULL;
 }
 
 int pipe_fit_learned(const pipe_fit *f, int eye)
 {
-    return f->learned[eye ? 1 : 0];
+    return f ? f->learned[eye ? 1 : 0] : 0;
 }
 
 fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint8_t *mask,
@@ -1053,9 +1092,17 @@ fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint
     if (!f || !P || !P->pixels || !mask || eye < 0 || eye > 1 || P->width != f->width ||
         P->height != f->height || mask_stride < f->width || (prev && prev_stride < f->width))
         return FUSE_ERR_ARGS;
-    const uint8_t *learn = mask;
-    int stride = mask_stride;
-    if (prev) {
+    const uint8_t *learn = f->learn[eye];
+    const int stride = f->width;
+    if (!prev) {
+        /* inside = >= 128: 255 or 0 (fuse_colour_model_learn leaves any
+         * other value out) */
+        for (int y = 0; y < f->height; y++) {
+            const uint8_t *a = mask + (size_t)y * (size_t)mask_stride;
+            uint8_t *L = f->learn[eye] + (size_t)y * (size_t)f->width;
+            for (int x = 0; x < f->width; x++) L[x] = (uint8_t)(0u - (unsigned)(a[x] >> 7));
+        }
+    } else {
         /* 255 where both hold the pixel, 0 where neither does, else 128
          * (branch-free, so that the compiler vectorises the rows) */
         for (int y = 0; y < f->height; y++) {
@@ -1067,8 +1114,6 @@ fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint
                 L[x] = (uint8_t)(128u + 127u * (ia & ib) - 128u * ((ia | ib) ^ 1u));
             }
         }
-        learn = f->learn[eye];
-        stride = f->width;
     }
     fuse_result r = fuse_colour_model_learn(&f->cm[eye], P, learn, stride, 4, 2, 3.0f, 64,
                                             f->scratch[eye], f->scratch_size);
@@ -1319,7 +1364,9 @@ void pipe_fit_measure(pipe_fit *f, int eye, const kin_camera *cam, const kin_mat
                       const uint8_t *mask, int mask_stride, const uint8_t *refined,
                       int refined_stride)
 {
-    if (!f || eye < 0 || eye > 1 || !cam || !world || !mask || !refined || f->frozen) return;
+    if (!f || eye < 0 || eye > 1 || !cam || !world || !mask || !refined || f->frozen ||
+        mask_stride < f->width || refined_stride < f->width)
+        return;
     const int W = f->width, H = f->height;
     for (int s = 0; s < 2; s++)
         for (int g = 0; g < 2; g++) {
@@ -1390,6 +1437,7 @@ void pipe_fit_measure(pipe_fit *f, int eye, const kin_camera *cam, const kin_mat
 
 void pipe_fit_shape(const pipe_fit *f, const kin_mat4 *world, float *pos)
 {
+    if (!f || !world || !pos) return;
     for (int s = 0; s < 2; s++) {
         float t0 = f->thick[s][0] - 1.0f, t1 = f->thick[s][1] - 1.0f;
         if (t0 == 0.0f && t1 == 0.0f) continue;
@@ -1421,7 +1469,8 @@ void pipe_fit_shape(const pipe_fit *f, const kin_mat4 *world, float *pos)
 
 void pipe_fit_thickness(const pipe_fit *f, float thick[2][2], int *frozen)
 {
-    for (int s = 0; s < 2; s++)
-        for (int g = 0; g < 2; g++) thick[s][g] = f->thick[s][g];
-    if (frozen) *frozen = f->frozen;
+    if (thick)
+        for (int s = 0; s < 2; s++)
+            for (int g = 0; g < 2; g++) thick[s][g] = f ? f->thick[s][g] : 1.0f;
+    if (frozen) *frozen = f ? f->frozen : 0;
 }

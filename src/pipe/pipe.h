@@ -93,13 +93,23 @@ typedef struct pipe_desc {
     int refine_band;          /* 0 = off; 1..64: each eye's mask is refined
                                  by colour in a band of this half width
                                  around its edge (fuse_refine_mask; with
-                                 fit_rig, fuse_refine_mask_global with the
-                                 elbow fit's colour model, weight 0.5:
-                                 `egofuse eval`'s refine method) */
+                                 fit_rig, once the eye's colour model is
+                                 learned (pipe_fit_learned), fuse_refine_mask_global
+                                 with it, weight 0.5: `egofuse eval`'s
+                                 refine method; before that, and for a
+                                 fresh pipe on animation-posed frames, the
+                                 bytes of no fit_rig) */
     const kin_arm_rig *fit_rig; /* with refine_band, and frames posed by
                                  pipe_frame_in.locals: fit the elbows to the
                                  camera images (pipe_fit) before the eyes
-                                 are drawn; NULL = no fit. Copied. */
+                                 are drawn, then learn the colour models
+                                 and measure the limb widths from the
+                                 refined masks (not where the refinement
+                                 fell back to the kinematic mask,
+                                 fuse_refine_stats.used_colour 0). The
+                                 thickness measured applies to every frame,
+                                 animation-posed ones too. NULL = no fit.
+                                 Copied. */
 } pipe_desc;
 
 typedef struct pipe_ctx pipe_ctx;
@@ -175,6 +185,12 @@ typedef enum pipe_result {
  * rig (mesh 0's skin, the arms' node chains). */
 pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model);
 void  pipe_destroy(pipe_ctx *p);
+/* Forgets the elbow fit's state (pipe_fit_forget: swivels, colour
+ * models, limb thickness; the next frame's colour model is learned from
+ * its kinematic mask alone), e.g. when the operator or the scene changes.
+ * Nothing without a fit (fit_rig NULL) or for p NULL. Not during
+ * pipe_frame. */
+void  pipe_reset_fit(pipe_ctx *p);
 /* One stereo frame. stats may be NULL. On error, why (if not NULL) gets a
  * sentence naming the eye and the reason. */
 pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
@@ -215,11 +231,13 @@ const char *pipe_result_str(pipe_result r);
  * from the camera image where a kinematic mask and a refined mask agree
  * (learning margin 4 px, every 2nd pixel, clamp 3 nats, >= 64 samples
  * per class). pipe_frame and `egofuse eval` learn it after each frame's
- * refinement, from that frame's masks, and fit the next frame with it
- * (no raster for the fit); only before the first model (pipe_fit_learned)
- * do they draw the kinematic mask first and learn from it alone. The
- * same model is the band refinement's global term
- * (fuse_refine_mask_global). 5 bits per channel: on `egofuse eval`'s
+ * refinement, from that frame's masks (not when the refinement fell
+ * back to the kinematic mask), and fit the next frame with it (no raster
+ * for the fit); only while there is no model (pipe_fit_learned 0) do
+ * they draw the kinematic mask first and learn from it (and the last
+ * refined mask, if any). The same model, once learned, is the band
+ * refinement's global term (fuse_refine_mask_global; plain
+ * fuse_refine_mask before). 5 bits per channel: on `egofuse eval`'s
  * reach_grasp the finer model separates the dark sleeve from the dark
  * desk, IoU 0.960 -> 0.973 against 4 bits (6 bits: 0.973, slower).
  * Points outside the image are unknown, not dropped: per eye, only the
@@ -268,17 +286,26 @@ typedef struct pipe_fit pipe_fit;
  * mesh 0 has no valid skin (its skin index or a joint index out of
  * range), when a side's rig joints are not a chain upper arm -> forearm
  * -> hand (each a descendant of the one before: nodes between them, e.g.
- * a twist or wrist node, are fine) or the model has no vertex bound to an
- * arm. */
+ * a twist or wrist node, are fine), when the two sides' chains share a
+ * node or one side's upper arm is a descendant of the other's (the same
+ * limb would be turned and thickened twice), or the model has no vertex
+ * bound to an arm. */
 pipe_fit *pipe_fit_create(const pipe_fit_desc *desc, const kin_model *model,
                           const kin_arm_rig *rig, int width, int height);
 void pipe_fit_destroy(pipe_fit *f);
-/* Forgets the last swivels (the next fit searches the whole range). */
+/* Forgets the last swivels (the next fit searches the whole range); the
+ * colour models and the thickness are kept (pipe_fit_forget drops them
+ * too). Nothing for f NULL. */
 void pipe_fit_reset(pipe_fit *f);
+/* Forgets everything learned: pipe_fit_reset, pipe_fit_reset_shape, and
+ * the colour models (pipe_fit_learned 0, all-zero llr): the state of
+ * pipe_fit_create. Nothing for f NULL. */
+void pipe_fit_forget(pipe_fit *f);
 /* Learns eye's colour model from P (RGBA8, width x height) and a
  * kinematic mask (inside = >= 128): arm where it and the refined mask
  * prev agree on inside, background where they agree on outside (prev
- * NULL: the kinematic mask alone). FUSE_ERR_ARGS for bad arguments. */
+ * NULL: the kinematic mask alone, inside = >= 128 as well). FUSE_ERR_ARGS
+ * for bad arguments (f NULL, strides < width included). */
 fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P,
                            const uint8_t *mask, int mask_stride,
                            const uint8_t *prev, int prev_stride);
@@ -291,14 +318,16 @@ fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P,
 void pipe_fit_elbows(pipe_fit *f, const kin_mat4 *world, const float *pos,
                      const kin_camera cam[2], const fuse_image P[2],
                      unsigned sides, kin_transform *locals, float swivel[2]);
-/* The colour model eye learned last (for fuse_refine_mask_global). */
+/* The colour model eye learned last (for fuse_refine_mask_global; all
+ * zero while pipe_fit_learned is 0: use fuse_refine_mask then); NULL for
+ * f NULL. */
 const fuse_colour_model *pipe_fit_colour(const pipe_fit *f, int eye);
 /* 1 when eye has a colour model (both classes had >= 64 samples). A
  * caller that learns each frame's model after its refinement, from that
  * frame's kinematic and refined masks (pipe_frame and `egofuse eval` do),
  * fits the next frame with it and needs no extra raster per eye; only
  * while this is 0 (the first frame) does it draw the kinematic mask for
- * pipe_fit_learn before the fit. */
+ * pipe_fit_learn before the fit. 0 for f NULL. */
 int pipe_fit_learned(const pipe_fit *f, int eye);
 
 /* ---------------------------------------- limb thickness (self-calibration)
@@ -339,20 +368,23 @@ int pipe_fit_learned(const pipe_fit *f, int eye);
 
 /* Scales the arms of the posed mesh 0 (pos: 3 floats per vertex, world
  * space; world: FK of the pose) radially about their bones by the
- * thickness factors; nothing while they are 1. Call after each skinning
- * of the pose that is fitted or drawn. */
+ * thickness factors; nothing while they are 1 or for NULL arguments. Call
+ * after each skinning of the pose that is fitted or drawn. */
 void pipe_fit_shape(const pipe_fit *f, const kin_mat4 *world, float *pos);
 /* Measures one eye (see above): cam and world of the frame as drawn,
  * mask = its kinematic mask, refined = its refined mask (inside = >= 128,
- * width x height). Does nothing once frozen or for bad arguments. */
+ * width x height). Does nothing once frozen or for bad arguments (NULL
+ * pointers, eye not 0 or 1, a stride < width). A caller measures only
+ * masks the colour refined (fuse_refine_stats.used_colour): a fallback
+ * mask is the kinematic one and adds samples equal to the factor in use. */
 void pipe_fit_measure(pipe_fit *f, int eye, const kin_camera *cam, const kin_mat4 *world,
                       const uint8_t *mask, int mask_stride, const uint8_t *refined,
                       int refined_stride);
 /* The factors in use, [side][0 upper arm, 1 forearm]; *frozen (may be
- * NULL) = 1 once frozen. */
+ * NULL) = 1 once frozen. f NULL: factors 1, not frozen. */
 void pipe_fit_thickness(const pipe_fit *f, float thick[2][2], int *frozen);
 /* Forgets the thickness (factors 1, measuring again from the next
- * frame); pipe_fit_create starts so. */
+ * frame); pipe_fit_create starts so. Nothing for f NULL. */
 void pipe_fit_reset_shape(pipe_fit *f);
 
 #ifdef __cplusplus
