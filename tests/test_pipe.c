@@ -691,6 +691,105 @@ static double mask_iou(const uint8_t *a, const uint8_t *b)
     return u_n ? (double)i_n / (double)u_n : 1.0;
 }
 
+/* Turns the tubes of T's upper arms and forearms about their
+ * shoulder-wrist lines by +deg (left) and -deg (right) degrees: the truth
+ * the camera images show. */
+static void turn_arms(fit_arms *T, float deg)
+{
+    for (int v = 0; v < T->nv; v++) {
+        int j = T->jnt[v * 4], s = j >= 4, k = j - 1 - 3 * s;
+        if (k > 1) continue;
+        float x = s ? 0.2f : -0.2f;
+        kin_vec3 S = kin_v3(x, -0.1f, 0), u = kin_v3_norm(kin_v3(0, 0.05f, -0.6f));
+        kin_quat q = kin_quat_axis_angle(u, (s ? -deg : deg) * 0.01745329f);
+        kin_vec3 p;
+        memcpy(&p, &T->pos[v * 3], sizeof p);
+        p = kin_v3_add(S, kin_quat_rotate(q, kin_v3_sub(p, S)));
+        memcpy(&T->pos[v * 3], &p, sizeof p);
+    }
+}
+
+/* The scene of the fit tests: the model's arms A, the truth T (both
+ * fit_arms_build; the test changes T), frame buffers of make_frame(seed),
+ * the head at the identity (in.head_node -1, in.world_from_head = &head,
+ * in.locals = A->rest) and two pipes of 2 threads and refine_band 16: pr
+ * without and pf with fit_rig = &A->rig. Keep the scene where it is
+ * (in points into it). */
+typedef struct fit_scene {
+    fit_arms *A, *T;
+    frame_bufs b;
+    pipe_frame_in in;
+    kin_mat4 head;
+    pipe_ctx *pr, *pf;
+} fit_scene;
+
+static void fit_scene_open(fit_scene *S, uint64_t seed)
+{
+    S->A = malloc(sizeof *S->A);
+    S->T = malloc(sizeof *S->T);
+    assert_true(S->A && S->T);
+    fit_arms_build(S->A);
+    fit_arms_build(S->T);
+    make_frame(&S->b, &S->in, seed);
+    S->head = kin_mat4_identity();
+    S->in.head_node = -1;
+    S->in.world_from_head = &S->head;
+    S->in.locals = S->A->rest;
+    pipe_desc d = {0};
+    d.threads = 2;
+    d.refine_band = 16;
+    S->pr = pipe_create(&d, &S->A->m);
+    d.fit_rig = &S->A->rig;
+    S->pf = pipe_create(&d, &S->A->m);
+    assert_true(S->pr && S->pf);
+}
+
+static void fit_scene_close(fit_scene *S)
+{
+    pipe_destroy(S->pf);
+    pipe_destroy(S->pr);
+    free_frame(&S->b);
+    free(S->A);
+    free(S->T);
+}
+
+/* The camera images of both eyes (b->cam, 640x480) for the arms T seen
+ * from head: skin-red arms over blue-grey, noise +-4 (seeded). With sil
+ * not NULL, each eye's silhouette of T (640x400, the crop) is left in
+ * sil[e]. */
+static void paint_arms(const fit_arms *T, const kin_mat4 *head, kin_sthmd_geometry g,
+                       frame_bufs *b, uint64_t seed, uint8_t *const sil[2])
+{
+    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
+    uint8_t *own = malloc(640 * 400);
+    float *clip = malloc(sizeof(float) * 4 * (size_t)T->nv), *depth = malloc(sizeof(float) * 640 * 400);
+    assert_true(own && clip && depth);
+    tu_rng r = {seed};
+    for (int e = 0; e < 2; e++) {
+        uint8_t *s = sil ? sil[e] : own;
+        kin_camera cam = kin_sthmd_camera(&hd, head, (kin_eye)e);
+        rast_target t = { 640, 400, depth, 640, s, 640, NULL, 0, 0 };
+        rast_target_clear(&t);
+        rast_transform_points(cam.view_proj.m, T->pos, T->nv, clip);
+        rast_mesh_desc md = { clip, T->nv, NULL, 0, T->idx, T->nt, RAST_CULL_NONE };
+        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
+        for (int y = 0; y < 480; y++)
+            for (int x = 0; x < 640; x++) {
+                int yy = y - g.crop_y0;
+                int in_arm = yy >= 0 && yy < 400 && s[yy * 640 + x];
+                uint8_t *px = &b->cam[e][(y * 640 + x) * 4];
+                int n = (int)(tu_next(&r) % 9) - 4;
+                px[0] = (uint8_t)((in_arm ? 200 : 70) + n);
+                px[1] = (uint8_t)((in_arm ? 120 : 90) + n);
+                px[2] = (uint8_t)((in_arm ? 100 : 150) + n);
+                px[3] = 255;
+            }
+    }
+    free(own);
+    free(clip);
+    free(depth);
+}
+
 /* pipe_desc.fit_rig: the camera images show the arms turned about their
  * shoulder-wrist lines by +20 (left) and -20 (right) degrees from the
  * model's pose (skin-red over blue-grey, noise +-4); the pipe gets the
@@ -703,135 +802,75 @@ static double mask_iou(const uint8_t *a, const uint8_t *b)
 static void fit_in_pipe_frame(void **state)
 {
     (void)state;
-    fit_arms *A = malloc(sizeof *A), *T = malloc(sizeof *T);
-    assert_true(A && T);
-    fit_arms_build(A);
-    fit_arms_build(T);
-    /* the truth: the tubes of the upper arm and forearm turned */
-    for (int v = 0; v < T->nv; v++) {
-        int j = T->jnt[v * 4], s = j >= 4, k = j - 1 - 3 * s;
-        if (k > 1) continue;
-        float x = s ? 0.2f : -0.2f;
-        kin_vec3 S = kin_v3(x, -0.1f, 0), u = kin_v3_norm(kin_v3(0, 0.05f, -0.6f));
-        kin_quat q = kin_quat_axis_angle(u, (s ? -20.0f : 20.0f) * 0.01745329f);
-        kin_vec3 p;
-        memcpy(&p, &T->pos[v * 3], sizeof p);
-        p = kin_v3_add(S, kin_quat_rotate(q, kin_v3_sub(p, S)));
-        memcpy(&T->pos[v * 3], &p, sizeof p);
-    }
-    frame_bufs b;
-    pipe_frame_in in;
-    make_frame(&b, &in, 91);
-    kin_mat4 head = kin_mat4_identity();
-    in.head_node = -1;
-    in.world_from_head = &head;
-    in.locals = A->rest;
-    pipe_desc d = {0};
-    d.threads = 2;
-    d.refine_band = 16;
-    pipe_ctx *pr = pipe_create(&d, &A->m);
-    d.fit_rig = &A->rig;
-    pipe_ctx *pf = pipe_create(&d, &A->m);
-    assert_true(pr && pf);
-    kin_sthmd_geometry g = pipe_geometry(pf);
+    fit_scene S;
+    fit_scene_open(&S, 91);
+    turn_arms(S.T, 20.0f);
+    kin_sthmd_geometry g = pipe_geometry(S.pf);
     assert_int_equal(g.crop_width, 640);
     assert_int_equal(g.crop_height, 400);
-    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
     uint8_t *sil[2];
-    float *clip = malloc(sizeof(float) * 4 * (size_t)T->nv), *depth = malloc(sizeof(float) * 640 * 400);
-    assert_true(clip && depth);
-    tu_rng r = {92};
     for (int e = 0; e < 2; e++) {
         sil[e] = malloc(640 * 400);
         assert_non_null(sil[e]);
-        kin_camera cam = kin_sthmd_camera(&hd, &head, (kin_eye)e);
-        rast_target t = { 640, 400, depth, 640, sil[e], 640, NULL, 0, 0 };
-        rast_target_clear(&t);
-        rast_transform_points(cam.view_proj.m, T->pos, T->nv, clip);
-        rast_mesh_desc md = { clip, T->nv, NULL, 0, T->idx, T->nt, RAST_CULL_NONE };
-        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
-        for (int y = 0; y < 480; y++)
-            for (int x = 0; x < 640; x++) {
-                int yy = y - g.crop_y0;
-                int in_arm = yy >= 0 && yy < 400 && sil[e][yy * 640 + x];
-                uint8_t *px = &b.cam[e][(y * 640 + x) * 4];
-                int n = (int)(tu_next(&r) % 9) - 4;
-                px[0] = (uint8_t)((in_arm ? 200 : 70) + n);
-                px[1] = (uint8_t)((in_arm ? 120 : 90) + n);
-                px[2] = (uint8_t)((in_arm ? 100 : 150) + n);
-                px[3] = 255;
-            }
     }
+    paint_arms(S.T, &S.head, g, &S.b, 92, sil);
     long area = 0;
     for (int i = 0; i < 640 * 400; i++) area += sil[0][i] != 0;
     assert_true(area > 5000);
     char why[200];
     for (int f = 0; f < 3; f++) {
-        assert_int_equal(pipe_frame(pf, &in, NULL, why, sizeof why), PIPE_OK);
-        assert_int_equal(pipe_frame(pr, &in, NULL, why, sizeof why), PIPE_OK);
+        assert_int_equal(pipe_frame(S.pf, &S.in, NULL, why, sizeof why), PIPE_OK);
+        assert_int_equal(pipe_frame(S.pr, &S.in, NULL, why, sizeof why), PIPE_OK);
         for (int e = 0; e < 2; e++) {
-            double iou_f = mask_iou(pipe_mask(pf, e, NULL, NULL), sil[e]);
-            double iou_r = mask_iou(pipe_mask(pr, e, NULL, NULL), sil[e]);
+            double iou_f = mask_iou(pipe_mask(S.pf, e, NULL, NULL), sil[e]);
+            double iou_r = mask_iou(pipe_mask(S.pr, e, NULL, NULL), sil[e]);
             assert_true(iou_f > 0.995);
             assert_true(iou_r < 0.95);
         }
     }
-    pipe_destroy(pf);
-    pipe_destroy(pr);
     for (int e = 0; e < 2; e++) free(sil[e]);
-    free(clip);
-    free(depth);
-    free_frame(&b);
-    free(A);
-    free(T);
+    fit_scene_close(&S);
 }
 
-/* The camera images of both eyes (b->cam, 640x480) for the arms T seen
- * from head: skin-red arms over blue-grey, noise +-4 (seeded). */
-static void paint_arms(const fit_arms *T, const kin_mat4 *head, kin_sthmd_geometry g,
-                       frame_bufs *b, uint64_t seed)
+/* Outputs (1280x800 RGBA8) and masks (640x400) of both eyes kept by
+ * frame_pair. */
+typedef struct kept_frame {
+    uint8_t *out[2], *mask[2];
+} kept_frame;
+
+static void kept_alloc(kept_frame *k)
 {
-    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
-    uint8_t *sil = malloc(640 * 400);
-    float *clip = malloc(sizeof(float) * 4 * (size_t)T->nv), *depth = malloc(sizeof(float) * 640 * 400);
-    assert_true(sil && clip && depth);
-    tu_rng r = {seed};
     for (int e = 0; e < 2; e++) {
-        kin_camera cam = kin_sthmd_camera(&hd, head, (kin_eye)e);
-        rast_target t = { 640, 400, depth, 640, sil, 640, NULL, 0, 0 };
-        rast_target_clear(&t);
-        rast_transform_points(cam.view_proj.m, T->pos, T->nv, clip);
-        rast_mesh_desc md = { clip, T->nv, NULL, 0, T->idx, T->nt, RAST_CULL_NONE };
-        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
-        for (int y = 0; y < 480; y++)
-            for (int x = 0; x < 640; x++) {
-                int yy = y - g.crop_y0;
-                int in_arm = yy >= 0 && yy < 400 && sil[yy * 640 + x];
-                uint8_t *px = &b->cam[e][(y * 640 + x) * 4];
-                int n = (int)(tu_next(&r) % 9) - 4;
-                px[0] = (uint8_t)((in_arm ? 200 : 70) + n);
-                px[1] = (uint8_t)((in_arm ? 120 : 90) + n);
-                px[2] = (uint8_t)((in_arm ? 100 : 150) + n);
-                px[3] = 255;
-            }
+        k->out[e] = malloc(1280 * 800 * 4);
+        k->mask[e] = malloc(640 * 400);
+        assert_true(k->out[e] && k->mask[e]);
     }
-    free(sil);
-    free(clip);
-    free(depth);
 }
 
-/* One frame of each pipe (pf, then pr) on `in`; pf's outputs are kept in
- * keep[e] (1280x800 RGBA8 each), its masks in kmask[e] (640x400). */
-static void frame_pair(pipe_ctx *pf, pipe_ctx *pr, const pipe_frame_in *in, uint8_t *keep[2],
-                       uint8_t *kmask[2])
+static void kept_free(kept_frame *k)
+{
+    for (int e = 0; e < 2; e++) {
+        free(k->out[e]);
+        free(k->mask[e]);
+    }
+}
+
+/* One frame of each of the scene's pipes (pf, then pr) on S->in; pf's
+ * outputs and masks are kept in k. Then pr's bytes must be pf's: outputs
+ * and masks. */
+static void frame_pair_same_bytes(fit_scene *S, kept_frame *k)
 {
     char why[200];
-    assert_int_equal(pipe_frame(pf, in, NULL, why, sizeof why), PIPE_OK);
+    assert_int_equal(pipe_frame(S->pf, &S->in, NULL, why, sizeof why), PIPE_OK);
     for (int e = 0; e < 2; e++) {
-        memcpy(keep[e], in->out[e].pixels, 1280 * 800 * 4);
-        memcpy(kmask[e], pipe_mask(pf, e, NULL, NULL), 640 * 400);
+        memcpy(k->out[e], S->in.out[e].pixels, 1280 * 800 * 4);
+        memcpy(k->mask[e], pipe_mask(S->pf, e, NULL, NULL), 640 * 400);
     }
-    assert_int_equal(pipe_frame(pr, in, NULL, why, sizeof why), PIPE_OK);
+    assert_int_equal(pipe_frame(S->pr, &S->in, NULL, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) {
+        assert_memory_equal(k->out[e], S->b.out[e], 1280 * 800 * 4);
+        assert_memory_equal(k->mask[e], pipe_mask(S->pr, e, NULL, NULL), 640 * 400);
+    }
 }
 
 /* Review fix: frames posed by the animation (in.locals NULL, as `egofuse
@@ -843,59 +882,17 @@ static void frame_pair(pipe_ctx *pf, pipe_ctx *pr, const pipe_frame_in *in, uint
 static void fit_anim_same_bytes(void **state)
 {
     (void)state;
-    fit_arms *A = malloc(sizeof *A), *T = malloc(sizeof *T);
-    assert_true(A && T);
-    fit_arms_build(A);
-    fit_arms_build(T);
-    for (int v = 0; v < T->nv; v++) {   /* the truth's arms turned +-20 deg */
-        int j = T->jnt[v * 4], s = j >= 4, k = j - 1 - 3 * s;
-        if (k > 1) continue;
-        float x = s ? 0.2f : -0.2f;
-        kin_vec3 S = kin_v3(x, -0.1f, 0), u = kin_v3_norm(kin_v3(0, 0.05f, -0.6f));
-        kin_quat q = kin_quat_axis_angle(u, (s ? -20.0f : 20.0f) * 0.01745329f);
-        kin_vec3 p;
-        memcpy(&p, &T->pos[v * 3], sizeof p);
-        p = kin_v3_add(S, kin_quat_rotate(q, kin_v3_sub(p, S)));
-        memcpy(&T->pos[v * 3], &p, sizeof p);
-    }
-    frame_bufs b;
-    pipe_frame_in in;
-    make_frame(&b, &in, 93);
-    kin_mat4 head = kin_mat4_identity();
-    in.head_node = -1;
-    in.world_from_head = &head;
-    in.locals = NULL;
-    in.anim = NULL;                     /* the rest pose: the model's */
-    pipe_desc d = {0};
-    d.threads = 2;
-    d.refine_band = 16;
-    pipe_ctx *pr = pipe_create(&d, &A->m);
-    d.fit_rig = &A->rig;
-    pipe_ctx *pf = pipe_create(&d, &A->m);
-    assert_true(pr && pf);
-    paint_arms(T, &head, pipe_geometry(pf), &b, 94);
-    uint8_t *keep[2], *km[2];
-    for (int e = 0; e < 2; e++) {
-        keep[e] = malloc(1280 * 800 * 4);
-        km[e] = malloc(640 * 400);
-        assert_true(keep[e] && km[e]);
-    }
-    for (int f = 0; f < 2; f++) {
-        frame_pair(pf, pr, &in, keep, km);
-        for (int e = 0; e < 2; e++) {
-            assert_memory_equal(keep[e], b.out[e], 1280 * 800 * 4);
-            assert_memory_equal(km[e], pipe_mask(pr, e, NULL, NULL), 640 * 400);
-        }
-    }
-    pipe_destroy(pf);
-    pipe_destroy(pr);
-    for (int e = 0; e < 2; e++) {
-        free(keep[e]);
-        free(km[e]);
-    }
-    free_frame(&b);
-    free(A);
-    free(T);
+    fit_scene S;
+    fit_scene_open(&S, 93);
+    turn_arms(S.T, 20.0f);              /* the truth's arms turned +-20 deg */
+    S.in.locals = NULL;
+    S.in.anim = NULL;                   /* the rest pose: the model's */
+    paint_arms(S.T, &S.head, pipe_geometry(S.pf), &S.b, 94, NULL);
+    kept_frame k;
+    kept_alloc(&k);
+    for (int f = 0; f < 2; f++) frame_pair_same_bytes(&S, &k);
+    kept_free(&k);
+    fit_scene_close(&S);
 }
 
 /* Review fixes of the fit's state across frames. The truth's forearms
@@ -908,10 +905,9 @@ static void fit_anim_same_bytes(void **state)
 static void fit_state_across_frames(void **state)
 {
     (void)state;
-    fit_arms *A = malloc(sizeof *A), *T = malloc(sizeof *T);
-    assert_true(A && T);
-    fit_arms_build(A);
-    fit_arms_build(T);
+    fit_scene S;
+    fit_scene_open(&S, 95);
+    fit_arms *T = S.T;
     for (int s = 0; s < 2; s++) {       /* the truth's forearms thinner */
         float x = s ? 0.2f : -0.2f, in = s ? -0.12f : 0.12f;
         kin_vec3 E = kin_v3(x + in, -0.1f, -0.3f), Wr = kin_v3(x, -0.05f, -0.6f);
@@ -926,61 +922,32 @@ static void fit_state_across_frames(void **state)
             memcpy(&T->pos[v * 3], &p, sizeof p);
         }
     }
-    frame_bufs b;
-    pipe_frame_in in;
-    make_frame(&b, &in, 95);
-    kin_mat4 head = kin_mat4_identity();
-    in.head_node = -1;
-    in.locals = A->rest;
-    pipe_desc d = {0};
-    d.threads = 2;
-    d.refine_band = 16;
-    pipe_ctx *pr = pipe_create(&d, &A->m);
-    d.fit_rig = &A->rig;
-    pipe_ctx *pf = pipe_create(&d, &A->m);
-    assert_true(pr && pf);
     char why[200];
     pipe_frame_stats st;
     /* (a) tracked */
-    in.world_from_head = &head;
-    paint_arms(T, &head, pipe_geometry(pf), &b, 97);
-    in.fit_skip = 3;                    /* the pose stays the model's */
+    paint_arms(T, &S.head, pipe_geometry(S.pf), &S.b, 97, NULL);
+    S.in.fit_skip = 3;                  /* the pose stays the model's */
     double c1[2], c4[2];
     for (int f = 0; f < 4; f++) {
-        assert_int_equal(pipe_frame(pf, &in, &st, why, sizeof why), PIPE_OK);
+        assert_int_equal(pipe_frame(S.pf, &S.in, &st, why, sizeof why), PIPE_OK);
         for (int e = 0; e < 2; e++) (f ? c4 : c1)[e] = st.coverage[e];
     }
     for (int e = 0; e < 2; e++) assert_true(c4[e] < 0.97 * c1[e]);
     /* (b) animation frame of the same pose: the same thickness */
-    in.locals = NULL;
-    in.anim = NULL;
-    assert_int_equal(pipe_frame(pf, &in, &st, why, sizeof why), PIPE_OK);
+    S.in.locals = NULL;
+    S.in.anim = NULL;
+    assert_int_equal(pipe_frame(S.pf, &S.in, &st, why, sizeof why), PIPE_OK);
     for (int e = 0; e < 2; e++) assert_true(st.coverage[e] == c4[e]);
     /* (c) forgotten: the bytes of no fit */
-    pipe_reset_fit(pf);
-    uint8_t *keep[2], *km[2];
-    for (int e = 0; e < 2; e++) {
-        keep[e] = malloc(1280 * 800 * 4);
-        km[e] = malloc(640 * 400);
-        assert_true(keep[e] && km[e]);
-    }
-    frame_pair(pf, pr, &in, keep, km);
-    for (int e = 0; e < 2; e++) {
-        assert_memory_equal(keep[e], b.out[e], 1280 * 800 * 4);
-        assert_memory_equal(km[e], pipe_mask(pr, e, NULL, NULL), 640 * 400);
-    }
-    assert_int_equal(pipe_frame(pf, &in, &st, why, sizeof why), PIPE_OK);
+    pipe_reset_fit(S.pf);
+    kept_frame k;
+    kept_alloc(&k);
+    frame_pair_same_bytes(&S, &k);
+    assert_int_equal(pipe_frame(S.pf, &S.in, &st, why, sizeof why), PIPE_OK);
     for (int e = 0; e < 2; e++) assert_true(st.coverage[e] == c1[e]);
     pipe_reset_fit(NULL);
-    pipe_destroy(pf);
-    pipe_destroy(pr);
-    for (int e = 0; e < 2; e++) {
-        free(keep[e]);
-        free(km[e]);
-    }
-    free_frame(&b);
-    free(A);
-    free(T);
+    kept_free(&k);
+    fit_scene_close(&S);
 }
 
 int main(void)
