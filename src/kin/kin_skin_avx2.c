@@ -38,11 +38,6 @@
 #define VABS(x) _mm256_and_ps(x, _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF)))
 #define VEXP2(x) _mm256_and_ps(x, _mm256_castsi256_ps(_mm256_set1_epi32(0x7F800000)))
 
-static inline unsigned nonzero4(const float *w)
-{
-    return (unsigned)_mm_movemask_ps(_mm_cmpneq_ps(_mm_loadu_ps(w), _mm_setzero_ps()));
-}
-
 /* In-lane 4x4 transposes (per 128-bit lane) of r0..r3. */
 static inline void tr4(__m256 r0, __m256 r1, __m256 r2, __m256 r3, __m256 o[4])
 {
@@ -71,7 +66,7 @@ static inline void lbs_block(skin_tab *tab, const kin_mesh *mesh, const kin_mat4
     for (int l = 0; l < 8; l++, j += 4, w += 4) {
         __m256 lo = _mm256_setzero_ps(), hi = _mm256_setzero_ps();
         float s = 0.0f;
-        for (unsigned bits = nonzero4(w); bits; bits &= bits - 1) {
+        for (unsigned bits = kin__nonzero4(w); bits; bits &= bits - 1) {
             int i = __builtin_ctz(bits);
             __m256 wv = _mm256_set1_ps(w[i]);
             lo = _mm256_add_ps(lo, _mm256_mul_ps(wv, _mm256_loadu_ps(jm[j[i]].m)));
@@ -107,7 +102,7 @@ static inline void dqs_block(skin_tab *tab, const kin_mesh *mesh, const kin_dual
         __m256 acc = _mm256_setzero_ps();
         float s = 0.0f;
         const kin_quat *r0 = NULL;
-        for (unsigned bits = nonzero4(w); bits; bits &= bits - 1) {
+        for (unsigned bits = kin__nonzero4(w); bits; bits &= bits - 1) {
             int i = __builtin_ctz(bits);
             const kin_dualquat *q = &dq[j[i]];
             float sw = w[i];

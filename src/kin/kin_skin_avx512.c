@@ -38,13 +38,6 @@
 #define VABS(x) _mm512_and_ps(x, _mm512_castsi512_ps(_mm512_set1_epi32(0x7FFFFFFF)))
 #define VEXP2(x) _mm512_and_ps(x, _mm512_castsi512_ps(_mm512_set1_epi32(0x7F800000)))
 
-/* Bit i set when weight i is not 0 (NaN counts as not 0, as in the
- * reference's "w == 0: skip"). */
-static inline unsigned nonzero4(const float *w)
-{
-    return (unsigned)_mm_movemask_ps(_mm_cmpneq_ps(_mm_loadu_ps(w), _mm_setzero_ps()));
-}
-
 /* In-lane 4x4 transposes of r0..r3: o[k] holds, in each 128-bit block,
  * element k of that block of r0, r1, r2, r3. */
 static inline void tr4(__m512 r0, __m512 r1, __m512 r2, __m512 r3, __m512 o[4])
@@ -69,7 +62,7 @@ static inline void lbs_rows(const kin_mesh *mesh, const kin_mat4 *jm, int v,
     for (int l = 0; l < 16; l++, j += 4, w += 4) {
         __m512 acc = _mm512_setzero_ps();
         float s = 0.0f;
-        for (unsigned bits = nonzero4(w); bits; bits &= bits - 1) {
+        for (unsigned bits = kin__nonzero4(w); bits; bits &= bits - 1) {
             int i = __builtin_ctz(bits);
             acc = _mm512_add_ps(acc, _mm512_mul_ps(_mm512_set1_ps(w[i]),
                                                    _mm512_loadu_ps(jm[j[i]].m)));
@@ -107,7 +100,7 @@ static inline void dqs_rows(const kin_mesh *mesh, const kin_dualquat *dq, int v,
         __m256 acc = _mm256_setzero_ps();
         float s = 0.0f;
         const kin_quat *r0 = NULL;
-        for (unsigned bits = nonzero4(w); bits; bits &= bits - 1) {
+        for (unsigned bits = kin__nonzero4(w); bits; bits &= bits - 1) {
             int i = __builtin_ctz(bits);
             const kin_dualquat *q = &dq[j[i]];
             float sw = w[i];

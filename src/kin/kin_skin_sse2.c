@@ -39,13 +39,6 @@
 #define VABS(x) _mm_and_ps(x, _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF)))
 #define VEXP2(x) _mm_and_ps(x, _mm_castsi128_ps(_mm_set1_epi32(0x7F800000)))
 
-/* Bit i set when weight i is not 0 (NaN counts as not 0, as in the
- * reference's "w == 0: skip"). */
-static inline unsigned nonzero4(const float *w)
-{
-    return (unsigned)_mm_movemask_ps(_mm_cmpneq_ps(_mm_loadu_ps(w), _mm_setzero_ps()));
-}
-
 /* No per-call state here. */
 typedef struct skin_tab { int unused; } skin_tab;
 static inline void tab_init(skin_tab *t) { t->unused = 0; }
@@ -61,7 +54,7 @@ static inline void lbs_block(skin_tab *tab, const kin_mesh *mesh, const kin_mat4
     for (int l = 0; l < 4; l++, j += 4, w += 4) {
         __m128 c[4] = { _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps(), _mm_setzero_ps() };
         float s = 0.0f;
-        for (unsigned bits = nonzero4(w); bits; bits &= bits - 1) {
+        for (unsigned bits = kin__nonzero4(w); bits; bits &= bits - 1) {
             int i = __builtin_ctz(bits);
             __m128 wv = _mm_set1_ps(w[i]);
             const float *m = jm[j[i]].m;
@@ -92,7 +85,7 @@ static inline void dqs_block(skin_tab *tab, const kin_mesh *mesh, const kin_dual
         __m128 qr = _mm_setzero_ps(), qd = _mm_setzero_ps();
         float s = 0.0f;
         const kin_quat *r0 = NULL;
-        for (unsigned bits = nonzero4(w); bits; bits &= bits - 1) {
+        for (unsigned bits = kin__nonzero4(w); bits; bits &= bits - 1) {
             int i = __builtin_ctz(bits);
             const kin_dualquat *q = &dq[j[i]];
             float sw = w[i];
