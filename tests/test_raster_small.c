@@ -27,7 +27,12 @@
 #include "../src/raster/raster_internal.h"
 
 #define NCASES 6000
-#define SMALL_CRC 0x7AE0501Fu   /* recorded: reference output of all cases */
+/* Recorded: reference output of all cases. Since the ninth round of
+ * issue 3 the set-up drops boxes of at most 2x2 pixels with no centre
+ * inside (RAST__SETUP_EMPTY, one-pixel boxes only before), so those cases
+ * are no longer scanned here and the CRC changed (0x7AE0501F before); the
+ * output of every remaining case is unchanged. */
+#define SMALL_CRC 0xE9BDBF99u
 
 typedef struct planes {
     rast_target t;

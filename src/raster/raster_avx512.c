@@ -289,9 +289,10 @@ _Static_assert(sizeof(rast__vc_entry) == 32 && offsetof(rast__vc_entry, flags) =
  *   degenerate (area 0), culled (back: area > 0, front: area < 0);
  *   box: x0 = max((xmin + 127) >> 8, 0), x1 = min((xmax - 128) >> 8, W-1)
  *     (y alike), off screen when empty;
- *   one-pixel box (before clamping too, so every coordinate difference is
- *     below 512 and the int32 products below 2^18): the three biased edge
- *     values at the centre, winding normalised, all >= 0 or empty. */
+ *   box of at most 2x2 pixels (before clamping too, so every coordinate
+ *     difference is below 768 and the int32 products below 2^20): the
+ *     three biased edge values at each pixel centre of the clamped box,
+ *     winding normalised; empty when no centre has all three >= 0. */
 unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__vcache *vc,
                             int ti, rast_stats *st, rast__vfill_fn vfill)
 {
@@ -353,14 +354,15 @@ unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__
     const front_box bx = front_box_of(X, Y, v->width, v->height);
     const unsigned live2 = cl.live & ~bx.off;
     unsigned empty = 0;
-    const unsigned single = live2 & bx.uone;
-    if (single) {
+    const unsigned small = live2 & bx.usmall;
+    if (small) {
         const __mmask16 sw = (__mmask16)neg;   /* normalise: swap 1 and 2 */
         const __m512i x1 = _mm512_mask_blend_epi32(sw, X[1], X[2]);
         const __m512i x2 = _mm512_mask_blend_epi32(sw, X[2], X[1]);
         const __m512i y1 = _mm512_mask_blend_epi32(sw, Y[1], Y[2]);
         const __m512i y2 = _mm512_mask_blend_epi32(sw, Y[2], Y[1]);
-        empty = single & front_empty_bits(X[0], Y[0], x1, y1, x2, y2, bx.bx0, bx.by0);
+        empty = small & front_empty_small(X[0], Y[0], x1, y1, x2, y2, bx.bx0, bx.by0, bx.bx1,
+                                          bx.by1);
     }
     front_count(st, cl.degen, cl.culled, cl.live & bx.off, empty);
     return special | (live2 & ~empty);

@@ -62,11 +62,11 @@ static inline front_class front_classify(rast_cull cull, unsigned valid, unsigne
 }
 
 /* setup_box_edges: the pixel box before (r*) and after (b*) clamping to
- * the target; off: the clamped box is empty; one, uone: the clamped, the
- * unclamped box is a single pixel. */
+ * the target; off: the clamped box is empty; small, usmall: the clamped,
+ * the unclamped box is at most 2x2 pixels. */
 typedef struct front_box {
     fvi rx0, rx1, ry0, ry1, bx0, by0, bx1, by1;
-    unsigned off, one, uone;
+    unsigned off, small, usmall;
 } front_box;
 
 static inline front_box front_box_of(const fvi X[3], const fvi Y[3], int width, int height)
@@ -87,17 +87,25 @@ static inline front_box front_box_of(const fvi X[3], const fvi Y[3], int width, 
     b.bx1 = FI_MIN(b.rx1, FI_SET1(width - 1));
     b.by1 = FI_MIN(b.ry1, FI_SET1(height - 1));
     b.off = FM_BITS(FM_OR(FI_GT(b.bx0, b.bx1), FI_GT(b.by0, b.by1)));
-    b.one = FM_BITS(FM_AND(FI_EQ(b.bx0, b.bx1), FI_EQ(b.by0, b.by1)));
-    b.uone = FM_BITS(FM_AND(FI_EQ(b.rx0, b.rx1), FI_EQ(b.ry0, b.ry1)));
+    /* at most 2 pixels a side: x1 < x0 + 2 */
+    const fvi two = FI_SET1(2);
+    b.small = FM_BITS(FM_AND(FI_GT(FI_ADD(b.bx0, two), b.bx1), FI_GT(FI_ADD(b.by0, two), b.by1))) &
+              ~b.off;
+    b.usmall = FM_BITS(FM_AND(FI_GT(FI_ADD(b.rx0, two), b.rx1), FI_GT(FI_ADD(b.ry0, two), b.ry1))) &
+               ~b.off;
     return b;
 }
 
-/* One-pixel boxes (before clamping too: coordinate differences below 512,
- * int32 products below 2^18): lanes where the centre of (bx0, by0) fails
- * an edge of the triangle (X0, Y0), (x1, y1), (x2, y2), winding
- * normalised (area > 0). */
-static inline unsigned front_empty_bits(fvi X0, fvi Y0, fvi x1, fvi y1, fvi x2, fvi y2,
-                                        fvi bx0, fvi by0)
+/* Boxes of at most 2x2 pixels, before clamping too: lanes where no pixel
+ * centre of the clamped box bx0..bx1 x by0..by1 lies inside the triangle
+ * (X0, Y0), (x1, y1), (x2, y2), winding normalised (area > 0): the
+ * biased edge test of the scan at each centre. int32 is exact here: with
+ * an unclamped box of at most 2 pixels a side, every vertex coordinate
+ * difference is below 768 (1/256 px) and every centre lies within 768 of
+ * every vertex, so the products stay below 2^20 and the steps below
+ * 2^18. */
+static inline unsigned front_empty_small(fvi X0, fvi Y0, fvi x1, fvi y1, fvi x2, fvi y2,
+                                         fvi bx0, fvi by0, fvi bx1, fvi by1)
 {
     const fvi c128 = FI_SET1(RAST__FIX_HALF);
     const fvi cx = FI_ADD(FI_SLLI(bx0, RAST_SUBPIXEL_BITS), c128);
@@ -105,7 +113,22 @@ static inline unsigned front_empty_bits(fvi X0, fvi Y0, fvi x1, fvi y1, fvi x2, 
     const fvi e0 = front_edge32(x1, y1, x2, y2, cx, cy);
     const fvi e1 = front_edge32(x2, y2, X0, Y0, cx, cy);
     const fvi e2 = front_edge32(X0, Y0, x1, y1, cx, cy);
-    return FI_NEG_BITS(FI_OR(FI_OR(e0, e1), e2));
+    /* one pixel right: E - dy*256; one pixel down: E + dx*256 */
+    const fvi r0 = FI_SLLI(FI_SUB(y2, y1), RAST_SUBPIXEL_BITS);
+    const fvi r1 = FI_SLLI(FI_SUB(Y0, y2), RAST_SUBPIXEL_BITS);
+    const fvi r2 = FI_SLLI(FI_SUB(y1, Y0), RAST_SUBPIXEL_BITS);
+    const fvi d0 = FI_SLLI(FI_SUB(x2, x1), RAST_SUBPIXEL_BITS);
+    const fvi d1 = FI_SLLI(FI_SUB(X0, x2), RAST_SUBPIXEL_BITS);
+    const fvi d2 = FI_SLLI(FI_SUB(x1, X0), RAST_SUBPIXEL_BITS);
+    const fvi e0d = FI_ADD(e0, d0), e1d = FI_ADD(e1, d1), e2d = FI_ADD(e2, d2);
+    const unsigned wide = FM_BITS(FI_GT(bx1, bx0)), tall = FM_BITS(FI_GT(by1, by0));
+    const unsigned c00 = ~FI_NEG_BITS(FI_OR(FI_OR(e0, e1), e2));
+    const unsigned c10 = ~FI_NEG_BITS(FI_OR(FI_OR(FI_SUB(e0, r0), FI_SUB(e1, r1)),
+                                            FI_SUB(e2, r2))) & wide;
+    const unsigned c01 = ~FI_NEG_BITS(FI_OR(FI_OR(e0d, e1d), e2d)) & tall;
+    const unsigned c11 = ~FI_NEG_BITS(FI_OR(FI_OR(FI_SUB(e0d, r0), FI_SUB(e1d, r1)),
+                                            FI_SUB(e2d, r2))) & wide & tall;
+    return ~(c00 | c10 | c01 | c11);
 }
 
 /* The statistics of one group. */
@@ -230,5 +253,6 @@ static inline rast__tri *front_record(const squeue *q, int l, const int64_t (*ec
     t->b2.dx = pl[10][l];
     t->b2.dy = pl[11][l];
     t->attr_count = ac;
+    t->micro = 0;
     return t;
 }

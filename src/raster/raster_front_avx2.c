@@ -123,7 +123,7 @@ static inline __m256i top_left(__m256i dx, __m256i dy)
                                             _mm256_cmpgt_epi32(dx, zero)));
 }
 
-/* Biased edge value in int32 (one-pixel boxes only). */
+/* Biased edge value in int32 (boxes of at most 2x2 pixels only). */
 static inline __m256i front_edge32(__m256i xa, __m256i ya, __m256i xb, __m256i yb,
                                    __m256i cx, __m256i cy)
 {
@@ -194,9 +194,84 @@ typedef __m256d fdm;
 
 /* ---- survivor set-up ---------------------------------------------------- */
 
-/* Sets up queue lanes 0 .. k-1 (k = 1..8) into their records. */
+/* Micro lanes (clamped box at most 2x2 pixels; raster_front_avx512.c,
+ * micro_lanes): the covered pixels (bit i + 2j of cov[l]) by the int64
+ * edge test of the scan, and the clamped depth and the barycentrics of
+ * the box's four pixels by the scan's float operations per lane. Returns
+ * the micro lanes. */
+static inline unsigned micro_lanes(const squeue *q, unsigned L, const int64_t (*ec)[8],
+                                   const int64_t (*edx)[8], const int64_t (*edy)[8],
+                                   const float (*pl)[8], uint8_t *cov, float (*mz)[8],
+                                   float (*mb1)[8], float (*mb2)[8])
+{
+    const __m256i one = _mm256_set1_epi32(1), two = _mm256_set1_epi32(2);
+    const __m256i w1 = _mm256_sub_epi32(_mm256_load_si256((const __m256i *)(const void *)q->f[Q_BX1]),
+                                        _mm256_load_si256((const __m256i *)(const void *)q->f[Q_BX0]));
+    const __m256i h1 = _mm256_sub_epi32(_mm256_load_si256((const __m256i *)(const void *)q->f[Q_BY1]),
+                                        _mm256_load_si256((const __m256i *)(const void *)q->f[Q_BY0]));
+    const unsigned wide = bits8(_mm256_cmpeq_epi32(w1, one));   /* 2 columns */
+    const unsigned tall = bits8(_mm256_cmpeq_epi32(h1, one));   /* 2 rows */
+    const unsigned mic = L & bits8(_mm256_and_si256(_mm256_cmpgt_epi32(two, w1),
+                                                    _mm256_cmpgt_epi32(two, h1)));
+    if (!mic)
+        return 0;
+    /* Coverage: E = e_c + i*e_dx + j*e_dy, int64, at the four pixels. */
+    unsigned cv[4] = { 0, 0, 0, 0 };
+    for (int h = 0; h < 2; h++) {
+        __m256i o[4] = { _mm256_setzero_si256(), _mm256_setzero_si256(),
+                         _mm256_setzero_si256(), _mm256_setzero_si256() };
+        for (int e = 0; e < 3; e++) {
+            const __m256i c = _mm256_load_si256((const __m256i *)(const void *)&ec[e][4 * h]);
+            const __m256i ex = _mm256_load_si256((const __m256i *)(const void *)&edx[e][4 * h]);
+            const __m256i ey = _mm256_load_si256((const __m256i *)(const void *)&edy[e][4 * h]);
+            const __m256i c01 = _mm256_add_epi64(c, ey);
+            o[0] = _mm256_or_si256(o[0], c);
+            o[1] = _mm256_or_si256(o[1], _mm256_add_epi64(c, ex));
+            o[2] = _mm256_or_si256(o[2], c01);
+            o[3] = _mm256_or_si256(o[3], _mm256_add_epi64(c01, ex));
+        }
+        for (int p = 0; p < 4; p++)
+            cv[p] |= (~(unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(o[p])) & 15u) << (4 * h);
+    }
+    cv[0] &= mic;
+    cv[1] &= mic & wide;
+    cv[2] &= mic & tall;
+    cv[3] &= mic & wide & tall;
+    if (!(cv[0] | cv[1] | cv[2] | cv[3]))
+        return mic;
+    for (int l = 0; l < 8; l++)
+        cov[l] = (uint8_t)(((cv[0] >> l) & 1u) | (((cv[1] >> l) & 1u) << 1) |
+                           (((cv[2] >> l) & 1u) << 2) | (((cv[3] >> l) & 1u) << 3));
+    /* The values (the scan's expressions; unused lanes compute garbage). */
+    const __m256 zero = _mm256_setzero_ps(), fone = _mm256_set1_ps(1.0f);
+    __m256 P[12];
+    for (int i = 0; i < 12; i++)
+        P[i] = _mm256_load_ps(pl[i]);
+    for (int j = 0; j < 2; j++) {
+        const __m256 fj = j ? fone : zero;
+        const __m256 zr = _mm256_add_ps(P[0], _mm256_mul_ps(P[2], fj));
+        const __m256 qr = _mm256_add_ps(P[3], _mm256_mul_ps(P[5], fj));
+        const __m256 b1r = _mm256_add_ps(P[6], _mm256_mul_ps(P[8], fj));
+        const __m256 b2r = _mm256_add_ps(P[9], _mm256_mul_ps(P[11], fj));
+        for (int i = 0; i < 2; i++) {
+            const int p = i + 2 * j;
+            const __m256 fi = i ? fone : zero;
+            __m256 z = _mm256_add_ps(zr, _mm256_mul_ps(P[1], fi));
+            z = _mm256_max_ps(zero, z);
+            z = _mm256_min_ps(fone, z);
+            _mm256_store_ps(mz[p], z);
+            const __m256 r = _mm256_div_ps(fone, _mm256_add_ps(qr, _mm256_mul_ps(P[4], fi)));
+            _mm256_store_ps(mb1[p], _mm256_mul_ps(_mm256_add_ps(b1r, _mm256_mul_ps(P[7], fi)), r));
+            _mm256_store_ps(mb2[p], _mm256_mul_ps(_mm256_add_ps(b2r, _mm256_mul_ps(P[10], fi)), r));
+        }
+    }
+    return mic;
+}
+
+/* Sets up queue lanes 0 .. k-1 (k = 1..8) into their records (micro: the
+ * micro records of boxes of at most 2x2 pixels). */
 static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
-                  const squeue *q, int k, rast__tri *out)
+                  const squeue *q, int k, rast__tri *out, int micro)
 {
     const __m256i L = _mm256_cmpgt_epi32(_mm256_set1_epi32(k),
                                          _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
@@ -262,8 +337,31 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
         }
     }
 
+    _Alignas(32) uint8_t cov[8] = { 0 };
+    _Alignas(32) float mz[4][8], mb1[4][8], mb2[4][8];
+    const unsigned mic = micro ? micro_lanes(q, (1u << k) - 1u, ec, edx, edy,
+                                             (const float (*)[8])pl, cov, mz, mb1, mb2)
+                               : 0u;
     for (int l = 0; l < k; l++) {
-        rast__tri *t = front_record(q, l, ec, edx, edy, pl, ac, out);
+        rast__tri *t;
+        if ((mic >> l) & 1u) {
+            t = out + q->f[Q_SLOT][l];
+            t->micro = RAST__MICRO | cov[l];
+            if (!cov[l])
+                continue;
+            t->x0 = q->f[Q_BX0][l];
+            t->y0 = q->f[Q_BY0][l];
+            t->x1 = q->f[Q_BX1][l];
+            t->y1 = q->f[Q_BY1][l];
+            t->attr_count = ac;
+            for (int p = 0; p < 4; p++) {
+                t->mz[p] = mz[p][l];
+                t->mb1[p] = mb1[p][l];
+                t->mb2[p] = mb2[p][l];
+            }
+        } else {
+            t = front_record(q, l, ec, edx, edy, pl, ac, out);
+        }
         for (int a = 0; a < ac; a++) {
             t->a0[a] = at[0][a][l];
             t->d1[a] = at[1][a][l];
@@ -273,7 +371,7 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
 }
 
 int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
-                      int ti0, int ti1, rast__tri *out, rast_stats *st)
+                      int ti0, int ti1, rast__tri *out, rast_stats *st, int micro)
 {
     rast_stats ls = *st;
     squeue q;
@@ -317,17 +415,18 @@ int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__
         /* setup_box_edges: the clamped pixel box, off screen, empty (as
          * raster_front_avx512.c). */
         const front_box b = front_box_of(X, Y, vw, vh);
-        const unsigned csingle = c.live & ~b.off & b.one;
-        const unsigned odd = csingle & ~b.uone;
+        const unsigned csmall = c.live & ~b.off & b.small;
+        const unsigned odd = csmall & ~b.usmall;
         const unsigned special = special0 | odd;
         const unsigned live2 = c.live & ~b.off & ~odd;
         const __m256i sw = vmask(neg);
         const __m256i x1 = blend8(X[1], X[2], sw), x2 = blend8(X[2], X[1], sw);
         const __m256i y1 = blend8(Y[1], Y[2], sw), y2 = blend8(Y[2], Y[1], sw);
-        const unsigned single = csingle & b.uone;
+        const unsigned small = csmall & b.usmall;
         unsigned empty = 0;
-        if (single)
-            empty = single & front_empty_bits(X[0], Y[0], x1, y1, x2, y2, b.bx0, b.by0);
+        if (small)
+            empty = small & front_empty_small(X[0], Y[0], x1, y1, x2, y2, b.bx0, b.by0,
+                                              b.bx1, b.by1);
         const unsigned surv = live2 & ~empty;
         front_count(&ls, c.degen, c.culled, c.live & b.off, live2);
         if (!surv && !special)
@@ -354,7 +453,7 @@ int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__
         _mm256_storeu_si256((__m256i *)(void *)(q.f[Q_SLOT] + q.n), slot);
         q.n += __builtin_popcount(surv);
         if (q.n >= 8) {
-            flush(v, m, vb, &q, 8, out);
+            flush(v, m, vb, &q, 8, out, micro);
             q.n -= 8;
             for (int f = 0; f < Q_FIELDS; f++)
                 _mm256_store_si256((__m256i *)(void *)q.f[f],
@@ -362,7 +461,7 @@ int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__
         }
     }
     if (q.n)
-        flush(v, m, vb, &q, q.n, out);
+        flush(v, m, vb, &q, q.n, out, micro);
     *st = ls;
     return n;
 }

@@ -9,9 +9,12 @@
  * with the scalar set-up:
  *   vertex pass   vc_fill_one (finiteness, outcode, w > 0, snap, zw, iw);
  *   rejection     prepare_cached_one + setup_box_edges (area sign exact in
- *                 double, culling, clamped box, empty one-pixel boxes);
+ *                 double, culling, clamped box, empty boxes of at most
+ *                 2x2 pixels);
  *   set-up        setup_edges (int64 edges by vpmuldq), planes_one (the
- *                 double plane set-up, as raster_planes.inl), setup_attrs.
+ *                 double plane set-up, as raster_planes.inl), setup_attrs;
+ *                 for boxes of at most 2x2 pixels, micro records instead
+ *                 (micro_lanes: the scan's per-pixel values, in lanes).
  * Triangles with a vertex that is not finite, outside a clip plane or at
  * w <= 0 go through rast__prepare at their place in the order. */
 #include "raster_internal.h"
@@ -114,8 +117,88 @@ void rast__vpass_avx512(const rast__view *v, const float *clip, int count, rast_
 /* ---- survivor set-up ---------------------------------------------------- */
 
 /* Sets up queue lanes 0 .. k-1 (k = 1..16) into their records. */
+/* Micro lanes (clamped box at most 2x2 pixels): the covered pixels and,
+ * for each of the box's four pixels (i, j), the scan's values: the clamped
+ * depth z and the barycentrics b1, b2, computed per lane with the float
+ * operations of rast__scan_rows_ref in its order (fi, fj are 0.0f or
+ * 1.0f, multiplied as the scan multiplies them). cov[l]: bit i + 2j for
+ * a covered pixel (the int64 edge test of the scan at that pixel). */
+static inline unsigned micro_lanes(const squeue *q, __mmask16 L, const int64_t (*ec)[16],
+                                   const int64_t (*edx)[16], const int64_t (*edy)[16],
+                                   const float (*pl)[16], uint8_t *cov, float (*mz)[16],
+                                   float (*mb1)[16], float (*mb2)[16])
+{
+    const __m512i one = _mm512_set1_epi32(1);
+    const __m512i w1 = _mm512_sub_epi32(_mm512_load_si512((const void *)q->f[Q_BX1]),
+                                        _mm512_load_si512((const void *)q->f[Q_BX0]));
+    const __m512i h1 = _mm512_sub_epi32(_mm512_load_si512((const void *)q->f[Q_BY1]),
+                                        _mm512_load_si512((const void *)q->f[Q_BY0]));
+    const __mmask16 wide = _mm512_cmpeq_epi32_mask(w1, one);   /* 2 columns */
+    const __mmask16 tall = _mm512_cmpeq_epi32_mask(h1, one);   /* 2 rows */
+    const __mmask16 mic = L & _mm512_cmple_epi32_mask(w1, one) &
+                          _mm512_cmple_epi32_mask(h1, one);
+    if (!mic)
+        return 0;
+    /* Coverage: E = e_c + i*e_dx + j*e_dy, int64, at the four pixels. */
+    __mmask16 cv[4];
+    for (int p = 0; p < 4; p++)
+        cv[p] = 0;
+    for (int h = 0; h < 2; h++) {
+        __m512i o[4] = { _mm512_setzero_si512(), _mm512_setzero_si512(),
+                         _mm512_setzero_si512(), _mm512_setzero_si512() };
+        for (int e = 0; e < 3; e++) {
+            const __m512i c = _mm512_load_si512((const void *)&ec[e][8 * h]);
+            const __m512i ex = _mm512_load_si512((const void *)&edx[e][8 * h]);
+            const __m512i ey = _mm512_load_si512((const void *)&edy[e][8 * h]);
+            const __m512i c01 = _mm512_add_epi64(c, ey);
+            o[0] = _mm512_or_si512(o[0], c);
+            o[1] = _mm512_or_si512(o[1], _mm512_add_epi64(c, ex));
+            o[2] = _mm512_or_si512(o[2], c01);
+            o[3] = _mm512_or_si512(o[3], _mm512_add_epi64(c01, ex));
+        }
+        for (int p = 0; p < 4; p++)
+            cv[p] |= (__mmask16)((unsigned)(uint8_t)~_mm512_movepi64_mask(o[p]) << (8 * h));
+    }
+    cv[0] &= mic;
+    cv[1] &= mic & wide;
+    cv[2] &= mic & tall;
+    cv[3] &= mic & wide & tall;
+    const __mmask16 any = cv[0] | cv[1] | cv[2] | cv[3];
+    if (!any)
+        return mic;
+    const __m512i bit = _mm512_set1_epi32(1);
+    __m512i cb = _mm512_setzero_si512();
+    for (int p = 0; p < 4; p++)
+        cb = _mm512_mask_or_epi32(cb, cv[p], cb, _mm512_slli_epi32(bit, p));
+    _mm_storeu_si128((__m128i *)(void *)cov, _mm512_cvtepi32_epi8(cb));
+    /* The values (the scan's expressions; unused lanes compute garbage). */
+    const __m512 zero = _mm512_setzero_ps(), fone = _mm512_set1_ps(1.0f);
+    __m512 P[12];
+    for (int i = 0; i < 12; i++)
+        P[i] = _mm512_load_ps(pl[i]);
+    for (int j = 0; j < 2; j++) {
+        const __m512 fj = j ? fone : zero;
+        const __m512 zr = _mm512_add_ps(P[0], _mm512_mul_ps(P[2], fj));
+        const __m512 qr = _mm512_add_ps(P[3], _mm512_mul_ps(P[5], fj));
+        const __m512 b1r = _mm512_add_ps(P[6], _mm512_mul_ps(P[8], fj));
+        const __m512 b2r = _mm512_add_ps(P[9], _mm512_mul_ps(P[11], fj));
+        for (int i = 0; i < 2; i++) {
+            const int p = i + 2 * j;
+            const __m512 fi = i ? fone : zero;
+            __m512 z = _mm512_add_ps(zr, _mm512_mul_ps(P[1], fi));
+            z = _mm512_max_ps(zero, z);
+            z = _mm512_min_ps(fone, z);
+            _mm512_store_ps(mz[p], z);
+            const __m512 r = _mm512_div_ps(fone, _mm512_add_ps(qr, _mm512_mul_ps(P[4], fi)));
+            _mm512_store_ps(mb1[p], _mm512_mul_ps(_mm512_add_ps(b1r, _mm512_mul_ps(P[7], fi)), r));
+            _mm512_store_ps(mb2[p], _mm512_mul_ps(_mm512_add_ps(b2r, _mm512_mul_ps(P[10], fi)), r));
+        }
+    }
+    return mic;
+}
+
 static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
-                  const squeue *q, int k, rast__tri *out)
+                  const squeue *q, int k, rast__tri *out, int micro)
 {
     const __mmask16 L = k >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << k) - 1u);
     __m512i X[3], Y[3], V[3];
@@ -159,10 +242,34 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
         front_planes_half(X, Y, V, bx0, by0, (__mmask8)(L >> (8 * h)), h, vb, pl);
 
     /* The records: lane l -> out[slot l]. */
+    _Alignas(64) uint8_t cov[16] = { 0 };
+    _Alignas(64) float mz[4][16], mb1[4][16], mb2[4][16];
+    const unsigned mic = micro ? micro_lanes(q, L, ec, edx, edy,
+                                             (const float (*)[16])pl, cov, mz, mb1, mb2)
+                               : 0u;
+
     const int ac = v->attr_count;
     const __mmask8 AM = (__mmask8)((1u << ac) - 1u);
     for (int l = 0; l < k; l++) {
-        rast__tri *t = front_record(q, l, ec, edx, edy, pl, ac, out);
+        rast__tri *t;
+        if ((mic >> l) & 1u) {
+            t = out + q->f[Q_SLOT][l];
+            t->micro = RAST__MICRO | cov[l];
+            if (!cov[l])
+                continue;
+            t->x0 = q->f[Q_BX0][l];
+            t->y0 = q->f[Q_BY0][l];
+            t->x1 = q->f[Q_BX1][l];
+            t->y1 = q->f[Q_BY1][l];
+            t->attr_count = ac;
+            for (int p = 0; p < 4; p++) {
+                t->mz[p] = mz[p][l];
+                t->mb1[p] = mb1[p][l];
+                t->mb2[p] = mb2[p][l];
+            }
+        } else {
+            t = front_record(q, l, ec, edx, edy, pl, ac, out);
+        }
         /* setup_attrs: a0 = attribute of vertex 0, d1 = a1 - a0,
          * d2 = a2 - a0, per record by masked loads (no byte past the
          * vertex's ac floats is read) and masked stores (no byte past
@@ -185,7 +292,7 @@ _Static_assert(RAST__FRONT_GROUP == 16, "one group per 16-lane vector");
 _Static_assert(RAST_MAX_ATTRS <= 8, "attributes by 8-lane masked loads and stores");
 
 int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
-                        int ti0, int ti1, rast__tri *out, rast_stats *st)
+                        int ti0, int ti1, rast__tri *out, rast_stats *st, int micro)
 {
     rast_stats ls = *st;
     squeue q;
@@ -228,11 +335,12 @@ int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast
         const front_class c = front_classify(m->cull, L & ~special0, pos, neg);
         /* setup_box_edges: the clamped pixel box, off screen, empty. */
         const front_box b = front_box_of(X, Y, vw, vh);
-        /* A box of one pixel after clamping but not before (a triangle
-         * across the border): the empty test needs int64 edges there, so
-         * the (rare) lane takes the scalar path, which counts it. */
-        const unsigned csingle = c.live & ~b.off & b.one;
-        const unsigned odd = csingle & ~b.uone;
+        /* A box of at most 2x2 pixels after clamping but not before (a
+         * triangle across the border): the empty test needs int64 edges
+         * there, so the (rare) lane takes the scalar path, which counts
+         * it. */
+        const unsigned csmall = c.live & ~b.off & b.small;
+        const unsigned odd = csmall & ~b.usmall;
         const unsigned special = special0 | odd;
         const unsigned live2 = c.live & ~b.off & ~odd;
         /* Winding normalised (vertices 1 and 2 swapped where area < 0). */
@@ -241,11 +349,12 @@ int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast
         const __m512i x2 = _mm512_mask_blend_epi32(sw, X[2], X[1]);
         const __m512i y1 = _mm512_mask_blend_epi32(sw, Y[1], Y[2]);
         const __m512i y2 = _mm512_mask_blend_epi32(sw, Y[2], Y[1]);
-        /* one pixel before clamping: differences below 512, int32 edges */
-        const unsigned single = csingle & b.uone;
+        /* at most 2x2 before clamping: differences below 768, int32 edges */
+        const unsigned small = csmall & b.usmall;
         unsigned empty = 0;
-        if (single)
-            empty = single & front_empty_bits(X[0], Y[0], x1, y1, x2, y2, b.bx0, b.by0);
+        if (small)
+            empty = small & front_empty_small(X[0], Y[0], x1, y1, x2, y2, b.bx0, b.by0,
+                                              b.bx1, b.by1);
         const unsigned surv = live2 & ~empty;
         /* drawn: survivors and empty ones */
         front_count(&ls, c.degen, c.culled, c.live & b.off, live2);
@@ -275,14 +384,14 @@ int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast
         _mm512_storeu_si512((void *)(q.f[Q_SLOT] + q.n), slot);
         q.n += __builtin_popcount(surv);
         if (q.n >= 16) {
-            flush(v, m, vb, &q, 16, out);
+            flush(v, m, vb, &q, 16, out, micro);
             q.n -= 16;
             for (int f = 0; f < Q_FIELDS; f++)
                 _mm512_store_si512((void *)q.f[f], _mm512_load_si512((const void *)(q.f[f] + 16)));
         }
     }
     if (q.n)
-        flush(v, m, vb, &q, q.n, out);
+        flush(v, m, vb, &q, q.n, out, micro);
     *st = ls;
     return n;
 }

@@ -106,8 +106,8 @@ static inline __mmask16 top_left(__m512i dx, __m512i dy)
            (_mm512_cmpeq_epi32_mask(dy, zero) & _mm512_cmpgt_epi32_mask(dx, zero));
 }
 
-/* Biased edge value from a to b at (cx, cy) in int32 (one-pixel boxes:
- * differences below 512, products below 2^18). */
+/* Biased edge value from a to b at (cx, cy) in int32 (boxes up to 2x2:
+ * differences below 768, products below 2^20; front_empty_small). */
 static inline __m512i front_edge32(__m512i xa, __m512i ya, __m512i xb, __m512i yb,
                                    __m512i cx, __m512i cy)
 {

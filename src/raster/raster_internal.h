@@ -95,7 +95,17 @@ typedef struct rast__tri {
      * normalisation. A constant attribute is reproduced exactly. */
     float a0[RAST_MAX_ATTRS], d1[RAST_MAX_ATTRS], d2[RAST_MAX_ATTRS];
     int attr_count;
+    /* 0: a triangle to scan (every set-up path writes 0). Otherwise a
+     * "micro record" of the vector front end (docs/raster.md section 11):
+     * RAST__MICRO | the covered pixels of a box of at most 2x2 (bit
+     * i + 2*j for pixel (x0 + i, y0 + j)); the edges and planes are not
+     * written, mz, mb1, mb2 hold the clamped depth and the barycentrics
+     * b1, b2 of each covered pixel, computed with the scan's float
+     * operations, and a0, d1, d2 the attributes as usual. */
+    int micro;
+    float mz[4], mb1[4], mb2[4];
 } rast__tri;
+#define RAST__MICRO 0x10
 
 /* Result of rast__setup_tri. */
 enum {
@@ -104,7 +114,7 @@ enum {
     RAST__SETUP_CULLED,
     RAST__SETUP_OFFSCREEN,       /* bounding box misses the target */
     /* Set up (counted as drawn) but provably writes no pixel: a box of
-     * one pixel whose centre fails the edge test. rast__prepare and the
+     * at most 2x2 pixels whose centres all fail the edge test. rast__prepare and the
      * cached path count it as drawn and emit no triangle (its scan would
      * write nothing); *tri has the box and edges but no planes. */
     RAST__SETUP_EMPTY
@@ -171,6 +181,13 @@ void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
 /* The same with a vertex buffer: when the scan's set-up ISA has a vector
  * front end and the mesh fits (vertex_count <= vb->cap), the draw runs
  * it (same bytes and counters); otherwise (or vb NULL) rast__draw_valid. */
+/* Scans the n set-up triangles tri in order into t (micro: micro records
+ * may occur, their pixels are written as the scan would write them);
+ * marks the tiles of every triangle that may write a pixel in tiles
+ * (unless NULL; last: the tile rectangle marked last, x0, x1, y0, y1, as
+ * {1, 0, 1, 0} before the first call). Returns the pixels written. */
+long rast__scan_list(const rast_target *t, const rast__tri *tri, int n,
+                     rast__scan_rows_fn scan, rast__tiles *tiles, int last[4], int micro);
 struct rast__vbuf;
 void rast__draw_valid_vb(const rast_target *t, const rast_mesh_desc *m,
                          rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles,
@@ -260,8 +277,8 @@ void rast__vfill_avx512(const rast__view *v, const float *clip, uint32_t base, i
  * at a time (meshes index nearby vertices together). */
 /* Trivial rejection of RAST__FRONT_GROUP submitted triangles ti .. ti+15
  * at once (one per lane): for triangles whose three vertices are cached
- * and valid (flags 0), the area, culling, pixel box and, for one-pixel
- * boxes, the empty-centre test of the scalar set-up; those rejected (and
+ * and valid (flags 0), the area, culling, pixel box and, for boxes of at
+ * most 2x2 pixels, the empty-centre test of the scalar set-up; those rejected (and
  * empty ones) are counted in *st exactly as the scalar path counts them.
  * Returns the lanes the scalar path must still run (survivors, vertices
  * not cached or needing clipping), bit l for triangle ti + l. May fill
@@ -281,12 +298,16 @@ unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__
  * outside a clip plane or at w <= 0, i.e. when the vertex cache would give
  * it flags != 0) and the double plane inputs zw, iw (valid when X is not
  * the marker). Then groups of RAST__FRONT_GROUP submitted triangles are
- * rejected in lanes (area, culling, box, empty one-pixel boxes), the
+ * rejected in lanes (area, culling, box, empty boxes up to 2x2), the
  * survivors queued (compressed) and set up RAST__FRONT_GROUP at a time in
  * lanes straight into their scan-ready records: box, biased int64 edges,
  * planes (the double operations of planes_one per lane) and attributes.
  * Triangles with a marked vertex go through rast__prepare in order. The
- * records and counters are those of rast__prepare_range. */
+ * records and counters are those of rast__prepare_range. With micro set,
+ * the survivors whose box is at most 2x2 pixels get micro records instead
+ * (rast__tri.micro: the scan's per-pixel values computed in lanes, one
+ * triangle per lane), in the same slots; rast__scan_list with micro set
+ * writes their pixels. */
 #define RAST__VX_SPECIAL INT32_MIN
 #define RAST__VX_CHUNK 128                        /* submitted triangles per chunk */
 #define RAST__VX_CAP (1 << 17)                    /* vertices per buffer */
@@ -307,16 +328,17 @@ typedef void (*rast__vpass_fn)(const rast__view *v, const float *clip, int count
  * filled by the vpass of the same ISA for m's clip coordinates) into out
  * (room for (ti1 - ti0) * RAST__MAX_FAN): returns the record count; adds
  * the counters but tris_in and pixels_written to *st. Records and
- * counters equal rast__prepare_range's (bytes of the fields it writes). */
+ * counters equal rast__prepare_range's (bytes of the fields it writes)
+ * when micro is 0. */
 typedef int (*rast__frontv_fn)(const rast__view *v, const rast_mesh_desc *m,
                                const rast__vbuf *vb, int ti0, int ti1, rast__tri *out,
-                               rast_stats *st);
+                               rast_stats *st, int micro);
 void rast__vpass_avx2(const rast__view *v, const float *clip, int count, rast__vbuf *vb);
 int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
-                      int ti0, int ti1, rast__tri *out, rast_stats *st);
+                      int ti0, int ti1, rast__tri *out, rast_stats *st, int micro);
 void rast__vpass_avx512(const rast__view *v, const float *clip, int count, rast__vbuf *vb);
 int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
-                        int ti0, int ti1, rast__tri *out, rast_stats *st);
+                        int ti0, int ti1, rast__tri *out, rast_stats *st, int micro);
 
 typedef struct rast__setup_isa {
     rast__planes_fn planes;

@@ -281,6 +281,7 @@ static inline void setup_edges(rast__tri *tri, const int32_t X[3], const int32_t
     tri->y0 = by0;
     tri->x1 = bx1;
     tri->y1 = by1;
+    tri->micro = 0;
     const int32_t cx = bx0 * RAST__FIX_ONE + RAST__FIX_HALF;
     const int32_t cy = by0 * RAST__FIX_ONE + RAST__FIX_HALF;
     static const int ea[3] = { 1, 2, 0 }, eb[3] = { 2, 0, 1 };
@@ -319,13 +320,21 @@ static inline int setup_box_edges(const rast__view *v, const int32_t X[3],
     if (bx0 > bx1 || by0 > by1)
         return RAST__SETUP_OFFSCREEN;
     setup_edges(tri, X, Y, bx0, by0, bx1, by1);
-    /* A box of one pixel whose centre is outside (20% of the scanned
-     * triangles of the 10k bench model, 55% at 41k): the scan would write
-     * nothing, so the planes
-     * are not set up and the triangle is not scanned; it still counts as
-     * drawn (the counters of the full path). */
-    if (bx0 == bx1 && by0 == by1 && (tri->e_c[0] | tri->e_c[1] | tri->e_c[2]) < 0)
+    /* A box of at most 2x2 pixels none of whose centres is inside (at
+     * 10k triangles a third of the triangles the bench model used to
+     * scan; one-pixel boxes only until the ninth round, docs/raster.md
+     * section 11): the scan would write nothing, so the planes are not
+     * set up and the triangle is not scanned; it still counts as drawn
+     * (the counters of the full path). */
+    if (bx1 - bx0 <= 1 && by1 - by0 <= 1) {
+        for (int j = 0; j <= by1 - by0; j++)
+            for (int i = 0; i <= bx1 - bx0; i++)
+                if (((tri->e_c[0] + i * tri->e_dx[0] + j * tri->e_dy[0]) |
+                     (tri->e_c[1] + i * tri->e_dx[1] + j * tri->e_dy[1]) |
+                     (tri->e_c[2] + i * tri->e_dx[2] + j * tri->e_dy[2])) >= 0)
+                    return RAST__SETUP_OK;
         return RAST__SETUP_EMPTY;
+    }
     return RAST__SETUP_OK;
 }
 
@@ -875,15 +884,48 @@ void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1)
         }
 }
 
-/* Scans the n set-up triangles tri in order; marks their tiles (last:
- * the tile rectangle marked last, x0, x1, y0, y1). */
-static long scan_list(const rast_target *t, const rast__tri *tri, int n,
-                      rast__scan_rows_fn scan, rast__tiles *tiles, int last[4])
+/* The pixels of a micro record (r->micro != 0): the depth test and the
+ * stores of the scan (rast__scan_rows_ref) for its covered pixels, from
+ * the values the front end computed with the scan's operations. */
+static long micro_apply(const rast_target *t, const rast__tri *r)
+{
+    long n = 0;
+    const int na = t->attr ? r->attr_count : 0;
+    for (unsigned bits = (unsigned)r->micro & 15u; bits; bits &= bits - 1) {
+        const int p = __builtin_ctz(bits);
+        const int x = r->x0 + (p & 1), y = r->y0 + (p >> 1);
+        const float z = r->mz[p];
+        if (t->depth) {
+            float *d = t->depth + (size_t)y * (size_t)t->depth_stride + x;
+            if (!(z < *d))
+                continue;
+            *d = z;
+        }
+        t->mask[(size_t)y * (size_t)t->mask_stride + x] = 255;
+        n++;
+        if (na) {
+            const float b1 = r->mb1[p], b2 = r->mb2[p];
+            float *a = t->attr + (size_t)y * (size_t)t->attr_stride + (size_t)x * (size_t)na;
+            for (int k = 0; k < na; k++)
+                a[k] = (r->a0[k] + b1 * r->d1[k]) + b2 * r->d2[k];
+        }
+    }
+    return n;
+}
+
+long rast__scan_list(const rast_target *t, const rast__tri *tri, int n,
+                     rast__scan_rows_fn scan, rast__tiles *tiles, int last[4], int micro)
 {
     long px = 0;
     for (int i = 0; i < n; i++) {
         const rast__tri *r = &tri[i];
-        px += scan(t, r, r->y0, r->y1);
+        if (micro && r->micro) {
+            if (!(r->micro & 15))
+                continue;          /* no pixel centre covered */
+            px += micro_apply(t, r);
+        } else {
+            px += scan(t, r, r->y0, r->y1);
+        }
         if (!tiles)
             continue;
         /* Neighbouring triangles mostly lie in the tiles just marked:
@@ -920,7 +962,7 @@ void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
     for (int ti = 0; ti < m->tri_count; ti += CHUNK) {
         const int te = m->tri_count - ti > CHUNK ? ti + CHUNK : m->tri_count;
         const int n = rast__prepare_range(&view, m, ti, te, &vc, tri, &st, isa);
-        st.pixels_written += scan_list(t, tri, n, scan, tiles, last);
+        st.pixels_written += rast__scan_list(t, tri, n, scan, tiles, last, 0);
     }
     if (stats)
         rast__stats_add(stats, &st);
@@ -943,8 +985,8 @@ void rast__draw_valid_vb(const rast_target *t, const rast_mesh_desc *m,
     int last[4] = { 1, 0, 1, 0 };
     for (int ti = 0; ti < m->tri_count; ti += RAST__VX_CHUNK) {
         const int te = m->tri_count - ti > RAST__VX_CHUNK ? ti + RAST__VX_CHUNK : m->tri_count;
-        const int n = isa->frontv(&view, m, vb, ti, te, vb->out, &st);
-        st.pixels_written += scan_list(t, vb->out, n, scan, tiles, last);
+        const int n = isa->frontv(&view, m, vb, ti, te, vb->out, &st, 1);
+        st.pixels_written += rast__scan_list(t, vb->out, n, scan, tiles, last, 1);
     }
     if (stats)
         rast__stats_add(stats, &st);

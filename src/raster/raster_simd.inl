@@ -102,8 +102,9 @@ static inline void simd_attr_store(float *dst, int na, unsigned pass, int lanes,
 /* One pixel (x, y) of the box: the reference's scalar expressions for
  * that pixel (fi, fj are the same floats, every op the same IEEE op),
  * without the vector set-up of SIMD_FN. Used for boxes of one or two
- * pixels (1x1, 2x1, 1x2: two thirds of the scanned triangles of the 10k
- * bench model), whose vector set-up costs more than their pixels. */
+ * pixels (1x1, 2x1, 1x2), whose vector set-up costs more than their
+ * pixels. (Drawn through a context with the vector front end, such boxes
+ * come as micro records instead and are not scanned.) */
 static inline long simd_scan_pixel(const rast_target *t, const rast__tri *tri, int x, int y)
 {
     const int64_t i = x - tri->x0, j = y - tri->y0;
