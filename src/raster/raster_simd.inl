@@ -44,7 +44,11 @@
  *     value and every step difference fits int32: int32 adds give the
  *     exact integers. Triangles one vector wide (most of a fine mesh)
  *     take a loop that tests coverage first and computes the float row
- *     values only for rows with covered pixels.
+ *     values only for rows with covered pixels. Wider ones test a row's
+ *     coverage vectors first (from the left, up to the end of the row's
+ *     one run of covered pixels) and then do the float work on vectors
+ *     that start at the run's first pixel: a run of at most SIMD_V
+ *     pixels costs one vector wherever it lies (long thin slivers).
  *   * Otherwise (huge triangles, vertices far in the guard band): E' of the
  *     first lane of each vector is computed in int64 and clamped to
  *     [-2^29, 2^29] before adding the lane offsets l*(-dy), |l*dy| <
@@ -235,11 +239,111 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
         return written;
     }
 
-    const vi st0 = VI_SET1(fits ? (int32_t)(SIMD_V * sx[0]) : 0);
-    const vi st1 = VI_SET1(fits ? (int32_t)(SIMD_V * sx[1]) : 0);
-    const vi st2 = VI_SET1(fits ? (int32_t)(SIMD_V * sx[2]) : 0);
     const vf qdx = VF_SET1(tri->q.dx);
     const vf b1dx = VF_SET1(tri->b1.dx), b2dx = VF_SET1(tri->b2.dx);
+    if (fits) {
+        /* Several vectors per row, int32 coverage. The covered pixels of a
+         * row are one run: each E'_k is affine in i, so E'_k >= 0 holds on
+         * a half-line of i and the three intersect in an interval (the box
+         * one too). The row's coverage vectors (aligned at x0) are tested
+         * first, from the left: leading empty vectors are skipped and the
+         * run ends in the first vector whose last lane is not covered.
+         * Then the float work runs on vectors starting at the run's first
+         * pixel (lane l = pixel xf + l, fi = (float)(xf + l): the same ops
+         * per pixel), so a run of at most SIMD_V pixels takes one vector
+         * however it straddles the aligned ones (the slivers of capsule
+         * sides: runs of 4-10 pixels in boxes up to hundreds wide). Loads
+         * and stores are masked to the run; no other pixel is accessed. */
+        const unsigned lastvalid = SIMD_FULL >> (nvec * SIMD_V - nx);
+        const vi st0 = VI_SET1((int32_t)(SIMD_V * sx[0]));
+        const vi st1 = VI_SET1((int32_t)(SIMD_V * sx[1]));
+        const vi st2 = VI_SET1((int32_t)(SIMD_V * sx[2]));
+        const vi sy0 = VI_SET1(sy[0]), sy1 = VI_SET1(sy[1]), sy2 = VI_SET1(sy[2]);
+        vi r0 = VI_ADD(VI_SET1((int32_t)c[0]), off0);
+        vi r1 = VI_ADD(VI_SET1((int32_t)c[1]), off1);
+        vi r2 = VI_ADD(VI_SET1((int32_t)c[2]), off2);
+        for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
+                 drow = drow ? drow + t->depth_stride : NULL,
+                 arow = arow ? arow + t->attr_stride : NULL) {
+            vi e0 = r0, e1 = r1, e2 = r2;
+            r0 = VI_ADD(r0, sy0);
+            r1 = VI_ADD(r1, sy1);
+            r2 = VI_ADD(r2, sy2);
+            int v = 0;
+            unsigned cov;
+            for (;;) {
+                cov = ~VI_NEG_BITS(VI_OR(VI_OR(e0, e1), e2)) &
+                      (v == nvec - 1 ? lastvalid : SIMD_FULL);
+                if (cov || v == nvec - 1)
+                    break;
+                v++;
+                e0 = VI_ADD(e0, st0);
+                e1 = VI_ADD(e1, st1);
+                e2 = VI_ADD(e2, st2);
+            }
+            if (!cov)
+                continue;
+            const int xf = v * SIMD_V + __builtin_ctz(cov);
+            while ((cov >> (SIMD_V - 1)) && v < nvec - 1) {
+                e0 = VI_ADD(e0, st0);
+                e1 = VI_ADD(e1, st1);
+                e2 = VI_ADD(e2, st2);
+                const unsigned nc = ~VI_NEG_BITS(VI_OR(VI_OR(e0, e1), e2)) &
+                                    (v + 1 == nvec - 1 ? lastvalid : SIMD_FULL);
+                if (!nc)
+                    break;
+                cov = nc;
+                v++;
+            }
+            const int xe = v * SIMD_V + 32 - __builtin_clz(cov);   /* last + 1 */
+
+            /* Row bases: the reference's scalar expressions. */
+            const float fj = (float)(y - tri->y0);
+            const vf zrv = VF_SET1(tri->z.c + tri->z.dy * fj);
+            const float qr = tri->q.c + tri->q.dy * fj;
+            const float b1r = tri->b1.c + tri->b1.dy * fj;
+            const float b2r = tri->b2.c + tri->b2.dy * fj;
+            for (int i0 = xf; i0 < xe; i0 += SIMD_V) {
+                const int rem = xe - i0;
+                const unsigned run = rem >= SIMD_V ? SIMD_FULL : (1u << rem) - 1u;
+                const vf fi = VF_CVT(VI_ADD(VI_SET1(i0), lanev));
+                vf z = VF_ADD(zrv, VF_MUL(zdx, fi));
+                z = VF_MAX(zero, z);
+                z = VF_MIN(one, z);
+                unsigned pass = run;
+                if (drow) {
+                    const vf d = VF_LOAD_M(drow + i0, run, run == SIMD_FULL);
+                    pass = run & VF_LT_BITS(z, d);
+                    if (!pass)
+                        continue;
+                    VF_STORE_M(drow + i0, pass, pass == SIMD_FULL, z);
+                }
+                MASK_STORE_M(mrow + i0, pass, pass == SIMD_FULL);
+                written += __builtin_popcount(pass);
+                if (!na)
+                    continue;
+                const vf r = VF_DIV(one, VF_ADD(VF_SET1(qr), VF_MUL(qdx, fi)));
+                const vf b1 = VF_MUL(VF_ADD(VF_SET1(b1r), VF_MUL(b1dx, fi)), r);
+                const vf b2 = VF_MUL(VF_ADD(VF_SET1(b2r), VF_MUL(b2dx, fi)), r);
+                float *dst = arow + (size_t)i0 * (size_t)na;
+#ifdef ATTR3_STORE_FULL
+                if (na == 3 && pass == SIMD_FULL) {
+                    ATTR3_STORE_FULL(dst,
+                        VF_ADD(VF_ADD(av0[0], VF_MUL(b1, av1[0])), VF_MUL(b2, av2[0])),
+                        VF_ADD(VF_ADD(av0[1], VF_MUL(b1, av1[1])), VF_MUL(b2, av2[1])),
+                        VF_ADD(VF_ADD(av0[2], VF_MUL(b1, av1[2])), VF_MUL(b2, av2[2])));
+                    continue;
+                }
+#endif
+                simd_attr_store(dst, na, pass, rem < SIMD_V ? rem : SIMD_V, b1, b2, av0, av1,
+                                av2);
+            }
+        }
+        return written;
+    }
+
+    /* Int64 coverage (clamped starts, see COVERAGE): vectors aligned at
+     * x0, every vector of every row tested. */
     int64_t rb[3] = { c[0], c[1], c[2] };
     for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
              drow = drow ? drow + t->depth_stride : NULL,
@@ -251,32 +355,18 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
         const float b1r = tri->b1.c + tri->b1.dy * fj;
         const float b2r = tri->b2.c + tri->b2.dy * fj;
         const vf zrv = VF_SET1(zr);
-        vi e0 = lanev, e1 = lanev, e2 = lanev;
-        if (fits) {
-            e0 = VI_ADD(VI_SET1((int32_t)rb[0]), off0);
-            e1 = VI_ADD(VI_SET1((int32_t)rb[1]), off1);
-            e2 = VI_ADD(VI_SET1((int32_t)rb[2]), off2);
-        }
         int64_t eb0 = rb[0], eb1 = rb[1], eb2 = rb[2];
         for (int v = 0; v < nvec; v++) {
             const int i0 = v * SIMD_V;
             const int rem = nx - i0;
             const unsigned valid = rem >= SIMD_V ? SIMD_FULL : (1u << rem) - 1u;
-            unsigned neg;
-            if (fits) {
-                neg = VI_NEG_BITS(VI_OR(VI_OR(e0, e1), e2));
-                e0 = VI_ADD(e0, st0);
-                e1 = VI_ADD(e1, st1);
-                e2 = VI_ADD(e2, st2);
-            } else {
-                const vi t0 = VI_ADD(VI_SET1(simd_clamp29(eb0)), off0);
-                const vi t1 = VI_ADD(VI_SET1(simd_clamp29(eb1)), off1);
-                const vi t2 = VI_ADD(VI_SET1(simd_clamp29(eb2)), off2);
-                neg = VI_NEG_BITS(VI_OR(VI_OR(t0, t1), t2));
-                eb0 += SIMD_V * (int64_t)sx[0];
-                eb1 += SIMD_V * (int64_t)sx[1];
-                eb2 += SIMD_V * (int64_t)sx[2];
-            }
+            const vi t0 = VI_ADD(VI_SET1(simd_clamp29(eb0)), off0);
+            const vi t1 = VI_ADD(VI_SET1(simd_clamp29(eb1)), off1);
+            const vi t2 = VI_ADD(VI_SET1(simd_clamp29(eb2)), off2);
+            const unsigned neg = VI_NEG_BITS(VI_OR(VI_OR(t0, t1), t2));
+            eb0 += SIMD_V * (int64_t)sx[0];
+            eb1 += SIMD_V * (int64_t)sx[1];
+            eb2 += SIMD_V * (int64_t)sx[2];
             const unsigned cov = ~neg & valid;
             if (!cov)
                 continue;
