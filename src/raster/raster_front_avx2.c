@@ -11,6 +11,7 @@
 #include <float.h>
 #include <immintrin.h>
 #include <stddef.h>
+#include <string.h>
 
 /* ---- vertex pass -------------------------------------------------------- */
 
@@ -159,6 +160,20 @@ static inline __m256i compress_idx(unsigned b)
                             _mm256_set1_epi32(7));
 }
 
+/* FD_GATHER: p[lane of half h of v] where lh, else d, by four scalar
+ * loads and a blend instead of a masked vgatherdpd (12 per flush: the
+ * front end took 0.98-0.99 of the time with these, one process,
+ * alternating). Every lane of v must index a readable double: flush
+ * masks its vertex indices with the lanes in use (unused lanes read
+ * vertex 0, which every mesh with a triangle has). */
+static inline __m256d gather4(__m256d d, const double *p, __m256i v, int h, __m256d lh)
+{
+    const __m128i i = half4(v, h);
+    const __m256d g = _mm256_setr_pd(p[_mm_cvtsi128_si32(i)], p[_mm_extract_epi32(i, 1)],
+                                     p[_mm_extract_epi32(i, 2)], p[_mm_extract_epi32(i, 3)]);
+    return _mm256_blendv_pd(d, g, lh);
+}
+
 /* Lane macros of raster_front.inl (8 int32 lanes, 4 double lanes). */
 #define FRONT_V 8
 typedef __m256i fvi;
@@ -187,7 +202,7 @@ typedef __m256d fdm;
 #define FD_DIV(a, b) _mm256_div_pd(a, b)
 #define FD_MAX(a, b) _mm256_max_pd(a, b)
 #define FD_HALF_CVT(v, h) _mm256_cvtepi32_pd(half4(v, h))
-#define FD_GATHER(d, p, v, h, lh) _mm256_mask_i32gather_pd(d, p, half4(v, h), lh, 8)
+#define FD_GATHER(d, p, v, h, lh) gather4(d, p, v, h, lh)
 #define FD_KEEP(lh, a, b) _mm256_blendv_pd(b, a, lh)
 #define FD_STORE_F(p, v) _mm_store_ps(p, _mm256_cvtpd_ps(v))
 #include "raster_front.inl"
@@ -205,10 +220,11 @@ static inline unsigned micro_lanes(const squeue *q, unsigned L, const int64_t (*
                                    float (*mb1)[8], float (*mb2)[8])
 {
     const __m256i one = _mm256_set1_epi32(1), two = _mm256_set1_epi32(2);
-    const __m256i w1 = _mm256_sub_epi32(_mm256_load_si256((const __m256i *)(const void *)q->f[Q_BX1]),
-                                        _mm256_load_si256((const __m256i *)(const void *)q->f[Q_BX0]));
-    const __m256i h1 = _mm256_sub_epi32(_mm256_load_si256((const __m256i *)(const void *)q->f[Q_BY1]),
-                                        _mm256_load_si256((const __m256i *)(const void *)q->f[Q_BY0]));
+    const __m256i *qf = (const __m256i *)(const void *)q->f;   /* field f: qf[2 * f] */
+    const __m256i w1 = _mm256_sub_epi32(_mm256_load_si256(qf + 2 * Q_BX1),
+                                        _mm256_load_si256(qf + 2 * Q_BX0));
+    const __m256i h1 = _mm256_sub_epi32(_mm256_load_si256(qf + 2 * Q_BY1),
+                                        _mm256_load_si256(qf + 2 * Q_BY0));
     const unsigned wide = bits8(_mm256_cmpeq_epi32(w1, one));   /* 2 columns */
     const unsigned tall = bits8(_mm256_cmpeq_epi32(h1, one));   /* 2 rows */
     const unsigned mic = L & bits8(_mm256_and_si256(_mm256_cmpgt_epi32(two, w1),
@@ -244,28 +260,84 @@ static inline unsigned micro_lanes(const squeue *q, unsigned L, const int64_t (*
                            (((cv[2] >> l) & 1u) << 2) | (((cv[3] >> l) & 1u) << 3));
     /* The values (the scan's expressions; unused lanes compute garbage). */
     const __m256 zero = _mm256_setzero_ps(), fone = _mm256_set1_ps(1.0f);
-    __m256 P[12];
-    for (int i = 0; i < 12; i++)
-        P[i] = _mm256_load_ps(pl[i]);
+    /* pl read in place (an array of 12 loaded vectors became a rep movsq
+     * of 384 bytes to the stack: 6% of flush). */
+#define P(i) _mm256_load_ps(pl[i])
     for (int j = 0; j < 2; j++) {
         const __m256 fj = j ? fone : zero;
-        const __m256 zr = _mm256_add_ps(P[0], _mm256_mul_ps(P[2], fj));
-        const __m256 qr = _mm256_add_ps(P[3], _mm256_mul_ps(P[5], fj));
-        const __m256 b1r = _mm256_add_ps(P[6], _mm256_mul_ps(P[8], fj));
-        const __m256 b2r = _mm256_add_ps(P[9], _mm256_mul_ps(P[11], fj));
+        const __m256 zr = _mm256_add_ps(P(0), _mm256_mul_ps(P(2), fj));
+        const __m256 qr = _mm256_add_ps(P(3), _mm256_mul_ps(P(5), fj));
+        const __m256 b1r = _mm256_add_ps(P(6), _mm256_mul_ps(P(8), fj));
+        const __m256 b2r = _mm256_add_ps(P(9), _mm256_mul_ps(P(11), fj));
         for (int i = 0; i < 2; i++) {
             const int p = i + 2 * j;
             const __m256 fi = i ? fone : zero;
-            __m256 z = _mm256_add_ps(zr, _mm256_mul_ps(P[1], fi));
+            __m256 z = _mm256_add_ps(zr, _mm256_mul_ps(P(1), fi));
             z = _mm256_max_ps(zero, z);
             z = _mm256_min_ps(fone, z);
             _mm256_store_ps(mz[p], z);
-            const __m256 r = _mm256_div_ps(fone, _mm256_add_ps(qr, _mm256_mul_ps(P[4], fi)));
-            _mm256_store_ps(mb1[p], _mm256_mul_ps(_mm256_add_ps(b1r, _mm256_mul_ps(P[7], fi)), r));
-            _mm256_store_ps(mb2[p], _mm256_mul_ps(_mm256_add_ps(b2r, _mm256_mul_ps(P[10], fi)), r));
+            const __m256 r = _mm256_div_ps(fone, _mm256_add_ps(qr, _mm256_mul_ps(P(4), fi)));
+            _mm256_store_ps(mb1[p], _mm256_mul_ps(_mm256_add_ps(b1r, _mm256_mul_ps(P(7), fi)), r));
+            _mm256_store_ps(mb2[p], _mm256_mul_ps(_mm256_add_ps(b2r, _mm256_mul_ps(P(10), fi)), r));
         }
     }
+#undef P
     return mic;
+}
+
+/* The first n (1..4) floats of v to p; no other byte is written. */
+static inline void store_n(float *p, __m128 v, int n)
+{
+    switch (n) {
+    case 1:
+        _mm_store_ss(p, v);
+        break;
+    case 2:
+        _mm_storel_pi((__m64 *)(void *)p, v);
+        break;
+    case 3:
+        _mm_storel_pi((__m64 *)(void *)p, v);
+        _mm_store_ss(p + 2, _mm_movehl_ps(v, v));
+        break;
+    default:
+        _mm_storeu_ps(p, v);
+        break;
+    }
+}
+
+/* setup_attrs for one record: a0 = attribute of vertex v0, d1 = a1 - a0,
+ * d2 = a2 - a0 (ac = 1..8 floats each), by masked loads (am: the first
+ * ac lanes; no byte past a vertex's ac floats is read) and stores of
+ * exactly ac floats (no byte past a0[ac - 1], d1[ac - 1], d2[ac - 1] is
+ * written), as raster_front_avx512.c. This replaced 3 * ac 8-lane
+ * gathers per flush, an SoA scratch and 3 * ac scalar copies per record. */
+_Static_assert(RAST_MAX_ATTRS <= 8, "attributes by one 8-lane masked load");
+static inline void record_attrs(rast__tri *t, const float *attr, int ac, __m256i am,
+                                 int32_t v0, int32_t v1, int32_t v2)
+{
+    const float *p0 = attr + (size_t)v0 * (size_t)ac;
+    const float *p1 = attr + (size_t)v1 * (size_t)ac;
+    const float *p2 = attr + (size_t)v2 * (size_t)ac;
+    if (ac <= 4) {
+        const __m128i m4 = _mm256_castsi256_si128(am);
+        const __m128 a0 = _mm_maskload_ps(p0, m4);
+        const __m128 a1 = _mm_maskload_ps(p1, m4);
+        const __m128 a2 = _mm_maskload_ps(p2, m4);
+        store_n(t->a0, a0, ac);
+        store_n(t->d1, _mm_sub_ps(a1, a0), ac);
+        store_n(t->d2, _mm_sub_ps(a2, a0), ac);
+    } else {
+        const __m256 a0 = _mm256_maskload_ps(p0, am);
+        const __m256 a1 = _mm256_maskload_ps(p1, am);
+        const __m256 a2 = _mm256_maskload_ps(p2, am);
+        const __m256 d1 = _mm256_sub_ps(a1, a0), d2 = _mm256_sub_ps(a2, a0);
+        _mm_storeu_ps(t->a0, _mm256_castps256_ps128(a0));
+        _mm_storeu_ps(t->d1, _mm256_castps256_ps128(d1));
+        _mm_storeu_ps(t->d2, _mm256_castps256_ps128(d2));
+        store_n(t->a0 + 4, _mm256_extractf128_ps(a0, 1), ac - 4);
+        store_n(t->d1 + 4, _mm256_extractf128_ps(d1, 1), ac - 4);
+        store_n(t->d2 + 4, _mm256_extractf128_ps(d2, 1), ac - 4);
+    }
 }
 
 /* Sets up queue lanes 0 .. k-1 (k = 1..8) into their records (micro: the
@@ -316,32 +388,14 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
         front_planes_half(X, Y, V, bx0, by0,
                           _mm256_castsi256_pd(_mm256_cvtepi32_epi64(half4(L, h))), h, vb, pl);
 
-    const int ac = v->attr_count;
-    _Alignas(32) float at[3][RAST_MAX_ATTRS][8];
-    if (ac > 0) {
-        const __m256i vac = _mm256_set1_epi32(ac);
-        const __m256i b0 = _mm256_mullo_epi32(V[0], vac), b1 = _mm256_mullo_epi32(V[1], vac),
-                      b2 = _mm256_mullo_epi32(V[2], vac);
-        const __m256 fz = _mm256_setzero_ps(), lm = _mm256_castsi256_ps(L);
-        for (int a = 0; a < ac; a++) {
-            const __m256i ka = _mm256_set1_epi32(a);
-            const __m256 a0 =
-                _mm256_mask_i32gather_ps(fz, m->attr, _mm256_add_epi32(b0, ka), lm, 4);
-            const __m256 a1 =
-                _mm256_mask_i32gather_ps(fz, m->attr, _mm256_add_epi32(b1, ka), lm, 4);
-            const __m256 a2 =
-                _mm256_mask_i32gather_ps(fz, m->attr, _mm256_add_epi32(b2, ka), lm, 4);
-            _mm256_store_ps(at[0][a], a0);
-            _mm256_store_ps(at[1][a], _mm256_sub_ps(a1, a0));
-            _mm256_store_ps(at[2][a], _mm256_sub_ps(a2, a0));
-        }
-    }
-
     _Alignas(32) uint8_t cov[8] = { 0 };
     _Alignas(32) float mz[4][8], mb1[4][8], mb2[4][8];
     const unsigned mic = micro ? micro_lanes(q, (1u << k) - 1u, ec, edx, edy,
                                              (const float (*)[8])pl, cov, mz, mb1, mb2)
                                : 0u;
+    const int ac = v->attr_count;
+    const __m256i am = _mm256_cmpgt_epi32(_mm256_set1_epi32(ac),
+                                          _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
     for (int l = 0; l < k; l++) {
         rast__tri *t;
         if ((mic >> l) & 1u) {
@@ -362,12 +416,53 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
         } else {
             t = front_record(q, l, ec, edx, edy, pl, ac, out);
         }
-        for (int a = 0; a < ac; a++) {
-            t->a0[a] = at[0][a][l];
-            t->d1[a] = at[1][a][l];
-            t->d2[a] = at[2][a][l];
-        }
+        if (ac > 0)
+            record_attrs(t, m->attr, ac, am, q->f[Q_V0][l], q->f[Q_V1][l], q->f[Q_V2][l]);
     }
+}
+
+/* The vertex indices of cnt (1..8) triangles at ix, de-interleaved:
+ * iv[k] lane l = ix[3l + k], 0 for l >= cnt. Three vector loads (masked
+ * for a partial group: no index past the group is read), blends and
+ * permutes; the scalar copy through a stack array it replaced cost a
+ * store-forwarding stall before the position gathers. */
+static inline void load_tris(const uint32_t *ix, int cnt, __m256i iv[3])
+{
+    __m256i v[3];
+    if (cnt == 8) {
+        for (int i = 0; i < 3; i++)
+            v[i] = _mm256_loadu_si256((const __m256i *)(const void *)(ix + 8 * i));
+    } else {
+        const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        for (int i = 0; i < 3; i++)
+            v[i] = _mm256_maskload_epi32((const int *)(const void *)(ix + 8 * i),
+                                         _mm256_cmpgt_epi32(_mm256_set1_epi32(3 * cnt - 8 * i),
+                                                            iota));
+    }
+    /* Component k of triangle j is int 3j + k, in v[(3j + k) / 8]: lane p
+     * of blend k is lane p of v[(p - k) mod 3], which holds int 3j + k for
+     * the j whose lane is p = (3j + k) mod 8; the vpermd moves it to j. */
+    const __m256i a = _mm256_blend_epi32(_mm256_blend_epi32(v[0], v[1], 0x92), v[2], 0x24);
+    const __m256i b = _mm256_blend_epi32(_mm256_blend_epi32(v[0], v[1], 0x24), v[2], 0x49);
+    const __m256i c = _mm256_blend_epi32(_mm256_blend_epi32(v[0], v[1], 0x49), v[2], 0x92);
+    iv[0] = _mm256_permutevar8x32_epi32(a, _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5));
+    iv[1] = _mm256_permutevar8x32_epi32(b, _mm256_setr_epi32(1, 4, 7, 2, 5, 0, 3, 6));
+    iv[2] = _mm256_permutevar8x32_epi32(c, _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7));
+}
+
+/* The (X, Y) pairs of the vertices ix[0], ix[3], ix[6], ix[9] as four
+ * 64-bit lanes: scalar 64-bit loads (the two vpgatherdq per vertex of a
+ * group they replaced were the front end's hottest spot). */
+static inline __m256i pairs4(const long long *xyb, const uint32_t *ix)
+{
+    const __m128d a = _mm_loadh_pd(_mm_castsi128_pd(_mm_loadl_epi64(
+                                       (const __m128i *)(const void *)(xyb + ix[0]))),
+                                   (const double *)(const void *)(xyb + ix[3]));
+    const __m128d b = _mm_loadh_pd(_mm_castsi128_pd(_mm_loadl_epi64(
+                                       (const __m128i *)(const void *)(xyb + ix[6]))),
+                                   (const double *)(const void *)(xyb + ix[9]));
+    return _mm256_insertf128_si256(_mm256_castsi128_si256(_mm_castpd_si128(a)),
+                                   _mm_castpd_si128(b), 1);
 }
 
 int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
@@ -386,18 +481,19 @@ int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__
         const int cnt = ti1 - ti < 8 ? ti1 - ti : 8;
         const unsigned L = (1u << cnt) - 1u;
         /* Indices, de-interleaved (lanes past cnt: vertex 0). */
-        const uint32_t *ix = m->indices + 3 * (size_t)ti;
-        _Alignas(32) int32_t ib[3][8] = { { 0 } };
-        for (int l = 0; l < cnt; l++) {
-            ib[0][l] = (int32_t)ix[3 * l];
-            ib[1][l] = (int32_t)ix[3 * l + 1];
-            ib[2][l] = (int32_t)ix[3 * l + 2];
-        }
         __m256i iv[3], X[3], Y[3], spec = zero;
+        const uint32_t *ix = m->indices + 3 * (size_t)ti;
+        load_tris(ix, cnt, iv);
+        uint32_t pad[24];
+        if (cnt < 8) {
+            /* the same indices, lanes past cnt vertex 0 */
+            memset(pad, 0, sizeof pad);
+            memcpy(pad, ix, 3 * (size_t)cnt * sizeof *ix);
+            ix = pad;
+        }
         for (int k = 0; k < 3; k++) {
-            iv[k] = _mm256_load_si256((const __m256i *)(const void *)ib[k]);
-            const __m256i p0 = _mm256_i32gather_epi64(xyb, half4(iv[k], 0), 8);
-            const __m256i p1 = _mm256_i32gather_epi64(xyb, half4(iv[k], 1), 8);
+            const __m256i p0 = pairs4(xyb, ix + k);
+            const __m256i p1 = pairs4(xyb, ix + 12 + k);
             const __m256 s0 = _mm256_castsi256_ps(p0), s1 = _mm256_castsi256_ps(p1);
             X[k] = _mm256_permute4x64_epi64(
                 _mm256_castps_si256(_mm256_shuffle_ps(s0, s1, _MM_SHUFFLE(2, 0, 2, 0))),
