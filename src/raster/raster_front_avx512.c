@@ -114,6 +114,22 @@ void rast__vpass_avx512(const rast__view *v, const float *clip, int count, rast_
 /* Lane macros, the rejection helpers and raster_front.inl. */
 #include "raster_front_avx512.inl"
 
+/* The qwords p64[idx[l]] for the 16 lanes l: lanes 0..7 in p[0], 8..15
+ * in p[1] (gather_pairs by scalar loads). */
+static inline void load_pairs(const long long *p64, const uint32_t *idx, __m512i p[2])
+{
+    for (int h = 0; h < 2; h++) {
+        const uint32_t *s = idx + 8 * h;
+        const __m128i q0 = _mm_set_epi64x(p64[s[1]], p64[s[0]]);
+        const __m128i q1 = _mm_set_epi64x(p64[s[3]], p64[s[2]]);
+        const __m128i q2 = _mm_set_epi64x(p64[s[5]], p64[s[4]]);
+        const __m128i q3 = _mm_set_epi64x(p64[s[7]], p64[s[6]]);
+        const __m256i lo = _mm256_inserti128_si256(_mm256_castsi128_si256(q0), q1, 1);
+        const __m256i hi = _mm256_inserti128_si256(_mm256_castsi128_si256(q2), q3, 1);
+        p[h] = _mm512_inserti64x4(_mm512_castsi256_si512(lo), hi, 1);
+    }
+}
+
 /* ---- survivor set-up ---------------------------------------------------- */
 
 /* Sets up queue lanes 0 .. k-1 (k = 1..16) into their records. */
@@ -319,11 +335,16 @@ int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast
         }
         __m512i iv[3], X[3], Y[3];
         deint_tris(iw3[0], iw3[1], iw3[2], iv);
-        /* (X, Y) pairs: one 64-bit gather element per vertex. */
         __mmask16 spec = 0;
+        /* (X, Y) pairs: one 64-bit load per vertex, by scalar loads
+         * (faster than vpgatherdq on Zen 4: 0.95-0.97 of the whole draw's
+         * time at 41k triangles, 0.97-0.99 at 10k, in one process). */
+        _Alignas(64) uint32_t ivs[3][16];
+        for (int k = 0; k < 3; k++)
+            _mm512_store_si512((void *)ivs[k], iv[k]);
         for (int k = 0; k < 3; k++) {
             __m512i p[2];
-            gather_pairs(xyb, iv[k], p);
+            load_pairs(xyb, ivs[k], p);
             X[k] = pairs_lo(p);
             Y[k] = pairs_hi(p);
             spec |= _mm512_cmpeq_epi32_mask(X[k], mark);
