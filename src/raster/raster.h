@@ -25,6 +25,12 @@
  *   operations (docs/raster.md, summarised in docs/rounding.md), so SIMD
  *   paths can reproduce every byte. Attributes use perspective-correct
  *   barycentrics, so a constant attribute comes out exactly constant.
+ *   One exception: where an output attribute is NaN (a NaN attribute in
+ *   the mesh, or inf - inf), every path writes a NaN, but its sign and
+ *   payload are not specified and may differ between paths (x86 returns
+ *   one operand's NaN, and C does not fix the operand order of a
+ *   commutative addition). Every other output value, depth and mask are
+ *   the same bytes on every path.
  *   Facing is decided per triangle after clipping and snapping, from the
  *   sign of its snapped screen area (as GPUs do).
  *

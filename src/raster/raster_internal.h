@@ -114,9 +114,10 @@ enum {
     RAST__SETUP_CULLED,
     RAST__SETUP_OFFSCREEN,       /* bounding box misses the target */
     /* Set up (counted as drawn) but provably writes no pixel: a box of
-     * at most 2x2 pixels whose centres all fail the edge test. rast__prepare and the
-     * cached path count it as drawn and emit no triangle (its scan would
-     * write nothing); *tri has the box and edges but no planes. */
+     * at most 2x2 pixels whose centres all fail the edge test.
+     * rast__prepare and the cached path count it as drawn and emit no
+     * triangle (its scan would write nothing); *tri has the box and
+     * edges but no planes. */
     RAST__SETUP_EMPTY
 };
 
@@ -178,9 +179,6 @@ void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1);
  * pixel the draw may have written lies in a marked tile). */
 void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
                       rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles);
-/* The same with a vertex buffer: when the scan's set-up ISA has a vector
- * front end and the mesh fits (vertex_count <= vb->cap), the draw runs
- * it (same bytes and counters); otherwise (or vb NULL) rast__draw_valid. */
 /* Scans the n set-up triangles tri in order into t (micro: micro records
  * may occur, their pixels are written as the scan would write them);
  * marks the tiles of every triangle that may write a pixel in tiles
@@ -188,6 +186,10 @@ void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
  * {1, 0, 1, 0} before the first call). Returns the pixels written. */
 long rast__scan_list(const rast_target *t, const rast__tri *tri, int n,
                      rast__scan_rows_fn scan, rast__tiles *tiles, int last[4], int micro);
+/* The same with a vertex buffer: when the scan's set-up ISA has a vector
+ * front end and the mesh fits (vertex_count <= vb->cap), the draw runs
+ * it with micro records (same bytes and counters); otherwise (or vb NULL)
+ * rast__draw_valid. */
 struct rast__vbuf;
 void rast__draw_valid_vb(const rast_target *t, const rast_mesh_desc *m,
                          rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles,

@@ -920,8 +920,10 @@ long rast__scan_list(const rast_target *t, const rast__tri *tri, int n,
     for (int i = 0; i < n; i++) {
         const rast__tri *r = &tri[i];
         if (micro && r->micro) {
+            /* Defensive: the empty test drops boxes up to 2x2 with no
+             * covered centre before they get a record. */
             if (!(r->micro & 15))
-                continue;          /* no pixel centre covered */
+                continue;
             px += micro_apply(t, r);
         } else {
             px += scan(t, r, r->y0, r->y1);
