@@ -16,13 +16,22 @@
  *                 for boxes of at most 2x2 pixels, micro records instead
  *                 (micro_lanes: the scan's per-pixel values, in lanes).
  * Triangles with a vertex that is not finite, outside a clip plane or at
- * w <= 0 go through rast__prepare at their place in the order. */
+ * w <= 0 go through rast__prepare at their place in the order.
+ *
+ * Speed (issue 3, tenth round; Zen 4): the survivor queue stays in
+ * registers (survivors merged in by one masked permutation per field, no
+ * unaligned store reloaded by flush); flush keeps the edges and planes in
+ * vectors (planes16, the loops written out or unrolled so that no vector
+ * goes through the stack) and writes each record by 16-byte copies from
+ * lane-transposed stack layouts (quads, pairs) instead of a scalar copy
+ * per field; the positions are loaded with the indices read from the mesh. */
 #include "raster_internal.h"
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <float.h>
 #include <immintrin.h>
 #include <stddef.h>
+#include <string.h>
 
 /* ---- vertex pass -------------------------------------------------------- */
 
@@ -114,41 +123,150 @@ void rast__vpass_avx512(const rast__view *v, const float *clip, int count, rast_
 /* Lane macros, the rejection helpers and raster_front.inl. */
 #include "raster_front_avx512.inl"
 
-/* The qwords p64[idx[l]] for the 16 lanes l: lanes 0..7 in p[0], 8..15
- * in p[1] (gather_pairs by scalar loads). */
-static inline void load_pairs(const long long *p64, const uint32_t *idx, __m512i p[2])
+/* The (X, Y) pairs p64[ix[s * l]] of the 16 lanes l, by scalar 64-bit
+ * loads (gather_pairs without vpgatherdq), split into X (low dwords) and
+ * Y (high dwords). Written out so that no vector goes through memory. */
+static inline __attribute__((always_inline)) void load_xy(const long long *p64,
+                                                          const uint32_t *ix, ptrdiff_t s,
+                                                          __m512i *X, __m512i *Y)
 {
-    for (int h = 0; h < 2; h++) {
-        const uint32_t *s = idx + 8 * h;
-        const __m128i q0 = _mm_set_epi64x(p64[s[1]], p64[s[0]]);
-        const __m128i q1 = _mm_set_epi64x(p64[s[3]], p64[s[2]]);
-        const __m128i q2 = _mm_set_epi64x(p64[s[5]], p64[s[4]]);
-        const __m128i q3 = _mm_set_epi64x(p64[s[7]], p64[s[6]]);
-        const __m256i lo = _mm256_inserti128_si256(_mm256_castsi128_si256(q0), q1, 1);
-        const __m256i hi = _mm256_inserti128_si256(_mm256_castsi128_si256(q2), q3, 1);
-        p[h] = _mm512_inserti64x4(_mm512_castsi256_si512(lo), hi, 1);
-    }
+#define PAIR(l0, l1) _mm_set_epi64x(p64[ix[s * (l1)]], p64[ix[s * (l0)]])
+#define QUAD(l) _mm256_inserti128_si256(_mm256_castsi128_si256(PAIR(l, l + 1)), \
+                                        PAIR(l + 2, l + 3), 1)
+    const __m512i p0 = _mm512_inserti64x4(_mm512_castsi256_si512(QUAD(0)), QUAD(4), 1);
+    const __m512i p1 = _mm512_inserti64x4(_mm512_castsi256_si512(QUAD(8)), QUAD(12), 1);
+#undef QUAD
+#undef PAIR
+    const __m512i ie = _mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26,
+                                         28, 30);
+    *X = _mm512_permutex2var_epi32(p0, ie, p1);
+    *Y = _mm512_permutex2var_epi32(p0, _mm512_add_epi32(ie, _mm512_set1_epi32(1)), p1);
 }
 
 /* ---- survivor set-up ---------------------------------------------------- */
 
-/* Sets up queue lanes 0 .. k-1 (k = 1..16) into their records. */
+/* The records are written per lane from two stack layouts filled by
+ * shuffles (instead of a scalar copy per field):
+ *   quads  4 float or int32 vectors a, b, c, d: lane l's (a, b, c, d) as 16
+ *          bytes at s + QUAD_AT(l) (4 stores of 64 bytes);
+ *   pairs  2 int64 vectors a, b of lanes 8h .. 8h+7: lane l's (a, b) as 16
+ *          bytes at s + PAIR_AT(l) (2 stores of 64 bytes per half). */
+#define QUAD_AT(l) (16 * ((l) & 3) + 4 * ((l) >> 2))
+#define PAIR_AT(l) (16 * ((l) >> 3) + 8 * ((l) & 1) + 2 * (((l) >> 1) & 3))
+
+static inline void quads(__m512 a, __m512 b, __m512 c, __m512 d, float *s)
+{
+    const __m512d ablo = _mm512_castps_pd(_mm512_unpacklo_ps(a, b));   /* a0 b0 a1 b1 */
+    const __m512d abhi = _mm512_castps_pd(_mm512_unpackhi_ps(a, b));   /* a2 b2 a3 b3 */
+    const __m512d cdlo = _mm512_castps_pd(_mm512_unpacklo_ps(c, d));
+    const __m512d cdhi = _mm512_castps_pd(_mm512_unpackhi_ps(c, d));
+    _mm512_store_pd((double *)(void *)s, _mm512_unpacklo_pd(ablo, cdlo));   /* lanes 4k */
+    _mm512_store_pd((double *)(void *)(s + 16), _mm512_unpackhi_pd(ablo, cdlo));
+    _mm512_store_pd((double *)(void *)(s + 32), _mm512_unpacklo_pd(abhi, cdhi));
+    _mm512_store_pd((double *)(void *)(s + 48), _mm512_unpackhi_pd(abhi, cdhi));
+}
+
+static inline void pairs(__m512i a, __m512i b, int64_t *s)
+{
+    _mm512_store_si512((void *)s, _mm512_unpacklo_epi64(a, b));         /* lanes 2k */
+    _mm512_store_si512((void *)(s + 8), _mm512_unpackhi_epi64(a, b));   /* lanes 2k+1 */
+}
+
+/* 16 bytes from s to d. */
+static inline void copy16(void *d, const void *s)
+{
+    _mm_storeu_si128((__m128i *)d, _mm_load_si128((const __m128i *)s));
+}
+
+/* front_plane with the results as vectors: c, dx, dy of 8 lanes. */
+static inline __attribute__((always_inline)) void plane8(__m512d f0, __m512d f1, __m512d f2,
+                                                         __m512d ex1, __m512d ey1,
+                                                         __m512d ex2, __m512d ey2,
+                                                         __m512d ox, __m512d oy,
+                                                         __m512d area, __m256 *r)
+{
+    const __m512d df1 = _mm512_sub_pd(f1, f0), df2 = _mm512_sub_pd(f2, f0);
+    const __m512d gx = _mm512_div_pd(
+        _mm512_sub_pd(_mm512_mul_pd(df1, ey2), _mm512_mul_pd(df2, ey1)), area);
+    const __m512d gy = _mm512_div_pd(
+        _mm512_sub_pd(_mm512_mul_pd(df2, ex1), _mm512_mul_pd(df1, ex2)), area);
+    const __m512d cc =
+        _mm512_add_pd(_mm512_add_pd(f0, _mm512_mul_pd(gx, ox)), _mm512_mul_pd(gy, oy));
+    r[0] = _mm512_cvtpd_ps(cc);
+    r[1] = _mm512_cvtpd_ps(gx);
+    r[2] = _mm512_cvtpd_ps(gy);
+}
+
+/* front_planes_half for both halves, the planes z, q, b1, b2 of the 16
+ * queue lanes as vectors P[plane * 3 + {c, dx, dy}] (the same operations
+ * per lane; written out so that nothing goes through memory). */
+static inline __attribute__((always_inline)) void planes16(const __m512i X[3],
+                                                           const __m512i Y[3],
+                                                           const __m512i V[3], __m512i bx0,
+                                                           __m512i by0, __mmask16 L,
+                                                           const rast__vbuf *vb, __m512 P[12])
+{
+    const __m512d inv256 = _mm512_set1_pd(1.0 / RAST__FIX_ONE), dzero = _mm512_setzero_pd();
+    const __m512d dhalf = _mm512_set1_pd(0.5), done = _mm512_set1_pd(1.0);
+    __m256 r[2][12];
+#pragma GCC unroll 2
+    for (int h = 0; h < 2; h++) {
+        const __mmask8 lh = (__mmask8)(L >> (8 * h));
+        if (h && !lh) {   /* no lane in use: the values of the first half */
+#pragma GCC unroll 12
+            for (int j = 0; j < 12; j++)
+                r[1][j] = r[0][j];
+            break;
+        }
+        __m512d Xd[3], Yd[3], zw[3], iw[3];
+#pragma GCC unroll 3
+        for (int i = 0; i < 3; i++) {
+            zw[i] = _mm512_mask_i32gather_pd(dzero, lh, half_i(V[i], h), vb->zw, 8);
+            iw[i] = _mm512_mask_i32gather_pd(done, lh, half_i(V[i], h), vb->iw, 8);
+        }
+#pragma GCC unroll 3
+        for (int i = 0; i < 3; i++) {
+            Xd[i] = _mm512_mul_pd(_mm512_cvtepi32_pd(half_i(X[i], h)), inv256);
+            Yd[i] = _mm512_mul_pd(_mm512_cvtepi32_pd(half_i(Y[i], h)), inv256);
+        }
+        const __m512d ex1 = _mm512_sub_pd(Xd[1], Xd[0]), ey1 = _mm512_sub_pd(Yd[1], Yd[0]);
+        const __m512d ex2 = _mm512_sub_pd(Xd[2], Xd[0]), ey2 = _mm512_sub_pd(Yd[2], Yd[0]);
+        const __m512d area = _mm512_mask_blend_pd(
+            lh, done, _mm512_sub_pd(_mm512_mul_pd(ex1, ey2), _mm512_mul_pd(ey1, ex2)));
+        const __m512d ocx = _mm512_add_pd(_mm512_cvtepi32_pd(half_i(bx0, h)), dhalf);
+        const __m512d ocy = _mm512_add_pd(_mm512_cvtepi32_pd(half_i(by0, h)), dhalf);
+        const __m512d ox = _mm512_sub_pd(ocx, Xd[0]), oy = _mm512_sub_pd(ocy, Yd[0]);
+        const __m512d qmax =
+            _mm512_max_pd(iw[2], _mm512_max_pd(iw[1], _mm512_max_pd(iw[0], dzero)));
+        const __m512d q0 = _mm512_div_pd(iw[0], qmax), q1 = _mm512_div_pd(iw[1], qmax);
+        const __m512d q2 = _mm512_div_pd(iw[2], qmax);
+        plane8(zw[0], zw[1], zw[2], ex1, ey1, ex2, ey2, ox, oy, area, r[h]);
+        plane8(q0, q1, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 3);
+        plane8(dzero, q1, dzero, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 6);
+        plane8(dzero, dzero, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 9);
+    }
+#pragma GCC unroll 12
+    for (int j = 0; j < 12; j++)
+        P[j] = _mm512_insertf32x8(_mm512_castps256_ps512(r[0][j]), r[1][j], 1);
+}
+
 /* Micro lanes (clamped box at most 2x2 pixels): the covered pixels and,
  * for each of the box's four pixels (i, j), the scan's values: the clamped
  * depth z and the barycentrics b1, b2, computed per lane with the float
  * operations of rast__scan_rows_ref in its order (fi, fj are 0.0f or
  * 1.0f, multiplied as the scan multiplies them). cov[l]: bit i + 2j for
- * a covered pixel (the int64 edge test of the scan at that pixel). */
-static inline unsigned micro_lanes(const squeue *q, __mmask16 L, const int64_t (*ec)[16],
-                                   const int64_t (*edx)[16], const int64_t (*edy)[16],
-                                   const float (*pl)[16], uint8_t *cov, float (*mz)[16],
-                                   float (*mb1)[16], float (*mb2)[16])
+ * a covered pixel (the int64 edge test of the scan at that pixel); the
+ * values of lane l as quads (mz, mb1, mb2 of its record) at mq + QUAD_AT(l),
+ * mq + 64 + QUAD_AT(l), mq + 128 + QUAD_AT(l). */
+static inline __attribute__((always_inline)) unsigned micro_lanes(const __m512i *qf,
+                                                                   __mmask16 L,
+                                                                   const __m512i (*E)[2],
+                                                                   const __m512 *P,
+                                                                   uint8_t *cov, float *mq)
 {
     const __m512i one = _mm512_set1_epi32(1);
-    const __m512i w1 = _mm512_sub_epi32(_mm512_load_si512((const void *)q->f[Q_BX1]),
-                                        _mm512_load_si512((const void *)q->f[Q_BX0]));
-    const __m512i h1 = _mm512_sub_epi32(_mm512_load_si512((const void *)q->f[Q_BY1]),
-                                        _mm512_load_si512((const void *)q->f[Q_BY0]));
+    const __m512i w1 = _mm512_sub_epi32(qf[Q_BX1], qf[Q_BX0]);
+    const __m512i h1 = _mm512_sub_epi32(qf[Q_BY1], qf[Q_BY0]);
     const __mmask16 wide = _mm512_cmpeq_epi32_mask(w1, one);   /* 2 columns */
     const __mmask16 tall = _mm512_cmpeq_epi32_mask(h1, one);   /* 2 rows */
     const __mmask16 mic = L & _mm512_cmple_epi32_mask(w1, one) &
@@ -156,22 +274,21 @@ static inline unsigned micro_lanes(const squeue *q, __mmask16 L, const int64_t (
     if (!mic)
         return 0;
     /* Coverage: E = e_c + i*e_dx + j*e_dy, int64, at the four pixels. */
-    __mmask16 cv[4];
-    for (int p = 0; p < 4; p++)
-        cv[p] = 0;
+    __mmask16 cv[4] = { 0, 0, 0, 0 };
+#pragma GCC unroll 2
     for (int h = 0; h < 2; h++) {
         __m512i o[4] = { _mm512_setzero_si512(), _mm512_setzero_si512(),
                          _mm512_setzero_si512(), _mm512_setzero_si512() };
+#pragma GCC unroll 3
         for (int e = 0; e < 3; e++) {
-            const __m512i c = _mm512_load_si512((const void *)&ec[e][8 * h]);
-            const __m512i ex = _mm512_load_si512((const void *)&edx[e][8 * h]);
-            const __m512i ey = _mm512_load_si512((const void *)&edy[e][8 * h]);
+            const __m512i c = E[e][h], ex = E[3 + e][h], ey = E[6 + e][h];
             const __m512i c01 = _mm512_add_epi64(c, ey);
             o[0] = _mm512_or_si512(o[0], c);
             o[1] = _mm512_or_si512(o[1], _mm512_add_epi64(c, ex));
             o[2] = _mm512_or_si512(o[2], c01);
             o[3] = _mm512_or_si512(o[3], _mm512_add_epi64(c01, ex));
         }
+#pragma GCC unroll 4
         for (int p = 0; p < 4; p++)
             cv[p] |= (__mmask16)((unsigned)(uint8_t)~_mm512_movepi64_mask(o[p]) << (8 * h));
     }
@@ -184,60 +301,75 @@ static inline unsigned micro_lanes(const squeue *q, __mmask16 L, const int64_t (
         return mic;
     const __m512i bit = _mm512_set1_epi32(1);
     __m512i cb = _mm512_setzero_si512();
+#pragma GCC unroll 4
     for (int p = 0; p < 4; p++)
         cb = _mm512_mask_or_epi32(cb, cv[p], cb, _mm512_slli_epi32(bit, p));
     _mm_storeu_si128((__m128i *)(void *)cov, _mm512_cvtepi32_epi8(cb));
     /* The values (the scan's expressions; unused lanes compute garbage). */
     const __m512 zero = _mm512_setzero_ps(), fone = _mm512_set1_ps(1.0f);
-    __m512 P[12];
-    for (int i = 0; i < 12; i++)
-        P[i] = _mm512_load_ps(pl[i]);
+    __m512 Z[4], B1[4], B2[4];
+#pragma GCC unroll 2
     for (int j = 0; j < 2; j++) {
         const __m512 fj = j ? fone : zero;
         const __m512 zr = _mm512_add_ps(P[0], _mm512_mul_ps(P[2], fj));
         const __m512 qr = _mm512_add_ps(P[3], _mm512_mul_ps(P[5], fj));
         const __m512 b1r = _mm512_add_ps(P[6], _mm512_mul_ps(P[8], fj));
         const __m512 b2r = _mm512_add_ps(P[9], _mm512_mul_ps(P[11], fj));
+#pragma GCC unroll 2
         for (int i = 0; i < 2; i++) {
             const int p = i + 2 * j;
             const __m512 fi = i ? fone : zero;
             __m512 z = _mm512_add_ps(zr, _mm512_mul_ps(P[1], fi));
             z = _mm512_max_ps(zero, z);
-            z = _mm512_min_ps(fone, z);
-            _mm512_store_ps(mz[p], z);
+            Z[p] = _mm512_min_ps(fone, z);
             const __m512 r = _mm512_div_ps(fone, _mm512_add_ps(qr, _mm512_mul_ps(P[4], fi)));
-            _mm512_store_ps(mb1[p], _mm512_mul_ps(_mm512_add_ps(b1r, _mm512_mul_ps(P[7], fi)), r));
-            _mm512_store_ps(mb2[p], _mm512_mul_ps(_mm512_add_ps(b2r, _mm512_mul_ps(P[10], fi)), r));
+            B1[p] = _mm512_mul_ps(_mm512_add_ps(b1r, _mm512_mul_ps(P[7], fi)), r);
+            B2[p] = _mm512_mul_ps(_mm512_add_ps(b2r, _mm512_mul_ps(P[10], fi)), r);
         }
     }
+    quads(Z[0], Z[1], Z[2], Z[3], mq);
+    quads(B1[0], B1[1], B1[2], B1[3], mq + 64);
+    quads(B2[0], B2[1], B2[2], B2[3], mq + 128);
     return mic;
 }
 
+/* Sets up queue lanes 0 .. k-1 (k = 1..16; qf[field] as in the queue)
+ * into their records. */
 static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
-                  const squeue *q, int k, rast__tri *out, int micro)
+                  const __m512i *qf, int k, rast__tri *out, int micro)
 {
     const __mmask16 L = k >= 16 ? (__mmask16)0xFFFF : (__mmask16)((1u << k) - 1u);
     __m512i X[3], Y[3], V[3];
+#pragma GCC unroll 3
     for (int i = 0; i < 3; i++) {
-        X[i] = _mm512_load_si512((const void *)q->f[Q_X0 + i]);
-        Y[i] = _mm512_load_si512((const void *)q->f[Q_Y0 + i]);
-        V[i] = _mm512_maskz_load_epi32(L, (const void *)q->f[Q_V0 + i]);
+        X[i] = qf[Q_X0 + i];
+        Y[i] = qf[Q_Y0 + i];
+        V[i] = _mm512_maskz_mov_epi32(L, qf[Q_V0 + i]);
     }
-    const __m512i bx0 = _mm512_load_si512((const void *)q->f[Q_BX0]);
-    const __m512i by0 = _mm512_load_si512((const void *)q->f[Q_BY0]);
+    const __m512i bx0 = qf[Q_BX0], by0 = qf[Q_BY0];
+    /* the per-lane fields the record loop reads */
+    _Alignas(64) int32_t qs[Q_FIELDS][16];
+#pragma GCC unroll 3
+    for (int f = Q_V0; f <= Q_V2; f++)
+        _mm512_store_si512((void *)qs[f], qf[f]);
+    _mm512_store_si512((void *)qs[Q_SLOT], qf[Q_SLOT]);
     const __m512i c128 = _mm512_set1_epi32(RAST__FIX_HALF);
     const __m512i cx = _mm512_add_epi32(_mm512_slli_epi32(bx0, RAST_SUBPIXEL_BITS), c128);
     const __m512i cy = _mm512_add_epi32(_mm512_slli_epi32(by0, RAST_SUBPIXEL_BITS), c128);
 
-    /* setup_edges: edge e from vertex ea[e] to eb[e]. */
-    _Alignas(64) int64_t ec[3][16], edx[3][16], edy[3][16];
+    /* setup_edges: edge e from vertex ea[e] to eb[e]; E[f][h] the int64
+     * lanes 8h .. 8h+7 of e_c[e] (f = e), e_dx[e] (3 + e), e_dy[e] (6 + e),
+     * the order of the record. */
+    __m512i E[9][2];
     static const int ea[3] = { 1, 2, 0 }, eb[3] = { 2, 0, 1 };
     const __m512i one64 = _mm512_set1_epi64(1), zero = _mm512_setzero_si512();
+#pragma GCC unroll 3
     for (int e = 0; e < 3; e++) {
         const int a = ea[e], b = eb[e];
         const __m512i dx = _mm512_sub_epi32(X[b], X[a]), dy = _mm512_sub_epi32(Y[b], Y[a]);
         const __mmask16 tl = top_left(dx, dy);
         const __m512i oy = _mm512_sub_epi32(cy, Y[a]), ox = _mm512_sub_epi32(cx, X[a]);
+#pragma GCC unroll 2
         for (int h = 0; h < 2; h++) {
             const __m512i dx64 = _mm512_cvtepi32_epi64(half_i(dx, h));
             const __m512i dy64 = _mm512_cvtepi32_epi64(half_i(dy, h));
@@ -245,55 +377,79 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
             const __m512i p2 = _mm512_mul_epi32(dy64, _mm512_cvtepi32_epi64(half_i(ox, h)));
             const __m512i r = _mm512_sub_epi64(p1, p2);
             const __mmask8 bias = (__mmask8)~(tl >> (8 * h));
-            _mm512_store_si512((void *)&ec[e][8 * h], _mm512_mask_sub_epi64(r, bias, r, one64));
-            _mm512_store_si512((void *)&edx[e][8 * h],
-                               _mm512_sub_epi64(zero, _mm512_slli_epi64(dy64, RAST_SUBPIXEL_BITS)));
-            _mm512_store_si512((void *)&edy[e][8 * h], _mm512_slli_epi64(dx64, RAST_SUBPIXEL_BITS));
+            E[e][h] = _mm512_mask_sub_epi64(r, bias, r, one64);
+            E[3 + e][h] = _mm512_sub_epi64(zero, _mm512_slli_epi64(dy64, RAST_SUBPIXEL_BITS));
+            E[6 + e][h] = _mm512_slli_epi64(dx64, RAST_SUBPIXEL_BITS);
         }
     }
 
     /* planes_one per lane. */
-    _Alignas(64) float pl[12][16];
-    for (int h = 0; h < 2; h++)
-        front_planes_half(X, Y, V, bx0, by0, (__mmask8)(L >> (8 * h)), h, vb, pl);
+    __m512 P[12];
+    planes16(X, Y, V, bx0, by0, L, vb, P);
 
     /* The records: lane l -> out[slot l]. */
     _Alignas(64) uint8_t cov[16] = { 0 };
-    _Alignas(64) float mz[4][16], mb1[4][16], mb2[4][16];
-    const unsigned mic = micro ? micro_lanes(q, L, ec, edx, edy,
-                                             (const float (*)[16])pl, cov, mz, mb1, mb2)
+    _Alignas(64) float mq[3 * 64];
+    const unsigned mic = micro ? micro_lanes(qf, L, (const __m512i (*)[2])E, P, cov, mq)
                                : 0u;
-
+    /* box; the planes z.c .. q.c, q.dx .. b1.dx, b1.dy .. b2.dy */
+    _Alignas(64) int32_t bq[64];
+    _Alignas(64) float pq[3 * 64];
+    quads(_mm512_castsi512_ps(bx0), _mm512_castsi512_ps(by0), _mm512_castsi512_ps(qf[Q_BX1]),
+          _mm512_castsi512_ps(qf[Q_BY1]), (float *)(void *)bq);
+    /* the edge pairs (e_c[0], e_c[1]) .. (e_dy[0], e_dy[1]) at 16 .. 79 and
+     * e_dy[2] at 80 */
+    _Alignas(64) int64_t eq[4][32], e8[16];
+    if (mic != L) {
+#pragma GCC unroll 3
+        for (int i = 0; i < 3; i++)
+            quads(P[4 * i], P[4 * i + 1], P[4 * i + 2], P[4 * i + 3], pq + 64 * i);
+#pragma GCC unroll 2
+        for (int h = 0; h < 2; h++) {
+#pragma GCC unroll 4
+            for (int i = 0; i < 4; i++)
+                pairs(E[2 * i][h], E[2 * i + 1][h], eq[i] + 16 * h);
+            _mm512_store_si512((void *)(e8 + 8 * h), E[8][h]);
+        }
+    }
     const int ac = v->attr_count;
     const __mmask8 AM = (__mmask8)((1u << ac) - 1u);
     for (int l = 0; l < k; l++) {
-        rast__tri *t;
+        rast__tri *t = out + qs[Q_SLOT][l];
+        char *d = (char *)(void *)t;
+        const int qa = QUAD_AT(l), pa = PAIR_AT(l);
         if ((mic >> l) & 1u) {
-            t = out + q->f[Q_SLOT][l];
             t->micro = RAST__MICRO | cov[l];
             if (!cov[l])
                 continue;
-            t->x0 = q->f[Q_BX0][l];
-            t->y0 = q->f[Q_BY0][l];
-            t->x1 = q->f[Q_BX1][l];
-            t->y1 = q->f[Q_BY1][l];
             t->attr_count = ac;
-            for (int p = 0; p < 4; p++) {
-                t->mz[p] = mz[p][l];
-                t->mb1[p] = mb1[p][l];
-                t->mb2[p] = mb2[p][l];
-            }
+            copy16(d, bq + qa);
+            copy16(t->mz, mq + qa);
+            copy16(t->mb1, mq + 64 + qa);
+            copy16(t->mb2, mq + 128 + qa);
         } else {
-            t = front_record(q, l, ec, edx, edy, pl, ac, out);
+            /* the fields of front_record: box, edges, planes, attr_count
+             * and micro = 0 (one 8-byte store, little-endian) */
+            const uint64_t acm = (uint32_t)ac;
+            copy16(d, bq + qa);
+            copy16(d + 16, eq[0] + pa);
+            copy16(d + 32, eq[1] + pa);
+            copy16(d + 48, eq[2] + pa);
+            copy16(d + 64, eq[3] + pa);
+            memcpy(d + 80, &e8[l], 8);
+            copy16(d + 88, pq + qa);
+            copy16(d + 104, pq + 64 + qa);
+            copy16(d + 120, pq + 128 + qa);
+            memcpy(&t->attr_count, &acm, 8);
         }
         /* setup_attrs: a0 = attribute of vertex 0, d1 = a1 - a0,
          * d2 = a2 - a0, per record by masked loads (no byte past the
          * vertex's ac floats is read) and masked stores (no byte past
          * a0[ac - 1], d1[ac - 1], d2[ac - 1] is written). */
         if (ac > 0) {
-            const float *a0p = m->attr + (size_t)q->f[Q_V0][l] * (size_t)ac;
-            const float *a1p = m->attr + (size_t)q->f[Q_V1][l] * (size_t)ac;
-            const float *a2p = m->attr + (size_t)q->f[Q_V2][l] * (size_t)ac;
+            const float *a0p = m->attr + (size_t)qs[Q_V0][l] * (size_t)ac;
+            const float *a1p = m->attr + (size_t)qs[Q_V1][l] * (size_t)ac;
+            const float *a2p = m->attr + (size_t)qs[Q_V2][l] * (size_t)ac;
             const __m256 a0 = _mm256_maskz_loadu_ps(AM, a0p);
             const __m256 a1 = _mm256_maskz_loadu_ps(AM, a1p);
             const __m256 a2 = _mm256_maskz_loadu_ps(AM, a2p);
@@ -304,6 +460,18 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
     }
 }
 
+/* The record layout the 16-byte copies of flush assume. */
+_Static_assert(offsetof(rast__tri, x0) == 0 && offsetof(rast__tri, y0) == 4 &&
+                   offsetof(rast__tri, x1) == 8 && offsetof(rast__tri, y1) == 12 &&
+                   offsetof(rast__tri, e_c) == 16 && offsetof(rast__tri, e_dx) == 40 &&
+                   offsetof(rast__tri, e_dy) == 64 && offsetof(rast__tri, z) == 88 &&
+                   offsetof(rast__tri, q) == 100 && offsetof(rast__tri, b1) == 112 &&
+                   offsetof(rast__tri, b2) == 124 && sizeof(rast__plane) == 12 &&
+                   offsetof(rast__tri, micro) == offsetof(rast__tri, attr_count) + 4 &&
+                   offsetof(rast__tri, mb1) == offsetof(rast__tri, mz) + 16 &&
+                   offsetof(rast__tri, mb2) == offsetof(rast__tri, mz) + 32,
+               "record layout of flush's copies");
+
 _Static_assert(RAST__FRONT_GROUP == 16, "one group per 16-lane vector");
 _Static_assert(RAST_MAX_ATTRS <= 8, "attributes by 8-lane masked loads and stores");
 
@@ -311,8 +479,12 @@ int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast
                         int ti0, int ti1, rast__tri *out, rast_stats *st, int micro)
 {
     rast_stats ls = *st;
-    squeue q;
-    q.n = 0;
+    /* The survivor queue in registers: qf[field] lanes 0 .. qn-1. */
+    __m512i qf[Q_FIELDS];
+#pragma GCC unroll 14
+    for (int f = 0; f < Q_FIELDS; f++)
+        qf[f] = _mm512_setzero_si512();
+    int qn = 0;
     int n = 0;
     const long long *xyb = (const long long *)(const void *)vb->xy;
     const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -326,6 +498,7 @@ int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast
         const uint32_t *ix = m->indices + 3 * (size_t)ti;
         const int ne = 3 * cnt;
         __m512i iw3[3];
+#pragma GCC unroll 3
         for (int i = 0; i < 3; i++) {
             const int left = ne - 16 * i;
             iw3[i] = left >= 16 ? _mm512_loadu_si512((const void *)(ix + 16 * i))
@@ -335,20 +508,26 @@ int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast
         }
         __m512i iv[3], X[3], Y[3];
         deint_tris(iw3[0], iw3[1], iw3[2], iv);
-        __mmask16 spec = 0;
         /* (X, Y) pairs: one 64-bit load per vertex, by scalar loads
          * (faster than vpgatherdq on Zen 4: 0.95-0.97 of the whole draw's
-         * time at 41k triangles, 0.97-0.99 at 10k, in one process). */
-        _Alignas(64) uint32_t ivs[3][16];
-        for (int k = 0; k < 3; k++)
-            _mm512_store_si512((void *)ivs[k], iv[k]);
-        for (int k = 0; k < 3; k++) {
-            __m512i p[2];
-            load_pairs(xyb, ivs[k], p);
-            X[k] = pairs_lo(p);
-            Y[k] = pairs_hi(p);
-            spec |= _mm512_cmpeq_epi32_mask(X[k], mark);
+         * time at 41k triangles, 0.97-0.99 at 10k, in one process), the
+         * indices read from the mesh (a partial group: from a copy of the
+         * de-interleaved vectors, vertex 0 past cnt). */
+        if (cnt == 16) {
+#pragma GCC unroll 3
+            for (int k = 0; k < 3; k++)
+                load_xy(xyb, ix + k, 3, &X[k], &Y[k]);
+        } else {
+            _Alignas(64) uint32_t ivs[3][16];
+            for (int k = 0; k < 3; k++)
+                _mm512_store_si512((void *)ivs[k], iv[k]);
+            for (int k = 0; k < 3; k++)
+                load_xy(xyb, ivs[k], 1, &X[k], &Y[k]);
         }
+        __mmask16 spec = 0;
+#pragma GCC unroll 3
+        for (int k = 0; k < 3; k++)
+            spec |= _mm512_cmpeq_epi32_mask(X[k], mark);
         const unsigned special0 = spec & L;
         /* prepare_cached_one: area sign, degenerate, culling. */
         unsigned pos, neg;
@@ -395,24 +574,35 @@ int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast
         }
         if (!surv)
             continue;
-        const __mmask16 sv = (__mmask16)surv;
         const __m512i vi1 = _mm512_mask_blend_epi32(sw, iv[1], iv[2]);
         const __m512i vi2 = _mm512_mask_blend_epi32(sw, iv[2], iv[1]);
         const __m512i fld[Q_FIELDS] = { X[0], x1, x2, Y[0], y1, y2, iv[0], vi1, vi2,
                                         b.bx0, b.by0, b.bx1, b.by1, slot };
+        /* Append the survivors in registers: queue lane j >= qn takes
+         * survivor j - qn, i.e. group lane idx[j] (rot: the slots, already
+         * compressed); lanes j < qn of the same permutation hold the
+         * survivors past lane 15 (survivor j - qn + 16), the next queue. */
+        const int ns = __builtin_popcount(surv);
+        const __m512i rot = _mm512_sub_epi32(iota, _mm512_set1_epi32(qn));
+        const __m512i idx =
+            _mm512_permutexvar_epi32(rot, _mm512_maskz_compress_epi32((__mmask16)surv, iota));
+        const __mmask16 up = (__mmask16)(0xFFFFu << qn);
+#pragma GCC unroll 13
         for (int f = 0; f < Q_SLOT; f++)
-            _mm512_storeu_si512((void *)(q.f[f] + q.n), _mm512_maskz_compress_epi32(sv, fld[f]));
-        _mm512_storeu_si512((void *)(q.f[Q_SLOT] + q.n), slot);
-        q.n += __builtin_popcount(surv);
-        if (q.n >= 16) {
-            flush(v, m, vb, &q, 16, out, micro);
-            q.n -= 16;
-            for (int f = 0; f < Q_FIELDS; f++)
-                _mm512_store_si512((void *)q.f[f], _mm512_load_si512((const void *)(q.f[f] + 16)));
+            qf[f] = _mm512_mask_permutexvar_epi32(qf[f], up, idx, fld[f]);
+        qf[Q_SLOT] = _mm512_mask_permutexvar_epi32(qf[Q_SLOT], up, rot, slot);
+        qn += ns;
+        if (qn >= 16) {
+            flush(v, m, vb, qf, 16, out, micro);
+            qn -= 16;
+#pragma GCC unroll 13
+            for (int f = 0; f < Q_SLOT; f++)
+                qf[f] = _mm512_permutexvar_epi32(idx, fld[f]);
+            qf[Q_SLOT] = _mm512_permutexvar_epi32(rot, slot);
         }
     }
-    if (q.n)
-        flush(v, m, vb, &q, q.n, out, micro);
+    if (qn)
+        flush(v, m, vb, qf, qn, out, micro);
     *st = ls;
     return n;
 }
