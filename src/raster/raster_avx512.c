@@ -112,6 +112,81 @@ static inline void attr3_store_m(float *p, unsigned bits, int lanes, __m512 a, _
 #define ATTR3_STORE_M(p, bits, lanes, a, b, c) attr3_store_m(p, bits, lanes, a, b, c)
 #define ATTR3_STORE_FULL(p, a, b, c) attr3_store(p, a, b, c)
 
+/* The attributes of a one-vector row computed in the interleaved layout:
+ * lane f of output vector o is attribute (16*o + f) % 3 of pixel
+ * (16*o + f) / 3. Its barycentrics are lanes of the pixels' b1, b2
+ * (permutes copy bits) and its constants a0, d1, d2 of that attribute, so
+ * each float gets the reference's (a0 + b1 * d1) + b2 * d2, and no
+ * transposition is needed: two permutes, four operations and a masked
+ * store per output vector (a row of up to 5 pixels needs one). */
+static const int32_t pix3[3][16] __attribute__((aligned(64))) = {
+    { 0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4, 5 },
+    { 5, 5, 6, 6, 6, 7, 7, 7, 8, 8, 8, 9, 9, 9, 10, 10 },
+    { 10, 11, 11, 11, 12, 12, 12, 13, 13, 13, 14, 14, 14, 15, 15, 15 },
+};
+static const int32_t att3[3][16] __attribute__((aligned(64))) = {
+    { 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0 },
+    { 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1 },
+    { 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2 },
+};
+typedef struct attr3_state {
+    __m512 a0[3], d1[3], d2[3];   /* per output vector, its lanes' constants */
+    int nout;                     /* output vectors a row needs (1..3) */
+} attr3_state;
+
+static inline void attr3_prep(attr3_state *st, const rast__tri *tri, int lanes)
+{
+    const __m512 a0 = _mm512_castps128_ps512(_mm_maskz_loadu_ps(7, tri->a0));
+    const __m512 d1 = _mm512_castps128_ps512(_mm_maskz_loadu_ps(7, tri->d1));
+    const __m512 d2 = _mm512_castps128_ps512(_mm_maskz_loadu_ps(7, tri->d2));
+    st->nout = lanes >= 16 ? 3 : (3 * lanes + 15) >> 4;
+    for (int o = 0; o < 3; o++) {
+        const __m512i k = _mm512_load_si512(att3[o]);
+        st->a0[o] = _mm512_permutexvar_ps(k, a0);
+        st->d1[o] = _mm512_permutexvar_ps(k, d1);
+        st->d2[o] = _mm512_permutexvar_ps(k, d2);
+    }
+}
+
+static inline void attr3_out(float *p, __m512i pb, const attr3_state *st, int o, __m512 b1,
+                             __m512 b2)
+{
+    const __m512i pix = _mm512_load_si512(pix3[o]);
+    const __m512 b1o = _mm512_permutexvar_ps(pix, b1);
+    const __m512 b2o = _mm512_permutexvar_ps(pix, b2);
+    const __m512 a = _mm512_add_ps(_mm512_add_ps(st->a0[o], _mm512_mul_ps(b1o, st->d1[o])),
+                                   _mm512_mul_ps(b2o, st->d2[o]));
+    const __mmask16 k = _mm512_test_epi32_mask(pb, _mm512_load_si512(sel3[o]));
+    _mm512_mask_storeu_ps(p + 16 * o, k, a);
+}
+
+static inline void attr3_store_p(float *p, unsigned bits, const attr3_state *st, __m512 b1,
+                                 __m512 b2)
+{
+    const __m512i pb = _mm512_set1_epi32((int)bits);
+    attr3_out(p, pb, st, 0, b1, b2);
+    if (st->nout > 1) {
+        attr3_out(p, pb, st, 1, b1, b2);
+        if (st->nout > 2)
+            attr3_out(p, pb, st, 2, b1, b2);
+    }
+}
+
+/* a / b in the first `lanes` lanes (the others 0 or a / b, never stored):
+ * one 256-bit division when they fit in 8 (half the divider's time on
+ * Zen 4). */
+static inline __m512 div_lanes(__m512 a, __m512 b, int lanes)
+{
+    if (lanes <= 8)
+        return _mm512_zextps256_ps512(
+            _mm256_div_ps(_mm512_castps512_ps256(a), _mm512_castps512_ps256(b)));
+    return _mm512_div_ps(a, b);
+}
+#define VF_DIV_LANES(a, b, lanes) div_lanes(a, b, lanes)
+#define ATTR3_STATE attr3_state
+#define ATTR3_PREP(st, tri, lanes) attr3_prep(st, tri, lanes)
+#define ATTR3_STORE_P(p, bits, st, b1, b2) attr3_store_p(p, bits, st, b1, b2)
+
 #include "raster_simd.inl"
 
 /* ---- vertex transforms (rast_transform_points / rast_transform_dirs) ----

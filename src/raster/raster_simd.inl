@@ -32,6 +32,15 @@
  *                          in the first `lanes` lanes (the box width of a
  *                          one-vector row, the lanes left in a wider one),
  *                          so the outputs needed are known per triangle.
+ *   ATTR3_STATE, ATTR3_PREP(st, tri, lanes), ATTR3_STORE_P(p, bits, st, b1, b2)
+ *                          three attributes of a one-vector row from the
+ *                          pixels' barycentrics b1, b2: PREP fills the
+ *                          per-triangle state *st (rows at most `lanes`
+ *                          pixels), STORE_P writes the pixels in bits of
+ *                          p[3*lanes] as (a0 + b1*d1) + b2*d2 per float.
+ *   VF_DIV_LANES(a, b, lanes)  a / b in the first `lanes` lanes (the
+ *                          others: any value; nothing derived from them is
+ *                          stored).
  *
  * COVERAGE. The reference tests E >= 0 with int64 E stepped by multiples of
  * 256 (e_dx = -dy*256, e_dy = dx*256). Since floor((E + 256k)/256) =
@@ -43,8 +52,10 @@
  *     the largest corner value, E' being affine) lies below 2^30, every
  *     value and every step difference fits int32: int32 adds give the
  *     exact integers. Triangles one vector wide (most of a fine mesh)
- *     take a loop that tests coverage first and computes the float row
- *     values only for rows with covered pixels. Wider ones test a row's
+ *     take their own loop (simd_scan_vec1, with its own short prologue):
+ *     coverage first, the float row values only for rows with covered
+ *     pixels, the attribute set-up only from the first row that writes a
+ *     pixel. Wider ones test a row's
  *     coverage vectors first (from the left, up to the end of the row's
  *     one run of covered pixels) and then do the float work on vectors
  *     that start at the run's first pixel: a run of at most SIMD_V
@@ -76,6 +87,21 @@ static inline int32_t simd_clamp29(int64_t a)
 static inline int64_t simd_abs64(int64_t a)
 {
     return a < 0 ? -a : a;
+}
+
+/* Set bits of a lane mask. Without the popcnt instruction (the SSE2
+ * build) __builtin_popcount is a libgcc call, around which every live
+ * vector register is spilled: a few integer operations instead. */
+static inline int simd_popcount(unsigned v)
+{
+#ifdef __POPCNT__
+    return __builtin_popcount(v);
+#else
+    v = v - ((v >> 1) & 0x55555555u);
+    v = (v & 0x33333333u) + ((v >> 2) & 0x33333333u);
+    v = (v + (v >> 4)) & 0x0F0F0F0Fu;
+    return (int)((v * 0x01010101u) >> 24);
+#endif
 }
 
 /* The attributes of the lanes in pass, written interleaved to dst. */
@@ -139,6 +165,128 @@ static inline long simd_scan_pixel(const rast_target *t, const rast__tri *tri, i
     return 1;
 }
 
+/* Row state of the one-vector loop. */
+typedef struct simd_vec1 {
+    vi e0, e1, e2;                /* reduced edges of the current row */
+    uint8_t *mrow;
+    float *drow, *arow;           /* NULL without depth / attributes */
+    long written;
+} simd_vec1;
+
+/* Coverage, depth and mask of row y (the reference's z per lane), the
+ * edges stepped to the next row; returns the lanes written. */
+static inline unsigned simd_vec1_row(simd_vec1 *s, const rast__tri *tri, int y,
+                                     unsigned valid, vi dy0, vi dy1, vi dy2, vf zfi)
+{
+    const unsigned cov = ~VI_NEG_BITS(VI_OR(VI_OR(s->e0, s->e1), s->e2)) & valid;
+    s->e0 = VI_ADD(s->e0, dy0);
+    s->e1 = VI_ADD(s->e1, dy1);
+    s->e2 = VI_ADD(s->e2, dy2);
+    if (!cov)
+        return 0;
+    const float fj = (float)(y - tri->y0);
+    vf z = VF_ADD(VF_SET1(tri->z.c + tri->z.dy * fj), zfi);
+    z = VF_MAX(VF_SET1(0.0f), z);
+    z = VF_MIN(VF_SET1(1.0f), z);
+    unsigned pass = cov;
+    if (s->drow) {
+        const vf d = VF_LOAD_M(s->drow, cov, cov == SIMD_FULL);
+        pass = cov & VF_LT_BITS(z, d);
+        if (!pass)
+            return 0;
+        VF_STORE_M(s->drow, pass, pass == SIMD_FULL, z);
+    }
+    MASK_STORE_M(s->mrow, pass, pass == SIMD_FULL);
+    s->written += simd_popcount(pass);
+    return pass;
+}
+
+static inline void simd_vec1_next(simd_vec1 *s, const rast_target *t)
+{
+    s->mrow += t->mask_stride;
+    if (s->drow)
+        s->drow += t->depth_stride;
+    if (s->arow)
+        s->arow += t->attr_stride;
+}
+
+/* Triangles one vector wide (nx <= SIMD_V; most of a fine mesh), int32
+ * coverage (the caller checked the bound, see COVERAGE): c, sx, sy are the
+ * reduced edge values at (x0, ys) and their steps. Coverage first, the
+ * float work only for rows with covered pixels, and nothing is set up for
+ * the attributes before the first row that writes a pixel (many scanned
+ * triangles are hidden). Every row-invariant product (dx * fi) is computed
+ * once: the same IEEE product in every row. */
+static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, int ye,
+                           int nx, int na, int32_t c0, int32_t c1, int32_t c2,
+                           int32_t sx0, int32_t sx1, int32_t sx2, int32_t sy0,
+                           int32_t sy1, int32_t sy2)
+{
+    const unsigned valid = nx >= SIMD_V ? SIMD_FULL : (1u << nx) - 1u;
+    const vi lanev = VI_LANES();
+    simd_vec1 s;
+    s.e0 = VI_ADD(VI_SET1(c0), VI_LANE_MUL(lanev, sx0));
+    s.e1 = VI_ADD(VI_SET1(c1), VI_LANE_MUL(lanev, sx1));
+    s.e2 = VI_ADD(VI_SET1(c2), VI_LANE_MUL(lanev, sx2));
+    s.written = 0;
+    s.mrow = t->mask + (size_t)ys * (size_t)t->mask_stride + tri->x0;
+    s.drow = t->depth ? t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0 : NULL;
+    s.arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride + (size_t)tri->x0 * (size_t)na
+                : NULL;
+    const vi dy0 = VI_SET1(sy0), dy1 = VI_SET1(sy1), dy2 = VI_SET1(sy2);
+    const vf fi = VF_CVT(lanev);
+    const vf zfi = VF_MUL(VF_SET1(tri->z.dx), fi);
+    int y = ys;
+    unsigned pass = 0;
+    for (; y <= ye; y++, simd_vec1_next(&s, t))
+        if ((pass = simd_vec1_row(&s, tri, y, valid, dy0, dy1, dy2, zfi)) && na)
+            break;
+    if (y > ye)
+        return s.written;
+
+    /* Row y wrote pixels (pass) and there are attributes. */
+    const vf one = VF_SET1(1.0f);
+    const vf qfi = VF_MUL(VF_SET1(tri->q.dx), fi);
+    const vf b1fi = VF_MUL(VF_SET1(tri->b1.dx), fi);
+    const vf b2fi = VF_MUL(VF_SET1(tri->b2.dx), fi);
+    vf av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
+#ifdef ATTR3_PREP
+    ATTR3_STATE a3;
+    if (na == 3)
+        ATTR3_PREP(&a3, tri, nx);
+    else
+#endif
+        for (int k = 0; k < na; k++) {
+            av0[k] = VF_SET1(tri->a0[k]);
+            av1[k] = VF_SET1(tri->d1[k]);
+            av2[k] = VF_SET1(tri->d2[k]);
+        }
+    for (;;) {
+        const float fj = (float)(y - tri->y0);
+        const float qr = tri->q.c + tri->q.dy * fj;
+        const float b1r = tri->b1.c + tri->b1.dy * fj;
+        const float b2r = tri->b2.c + tri->b2.dy * fj;
+#ifdef VF_DIV_LANES
+        const vf r = VF_DIV_LANES(one, VF_ADD(VF_SET1(qr), qfi), nx);
+#else
+        const vf r = VF_DIV(one, VF_ADD(VF_SET1(qr), qfi));
+#endif
+        const vf b1 = VF_MUL(VF_ADD(VF_SET1(b1r), b1fi), r);
+        const vf b2 = VF_MUL(VF_ADD(VF_SET1(b2r), b2fi), r);
+#ifdef ATTR3_PREP
+        if (na == 3)
+            ATTR3_STORE_P(s.arow, pass, &a3, b1, b2);
+        else
+#endif
+            simd_attr_store(s.arow, na, pass, nx, b1, b2, av0, av1, av2);
+        do {
+            if (++y > ye)
+                return s.written;
+            simd_vec1_next(&s, t);
+        } while (!(pass = simd_vec1_row(&s, tri, y, valid, dy0, dy1, dy2, zfi)));
+    }
+}
+
 long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
 {
     const int ys = ya > tri->y0 ? ya : tri->y0;
@@ -155,13 +303,32 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
     }
     const int na = t->attr ? tri->attr_count : 0;
     const int nx = tri->x1 - tri->x0 + 1;
+    if (nx <= SIMD_V) {
+        /* One vector wide: the int32 bound over rows ys..ye and the
+         * SIMD_V lanes (as below with nvec = 1); when it fails, the int64
+         * loop below. */
+        const int64_t dj = ys - tri->y0, rows = ye - ys;
+        const int64_t c0 = simd_floor256(tri->e_c[0] + dj * tri->e_dy[0]);
+        const int64_t c1 = simd_floor256(tri->e_c[1] + dj * tri->e_dy[1]);
+        const int64_t c2 = simd_floor256(tri->e_c[2] + dj * tri->e_dy[2]);
+        const int32_t sx0 = (int32_t)(tri->e_dx[0] >> 8), sy0 = (int32_t)(tri->e_dy[0] >> 8);
+        const int32_t sx1 = (int32_t)(tri->e_dx[1] >> 8), sy1 = (int32_t)(tri->e_dy[1] >> 8);
+        const int32_t sx2 = (int32_t)(tri->e_dx[2] >> 8), sy2 = (int32_t)(tri->e_dy[2] >> 8);
+        const int64_t cols = SIMD_V - 1;
+        if (simd_abs64(c0) + rows * simd_abs64(sy0) + cols * simd_abs64(sx0) <= SIMD_LIM30 &&
+            simd_abs64(c1) + rows * simd_abs64(sy1) + cols * simd_abs64(sx1) <= SIMD_LIM30 &&
+            simd_abs64(c2) + rows * simd_abs64(sy2) + cols * simd_abs64(sx2) <= SIMD_LIM30)
+            return simd_scan_vec1(t, tri, ys, ye, nx, na, (int32_t)c0, (int32_t)c1,
+                                  (int32_t)c2, sx0, sx1, sx2, sy0, sy1, sy2);
+    }
     const int nvec = (nx + SIMD_V - 1) / SIMD_V;
     const int64_t rows = ye - ys;
 
     /* Reduced edges, relative to (x0, ys). sx, sy are the snapped edge
      * deltas (|dx|, |dy| < 2^23). The int32 path is taken when a bound
      * of |E'| over the scanned rectangle (|c| + rows*|sy| + cols*|sx|,
-     * at least the largest corner value) stays below 2^30. */
+     * at least the largest corner value) stays below 2^30 (always fails
+     * for nvec == 1: such boxes that fit took simd_scan_vec1). */
     int64_t c[3];
     int32_t sx[3], sy[3];
     int fits = 1;
@@ -193,52 +360,6 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
     float *arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride +
                            (size_t)tri->x0 * (size_t)na
                      : NULL;
-    if (fits && nvec == 1) {
-        /* One vector per row (most triangles of a fine mesh): coverage
-         * first, the float work only for rows with covered pixels. */
-        const unsigned valid = nx >= SIMD_V ? SIMD_FULL : (1u << nx) - 1u;
-        vi e0 = VI_ADD(VI_SET1((int32_t)c[0]), off0);
-        vi e1 = VI_ADD(VI_SET1((int32_t)c[1]), off1);
-        vi e2 = VI_ADD(VI_SET1((int32_t)c[2]), off2);
-        const vi sy0 = VI_SET1(sy[0]), sy1 = VI_SET1(sy[1]), sy2 = VI_SET1(sy[2]);
-        const vf fi = VF_CVT(lanev);
-        for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
-                 drow = drow ? drow + t->depth_stride : NULL,
-                 arow = arow ? arow + t->attr_stride : NULL) {
-            const unsigned cov = ~VI_NEG_BITS(VI_OR(VI_OR(e0, e1), e2)) & valid;
-            e0 = VI_ADD(e0, sy0);
-            e1 = VI_ADD(e1, sy1);
-            e2 = VI_ADD(e2, sy2);
-            if (!cov)
-                continue;
-            const float fj = (float)(y - tri->y0);
-            const float zr = tri->z.c + tri->z.dy * fj;
-            vf z = VF_ADD(VF_SET1(zr), VF_MUL(zdx, fi));
-            z = VF_MAX(zero, z);
-            z = VF_MIN(one, z);
-            unsigned pass = cov;
-            if (drow) {
-                const vf d = VF_LOAD_M(drow, cov, cov == SIMD_FULL);
-                pass = cov & VF_LT_BITS(z, d);
-                if (!pass)
-                    continue;
-                VF_STORE_M(drow, pass, pass == SIMD_FULL, z);
-            }
-            MASK_STORE_M(mrow, pass, pass == SIMD_FULL);
-            written += __builtin_popcount(pass);
-            if (!na)
-                continue;
-            const float qr = tri->q.c + tri->q.dy * fj;
-            const float b1r = tri->b1.c + tri->b1.dy * fj;
-            const float b2r = tri->b2.c + tri->b2.dy * fj;
-            const vf r = VF_DIV(one, VF_ADD(VF_SET1(qr), VF_MUL(VF_SET1(tri->q.dx), fi)));
-            const vf b1 = VF_MUL(VF_ADD(VF_SET1(b1r), VF_MUL(VF_SET1(tri->b1.dx), fi)), r);
-            const vf b2 = VF_MUL(VF_ADD(VF_SET1(b2r), VF_MUL(VF_SET1(tri->b2.dx), fi)), r);
-            simd_attr_store(arow, na, pass, nx, b1, b2, av0, av1, av2);
-        }
-        return written;
-    }
-
     const vf qdx = VF_SET1(tri->q.dx);
     const vf b1dx = VF_SET1(tri->b1.dx), b2dx = VF_SET1(tri->b2.dx);
     if (fits) {
@@ -319,7 +440,7 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
                     VF_STORE_M(drow + i0, pass, pass == SIMD_FULL, z);
                 }
                 MASK_STORE_M(mrow + i0, pass, pass == SIMD_FULL);
-                written += __builtin_popcount(pass);
+                written += simd_popcount(pass);
                 if (!na)
                     continue;
                 const vf r = VF_DIV(one, VF_ADD(VF_SET1(qr), VF_MUL(qdx, fi)));
@@ -383,7 +504,7 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
                 VF_STORE_M(drow + i0, pass, pass == SIMD_FULL, z);
             }
             MASK_STORE_M(mrow + i0, pass, pass == SIMD_FULL);
-            written += __builtin_popcount(pass);
+            written += simd_popcount(pass);
             if (!na)
                 continue;
             const vf r = VF_DIV(one, VF_ADD(VF_SET1(qr), VF_MUL(qdx, fi)));
