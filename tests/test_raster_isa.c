@@ -1049,12 +1049,19 @@ static void frontv_case(const rcase *k, const rast__setup_isa *isa, tu_rng *r, u
         rast__vc_entry e;
         rast__vfill_ref(&view, m->clip, (uint32_t)i, 1, &e);
         const int mark = vb->xy[2 * i] == RAST__VX_SPECIAL;
-        if (mark != (e.flags != 0) ||
+        /* a marked vertex's Y: its outcode | RAST__VX_NONFINITE */
+        const int32_t oy = vb->xy[2 * i + 1];
+        const int32_t ocbits = RAST__VX_NONFINITE | RAST__VX_OUTCODE;
+        const int bad_oc =
+            mark && ((e.flags & RAST__VF_NONFINITE)
+                         ? !(oy & RAST__VX_NONFINITE) || (oy & ~ocbits)
+                         : oy != (int32_t)(e.flags & RAST__VX_OUTCODE));
+        if (mark != (e.flags != 0) || bad_oc ||
             (!mark && (vb->xy[2 * i] != e.X || vb->xy[2 * i + 1] != e.Y ||
                        memcmp(&vb->zw[i], &e.zw, sizeof e.zw) ||
                        memcmp(&vb->iw[i], &e.iw, sizeof e.iw))))
             fail_msg("%s: vertex %d of the vertex pass differs from the scalar fill "
-                     "(flags %u)", what, i, e.flags);
+                     "(flags %u, Y %d)", what, i, e.flags, (int)oy);
     }
     const size_t cap = (size_t)m->tri_count * RAST__MAX_FAN + 1;
     rast__tri *a = calloc(cap, sizeof *a), *b = calloc(cap, sizeof *b);

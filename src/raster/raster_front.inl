@@ -6,7 +6,7 @@
  * depend on the lane width (docs/raster.md section 11).
  *
  * Lane macros, defined by the includer (bits = unsigned, bit l for lane l):
- *   FRONT_V                lanes (8 or 16); the queue holds 2 * FRONT_V
+ *   FRONT_V                lanes (8 or 16)
  *   fvi                    the int32 vector type
  *   FI_ZERO() FI_SET1(x)
  *   FI_ADD FI_SUB FI_OR FI_MIN FI_MAX   one int32 operation per lane
@@ -15,15 +15,6 @@
  *   FI_GT(a, b), FI_EQ(a, b)  the lanes with a > b, a == b as fvm
  *   FM_OR(a, b), FM_AND(a, b), FM_BITS(m)  on fvm; FM_BITS: as bits
  *   FI_NEG_BITS(v)         lanes whose sign bit is set
- *   fvd                    the double vector type (FRONT_V / 2 lanes)
- *   fdm                    a lane mask of the doubles of one half
- *   FD_SET1 FD_ADD FD_SUB FD_MUL FD_DIV  one IEEE operation per lane
- *   FD_MAX(a, b)           a > b ? a : b (the x86 max; no NaN here)
- *   FD_HALF_CVT(v, h)      int32 lanes of half h (0 or 1) of v as doubles
- *   FD_GATHER(d, p, v, h, lh)  p[lane of half h of v] where lh, else d
- *   FD_KEEP(lh, a, b)      a where lh, else b
- *   FD_STORE_F(p, v)       the lanes as float (round to nearest) to the
- *                          FRONT_V / 2 aligned floats at p
  * and, before the include, two static inline functions:
  *   unsigned prod_cmp(fvi a, fvi b, fvi c, fvi d, int gt)   lanes with
  *                          a*b > c*d (gt) or a*b < c*d (!gt), exact
@@ -143,15 +134,12 @@ static inline void front_count(rast_stats *st, unsigned degen, unsigned culled, 
 
 /* ---- survivor queue and set-up ------------------------------------------ */
 
-/* Survivors waiting for their set-up, one int32 per lane and field:
- * oriented (area > 0) snapped positions and vertex indices, the clamped
- * pixel box and the record's index in out. */
+/* The fields of a survivor waiting for its set-up (one int32 vector per
+ * field in the front ends' queues): oriented (area > 0) snapped positions
+ * and vertex indices, the clamped pixel box and the record's index in
+ * out. */
 enum { Q_X0, Q_X1, Q_X2, Q_Y0, Q_Y1, Q_Y2, Q_V0, Q_V1, Q_V2, Q_BX0, Q_BY0, Q_BX1, Q_BY1,
        Q_SLOT, Q_FIELDS };
-typedef struct squeue {
-    int n;
-    _Alignas(4 * FRONT_V) int32_t f[Q_FIELDS][2 * FRONT_V];
-} squeue;
 
 /* Record slots in submission order for the lanes of special | surv of the
  * group at ti: special triangles through the scalar path at their place
@@ -168,91 +156,4 @@ static inline int front_slots(const rast__view *v, const rast_mesh_desc *m, int 
             sl[l] = n++;
     }
     return n;
-}
-
-/* The double operations of planes_one for one plane, FRONT_V / 2 lanes
- * (raster_planes.inl, planes_lane). */
-static inline void front_plane(fvd f0, fvd f1, fvd f2, fvd ex1, fvd ey1, fvd ex2, fvd ey2,
-                               fvd ox, fvd oy, fvd area, float *c, float *gxo, float *gyo)
-{
-    const fvd df1 = FD_SUB(f1, f0), df2 = FD_SUB(f2, f0);
-    const fvd gx = FD_DIV(FD_SUB(FD_MUL(df1, ey2), FD_MUL(df2, ey1)), area);
-    const fvd gy = FD_DIV(FD_SUB(FD_MUL(df2, ex1), FD_MUL(df1, ex2)), area);
-    const fvd cc = FD_ADD(FD_ADD(f0, FD_MUL(gx, ox)), FD_MUL(gy, oy));
-    FD_STORE_F(c, cc);
-    FD_STORE_F(gxo, gx);
-    FD_STORE_F(gyo, gy);
-}
-
-/* planes_one for the queue lanes of half h (lh: the lanes in use): the
- * planes z, q, b1, b2 as pl[plane * 3 + {c, dx, dy}][lane]. */
-static inline void front_planes_half(const fvi X[3], const fvi Y[3], const fvi V[3], fvi bx0,
-                                     fvi by0, fdm lh, int h, const rast__vbuf *vb,
-                                     float (*pl)[FRONT_V])
-{
-    const fvd inv256 = FD_SET1(1.0 / RAST__FIX_ONE), dzero = FD_SET1(0.0);
-    const fvd dhalf = FD_SET1(0.5), done = FD_SET1(1.0);
-    fvd Xd[3], Yd[3], zw[3], iw[3];
-    for (int i = 0; i < 3; i++) {
-        /* (double)X / 256: exact, as a multiplication by 2^-8 */
-        Xd[i] = FD_MUL(FD_HALF_CVT(X[i], h), inv256);
-        Yd[i] = FD_MUL(FD_HALF_CVT(Y[i], h), inv256);
-        zw[i] = FD_GATHER(dzero, vb->zw, V[i], h, lh);
-        iw[i] = FD_GATHER(done, vb->iw, V[i], h, lh);
-    }
-    const fvd ex1 = FD_SUB(Xd[1], Xd[0]), ey1 = FD_SUB(Yd[1], Yd[0]);
-    const fvd ex2 = FD_SUB(Xd[2], Xd[0]), ey2 = FD_SUB(Yd[2], Yd[0]);
-    /* |snapped area| / 65536: both products and the difference are exact
-     * (below 2^46 and 2^47 in 1/65536 units), so this is the scalar
-     * (double)area / 65536. Unused lanes: 1. */
-    const fvd area = FD_KEEP(lh, FD_SUB(FD_MUL(ex1, ey2), FD_MUL(ey1, ex2)), done);
-    const fvd ocx = FD_ADD(FD_HALF_CVT(bx0, h), dhalf);
-    const fvd ocy = FD_ADD(FD_HALF_CVT(by0, h), dhalf);
-    const fvd ox = FD_SUB(ocx, Xd[0]), oy = FD_SUB(ocy, Yd[0]);
-    /* max(a, b) = a > b ? a : b, as the scalar loop */
-    const fvd qmax = FD_MAX(iw[2], FD_MAX(iw[1], FD_MAX(iw[0], dzero)));
-    const fvd q0 = FD_DIV(iw[0], qmax), q1 = FD_DIV(iw[1], qmax), q2 = FD_DIV(iw[2], qmax);
-    const int o = FRONT_V / 2 * h;
-    front_plane(zw[0], zw[1], zw[2], ex1, ey1, ex2, ey2, ox, oy, area, pl[0] + o, pl[1] + o,
-                pl[2] + o);
-    front_plane(q0, q1, q2, ex1, ey1, ex2, ey2, ox, oy, area, pl[3] + o, pl[4] + o, pl[5] + o);
-    front_plane(dzero, q1, dzero, ex1, ey1, ex2, ey2, ox, oy, area, pl[6] + o, pl[7] + o,
-                pl[8] + o);
-    front_plane(dzero, dzero, q2, ex1, ey1, ex2, ey2, ox, oy, area, pl[9] + o, pl[10] + o,
-                pl[11] + o);
-}
-
-/* The record of queue lane l: box, edges (ec, edx, edy per edge and lane),
- * planes (pl as front_planes_half) and attribute count; the attributes
- * are the caller's. Returns the record. */
-static inline rast__tri *front_record(const squeue *q, int l, const int64_t (*ec)[FRONT_V],
-                                      const int64_t (*edx)[FRONT_V],
-                                      const int64_t (*edy)[FRONT_V],
-                                      const float (*pl)[FRONT_V], int ac, rast__tri *out)
-{
-    rast__tri *t = out + q->f[Q_SLOT][l];
-    t->x0 = q->f[Q_BX0][l];
-    t->y0 = q->f[Q_BY0][l];
-    t->x1 = q->f[Q_BX1][l];
-    t->y1 = q->f[Q_BY1][l];
-    for (int e = 0; e < 3; e++) {
-        t->e_c[e] = ec[e][l];
-        t->e_dx[e] = edx[e][l];
-        t->e_dy[e] = edy[e][l];
-    }
-    t->z.c = pl[0][l];
-    t->z.dx = pl[1][l];
-    t->z.dy = pl[2][l];
-    t->q.c = pl[3][l];
-    t->q.dx = pl[4][l];
-    t->q.dy = pl[5][l];
-    t->b1.c = pl[6][l];
-    t->b1.dx = pl[7][l];
-    t->b1.dy = pl[8][l];
-    t->b2.c = pl[9][l];
-    t->b2.dx = pl[10][l];
-    t->b2.dy = pl[11][l];
-    t->attr_count = ac;
-    t->micro = 0;
-    return t;
 }

@@ -86,13 +86,23 @@ void rast__vpass_avx2(const rast__view *v, const float *clip, int count, rast__v
                           _mm256_and_ps(_mm256_cmp_ps(w, big, _CMP_LE_OQ),
                                         _mm256_cmp_ps(nbig, w, _CMP_LE_OQ))));
         const __m256 gxw = _mm256_mul_ps(gx, w), gyw = _mm256_mul_ps(gy, w);
-        const __m256 out = _mm256_or_ps(
-            _mm256_or_ps(_mm256_or_ps(_mm256_cmp_ps(_mm256_add_ps(z, w), zero, _CMP_LT_OQ),
-                                      _mm256_cmp_ps(_mm256_sub_ps(w, z), zero, _CMP_LT_OQ)),
-                         _mm256_or_ps(_mm256_cmp_ps(_mm256_add_ps(gxw, x), zero, _CMP_LT_OQ),
-                                      _mm256_cmp_ps(_mm256_sub_ps(gxw, x), zero, _CMP_LT_OQ))),
-            _mm256_or_ps(_mm256_cmp_ps(_mm256_add_ps(gyw, y), zero, _CMP_LT_OQ),
-                         _mm256_cmp_ps(_mm256_sub_ps(gyw, y), zero, _CMP_LT_OQ)));
+        /* outcode_inl, plane by plane (the same float expressions) */
+        const __m256 ob[6] = { _mm256_cmp_ps(_mm256_add_ps(z, w), zero, _CMP_LT_OQ),
+                               _mm256_cmp_ps(_mm256_sub_ps(w, z), zero, _CMP_LT_OQ),
+                               _mm256_cmp_ps(_mm256_add_ps(gxw, x), zero, _CMP_LT_OQ),
+                               _mm256_cmp_ps(_mm256_sub_ps(gxw, x), zero, _CMP_LT_OQ),
+                               _mm256_cmp_ps(_mm256_add_ps(gyw, y), zero, _CMP_LT_OQ),
+                               _mm256_cmp_ps(_mm256_sub_ps(gyw, y), zero, _CMP_LT_OQ) };
+        const __m256 out = _mm256_or_ps(_mm256_or_ps(_mm256_or_ps(ob[0], ob[1]),
+                                                     _mm256_or_ps(ob[2], ob[3])),
+                                        _mm256_or_ps(ob[4], ob[5]));
+        /* Y of a marked vertex: its outcode | RAST__VX_NONFINITE */
+        __m256i oc = _mm256_andnot_si256(_mm256_castps_si256(fin),
+                                         _mm256_set1_epi32(RAST__VX_NONFINITE));
+#pragma GCC unroll 6
+        for (int b = 0; b < 6; b++)
+            oc = _mm256_or_si256(oc, _mm256_and_si256(_mm256_castps_si256(ob[b]),
+                                                      _mm256_set1_epi32(1 << b)));
         const __m256 wpos = _mm256_cmp_ps(w, zero, _CMP_GT_OQ);
         /* special = !fin | out | !(w > 0) */
         const __m256 ok = _mm256_andnot_ps(out, _mm256_and_ps(fin, wpos));
@@ -100,10 +110,12 @@ void rast__vpass_avx2(const rast__view *v, const float *clip, int count, rast__v
         const __m256 sx = _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(nx, half), half), fw);
         const __m256 sy = _mm256_mul_ps(_mm256_sub_ps(half, _mm256_mul_ps(ny, half)), fh);
         __m256i X = _mm256_cvtps_epi32(_mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(sx, fix), lox), hix));
-        const __m256i Y =
+        __m256i Y =
             _mm256_cvtps_epi32(_mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(sy, fix), loy), hiy));
         X = _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(mark),
                                                  _mm256_castsi256_ps(X), ok));
+        Y = _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(oc),
+                                                 _mm256_castsi256_ps(Y), ok));
         const __m256i lo = _mm256_unpacklo_epi32(X, Y), hi = _mm256_unpackhi_epi32(X, Y);
         int32_t *xy = vb->xy + 2 * (size_t)base;
         _mm256_store_si256((__m256i *)(void *)xy, _mm256_permute2x128_si256(lo, hi, 0x20));
@@ -192,7 +204,7 @@ static inline __m256i compress_idx(unsigned b)
                             _mm256_set1_epi32(7));
 }
 
-/* FD_GATHER: p[lane of half h of v] where lh, else d, by four scalar
+/* p[lane of half h of v] where lh, else d, by four scalar
  * loads and a blend instead of a masked vgatherdpd (12 per flush: the
  * front end took 0.98-0.99 of the time with these, one process,
  * alternating). Every lane of v must index a readable double: flush
@@ -206,7 +218,7 @@ static inline __m256d gather4(__m256d d, const double *p, __m256i v, int h, __m2
     return _mm256_blendv_pd(d, g, lh);
 }
 
-/* Lane macros of raster_front.inl (8 int32 lanes, 4 double lanes). */
+/* Lane macros of raster_front.inl (8 int32 lanes). */
 #define FRONT_V 8
 typedef __m256i fvi;
 #define FI_ZERO() _mm256_setzero_si256()
@@ -225,24 +237,12 @@ typedef __m256i fvm;
 #define FM_AND(a, b) _mm256_and_si256(a, b)
 #define FM_BITS(m) bits8(m)
 #define FI_NEG_BITS(v) bits8(v)
-typedef __m256d fvd;
-typedef __m256d fdm;
-#define FD_SET1(x) _mm256_set1_pd(x)
-#define FD_ADD(a, b) _mm256_add_pd(a, b)
-#define FD_SUB(a, b) _mm256_sub_pd(a, b)
-#define FD_MUL(a, b) _mm256_mul_pd(a, b)
-#define FD_DIV(a, b) _mm256_div_pd(a, b)
-#define FD_MAX(a, b) _mm256_max_pd(a, b)
-#define FD_HALF_CVT(v, h) _mm256_cvtepi32_pd(half4(v, h))
-#define FD_GATHER(d, p, v, h, lh) gather4(d, p, v, h, lh)
-#define FD_KEEP(lh, a, b) _mm256_blendv_pd(b, a, lh)
-#define FD_STORE_F(p, v) _mm_store_ps(p, _mm256_cvtpd_ps(v))
 #include "raster_front.inl"
 
 /* ---- survivor set-up ---------------------------------------------------- */
 
 /* The survivor queue lives in vectors (qf[field], lanes 0 .. qn-1; the
- * fields of raster_front.inl's squeue) and flush keeps the edges and
+ * fields Q_* of raster_front.inl) and flush keeps the edges and
  * planes in vectors; the records are written per lane from two stack
  * layouts filled by shuffles (instead of a scalar copy per field):
  *   quads  4 float or int32 vectors a, b, c, d: lane l's (a, b, c, d) as 16
@@ -702,11 +702,29 @@ int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__
                 _MM_SHUFFLE(3, 1, 2, 0));
             spec = _mm256_or_si256(spec, _mm256_cmpeq_epi32(X[k], mark));
         }
-        const unsigned special0 = bits8(spec) & L;
+        const unsigned marked = bits8(spec) & L;   /* lanes with a marked vertex */
+        unsigned special0 = marked;
+        const unsigned all3 = marked & bits8(_mm256_cmpeq_epi32(X[0], mark)) &
+                              bits8(_mm256_cmpeq_epi32(X[1], mark)) &
+                              bits8(_mm256_cmpeq_epi32(X[2], mark));
+        if (all3) {
+            /* As raster_front_avx512.c: three marked vertices, a
+             * non-finite one or an outcode bit shared by the three. */
+            const __m256i yo = _mm256_or_si256(_mm256_or_si256(Y[0], Y[1]), Y[2]);
+            const __m256i ya = _mm256_and_si256(_mm256_and_si256(Y[0], Y[1]), Y[2]);
+            const __m256i z8 = _mm256_setzero_si256();
+            const unsigned nf = all3 & ~bits8(_mm256_cmpeq_epi32(
+                _mm256_and_si256(yo, _mm256_set1_epi32(RAST__VX_NONFINITE)), z8));
+            const unsigned away = all3 & ~nf & ~bits8(_mm256_cmpeq_epi32(
+                _mm256_and_si256(ya, _mm256_set1_epi32(RAST__VX_OUTCODE)), z8));
+            ls.tris_nonfinite += __builtin_popcount(nf);
+            ls.tris_clipped_away += __builtin_popcount(away);
+            special0 &= ~(nf | away);
+        }
         /* prepare_cached_one: area sign, degenerate, culling. */
         unsigned pos, neg;
         front_area_signs(X, Y, &pos, &neg);
-        const front_class c = front_classify(m->cull, L & ~special0, pos, neg);
+        const front_class c = front_classify(m->cull, L & ~marked, pos, neg);
         /* setup_box_edges: the clamped pixel box, off screen, empty (as
          * raster_front_avx512.c). */
         const front_box b = front_box_of(X, Y, vw, vh);

@@ -87,23 +87,32 @@ void rast__vpass_avx512(const rast__view *v, const float *clip, int count, rast_
             _mm512_cmp_ps_mask(z, big, _CMP_LE_OQ) & _mm512_cmp_ps_mask(nbig, z, _CMP_LE_OQ) &
             _mm512_cmp_ps_mask(w, big, _CMP_LE_OQ) & _mm512_cmp_ps_mask(nbig, w, _CMP_LE_OQ);
         const __m512 gxw = _mm512_mul_ps(gx, w), gyw = _mm512_mul_ps(gy, w);
-        const __mmask16 out =
-            _mm512_cmp_ps_mask(_mm512_add_ps(z, w), zero, _CMP_LT_OQ) |
-            _mm512_cmp_ps_mask(_mm512_sub_ps(w, z), zero, _CMP_LT_OQ) |
-            _mm512_cmp_ps_mask(_mm512_add_ps(gxw, x), zero, _CMP_LT_OQ) |
-            _mm512_cmp_ps_mask(_mm512_sub_ps(gxw, x), zero, _CMP_LT_OQ) |
-            _mm512_cmp_ps_mask(_mm512_add_ps(gyw, y), zero, _CMP_LT_OQ) |
-            _mm512_cmp_ps_mask(_mm512_sub_ps(gyw, y), zero, _CMP_LT_OQ);
+        /* outcode_inl, plane by plane (the same float expressions) */
+        const __mmask16 o0 = _mm512_cmp_ps_mask(_mm512_add_ps(z, w), zero, _CMP_LT_OQ);
+        const __mmask16 o1 = _mm512_cmp_ps_mask(_mm512_sub_ps(w, z), zero, _CMP_LT_OQ);
+        const __mmask16 o2 = _mm512_cmp_ps_mask(_mm512_add_ps(gxw, x), zero, _CMP_LT_OQ);
+        const __mmask16 o3 = _mm512_cmp_ps_mask(_mm512_sub_ps(gxw, x), zero, _CMP_LT_OQ);
+        const __mmask16 o4 = _mm512_cmp_ps_mask(_mm512_add_ps(gyw, y), zero, _CMP_LT_OQ);
+        const __mmask16 o5 = _mm512_cmp_ps_mask(_mm512_sub_ps(gyw, y), zero, _CMP_LT_OQ);
+        const __mmask16 out = (__mmask16)(o0 | o1 | o2 | o3 | o4 | o5);
         const __mmask16 wpos = _mm512_cmp_ps_mask(w, zero, _CMP_GT_OQ);
         const __mmask16 special = (__mmask16)(~fin | out | ~wpos);
+        /* Y of a marked vertex: its outcode | RAST__VX_NONFINITE */
+        __m512i oc =
+            _mm512_maskz_mov_epi32((__mmask16)~fin, _mm512_set1_epi32(RAST__VX_NONFINITE));
+        const __mmask16 ob[6] = { o0, o1, o2, o3, o4, o5 };
+#pragma GCC unroll 6
+        for (int b = 0; b < 6; b++)
+            oc = _mm512_mask_or_epi32(oc, ob[b], oc, _mm512_set1_epi32(1 << b));
         /* snap_inl */
         const __m512 nx = _mm512_div_ps(x, w), ny = _mm512_div_ps(y, w);
         const __m512 sx = _mm512_mul_ps(_mm512_add_ps(_mm512_mul_ps(nx, half), half), fw);
         const __m512 sy = _mm512_mul_ps(_mm512_sub_ps(half, _mm512_mul_ps(ny, half)), fh);
         __m512i X = _mm512_cvtps_epi32(_mm512_min_ps(_mm512_max_ps(_mm512_mul_ps(sx, fix), lox), hix));
-        const __m512i Y =
+        __m512i Y =
             _mm512_cvtps_epi32(_mm512_min_ps(_mm512_max_ps(_mm512_mul_ps(sy, fix), loy), hiy));
         X = _mm512_mask_blend_epi32(special, X, mark);
+        Y = _mm512_mask_blend_epi32(special, Y, oc);
         int32_t *xy = vb->xy + 2 * (size_t)base;
         _mm512_store_si512((void *)xy, _mm512_permutex2var_epi32(X, ilo, Y));
         _mm512_store_si512((void *)(xy + 16), _mm512_permutex2var_epi32(X, ihi, Y));
@@ -524,15 +533,35 @@ int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast
             for (int k = 0; k < 3; k++)
                 load_xy(xyb, ivs[k], 1, &X[k], &Y[k]);
         }
-        __mmask16 spec = 0;
+        __mmask16 spec = 0, all3 = (__mmask16)L;
 #pragma GCC unroll 3
-        for (int k = 0; k < 3; k++)
-            spec |= _mm512_cmpeq_epi32_mask(X[k], mark);
-        const unsigned special0 = spec & L;
+        for (int k = 0; k < 3; k++) {
+            const __mmask16 mk = _mm512_cmpeq_epi32_mask(X[k], mark);
+            spec |= mk;
+            all3 &= mk;
+        }
+        const unsigned marked = spec & L;   /* lanes with a marked vertex */
+        unsigned special0 = marked;
+        if (all3) {
+            /* clip_snap's first steps for triangles of three marked
+             * vertices (Y: outcode | RAST__VX_NONFINITE): a non-finite
+             * vertex drops the triangle as non-finite, else an outcode
+             * bit shared by the three as clipped away; the rest (to be
+             * clipped) take the scalar path. */
+            const __m512i yo = _mm512_or_si512(_mm512_or_si512(Y[0], Y[1]), Y[2]);
+            const __m512i ya = _mm512_and_si512(_mm512_and_si512(Y[0], Y[1]), Y[2]);
+            const __mmask16 nf =
+                _mm512_mask_test_epi32_mask(all3, yo, _mm512_set1_epi32(RAST__VX_NONFINITE));
+            const __mmask16 away = (__mmask16)(
+                _mm512_mask_test_epi32_mask(all3, ya, _mm512_set1_epi32(RAST__VX_OUTCODE)) & ~nf);
+            ls.tris_nonfinite += __builtin_popcount(nf);
+            ls.tris_clipped_away += __builtin_popcount(away);
+            special0 &= ~(unsigned)(nf | away);
+        }
         /* prepare_cached_one: area sign, degenerate, culling. */
         unsigned pos, neg;
         front_area_signs(X, Y, &pos, &neg);
-        const front_class c = front_classify(m->cull, L & ~special0, pos, neg);
+        const front_class c = front_classify(m->cull, L & ~marked, pos, neg);
         /* setup_box_edges: the clamped pixel box, off screen, empty. */
         const front_box b = front_box_of(X, Y, vw, vh);
         /* A box of at most 2x2 pixels after clamping but not before (a

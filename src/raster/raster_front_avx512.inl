@@ -22,18 +22,6 @@ typedef __mmask16 fvm;
 #define FM_AND(a, b) ((__mmask16)((a) & (b)))
 #define FM_BITS(m) ((unsigned)(m))
 #define FI_NEG_BITS(v) ((unsigned)_mm512_movepi32_mask(v))
-typedef __m512d fvd;
-typedef __mmask8 fdm;
-#define FD_SET1(x) _mm512_set1_pd(x)
-#define FD_ADD(a, b) _mm512_add_pd(a, b)
-#define FD_SUB(a, b) _mm512_sub_pd(a, b)
-#define FD_MUL(a, b) _mm512_mul_pd(a, b)
-#define FD_DIV(a, b) _mm512_div_pd(a, b)
-#define FD_MAX(a, b) _mm512_max_pd(a, b)
-#define FD_HALF_CVT(v, h) _mm512_cvtepi32_pd(half_i(v, h))
-#define FD_GATHER(d, p, v, h, lh) _mm512_mask_i32gather_pd(d, lh, half_i(v, h), p, 8)
-#define FD_KEEP(lh, a, b) _mm512_mask_blend_pd(lh, b, a)
-#define FD_STORE_F(p, v) _mm256_store_ps(p, _mm512_cvtpd_ps(v))
 
 static inline __m256i half_i(__m512i v, int h)
 {

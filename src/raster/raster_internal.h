@@ -311,6 +311,11 @@ unsigned rast__front_avx512(const rast__view *v, const rast_mesh_desc *m, rast__
  * triangle per lane), in the same slots; rast__scan_list with micro set
  * writes their pixels. */
 #define RAST__VX_SPECIAL INT32_MIN
+/* Y of a marked vertex (both vertex passes): its outcode (bits 0..5,
+ * RAST__VX_OUTCODE) | RAST__VX_NONFINITE when a coordinate is not finite
+ * (then the outcode bits are unspecified). */
+#define RAST__VX_OUTCODE 0x3F
+#define RAST__VX_NONFINITE 0x40
 #define RAST__VX_CHUNK 128                        /* submitted triangles per chunk */
 #define RAST__VX_CAP (1 << 17)                    /* vertices per buffer */
 typedef struct rast__vbuf {
