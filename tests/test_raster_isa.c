@@ -480,6 +480,36 @@ static void test_context_api(void **state)
     assert_int_equal(st.tris_in, 1);
     assert_int_equal(st.pixels_written, 6);     /* below the diagonal; the
                                                    diagonal is a right edge */
+
+    /* Two jobs: the index check runs once per index set (same indices,
+     * triangle and vertex counts), but a job whose vertex count is
+     * smaller, or whose indices differ, is checked on its own: an error,
+     * nothing drawn, stats untouched. */
+    uint8_t mask2[4 * 4];
+    rast_target t2 = { 4, 4, NULL, 4, mask2, 4, NULL, 0, 0 };
+    rast_mesh_desc m2 = m;
+    const rast_target *tj[2] = { &t, &t2 };
+    const rast_mesh_desc *mj[2] = { &m, &m2 };
+    rast_target_clear(&t);
+    rast_target_clear(&t2);
+    memset(&st, 0, sizeof st);
+    assert_int_equal(rast_context_draw_jobs(c, 2, tj, mj, &st), RAST_OK);
+    assert_int_equal(st.pixels_written, 12);
+    m2.vertex_count = 2;                        /* index 2 now out of range */
+    rast_target_clear(&t);
+    rast_target_clear(&t2);
+    memset(&st, 0, sizeof st);
+    assert_int_equal(rast_context_draw_jobs(c, 2, tj, mj, &st), RAST_ERR_INDEX);
+    assert_int_equal(st.tris_in, 0);
+    m2.vertex_count = 3;
+    m2.indices = bad_idx;
+    assert_int_equal(rast_context_draw_jobs(c, 2, tj, mj, &st), RAST_ERR_INDEX);
+    m.indices = bad_idx;                        /* the shared set, bad */
+    assert_int_equal(rast_context_draw_jobs(c, 2, tj, mj, &st), RAST_ERR_INDEX);
+    assert_int_equal(st.tris_in, 0);
+    for (int i = 0; i < 16; i++)
+        assert_true(mask[i] == 0 && mask2[i] == 0);
+    m.indices = idx;
     rast_context_destroy(c);
 
     /* EGOFUSE_ISA caps both rast_draw and new contexts. */

@@ -577,8 +577,19 @@ rast_result rast_context_draw_jobs(rast_context *c, int n, const rast_target *co
     if (!c || n < 0 || n > RAST_MAX_JOBS || (n > 0 && (!t || !mesh)))
         return RAST_ERR_ARGS;
     for (int i = 0; i < n; i++) {
-        rast_result r = rast__validate(t[i], mesh[i]);
+        rast_result r = rast__validate_desc(t[i], mesh[i]);
         if (r != RAST_OK)
+            return r;
+        /* The index check once per index set: the eyes of a stereo frame
+         * draw the same indices over their own clip coordinates. */
+        int seen = 0;
+        for (int j = 0; j < i && !seen; j++)
+            seen = mesh[j]->indices == mesh[i]->indices &&
+                   mesh[j]->tri_count == mesh[i]->tri_count &&
+                   mesh[j]->vertex_count == mesh[i]->vertex_count;
+        if (seen)
+            continue;
+        if ((r = rast__validate_indices(mesh[i])) != RAST_OK)
             return r;
     }
     for (int i = 0; i < n; i++)

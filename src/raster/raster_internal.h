@@ -157,6 +157,10 @@ int rast__setup_tri(const rast__view *v, const rast__vert *const p[3],
 
 /* Checks the arguments (RAST_OK or the error of rast_draw). */
 rast_result rast__validate(const rast_target *t, const rast_mesh_desc *m);
+/* rast__validate in two parts: everything but the indices (_desc), and
+ * every index below the vertex count (_indices; m already passed _desc). */
+rast_result rast__validate_desc(const rast_target *t, const rast_mesh_desc *m);
+rast_result rast__validate_indices(const rast_mesh_desc *m);
 
 /* rast_draw on the calling thread with a given row scan (the reference
  * or a SIMD one). */

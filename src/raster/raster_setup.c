@@ -460,6 +460,12 @@ int rast__setup_tri(const rast__view *v, const rast__vert *const p[3],
 
 rast_result rast__validate(const rast_target *t, const rast_mesh_desc *m)
 {
+    const rast_result r = rast__validate_desc(t, m);
+    return r != RAST_OK ? r : rast__validate_indices(m);
+}
+
+rast_result rast__validate_desc(const rast_target *t, const rast_mesh_desc *m)
+{
     if (!t || !m || !t->mask)
         return RAST_ERR_ARGS;
     if (t->width <= 0 || t->height <= 0 || t->width > RAST_MAX_DIM ||
@@ -481,6 +487,11 @@ rast_result rast__validate(const rast_target *t, const rast_mesh_desc *m)
     if (m->cull != RAST_CULL_NONE && m->cull != RAST_CULL_BACK &&
         m->cull != RAST_CULL_FRONT)
         return RAST_ERR_ARGS;
+    return RAST_OK;
+}
+
+rast_result rast__validate_indices(const rast_mesh_desc *m)
+{
     /* Every index below the vertex count, without a branch per index
      * (4 at a time with SSE2: unsigned idx > nv - 1 as a signed compare
      * of both sides biased by 2^31). */
