@@ -296,7 +296,7 @@ static inline __attribute__((always_inline)) void plane4(__m256d f0, __m256d f1,
     r[2] = _mm256_cvtpd_ps(gy);
 }
 
-/* front_planes_half for both halves: the planes z, q, b1, b2 of the 8
+/* planes_one (raster_setup.c) per lane: the planes z, q, b1, b2 of the 8
  * queue lanes as vectors P[plane * 3 + {c, dx, dy}] (the same operations
  * per lane; the halves joined in registers: 16-byte stores reloaded as
  * 32 bytes cannot be forwarded). L: the lanes in use (the first k); with
@@ -583,7 +583,7 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
             copy16(t->mb1, mq + 32 + qa);
             copy16(t->mb2, mq + 64 + qa);
         } else {
-            /* the fields of front_record: box, edges, planes, attr_count
+            /* a full record: box, edges, planes, attr_count
              * and micro = 0 (one 8-byte store, little-endian) */
             const uint64_t acm = (uint32_t)ac;
             copy16(d, bq + qa);

@@ -206,7 +206,7 @@ static inline __attribute__((always_inline)) void plane8(__m512d f0, __m512d f1,
     r[2] = _mm512_cvtpd_ps(gy);
 }
 
-/* front_planes_half for both halves, the planes z, q, b1, b2 of the 16
+/* planes_one (raster_setup.c) per lane: the planes z, q, b1, b2 of the 16
  * queue lanes as vectors P[plane * 3 + {c, dx, dy}] (the same operations
  * per lane; written out so that nothing goes through memory). */
 static inline __attribute__((always_inline)) void planes16(const __m512i X[3],
@@ -437,7 +437,7 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
             copy16(t->mb1, mq + 64 + qa);
             copy16(t->mb2, mq + 128 + qa);
         } else {
-            /* the fields of front_record: box, edges, planes, attr_count
+            /* a full record: box, edges, planes, attr_count
              * and micro = 0 (one 8-byte store, little-endian) */
             const uint64_t acm = (uint32_t)ac;
             copy16(d, bq + qa);
