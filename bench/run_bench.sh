@@ -10,7 +10,8 @@
 # bench.csv), then the per-stage benchmarks, then the charts (gnuplot,
 # bench/plot/*.gp) and a summary with the ratios, bench/out/summary.md.
 # BENCH_FRAME_ARGS (e.g. "--quick", "--seconds 20"), LLVMPIPE_FRAMES and
-# STAGE_RUNS (runs of the per-stage benchmarks) change the counts;
+# STAGE_RUNS (runs of the per-stage benchmarks) and RASTER_RUNS (of
+# bench_raster and llvmpipe_raster) change the counts;
 # SAMPLES the sample folder, OUT the output folder. REPORT_ONLY=1 skips
 # the benchmarks and redraws the charts and the summary from the CSVs. The defaults keep the
 # whole of `make bench` to about 3-4 minutes on the 2-core machine.
@@ -19,6 +20,9 @@ OUT=${OUT:-bench/out}
 SAMPLES=${SAMPLES:-$BUILD/samples}
 LLVMPIPE_FRAMES=${LLVMPIPE_FRAMES:-120}
 STAGE_RUNS=${STAGE_RUNS:-15}
+# The raster draws take well under a millisecond: more runs for a stable
+# median (bench_raster and llvmpipe_raster).
+RASTER_RUNS=${RASTER_RUNS:-101}
 mkdir -p "$OUT"
 T0=$(date +%s)
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//'), $(nproc) cores"
@@ -65,14 +69,16 @@ for b in "$BUILD"/bench/bench_*; do
         bench_kin) # its own figures and CSVs into bench/out; no --csv, no --runs
             "$b" || echo "($name exited with status $?)" ;;
         *)
-            "$b" --runs "$STAGE_RUNS" || echo "($name exited with status $?)"
-            "$b" --csv --runs "$STAGE_RUNS" > "$OUT/$name.csv" 2>/dev/null || true ;;
+            runs=$STAGE_RUNS
+            [ "$name" = bench_raster ] && runs=$RASTER_RUNS
+            "$b" --runs "$runs" || echo "($name exited with status $?)"
+            "$b" --csv --runs "$runs" > "$OUT/$name.csv" 2>/dev/null || true ;;
     esac
     echo
 done
 if [ -x "$BUILD/bench/llvmpipe_raster" ]; then
     echo "==== llvmpipe_raster (coverage agreement and speed against Mesa llvmpipe)"
-    "$BUILD/bench/llvmpipe_raster" --runs "$STAGE_RUNS"
+    "$BUILD/bench/llvmpipe_raster" --runs "$RASTER_RUNS"
     case $? in
         0) ;;
         3) echo "(llvmpipe is not available here)" ;;
