@@ -187,6 +187,8 @@ static inline void copy16(void *d, const void *s)
     _mm_storeu_si128((__m128i *)d, _mm_load_si128((const __m128i *)s));
 }
 
+#include "raster_front_rec.inl"
+
 /* front_plane with the results as vectors: c, dx, dy of 8 lanes. */
 static inline __attribute__((always_inline)) void plane8(__m512d f0, __m512d f1, __m512d f2,
                                                          __m512d ex1, __m512d ey1,
@@ -425,32 +427,9 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
     const __mmask8 AM = (__mmask8)((1u << ac) - 1u);
     for (int l = 0; l < k; l++) {
         rast__tri *t = out + qs[Q_SLOT][l];
-        char *d = (char *)(void *)t;
-        const int qa = QUAD_AT(l), pa = PAIR_AT(l);
-        if ((mic >> l) & 1u) {
-            t->micro = RAST__MICRO | cov[l];
-            if (!cov[l])
-                continue;
-            t->attr_count = ac;
-            copy16(d, bq + qa);
-            copy16(t->mz, mq + qa);
-            copy16(t->mb1, mq + 64 + qa);
-            copy16(t->mb2, mq + 128 + qa);
-        } else {
-            /* a full record: box, edges, planes, attr_count
-             * and micro = 0 (one 8-byte store, little-endian) */
-            const uint64_t acm = (uint32_t)ac;
-            copy16(d, bq + qa);
-            copy16(d + 16, eq[0] + pa);
-            copy16(d + 32, eq[1] + pa);
-            copy16(d + 48, eq[2] + pa);
-            copy16(d + 64, eq[3] + pa);
-            memcpy(d + 80, &e8[l], 8);
-            copy16(d + 88, pq + qa);
-            copy16(d + 104, pq + 64 + qa);
-            copy16(d + 120, pq + 128 + qa);
-            memcpy(&t->attr_count, &acm, 8);
-        }
+        if (!front_write_record(t, l, (int)((mic >> l) & 1u), (unsigned)cov[l], ac, bq, mq, pq,
+                                (const int64_t (*)[2 * FRONT_V])eq, e8))
+            continue;
         /* setup_attrs: a0 = attribute of vertex 0, d1 = a1 - a0,
          * d2 = a2 - a0, per record by masked loads (no byte past the
          * vertex's ac floats is read) and masked stores (no byte past
@@ -468,18 +447,6 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
         }
     }
 }
-
-/* The record layout the 16-byte copies of flush assume. */
-_Static_assert(offsetof(rast__tri, x0) == 0 && offsetof(rast__tri, y0) == 4 &&
-                   offsetof(rast__tri, x1) == 8 && offsetof(rast__tri, y1) == 12 &&
-                   offsetof(rast__tri, e_c) == 16 && offsetof(rast__tri, e_dx) == 40 &&
-                   offsetof(rast__tri, e_dy) == 64 && offsetof(rast__tri, z) == 88 &&
-                   offsetof(rast__tri, q) == 100 && offsetof(rast__tri, b1) == 112 &&
-                   offsetof(rast__tri, b2) == 124 && sizeof(rast__plane) == 12 &&
-                   offsetof(rast__tri, micro) == offsetof(rast__tri, attr_count) + 4 &&
-                   offsetof(rast__tri, mb1) == offsetof(rast__tri, mz) + 16 &&
-                   offsetof(rast__tri, mb2) == offsetof(rast__tri, mz) + 32,
-               "record layout of flush's copies");
 
 _Static_assert(RAST__FRONT_GROUP == 16, "one group per 16-lane vector");
 _Static_assert(RAST_MAX_ATTRS <= 8, "attributes by 8-lane masked loads and stores");
