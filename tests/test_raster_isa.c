@@ -1065,6 +1065,22 @@ static void make_mesh(int n, rcase *k)
  * against rast__prepare_range with the scalar set-up (memcmp of the
  * records, counters). Adds the reference records and counters to *crc
  * and counts the set-up triangles and those of special vertices. */
+/* m through the vector front end of isa in random chunks of 1..300
+ * submitted triangles (a quarter of them 1..16); returns the records. */
+static int frontv_chunks(const rast__setup_isa *isa, const rast__view *view,
+                         const rast_mesh_desc *m, rast__vbuf *vb, tu_rng *r, rast__tri *out,
+                         rast_stats *st, int micro)
+{
+    int n = 0;
+    for (int ti = 0; ti < m->tri_count;) {
+        const int len = tu_int(r, 4) == 0 ? 1 + tu_int(r, 16) : 1 + tu_int(r, 300);
+        const int te = m->tri_count - ti > len ? ti + len : m->tri_count;
+        n += isa->frontv(view, m, vb, ti, te, out + n, st, micro);
+        ti = te;
+    }
+    return n;
+}
+
 static long frontv_micro, frontv_border;   /* micro records seen by frontv_case, on a border */
 static void frontv_case(const rcase *k, const rast__setup_isa *isa, tu_rng *r, uint32_t *crc,
                         long *made, long *clipped, const char *what)
@@ -1102,13 +1118,7 @@ static void frontv_case(const rcase *k, const rast__setup_isa *isa, tu_rng *r, u
     rast__vcache_reset(&vc);
     const int na = rast__prepare_range(&view, m, 0, m->tri_count, &vc, a, &sa,
                                        &rast__setup_isa_ref);
-    int nb = 0;
-    for (int ti = 0; ti < m->tri_count;) {
-        const int len = tu_int(r, 4) == 0 ? 1 + tu_int(r, 16) : 1 + tu_int(r, 300);
-        const int te = m->tri_count - ti > len ? ti + len : m->tri_count;
-        nb += isa->frontv(&view, m, vb, ti, te, b + nb, &sb, 0);
-        ti = te;
-    }
+    const int nb = frontv_chunks(isa, &view, m, vb, r, b, &sb, 0);
     if (na != nb || memcmp(&sa, &sb, sizeof sa))
         fail_msg("%s: %d vs %d records; drawn %ld vs %ld, culled %ld vs %ld, degenerate "
                  "%ld vs %ld, clipped %ld vs %ld, non-finite %ld vs %ld", what, nb, na,
@@ -1127,13 +1137,7 @@ static void frontv_case(const rcase *k, const rast__setup_isa *isa, tu_rng *r, u
     rast__tri *c = calloc(cap, sizeof *c);
     rast_stats sc;
     memset(&sc, 0, sizeof sc);
-    int nc = 0;
-    for (int ti = 0; ti < m->tri_count;) {
-        const int len = tu_int(r, 4) == 0 ? 1 + tu_int(r, 16) : 1 + tu_int(r, 300);
-        const int te = m->tri_count - ti > len ? ti + len : m->tri_count;
-        nc += isa->frontv(&view, m, vb, ti, te, c + nc, &sc, 1);
-        ti = te;
-    }
+    const int nc = frontv_chunks(isa, &view, m, vb, r, c, &sc, 1);
     if (nc != na || memcmp(&sa, &sc, sizeof sa))
         fail_msg("%s: with micro records %d vs %d records, or other counters", what, nc, na);
     for (int i = 0; i < nc; i++) {

@@ -25,6 +25,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
+#include "support/raster_planes.h"
 
 #define NCASES 6000
 /* Recorded: reference output of all cases. Since the ninth round of
@@ -33,50 +34,6 @@
  * are no longer scanned here and the CRC changed (0x7AE0501F before); the
  * output of every remaining case is unchanged. */
 #define SMALL_CRC 0xE9BDBF99u
-
-typedef struct planes {
-    rast_target t;
-    float *depth, *attr;
-    uint8_t *mask;
-    size_t nd, nm, na;
-} planes;
-
-static void planes_alloc(planes *p, const rast_target *shape)
-{
-    p->t = *shape;
-    p->nd = shape->depth ? (size_t)shape->depth_stride * (size_t)shape->height : 0;
-    p->nm = (size_t)shape->mask_stride * (size_t)shape->height;
-    p->na = shape->attr ? (size_t)shape->attr_stride * (size_t)shape->height : 0;
-    p->depth = p->nd ? malloc(p->nd * sizeof(float)) : NULL;
-    p->mask = malloc(p->nm);
-    p->attr = p->na ? malloc(p->na * sizeof(float)) : NULL;
-    p->t.depth = p->depth;
-    p->t.mask = p->mask;
-    p->t.attr = p->attr;
-}
-
-static void planes_copy(planes *dst, const planes *src)
-{
-    if (src->nd)
-        memcpy(dst->depth, src->depth, src->nd * sizeof(float));
-    memcpy(dst->mask, src->mask, src->nm);
-    if (src->na)
-        memcpy(dst->attr, src->attr, src->na * sizeof(float));
-}
-
-static int planes_equal(const planes *a, const planes *b)
-{
-    return (!a->nd || !memcmp(a->depth, b->depth, a->nd * sizeof(float))) &&
-           !memcmp(a->mask, b->mask, a->nm) &&
-           (!a->na || !memcmp(a->attr, b->attr, a->na * sizeof(float)));
-}
-
-static void planes_free(planes *p)
-{
-    free(p->depth);
-    free(p->mask);
-    free(p->attr);
-}
 
 /* A snapped coordinate near pixel centre c (in pixels): on the centre, half
  * a pixel off, or random within +-1.5 px. */

@@ -29,56 +29,12 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
+#include "support/raster_planes.h"
 
 #define NCASES 2500
 #define PERIOD 1021
 /* Recorded: the reference output of all cases. */
 #define SPAN_CRC 0x0B137BDBu
-
-typedef struct planes {
-    rast_target t;
-    float *depth, *attr;
-    uint8_t *mask;
-    size_t nd, nm, na;
-} planes;
-
-static void planes_alloc(planes *p, const rast_target *shape)
-{
-    p->t = *shape;
-    p->nd = shape->depth ? (size_t)shape->depth_stride * (size_t)shape->height : 0;
-    p->nm = (size_t)shape->mask_stride * (size_t)shape->height;
-    p->na = shape->attr ? (size_t)shape->attr_stride * (size_t)shape->height : 0;
-    p->depth = p->nd ? malloc(p->nd * sizeof(float)) : NULL;
-    p->mask = malloc(p->nm);
-    p->attr = p->na ? malloc(p->na * sizeof(float)) : NULL;
-    assert_true(p->mask && (!p->nd || p->depth) && (!p->na || p->attr));
-    p->t.depth = p->depth;
-    p->t.mask = p->mask;
-    p->t.attr = p->attr;
-}
-
-static void planes_copy(planes *dst, const planes *src)
-{
-    if (src->nd)
-        memcpy(dst->depth, src->depth, src->nd * sizeof(float));
-    memcpy(dst->mask, src->mask, src->nm);
-    if (src->na)
-        memcpy(dst->attr, src->attr, src->na * sizeof(float));
-}
-
-static int planes_equal(const planes *a, const planes *b)
-{
-    return (!a->nd || !memcmp(a->depth, b->depth, a->nd * sizeof(float))) &&
-           !memcmp(a->mask, b->mask, a->nm) &&
-           (!a->na || !memcmp(a->attr, b->attr, a->na * sizeof(float)));
-}
-
-static void planes_free(planes *p)
-{
-    free(p->depth);
-    free(p->mask);
-    free(p->attr);
-}
 
 /* A snapped coordinate (1/256 px) at pixel position c (in pixels, float):
  * on the centre of the pixel, half a pixel off, or c itself snapped. */
