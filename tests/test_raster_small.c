@@ -57,24 +57,9 @@ typedef struct shapes {
 static int make_case(int n, planes *ref, rast__tri *tri, int *ya, int *yb)
 {
     tu_rng r = { 0x5A11000ull + (uint64_t)n * 0x9E3779B97F4A7C15ull };
-    rast_target shape;
-    memset(&shape, 0, sizeof shape);
-    shape.width = 1 + tu_int(&r, 40);
-    shape.height = 1 + tu_int(&r, 30);
-    const int pad = tu_int(&r, 3) ? 1 + tu_int(&r, 9) : 0;
-    static const int nas[3] = { 0, 3, 5 };
-    const int na = nas[tu_int(&r, 3)];
-    shape.mask_stride = shape.width + pad;
-    if (tu_int(&r, 4)) {
-        shape.depth_stride = shape.width + tu_int(&r, 5);
-        shape.depth = (float *)1;   /* allocated by planes_alloc */
-    }
-    shape.attr_count = na;
-    if (na && tu_int(&r, 5)) {
-        shape.attr_stride = shape.width * na + tu_int(&r, 7);
-        shape.attr = (float *)1;
-    }
-    planes_alloc(ref, &shape);
+    planes_draw(ref, &r, 1, 40, 30, 9, 5, 7);
+    const rast_target shape = ref->t;
+    const int na = shape.attr_count;
     for (size_t i = 0; i < ref->nd; i++)
         ref->depth[i] = tu_int(&r, 4) ? tu_range(&r, 0.0f, 1.0f) : 1.0f;
     for (size_t i = 0; i < ref->nm; i++)

@@ -56,24 +56,9 @@ enum { KIND_SLIVER, KIND_FAT, KIND_GUARD };
 static int make_case(int n, planes *ref, rast__tri *tri, int *ya, int *yb)
 {
     tu_rng r = { 0x59A40000ull + (uint64_t)n * 0x9E3779B97F4A7C15ull };
-    rast_target shape;
-    memset(&shape, 0, sizeof shape);
-    shape.width = 24 + tu_int(&r, 277);
-    shape.height = 1 + tu_int(&r, 320);
-    const int pad = tu_int(&r, 3) ? 1 + tu_int(&r, 19) : 0;
-    static const int nas[3] = { 0, 3, 5 };
-    const int na = nas[tu_int(&r, 3)];
-    shape.mask_stride = shape.width + pad;
-    if (tu_int(&r, 4)) {
-        shape.depth_stride = shape.width + tu_int(&r, 20);
-        shape.depth = (float *)1;   /* allocated by planes_alloc */
-    }
-    shape.attr_count = na;
-    if (na && tu_int(&r, 5)) {
-        shape.attr_stride = shape.width * na + tu_int(&r, 23);
-        shape.attr = (float *)1;
-    }
-    planes_alloc(ref, &shape);
+    planes_draw(ref, &r, 24, 277, 320, 19, 20, 23);
+    const rast_target shape = ref->t;
+    const int na = shape.attr_count;
     /* Random contents (cheap: tables of a prime period, at a random
      * phase; depth 1.0 for a quarter of the pixels). */
     float dtab[PERIOD], atab[PERIOD];

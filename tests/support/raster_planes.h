@@ -33,6 +33,35 @@ static inline void planes_alloc(planes *p, const rast_target *shape)
     p->t.attr = p->attr;
 }
 
+/* A random target shape drawn from r and its planes (in this order:
+ * width w0 + [0, wn), height 1 + [0, hn), mask padding (none in a third of
+ * the cases, else 1 + [0, padn)), 0, 3 or 5 attributes, a depth plane in
+ * three cases of four with padding [0, dpadn), an attribute plane in four
+ * of five when there are attributes, padding [0, apadn)); the planes are
+ * not initialised. */
+static inline void planes_draw(planes *p, tu_rng *r, int w0, int wn, int hn, int padn,
+                               int dpadn, int apadn)
+{
+    rast_target shape;
+    memset(&shape, 0, sizeof shape);
+    shape.width = w0 + tu_int(r, wn);
+    shape.height = 1 + tu_int(r, hn);
+    const int pad = tu_int(r, 3) ? 1 + tu_int(r, padn) : 0;
+    static const int nas[3] = { 0, 3, 5 };
+    const int na = nas[tu_int(r, 3)];
+    shape.mask_stride = shape.width + pad;
+    if (tu_int(r, 4)) {
+        shape.depth_stride = shape.width + tu_int(r, dpadn);
+        shape.depth = (float *)1;   /* allocated by planes_alloc */
+    }
+    shape.attr_count = na;
+    if (na && tu_int(r, 5)) {
+        shape.attr_stride = shape.width * na + tu_int(r, apadn);
+        shape.attr = (float *)1;
+    }
+    planes_alloc(p, &shape);
+}
+
 static inline void planes_copy(planes *dst, const planes *src)
 {
     if (src->nd)
