@@ -172,6 +172,21 @@ static inline void attr3_store_p(float *p, unsigned bits, const attr3_state *st,
     }
 }
 
+/* As attr3_store_p for a vector of `lanes` pixels (bits within them) of
+ * a wider row: the output vectors those lanes reach, whatever the state
+ * was prepared for. */
+static inline void attr3_store_pl(float *p, unsigned bits, int lanes, const attr3_state *st,
+                                  __m512 b1, __m512 b2)
+{
+    const __m512i pb = _mm512_set1_epi32((int)bits);
+    attr3_out(p, pb, st, 0, b1, b2);
+    if (lanes > 5) {
+        attr3_out(p, pb, st, 1, b1, b2);
+        if (lanes > 10)
+            attr3_out(p, pb, st, 2, b1, b2);
+    }
+}
+
 /* a / b in the first `lanes` lanes (the others 0 or a / b, never stored):
  * one 256-bit division when they fit in 8 (half the divider's time on
  * Zen 4). */
@@ -186,6 +201,7 @@ static inline __m512 div_lanes(__m512 a, __m512 b, int lanes)
 #define ATTR3_STATE attr3_state
 #define ATTR3_PREP(st, tri, lanes) attr3_prep(st, tri, lanes)
 #define ATTR3_STORE_P(p, bits, st, b1, b2) attr3_store_p(p, bits, st, b1, b2)
+#define ATTR3_STORE_PL(p, bits, lanes, st, b1, b2) attr3_store_pl(p, bits, lanes, st, b1, b2)
 
 #include "raster_simd.inl"
 

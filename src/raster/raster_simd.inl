@@ -38,6 +38,9 @@
  *                          per-triangle state *st (rows at most `lanes`
  *                          pixels), STORE_P writes the pixels in bits of
  *                          p[3*lanes] as (a0 + b1*d1) + b2*d2 per float.
+ *   ATTR3_STORE_PL(p, bits, lanes, st, b1, b2)  as ATTR3_STORE_P for a run
+ *                          vector of `lanes` pixels of a wider row (bits
+ *                          within them; st prepared with SIMD_V lanes).
  *   VF_DIV_LANES(a, b, lanes)  a / b in the first `lanes` lanes (the
  *                          others: any value; nothing derived from them is
  *                          stored).
@@ -287,6 +290,163 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
     }
 }
 
+/* Rows wider than one vector, int32 coverage (the caller checked the
+ * bound over rows ys..ye x [0, nvec*SIMD_V), see COVERAGE): c, sx, sy are
+ * the reduced edge values at (x0, ys) and their steps. The covered pixels
+ * of a row are one run: each E'_k is affine in i, so E'_k >= 0 holds on a
+ * half-line of i and the three intersect in an interval (the box one too).
+ * The row's coverage vectors (aligned at x0) are tested first, from the
+ * left: leading empty vectors are skipped and the run ends in the first
+ * vector whose last lane is not covered. Then the float work runs on
+ * vectors starting at the run's first pixel (lane l = pixel xf + l,
+ * fi = (float)(xf + l): the same ops per pixel), so a run of at most
+ * SIMD_V pixels takes one vector however it straddles the aligned ones
+ * (the slivers of capsule sides: runs of 4-10 pixels in boxes up to
+ * hundreds wide). Loads and stores are masked to the run; no other pixel
+ * is accessed. As in simd_scan_vec1, the attribute set-up waits for the
+ * first pixel written and a row's attribute bases for its first vector
+ * that writes (hidden rows and triangles never pay for them); a run
+ * vector of at most half the lanes divides on half a vector where the
+ * lane macros allow it (VF_DIV_LANES). */
+static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, int ye,
+                           int nx, int nvec, int na, const int64_t *c, const int32_t *sx,
+                           const int32_t *sy)
+{
+    const vi lanev = VI_LANES();
+    const unsigned lastvalid = SIMD_FULL >> (nvec * SIMD_V - nx);
+    const vi st0 = VI_SET1((int32_t)(SIMD_V * sx[0]));
+    const vi st1 = VI_SET1((int32_t)(SIMD_V * sx[1]));
+    const vi st2 = VI_SET1((int32_t)(SIMD_V * sx[2]));
+    const vi sy0 = VI_SET1(sy[0]), sy1 = VI_SET1(sy[1]), sy2 = VI_SET1(sy[2]);
+    vi r0 = VI_ADD(VI_SET1((int32_t)c[0]), VI_LANE_MUL(lanev, sx[0]));
+    vi r1 = VI_ADD(VI_SET1((int32_t)c[1]), VI_LANE_MUL(lanev, sx[1]));
+    vi r2 = VI_ADD(VI_SET1((int32_t)c[2]), VI_LANE_MUL(lanev, sx[2]));
+    const vf zdx = VF_SET1(tri->z.dx);
+    long written = 0;
+    uint8_t *mrow = t->mask + (size_t)ys * (size_t)t->mask_stride + tri->x0;
+    float *drow = t->depth ? t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0
+                           : NULL;
+    float *arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride +
+                           (size_t)tri->x0 * (size_t)na
+                     : NULL;
+    /* Attribute state, set up at the first pixel written (aset). */
+    int aset = 0;
+    vf qdx = VF_SET1(0.0f), b1dx = qdx, b2dx = qdx;
+    vf av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
+#if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
+    ATTR3_STATE a3;
+#endif
+    for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
+             drow = drow ? drow + t->depth_stride : NULL,
+             arow = arow ? arow + t->attr_stride : NULL) {
+        vi e0 = r0, e1 = r1, e2 = r2;
+        r0 = VI_ADD(r0, sy0);
+        r1 = VI_ADD(r1, sy1);
+        r2 = VI_ADD(r2, sy2);
+        int v = 0;
+        unsigned cov;
+        for (;;) {
+            cov = ~VI_NEG_BITS(VI_OR(VI_OR(e0, e1), e2)) &
+                  (v == nvec - 1 ? lastvalid : SIMD_FULL);
+            if (cov || v == nvec - 1)
+                break;
+            v++;
+            e0 = VI_ADD(e0, st0);
+            e1 = VI_ADD(e1, st1);
+            e2 = VI_ADD(e2, st2);
+        }
+        if (!cov)
+            continue;
+        const int xf = v * SIMD_V + __builtin_ctz(cov);
+        while ((cov >> (SIMD_V - 1)) && v < nvec - 1) {
+            e0 = VI_ADD(e0, st0);
+            e1 = VI_ADD(e1, st1);
+            e2 = VI_ADD(e2, st2);
+            const unsigned nc = ~VI_NEG_BITS(VI_OR(VI_OR(e0, e1), e2)) &
+                                (v + 1 == nvec - 1 ? lastvalid : SIMD_FULL);
+            if (!nc)
+                break;
+            cov = nc;
+            v++;
+        }
+        const int xe = v * SIMD_V + 32 - __builtin_clz(cov);   /* last + 1 */
+
+        /* Row bases: the reference's scalar expressions (the attribute
+         * ones at the row's first vector that writes). */
+        const float fj = (float)(y - tri->y0);
+        const vf zrv = VF_SET1(tri->z.c + tri->z.dy * fj);
+        vf qrv = zrv, b1rv = zrv, b2rv = zrv;
+        int rowset = 0;
+        for (int i0 = xf; i0 < xe; i0 += SIMD_V) {
+            const int rem = xe - i0;
+            const int lanes = rem < SIMD_V ? rem : SIMD_V;
+            const unsigned run = rem >= SIMD_V ? SIMD_FULL : (1u << rem) - 1u;
+            const vf fi = VF_CVT(VI_ADD(VI_SET1(i0), lanev));
+            vf z = VF_ADD(zrv, VF_MUL(zdx, fi));
+            z = VF_MAX(VF_SET1(0.0f), z);
+            z = VF_MIN(VF_SET1(1.0f), z);
+            unsigned pass = run;
+            if (drow) {
+                const vf d = VF_LOAD_M(drow + i0, run, run == SIMD_FULL);
+                pass = run & VF_LT_BITS(z, d);
+                if (!pass)
+                    continue;
+                VF_STORE_M(drow + i0, pass, pass == SIMD_FULL, z);
+            }
+            MASK_STORE_M(mrow + i0, pass, pass == SIMD_FULL);
+            written += simd_popcount(pass);
+            if (!na)
+                continue;
+            if (!aset) {
+                aset = 1;
+                qdx = VF_SET1(tri->q.dx);
+                b1dx = VF_SET1(tri->b1.dx);
+                b2dx = VF_SET1(tri->b2.dx);
+#if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
+                if (na == 3)
+                    ATTR3_PREP(&a3, tri, SIMD_V);
+                else
+#endif
+                    for (int k = 0; k < na; k++) {
+                        av0[k] = VF_SET1(tri->a0[k]);
+                        av1[k] = VF_SET1(tri->d1[k]);
+                        av2[k] = VF_SET1(tri->d2[k]);
+                    }
+            }
+            if (!rowset) {
+                rowset = 1;
+                qrv = VF_SET1(tri->q.c + tri->q.dy * fj);
+                b1rv = VF_SET1(tri->b1.c + tri->b1.dy * fj);
+                b2rv = VF_SET1(tri->b2.c + tri->b2.dy * fj);
+            }
+#ifdef VF_DIV_LANES
+            const vf r = VF_DIV_LANES(VF_SET1(1.0f), VF_ADD(qrv, VF_MUL(qdx, fi)), lanes);
+#else
+            const vf r = VF_DIV(VF_SET1(1.0f), VF_ADD(qrv, VF_MUL(qdx, fi)));
+#endif
+            const vf b1 = VF_MUL(VF_ADD(b1rv, VF_MUL(b1dx, fi)), r);
+            const vf b2 = VF_MUL(VF_ADD(b2rv, VF_MUL(b2dx, fi)), r);
+            float *dst = arow + (size_t)i0 * (size_t)na;
+#if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
+            if (na == 3) {
+                ATTR3_STORE_PL(dst, pass, lanes, &a3, b1, b2);
+                continue;
+            }
+#elif defined(ATTR3_STORE_FULL)
+            if (na == 3 && pass == SIMD_FULL) {
+                ATTR3_STORE_FULL(dst,
+                    VF_ADD(VF_ADD(av0[0], VF_MUL(b1, av1[0])), VF_MUL(b2, av2[0])),
+                    VF_ADD(VF_ADD(av0[1], VF_MUL(b1, av1[1])), VF_MUL(b2, av2[1])),
+                    VF_ADD(VF_ADD(av0[2], VF_MUL(b1, av1[2])), VF_MUL(b2, av2[2])));
+                continue;
+            }
+#endif
+            simd_attr_store(dst, na, pass, lanes, b1, b2, av0, av1, av2);
+        }
+    }
+    return written;
+}
+
 long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
 {
     const int ys = ya > tri->y0 ? ya : tri->y0;
@@ -340,6 +500,8 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
         fits &= simd_abs64(c[k]) + rows * simd_abs64(sy[k]) + cols * simd_abs64(sx[k]) <=
                 SIMD_LIM30;
     }
+    if (fits)
+        return simd_scan_wide(t, tri, ys, ye, nx, nvec, na, c, sx, sy);
     const vi lanev = VI_LANES();
     const vi off0 = VI_LANE_MUL(lanev, sx[0]), off1 = VI_LANE_MUL(lanev, sx[1]),
              off2 = VI_LANE_MUL(lanev, sx[2]);
@@ -362,106 +524,6 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
                      : NULL;
     const vf qdx = VF_SET1(tri->q.dx);
     const vf b1dx = VF_SET1(tri->b1.dx), b2dx = VF_SET1(tri->b2.dx);
-    if (fits) {
-        /* Several vectors per row, int32 coverage. The covered pixels of a
-         * row are one run: each E'_k is affine in i, so E'_k >= 0 holds on
-         * a half-line of i and the three intersect in an interval (the box
-         * one too). The row's coverage vectors (aligned at x0) are tested
-         * first, from the left: leading empty vectors are skipped and the
-         * run ends in the first vector whose last lane is not covered.
-         * Then the float work runs on vectors starting at the run's first
-         * pixel (lane l = pixel xf + l, fi = (float)(xf + l): the same ops
-         * per pixel), so a run of at most SIMD_V pixels takes one vector
-         * however it straddles the aligned ones (the slivers of capsule
-         * sides: runs of 4-10 pixels in boxes up to hundreds wide). Loads
-         * and stores are masked to the run; no other pixel is accessed. */
-        const unsigned lastvalid = SIMD_FULL >> (nvec * SIMD_V - nx);
-        const vi st0 = VI_SET1((int32_t)(SIMD_V * sx[0]));
-        const vi st1 = VI_SET1((int32_t)(SIMD_V * sx[1]));
-        const vi st2 = VI_SET1((int32_t)(SIMD_V * sx[2]));
-        const vi sy0 = VI_SET1(sy[0]), sy1 = VI_SET1(sy[1]), sy2 = VI_SET1(sy[2]);
-        vi r0 = VI_ADD(VI_SET1((int32_t)c[0]), off0);
-        vi r1 = VI_ADD(VI_SET1((int32_t)c[1]), off1);
-        vi r2 = VI_ADD(VI_SET1((int32_t)c[2]), off2);
-        for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
-                 drow = drow ? drow + t->depth_stride : NULL,
-                 arow = arow ? arow + t->attr_stride : NULL) {
-            vi e0 = r0, e1 = r1, e2 = r2;
-            r0 = VI_ADD(r0, sy0);
-            r1 = VI_ADD(r1, sy1);
-            r2 = VI_ADD(r2, sy2);
-            int v = 0;
-            unsigned cov;
-            for (;;) {
-                cov = ~VI_NEG_BITS(VI_OR(VI_OR(e0, e1), e2)) &
-                      (v == nvec - 1 ? lastvalid : SIMD_FULL);
-                if (cov || v == nvec - 1)
-                    break;
-                v++;
-                e0 = VI_ADD(e0, st0);
-                e1 = VI_ADD(e1, st1);
-                e2 = VI_ADD(e2, st2);
-            }
-            if (!cov)
-                continue;
-            const int xf = v * SIMD_V + __builtin_ctz(cov);
-            while ((cov >> (SIMD_V - 1)) && v < nvec - 1) {
-                e0 = VI_ADD(e0, st0);
-                e1 = VI_ADD(e1, st1);
-                e2 = VI_ADD(e2, st2);
-                const unsigned nc = ~VI_NEG_BITS(VI_OR(VI_OR(e0, e1), e2)) &
-                                    (v + 1 == nvec - 1 ? lastvalid : SIMD_FULL);
-                if (!nc)
-                    break;
-                cov = nc;
-                v++;
-            }
-            const int xe = v * SIMD_V + 32 - __builtin_clz(cov);   /* last + 1 */
-
-            /* Row bases: the reference's scalar expressions. */
-            const float fj = (float)(y - tri->y0);
-            const vf zrv = VF_SET1(tri->z.c + tri->z.dy * fj);
-            const float qr = tri->q.c + tri->q.dy * fj;
-            const float b1r = tri->b1.c + tri->b1.dy * fj;
-            const float b2r = tri->b2.c + tri->b2.dy * fj;
-            for (int i0 = xf; i0 < xe; i0 += SIMD_V) {
-                const int rem = xe - i0;
-                const unsigned run = rem >= SIMD_V ? SIMD_FULL : (1u << rem) - 1u;
-                const vf fi = VF_CVT(VI_ADD(VI_SET1(i0), lanev));
-                vf z = VF_ADD(zrv, VF_MUL(zdx, fi));
-                z = VF_MAX(zero, z);
-                z = VF_MIN(one, z);
-                unsigned pass = run;
-                if (drow) {
-                    const vf d = VF_LOAD_M(drow + i0, run, run == SIMD_FULL);
-                    pass = run & VF_LT_BITS(z, d);
-                    if (!pass)
-                        continue;
-                    VF_STORE_M(drow + i0, pass, pass == SIMD_FULL, z);
-                }
-                MASK_STORE_M(mrow + i0, pass, pass == SIMD_FULL);
-                written += simd_popcount(pass);
-                if (!na)
-                    continue;
-                const vf r = VF_DIV(one, VF_ADD(VF_SET1(qr), VF_MUL(qdx, fi)));
-                const vf b1 = VF_MUL(VF_ADD(VF_SET1(b1r), VF_MUL(b1dx, fi)), r);
-                const vf b2 = VF_MUL(VF_ADD(VF_SET1(b2r), VF_MUL(b2dx, fi)), r);
-                float *dst = arow + (size_t)i0 * (size_t)na;
-#ifdef ATTR3_STORE_FULL
-                if (na == 3 && pass == SIMD_FULL) {
-                    ATTR3_STORE_FULL(dst,
-                        VF_ADD(VF_ADD(av0[0], VF_MUL(b1, av1[0])), VF_MUL(b2, av2[0])),
-                        VF_ADD(VF_ADD(av0[1], VF_MUL(b1, av1[1])), VF_MUL(b2, av2[1])),
-                        VF_ADD(VF_ADD(av0[2], VF_MUL(b1, av1[2])), VF_MUL(b2, av2[2])));
-                    continue;
-                }
-#endif
-                simd_attr_store(dst, na, pass, rem < SIMD_V ? rem : SIMD_V, b1, b2, av0, av1,
-                                av2);
-            }
-        }
-        return written;
-    }
 
     /* Int64 coverage (clamped starts, see COVERAGE): vectors aligned at
      * x0, every vector of every row tested. */
