@@ -75,13 +75,7 @@ static int make_case(int n, planes *ref, rast__tri *tri, int *ya, int *yb)
     for (int i = 0; i < 3; i++) {
         fx[i] = near_centre(&r, px);
         fy[i] = near_centre(&r, py);
-        const float w = tu_int(&r, 3) ? 1.0f : tu_range(&r, 0.05f, 8.0f);
-        v[i].x = 0.0f;   /* the set-up uses the snapped fx, fy */
-        v[i].y = 0.0f;
-        v[i].z = tu_range(&r, -1.2f, 1.2f) * w;
-        v[i].w = w;
-        for (int k = 0; k < na; k++)
-            v[i].a[k] = tu_range(&r, -2.0f, 2.0f);
+        planes_draw_vert(&r, &v[i], na);
     }
     rast__view view;
     rast__view_init(&view, shape.width, shape.height, na);
@@ -110,24 +104,14 @@ static void small_isa(int isa)
     memset(&sh, 0, sizeof sh);
     long cases = 0, written = 0;
     for (int n = 0; n < NCASES; n++) {
-        planes ref, got;
+        planes ref;
         rast__tri tri;
         int ya, yb;
         if (!make_case(n, &ref, &tri, &ya, &yb)) {
             planes_free(&ref);
             continue;
         }
-        planes_alloc(&got, &ref.t);
-        planes_copy(&got, &ref);
-        const long wr = rast__scan_rows_ref(&ref.t, &tri, ya, yb);
-        const long wg = scan(&got.t, &tri, ya, yb);
-        if (wr != wg || !planes_equal(&ref, &got)) {
-            print_error("case %d (%s): box %d..%d x %d..%d rows %d..%d: %ld vs %ld pixels, "
-                        "planes %s\n",
-                        n, ef_isa_name((ef_isa)isa), tri.x0, tri.x1, tri.y0, tri.y1, ya, yb, wr,
-                        wg, planes_equal(&ref, &got) ? "equal" : "differ");
-            fail();
-        }
+        const long wr = planes_check_scan(&ref, &tri, ya, yb, scan, isa, n);
         const int ys = ya > tri.y0 ? ya : tri.y0, ye = yb < tri.y1 ? yb : tri.y1;
         const int cols = tri.x1 - tri.x0 + 1, rows = ye - ys + 1;
         if (rows >= 1 && rows <= 3 && cols <= 3)
@@ -140,7 +124,6 @@ static void small_isa(int isa)
         cases++;
         written += wr;
         planes_free(&ref);
-        planes_free(&got);
     }
     print_message("NOTE %s: %ld small triangles, %ld pixels written, equal to the reference; "
                   "boxes 1x1 %ld, 2x1 %ld, 1x2 %ld, 2x2 %ld, 3x1 %ld, 1x3 %ld; "

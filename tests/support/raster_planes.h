@@ -1,8 +1,9 @@
 /* raster_planes.h - a render target with its own planes for the raster
  * scan tests (tests/test_raster_small.c, tests/test_raster_span.c): the
  * planes of a target shape allocated (padding included), copied and
- * compared byte for byte. Header-only (static inline); include after
- * support/testutil.h, <cmocka.h> and src/raster/raster.h. */
+ * compared byte for byte, and one scan checked against the reference.
+ * Header-only (static inline); include after support/testutil.h,
+ * <cmocka.h>, src/cpu/cpu.h and src/raster/raster_internal.h. */
 #ifndef EGOFUSE_RASTER_PLANES_H
 #define EGOFUSE_RASTER_PLANES_H
 
@@ -83,6 +84,44 @@ static inline void planes_free(planes *p)
     free(p->depth);
     free(p->mask);
     free(p->attr);
+}
+
+/* The clip-space part of a test vertex the set-up will use with a snapped
+ * position given apart: w (1 in two cases of three, else 0.05..8), depth
+ * z/w in -1.2..1.2, na attributes in -2..2 (x, y 0), drawn from r in this
+ * order. */
+static inline void planes_draw_vert(tu_rng *r, rast__vert *v, int na)
+{
+    const float w = tu_int(r, 3) ? 1.0f : tu_range(r, 0.05f, 8.0f);
+    v->x = 0.0f;   /* the set-up uses the snapped fx, fy */
+    v->y = 0.0f;
+    v->z = tu_range(r, -1.2f, 1.2f) * w;
+    v->w = w;
+    for (int k = 0; k < na; k++)
+        v->a[k] = tu_range(r, -2.0f, 2.0f);
+}
+
+/* Scans tri over rows ya..yb into ref's planes with the reference and into
+ * a copy with scan (of ISA isa, for the message); fails the test (case n)
+ * unless the pixel counts and every byte of the planes agree. Returns the
+ * reference's pixel count. */
+static inline long planes_check_scan(planes *ref, const rast__tri *tri, int ya, int yb,
+                                     rast__scan_rows_fn scan, int isa, int n)
+{
+    planes got;
+    planes_alloc(&got, &ref->t);
+    planes_copy(&got, ref);
+    const long wr = rast__scan_rows_ref(&ref->t, tri, ya, yb);
+    const long wg = scan(&got.t, tri, ya, yb);
+    if (wr != wg || !planes_equal(ref, &got)) {
+        print_error("case %d (%s): box %d..%d x %d..%d rows %d..%d: %ld vs %ld pixels, "
+                    "planes %s\n",
+                    n, ef_isa_name((ef_isa)isa), tri->x0, tri->x1, tri->y0, tri->y1, ya, yb,
+                    wr, wg, planes_equal(ref, &got) ? "equal" : "differ");
+        fail();
+    }
+    planes_free(&got);
+    return wr;
 }
 
 #endif
