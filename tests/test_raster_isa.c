@@ -882,6 +882,7 @@ static void test_jobs_equal(void **state)
  * same frames cleared with rast_target_clear (padding included, which
  * neither may touch). A target the context does not know and a forgotten
  * one are cleared whole. */
+static void make_mesh(int n, rcase *k);
 static void test_context_clear(void **state)
 {
     (void)state;
@@ -925,10 +926,16 @@ static void test_context_clear(void **state)
             rcase k[2];
             rast_mesh_desc m[2];
             for (int e = 0; e < 2; e++) {
-                /* A soup case with 3 attributes, drawn on this target. */
+                /* A soup case (big triangles, whole tile rows) or, every
+                 * third frame, a grid mesh (small triangles in a window:
+                 * runs of marked tiles ending inside a row), with 3
+                 * attributes, drawn on this target. */
                 int n = 11 * frame + e;
                 do {
-                    make_case(n++, &k[e]);
+                    if (frame % 3 == 2)
+                        make_mesh(n++, &k[e]);
+                    else
+                        make_case(n++, &k[e]);
                     if (k[e].m.attr_count == 3)
                         break;
                     free_case(&k[e]);
@@ -958,7 +965,8 @@ static void test_context_clear(void **state)
         rast_context_destroy(c);
     }
     rast_context_clear(NULL, NULL);      /* no crash */
-    print_message("NOTE context clear: %d frames equal to full clears\n", checked);
+    print_message("NOTE context clear: %d frames equal to full clears (%d of grid meshes)\n",
+                  checked, checked / 3);
 }
 
 /* ---- the vector front end (rast__vpass_*, rast__frontv_*) --------------- */

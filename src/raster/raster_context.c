@@ -422,6 +422,36 @@ static void prefetch_span(const rast_target *t, int y, int x0, int x1)
     }
 }
 
+/* The next run of marked tiles of tile row ty at or after tile *tx (of
+ * tw): tiles *tx .. *te, 1; or 0 when the row has none left. */
+static int next_run(const rast__tiles *d, int ty, int tw, int *tx, int *te)
+{
+    int a = *tx;
+    while (a < tw && !((d->bits[ty][a / 64] >> (a % 64)) & 1u))
+        a++;
+    if (a >= tw)
+        return 0;
+    int e = a;
+    while (e + 1 < tw && ((d->bits[ty][(e + 1) / 64] >> ((e + 1) % 64)) & 1u))
+        e++;
+    *tx = a;
+    *te = e;
+    return 1;
+}
+
+/* The last pixel row of tile row ty, the last pixel column of tile te. */
+static int tile_y1(const rast_target *t, int ty)
+{
+    const int y = ty * RAST__TILE + RAST__TILE - 1;
+    return y < t->height - 1 ? y : t->height - 1;
+}
+
+static int tile_x1(const rast_target *t, int te)
+{
+    const int x = (te + 1) * RAST__TILE - 1;
+    return x < t->width - 1 ? x : t->width - 1;
+}
+
 void rast_context_clear(rast_context *c, const rast_target *t)
 {
     if (!c || !t || !t->mask || t->width <= 0 || t->height <= 0 ||
@@ -435,25 +465,14 @@ void rast_context_clear(rast_context *c, const rast_target *t)
     if (k) {
         /* Runs of marked tiles of each tile row, row by row. */
         for (int ty = 0; ty < th; ty++) {
-            const int ya = ty * RAST__TILE;
-            const int yb = ya + RAST__TILE - 1 < t->height - 1 ? ya + RAST__TILE - 1
-                                                              : t->height - 1;
-            for (int tx = 0; tx < tw;) {
-                if (!((k->dirty->bits[ty][tx / 64] >> (tx % 64)) & 1u)) {
-                    tx++;
-                    continue;
-                }
-                int te = tx;
-                while (te + 1 < tw && ((k->dirty->bits[ty][(te + 1) / 64] >> ((te + 1) % 64)) & 1u))
-                    te++;
-                const int x1 = (te + 1) * RAST__TILE - 1 < t->width - 1
-                                   ? (te + 1) * RAST__TILE - 1 : t->width - 1;
+            const int ya = ty * RAST__TILE, yb = tile_y1(t, ty);
+            for (int tx = 0, te; next_run(k->dirty, ty, tw, &tx, &te); tx = te + 1) {
+                const int x0 = tx * RAST__TILE, x1 = tile_x1(t, te);
                 for (int y = ya; y <= yb; y++) {
                     if (y < yb)
-                        prefetch_span(t, y + 1, tx * RAST__TILE, x1);
-                    clear_span(t, y, tx * RAST__TILE, x1);
+                        prefetch_span(t, y + 1, x0, x1);
+                    clear_span(t, y, x0, x1);
                 }
-                tx = te + 1;
             }
         }
     } else {
@@ -506,23 +525,12 @@ long rast_context_count(rast_context *c, const rast_target *t)
     const int tw = (t->width + RAST__TILE - 1) / RAST__TILE;
     const int th = (t->height + RAST__TILE - 1) / RAST__TILE;
     for (int ty = 0; ty < th; ty++) {
-        const int ya = ty * RAST__TILE;
-        const int yb = ya + RAST__TILE - 1 < t->height - 1 ? ya + RAST__TILE - 1 : t->height - 1;
-        for (int tx = 0; tx < tw;) {
-            if (!((k->dirty->bits[ty][tx / 64] >> (tx % 64)) & 1u)) {
-                tx++;
-                continue;
-            }
-            int te = tx;
-            while (te + 1 < tw && ((k->dirty->bits[ty][(te + 1) / 64] >> ((te + 1) % 64)) & 1u))
-                te++;
-            const int x0 = tx * RAST__TILE;
-            const int x1 = (te + 1) * RAST__TILE - 1 < t->width - 1 ? (te + 1) * RAST__TILE - 1
-                                                                      : t->width - 1;
+        const int ya = ty * RAST__TILE, yb = tile_y1(t, ty);
+        for (int tx = 0, te; next_run(k->dirty, ty, tw, &tx, &te); tx = te + 1) {
+            const int x0 = tx * RAST__TILE, x1 = tile_x1(t, te);
             for (int y = ya; y <= yb; y++)
                 n += count_nonzero(t->mask + (size_t)y * (size_t)t->mask_stride + x0,
                                    (size_t)(x1 - x0 + 1));
-            tx = te + 1;
         }
     }
     return n;
