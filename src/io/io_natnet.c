@@ -1065,7 +1065,9 @@ io_result io_natnet_wait_ready(io_natnet *n, int timeout_ms, io_error *err)
         }
         double left = end - mono_now();
         if (left <= 0) break;
-        io_result r = io_natnet_poll(n, (int)(left * 1e3) + 1, NULL, NULL, err);
+        int slice = (int)(left * 1e3) + 1;
+        if (slice > n->cfg.resend_ms) slice = n->cfg.resend_ms;   /* resend on time */
+        io_result r = io_natnet_poll(n, slice, NULL, NULL, err);
         if (r != IO_OK) return r;
     }
     return io_fail(err, IO_ERR_DEVICE, "natnet server %s:%d: no answer in %d ms (%s%s); is Motive "
