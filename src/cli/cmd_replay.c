@@ -445,7 +445,7 @@ static int replay(const replay_opts *o)
             }
             if (stop_flag) break;
             kin_track_sample s = smp[i];
-            s.t = smp[0].t + rel;
+            s.t = smp[i].t + loop * period;   /* the file's own stamp on the first pass */
             if (o->natnet) {
                 serve(&srv, o);
                 buf b;

@@ -879,6 +879,7 @@ static void on_frame(io_natnet *n, const uint8_t *pl, size_t len, const char *fr
     if (n->frames && !restart && !(t > n->last.t)) t = n->last.t + 1e-6;
     build_sample(n, t);
     n->frames++;
+    if (n->on_sample) n->on_sample(n->user, &n->last, n);
     (*got)++;
     if (f.params & 2) {   /* the tracked models changed: ask again */
         send_cmd(n, IO_NATNET_REQUEST_MODELDEF);

@@ -166,6 +166,11 @@ typedef struct io_natnet {
              model_defs, dropouts, requests_sent;
     double t_open, t_connect_sent, t_model_sent, t_keepalive;
     int connects_sent, models_sent;
+    /* called for every accepted frame with its sample (a poll may accept
+     * several: push each into kin_filter here), NULL = none; set after
+     * io_natnet_open */
+    void (*on_sample)(void *user, const kin_track_sample *s, const struct io_natnet *n);
+    void *user;
     char last_error[512];            /* last bad packet / problem */
     char status[512];                /* last report of any kind */
 } io_natnet;
