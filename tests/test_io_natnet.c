@@ -475,6 +475,8 @@ static void validity_bad_packets(void **state)
     server_send(&s, "frame_3.1_1.bin");
     assert_int_equal(pump(&n, 1, NULL), 0);
     assert_non_null(strstr(n.last_error, "NatNet version is unknown"));
+    assert_int_equal(n.unversioned, 1);
+    assert_int_equal(n.bad, 0);
     io_natnet_close(&n);
     /* ... and taken with a configured version */
     assert_int_equal(io_natnet_config_set(&c, "version", "3.1", &err), IO_OK);

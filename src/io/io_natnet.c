@@ -828,9 +828,11 @@ static void bad_packet(io_natnet *n, const char *from, const char *fmt, ...)
 static void on_frame(io_natnet *n, const uint8_t *pl, size_t len, const char *from, double t_rx,
                      int *got)
 {
-    if (n->version_major < 3) {
-        bad_packet(n, from, "frame of data, but the NatNet version is unknown (no NAT_SERVERINFO "
-                   "yet and no version configured)");
+    if (n->version_major < 3) {   /* not the packet's fault: counted apart */
+        n->unversioned++;
+        set_status(n, 1, "natnet frame from %s: the NatNet version is unknown (no NAT_SERVERINFO "
+                   "yet and no version configured); %llu frames skipped", from,
+                   (unsigned long long)n->unversioned);
         return;
     }
     io_natnet_body_pose bodies[IO_NATNET_MAX_BODIES];

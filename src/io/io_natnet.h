@@ -164,6 +164,8 @@ typedef struct io_natnet {
     /* counters */
     uint64_t packets, frames, dropped_order, restarts, bad, other,
              model_defs, dropouts, requests_sent;
+    uint64_t unversioned;            /* frames skipped: no version known
+                                        yet (before NAT_SERVERINFO) */
     double t_open, t_connect_sent, t_model_sent, t_keepalive;
     int connects_sent, models_sent;
     /* called for every accepted frame with its sample (a poll may accept
