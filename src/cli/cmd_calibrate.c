@@ -193,6 +193,11 @@ int cmd_calibrate(int argc, char **argv)
            (double)cal.hand_scale[0], (double)cal.hand_scale[1],
            cal.has_glove[0] || cal.has_glove[1] ? ", gloves" : "",
            er == 1 ? " (from the arms: no fingertip gesture found)" : " (fingertip gesture)", out);
+    for (int k = 0; k < 2; k++)
+        if (fabsf(cal.arm_scale[k] - 1.0f) > 0.2f)
+            fprintf(stderr, "egofuse calibrate: warning: %s arm scale %.3f is far from the model's: "
+                    "were the arms stretched straight during the recording?\n", k ? "right" : "left",
+                    (double)cal.arm_scale[k]);
     if (er == 1)
         fprintf(stderr, "egofuse calibrate: hand scale from the arms: %s%s%s\n", why,
                 have_tips ? "" : "; ", have_tips ? "" : tip_why);
