@@ -88,9 +88,11 @@ io_result io_display_parse(const char *spec, io_display_spec *o, io_error *err)
         char *next = strchr(opts, ',');
         if (next) *next++ = '\0';
         char *val = strchr(opts, '=');
-        if (!val || !val[1])
+        if (!val)
             return io_fail(err, IO_ERR_ARGS, "display '%s': option '%s' is not key=value", spec, opts);
         *val++ = '\0';
+        if (!val[0])
+            return io_fail(err, IO_ERR_ARGS, "display '%s': option '%s' has no value", spec, opts);
         if (!strcmp(opts, "connector")) {
             char *plus = strchr(val, '+');
             if (plus) *plus++ = '\0';
