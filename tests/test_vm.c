@@ -76,8 +76,32 @@ static void log_append(const char *s, size_t n)
     vm_log[vm_log_len] = '\0';
 }
 
+/* ---- display (KMS on -device bochs-display): the guest asks for a
+ * screendump of what is on screen, the host takes it and answers with
+ * FILE.ack; test_vm_display compares FILE with the expected image. */
+#include "vm/display_pattern.h"
+static char display_dump[1024];
+static int display_dump_rc = -1;
+
+static void on_display_dump(const char *file, const char *qmp_sock)
+{
+    char cmd[1400], ack[1100];
+    snprintf(display_dump, sizeof display_dump, "%.*s", (int)strcspn(file, " \r\n"), file);
+    snprintf(cmd, sizeof cmd, "{\"execute\":\"screendump\",\"arguments\":{\"filename\":\"%s\"}}\n",
+             display_dump);
+    display_dump_rc = qmp(qmp_sock, cmd);
+    snprintf(ack, sizeof ack, "%s.ack", display_dump);
+    FILE *f = fopen(ack, "w");
+    if (f) {
+        fprintf(f, "%d\n", display_dump_rc);
+        fclose(f);
+    }
+}
+/* ---- end display */
+
 static void on_line(const char *line, const char *qmp_sock)
 {
+    if (!strncmp(line, "VMSYNC display-dump ", 20)) on_display_dump(line + 20, qmp_sock);
     if (!strncmp(line, "VMSYNC usb-unplug", 17))
         qmp(qmp_sock, "{\"execute\":\"device_del\",\"arguments\":{\"id\":\"camr\"}}\n");
     else if (!strncmp(line, "VMSYNC usb-replug", 17))
@@ -147,6 +171,7 @@ static int boot_vm(void)
                   "-device", "usb-tablet,bus=xhci.0,port=1.2,serial=CAM-L-0001,id=caml",
                   "-device", "usb-kbd,bus=xhci.0,port=2,serial=CAM-R-0002,id=camr",
                   "-device", "isa-debug-exit,iobase=0xf4,iosize=0x04",
+                  "-device", "bochs-display,id=display0",
                   "-qmp", qmp_arg, "-serial", "stdio", "-display", "none", "-monitor", "none",
                   "-no-reboot", NULL};
     int pfd[2];
@@ -295,6 +320,56 @@ static void test_vm_run(void **st)
     expect(names, 1);
 }
 
+/* ---- display: the guest's checks, then qemu's screendump of the
+ * bochs-display compared exactly with the test image as io_display lays
+ * it out (each eye centred in its half of the mode, black around). */
+static void test_vm_display(void **st)
+{
+    (void)st;
+    static const char *const names[] = {"display_no_connector", "display_no_mode", "display_missing",
+                                        "display_not_kms", "display_open", "display_busy", "display_flip",
+                                        "display_queue", "display_shown", "display_dump_ack",
+                                        "display_restore", "display_reopen", "display_no_fd_leak"};
+    expect(names, (int)(sizeof names / sizeof names[0]));
+    const char *m = strstr(vm_log, "VMINFO display mode ");
+    int w = 0, h = 0;
+    if (!m || sscanf(m + 20, "%dx%d", &w, &h) != 2) fail_msg("the guest did not print its display mode");
+    assert_int_equal(display_dump_rc, 0);
+    FILE *f = fopen(display_dump, "rb");
+    if (!f) fail_msg("%s: %s", display_dump, strerror(errno));
+    int pw = 0, ph = 0, maxv = 0;
+    int n = fscanf(f, "P6 %d %d %d", &pw, &ph, &maxv);
+    fgetc(f);
+    size_t bytes = (size_t)pw * (size_t)ph * 3;
+    uint8_t *got = n == 3 && pw > 0 && ph > 0 ? malloc(bytes) : NULL;
+    uint8_t *want = malloc((size_t)w * (size_t)h * 3);
+    size_t rd = got ? fread(got, 1, bytes, f) : 0;
+    fclose(f);
+    printf("    screendump %s: %dx%d (max %d), the mode %dx%d\n", display_dump, pw, ph, maxv, w, h);
+    assert_non_null(want);
+    assert_int_equal(n, 3);
+    assert_int_equal(pw, w);
+    assert_int_equal(ph, h);
+    assert_int_equal(maxv, 255);
+    assert_true(rd == bytes);
+    vmd_expected(w, h, 0, want);
+    size_t bad = 0, first = (size_t)-1;
+    for (size_t i = 0; i < bytes; i++)
+        if (got[i] != want[i]) {
+            if (first == (size_t)-1) first = i;
+            bad++;
+        }
+    if (bad)
+        printf("    %zu of %zu bytes differ; first at pixel (%zu, %zu): got %u, want %u\n", bad, bytes,
+               (first / 3) % (size_t)w, (first / 3) / (size_t)w, got[first], want[first]);
+    else
+        printf("    screendump = expected image, all %zu bytes\n", bytes);
+    free(got);
+    free(want);
+    assert_int_equal(bad, 0);
+}
+/* ---- end display */
+
 static void test_vm_all_passed(void **st)
 {
     (void)st;
@@ -318,6 +393,7 @@ int main(void)
         cmocka_unit_test(test_vm_usb),
         cmocka_unit_test(test_vm_glove),
         cmocka_unit_test(test_vm_run),
+        cmocka_unit_test(test_vm_display),
         cmocka_unit_test(test_vm_all_passed),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
