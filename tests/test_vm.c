@@ -171,7 +171,7 @@ static int boot_vm(void)
                   "-device", "usb-tablet,bus=xhci.0,port=1.2,serial=CAM-L-0001,id=caml",
                   "-device", "usb-kbd,bus=xhci.0,port=2,serial=CAM-R-0002,id=camr",
                   "-device", "isa-debug-exit,iobase=0xf4,iosize=0x04",
-                  "-device", "bochs-display,id=display0",
+                  "-vga", "none", "-device", "bochs-display,id=display0",
                   "-qmp", qmp_arg, "-serial", "stdio", "-display", "none", "-monitor", "none",
                   "-no-reboot", NULL};
     int pfd[2];
