@@ -37,4 +37,17 @@ static inline void vmd_expected(int w, int h, int f, uint8_t *rgb)
     }
 }
 
+/* The RGB image the w x h panel of eye e shows for frame f (layout two). */
+static inline void vmd_expected_eye(int w, int h, int e, int f, uint8_t *rgb)
+{
+    memset(rgb, 0, (size_t)w * h * 3);
+    int x0 = (w - VMD_EYE_W) / 2, y0 = (h - VMD_EYE_H) / 2;
+    for (int y = 0; y < VMD_EYE_H; y++)
+        for (int x = 0; x < VMD_EYE_W; x++) {
+            uint8_t px[4];
+            vmd_pixel(e, x, y, f, px);
+            memcpy(rgb + ((size_t)(y0 + y) * w + (size_t)(x0 + x)) * 3, px, 3);
+        }
+}
+
 #endif

@@ -65,8 +65,9 @@ cp /bin/busybox "$IR/bin/busybox"
 cp "$ROOT/tests/vm/init" "$IR/init"
 chmod +x "$IR/init"
 : > "$IR/modules.list"
-# bochs: the DRM driver of qemu's -device bochs-display (the display tests)
-for m in virtio_pci 9pnet_virtio 9p vivid xhci_pci dummy_hcd usb_f_hid bochs; do
+# bochs, virtio-gpu: the DRM drivers of qemu's -device bochs-display and
+# virtio-gpu-pci (the display tests; bochs first, so it is card0)
+for m in virtio_pci 9pnet_virtio 9p vivid xhci_pci dummy_hcd usb_f_hid bochs virtio-gpu; do
     modprobe -d "$VM/kernel" -S "$KV" --show-depends "$m" | while read -r cmd path rest; do
         [ "$cmd" = insmod ] || continue
         base=$(basename "$path")

@@ -7,7 +7,8 @@
  * (tests/vm/display_pattern.h) and writes FILE.ack, which this program
  * waits for before it closes the display.
  *
- *   vm_display OUTDIR
+ *   vm_display OUTDIR        bochs-display: one panel, side by side
+ *   vm_display two OUTDIR    virtio-gpu with two outputs: one eye each
  *
  * A second descriptor on the card (master dropped) watches the CRTCs, so
  * the state after io_display_close is what the display restored, not the
@@ -164,12 +165,121 @@ static void expect_fail(const char *name, const char *spec, int ew, int eh, cons
     if (d) io_display_close(&d);
 }
 
+/* The first card whose driver is `driver` ("" when none). */
+static void find_card(const char *driver, char *out, size_t n)
+{
+    out[0] = '\0';
+    for (int i = 0; i < 8 && !out[0]; i++) {
+        char path[64];
+        snprintf(path, sizeof path, "/dev/dri/card%d", i);
+        int fd = open(path, O_RDWR | O_CLOEXEC);
+        if (fd < 0) continue;
+        drmVersion *v = drmGetVersion(fd);
+        if (v && v->name && !strcmp(v->name, driver)) snprintf(out, n, "%s", path);
+        if (v) drmFreeVersion(v);
+        close(fd);
+    }
+}
+
+static int wait_ack(const char *ack)
+{
+    for (int i = 0; i < 600; i++) {     /* the host answers in well under a minute */
+        struct stat sb;
+        if (stat(ack, &sb) == 0) return 1;
+        struct timespec ts = {0, 100000000};
+        nanosleep(&ts, NULL);
+    }
+    return 0;
+}
+
+/* Layout two on virtio-gpu with two outputs (the second forced on with
+ * video=Virtual-3:e): one eye per connector, one event per frame when
+ * both CRTCs have flipped; the host dumps both heads. */
+static int cmd_two(const char *outdir)
+{
+    int fds0 = count_fds();
+    char card[64], spec[128];
+    find_card("virtio_gpu", card, sizeof card);
+    if (!card[0]) {
+        check(0, "display_two_open", "no virtio_gpu card (is virtio-gpu loaded, -device virtio-gpu-pci given?)");
+        return 1;
+    }
+    int cfd = open(card, O_RDWR | O_CLOEXEC);
+    drmDropMaster(cfd);
+    crtc_state before, now;
+    snapshot(cfd, &before);
+    char desc[1024];
+    describe(&before, desc, sizeof desc);
+    printf("VMINFO display two before: %s\n", desc);
+    snprintf(spec, sizeof spec, "kms:%s,layout=two", card);
+    io_display_config c = {spec, VMD_EYE_W, VMD_EYE_H, 2};
+    io_display *d = NULL;
+    io_error err;
+    memset(&err, 0, sizeof err);
+    if (io_display_open(&d, &c, &err) != IO_OK) {
+        check(0, "display_two_open", "%s", err.msg);
+        close(cfd);
+        return 1;
+    }
+    snapshot(cfd, &now);
+    describe(&now, desc, sizeof desc);
+    check(1, "display_two_open", "%s; %s", io_display_describe(d), desc);
+    /* the panel sizes, from the CRTCs the display set (in CRTC order) */
+    int ok = 1;
+    char why[512] = "";
+    for (int f = 1; f <= 4 && ok; f++) {
+        uint64_t t0 = now_ns();
+        io_display_flip ev;
+        int got = 0;
+        if (present(d, f, 300 + (uint64_t)f, &err) != IO_OK || wait_flip(d, &ev, &err) != 0) {
+            ok = 0;
+            snprintf(why, sizeof why, "frame %d: %s", f, err.msg);
+            break;
+        }
+        /* exactly one event per frame, after both CRTCs flipped */
+        io_display_poll(d, 0, &ev, &got, &err);
+        if (ev.frame_id != 300 + (uint64_t)f || ev.t_ns < t0 || got || io_display_busy(d)) {
+            ok = 0;
+            snprintf(why, sizeof why, "frame %d: event id %llu, extra event %d, busy %d", f,
+                     (unsigned long long)ev.frame_id, got, io_display_busy(d));
+        }
+    }
+    check(ok, "display_two_flip", "4 frames on two CRTCs, one event each%s%s", ok ? "" : ": ", why);
+    io_display_flip ev;
+    ok = present(d, 0, 999, &err) == IO_OK && wait_flip(d, &ev, &err) == 0 && ev.frame_id == 999;
+    check(ok, "display_two_shown", "test image presented on both%s%s", ok ? "" : ": ", ok ? "" : err.msg);
+    /* the mode of each connector's CRTC, for the host's comparison */
+    snapshot(cfd, &now);
+    printf("VMINFO display two modes");
+    for (int k = 0; k < now.n; k++)
+        if (now.valid[k]) printf(" %dx%d", now.mode[k].hdisplay, now.mode[k].vdisplay);
+    printf("\n");
+    char ppm[1024], ack[1100];
+    snprintf(ppm, sizeof ppm, "%s/display_two", outdir);
+    snprintf(ack, sizeof ack, "%s.ack", ppm);
+    unlink(ack);
+    printf("VMSYNC display-two-dump %s\n", ppm);
+    fflush(stdout);
+    int acked = wait_ack(ack);
+    check(acked, "display_two_dump_ack", "%s", acked ? "the host took both screendumps" : "no answer from the host");
+    io_display_close(&d);
+    snapshot(cfd, &now);
+    describe(&now, desc, sizeof desc);
+    check(same(&before, &now), "display_two_restore", "after close: %s", desc);
+    close(cfd);
+    check(count_fds() == fds0, "display_two_no_fd_leak", "descriptors before %d, after %d", fds0, count_fds());
+    return failures ? 1 : 0;
+}
+
 int main(int argc, char **argv)
 {
     setvbuf(stdout, NULL, _IOLBF, 0);
+    if (argc > 2 && !strcmp(argv[1], "two")) return cmd_two(argv[2]);
     const char *outdir = argc > 1 ? argv[1] : "/tmp";
     int fds0 = count_fds();
-    const char *card = "/dev/dri/card0";
+    char card[64];
+    find_card("bochs-drm", card, sizeof card);
+    if (!card[0]) snprintf(card, sizeof card, "/dev/dri/card0");
     int cfd = open(card, O_RDWR | O_CLOEXEC);
     if (cfd < 0) {
         check(0, "display_open", "%s: %s (is the bochs module loaded, -device bochs-display given?)", card,
@@ -184,21 +294,27 @@ int main(int argc, char **argv)
     describe(&before, desc, sizeof desc);
     printf("VMINFO display before: %s\n", desc);
 
-    /* refusals first: nothing may change on screen */
-    expect_fail("display_no_connector", "kms,connector=HDMI-A-7", VMD_EYE_W, VMD_EYE_H,
-                "/dev/dri/card0: no connector 'HDMI-A-7' (connectors: Virtual-1 (id ", &before, cfd);
-    expect_fail("display_no_mode", "kms", 5000, 3000, "/dev/dri/card0: Virtual-1: no mode fits 10000x3000; modes: ",
-                &before, cfd);
-    expect_fail("display_no_mode", "kms:/dev/dri/card0,mode=1234x567", VMD_EYE_W, VMD_EYE_H,
-                "Virtual-1: no mode 1234x567; modes: ", &before, cfd);
-    expect_fail("display_no_mode", "kms,mode=640x480", VMD_EYE_W, VMD_EYE_H,
+    /* refusals first: nothing may change on screen. The specs name the
+     * card (virtio-gpu is another card in the same VM); the default
+     * device is what "kms" with no card finds: card0 (bochs, loaded first) */
+    char spec[256], want[256];
+    snprintf(spec, sizeof spec, "kms:%s,connector=HDMI-A-7", card);
+    snprintf(want, sizeof want, "%s: no connector 'HDMI-A-7' (connectors: Virtual-1 (id ", card);
+    expect_fail("display_no_connector", spec, VMD_EYE_W, VMD_EYE_H, want, &before, cfd);
+    snprintf(spec, sizeof spec, "kms:%s", card);
+    snprintf(want, sizeof want, "%s: Virtual-1: no mode fits 10000x3000; modes: ", card);
+    expect_fail("display_no_mode", spec, 5000, 3000, want, &before, cfd);
+    snprintf(spec, sizeof spec, "kms:%s,mode=1234x567", card);
+    expect_fail("display_no_mode", spec, VMD_EYE_W, VMD_EYE_H, "Virtual-1: no mode 1234x567; modes: ", &before, cfd);
+    snprintf(spec, sizeof spec, "kms:%s,mode=640x480", card);
+    expect_fail("display_no_mode", spec, VMD_EYE_W, VMD_EYE_H,
                 "Virtual-1: mode 640x480 is smaller than the 1000x380 the eyes need", &before, cfd);
     expect_fail("display_missing", "kms:/dev/dri/card7", VMD_EYE_W, VMD_EYE_H, "/dev/dri/card7: no such device",
                 &before, cfd);
     expect_fail("display_not_kms", "kms:/dev/zero", VMD_EYE_W, VMD_EYE_H, "/dev/zero: not a KMS display device",
                 &before, cfd);
 
-    /* open */
+    /* open: the default card, connector, mode and layout */
     io_display_config c = {"kms", VMD_EYE_W, VMD_EYE_H, 2};
     io_display *d = NULL;
     io_error err;
@@ -216,6 +332,10 @@ int main(int argc, char **argv)
     check(w >= 2 * VMD_EYE_W && h >= VMD_EYE_H && period > 0 && io_display_fd(d) >= 0 && !io_display_busy(d),
           "display_open", "%s, refresh %.3f ms; %s", io_display_describe(d), (double)period / 1e6, desc);
     printf("VMINFO display mode %dx%d\n", w, h);
+    check(!strncmp(io_display_describe(d), "kms /dev/dri/card0 Virtual-1 ", 29) && !strcmp(card, "/dev/dri/card0"),
+          "display_default", "kms -> %s (bochs is %s)", io_display_describe(d), card);
+    snprintf(spec, sizeof spec, "kms:%s", card);
+    c.spec = spec;
 
     /* busy: a second open while the first holds master */
     {
