@@ -428,7 +428,8 @@ static void test_vm_display(void **st)
     static const char *const names[] = {"display_no_connector", "display_no_mode", "display_missing",
                                         "display_not_kms", "display_open", "display_busy", "display_flip",
                                         "display_queue", "display_shown", "display_dump_ack", "display_default",
-                                        "display_restore", "display_reopen", "display_no_fd_leak"};
+                                        "display_restore", "display_reopen", "display_sigint_restore",
+                                        "display_kill_restore", "display_no_fd_leak"};
     expect(names, (int)(sizeof names / sizeof names[0]));
     const char *m = strstr(vm_log, "VMINFO display mode ");
     int w = 0, h = 0;

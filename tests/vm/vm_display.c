@@ -16,11 +16,13 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -31,6 +33,12 @@
 #include "display_pattern.h"
 
 static int failures;
+static volatile sig_atomic_t sigint_seen;
+static void on_sigint(int sig)
+{
+    (void)sig;
+    sigint_seen = 1;
+}
 
 static void check(int ok, const char *name, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 static void check(int ok, const char *name, const char *fmt, ...)
@@ -447,7 +455,79 @@ int main(int argc, char **argv)
         check(ok && same(&before, &now), "display_reopen", "open, present, close again%s%s", ok ? "" : ": ",
               ok ? "" : err.msg);
     }
+    /* Ctrl-C as egofuse run handles it: the handler sets a flag, the
+     * loop (blocked in io_display_poll) sees it and closes */
+    {
+        int ready[2];
+        int ok = pipe(ready) == 0;
+        pid_t pid = ok ? fork() : -1;
+        if (pid == 0) {
+            close(ready[0]);
+            struct sigaction sa;
+            memset(&sa, 0, sizeof sa);
+            sa.sa_handler = on_sigint;
+            sigaction(SIGINT, &sa, NULL);
+            io_display *dc = NULL;
+            if (io_display_open(&dc, &c, &err) != IO_OK) _exit(2);
+            uint64_t frames = 0;
+            while (!sigint_seen) {
+                io_display_flip ev;
+                int got;
+                if (present(dc, (int)(frames % 7), frames, &err) != IO_OK) break;
+                if (++frames == 3 && write(ready[1], "r", 1) != 1) break;
+                io_display_poll(dc, -1, &ev, &got, &err);
+            }
+            io_display_close(&dc);
+            _exit(sigint_seen ? 0 : 3);
+        }
+        char r = 0;
+        int st = -1;
+        if (pid > 0) {
+            close(ready[1]);
+            ok = read(ready[0], &r, 1) == 1;
+            kill(pid, SIGINT);
+            waitpid(pid, &st, 0);
+            close(ready[0]);
+        }
+        snapshot(cfd, &now);
+        describe(&now, desc, sizeof desc);
+        check(ok && WIFEXITED(st) && WEXITSTATUS(st) == 0 && same(&before, &now), "display_sigint_restore",
+              "SIGINT during the flip loop: exit %d, %s", WIFEXITED(st) ? WEXITSTATUS(st) : -1, desc);
+    }
     close(cfd);
+
+    /* killed without closing (SIGKILL, a crash): the kernel removes the
+     * buffers on the descriptor's close and, on the card's last close, its
+     * console takes the display back. Nothing else may hold the card. */
+    {
+        int ready[2];
+        int ok = pipe(ready) == 0;
+        pid_t pid = ok ? fork() : -1;
+        if (pid == 0) {
+            close(ready[0]);
+            io_display *dk = NULL;
+            if (io_display_open(&dk, &c, &err) != IO_OK) _exit(2);
+            io_display_flip ev;
+            present(dk, 5, 5, &err);
+            wait_flip(dk, &ev, &err);
+            if (write(ready[1], "r", 1) != 1) _exit(3);
+            for (;;) pause();
+        }
+        char r = 0;
+        if (pid > 0) {
+            close(ready[1]);
+            ok = read(ready[0], &r, 1) == 1;
+            kill(pid, SIGKILL);
+            waitpid(pid, NULL, 0);
+            close(ready[0]);
+        }
+        cfd = open(card, O_RDWR | O_CLOEXEC);
+        drmDropMaster(cfd);
+        snapshot(cfd, &now);
+        describe(&now, desc, sizeof desc);
+        close(cfd);
+        check(ok && same(&before, &now), "display_kill_restore", "after SIGKILL: %s", desc);
+    }
     int fds1 = count_fds();
     check(fds1 == fds0, "display_no_fd_leak", "descriptors before %d, after %d", fds0, fds1);
     return failures ? 1 : 0;
