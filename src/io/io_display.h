@@ -106,7 +106,10 @@ typedef struct io_display_flip {
 } io_display_flip;
 
 /* Hands out the next flip event, waiting up to timeout_ms (0 = no wait,
- * < 0 = until one comes): *got = 1 with *ev filled, or 0. */
+ * < 0 = until one comes): *got = 1 with *ev filled, or 0. Returns at once
+ * with *got = 0 when no flip is pending (none can come). A signal (the
+ * caller's SIGINT handler) ends the wait early with IO_OK and *got = 0.
+ * SDL: also handles the window's events (quit requests). */
 io_result io_display_poll(io_display *d, int timeout_ms, io_display_flip *ev,
                           int *got, io_error *err);
 /* 1 while a flip is pending (presenting now would wait for it). */
