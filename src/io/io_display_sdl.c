@@ -33,8 +33,7 @@
     X(int, SDL_RenderClear, (SDL_Renderer *))                                              \
     X(int, SDL_RenderCopy, (SDL_Renderer *, SDL_Texture *, const SDL_Rect *, const SDL_Rect *)) \
     X(void, SDL_RenderPresent, (SDL_Renderer *))                                           \
-    X(int, SDL_PollEvent, (SDL_Event *))                                                   \
-    X(int, SDL_WaitEventTimeout, (SDL_Event *, int))
+    X(int, SDL_PollEvent, (SDL_Event *))
 
 typedef struct sdl_api {
 #define X(ret, name, args) ret(*name) args;
@@ -110,16 +109,14 @@ static io_result sdl_present(io_display *d, const uint8_t *const rgba[2], const 
     return IO_OK;
 }
 
+/* Flips are queued by the present itself: nothing is ever pending, so
+ * this only handles the window's events (no wait, as KMS with no flip
+ * pending). */
 static io_result sdl_wait(io_display *d, int timeout_ms, io_error *err)
 {
     (void)err;
+    (void)timeout_ms;
     pump(d);
-    if (d->qlen || d->quit || timeout_ms == 0) return IO_OK;
-    SDL_Event e;
-    if (api.SDL_WaitEventTimeout(&e, timeout_ms < 0 ? -1 : timeout_ms)) {
-        handle(d, &e);
-        pump(d);
-    }
     return IO_OK;
 }
 
