@@ -25,6 +25,7 @@
 #include <SDL.h>
 
 #include "../src/io/io_display.h"
+#include "../src/io/io_display_impl.h"
 
 static int count_fds(void)
 {
@@ -93,6 +94,38 @@ static void test_parse(void **st)
         if (r != IO_ERR_ARGS || !strstr(err.msg, bad[i].msg))
             fail_msg("'%s': got %d '%s', wanted '%s'", bad[i].spec, r, err.msg, bad[i].msg);
     }
+}
+
+/* ------------------------------------------------ the KMS conversion */
+
+/* io_display_blit_xrgb (SSE2 groups of 4 and a scalar tail) against the
+ * definition of XRGB8888: a little-endian word 0x00RRGGBB. Pixels around
+ * the target rectangle stay untouched. */
+static void test_blit(void **st)
+{
+    (void)st;
+    tu_rng rng = {7};
+    enum { DW = 40, DH = 9 };
+    static uint8_t src[13 * 4 * 8], dst[DW * 4 * DH];
+    for (int w = 1; w <= 13; w++)
+        for (int x0 = 0; x0 < 3; x0++) {
+            int h = 1 + w % 7;
+            for (size_t i = 0; i < sizeof src; i++) src[i] = (uint8_t)tu_next(&rng);
+            memset(dst, 0xa5, sizeof dst);
+            io_display_blit_xrgb(dst, DW * 4, x0 + 5, 1, src, (size_t)w * 4 + 4, w, h);
+            for (int y = 0; y < DH; y++)
+                for (int x = 0; x < DW; x++) {
+                    const uint8_t *o = dst + ((size_t)y * DW + x) * 4;
+                    uint32_t got = (uint32_t)o[0] | (uint32_t)o[1] << 8 | (uint32_t)o[2] << 16 | (uint32_t)o[3] << 24;
+                    uint32_t want = 0xa5a5a5a5u;
+                    int sx = x - x0 - 5, sy = y - 1;
+                    if (sx >= 0 && sx < w && sy >= 0 && sy < h) {
+                        const uint8_t *p = src + (size_t)sy * ((size_t)w * 4 + 4) + (size_t)sx * 4;
+                        want = (uint32_t)p[0] << 16 | (uint32_t)p[1] << 8 | p[2];
+                    }
+                    if (got != want) fail_msg("w %d x0 %d at (%d, %d): 0x%08x, want 0x%08x", w, x0, x, y, got, want);
+                }
+        }
 }
 
 /* ---------------------------------------------------------- KMS refusals */
@@ -437,6 +470,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_parse),
+        cmocka_unit_test(test_blit),
         cmocka_unit_test(test_kms_refusals),
         cmocka_unit_test(test_sdl_missing),
         cmocka_unit_test(test_sdl_window),

@@ -34,6 +34,10 @@ struct io_display {
 /* Queues a flip event (the oldest is dropped when full). */
 void io_display_push_flip(io_display *d, uint64_t frame_id, uint64_t t_ns, uint32_t seq);
 uint64_t io_display_now_ns(void);
+/* RGBA rows (alpha ignored) into XRGB8888 (little-endian B, G, R, X) at
+ * (x0, y0) of a buffer with dst_pitch bytes per row. */
+void io_display_blit_xrgb(uint8_t *dst, size_t dst_pitch, int x0, int y0, const uint8_t *src,
+                          size_t stride, int w, int h);
 
 io_result io_display_kms_open(io_display *d, const io_display_spec *s, int buffers,
                               io_error *err);

@@ -305,17 +305,6 @@ static io_result kms_wait(io_display *d, int timeout_ms, io_error *err)
     return kms_read_events(k, timeout_ms, err);
 }
 
-/* RGBA rows into XRGB8888 at (x0, y0) of b. */
-static void blit(const kms_buf *b, int x0, int y0, const uint8_t *src, size_t stride, int w, int h)
-{
-    for (int y = 0; y < h; y++) {
-        const uint8_t *s = src + (size_t)y * stride;
-        uint32_t *dst = (uint32_t *)(b->map + (size_t)(y0 + y) * b->pitch) + x0;
-        for (int x = 0; x < w; x++)
-            dst[x] = ((uint32_t)s[4 * x] << 16) | ((uint32_t)s[4 * x + 1] << 8) | s[4 * x + 2];
-    }
-}
-
 static io_result kms_present(io_display *d, const uint8_t *const rgba[2], const size_t stride[2],
                              uint64_t frame_id, io_error *err)
 {
@@ -335,7 +324,8 @@ static io_result kms_present(io_display *d, const uint8_t *const rgba[2], const 
         int half = o->mode.hdisplay / o->eyes;
         for (int e = 0; e < o->eyes; e++) {
             int x0 = e * half + (half - d->eye_w) / 2, y0 = (o->mode.vdisplay - d->eye_h) / 2;
-            blit(b, x0, y0, rgba[o->eye0 + e], stride[o->eye0 + e], d->eye_w, d->eye_h);
+            io_display_blit_xrgb(b->map, b->pitch, x0, y0, rgba[o->eye0 + e], stride[o->eye0 + e], d->eye_w,
+                                 d->eye_h);
         }
         if (drmModePageFlip(k->fd, o->crtc_id, b->fb_id, DRM_MODE_PAGE_FLIP_EVENT, o) != 0) {
             int e = errno;
