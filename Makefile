@@ -47,8 +47,10 @@ TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC)) \
              $(patsubst bench/llvmpipe/%.c,$(BUILD)/bench/%,$(LLVMPIPE_SRC))
 
-IO_PKGS  := OpenImageIO tinygltf libusb-1.0 libv4l2
-IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) 2>/dev/null)
+IO_PKGS  := OpenImageIO tinygltf libusb-1.0 libv4l2 libdrm
+# SDL2: headers only; src/io/io_display_sdl.c loads libSDL2 with dlopen when
+# a window is opened, so the program does not link it.
+IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) sdl2 2>/dev/null)
 IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lstdc++
 SYS_LIBS := -lm -lpthread
 # Peers measured by the benchmarks: pixman (compositing), Mesa llvmpipe
@@ -141,7 +143,7 @@ test: deps
 # Every public header compiles on its own as C and as C++ (sokol's rule).
 HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
            src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/io/io.h src/io/io_dev.h \
-           src/io/io_natnet.h
+           src/io/io_natnet.h src/io/io_display.h src/io/io_sched.h src/io/io_live.h
 check-headers:
 	@for h in $(HEADERS); do \
 	    echo "#include \"$$h\"" | $(CC) -std=c99 -Wall -Wextra -Werror -x c -fsyntax-only - || exit 1; \

@@ -56,6 +56,13 @@ else
     fail=1
 fi
 
+step display
+# KMS on qemu's bochs-display: the host takes a screendump when it reads
+# "VMSYNC display-dump FILE" and answers with FILE.ack
+"$VM/vm_display" "$OUT" || fail=1
+# layout two: virtio-gpu's two outputs, one eye each
+"$VM/vm_display" two "$OUT" || fail=1
+
 step run
 # the live pipeline on both vivid cameras, HDMI input at 60 FPS
 EGOFUSE=${EGOFUSE_BIN:-$ROOT/build/egofuse}
