@@ -117,6 +117,8 @@ typedef struct run_state {
     int have_model;
     pipe_ctx *pipe;
     io_image virt[2], outimg[2], camimg[2];
+    io_image vdepth[2];       /* the still virtual images' depth, if any */
+    char vdepth_path[2][IO_PATH_MAX + 64];
     io_cam cam[2];
     io_glove glove[2];
     int have_glove[2];
@@ -139,6 +141,7 @@ static void run_close(run_state *r)
         io_image_free(&r->virt[e]);
         io_image_free(&r->outimg[e]);
         io_image_free(&r->camimg[e]);
+        io_image_free(&r->vdepth[e]);
     }
     if (r->udp.fd >= 0) io_track_udp_close(&r->udp);
     io_stats_abandon(&r->stats);
@@ -218,6 +221,12 @@ static int dump_frame(const run_opts *o, run_state *r, const kin_track_sample *s
                       "camera_right = cam_right_%%04d.png\nvirtual_left = virt_left_%%04d.png\n"
                       "virtual_right = virt_right_%%04d.png\n%s",
                       model_abs, tracked ? "tracking = track.txt\n" : "") < 0;
+    for (int e = 0; e < 2; e++) {
+        char dabs[IO_PATH_MAX + 64];
+        if (!r->vdepth[e].data) continue;
+        if (!realpath(r->vdepth_path[e], dabs)) snprintf(dabs, sizeof dabs, "%s", r->vdepth_path[e]);
+        bad |= fprintf(f, "virtual_depth_%s = %s\n", eye[e], dabs) < 0;
+    }
     if (r->have_scene && r->sc.head_node[0]) bad |= fprintf(f, "head_node = %s\n", r->sc.head_node) < 0;
     if (r->have_scene && r->sc.animation[0]) bad |= fprintf(f, "animation = %s\n", r->sc.animation) < 0;
     if (r->have_scene && r->sc.has_lighting) {
@@ -336,6 +345,21 @@ static int run(const run_opts *o)
         }
         if (vpath) {
             if (load_virt(vpath, W, H, &r->virt[e])) goto done;
+            if (!o->virt[e] && r->sc.virt_depth[e][0]) {
+                /* the scene's depth of that image: virtual objects in front
+                 * of the hands hide them */
+                io_scene_frame_path(&r->sc, r->sc.virt_depth[e], 0, r->vdepth_path[e],
+                                    sizeof r->vdepth_path[e]);
+                if (io_image_load(r->vdepth_path[e], IO_F32, 1, &r->vdepth[e], &err) != IO_OK) {
+                    cli_fail("%s", err.msg);
+                    goto done;
+                }
+                if (r->vdepth[e].width != W || r->vdepth[e].height != H) {
+                    cli_fail("%s: virtual depth image is %dx%d, expected %dx%d", r->vdepth_path[e],
+                             r->vdepth[e].width, r->vdepth[e].height, W, H);
+                    goto done;
+                }
+            }
         } else if (io_image_alloc(&r->virt[e], W, H, 4, IO_U8, &err) == IO_OK) {
             /* plain grey, opaque (until a live source delivers) */
             for (int y = 0; y < H; y++) {
@@ -450,6 +474,10 @@ static int run(const run_opts *o)
                                     (int)r->camimg[e].stride};
         in.virt[e] = (fuse_image){r->virt[e].data, W, H, (int)r->virt[e].stride};
         in.out[e] = (fuse_image){r->outimg[e].data, W, H, (int)r->outimg[e].stride};
+        if (r->vdepth[e].data) {
+            in.virt_depth[e] = r->vdepth[e].data;
+            in.virt_depth_stride[e] = (int)(r->vdepth[e].stride / sizeof(float));
+        }
     }
     /* Still virtual images: checked once. Opaque (the grey fallback is),
      * the composite copies V where the hand is not without reading its
