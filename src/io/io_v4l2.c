@@ -379,26 +379,19 @@ static void yuv_to_rgb(int y, int u, int v, uint8_t *d)
     d[3] = 255;
 }
 
-static void yuv_full_to_rgb(int y, int u, int v, uint8_t *d)
-{
-    /* BT.601 full range (JPEG), 8-bit fixed point (x256) */
-    int c = 256 * y, du = u - 128, dv = v - 128;
-    d[0] = clamp_u8((c + 359 * dv + 128) >> 8);
-    d[1] = clamp_u8((c - 88 * du - 183 * dv + 128) >> 8);
-    d[2] = clamp_u8((c + 454 * du + 128) >> 8);
-    d[3] = 255;
-}
-
 /* Planar and semi-planar YUV: chroma of pixel (x, y) at (x >> sx, y >> sy);
- * NV12 (uv_step 2) has U and V interleaved in one plane. */
+ * NV12 has U and V interleaved in one plane. BT.601 in 8-bit fixed point
+ * (x256): limited range as yuv_to_rgb (same results), or full range (JPEG:
+ * 256, 359, 88, 183, 454); the chroma terms once per chroma sample. */
 static void planar_to_rgba(const io_frame *f, int sx, int sy, int nv12, int full, uint8_t *dst,
                            size_t ds)
 {
-    void (*cv)(int, int, int, uint8_t *) = full ? yuv_full_to_rgb : yuv_to_rgb;
+    const int ky = full ? 256 : 298, y0 = full ? 0 : 16, kr = full ? 359 : 409,
+              kgu = full ? 88 : 100, kgv = full ? 183 : 208, kb = full ? 454 : 516;
     int w = f->width, h = f->height;
     size_t ys = f->stride, h_sz = (size_t)h;
     const uint8_t *ybase = f->data, *ubase, *vbase;
-    size_t cs;
+    size_t cs, step = nv12 ? 2 : 1;
     if (nv12) {
         cs = ys;
         ubase = f->data + ys * h_sz;
@@ -413,10 +406,20 @@ static void planar_to_rgba(const io_frame *f, int sx, int sy, int nv12, int full
         const uint8_t *yr = ybase + (size_t)y * ys;
         const uint8_t *ur = ubase + (size_t)(y >> sy) * cs, *vr = vbase + (size_t)(y >> sy) * cs;
         uint8_t *d = dst + (size_t)y * ds;
-        if (nv12)
-            for (int x = 0; x < w; x++) cv(yr[x], ur[2 * (x >> 1)], vr[2 * (x >> 1)], d + 4 * x);
-        else
-            for (int x = 0; x < w; x++) cv(yr[x], ur[x >> sx], vr[x >> sx], d + 4 * x);
+        int x = 0;
+        for (size_t c = 0; x < w; c++) {
+            int du = ur[c * step] - 128, dv = vr[c * step] - 128;
+            int rv = kr * dv + 128, guv = kgu * du + kgv * dv - 128, bu = kb * du + 128;
+            int n = sx ? 2 : 1;
+            for (int k = 0; k < n && x < w; k++, x++) {
+                int l = ky * (yr[x] - y0);
+                uint8_t *o = d + 4 * (size_t)x;
+                o[0] = clamp_u8((l + rv) >> 8);
+                o[1] = clamp_u8((l - guv) >> 8);
+                o[2] = clamp_u8((l + bu) >> 8);
+                o[3] = 255;
+            }
+        }
     }
 }
 
