@@ -143,7 +143,8 @@ test: deps
 # Every public header compiles on its own as C and as C++ (sokol's rule).
 HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
            src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/io/io.h src/io/io_dev.h \
-           src/io/io_natnet.h src/io/io_display.h src/io/io_sched.h src/io/io_live.h
+           src/io/io_natnet.h src/io/io_display.h src/io/io_sched.h src/io/io_live.h \
+           src/io/io_vsrc.h
 check-headers:
 	@for h in $(HEADERS); do \
 	    echo "#include \"$$h\"" | $(CC) -std=c99 -Wall -Wextra -Werror -x c -fsyntax-only - || exit 1; \

@@ -470,6 +470,14 @@ static void test_vm_display(void **st)
 }
 /* ---- end display */
 
+static void test_vm_vsrc(void **st)
+{
+    (void)st;
+    static const char *const names[] = {"vsrc_format", "vsrc_sbs", "vsrc_unplug",
+                                        "vsrc_no_fd_leak"};
+    expect(names, (int)(sizeof names / sizeof names[0]));
+}
+
 static void test_vm_all_passed(void **st)
 {
     (void)st;
@@ -495,6 +503,7 @@ int main(void)
         cmocka_unit_test(test_vm_run),
         cmocka_unit_test(test_vm_display),
         cmocka_unit_test(test_vm_display_two),
+        cmocka_unit_test(test_vm_vsrc),
         cmocka_unit_test(test_vm_all_passed),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

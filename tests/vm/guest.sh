@@ -14,6 +14,10 @@ step() { echo "VMSTEP $* at $(cut -d" " -f1 /proc/uptime) s"; }
 step capture
 "$BIN" capture || fail=1
 
+step vsrc
+# the V source (io_vsrc) on vivid's video2 + video3: formats, unplug, reopen
+"$BIN" vsrc || fail=1
+
 step usb
 # hotplug is seen by io_usb_watch's sysfs rescans (libusb's own events
 # would need a udev daemon, which this VM does not run)
