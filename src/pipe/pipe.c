@@ -1,5 +1,6 @@
 /* pipe.c - one stereo frame, end to end (see pipe.h). */
 #include "pipe.h"
+#include "pipe_parts.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -240,6 +241,7 @@ struct pipe_ctx {
     kin_arm_rig fit_rig;
     int fit_no_prev;          /* pipe_reset_fit: the refined masks are of
                                  before it, not to be learned from */
+    pipe__cockpit *ck;        /* hidden parts and props (pipe_parts.c) */
 };
 
 enum { JOB_SKIN, JOB_EYE };
@@ -278,8 +280,11 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
     rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
     rast_context_clear(e->rast, &tg); /* only what the last frame drew */
-    rast_result rr = pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, p->desc.cull, e->clip,
-                                    e->vnrm, NULL);
+    rast_result rr = pipe__cockpit_active(p->ck)
+                         ? pipe__cockpit_draw(p->ck, &p->pose, e->eye, e->rast, &e->cam, &tg,
+                                              p->desc.cull, e->clip, e->vnrm)
+                         : pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, p->desc.cull,
+                                          e->clip, e->vnrm, NULL);
     double t1 = now_ms();
     e->ms_raster = t1 - t0;
     if (rr != RAST_OK) {
@@ -345,6 +350,8 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                      e->eye ? "right" : "left", fuse_result_str(rr2));
             return;
         }
+        pipe__cockpit_clamp(p->ck, &p->pose, e->eye, e->rast, &e->cam, e->mask, cw, e->refined,
+                            cw, p->desc.refine_band, e->clip);
         e->have_refined = 1;
         fe.mask = e->refined;
         if (p->fit && in->locals && rs.used_colour) {
@@ -457,6 +464,8 @@ static void free_eyes(pipe_ctx *p)
     }
     pipe_fit_destroy(p->fit);
     p->fit = NULL;
+    pipe__cockpit_destroy(p->ck);
+    p->ck = NULL;
 }
 
 static void skin_plans_free(pipe_ctx *p)
@@ -539,6 +548,11 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         ok = p->fit != NULL;
     }
     ok = ok && skin_plans_build(p) == 0;
+    if (ok) {
+        p->ck = pipe__cockpit_create(model, p->desc.fit_rig, p->geo.crop_width,
+                                     p->geo.crop_height, p->desc.refine_band);
+        ok = p->ck != NULL;
+    }
     p->threaded = p->desc.threads != 1;
     long nv_all = 0;
     for (int i = 0; i < model->mesh_count; i++) nv_all += model->meshes[i].vertex_count;
@@ -671,6 +685,8 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
                      p->pose.model->node_count);
         return PIPE_ERR_ARGS;
     }
+    pipe_result cr = pipe__cockpit_frame(p->ck, in, why, why_size);
+    if (cr != PIPE_OK) return cr;
 
     double t0 = now_ms();
     if (in->locals)
@@ -748,6 +764,17 @@ const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
 kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].cam; }
 
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }
+
+kin_sthmd_desc pipe_hmd(const pipe_ctx *p) { return p->hmd; }
+
+unsigned pipe_parts_present(const pipe_ctx *p) { return p ? pipe__cockpit_present(p->ck) : 0; }
+
+int pipe_add_prop(pipe_ctx *p, const kin_model *m)
+{
+    return p ? pipe__cockpit_add_prop(p->ck, m) : -1;
+}
+
+int pipe_prop_count(const pipe_ctx *p) { return p ? pipe__cockpit_prop_count(p->ck) : 0; }
 
 int pipe_image_opaque(const fuse_image *im, int x0, int y0, int w, int h)
 {
