@@ -341,6 +341,84 @@ static void parse_names(void **state)
 
 /* ------------------------------------------------------------- hiding */
 
+/* The rule for triangles across parts, on four small skinned triangles
+ * side by side (joints: body, L_upper_arm, L_hand, identity binds):
+ *   T0 all body: no part;  T1 body 1 + hand 1 + half/half: a tie of no
+ *   part and the hand: no part;  T2 arm 1 + hand 1 + half/half: a tie of
+ *   arm and hand: the hand (the lower bit);  T3 hand 1.6 : body 1.4: the
+ *   hand. Each triangle is seen at its centre or not. */
+static void tie_rule(void **state)
+{
+    (void)state;
+    static const char *const names[4] = {"head", "body", "L_upper_arm", "L_hand"};
+    static const int16_t parents[4] = {-1, -1, 1, 2};
+    kin_model m;
+    name_model(&m, 4, names, parents);
+    static float pos[36];
+    static uint16_t jnt[48];
+    static float wgt[48];
+    static uint32_t idx[12];
+    static int joints[3] = {1, 2, 3};
+    static kin_mat4 ibm[3];
+    /* per triangle, per vertex: (joint a, weight a, joint b, weight b);
+     * joints: 0 body, 1 arm, 2 hand */
+    static const float W[4][3][4] = {
+        {{0, 1, 0, 0}, {0, 1, 0, 0}, {0, 1, 0, 0}},
+        {{0, 1, 0, 0}, {2, 1, 0, 0}, {0, 0.5f, 2, 0.5f}},
+        {{1, 1, 0, 0}, {2, 1, 0, 0}, {1, 0.5f, 2, 0.5f}},
+        {{2, 1, 0, 0}, {2, 0.6f, 0, 0.4f}, {0, 1, 0, 0}},
+    };
+    for (int t = 0; t < 4; t++) {
+        float cx = -0.15f + 0.1f * (float)t;
+        const float corner[3][2] = {{-0.025f, -0.02f}, {0.025f, -0.02f}, {0.0f, 0.03f}};
+        for (int k = 0; k < 3; k++) {
+            int v = 3 * t + k;
+            pos[3 * v] = cx + corner[k][0];
+            pos[3 * v + 1] = corner[k][1];
+            pos[3 * v + 2] = -0.5f;
+            jnt[4 * v] = (uint16_t)W[t][k][0];
+            wgt[4 * v] = W[t][k][1];
+            jnt[4 * v + 1] = (uint16_t)W[t][k][2];
+            wgt[4 * v + 1] = W[t][k][3];
+            idx[v] = (uint32_t)v;
+        }
+    }
+    for (int j = 0; j < 3; j++) ibm[j] = kin_mat4_identity();
+    kin_skin skin = {3, joints, ibm};
+    kin_mesh mesh = {.vertex_count = 12, .positions = pos, .joints = jnt, .weights = wgt,
+                     .index_count = 12, .indices = idx, .node = 1, .skin = 0};
+    m.mesh_count = 1;
+    m.meshes = &mesh;
+    m.skin_count = 1;
+    m.skins = &skin;
+    char why[200];
+    assert_int_equal(kin_model_validate(&m, why, sizeof why), 0);
+    pipe_ctx *p = pipe_create(NULL, &m);
+    assert_non_null(p);
+    assert_int_equal(pipe_parts_present(p), PIPE_PART_HAND_L); /* T2 and T3 */
+    bufs b;
+    pipe_frame_in in;
+    bufs_make(&b, &in, 71);
+    in.head_node = 0;
+    static const unsigned hide[3] = {0, PIPE_PART_HAND_L, PIPE_PART_ARM_L};
+    static const int seen[3][4] = {{1, 1, 1, 1}, {1, 1, 0, 0}, {1, 1, 1, 1}};
+    for (int h = 0; h < 3; h++) {
+        in.hide = hide[h];
+        assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_OK);
+        const uint8_t *mk = pipe_mask(p, 0, NULL, NULL);
+        kin_camera cam = pipe_camera(p, 0);
+        for (int t = 0; t < 4; t++) {
+            kin_vec3 c = kin_mat4_mul_point(&cam.view, kin_v3(-0.15f + 0.1f * (float)t, 0.0f, -0.5f));
+            int x = (int)(cam.cx + cam.fx * c.x / -c.z), y = (int)(cam.cy - cam.fy * c.y / -c.z);
+            if ((mk[y * MW + x] != 0) != seen[h][t])
+                fail_msg("hide 0x%x: triangle %d %s", hide[h], t, seen[h][t] ? "not drawn" : "drawn");
+        }
+    }
+    bufs_free(&b);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
 /* Runs one frame of p with in and returns copies of both masks and outputs
  * in m[2] (MW x MH) and o[2] (LW x LH x 4). */
 static void run_keep(pipe_ctx *p, pipe_frame_in *in, bufs *b, uint8_t *m[2], uint8_t *o[2])
@@ -869,6 +947,7 @@ int main(void)
         cmocka_unit_test(names_generic),
         cmocka_unit_test(names_sample),
         cmocka_unit_test(parse_names),
+        cmocka_unit_test(tie_rule),
         cmocka_unit_test(hide_each_part),
         cmocka_unit_test(hidden_not_refined_back),
         cmocka_unit_test(prop_cube_mask),
