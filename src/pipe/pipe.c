@@ -271,6 +271,24 @@ static int image_fits(const fuse_image *im, int w, int h, int eye,
     return 0;
 }
 
+/* Columns crop_x0 .. of rows already cropped (eq. 1 with a camera wider
+ * than the LCD's aspect; v itself otherwise). */
+static fuse_image crop_cols(const pipe_ctx *p, fuse_image v)
+{
+    if (v.pixels && v.width != p->geo.crop_width) {
+        v.pixels += (size_t)4 * (size_t)p->geo.crop_x0;
+        v.width = p->geo.crop_width;
+    }
+    return v;
+}
+
+/* buf (an eye's cam_rgba) as the cropped rows of a raw frame, converted
+ * at the sensor's width. */
+static fuse_image raw_rows(const pipe_ctx *p, uint8_t *buf)
+{
+    return (fuse_image){buf, p->hmd.cam_width, p->geo.crop_height, 4 * p->hmd.cam_width};
+}
+
 static void run_eye(pipe_ctx *p, eye_state *e)
 {
     const pipe_frame_in *in = e->in;
@@ -312,12 +330,13 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     fe.intrinsics = &K;
     e->ms_convert = 0.0;
     if (e->converted) {
-        fe.P = (fuse_image){e->cam_rgba, cw, ch, 4 * cw};
+        fe.P = crop_cols(p, raw_rows(p, e->cam_rgba));
     } else if (in->camera_raw[e->eye].data) {
         double tc = now_ms();
-        fe.P = (fuse_image){e->cam_rgba, cw, ch, 4 * cw};
-        fuse_result cr = fuse_frame_to_rgba_isa(&in->camera_raw[e->eye], p->geo.crop_y0, &fe.P,
+        fuse_image rows = raw_rows(p, e->cam_rgba);
+        fuse_result cr = fuse_frame_to_rgba_isa(&in->camera_raw[e->eye], p->geo.crop_y0, &rows,
                                                 (ef_isa)p->desc.max_isa);
+        fe.P = crop_cols(p, rows);
         e->ms_convert = now_ms() - tc;
         if (cr != FUSE_OK) {
             e->result = PIPE_ERR_ARGS;
@@ -326,7 +345,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
             return;
         }
     } else {
-        fe.P = fuse_image_rows(&in->camera[e->eye], p->geo.crop_y0, ch);
+        fe.P = crop_cols(p, fuse_image_rows(&in->camera[e->eye], p->geo.crop_y0, ch));
     }
     fe.mask = e->mask;
     fe.mask_stride = cw;
@@ -520,7 +539,7 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         s->nrm = malloc(sizeof(float) * 3 * px);
         s->mask = malloc(px);
         s->layer = malloc(4 * px);
-        s->cam_rgba = malloc(4 * px);
+        s->cam_rgba = malloc(4 * (size_t)p->hmd.cam_width * (size_t)p->geo.crop_height);
         s->clip = malloc(sizeof(float) * 4 * nv);
         s->vnrm = malloc(sizeof(float) * 3 * nv);
         rast_context_desc rd = {p->desc.max_isa, 1};
@@ -609,9 +628,10 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
         eye_state *s = &p->eye[e];
         cam[e] = kin_sthmd_camera(&p->hmd, head, (kin_eye)e);
         if (in->camera_raw[e].data) {
-            P[e] = (fuse_image){s->cam_rgba, cw, ch, 4 * cw};
-            fuse_result cr = fuse_frame_to_rgba_isa(&in->camera_raw[e], p->geo.crop_y0, &P[e],
+            fuse_image rows = raw_rows(p, s->cam_rgba);
+            fuse_result cr = fuse_frame_to_rgba_isa(&in->camera_raw[e], p->geo.crop_y0, &rows,
                                                     (ef_isa)p->desc.max_isa);
+            P[e] = crop_cols(p, rows);
             if (cr != FUSE_OK) {
                 if (why && why_size > 0)
                     snprintf(why, (size_t)why_size, "%s eye: camera frame: %s",
@@ -620,7 +640,7 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
             }
             s->converted = 1;
         } else {
-            P[e] = fuse_image_rows(&in->camera[e], p->geo.crop_y0, ch);
+            P[e] = crop_cols(p, fuse_image_rows(&in->camera[e], p->geo.crop_y0, ch));
         }
         /* the colour model of the last frame's masks (run_eye) when there
          * is one; else this frame's kinematic mask is drawn for it */
