@@ -1,8 +1,9 @@
 /* test_pipe_parts.c - what the operator sees of the real cockpit (pipe.h,
  * "the operator's cockpit"):
  *   - node names: the sample's rig names and generic glTF arms (Mixamo,
- *     Unreal, Blender/Rigify, 3ds Max Biped, VRoid) give the four parts,
- *     body/head/spine none; pipe_parts_parse;
+ *     Unreal, Blender/Rigify, 3ds Max Biped, VRoid, numbered arm chains
+ *     as in Khronos' RiggedFigure) give the four parts, body/head/spine
+ *     none; pipe_parts_parse;
  *   - hiding each part of the sample model (build/samples/model/arms.glb,
  *     generated into a scratch folder when missing) draws exactly the
  *     mask, and the output images, of a pipe whose model has those
@@ -275,6 +276,13 @@ static void names_generic(void **state)
           "Bip01 L Hand", "J_Bip_L_Hand", "Armature"},
          {-1, 0, 1, 2, 3, 4, 0, 6, 7, 8, -1, -1},
          {0, AR, AR, AR, HR, HR, A, A, A, H, H, 0}, 12},
+        /* numbered "arm" chains without roles (Khronos' RiggedFigure,
+         * CesiumMan): the last of a side's chain is the hand (wrist) */
+        {{"Z_UP", "Armature", "torso_joint_1", "arm_joint_L_1", "arm_joint_L_2", "arm_joint_L_3",
+          "Skeleton_arm_joint_R", "Skeleton_arm_joint_R__2_", "Skeleton_arm_joint_R__3_",
+          "leg_joint_L_1", "neck_joint_1"},
+         {-1, 0, 1, 2, 3, 4, 2, 6, 7, 1, 2},
+         {0, 0, 0, A, A, H, AR, AR, HR, 0, 0}, 11},
     };
     for (size_t r = 0; r < sizeof rigs / sizeof rigs[0]; r++) {
         kin_model m;
@@ -292,6 +300,37 @@ static void names_generic(void **state)
         kin_model_free(&m);
     }
     assert_int_equal(pipe_parts_of_nodes(NULL, NULL, NULL), 0);
+}
+
+/* Khronos' sample models with arms (EGOFUSE_SHARED/gltf; SKIP when
+ * missing): every part owns triangles, and the rest (torso, legs) none. */
+static void names_shared_models(void **state)
+{
+    (void)state;
+    static const char *const files[] = {"gltf/CesiumMan/CesiumMan.glb",
+                                        "gltf/RiggedFigure/RiggedFigure.glb",
+                                        "gltf/Fox/Fox.glb"};
+    int seen = 0;
+    for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
+        char path[1200];
+        tu_shared_path(files[k], path, sizeof path);
+        if (!tu_exists(path)) continue;
+        kin_model m;
+        io_error err;
+        assert_int_equal(io_gltf_load(path, &m, &err), IO_OK);
+        pipe_ctx *p = pipe_create(NULL, &m);
+        assert_non_null(p);
+        if (pipe_parts_present(p) != PIPE_PART_ALL)
+            fail_msg("%s: parts 0x%x, expected all four", files[k], pipe_parts_present(p));
+        print_message("NOTE %s: all four parts found\n", files[k]);
+        pipe_destroy(p);
+        kin_model_free(&m);
+        seen++;
+    }
+    if (!seen) {
+        print_message("SKIP shared glTF models not found (EGOFUSE_SHARED/gltf)\n");
+        skip();
+    }
 }
 
 /* The sample's own names, and a rig that names other nodes. */
@@ -946,6 +985,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(names_generic),
         cmocka_unit_test(names_sample),
+        cmocka_unit_test(names_shared_models),
         cmocka_unit_test(parse_names),
         cmocka_unit_test(tie_rule),
         cmocka_unit_test(hide_each_part),

@@ -24,12 +24,14 @@ static int ends_with(const char *s, size_t n, const char *suffix)
  * changes ("Bip01"); a word "l"/"left" or "r"/"right" gives the side; the
  * other words without the all-digit ones, joined, give the role by their
  * ending: "forearm"/"lowerarm" forearm, "upperarm"/"uparm"/"arm" upper arm,
- * "hand"/"wrist" hand, "shoulder"/"clavicle"/"collar" shoulder. */
-static void name_role(const char *name, int *side, int *role)
+ * "hand"/"wrist" hand, "shoulder"/"clavicle"/"collar" shoulder.
+ * arm_word: one of the words is "arm" (for numbered chains, see below). */
+static void name_role(const char *name, int *side, int *role, int *arm_word)
 {
     char joined[KIN_NAME_MAX * 2];
     size_t jn = 0;
     int left = 0, right = 0;
+    *arm_word = 0;
     size_t n = strnlen(name, KIN_NAME_MAX);
     size_t i = 0;
     while (i < n) {
@@ -56,6 +58,7 @@ static void name_role(const char *name, int *side, int *role)
         if (!strcmp(w, "l") || !strcmp(w, "left")) { left = 1; continue; }
         if (!strcmp(w, "r") || !strcmp(w, "right")) { right = 1; continue; }
         if (digits) continue;
+        if (!strcmp(w, "arm")) *arm_word = 1;
         if (jn + wl < sizeof joined) {
             memcpy(joined + jn, w, wl);
             jn += wl;
@@ -79,11 +82,37 @@ unsigned pipe_parts_of_nodes(const kin_model *model, const kin_arm_rig *rig,
     /* role per node: 0 none, else ROLE_* | side << 3 */
     unsigned char *role = calloc((size_t)n, 1);
     if (!role) return 0;
-    for (int i = 0; i < n && model->names; i++) {
-        int side, r;
-        name_role(model->names[i], &side, &r);
-        if (side >= 0 && r != ROLE_NONE) role[i] = (unsigned char)(r | side << 3);
+    unsigned char *armw = calloc((size_t)n, 1);
+    if (!armw) {
+        free(role);
+        return 0;
     }
+    int named[2] = {0, 0};
+    for (int i = 0; i < n && model->names; i++) {
+        int side, r, aw;
+        name_role(model->names[i], &side, &r, &aw);
+        if (side >= 0 && r != ROLE_NONE) {
+            role[i] = (unsigned char)(r | side << 3);
+            if (r != ROLE_SHOULDER) named[side] = 1;
+        }
+        if (side >= 0 && aw) armw[i] = (unsigned char)(1 + side);
+    }
+    /* A side without named roles but a chain of numbered "arm" nodes
+     * ("arm_joint_L_1" .. "_3", as in Khronos' RiggedFigure and
+     * CesiumMan): the nodes of the chain that have no "arm" node of the
+     * side below them are the hand (the wrist), the others the arm. */
+    for (int i = n - 1; i >= 0; i--) {
+        if (!armw[i] || named[armw[i] - 1] || role[i]) continue;
+        int side = armw[i] - 1, below = 0;
+        for (int j = i + 1; j < n && !below; j++)
+            for (int a = model->parents[j]; a >= 0 && a < j; a = model->parents[a])
+                if (a == i) {
+                    below = armw[j] == armw[i];
+                    break;
+                }
+        role[i] = (unsigned char)((below ? ROLE_UPPER : ROLE_HAND) | side << 3);
+    }
+    free(armw);
     if (rig) {
         static const int rj[4] = {KIN_RIG_SHOULDER, KIN_RIG_UPPER_ARM, KIN_RIG_FOREARM,
                                   KIN_RIG_HAND};
