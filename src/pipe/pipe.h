@@ -23,7 +23,9 @@
  *   pipe_frame_in in = {0};
  *   in.anim = &model.anims[0]; in.time = f / 60.0f; in.head_node = head;
  *   in.camera[0] = left_640x480; in.virt[0] = left_1280x800; in.out[0] = ...;
+ *   // (the sizes of pipe_hmd(p): cam_width x cam_height, lcd_width x lcd_height)
  *   in.lighting = pipe_lighting_default(); // lights in world space
+ *   in.hide = PIPE_PART_HAND_R;             // optional: parts not shown
  *   pipe_frame(p, &in, &stats);
  *   pipe_destroy(p);
  */
