@@ -251,7 +251,7 @@ kin_sthmd_desc pipe_hmd(const pipe_ctx *p);
  * A hidden triangle is not drawn at all: per visibility set (the hide
  * bits of the parts the model has), the meshes' index lists are filtered
  * once, in their order, on the first frame that uses it, and kept (at
- * most 15 sets: one allocation each). With hide = 0 and no props the
+ * most 15 sets, each a list per mesh). With hide = 0 and no props the
  * frame is drawn exactly as before (the same bytes).
  * With the refinement (pipe_desc.refine_band) a hidden part does not come
  * back by colour: the refined mask keeps no pixel outside the kinematic
