@@ -7,9 +7,7 @@
 #include "cli.h"
 
 #define RUN_MAX_PROPS 8
-/* Parts of the operator that --hide can take out of the mask. */
-enum { RUN_PART_HAND_L = 1, RUN_PART_ARM_L = 2, RUN_PART_HAND_R = 4, RUN_PART_ARM_R = 8 };
-#define RUN_MAX_BODIES 16
+#define RUN_MAX_NATNET 32
 
 /* A real object of the cockpit cut in like the hands (--prop). */
 typedef struct run_prop {
@@ -24,15 +22,18 @@ typedef struct run_prop {
 typedef struct run_opts {
     const char *scene, *model, *virt[2], *sel[2], *glove_sel[2], *calib, *out, *stats, *dump;
     const char *virt_source, *virt_layout, *display;
-    const char *track_addr, *natnet_server, *natnet_local, *natnet_multicast;
-    const char *natnet_up, *natnet_units;
-    const char *natnet_body[RUN_MAX_BODIES];
-    int natnet_body_count, natnet_version[2];
+    const char *track_addr;
+    /* NatNet: key, value pairs for io_natnet_config_set, in order */
+    int natnet;                   /* 1: --natnet given */
+    const char *natnet_kv[RUN_MAX_NATNET][2];
+    int natnet_kv_count;
     int virt_stale_ms, virt_fps;
     uint32_t fourcc;
     int fps, input, dv, buffers, track_port, raw, frames, quiet;
+    int format_set;           /* --format given (file cameras default to RGB) */
+    int loop;                 /* file cameras: start again at the end */
+    int hold;                 /* --display: keep the last frame shown until Ctrl-C */
     int refine;               /* refinement band, px; 0 = off */
-    float ipd_m;              /* eye separation, 0 = the camera baseline */
     float predict_ms;         /* pose time = camera time + this */
     unsigned hide;            /* PIPE_PART_* bits hidden */
     kin_sthmd_desc hmd;       /* zero fields = the paper's */

@@ -11,6 +11,8 @@
 
 #include "../io/io_dev.h"
 #include "../io/io_live.h"
+#include "../io/io_natnet.h"
+#include "../io/io_vsrc.h"
 
 const char *run_usage =
     "usage: egofuse run [--config FILE] (--scene FILE | --model FILE)\n"
@@ -88,6 +90,7 @@ enum {
     O_TRACK, O_TRACK_ADDR, O_GLOVE_L, O_GLOVE_R, O_CALIB, O_OUT, O_RAW, O_FRAMES, O_QUIET,
     O_REFINE, O_CONFIG, O_STATS, O_PREDICT, O_HIDE, O_PROP, O_VSRC, O_VLAYOUT, O_VFPS, O_VSTALE,
     O_DISPLAY, O_NATNET, O_NN_LOCAL, O_NN_MCAST, O_NN_BODY, O_NN_UP, O_NN_UNITS, O_NN_VERSION,
+    O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD,
     O_HMD_CAM, O_HMD_CAM_HFOV, O_HMD_BASE, O_HMD_OFFSET, O_HMD_DISP, O_HMD_HFOV, O_HMD_VFOV,
     O_HMD_FOCAL, O_HMD_IPD, O_DUMP
 };
@@ -132,6 +135,11 @@ static const struct option run_long_opts[] = {
     {"natnet-up", required_argument, 0, O_NN_UP},
     {"natnet-units", required_argument, 0, O_NN_UNITS},
     {"natnet-version", required_argument, 0, O_NN_VERSION},
+    {"natnet-offset", required_argument, 0, O_NN_OFFSET},
+    {"natnet-command-port", required_argument, 0, O_NN_CMDPORT},
+    {"natnet-data-port", required_argument, 0, O_NN_DATAPORT},
+    {"loop", no_argument, 0, O_LOOP},
+    {"hold", no_argument, 0, O_HOLD},
     {"hmd-camera", required_argument, 0, O_HMD_CAM},
     {"hmd-camera-hfov", required_argument, 0, O_HMD_CAM_HFOV},
     {"hmd-baseline", required_argument, 0, O_HMD_BASE},
@@ -158,29 +166,6 @@ static int parse_size(const char *s, int *w, int *h)
 static int parse_range(const char *s, float lo, float hi, float *out)
 {
     return cli_parse_float(s, out) && *out >= lo && *out <= hi;
-}
-
-/* left-hand,left-arm,right-hand,right-arm (any order, "none" = none) */
-static int parse_hide(const char *s, unsigned *out)
-{
-    static const char *const names[] = {"left-hand", "left-arm", "right-hand", "right-arm"};
-    char buf[256];
-    if (strlen(s) >= sizeof buf) return 0;
-    snprintf(buf, sizeof buf, "%s", s);
-    unsigned bits = 0;
-    for (char *t = strtok(buf, ","); t; t = strtok(NULL, ",")) {
-        if (!strcmp(t, "none")) continue;
-        int k = -1;
-        for (int i = 0; i < 4; i++)
-            if (!strcmp(t, names[i])) k = i;
-        if (!strcmp(t, "left")) bits |= RUN_PART_HAND_L | RUN_PART_ARM_L;
-        else if (!strcmp(t, "right")) bits |= RUN_PART_HAND_R | RUN_PART_ARM_R;
-        else if (k < 0) return 0;
-        else bits |= (unsigned[]){RUN_PART_HAND_L, RUN_PART_ARM_L, RUN_PART_HAND_R,
-                                  RUN_PART_ARM_R}[k];
-    }
-    *out = bits;
-    return 1;
 }
 
 /* [NAME=]MODEL[@X,Y,Z[,YAW,PITCH,ROLL]][#BODY] */
@@ -310,6 +295,7 @@ int run_parse(int argc, char **argv, run_opts *o)
         case O_FORMAT:
             if (strlen(optarg) != 4) BAD("--format '%s': 4 letters", optarg);
             o->fourcc = IO_FOURCC(optarg[0], optarg[1], optarg[2], optarg[3]);
+            o->format_set = 1;
             break;
         case O_FPS:
             if (!cli_parse_int(optarg, 1, 1000, &o->fps)) BAD("--fps '%s': not a frame rate", optarg);
@@ -319,6 +305,8 @@ int run_parse(int argc, char **argv, run_opts *o)
                 BAD("--input '%s': not an input number", optarg);
             break;
         case O_DV: o->dv = 1; break;
+        case O_LOOP: o->loop = 1; break;
+        case O_HOLD: o->hold = 1; break;
         case O_BUFFERS:
             if (!cli_parse_int(optarg, 2, IO_CAM_MAX_BUFFERS, &o->buffers))
                 BAD("--buffers '%s': 2..%d", optarg, IO_CAM_MAX_BUFFERS);
@@ -348,12 +336,12 @@ int run_parse(int argc, char **argv, run_opts *o)
             if (!parse_range(optarg, -200, 200, &o->predict_ms))
                 BAD("--predict-ms '%s': -200..200 ms", optarg);
             break;
-        case O_HIDE:
-            if (!parse_hide(optarg, &o->hide))
-                BAD("--hide '%s': a list of left-hand, left-arm, right-hand, right-arm, left, "
-                    "right, none",
-                    optarg);
+        case O_HIDE: {
+            char why[256];
+            if (pipe_parts_parse(optarg, &o->hide, why, (int)sizeof why) != 0)
+                BAD("--hide '%s': %s", optarg, why);
             break;
+        }
         case O_PROP: {
             char why[128];
             if (o->prop_count == RUN_MAX_PROPS) BAD("--prop: at most %d props", RUN_MAX_PROPS);
@@ -368,8 +356,7 @@ int run_parse(int argc, char **argv, run_opts *o)
         }
         case O_VSRC: o->virt_source = optarg; break;
         case O_VLAYOUT:
-            if (strcmp(optarg, "sbs") && strcmp(optarg, "tb") && strcmp(optarg, "mono"))
-                BAD("--virt-layout '%s': sbs, tb or mono", optarg);
+            if (io_vsrc_layout_parse(optarg) < 0) BAD("--virt-layout '%s': sbs, tb or mono", optarg);
             o->virt_layout = optarg;
             break;
         case O_VFPS:
@@ -381,31 +368,21 @@ int run_parse(int argc, char **argv, run_opts *o)
                 BAD("--virt-stale '%s': 1..60000 ms", optarg);
             break;
         case O_DISPLAY: o->display = optarg; break;
-        case O_NATNET: o->natnet_server = optarg; break;
-        case O_NN_LOCAL: o->natnet_local = optarg; break;
-        case O_NN_MCAST: o->natnet_multicast = optarg; break;
-        case O_NN_BODY:
-            if (o->natnet_body_count == RUN_MAX_BODIES)
-                BAD("--natnet-body: at most %d", RUN_MAX_BODIES);
-            if (!strchr(optarg, '=')) BAD("--natnet-body '%s': POINT=NAME or POINT=#ID", optarg);
-            o->natnet_body[o->natnet_body_count++] = optarg;
-            break;
-        case O_NN_UP:
-            if (strcmp(optarg, "y") && strcmp(optarg, "z")) BAD("--natnet-up '%s': y or z", optarg);
-            o->natnet_up = optarg;
-            break;
-        case O_NN_UNITS:
-            if (strcmp(optarg, "m") && strcmp(optarg, "mm"))
-                BAD("--natnet-units '%s': m or mm", optarg);
-            o->natnet_units = optarg;
-            break;
-        case O_NN_VERSION: {
-            int ma = 0, mi = 0, n = 0;
-            if (sscanf(optarg, "%d.%d%n", &ma, &mi, &n) != 2 || optarg[n] || ma < 2 || ma > 4 ||
-                mi < 0 || mi > 9)
-                BAD("--natnet-version '%s': MAJOR.MINOR such as 3.1 or 4.1", optarg);
-            o->natnet_version[0] = ma;
-            o->natnet_version[1] = mi;
+        case O_NATNET: case O_NN_LOCAL: case O_NN_MCAST: case O_NN_BODY: case O_NN_UP:
+        case O_NN_UNITS: case O_NN_VERSION: case O_NN_OFFSET: case O_NN_CMDPORT:
+        case O_NN_DATAPORT: {
+            static const char *const key[] = {"server", "local", "multicast", "body", "up",
+                                              "units", "version", "offset", "command-port",
+                                              "data-port"};
+            const char *k = key[c == O_NATNET ? 0 : c - O_NN_LOCAL + 1];
+            io_natnet_config scratch;
+            io_error err;
+            io_natnet_config_default(&scratch);
+            if (io_natnet_config_set(&scratch, k, optarg, &err) != IO_OK) BAD("%s", err.msg);
+            if (o->natnet_kv_count == RUN_MAX_NATNET) BAD("at most %d NatNet options", RUN_MAX_NATNET);
+            o->natnet_kv[o->natnet_kv_count][0] = k;
+            o->natnet_kv[o->natnet_kv_count++][1] = optarg;
+            if (c == O_NATNET) o->natnet = 1;
             break;
         }
         case O_HMD_CAM:
@@ -442,7 +419,7 @@ int run_parse(int argc, char **argv, run_opts *o)
             break;
         case O_HMD_IPD:
             if (!parse_range(optarg, 0.04f, 0.09f, &f)) BAD("--hmd-ipd '%s': 0.04..0.09 m", optarg);
-            o->ipd_m = f;
+            o->hmd.ipd_m = f;
             break;
         case ':': BAD("option %s needs a value", av[optind - 1]);
         default: BAD("unknown option '%s'", av[optind - 1]);
@@ -453,19 +430,22 @@ int run_parse(int argc, char **argv, run_opts *o)
     if (!o->sel[0] != !o->sel[1]) return cli_usage_error("run", "give both --left and --right");
     for (int e = 0; e < 2; e++) {
         io_error err;
-        if (o->sel[e] && strncmp(o->sel[e], "/dev/", 5) && strncmp(o->sel[e], "file:", 5) &&
+        if (o->sel[e] && strncmp(o->sel[e], "/dev/", 5) && !io_cam_file_selector(o->sel[e]) &&
             io_usb_selector_check(o->sel[e], &err) != IO_OK)
             return cli_usage_error("run", "--%s: %s", e ? "right" : "left", err.msg);
     }
     int outs = !!o->out + !!o->raw + !!o->display;
     if (outs > 1) return cli_usage_error("run", "--display, --out and --raw exclude each other");
     if (o->dump && !o->frames) return cli_usage_error("run", "--dump needs --frames N");
-    if (o->track_port && o->natnet_server)
+    if (o->hold && !o->display) return cli_usage_error("run", "--hold needs --display");
+    if (o->natnet_kv_count && !o->natnet)
+        return cli_usage_error("run", "--natnet-* options need --natnet SERVER");
+    if (o->track_port && o->natnet)
         return cli_usage_error("run", "--track-port and --natnet exclude each other");
     if (o->virt_source && o->virt[0])
         return cli_usage_error("run", "--virt-source and --virt exclude each other");
     for (int i = 0; i < o->prop_count; i++)
-        if (o->prop[i].body[0] && !o->natnet_server)
+        if (o->prop[i].body[0] && !o->natnet)
             return cli_usage_error("run", "--prop %s#%s: a prop posed by a rigid body needs --natnet",
                                    o->prop[i].name, o->prop[i].body);
     return -1;
