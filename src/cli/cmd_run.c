@@ -224,6 +224,16 @@ static void on_flip(const run_opts *o, run_state *r, const io_display_flip *ev, 
     }
 }
 
+/* The flip events that came, without waiting. */
+static void drain_flips(const run_opts *o, run_state *r, io_lat *lat_shown, io_lat *lat_deq)
+{
+    io_display_flip ev;
+    int got = 0;
+    io_error err;
+    while (io_display_poll(r->disp, 0, &ev, &got, &err) == IO_OK && got)
+        on_flip(o, r, &ev, lat_shown, lat_deq);
+}
+
 /* Waits until deadline_ns (or, with want_cams, until a camera has a
  * frame), serving the display's flip events, the tracker and the V source
  * meanwhile. Returns 1 when a camera became readable. */
@@ -256,18 +266,9 @@ static int wait_until(const run_opts *o, run_state *r, uint64_t deadline_ns, int
         if (k < 0 && errno != EINTR) return 0;
         if (stop_flag) return 0;
         io_error err;
-        if (disp_i >= 0 && (pf[disp_i].revents & POLLIN)) {
-            io_display_flip ev;
-            int got = 0;
-            while (io_display_poll(r->disp, 0, &ev, &got, &err) == IO_OK && got)
-                on_flip(o, r, &ev, lat_shown, lat_deq);
-        }
-        if (r->disp && io_display_fd(r->disp) < 0) { /* SDL: events by polling */
-            io_display_flip ev;
-            int got = 0;
-            while (io_display_poll(r->disp, 0, &ev, &got, &err) == IO_OK && got)
-                on_flip(o, r, &ev, lat_shown, lat_deq);
-        }
+        /* flip events (SDL has no descriptor: its come by polling) */
+        if (r->disp && (disp_i < 0 || (pf[disp_i].revents & POLLIN)))
+            drain_flips(o, r, lat_shown, lat_deq);
         track_service(r);
         if (r->vsrc) {
             int fresh;
@@ -802,6 +803,7 @@ static int run(const run_opts *o)
          * vblank that shows the frame (free-running without a display) */
         io_sched_plan plan = {now, 0, 0};
         if (r->disp) {
+            drain_flips(o, r, &lat_cam, &lat_deq);
             plan = io_sched_next(&r->sched, now);
             if (plan.start_ns > now) wait_until(o, r, plan.start_ns, 0, &lat_cam, &lat_deq);
             if (stop_flag) break;
@@ -949,6 +951,7 @@ static int run(const run_opts *o)
                 r->pending[0] = r->pending[--r->npending];
             }
             r->pending[r->npending++] = lg;
+            drain_flips(o, r, &lat_cam, &lat_deq); /* SDL's come with the present */
         } else {
             if (write_outputs(o, r, frames, W, H) != EXIT_OK) goto done;
             lg.t_shown = mono_ns();
