@@ -8,6 +8,8 @@
 #include "support/testutil.h"
 #include <cmocka.h>
 
+#include "../src/io/io.h"
+
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
@@ -22,7 +24,7 @@
 #include <unistd.h>
 
 #define LOG_MAX (1 << 20)
-#define VM_TIMEOUT_S 420
+#define VM_TIMEOUT_S 900
 
 static char skip_reason[512];
 static char *vm_log;      /* guest output */
@@ -121,9 +123,31 @@ static void on_display_two_dump(const char *prefix, const char *qmp_sock)
 }
 /* ---- end display */
 
+/* ---- cockpit: `egofuse run` on the KMS display holds its last frame;
+ * the host takes its screendump (test_vm_cockpit compares it with
+ * `egofuse render` of the inputs run dumped). */
+static char cockpit_dump[1024];
+static int cockpit_dump_rc = -1;
+
+static void on_cockpit_dump(const char *file, const char *qmp_sock)
+{
+    char cmd[1400], ack[1100];
+    snprintf(cockpit_dump, sizeof cockpit_dump, "%.*s", (int)strcspn(file, " \r\n"), file);
+    snprintf(cmd, sizeof cmd, "{\"execute\":\"screendump\",\"arguments\":{\"filename\":\"%s\","
+             "\"device\":\"display0\"}}\n", cockpit_dump);
+    cockpit_dump_rc = qmp(qmp_sock, cmd);
+    snprintf(ack, sizeof ack, "%s.ack", cockpit_dump);
+    FILE *f = fopen(ack, "w");
+    if (f) {
+        fprintf(f, "%d\n", cockpit_dump_rc);
+        fclose(f);
+    }
+}
+
 static void on_line(const char *line, const char *qmp_sock)
 {
     if (!strncmp(line, "VMSYNC display-dump ", 20)) on_display_dump(line + 20, qmp_sock);
+    if (!strncmp(line, "VMSYNC cockpit-dump ", 20)) on_cockpit_dump(line + 20, qmp_sock);
     if (!strncmp(line, "VMSYNC display-two-dump ", 24)) on_display_two_dump(line + 24, qmp_sock);
     if (!strncmp(line, "VMSYNC usb-unplug", 17))
         qmp(qmp_sock, "{\"execute\":\"device_del\",\"arguments\":{\"id\":\"camr\"}}\n");
@@ -470,6 +494,61 @@ static void test_vm_display(void **st)
 }
 /* ---- end display */
 
+/* The live cockpit in the VM: what the KMS display showed (qemu's
+ * screendump of the held last frame) is byte for byte what `egofuse
+ * render` composites from the inputs that `run --dump` wrote for that
+ * frame: the camera pair, the V pair from vivid, the NatNet pose. */
+static void test_vm_cockpit(void **st)
+{
+    (void)st;
+    static const char *const names[] = {"cockpit_dump_ack", "cockpit_kms", "cockpit_sources_end"};
+    expect(names, (int)(sizeof names / sizeof names[0]));
+    assert_int_equal(cockpit_dump_rc, 0);
+    char dir[1100], scene[1200], out[1200];
+    snprintf(dir, sizeof dir, "%.*s", (int)(strrchr(cockpit_dump, '/') - cockpit_dump), cockpit_dump);
+    snprintf(scene, sizeof scene, "%s/dump/scene.txt", dir);
+    snprintf(out, sizeof out, "%s/render", dir);
+    const char *bin = getenv("EGOFUSE_BIN") ? getenv("EGOFUSE_BIN") : "build/egofuse";
+    char *argv[] = {(char *)bin, "render", "--scene", scene, "--out", out, "--pose", "tracking",
+                    "--no-filter", NULL};
+    static char rout[65536];
+    int rc = tu_run(argv, rout, sizeof rout);
+    if (rc != 0) fail_msg("egofuse render of the dump: exit %d: %s", rc, rout);
+    int pw = 0, ph = 0;
+    uint8_t *got = read_ppm(cockpit_dump, &pw, &ph);
+    if (!got) fail_msg("%s: not a P6 PPM", cockpit_dump);
+    printf("    screendump %s: %dx%d\n", cockpit_dump, pw, ph);
+    assert_true(pw >= 2 * 1280 && ph >= 800);
+    size_t bad = 0, total = 0;
+    for (int e = 0; e < 2; e++) {
+        char png[1300];
+        snprintf(png, sizeof png, "%s/%s_0000.png", out, e ? "right" : "left");
+        io_image im;
+        io_error err;
+        if (io_image_load(png, IO_U8, 3, &im, &err) != IO_OK) fail_msg("%s", err.msg);
+        assert_int_equal(im.width, 1280);
+        assert_int_equal(im.height, 800);
+        /* each eye centred in its half of the mode (io_display's rule) */
+        int half = pw / 2, x0 = e * half + (half - 1280) / 2, y0 = (ph - 800) / 2;
+        size_t first = (size_t)-1;
+        for (int y = 0; y < 800; y++)
+            for (int x = 0; x < 1280 * 3; x++) {
+                uint8_t a = got[((size_t)(y0 + y) * (size_t)pw + (size_t)x0) * 3 + (size_t)x];
+                uint8_t b = ((const uint8_t *)im.data)[(size_t)y * im.stride + (size_t)x];
+                total++;
+                if (a != b && !bad++) first = (size_t)y * 1280 * 3 + (size_t)x;
+            }
+        if (first != (size_t)-1)
+            printf("    %s eye: first difference at (%zu, %zu)\n", e ? "right" : "left",
+                   (first / 3) % 1280, first / 3840);
+        io_image_free(&im);
+    }
+    free(got);
+    printf("    %zu of %zu bytes differ between the display and egofuse render of the dump\n", bad,
+           total);
+    assert_int_equal(bad, 0);
+}
+
 static void test_vm_vsrc(void **st)
 {
     (void)st;
@@ -504,6 +583,7 @@ int main(void)
         cmocka_unit_test(test_vm_display),
         cmocka_unit_test(test_vm_display_two),
         cmocka_unit_test(test_vm_vsrc),
+        cmocka_unit_test(test_vm_cockpit),
         cmocka_unit_test(test_vm_all_passed),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

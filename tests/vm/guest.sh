@@ -94,5 +94,90 @@ else
     rm -f "$OUT/run.rgb"
 fi
 
+step cockpit
+# The live cockpit end to end: vivid's video0/video1 as the HMD cameras,
+# video2/video3 as the remote scene V, NatNet from `egofuse replay-track`
+# on the loopback, the composite on the KMS display (bochs). The host takes
+# a screendump of the held last frame ("VMSYNC cockpit-dump FILE", answered
+# with FILE.ack) and compares it with `egofuse render` of the inputs that
+# `run --dump` wrote (tests/test_vm.c, test_vm_cockpit). Then a second run
+# with V from a gst-launch-1.0 pipe that ends mid-run and a tracker that
+# stops mid-run: both reported, the run goes on to its last frame.
+S="$VM/samples"
+CK="$OUT/cockpit"
+rm -rf "$CK"
+mkdir -p "$CK"
+wait_file() { i=0; while [ ! -e "$1" ] && [ $i -lt "$2" ]; do sleep 0.2; i=$((i + 1)); done; [ -e "$1" ]; }
+wait_grep() { i=0; while ! tr '\r' '\n' < "$1" 2>/dev/null | grep -q "$2" && [ $i -lt "$3" ]; do sleep 0.2; i=$((i + 1)); done; tr '\r' '\n' < "$1" | grep -q "$2"; }
+if [ ! -x "$EGOFUSE" ] || [ ! -f "$S/scene.txt" ]; then
+    echo "VMTEST cockpit_kms FAIL $EGOFUSE or $S/scene.txt missing"
+    fail=1
+else
+    "$EGOFUSE" replay-track "$S/track.txt" --to natnet:127.0.0.1:1510 --loop > "$CK/replay.log" 2>&1 &
+    RP=$!
+    "$EGOFUSE" run --scene "$S/scene.txt" --left /dev/video0 --right /dev/video1 --input 1 --dv \
+        --fps 60 --virt-source v4l2:/dev/video2,/dev/video3 --natnet 127.0.0.1 \
+        --display kms --frames 6 --hold --dump "$CK/dump" --stats "$CK/frames.csv" \
+        > "$CK/run.out" 2> "$CK/run.err" &
+    RUN=$!
+    if wait_grep "$CK/run.err" "holding frame" 900; then
+        tr '\r' '\n' < "$CK/run.err" | grep . | tail -n 4 | sed 's/^/VMINFO cockpit /'
+        rm -f "$CK/screen.ppm.ack"
+        echo "VMSYNC cockpit-dump $CK/screen.ppm"
+        if wait_file "$CK/screen.ppm.ack" 300; then
+            echo "VMTEST cockpit_dump_ack PASS the host took the screendump of the held frame"
+        else
+            echo "VMTEST cockpit_dump_ack FAIL no answer from the host"
+            fail=1
+        fi
+    else
+        echo "VMTEST cockpit_kms FAIL run did not reach its held last frame: $(tr '\r' '\n' < "$CK/run.err" | tail -n 3)"
+        fail=1
+    fi
+    kill -INT $RUN 2>/dev/null
+    wait $RUN
+    rc=$?
+    kill $RP 2>/dev/null
+    wait $RP 2>/dev/null
+    sum=$(grep 'stereo frames' "$CK/run.out" | tail -n 1)
+    echo "VMINFO cockpit summary $sum"
+    grep 'display ' "$CK/run.out" | sed 's/^/VMINFO cockpit /'
+    if [ $rc -eq 0 ] && echo "$sum" | grep -q '^egofuse run: 6 stereo frames' && echo "$sum" | grep -q 'V live' &&
+        echo "$sum" | grep -q 'tracker ' && ! echo "$sum" | grep -q 'no pose yet' && [ -f "$CK/dump/scene.txt" ] &&
+        [ -f "$CK/dump/track.txt" ] && [ "$(wc -l < "$CK/frames.csv")" -eq 7 ]; then
+        echo "VMTEST cockpit_kms PASS exit 0 after Ctrl-C; 6 frames logged; V live; NatNet pose; dump written"
+    else
+        echo "VMTEST cockpit_kms FAIL exit $rc: $sum $(tail -c 300 "$CK/run.err")"
+        fail=1
+    fi
+
+    # second run: V from a real producer on a pipe, ending after 4 frames
+    # of its own; the tracker replays 2 samples and stops
+    if command -v gst-launch-1.0 >/dev/null 2>&1; then
+        export GST_REGISTRY=/tmp/gst-registry.bin XDG_CACHE_HOME=/tmp
+        "$EGOFUSE" replay-track "$S/track.txt" --to natnet:127.0.0.1:1510 > "$CK/replay2.log" 2>&1 &
+        RP=$!
+        gst-launch-1.0 -q videotestsrc num-buffers=4 pattern=smpte ! \
+            video/x-raw,format=I420,width=640,height=200,framerate=30/1 ! y4menc ! fdsink fd=1 2> "$CK/gst.err" |
+            "$EGOFUSE" run --scene "$S/scene.txt" --left /dev/video0 --right /dev/video1 --input 1 --dv \
+            --fps 60 --virt-source stream:- --natnet 127.0.0.1 --frames 12 --raw \
+            > /dev/null 2> "$CK/run2.err"
+        rc=$?
+        wait $RP 2>/dev/null
+        sum=$(tr '\r' '\n' < "$CK/run2.err" | grep 'stereo frames' | tail -n 1)
+        echo "VMINFO cockpit2 $sum"
+        if [ $rc -eq 0 ] && echo "$sum" | grep -q '^egofuse run: 12 stereo frames' &&
+            echo "$sum" | grep -q 'V ended (last good held' && echo "$sum" | grep -q 'tracker stale'; then
+            echo "VMTEST cockpit_sources_end PASS V from gst-launch-1.0 ended and the tracker stopped mid-run: reported, 12 frames composited"
+        else
+            echo "VMTEST cockpit_sources_end FAIL exit $rc: $sum $(tail -c 300 "$CK/run2.err") $(cat "$CK/gst.err")"
+            fail=1
+        fi
+    else
+        echo "VMTEST cockpit_sources_end FAIL gst-launch-1.0 is not installed (scripts/deps.sh installs it)"
+        fail=1
+    fi
+fi
+
 step end
 exit $fail
