@@ -565,6 +565,8 @@ static void validity_config(void **state)
     assert_int_equal(io_natnet_config_set(&c, "natnet.body", "shoulder-right=none", &err), IO_OK);
     assert_int_equal(c.point[IO_NATNET_SHOULDER_R].name[0], 0);
     assert_int_equal(io_natnet_config_set(&c, "version", "4.1", &err), IO_OK);
+    assert_int_equal(io_natnet_config_set(&c, "natnet", "10.1.2.3", &err), IO_OK);
+    assert_string_equal(c.server, "10.1.2.3");
     assert_int_equal(c.version_major * 10 + c.version_minor, 41);
     static const struct { const char *k, *v, *why; } bad[] = {
         { "colour", "red", "unknown key 'colour'" },
