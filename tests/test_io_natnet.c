@@ -544,7 +544,7 @@ static void validity_no_answer(void **state)
     char want[64];
     snprintf(want, sizeof want, "natnet server 127.0.0.1:%d: no answer in 300 ms", s.port);
     assert_non_null(strstr(err.msg, want));
-    assert_true(n.connects_sent >= 3);
+    assert_true(n.connects_sent >= 2);   /* sent again while unanswered */
     assert_non_null(strstr(n.last_error, "no answer to NAT_CONNECT"));
     /* the requests did arrive */
     assert_int_equal(server_expect(&s, IO_NATNET_CONNECT), 271);
