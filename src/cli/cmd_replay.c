@@ -39,7 +39,8 @@ static const char *replay_usage =
     "                        its tracking-valid bit clear; gloves are not\n"
     "                        sent). Unicast (default): frames go to every\n"
     "                        client that sent NAT_CONNECT, and the replay\n"
-    "                        starts with the first one\n"
+    "                        starts with the first one (once it asked for the\n"
+    "                        model definitions, or 1 s after it came)\n"
     "  --multicast GROUP[:PORT]  natnet: frames to the group instead\n"
     "                        (239.255.42.99:1511 is Motive's default); starts\n"
     "                        at once\n"
@@ -117,7 +118,7 @@ typedef struct server {
     struct sockaddr_in group;
     struct sockaddr_in client[16];
     int clients;
-    uint64_t requests;
+    uint64_t requests, model_requests;
 } server;
 
 static int v41(const server *s) { return s->major > 4 || (s->major == 4 && s->minor >= 1); }
@@ -267,6 +268,7 @@ static void serve(server *s, const replay_opts *o)
                 }
             }
         } else if (id == IO_NATNET_REQUEST_MODELDEF) {
+            s->model_requests++;
             model_def(s, &b);
             send_to(s->cmd_fd, &b, &from);
         } else if (id == IO_NATNET_REQUEST) {
@@ -406,10 +408,18 @@ static int replay(const replay_opts *o)
             if (!o->quiet)
                 fprintf(stderr, "egofuse replay-track: %s waiting for a client\n", dest);
             uint64_t t_end = o->wait_s > 0 ? mono_ns() + (uint64_t)(o->wait_s * 1e9) : 0;
-            while (!srv.clients && !stop_flag) {
+            uint64_t t_client = 0;
+            /* start when the first client connected and asked for the
+             * model definitions (its frames then carry names), or 1 s
+             * after it connected */
+            while (!stop_flag && (!srv.clients || (!srv.model_requests &&
+                                                   mono_ns() - t_client < 1000000000ull))) {
                 struct pollfd pf = { srv.cmd_fd, POLLIN, 0 };
-                poll(&pf, 1, 100);
+                poll(&pf, 1, srv.clients ? 10 : 100);
+                int had = srv.clients;
                 serve(&srv, o);
+                if (!had && srv.clients) t_client = mono_ns();
+                if (srv.clients) continue;
                 if (t_end && mono_ns() > t_end) {
                     cli_fail("%s: no NatNet client connected within %g s", dest, o->wait_s);
                     goto done;

@@ -433,6 +433,7 @@ io_result io_natnet_config_set(io_natnet_config *c, const char *key, const char 
                                io_error *err)
 {
     if (!c || !key || !value) return io_fail(err, IO_ERR_ARGS, "natnet: NULL key or value");
+    if (!strcmp(key, "natnet")) key = "server";   /* `--natnet SERVER` */
     if (!strncmp(key, "natnet-", 7) || !strncmp(key, "natnet.", 7)) key += 7;
 #define BAD(...) return io_fail(err, IO_ERR_ARGS, "natnet %s '%s': " __VA_ARGS__)
     if (!strcmp(key, "server") || !strcmp(key, "local")) {

@@ -109,7 +109,9 @@ void io_natnet_config_default(io_natnet_config *c);
  * up (y|z), body (POINT=NAME, POINT=#ID or POINT=none), offset
  * (POINT=x,y,z[,qx,qy,qz,qw]); POINT is head, shoulder-left,
  * shoulder-right, hand-left or hand-right (also head, sl, sr, hl, hr).
- * Keys may carry a "natnet-" or "natnet." prefix. IO_ERR_ARGS with the
+ * Keys may carry a "natnet-" or "natnet." prefix ("natnet" alone is
+ * "server"), so a command line's long option names (--natnet SERVER,
+ * --natnet-body ...) can be passed as they are. IO_ERR_ARGS with the
  * key, value and reason on a bad key or value. */
 io_result io_natnet_config_set(io_natnet_config *c, const char *key, const char *value,
                                io_error *err);
