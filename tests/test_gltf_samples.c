@@ -393,6 +393,113 @@ static void scenes_pick_their_nodes(void **state)
     assert_non_null(strstr(err.msg, "scene 2"));
 }
 
+/* ------------------------------------ the pipeline (render / run) */
+
+/* pipe_frame (what `egofuse render` and `run` call per frame, both eyes
+ * on two threads) draws morphed and strip/fan models like pipe_pose_draw
+ * of the same pose through the same eye camera, and the masks change
+ * with the animation's morph weights; a frame posed by locals uses the
+ * default weights again. */
+static void pipeline_draws_morphs_and_strips(void **state)
+{
+    (void)state;
+    static const struct { const char *rel; float head[3]; } cases[] = {
+        {"gltf/SimpleMorph/glTF/SimpleMorph.gltf", {0.5f, 0.5f, 2.0f}},
+        {"gltf/AnimatedMorphCube/glTF-Quantized/AnimatedMorphCube.gltf", {0.0f, 0.0f, 4.0f}},
+        {"gltf/MeshPrimitiveModes/glTF/MeshPrimitiveModes.gltf", {0.0f, -1.5f, 8.0f}},
+    };
+    int ran = 0;
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        char path[1024], msg[1200];
+        if (!shared_ok(cases[c].rel, path, sizeof path)) continue;
+        loaded l;
+        if (!load(path, -1, &l, msg, sizeof msg)) fail_msg("%s", msg);
+        pipe_desc d = {0};
+        d.threads = 2;
+        pipe_ctx *p = pipe_create(&d, &l.model);
+        assert_non_null(p);
+        kin_sthmd_geometry g = pipe_geometry(p);
+        const kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
+        uint8_t *cam = calloc((size_t)hd.cam_width * hd.cam_height * 4, 1);
+        uint8_t *virt = calloc((size_t)hd.lcd_width * hd.lcd_height * 4, 1);
+        uint8_t *out[2] = {calloc((size_t)hd.lcd_width * hd.lcd_height * 4, 1),
+                           calloc((size_t)hd.lcd_width * hd.lcd_height * 4, 1)};
+        const int cw = g.crop_width, ch = g.crop_height;
+        uint8_t *mask = malloc((size_t)cw * ch), *prev = calloc((size_t)cw * ch, 1);
+        float *depth = malloc(sizeof(float) * (size_t)cw * ch);
+        kin_mat4 head = kin_mat4_from_tr(kin_v3(cases[c].head[0], cases[c].head[1], cases[c].head[2]),
+                                         kin_quat_identity());
+        pipe_frame_in in;
+        memset(&in, 0, sizeof in);
+        in.head_node = -1;
+        in.world_from_head = &head;
+        for (int e = 0; e < 2; e++) {
+            in.camera[e] = (fuse_image){cam, hd.cam_width, hd.cam_height, 4 * hd.cam_width};
+            in.virt[e] = (fuse_image){virt, hd.lcd_width, hd.lcd_height, 4 * hd.lcd_width};
+            in.out[e] = (fuse_image){out[e], hd.lcd_width, hd.lcd_height, 4 * hd.lcd_width};
+        }
+        in.lighting = pipe_lighting_default();
+        const kin_animation *an = l.model.anim_count ? &l.model.anims[0] : NULL;
+        int changed = 0;
+        for (int ti = 0; ti < TIMES + 1; ti++) {
+            /* the last frame: posed by locals (the rest transforms) */
+            kin_transform *loc = NULL;
+            if (ti == TIMES) {
+                loc = malloc(sizeof *loc * (size_t)l.model.node_count);
+                kin_pose_rest(&l.model, loc);
+            }
+            in.locals = loc;
+            in.anim = ti > 0 && ti < TIMES ? an : NULL;
+            in.time = an && ti > 0 && ti < TIMES ? time_frac[ti] * an->duration : 0.0f;
+            char why[256] = "";
+            assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_OK);
+            /* the same pose drawn directly */
+            if (loc) pipe_pose_locals(&l.ps, loc);
+            else pipe_pose_anim(&l.ps, in.anim, in.time);
+            for (int e = 0; e < 2; e++) {
+                int mw = 0, mh = 0;
+                const uint8_t *pm = pipe_mask(p, e, &mw, &mh);
+                assert_int_equal(mw, cw);
+                assert_int_equal(mh, ch);
+                kin_camera kc = pipe_camera(p, e);
+                rast_target tg = {cw, ch, depth, cw, mask, cw, NULL, 0, 0};
+                rast_target_clear(&tg);
+                assert_int_equal(pipe_pose_draw(&l.ps, NULL, &kc, &tg, RAST_CULL_NONE, l.clip,
+                                                l.vnrm, NULL), RAST_OK);
+                int set = 0, diff = 0;
+                for (int i = 0; i < cw * ch; i++) {
+                    set += pm[i] != 0;
+                    diff += (pm[i] != 0) != (mask[i] != 0);
+                }
+                if (set == 0 || diff != 0)
+                    fail_msg("%s frame %d eye %d: %d px set, %d differ from pipe_pose_draw",
+                             cases[c].rel, ti, e, set, diff);
+                if (e == 0) {
+                    if (ti > 0 && memcmp(prev, pm, (size_t)cw * ch) != 0) changed++;
+                    memcpy(prev, pm, (size_t)cw * ch);
+                }
+            }
+            free(loc);
+        }
+        /* morphs: the weights move the mask (frames 1, 2, and back to the
+         * defaults in frame 3) */
+        if (an) assert_true(changed >= 2);
+        printf("NOTE: %s through pipe_frame: %d of %d frames changed the left mask\n",
+               cases[c].rel + 5, changed, TIMES);
+        pipe_destroy(p);
+        free(cam);
+        free(virt);
+        free(out[0]);
+        free(out[1]);
+        free(mask);
+        free(prev);
+        free(depth);
+        unload(&l);
+        ran++;
+    }
+    if (!ran) skip();
+}
+
 /* ----------------------------------------------- gltfpack variants */
 
 static int find_gltfpack(char *buf, size_t n)
@@ -700,6 +807,7 @@ int main(void)
         cmocka_unit_test(morph_weights_drive_the_geometry),
         cmocka_unit_test(primitive_modes_in_spec_order),
         cmocka_unit_test(scenes_pick_their_nodes),
+        cmocka_unit_test(pipeline_draws_morphs_and_strips),
         cmocka_unit_test(gltfpack_variants),
         cmocka_unit_test(bad_input_named),
         cmocka_unit_test(cli_refuses_without_output),
