@@ -49,7 +49,7 @@ BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC)) \
 
 IO_PKGS  := OpenImageIO tinygltf libusb-1.0 libv4l2
 IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) 2>/dev/null)
-IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lstdc++
+IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lmeshoptimizer -lstdc++
 SYS_LIBS := -lm -lpthread
 # Peers measured by the benchmarks: pixman (compositing), Mesa llvmpipe
 # through EGL + GLES (the same frame as GL shaders).

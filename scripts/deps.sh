@@ -10,7 +10,7 @@ set -eu
 
 PKGS="build-essential pkg-config
 libopenimageio-dev openimageio-tools
-libtinygltf-dev
+libtinygltf-dev libmeshoptimizer-dev gltfpack
 libv4l-dev libusb-1.0-0-dev
 libcmocka-dev
 gnuplot-nox

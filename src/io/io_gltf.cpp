@@ -13,8 +13,13 @@
  *   TINYGLTF_IMPLEMENTATION and without any TINYGLTF_NO_* / _USE_* macro:
  *   those change the layout of tinygltf::TinyGLTF and must match the
  *   library's build.
+ *   Debian's libmeshoptimizer (-lmeshoptimizer, 0.18) decodes the buffer
+ *   views of EXT_meshopt_compression (meshopt_decodeVertexBuffer,
+ *   meshopt_decodeIndexBuffer / IndexSequence and the filters) into the
+ *   fallback buffer tinygltf allocated, before anything reads them.
  */
 #include <tiny_gltf.h>
+#include <meshoptimizer.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -1372,6 +1377,7 @@ bool extension_implemented(const std::string &e)
 {
     static const char *const geometry[] = {
         "KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
+        "EXT_meshopt_compression",
     };
     static const char *const neutral[] = {
         "KHR_texture_transform", "KHR_texture_basisu", "EXT_texture_webp",
@@ -1384,6 +1390,164 @@ bool extension_implemented(const std::string &e)
         if (n[len - 1] == '_' ? e.compare(0, len, n) == 0 : e == n) return true;
     }
     return false;
+}
+
+/* EXT_meshopt_compression: decodes every buffer view that has it into
+ * the view's own bytes (its buffer is the fallback buffer, which tinygltf
+ * allocated, zeroed, when it has no uri), checking every range first. */
+io_result decode_meshopt(const char *path, tinygltf::Model &g, io_error *err)
+{
+    for (size_t vi = 0; vi < g.bufferViews.size(); vi++) {
+        tinygltf::BufferView &bv = g.bufferViews[vi];
+        tinygltf::ExtensionMap::const_iterator it =
+            bv.extensions.find("EXT_meshopt_compression");
+        if (it == bv.extensions.end()) continue;
+        const tinygltf::Value &e = it->second;
+        auto num = [&](const char *k, long long dflt, long long *out) -> bool {
+            if (!e.Has(k)) { *out = dflt; return dflt >= 0; }
+            const tinygltf::Value &v = e.Get(k);
+            if (!v.IsNumber() && !v.IsInt()) return false;
+            double d = v.GetNumberAsDouble();
+            if (!(d >= 0.0 && d <= 9.0e15) || d != std::floor(d)) return false;
+            *out = (long long)d;
+            return true;
+        };
+        long long src_buf, src_off, src_len, stride, count;
+        if (!num("buffer", -1, &src_buf) || !num("byteOffset", 0, &src_off) ||
+            !num("byteLength", -1, &src_len) || !num("byteStride", -1, &stride) ||
+            !num("count", -1, &count))
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression needs "
+                           "buffer, byteLength, byteStride and count as "
+                           "non-negative integers", path, vi);
+        std::string mode = e.Has("mode") ? e.Get("mode").Get<std::string>() : "";
+        std::string filter = e.Has("filter") ? e.Get("filter").Get<std::string>() : "NONE";
+        if ((size_t)src_buf >= g.buffers.size() ||
+            (size_t)src_off > g.buffers[(size_t)src_buf].data.size() ||
+            (size_t)src_len > g.buffers[(size_t)src_buf].data.size() - (size_t)src_off)
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression data "
+                           "(buffer %lld, bytes %lld..%lld) lies outside its "
+                           "buffer", path, vi, src_buf, src_off, src_off + src_len);
+        if (count > (long long)MAX_COUNT || stride < 1 || stride > 256 ||
+            (size_t)(count * stride) != bv.byteLength)
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression count "
+                           "%lld x byteStride %lld does not give its byteLength "
+                           "%zu", path, vi, count, stride, bv.byteLength);
+        if (bv.buffer < 0 || (size_t)bv.buffer >= g.buffers.size() ||
+            bv.byteOffset > g.buffers[(size_t)bv.buffer].data.size() ||
+            bv.byteLength > g.buffers[(size_t)bv.buffer].data.size() - bv.byteOffset)
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu (the output of "
+                           "EXT_meshopt_compression) lies outside its buffer",
+                           path, vi);
+        if (bv.buffer == (int)src_buf)
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression "
+                           "decodes into the buffer it reads", path, vi);
+        unsigned char *dst = g.buffers[(size_t)bv.buffer].data.data() + bv.byteOffset;
+        const unsigned char *src = g.buffers[(size_t)src_buf].data.data() + src_off;
+        int rc = -1;
+        if (mode == "ATTRIBUTES") {
+            if (stride % 4 != 0)
+                return io_fail(err, IO_ERR_FORMAT,
+                               "%s: buffer view %zu: EXT_meshopt_compression "
+                               "ATTRIBUTES with byteStride %lld (a multiple of 4 "
+                               "is required)", path, vi, stride);
+            rc = meshopt_decodeVertexBuffer(dst, (size_t)count, (size_t)stride, src,
+                                            (size_t)src_len);
+            if (rc == 0 && filter == "OCTAHEDRAL" && (stride == 4 || stride == 8))
+                meshopt_decodeFilterOct(dst, (size_t)count, (size_t)stride);
+            else if (rc == 0 && filter == "QUATERNION" && stride == 8)
+                meshopt_decodeFilterQuat(dst, (size_t)count, (size_t)stride);
+            else if (rc == 0 && filter == "EXPONENTIAL")
+                meshopt_decodeFilterExp(dst, (size_t)count, (size_t)stride);
+            else if (rc == 0 && filter != "NONE")
+                return io_fail(err, IO_ERR_FORMAT,
+                               "%s: buffer view %zu: EXT_meshopt_compression "
+                               "filter '%.20s' with byteStride %lld is not "
+                               "defined", path, vi, filter.c_str(), stride);
+        } else if (mode == "TRIANGLES" || mode == "INDICES") {
+            if ((stride != 2 && stride != 4) || filter != "NONE" ||
+                (mode == "TRIANGLES" && count % 3 != 0))
+                return io_fail(err, IO_ERR_FORMAT,
+                               "%s: buffer view %zu: EXT_meshopt_compression %s "
+                               "with byteStride %lld, count %lld, filter %.20s",
+                               path, vi, mode.c_str(), stride, count,
+                               filter.c_str());
+            rc = mode == "TRIANGLES"
+                     ? meshopt_decodeIndexBuffer(dst, (size_t)count, (size_t)stride,
+                                                 src, (size_t)src_len)
+                     : meshopt_decodeIndexSequence(dst, (size_t)count, (size_t)stride,
+                                                   src, (size_t)src_len);
+        } else {
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression mode "
+                           "'%.20s' (ATTRIBUTES, TRIANGLES or INDICES)", path,
+                           vi, mode.c_str());
+        }
+        if (rc != 0)
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression data "
+                           "does not decode (meshoptimizer error %d)", path, vi,
+                           rc);
+    }
+    return IO_OK;
+}
+
+/* tinygltf 2.7 gives every buffer of a .glb without a uri the first
+ * byteLength bytes of the BIN chunk, and refuses the file when byteLength
+ * is larger than the chunk: the fallback buffers of EXT_meshopt_compression
+ * (no uri, often larger than the compressed BIN) then fail to load. For a
+ * .glb that names EXT_meshopt_compression, the BIN chunk is padded with
+ * zeros to the largest byteLength written in the JSON (at most 1 GiB):
+ * buffer 0 keeps its bytes, and the fallback buffers get room that
+ * decode_meshopt overwrites. */
+void pad_glb_for_meshopt(std::vector<unsigned char> &b)
+{
+    auto u32 = [&](size_t off) {
+        uint32_t v;
+        memcpy(&v, b.data() + off, 4);
+        return v;
+    };
+    if (b.size() < 20 || memcmp(b.data(), "glTF", 4) != 0) return;
+    uint32_t json_len = u32(12);
+    if (u32(16) != 0x4E4F534Au || json_len > b.size() - 20) return;
+    std::string json(reinterpret_cast<const char *>(b.data() + 20), json_len);
+    if (json.find("EXT_meshopt_compression") == std::string::npos) return;
+    unsigned long long need = 0;
+    for (size_t at = json.find("\"byteLength\""); at != std::string::npos;
+         at = json.find("\"byteLength\"", at + 1)) {
+        size_t k = at + 12;
+        while (k < json.size() && (json[k] == ' ' || json[k] == ':' ||
+                                   json[k] == '\t' || json[k] == '\n' ||
+                                   json[k] == '\r'))
+            k++;
+        unsigned long long v = 0;
+        while (k < json.size() && json[k] >= '0' && json[k] <= '9' && v < (1ull << 40))
+            v = v * 10 + (unsigned long long)(json[k++] - '0');
+        need = std::max(need, v);
+    }
+    if (need > (1ull << 30)) return;
+    size_t bin_at = 20 + (size_t)json_len;
+    size_t bin_len = 0;
+    if (b.size() >= bin_at + 8 && u32(bin_at + 4) == 0x004E4942u) {
+        bin_len = u32(bin_at);
+        if (bin_len > b.size() - bin_at - 8) return;
+    } else if (b.size() != bin_at) {
+        return;  /* another chunk: left to tinygltf */
+    }
+    if (need <= bin_len) return;
+    size_t padded = ((size_t)need + 3) & ~(size_t)3;
+    std::vector<unsigned char> out(b.begin(), b.begin() + (long)bin_at);
+    out.resize(bin_at + 8 + padded, 0);
+    if (bin_len) memcpy(out.data() + bin_at + 8, b.data() + bin_at + 8, bin_len);
+    uint32_t v = (uint32_t)padded, type = 0x004E4942u, total = (uint32_t)out.size();
+    memcpy(out.data() + bin_at, &v, 4);
+    memcpy(out.data() + bin_at + 4, &type, 4);
+    memcpy(out.data() + 8, &total, 4);
+    b.swap(out);
 }
 
 /* The first extension of extensionsRequired egofuse does not implement,
@@ -1409,6 +1573,8 @@ io_result load(const char *path, int scene, kin_model *out, io_gltf_info *info,
     std::string base = dir_of(path);
     bool ok;
     if (bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0)
+        pad_glb_for_meshopt(bytes);
+    if (bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0)
         ok = parser.LoadBinaryFromMemory(&g, &terr, &twarn, bytes.data(),
                                          (unsigned)bytes.size(), base);
     else if (bytes.empty())
@@ -1427,7 +1593,7 @@ io_result load(const char *path, int scene, kin_model *out, io_gltf_info *info,
     if (!ok) {
         const char *hint = "";
         for (const std::string &e : g.extensionsUsed)
-            if (e == "EXT_meshopt_compression" || e == "KHR_meshopt_compression")
+            if (e == "KHR_meshopt_compression")
                 hint = " (the file uses meshopt compression, which egofuse "
                        "does not implement)";
             else if (e == "KHR_draco_mesh_compression")
@@ -1437,6 +1603,10 @@ io_result load(const char *path, int scene, kin_model *out, io_gltf_info *info,
                        one_line(terr).c_str(), hint);
     }
     std::vector<unsigned char>().swap(bytes);
+    bool meshopt = false;
+    for (const std::string &e : g.extensionsUsed)
+        if (e == "EXT_meshopt_compression") meshopt = true;
+    if (meshopt && (r = decode_meshopt(path, g, err)) != IO_OK) return r;
 
     Loader L;
     L.path = path;
