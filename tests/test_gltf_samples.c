@@ -619,7 +619,8 @@ static void base64(const unsigned char *in, size_t n, char *out)
  *   0 POSITION float VEC3 x4      1 POSITION short VEC3 x4 (stride 8)
  *   2 NORMAL byte VEC3 x4 (stride 4, normalized unless said)
  *   3 indices u16 x6               4 indices u16 x2
- *   5 POSITION float VEC3 x3 (a target of the wrong count) */
+ *   5 POSITION float VEC3 x3 (a target of the wrong count)
+ *   6 indices u16 x6, normalized (which indices must not be) */
 static void write_model(const char *path, const char *extra_json, const char *meshes,
                         const char *scenes, int normal_normalized)
 {
@@ -658,7 +659,9 @@ static void write_model(const char *path, const char *extra_json, const char *me
             "{\"bufferView\":2,\"componentType\":5120,\"count\":4,\"type\":\"VEC3\",\"normalized\":%s},"
             "{\"bufferView\":3,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"},"
             "{\"bufferView\":3,\"byteOffset\":12,\"componentType\":5123,\"count\":2,\"type\":\"SCALAR\"},"
-            "{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"
+            "{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+            "{\"bufferView\":3,\"componentType\":5123,\"normalized\":true,\"count\":6,"
+            "\"type\":\"SCALAR\"}],"
             "\"meshes\":[%s],\"nodes\":[{\"mesh\":0}],%s}\n",
             extra, data,
             mv ? ",{\"byteLength\":48,\"uri\":\"data:application/octet-stream;base64,"
@@ -684,6 +687,7 @@ static void expect_refused(const char *name, const char *extra, const char *mesh
     if (r == IO_OK || !strstr(err.msg, name) || !strstr(err.msg, needle))
         fail_msg("%s: result %s, message '%s' (wanted '%s')", name, io_result_str(r), err.msg,
                  needle);
+    if (getenv("EGOFUSE_GLTF_VERBOSE")) printf("refused: %s\n", err.msg);
     static const kin_model zero;
     assert_memory_equal(&m, &zero, sizeof m);
     remove(path);
@@ -708,6 +712,16 @@ static void bad_input_named(void **state)
     assert_int_equal(io_gltf_load(path, &m, &err), IO_OK);
     assert_true(m.meshes[0].positions[3] == 100.0f);  /* SHORT, not normalized */
     NEAR(m.meshes[0].normals[2], 1.0, 0.0);           /* BYTE 127 normalized */
+    kin_model_free(&m);
+    /* Draco used but not required: drawn from the uncompressed accessors */
+    write_model(path, "\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],",
+                "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":3,"
+                "\"extensions\":{\"KHR_draco_mesh_compression\":{\"bufferView\":3,"
+                "\"attributes\":{\"POSITION\":0}}}}]}",
+                NULL, 1);
+    assert_int_equal(io_gltf_load(path, &m, &err), IO_OK);
+    assert_int_equal(m.meshes[0].index_count, 6);
+    assert_true(m.meshes[0].positions[3] == 1.0f);
     kin_model_free(&m);
     remove(path);
 
@@ -755,8 +769,9 @@ static void bad_input_named(void **state)
                    "{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":2},\"indices\":3}]}",
                    NULL, 0, "NORMAL of mesh 0 primitive 0) is BYTE but not normalized");
     expect_refused("indices_normalized.gltf", "\"extensionsUsed\":[\"KHR_mesh_quantization\"],",
-                   "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2}]}", NULL, 1,
-                   "indices of mesh 0 primitive 0) is BYTE VEC3");
+                   "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":6}]}", NULL, 1,
+                   "accessor 6 (indices of mesh 0 primitive 0) is UNSIGNED_SHORT and normalized, "
+                   "which it must not be");
     expect_refused("points_only.gltf", "",
                    "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":0}]}", NULL, 1,
                    "POINTS and LINES are not drawn");
