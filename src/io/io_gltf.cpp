@@ -1572,8 +1572,8 @@ io_result load(const char *path, int scene, kin_model *out, io_gltf_info *info,
     std::string terr, twarn;
     std::string base = dir_of(path);
     bool ok;
-    if (bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0)
-        pad_glb_for_meshopt(bytes);
+    const bool glb = bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0;
+    if (glb) pad_glb_for_meshopt(bytes);
     if (bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0)
         ok = parser.LoadBinaryFromMemory(&g, &terr, &twarn, bytes.data(),
                                          (unsigned)bytes.size(), base);
@@ -1593,7 +1593,12 @@ io_result load(const char *path, int scene, kin_model *out, io_gltf_info *info,
     if (!ok) {
         const char *hint = "";
         for (const std::string &e : g.extensionsUsed)
-            if (e == "KHR_meshopt_compression")
+            if (e == "EXT_meshopt_compression" && !glb)
+                hint = " (EXT_meshopt_compression in a .gltf: tinygltf 2.7 "
+                       "cannot load its fallback buffer without a uri; egofuse "
+                       "decodes meshopt in .glb files, e.g. gltfpack -c -o "
+                       "file.glb)";
+            else if (e == "KHR_meshopt_compression")
                 hint = " (the file uses meshopt compression, which egofuse "
                        "does not implement)";
             else if (e == "KHR_draco_mesh_compression")
