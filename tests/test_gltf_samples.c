@@ -8,7 +8,7 @@
  * glTF 2.0 specification: its own accessor, scene, morph, skin, primitive
  * mode and animation code, exact pixel-centre coverage in double
  * precision): all 56 masks (and the 4 of the synthetic instancing and
- * two-influence-set models below) agreed except 6 pixels, each with its
+ * two-influence-set models below) agreed except 9 pixels, each with its
  * centre within 0.002 px of an edge (egofuse snaps vertices to 1/256 px).
  * To redo that:
  *   EGOFUSE_GLTF_DUMP=/tmp/d build/tests/test_gltf_samples   (PGM + camera)
@@ -628,7 +628,9 @@ static void base64(const unsigned char *in, size_t n, char *out)
  *   2 NORMAL byte VEC3 x4 (stride 4, normalized unless said)
  *   3 indices u16 x6               4 indices u16 x2
  *   5 POSITION float VEC3 x3 (a target of the wrong count)
- *   6 indices u16 x6, normalized (which indices must not be) */
+ *   6 indices u16 x6, normalized (which indices must not be)
+ *   7 sparse VEC3 x4 without a buffer view: zeros, and element 0 (the
+ *     first u16 at byte 108) := (1, 0, 0) (the floats at byte 12) */
 static void write_model(const char *path, const char *extra_json, const char *meshes,
                         const char *scenes, int normal_normalized)
 {
@@ -669,7 +671,10 @@ static void write_model(const char *path, const char *extra_json, const char *me
             "{\"bufferView\":3,\"byteOffset\":12,\"componentType\":5123,\"count\":2,\"type\":\"SCALAR\"},"
             "{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
             "{\"bufferView\":3,\"componentType\":5123,\"normalized\":true,\"count\":6,"
-            "\"type\":\"SCALAR\"}],"
+            "\"type\":\"SCALAR\"},"
+            "{\"componentType\":5126,\"count\":4,\"type\":\"VEC3\",\"sparse\":{\"count\":1,"
+            "\"indices\":{\"bufferView\":3,\"byteOffset\":12,\"componentType\":5123},"
+            "\"values\":{\"bufferView\":0,\"byteOffset\":12}}}],"
             "\"meshes\":[%s],\"nodes\":[{\"mesh\":0}],%s}\n",
             extra, data,
             mv ? ",{\"byteLength\":48,\"uri\":\"data:application/octet-stream;base64,"
@@ -720,6 +725,22 @@ static void bad_input_named(void **state)
     assert_int_equal(io_gltf_load(path, &m, &err), IO_OK);
     assert_true(m.meshes[0].positions[3] == 100.0f);  /* SHORT, not normalized */
     NEAR(m.meshes[0].normals[2], 1.0, 0.0);           /* BYTE 127 normalized */
+    kin_model_free(&m);
+    /* a morph target given by a sparse accessor: vertex 0 moves by half
+     * of (1, 0, 0), the others stay */
+    write_model(path, "",
+                "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":3,"
+                "\"targets\":[{\"POSITION\":7}]}],\"weights\":[0.5]}",
+                NULL, 1);
+    assert_int_equal(io_gltf_load(path, &m, &err), IO_OK);
+    {
+        pipe_pose ps;
+        assert_int_equal(pipe_pose_init(&ps, &m), 0);
+        pipe_pose_anim(&ps, NULL, 0.0f);
+        static const float want[12] = {0.5f, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+        for (int i = 0; i < 12; i++) NEAR(ps.pos[0][i], want[i], 0.0);
+        pipe_pose_free(&ps);
+    }
     kin_model_free(&m);
     /* Draco used but not required: drawn from the uncompressed accessors */
     write_model(path, "\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],",
