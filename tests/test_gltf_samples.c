@@ -742,6 +742,14 @@ static void bad_input_named(void **state)
         pipe_pose_free(&ps);
     }
     kin_model_free(&m);
+    /* required extensions that change only materials and textures */
+    write_model(path,
+                "\"extensionsUsed\":[\"KHR_materials_emissive_strength\",\"KHR_texture_transform\"],"
+                "\"extensionsRequired\":[\"KHR_materials_emissive_strength\","
+                "\"KHR_texture_transform\"],",
+                TRI, NULL, 1);
+    assert_int_equal(io_gltf_load(path, &m, &err), IO_OK);
+    kin_model_free(&m);
     /* Draco used but not required: drawn from the uncompressed accessors */
     write_model(path, "\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],",
                 "{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":3,"
