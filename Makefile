@@ -51,7 +51,7 @@ IO_PKGS  := OpenImageIO tinygltf libusb-1.0 libv4l2 libdrm
 # SDL2: headers only; src/io/io_display_sdl.c loads libSDL2 with dlopen when
 # a window is opened, so the program does not link it.
 IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) sdl2 2>/dev/null)
-IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lstdc++
+IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lmeshoptimizer -lstdc++
 SYS_LIBS := -lm -lpthread
 # Peers measured by the benchmarks: pixman (compositing), Mesa llvmpipe
 # through EGL + GLES (the same frame as GL shaders).

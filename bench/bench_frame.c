@@ -934,7 +934,7 @@ static int mesh_model_make(mesh_model *mm, int tris)
     mm->ibind = kin_mat4_identity();
     mm->skin = (kin_skin){1, &mm->joint, &mm->ibind};
     mm->mesh = (kin_mesh){nv, mm->bm.pos, mm->bm.nrm, mm->joints, mm->weights,
-                          3 * mm->bm.tri_count, mm->bm.idx, 0, 0};
+                          3 * mm->bm.tri_count, mm->bm.idx, 0, 0, .target_count = 0};
     mm->m.node_count = 1;
     mm->m.parents = &mm->parent;
     mm->m.rest = &mm->rest;

@@ -13,7 +13,7 @@ set -eu
 
 PKGS="build-essential pkg-config
 libopenimageio-dev openimageio-tools
-libtinygltf-dev
+libtinygltf-dev libmeshoptimizer-dev gltfpack
 libv4l-dev libusb-1.0-0-dev
 libdrm-dev libsdl2-dev xvfb x11-apps
 libcmocka-dev

@@ -9,12 +9,24 @@
 static const char *usage =
     "usage: egofuse mask MODEL.gltf|MODEL.glb --width W --height H --fov-y DEG\n"
     "                    --eye X,Y,Z --target X,Y,Z [--up X,Y,Z]\n"
-    "                    [--anim I --time T] [--near N --far F]\n"
+    "                    [--anim I --time T] [--scene S] [--near N --far F]\n"
     "                    --out mask.png [--normals n.png] [--depth d.exr]\n"
     "\n"
     "Renders the coverage mask of a skinned or unskinned glTF 2.0 model, at\n"
     "its rest pose or at time T (seconds) of animation I, exactly and\n"
     "deterministically: a reference for GPU pipelines' unit tests.\n"
+    "\n"
+    "Drawn as a GPU draws it: the default scene (`scene`, else scene 0; all\n"
+    "nodes when the file has no scenes), triangle primitives of mode\n"
+    "TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN (POINTS and LINES are not\n"
+    "drawn: a note says so), morph targets (POSITION and NORMAL; weights of\n"
+    "the animation, else the node, else the mesh) before skinning, every\n"
+    "JOINTS_n/WEIGHTS_n set with the weights as stored, KHR_mesh_quantization,\n"
+    "EXT_mesh_gpu_instancing and EXT_meshopt_compression (.glb; gltfpack -c).\n"
+    "A file whose extensionsRequired names anything else that changes the\n"
+    "geometry (KHR_draco_mesh_compression, ...) is refused with the\n"
+    "extension's name; material, texture and light extensions are ignored\n"
+    "(docs/io.md lists what is supported and refused).\n"
     "\n"
     "Camera: right-handed look-at from --eye to --target with --up (default\n"
     "0,1,0); OpenGL-style symmetric perspective with vertical FOV --fov-y,\n"
@@ -32,10 +44,11 @@ static const char *usage =
     "  --fov-y DEG             vertical field of view, (0, 180)\n"
     "  --anim I                animation index (default: rest pose)\n"
     "  --time T                time in seconds (clamped to the animation)\n"
+    "  --scene S               draw scene S instead of the default scene\n"
     "  -h, --help              this text\n";
 
 enum { O_WIDTH = 256, O_HEIGHT, O_FOVY, O_EYE, O_TARGET, O_UP, O_ANIM, O_TIME,
-       O_NEAR, O_FAR, O_OUT, O_NORMALS, O_DEPTH };
+       O_NEAR, O_FAR, O_OUT, O_NORMALS, O_DEPTH, O_SCENE };
 
 static const struct option opts[] = {
     {"width", required_argument, 0, O_WIDTH},
@@ -51,13 +64,14 @@ static const struct option opts[] = {
     {"out", required_argument, 0, O_OUT},
     {"normals", required_argument, 0, O_NORMALS},
     {"depth", required_argument, 0, O_DEPTH},
+    {"scene", required_argument, 0, O_SCENE},
     {"help", no_argument, 0, 'h'},
     {0, 0, 0, 0},
 };
 
 int cmd_mask(int argc, char **argv)
 {
-    int width = 0, height = 0, anim = -1, have_time = 0;
+    int width = 0, height = 0, anim = -1, have_time = 0, scene = -1;
     float fovy = 0.0f, tsec = 0.0f, znear = 0.01f, zfar = 100.0f;
     float eye[3], target[3], up[3] = {0.0f, 1.0f, 0.0f};
     int have_eye = 0, have_target = 0;
@@ -108,6 +122,10 @@ int cmd_mask(int argc, char **argv)
         case O_FAR:
             if (!cli_parse_float(a, &zfar)) return cli_usage_error("mask", "--far '%s': not a number", a);
             break;
+        case O_SCENE:
+            if (!cli_parse_int(a, 0, 1 << 20, &scene))
+                return cli_usage_error("mask", "--scene '%s': not a scene index", a);
+            break;
         case O_OUT: out = a; break;
         case O_NORMALS: out_n = a; break;
         case O_DEPTH: out_d = a; break;
@@ -138,7 +156,13 @@ int cmd_mask(int argc, char **argv)
 
     io_error err;
     kin_model model;
-    if (io_gltf_load(model_path, &model, &err) != IO_OK) return cli_fail("%s", err.msg);
+    io_gltf_info info;
+    if (io_gltf_load_ex(model_path, scene, &model, &info, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (info.skipped_points || info.skipped_lines)
+        fprintf(stderr, "egofuse: note: %s: %d POINTS and %d LINES/LINE_LOOP/LINE_STRIP "
+                "primitive%s not drawn (a mask holds triangles only)\n", model_path,
+                info.skipped_points, info.skipped_lines,
+                info.skipped_points + info.skipped_lines == 1 ? "" : "s");
     const kin_animation *an = NULL;
     if (anim >= 0) {
         if (anim >= model.anim_count) {

@@ -102,12 +102,34 @@ void io_image_free(io_image *img);
 /* ----------------------------------------------------------------- glTF */
 
 /* Loads a glTF 2.0 model (.gltf with embedded or external buffers, or
- * .glb) of the default scene: every node (sorted parent first), every
- * TRIANGLES primitive of every mesh node as one kin_mesh (positions
- * required; normals, JOINTS_0 / WEIGHTS_0 when present; non-indexed
- * primitives get 0..n-1), skins and animations. The result is validated
- * with kin_model_validate(); free it with kin_model_free(). */
+ * .glb): every node (sorted parent first), one kin_mesh per triangle
+ * primitive (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN; POINTS and LINES*
+ * are not drawn) of every mesh node of the default scene (`scene`, else
+ * scenes[0]; all nodes when the file has no scenes), one per instance
+ * with EXT_mesh_gpu_instancing; positions required; normals, morph
+ * targets, every JOINTS_n / WEIGHTS_n set when present (quantized with
+ * KHR_mesh_quantization or float); skins and animations. A file whose
+ * extensionsRequired names an extension egofuse does not implement is
+ * refused with its name (docs/io.md). The result is validated with
+ * kin_model_validate(); free it with kin_model_free(). */
 io_result io_gltf_load(const char *path, kin_model *out, io_error *err);
+
+/* What io_gltf_load_ex drew and skipped (for notes to the user). */
+typedef struct io_gltf_info {
+    int scene;             /* the scene drawn, -1 when the file has none */
+    int scene_count;
+    int skipped_points;    /* primitives of mode POINTS (not drawn) */
+    int skipped_lines;     /* LINES, LINE_LOOP, LINE_STRIP (not drawn) */
+    int strips, fans;      /* TRIANGLE_STRIP / TRIANGLE_FAN primitives drawn */
+    int morph_meshes;      /* kin_meshes with morph targets */
+    int instances;         /* kin_meshes made by EXT_mesh_gpu_instancing */
+} io_gltf_info;
+
+/* io_gltf_load with the scene to draw: scene >= 0 picks scenes[scene]
+ * (IO_ERR_ARGS when the file has fewer), -1 the default. info (or NULL)
+ * receives the counts above. */
+io_result io_gltf_load_ex(const char *path, int scene, kin_model *out,
+                          io_gltf_info *info, io_error *err);
 
 /* ---------------------------------------------------------------- scene */
 

@@ -13,8 +13,13 @@
  *   TINYGLTF_IMPLEMENTATION and without any TINYGLTF_NO_* / _USE_* macro:
  *   those change the layout of tinygltf::TinyGLTF and must match the
  *   library's build.
+ *   Debian's libmeshoptimizer (-lmeshoptimizer, 0.18) decodes the buffer
+ *   views of EXT_meshopt_compression (meshopt_decodeVertexBuffer,
+ *   meshopt_decodeIndexBuffer / IndexSequence and the filters) into the
+ *   fallback buffer tinygltf allocated, before anything reads them.
  */
 #include <tiny_gltf.h>
+#include <meshoptimizer.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -41,12 +46,29 @@ namespace {
 const size_t MAX_COUNT = (size_t)1 << 26;
 
 /* The state of one load: the source model, the output and the error. */
+/* Largest number of floats of all morph target deltas of one primitive. */
+const size_t MAX_TARGET_FLOATS = (size_t)1 << 28;
+
+/* One instance of EXT_mesh_gpu_instancing: a node added as a child of the
+ * instancing node, with the instance's TRS as its rest transform. */
+struct Instance {
+    int src;               /* source node that has the extension */
+    kin_transform trs;
+};
+
 struct Loader {
     const char *path;
     const tinygltf::Model *g;
     kin_model *out;
     io_error *err;
+    io_gltf_info *info;
+    int scene_request;               /* -1: the default scene */
+    bool quantization;               /* KHR_mesh_quantization declared */
     std::vector<int> sorted_of_src;  /* source node index -> sorted index */
+    std::vector<char> in_scene;      /* source node is drawn */
+    std::vector<Instance> instances; /* appended after the source nodes */
+    std::vector<int> first_instance; /* source node -> index in instances, or -1 */
+    std::vector<int> instance_count; /* source node -> its instances */
 };
 
 template <typename T>
@@ -160,11 +182,13 @@ double read_comp(const unsigned char *p, int ct, bool normalized)
 }
 
 /* What a caller expects of an accessor. */
+enum { NORM_ANY = 0, NORM_REQUIRED = 1, NORM_FORBIDDEN = 2 };
+
 struct Want {
     const char *what;      /* for messages, e.g. "JOINTS_0 of mesh 0 primitive 1" */
     int type;              /* TINYGLTF_TYPE_* */
     unsigned ctypes;       /* bit (ct - 5120) for each accepted component type */
-    bool need_normalized;  /* integer component types must be normalized */
+    int norm;              /* NORM_*: integer types must (not) be normalized */
 };
 
 inline unsigned ct_bit(int ct) { return 1u << (unsigned)(ct - 5120); }
@@ -220,11 +244,17 @@ io_result decode(Loader &L, int acc, const Want &w, std::vector<double> &out,
                        "%s: accessor %d (%s) is %s %s, which is not supported "
                        "here", L.path, acc, w.what, ctype_name(ct),
                        type_name(a.type));
-    if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT && w.need_normalized &&
+    if (ct != TINYGLTF_COMPONENT_TYPE_FLOAT && w.norm == NORM_REQUIRED &&
         !a.normalized)
         return io_fail(L.err, IO_ERR_FORMAT,
                        "%s: accessor %d (%s) is %s but not normalized", L.path,
                        acc, w.what, ctype_name(ct));
+    if (a.normalized && (ct == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+                         ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT ||
+                         w.norm == NORM_FORBIDDEN))
+        return io_fail(L.err, IO_ERR_FORMAT,
+                       "%s: accessor %d (%s) is %s and normalized, which it "
+                       "must not be", L.path, acc, w.what, ctype_name(ct));
     if (a.count > MAX_COUNT)
         return io_fail(L.err, IO_ERR_FORMAT,
                        "%s: accessor %d (%s) has %zu elements (at most %zu)",
@@ -443,6 +473,129 @@ io_result node_transform(Loader &L, int src, kin_transform *t)
     return IO_OK;
 }
 
+/* Component types of quantized attributes (KHR_mesh_quantization). */
+const unsigned CT_INT8_16 = (1u << (TINYGLTF_COMPONENT_TYPE_BYTE - 5120)) |
+                            (1u << (TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE - 5120)) |
+                            (1u << (TINYGLTF_COMPONENT_TYPE_SHORT - 5120)) |
+                            (1u << (TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT - 5120));
+const unsigned CT_SIGNED8_16 = (1u << (TINYGLTF_COMPONENT_TYPE_BYTE - 5120)) |
+                               (1u << (TINYGLTF_COMPONENT_TYPE_SHORT - 5120));
+
+/* Before decoding an attribute of a component type that only
+ * KHR_mesh_quantization allows: refuses it, naming the extension, when
+ * the file does not declare it. */
+io_result need_quantization(Loader &L, int acc, const char *what)
+{
+    const tinygltf::Model &g = *L.g;
+    if (L.quantization || acc < 0 || (size_t)acc >= g.accessors.size())
+        return IO_OK;
+    const tinygltf::Accessor &a = g.accessors[(size_t)acc];
+    if (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT) return IO_OK;
+    return io_fail(L.err, IO_ERR_FORMAT,
+                   "%s: accessor %d (%s) is %s%s %s, which needs "
+                   "KHR_mesh_quantization, not in the file's extensionsUsed",
+                   L.path, acc, what, a.normalized ? "normalized " : "",
+                   ctype_name(a.componentType), type_name(a.type));
+}
+
+/* EXT_mesh_gpu_instancing of the drawn mesh nodes, in sorted node order:
+ * TRANSLATION / ROTATION / SCALE per instance (each optional, the same
+ * count). */
+io_result load_instances(Loader &L, const std::vector<int> &order)
+{
+    const tinygltf::Model &g = *L.g;
+    L.first_instance.assign(g.nodes.size(), -1);
+    L.instance_count.assign(g.nodes.size(), 0);
+    for (int src : order) {
+        const tinygltf::Node &n = g.nodes[(size_t)src];
+        if (!L.in_scene[(size_t)src] || n.mesh < 0) continue;
+        tinygltf::ExtensionMap::const_iterator it =
+            n.extensions.find("EXT_mesh_gpu_instancing");
+        if (it == n.extensions.end()) continue;
+        if (n.skin >= 0)
+            return io_fail(L.err, IO_ERR_FORMAT,
+                           "%s: node %d: EXT_mesh_gpu_instancing of a skinned "
+                           "mesh, which egofuse does not implement", L.path, src);
+        const tinygltf::Value &attrs = it->second.Get("attributes");
+        if (!attrs.IsObject())
+            return io_fail(L.err, IO_ERR_FORMAT,
+                           "%s: node %d: EXT_mesh_gpu_instancing without "
+                           "attributes", L.path, src);
+        static const char *const names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+        std::vector<double> v[3];
+        size_t cnt[3] = {0, 0, 0};
+        bool have[3] = {false, false, false};
+        size_t count = 0;
+        for (int k = 0; k < 3; k++) {
+            if (!attrs.Has(names[k])) continue;
+            const tinygltf::Value &ix = attrs.Get(names[k]);
+            if (!ix.IsNumber() && !ix.IsInt())
+                return io_fail(L.err, IO_ERR_FORMAT,
+                               "%s: node %d: EXT_mesh_gpu_instancing %s is not "
+                               "an accessor index", L.path, src, names[k]);
+            int acc = ix.GetNumberAsInt();
+            char what[96];
+            snprintf(what, sizeof what, "EXT_mesh_gpu_instancing %s of node %d",
+                     names[k], src);
+            io_result r = need_quantization(L, acc, what);
+            if (r != IO_OK) return r;
+            Want w = {what, k == 1 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3,
+                      k == 1 ? (CT_FLOAT | CT_SIGNED8_16) : (CT_FLOAT | CT_INT8_16),
+                      k == 1 ? NORM_REQUIRED : NORM_ANY};
+            if ((r = decode(L, acc, w, v[k], &cnt[k])) != IO_OK) return r;
+            if ((r = check_finite(L, v[k], acc, what)) != IO_OK) return r;
+            if (count && cnt[k] != count)
+                return io_fail(L.err, IO_ERR_FORMAT,
+                               "%s: node %d: EXT_mesh_gpu_instancing %s has %zu "
+                               "elements, the other attributes %zu", L.path,
+                               src, names[k], cnt[k], count);
+            count = cnt[k];
+            have[k] = true;
+        }
+        if (!have[0] && !have[1] && !have[2])
+            return io_fail(L.err, IO_ERR_FORMAT,
+                           "%s: node %d: EXT_mesh_gpu_instancing without "
+                           "TRANSLATION, ROTATION or SCALE", L.path, src);
+        if (count > KIN_MAX_NODES)
+            return io_fail(L.err, IO_ERR_FORMAT,
+                           "%s: node %d: %zu EXT_mesh_gpu_instancing instances "
+                           "(at most %d nodes in all)", L.path, src, count,
+                           KIN_MAX_NODES);
+        L.first_instance[(size_t)src] = (int)L.instances.size();
+        L.instance_count[(size_t)src] = (int)count;
+        for (size_t i = 0; i < count; i++) {
+            Instance in;
+            in.src = src;
+            in.trs = kin_transform{{0.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 0.0f, 1.0f},
+                                   {1.0f, 1.0f, 1.0f}};
+            if (have[0])
+                in.trs.t = kin_vec3{(float)v[0][i * 3], (float)v[0][i * 3 + 1],
+                                    (float)v[0][i * 3 + 2]};
+            if (have[2])
+                in.trs.s = kin_vec3{(float)v[2][i * 3], (float)v[2][i * 3 + 1],
+                                    (float)v[2][i * 3 + 2]};
+            if (have[1]) {
+                const double *q = &v[1][i * 4];
+                double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] +
+                                       q[3] * q[3]);
+                if (!(len > 0.0))
+                    return io_fail(L.err, IO_ERR_FORMAT,
+                                   "%s: node %d: EXT_mesh_gpu_instancing "
+                                   "instance %zu has a zero rotation", L.path,
+                                   src, i);
+                in.trs.r = kin_quat{(float)(q[0] / len), (float)(q[1] / len),
+                                    (float)(q[2] / len), (float)(q[3] / len)};
+            }
+            L.instances.push_back(in);
+            if (L.instances.size() > KIN_MAX_NODES)
+                return io_fail(L.err, IO_ERR_FORMAT,
+                               "%s: more than %d EXT_mesh_gpu_instancing "
+                               "instances", L.path, KIN_MAX_NODES);
+        }
+    }
+    return IO_OK;
+}
+
 /* Parents from the children lists, then a depth-first order from the
  * roots of the default scene (or scene 0), then the other roots. */
 io_result load_nodes(Loader &L)
@@ -473,6 +626,23 @@ io_result load_nodes(Loader &L)
     std::vector<int> roots;
     std::vector<char> queued(count, 0);
     int scene = g.defaultScene >= 0 ? g.defaultScene : (g.scenes.empty() ? -1 : 0);
+    if (L.scene_request >= 0) {
+        if ((size_t)L.scene_request >= g.scenes.size())
+            return io_fail(L.err, IO_ERR_ARGS,
+                           "%s: scene %d requested, but the file has %zu "
+                           "scene%s", L.path, L.scene_request, g.scenes.size(),
+                           g.scenes.size() == 1 ? "" : "s");
+        scene = L.scene_request;
+    } else if (scene >= 0 && (size_t)scene >= g.scenes.size()) {
+        return io_fail(L.err, IO_ERR_FORMAT,
+                       "%s: the default scene is %d, but the file has %zu "
+                       "scene%s", L.path, scene, g.scenes.size(),
+                       g.scenes.size() == 1 ? "" : "s");
+    }
+    if (L.info) {
+        L.info->scene = scene;
+        L.info->scene_count = (int)g.scenes.size();
+    }
     if (scene >= 0 && (size_t)scene < g.scenes.size()) {
         for (int r : g.scenes[(size_t)scene].nodes) {
             if (r < 0 || (size_t)r >= count)
@@ -511,14 +681,36 @@ io_result load_nodes(Loader &L)
                                "%s: node %zu is part of a cycle", L.path, i);
     }
 
+    /* The nodes drawn: those of the scene and their descendants (every
+     * node when the file has no scene). */
+    L.in_scene.assign(count, scene < 0 ? 1 : 0);
+    if (scene >= 0) {
+        for (int r : g.scenes[(size_t)scene].nodes) stack.push_back(r);
+        while (!stack.empty()) {
+            int n = stack.back();
+            stack.pop_back();
+            if (L.in_scene[(size_t)n]) continue;
+            L.in_scene[(size_t)n] = 1;
+            for (int c : g.nodes[(size_t)n].children) stack.push_back(c);
+        }
+    }
+    io_result ri = load_instances(L, order);
+    if (ri != IO_OK) return ri;
+    size_t total = count + L.instances.size();
+    if (total > KIN_MAX_NODES)
+        return io_fail(L.err, IO_ERR_FORMAT,
+                       "%s: %zu nodes and %zu EXT_mesh_gpu_instancing "
+                       "instances (at most %d together)", L.path, count,
+                       L.instances.size(), KIN_MAX_NODES);
+
     kin_model *m = L.out;
-    int16_t *parents = alloc_n<int16_t>(L, count);
-    kin_transform *rest = alloc_n<kin_transform>(L, count);
+    int16_t *parents = alloc_n<int16_t>(L, total);
+    kin_transform *rest = alloc_n<kin_transform>(L, total);
     char(*names)[KIN_NAME_MAX] =
         static_cast<char(*)[KIN_NAME_MAX]>(kin_block_alloc(
-            &m->block, count * KIN_NAME_MAX));
+            &m->block, total * KIN_NAME_MAX));
     if (!names) throw std::bad_alloc();
-    int *node_src = alloc_n<int>(L, count);
+    int *node_src = alloc_n<int>(L, total);
     for (size_t i = 0; i < count; i++) {
         int src = order[i];
         int p = parent[(size_t)src];
@@ -532,7 +724,18 @@ io_result load_nodes(Loader &L)
         io_result r = node_transform(L, src, &rest[i]);
         if (r != IO_OK) return r;
     }
-    m->node_count = (int)count;
+    /* instances: children of their node, after every source node */
+    for (size_t k = 0; k < L.instances.size(); k++) {
+        const Instance &in = L.instances[k];
+        size_t i = count + k;
+        parents[i] = (int16_t)L.sorted_of_src[(size_t)in.src];
+        node_src[i] = in.src;
+        rest[i] = in.trs;
+        snprintf(names[i], KIN_NAME_MAX, "%.40s#%zu",
+                 names[L.sorted_of_src[(size_t)in.src]],
+                 k - (size_t)L.first_instance[(size_t)in.src]);
+    }
+    m->node_count = (int)total;
     m->parents = parents;
     m->rest = rest;
     m->names = names;
@@ -548,15 +751,36 @@ int find_attr(const tinygltf::Primitive &p, const char *name)
     return it == p.attributes.end() ? -1 : it->second;
 }
 
-/* Converts one TRIANGLES primitive (arrays only; node and skin are set by
- * the caller). `skinned` requires JOINTS_0 and WEIGHTS_0. */
+/* Decodes one VEC3 attribute of n elements (POSITION, NORMAL, or one of a
+ * morph target): float, or with KHR_mesh_quantization the integer types
+ * `ints` (normalized as `norm` says); checks count and finiteness. */
+io_result load_vec3(Loader &L, int acc, const char *what, unsigned ints,
+                    int norm, size_t n, const char *count_label,
+                    std::vector<double> &v)
+{
+    io_result r = need_quantization(L, acc, what);
+    if (r != IO_OK) return r;
+    size_t k = 0;
+    r = decode(L, acc, Want{what, TINYGLTF_TYPE_VEC3, CT_FLOAT | ints, norm}, v, &k);
+    if (r != IO_OK) return r;
+    if (count_label && k != n)
+        return io_fail(L.err, IO_ERR_FORMAT, "%s: %s has %zu elements, the "
+                       "primitive %zu", L.path, count_label, k, n);
+    return check_finite(L, v, acc, what);
+}
+
+/* Converts one primitive of mode TRIANGLES, TRIANGLE_STRIP or
+ * TRIANGLE_FAN (arrays only; node, skin and morph weights are set by the
+ * caller). `skinned` requires JOINTS_0 and WEIGHTS_0. */
 io_result load_primitive(Loader &L, int mi, int pi, bool skinned,
                          kin_mesh *km)
 {
     const tinygltf::Mesh &mesh = L.g->meshes[(size_t)mi];
     const tinygltf::Primitive &prim = mesh.primitives[(size_t)pi];
+    const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
     char label[160];
     char what[200];
+    char clabel[240];
     if (mesh.name.empty())
         snprintf(label, sizeof label, "mesh %d primitive %d", mi, pi);
     else
@@ -571,7 +795,9 @@ io_result load_primitive(Loader &L, int mi, int pi, bool skinned,
         return io_fail(L.err, IO_ERR_MISSING, "%s: %s has no POSITION",
                        L.path, label);
     snprintf(what, sizeof what, "POSITION of %s", label);
-    r = decode(L, pos, Want{what, TINYGLTF_TYPE_VEC3, CT_FLOAT, false}, v, &n);
+    if ((r = need_quantization(L, pos, what)) != IO_OK) return r;
+    r = decode(L, pos, Want{what, TINYGLTF_TYPE_VEC3, CT_FLOAT | CT_INT8_16,
+                            NORM_ANY}, v, &n);
     if (r != IO_OK) return r;
     if (n == 0)
         return io_fail(L.err, IO_ERR_MISSING, "%s: %s has no vertices",
@@ -583,95 +809,235 @@ io_result load_primitive(Loader &L, int mi, int pi, bool skinned,
     int nrm = find_attr(prim, "NORMAL");
     if (nrm >= 0) {
         snprintf(what, sizeof what, "NORMAL of %s", label);
-        r = decode(L, nrm, Want{what, TINYGLTF_TYPE_VEC3, CT_FLOAT, false}, v, &k);
+        snprintf(clabel, sizeof clabel, "%s: NORMAL", label);
+        r = load_vec3(L, nrm, what, CT_SIGNED8_16, NORM_REQUIRED, n, clabel, v);
         if (r != IO_OK) return r;
-        if (k != n)
-            return io_fail(L.err, IO_ERR_FORMAT,
-                           "%s: accessor %d (%s) has %zu elements for %zu "
-                           "vertices", L.path, nrm, what, k, n);
-        if ((r = check_finite(L, v, nrm, what)) != IO_OK) return r;
         km->normals = to_floats(L, v);
     }
 
-    int jnt = find_attr(prim, "JOINTS_0");
-    int wgt = find_attr(prim, "WEIGHTS_0");
-    if (skinned && jnt < 0)
-        return io_fail(L.err, IO_ERR_MISSING,
-                       "%s: %s is skinned but has no JOINTS_0", L.path, label);
-    if (skinned && wgt < 0)
-        return io_fail(L.err, IO_ERR_MISSING,
-                       "%s: %s is skinned but has no WEIGHTS_0", L.path, label);
-    if (jnt >= 0 && wgt >= 0) {
-        snprintf(what, sizeof what, "JOINTS_0 of %s", label);
+    /* Skin influences: every JOINTS_n / WEIGHTS_n pair, weights as stored
+     * (a GPU sums them without renormalising). */
+    std::vector<uint16_t> xj;
+    std::vector<float> xw;
+    int sets = 0;
+    for (int set = 0; set < 64; set++) {
+        char jn[16], wn[16];
+        snprintf(jn, sizeof jn, "JOINTS_%d", set);
+        snprintf(wn, sizeof wn, "WEIGHTS_%d", set);
+        int jnt = find_attr(prim, jn);
+        int wgt = find_attr(prim, wn);
+        if (skinned && set == 0 && jnt < 0)
+            return io_fail(L.err, IO_ERR_MISSING,
+                           "%s: %s is skinned but has no JOINTS_0", L.path, label);
+        if (skinned && set == 0 && wgt < 0)
+            return io_fail(L.err, IO_ERR_MISSING,
+                           "%s: %s is skinned but has no WEIGHTS_0", L.path, label);
+        if (jnt < 0 && wgt < 0) break;
+        if (jnt < 0 || wgt < 0) {
+            if (set == 0 && !skinned) break;  /* unused: not read */
+            return io_fail(L.err, IO_ERR_FORMAT, "%s: %s has %s without %s",
+                           L.path, label, jnt < 0 ? wn : jn, jnt < 0 ? jn : wn);
+        }
+        if (set > 0 && !skinned) break;  /* only set 0 is kept unskinned */
+        snprintf(what, sizeof what, "%s of %s", jn, label);
         r = decode(L, jnt, Want{what, TINYGLTF_TYPE_VEC4,
                                 ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) |
                                 ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT),
-                                false}, v, &k);
+                                NORM_FORBIDDEN}, v, &k);
         if (r != IO_OK) return r;
         if (k != n)
             return io_fail(L.err, IO_ERR_FORMAT,
                            "%s: accessor %d (%s) has %zu elements for %zu "
                            "vertices", L.path, jnt, what, k, n);
-        uint16_t *j = alloc_n<uint16_t>(L, v.size());
-        for (size_t i = 0; i < v.size(); i++) j[i] = (uint16_t)v[i];
-        km->joints = j;
+        std::vector<uint16_t> js(v.size());
+        for (size_t i = 0; i < v.size(); i++) js[i] = (uint16_t)v[i];
 
-        snprintf(what, sizeof what, "WEIGHTS_0 of %s", label);
+        snprintf(what, sizeof what, "%s of %s", wn, label);
         r = decode(L, wgt, Want{what, TINYGLTF_TYPE_VEC4,
                                 CT_FLOAT |
                                 ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) |
                                 ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT),
-                                true}, v, &k);
+                                NORM_REQUIRED}, v, &k);
         if (r != IO_OK) return r;
         if (k != n)
             return io_fail(L.err, IO_ERR_FORMAT,
                            "%s: accessor %d (%s) has %zu elements for %zu "
                            "vertices", L.path, wgt, what, k, n);
         if ((r = check_finite(L, v, wgt, what)) != IO_OK) return r;
-        float *w = alloc_n<float>(L, v.size());
-        for (size_t i = 0; i < n; i++) {
-            double sum = v[i * 4] + v[i * 4 + 1] + v[i * 4 + 2] + v[i * 4 + 3];
-            for (size_t c = 0; c < 4; c++)
-                w[i * 4 + c] = (float)(sum > 0.0 ? v[i * 4 + c] / sum
-                                                 : v[i * 4 + c]);
+        if (set == 0) {
+            uint16_t *j = alloc_n<uint16_t>(L, js.size());
+            std::copy(js.begin(), js.end(), j);
+            km->joints = j;
+            float *w = alloc_n<float>(L, v.size());
+            for (size_t i = 0; i < v.size(); i++) w[i] = (float)v[i];
+            km->weights = w;
+        } else {
+            xj.insert(xj.end(), js.begin(), js.end());
+            for (size_t i = 0; i < v.size(); i++) xw.push_back((float)v[i]);
+            sets = set;
         }
-        km->weights = w;
+    }
+    if (sets > 0) {
+        /* per vertex: the extra sets one after the other */
+        uint16_t *j = alloc_n<uint16_t>(L, xj.size());
+        float *w = alloc_n<float>(L, xw.size());
+        for (size_t vi = 0; vi < n; vi++)
+            for (int e = 0; e < sets; e++)
+                for (size_t c = 0; c < 4; c++) {
+                    size_t from = ((size_t)e * n + vi) * 4 + c;
+                    size_t to = (vi * (size_t)sets + (size_t)e) * 4 + c;
+                    j[to] = xj[from];
+                    w[to] = xw[from];
+                }
+        km->extra_sets = sets;
+        km->joints_extra = j;
+        km->weights_extra = w;
     }
 
+    /* Morph targets: POSITION and NORMAL deltas (TANGENT is not used). */
+    size_t nt = prim.targets.size();
+    if (nt > 0) {
+        if (nt > MAX_TARGET_FLOATS / 3 / n)
+            return io_fail(L.err, IO_ERR_FORMAT,
+                           "%s: %s has %zu morph targets of %zu vertices: "
+                           "more than %zu values", L.path, label, nt, n,
+                           MAX_TARGET_FLOATS);
+        float *tp = alloc_n<float>(L, nt * n * 3);
+        float *tn = nullptr;
+        bool any_n = false;
+        for (size_t t = 0; t < nt; t++)
+            if (prim.targets[t].count("NORMAL")) any_n = true;
+        if (any_n && km->normals) tn = alloc_n<float>(L, nt * n * 3);
+        for (size_t t = 0; t < nt; t++) {
+            const std::map<std::string, int> &tg = prim.targets[t];
+            std::map<std::string, int>::const_iterator it = tg.find("POSITION");
+            if (it != tg.end()) {
+                snprintf(what, sizeof what, "POSITION of %s target %zu", label, t);
+                snprintf(clabel, sizeof clabel, "%s target %zu: POSITION", label, t);
+                r = load_vec3(L, it->second, what, CT_SIGNED8_16, NORM_ANY, n,
+                              clabel, v);
+                if (r != IO_OK) return r;
+                for (size_t i = 0; i < n * 3; i++) tp[t * n * 3 + i] = (float)v[i];
+            }
+            it = tg.find("NORMAL");
+            if (it != tg.end()) {
+                snprintf(what, sizeof what, "NORMAL of %s target %zu", label, t);
+                snprintf(clabel, sizeof clabel, "%s target %zu: NORMAL", label, t);
+                r = load_vec3(L, it->second, what, CT_SIGNED8_16, NORM_REQUIRED,
+                              n, clabel, v);
+                if (r != IO_OK) return r;
+                if (tn)
+                    for (size_t i = 0; i < n * 3; i++) tn[t * n * 3 + i] = (float)v[i];
+            }
+        }
+        km->target_count = (int)nt;
+        km->target_positions = tp;
+        km->target_normals = tn;
+    }
+
+    /* Indices, then the triangles of the mode in the spec's vertex order. */
+    std::vector<uint32_t> src;
     if (prim.indices >= 0) {
         snprintf(what, sizeof what, "indices of %s", label);
         r = decode(L, prim.indices,
                    Want{what, TINYGLTF_TYPE_SCALAR,
                         ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) |
                         ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT) |
-                        ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT), false},
+                        ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT),
+                        NORM_FORBIDDEN},
                    v, &k);
         if (r != IO_OK) return r;
-        if (k % 3 != 0)
-            return io_fail(L.err, IO_ERR_FORMAT,
-                           "%s: %s has %zu indices, not a multiple of 3",
-                           L.path, label, k);
-        uint32_t *idx = alloc_n<uint32_t>(L, k);
+        src.resize(k);
         for (size_t i = 0; i < k; i++) {
             if (!(v[i] < (double)n))
                 return io_fail(L.err, IO_ERR_FORMAT,
                                "%s: accessor %d (%s): index %zu is %.0f, past "
                                "the %zu vertices", L.path, prim.indices, what,
                                i, v[i], n);
-            idx[i] = (uint32_t)v[i];
+            src[i] = (uint32_t)v[i];
         }
+    } else {
+        k = n;
+        src.resize(n);
+        for (size_t i = 0; i < n; i++) src[i] = (uint32_t)i;
+    }
+    const char *idx_what = prim.indices >= 0 ? "indices" : "vertices";
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        if (k % 3 != 0)
+            return io_fail(L.err, IO_ERR_FORMAT,
+                           prim.indices >= 0
+                               ? "%s: %s has %zu indices, not a multiple of 3"
+                               : "%s: %s is not indexed and has %zu vertices, "
+                                 "not a multiple of 3",
+                           L.path, label, k);
+        uint32_t *idx = alloc_n<uint32_t>(L, k);
+        std::copy(src.begin(), src.end(), idx);
         km->index_count = (int)k;
         km->indices = idx;
-    } else {
-        if (n % 3 != 0)
-            return io_fail(L.err, IO_ERR_FORMAT,
-                           "%s: %s is not indexed and has %zu vertices, not a "
-                           "multiple of 3", L.path, label, n);
-        uint32_t *idx = alloc_n<uint32_t>(L, n);
-        for (size_t i = 0; i < n; i++) idx[i] = (uint32_t)i;
-        km->index_count = (int)n;
-        km->indices = idx;
+        return IO_OK;
     }
+    const char *mname = mode == TINYGLTF_MODE_TRIANGLE_STRIP ? "TRIANGLE_STRIP"
+                                                             : "TRIANGLE_FAN";
+    if (k < 3)
+        return io_fail(L.err, IO_ERR_FORMAT,
+                       "%s: %s is a %s of %zu %s (at least 3)", L.path, label,
+                       mname, k, idx_what);
+    size_t tris = k - 2;
+    uint32_t *idx = alloc_n<uint32_t>(L, tris * 3);
+    for (size_t i = 0; i < tris; i++) {
+        uint32_t *o = idx + i * 3;
+        if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+            /* p_i = {v_i, v_(i+(1+i%2)), v_(i+(2-i%2))} */
+            o[0] = src[i];
+            o[1] = src[i + 1 + i % 2];
+            o[2] = src[i + 2 - i % 2];
+        } else {
+            /* p_i = {v_(i+1), v_(i+2), v_0} */
+            o[0] = src[i + 1];
+            o[1] = src[i + 2];
+            o[2] = src[0];
+        }
+    }
+    km->index_count = (int)(tris * 3);
+    km->indices = idx;
+    return IO_OK;
+}
+
+/* The morph weights of node `src` for a primitive of mesh mi with nt
+ * targets: the node's `weights`, else the mesh's, else zeros. */
+io_result morph_defaults(Loader &L, int src, int mi, size_t nt,
+                         const float **out)
+{
+    const tinygltf::Node &node = L.g->nodes[(size_t)src];
+    const tinygltf::Mesh &mesh = L.g->meshes[(size_t)mi];
+    *out = nullptr;
+    if (nt == 0) return IO_OK;
+    const std::vector<double> *w = nullptr;
+    if (!node.weights.empty()) {
+        if (node.weights.size() != nt)
+            return io_fail(L.err, IO_ERR_FORMAT,
+                           "%s: node %d has %zu weights for the %zu morph "
+                           "targets of mesh %d", L.path, src,
+                           node.weights.size(), nt, mi);
+        w = &node.weights;
+    } else if (!mesh.weights.empty()) {
+        if (mesh.weights.size() != nt)
+            return io_fail(L.err, IO_ERR_FORMAT,
+                           "%s: mesh %d has %zu weights for %zu morph targets",
+                           L.path, mi, mesh.weights.size(), nt);
+        w = &mesh.weights;
+    }
+    float *f = alloc_n<float>(L, nt);
+    for (size_t i = 0; w && i < nt; i++) {
+        double d = (*w)[i];
+        if (!std::isfinite(d) || std::fabs(d) > 1e30)
+            return io_fail(L.err, IO_ERR_FORMAT,
+                           "%s: %s %d has a non-finite morph weight", L.path,
+                           w == &node.weights ? "node" : "mesh",
+                           w == &node.weights ? src : mi);
+        f[i] = (float)d;
+    }
+    *out = f;
     return IO_OK;
 }
 
@@ -682,19 +1048,47 @@ io_result load_meshes(Loader &L)
     std::vector<kin_mesh> meshes;
     /* primitives instanced by several nodes share their arrays */
     std::map<std::pair<int, int>, kin_mesh> done;
-    for (int i = 0; i < m->node_count; i++) {
-        const tinygltf::Node &n = g.nodes[(size_t)m->node_src[i]];
-        if (n.mesh < 0) continue;
+    const int src_nodes = (int)g.nodes.size();
+    for (int i = 0; i < src_nodes; i++) {
+        const int src = m->node_src[i];
+        const tinygltf::Node &n = g.nodes[(size_t)src];
+        if (n.mesh < 0 || !L.in_scene[(size_t)src]) continue;
         if ((size_t)n.mesh >= g.meshes.size())
             return io_fail(L.err, IO_ERR_FORMAT, "%s: node %d names mesh %d of %zu",
-                           L.path, m->node_src[i], n.mesh, g.meshes.size());
+                           L.path, src, n.mesh, g.meshes.size());
         if (n.skin >= 0 && (size_t)n.skin >= g.skins.size())
             return io_fail(L.err, IO_ERR_FORMAT, "%s: node %d names skin %d of %zu",
-                           L.path, m->node_src[i], n.skin, g.skins.size());
+                           L.path, src, n.skin, g.skins.size());
         const tinygltf::Mesh &mesh = g.meshes[(size_t)n.mesh];
         for (size_t p = 0; p < mesh.primitives.size(); p++) {
-            int mode = mesh.primitives[p].mode;
-            if (mode != -1 && mode != TINYGLTF_MODE_TRIANGLES) continue;
+            const tinygltf::Primitive &prim = mesh.primitives[p];
+            if (prim.targets.size() != mesh.primitives[0].targets.size())
+                return io_fail(L.err, IO_ERR_FORMAT,
+                               "%s: mesh %d primitive %zu has %zu morph targets, "
+                               "primitive 0 %zu", L.path, n.mesh, p,
+                               prim.targets.size(),
+                               mesh.primitives[0].targets.size());
+            int mode = prim.mode;
+            switch (mode) {
+            case -1:
+            case TINYGLTF_MODE_TRIANGLES:
+            case TINYGLTF_MODE_TRIANGLE_STRIP:
+            case TINYGLTF_MODE_TRIANGLE_FAN:
+                break;
+            case TINYGLTF_MODE_POINTS:
+                if (L.info) L.info->skipped_points++;
+                continue;
+            case TINYGLTF_MODE_LINE:
+            case TINYGLTF_MODE_LINE_LOOP:
+            case TINYGLTF_MODE_LINE_STRIP:
+                if (L.info) L.info->skipped_lines++;
+                continue;
+            default:
+                return io_fail(L.err, IO_ERR_FORMAT,
+                               "%s: mesh %d primitive %zu has mode %d, not a "
+                               "glTF primitive mode (0..6)", L.path, n.mesh, p,
+                               mode);
+            }
             std::pair<int, int> key(n.mesh, (int)p);
             kin_mesh km;
             std::map<std::pair<int, int>, kin_mesh>::iterator it = done.find(key);
@@ -706,14 +1100,36 @@ io_result load_meshes(Loader &L)
                 if (r != IO_OK) return r;
                 done[key] = km;
             }
-            km.node = i;
+            io_result r = morph_defaults(L, src, n.mesh, (size_t)km.target_count,
+                                         &km.target_weights);
+            if (r != IO_OK) return r;
             km.skin = n.skin;
-            meshes.push_back(km);
+            if (L.info) {
+                if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) L.info->strips++;
+                if (mode == TINYGLTF_MODE_TRIANGLE_FAN) L.info->fans++;
+            }
+            int ni = L.instance_count[(size_t)src];
+            if (ni == 0) {
+                km.node = i;
+                meshes.push_back(km);
+                if (L.info && km.target_count) L.info->morph_meshes++;
+                continue;
+            }
+            for (int k = 0; k < ni; k++) {
+                km.node = src_nodes + L.first_instance[(size_t)src] + k;
+                meshes.push_back(km);
+                if (L.info) {
+                    L.info->instances++;
+                    if (km.target_count) L.info->morph_meshes++;
+                }
+            }
         }
     }
     if (meshes.empty())
-        return io_fail(L.err, IO_ERR_MISSING, "%s: no triangle primitives",
-                       L.path);
+        return io_fail(L.err, IO_ERR_MISSING, "%s: no triangle primitives%s",
+                       L.path,
+                       L.info && (L.info->skipped_points || L.info->skipped_lines)
+                           ? " (POINTS and LINES are not drawn)" : "");
     kin_mesh *arr = alloc_n<kin_mesh>(L, meshes.size());
     std::copy(meshes.begin(), meshes.end(), arr);
     m->mesh_count = (int)meshes.size();
@@ -788,6 +1204,11 @@ io_result load_animations(Loader &L)
     const tinygltf::Model &g = *L.g;
     kin_model *m = L.out;
     if (g.animations.empty()) return IO_OK;
+    /* morph target count of the meshes of each node (-1: none) */
+    std::vector<int> targets_of((size_t)m->node_count, -1);
+    for (int i = 0; i < m->mesh_count; i++)
+        if (m->meshes[i].target_count > 0 && m->meshes[i].node >= 0)
+            targets_of[(size_t)m->meshes[i].node] = m->meshes[i].target_count;
     kin_animation *anims = alloc_n<kin_animation>(L, g.animations.size());
     for (size_t a = 0; a < g.animations.size(); a++) {
         const tinygltf::Animation &an = g.animations[a];
@@ -872,6 +1293,21 @@ io_result load_animations(Loader &L)
             kc.values = to_floats(L, ov);
             duration = std::max(duration, kc.times[keys - 1]);
             chans.push_back(kc);
+            if (path != KIN_PATH_WEIGHTS) continue;
+            int src = ch.target_node;
+            int ni = L.instance_count.empty() ? 0 : L.instance_count[(size_t)src];
+            int node = ni ? (int)g.nodes.size() + L.first_instance[(size_t)src] : kc.node;
+            int nt = targets_of[(size_t)node];
+            if (nt >= 0 && nt != comps)
+                return io_fail(L.err, IO_ERR_FORMAT,
+                               "%s: animation %zu channel %zu has %d weights "
+                               "per key for the %d morph targets of node %d",
+                               L.path, a, c, comps, nt, src);
+            /* instances (EXT_mesh_gpu_instancing) morph with their node */
+            for (int k = 0; k < ni; k++) {
+                kc.node = (int)g.nodes.size() + L.first_instance[(size_t)src] + k;
+                chans.push_back(kc);
+            }
         }
         kin_channel *arr = nullptr;
         if (!chans.empty()) {
@@ -934,7 +1370,197 @@ std::string one_line(std::string s)
     return s.empty() ? std::string("unknown error") : s;
 }
 
-io_result load(const char *path, kin_model *out, io_error *err)
+/* Extensions egofuse implements (geometry), and those that change only
+ * materials, textures or lights, which a coverage mask and normals do not
+ * depend on: a file requiring them is drawn right. */
+bool extension_implemented(const std::string &e)
+{
+    static const char *const geometry[] = {
+        "KHR_mesh_quantization", "EXT_mesh_gpu_instancing",
+        "EXT_meshopt_compression",
+    };
+    static const char *const neutral[] = {
+        "KHR_texture_transform", "KHR_texture_basisu", "EXT_texture_webp",
+        "EXT_texture_avif", "KHR_lights_punctual", "KHR_materials_",
+    };
+    for (const char *g : geometry)
+        if (e == g) return true;
+    for (const char *n : neutral) {
+        size_t len = strlen(n);
+        if (n[len - 1] == '_' ? e.compare(0, len, n) == 0 : e == n) return true;
+    }
+    return false;
+}
+
+/* EXT_meshopt_compression: decodes every buffer view that has it into
+ * the view's own bytes (its buffer is the fallback buffer, which tinygltf
+ * allocated, zeroed, when it has no uri), checking every range first. */
+io_result decode_meshopt(const char *path, tinygltf::Model &g, io_error *err)
+{
+    for (size_t vi = 0; vi < g.bufferViews.size(); vi++) {
+        tinygltf::BufferView &bv = g.bufferViews[vi];
+        tinygltf::ExtensionMap::const_iterator it =
+            bv.extensions.find("EXT_meshopt_compression");
+        if (it == bv.extensions.end()) continue;
+        const tinygltf::Value &e = it->second;
+        auto num = [&](const char *k, long long dflt, long long *out) -> bool {
+            if (!e.Has(k)) { *out = dflt; return dflt >= 0; }
+            const tinygltf::Value &v = e.Get(k);
+            if (!v.IsNumber() && !v.IsInt()) return false;
+            double d = v.GetNumberAsDouble();
+            if (!(d >= 0.0 && d <= 9.0e15) || d != std::floor(d)) return false;
+            *out = (long long)d;
+            return true;
+        };
+        long long src_buf, src_off, src_len, stride, count;
+        if (!num("buffer", -1, &src_buf) || !num("byteOffset", 0, &src_off) ||
+            !num("byteLength", -1, &src_len) || !num("byteStride", -1, &stride) ||
+            !num("count", -1, &count))
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression needs "
+                           "buffer, byteLength, byteStride and count as "
+                           "non-negative integers", path, vi);
+        std::string mode = e.Has("mode") ? e.Get("mode").Get<std::string>() : "";
+        std::string filter = e.Has("filter") ? e.Get("filter").Get<std::string>() : "NONE";
+        if ((size_t)src_buf >= g.buffers.size() ||
+            (size_t)src_off > g.buffers[(size_t)src_buf].data.size() ||
+            (size_t)src_len > g.buffers[(size_t)src_buf].data.size() - (size_t)src_off)
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression data "
+                           "(buffer %lld, bytes %lld..%lld) lies outside its "
+                           "buffer", path, vi, src_buf, src_off, src_off + src_len);
+        if (count > (long long)MAX_COUNT || stride < 1 || stride > 256 ||
+            (size_t)(count * stride) != bv.byteLength)
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression count "
+                           "%lld x byteStride %lld does not give its byteLength "
+                           "%zu", path, vi, count, stride, bv.byteLength);
+        if (bv.buffer < 0 || (size_t)bv.buffer >= g.buffers.size() ||
+            bv.byteOffset > g.buffers[(size_t)bv.buffer].data.size() ||
+            bv.byteLength > g.buffers[(size_t)bv.buffer].data.size() - bv.byteOffset)
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu (the output of "
+                           "EXT_meshopt_compression) lies outside its buffer",
+                           path, vi);
+        if (bv.buffer == (int)src_buf)
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression "
+                           "decodes into the buffer it reads", path, vi);
+        unsigned char *dst = g.buffers[(size_t)bv.buffer].data.data() + bv.byteOffset;
+        const unsigned char *src = g.buffers[(size_t)src_buf].data.data() + src_off;
+        int rc = -1;
+        if (mode == "ATTRIBUTES") {
+            if (stride % 4 != 0)
+                return io_fail(err, IO_ERR_FORMAT,
+                               "%s: buffer view %zu: EXT_meshopt_compression "
+                               "ATTRIBUTES with byteStride %lld (a multiple of 4 "
+                               "is required)", path, vi, stride);
+            rc = meshopt_decodeVertexBuffer(dst, (size_t)count, (size_t)stride, src,
+                                            (size_t)src_len);
+            if (rc == 0 && filter == "OCTAHEDRAL" && (stride == 4 || stride == 8))
+                meshopt_decodeFilterOct(dst, (size_t)count, (size_t)stride);
+            else if (rc == 0 && filter == "QUATERNION" && stride == 8)
+                meshopt_decodeFilterQuat(dst, (size_t)count, (size_t)stride);
+            else if (rc == 0 && filter == "EXPONENTIAL")
+                meshopt_decodeFilterExp(dst, (size_t)count, (size_t)stride);
+            else if (rc == 0 && filter != "NONE")
+                return io_fail(err, IO_ERR_FORMAT,
+                               "%s: buffer view %zu: EXT_meshopt_compression "
+                               "filter '%.20s' with byteStride %lld is not "
+                               "defined", path, vi, filter.c_str(), stride);
+        } else if (mode == "TRIANGLES" || mode == "INDICES") {
+            if ((stride != 2 && stride != 4) || filter != "NONE" ||
+                (mode == "TRIANGLES" && count % 3 != 0))
+                return io_fail(err, IO_ERR_FORMAT,
+                               "%s: buffer view %zu: EXT_meshopt_compression %s "
+                               "with byteStride %lld, count %lld, filter %.20s",
+                               path, vi, mode.c_str(), stride, count,
+                               filter.c_str());
+            rc = mode == "TRIANGLES"
+                     ? meshopt_decodeIndexBuffer(dst, (size_t)count, (size_t)stride,
+                                                 src, (size_t)src_len)
+                     : meshopt_decodeIndexSequence(dst, (size_t)count, (size_t)stride,
+                                                   src, (size_t)src_len);
+        } else {
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression mode "
+                           "'%.20s' (ATTRIBUTES, TRIANGLES or INDICES)", path,
+                           vi, mode.c_str());
+        }
+        if (rc != 0)
+            return io_fail(err, IO_ERR_FORMAT,
+                           "%s: buffer view %zu: EXT_meshopt_compression data "
+                           "does not decode (meshoptimizer error %d)", path, vi,
+                           rc);
+    }
+    return IO_OK;
+}
+
+/* tinygltf 2.7 gives every buffer of a .glb without a uri the first
+ * byteLength bytes of the BIN chunk, and refuses the file when byteLength
+ * is larger than the chunk: the fallback buffers of EXT_meshopt_compression
+ * (no uri, often larger than the compressed BIN) then fail to load. For a
+ * .glb that names EXT_meshopt_compression, the BIN chunk is padded with
+ * zeros to the largest byteLength written in the JSON (at most 1 GiB):
+ * buffer 0 keeps its bytes, and the fallback buffers get room that
+ * decode_meshopt overwrites. */
+void pad_glb_for_meshopt(std::vector<unsigned char> &b)
+{
+    auto u32 = [&](size_t off) {
+        uint32_t v;
+        memcpy(&v, b.data() + off, 4);
+        return v;
+    };
+    if (b.size() < 20 || memcmp(b.data(), "glTF", 4) != 0) return;
+    uint32_t json_len = u32(12);
+    if (u32(16) != 0x4E4F534Au || json_len > b.size() - 20) return;
+    std::string json(reinterpret_cast<const char *>(b.data() + 20), json_len);
+    if (json.find("EXT_meshopt_compression") == std::string::npos) return;
+    unsigned long long need = 0;
+    for (size_t at = json.find("\"byteLength\""); at != std::string::npos;
+         at = json.find("\"byteLength\"", at + 1)) {
+        size_t k = at + 12;
+        while (k < json.size() && (json[k] == ' ' || json[k] == ':' ||
+                                   json[k] == '\t' || json[k] == '\n' ||
+                                   json[k] == '\r'))
+            k++;
+        unsigned long long v = 0;
+        while (k < json.size() && json[k] >= '0' && json[k] <= '9' && v < (1ull << 40))
+            v = v * 10 + (unsigned long long)(json[k++] - '0');
+        need = std::max(need, v);
+    }
+    if (need > (1ull << 30)) return;
+    size_t bin_at = 20 + (size_t)json_len;
+    size_t bin_len = 0;
+    if (b.size() >= bin_at + 8 && u32(bin_at + 4) == 0x004E4942u) {
+        bin_len = u32(bin_at);
+        if (bin_len > b.size() - bin_at - 8) return;
+    } else if (b.size() != bin_at) {
+        return;  /* another chunk: left to tinygltf */
+    }
+    if (need <= bin_len) return;
+    size_t padded = ((size_t)need + 3) & ~(size_t)3;
+    std::vector<unsigned char> out(b.begin(), b.begin() + (long)bin_at);
+    out.resize(bin_at + 8 + padded, 0);
+    if (bin_len) memcpy(out.data() + bin_at + 8, b.data() + bin_at + 8, bin_len);
+    uint32_t v = (uint32_t)padded, type = 0x004E4942u, total = (uint32_t)out.size();
+    memcpy(out.data() + bin_at, &v, 4);
+    memcpy(out.data() + bin_at + 4, &type, 4);
+    memcpy(out.data() + 8, &total, 4);
+    b.swap(out);
+}
+
+/* The first extension of extensionsRequired egofuse does not implement,
+ * or "". */
+std::string unimplemented_required(const tinygltf::Model &g)
+{
+    for (const std::string &e : g.extensionsRequired)
+        if (!extension_implemented(e)) return e;
+    return std::string();
+}
+
+io_result load(const char *path, int scene, kin_model *out, io_gltf_info *info,
+               io_error *err)
 {
     std::vector<unsigned char> bytes;
     io_result r = read_file(path, bytes, err);
@@ -946,6 +1572,8 @@ io_result load(const char *path, kin_model *out, io_error *err)
     std::string terr, twarn;
     std::string base = dir_of(path);
     bool ok;
+    const bool glb = bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0;
+    if (glb) pad_glb_for_meshopt(bytes);
     if (bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0)
         ok = parser.LoadBinaryFromMemory(&g, &terr, &twarn, bytes.data(),
                                          (unsigned)bytes.size(), base);
@@ -955,16 +1583,46 @@ io_result load(const char *path, kin_model *out, io_error *err)
         ok = parser.LoadASCIIFromString(
             &g, &terr, &twarn, reinterpret_cast<const char *>(bytes.data()),
             (unsigned)bytes.size(), base);
-    if (!ok)
-        return io_fail(err, IO_ERR_FORMAT, "%s: %s", path,
-                       one_line(terr).c_str());
+    /* tinygltf reads extensionsRequired before the buffers, so a file it
+     * cannot load (Draco, meshopt) is still refused by name. */
+    std::string missing = unimplemented_required(g);
+    if (!missing.empty())
+        return io_fail(err, IO_ERR_FORMAT,
+                       "%s: requires extension %.80s, which egofuse does not "
+                       "implement", path, missing.c_str());
+    if (!ok) {
+        const char *hint = "";
+        for (const std::string &e : g.extensionsUsed)
+            if (e == "EXT_meshopt_compression" && !glb)
+                hint = " (EXT_meshopt_compression in a .gltf: tinygltf 2.7 "
+                       "cannot load its fallback buffer without a uri; egofuse "
+                       "decodes meshopt in .glb files, e.g. gltfpack -c -o "
+                       "file.glb)";
+            else if (e == "KHR_meshopt_compression")
+                hint = " (the file uses meshopt compression, which egofuse "
+                       "does not implement)";
+            else if (e == "KHR_draco_mesh_compression")
+                hint = " (the file uses KHR_draco_mesh_compression, which "
+                       "egofuse does not implement)";
+        return io_fail(err, IO_ERR_FORMAT, "%s: %s%s", path,
+                       one_line(terr).c_str(), hint);
+    }
     std::vector<unsigned char>().swap(bytes);
+    bool meshopt = false;
+    for (const std::string &e : g.extensionsUsed)
+        if (e == "EXT_meshopt_compression") meshopt = true;
+    if (meshopt && (r = decode_meshopt(path, g, err)) != IO_OK) return r;
 
     Loader L;
     L.path = path;
     L.g = &g;
     L.out = out;
     L.err = err;
+    L.info = info;
+    L.scene_request = scene;
+    L.quantization = false;
+    for (const std::string &e : g.extensionsUsed)
+        if (e == "KHR_mesh_quantization") L.quantization = true;
     if ((r = load_nodes(L)) != IO_OK) return r;
     if ((r = load_skins(L)) != IO_OK) return r;
     if ((r = load_meshes(L)) != IO_OK) return r;
@@ -981,13 +1639,24 @@ io_result load(const char *path, kin_model *out, io_error *err)
 extern "C" io_result io_gltf_load(const char *path, kin_model *out,
                                   io_error *err)
 {
+    return io_gltf_load_ex(path, -1, out, NULL, err);
+}
+
+extern "C" io_result io_gltf_load_ex(const char *path, int scene,
+                                     kin_model *out, io_gltf_info *info,
+                                     io_error *err)
+{
+    io_gltf_info local;
+    if (!info) info = &local;
+    memset(info, 0, sizeof *info);
+    info->scene = -1;
     if (!out) return io_fail(err, IO_ERR_ARGS, "io_gltf_load: no output model");
     memset(out, 0, sizeof *out);
     if (!path || !*path)
         return io_fail(err, IO_ERR_ARGS, "io_gltf_load: no path");
     io_result r;
     try {
-        r = load(path, out, err);
+        r = load(path, scene < 0 ? -1 : scene, out, info, err);
     } catch (const std::bad_alloc &) {
         r = io_fail(err, IO_ERR_NOMEM, "%s: out of memory", path);
     } catch (const std::exception &e) {

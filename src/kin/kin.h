@@ -106,7 +106,7 @@ typedef enum kin_path {
     KIN_PATH_TRANSLATION,
     KIN_PATH_ROTATION,
     KIN_PATH_SCALE,
-    KIN_PATH_WEIGHTS          /* morph weights: loaded, not applied */
+    KIN_PATH_WEIGHTS          /* morph weights (kin_anim_sample_weights) */
 } kin_path;
 
 typedef enum kin_interp {
@@ -136,17 +136,42 @@ typedef struct kin_animation {
     float duration;           /* last key time over all channels, seconds */
 } kin_animation;
 
-/* One triangle mesh (a glTF primitive with mode TRIANGLES). */
+/* One triangle mesh (a glTF primitive with mode TRIANGLES, or a
+ * TRIANGLE_STRIP / TRIANGLE_FAN turned into its triangles).
+ *
+ * Morph targets (glTF): a posed vertex is
+ *   p = positions[v] + sum_k w_k target_positions[(k * vertex_count + v) * 3]
+ * (the same for normals with target_normals), applied before skinning
+ * (kin_morph_apply); w_k are the node's current morph weights:
+ * target_weights unless an animation's `weights` channel drives them
+ * (kin_anim_sample_weights). Without targets the last five fields are 0.
+ *
+ * Skin influences: joints/weights hold the first 4 (glTF JOINTS_0 /
+ * WEIGHTS_0); a file with JOINTS_1/WEIGHTS_1 ... adds extra_sets more sets
+ * of 4 in joints_extra / weights_extra (4 * extra_sets per vertex, set
+ * after set). All are summed as stored (no renormalisation). Fields added
+ * at the end: a mesh built with {...} or memset to 0 has neither. */
 typedef struct kin_mesh {
     int vertex_count;
     const float *positions;   /* 3 per vertex, in the mesh node's space */
     const float *normals;     /* 3 per vertex, or NULL if the file has none */
     const uint16_t *joints;   /* 4 per vertex (indices into the skin), or NULL */
-    const float *weights;     /* 4 per vertex, summing to 1, or NULL */
+    const float *weights;     /* 4 per vertex (as stored; >= 0), or NULL */
     int index_count;          /* multiple of 3 */
     const uint32_t *indices;  /* < vertex_count */
     int node;                 /* node that instantiates the mesh */
     int skin;                 /* index into skins, or -1 when unskinned */
+    int target_count;         /* morph targets, 0 if none */
+    const float *target_positions; /* target_count * vertex_count * 3 deltas
+                                      (zeros for a target without POSITION) */
+    const float *target_normals;   /* the same for NORMAL, or NULL when no
+                                      target has NORMAL (or no normals) */
+    const float *target_weights;   /* target_count default weights: the
+                                      node's `weights`, else the mesh's,
+                                      else 0 */
+    int extra_sets;           /* influence sets beyond the first, 0 if none */
+    const uint16_t *joints_extra;  /* 4 * extra_sets per vertex, or NULL */
+    const float *weights_extra;    /* 4 * extra_sets per vertex, or NULL */
 } kin_mesh;
 
 typedef struct kin_skin {
@@ -196,6 +221,24 @@ void kin_pose_rest(const kin_model *model, kin_transform *locals);
  * naming a node >= node_count are ignored). Rotations are renormalised. */
 void kin_anim_sample(const kin_animation *anim, int node_count, float t,
                      kin_transform *locals);
+
+/* Morph weights of `node` at time t: samples the last `weights` channel
+ * of anim that targets the node with `count` values per key (STEP, LINEAR
+ * per component, CUBICSPLINE; clamped like kin_anim_sample) into
+ * weights[count]. Returns 1, or 0 (weights untouched) when anim has no
+ * such channel. */
+int kin_anim_sample_weights(const kin_animation *anim, int node, float t,
+                            float *weights, int count);
+
+/* Morph targets of vertices [v0, v1) of mesh with weights[target_count]:
+ * pos_out[v] = positions[v] + sum_k weights[k] * target_positions[k][v],
+ * in target order, a weight of exactly 0 skipped; normals likewise into
+ * nrm_out when both mesh->normals and nrm_out are non-NULL (without
+ * target_normals they are copied). Not renormalised (skinning and
+ * kin_mesh_transform renormalise). pos_out / nrm_out hold the whole mesh
+ * (indexed by v) and must not alias the mesh arrays. */
+void kin_morph_apply(const kin_mesh *mesh, const float *weights,
+                     float *pos_out, float *nrm_out, int v0, int v1);
 
 /* Forward kinematics: world[i] = world[parent[i]] * M(locals[i]), with
  * root = root_or_null (identity if NULL) as the parent of roots.
@@ -789,7 +832,10 @@ size_t kin_skin_plan_scratch_size(const kin_mesh *mesh);
 size_t kin_skin_plan_size(const kin_mesh *mesh, void *scratch);
 /* Builds the plan into mem (64-byte aligned, size >= kin_skin_plan_size).
  * Returns 0, or -1 (plan zeroed) when the mesh is invalid, mem is not
- * aligned or too small. Not a per-frame call: it sorts. */
+ * aligned or too small, or the mesh has extra influence sets (extra_sets:
+ * skin it with kin_skin_lbs). Not a per-frame call: it sorts. A plan
+ * copies the bind positions: a morphed mesh is skinned with kin_skin_lbs
+ * on the output of kin_morph_apply instead. */
 int kin_skin_plan_init(kin_skin_plan *plan, const kin_mesh *mesh, void *scratch,
                        void *mem, size_t size);
 /* kin_skin_lbs / kin_skin_dqs of the plan's mesh, same bytes. jm / dq

@@ -103,6 +103,21 @@ int kin_model_validate(const kin_model *m, char *why, size_t why_size)
         if (me->normals &&
             !finite_all(me->normals, (size_t)me->vertex_count * 3))
             return fail(why, why_size, "mesh %d has non-finite normals", k);
+        if (me->target_count < 0 ||
+            (me->target_count > 0 && (!me->target_positions || !me->target_weights)))
+            return fail(why, why_size, "mesh %d has %d morph targets without data", k,
+                        me->target_count);
+        if (me->target_count > 0) {
+            size_t nd = (size_t)me->target_count * (size_t)me->vertex_count * 3;
+            if (!finite_all(me->target_positions, nd) ||
+                (me->target_normals && !finite_all(me->target_normals, nd)) ||
+                !finite_all(me->target_weights, (size_t)me->target_count))
+                return fail(why, why_size, "mesh %d has non-finite morph targets or weights", k);
+        }
+        if (me->extra_sets < 0 ||
+            (me->extra_sets > 0 && (!me->joints_extra || !me->weights_extra || !me->joints)))
+            return fail(why, why_size, "mesh %d has %d extra influence sets without data", k,
+                        me->extra_sets);
         if (me->node < -1 || me->node >= m->node_count)
             return fail(why, why_size, "mesh %d belongs to node %d of %d", k,
                         me->node, m->node_count);
@@ -124,6 +139,18 @@ int kin_model_validate(const kin_model *m, char *why, size_t why_size)
                         return fail(why, why_size,
                                     "mesh %d vertex %d uses joint %u of %d", k,
                                     v, me->joints[v * 4 + c], jc);
+                }
+                for (int c = 0; c < 4 * me->extra_sets; c++) {
+                    size_t e = (size_t)v * 4 * (size_t)me->extra_sets + (size_t)c;
+                    float w = me->weights_extra[e];
+                    if (!isfinite(w) || w < 0.0f)
+                        return fail(why, why_size,
+                                    "mesh %d vertex %d has weight %g (set %d)", k, v, w,
+                                    1 + c / 4);
+                    if (w > 0.0f && me->joints_extra[e] >= jc)
+                        return fail(why, why_size,
+                                    "mesh %d vertex %d uses joint %u of %d (set %d)", k,
+                                    v, me->joints_extra[e], jc, 1 + c / 4);
                 }
             }
         }

@@ -66,6 +66,8 @@ void kin__skin_lbs_ref(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
 {
     const int do_n = mesh->normals && nrm_out;
     const int skinned = mesh->joints && mesh->weights && jm;
+    const int extra = mesh->joints_extra && mesh->weights_extra && mesh->extra_sets > 0
+                      ? mesh->extra_sets : 0;
     for (int v = v0; v < v1; v++) {
         const float *p = mesh->positions + (size_t)v * 3;
         float *po = pos_out + (size_t)v * 3;
@@ -74,9 +76,12 @@ void kin__skin_lbs_ref(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
 
         affine b = { { 0 } };
         float wsum = 0.0f;
-        if (skinned) {
-            const uint16_t *j = mesh->joints + (size_t)v * 4;
-            const float *w = mesh->weights + (size_t)v * 4;
+        for (int set = 0; skinned && set <= extra; set++) {
+            /* set 0: JOINTS_0/WEIGHTS_0; then the extra sets in order */
+            const uint16_t *j = set ? mesh->joints_extra + ((size_t)v * (size_t)extra + (size_t)(set - 1)) * 4
+                                    : mesh->joints + (size_t)v * 4;
+            const float *w = set ? mesh->weights_extra + ((size_t)v * (size_t)extra + (size_t)(set - 1)) * 4
+                                 : mesh->weights + (size_t)v * 4;
             for (int i = 0; i < 4; i++) {
                 if (w[i] == 0.0f) continue;
                 const float *m = jm[j[i]].m;
@@ -116,7 +121,8 @@ void kin_skin_lbs_isa(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
 {
     if (!mesh || !pos_out) return;
     int v = 0, n = mesh->vertex_count;
-    if (mesh->joints && mesh->weights && jm) {
+    /* extra influence sets: the reference alone */
+    if (mesh->joints && mesh->weights && jm && mesh->extra_sets == 0) {
         switch ((ef_isa)kin__skin_isa_of(isa)) {
 #if defined(__x86_64__)
         case EF_ISA_AVX512: v = kin__skin_lbs_avx512(mesh, jm, pos_out, nrm_out, 0, n); break;

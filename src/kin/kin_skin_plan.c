@@ -35,7 +35,8 @@ _Static_assert(sizeof(kin__plan_batch) % 64 == 0, "batches stay 64-byte aligned"
 
 static int mesh_ok(const kin_mesh *m)
 {
-    return m && m->vertex_count >= 0 && (m->positions || m->vertex_count == 0);
+    return m && m->vertex_count >= 0 && (m->positions || m->vertex_count == 0) &&
+           m->extra_sets == 0;
 }
 
 static int key_cmp(const void *pa, const void *pb)

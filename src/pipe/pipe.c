@@ -1,5 +1,6 @@
 /* pipe.c - one stereo frame, end to end (see pipe.h). */
 #include "pipe.h"
+#include "pipe_morph.h"
 #include "pipe_parts.h"
 
 #include <math.h>
@@ -73,6 +74,7 @@ int pipe_pose_init(pipe_pose *ps, const kin_model *m)
         ps->nrm[i] = malloc(sizeof(float) * 3 * nv);
         if (!ps->pos[i] || !ps->nrm[i]) goto oom;
     }
+    if (pipe__morph_init(ps) != 0) goto oom;
     return 0;
 oom:
     pipe_pose_free(ps);
@@ -91,6 +93,7 @@ void pipe_pose_free(pipe_pose *ps)
             if (ps->nrm) free(ps->nrm[i]);
         }
     }
+    pipe__morph_free(ps);
     free(ps->joint_mats);
     free(ps->own_normals);
     free(ps->meshes);
@@ -129,7 +132,7 @@ static void pose_skin_part(pipe_pose *ps, const kin_skin_plan *plans, int part, 
         int per = ((me->vertex_count + parts - 1) / parts + 15) & ~15;
         int v0 = part * per, v1 = v0 + per < me->vertex_count ? v0 + per : me->vertex_count;
         if (v0 >= v1) continue;
-        kin_mesh sub = *me; /* a view of vertices [v0, v1) */
+        kin_mesh sub = pipe__morph_mesh(ps, i, v0, v1); /* a view of [v0, v1) */
         sub.vertex_count = v1 - v0;
         sub.positions += 3 * v0;
         if (sub.normals) sub.normals += 3 * v0;
@@ -158,6 +161,7 @@ static void pose_locals_anim(pipe_pose *ps, const kin_animation *anim, float t)
 {
     kin_pose_rest(ps->model, ps->locals);
     if (anim) kin_anim_sample(anim, ps->model->node_count, t, ps->locals);
+    pipe__morph_weights(ps, anim, t);
 }
 
 void pipe_pose_anim(pipe_pose *ps, const kin_animation *anim, float t)
@@ -169,6 +173,7 @@ void pipe_pose_anim(pipe_pose *ps, const kin_animation *anim, float t)
 void pipe_pose_locals(pipe_pose *ps, const kin_transform *locals)
 {
     memcpy(ps->locals, locals, sizeof *locals * (size_t)ps->model->node_count);
+    pipe__morph_weights(ps, NULL, 0.0f);
     pose_skin(ps);
 }
 
@@ -506,7 +511,8 @@ static int skin_plans_build(pipe_ctx *p)
     if (!p->plans || !p->plan_mem) return -1;
     for (int i = 0; i < nm; i++) {
         const kin_mesh *me = &p->pose.meshes[i];
-        if (me->skin < 0) continue;
+        /* morphed meshes and extra influence sets: kin_skin_lbs */
+        if (me->skin < 0 || me->target_count > 0 || me->extra_sets > 0) continue;
         void *scratch = malloc(kin_skin_plan_scratch_size(me) + 16);
         size_t bytes = scratch ? kin_skin_plan_size(me, scratch) : 0;
         p->plan_mem[i] = bytes ? aligned_alloc(64, (bytes + 63) & ~(size_t)63) : NULL;
@@ -709,9 +715,10 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
     if (cr != PIPE_OK) return cr;
 
     double t0 = now_ms();
-    if (in->locals)
+    if (in->locals) {
         memcpy(p->pose.locals, in->locals, sizeof *in->locals * (size_t)p->pose.model->node_count);
-    else
+        pipe__morph_weights(&p->pose, NULL, 0.0f);
+    } else
         pose_locals_anim(&p->pose, in->anim, in->time);
     pose_fk(&p->pose);
     if (p->threaded && p->skin_split) {

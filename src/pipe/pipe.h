@@ -56,6 +56,14 @@ typedef struct pipe_pose {
     float **pos;              /* per mesh, 3 per vertex, world space */
     float **nrm;              /* per mesh, 3 per vertex, world space, unit */
     int max_vertices;         /* of the largest mesh */
+    /* morph targets (pipe_morph.c), per mesh, NULL for meshes without:
+     * the current weights (target_count; the node's defaults, or the
+     * animation's `weights` channel in pipe_pose_anim / pipe_frame with
+     * an animation), and the morphed bind positions / normals that are
+     * then skinned (3 per vertex) */
+    float **morph_w;
+    float **morph_pos;
+    float **morph_nrm;
 } pipe_pose;
 
 /* 0 on success, -1 when out of memory (nothing to free then). */
