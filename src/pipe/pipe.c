@@ -1,6 +1,5 @@
 /* pipe.c - one stereo frame, end to end (see pipe.h). */
 #include "pipe.h"
-#include "pipe_parts.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -8,6 +7,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+#include "pipe_parts.h" /* hidden parts and props */
 
 /* ------------------------------------------------------------- posing */
 
