@@ -10,6 +10,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "pipe_parts.h" /* hidden parts and props */
+
 /* ------------------------------------------------------------- posing */
 
 /* Area-weighted smooth vertex normals for meshes without NORMAL. (glTF
