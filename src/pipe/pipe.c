@@ -373,11 +373,18 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     fe.out = in->out[e->eye];
     fe.v_opaque = in->virt_opaque != 0;
     fuse_depth dt;
+    int filled[4] = {0, 0, 0, 0};
     if (in->virt_depth[e->eye]) {
         dt = (fuse_depth){e->depth, cw, p->hmd.znear, p->hmd.zfar, p->hmd.cam_offset_m,
                           in->virt_depth[e->eye], in->virt_depth_stride[e->eye],
                           fe.V.width, fe.V.height};
         fe.depth = &dt;
+        /* refined pixels outside the model have no depth: they take the
+         * model's beside them, so the depth test hides them too */
+        if (fe.mask == e->refined) {
+            const int b = p->desc.refine_band;
+            fuse_depth_fill(e->refined, cw, e->depth, cw, cw, ch, b + b / 8 + 2, filled);
+        }
     }
     fuse_result fr = FUSE_OK;
     if (p->desc.tone_match > 0.0f) {
@@ -387,6 +394,10 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         for (int k = 0; k < 3; k++) L.tone[k] *= tone[k];
     }
     if (fr == FUSE_OK) fr = fuse_context_frame(e->fuse, &fe, 1);
+    /* the raster's planes as it left them (it clears only what it drew) */
+    for (int y = filled[1]; y < filled[3]; y++)
+        for (int x = filled[0]; x < filled[2]; x++)
+            if (e->mask[(size_t)y * cw + x] == 0) e->depth[(size_t)y * cw + x] = 1.0f;
     e->ms_fuse = now_ms() - t1 - e->ms_convert;
     if (fr != FUSE_OK) {
         e->result = PIPE_ERR_FUSE;
