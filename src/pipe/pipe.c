@@ -756,6 +756,13 @@ const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
     return e->have_refined ? e->refined : e->mask;
 }
 
+const uint8_t *pipe_layer(const pipe_ctx *p, int eye, int *width, int *height)
+{
+    if (width) *width = p->geo.crop_width;
+    if (height) *height = p->geo.crop_height;
+    return p->eye[eye ? 1 : 0].layer;
+}
+
 kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].cam; }
 
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }

@@ -198,6 +198,10 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
 /* The last frame's mask of one eye (valid until the next frame): the
  * refined one with pipe_desc.refine_band, else the G-buffer's. */
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
+/* The last frame's lit layer of one eye (premultiplied RGBA8, the
+ * mask's size, 4 * width bytes per row; valid until the next frame):
+ * alpha 0 wherever the mask was 0 or the depth test hid the hand. */
+const uint8_t *pipe_layer(const pipe_ctx *p, int eye, int *width, int *height);
 /* The camera of one eye in the last frame. */
 kin_camera pipe_camera(const pipe_ctx *p, int eye);
 /* The ISA that raster and fuse use (an ef_isa value). */
