@@ -204,6 +204,7 @@ typedef struct eye_state {
     float *depth, *nrm, *clip, *vnrm;
     uint8_t *mask, *layer;
     uint8_t *cam_rgba;        /* the cropped camera image, when given raw */
+    float *snrm;              /* smoothed normals (normal_smooth) */
     uint8_t *refined;         /* the refined mask (refine_band) */
     void *refine_scratch;
     size_t refine_scratch_size;
@@ -364,6 +365,10 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     }
     fe.normal = e->nrm;
     fe.normal_stride = 3 * cw;
+    if (p->desc.normal_smooth > 0 &&
+        fuse_normal_smooth(fe.mask, fe.mask_stride, e->nrm, 3 * cw, e->snrm, 3 * cw, cw, ch,
+                           p->desc.normal_smooth) == FUSE_OK)
+        fe.normal = e->snrm;
     fe.Q = (fuse_image){e->layer, cw, ch, 4 * cw};
     fe.V = in->virt[e->eye];
     fe.vp_x0 = p->geo.vp_x0;
@@ -456,6 +461,7 @@ static void free_eyes(pipe_ctx *p)
     for (int e = 0; e < 2; e++) {
         free(p->eye[e].depth);
         free(p->eye[e].nrm);
+        free(p->eye[e].snrm);
         free(p->eye[e].clip);
         free(p->eye[e].vnrm);
         free(p->eye[e].mask);
@@ -503,6 +509,8 @@ static int skin_plans_build(pipe_ctx *p)
 pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
 {
     if (!model) return NULL;
+    if (desc && (desc->normal_smooth < 0 || desc->normal_smooth > FUSE_NORMAL_SMOOTH_MAX))
+        return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
     if (desc) p->desc = *desc;
@@ -531,6 +539,10 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         s->fuse = fuse_context_create(&fd);
         ok = ok && s->depth && s->nrm && s->mask && s->layer && s->cam_rgba && s->clip && s->vnrm &&
              s->rast && s->fuse;
+        if (ok && p->desc.normal_smooth > 0) {
+            s->snrm = malloc(sizeof(float) * 3 * px);
+            ok = s->snrm != NULL;
+        }
         if (ok && p->desc.refine_band > 0) {
             fuse_refine_params rp = fuse_refine_params_default();
             rp.band = p->desc.refine_band;

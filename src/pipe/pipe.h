@@ -31,6 +31,7 @@
 #define EGOFUSE_PIPE_H
 
 #include "../fuse/fuse.h"
+#include "../fuse/fuse_normals.h"
 #include "../fuse/fuse_refine.h"
 #include "../kin/kin.h"
 #include "../raster/raster.h"
@@ -110,6 +111,13 @@ typedef struct pipe_desc {
                                  thickness measured applies to every frame,
                                  animation-posed ones too. NULL = no fit.
                                  Copied. */
+    int normal_smooth;        /* 0 = off (default); 1..FUSE_NORMAL_SMOOTH_MAX:
+                                 the lit mask's normals are summed over
+                                 the (2r + 1)^2 window before lighting
+                                 (fuse_normal_smooth): for models of
+                                 crossing parts with their own normals,
+                                 whose shading seams become ramps. Out of
+                                 range: pipe_create returns NULL. */
 } pipe_desc;
 
 typedef struct pipe_ctx pipe_ctx;
