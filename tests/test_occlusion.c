@@ -28,7 +28,8 @@
  *   - every ISA gives the reference's bytes (outputs and layers).
  * Before fuse_depth_fill (the refined pixels outside the model had no
  * depth and were kept) refine and refine-anim drew hundreds of hand
- * pixels inside the band per frame. */
+ * pixels inside the band per frame (with the fill disabled: refine 25,913,
+ * refine-anim 9,939, skin 527,555 over the 5 stereo frames). */
 #include "support/testutil.h"
 
 #include <cmocka.h>
