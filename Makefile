@@ -115,6 +115,12 @@ $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(IOLIB) $(LIB)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(IOLIB) $(LIB) \
 	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
+# Tests on the generated samples' scenes also link the generator.
+$(BUILD)/tests/test_occlusion: tests/test_occlusion.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) \
+	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
+
 $(BUILD)/bench/%: bench/%.c $(IOLIB) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) $(BENCH_CFLAGS) -o $@ $< $(IOLIB) $(LIB) \

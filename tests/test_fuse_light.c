@@ -14,7 +14,7 @@
 
 /* CRC32 over the outputs of crc_cases(). It changes only when the rules
  * of docs/fuse.md change on purpose; then record the printed value. */
-#define LIGHT_CRC 0x9D72228Bu
+#define LIGHT_CRC 0xEF99B600u   /* issue 14: Schlick Fresnel (was 0x9D72228B) */
 
 /* ---- test images ---------------------------------------------------- */
 
@@ -124,8 +124,8 @@ static void ref_pixel(const fuse_lighting *L, const fuse_intrinsics *K,
             L->ks * pow(fmin(1.0, fmax(0.0, dot3(N, H))), L->shininess);
         for (c = 0; c < 3; c++) C[c] += L->lights[i].color[c] * w;
     }
-    F = fmax(0.0, 1.0 - dot3(N, V));
-    F = F * F;
+    F = fmin(1.0, fmax(0.0, 1.0 - dot3(N, V)));
+    F = F * F * F * F * F;
     mp = m / 255.0 * clamp01d(1.0 - L->kf * F);
     for (c = 0; c < 3; c++)
         res[c] = 255.0 * mp * clamp01d(p[c] / 255.0 * C[c] * L->tone[c]);
@@ -359,11 +359,12 @@ static void test_grazing(void **state)
     L.kf = 1.0f;
     assert_int_equal(light1(&L, &p), FUSE_OK);
     assert_int_equal(p.out[0] | p.out[1] | p.out[2] | p.out[3], 0);
-    /* A back-facing normal has F = 4: clamped to 0 as well with kf 0.6. */
+    /* A back-facing normal: 1 - N.V = 2 is clamped to 1, F = 1, as at a
+     * grazing edge (the squared term without that clamp gave F = 4). */
     L.kf = 0.6f;
     p.n[0] = 0; p.n[2] = -1;
     assert_int_equal(light1(&L, &p), FUSE_OK);
-    assert_int_equal(p.out[3], 0);
+    assert_int_equal(p.out[3], 102);
     /* A zero, NaN or infinite normal is replaced by V: F = 0. */
     p.n[2] = 0;
     assert_int_equal(light1(&L, &p), FUSE_OK);
@@ -439,9 +440,9 @@ static void test_view_vector(void **state)
     assert_int_equal(out[i + 3], 255);       /* F = 0 */
     assert_int_equal(out[i], 70);            /* C = 0.2 + 0.5 (0.6 + 0.4) */
     /* Pixel (0, 1): V = (0, 0, 1) there; N.V = 1/sqrt(10), F =
-     * (1 - 0.316228)^2 = 0.467544, M' = 1 - 0.6 F = 0.719474: 183.46. */
+     * (1 - 0.316228)^5 = 0.149470, M' = 1 - 0.6 F = 0.910318: 232.13. */
     i = 4 * (1 * 4 + 0);
-    assert_int_equal(out[i + 3], 183);
+    assert_int_equal(out[i + 3], 232);
 }
 
 /* ---- validation -------------------------------------------------------- */

@@ -112,6 +112,8 @@ typedef struct tube {
     int cap_rings;            /* rings in each rounded cap */
     float cap0, cap1;         /* cap depth as a fraction of the end radius */
     float squareness;         /* super-ellipse exponent: 2 = ellipse */
+    float square2, square2_from, square2_to; /* blends to square2 over
+                                 [from, to] when to > from (else none) */
     float albedo[3], albedo2[3];
     float albedo2_from;       /* s from which albedo2 applies (or > length) */
     gen_pattern pat, pat2;
@@ -172,7 +174,11 @@ static int emit_vertex(builder *b, const tube *tb, float s, float phi,
 {
     if (b->vcount >= MAX_VERTS) return -1;
     prof_key k = profile_at(tb, s);
-    float e = 2.0f / tb->squareness;
+    float sq = tb->squareness;
+    if (tb->square2_to > tb->square2_from)
+        sq += (tb->square2 - sq) *
+              smooth01((s - tb->square2_from) / (tb->square2_to - tb->square2_from));
+    float e = 2.0f / sq;
     float c = sgnpow(cosf(phi), e), sn = sgnpow(sinf(phi), e);
     kin_vec3 lp = kin_v3(k.rx * scale * c, k.oy + k.ry * scale * sn, -s);
     kin_vec3 wp = kin_mat4_mul_point(&b->bind[tb->bone], lp);
@@ -391,7 +397,13 @@ static void build_skeleton(builder *b, gen_arms *a)
 static int emit_side(builder *b, const gen_arms *a, int side)
 {
     const int *J = a->joint[side];
-    /* arm: shoulder ball to the wrist, along the upper arm's axis */
+    /* arm and palm: one surface from the shoulder ball over the wrist to
+     * the knuckles, along the upper arm's axis. (Two parts, a forearm
+     * running into a palm that started inside it, gave the wrist two
+     * crossing surfaces with their own normals: a shading seam with a
+     * staircase boundary, issue 14.) The wrist is at s = 0.56, the palm's
+     * profile follows from s = 0.58 and the cross section turns from an
+     * ellipse into the palm's boxy super-ellipse between them. */
     static const prof_key arm_prof[] = {
         { -0.040f, 0.046f, 0.048f, 0.004f },
         { 0.000f, 0.053f, 0.055f, 0.004f },
@@ -402,43 +414,28 @@ static int emit_side(builder *b, const gen_arms *a, int side)
         { 0.360f, 0.043f, 0.039f, -0.002f },
         { 0.450f, 0.035f, 0.029f, 0.000f },
         { 0.540f, 0.029f, 0.020f, 0.000f },
-        { 0.585f, 0.028f, 0.019f, 0.000f },
+        { 0.565f, 0.029f, 0.0190f, -0.001f },   /* wrist */
+        { 0.580f, 0.033f, 0.0190f, -0.002f },   /* the palm: its old */
+        { 0.610f, 0.040f, 0.017f, -0.003f },    /* profile from 0.02 */
+        { 0.645f, 0.043f, 0.0145f, -0.002f },   /* past the wrist */
+        { 0.663f, 0.041f, 0.0135f, -0.001f },
     };
     const span arm_spans[] = {
         { J[GEN_J_UPPER_ARM], UPPER_ARM_LEN, 0.045f },
         { J[GEN_J_FOREARM], UPPER_ARM_LEN + FOREARM_LEN, 0.018f },
-        { J[GEN_J_HAND], 10.0f, 0.01f },
+        { J[GEN_J_HAND], UPPER_ARM_LEN + FOREARM_LEN + WRIST_TO_PALM - 0.005f, 0.015f },
+        { J[GEN_J_PALM], 10.0f, 0.01f },
     };
     tube arm = {
-        .bone = J[GEN_J_UPPER_ARM], .prof = arm_prof, .prof_count = 10,
-        .spans = arm_spans, .span_count = 3, .around = 24, .along = 44,
-        .cap_rings = 5, .cap0 = 0.9f, .cap1 = 0.5f, .squareness = 2.0f,
+        .bone = J[GEN_J_UPPER_ARM], .prof = arm_prof, .prof_count = 14,
+        .spans = arm_spans, .span_count = 4, .around = 28, .along = 84,
+        .cap_rings = 5, .cap0 = 0.9f, .cap1 = 0.8f, .squareness = 2.0f,
+        .square2 = 2.8f, .square2_from = 0.555f, .square2_to = 0.59f,
         .albedo = { sleeve_rgb[0], sleeve_rgb[1], sleeve_rgb[2] },
         .albedo2 = { skin_rgb[0], skin_rgb[1], skin_rgb[2] },
         .albedo2_from = 0.47f, .pat = GEN_PAT_FABRIC, .pat2 = GEN_PAT_SKIN,
     };
     if (emit_part(b, &arm) < 0) return -1;
-
-    /* palm: flattened, slightly boxy, from the wrist to the knuckles */
-    static const prof_key palm_prof[] = {
-        { -0.010f, 0.026f, 0.018f, 0.000f },
-        { 0.020f, 0.033f, 0.019f, -0.002f },
-        { 0.050f, 0.040f, 0.017f, -0.003f },
-        { 0.085f, 0.043f, 0.0145f, -0.002f },
-        { 0.103f, 0.041f, 0.0135f, -0.001f },
-    };
-    const span palm_spans[] = {
-        { J[GEN_J_HAND], WRIST_TO_PALM - 0.005f, 0.015f },
-        { J[GEN_J_PALM], 10.0f, 0.01f },
-    };
-    tube palm = {
-        .bone = J[GEN_J_HAND], .prof = palm_prof, .prof_count = 5,
-        .spans = palm_spans, .span_count = 2, .around = 28, .along = 16,
-        .cap_rings = 4, .cap0 = 0.6f, .cap1 = 0.8f, .squareness = 2.8f,
-        .albedo = { skin_rgb[0], skin_rgb[1], skin_rgb[2] },
-        .albedo2_from = 10.0f, .pat = GEN_PAT_SKIN,
-    };
-    if (emit_part(b, &palm) < 0) return -1;
 
     for (int f = 0; f < 5; f++) {
         const finger_spec *fs = &fingers[f];

@@ -9,7 +9,7 @@
  *     1. fuse_light(): the lighting layer of the paper (Blinn-Phong + Fresnel,
  *        eq. 6), at camera resolution, only where M > 0:
  *          C  = a + sum_i c_i (kd max(0, N.L_i) + ks max(0, N.H_i)^s)
- *          F  = max(0, 1 - N.V)^2,   H_i = normalize(L_i + V)
+ *          F  = clamp01(1 - N.V)^5,  H_i = normalize(L_i + V)
  *          P' = clamp(P * C * tone),  M' = M * clamp(1 - kf F)
  *        and writes the premultiplied layer Q = (M' P', M') as RGBA8.
  *     2. fuse_composite(): bilinear resampling of Q into the viewport (eq. 4,

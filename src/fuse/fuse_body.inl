@@ -175,8 +175,9 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
         }
     }
     EACH {
-        const VF t = FMAX0(FSUB(one, ndv[u]));
-        const VF fade = clamp01_lanes(FSUB(one, FMUL(F1(p->kf), FMUL(t, t))));
+        const VF t = clamp01_lanes(FSUB(one, ndv[u]));
+        const VF t2 = FMUL(t, t);
+        const VF fade = clamp01_lanes(FSUB(one, FMUL(F1(p->kf), FMUL(FMUL(t2, t2), t))));
         const VF mp = FMUL(FMUL(I2F(Mi[u]), inv255), fade);
         VF v0, v1, v2;
         VI rgba;

@@ -151,7 +151,7 @@ void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
     out += 4 * (size_t)x0;
     for (x = x0; x < x1; x++, P += 4, normal += 3, out += 4) {
         const unsigned M = mask[x];
-        float px, il, vx, vy, vz, nx, ny, nz, nn, ndv, t, fade, mp;
+        float px, il, vx, vy, vz, nx, ny, nz, nn, ndv, t, t2, fade, mp;
         float C[3];
         if (M == 0) {
             out[0] = out[1] = out[2] = out[3] = 0;
@@ -197,8 +197,9 @@ void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
             C[1] = C[1] + p->color[i][1] * w;
             C[2] = C[2] + p->color[i][2] * w;
         }
-        t = fuse__max0(1.0f - ndv);
-        fade = fuse__clamp01(1.0f - p->kf * (t * t));
+        t = fuse__clamp01(1.0f - ndv);      /* Schlick's (1 - cos)^5 */
+        t2 = t * t;
+        fade = fuse__clamp01(1.0f - p->kf * ((t2 * t2) * t));
         mp = ((float)M * FUSE__INV255) * fade;
         for (c = 0; c < 3; c++) {
             float v = fuse__clamp01((((float)P[c] * FUSE__INV255) * C[c]) * p->tone[c]);

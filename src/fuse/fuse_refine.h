@@ -166,6 +166,38 @@ fuse_result fuse_refine_mask_global(const fuse_refine_params *p,
                                     size_t scratch_size,
                                     fuse_refine_stats *stats);
 
+/* ------------------------------------- refined pixels and the depth test
+ *
+ * The depth test against the virtual scene (fuse_depth, fuse_eye.depth)
+ * needs the hand's depth at every pixel of the mask it tests, and keeps a
+ * pixel whose depth is unknown (z not in [0, 1): the rasterizer's clear
+ * value 1). A mask refined by colour (fuse_refine_mask*) has pixels the
+ * model did not cover: they have no depth and would be drawn over a
+ * virtual object that hides the hand beside them. fuse_depth_fill gives
+ * them one:
+ *   every pixel with mask != 0 whose depth is unknown takes the depth of
+ *   the nearest pixel (Euclidean; ties: the upper row, then the left
+ *   column) within a square of half width radius whose depth is known
+ *   (the depths as they were before the call: filled pixels are never
+ *   sources); with none there it gets the largest float below 1 (the far
+ *   plane), so that any virtual object hides it.
+ * A refined pixel lies within band (chamfer, which is at most 6% short of
+ * Euclidean) of the kinematic mask's edge, so radius = band + band / 8 + 2
+ * always finds the model's surface beside it. The pixel is then hidden
+ * exactly where the virtual scene is in front of that surface. Pixels
+ * with mask == 0 and pixels with a known depth are not written. One
+ * scalar code for every ISA (the depth test's ISA paths then see the same
+ * depths). Returns the number of pixels written and, in box (may be NULL),
+ * their bounding box x0, y0, x1, y1 (exclusive; all 0 when none): a
+ * caller whose depth buffer must stay the rasterizer's (rast_context_clear
+ * clears only what the draws touched) sets the box's pixels outside the
+ * kinematic mask back to 1 after the depth test. -1 for NULL pointers, a
+ * size outside 1..FUSE_MAX_DIM, strides below width, radius outside
+ * 1..FUSE_DEPTH_FILL_MAX_RADIUS (nothing written). */
+#define FUSE_DEPTH_FILL_MAX_RADIUS 128
+long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int depth_stride,
+                     int width, int height, int radius, int box[4]);
+
 /* ------------------------------------------------- paths */
 
 /* The refinement (fuse_refine_mask_global with g, fuse_refine_mask when g

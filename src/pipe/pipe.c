@@ -10,7 +10,6 @@
 #include <string.h>
 #include <time.h>
 
-#include "pipe_parts.h" /* hidden parts and props */
 
 /* ------------------------------------------------------------- posing */
 
@@ -212,6 +211,7 @@ typedef struct eye_state {
     float *depth, *nrm, *clip, *vnrm;
     uint8_t *mask, *layer;
     uint8_t *cam_rgba;        /* the cropped camera image, when given raw */
+    float *snrm;              /* smoothed normals (normal_smooth) */
     uint8_t *refined;         /* the refined mask (refine_band) */
     void *refine_scratch;
     size_t refine_scratch_size;
@@ -397,6 +397,10 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     }
     fe.normal = e->nrm;
     fe.normal_stride = 3 * cw;
+    if (p->desc.normal_smooth > 0 &&
+        fuse_normal_smooth(fe.mask, fe.mask_stride, e->nrm, 3 * cw, e->snrm, 3 * cw, cw, ch,
+                           p->desc.normal_smooth) == FUSE_OK)
+        fe.normal = e->snrm;
     fe.Q = (fuse_image){e->layer, cw, ch, 4 * cw};
     fe.V = in->virt[e->eye];
     fe.vp_x0 = p->geo.vp_x0;
@@ -406,11 +410,18 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     fe.out = in->out[e->eye];
     fe.v_opaque = in->virt_opaque != 0;
     fuse_depth dt;
+    int filled[4] = {0, 0, 0, 0};
     if (in->virt_depth[e->eye]) {
         dt = (fuse_depth){e->depth, cw, p->hmd.znear, p->hmd.zfar, p->hmd.cam_offset_m,
                           in->virt_depth[e->eye], in->virt_depth_stride[e->eye],
                           fe.V.width, fe.V.height};
         fe.depth = &dt;
+        /* refined pixels outside the model have no depth: they take the
+         * model's beside them, so the depth test hides them too */
+        if (fe.mask == e->refined) {
+            const int b = p->desc.refine_band;
+            fuse_depth_fill(e->refined, cw, e->depth, cw, cw, ch, b + b / 8 + 2, filled);
+        }
     }
     fuse_result fr = FUSE_OK;
     if (p->desc.tone_match > 0.0f) {
@@ -420,6 +431,10 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         for (int k = 0; k < 3; k++) L.tone[k] *= tone[k];
     }
     if (fr == FUSE_OK) fr = fuse_context_frame(e->fuse, &fe, 1);
+    /* the raster's planes as it left them (it clears only what it drew) */
+    for (int y = filled[1]; y < filled[3]; y++)
+        for (int x = filled[0]; x < filled[2]; x++)
+            if (e->mask[(size_t)y * cw + x] == 0) e->depth[(size_t)y * cw + x] = 1.0f;
     e->ms_fuse = now_ms() - t1 - e->ms_convert;
     if (fr != FUSE_OK) {
         e->result = PIPE_ERR_FUSE;
@@ -478,6 +493,7 @@ static void free_eyes(pipe_ctx *p)
     for (int e = 0; e < 2; e++) {
         free(p->eye[e].depth);
         free(p->eye[e].nrm);
+        free(p->eye[e].snrm);
         free(p->eye[e].clip);
         free(p->eye[e].vnrm);
         free(p->eye[e].mask);
@@ -528,6 +544,8 @@ static int skin_plans_build(pipe_ctx *p)
 pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
 {
     if (!model) return NULL;
+    if (desc && (desc->normal_smooth < 0 || desc->normal_smooth > FUSE_NORMAL_SMOOTH_MAX))
+        return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
     if (desc) p->desc = *desc;
@@ -556,6 +574,10 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         s->fuse = fuse_context_create(&fd);
         ok = ok && s->depth && s->nrm && s->mask && s->layer && s->cam_rgba && s->clip && s->vnrm &&
              s->rast && s->fuse;
+        if (ok && p->desc.normal_smooth > 0) {
+            s->snrm = malloc(sizeof(float) * 3 * px);
+            ok = s->snrm != NULL;
+        }
         if (ok && p->desc.refine_band > 0) {
             fuse_refine_params rp = fuse_refine_params_default();
             rp.band = p->desc.refine_band;
@@ -788,6 +810,13 @@ const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
     if (height) *height = p->geo.crop_height;
     const eye_state *e = &p->eye[eye ? 1 : 0];
     return e->have_refined ? e->refined : e->mask;
+}
+
+const uint8_t *pipe_layer(const pipe_ctx *p, int eye, int *width, int *height)
+{
+    if (width) *width = p->geo.crop_width;
+    if (height) *height = p->geo.crop_height;
+    return p->eye[eye ? 1 : 0].layer;
 }
 
 kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].cam; }

@@ -33,6 +33,7 @@
 #define EGOFUSE_PIPE_H
 
 #include "../fuse/fuse.h"
+#include "../fuse/fuse_normals.h"
 #include "../fuse/fuse_refine.h"
 #include "../kin/kin.h"
 #include "../raster/raster.h"
@@ -120,6 +121,13 @@ typedef struct pipe_desc {
                                  thickness measured applies to every frame,
                                  animation-posed ones too. NULL = no fit.
                                  Copied. */
+    int normal_smooth;        /* 0 = off (default); 1..FUSE_NORMAL_SMOOTH_MAX:
+                                 the lit mask's normals are summed over
+                                 the (2r + 1)^2 window before lighting
+                                 (fuse_normal_smooth): for models of
+                                 crossing parts with their own normals,
+                                 whose shading seams become ramps. Out of
+                                 range: pipe_create returns NULL. */
 } pipe_desc;
 
 typedef struct pipe_ctx pipe_ctx;
@@ -217,6 +225,10 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
 /* The last frame's mask of one eye (valid until the next frame): the
  * refined one with pipe_desc.refine_band, else the G-buffer's. */
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
+/* The last frame's lit layer of one eye (premultiplied RGBA8, the
+ * mask's size, 4 * width bytes per row; valid until the next frame):
+ * alpha 0 wherever the mask was 0 or the depth test hid the hand. */
+const uint8_t *pipe_layer(const pipe_ctx *p, int eye, int *width, int *height);
 /* The camera of one eye in the last frame. */
 kin_camera pipe_camera(const pipe_ctx *p, int eye);
 /* The ISA that raster and fuse use (an ef_isa value). */
