@@ -221,7 +221,9 @@ static int boot_vm(void)
                   "-device", "usb-tablet,bus=xhci.0,port=1.2,serial=CAM-L-0001,id=caml",
                   "-device", "usb-kbd,bus=xhci.0,port=2,serial=CAM-R-0002,id=camr",
                   "-device", "isa-debug-exit,iobase=0xf4,iosize=0x04",
-                  "-vga", "none", "-device", "bochs-display,id=display0",
+                  "-vga", "none", "-device",
+                  /* 2560x800 preferred: the cockpit step shows two 1280x800 eyes side by side */
+                  "bochs-display,id=display0,xres=2560,yres=800,xmax=2560,ymax=1600,vgamem=67108864",
                   "-device", "virtio-gpu-pci,max_outputs=2,id=vgpu",
                   "-qmp", qmp_arg, "-serial", "stdio", "-display", "none", "-monitor", "none",
                   "-no-reboot", NULL};

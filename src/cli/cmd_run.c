@@ -178,6 +178,21 @@ static void run_close(run_state *r)
 
 /* The tracker: every pending sample into the filter (called whenever the
  * loop waits, so the filter sees each sample near its arrival). */
+/* Every NatNet frame accepted goes into the filter (a poll may accept
+ * several and hand out only the newest). */
+static void natnet_sample(void *user, const kin_track_sample *s, const io_natnet *n)
+{
+    (void)n;
+    run_state *r = user;
+    if (!s->valid) return;
+    if (kin_filter_push(&r->filter, s) & KIN_FILTER_ACCEPTED) {
+        r->track_samples++;
+        r->t_track = (uint64_t)(s->t * 1e9); /* NatNet's times are CLOCK_MONOTONIC */
+    }
+    r->tclock.have = 1;
+    r->tclock.offset_s = 0;
+}
+
 static void track_service(run_state *r)
 {
     io_error err;
@@ -187,18 +202,14 @@ static void track_service(run_state *r)
     if (r->udp.fd >= 0) {
         if (io_track_udp_poll(&r->udp, 0, &s, &fresh, &err) != IO_OK) return;
     } else if (r->have_natnet) {
-        if (io_natnet_poll(&r->natnet, 0, &s, &fresh, &err) != IO_OK) return;
+        io_natnet_poll(&r->natnet, 0, &s, &fresh, &err); /* natnet_sample takes each frame */
+        return;
     } else {
         return;
     }
     if (!fresh || !s.valid) return; /* the newest of the datagrams read */
     int bits = kin_filter_push(&r->filter, &s);
-    if (r->have_natnet) { /* NatNet's sample times are CLOCK_MONOTONIC already */
-        r->tclock.have = 1;
-        r->tclock.offset_s = 0;
-    } else {
-        track_local_time(&r->tclock, s.t, t_arr, bits & KIN_FILTER_RESTART);
-    }
+    track_local_time(&r->tclock, s.t, t_arr, bits & KIN_FILTER_RESTART);
     if (bits & KIN_FILTER_ACCEPTED) {
         r->track_samples++;
         r->t_track = (uint64_t)((s.t + r->tclock.offset_s) * 1e9);
@@ -637,6 +648,8 @@ static int run(const run_opts *o)
             goto done;
         }
         r->have_natnet = 1;
+        r->natnet.on_sample = natnet_sample;
+        r->natnet.user = r;
         /* The names are resolved once the server answers; the cameras do
          * not wait for it: a short wait for a clear message at start. */
         if (io_natnet_wait_ready(&r->natnet, 1000, &err) != IO_OK && !o->quiet)
