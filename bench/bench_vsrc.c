@@ -16,6 +16,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include "../src/io/io_vsrc.h"
@@ -65,6 +66,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "bench_vsrc: %s\n", err.msg);
         return 1;
     }
+    struct stat sb;
+    const char *colon = strchr(argv[1], ':');
+    int fifo = colon && stat(colon + 1, &sb) == 0 && S_ISFIFO(sb.st_mode);
     size_t cap = 1 << 16, n = 0;
     double *poll_ms = malloc(cap * sizeof *poll_ms), *age_ms = malloc(cap * sizeof *age_ms);
     if (!poll_ms || !age_ms) return 1;
@@ -85,7 +89,8 @@ int main(int argc, char **argv)
             if (!t_first) t_first = b;
             t_last = b;
         }
-        if (st.state == IO_VSRC_ENDED || st.state == IO_VSRC_FAILED) break;
+        /* a FIFO's writer may come back: keep reading it */
+        if (st.state == IO_VSRC_FAILED || (st.state == IO_VSRC_ENDED && !fifo)) break;
     }
     io_vsrc_status(v, 0, &st);
     char fs[5];

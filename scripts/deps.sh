@@ -1,6 +1,8 @@
 #!/bin/sh
 # Installs the Debian packages egofuse needs to build, test and run its demo
-# (the last line: the virtual machine that tests the camera, USB and glove
+# (ffmpeg, gst-launch-1.0 and python3: the real producers and the framing
+# generator of tests/test_io_vsrc.c, and the video decoder of file cameras;
+# the last line: the virtual machine that tests the camera, USB and glove
 # code against the Linux kernel's own drivers, tests/vm/; the kernel itself
 # is fetched by tests/vm/prepare.sh with apt-get download, not installed).
 # Called by `make demo`, `make test` and `make bench`; safe to run again (it
@@ -16,6 +18,7 @@ libcmocka-dev
 gnuplot-nox
 libpixman-1-dev
 libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
+ffmpeg gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good python3
 qemu-system-x86 busybox-static cpio kmod xz-utils"
 
 missing=""

@@ -249,21 +249,24 @@ static void poll_v4l2_once(io_vsrc *v, uint64_t now, int *fresh)
         if (c->state != IO_CAM_STREAMING) {
             if (now - v->last_try[i] < 1000000000ull && v->last_try[i]) continue;
             v->last_try[i] = now;
-            uint64_t sk = c->stats.skipped;
-            if (io_cam_reopen(c, NULL, &e2) == IO_OK) {
+            io_result r = io_cam_reopen(c, NULL, &e2);
+            if (r == IO_OK && c->state != IO_CAM_STREAMING) r = io_cam_start(c, &e2);
+            if (r == IO_OK) {
                 v->reopens++;
-                v->hard = 0;
                 set_msg(v, "V source %s: %s is back", v->spec, c->cfg.path);
             } else {
+                io_cam_close(c); /* nothing held between tries */
                 set_msg(v, "V source %s: %s (reopening once a second)", v->spec, e2.msg);
             }
-            (void)sk;
             continue;
         }
         io_frame f;
         int got = 0;
         io_result r = io_cam_grab(c, 0, &f, &got, &e2);
         if (r != IO_OK) {
+            /* gone: let go of the node at once (a replugged device may
+             * take the same number), try again in a second */
+            io_cam_close(c);
             v->hard = IO_VSRC_FAILED;
             v->last_try[i] = now;
             set_msg(v, "V source %s: %s (reopening once a second)", v->spec, e2.msg);
@@ -288,7 +291,8 @@ static void poll_v4l2_once(io_vsrc *v, uint64_t now, int *fresh)
     }
     int failed = 0;
     for (int i = 0; i < v->ndev; i++) failed |= v->cam[i].state != IO_CAM_STREAMING;
-    if (!failed && v->hard == IO_VSRC_FAILED) v->hard = 0;
+    if (failed) v->hard = IO_VSRC_FAILED;
+    else if (v->hard == IO_VSRC_FAILED) v->hard = 0;
 }
 
 /* ------------------------------------------------------------ stream */
@@ -499,6 +503,15 @@ static void stream_take(io_vsrc *v, uint64_t now, int *fresh)
             read_total += (size_t)n;
             continue;
         }
+        if (n == 0 && v->is_fifo && r->offset + r->len == 0) {
+            /* a FIFO without a writer yet: not an end, look again later */
+            r->eof = 0;
+            stream_close_fd(v);
+            v->retry_ns = now + 1000000000ull;
+            if (!v->have_eye[0])
+                set_msg(v, "V source %s: no writer on the FIFO yet (looking once a second)", v->spec);
+            break;
+        }
         if (n == 0) continue; /* EOF: parse the rest with eof set */
         if (n == -1) break;   /* nothing more now */
         set_msg(v, "V source %s", r->msg);
@@ -539,8 +552,12 @@ static void stream_take(io_vsrc *v, uint64_t now, int *fresh)
     v->t_arrival[0] = v->t_arrival[1] = now;
     v->t_frame[0] = v->t_frame[1] = pend.t_ns && pend.t_ns <= now ? pend.t_ns : now;
     if (v->reopened) {
-        v->reopens++;
         v->reopened = 0;
+        if (v->frames > 1) { /* not the first writer */
+            v->reopens++;
+            set_msg(v, "V source %s: a new writer (reopen %llu)", v->spec,
+                    (unsigned long long)v->reopens);
+        }
     }
     if (v->hard == IO_VSRC_ENDED && v->fd >= 0) v->hard = 0;
     *fresh = 1;

