@@ -269,15 +269,13 @@ static void test_egfv_tb_u16_depth(void **st)
 
 /* The documented bilinear rule, computed here independently in double:
  * must agree with the integer scaler within 1 (8-bit weights). */
-static void test_egfv_scaled(void **st)
+static void scaled_case(int EW, int EH)
 {
-    (void)st;
     size_t n;
     uint8_t *bytes = gen("basic", &n);
     tpipe t;
     tpipe_open(&t, "stream:");
-    const int EW = 20, EH = 12;
-    io_vsrc *v = open_src(t.spec, EW, EH, IO_VSRC_AUTO, NULL);
+    io_vsrc *v = open_src(t.spec, EW, EH, IO_VSRC_SBS, NULL);
     tpipe_write(&t, bytes, n);
     assert_int_equal(poll_fresh(v, 0), 1);
     int maxd = 0;
@@ -332,6 +330,14 @@ static void test_egfv_scaled(void **st)
     io_vsrc_close(v);
     tpipe_close(&t);
     free(bytes);
+}
+
+static void test_egfv_scaled(void **st)
+{
+    (void)st;
+    scaled_case(20, 12); /* down */
+    scaled_case(45, 70); /* up: rows reused */
+    scaled_case(32, 33);
 }
 
 /* Runs a generator scenario through a pipe (writer closed), one poll. */

@@ -35,6 +35,7 @@ struct io_vsrc {
     uint8_t *stage[2];            /* converted source frame per device */
     size_t stage_cap[2];
     int *xt, *yt;                 /* scaler scratch */
+    uint16_t *rows;
     int have_eye[2];
     /* status */
     io_vsrc_state hard;           /* 0, IO_VSRC_ENDED or IO_VSRC_FAILED */
@@ -179,7 +180,7 @@ static io_result apply_frame(io_vsrc *v, const io_frame *f, int full, int layout
             v->eye_stride[1] = v->eye_stride[0];
         } else {
             vs_scale_rgba(src, rw, rh, ss, v->eyebuf[e], v->ew, v->eh, 4 * (size_t)v->ew, v->xt,
-                          v->yt);
+                          v->yt, v->rows);
             v->eye[e] = v->eyebuf[e];
             v->eye_stride[e] = 4 * (size_t)v->ew;
         }
@@ -607,8 +608,9 @@ io_result io_vsrc_open(io_vsrc **out, const io_vsrc_config *c, io_error *err)
     v->dbuf[1] = malloc(eb);
     v->xt = malloc(sizeof(int) * 2 * (size_t)v->ew);
     v->yt = malloc(sizeof(int) * 2 * (size_t)v->eh);
+    v->rows = malloc(sizeof(uint16_t) * 6 * (size_t)v->ew);
     io_result r = IO_OK;
-    if (!v->eyebuf[0] || !v->eyebuf[1] || !v->dbuf[0] || !v->dbuf[1] || !v->xt || !v->yt) {
+    if (!v->eyebuf[0] || !v->eyebuf[1] || !v->dbuf[0] || !v->dbuf[1] || !v->xt || !v->yt || !v->rows) {
         r = io_fail(err, IO_ERR_NOMEM, "V source %s: out of memory for %dx%d eyes", c->spec, v->ew,
                     v->eh);
     } else if (!strncmp(v->spec, "v4l2:", 5)) {
@@ -769,6 +771,7 @@ void io_vsrc_close(io_vsrc *v)
     }
     free(v->xt);
     free(v->yt);
+    free(v->rows);
     stream_close_fd(v);
     if (v->tfd >= 0) close(v->tfd);
     vs_free(&v->r);
