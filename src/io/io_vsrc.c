@@ -52,6 +52,7 @@ struct io_vsrc {
     /* stream */
     char path[1024];
     int fd, own_fd;
+    int fd_flags;                 /* stdin's flags before, restored at close */
     int is_fifo, is_reg;
     vs_reader r;
     uint64_t retry_ns;
@@ -301,6 +302,7 @@ static void poll_v4l2_once(io_vsrc *v, uint64_t now, int *fresh)
 static void stream_close_fd(io_vsrc *v)
 {
     if (v->fd >= 0 && v->own_fd) close(v->fd);
+    else if (v->fd >= 0 && v->fd_flags >= 0) fcntl(v->fd, F_SETFL, v->fd_flags); /* a shared tty */
     v->fd = -1;
 }
 
@@ -329,6 +331,7 @@ static io_result stream_open_fd(io_vsrc *v, io_error *err)
         }
     }
     int fl = fcntl(v->fd, F_GETFL);
+    v->fd_flags = fl;
     if (fl >= 0 && !(fl & O_NONBLOCK)) fcntl(v->fd, F_SETFL, fl | O_NONBLOCK);
     return IO_OK;
 }
