@@ -841,6 +841,7 @@ static void test_file_cam_sequence(void **st)
         io_cam cam[2];
         io_file_cam_opts o = {0};
         o.loop = loop;
+        o.cache_bytes = loop ? 1 : 0; /* with loop: each frame decoded when due */
         o.t0_ns = clock;
         o.clock_ns = &clock;
         io_error err;
