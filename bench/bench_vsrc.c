@@ -9,6 +9,10 @@
  *
  *   bench_vsrc SPEC [--seconds S] [--eye WxH] [--layout sbs|tb|mono|auto]
  *              [--fps N] [--stale MS] [--loop]
+ *   bench_vsrc --cams SEL_L SEL_R [--seconds S] [--fps N] [--size WxH] [--loop]
+ *              two file cameras (io_cam_file, e.g. file:cam/left_%04d.png)
+ *              paired by io_stereo in real time: pairs per second, skew,
+ *              and the delay from a pair's time stamp to its hand-out
  *   bench_vsrc --convert [WxH]   conversion of one frame of each format to
  *              RGBA (io_frame_to_rgba) and the bilinear scale of one eye,
  *              median thread CPU time of 30 runs (2560x800 by default)
@@ -95,8 +99,71 @@ static int bench_convert(int w, int h)
     return 0;
 }
 
+static int bench_cams(int argc, char **argv)
+{
+    double seconds = 3;
+    int fps = 60, w = 640, h = 480, loop = 0;
+    for (int i = 4; i < argc; i++) {
+        if (!strcmp(argv[i], "--seconds") && i + 1 < argc) seconds = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--fps") && i + 1 < argc) fps = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--size") && i + 1 < argc) sscanf(argv[++i], "%dx%d", &w, &h);
+        else if (!strcmp(argv[i], "--loop")) loop = 1;
+    }
+    io_file_cam_opts o;
+    memset(&o, 0, sizeof o);
+    o.loop = loop;
+    o.t0_ns = mono_ns() + 200000000ull; /* both eyes: the same t0 */
+    io_cam cam[2];
+    io_error err;
+    for (int e = 0; e < 2; e++) {
+        io_cam_config c = io_cam_config_default(argv[2 + e]);
+        c.width = w;
+        c.height = h;
+        c.fps = fps;
+        c.fourcc = 0;
+        c.backend_opts = &o;
+        if (io_cam_open(&cam[e], &io_cam_file, &c, &err) != IO_OK ||
+            io_cam_start(&cam[e], &err) != IO_OK) {
+            fprintf(stderr, "bench_vsrc: %s\n", err.msg);
+            return 1;
+        }
+    }
+    io_stereo st;
+    io_stereo_init(&st, &cam[0], &cam[1], 0);
+    size_t cap = 100000, n = 0;
+    double *delay = malloc(cap * sizeof *delay);
+    uint64_t t_end = o.t0_ns + (uint64_t)(seconds * 1e9);
+    while (mono_ns() < t_end) {
+        io_frame f[2];
+        int got = 0;
+        if (io_stereo_grab(&st, 100, f, &got, &err) != IO_OK) {
+            printf("cams       %s\n", err.msg);
+            break;
+        }
+        if (got == 3) {
+            if (n < cap) delay[n++] = 1e-6 * (double)(mono_ns() - f[0].t_ns);
+            io_stereo_release(&st, f, &err);
+        }
+    }
+    qsort(delay, n, sizeof *delay, cmp_d);
+    printf("cams       %s + %s, %dx%d at %d FPS: %llu pairs in %.1f s (%.1f/s), max |skew| %.3f ms, "
+           "dropped %llu/%llu, unpaired %llu/%llu\n", argv[2], argv[3], w, h, fps,
+           (unsigned long long)st.pairs, seconds, (double)st.pairs / seconds,
+           1e-6 * (double)st.max_abs_skew_ns, (unsigned long long)cam[0].stats.dropped,
+           (unsigned long long)cam[1].stats.dropped, (unsigned long long)st.unpaired[0],
+           (unsigned long long)st.unpaired[1]);
+    if (n)
+        printf("delay      time stamp -> pair handed out: %.3f ms median, %.3f ms p99, %.3f ms max\n",
+               delay[n / 2], delay[(size_t)(0.99 * (double)(n - 1))], delay[n - 1]);
+    free(delay);
+    io_cam_close(&cam[0]);
+    io_cam_close(&cam[1]);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc >= 4 && !strcmp(argv[1], "--cams")) return bench_cams(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "--convert")) {
         int w = 2560, h = 800;
         if (argc >= 3) sscanf(argv[2], "%dx%d", &w, &h);

@@ -540,11 +540,11 @@ static void file_close(io_cam *cam)
         for (int i = 0; i < p->count; i++) free(p->cache[i]);
         free(p->cache);
     }
-    if (p->vfd >= 0) close(p->vfd);
-    if (p->pid > 0) {
-        kill(p->pid, SIGTERM);
+    if (p->pid > 0) { /* first, so that it does not report the closed pipe */
+        kill(p->pid, SIGKILL);
         waitpid(p->pid, NULL, 0);
     }
+    if (p->vfd >= 0) close(p->vfd);
     if (p->tfd >= 0) close(p->tfd);
     vs_free(&p->r);
     free(p->hold);
