@@ -393,7 +393,11 @@ static io_result file_start(io_cam *cam, io_error *err)
 {
     fcam *p = fc_of(cam);
     (void)err;
-    p->t0 = p->o.t0_ns ? p->o.t0_ns : now_of(p);
+    /* t0 from the caller's struct as it is now: it may be set between
+     * opening both eyes and starting them */
+    const io_file_cam_opts *live = (const io_file_cam_opts *)cam->cfg.backend_opts;
+    uint64_t t0 = live ? live->t0_ns : 0;
+    p->t0 = t0 ? t0 : now_of(p);
     p->next_k = 0;
     p->nq = 0;
     for (int i = 0; i < cam->nbuf; i++) {
