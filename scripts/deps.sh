@@ -2,7 +2,9 @@
 # Installs the Debian packages egofuse needs to build, test and run its demo
 # (libdrm-dev: the KMS display output; libsdl2-dev: the SDL window output's
 # headers, its library is loaded at run time; xvfb + x11-apps: the window's
-# test, a virtual X server and xwd; the last line: the virtual machine that
+# test, a virtual X server and xwd; ffmpeg, gst-launch-1.0 and python3: the
+# real producers and the framing generator of tests/test_io_vsrc.c, and the
+# video decoder of file cameras; the last line: the virtual machine that
 # tests the camera, USB, glove and display code against the Linux kernel's
 # own drivers, tests/vm/; the kernel itself is fetched by tests/vm/prepare.sh
 # with apt-get download, not installed).
@@ -20,6 +22,7 @@ libcmocka-dev
 gnuplot-nox
 libpixman-1-dev
 libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
+ffmpeg gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good python3
 qemu-system-x86 busybox-static cpio kmod xz-utils"
 
 missing=""

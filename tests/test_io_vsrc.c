@@ -27,6 +27,8 @@
 
 /* ------------------------------------------------------------ helpers */
 
+static const char *tmp(const char *name, char *buf, size_t n);
+
 static int have_tool(const char *name)
 {
     char cmd[256];
@@ -267,15 +269,13 @@ static void test_egfv_tb_u16_depth(void **st)
 
 /* The documented bilinear rule, computed here independently in double:
  * must agree with the integer scaler within 1 (8-bit weights). */
-static void test_egfv_scaled(void **st)
+static void scaled_case(int EW, int EH)
 {
-    (void)st;
     size_t n;
     uint8_t *bytes = gen("basic", &n);
     tpipe t;
     tpipe_open(&t, "stream:");
-    const int EW = 20, EH = 12;
-    io_vsrc *v = open_src(t.spec, EW, EH, IO_VSRC_AUTO, NULL);
+    io_vsrc *v = open_src(t.spec, EW, EH, IO_VSRC_SBS, NULL);
     tpipe_write(&t, bytes, n);
     assert_int_equal(poll_fresh(v, 0), 1);
     int maxd = 0;
@@ -303,6 +303,20 @@ static void test_egfv_scaled(void **st)
                     int got = im[(size_t)y * stride + 4 * (size_t)x + (size_t)k];
                     int diff = abs(got - (int)lround(ref));
                     if (diff > maxd) maxd = diff;
+                    /* and exactly the rule of docs/vstream.md (1/256 steps,
+                     * rounded half up), evaluated in double */
+                    long cx = (long)floor((2.0 * x + 1) * 32 * 256 / (2.0 * EW)) - 128;
+                    long cy = (long)floor((2.0 * y + 1) * 32 * 256 / (2.0 * EH)) - 128;
+                    cx = cx < 0 ? 0 : cx > 31 * 256 ? 31 * 256 : cx;
+                    cy = cy < 0 ? 0 : cy > 31 * 256 ? 31 * 256 : cy;
+                    if (cx >> 8 == x0 && cy >> 8 == y0) {
+                        double wx = (double)(cx & 255), wy = (double)(cy & 255);
+                        double rule = ((a[k] * (256 - wx) + b[k] * wx) * (256 - wy) +
+                                       (c[k] * (256 - wx) + dd[k] * wx) * wy) / 65536.0;
+                        if (got != (int)floor(rule + 0.5))
+                            fail_msg("eye %d (%d,%d) channel %d: %d, the documented rule gives %.4f",
+                                     e, x, y, k, got, rule);
+                    }
                 }
                 assert_int_equal(im[(size_t)y * stride + 4 * (size_t)x + 3], 255);
                 /* depth: nearest, never blended */
@@ -316,6 +330,14 @@ static void test_egfv_scaled(void **st)
     io_vsrc_close(v);
     tpipe_close(&t);
     free(bytes);
+}
+
+static void test_egfv_scaled(void **st)
+{
+    (void)st;
+    scaled_case(20, 12); /* down */
+    scaled_case(45, 70); /* up: rows reused */
+    scaled_case(32, 33);
 }
 
 /* Runs a generator scenario through a pipe (writer closed), one poll. */
@@ -479,6 +501,59 @@ static void test_stalled_producer(void **st)
     assert_int_equal(io_vsrc_pollfds(v, pf, 2), 0); /* nothing left to wait on */
     io_vsrc_close(v);
     tpipe_close(&t);
+    free(bytes);
+}
+
+/* A FIFO: no writer yet is not an end; the writer goes (ended, V held)
+ * and a new one comes back (reopened once a second, by the clock given). */
+static void test_fifo_writers(void **st)
+{
+    (void)st;
+    char fifo[600], spec[700];
+    tmp("v.fifo", fifo, sizeof fifo);
+    unlink(fifo);
+    assert_int_equal(mkfifo(fifo, 0600), 0);
+    snprintf(spec, sizeof spec, "stream:%s", fifo);
+    size_t n;
+    uint8_t *bytes = gen("basic", &n);
+    size_t fl = n / 3;
+    uint64_t clock = 10000 * MS;
+    int fds0 = count_fds();
+    io_vsrc *v = open_src(spec, 32, 32, IO_VSRC_SBS, &clock);
+    io_vsrc_stat s;
+    assert_int_equal(poll_fresh(v, 0), 0);
+    io_vsrc_status(v, clock, &s);
+    assert_int_equal(s.state, IO_VSRC_WAITING);
+    assert_non_null(strstr(s.msg, "no writer on the FIFO yet"));
+    /* a writer (O_RDWR: opens without blocking), looked for a second later */
+    int w = open(fifo, O_RDWR);
+    assert_true(w >= 0);
+    assert_int_equal(write(w, bytes, fl), (ssize_t)fl);
+    clock += 500 * MS;
+    assert_int_equal(poll_fresh(v, 0), 0); /* not yet a second */
+    clock += 600 * MS;
+    assert_int_equal(poll_fresh(v, 0), 1);
+    check_eye_frame(v, 0);
+    close(w);
+    poll_fresh(v, 0);
+    io_vsrc_status(v, clock, &s);
+    assert_int_equal(s.state, IO_VSRC_ENDED);
+    assert_non_null(strstr(s.msg, "waiting for a new writer"));
+    check_eye_frame(v, 0);
+    w = open(fifo, O_RDWR);
+    assert_true(w >= 0);
+    assert_int_equal(write(w, bytes + fl, fl), (ssize_t)fl);
+    clock += 1100 * MS;
+    assert_int_equal(poll_fresh(v, 0), 1);
+    check_eye_frame(v, 1);
+    io_vsrc_status(v, clock, &s);
+    assert_int_equal(s.state, IO_VSRC_LIVE);
+    assert_int_equal(s.reopens, 1);
+    assert_non_null(strstr(s.msg, "a new writer"));
+    close(w);
+    io_vsrc_close(v);
+    assert_int_equal(count_fds(), fds0);
+    unlink(fifo);
     free(bytes);
 }
 
@@ -766,6 +841,7 @@ static void test_file_cam_sequence(void **st)
         io_cam cam[2];
         io_file_cam_opts o = {0};
         o.loop = loop;
+        o.cache_bytes = loop ? 1 : 0; /* with loop: each frame decoded when due */
         o.t0_ns = clock;
         o.clock_ns = &clock;
         io_error err;
@@ -910,6 +986,7 @@ int main(void)
         cmocka_unit_test(test_egfv_scaled),
         cmocka_unit_test(test_egfv_bad_input),
         cmocka_unit_test(test_stalled_producer),
+        cmocka_unit_test(test_fifo_writers),
         cmocka_unit_test(test_y4m_gstreamer),
         cmocka_unit_test(test_y4m_ffmpeg),
         cmocka_unit_test(test_raw_ffmpeg),

@@ -393,7 +393,11 @@ static io_result file_start(io_cam *cam, io_error *err)
 {
     fcam *p = fc_of(cam);
     (void)err;
-    p->t0 = p->o.t0_ns ? p->o.t0_ns : now_of(p);
+    /* t0 from the caller's struct as it is now: it may be set between
+     * opening both eyes and starting them */
+    const io_file_cam_opts *live = (const io_file_cam_opts *)cam->cfg.backend_opts;
+    uint64_t t0 = live ? live->t0_ns : 0;
+    p->t0 = t0 ? t0 : now_of(p);
     p->next_k = 0;
     p->nq = 0;
     for (int i = 0; i < cam->nbuf; i++) {
@@ -540,11 +544,11 @@ static void file_close(io_cam *cam)
         for (int i = 0; i < p->count; i++) free(p->cache[i]);
         free(p->cache);
     }
-    if (p->vfd >= 0) close(p->vfd);
-    if (p->pid > 0) {
-        kill(p->pid, SIGTERM);
+    if (p->pid > 0) { /* first, so that it does not report the closed pipe */
+        kill(p->pid, SIGKILL);
         waitpid(p->pid, NULL, 0);
     }
+    if (p->vfd >= 0) close(p->vfd);
     if (p->tfd >= 0) close(p->tfd);
     vs_free(&p->r);
     free(p->hold);

@@ -407,18 +407,32 @@ static void planar_to_rgba(const io_frame *f, int sx, int sy, int nv12, int full
         const uint8_t *ur = ubase + (size_t)(y >> sy) * cs, *vr = vbase + (size_t)(y >> sy) * cs;
         uint8_t *d = dst + (size_t)y * ds;
         int x = 0;
-        for (size_t c = 0; x < w; c++) {
-            int du = ur[c * step] - 128, dv = vr[c * step] - 128;
-            int rv = kr * dv + 128, guv = kgu * du + kgv * dv - 128, bu = kb * du + 128;
-            int n = sx ? 2 : 1;
-            for (int k = 0; k < n && x < w; k++, x++) {
-                int l = ky * (yr[x] - y0);
+        if (sx) {
+            /* two pixels per chroma sample */
+            for (size_t c = 0; x + 1 < w; c++, x += 2) {
+                int du = ur[c * step] - 128, dv = vr[c * step] - 128;
+                int rv = kr * dv + 128, guv = kgu * du + kgv * dv - 128, bu = kb * du + 128;
+                int l0 = ky * (yr[x] - y0), l1 = ky * (yr[x + 1] - y0);
                 uint8_t *o = d + 4 * (size_t)x;
-                o[0] = clamp_u8((l + rv) >> 8);
-                o[1] = clamp_u8((l - guv) >> 8);
-                o[2] = clamp_u8((l + bu) >> 8);
+                o[0] = clamp_u8((l0 + rv) >> 8);
+                o[1] = clamp_u8((l0 - guv) >> 8);
+                o[2] = clamp_u8((l0 + bu) >> 8);
                 o[3] = 255;
+                o[4] = clamp_u8((l1 + rv) >> 8);
+                o[5] = clamp_u8((l1 - guv) >> 8);
+                o[6] = clamp_u8((l1 + bu) >> 8);
+                o[7] = 255;
             }
+        }
+        for (; x < w; x++) { /* 4:4:4, or the last column of an odd width */
+            size_t c = (size_t)(x >> sx) * step;
+            int du = ur[c] - 128, dv = vr[c] - 128;
+            int l = ky * (yr[x] - y0);
+            uint8_t *o = d + 4 * (size_t)x;
+            o[0] = clamp_u8((l + kr * dv + 128) >> 8);
+            o[1] = clamp_u8((l - kgu * du - kgv * dv + 128) >> 8);
+            o[2] = clamp_u8((l + kb * du + 128) >> 8);
+            o[3] = 255;
         }
     }
 }

@@ -35,6 +35,7 @@ struct io_vsrc {
     uint8_t *stage[2];            /* converted source frame per device */
     size_t stage_cap[2];
     int *xt, *yt;                 /* scaler scratch */
+    uint16_t *rows;
     int have_eye[2];
     /* status */
     io_vsrc_state hard;           /* 0, IO_VSRC_ENDED or IO_VSRC_FAILED */
@@ -51,6 +52,7 @@ struct io_vsrc {
     /* stream */
     char path[1024];
     int fd, own_fd;
+    int fd_flags;                 /* stdin's flags before, restored at close */
     int is_fifo, is_reg;
     vs_reader r;
     uint64_t retry_ns;
@@ -179,7 +181,7 @@ static io_result apply_frame(io_vsrc *v, const io_frame *f, int full, int layout
             v->eye_stride[1] = v->eye_stride[0];
         } else {
             vs_scale_rgba(src, rw, rh, ss, v->eyebuf[e], v->ew, v->eh, 4 * (size_t)v->ew, v->xt,
-                          v->yt);
+                          v->yt, v->rows);
             v->eye[e] = v->eyebuf[e];
             v->eye_stride[e] = 4 * (size_t)v->ew;
         }
@@ -249,21 +251,24 @@ static void poll_v4l2_once(io_vsrc *v, uint64_t now, int *fresh)
         if (c->state != IO_CAM_STREAMING) {
             if (now - v->last_try[i] < 1000000000ull && v->last_try[i]) continue;
             v->last_try[i] = now;
-            uint64_t sk = c->stats.skipped;
-            if (io_cam_reopen(c, NULL, &e2) == IO_OK) {
+            io_result r = io_cam_reopen(c, NULL, &e2);
+            if (r == IO_OK && c->state != IO_CAM_STREAMING) r = io_cam_start(c, &e2);
+            if (r == IO_OK) {
                 v->reopens++;
-                v->hard = 0;
                 set_msg(v, "V source %s: %s is back", v->spec, c->cfg.path);
             } else {
+                io_cam_close(c); /* nothing held between tries */
                 set_msg(v, "V source %s: %s (reopening once a second)", v->spec, e2.msg);
             }
-            (void)sk;
             continue;
         }
         io_frame f;
         int got = 0;
         io_result r = io_cam_grab(c, 0, &f, &got, &e2);
         if (r != IO_OK) {
+            /* gone: let go of the node at once (a replugged device may
+             * take the same number), try again in a second */
+            io_cam_close(c);
             v->hard = IO_VSRC_FAILED;
             v->last_try[i] = now;
             set_msg(v, "V source %s: %s (reopening once a second)", v->spec, e2.msg);
@@ -288,7 +293,8 @@ static void poll_v4l2_once(io_vsrc *v, uint64_t now, int *fresh)
     }
     int failed = 0;
     for (int i = 0; i < v->ndev; i++) failed |= v->cam[i].state != IO_CAM_STREAMING;
-    if (!failed && v->hard == IO_VSRC_FAILED) v->hard = 0;
+    if (failed) v->hard = IO_VSRC_FAILED;
+    else if (v->hard == IO_VSRC_FAILED) v->hard = 0;
 }
 
 /* ------------------------------------------------------------ stream */
@@ -296,6 +302,7 @@ static void poll_v4l2_once(io_vsrc *v, uint64_t now, int *fresh)
 static void stream_close_fd(io_vsrc *v)
 {
     if (v->fd >= 0 && v->own_fd) close(v->fd);
+    else if (v->fd >= 0 && v->fd_flags >= 0) fcntl(v->fd, F_SETFL, v->fd_flags); /* a shared tty */
     v->fd = -1;
 }
 
@@ -324,6 +331,7 @@ static io_result stream_open_fd(io_vsrc *v, io_error *err)
         }
     }
     int fl = fcntl(v->fd, F_GETFL);
+    v->fd_flags = fl;
     if (fl >= 0 && !(fl & O_NONBLOCK)) fcntl(v->fd, F_SETFL, fl | O_NONBLOCK);
     return IO_OK;
 }
@@ -499,6 +507,15 @@ static void stream_take(io_vsrc *v, uint64_t now, int *fresh)
             read_total += (size_t)n;
             continue;
         }
+        if (n == 0 && v->is_fifo && r->offset + r->len == 0) {
+            /* a FIFO without a writer yet: not an end, look again later */
+            r->eof = 0;
+            stream_close_fd(v);
+            v->retry_ns = now + 1000000000ull;
+            if (!v->have_eye[0])
+                set_msg(v, "V source %s: no writer on the FIFO yet (looking once a second)", v->spec);
+            break;
+        }
         if (n == 0) continue; /* EOF: parse the rest with eof set */
         if (n == -1) break;   /* nothing more now */
         set_msg(v, "V source %s", r->msg);
@@ -539,8 +556,12 @@ static void stream_take(io_vsrc *v, uint64_t now, int *fresh)
     v->t_arrival[0] = v->t_arrival[1] = now;
     v->t_frame[0] = v->t_frame[1] = pend.t_ns && pend.t_ns <= now ? pend.t_ns : now;
     if (v->reopened) {
-        v->reopens++;
         v->reopened = 0;
+        if (v->frames > 1) { /* not the first writer */
+            v->reopens++;
+            set_msg(v, "V source %s: a new writer (reopen %llu)", v->spec,
+                    (unsigned long long)v->reopens);
+        }
     }
     if (v->hard == IO_VSRC_ENDED && v->fd >= 0) v->hard = 0;
     *fresh = 1;
@@ -590,8 +611,9 @@ io_result io_vsrc_open(io_vsrc **out, const io_vsrc_config *c, io_error *err)
     v->dbuf[1] = malloc(eb);
     v->xt = malloc(sizeof(int) * 2 * (size_t)v->ew);
     v->yt = malloc(sizeof(int) * 2 * (size_t)v->eh);
+    v->rows = malloc(sizeof(uint16_t) * 6 * (size_t)v->ew);
     io_result r = IO_OK;
-    if (!v->eyebuf[0] || !v->eyebuf[1] || !v->dbuf[0] || !v->dbuf[1] || !v->xt || !v->yt) {
+    if (!v->eyebuf[0] || !v->eyebuf[1] || !v->dbuf[0] || !v->dbuf[1] || !v->xt || !v->yt || !v->rows) {
         r = io_fail(err, IO_ERR_NOMEM, "V source %s: out of memory for %dx%d eyes", c->spec, v->ew,
                     v->eh);
     } else if (!strncmp(v->spec, "v4l2:", 5)) {
@@ -752,6 +774,7 @@ void io_vsrc_close(io_vsrc *v)
     }
     free(v->xt);
     free(v->yt);
+    free(v->rows);
     stream_close_fd(v);
     if (v->tfd >= 0) close(v->tfd);
     vs_free(&v->r);

@@ -175,7 +175,9 @@ void io_vsrc_close(io_vsrc *v);
 typedef struct io_file_cam_opts {
     int loop;                     /* start again after the last frame */
     uint64_t t0_ns;               /* time of frame 0 (CLOCK_MONOTONIC);
-                                     0 = when io_cam_start is called */
+                                     0 = when io_cam_start is called; read
+                                     at io_cam_start (set it after opening
+                                     both eyes, before starting them) */
     const uint64_t *clock_ns;     /* tests: the clock (NULL = CLOCK_MONOTONIC);
                                      then cam->fd is -1 */
     size_t cache_bytes;           /* image sequences up to this total are

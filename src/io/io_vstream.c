@@ -466,25 +466,53 @@ static void bilinear_table(int s, int d, int *t)
     }
 }
 
-void vs_scale_rgba(const uint8_t *s, int sw, int sh, size_t ss, uint8_t *d, int dw, int dh,
-                   size_t ds, int *xt, int *yt)
+/* Horizontal pass of one source row: top[x] = a (256 - wx) + b wx per
+ * channel (at most 65280: 16 bits), the first factor of the rule. */
+static void hrow(const uint8_t *r, int sw, int dw, const int *xt, uint16_t *o)
 {
+    for (int x = 0; x < dw; x++) {
+        int x0 = xt[2 * x], wx = xt[2 * x + 1];
+        const uint8_t *a = r + 4 * x0, *b = r + 4 * (x0 + 1 < sw ? x0 + 1 : x0);
+        o[3 * x] = (uint16_t)(a[0] * (256 - wx) + b[0] * wx);
+        o[3 * x + 1] = (uint16_t)(a[1] * (256 - wx) + b[1] * wx);
+        o[3 * x + 2] = (uint16_t)(a[2] * (256 - wx) + b[2] * wx);
+    }
+}
+
+void vs_scale_rgba(const uint8_t *s, int sw, int sh, size_t ss, uint8_t *d, int dw, int dh,
+                   size_t ds, int *xt, int *yt, uint16_t *rows)
+{
+    /* separable and exact: the horizontal blends of the two source rows an
+     * output row needs are kept (rows: 2 x 3 dw) and reused by the next
+     * output rows while they need the same source rows */
     bilinear_table(sw, dw, xt);
     bilinear_table(sh, dh, yt);
+    uint16_t *h[2] = {rows, rows + 3 * (size_t)dw};
+    int have[2] = {-1, -1};
     for (int y = 0; y < dh; y++) {
         int y0 = yt[2 * y], wy = yt[2 * y + 1];
         int y1 = y0 + 1 < sh ? y0 + 1 : y0;
-        const uint8_t *r0 = s + (size_t)y0 * ss, *r1 = s + (size_t)y1 * ss;
-        uint8_t *o = d + (size_t)y * ds;
-        for (int x = 0; x < dw; x++) {
-            int x0 = xt[2 * x], wx = xt[2 * x + 1];
-            int x1 = x0 + 1 < sw ? x0 + 1 : x0;
-            const uint8_t *a = r0 + 4 * x0, *b = r0 + 4 * x1, *c = r1 + 4 * x0, *e = r1 + 4 * x1;
-            for (int k = 0; k < 3; k++) {
-                uint32_t top = (uint32_t)a[k] * (uint32_t)(256 - wx) + (uint32_t)b[k] * (uint32_t)wx;
-                uint32_t bot = (uint32_t)c[k] * (uint32_t)(256 - wx) + (uint32_t)e[k] * (uint32_t)wx;
-                o[4 * x + k] = (uint8_t)((top * (uint32_t)(256 - wy) + bot * (uint32_t)wy + 32768u) >> 16);
+        int want[2] = {y0, y1};
+        for (int k = 0; k < 2; k++) {
+            if (have[k] == want[k]) continue;
+            if (k == 0 && have[1] == y0) { /* slide down: row 1 becomes row 0 */
+                uint16_t *t = h[0];
+                h[0] = h[1];
+                h[1] = t;
+                have[0] = y0;
+                have[1] = -1;
+                continue;
             }
+            hrow(s + (size_t)want[k] * ss, sw, dw, xt, h[k]);
+            have[k] = want[k];
+        }
+        const uint16_t *t0 = h[0], *t1 = h[1];
+        uint8_t *o = d + (size_t)y * ds;
+        uint32_t iy = (uint32_t)(256 - wy), fy = (uint32_t)wy;
+        for (int x = 0; x < dw; x++) {
+            o[4 * x] = (uint8_t)((t0[3 * x] * iy + t1[3 * x] * fy + 32768u) >> 16);
+            o[4 * x + 1] = (uint8_t)((t0[3 * x + 1] * iy + t1[3 * x + 1] * fy + 32768u) >> 16);
+            o[4 * x + 2] = (uint8_t)((t0[3 * x + 2] * iy + t1[3 * x + 2] * fy + 32768u) >> 16);
             o[4 * x + 3] = 255;
         }
     }

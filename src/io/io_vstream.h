@@ -73,9 +73,10 @@ int vs_parse(vs_reader *r, vs_frame *f);
 void vs_drop(vs_reader *r, size_t keep);
 
 /* Bilinear scale of an RGBA8 region (alpha of the result 255). xt / yt:
- * scratch of 2 * dw / 2 * dh ints. docs/vstream.md gives the rule. */
+ * scratch of 2 * dw / 2 * dh ints, rows of 6 * dw uint16. docs/vstream.md
+ * gives the rule. */
 void vs_scale_rgba(const uint8_t *s, int sw, int sh, size_t ss, uint8_t *d, int dw, int dh,
-                   size_t ds, int *xt, int *yt);
+                   size_t ds, int *xt, int *yt, uint16_t *rows);
 /* Nearest-neighbour depth: src of sw x sh values (float32 or uint16 *
  * scale, row stride ss bytes) into float metres (stride dsf floats). */
 void vs_scale_depth(const uint8_t *s, int fmt, float scale, int sw, int sh, size_t ss, float *d,
