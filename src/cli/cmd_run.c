@@ -193,6 +193,18 @@ static void natnet_sample(void *user, const kin_track_sample *s, const io_natnet
     r->tclock.offset_s = 0;
 }
 
+/* The tracking file's parser normalises the rotations it reads: the pose
+ * is made from the normalised sample, and --dump writes the one before,
+ * so that render reads back exactly the pose run used. */
+static void sample_normalised(const kin_track_sample *in, kin_track_sample *out)
+{
+    *out = *in;
+    if (out->valid & KIN_TRACK_HEAD) out->head_rot = kin_quat_normalize(out->head_rot);
+    for (int k = 0; k < 2; k++)
+        if (out->valid & (KIN_TRACK_HAND_L << k))
+            out->hand_rot[k] = kin_quat_normalize(out->hand_rot[k]);
+}
+
 static void track_service(run_state *r)
 {
     io_error err;
@@ -346,6 +358,34 @@ static int write_outputs(const run_opts *o, run_state *r, int frame, int W, int 
     return EXIT_OK;
 }
 
+/* Copies a file byte for byte (to a temporary, renamed when complete). */
+static int copy_file(const char *from, const char *to)
+{
+    char tmp[IO_PATH_MAX + 96];
+    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", to, (long)getpid());
+    FILE *in = fopen(from, "rb");
+    if (!in) return -1;
+    FILE *o = fopen(tmp, "wb");
+    if (!o) {
+        fclose(in);
+        return -1;
+    }
+    char buf[65536];
+    size_t n;
+    int bad = 0;
+    while (!bad && (n = fread(buf, 1, sizeof buf, in)) > 0) bad = fwrite(buf, 1, n, o) != n;
+    bad |= ferror(in);
+    fclose(in);
+    bad |= fclose(o) != 0;
+    if (bad || rename(tmp, to) != 0) {
+        int e = errno;
+        unlink(tmp);
+        errno = e ? e : EIO;
+        return -1;
+    }
+    return 0;
+}
+
 /* --dump DIR: the inputs of the last frame as a one-frame scene that
  * `egofuse render` composites to the same bytes (camera images as
  * converted, the virtual images used, the pose sample used; the scene's
@@ -399,8 +439,16 @@ static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
             continue;
         }
         if (!r->vdepth[e].data || !in->virt_depth[e]) continue;
-        if (!realpath(r->vdepth_path[e], dabs)) snprintf(dabs, sizeof dabs, "%s", r->vdepth_path[e]);
-        bad |= fprintf(f, "virtual_depth_%s = %s\n", eye[e], dabs) < 0;
+        /* the still image's depth file, copied as it is (a frame pattern) */
+        snprintf(dabs, sizeof dabs, "%s/virt_depth_%s_0000%s", o->dump, eye[e],
+                 strrchr(r->vdepth_path[e], '.') ? strrchr(r->vdepth_path[e], '.') : "");
+        if (copy_file(r->vdepth_path[e], dabs) != 0) {
+            fclose(f);
+            unlink(tmp);
+            return cli_fail("%s: cannot copy %s: %s", dabs, r->vdepth_path[e], strerror(errno));
+        }
+        bad |= fprintf(f, "virtual_depth_%s = virt_depth_%s_%%04d%s\n", eye[e], eye[e],
+                       strrchr(dabs, '.') ? strrchr(dabs, '.') : "") < 0;
     }
     if (r->have_scene && r->sc.head_node[0]) bad |= fprintf(f, "head_node = %s\n", r->sc.head_node) < 0;
     if (r->have_scene && r->sc.animation[0]) bad |= fprintf(f, "animation = %s\n", r->sc.animation) < 0;
@@ -920,11 +968,13 @@ static int run(const run_opts *o)
                 kin_filter_output(&r->filter, t_pose, &sample, NULL);
                 for (int e = 0; e < 2; e++)
                     if (r->have_glove[e]) io_glove_to_sample(&r->glove[e], &sample);
+                kin_track_sample posed;
+                sample_normalised(&sample, &posed);
                 kin_pose_rest(model, r->locals);
-                if (kin_arm_rig_pose(&r->rig, model, &r->ucal, NULL, &sample, r->locals, NULL))
+                if (kin_arm_rig_pose(&r->rig, model, &r->ucal, NULL, &posed, r->locals, NULL))
                     in.locals = r->locals;
-                in.fit_skip = ((sample.valid & KIN_TRACK_HAND_L) ? 0u : 1u) |
-                              ((sample.valid & KIN_TRACK_HAND_R) ? 0u : 2u);
+                in.fit_skip = ((posed.valid & KIN_TRACK_HAND_L) ? 0u : 1u) |
+                              ((posed.valid & KIN_TRACK_HAND_R) ? 0u : 2u);
                 lg.track_age_ms = 1e-6 * ((double)t_cam - (double)r->t_track);
             }
         }

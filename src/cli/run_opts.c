@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "../io/io_dev.h"
+#include "../io/io_display.h"
 #include "../io/io_live.h"
 #include "../io/io_natnet.h"
 #include "../io/io_vsrc.h"
@@ -367,7 +368,13 @@ int run_parse(int argc, char **argv, run_opts *o)
             if (!cli_parse_int(optarg, 1, 60000, &o->virt_stale_ms))
                 BAD("--virt-stale '%s': 1..60000 ms", optarg);
             break;
-        case O_DISPLAY: o->display = optarg; break;
+        case O_DISPLAY: {
+            io_display_spec ds;
+            io_error err;
+            if (io_display_parse(optarg, &ds, &err) != IO_OK) BAD("--display: %s", err.msg);
+            o->display = optarg;
+            break;
+        }
         case O_NATNET: case O_NN_LOCAL: case O_NN_MCAST: case O_NN_BODY: case O_NN_UP:
         case O_NN_UNITS: case O_NN_VERSION: case O_NN_OFFSET: case O_NN_CMDPORT:
         case O_NN_DATAPORT: {
