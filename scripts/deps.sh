@@ -9,7 +9,7 @@
 set -eu
 
 PKGS="build-essential pkg-config
-libopenimageio-dev openimageio-tools
+libopenimageio-dev openimageio-tools libpng-dev
 libtinygltf-dev
 libv4l-dev libusb-1.0-0-dev
 libcmocka-dev
