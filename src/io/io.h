@@ -141,6 +141,12 @@ void io_image_free(io_image *img);
  * primitives get 0..n-1), skins and animations. The result is validated
  * with kin_model_validate(); free it with kin_model_free(). */
 io_result io_gltf_load(const char *path, kin_model *out, io_error *err);
+/* io_glb_check.c: the container of a binary glTF (header length, chunk
+ * lengths) against its len bytes, so a truncated file says where it ends:
+ * "arms.glb: truncated GLB: the header gives 9000 bytes, the file has 4096
+ * (it ends 4904 bytes early)". IO_OK for data that is not GLB. */
+io_result io_glb_check(const char *path, const void *data, size_t len,
+                       io_error *err);
 
 /* ---------------------------------------------------------------- scene */
 
