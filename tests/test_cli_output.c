@@ -350,7 +350,8 @@ static void eval_report_write_fails_cleanly(void **state)
     assert_true(lines_of(p) > 10);
     assert_int_equal(temps_in(dir), 0);
     if (system("command -v gnuplot >/dev/null 2>&1") != 0) {
-        skip();  /* SKIP: gnuplot missing: the charts are not drawn at all */
+        printf("SKIP: gnuplot missing: the charts of eval --report are not drawn\n");
+        skip();
         return;
     }
     assert_int_equal(rc, 1);

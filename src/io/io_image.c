@@ -8,8 +8,8 @@
  *
  * Pixel values are the ones the OpenImageIO path gave (docs/io.md, Images):
  * 8-bit to float is v * (1/255), 16-bit to 8-bit is
- * (uint8)(v * (255/65535) + 0.5), float to 8-bit is round-to-nearest of
- * v * 255 clamped to [0, 255] (NaN -> 0); channel adaptation as documented
+ * (uint8)(v * (255/65535) + 0.5), float to 8-bit is v * 255 rounded to
+ * nearest (ties away from zero) and clamped to [0, 255] (NaN -> 0); channel adaptation as documented
  * in io.h.
  *
  * Every write goes through io_out (io_out.c): complete or absent.
@@ -191,7 +191,7 @@ static io_result adapt(const char *path, const raw_image *r, io_type type, int w
 
 static unsigned char float_to_u8(float v)
 {
-    float s = nearbyintf(v * 255.0f);
+    float s = roundf(v * 255.0f);  /* ties away from zero, as OpenImageIO */
     if (!(s > 0.0f)) return 0;  /* also NaN */
     return s >= 255.0f ? 255 : (unsigned char)s;
 }
