@@ -10,6 +10,7 @@
 #include <getopt.h>
 #include <signal.h>
 #include <stdlib.h>
+#include <errno.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
@@ -424,7 +425,7 @@ static int run(const run_opts *o)
                     }
                 }
             if (fwrite(rawbuf, 1, (size_t)W * (size_t)H * 6, stdout) != (size_t)W * (size_t)H * 6) {
-                cli_fail("stdout: write error (reader gone?)");
+                cli_fail("stdout: write error: %s (reader gone?)", strerror(errno));
                 goto done;
             }
             fflush(stdout);
