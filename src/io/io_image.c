@@ -295,7 +295,9 @@ static io_result png_load(const char *path, FILE *f, io_type type, int want, io_
     if (ct == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png);
     if (ct == PNG_COLOR_TYPE_GRAY && depth < 8) png_set_expand_gray_1_2_4_to_8(png);
     if (png_get_valid(png, info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(png);
-    if (depth == 16) png_set_swap(png);  /* native order (little-endian hosts) */
+    const uint16_t one = 1;
+    if (depth == 16 && *(const unsigned char *)&one == 1)
+        png_set_swap(png);  /* PNG is big-endian: 16-bit samples in host order */
     png_set_interlace_handling(png);
     png_read_update_info(png, info);
     r.w = (int)png_get_image_width(png, info);
