@@ -243,6 +243,58 @@ static void mask_write_fails_cleanly(void **state)
     assert_int_equal(temps_in(dir), 0);
 }
 
+/* The formats written through the OpenImageIO plugin (EXR depth, TIFF
+ * normals) fail the same way: exit 1, the reason, nothing left. */
+static void plugin_write_fails_cleanly(void **state)
+{
+    (void)state;
+    char dir[1024], model[1100], mask[1100], depth[1100], tif[1100];
+    make_dir("out_plugin", dir, sizeof dir);
+    snprintf(model, sizeof model, "%s/quad.glb", dir);
+    snprintf(mask, sizeof mask, "%s/mask.png", dir);
+    snprintf(depth, sizeof depth, "%s/depth.exr", dir);
+    snprintf(tif, sizeof tif, "%s/normals.tif", dir);
+    write_glb(model);
+    const char *a[40];
+    mask_args(a, model, mask, tif);
+    int n = 0;
+    while (a[n]) n++;
+    a[n++] = "--depth";
+    a[n++] = depth;
+    a[n] = NULL;
+    int rc = run_limited(-1, XFSZ_IGNORE, a);
+    if (rc) fprintf(stderr, "%s\n", out);
+    assert_int_equal(rc, 0);
+    struct stat st;
+    assert_int_equal(stat(mask, &st), 0);
+    long limit = (long)st.st_size + 64;
+    assert_int_equal(stat(tif, &st), 0);
+    assert_true((long)st.st_size > limit);
+    assert_int_equal(stat(depth, &st), 0);
+    assert_true((long)st.st_size > limit);
+    assert_int_equal(remove(tif), 0);
+    assert_int_equal(remove(depth), 0);
+    rc = run_limited(limit, XFSZ_IGNORE, a);
+    assert_int_equal(rc, 1);
+    assert_non_null(strstr(out, "normals.tif"));
+    assert_non_null(strstr(out, strerror(EFBIG)));
+    assert_false(tu_exists(tif));
+    assert_false(tu_exists(depth));
+    /* without the normals, the depth is the one that fails */
+    mask_args(a, model, mask, NULL);
+    n = 0;
+    while (a[n]) n++;
+    a[n++] = "--depth";
+    a[n++] = depth;
+    a[n] = NULL;
+    rc = run_limited(limit, XFSZ_IGNORE, a);
+    assert_int_equal(rc, 1);
+    assert_non_null(strstr(out, "depth.exr"));
+    assert_non_null(strstr(out, strerror(EFBIG)));
+    assert_false(tu_exists(depth));
+    assert_int_equal(temps_in(dir), 0);
+}
+
 /* Killed in the middle of a write (SIGXFSZ at its default): the unnamed
  * file dies with the process, nothing is left. */
 static void mask_killed_leaves_nothing(void **state)
@@ -478,6 +530,7 @@ int main(void)
     }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(mask_write_fails_cleanly),
+        cmocka_unit_test(plugin_write_fails_cleanly),
         cmocka_unit_test(mask_killed_leaves_nothing),
         cmocka_unit_test(render_write_fails_cleanly),
         cmocka_unit_test(eval_report_write_fails_cleanly),
