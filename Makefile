@@ -48,8 +48,10 @@ TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC)) \
              $(patsubst bench/llvmpipe/%.c,$(BUILD)/bench/%,$(LLVMPIPE_SRC))
 
-IO_PKGS  := libpng tinygltf libusb-1.0 libv4l2
-IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) 2>/dev/null)
+IO_PKGS  := libpng tinygltf libusb-1.0 libv4l2 libdrm
+# SDL2: headers only; src/io/io_display_sdl.c loads libSDL2 with dlopen when
+# a window is opened, so the program does not link it.
+IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) sdl2 2>/dev/null)
 IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lstdc++ -ldl
 # OpenImageIO (EXR, TIFF, JPEG ...) lives in a plugin that io_image.c loads
 # with dlopen only when a file is neither PNG nor PPM/PGM (docs/io.md), so
@@ -162,7 +164,9 @@ test: deps
 
 # Every public header compiles on its own as C and as C++ (sokol's rule).
 HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
-           src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/io/io.h src/io/io_dev.h
+           src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/io/io.h src/io/io_dev.h \
+           src/io/io_natnet.h src/io/io_display.h src/io/io_sched.h src/io/io_live.h \
+           src/io/io_vsrc.h
 check-headers:
 	@for h in $(HEADERS); do \
 	    echo "#include \"$$h\"" | $(CC) -std=c99 -Wall -Wextra -Werror -x c -fsyntax-only - || exit 1; \

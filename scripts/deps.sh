@@ -1,8 +1,11 @@
 #!/bin/sh
 # Installs the Debian packages egofuse needs to build, test and run its demo
-# (the last line: the virtual machine that tests the camera, USB and glove
-# code against the Linux kernel's own drivers, tests/vm/; the kernel itself
-# is fetched by tests/vm/prepare.sh with apt-get download, not installed).
+# (libdrm-dev: the KMS display output; libsdl2-dev: the SDL window output's
+# headers, its library is loaded at run time; xvfb + x11-apps: the window's
+# test, a virtual X server and xwd; the last line: the virtual machine that
+# tests the camera, USB, glove and display code against the Linux kernel's
+# own drivers, tests/vm/; the kernel itself is fetched by tests/vm/prepare.sh
+# with apt-get download, not installed).
 # Called by `make demo`, `make test` and `make bench`; safe to run again (it
 # only installs what is missing). As a non-root user it prints the exact
 # apt-get line and stops.
@@ -12,6 +15,7 @@ PKGS="build-essential pkg-config
 libopenimageio-dev openimageio-tools libpng-dev
 libtinygltf-dev
 libv4l-dev libusb-1.0-0-dev
+libdrm-dev libsdl2-dev xvfb x11-apps
 libcmocka-dev
 gnuplot-nox
 libpixman-1-dev

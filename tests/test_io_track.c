@@ -129,8 +129,18 @@ static void validity_udp_arguments(void **state)
     (void)state;
     io_track_udp u;
     io_error err;
-    assert_int_equal(io_track_udp_listen(&u, "localhost", 0, &err), IO_ERR_ARGS);
-    assert_non_null(strstr(err.msg, "not a dotted IPv4"));
+    /* any address of the user's choice: every interface, a host name */
+    assert_int_equal(io_track_udp_listen(&u, "0.0.0.0", 0, &err), IO_OK);
+    assert_true(u.port > 0);
+    io_track_udp_close(&u);
+    assert_int_equal(io_track_udp_listen(&u, "localhost", 0, &err), IO_OK);
+    io_track_udp_close(&u);
+    assert_int_equal(io_track_udp_listen(&u, "no-such-host.invalid", 0, &err), IO_ERR_ARGS);
+    assert_non_null(strstr(err.msg, "'no-such-host.invalid' is neither a dotted IPv4 address "
+                                    "nor a known host name"));
+    /* an address of another machine cannot be bound: named */
+    assert_int_equal(io_track_udp_listen(&u, "192.0.2.1", 0, &err), IO_ERR_DEVICE);
+    assert_non_null(strstr(err.msg, "udp bind 192.0.2.1:0: "));
     assert_int_equal(io_track_udp_listen(&u, NULL, 70000, &err), IO_ERR_ARGS);
     assert_int_equal(io_track_udp_connect(&u, NULL, 0, &err), IO_ERR_ARGS);
 }

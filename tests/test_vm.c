@@ -76,8 +76,55 @@ static void log_append(const char *s, size_t n)
     vm_log[vm_log_len] = '\0';
 }
 
+/* ---- display (KMS on -device bochs-display): the guest asks for a
+ * screendump of what is on screen, the host takes it and answers with
+ * FILE.ack; test_vm_display compares FILE with the expected image. */
+#include "vm/display_pattern.h"
+static char display_dump[1024];
+static int display_dump_rc = -1;
+
+static void on_display_dump(const char *file, const char *qmp_sock)
+{
+    char cmd[1400], ack[1100];
+    snprintf(display_dump, sizeof display_dump, "%.*s", (int)strcspn(file, " \r\n"), file);
+    snprintf(cmd, sizeof cmd, "{\"execute\":\"screendump\",\"arguments\":{\"filename\":\"%s\","
+             "\"device\":\"display0\"}}\n", display_dump);
+    display_dump_rc = qmp(qmp_sock, cmd);
+    snprintf(ack, sizeof ack, "%s.ack", display_dump);
+    FILE *f = fopen(ack, "w");
+    if (f) {
+        fprintf(f, "%d\n", display_dump_rc);
+        fclose(f);
+    }
+}
+
+/* layout two on virtio-gpu: heads 0 and 1 to PREFIX.0.ppm, PREFIX.1.ppm */
+static char display_two[1024];
+static int display_two_rc = -1;
+
+static void on_display_two_dump(const char *prefix, const char *qmp_sock)
+{
+    char cmd[1400], ack[1100];
+    snprintf(display_two, sizeof display_two, "%.*s", (int)strcspn(prefix, " \r\n"), prefix);
+    display_two_rc = 0;
+    for (int head = 0; head < 2; head++) {
+        snprintf(cmd, sizeof cmd, "{\"execute\":\"screendump\",\"arguments\":{\"filename\":\"%s.%d.ppm\","
+                 "\"device\":\"vgpu\",\"head\":%d}}\n", display_two, head, head);
+        if (qmp(qmp_sock, cmd) != 0) display_two_rc = -1;
+    }
+    snprintf(ack, sizeof ack, "%s.ack", display_two);
+    FILE *f = fopen(ack, "w");
+    if (f) {
+        fprintf(f, "%d\n", display_two_rc);
+        fclose(f);
+    }
+}
+/* ---- end display */
+
 static void on_line(const char *line, const char *qmp_sock)
 {
+    if (!strncmp(line, "VMSYNC display-dump ", 20)) on_display_dump(line + 20, qmp_sock);
+    if (!strncmp(line, "VMSYNC display-two-dump ", 24)) on_display_two_dump(line + 24, qmp_sock);
     if (!strncmp(line, "VMSYNC usb-unplug", 17))
         qmp(qmp_sock, "{\"execute\":\"device_del\",\"arguments\":{\"id\":\"camr\"}}\n");
     else if (!strncmp(line, "VMSYNC usb-replug", 17))
@@ -130,7 +177,10 @@ static int boot_vm(void)
     const char *bin = getenv("EGOFUSE_BIN");
     char binarg[600] = "";
     if (bin && bin[0] == '/' && !strchr(bin, ' ')) snprintf(binarg, sizeof binarg, " egofuse.bin=%.500s", bin);
-    snprintf(append, sizeof append, "console=ttyS0 quiet panic=-1 egofuse.out=%s egofuse.root=%s%s",
+    /* video=Virtual-3:e: virtio-gpu's second output counts as connected
+     * (qemu enables only the first without a UI); connector names count
+     * across cards: bochs's is Virtual-1, virtio-gpu's Virtual-2 and -3 */
+    snprintf(append, sizeof append, "console=ttyS0 quiet panic=-1 video=Virtual-3:e egofuse.out=%s egofuse.root=%s%s",
              out, root, binarg);
     snprintf(fs_root, sizeof fs_root, "local,path=/,mount_tag=hostroot,security_model=none,"
              "readonly=on,multidevs=remap");
@@ -147,6 +197,8 @@ static int boot_vm(void)
                   "-device", "usb-tablet,bus=xhci.0,port=1.2,serial=CAM-L-0001,id=caml",
                   "-device", "usb-kbd,bus=xhci.0,port=2,serial=CAM-R-0002,id=camr",
                   "-device", "isa-debug-exit,iobase=0xf4,iosize=0x04",
+                  "-vga", "none", "-device", "bochs-display,id=display0",
+                  "-device", "virtio-gpu-pci,max_outputs=2,id=vgpu",
                   "-qmp", qmp_arg, "-serial", "stdio", "-display", "none", "-monitor", "none",
                   "-no-reboot", NULL};
     int pfd[2];
@@ -295,6 +347,137 @@ static void test_vm_run(void **st)
     expect(names, 1);
 }
 
+/* Reads a binary PPM (P6, maxval 255); NULL with *w = 0 on failure. */
+static uint8_t *read_ppm(const char *path, int *w, int *h)
+{
+    *w = *h = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    int pw = 0, ph = 0, maxv = 0;
+    uint8_t *px = NULL;
+    if (fscanf(f, "P6 %d %d %d", &pw, &ph, &maxv) == 3 && maxv == 255 && pw > 0 && ph > 0 && fgetc(f) != EOF) {
+        size_t bytes = (size_t)pw * (size_t)ph * 3;
+        px = malloc(bytes);
+        if (px && fread(px, 1, bytes, f) != bytes) {
+            free(px);
+            px = NULL;
+        }
+    }
+    fclose(f);
+    if (px) {
+        *w = pw;
+        *h = ph;
+    }
+    return px;
+}
+
+/* Bytes of got that differ from want (both w x h RGB), with the first. */
+static size_t compare_rgb(const uint8_t *got, const uint8_t *want, int w, int h, const char *what)
+{
+    size_t bytes = (size_t)w * (size_t)h * 3, bad = 0, first = 0;
+    for (size_t i = 0; i < bytes; i++)
+        if (got[i] != want[i] && !bad++) first = i;
+    if (bad)
+        printf("    %s: %zu of %zu bytes differ; first at pixel (%zu, %zu): got %u, want %u\n", what, bad, bytes,
+               (first / 3) % (size_t)w, (first / 3) / (size_t)w, got[first], want[first]);
+    else
+        printf("    %s = expected image, all %zu bytes\n", what, bytes);
+    return bad;
+}
+
+/* ---- display, layout two: virtio-gpu's two heads, one eye each */
+static void test_vm_display_two(void **st)
+{
+    (void)st;
+    static const char *const names[] = {"display_two_open", "display_two_flip", "display_two_shown",
+                                        "display_two_dump_ack", "display_two_restore", "display_two_no_fd_leak"};
+    expect(names, (int)(sizeof names / sizeof names[0]));
+    const char *m = strstr(vm_log, "VMINFO display two modes ");
+    int w[2] = {0, 0}, h[2] = {0, 0};
+    if (!m || sscanf(m + 25, "%dx%d %dx%d", &w[0], &h[0], &w[1], &h[1]) != 4)
+        fail_msg("the guest did not print the two modes");
+    assert_int_equal(display_two_rc, 0);
+    size_t bad = 0;
+    for (int e = 0; e < 2; e++) {
+        char path[1100], what[64];
+        snprintf(path, sizeof path, "%s.%d.ppm", display_two, e);
+        int pw, ph;
+        uint8_t *got = read_ppm(path, &pw, &ph);
+        printf("    head %d: %s %dx%d, the mode %dx%d\n", e, path, pw, ph, w[e], h[e]);
+        if (!got || pw != w[e] || ph != h[e]) {
+            free(got);
+            fail_msg("%s: not a %dx%d PPM", path, w[e], h[e]);
+        }
+        uint8_t *want = malloc((size_t)pw * (size_t)ph * 3);
+        assert_non_null(want);
+        vmd_expected_eye(pw, ph, e, 0, want);
+        snprintf(what, sizeof what, "head %d (%s eye)", e, e ? "right" : "left");
+        bad += compare_rgb(got, want, pw, ph, what);
+        free(got);
+        free(want);
+    }
+    assert_int_equal(bad, 0);
+}
+
+/* ---- display: the guest's checks, then qemu's screendump of the
+ * bochs-display compared exactly with the test image as io_display lays
+ * it out (each eye centred in its half of the mode, black around). */
+static void test_vm_display(void **st)
+{
+    (void)st;
+    static const char *const names[] = {"display_no_connector", "display_no_mode", "display_missing",
+                                        "display_not_kms", "display_open", "display_busy", "display_flip",
+                                        "display_queue", "display_shown", "display_dump_ack", "display_default",
+                                        "display_restore", "display_reopen", "display_sigint_restore",
+                                        "display_kill_restore", "display_no_fd_leak"};
+    expect(names, (int)(sizeof names / sizeof names[0]));
+    const char *m = strstr(vm_log, "VMINFO display mode ");
+    int w = 0, h = 0;
+    if (!m || sscanf(m + 20, "%dx%d", &w, &h) != 2) fail_msg("the guest did not print its display mode");
+    assert_int_equal(display_dump_rc, 0);
+    FILE *f = fopen(display_dump, "rb");
+    if (!f) fail_msg("%s: %s", display_dump, strerror(errno));
+    int pw = 0, ph = 0, maxv = 0;
+    int n = fscanf(f, "P6 %d %d %d", &pw, &ph, &maxv);
+    fgetc(f);
+    size_t bytes = (size_t)pw * (size_t)ph * 3;
+    uint8_t *got = n == 3 && pw > 0 && ph > 0 ? malloc(bytes) : NULL;
+    uint8_t *want = malloc((size_t)w * (size_t)h * 3);
+    size_t rd = got ? fread(got, 1, bytes, f) : 0;
+    fclose(f);
+    printf("    screendump %s: %dx%d (max %d), the mode %dx%d\n", display_dump, pw, ph, maxv, w, h);
+    assert_non_null(want);
+    assert_int_equal(n, 3);
+    assert_int_equal(pw, w);
+    assert_int_equal(ph, h);
+    assert_int_equal(maxv, 255);
+    assert_true(rd == bytes);
+    vmd_expected(w, h, 0, want);
+    size_t bad = 0, first = (size_t)-1;
+    for (size_t i = 0; i < bytes; i++)
+        if (got[i] != want[i]) {
+            if (first == (size_t)-1) first = i;
+            bad++;
+        }
+    if (bad)
+        printf("    %zu of %zu bytes differ; first at pixel (%zu, %zu): got %u, want %u\n", bad, bytes,
+               (first / 3) % (size_t)w, (first / 3) / (size_t)w, got[first], want[first]);
+    else
+        printf("    screendump = expected image, all %zu bytes\n", bytes);
+    free(got);
+    free(want);
+    assert_int_equal(bad, 0);
+}
+/* ---- end display */
+
+static void test_vm_vsrc(void **st)
+{
+    (void)st;
+    static const char *const names[] = {"vsrc_format", "vsrc_sbs", "vsrc_unplug",
+                                        "vsrc_no_fd_leak"};
+    expect(names, (int)(sizeof names / sizeof names[0]));
+}
+
 static void test_vm_all_passed(void **st)
 {
     (void)st;
@@ -318,6 +501,9 @@ int main(void)
         cmocka_unit_test(test_vm_usb),
         cmocka_unit_test(test_vm_glove),
         cmocka_unit_test(test_vm_run),
+        cmocka_unit_test(test_vm_display),
+        cmocka_unit_test(test_vm_display_two),
+        cmocka_unit_test(test_vm_vsrc),
         cmocka_unit_test(test_vm_all_passed),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

@@ -23,6 +23,8 @@ int cmd_demo(int argc, char **argv);
 int cmd_eval(int argc, char **argv);   /* cmd_eval.c, docs/accuracy.md */
 int cmd_run(int argc, char **argv);    /* cmd_run.c, docs/devices.md */
 int cmd_devices(int argc, char **argv);/* cmd_devices.c, docs/devices.md */
+int cmd_replay(int argc, char **argv); /* cmd_replay.c, docs/tracking.md */
+int cmd_calibrate(int argc, char **argv); /* cmd_calibrate.c, docs/tracking.md */
 
 /* Prints "egofuse: " + message to stderr; returns EXIT_FAIL. */
 int cli_fail(const char *fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -14,14 +14,16 @@ static const char *render_usage =
     "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
     "                      [--tone-match S] [--pose animation|tracking]\n"
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
-    "                      [--refine BAND]\n"
+    "                      [--refine BAND] [--hide PARTS]\n"
+    "                      [--prop MODEL@X,Y,Z[,YAW]]...\n"
     "\n"
     "Composites a recorded sequence (docs/scene.md): for each frame, poses the\n"
     "mask model at t = frame / fps, renders its mask and normals from both\n"
-    "HMD cameras (640x400 after the crop of eq. 1), lights the camera images\n"
-    "inside the mask (Blinn-Phong + Fresnel), resamples them into the\n"
-    "1194x746 viewport (eq. 2-4) and composites them over the virtual scene:\n"
-    "DIR/left_NNNN.png and DIR/right_NNNN.png, 1280x800 RGB.\n"
+    "HMD cameras (the paper's HMD: 640x400 after the crop of eq. 1), lights\n"
+    "the camera images inside the mask (Blinn-Phong + Fresnel), resamples\n"
+    "them into the viewport (1194x746, eq. 2-4) and composites them over the\n"
+    "virtual scene: DIR/left_NNNN.png and DIR/right_NNNN.png, RGB of the\n"
+    "display's size (1280x800).\n"
     "\n"
     "  --scene FILE   the scene file\n"
     "  --out DIR      output folder (created if missing)\n"
@@ -53,6 +55,14 @@ static const char *render_usage =
     "                 16 is `egofuse eval`'s default) around their edges; with\n"
     "                 --pose tracking the elbows are first fitted to the camera\n"
     "                 images (pipe_fit): eval's method refine\n"
+    "  --hide PARTS   do not show these parts of the operator's arms: a comma\n"
+    "                 list of left-hand, left-arm, right-hand, right-arm (or\n"
+    "                 hands, arms, all); a hand is the wrist joint and below,\n"
+    "                 an arm the shoulder, upper arm and forearm (src/pipe/pipe.h)\n"
+    "  --prop MODEL@X,Y,Z[,YAW]\n"
+    "                 cut in a real object like the hands: the glTF MODEL in its\n"
+    "                 rest pose, placed at (X, Y, Z) metres in the world frame and\n"
+    "                 turned YAW degrees about +Y (default 0); up to 8 props\n"
     "  -h, --help     this text\n";
 
 static const char *demo_usage =
@@ -66,6 +76,8 @@ static const char *demo_usage =
     "  --out DIR      output folder (default out/demo)\n"
     "  --frames N     number of frames (default: all)\n"
     "  -h, --help     this text\n";
+
+#define RENDER_MAX_PROPS 8
 
 typedef struct render_opts {
     const char *scene;
@@ -81,6 +93,12 @@ typedef struct render_opts {
     int no_filter;         /* raw samples instead of the One Euro filter */
     int cull_back;         /* cull back faces (closed models) */
     int refine;            /* refinement band, px; 0 = off */
+    unsigned hide;         /* PIPE_PART_* bits not shown */
+    int nprops;            /* --prop: models fixed in the world frame */
+    struct {
+        const char *path;
+        float at[3], yaw_deg;
+    } props[RENDER_MAX_PROPS];
 } render_opts;
 
 /* The pose from tracking: the recording, the rig, the filter and the
@@ -209,6 +227,29 @@ static fuse_image as_fuse(const io_image *img)
     return f;
 }
 
+/* Loads the --prop models, adds them to the pipe and places them:
+ * world_from_prop = translate(at) * rotate_y(yaw). *loaded counts the
+ * models to free (also on failure). */
+static int render_props(const render_opts *o, pipe_ctx *pp, kin_model *props, int *loaded,
+                        kin_mat4 *world, const kin_mat4 **ptr)
+{
+    io_error err;
+    for (int k = 0; k < o->nprops; k++) {
+        if (io_gltf_load(o->props[k].path, &props[k], &err) != IO_OK)
+            return cli_fail("--prop %s: %s", o->props[k].path, err.msg);
+        (*loaded)++;
+        if (pipe_add_prop(pp, &props[k]) != k)
+            return cli_fail("--prop %s: the model has no triangles (or out of memory)",
+                            o->props[k].path);
+        kin_vec3 t = kin_v3(o->props[k].at[0], o->props[k].at[1], o->props[k].at[2]);
+        kin_quat r = kin_quat_axis_angle(kin_v3(0, 1, 0),
+                                         o->props[k].yaw_deg * 0.017453292519943295f);
+        world[k] = kin_mat4_from_tr(t, r);
+        ptr[k] = &world[k];
+    }
+    return EXIT_OK;
+}
+
 static int render(const render_opts *o)
 {
     io_error err;
@@ -273,8 +314,12 @@ static int render(const render_opts *o)
     pd.refine_band = o->refine;
     pd.fit_rig = o->refine && o->pose_tracking ? &tp.rig : NULL;
     pipe_ctx *pp = pipe_create(&pd, &model);
-    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
+    kin_sthmd_desc hd = pp ? pipe_hmd(pp) : kin_sthmd_desc_resolved(&pd.hmd);
     io_image cam[2] = {{0}}, virt[2] = {{0}}, vdepth[2] = {{0}}, rgb = {0};
+    kin_model props[RENDER_MAX_PROPS];
+    kin_mat4 prop_world[RENDER_MAX_PROPS];
+    const kin_mat4 *prop_ptr[RENDER_MAX_PROPS];
+    int props_loaded = 0;
     if (!pp) {
         if (pd.fit_rig)
             cli_fail("cannot start the pipeline: out of memory, no thread, or the elbow fit "
@@ -283,6 +328,14 @@ static int render(const render_opts *o)
             cli_fail("cannot start the pipeline: out of memory or no thread");
         goto done;
     }
+    if (render_props(o, pp, props, &props_loaded, prop_world, prop_ptr) != EXIT_OK) goto done;
+    if (o->hide & ~pipe_parts_present(pp))
+        fprintf(stderr, "egofuse: --hide: %s has no triangles of some of these parts (found: "
+                "%s%s%s%s)\n", model_path,
+                pipe_parts_present(pp) & PIPE_PART_HAND_L ? "left-hand " : "",
+                pipe_parts_present(pp) & PIPE_PART_ARM_L ? "left-arm " : "",
+                pipe_parts_present(pp) & PIPE_PART_HAND_R ? "right-hand " : "",
+                pipe_parts_present(pp) & PIPE_PART_ARM_R ? "right-arm" : "");
     if (io_image_alloc(&rgb, hd.lcd_width, hd.lcd_height, 3, IO_U8, &err) != IO_OK) {
         cli_fail("out of memory");
         goto done;
@@ -297,6 +350,9 @@ static int render(const render_opts *o)
     in.anim = anim;
     in.head_node = head;
     in.lighting.light = io_scene_lighting(&sc);
+    in.hide = o->hide;
+    in.prop_world = props_loaded ? prop_ptr : NULL;
+    in.prop_count = props_loaded;
     static const char *eye_name[2] = {"left", "right"};
     pipe_frame_stats st, sum = {0};
     progress pr;
@@ -367,7 +423,8 @@ static int render(const render_opts *o)
     progress_end(&pr);
     if (!o->quiet) {
         double wall = cli_now() - pr.t0;
-        printf("egofuse: wrote %d stereo frames (1280x800 per eye) to %s\n", count, o->out);
+        printf("egofuse: wrote %d stereo frames (%dx%d per eye) to %s\n", count, hd.lcd_width,
+               hd.lcd_height, o->out);
         printf("egofuse: per stereo frame, %s, %d thread%s: %.3f ms (pose+skin %.3f ms; "
                "per eye: raster %.3f ms, lighting+composite %.3f ms); with image files %.1f ms\n",
                ef_isa_name((ef_isa)pipe_isa(pp)),
@@ -389,13 +446,43 @@ done:
     }
     io_image_free(&rgb);
     pipe_destroy(pp);
+    for (int k = 0; k < props_loaded; k++) kin_model_free(&props[k]);
     track_pose_free(&tp);
     kin_model_free(&model);
     return rc;
 }
 
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
-       O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE };
+       O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
+       O_PROP };
+
+/* "MODEL@X,Y,Z[,YAW]" (the last '@' ends the path). 1, or 0 when it is
+ * not of that form. */
+static int parse_prop(char *arg, render_opts *o)
+{
+    char *at = strrchr(arg, '@');
+    if (!at || at == arg || o->nprops >= RENDER_MAX_PROPS) return 0;
+    char nums[256];
+    if (strlen(at + 1) >= sizeof nums) return 0;
+    strcpy(nums, at + 1);
+    float yaw = 0.0f;
+    char *c3 = NULL;
+    int commas = 0;
+    for (char *q = nums; *q; q++)
+        if (*q == ',' && ++commas == 3) c3 = q;
+    if (commas == 3) {
+        *c3 = '\0';
+        if (!cli_parse_float(c3 + 1, &yaw)) return 0;
+    } else if (commas != 2) {
+        return 0;
+    }
+    if (!cli_parse_vec3(nums, o->props[o->nprops].at)) return 0;
+    o->props[o->nprops].yaw_deg = yaw;
+    *at = '\0';
+    o->props[o->nprops].path = arg;
+    o->nprops++;
+    return 1;
+}
 
 int cmd_render(int argc, char **argv)
 {
@@ -415,10 +502,13 @@ int cmd_render(int argc, char **argv)
         {"calib", required_argument, 0, O_CALIB},
         {"predict", required_argument, 0, O_PREDICT},
         {"no-filter", no_argument, 0, O_NO_FILTER},
+        {"hide", required_argument, 0, O_HIDE},
+        {"prop", required_argument, 0, O_PROP},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
     render_opts o = {0};
+    char why[200];
     int tracking_only = 0;   /* an option that needs --pose tracking */
     optind = 1;
     opterr = 0;
@@ -465,6 +555,17 @@ int cmd_render(int argc, char **argv)
             tracking_only = O_PREDICT;
             break;
         case O_NO_FILTER: o.no_filter = 1; tracking_only = O_NO_FILTER; break;
+        case O_HIDE:
+            if (pipe_parts_parse(optarg, &o.hide, why, sizeof why) != 0)
+                return cli_usage_error("render", "--hide '%s': %s", optarg, why);
+            break;
+        case O_PROP:
+            if (o.nprops >= RENDER_MAX_PROPS)
+                return cli_usage_error("render", "--prop: at most %d props", RENDER_MAX_PROPS);
+            if (!parse_prop(optarg, &o))
+                return cli_usage_error("render", "--prop '%s': MODEL@X,Y,Z or MODEL@X,Y,Z,YAW "
+                                       "(metres, degrees)", optarg);
+            break;
         case ':': return cli_usage_error("render", "option %s needs a value", argv[optind - 1]);
         default: return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);
         }

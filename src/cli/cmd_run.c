@@ -1,68 +1,32 @@
-/* cmd_run.c - `egofuse run`: the live pipeline. Two V4L2 cameras (paired
- * by time stamp), the pose from the tracking stream (UDP) or the model's
- * animation, the data gloves, then pipe_frame per stereo pair; output to
- * PNG files or a raw RGB24 stream on stdout, a status line on stderr.
+/* cmd_run.c - `egofuse run`: the live cockpit. Two cameras (V4L2, paired
+ * by time stamp, or recorded frames for a dry run), the pose from a
+ * tracker (egofuse's UDP stream or OptiTrack NatNet, through the One Euro
+ * filter, posed at the cameras' time stamp) or the model's animation, the
+ * data gloves, the virtual scene (a still image or a live source), then
+ * pipe_frame per stereo pair; output to the HMD's displays (KMS), a
+ * window, PNG files or raw frames on stdout. Every frame's stage times and
+ * latencies go to the status line (median, p99) and to --stats FILE.
  * A camera that fails is reopened once a second (found again by its
- * selector, so a replug onto another /dev/videoN is followed); meanwhile
- * its eye holds its last image. docs/devices.md. */
-#include "cli.h"
+ * selector); meanwhile its eye holds its last image. docs/cockpit.md,
+ * docs/devices.md. */
+#include "run.h"
 
-#include <getopt.h>
+#include <errno.h>
+#include <math.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdlib.h>
-#include <errno.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "../io/io_dev.h"
+#include "../io/io_display.h"
+#include "../io/io_live.h"
+#include "../io/io_natnet.h"
+#include "../io/io_sched.h"
+#include "../io/io_vsrc.h"
 #include "../pipe/pipe.h"
-
-static const char *run_usage =
-    "usage: egofuse run (--scene FILE | --model FILE) [--left SEL --right SEL]\n"
-    "                   [--out DIR | --raw] [--frames N] [options]\n"
-    "\n"
-    "Composites the live stereo cameras: each pair of frames (matched by\n"
-    "kernel time stamp) is lit inside the mask of the posed arm model and\n"
-    "composited over the virtual scene, per eye 1280x800.\n"
-    "\n"
-    "  --scene FILE     model, animation, head node, lighting and virtual\n"
-    "                   images (frame 0) from a scene file (docs/scene.md)\n"
-    "  --model FILE     glTF model (head node 'head' if it has one)\n"
-    "  --virt L,R       virtual scene images (default: the scene's, or grey)\n"
-    "  --left SEL       left camera: /dev/videoN, serial:SN, port:1-2.3 or\n"
-    "  --right SEL      id:VVVV:PPPP ('egofuse devices' shows them); default:\n"
-    "                   the first two capture nodes\n"
-    "  --format F       YUYV (default), GREY, BA81, RGGB, GBRG, GRBG\n"
-    "  --fps N          frame rate asked (default 60)\n"
-    "  --input N        V4L2 input to select\n"
-    "  --dv             the input takes DV timings (HDMI): 640x480 at --fps\n"
-    "  --buffers N      mmap buffers per camera (default 4)\n"
-    "  --track-port P   pose from the UDP tracking stream on 127.0.0.1:P\n"
-    "                   (docs/tracking.md); default: the model's animation\n"
-    "  --glove-left SEL, --glove-right SEL   5DT gloves (SEL as above, or any)\n"
-    "  --calib FILE     user calibration (egofuse-calib 1) for the gloves\n"
-    "  --out DIR        write DIR/left_NNNN.png and DIR/right_NNNN.png\n"
-    "  --raw            write rgb24 frames, left above right (1280x1600), on\n"
-    "                   stdout: | ffplay -f rawvideo -pixel_format rgb24\n"
-    "                   -video_size 1280x1600 -\n"
-    "  --frames N       stop after N stereo frames (default: until Ctrl-C)\n"
-    "  --refine BAND    refine the masks by colour in a band of BAND px (1..64,\n"
-    "                   16 in `egofuse eval`) around their edges; with\n"
-    "                   --track-port the elbows are first fitted to the\n"
-    "                   camera images (eval's method refine)\n"
-    "  --quiet          no status line\n"
-    "  -h, --help       this text\n"
-    "\n"
-    "Without cameras, composite recorded input instead:\n"
-    "  egofuse render --scene FILE --out DIR   (egofuse demo for the samples)\n";
-
-typedef struct run_opts {
-    const char *scene, *model, *virt[2], *sel[2], *glove_sel[2], *calib, *out;
-    uint32_t fourcc;
-    int fps, input, dv, buffers, track_port, raw, frames, quiet;
-    int refine;             /* refinement band, px; 0 = off */
-} run_opts;
 
 static volatile sig_atomic_t stop_flag;
 static void on_signal(int s)
@@ -71,11 +35,11 @@ static void on_signal(int s)
     stop_flag = 1;
 }
 
-static double mono_s(void)
+static uint64_t mono_ns(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
 }
 
 /* Resolves a camera selector to a /dev/videoN path. */
@@ -108,8 +72,11 @@ static int no_cameras(const char *why)
 {
     fprintf(stderr,
             "egofuse run: no cameras found%s%s.\n"
-            "  Plug in the HMD's two cameras (egofuse devices lists what is seen), or\n"
-            "  composite recorded input instead:\n"
+            "  Plug in the HMD's two cameras ('egofuse devices' lists what is seen), or\n"
+            "  make a dry run from recorded camera frames or a video:\n"
+            "    egofuse run --scene FILE --left file:cam_left_%%04d.png --right "
+            "file:cam_right_%%04d.png\n"
+            "  or composite recorded input offline:\n"
             "    egofuse render --scene FILE --out DIR   (docs/scene.md)\n"
             "    egofuse demo                            (the bundled samples)\n",
             why ? ": " : "", why ? why : "");
@@ -128,16 +95,415 @@ static int load_virt(const char *path, int w, int h, io_image *img)
     return EXIT_OK;
 }
 
+/* The tracker's clock mapped onto CLOCK_MONOTONIC: offset = the smallest
+ * (arrival - sample time) seen (the fastest delivery), re-learned when the
+ * filter restarts. */
+typedef struct track_clock {
+    int have;
+    double offset_s;
+} track_clock;
+
+static double track_local_time(track_clock *c, double t_sample, double t_arrival, int restart)
+{
+    double off = t_arrival - t_sample;
+    if (!c->have || restart || off < c->offset_s) {
+        c->offset_s = off;
+        c->have = 1;
+    }
+    return t_sample + c->offset_s;
+}
+
+
+/* Everything a run holds, released by run_close. */
+typedef struct run_state {
+    io_scene sc;
+    int have_scene;
+    kin_model model;
+    int have_model;
+    char model_path[IO_PATH_MAX + 64];
+    pipe_ctx *pipe;
+    io_image virt[2], outimg[2], camimg[2];
+    io_image vdepth[2];       /* the still virtual images' depth, if any */
+    char vdepth_path[2][IO_PATH_MAX + 64];
+    io_cam cam[2];
+    int file_cams;            /* the cameras are recorded frames */
+    io_glove glove[2];
+    int have_glove[2];
+    io_track_udp udp;
+    io_natnet natnet;
+    int have_natnet;
+    kin_arm_rig rig;
+    kin_transform *locals;
+    kin_user_calib ucal;
+    kin_filter filter;
+    track_clock tclock;
+    uint64_t track_samples;   /* samples taken into the filter */
+    uint64_t t_track;         /* CLOCK_MONOTONIC time of the newest one */
+    io_vsrc *vsrc;
+    io_display *disp;
+    io_sched sched;
+    kin_model props[RUN_MAX_PROPS];
+    int props_loaded;
+    kin_mat4 prop_world[RUN_MAX_PROPS];
+    const kin_mat4 *prop_ptr[RUN_MAX_PROPS];
+    uint8_t *rawbuf;
+    io_stats_log stats;
+    /* the frames presented and not yet shown (display): their log rows */
+    io_frame_log pending[4];
+    int npending;
+} run_state;
+
+static void run_close(run_state *r)
+{
+    io_display_close(&r->disp); /* first: the previous mode comes back */
+    io_vsrc_close(r->vsrc);
+    r->vsrc = NULL;
+    for (int e = 0; e < 2; e++) {
+        io_cam_close(&r->cam[e]);
+        io_glove_close(&r->glove[e]);
+        io_image_free(&r->virt[e]);
+        io_image_free(&r->outimg[e]);
+        io_image_free(&r->camimg[e]);
+        io_image_free(&r->vdepth[e]);
+    }
+    if (r->udp.fd >= 0) io_track_udp_close(&r->udp);
+    if (r->have_natnet) io_natnet_close(&r->natnet);
+    io_stats_abandon(&r->stats);
+    free(r->locals);
+    free(r->rawbuf);
+    if (r->pipe) pipe_destroy(r->pipe);
+    for (int k = 0; k < r->props_loaded; k++) kin_model_free(&r->props[k]);
+    if (r->have_model) kin_model_free(&r->model);
+}
+
+/* The tracker: every pending sample into the filter (called whenever the
+ * loop waits, so the filter sees each sample near its arrival). */
+static void track_service(run_state *r)
+{
+    io_error err;
+    kin_track_sample s;
+    int fresh = 0;
+    double t_arr = 1e-9 * (double)mono_ns();
+    if (r->udp.fd >= 0) {
+        if (io_track_udp_poll(&r->udp, 0, &s, &fresh, &err) != IO_OK) return;
+    } else if (r->have_natnet) {
+        if (io_natnet_poll(&r->natnet, 0, &s, &fresh, &err) != IO_OK) return;
+    } else {
+        return;
+    }
+    if (!fresh || !s.valid) return; /* the newest of the datagrams read */
+    int bits = kin_filter_push(&r->filter, &s);
+    if (r->have_natnet) { /* NatNet's sample times are CLOCK_MONOTONIC already */
+        r->tclock.have = 1;
+        r->tclock.offset_s = 0;
+    } else {
+        track_local_time(&r->tclock, s.t, t_arr, bits & KIN_FILTER_RESTART);
+    }
+    if (bits & KIN_FILTER_ACCEPTED) {
+        r->track_samples++;
+        r->t_track = (uint64_t)((s.t + r->tclock.offset_s) * 1e9);
+    }
+}
+
+/* One flip event: the frame it shows is logged with its time. */
+static void on_flip(const run_opts *o, run_state *r, const io_display_flip *ev, io_lat *lat_shown,
+                    io_lat *lat_deq)
+{
+    (void)o;
+    io_sched_flipped(&r->sched, ev->t_ns, ev->seq);
+    for (int i = 0; i < r->npending; i++) {
+        if (r->pending[i].frame != ev->frame_id) continue;
+        io_frame_log *lg = &r->pending[i];
+        lg->t_shown = ev->t_ns;
+        uint64_t tc = lg->t_cam_l > lg->t_cam_r ? lg->t_cam_l : lg->t_cam_r;
+        io_lat_push(lat_shown, 1e-6 * ((double)lg->t_shown - (double)tc));
+        io_lat_push(lat_deq, 1e-6 * ((double)lg->t_shown - (double)lg->t_dequeue));
+        io_stats_row(&r->stats, lg);
+        r->pending[i] = r->pending[--r->npending];
+        return;
+    }
+}
+
+/* The flip events that came, without waiting. */
+static void drain_flips(const run_opts *o, run_state *r, io_lat *lat_shown, io_lat *lat_deq)
+{
+    io_display_flip ev;
+    int got = 0;
+    io_error err;
+    while (io_display_poll(r->disp, 0, &ev, &got, &err) == IO_OK && got)
+        on_flip(o, r, &ev, lat_shown, lat_deq);
+}
+
+/* Waits until deadline_ns (or, with want_cams, until a camera has a
+ * frame), serving the display's flip events, the tracker and the V source
+ * meanwhile. Returns 1 when a camera became readable. */
+static int wait_until(const run_opts *o, run_state *r, uint64_t deadline_ns, int want_cams,
+                      io_lat *lat_shown, io_lat *lat_deq)
+{
+    for (;;) {
+        struct pollfd pf[16];
+        int n = 0, cam0 = -1, ncam = 0, disp_i = -1;
+        if (r->disp && io_display_fd(r->disp) >= 0) {
+            disp_i = n;
+            pf[n++] = (struct pollfd){io_display_fd(r->disp), POLLIN, 0};
+        }
+        if (r->udp.fd >= 0) pf[n++] = (struct pollfd){r->udp.fd, POLLIN, 0};
+        if (r->have_natnet && io_natnet_fd(&r->natnet) >= 0)
+            pf[n++] = (struct pollfd){io_natnet_fd(&r->natnet), POLLIN, 0};
+        if (r->vsrc) n += io_vsrc_pollfds(r->vsrc, pf + n, 4);
+        if (want_cams) {
+            cam0 = n;
+            for (int e = 0; e < 2; e++)
+                if (r->cam[e].state == IO_CAM_STREAMING && io_cam_fd(&r->cam[e]) >= 0) {
+                    pf[n++] = (struct pollfd){io_cam_fd(&r->cam[e]), POLLIN, 0};
+                    ncam++;
+                }
+        }
+        uint64_t now = mono_ns();
+        int ms = now >= deadline_ns ? 0 : (int)((deadline_ns - now + 999999) / 1000000);
+        if (ms > 100) ms = 100;
+        int k = poll(pf, (nfds_t)n, ms);
+        if (k < 0 && errno != EINTR) return 0;
+        if (stop_flag) return 0;
+        io_error err;
+        /* flip events (SDL has no descriptor: its come by polling) */
+        if (r->disp && (disp_i < 0 || (pf[disp_i].revents & POLLIN)))
+            drain_flips(o, r, lat_shown, lat_deq);
+        track_service(r);
+        if (r->vsrc) {
+            int fresh;
+            io_vsrc_poll(r->vsrc, 0, &fresh, &err);
+        }
+        if (want_cams)
+            for (int i = 0; i < ncam; i++)
+                if (pf[cam0 + i].revents) return 1;
+        if (mono_ns() >= deadline_ns) return 0;
+    }
+}
+
+/* World matrix of a prop this frame; NULL when its rigid body is not
+ * seen. */
+static const kin_mat4 *prop_pose(const run_opts *o, run_state *r, int k)
+{
+    const run_prop *p = &o->prop[k];
+    const float d2r = 0.017453292519943295f;
+    kin_quat q = kin_quat_mul(kin_quat_axis_angle(kin_v3(0, 1, 0), p->rot_deg[0] * d2r),
+                              kin_quat_mul(kin_quat_axis_angle(kin_v3(1, 0, 0), p->rot_deg[1] * d2r),
+                                           kin_quat_axis_angle(kin_v3(0, 0, 1), p->rot_deg[2] * d2r)));
+    kin_mat4 local = kin_mat4_from_tr(kin_v3(p->at[0], p->at[1], p->at[2]), q);
+    if (!p->body[0]) {
+        r->prop_world[k] = local;
+        return &r->prop_world[k];
+    }
+    kin_mat4 body;
+    int valid = 0, id = -1;
+    if (p->body[0] == '#') id = atoi(p->body + 1);
+    if (!r->have_natnet || io_natnet_body(&r->natnet, id, id >= 0 ? NULL : p->body, &body, &valid) != 0 ||
+        !valid)
+        return NULL;
+    r->prop_world[k] = kin_mat4_mul(&body, &local);
+    return &r->prop_world[k];
+}
+
+
+static int write_outputs(const run_opts *o, run_state *r, int frame, int W, int H)
+{
+    io_error err;
+    if (o->out) {
+        static const char *const eye[2] = {"left", "right"};
+        for (int e = 0; e < 2; e++) {
+            char p[IO_PATH_MAX + 64];
+            snprintf(p, sizeof p, "%s/%s_%04d.png", o->out, eye[e], frame);
+            if (io_image_save(p, &r->outimg[e], &err) != IO_OK) return cli_fail("%s", err.msg);
+        }
+    }
+    if (o->raw) {
+        uint8_t *d = r->rawbuf;
+        for (int e = 0; e < 2; e++)
+            for (int y = 0; y < H; y++) {
+                const uint8_t *s = (const uint8_t *)r->outimg[e].data + (size_t)y * r->outimg[e].stride;
+                for (int x = 0; x < W; x++, d += 3) {
+                    d[0] = s[4 * x];
+                    d[1] = s[4 * x + 1];
+                    d[2] = s[4 * x + 2];
+                }
+            }
+        size_t n = (size_t)W * (size_t)H * 6;
+        if (fwrite(r->rawbuf, 1, n, stdout) != n || fflush(stdout) != 0)
+            return cli_fail("stdout: write error: %s (reader gone?)", strerror(errno));
+    }
+    return EXIT_OK;
+}
+
+/* --dump DIR: the inputs of the last frame as a one-frame scene that
+ * `egofuse render` composites to the same bytes (camera images as
+ * converted, the virtual images used, the pose sample used; the scene's
+ * lighting lines copied verbatim). With --refine the elbow fit's learned
+ * state is not part of it, so render differs there. */
+static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
+                      const kin_track_sample *sample, int tracked, int W, int H)
+{
+    io_error err;
+    if (cli_mkdirs(o->dump) != 0)
+        return cli_fail("%s: cannot create the dump folder: %s", o->dump, strerror(errno));
+    static const char *const eye[2] = {"left", "right"};
+    for (int e = 0; e < 2; e++) {
+        char p[IO_PATH_MAX + 64];
+        snprintf(p, sizeof p, "%s/cam_%s_0000.png", o->dump, eye[e]);
+        if (io_image_save(p, &r->camimg[e], &err) != IO_OK) return cli_fail("%s", err.msg);
+        io_image v = {in->virt[e].pixels, W, H, 4, IO_U8, (size_t)in->virt[e].stride};
+        snprintf(p, sizeof p, "%s/virt_%s_0000.png", o->dump, eye[e]);
+        if (io_image_save(p, &v, &err) != IO_OK) return cli_fail("%s", err.msg);
+        if (in->virt_depth[e] && in->virt_depth[e] != r->vdepth[e].data) {
+            /* a live source's depth, as float EXR */
+            io_image d = {(void *)in->virt_depth[e], W, H, 1, IO_F32,
+                          (size_t)in->virt_depth_stride[e] * sizeof(float)};
+            snprintf(p, sizeof p, "%s/virt_depth_%s_0000.exr", o->dump, eye[e]);
+            if (io_image_save(p, &d, &err) != IO_OK) return cli_fail("%s", err.msg);
+        }
+    }
+    char path[IO_PATH_MAX + 64], tmp[IO_PATH_MAX + 96];
+    if (tracked) {
+        kin_track_sample s = *sample;
+        s.t = 0;
+        snprintf(path, sizeof path, "%s/track.txt", o->dump);
+        if (io_track_save(path, &s, 1, &err) != IO_OK) return cli_fail("%s", err.msg);
+    }
+    char model_abs[IO_PATH_MAX + 64];
+    if (!realpath(r->model_path, model_abs)) snprintf(model_abs, sizeof model_abs, "%s", r->model_path);
+    snprintf(path, sizeof path, "%s/scene.txt", o->dump);
+    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
+    FILE *f = fopen(tmp, "w");
+    if (!f) return cli_fail("%s: %s", path, strerror(errno));
+    int bad = fprintf(f,
+                      "egofuse-scene 1\n# the last frame of egofuse run (--dump)\nmodel = %s\n"
+                      "frames = 1\nfps = 60\ncamera_left = cam_left_%%04d.png\n"
+                      "camera_right = cam_right_%%04d.png\nvirtual_left = virt_left_%%04d.png\n"
+                      "virtual_right = virt_right_%%04d.png\n%s",
+                      model_abs, tracked ? "tracking = track.txt\n" : "") < 0;
+    for (int e = 0; e < 2; e++) {
+        char dabs[IO_PATH_MAX + 64];
+        if (in->virt_depth[e] && in->virt_depth[e] != r->vdepth[e].data) {
+            bad |= fprintf(f, "virtual_depth_%s = virt_depth_%s_%%04d.exr\n", eye[e], eye[e]) < 0;
+            continue;
+        }
+        if (!r->vdepth[e].data || !in->virt_depth[e]) continue;
+        if (!realpath(r->vdepth_path[e], dabs)) snprintf(dabs, sizeof dabs, "%s", r->vdepth_path[e]);
+        bad |= fprintf(f, "virtual_depth_%s = %s\n", eye[e], dabs) < 0;
+    }
+    if (r->have_scene && r->sc.head_node[0]) bad |= fprintf(f, "head_node = %s\n", r->sc.head_node) < 0;
+    if (r->have_scene && r->sc.animation[0]) bad |= fprintf(f, "animation = %s\n", r->sc.animation) < 0;
+    if (r->have_scene && r->sc.has_lighting) {
+        /* the lighting lines as written, so render parses the same floats */
+        FILE *in = fopen(o->scene, "r");
+        char line[4096];
+        static const char *const keys[] = {"ambient", "light", "kd", "ks", "shininess", "kf", "tone", NULL};
+        while (in && fgets(line, sizeof line, in)) {
+            const char *t = line + strspn(line, " \t");
+            for (int k = 0; keys[k]; k++) {
+                size_t n = strlen(keys[k]);
+                if (!strncmp(t, keys[k], n) && strchr(" \t=", t[n])) {
+                    bad |= fputs(line, f) == EOF;
+                    break;
+                }
+            }
+        }
+        if (in) fclose(in);
+        else bad = 1;
+    }
+    bad |= fclose(f) != 0;
+    if (bad || rename(tmp, path) != 0) {
+        int e = errno;
+        unlink(tmp);
+        return cli_fail("%s: %s", path, strerror(e ? e : EIO));
+    }
+    snprintf(path, sizeof path, "%s/command.txt", o->dump);
+    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
+    f = fopen(tmp, "w");
+    if (!f) return cli_fail("%s: %s", path, strerror(errno));
+    bad = fprintf(f, "egofuse render --scene %s/scene.txt --out OUT%s%s%s", o->dump,
+                  tracked ? " --pose tracking --no-filter" : "", o->calib ? " --calib " : "",
+                  o->calib ? o->calib : "") < 0;
+    if (o->hide) {
+        static const char *const part[4] = {"left-hand", "left-arm", "right-hand", "right-arm"};
+        int first = 1;
+        bad |= fputs(" --hide ", f) == EOF;
+        for (int k = 0; k < 4; k++)
+            if (o->hide & (1u << k)) {
+                bad |= fprintf(f, "%s%s", first ? "" : ",", part[k]) < 0;
+                first = 0;
+            }
+    }
+    for (int k = 0; k < o->prop_count; k++) {
+        const run_prop *p = &o->prop[k];
+        if (p->body[0] || p->rot_deg[1] != 0 || p->rot_deg[2] != 0)
+            bad |= fprintf(f, " # prop %s is tracked or tilted: render cannot place it", p->name) < 0;
+        else
+            bad |= fprintf(f, " --prop %s@%.9g,%.9g,%.9g,%.9g", p->model, (double)p->at[0],
+                           (double)p->at[1], (double)p->at[2], (double)p->rot_deg[0]) < 0;
+    }
+    if (o->refine) bad |= fprintf(f, " --refine %d # the elbow fit's learned state differs", o->refine) < 0;
+    bad |= fputc('\n', f) == EOF;
+    bad |= fclose(f) != 0;
+    if (bad || rename(tmp, path) != 0) {
+        int e = errno;
+        unlink(tmp);
+        return cli_fail("%s: %s", path, strerror(e ? e : EIO));
+    }
+    return EXIT_OK;
+}
+
+static const char *vstate_word(const run_state *r, uint64_t now, char *buf, size_t n)
+{
+    if (!r->vsrc) return "";
+    io_vsrc_stat vs;
+    io_vsrc_status(r->vsrc, now, &vs);
+    if (vs.state == IO_VSRC_LIVE)
+        snprintf(buf, n, ", V live %.0f ms old", 1e-6 * (double)vs.age_ns);
+    else if (vs.t_ns)
+        snprintf(buf, n, ", V %s (last good held, %.1f s old)%s%.120s", io_vsrc_state_name(vs.state),
+                 1e-9 * (double)vs.age_ns, vs.msg[0] ? ": " : "", vs.msg);
+    else
+        snprintf(buf, n, ", V %s%s%.120s", io_vsrc_state_name(vs.state), vs.msg[0] ? ": " : "",
+                 vs.msg);
+    return buf;
+}
+
+static const char *track_word(const run_opts *o, const run_state *r, uint64_t now, char *buf,
+                              size_t n)
+{
+    if (!o->track_port && !o->natnet) return "";
+    if (!r->t_track) {
+        snprintf(buf, n, ", tracker: no pose yet%s%.160s", r->have_natnet ? " (" : "",
+                 r->have_natnet ? r->natnet.status : "");
+        if (r->have_natnet) strncat(buf, ")", n - strlen(buf) - 1);
+        return buf;
+    }
+    double age = 1e-9 * ((double)now - (double)r->t_track);
+    if (age > 0.5)
+        snprintf(buf, n, ", tracker stale (last pose %.1f s old, held then faded)", age);
+    else
+        snprintf(buf, n, ", tracker %.0f ms", 1e3 * age);
+    return buf;
+}
+
 static int run(const run_opts *o)
 {
     io_error err;
     int rc = EXIT_FAIL;
     /* ---- cameras first: without them nothing else matters */
     char path[2][IO_CAM_NAME_MAX];
+    int file_cams = o->sel[0] && io_cam_file_selector(o->sel[0]);
     if (o->sel[0]) {
-        for (int e = 0; e < 2; e++)
-            if (resolve(o->sel[e], path[e], sizeof path[e], &err) != 0)
-                return no_cameras(err.msg);
+        if (io_cam_file_selector(o->sel[0]) != io_cam_file_selector(o->sel[1]))
+            return cli_usage_error("run", "--left and --right: both cameras or both recorded");
+        for (int e = 0; e < 2; e++) {
+            if (file_cams) {
+                snprintf(path[e], sizeof path[e], "%s", o->sel[e]);
+                continue;
+            }
+            if (resolve(o->sel[e], path[e], sizeof path[e], &err) != 0) return no_cameras(err.msg);
+        }
     } else {
         io_cam_info ci[64];
         int n = 0, k = 0;
@@ -155,61 +521,71 @@ static int run(const run_opts *o)
     if (!o->scene && !o->model)
         return cli_usage_error("run", "--scene or --model is required (the arm model to mask)");
 
+    run_state *r = calloc(1, sizeof *r);
+    if (!r) return cli_fail("out of memory");
+    r->cam[0].fd = r->cam[1].fd = -1;
+    r->udp.fd = -1;
+    r->ucal = kin_user_calib_identity();
+    r->file_cams = file_cams;
+
     /* ---- model, scene, virtual images */
-    io_scene sc;
-    int have_scene = 0;
     char model_path[IO_PATH_MAX + 64];
     if (o->scene) {
-        if (io_scene_load(o->scene, &sc, &err) != IO_OK) return cli_fail("%s", err.msg);
-        have_scene = 1;
-        io_scene_frame_path(&sc, sc.model, 0, model_path, sizeof model_path);
-    } else {
-        snprintf(model_path, sizeof model_path, "%s", o->model);
+        if (io_scene_load(o->scene, &r->sc, &err) != IO_OK) {
+            cli_fail("%s", err.msg);
+            goto done;
+        }
+        r->have_scene = 1;
+        io_scene_frame_path(&r->sc, r->sc.model, 0, model_path, sizeof model_path);
     }
-    kin_model model;
-    if (io_gltf_load(model_path, &model, &err) != IO_OK) return cli_fail("%s", err.msg);
-    const kin_animation *anim = model.anim_count ? &model.anims[0] : NULL;
-    if (have_scene && sc.animation[0])
-        for (int i = 0; i < model.anim_count; i++)
-            if (!strcmp(model.anims[i].name, sc.animation)) anim = &model.anims[i];
-    int head = kin_model_find_node(&model, have_scene && sc.head_node[0] ? sc.head_node : "head");
+    if (o->model) snprintf(model_path, sizeof model_path, "%s", o->model);
+    if (io_gltf_load(model_path, &r->model, &err) != IO_OK) {
+        cli_fail("%s", err.msg);
+        goto done;
+    }
+    r->have_model = 1;
+    snprintf(r->model_path, sizeof r->model_path, "%s", model_path);
+    kin_model *model = &r->model;
+    const kin_animation *anim = model->anim_count ? &model->anims[0] : NULL;
+    if (r->have_scene && r->sc.animation[0])
+        for (int i = 0; i < model->anim_count; i++)
+            if (!strcmp(model->anims[i].name, r->sc.animation)) anim = &model->anims[i];
+    int head = kin_model_find_node(model, r->have_scene && r->sc.head_node[0] ? r->sc.head_node
+                                                                             : "head");
 
     pipe_desc pd;
     memset(&pd, 0, sizeof pd);
-    pipe_ctx *pipe = NULL;
-    io_image virt[2], outimg[2], camimg[2];
-    memset(virt, 0, sizeof virt);
-    memset(outimg, 0, sizeof outimg);
-    memset(camimg, 0, sizeof camimg);
-    io_cam cam[2];
-    memset(cam, 0, sizeof cam);
-    cam[0].fd = cam[1].fd = -1;
-    io_glove glove[2];
-    memset(glove, 0, sizeof glove);
-    int have_glove[2] = {0, 0};
-    io_track_udp udp;
-    memset(&udp, 0, sizeof udp);
-    udp.fd = -1;
-    kin_arm_rig rig;
-    kin_transform *locals = NULL;
-    kin_user_calib ucal = kin_user_calib_identity();
-    uint8_t *rawbuf = NULL;
-
-    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
+    pd.hmd = o->hmd;
+    kin_sthmd_desc hd = kin_sthmd_desc_resolved(&o->hmd);
     const int W = hd.lcd_width, H = hd.lcd_height;
     for (int e = 0; e < 2; e++) {
         char vp[IO_PATH_MAX + 64];
         const char *vpath = o->virt[e];
-        if (!vpath && have_scene) {
-            io_scene_frame_path(&sc, sc.virt[e], 0, vp, sizeof vp);
+        if (!vpath && r->have_scene && !o->virt_source) {
+            io_scene_frame_path(&r->sc, r->sc.virt[e], 0, vp, sizeof vp);
             vpath = vp;
         }
         if (vpath) {
-            if (load_virt(vpath, W, H, &virt[e])) goto done;
-        } else if (io_image_alloc(&virt[e], W, H, 4, IO_U8, &err) == IO_OK) {
-            /* plain grey, opaque */
+            if (load_virt(vpath, W, H, &r->virt[e])) goto done;
+            if (!o->virt[e] && r->sc.virt_depth[e][0]) {
+                /* the scene's depth of that image: virtual objects in front
+                 * of the hands hide them */
+                io_scene_frame_path(&r->sc, r->sc.virt_depth[e], 0, r->vdepth_path[e],
+                                    sizeof r->vdepth_path[e]);
+                if (io_image_load(r->vdepth_path[e], IO_F32, 1, &r->vdepth[e], &err) != IO_OK) {
+                    cli_fail("%s", err.msg);
+                    goto done;
+                }
+                if (r->vdepth[e].width != W || r->vdepth[e].height != H) {
+                    cli_fail("%s: virtual depth image is %dx%d, expected %dx%d", r->vdepth_path[e],
+                             r->vdepth[e].width, r->vdepth[e].height, W, H);
+                    goto done;
+                }
+            }
+        } else if (io_image_alloc(&r->virt[e], W, H, 4, IO_U8, &err) == IO_OK) {
+            /* plain grey, opaque (until a live source delivers) */
             for (int y = 0; y < H; y++) {
-                uint8_t *row = (uint8_t *)virt[e].data + (size_t)y * virt[e].stride;
+                uint8_t *row = (uint8_t *)r->virt[e].data + (size_t)y * r->virt[e].stride;
                 for (int x = 0; x < W; x++) {
                     row[4 * x + 0] = row[4 * x + 1] = row[4 * x + 2] = 96;
                     row[4 * x + 3] = 255;
@@ -219,356 +595,454 @@ static int run(const run_opts *o)
             cli_fail("%s", err.msg);
             goto done;
         }
-        if (io_image_alloc(&outimg[e], W, H, 4, IO_U8, &err) != IO_OK ||
-            io_image_alloc(&camimg[e], hd.cam_width, hd.cam_height, 4, IO_U8, &err) != IO_OK) {
+        if (io_image_alloc(&r->outimg[e], W, H, 4, IO_U8, &err) != IO_OK ||
+            io_image_alloc(&r->camimg[e], hd.cam_width, hd.cam_height, 4, IO_U8, &err) != IO_OK) {
             cli_fail("%s", err.msg);
             goto done;
         }
     }
-    if (o->raw && !(rawbuf = malloc((size_t)W * (size_t)H * 6))) {
+    if (o->raw && !(r->rawbuf = malloc((size_t)W * (size_t)H * 6))) {
         cli_fail("out of memory");
         goto done;
     }
-    if (o->track_port) {
+    /* ---- the pose */
+    int tracked = o->track_port != 0 || o->natnet;
+    if (tracked) {
         char why[256];
-        if (kin_arm_rig_init(&rig, &model, why, sizeof why) != 0) {
-            cli_fail("%s: cannot follow the tracking stream: %s", model_path, why);
+        if (kin_arm_rig_init(&r->rig, model, why, sizeof why) != 0) {
+            cli_fail("%s: cannot follow the tracker: %s", model_path, why);
             goto done;
         }
-        if (!(locals = malloc(sizeof(kin_transform) * (size_t)model.node_count))) {
+        if (!(r->locals = malloc(sizeof(kin_transform) * (size_t)model->node_count))) {
             cli_fail("out of memory");
             goto done;
         }
-        if (io_track_udp_listen(&udp, NULL, o->track_port, &err) != IO_OK) {
+        kin_filter_init(&r->filter, NULL);
+    }
+    if (o->track_port &&
+        io_track_udp_listen(&r->udp, o->track_addr, o->track_port, &err) != IO_OK) {
+        cli_fail("tracking stream: %s", err.msg);
+        goto done;
+    }
+    if (o->natnet) {
+        io_natnet_config nc;
+        io_natnet_config_default(&nc);
+        for (int i = 0; i < o->natnet_kv_count; i++)
+            if (io_natnet_config_set(&nc, o->natnet_kv[i][0], o->natnet_kv[i][1], &err) != IO_OK) {
+                cli_fail("%s", err.msg);
+                goto done;
+            }
+        if (io_natnet_open(&r->natnet, &nc, &err) != IO_OK) {
             cli_fail("%s", err.msg);
             goto done;
         }
+        r->have_natnet = 1;
+        /* The names are resolved once the server answers; the cameras do
+         * not wait for it: a short wait for a clear message at start. */
+        if (io_natnet_wait_ready(&r->natnet, 1000, &err) != IO_OK && !o->quiet)
+            fprintf(stderr, "egofuse run: NatNet: %s (the cameras run on; the pose comes when "
+                            "it does)\n", err.msg);
     }
-    if (o->calib && io_user_calib_load(o->calib, &ucal, &err) != IO_OK) {
+    if (o->calib && io_user_calib_load(o->calib, &r->ucal, &err) != IO_OK) {
         cli_fail("%s", err.msg);
         goto done;
     }
     for (int e = 0; e < 2; e++) {
         if (!o->glove_sel[e]) continue;
         const char *gs = strcmp(o->glove_sel[e], "any") ? o->glove_sel[e] : NULL;
-        if (io_glove_open(&glove[e], gs, &err) != IO_OK) {
+        if (io_glove_open(&r->glove[e], gs, &err) != IO_OK) {
             cli_fail("%s glove: %s", e ? "right" : "left", err.msg);
             goto done;
         }
-        have_glove[e] = 1;
-        glove[e].side = e;
-        if (ucal.has_glove[e]) io_glove_set_calib(&glove[e], &ucal.glove[e]);
+        r->have_glove[e] = 1;
+        r->glove[e].side = e;
+        if (r->ucal.has_glove[e]) io_glove_set_calib(&r->glove[e], &r->ucal.glove[e]);
+    }
+
+    /* ---- the virtual scene as a live source */
+    if (o->virt_source) {
+        io_vsrc_config vc = io_vsrc_config_default(o->virt_source);
+        vc.eye_width = W;
+        vc.eye_height = H;
+        if (o->virt_layout) vc.layout = io_vsrc_layout_parse(o->virt_layout);
+        vc.fps = o->virt_fps;
+        vc.stale_ms = o->virt_stale_ms;
+        vc.loop = o->loop;
+        if (io_vsrc_open(&r->vsrc, &vc, &err) != IO_OK) {
+            cli_fail("virtual scene: %s", err.msg);
+            goto done;
+        }
     }
 
     /* ---- cameras */
+    io_file_cam_opts fco;
+    memset(&fco, 0, sizeof fco);
+    fco.loop = o->loop;
+    /* recordings decoded once at open (up to 1 GiB for both): decoding a
+     * frame when it is due takes long enough that the two eyes would pick
+     * different frames */
+    fco.cache_bytes = (size_t)512 << 20;
     for (int e = 0; e < 2; e++) {
         io_cam_config c = io_cam_config_default(path[e]);
         c.width = hd.cam_width;
         c.height = hd.cam_height;
-        c.fourcc = o->fourcc;
+        c.fourcc = file_cams && !o->format_set ? 0 : o->fourcc;
         c.fps = o->fps;
         c.input = o->input;
         c.dv_timings = o->dv;
         c.buffers = o->buffers;
-        if (io_cam_open(&cam[e], &io_cam_v4l2, &c, &err) != IO_OK ||
-            io_cam_start(&cam[e], &err) != IO_OK) {
+        if (file_cams) c.backend_opts = &fco;
+        if (io_cam_open(&r->cam[e], file_cams ? &io_cam_file : &io_cam_v4l2, &c, &err) != IO_OK) {
             cli_fail("%s camera: %s", e ? "right" : "left", err.msg);
             goto done;
         }
     }
+    for (int e = 0; e < 2; e++) /* both opened: start together */
+        if (io_cam_start(&r->cam[e], &err) != IO_OK) {
+            cli_fail("%s camera: %s", e ? "right" : "left", err.msg);
+            goto done;
+        }
     pd.refine_band = o->refine;
-    pd.fit_rig = o->refine && o->track_port ? &rig : NULL;
-    if (!(pipe = pipe_create(&pd, &model))) {
+    pd.fit_rig = o->refine && tracked ? &r->rig : NULL;
+    if (!(r->pipe = pipe_create(&pd, model))) {
         cli_fail(pd.fit_rig ? "cannot start the pipeline (out of memory, no thread, or the elbow "
                               "fit cannot use the model: mesh 0's skin, the arms' node chains)"
                             : "cannot start the pipeline (out of memory or no thread)");
         goto done;
     }
+    unsigned parts = pipe_parts_present(r->pipe);
+    if ((o->hide & ~parts) && !o->quiet)
+        fprintf(stderr, "egofuse run: --hide: %s has no such part (its parts: %s%s%s%s)\n",
+                model_path, parts & PIPE_PART_HAND_L ? "left-hand " : "",
+                parts & PIPE_PART_ARM_L ? "left-arm " : "", parts & PIPE_PART_HAND_R ? "right-hand " : "",
+                parts & PIPE_PART_ARM_R ? "right-arm" : "");
+    for (int k = 0; k < o->prop_count; k++) {
+        if (io_gltf_load(o->prop[k].model, &r->props[k], &err) != IO_OK) {
+            cli_fail("--prop %s: %s", o->prop[k].name, err.msg);
+            goto done;
+        }
+        r->props_loaded++;
+        if (pipe_add_prop(r->pipe, &r->props[k]) != k) {
+            cli_fail("--prop %s: %s has no triangles (or out of memory)", o->prop[k].name,
+                     o->prop[k].model);
+            goto done;
+        }
+    }
     if (o->out && cli_mkdirs(o->out) != 0) {
-        cli_fail("%s: cannot create the output folder", o->out);
+        cli_fail("%s: cannot create the output folder: %s", o->out, strerror(errno));
+        goto done;
+    }
+    /* ---- the display last: the screen changes only once all else is up */
+    if (o->display) {
+        io_display_config dc = {o->display, W, H, 0};
+        if (io_display_open(&r->disp, &dc, &err) != IO_OK) {
+            cli_fail("display: %s", err.msg);
+            goto done;
+        }
+        io_sched_init(&r->sched, io_display_refresh_ns(r->disp));
+    }
+    if (o->stats && io_stats_open(&r->stats, o->stats, &err) != IO_OK) {
+        cli_fail("%s", err.msg);
         goto done;
     }
     if (!o->quiet) {
         char fs[5];
-        fprintf(stderr, "egofuse run: left %s (%s), right %s (%s), %s %dx%d at %d/%d s\n",
-                cam[0].cfg.path, cam[0].card, cam[1].cfg.path, cam[1].card,
-                io_fourcc_str(cam[0].fourcc, fs), cam[0].width, cam[0].height, cam[0].fps_den,
-                cam[0].fps_num);
+        fprintf(stderr, "egofuse run: left %s (%s), right %s (%s), %s %dx%d at %d/%d s%s%s\n",
+                r->cam[0].cfg.path, r->cam[0].card, r->cam[1].cfg.path, r->cam[1].card,
+                io_fourcc_str(r->cam[0].fourcc, fs), r->cam[0].width, r->cam[0].height,
+                r->cam[0].fps_den, r->cam[0].fps_num, r->disp ? "; display " : "",
+                r->disp ? io_display_describe(r->disp) : "");
     }
 
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
+    signal(SIGPIPE, SIG_IGN); /* a reader gone is a write error, reported */
     io_stereo st;
-    io_stereo_init(&st, &cam[0], &cam[1], 0);
+    io_stereo_init(&st, &r->cam[0], &r->cam[1], 0);
     pipe_frame_in in;
     memset(&in, 0, sizeof in);
     in.lighting = pipe_lighting_default();
-    if (have_scene) in.lighting.light = io_scene_lighting(&sc); /* the scene's lights */
+    if (r->have_scene) in.lighting.light = io_scene_lighting(&r->sc); /* the scene's lights */
     in.head_node = head;
     kin_mat4 ident = kin_mat4_identity();
     in.world_from_head = &ident;
+    in.hide = o->hide;
+    in.prop_world = r->props_loaded ? r->prop_ptr : NULL;
+    in.prop_count = r->props_loaded;
     for (int e = 0; e < 2; e++) {
-        in.camera[e] = (fuse_image){camimg[e].data, camimg[e].width, camimg[e].height,
-                                    (int)camimg[e].stride};
-        in.virt[e] = (fuse_image){virt[e].data, W, H, (int)virt[e].stride};
-        in.out[e] = (fuse_image){outimg[e].data, W, H, (int)outimg[e].stride};
+        in.camera[e] = (fuse_image){r->camimg[e].data, r->camimg[e].width, r->camimg[e].height,
+                                    (int)r->camimg[e].stride};
+        in.virt[e] = (fuse_image){r->virt[e].data, W, H, (int)r->virt[e].stride};
+        in.out[e] = (fuse_image){r->outimg[e].data, W, H, (int)r->outimg[e].stride};
+        if (r->vdepth[e].data) {
+            in.virt_depth[e] = r->vdepth[e].data;
+            in.virt_depth_stride[e] = (int)(r->vdepth[e].stride / sizeof(float));
+        }
     }
-    /* The virtual images do not change: checked once. Opaque (the grey
-     * fallback is), the composite copies V where the hand is not without
-     * looking at its alpha. */
-    const kin_sthmd_geometry geo = pipe_geometry(pipe);
-    in.virt_opaque = pipe_image_opaque(&in.virt[0], geo.vp_x0, geo.vp_y0, geo.vp_width,
-                                       geo.vp_height) &&
-                     pipe_image_opaque(&in.virt[1], geo.vp_x0, geo.vp_y0, geo.vp_width,
-                                       geo.vp_height);
+    /* Still virtual images: checked once. Opaque (the grey fallback is),
+     * the composite copies V where the hand is not without reading its
+     * alpha. A live source's eyes are opaque by construction. */
+    const kin_sthmd_geometry geo = pipe_geometry(r->pipe);
+    const int still_opaque =
+        pipe_image_opaque(&in.virt[0], geo.vp_x0, geo.vp_y0, geo.vp_width, geo.vp_height) &&
+        pipe_image_opaque(&in.virt[1], geo.vp_x0, geo.vp_y0, geo.vp_width, geo.vp_height);
     kin_track_sample sample;
     memset(&sample, 0, sizeof sample);
-    int have_pose = 0, have_img[2] = {0, 0};
-    double t_start = mono_s(), t_status = t_start, t_retry[2] = {0, 0};
-    double lat_sum = 0;
-    int frames = 0, frames_status = 0;
+    int have_img[2] = {0, 0};
+    uint64_t t_start = mono_ns(), t_status = t_start, t_retry[2] = {0, 0};
+    io_lat lat_cam, lat_pipe, lat_deq;
+    io_lat_reset(&lat_cam);
+    io_lat_reset(&lat_pipe);
+    io_lat_reset(&lat_deq);
+    int frames = 0, frames_status = 0, ended = 0;
+    uint64_t v_used = 0;
     while (!stop_flag && (o->frames == 0 || frames < o->frames)) {
+        if (r->disp && io_display_quit_requested(r->disp)) break;
+        uint64_t now = mono_ns();
+        /* ---- the repaint window: start so as to finish just before the
+         * vblank that shows the frame (free-running without a display) */
+        io_sched_plan plan = {now, 0, 0};
+        if (r->disp) {
+            drain_flips(o, r, &lat_cam, &lat_deq);
+            plan = io_sched_next(&r->sched, now);
+            if (plan.start_ns > now) wait_until(o, r, plan.start_ns, 0, &lat_cam, &lat_deq);
+            if (stop_flag) break;
+        }
         io_frame fr[2];
         int got = 0;
-        io_result gr = io_stereo_grab(&st, 200, fr, &got, &err);
-        double now = mono_s();
+        io_result gr = io_stereo_grab(&st, 0, fr, &got, &err);
+        now = mono_ns();
         /* a failed camera: reopen once a second, found again by its selector */
         for (int e = 0; e < 2; e++) {
-            if (cam[e].state != IO_CAM_FAILED || now - t_retry[e] < 1.0) continue;
+            if (r->cam[e].state != IO_CAM_FAILED || now - t_retry[e] < 1000000000ull) continue;
+            if (file_cams && io_cam_file_ended(&r->cam[e])) continue;
             t_retry[e] = now;
             char np[IO_CAM_NAME_MAX];
             io_error e2;
             const char *where = NULL;
-            if (o->sel[e] && resolve(o->sel[e], np, sizeof np, &e2) == 0) where = np;
-            if (io_cam_reopen(&cam[e], where, &e2) == IO_OK && !o->quiet)
+            if (o->sel[e] && !file_cams && resolve(o->sel[e], np, sizeof np, &e2) == 0) where = np;
+            if (io_cam_reopen(&r->cam[e], where, &e2) == IO_OK && !o->quiet)
                 fprintf(stderr, "\negofuse run: %s camera back (%s)\n", e ? "right" : "left",
-                        cam[e].cfg.path);
+                        r->cam[e].cfg.path);
+        }
+        if (file_cams && (io_cam_file_ended(&r->cam[0]) || io_cam_file_ended(&r->cam[1]))) {
+            ended = 1;
+            break;
         }
         if (gr != IO_OK) {
             if (!o->quiet) fprintf(stderr, "\regofuse run: %s (retrying)   ", err.msg);
-            struct timespec ts = {0, 200000000};
-            nanosleep(&ts, NULL);
+            wait_until(o, r, now + 200000000ull, 0, &lat_cam, &lat_deq);
             continue;
         }
-        if (!got) continue;
-        uint64_t t_cap = 0;
+        if (!got) { /* no new pair yet: wait for the cameras, then plan again */
+            wait_until(o, r, now + 200000000ull, 1, &lat_cam, &lat_deq);
+            continue;
+        }
+        io_frame_log lg;
+        memset(&lg, 0, sizeof lg);
+        lg.frame = (uint64_t)frames;
+        lg.t_dequeue = now;
+        lg.v_age_ms = -1;
+        lg.v_state = -1;
+        lg.track_age_ms = -1;
         for (int e = 0; e < 2; e++) {
             if (!(got & (1 << e))) continue;
-            if (io_frame_to_rgba(&fr[e], camimg[e].data, camimg[e].stride, &err) == IO_OK)
+            if (io_frame_to_rgba(&fr[e], r->camimg[e].data, r->camimg[e].stride, &err) == IO_OK)
                 have_img[e] = 1;
             else if (!o->quiet)
                 fprintf(stderr, "\regofuse run: %s   ", err.msg);
-            if (fr[e].t_ns > t_cap) t_cap = fr[e].t_ns;
+            if (e == 0) lg.t_cam_l = fr[e].t_ns;
+            else lg.t_cam_r = fr[e].t_ns;
         }
         if (got == 3) io_stereo_release(&st, fr, NULL);
         else
             for (int e = 0; e < 2; e++)
-                if (got & (1 << e)) io_cam_release(&cam[e], &fr[e], NULL);
+                if (got & (1 << e)) io_cam_release(&r->cam[e], &fr[e], NULL);
         if (!have_img[0] || !have_img[1]) continue; /* the other eye holds its last image */
+        if (got == 3) lg.skew_ms = 1e-6 * ((double)lg.t_cam_r - (double)lg.t_cam_l);
+        uint64_t t_cam = lg.t_cam_l > lg.t_cam_r ? lg.t_cam_l : lg.t_cam_r;
+        if (!t_cam) t_cam = now;
 
-        /* ---- pose: tracking stream (+ gloves), else the animation */
+        /* ---- the newest virtual frame (its own rate; the last good one is
+         * held when it is late or gone) */
+        in.virt_opaque = still_opaque;
+        if (r->vsrc) {
+            int fresh;
+            io_vsrc_poll(r->vsrc, 0, &fresh, &err);
+            io_vsrc_stat vs;
+            io_vsrc_status(r->vsrc, now, &vs);
+            lg.v_state = (int)vs.state;
+            for (int e = 0; e < 2 && vs.frames; e++) {
+                size_t stride = 0, dstride = 0;
+                const uint8_t *im = io_vsrc_eye(r->vsrc, e, &stride);
+                const float *dp = io_vsrc_depth(r->vsrc, e, &dstride);
+                if (!im) continue;
+                in.virt[e] = (fuse_image){(void *)im, W, H, (int)stride};
+                in.virt_depth[e] = dp;
+                in.virt_depth_stride[e] = dp ? (int)(dstride / sizeof(float)) : 0;
+            }
+            if (vs.frames) {
+                in.virt_opaque = 1;
+                lg.v_age_ms = vs.t_ns ? 1e-6 * ((double)t_cam - (double)vs.t_ns) : -1;
+                v_used = vs.frames;
+            }
+        }
+
+        /* ---- pose: the tracker (+ gloves) through the filter, posed at the
+         * cameras' time; else the animation */
         for (int e = 0; e < 2; e++) {
             int fresh;
-            if (have_glove[e] && io_glove_poll(&glove[e], 0, &fresh, &err) != IO_OK) {
+            if (r->have_glove[e] && io_glove_poll(&r->glove[e], 0, &fresh, &err) != IO_OK) {
                 if (!o->quiet) fprintf(stderr, "\regofuse run: %s   ", err.msg);
-                have_glove[e] = 0;
+                r->have_glove[e] = 0;
             }
         }
         in.locals = NULL;
         in.anim = anim;
-        in.time = (float)(now - t_start);
-        if (udp.fd >= 0) {
-            kin_track_sample s;
-            int fresh = 0;
-            if (io_track_udp_poll(&udp, 0, &s, &fresh, &err) == IO_OK && s.valid) {
-                sample = s;
-                have_pose = 1;
-            }
-            for (int e = 0; e < 2; e++)
-                if (have_glove[e]) io_glove_to_sample(&glove[e], &sample);
-            if (have_pose) {
-                kin_pose_rest(&model, locals);
-                if (kin_arm_rig_pose(&rig, &model, &ucal, NULL, &sample, locals, NULL))
-                    in.locals = locals;
+        in.time = 1e-9f * (float)(now - t_start);
+        if (tracked) {
+            track_service(r);
+            if (r->track_samples) {
+                double t_pose = 1e-9 * (double)t_cam + 1e-3 * o->predict_ms - r->tclock.offset_s;
+                kin_filter_output(&r->filter, t_pose, &sample, NULL);
+                for (int e = 0; e < 2; e++)
+                    if (r->have_glove[e]) io_glove_to_sample(&r->glove[e], &sample);
+                kin_pose_rest(model, r->locals);
+                if (kin_arm_rig_pose(&r->rig, model, &r->ucal, NULL, &sample, r->locals, NULL))
+                    in.locals = r->locals;
                 in.fit_skip = ((sample.valid & KIN_TRACK_HAND_L) ? 0u : 1u) |
                               ((sample.valid & KIN_TRACK_HAND_R) ? 0u : 2u);
+                lg.track_age_ms = 1e-6 * ((double)t_cam - (double)r->t_track);
             }
         }
+        for (int k = 0; k < r->props_loaded; k++) r->prop_ptr[k] = prop_pose(o, r, k);
+
         char why[256];
         pipe_frame_stats ps;
-        pipe_result pr = pipe_frame(pipe, &in, &ps, why, (int)sizeof why);
+        lg.t_start = mono_ns();
+        pipe_result pr = pipe_frame(r->pipe, &in, &ps, why, (int)sizeof why);
+        lg.t_done = mono_ns();
         if (pr != PIPE_OK) {
             cli_fail("frame %d: %s", frames, why);
             goto done;
         }
-        /* ---- output */
-        if (o->out) {
-            static const char *const eye[2] = {"left", "right"};
-            for (int e = 0; e < 2; e++) {
-                char p[IO_PATH_MAX + 64];
-                snprintf(p, sizeof p, "%s/%s_%04d.png", o->out, eye[e], frames);
-                if (io_image_save(p, &outimg[e], &err) != IO_OK) {
-                    cli_fail("%s", err.msg);
-                    goto done;
-                }
-            }
+        lg.ms_pose = ps.ms_pose;
+        for (int e = 0; e < 2; e++) {
+            lg.ms_raster[e] = ps.ms_raster[e];
+            lg.ms_fuse[e] = ps.ms_fuse[e];
         }
-        if (o->raw) {
-            uint8_t *d = rawbuf;
-            for (int e = 0; e < 2; e++)
-                for (int y = 0; y < H; y++) {
-                    const uint8_t *s = (const uint8_t *)outimg[e].data + (size_t)y * outimg[e].stride;
-                    for (int x = 0; x < W; x++, d += 3) {
-                        d[0] = s[4 * x];
-                        d[1] = s[4 * x + 1];
-                        d[2] = s[4 * x + 2];
-                    }
-                }
-            if (fwrite(rawbuf, 1, (size_t)W * (size_t)H * 6, stdout) != (size_t)W * (size_t)H * 6) {
-                cli_fail("stdout: write error: %s (reader gone?)", strerror(errno));
+        lg.ms_total = ps.ms_total;
+        io_lat_push(&lat_pipe, ps.ms_total);
+        if (o->dump && frames + 1 == o->frames &&
+            dump_frame(o, r, &in, &sample, tracked && r->track_samples, W, H) != EXIT_OK)
+            goto done;
+        /* ---- output */
+        lg.t_present = mono_ns();
+        if (r->disp) {
+            const uint8_t *eyes[2] = {r->outimg[0].data, r->outimg[1].data};
+            size_t stride[2] = {r->outimg[0].stride, r->outimg[1].stride};
+            if (io_display_present(r->disp, eyes, stride, lg.frame, &err) != IO_OK) {
+                cli_fail("display: %s", err.msg);
                 goto done;
             }
-            fflush(stdout);
+            io_sched_presented(&r->sched, &plan, lg.t_dequeue, mono_ns());
+            if (r->npending == (int)(sizeof r->pending / sizeof r->pending[0])) {
+                io_stats_row(&r->stats, &r->pending[0]); /* never shown */
+                r->pending[0] = r->pending[--r->npending];
+            }
+            r->pending[r->npending++] = lg;
+            drain_flips(o, r, &lat_cam, &lat_deq); /* SDL's come with the present */
+        } else {
+            if (write_outputs(o, r, frames, W, H) != EXIT_OK) goto done;
+            lg.t_shown = mono_ns();
+            io_stats_row(&r->stats, &lg);
+            io_lat_push(&lat_cam, 1e-6 * ((double)lg.t_shown - (double)t_cam));
+            io_lat_push(&lat_deq, 1e-6 * ((double)lg.t_shown - (double)lg.t_dequeue));
         }
         frames++;
         frames_status++;
-        struct timespec ts;
-        clock_gettime(CLOCK_MONOTONIC, &ts);
-        uint64_t t_out = (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
-        lat_sum += t_out > t_cap ? 1e-6 * (double)(t_out - t_cap) : 0;
-        now = mono_s();
-        if (!o->quiet && (now - t_status >= 1.0 || frames == o->frames)) {
-            fprintf(stderr, "\regofuse run: %d frames, %.1f FPS, latency %.1f ms, dropped %llu/%llu, "
-                    "unpaired %llu/%llu, skew %.2f ms, pipe %.1f ms%s   ",
-                    frames, frames_status / (now - t_status), lat_sum / frames_status,
-                    (unsigned long long)cam[0].stats.dropped, (unsigned long long)cam[1].stats.dropped,
+        now = mono_ns();
+        if (!o->quiet && (now - t_status >= 1000000000ull || frames == o->frames)) {
+            char vw[256], tw[256];
+            fprintf(stderr,
+                    "\regofuse run: %d frames, %.1f FPS, camera to %s %.1f / %.1f ms, dequeue to "
+                    "%s %.1f / %.1f ms, pipe %.1f / %.1f ms (median / p99), dropped %llu/%llu, "
+                    "unpaired %llu/%llu, skew %.2f ms%s%s%s   ",
+                    frames, frames_status / (1e-9 * (double)(now - t_status)),
+                    r->disp ? "flip" : "output", io_lat_quantile(&lat_cam, 0.5),
+                    io_lat_quantile(&lat_cam, 0.99), r->disp ? "flip" : "output",
+                    io_lat_quantile(&lat_deq, 0.5), io_lat_quantile(&lat_deq, 0.99),
+                    io_lat_quantile(&lat_pipe, 0.5), io_lat_quantile(&lat_pipe, 0.99),
+                    (unsigned long long)r->cam[0].stats.dropped,
+                    (unsigned long long)r->cam[1].stats.dropped,
                     (unsigned long long)st.unpaired[0], (unsigned long long)st.unpaired[1],
-                    1e-6 * (double)st.last_skew_ns, ps.ms_total,
-                    st.failed[0] || st.failed[1] ? ", one eye held" : "");
+                    1e-6 * (double)st.last_skew_ns,
+                    st.failed[0] || st.failed[1] ? ", one eye held" : "",
+                    vstate_word(r, now, vw, sizeof vw), track_word(o, r, now, tw, sizeof tw));
             t_status = now;
             frames_status = 0;
-            lat_sum = 0;
         }
     }
+    /* the last flips, then (--hold) the last frame stays on until Ctrl-C */
+    if (r->disp) {
+        uint64_t until = mono_ns() + 1000000000ull;
+        while (r->npending && !stop_flag && mono_ns() < until)
+            wait_until(o, r, until, 0, &lat_cam, &lat_deq);
+        if (o->hold && !stop_flag) {
+            fprintf(stderr, "\negofuse run: holding frame %d on %s (Ctrl-C ends)\n", frames - 1,
+                    io_display_describe(r->disp));
+            while (!stop_flag && !io_display_quit_requested(r->disp))
+                wait_until(o, r, mono_ns() + 100000000ull, 0, &lat_cam, &lat_deq);
+        }
+    }
+    for (int i = 0; i < r->npending; i++) io_stats_row(&r->stats, &r->pending[i]);
+    r->npending = 0;
     if (!o->quiet) fputc('\n', stderr);
-    /* stdout carries the frames with --raw */
-    fprintf(o->raw ? stderr : stdout, "egofuse run: %d stereo frames, %llu pairs, dropped %llu/%llu, unpaired %llu/%llu, "
-           "max skew %.2f ms, reopens %llu/%llu\n", frames, (unsigned long long)st.pairs,
-           (unsigned long long)cam[0].stats.dropped, (unsigned long long)cam[1].stats.dropped,
-           (unsigned long long)st.unpaired[0], (unsigned long long)st.unpaired[1],
-           1e-6 * (double)st.max_abs_skew_ns, (unsigned long long)cam[0].stats.reopens,
-           (unsigned long long)cam[1].stats.reopens);
+    if (io_stats_close(&r->stats, &err) != IO_OK) {
+        cli_fail("%s", err.msg);
+        goto done;
+    }
+    {
+        char vw[256], tw[256];
+        uint64_t now = mono_ns();
+        /* stdout carries the frames with --raw */
+        fprintf(o->raw ? stderr : stdout,
+                "egofuse run: %d stereo frames%s, %llu pairs, dropped %llu/%llu, unpaired "
+                "%llu/%llu, max skew %.2f ms, reopens %llu/%llu, camera to %s %.2f / %.2f ms, "
+                "dequeue to %s %.2f / %.2f ms, pipe %.2f / %.2f ms (median / p99)%s%s%s\n",
+                frames, ended ? " (end of the recording)" : "", (unsigned long long)st.pairs,
+                (unsigned long long)r->cam[0].stats.dropped,
+                (unsigned long long)r->cam[1].stats.dropped, (unsigned long long)st.unpaired[0],
+                (unsigned long long)st.unpaired[1], 1e-6 * (double)st.max_abs_skew_ns,
+                (unsigned long long)r->cam[0].stats.reopens,
+                (unsigned long long)r->cam[1].stats.reopens, r->disp ? "flip" : "output",
+                io_lat_quantile(&lat_cam, 0.5), io_lat_quantile(&lat_cam, 0.99),
+                r->disp ? "flip" : "output", io_lat_quantile(&lat_deq, 0.5),
+                io_lat_quantile(&lat_deq, 0.99), io_lat_quantile(&lat_pipe, 0.5),
+                io_lat_quantile(&lat_pipe, 0.99), vstate_word(r, now, vw, sizeof vw),
+                track_word(o, r, now, tw, sizeof tw),
+                r->disp ? "" : "");
+        if (r->disp)
+            fprintf(o->raw ? stderr : stdout,
+                    "egofuse run: display %s: %llu flips, %llu missed vblanks\n",
+                    io_display_describe(r->disp), (unsigned long long)r->sched.flips,
+                    (unsigned long long)r->sched.misses);
+        (void)v_used;
+    }
     io_stereo_flush(&st);
     rc = EXIT_OK;
 done:
-    for (int e = 0; e < 2; e++) {
-        io_cam_close(&cam[e]);
-        io_glove_close(&glove[e]);
-        io_image_free(&virt[e]);
-        io_image_free(&outimg[e]);
-        io_image_free(&camimg[e]);
-    }
-    if (udp.fd >= 0) io_track_udp_close(&udp);
-    free(locals);
-    free(rawbuf);
-    if (pipe) pipe_destroy(pipe);
-    kin_model_free(&model);
+    run_close(r);
+    free(r);
     return rc;
 }
 
-enum { O_SCENE = 256, O_MODEL, O_VIRT, O_LEFT, O_RIGHT, O_FORMAT, O_FPS, O_INPUT, O_DV, O_BUFFERS,
-       O_TRACK, O_GLOVE_L, O_GLOVE_R, O_CALIB, O_OUT, O_RAW, O_FRAMES, O_QUIET, O_REFINE };
-
 int cmd_run(int argc, char **argv)
 {
-    static const struct option opts[] = {
-        {"scene", required_argument, 0, O_SCENE},   {"model", required_argument, 0, O_MODEL},
-        {"virt", required_argument, 0, O_VIRT},     {"left", required_argument, 0, O_LEFT},
-        {"right", required_argument, 0, O_RIGHT},   {"format", required_argument, 0, O_FORMAT},
-        {"fps", required_argument, 0, O_FPS},       {"input", required_argument, 0, O_INPUT},
-        {"dv", no_argument, 0, O_DV},               {"buffers", required_argument, 0, O_BUFFERS},
-        {"track-port", required_argument, 0, O_TRACK},
-        {"glove-left", required_argument, 0, O_GLOVE_L},
-        {"glove-right", required_argument, 0, O_GLOVE_R},
-        {"calib", required_argument, 0, O_CALIB},   {"out", required_argument, 0, O_OUT},
-        {"raw", no_argument, 0, O_RAW},             {"frames", required_argument, 0, O_FRAMES},
-        {"quiet", no_argument, 0, O_QUIET},         {"help", no_argument, 0, 'h'},
-        {"refine", required_argument, 0, O_REFINE},
-        {0, 0, 0, 0},
-    };
     run_opts o;
-    memset(&o, 0, sizeof o);
-    o.fourcc = IO_FMT_YUYV;
-    o.fps = 60;
-    o.input = -1;
-    o.buffers = 4;
-    static char virt_buf[2 * IO_PATH_MAX];
-    optind = 1;
-    opterr = 0;
-    int c;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
-        switch (c) {
-        case 'h': fputs(run_usage, stdout); return EXIT_OK;
-        case O_SCENE: o.scene = optarg; break;
-        case O_MODEL: o.model = optarg; break;
-        case O_VIRT: {
-            snprintf(virt_buf, sizeof virt_buf, "%s", optarg);
-            char *comma = strchr(virt_buf, ',');
-            if (!comma) return cli_usage_error("run", "--virt needs LEFT,RIGHT");
-            *comma = '\0';
-            o.virt[0] = virt_buf;
-            o.virt[1] = comma + 1;
-            break;
-        }
-        case O_LEFT: o.sel[0] = optarg; break;
-        case O_RIGHT: o.sel[1] = optarg; break;
-        case O_FORMAT:
-            if (strlen(optarg) != 4) return cli_usage_error("run", "--format '%s': 4 letters", optarg);
-            o.fourcc = IO_FOURCC(optarg[0], optarg[1], optarg[2], optarg[3]);
-            break;
-        case O_FPS:
-            if (!cli_parse_int(optarg, 1, 1000, &o.fps))
-                return cli_usage_error("run", "--fps '%s': not a frame rate", optarg);
-            break;
-        case O_INPUT:
-            if (!cli_parse_int(optarg, 0, 255, &o.input))
-                return cli_usage_error("run", "--input '%s': not an input number", optarg);
-            break;
-        case O_DV: o.dv = 1; break;
-        case O_BUFFERS:
-            if (!cli_parse_int(optarg, 2, IO_CAM_MAX_BUFFERS, &o.buffers))
-                return cli_usage_error("run", "--buffers '%s': 2..%d", optarg, IO_CAM_MAX_BUFFERS);
-            break;
-        case O_TRACK:
-            if (!cli_parse_int(optarg, 1, 65535, &o.track_port))
-                return cli_usage_error("run", "--track-port '%s': not a port", optarg);
-            break;
-        case O_GLOVE_L: o.glove_sel[0] = optarg; break;
-        case O_GLOVE_R: o.glove_sel[1] = optarg; break;
-        case O_CALIB: o.calib = optarg; break;
-        case O_OUT: o.out = optarg; break;
-        case O_RAW: o.raw = 1; break;
-        case O_FRAMES:
-            if (!cli_parse_int(optarg, 1, 1 << 30, &o.frames))
-                return cli_usage_error("run", "--frames '%s': not a positive count", optarg);
-            break;
-        case O_QUIET: o.quiet = 1; break;
-        case O_REFINE:
-            if (!cli_parse_int(optarg, 1, 64, &o.refine))
-                return cli_usage_error("run", "--refine '%s': a band of 1..64 px", optarg);
-            break;
-        case ':': return cli_usage_error("run", "option %s needs a value", argv[optind - 1]);
-        default: return cli_usage_error("run", "unknown option '%s'", argv[optind - 1]);
-        }
-    }
-    if (optind < argc) return cli_usage_error("run", "unexpected argument '%s'", argv[optind]);
-    if (!o.sel[0] != !o.sel[1]) return cli_usage_error("run", "give both --left and --right");
-    for (int e = 0; e < 2; e++) {
-        io_error err;
-        if (o.sel[e] && strncmp(o.sel[e], "/dev/", 5) &&
-            io_usb_selector_check(o.sel[e], &err) != IO_OK)
-            return cli_usage_error("run", "--%s: %s", e ? "right" : "left", err.msg);
-    }
-    if (o.out && o.raw) return cli_usage_error("run", "--out and --raw exclude each other");
-    return run(&o);
+    int rc = run_parse(argc, argv, &o);
+    if (rc >= 0) return rc;
+    rc = run(&o);
+    run_opts_free(&o);
+    return rc;
 }

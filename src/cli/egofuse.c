@@ -23,6 +23,8 @@ static const char *main_usage =
     "  eval     measure the accuracy of each method against generated ground truth\n"
     "  run      composite the live stereo cameras (V4L2), tracking and gloves\n"
     "  devices  list the cameras, USB devices and data gloves found\n"
+    "  replay-track  replay a tracking recording over UDP or as a NatNet server\n"
+    "  calibrate     write the user calibration file from a calibration recording\n"
     "\n"
     "Run 'egofuse COMMAND --help' for the options of a command.\n";
 
@@ -48,6 +50,8 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "eval")) return cmd_eval(argc - 1, argv + 1);
     if (!strcmp(cmd, "run")) return cmd_run(argc - 1, argv + 1);
     if (!strcmp(cmd, "devices")) return cmd_devices(argc - 1, argv + 1);
+    if (!strcmp(cmd, "replay-track")) return cmd_replay(argc - 1, argv + 1);
+    if (!strcmp(cmd, "calibrate")) return cmd_calibrate(argc - 1, argv + 1);
     fprintf(stderr, "egofuse: unknown command '%s'\n\n%s", cmd, main_usage);
     return EXIT_USAGE;
 }

@@ -224,8 +224,10 @@ typedef struct io_track_udp {
                                     seq 15 (t = 1.250 s)" */
 } io_track_udp;
 
-/* Binds a receiver to addr (dotted IPv4, NULL = "127.0.0.1") and port
- * (0 = any free port; read it back from u->port). Non-blocking. */
+/* Binds a receiver to addr (dotted IPv4 or a host name resolved to IPv4;
+ * "0.0.0.0" = every interface, for a tracking PC on another machine;
+ * NULL or "" = "127.0.0.1") and port (0 = any free port; read it back
+ * from u->port). Non-blocking. A bad address names it and the reason. */
 io_result io_track_udp_listen(io_track_udp *u, const char *addr, int port,
                               io_error *err);
 /* Reads every pending datagram, waiting up to timeout_ms (0 = not at all)

@@ -53,11 +53,40 @@ extern "C" {
 #define IO_FMT_BGGR IO_FOURCC('B', 'A', '8', '1')   /* 8-bit Bayer BGGR */
 #define IO_FMT_GBRG IO_FOURCC('G', 'B', 'R', 'G')   /* 8-bit Bayer GBRG */
 #define IO_FMT_GRBG IO_FOURCC('G', 'R', 'B', 'G')   /* 8-bit Bayer GRBG */
+/* What capture cards and video streams give (the V source, io_vsrc.h).
+ * Bytes in memory order; YUV is BT.601 limited range. */
+#define IO_FMT_UYVY IO_FOURCC('U', 'Y', 'V', 'Y')   /* 4:2:2 packed, U Y V Y */
+#define IO_FMT_NV12 IO_FOURCC('N', 'V', '1', '2')   /* 4:2:0: Y plane, then
+                                                       interleaved U V rows,
+                                                       both of stride bytes */
+#define IO_FMT_YU12 IO_FOURCC('Y', 'U', '1', '2')   /* 4:2:0 planar (I420): Y,
+                                                       U, V; chroma stride =
+                                                       (stride + 1) / 2 */
+#define IO_FMT_422P IO_FOURCC('4', '2', '2', 'P')   /* 4:2:2 planar: Y, U, V */
+#define IO_FMT_444P IO_FOURCC('4', '4', '4', 'P')   /* 4:4:4 planar: Y, U, V
+                                                       (egofuse's code, y4m) */
+#define IO_FMT_RGB3 IO_FOURCC('R', 'G', 'B', '3')   /* RGB24: r g b */
+#define IO_FMT_BGR3 IO_FOURCC('B', 'G', 'R', '3')   /* BGR24: b g r */
+#define IO_FMT_BGR4 IO_FOURCC('B', 'G', 'R', '4')   /* BGR32: b g r x */
+#define IO_FMT_RGB4 IO_FOURCC('R', 'G', 'B', '4')   /* RGB32: x r g b */
+#define IO_FMT_XR24 IO_FOURCC('X', 'R', '2', '4')   /* XBGR32: b g r x */
+#define IO_FMT_AR24 IO_FOURCC('A', 'R', '2', '4')   /* ABGR32: b g r a */
+#define IO_FMT_XB24 IO_FOURCC('X', 'B', '2', '4')   /* RGBX32: r g b x */
+#define IO_FMT_AB24 IO_FOURCC('A', 'B', '2', '4')   /* RGBA32: r g b a */
+#define IO_FMT_BX24 IO_FOURCC('B', 'X', '2', '4')   /* XRGB32: x r g b */
+#define IO_FMT_BA24 IO_FOURCC('B', 'A', '2', '4')   /* ARGB32: a r g b */
 
 /* "YUYV" for a code (buf of at least 5 bytes). */
 const char *io_fourcc_str(uint32_t fourcc, char buf[5]);
-/* Bytes per line of a tightly packed image, 0 for unsupported formats. */
+/* Bytes per line of a tightly packed image, 0 for unsupported formats
+ * (for the planar and semi-planar formats: of the Y plane). */
 size_t io_fmt_min_stride(uint32_t fourcc, int width);
+/* Bytes an image of the format needs with `stride` bytes per line (of
+ * the Y plane for planar formats; the last line may be short: only its
+ * width counts), 0 for unsupported formats. NV12: stride * height +
+ * stride * ((height + 1) / 2); YU12: stride * height plus two chroma
+ * planes of (stride + 1) / 2 bytes by (height + 1) / 2 lines. */
+size_t io_fmt_image_bytes(uint32_t fourcc, size_t stride, int width, int height);
 
 /* Controls that matter for the see-through pipeline. */
 typedef enum io_cam_ctrl {
@@ -75,7 +104,8 @@ typedef struct io_cam_config {
     char path[IO_CAM_NAME_MAX];   /* "/dev/video0", or a dummy's name */
     uint32_t fourcc;              /* wanted format; 0 = the first the
                                      device offers of YUYV, GREY, Bayer */
-    int width, height;            /* 640 x 480 */
+    int width, height;            /* 640 x 480; 0 x 0 = the size the
+                                     device has now (V4L2; dummy 640x480) */
     int fps;                      /* frames per second; 0 = keep */
     int buffers;                  /* mmap buffers, 2..IO_CAM_MAX_BUFFERS */
     int input;                    /* VIDIOC_S_INPUT; -1 = keep */
@@ -195,10 +225,16 @@ typedef struct io_cam_info {
 io_result io_cam_list(const char *dev_dir, io_cam_info *out, int cap, int *count,
                       io_error *err);
 
-/* Converts a frame to RGBA8 (alpha 255) of the same size: YUYV (BT.601
- * limited range), GREY, 8-bit Bayer (bilinear). dst_stride in bytes. */
+/* Converts a frame to RGBA8 (alpha 255) of the same size: YUYV, UYVY,
+ * NV12, YU12, 422P, 444P (BT.601 limited range, chroma of a 2x1 or 2x2
+ * block shared by its pixels), GREY, 8-bit Bayer (bilinear), RGB3, BGR3
+ * and the 32-bit RGB formats above (their alpha byte ignored). dst_stride
+ * in bytes. */
 io_result io_frame_to_rgba(const io_frame *f, uint8_t *dst, size_t dst_stride,
                            io_error *err);
+/* The same with full-range YUV when full_range is 1 (y4m XCOLORRANGE=FULL). */
+io_result io_frame_to_rgba_range(const io_frame *f, uint8_t *dst, size_t dst_stride,
+                                 int full_range, io_error *err);
 
 /* ------------------------------------------------------------- stereo */
 

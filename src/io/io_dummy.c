@@ -82,6 +82,10 @@ static io_result dummy_open(io_cam *cam, io_error *err)
                        cam->cfg.path, io_fourcc_str(want, fs), list);
     }
     cam->fourcc = pick;
+    if (cam->cfg.width == 0 && cam->cfg.height == 0) {
+        cam->cfg.width = 640;
+        cam->cfg.height = 480;
+    }
     cam->width = cam->cfg.width;
     cam->height = cam->cfg.height;
     cam->stride = io_fmt_min_stride(pick, cam->width);

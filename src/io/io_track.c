@@ -7,6 +7,7 @@
 
 #include <arpa/inet.h>
 #include <errno.h>
+#include <netdb.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <stdio.h>
@@ -170,9 +171,19 @@ static io_result addr_of(const char *addr, int port, struct sockaddr_in *sa, io_
     memset(sa, 0, sizeof *sa);
     sa->sin_family = AF_INET;
     sa->sin_port = htons((uint16_t)port);
-    const char *a = addr ? addr : "127.0.0.1";
-    if (inet_pton(AF_INET, a, &sa->sin_addr) != 1)
-        return io_fail(err, IO_ERR_ARGS, "'%s' is not a dotted IPv4 address", a);
+    const char *a = addr && *addr ? addr : "127.0.0.1";
+    if (inet_pton(AF_INET, a, &sa->sin_addr) == 1) return IO_OK;
+    /* a host name (the tracking PC's, or this machine's own) */
+    struct addrinfo hints, *res = NULL;
+    memset(&hints, 0, sizeof hints);
+    hints.ai_family = AF_INET;
+    hints.ai_socktype = SOCK_DGRAM;
+    int rc = getaddrinfo(a, NULL, &hints, &res);
+    if (rc != 0 || !res)
+        return io_fail(err, IO_ERR_ARGS, "'%s' is neither a dotted IPv4 address nor a known host "
+                       "name (%s)", a, gai_strerror(rc));
+    sa->sin_addr = ((struct sockaddr_in *)res->ai_addr)->sin_addr;
+    freeaddrinfo(res);
     return IO_OK;
 }
 

@@ -42,8 +42,29 @@ size_t io_fmt_min_stride(uint32_t fourcc, int width)
     case IO_FMT_YUYV: return (size_t)width * 2;
     case IO_FMT_GREY: case IO_FMT_RGGB: case IO_FMT_BGGR: case IO_FMT_GBRG:
     case IO_FMT_GRBG: return (size_t)width;
-    case IO_FOURCC('R', 'G', 'B', '3'): return (size_t)width * 3;
+    case IO_FMT_UYVY: return (size_t)width * 2;
+    case IO_FMT_NV12: case IO_FMT_YU12: case IO_FMT_422P: case IO_FMT_444P:
+        return (size_t)width;
+    case IO_FMT_RGB3: case IO_FMT_BGR3: return (size_t)width * 3;
+    case IO_FMT_BGR4: case IO_FMT_RGB4: case IO_FMT_XR24: case IO_FMT_AR24:
+    case IO_FMT_XB24: case IO_FMT_AB24: case IO_FMT_BX24: case IO_FMT_BA24:
+        return (size_t)width * 4;
     default: return 0;
+    }
+}
+
+size_t io_fmt_image_bytes(uint32_t fourcc, size_t stride, int width, int height)
+{
+    size_t minst = io_fmt_min_stride(fourcc, width);
+    if (!minst || height <= 0 || stride < minst) return 0;
+    size_t h = (size_t)height, ch = (h + 1) / 2, cs = (stride + 1) / 2;
+    size_t cw = ((size_t)width + 1) / 2;
+    switch (fourcc) {
+    case IO_FMT_NV12: return stride * h + stride * (ch - 1) + 2 * cw;
+    case IO_FMT_YU12: return stride * h + cs * ch + cs * (ch - 1) + cw;
+    case IO_FMT_422P: return stride * h + cs * h + cs * (h - 1) + cw;
+    case IO_FMT_444P: return stride * h * 2 + stride * (h - 1) + (size_t)width;
+    default: return stride * (h - 1) + minst;
     }
 }
 
@@ -102,7 +123,8 @@ io_result io_cam_open(io_cam *cam, const io_cam_backend *be,
     for (int i = 0; i < IO_CAM_MAX_BUFFERS; i++) cam->buf[i] = NULL;
     if (!cfg->path[0])
         return io_fail(err, IO_ERR_ARGS, "camera: no device path given");
-    if (cfg->width <= 0 || cfg->height <= 0 || cfg->width > 16384 || cfg->height > 16384)
+    if (!(cfg->width == 0 && cfg->height == 0) &&
+        (cfg->width <= 0 || cfg->height <= 0 || cfg->width > 16384 || cfg->height > 16384))
         return io_fail(err, IO_ERR_ARGS, "%s: size %dx%d is not valid", cfg->path,
                        cfg->width, cfg->height);
     if (cfg->buffers < 2 || cfg->buffers > IO_CAM_MAX_BUFFERS)
@@ -357,6 +379,66 @@ static void yuv_to_rgb(int y, int u, int v, uint8_t *d)
     d[3] = 255;
 }
 
+/* Planar and semi-planar YUV: chroma of pixel (x, y) at (x >> sx, y >> sy);
+ * NV12 has U and V interleaved in one plane. BT.601 in 8-bit fixed point
+ * (x256): limited range as yuv_to_rgb (same results), or full range (JPEG:
+ * 256, 359, 88, 183, 454); the chroma terms once per chroma sample. */
+static void planar_to_rgba(const io_frame *f, int sx, int sy, int nv12, int full, uint8_t *dst,
+                           size_t ds)
+{
+    const int ky = full ? 256 : 298, y0 = full ? 0 : 16, kr = full ? 359 : 409,
+              kgu = full ? 88 : 100, kgv = full ? 183 : 208, kb = full ? 454 : 516;
+    int w = f->width, h = f->height;
+    size_t ys = f->stride, h_sz = (size_t)h;
+    const uint8_t *ybase = f->data, *ubase, *vbase;
+    size_t cs, step = nv12 ? 2 : 1;
+    if (nv12) {
+        cs = ys;
+        ubase = f->data + ys * h_sz;
+        vbase = ubase + 1;
+    } else {
+        size_t ch = sy ? (h_sz + 1) / 2 : h_sz;
+        cs = sx ? (ys + 1) / 2 : ys;
+        ubase = f->data + ys * h_sz;
+        vbase = ubase + cs * ch;
+    }
+    for (int y = 0; y < h; y++) {
+        const uint8_t *yr = ybase + (size_t)y * ys;
+        const uint8_t *ur = ubase + (size_t)(y >> sy) * cs, *vr = vbase + (size_t)(y >> sy) * cs;
+        uint8_t *d = dst + (size_t)y * ds;
+        int x = 0;
+        for (size_t c = 0; x < w; c++) {
+            int du = ur[c * step] - 128, dv = vr[c * step] - 128;
+            int rv = kr * dv + 128, guv = kgu * du + kgv * dv - 128, bu = kb * du + 128;
+            int n = sx ? 2 : 1;
+            for (int k = 0; k < n && x < w; k++, x++) {
+                int l = ky * (yr[x] - y0);
+                uint8_t *o = d + 4 * (size_t)x;
+                o[0] = clamp_u8((l + rv) >> 8);
+                o[1] = clamp_u8((l - guv) >> 8);
+                o[2] = clamp_u8((l + bu) >> 8);
+                o[3] = 255;
+            }
+        }
+    }
+}
+
+/* Packed RGB: byte offsets of r, g, b in a pixel of bpp bytes. */
+static void rgb_to_rgba(const io_frame *f, int bpp, int ro, int go, int bo, uint8_t *dst,
+                        size_t ds)
+{
+    for (int y = 0; y < f->height; y++) {
+        const uint8_t *s = f->data + (size_t)y * f->stride;
+        uint8_t *d = dst + (size_t)y * ds;
+        for (int x = 0; x < f->width; x++, s += bpp, d += 4) {
+            d[0] = s[ro];
+            d[1] = s[go];
+            d[2] = s[bo];
+            d[3] = 255;
+        }
+    }
+}
+
 /* Colour (0 R, 1 G, 2 B) of the Bayer site (x, y) for a pattern whose
  * top-left 2x2 block is p[0] p[1] / p[2] p[3]. */
 static int bayer_site(const int p[4], int x, int y) { return p[(y & 1) * 2 + (x & 1)]; }
@@ -402,6 +484,12 @@ static void bayer_to_rgba(const io_frame *f, const int p[4], uint8_t *dst, size_
 
 io_result io_frame_to_rgba(const io_frame *f, uint8_t *dst, size_t ds, io_error *err)
 {
+    return io_frame_to_rgba_range(f, dst, ds, 0, err);
+}
+
+io_result io_frame_to_rgba_range(const io_frame *f, uint8_t *dst, size_t ds, int full,
+                                 io_error *err)
+{
     char fs[5];
     if (!f || !f->data || !dst)
         return io_fail(err, IO_ERR_ARGS, "frame conversion: no frame or no output");
@@ -409,8 +497,8 @@ io_result io_frame_to_rgba(const io_frame *f, uint8_t *dst, size_t ds, io_error 
     if (!need)
         return io_fail(err, IO_ERR_FORMAT, "frame conversion: format %s is not supported",
                        io_fourcc_str(f->fourcc, fs));
-    if (f->stride < need || ds < 4 * (size_t)f->width ||
-        f->bytes < f->stride * (size_t)(f->height - 1) + need)
+    if (f->stride < need || ds < 4 * (size_t)f->width || f->height <= 0 ||
+        f->bytes < io_fmt_image_bytes(f->fourcc, f->stride, f->width, f->height))
         return io_fail(err, IO_ERR_SIZE, "frame conversion: %s %dx%d frame of %zu bytes "
                        "(stride %zu) is too small", io_fourcc_str(f->fourcc, fs), f->width,
                        f->height, f->bytes, f->stride);
@@ -439,18 +527,26 @@ io_result io_frame_to_rgba(const io_frame *f, uint8_t *dst, size_t ds, io_error 
             }
         }
         break;
-    case IO_FOURCC('R', 'G', 'B', '3'):
+    case IO_FMT_UYVY:
         for (int y = 0; y < h; y++) {
             const uint8_t *s = f->data + (size_t)y * f->stride;
             uint8_t *d = dst + (size_t)y * ds;
-            for (int x = 0; x < w; x++) {
-                d[4 * x] = s[3 * x];
-                d[4 * x + 1] = s[3 * x + 1];
-                d[4 * x + 2] = s[3 * x + 2];
-                d[4 * x + 3] = 255;
+            for (int x = 0; x + 1 < w; x += 2) {
+                yuv_to_rgb(s[2 * x + 1], s[2 * x], s[2 * x + 2], d + 4 * x);
+                yuv_to_rgb(s[2 * x + 3], s[2 * x], s[2 * x + 2], d + 4 * x + 4);
             }
+            if (w & 1) yuv_to_rgb(s[2 * (w - 1) + 1], 128, 128, d + 4 * (w - 1));
         }
         break;
+    case IO_FMT_NV12: planar_to_rgba(f, 1, 1, 1, full, dst, ds); break;
+    case IO_FMT_YU12: planar_to_rgba(f, 1, 1, 0, full, dst, ds); break;
+    case IO_FMT_422P: planar_to_rgba(f, 1, 0, 0, full, dst, ds); break;
+    case IO_FMT_444P: planar_to_rgba(f, 0, 0, 0, full, dst, ds); break;
+    case IO_FMT_RGB3: rgb_to_rgba(f, 3, 0, 1, 2, dst, ds); break;
+    case IO_FMT_BGR3: rgb_to_rgba(f, 3, 2, 1, 0, dst, ds); break;
+    case IO_FMT_BGR4: case IO_FMT_XR24: case IO_FMT_AR24: rgb_to_rgba(f, 4, 2, 1, 0, dst, ds); break;
+    case IO_FMT_XB24: case IO_FMT_AB24: rgb_to_rgba(f, 4, 0, 1, 2, dst, ds); break;
+    case IO_FMT_RGB4: case IO_FMT_BX24: case IO_FMT_BA24: rgb_to_rgba(f, 4, 1, 2, 3, dst, ds); break;
     case IO_FMT_RGGB: bayer_to_rgba(f, rggb, dst, ds); break;
     case IO_FMT_BGGR: bayer_to_rgba(f, bggr, dst, ds); break;
     case IO_FMT_GBRG: bayer_to_rgba(f, gbrg, dst, ds); break;
@@ -697,8 +793,12 @@ static io_result set_dv_timings(io_cam *cam, io_error *err)
     return IO_OK;
 }
 
+/* Cameras first (YUYV, GREY, Bayer), then what capture cards give. */
 static const uint32_t preferred[] = {IO_FMT_YUYV, IO_FMT_GREY, IO_FMT_RGGB, IO_FMT_BGGR,
-                                     IO_FMT_GBRG, IO_FMT_GRBG};
+                                     IO_FMT_GBRG, IO_FMT_GRBG, IO_FMT_UYVY, IO_FMT_NV12,
+                                     IO_FMT_YU12, IO_FMT_RGB3, IO_FMT_BGR3, IO_FMT_BGR4,
+                                     IO_FMT_XR24, IO_FMT_AR24, IO_FMT_XB24, IO_FMT_AB24,
+                                     IO_FMT_RGB4, IO_FMT_BX24, IO_FMT_BA24};
 
 static io_result pick_format(io_cam *cam, uint32_t *out, io_error *err)
 {
@@ -732,14 +832,9 @@ static io_result pick_format(io_cam *cam, uint32_t *out, io_error *err)
                 *out = preferred[k];
                 return IO_OK;
             }
-    if (ops_of(cam) == &lib_ops)
-        for (int i = 0; i < n; i++)
-            if (offered[i] == IO_FOURCC('R', 'G', 'B', '3')) {
-                *out = offered[i];
-                return IO_OK;
-            }
-    return io_fail(err, IO_ERR_FORMAT, "%s: none of YUYV, GREY, Bayer offered (the device "
-                   "offers: %s)", cam->cfg.path, n ? list : "nothing");
+    return io_fail(err, IO_ERR_FORMAT, "%s: none of YUYV, GREY, Bayer, UYVY, NV12, YU12, "
+                   "RGB24, BGR24, 32-bit RGB offered (the device offers: %s)", cam->cfg.path,
+                   n ? list : "nothing");
 }
 
 static io_result v4l2_open_cb(io_cam *cam, io_error *err)
@@ -801,6 +896,14 @@ static io_result v4l2_open_cb(io_cam *cam, io_error *err)
     struct v4l2_format fmt;
     memset(&fmt, 0, sizeof fmt);
     fmt.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    if (cam->cfg.width == 0 && cam->cfg.height == 0) {
+        /* 0 x 0: the size the device has now (an HDMI input's timings) */
+        if (xioctl(cam, VIDIOC_G_FMT, &fmt) < 0) return errno_fail(cam, err, "VIDIOC_G_FMT", errno);
+        cam->cfg.width = (int)fmt.fmt.pix.width;
+        cam->cfg.height = (int)fmt.fmt.pix.height;
+        memset(&fmt, 0, sizeof fmt);
+        fmt.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    }
     fmt.fmt.pix.width = (uint32_t)cam->cfg.width;
     fmt.fmt.pix.height = (uint32_t)cam->cfg.height;
     fmt.fmt.pix.pixelformat = fourcc;
@@ -819,7 +922,7 @@ static io_result v4l2_open_cb(io_cam *cam, io_error *err)
     cam->height = (int)fmt.fmt.pix.height;
     size_t minst = io_fmt_min_stride(fourcc, cam->width);
     cam->stride = fmt.fmt.pix.bytesperline >= minst ? fmt.fmt.pix.bytesperline : minst;
-    cam->image_bytes = cam->stride * (size_t)(cam->height - 1) + minst;
+    cam->image_bytes = io_fmt_image_bytes(fourcc, cam->stride, cam->width, cam->height);
     if (fmt.fmt.pix.sizeimage < cam->image_bytes)
         return io_fail(err, IO_ERR_FORMAT, "%s: the driver's image size %u is below %zu", path,
                        fmt.fmt.pix.sizeimage, cam->image_bytes);

@@ -229,17 +229,29 @@ void kin_mesh_transform(const kin_mesh *mesh, const kin_mat4 *m,
 
 /* ------------------------------------------------- STHMD camera model */
 
-/* Zero means default for every field (negative values too). */
+/* One HMD's description (docs/kin.md, "The STHMD camera model"). Zero
+ * means default for every field (negative values too). Which distance is
+ * which: baseline_m places the cameras (kin_sthmd_camera: the camera
+ * poses, hence the masks and everything drawn from the cameras), ipd_m
+ * places the eyes (kin_sthmd_eye: the eyes' viewpoints, e.g. a virtual
+ * scene rendered for the eyes or an eye reprojection). Eq. 1-4 (the crop
+ * and the viewport) use neither: they depend on the sizes, the FOVs, D and
+ * F only. The lighting's view vector is the camera pixel's ray (it
+ * relights the camera's image; fuse_intrinsics). */
 typedef struct kin_sthmd_desc {
     int   cam_width, cam_height;    /* camera sensor, default 640 x 480 */
-    float cam_hfov_deg;             /* camera horizontal FOV, default 62 */
-    float baseline_m;               /* camera (and eye) separation, 0.065 */
+    float cam_hfov_deg;             /* camera horizontal FOV (of the whole
+                                       sensor width), default 62 */
+    float baseline_m;               /* camera separation, 0.065 */
     float cam_offset_m;             /* D: cameras in front of the eyes, 0.085 */
     int   lcd_width, lcd_height;    /* per-eye display, 1280 x 800 */
     float hmd_hfov_deg;             /* display horizontal FOV, 61 */
     float hmd_vfov_deg;             /* display vertical FOV, 40 */
     float focal_m;                  /* F: eye projection plane distance, 1.0 */
     float znear, zfar;              /* clip planes, default 0.01 and 100 */
+    float ipd_m;                    /* eye separation (interpupillary
+                                       distance); 0 = baseline_m (so 0.065
+                                       by default) */
 } kin_sthmd_desc;
 
 /* The derived numbers of the paper (eq. 1-4). */
@@ -251,6 +263,10 @@ typedef struct kin_sthmd_geometry {
     int   vp_width, vp_height;      /* eq. 4: floor(LCD * ratio) = 1194 x 746 */
     int   vp_x0, vp_y0;             /* viewport corner, centred: 43, 27 */
     float crop_vfov_deg;            /* vertical FOV of the cropped image */
+    int   crop_x0;                  /* first camera column kept: 0, unless
+                                       the camera is wider than the LCD's
+                                       aspect (then the height is kept and
+                                       the width cropped, centred) */
 } kin_sthmd_geometry;
 
 typedef enum kin_eye { KIN_EYE_LEFT = 0, KIN_EYE_RIGHT = 1 } kin_eye;
@@ -276,6 +292,11 @@ kin_sthmd_geometry kin_sthmd_geometry_of(const kin_sthmd_desc *desc);
  * and images the cropped sensor (crop_width x crop_height). */
 kin_camera kin_sthmd_camera(const kin_sthmd_desc *desc,
                             const kin_mat4 *world_from_head, kin_eye eye);
+/* World pose of one eye (its viewpoint, looking down -Z with the head's
+ * orientation): world_from_head * translate(+-ipd/2, 0, 0), ipd the
+ * resolved ipd_m (NULL world_from_head: identity). */
+kin_mat4 kin_sthmd_eye(const kin_sthmd_desc *desc, const kin_mat4 *world_from_head,
+                       kin_eye eye);
 /* A general look-at camera (for `egofuse mask`). */
 kin_camera kin_camera_look_at(kin_vec3 eye, kin_vec3 target, kin_vec3 up,
                               float fovy_deg, int width, int height,

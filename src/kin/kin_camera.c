@@ -37,6 +37,7 @@ kin_sthmd_desc kin_sthmd_desc_resolved(const kin_sthmd_desc *desc)
     r.focal_m = def_f(d->focal_m, 1.0f);
     r.znear = def_f(d->znear, 0.01f);
     r.zfar = def_f(d->zfar, 100.0f);
+    r.ipd_m = def_f(d->ipd_m, r.baseline_m);
     return r;
 }
 
@@ -53,18 +54,33 @@ kin_sthmd_geometry kin_sthmd_geometry_of(const kin_sthmd_desc *desc)
     memset(&g, 0, sizeof g);
 
     /* eq. 1: keep the width, crop the height to the LCD aspect
-     * (rounded to the nearest row; never more rows than the sensor has). */
+     * (rounded to the nearest row). A camera wider than the LCD's aspect
+     * (a 16:9 camera, a portrait display) keeps all rows and crops the
+     * width to the aspect instead (nearest column), centred: both ways
+     * the cropped image has the LCD's aspect, which the viewport of eq. 4
+     * has too. */
     g.crop_width = r.cam_width;
     long h = ((long)r.cam_width * r.lcd_height + r.lcd_width / 2) / r.lcd_width;
-    if (h > r.cam_height) h = r.cam_height;
+    if (h > r.cam_height) {
+        h = r.cam_height;
+        long w = ((long)r.cam_height * r.lcd_width + r.lcd_height / 2) / r.lcd_height;
+        if (w > r.cam_width) w = r.cam_width;
+        if (w < 1) w = 1;
+        g.crop_width = (int)w;
+        g.crop_x0 = (r.cam_width - g.crop_width) / 2;
+    }
     if (h < 1) h = 1;
     g.crop_height = (int)h;
     g.crop_y0 = (r.cam_height - g.crop_height) / 2;
 
-    /* eq. 2: projected widths on the eye's projection plane at F, in mm. */
+    /* eq. 2: projected widths on the eye's projection plane at F, in mm;
+     * W2 of the cropped image's horizontal FOV (the camera's own unless
+     * the width is cropped: tan(hfov_crop / 2) = (crop_w / 2) / fx). */
     double f_mm = 1000.0 * r.focal_m, d_mm = 1000.0 * r.cam_offset_m;
     g.w1_mm = 2.0 * f_mm * tan(0.5 * r.hmd_hfov_deg * DEG2RAD);
-    g.w2_mm = 2.0 * (f_mm - d_mm) * tan(0.5 * r.cam_hfov_deg * DEG2RAD);
+    g.w2_mm = 2.0 * (f_mm - d_mm) *
+              (g.crop_width == r.cam_width ? tan(0.5 * r.cam_hfov_deg * DEG2RAD)
+                                           : 0.5 * g.crop_width / cam_focal_px(&r));
     /* eq. 3 and 4 */
     g.ratio = g.w2_mm / g.w1_mm;
     g.vp_width = (int)floor(r.lcd_width * g.ratio);
@@ -121,11 +137,23 @@ kin_camera kin_sthmd_camera(const kin_sthmd_desc *desc,
     c.height = g.crop_height;
     double f = cam_focal_px(&r);
     c.fx = c.fy = (float)f;
-    c.cx = 0.5f * (float)g.crop_width;
+    /* the principal point: the sensor's centre, in the crop */
+    c.cx = g.crop_width != r.cam_width ? 0.5f * (float)r.cam_width - (float)g.crop_x0
+                                       : 0.5f * (float)g.crop_width;
     c.cy = 0.5f * (float)r.cam_height - (float)g.crop_y0;
     c.proj = proj_from_intrinsics(f, f, c.cx, c.cy, c.width, c.height, r.znear, r.zfar);
     c.view_proj = kin_mat4_mul(&c.proj, &c.view);
     return c;
+}
+
+kin_mat4 kin_sthmd_eye(const kin_sthmd_desc *desc, const kin_mat4 *world_from_head,
+                       kin_eye eye)
+{
+    kin_sthmd_desc r = kin_sthmd_desc_resolved(desc);
+    kin_mat4 head = world_from_head ? *world_from_head : kin_mat4_identity();
+    kin_mat4 t = kin_mat4_identity();
+    t.m[12] = (eye == KIN_EYE_RIGHT ? 0.5f : -0.5f) * r.ipd_m;
+    return kin_mat4_mul(&head, &t);
 }
 
 kin_camera kin_camera_look_at(kin_vec3 eye, kin_vec3 target, kin_vec3 up,

@@ -1,5 +1,6 @@
 /* pipe.c - one stereo frame, end to end (see pipe.h). */
 #include "pipe.h"
+#include "pipe_parts.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -240,6 +241,7 @@ struct pipe_ctx {
     kin_arm_rig fit_rig;
     int fit_no_prev;          /* pipe_reset_fit: the refined masks are of
                                  before it, not to be learned from */
+    pipe__cockpit *ck;        /* hidden parts and props (pipe_parts.c) */
 };
 
 enum { JOB_SKIN, JOB_EYE };
@@ -269,6 +271,24 @@ static int image_fits(const fuse_image *im, int w, int h, int eye,
     return 0;
 }
 
+/* Columns crop_x0 .. of rows already cropped (eq. 1 with a camera wider
+ * than the LCD's aspect; v itself otherwise). */
+static fuse_image crop_cols(const pipe_ctx *p, fuse_image v)
+{
+    if (v.pixels && v.width != p->geo.crop_width) {
+        v.pixels += (size_t)4 * (size_t)p->geo.crop_x0;
+        v.width = p->geo.crop_width;
+    }
+    return v;
+}
+
+/* buf (an eye's cam_rgba) as the cropped rows of a raw frame, converted
+ * at the sensor's width. */
+static fuse_image raw_rows(const pipe_ctx *p, uint8_t *buf)
+{
+    return (fuse_image){buf, p->hmd.cam_width, p->geo.crop_height, 4 * p->hmd.cam_width};
+}
+
 static void run_eye(pipe_ctx *p, eye_state *e)
 {
     const pipe_frame_in *in = e->in;
@@ -278,8 +298,11 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
     rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
     rast_context_clear(e->rast, &tg); /* only what the last frame drew */
-    rast_result rr = pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, p->desc.cull, e->clip,
-                                    e->vnrm, NULL);
+    rast_result rr = pipe__cockpit_active(p->ck)
+                         ? pipe__cockpit_draw(p->ck, &p->pose, e->eye, e->rast, &e->cam, &tg,
+                                              p->desc.cull, e->clip, e->vnrm)
+                         : pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, p->desc.cull,
+                                          e->clip, e->vnrm, NULL);
     double t1 = now_ms();
     e->ms_raster = t1 - t0;
     if (rr != RAST_OK) {
@@ -307,12 +330,13 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     fe.intrinsics = &K;
     e->ms_convert = 0.0;
     if (e->converted) {
-        fe.P = (fuse_image){e->cam_rgba, cw, ch, 4 * cw};
+        fe.P = crop_cols(p, raw_rows(p, e->cam_rgba));
     } else if (in->camera_raw[e->eye].data) {
         double tc = now_ms();
-        fe.P = (fuse_image){e->cam_rgba, cw, ch, 4 * cw};
-        fuse_result cr = fuse_frame_to_rgba_isa(&in->camera_raw[e->eye], p->geo.crop_y0, &fe.P,
+        fuse_image rows = raw_rows(p, e->cam_rgba);
+        fuse_result cr = fuse_frame_to_rgba_isa(&in->camera_raw[e->eye], p->geo.crop_y0, &rows,
                                                 (ef_isa)p->desc.max_isa);
+        fe.P = crop_cols(p, rows);
         e->ms_convert = now_ms() - tc;
         if (cr != FUSE_OK) {
             e->result = PIPE_ERR_ARGS;
@@ -321,7 +345,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
             return;
         }
     } else {
-        fe.P = fuse_image_rows(&in->camera[e->eye], p->geo.crop_y0, ch);
+        fe.P = crop_cols(p, fuse_image_rows(&in->camera[e->eye], p->geo.crop_y0, ch));
     }
     fe.mask = e->mask;
     fe.mask_stride = cw;
@@ -345,6 +369,8 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                      e->eye ? "right" : "left", fuse_result_str(rr2));
             return;
         }
+        pipe__cockpit_clamp(p->ck, &p->pose, e->eye, e->rast, &e->cam, e->mask, cw, e->refined,
+                            cw, p->desc.refine_band, e->clip);
         e->have_refined = 1;
         fe.mask = e->refined;
         if (p->fit && in->locals && rs.used_colour) {
@@ -457,6 +483,8 @@ static void free_eyes(pipe_ctx *p)
     }
     pipe_fit_destroy(p->fit);
     p->fit = NULL;
+    pipe__cockpit_destroy(p->ck);
+    p->ck = NULL;
 }
 
 static void skin_plans_free(pipe_ctx *p)
@@ -511,7 +539,7 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         s->nrm = malloc(sizeof(float) * 3 * px);
         s->mask = malloc(px);
         s->layer = malloc(4 * px);
-        s->cam_rgba = malloc(4 * px);
+        s->cam_rgba = malloc(4 * (size_t)p->hmd.cam_width * (size_t)p->geo.crop_height);
         s->clip = malloc(sizeof(float) * 4 * nv);
         s->vnrm = malloc(sizeof(float) * 3 * nv);
         rast_context_desc rd = {p->desc.max_isa, 1};
@@ -539,6 +567,11 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         ok = p->fit != NULL;
     }
     ok = ok && skin_plans_build(p) == 0;
+    if (ok) {
+        p->ck = pipe__cockpit_create(model, p->desc.fit_rig, p->geo.crop_width,
+                                     p->geo.crop_height, p->desc.refine_band);
+        ok = p->ck != NULL;
+    }
     p->threaded = p->desc.threads != 1;
     long nv_all = 0;
     for (int i = 0; i < model->mesh_count; i++) nv_all += model->meshes[i].vertex_count;
@@ -595,9 +628,10 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
         eye_state *s = &p->eye[e];
         cam[e] = kin_sthmd_camera(&p->hmd, head, (kin_eye)e);
         if (in->camera_raw[e].data) {
-            P[e] = (fuse_image){s->cam_rgba, cw, ch, 4 * cw};
-            fuse_result cr = fuse_frame_to_rgba_isa(&in->camera_raw[e], p->geo.crop_y0, &P[e],
+            fuse_image rows = raw_rows(p, s->cam_rgba);
+            fuse_result cr = fuse_frame_to_rgba_isa(&in->camera_raw[e], p->geo.crop_y0, &rows,
                                                     (ef_isa)p->desc.max_isa);
+            P[e] = crop_cols(p, rows);
             if (cr != FUSE_OK) {
                 if (why && why_size > 0)
                     snprintf(why, (size_t)why_size, "%s eye: camera frame: %s",
@@ -606,7 +640,7 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
             }
             s->converted = 1;
         } else {
-            P[e] = fuse_image_rows(&in->camera[e], p->geo.crop_y0, ch);
+            P[e] = crop_cols(p, fuse_image_rows(&in->camera[e], p->geo.crop_y0, ch));
         }
         /* the colour model of the last frame's masks (run_eye) when there
          * is one; else this frame's kinematic mask is drawn for it */
@@ -671,6 +705,8 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
                      p->pose.model->node_count);
         return PIPE_ERR_ARGS;
     }
+    pipe_result cr = pipe__cockpit_frame(p->ck, in, why, why_size);
+    if (cr != PIPE_OK) return cr;
 
     double t0 = now_ms();
     if (in->locals)
@@ -748,6 +784,17 @@ const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
 kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].cam; }
 
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }
+
+kin_sthmd_desc pipe_hmd(const pipe_ctx *p) { return p->hmd; }
+
+unsigned pipe_parts_present(const pipe_ctx *p) { return p ? pipe__cockpit_present(p->ck) : 0; }
+
+int pipe_add_prop(pipe_ctx *p, const kin_model *m)
+{
+    return p ? pipe__cockpit_add_prop(p->ck, m) : -1;
+}
+
+int pipe_prop_count(const pipe_ctx *p) { return p ? pipe__cockpit_prop_count(p->ck) : 0; }
 
 int pipe_image_opaque(const fuse_image *im, int x0, int y0, int w, int h)
 {

@@ -23,7 +23,9 @@
  *   pipe_frame_in in = {0};
  *   in.anim = &model.anims[0]; in.time = f / 60.0f; in.head_node = head;
  *   in.camera[0] = left_640x480; in.virt[0] = left_1280x800; in.out[0] = ...;
+ *   // (the sizes of pipe_hmd(p): cam_width x cam_height, lcd_width x lcd_height)
  *   in.lighting = pipe_lighting_default(); // lights in world space
+ *   in.hide = PIPE_PART_HAND_R;             // optional: parts not shown
  *   pipe_frame(p, &in, &stats);
  *   pipe_destroy(p);
  */
@@ -162,6 +164,15 @@ typedef struct pipe_frame_in {
      * promise keeps rgb exact, but the alpha of those pixels may be V's
      * instead of 255. 0 (the default): no promise. */
     int virt_opaque;
+    /* What the operator sees of the real cockpit (see "the operator's
+     * cockpit" below). hide: PIPE_PART_* bits of the arm model's parts
+     * not drawn this frame (0: all shown). prop_world[i] (i < prop_count,
+     * at most pipe_prop_count): the world matrix of prop i this frame, or
+     * NULL when it is not seen (its rigid body is lost); props from
+     * prop_count on are not drawn. prop_world NULL: no props. */
+    unsigned hide;
+    const kin_mat4 *const *prop_world;
+    int prop_count;
 } pipe_frame_in;
 
 typedef struct pipe_frame_stats {
@@ -211,6 +222,85 @@ kin_sthmd_geometry pipe_geometry(const pipe_ctx *p);
 int pipe_image_opaque(const fuse_image *im, int x0, int y0, int w, int h);
 
 const char *pipe_result_str(pipe_result r);
+/* The resolved HMD description the pipe uses (pipe_desc.hmd with its
+ * defaults filled in): the sizes of pipe_frame_in's images. */
+kin_sthmd_desc pipe_hmd(const pipe_ctx *p);
+
+/* ------------------------------------------------ the operator's cockpit
+ *
+ * PARTS. pipe_create classifies the model's triangles once into four
+ * parts that a frame may hide (pipe_frame_in.hide):
+ *   nodes: per side, the arm chain is found by name as the rig names it
+ *   (kin_arm_rig: "L_shoulder", "L_upper_arm", "L_forearm", "L_hand"; the
+ *   fit rig's joints when pipe_desc.fit_rig is set) or as generic glTF
+ *   arms do (pipe_parts_of_nodes: "LeftArm", "mixamorig:LeftForeArm",
+ *   "upperarm_l", "hand.L", "Bip01 L Clavicle", "J_Bip_L_Hand", ...). A
+ *   hand is the hand (wrist) joint and all its descendants; an arm is the
+ *   shoulder (clavicle) joint, the upper arm and its descendants that are
+ *   not in the hand (forearm, twist and elbow nodes). Every other node
+ *   (body, head, spine, a prop of the model) is in no part.
+ *   vertices: a skinned vertex gives each of its four weights to the part
+ *   of that joint's node (or to "no part"); a vertex of an unskinned mesh
+ *   gives weight 1 to the part of its mesh's node.
+ *   triangles: a triangle is in the part holding the largest total
+ *   weight of its three vertices (summed in double); a triangle whose
+ *   largest total is "no part", and every tie with "no part", is in no
+ *   part and always drawn; a tie between parts goes to the lower
+ *   PIPE_PART_* bit. So a triangle across the wrist is hidden with the
+ *   hand when most of its weight is the hand's.
+ * A hidden triangle is not drawn at all: per visibility set (the hide
+ * bits of the parts the model has), the meshes' index lists are filtered
+ * once, in their order, on the first frame that uses it, and kept (at
+ * most 15 sets, each a list per mesh). With hide = 0 and no props the
+ * frame is drawn exactly as before (the same bytes).
+ * With the refinement (pipe_desc.refine_band) a hidden part does not come
+ * back by colour: the refined mask keeps no pixel outside the kinematic
+ * mask within refine_band px (chessboard distance) of the hidden
+ * triangles' silhouette (drawn for it on the eye's thread). The elbow fit
+ * still turns and measures both arms (a hidden arm has no mask pixels to
+ * measure) and learns its first colour model from the whole model's
+ * mask. */
+enum {
+    PIPE_PART_HAND_L = 1u << 0,
+    PIPE_PART_ARM_L = 1u << 1,
+    PIPE_PART_HAND_R = 1u << 2,
+    PIPE_PART_ARM_R = 1u << 3,
+    PIPE_PART_ALL = 0xFu
+};
+
+/* The part (a PIPE_PART_* bit, 0 = none) of every node of model into
+ * part[node_count], by the rule above; rig (or NULL) names the chain
+ * joints first (its shoulder, upper arm, forearm, hand). Returns the OR of
+ * the parts found, 0 for a NULL model or part. */
+unsigned pipe_parts_of_nodes(const kin_model *model, const kin_arm_rig *rig,
+                             unsigned char *part);
+/* The parts of the pipe's model that own at least one triangle. */
+unsigned pipe_parts_present(const pipe_ctx *p);
+/* Parses a comma list of part names ("left-hand", "left-arm",
+ * "right-hand", "right-arm", "hands", "arms", "all"; "none" or "" = 0)
+ * into PIPE_PART_* bits. 0, or -1 with a sentence naming the bad name in
+ * why. */
+int pipe_parts_parse(const char *list, unsigned *bits, char *why, int why_size);
+
+/* PROPS: real objects the operator touches (a joystick, a keyboard, the
+ * seat's armrests) cut in like the hands. Each is a kin_model (e.g. from
+ * io_gltf_load) in its rest pose (node transforms applied, skinned meshes
+ * skinned at rest), placed each frame by pipe_frame_in.prop_world[i]
+ * (world_from_prop: fixed in the cockpit, or the pose of its tracked
+ * rigid body). Its triangles (both faces: a prop need not be closed) go
+ * into the same depth, mask and normals as the arms: the depth test
+ * between arms and props is per pixel, the virtual scene's depth hides
+ * them like the hands, and they are lit like the hands (their normals
+ * are the mesh's, smooth ones where it has none). A hidden part of the
+ * arms does not hide a prop. Props are neither refined differently nor
+ * seen by the elbow fit, but the fit's colour model is learned from the
+ * mask with them. */
+/* Adds a prop; the model must outlive the pipe. Returns its index (0, 1,
+ * ...), or -1 when out of memory or the model has no triangles or fails
+ * kin_model_validate. Not during pipe_frame. */
+int pipe_add_prop(pipe_ctx *p, const kin_model *m);
+/* The number of props added. */
+int pipe_prop_count(const pipe_ctx *p);
 
 /* ------------------------------------------------------- elbow fit
  *

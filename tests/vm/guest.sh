@@ -14,6 +14,10 @@ step() { echo "VMSTEP $* at $(cut -d" " -f1 /proc/uptime) s"; }
 step capture
 "$BIN" capture || fail=1
 
+step vsrc
+# the V source (io_vsrc) on vivid's video2 + video3: formats, unplug, reopen
+"$BIN" vsrc || fail=1
+
 step usb
 # hotplug is seen by io_usb_watch's sysfs rescans (libusb's own events
 # would need a udev daemon, which this VM does not run)
@@ -55,6 +59,13 @@ else
     echo "VMTEST glove_gadget FAIL cannot create the configfs gadget"
     fail=1
 fi
+
+step display
+# KMS on qemu's bochs-display: the host takes a screendump when it reads
+# "VMSYNC display-dump FILE" and answers with FILE.ack
+"$VM/vm_display" "$OUT" || fail=1
+# layout two: virtio-gpu's two outputs, one eye each
+"$VM/vm_display" two "$OUT" || fail=1
 
 step run
 # the live pipeline on both vivid cameras, HDMI input at 60 FPS

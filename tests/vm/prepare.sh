@@ -65,7 +65,9 @@ cp /bin/busybox "$IR/bin/busybox"
 cp "$ROOT/tests/vm/init" "$IR/init"
 chmod +x "$IR/init"
 : > "$IR/modules.list"
-for m in virtio_pci 9pnet_virtio 9p vivid xhci_pci dummy_hcd usb_f_hid; do
+# bochs, virtio-gpu: the DRM drivers of qemu's -device bochs-display and
+# virtio-gpu-pci (the display tests; bochs first, so it is card0)
+for m in virtio_pci 9pnet_virtio 9p vivid xhci_pci dummy_hcd usb_f_hid bochs virtio-gpu; do
     modprobe -d "$VM/kernel" -S "$KV" --show-depends "$m" | while read -r cmd path rest; do
         [ "$cmd" = insmod ] || continue
         base=$(basename "$path")
@@ -83,5 +85,12 @@ PKGC=$(pkg-config --cflags libusb-1.0 libv4l2)
 cc -std=c11 -O2 -g -Wall -Wextra -D_GNU_SOURCE -ffp-contract=off $PKGC -o "$VM/vm_devices" \
     "$ROOT/tests/vm/vm_devices.c" "$ROOT"/src/io/io_v4l2.c "$ROOT"/src/io/io_dummy.c \
     "$ROOT"/src/io/io_usb.c "$ROOT"/src/io/io_glove.c "$ROOT"/src/io/io_common.c \
+    "$ROOT"/src/io/io_vsrc.c "$ROOT"/src/io/io_vstream.c \
     "$ROOT/$BUILD/libegofuse.a" $PKGL -lm -lpthread
+# ---- the guest display test (KMS through libdrm on the bochs driver)
+DRMC=$(pkg-config --cflags libdrm sdl2)
+DRML=$(pkg-config --libs libdrm)
+cc -std=c11 -O2 -g -Wall -Wextra -D_GNU_SOURCE -ffp-contract=off $DRMC -o "$VM/vm_display" \
+    "$ROOT/tests/vm/vm_display.c" "$ROOT"/src/io/io_display.c "$ROOT"/src/io/io_display_kms.c \
+    "$ROOT"/src/io/io_display_sdl.c "$ROOT"/src/io/io_common.c $DRML
 echo "prepared: kernel $KV, initramfs $(du -k "$VM/initramfs.cpio.gz" | cut -f1) KiB"

@@ -9,7 +9,9 @@
  *   vm_devices usb-assign L R       assigns left/right by selectors
  *   vm_devices usb-watch MS         waits for a hotplug change
  *   vm_devices glove HIDG SEL       writes reports to /dev/hidgN, reads
- *                                   them back over libusb */
+ *                                   them back over libusb
+ *   vm_devices vsrc                 the V source (io_vsrc) on video2 +
+ *                                   video3: formats, side by side, unplug */
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -21,6 +23,7 @@
 #include <unistd.h>
 
 #include "../../src/io/io_dev.h"
+#include "../../src/io/io_vsrc.h"
 
 static int failures;
 
@@ -410,6 +413,195 @@ static int cmd_glove(const char *hidg, const char *sel)
     return failures ? 1 : 0;
 }
 
+/* ---------------------------------------------------------------- vsrc */
+
+/* Polls the V source until both eyes have had `frames` frames or the
+ * time is up; returns the frames converted. */
+static uint64_t vsrc_run(io_vsrc *v, uint64_t frames, double seconds)
+{
+    io_error err;
+    io_vsrc_stat st;
+    double t0 = now_s();
+    do {
+        int fresh;
+        io_vsrc_poll(v, 100, &fresh, &err);
+        io_vsrc_status(v, 0, &st);
+    } while (st.frames < frames && now_s() - t0 < seconds);
+    return st.frames;
+}
+
+/* vivid's 75% colour bars, scaled into a 1280-wide eye: the first bar is
+ * grey-white, the second yellow, the last black; alpha 255. */
+static int vsrc_pixels_sane(io_vsrc *v, int eye, char *why, size_t n)
+{
+    size_t stride;
+    const uint8_t *im = io_vsrc_eye(v, eye, &stride);
+    if (!im) {
+        snprintf(why, n, "eye %d: no image", eye);
+        return 0;
+    }
+    const int y = 500;
+    const uint8_t *w = im + (size_t)y * stride + 4 * 80, *yel = im + (size_t)y * stride + 4 * 240,
+                  *blk = im + (size_t)y * stride + 4 * 1200;
+    int alpha = 1;
+    for (int x = 0; x < 1280; x += 7) alpha &= im[(size_t)y * stride + 4 * (size_t)x + 3] == 255;
+    snprintf(why, n, "eye %d row %d: bar 1 %d,%d,%d bar 2 %d,%d,%d bar 8 %d,%d,%d, alpha %s", eye,
+             y, w[0], w[1], w[2], yel[0], yel[1], yel[2], blk[0], blk[1], blk[2],
+             alpha ? "255" : "not 255");
+    return alpha && w[0] > 140 && abs(w[0] - w[1]) < 16 && abs(w[1] - w[2]) < 16 && yel[0] > 140 &&
+           yel[1] > 140 && yel[2] < 60 && blk[0] < 50 && blk[1] < 50 && blk[2] < 50;
+}
+
+static int vivid_sysfs(char *dev, size_t n)
+{
+    DIR *d = opendir("/sys/bus/platform/drivers/vivid");
+    struct dirent *e;
+    int found = 0;
+    while (d && (e = readdir(d)) != NULL)
+        if (!strncmp(e->d_name, "vivid", 5)) {
+            snprintf(dev, n, "%.100s", e->d_name);
+            found = 1;
+            break;
+        }
+    if (d) closedir(d);
+    return found;
+}
+
+static int write_sys(const char *path, const char *val)
+{
+    int fd = open(path, O_WRONLY);
+    if (fd < 0) return -1;
+    ssize_t k = write(fd, val, strlen(val));
+    close(fd);
+    return k == (ssize_t)strlen(val) ? 0 : -1;
+}
+
+static int cmd_vsrc(void)
+{
+    io_error err;
+    io_vsrc_stat st;
+    int fds0 = count_fds();
+    /* one device per eye, each format vivid offers, 640x360 scaled to 1280x800 */
+    static const uint32_t fmts[] = {IO_FMT_YUYV, IO_FMT_NV12, IO_FMT_RGB3, IO_FMT_BGR4, IO_FMT_XR24};
+    for (size_t k = 0; k < sizeof fmts / sizeof fmts[0]; k++) {
+        char fs[5];
+        io_vsrc_config c = io_vsrc_config_default("v4l2:/dev/video2,/dev/video3");
+        c.fourcc = fmts[k];
+        c.width = 640;
+        c.height = 360;
+        c.fps = 25;
+        c.input = 0;
+        io_vsrc *v;
+        io_result r = io_vsrc_open(&v, &c, &err);
+        if (r == IO_ERR_FORMAT && strstr(err.msg, "not offered")) {
+            printf("VMINFO vsrc %s not offered by vivid: %s\n", io_fourcc_str(fmts[k], fs), err.msg);
+            continue;
+        }
+        if (r != IO_OK) {
+            check(0, "vsrc_format", "%s: %s", io_fourcc_str(fmts[k], fs), err.msg);
+            continue;
+        }
+        double t0 = now_s();
+        uint64_t n = vsrc_run(v, 8, 6.0);
+        double dt = now_s() - t0;
+        io_vsrc_status(v, 0, &st);
+        char w0[256], w1[256];
+        int ok0 = vsrc_pixels_sane(v, 0, w0, sizeof w0), ok1 = vsrc_pixels_sane(v, 1, w1, sizeof w1);
+        size_t s0 = 0;
+        io_vsrc_eye(v, 0, &s0);
+        check(n >= 8 && st.state == IO_VSRC_LIVE && st.src_width == 640 && st.fourcc == fmts[k] &&
+                  s0 == 4 * 1280 && ok0 && ok1 && st.age_ns >= 0 && st.age_ns < 2000000000,
+              "vsrc_format", "%s 640x360 x2 -> eyes 1280x800: %llu frames in %.2f s (%s), "
+              "skipped %llu, age %.1f ms; %s; %s", io_fourcc_str(fmts[k], fs),
+              (unsigned long long)n, dt, io_vsrc_state_name(st.state),
+              (unsigned long long)st.skipped, 1e-6 * (double)st.age_ns, w0, w1);
+        io_vsrc_close(v);
+    }
+
+    /* one device carrying both eyes side by side: 1280x720 -> 2 x 640x720 */
+    {
+        io_vsrc_config c = io_vsrc_config_default("v4l2:/dev/video2");
+        c.fourcc = IO_FMT_YUYV;
+        c.width = 1280;
+        c.height = 720;
+        c.fps = 25;
+        c.input = 0;
+        c.layout = IO_VSRC_SBS;
+        io_vsrc *v;
+        io_result r = io_vsrc_open(&v, &c, &err);
+        uint64_t n = r == IO_OK ? vsrc_run(v, 4, 6.0) : 0;
+        if (r == IO_OK) io_vsrc_status(v, 0, &st);
+        /* left eye = the left half of the bars: bar 1 white, bar 4 (green) at its right */
+        size_t stride = 0;
+        const uint8_t *l = r == IO_OK ? io_vsrc_eye(v, 0, &stride) : NULL;
+        const uint8_t *rr = r == IO_OK ? io_vsrc_eye(v, 1, NULL) : NULL;
+        int ok = l && rr && l != rr;
+        const uint8_t *g = ok ? l + 500 * stride + 4 * 1200 : NULL; /* green bar */
+        const uint8_t *b = ok ? rr + 500 * stride + 4 * 1200 : NULL; /* black bar */
+        check(r == IO_OK && n >= 4 && ok && g[1] > 120 && g[0] < 60 && g[2] < 60 && b[1] < 50,
+              "vsrc_sbs", "%s%s: %llu frames, left eye's right end %d,%d,%d (green), right eye's "
+              "%d,%d,%d (black)", r == IO_OK ? "v4l2:/dev/video2 1280x720 sbs" : "",
+              r == IO_OK ? "" : err.msg, (unsigned long long)n, g ? g[0] : -1, g ? g[1] : -1,
+              g ? g[2] : -1, b ? b[0] : -1, b ? b[1] : -1, b ? b[2] : -1);
+        if (r == IO_OK) io_vsrc_close(v);
+    }
+
+    /* the devices vanish (driver unbound) and come back: failed, the last V
+     * held, reopened at most once a second */
+    char pdev[128];
+    if (!vivid_sysfs(pdev, sizeof pdev)) {
+        check(0, "vsrc_unplug", "no vivid device under /sys/bus/platform/drivers/vivid");
+    } else {
+        io_vsrc_config c = io_vsrc_config_default("v4l2:/dev/video2,/dev/video3");
+        c.fourcc = IO_FMT_YUYV;
+        c.width = 640;
+        c.height = 360;
+        c.fps = 25;
+        c.input = 0;
+        io_vsrc *v;
+        io_result r = io_vsrc_open(&v, &c, &err);
+        uint64_t n = r == IO_OK ? vsrc_run(v, 4, 6.0) : 0;
+        int unbound = r == IO_OK && write_sys("/sys/bus/platform/drivers/vivid/unbind", pdev) == 0;
+        io_vsrc_stat gone;
+        memset(&gone, 0, sizeof gone);
+        double t0 = now_s();
+        while (unbound && now_s() - t0 < 3.0) {
+            int fresh;
+            io_vsrc_poll(v, 100, &fresh, &err);
+            io_vsrc_status(v, 0, &gone);
+            if (gone.state == IO_VSRC_FAILED) break;
+        }
+        int held = r == IO_OK && io_vsrc_eye(v, 0, NULL) != NULL;
+        int bound = unbound && write_sys("/sys/bus/platform/drivers/vivid/bind", pdev) == 0;
+        io_vsrc_stat back;
+        memset(&back, 0, sizeof back);
+        t0 = now_s();
+        uint64_t f0 = gone.frames;
+        while (bound && now_s() - t0 < 8.0) {
+            int fresh;
+            io_vsrc_poll(v, 100, &fresh, &err);
+            io_vsrc_status(v, 0, &back);
+            if (back.state == IO_VSRC_LIVE && back.reopens >= 1 && back.frames > f0 + 2) break;
+        }
+        check(r == IO_OK && n >= 4 && gone.state == IO_VSRC_FAILED && held &&
+                  strstr(gone.msg, "/dev/video") && back.state == IO_VSRC_LIVE && back.reopens >= 1,
+              "vsrc_unplug", "%s%s unbound: %s (%s), last V %s; bound again: %s, reopens %llu, "
+              "frames %llu -> %llu", pdev, r == IO_OK ? "" : err.msg,
+              io_vsrc_state_name(gone.state), gone.msg, held ? "held" : "lost",
+              io_vsrc_state_name(back.state), (unsigned long long)back.reopens,
+              (unsigned long long)gone.frames, (unsigned long long)back.frames);
+        if (r == IO_OK) io_vsrc_close(v);
+        if (unbound && !bound) write_sys("/sys/bus/platform/drivers/vivid/bind", pdev);
+        /* the HMD cameras of the later steps are back too */
+        printf("VMINFO vsrc after rebind: /dev/video0 %s, /dev/video1 %s\n",
+               access("/dev/video0", F_OK) == 0 ? "present" : "MISSING",
+               access("/dev/video1", F_OK) == 0 ? "present" : "MISSING");
+    }
+    int fds1 = count_fds();
+    check(fds0 == fds1, "vsrc_no_fd_leak", "descriptors before %d, after %d", fds0, fds1);
+    return failures ? 1 : 0;
+}
+
 int main(int argc, char **argv)
 {
     setvbuf(stdout, NULL, _IOLBF, 0);
@@ -419,7 +611,8 @@ int main(int argc, char **argv)
         return cmd_usb_assign(argv[2], argv[3], argv[4], argv[5]);
     if (argc >= 4 && !strcmp(argv[1], "usb-watch")) return cmd_usb_watch(atoi(argv[2]), argv[3]);
     if (argc >= 4 && !strcmp(argv[1], "glove")) return cmd_glove(argv[2], argv[3]);
+    if (argc >= 2 && !strcmp(argv[1], "vsrc")) return cmd_vsrc();
     fprintf(stderr, "usage: vm_devices capture | usb-list [FILE] | usb-assign SEL_L SEL_R "
-                    "SERIAL_L SERIAL_R | usb-watch MS WHAT | glove /dev/hidgN SELECTOR\n");
+                    "SERIAL_L SERIAL_R | usb-watch MS WHAT | glove /dev/hidgN SELECTOR | vsrc\n");
     return 2;
 }

@@ -1,0 +1,54 @@
+/* run.h - `egofuse run`, the live cockpit: its options (run_opts.c: the
+ * command line merged with the cockpit configuration file) and the loop
+ * (cmd_run.c). docs/cockpit.md. */
+#ifndef EGOFUSE_RUN_H
+#define EGOFUSE_RUN_H
+
+#include "cli.h"
+
+#define RUN_MAX_PROPS 8
+#define RUN_MAX_NATNET 32
+
+/* A real object of the cockpit cut in like the hands (--prop). */
+typedef struct run_prop {
+    char name[64];
+    char model[IO_PATH_MAX];
+    float at[3];              /* metres: world position, or offset in the
+                                 body's frame when body is set */
+    float rot_deg[3];         /* yaw (about +Y), pitch (+X), roll (+Z) */
+    char body[64];            /* tracked rigid body (name or #id), "" = fixed */
+} run_prop;
+
+typedef struct run_opts {
+    const char *scene, *model, *virt[2], *sel[2], *glove_sel[2], *calib, *out, *stats, *dump;
+    const char *virt_source, *virt_layout, *display;
+    const char *track_addr;
+    /* NatNet: key, value pairs for io_natnet_config_set, in order */
+    int natnet;                   /* 1: --natnet given */
+    const char *natnet_kv[RUN_MAX_NATNET][2];
+    int natnet_kv_count;
+    int virt_stale_ms, virt_fps;
+    uint32_t fourcc;
+    int fps, input, dv, buffers, track_port, raw, frames, quiet;
+    int format_set;           /* --format given (file cameras default to RGB) */
+    int loop;                 /* file cameras: start again at the end */
+    int hold;                 /* --display: keep the last frame shown until Ctrl-C */
+    int refine;               /* refinement band, px; 0 = off */
+    float predict_ms;         /* pose time = camera time + this */
+    unsigned hide;            /* PIPE_PART_* bits hidden */
+    kin_sthmd_desc hmd;       /* zero fields = the paper's */
+    run_prop prop[RUN_MAX_PROPS];
+    int prop_count;
+    char *storage;            /* owned strings (config values) */
+} run_opts;
+
+/* Parses the command line of `egofuse run` (argv[0] = "run"), after the
+ * options of --config FILE when one is given (the command line wins).
+ * Returns -1 when the options are fine, else the exit code to return
+ * (EXIT_OK for --help, EXIT_USAGE / EXIT_FAIL with a message printed). */
+int run_parse(int argc, char **argv, run_opts *o);
+void run_opts_free(run_opts *o);
+
+extern const char *run_usage;
+
+#endif
