@@ -25,7 +25,8 @@ LDFLAGS  += $(SAN)
 
 CORE_SRC := $(wildcard src/cpu/*.c src/pipe/*.c src/raster/*.c src/kin/*.c src/fuse/*.c)
 IO_SRC   := $(wildcard src/io/*.c)
-IO_CXX   := $(wildcard src/io/*.cpp)
+# io_image_oiio.cpp is the OpenImageIO plugin, not part of the io library.
+IO_CXX   := $(filter-out src/io/io_image_oiio.cpp,$(wildcard src/io/*.cpp))
 CLI_SRC  := $(wildcard src/cli/*.c)
 GEN_SRC  := $(wildcard samples/gen/*.c)
 GT_SRC   := $(wildcard samples/gt/*.c)
@@ -47,11 +48,21 @@ TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC)) \
              $(patsubst bench/llvmpipe/%.c,$(BUILD)/bench/%,$(LLVMPIPE_SRC))
 
-IO_PKGS  := OpenImageIO tinygltf libusb-1.0 libv4l2 libdrm
+IO_PKGS  := libpng tinygltf libusb-1.0 libv4l2 libdrm
 # SDL2: headers only; src/io/io_display_sdl.c loads libSDL2 with dlopen when
 # a window is opened, so the program does not link it.
 IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) sdl2 2>/dev/null)
-IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lmeshoptimizer -lstdc++
+IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lmeshoptimizer -lstdc++ -ldl
+# OpenImageIO (EXR, TIFF, JPEG ...) lives in a plugin that io_image.c loads
+# with dlopen only when a file is neither PNG nor PPM/PGM (docs/io.md), so
+# no command pays for its ~260 libraries unless it reads or writes such a
+# file. It is found next to the program (or its parent folder).
+OIIO_PKGS := OpenImageIO
+OIIO_CFLAGS := $(shell pkg-config --cflags $(OIIO_PKGS) 2>/dev/null)
+OIIO_LIBS := $(shell pkg-config --libs $(OIIO_PKGS) 2>/dev/null)
+OIIO_PLUGIN := $(BUILD)/libegofuse_oiio.so
+OIIO_PLUGIN_SRC := src/io/io_image_oiio.cpp src/io/io_common.c src/io/io_image_mem.c
+OIIO_PLUGIN_OBJ := $(patsubst %,$(BUILD)/pic/%.o,$(OIIO_PLUGIN_SRC))
 SYS_LIBS := -lm -lpthread
 # Peers measured by the benchmarks: pixman (compositing), Mesa llvmpipe
 # through EGL + GLES (the same frame as GL shaders).
@@ -71,7 +82,7 @@ SAMPLES  := $(BUILD)/samples
 # Keep intermediate objects (tests/support/*.o), so a second make rebuilds nothing.
 .SECONDARY:
 
-all: $(LIB) $(IOLIB) $(EGOFUSE) $(GEN) $(TEST_BIN) $(BENCH_BIN)
+all: $(LIB) $(IOLIB) $(OIIO_PLUGIN) $(EGOFUSE) $(GEN) $(TEST_BIN) $(BENCH_BIN)
 
 deps:
 	@sh scripts/deps.sh
@@ -92,6 +103,17 @@ $(BUILD)/obj/%.cpp.o: %.cpp
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) -c $< -o $@
 
+$(BUILD)/pic/%.c.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -fPIC -fvisibility=hidden -c $< -o $@
+
+$(BUILD)/pic/%.cpp.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) -Wno-unused-parameter -fPIC -fvisibility=hidden -c $< -o $@
+
+$(OIIO_PLUGIN): $(OIIO_PLUGIN_OBJ)
+	$(CXX) -shared $(LDFLAGS) -Wl,-soname,libegofuse_oiio.so -o $@ $^ $(OIIO_LIBS) -lm
+
 $(LIB): $(CORE_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
@@ -104,29 +126,29 @@ $(SAMPLESLIB): $(SAMPLES_LIB_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@ && ar rcs $@ $^
 
-$(EGOFUSE): $(CLI_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB)
+$(EGOFUSE): $(CLI_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
 
-$(GEN): $(BUILD)/obj/samples/gen/gen_main.c.o $(SAMPLESLIB) $(IOLIB) $(LIB)
+$(GEN): $(BUILD)/obj/samples/gen/gen_main.c.o $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	$(CXX) $(LDFLAGS) -o $@ $< $(SAMPLESLIB) $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
 
-$(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(IOLIB) $(LIB)
+$(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(IOLIB) $(LIB) \
 	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
 # Tests on the generated samples' scenes also link the generator.
-$(BUILD)/tests/test_occlusion: tests/test_occlusion.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB)
+$(BUILD)/tests/test_occlusion: tests/test_occlusion.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) \
 	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
-$(BUILD)/bench/%: bench/%.c $(IOLIB) $(LIB)
+$(BUILD)/bench/%: bench/%.c $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) $(BENCH_CFLAGS) -o $@ $< $(IOLIB) $(LIB) \
 	    $(BENCH_LIBS) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
-$(BUILD)/bench/%: bench/llvmpipe/%.c $(IOLIB) $(LIB)
+$(BUILD)/bench/%: bench/llvmpipe/%.c $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) $(BENCH_CFLAGS) -o $@ $< $(IOLIB) $(LIB) \
 	    $(GL_LIBS) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)

@@ -14,7 +14,7 @@
 set -eu
 
 PKGS="build-essential pkg-config
-libopenimageio-dev openimageio-tools
+libopenimageio-dev openimageio-tools libpng-dev
 libtinygltf-dev libmeshoptimizer-dev gltfpack
 libv4l-dev libusb-1.0-0-dev
 libdrm-dev libsdl2-dev xvfb x11-apps

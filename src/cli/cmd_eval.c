@@ -13,10 +13,12 @@
 
 /* The ground truth comes from samples/gt/ and the sample generator
  * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
+#include <errno.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "../fuse/fuse_metrics.h"
 #include "../fuse/fuse_refine.h"
@@ -870,12 +872,30 @@ static void print_calib(FILE *f, const eval_ctx *c)
             (double)c->calib.shoulder_scale, (double)sh);
 }
 
+/* Report files go through io_out: complete or absent, a failed write is
+ * "path: write failed: reason" and exit 1 (io.h, OUTPUT FILES). */
+static FILE *out_open(io_out *o, const char *path)
+{
+    io_error err;
+    if (io_out_open(o, path, &err) != IO_OK) {
+        cli_fail("%s", err.msg);
+        return NULL;
+    }
+    return o->f;
+}
+
+static int out_commit(io_out *o)
+{
+    io_error err;
+    if (io_out_commit(o, &err) != IO_OK) return cli_fail("%s", err.msg);
+    return EXIT_OK;
+}
+
 static int write_csv(const char *path, const method_run *R, int n)
 {
-    char tmp[IO_PATH_MAX + 32];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) return cli_fail("%s: cannot write", path);
+    io_out of;
+    FILE *f = out_open(&of, path);
+    if (!f) return EXIT_FAIL;
     fprintf(f, "method,setting,iou,bf1,bf3,fp_area,fn_area,psnr,ms_per_frame,flicker,group\n");
     for (int i = 0; i < n; i++) {
         summary s = summarise(&R[i]);
@@ -883,11 +903,7 @@ static int write_csv(const char *path, const method_run *R, int n)
                 kind_name[R[i].cfg.kind], R[i].cfg.setting, s.iou, s.bf1, s.bf3, s.fp, s.fn,
                 s.psnr, s.ms, s.flicker, R[i].cfg.group);
     }
-    if (fclose(f) != 0 || rename(tmp, path) != 0) {
-        remove(tmp);
-        return cli_fail("%s: cannot write", path);
-    }
-    return EXIT_OK;
+    return out_commit(&of);
 }
 
 /* The limb thickness the first refine run with the elbow fit measured
@@ -935,8 +951,9 @@ static int write_group(const char *dir, const char *group, const method_run *R, 
 {
     char path[IO_PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/%s.dat", dir, group);
-    FILE *f = fopen(path, "w");
-    if (!f) return cli_fail("%s: cannot write", path);
+    io_out of;
+    FILE *f = out_open(&of, path);
+    if (!f) return EXIT_FAIL;
     for (int k = 0; k < 4; k++) {
         fprintf(f, "# %s\n", kind_name[k]);
         float xs[64];
@@ -965,8 +982,7 @@ static int write_group(const char *dir, const char *group, const method_run *R, 
         if (!m) fprintf(f, "nan nan nan nan nan\n");
         fprintf(f, "\n\n");
     }
-    fclose(f);
-    return EXIT_OK;
+    return out_commit(&of);
 }
 
 /* DIR/sequences.dat: per sequence, IoU then BF(3 px) of the four methods. */
@@ -974,8 +990,9 @@ static int write_sequences(const char *dir, const method_run *R, int n, const ev
 {
     char path[IO_PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/sequences.dat", dir);
-    FILE *f = fopen(path, "w");
-    if (!f) return cli_fail("%s: cannot write", path);
+    io_out of;
+    FILE *f = out_open(&of, path);
+    if (!f) return EXIT_FAIL;
     fprintf(f, "# sequence iou(kin kin-cal-pred skin refine) bf3(same)\n");
     for (int q = 0; gt_sequence_name(q); q++) {
         const char *name = gt_sequence_name(q);
@@ -1003,8 +1020,52 @@ static int write_sequences(const char *dir, const method_run *R, int n, const ev
         for (int k = 0; k < 4; k++) fprintf(f, " %.5f", bf3[k]);
         fprintf(f, "\n");
     }
-    fclose(f);
-    return EXIT_OK;
+    return out_commit(&of);
+}
+
+/* Runs gnuplot on DIR/charts.gp with its outputs named "<chart>.tmp.<pid>",
+ * then checks each chart decodes whole before giving it its name: gnuplot
+ * does not report a failed write, so a full disk would leave truncated
+ * charts. gnuplot missing or failing: a warning (the data is written);
+ * a chart written incomplete: removed, an error. */
+static int write_charts(const char *dir)
+{
+    static const char *const charts[] = {"speed_iou", "speed_bf", "noise", "latency",
+                                         "calib", "band", "sequences"};
+    enum { NCHART = sizeof charts / sizeof charts[0] };
+    char cmd[3 * IO_PATH_MAX], tmp[IO_PATH_MAX + 96], path[IO_PATH_MAX + 64];
+    long pid = (long)getpid();
+    snprintf(cmd, sizeof cmd, "gnuplot -e \"sfx='.tmp.%ld'\" '%s/charts.gp'", pid, dir);
+    int rc = system(cmd);
+    int bad = 0;
+    for (int i = 0; i < NCHART; i++) {
+        snprintf(path, sizeof path, "%s/%s.png", dir, charts[i]);
+        snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, pid);
+        if (rc != 0) {
+            remove(tmp);
+            continue;
+        }
+        io_image img;
+        io_error err;
+        if (io_image_load(tmp, IO_U8, 0, &img, &err) != IO_OK) {
+            remove(tmp);
+            if (!bad) fprintf(stderr, "egofuse: %s: gnuplot wrote it incomplete or not at all "
+                              "(%s); removed\n", path, err.msg);
+            bad = 1;
+            continue;
+        }
+        io_image_free(&img);
+        if (rename(tmp, path) != 0) {
+            fprintf(stderr, "egofuse: %s: cannot name it (rename from %s): %s\n", path, tmp,
+                    strerror(errno));
+            remove(tmp);
+            bad = 1;
+        }
+    }
+    if (rc != 0)
+        fprintf(stderr, "egofuse eval: gnuplot failed (status %d): the data files and "
+                        "%s/charts.gp are written, the PNG charts are not\n", rc, dir);
+    return bad ? EXIT_FAIL : EXIT_OK;
 }
 
 static int write_report(const char *dir, const method_run *R, int n, const eval_opts *o,
@@ -1014,8 +1075,9 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
     snprintf(path, sizeof path, "%s/summary.csv", dir);
     if (write_csv(path, R, n)) return EXIT_FAIL;
     snprintf(path, sizeof path, "%s/table.md", dir);
-    FILE *f = fopen(path, "w");
-    if (!f) return cli_fail("%s: cannot write", path);
+    io_out of;
+    FILE *f = out_open(&of, path);
+    if (!f) return EXIT_FAIL;
     fprintf(f, "Ground truth: sequence %s, tracking noise %g mm, latency %g ms, dropout %g, "
                "calibration error %g, speed %g, seed %d. Frames: %d for the methods (group "
                "methods), %d for the speed knobs (groups knobs, band, fit, global, lagcomp, "
@@ -1028,11 +1090,11 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
     print_thickness(f, c, R, n);
     fprintf(f, "\n");
     print_table(f, R, n, 1);
-    fclose(f);
+    if (out_commit(&of)) return EXIT_FAIL;
     /* speed-accuracy points: label, ms, iou, bf3 */
     snprintf(path, sizeof path, "%s/speed.dat", dir);
-    f = fopen(path, "w");
-    if (!f) return cli_fail("%s: cannot write", path);
+    f = out_open(&of, path);
+    if (!f) return EXIT_FAIL;
     for (int k = 0; k < 4; k++) {
         fprintf(f, "# %s\n", kind_name[k]);
         for (int i = 0; i < n; i++) {
@@ -1048,44 +1110,45 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
         }
         fprintf(f, "\n\n");
     }
-    fclose(f);
+    if (out_commit(&of)) return EXIT_FAIL;
     static const char *groups[] = { "noise", "latency", "calib", "band" };
     for (int g = 0; g < 4; g++)
         if (write_group(dir, groups[g], R, n, o)) return EXIT_FAIL;
     if (write_sequences(dir, R, n, o)) return EXIT_FAIL;
     snprintf(path, sizeof path, "%s/charts.gp", dir);
-    f = fopen(path, "w");
-    if (!f) return cli_fail("%s: cannot write", path);
+    f = out_open(&of, path);
+    if (!f) return EXIT_FAIL;
     fprintf(f,
+        "if (!exists('sfx')) sfx = ''\n"
         "set terminal pngcairo noenhanced size 900,600 font ',10'\n"
         "set grid\nset key bottom right\n"
         "titles = 'kin kin-cal-pred skin refine'\n"
-        "set output '%s/speed_iou.png'\n"
+        "set output '%s/speed_iou.png'.sfx\n"
         "set title 'Speed against accuracy: mask IoU (labels: setting)'\n"
         "set xlabel 'ms per stereo frame (pose, skin, raster, refine, light, composite; 1 thread)'\n"
         "set ylabel 'mask IoU'\nset logscale x\n"
         "plot for [i=0:3] '%s/speed.dat' index i using 1:2 with points pt 7 ps 1.3 title word(titles, i+1), \\\n"
         "     for [i=0:3] '%s/speed.dat' index i using 1:2:4 with labels offset 0,0.8 font ',7' notitle\n"
-        "set output '%s/speed_bf.png'\n"
+        "set output '%s/speed_bf.png'.sfx\n"
         "set title 'Speed against accuracy: boundary F-score within 3 px'\n"
         "set ylabel 'BF (3 px)'\n"
         "plot for [i=0:3] '%s/speed.dat' index i using 1:3 with points pt 7 ps 1.3 title word(titles, i+1), \\\n"
         "     for [i=0:3] '%s/speed.dat' index i using 1:3:4 with labels offset 0,0.8 font ',7' notitle\n"
         "unset logscale x\n"
-        "set output '%s/noise.png'\nset title 'Accuracy against tracking noise (latency %g ms)'\n"
+        "set output '%s/noise.png'.sfx\nset title 'Accuracy against tracking noise (latency %g ms)'\n"
         "set xlabel 'RMS position noise, mm'\nset ylabel 'mask IoU'\n"
         "plot for [i=0:3] '%s/noise.dat' index i using 1:2 with linespoints lw 2 title word(titles, i+1)\n"
-        "set output '%s/latency.png'\nset title 'Accuracy against tracking latency (noise %g mm)'\n"
+        "set output '%s/latency.png'.sfx\nset title 'Accuracy against tracking latency (noise %g mm)'\n"
         "set xlabel 'latency, ms'\n"
         "plot for [i=0:3] '%s/latency.dat' index i using 1:2 with linespoints lw 2 title word(titles, i+1)\n"
-        "set output '%s/calib.png'\nset title 'Accuracy against calibration error (on top of the estimate)'\n"
+        "set output '%s/calib.png'.sfx\nset title 'Accuracy against calibration error (on top of the estimate)'\n"
         "set xlabel 'error of the arm, hand and shoulder scales, %%'\n"
         "plot for [i=0:3] '%s/calib.dat' index i using 1:2 with linespoints lw 2 title word(titles, i+1)\n"
-        "set output '%s/band.png'\nset title 'Refinement band width'\n"
+        "set output '%s/band.png'.sfx\nset title 'Refinement band width'\n"
         "set xlabel 'band half width, px'\nset ylabel 'IoU, BF(3 px)'\n"
         "plot '%s/band.dat' index 3 using 1:2 with linespoints lw 2 title 'IoU', \\\n"
         "     '%s/band.dat' index 3 using 1:3 with linespoints lw 2 title 'BF 3px'\n"
-        "set output '%s/sequences.png'\nset title 'Mask IoU per sequence and method'\n"
+        "set output '%s/sequences.png'.sfx\nset title 'Mask IoU per sequence and method'\n"
         "set style data histograms\nset style histogram clustered gap 1\n"
         "set style fill solid 0.8 border -1\nset yrange [0:1.15]\nset key top center horizontal\n"
         "set xlabel 'sequence'\nset ylabel 'mask IoU'\n"
@@ -1093,14 +1156,8 @@ static int write_report(const char *dir, const method_run *R, int n, const eval_
         "'' using 4 title 'skin', '' using 5 title 'refine'\n",
         dir, dir, dir, dir, dir, dir, dir, (double)o->latency, dir, dir, (double)o->noise, dir,
         dir, dir, dir, dir, dir, dir, dir);
-    fclose(f);
-    char cmd[3 * IO_PATH_MAX];
-    snprintf(cmd, sizeof cmd, "gnuplot '%s/charts.gp'", dir);
-    int rc = system(cmd);
-    if (rc != 0)
-        fprintf(stderr, "egofuse eval: gnuplot failed (status %d): the data files and "
-                        "%s/charts.gp are written, the PNG charts are not\n", rc, dir);
-    return EXIT_OK;
+    if (out_commit(&of)) return EXIT_FAIL;
+    return write_charts(dir);
 }
 
 /* ---------------------------------------------------------------- run */

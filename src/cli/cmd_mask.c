@@ -151,6 +151,15 @@ int cmd_mask(int argc, char **argv)
     kin_vec3 fwd = kin_v3_sub(vt, ve);
     if (kin_v3_len(fwd) == 0.0f)
         return cli_usage_error("mask", "--eye and --target are the same point");
+    /* Coordinates whose squares overflow a float (|v| > ~1.8e19) are not
+     * the --up vector's fault: say which vector is out of range. */
+    if (!isfinite(kin_v3_len(fwd)))
+        return cli_usage_error("mask", "--eye and --target are too far apart (the view direction "
+                               "%g,%g,%g overflows float arithmetic; keep coordinates below 1e18)",
+                               (double)fwd.x, (double)fwd.y, (double)fwd.z);
+    if (!isfinite(kin_v3_len(vu)))
+        return cli_usage_error("mask", "--up is too large (overflows float arithmetic; its length "
+                               "does not matter, e.g. 0,1,0)");
     if (kin_v3_len(kin_v3_cross(fwd, vu)) <= 1e-6f * kin_v3_len(fwd) * kin_v3_len(vu))
         return cli_usage_error("mask", "--up is zero or parallel to the view direction");
 

@@ -10,8 +10,10 @@
  *   header (the C++ shims catch everything).
  *
  * OUTPUT FILES
- *   Writers never leave a half-written file: they write "<path>.tmp.<pid>"
- *   and rename it over <path> only when complete.
+ *   Writers never leave a half-written file: every write and the close are
+ *   checked (io_out below), the file gets its name only when complete, and
+ *   a failure (disk full, file size limit, folder not writable) is
+ *   IO_ERR_WRITE "path: reason (strerror)" with nothing left behind.
  *
  * USAGE
  *   io_error err;
@@ -28,6 +30,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include "../fuse/fuse.h"
 #include "../kin/kin.h"
 
@@ -72,6 +75,36 @@ io_result io_fail(io_error *err, io_result code, const char *fmt, ...)
  * IO_ERR_NOT_FOUND or IO_ERR_READ with "path: reason". */
 io_result io_check_file(const char *path, io_error *err);
 
+/* --------------------------------------------------------- output files
+ * io_out.c. An output file that is complete or absent: write with stdio on
+ * o.f (fprintf, fwrite: no need to check each call, the first failure and
+ * its errno are kept), then io_out_commit() names the file <path> when
+ * every byte was written, or removes it and fails with "path: write
+ * failed: No space left on device; nothing written". The file is unnamed
+ * until the commit (O_TMPFILE), so a killed process leaves nothing; where
+ * O_TMPFILE is missing it is "<path>.tmp.<pid>" until renamed. Do not copy
+ * an open io_out (its stream points at it). */
+
+#define IO_PATH_MAX 1024
+
+typedef struct io_out {
+    FILE *f;                      /* the stream to write; never fclose it */
+    int fd;                       /* its descriptor (-1 when closed) */
+    int unnamed;                  /* 1: O_TMPFILE, no name yet */
+    int error;                    /* errno of the first failed write, 0 */
+    char path[IO_PATH_MAX];
+    char tmp[IO_PATH_MAX + 32];   /* "<path>.tmp.<pid>" */
+} io_out;
+
+io_result io_out_open(io_out *o, const char *path, io_error *err);
+/* Flushes, checks, names the file; closes o in every case. */
+io_result io_out_commit(io_out *o, io_error *err);
+/* Discards the file (nothing is left); safe after a failed open. */
+void io_out_abort(io_out *o);
+/* A whole file from memory, through io_out. */
+io_result io_write_file(const char *path, const void *data, size_t len,
+                        io_error *err);
+
 /* --------------------------------------------------------------- images */
 
 typedef enum io_type { IO_U8 = 0, IO_F32 = 1 } io_type;
@@ -113,6 +146,12 @@ void io_image_free(io_image *img);
  * refused with its name (docs/io.md). The result is validated with
  * kin_model_validate(); free it with kin_model_free(). */
 io_result io_gltf_load(const char *path, kin_model *out, io_error *err);
+/* io_glb_check.c: the container of a binary glTF (header length, chunk
+ * lengths) against its len bytes, so a truncated file says where it ends:
+ * "arms.glb: truncated GLB: the header gives 9000 bytes, the file has 4096
+ * (it ends 4904 bytes early)". IO_OK for data that is not GLB. */
+io_result io_glb_check(const char *path, const void *data, size_t len,
+                       io_error *err);
 
 /* What io_gltf_load_ex drew and skipped (for notes to the user). */
 typedef struct io_gltf_info {
@@ -132,8 +171,6 @@ io_result io_gltf_load_ex(const char *path, int scene, kin_model *out,
                           io_gltf_info *info, io_error *err);
 
 /* ---------------------------------------------------------------- scene */
-
-#define IO_PATH_MAX 1024
 
 /* A recorded sequence to composite (`egofuse render --scene FILE`). The
  * text format is documented in docs/scene.md; relative paths in it are

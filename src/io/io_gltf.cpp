@@ -1565,6 +1565,7 @@ io_result load(const char *path, int scene, kin_model *out, io_gltf_info *info,
     std::vector<unsigned char> bytes;
     io_result r = read_file(path, bytes, err);
     if (r != IO_OK) return r;
+    if ((r = io_glb_check(path, bytes.data(), bytes.size(), err)) != IO_OK) return r;
 
     tinygltf::Model g;
     tinygltf::TinyGLTF parser;

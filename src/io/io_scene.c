@@ -404,6 +404,11 @@ io_result io_scene_load(const char *path, io_scene *out, io_error *err)
         out->dir[n] = '\0';
     }
 
+    io_result r0 = io_check_file(path, err);  /* a folder: "is a directory" */
+    if (r0 != IO_OK) {
+        memset(out, 0, sizeof *out);
+        return r0;
+    }
     FILE *f = fopen(path, "r");
     if (!f) {
         int e = errno;

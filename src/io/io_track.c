@@ -22,6 +22,8 @@
 /* Reads a whole file (NUL-terminated copy). */
 static io_result read_all(const char *path, char **out, size_t *len, io_error *err)
 {
+    io_result r0 = io_check_file(path, err);  /* says "is a directory" */
+    if (r0 != IO_OK) return r0;
     FILE *f = fopen(path, "rb");
     if (!f)
         return io_fail(err, errno == ENOENT ? IO_ERR_NOT_FOUND : IO_ERR_READ, "%s: %s", path,
@@ -46,30 +48,21 @@ static io_result read_all(const char *path, char **out, size_t *len, io_error *e
     }
     int bad = ferror(f);
     fclose(f);
-    if (bad) { free(buf); return io_fail(err, IO_ERR_READ, "%s: read error", path); }
+    if (bad) {
+        int e = errno;
+        free(buf);
+        return io_fail(err, IO_ERR_READ, "%s: read error: %s", path, strerror(e));
+    }
     buf[n] = '\0';
     *out = buf;
     *len = n;
     return IO_OK;
 }
 
-/* Writes len bytes to "<path>.tmp.<pid>" and renames it over path. */
+/* The whole file through io_out: complete or absent (io.h, OUTPUT FILES). */
 static io_result write_atomic(const char *path, const char *data, size_t len, io_error *err)
 {
-    char tmp[IO_PATH_MAX + 32];
-    int w = snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
-    if (w < 0 || (size_t)w >= sizeof tmp) return io_fail(err, IO_ERR_ARGS, "%s: path too long", path);
-    FILE *f = fopen(tmp, "wb");
-    if (!f) return io_fail(err, IO_ERR_WRITE, "%s: %s", tmp, strerror(errno));
-    size_t put = fwrite(data, 1, len, f);
-    int bad = put != len || fflush(f) != 0;
-    if (fclose(f) != 0) bad = 1;
-    if (bad || rename(tmp, path) != 0) {
-        int e = errno;
-        remove(tmp);
-        return io_fail(err, IO_ERR_WRITE, "%s: %s", path, strerror(e));
-    }
-    return IO_OK;
+    return io_write_file(path, data, len, err);
 }
 
 io_result io_track_load(const char *path, kin_track_sample **out, int *count, io_error *err)
