@@ -155,20 +155,23 @@ else
     # of its own; the tracker replays 2 samples and stops
     if command -v gst-launch-1.0 >/dev/null 2>&1; then
         export GST_REGISTRY=/tmp/gst-registry.bin XDG_CACHE_HOME=/tmp
+        # the plugin registry once, before the timed pipeline (slow under TCG)
+        gst-inspect-1.0 videotestsrc > /dev/null 2>&1
         "$EGOFUSE" replay-track "$S/track.txt" --to natnet:127.0.0.1:1510 > "$CK/replay2.log" 2>&1 &
         RP=$!
         gst-launch-1.0 -q videotestsrc num-buffers=4 pattern=smpte ! \
             video/x-raw,format=I420,width=640,height=200,framerate=30/1 ! y4menc ! fdsink fd=1 2> "$CK/gst.err" |
             "$EGOFUSE" run --scene "$S/scene.txt" --left /dev/video0 --right /dev/video1 --input 1 --dv \
-            --fps 60 --virt-source stream:- --natnet 127.0.0.1 --frames 12 --raw \
+            --fps 60 --virt-source stream:- --natnet 127.0.0.1 --frames 16 --raw \
             > /dev/null 2> "$CK/run2.err"
         rc=$?
+        kill $RP 2>/dev/null
         wait $RP 2>/dev/null
         sum=$(tr '\r' '\n' < "$CK/run2.err" | grep 'stereo frames' | tail -n 1)
         echo "VMINFO cockpit2 $sum"
-        if [ $rc -eq 0 ] && echo "$sum" | grep -q '^egofuse run: 12 stereo frames' &&
+        if [ $rc -eq 0 ] && echo "$sum" | grep -q '^egofuse run: 16 stereo frames' &&
             echo "$sum" | grep -q 'V ended (last good held' && echo "$sum" | grep -q 'tracker stale'; then
-            echo "VMTEST cockpit_sources_end PASS V from gst-launch-1.0 ended and the tracker stopped mid-run: reported, 12 frames composited"
+            echo "VMTEST cockpit_sources_end PASS V from gst-launch-1.0 ended and the tracker stopped mid-run: reported, 16 frames composited"
         else
             echo "VMTEST cockpit_sources_end FAIL exit $rc: $sum $(tail -c 300 "$CK/run2.err") $(cat "$CK/gst.err")"
             fail=1
