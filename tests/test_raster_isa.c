@@ -1235,7 +1235,10 @@ static void test_frontv_equal(void **state)
         rast_context_desc d = { simd[i], 1 };
         rast_context *c = rast_context_create(&d);
         assert_non_null(c);
-        assert_int_equal(rast_context_isa(c), simd[i]);
+        /* EGOFUSE_ISA caps the context too (the records above call the
+         * set-up of simd[i] directly): its draws against the reference
+         * hold either way. */
+        assert_int_equal(rast_context_isa(c), ef_isa_choose((ef_isa)simd[i]));
         for (int n = 0; n < 300; n++) {
             rcase k;
             make_mesh(n, &k);
