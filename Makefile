@@ -5,6 +5,8 @@
 #   make test       install what is missing, build, run every test
 #   make debug      the same tests under ASan + UBSan (build-debug/)
 #   make bench      benchmarks (they report, never pass or fail)
+#   make core-tests the core library and its tests only (no io library):
+#                   the ARM64 cross build of CI, .ci/run and docs/portability.md
 #   make clean
 #
 # Core (src/raster, src/kin, src/fuse): libc + libm + pthreads only, built
@@ -23,6 +25,16 @@ CFLAGS   += -std=c11 $(CFLAGS_COMMON)
 CXXFLAGS += -std=c++17 $(CFLAGS_COMMON)
 LDFLAGS  += $(SAN)
 
+# The target machine of $(CC) (x86_64-linux-gnu, aarch64-linux-gnu, ...):
+# the x86 ISA files get their -m flags only there (elsewhere they compile
+# to nothing and the dispatch keeps the portable path, src/cpu/cpu.c).
+TARGET   := $(shell $(CC) -dumpmachine 2>/dev/null)
+X86      := $(if $(filter x86_64-% i386-% i486-% i586-% i686-%,$(TARGET)),1,)
+# cmocka: the system's, or another one (CI's ARM64 cross build passes
+# the arm64 package unpacked into a folder, .ci/run).
+CMOCKA_CFLAGS ?=
+CMOCKA_LIBS   ?= -lcmocka
+
 CORE_SRC := $(wildcard src/cpu/*.c src/pipe/*.c src/raster/*.c src/kin/*.c src/fuse/*.c)
 IO_SRC   := $(wildcard src/io/*.c)
 IO_CXX   := $(wildcard src/io/*.cpp)
@@ -30,6 +42,9 @@ CLI_SRC  := $(wildcard src/cli/*.c)
 GEN_SRC  := $(wildcard samples/gen/*.c)
 GT_SRC   := $(wildcard samples/gt/*.c)
 TEST_SRC := $(wildcard tests/test_*.c)
+# Tests of the io library, the samples or the VM: not part of core-tests.
+IO_TEST_SRC := $(shell grep -lE 'src/io/|samples/' $(TEST_SRC)) tests/test_vm.c
+CORE_TEST_SRC := $(filter-out $(IO_TEST_SRC),$(TEST_SRC))
 TEST_SHARED := $(wildcard tests/support/*.c)
 BENCH_SRC := $(wildcard bench/bench_*.c)
 LLVMPIPE_SRC := $(wildcard bench/llvmpipe/*.c)
@@ -44,12 +59,21 @@ GEN_OBJ  := $(call obj,$(GEN_SRC))
 SAMPLES_LIB_OBJ := $(filter-out %/gen_main.c.o,$(GEN_OBJ)) $(call obj,$(GT_SRC))
 TEST_SHARED_OBJ := $(call obj,$(TEST_SHARED))
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
+CORE_TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(CORE_TEST_SRC))
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC)) \
              $(patsubst bench/llvmpipe/%.c,$(BUILD)/bench/%,$(LLVMPIPE_SRC))
 
 IO_PKGS  := OpenImageIO tinygltf libusb-1.0 libv4l2
+ifeq ($(CORE_ONLY),1)
+# core-tests: the tests link the core library alone.
+IO_CFLAGS :=
+IO_LIBS  :=
+TEST_IOLIB :=
+else
 IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) 2>/dev/null)
 IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lstdc++
+TEST_IOLIB = $(IOLIB)
+endif
 SYS_LIBS := -lm -lpthread
 # Peers measured by the benchmarks: pixman (compositing), Mesa llvmpipe
 # through EGL + GLES (the same frame as GL shaders).
@@ -64,7 +88,7 @@ EGOFUSE  := $(BUILD)/egofuse
 GEN      := $(BUILD)/gen_samples
 SAMPLES  := $(BUILD)/samples
 
-.PHONY: all deps demo test debug bench clean samples check-headers eval
+.PHONY: all deps demo test debug bench clean samples check-headers eval core-tests
 .DEFAULT_GOAL := all
 # Keep intermediate objects (tests/support/*.o), so a second make rebuilds nothing.
 .SECONDARY:
@@ -75,9 +99,16 @@ deps:
 	@sh scripts/deps.sh
 
 # Per-ISA files get their own flags; everything else stays at the baseline.
+ifeq ($(X86),1)
 $(BUILD)/obj/%_avx2.c.o: CFLAGS += -mavx2 -mf16c
 $(BUILD)/obj/%_avx512.c.o: CFLAGS += -mavx512f -mavx512bw -mavx512dq -mavx512vl -mavx2 -mf16c
 $(BUILD)/obj/%_sse41.c.o: CFLAGS += -msse4.1
+endif
+
+# The core library and the tests that need nothing else (CORE_ONLY=1 so
+# that they link without the io library): CI's ARM64 cross build,
+#   make CORE_ONLY=1 CC=aarch64-linux-gnu-gcc BUILD=build-arm64 core-tests
+core-tests: $(LIB) $(CORE_TEST_BIN)
 
 $(BUILD)/obj/src/io/%.o: CFLAGS += $(IO_CFLAGS)
 $(BUILD)/obj/src/io/%.o: CXXFLAGS += $(IO_CFLAGS) -Wno-unused-parameter
@@ -108,10 +139,10 @@ $(EGOFUSE): $(CLI_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB)
 $(GEN): $(BUILD)/obj/samples/gen/gen_main.c.o $(SAMPLESLIB) $(IOLIB) $(LIB)
 	$(CXX) $(LDFLAGS) -o $@ $< $(SAMPLESLIB) $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
 
-$(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(IOLIB) $(LIB)
+$(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(TEST_IOLIB) $(LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(IOLIB) $(LIB) \
-	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
+	$(CC) $(CFLAGS) $(IO_CFLAGS) $(CMOCKA_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(TEST_IOLIB) $(LIB) \
+	    $(CMOCKA_LIBS) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
 $(BUILD)/bench/%: bench/%.c $(IOLIB) $(LIB)
 	@mkdir -p $(dir $@)
