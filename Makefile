@@ -194,6 +194,6 @@ bench: deps
 	@sh bench/run_bench.sh $(BUILD)
 
 clean:
-	rm -rf build build-debug out
+	rm -rf build build-debug build-clang build-arm64 out
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
