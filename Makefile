@@ -5,6 +5,8 @@
 #   make test       install what is missing, build, run every test
 #   make debug      the same tests under ASan + UBSan (build-debug/)
 #   make bench      benchmarks (they report, never pass or fail)
+#   make core-tests the core library and its tests only (no io library):
+#                   the ARM64 cross build of CI, .ci/run and docs/portability.md
 #   make clean
 #
 # Core (src/raster, src/kin, src/fuse): libc + libm + pthreads only, built
@@ -23,6 +25,16 @@ CFLAGS   += -std=c11 $(CFLAGS_COMMON)
 CXXFLAGS += -std=c++17 $(CFLAGS_COMMON)
 LDFLAGS  += $(SAN)
 
+# The target machine of $(CC) (x86_64-linux-gnu, aarch64-linux-gnu, ...):
+# the x86 ISA files get their -m flags only there (elsewhere they compile
+# to nothing and the dispatch keeps the portable path, src/cpu/cpu.c).
+TARGET   := $(shell $(CC) -dumpmachine 2>/dev/null)
+X86      := $(if $(filter x86_64-% i386-% i486-% i586-% i686-%,$(TARGET)),1,)
+# cmocka: the system's, or another one (CI's ARM64 cross build passes
+# the arm64 package unpacked into a folder, .ci/run).
+CMOCKA_CFLAGS ?=
+CMOCKA_LIBS   ?= -lcmocka
+
 CORE_SRC := $(wildcard src/cpu/*.c src/pipe/*.c src/raster/*.c src/kin/*.c src/fuse/*.c)
 IO_SRC   := $(wildcard src/io/*.c)
 # io_image_oiio.cpp is the OpenImageIO plugin, not part of the io library.
@@ -31,6 +43,9 @@ CLI_SRC  := $(wildcard src/cli/*.c)
 GEN_SRC  := $(wildcard samples/gen/*.c)
 GT_SRC   := $(wildcard samples/gt/*.c)
 TEST_SRC := $(wildcard tests/test_*.c)
+# Tests of the io library, the samples or the VM: not part of core-tests.
+IO_TEST_SRC := $(shell grep -lE 'src/io/|samples/' $(TEST_SRC)) tests/test_vm.c
+CORE_TEST_SRC := $(filter-out $(IO_TEST_SRC),$(TEST_SRC))
 TEST_SHARED := $(wildcard tests/support/*.c)
 BENCH_SRC := $(wildcard bench/bench_*.c)
 LLVMPIPE_SRC := $(wildcard bench/llvmpipe/*.c)
@@ -45,14 +60,25 @@ GEN_OBJ  := $(call obj,$(GEN_SRC))
 SAMPLES_LIB_OBJ := $(filter-out %/gen_main.c.o,$(GEN_OBJ)) $(call obj,$(GT_SRC))
 TEST_SHARED_OBJ := $(call obj,$(TEST_SHARED))
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
+CORE_TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(CORE_TEST_SRC))
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC)) \
              $(patsubst bench/llvmpipe/%.c,$(BUILD)/bench/%,$(LLVMPIPE_SRC))
 
 IO_PKGS  := libpng tinygltf libusb-1.0 libv4l2 libdrm
+ifeq ($(CORE_ONLY),1)
+# core-tests: the tests link the core library alone.
+IO_CFLAGS :=
+IO_LIBS  :=
+TEST_IOLIB :=
+TEST_PLUGIN :=
+else
 # SDL2: headers only; src/io/io_display_sdl.c loads libSDL2 with dlopen when
 # a window is opened, so the program does not link it.
 IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) sdl2 2>/dev/null)
 IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lmeshoptimizer -lstdc++ -ldl
+TEST_IOLIB = $(IOLIB)
+TEST_PLUGIN = $(OIIO_PLUGIN)
+endif
 # OpenImageIO (EXR, TIFF, JPEG ...) lives in a plugin that io_image.c loads
 # with dlopen only when a file is neither PNG nor PPM/PGM (docs/io.md), so
 # no command pays for its ~260 libraries unless it reads or writes such a
@@ -77,7 +103,7 @@ EGOFUSE  := $(BUILD)/egofuse
 GEN      := $(BUILD)/gen_samples
 SAMPLES  := $(BUILD)/samples
 
-.PHONY: all deps demo test debug bench clean samples check-headers eval
+.PHONY: all deps demo test debug bench clean samples check-headers eval core-tests
 .DEFAULT_GOAL := all
 # Keep intermediate objects (tests/support/*.o), so a second make rebuilds nothing.
 .SECONDARY:
@@ -88,9 +114,16 @@ deps:
 	@sh scripts/deps.sh
 
 # Per-ISA files get their own flags; everything else stays at the baseline.
+ifeq ($(X86),1)
 $(BUILD)/obj/%_avx2.c.o: CFLAGS += -mavx2 -mf16c
 $(BUILD)/obj/%_avx512.c.o: CFLAGS += -mavx512f -mavx512bw -mavx512dq -mavx512vl -mavx2 -mf16c
 $(BUILD)/obj/%_sse41.c.o: CFLAGS += -msse4.1
+endif
+
+# The core library and the tests that need nothing else (CORE_ONLY=1 so
+# that they link without the io library): CI's ARM64 cross build,
+#   make CORE_ONLY=1 CC=aarch64-linux-gnu-gcc BUILD=build-arm64 core-tests
+core-tests: $(LIB) $(CORE_TEST_BIN)
 
 $(BUILD)/obj/src/io/%.o: CFLAGS += $(IO_CFLAGS)
 $(BUILD)/obj/src/io/%.o: CXXFLAGS += $(IO_CFLAGS) -Wno-unused-parameter
@@ -132,10 +165,10 @@ $(EGOFUSE): $(CLI_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 $(GEN): $(BUILD)/obj/samples/gen/gen_main.c.o $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	$(CXX) $(LDFLAGS) -o $@ $< $(SAMPLESLIB) $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
 
-$(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
+$(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(TEST_IOLIB) $(LIB) | $(TEST_PLUGIN)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(IOLIB) $(LIB) \
-	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
+	$(CC) $(CFLAGS) $(IO_CFLAGS) $(CMOCKA_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(TEST_IOLIB) $(LIB) \
+	    $(CMOCKA_LIBS) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
 # Tests on the generated samples' scenes also link the generator.
 $(BUILD)/tests/test_occlusion: tests/test_occlusion.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
@@ -195,6 +228,6 @@ bench: deps
 	@sh bench/run_bench.sh $(BUILD)
 
 clean:
-	rm -rf build build-debug out
+	rm -rf build build-debug build-clang build-arm64 out
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -11,6 +11,22 @@
 # Called by `make demo`, `make test` and `make bench`; safe to run again (it
 # only installs what is missing). As a non-root user it prints the exact
 # apt-get line and stops.
+#
+#   sh scripts/deps.sh              the packages above
+#   sh scripts/deps.sh ci           also CI's: clang, the ARM64 cross
+#                                   compiler and qemu-user (.ci/run)
+#   sh scripts/deps.sh arm64 DIR    CI's ARM64 cross build: the arm64
+#                                   architecture added to dpkg and cmocka
+#                                   for arm64 unpacked into DIR (nothing
+#                                   installed; empty DIR when the multiarch
+#                                   libcmocka-dev:arm64 is installed)
+#
+# A package counts as installed when dpkg has it for this machine's own
+# architecture (or as Architecture: all): with foreign architectures added
+# (dpkg --add-architecture), dpkg-query lists one entry per architecture.
+# An index that cannot be fetched (often a foreign architecture's) does not
+# stop the set-up: apt-get install then works with the indexes there are,
+# and only a package it cannot install is an error.
 set -eu
 
 PKGS="build-essential pkg-config
@@ -24,23 +40,94 @@ libpixman-1-dev
 libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
 ffmpeg gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good python3
 qemu-system-x86 busybox-static cpio kmod xz-utils"
+# .ci/run: a clang build, the ARM64 cross build under qemu-user, and
+# scripts/rng_order.py (clang's AST, python3).
+CI_PKGS="clang gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user-static python3"
 
-missing=""
-for p in $PKGS; do
-    st=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
-    [ "$st" = "installed" ] || missing="$missing $p"
-done
-[ -z "$missing" ] && exit 0
+mode=${1:-}
+native=$(dpkg --print-architecture)
 
-if [ "$(id -u)" != "0" ]; then
-    echo "egofuse: these Debian packages are missing:$missing" >&2
-    echo "egofuse: install them as root, then run make again:" >&2
-    echo "  sudo apt-get install -y$missing" >&2
-    exit 1
-fi
+# 0 if package $1 is installed for the native architecture (or for all).
+installed() {
+    dpkg-query -W -f='${Architecture} ${db:Status-Status}\n' "$1" 2>/dev/null |
+        grep -Eq "^($native|all) installed\$"
+}
 
-echo "egofuse: installing missing Debian packages:$missing"
-export DEBIAN_FRONTEND=noninteractive
-apt-get update -qq
-# shellcheck disable=SC2086
-apt-get install -y -qq --no-install-recommends $missing
+as_root() {
+    if [ "$(id -u)" != "0" ]; then
+        echo "egofuse: as root, run:" >&2
+        echo "  $*" >&2
+        exit 1
+    fi
+}
+
+apt_update() {
+    if ! apt-get update -qq; then
+        echo "egofuse: apt-get update could not fetch every index (a foreign" >&2
+        echo "egofuse: architecture's?); installing from the indexes there are" >&2
+    fi
+}
+
+install_missing() {
+    missing=""
+    for p in "$@"; do
+        installed "$p" || missing="$missing $p"
+    done
+    [ -z "$missing" ] && return 0
+    if [ "$(id -u)" != "0" ]; then
+        echo "egofuse: these Debian packages are missing:$missing" >&2
+        echo "egofuse: install them as root, then run make again:" >&2
+        echo "  sudo apt-get install -y$missing" >&2
+        exit 1
+    fi
+    echo "egofuse: installing missing Debian packages:$missing"
+    export DEBIAN_FRONTEND=noninteractive
+    apt_update
+    # shellcheck disable=SC2086
+    if ! apt-get install -y -qq --no-install-recommends $missing; then
+        echo "egofuse: apt-get could not install:$missing" >&2
+        exit 1
+    fi
+}
+
+case "$mode" in
+"")
+    # shellcheck disable=SC2086
+    install_missing $PKGS
+    ;;
+ci)
+    # shellcheck disable=SC2086
+    install_missing $PKGS $CI_PKGS
+    ;;
+arm64)
+    dir=${2:?usage: deps.sh arm64 DIR}
+    # shellcheck disable=SC2086
+    install_missing $CI_PKGS
+    if [ -e /usr/lib/aarch64-linux-gnu/libcmocka.so ]; then
+        exit 0   # the multiarch package: the cross compiler finds it
+    fi
+    [ -e "$dir/usr/lib/aarch64-linux-gnu/libcmocka.so" ] && exit 0
+    if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+        as_root "dpkg --add-architecture arm64 && apt-get update"
+        dpkg --add-architecture arm64
+        apt_update
+    fi
+    mkdir -p "$dir/debs"
+    # apt-get download needs no lock and no root: the .debs are unpacked,
+    # not installed.
+    if ! (cd "$dir/debs" && apt-get download -qq libcmocka0:arm64 libcmocka-dev:arm64); then
+        [ "$(id -u)" = "0" ] && apt_update
+        if ! (cd "$dir/debs" && apt-get download -qq libcmocka0:arm64 libcmocka-dev:arm64); then
+            echo "egofuse: cannot download libcmocka0:arm64 libcmocka-dev:arm64" >&2
+            exit 1
+        fi
+    fi
+    for d in "$dir"/debs/*.deb; do
+        dpkg-deb -x "$d" "$dir"
+    done
+    ;;
+*)
+    echo "usage: deps.sh [ci | arm64 DIR]" >&2
+    exit 2
+    ;;
+esac

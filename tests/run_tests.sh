@@ -2,6 +2,8 @@
 # Runs every test binary in BUILD/tests and prints one closing line
 # "N passed, N failed, N skipped" for the whole suite. A binary that dies
 # without reporting counts as one failure. Exit status 0 only if none failed.
+# EGOFUSE_RUNNER, when set, runs each binary (a cross build under qemu:
+# EGOFUSE_RUNNER="qemu-aarch64-static -L /usr/aarch64-linux-gnu").
 BUILD=${1:-build}
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 export EGOFUSE_BIN="$ROOT/$BUILD/egofuse"
@@ -16,7 +18,8 @@ for t in "$ROOT/$BUILD"/tests/test_*; do
     [ -x "$t" ] || continue
     name=$(basename "$t")
     log="$EGOFUSE_TMP/$name.log"
-    "$t" >"$log" 2>&1
+    # shellcheck disable=SC2086
+    ${EGOFUSE_RUNNER:-} "$t" >"$log" 2>&1
     rc=$?
     # cmocka prints one summary per group: add them all up.
     sum() { sed -n "s/^\[  $1 *\] \([0-9][0-9]*\) test(s).*/\1/p" "$log" | awk '{n+=$1} END {print n+0}'; }

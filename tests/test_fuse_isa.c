@@ -665,7 +665,10 @@ static int opaque_diff(const char *what, const char *isa, int n, const frame_eye
 /* fuse_context_frame on every ISA and 1..3 threads with 1..3 eyes equals
  * the reference stages one by one: the composite and the layer Q; also with
  * v_opaque = 1 (opaque_diff: a third of the cases have V opaque everywhere,
- * a third opaque inside the viewport and not outside, a third not). */
+ * a third opaque inside the viewport and not outside, a third not), where
+ * every ISA also gives the bytes of the reference with v_opaque = 1, alpha
+ * included when the promise is broken (issue 20: the reference used to
+ * ignore the flag). */
 static void test_frame_cases(void **state)
 {
     enum { FRAMES = 150 };
@@ -697,10 +700,22 @@ static void test_frame_cases(void **state)
         buf wq[3], wo[3];
         fuse_eye f[3];
         int k;
+        buf wp[3];
         for (k = 0; k < count; k++) {
             frame_eye_make(&r, &e[k]);
             frame_eye_expect(ref, &e[k], &wq[k], &wo[k]);
             kinds[v_opaque_kind(&e[k])]++;
+        }
+        /* The reference with v_opaque = 1 (wp): every ISA gives its bytes,
+         * with the promise broken too. */
+        for (k = 0; k < count; k++) {
+            f[k] = frame_eye_bind(&e[k]);
+            f[k].v_opaque = 1;
+        }
+        assert_int_equal(fuse_context_frame(ctx[N_SIMD][0], f, count), FUSE_OK);
+        for (k = 0; k < count; k++) {
+            wp[k] = buf_new(e[k].out.n, 0);
+            memcpy(wp[k].p, e[k].out.p, e[k].out.n);
         }
         for (i = 0; i <= N_SIMD; i++)
             for (t = 0; t < 3; t++)
@@ -717,7 +732,9 @@ static void test_frame_cases(void **state)
                              t + 1, op);
                     if (op)
                         bad += opaque_diff(what, ef_isa_name(fuse_context_isa(ctx[i][t])), n, &e[k],
-                                           &wo[k], &e[k].out);
+                                           &wo[k], &e[k].out) ||
+                               report_diff(what, ef_isa_name(fuse_context_isa(ctx[i][t])), n,
+                                           &wp[k], &e[k].out, 4 * e[k].W);
                     else
                         bad += report_diff(what, ef_isa_name(fuse_context_isa(ctx[i][t])), n,
                                            &wo[k], &e[k].out, 4 * e[k].W);
@@ -730,6 +747,7 @@ static void test_frame_cases(void **state)
         for (k = 0; k < count; k++) {
             free(wq[k].p);
             free(wo[k].p);
+            free(wp[k].p);
             frame_eye_free(&e[k]);
         }
     }

@@ -21,7 +21,8 @@ static void fill_random(io_image *img, tu_rng *rng)
                 row[x] = (unsigned char)tu_int(rng, 256);
             else {
                 /* any finite float, depths included: mantissa and exponent */
-                float v = tu_range(rng, -4.0f, 4.0f) * powf(10.0f, (float)tu_int(rng, 7) - 3.0f);
+                const float m = tu_range(rng, -4.0f, 4.0f);   /* drawn in order */
+                float v = m * powf(10.0f, (float)tu_int(rng, 7) - 3.0f);
                 memcpy(row + (size_t)x * 4, &v, 4);
             }
         }

@@ -8,6 +8,7 @@
  * effect: the calibrated rig reaches targets the model's own
  * arm cannot. */
 #include "support/testutil.h"
+#include "support/tu_kin.h"
 #include <cmocka.h>
 
 #include <math.h>
@@ -39,16 +40,16 @@ static int record(kin_track_sample *s, int n, float arm_len, float width, tu_rng
         s[i].head_pos = kin_v3(0, 1.3f, -0.08f);
         for (int k = 0; k < 2; k++) {
             float sx = k ? 1.0f : -1.0f;
-            kin_vec3 sh = kin_v3(0.5f * width * sx + 0.002f * tu_range(g, -1, 1), 1.0f,
-                                 0.002f * tu_range(g, -1, 1));
+            const float jx = tu_range(g, -1, 1);   /* drawn in order (tu_kin.h) */
+            const float jz = tu_range(g, -1, 1);
+            kin_vec3 sh = kin_v3(0.5f * width * sx + 0.002f * jx, 1.0f, 0.002f * jz);
             kin_vec3 dir;
             int phase = (i / 50) % 5;
             if (phase == 0) dir = kin_v3(0, 0, -1);
             else if (phase == 1) dir = kin_v3(sx, 0, 0);
             else dir = kin_v3_norm(kin_v3(0.3f * sx, -0.5f, -1));
             float len = phase <= 1 ? arm_len : arm_len * tu_range(g, 0.4f, 0.85f);
-            kin_vec3 noise = kin_v3(0.002f * tu_range(g, -1, 1), 0.002f * tu_range(g, -1, 1),
-                                    0.002f * tu_range(g, -1, 1));
+            kin_vec3 noise = kin_v3_scale(tu_v3(g, -1, 1), 0.002f);
             s[i].shoulder[k] = sh;
             s[i].hand_pos[k] = kin_v3_add(kin_v3_add(sh, kin_v3_scale(dir, len)), noise);
         }
@@ -90,8 +91,7 @@ static int gesture(kin_track_sample *s, int n, float scale, float gap, float noi
         s[i].hand_pos[1] = kin_v3_add(kin_v3_sub(C, tr), kin_v3_scale(x, 0.5f * gap));
         for (int k = 0; k < 2; k++)
             s[i].hand_pos[k] = kin_v3_add(s[i].hand_pos[k],
-                                          kin_v3(noise * tu_range(g, -1, 1), noise * tu_range(g, -1, 1),
-                                                 noise * tu_range(g, -1, 1)));
+                                          kin_v3_scale(tu_v3(g, -1, 1), noise));
     }
     return n;
 }

@@ -3,6 +3,7 @@
  * against the pinhole formula u = cx + fx X/-Z, v = cy - fy Y/-Z with the
  * rasterizer's viewport (u = (x_ndc/2 + 1/2) W, v = (1/2 - y_ndc/2) H). */
 #include "support/testutil.h"
+#include "support/tu_kin.h"
 #include <cmocka.h>
 
 #include <math.h>
@@ -188,8 +189,7 @@ static void result_projection_pinhole(void **state)
     for (int e = 0; e < 2; e++) {
         c = kin_sthmd_camera(NULL, &head, (kin_eye)e);
         for (int i = 0; i < 200; i++) {
-            kin_vec3 pv = kin_v3(tu_range(&g, -0.3f, 0.3f), tu_range(&g, -0.2f, 0.2f),
-                                 tu_range(&g, -1.0f, -0.15f));
+            kin_vec3 pv = tu_v3b(&g, -0.3f, 0.3f, -0.2f, 0.2f, -1.0f, -0.15f);
             kin_vec3 pw = kin_mat4_mul_point(&c.world_from_cam, pv);
             kin_vec3 q = kin_mat4_mul_point(&c.view, pw);
             project(&c, pw, &u, &v, NULL);
@@ -255,7 +255,7 @@ static void result_look_at_camera(void **state)
     /* and the pinhole formula for seeded view-space points */
     tu_rng g = { 0x6b696e07 };
     for (int i = 0; i < 100; i++) {
-        kin_vec3 pv = kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1), tu_range(&g, -5, -0.5f));
+        kin_vec3 pv = tu_v3b(&g, -1, 1, -1, 1, -5, -0.5f);
         project(&c, kin_mat4_mul_point(&c.world_from_cam, pv), &u, &v, NULL);
         NEAR(u, 400 + fy * pv.x / -pv.z, PX_TOL);
         NEAR(v, 300 - fy * pv.y / -pv.z, PX_TOL);

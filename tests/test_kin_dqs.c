@@ -8,6 +8,7 @@
  * every ISA, with weight sums from 1e-30 to 1e30; b.r = 0 with a nonzero
  * weight sum keeps the bind pose. */
 #include "support/testutil.h"
+#include "support/tu_kin.h"
 #include <cmocka.h>
 
 #include <math.h>
@@ -19,8 +20,7 @@
 
 static kin_quat rand_q(tu_rng *g)
 {
-    return kin_quat_normalize((kin_quat){ tu_range(g, -1, 1), tu_range(g, -1, 1),
-                                          tu_range(g, -1, 1), tu_range(g, -1, 1) });
+    return kin_quat_normalize(tu_quat(g, -1, 1));
 }
 
 static kin_mesh mesh_of(int n, const float *pos, const float *nrm, const uint16_t *j,
@@ -108,10 +108,10 @@ static void result_dualquat_matches_matrix(void **state)
     tu_rng g = { 0x64717331 };
     for (int i = 0; i < 200; i++) {
         kin_quat r = rand_q(&g);
-        kin_vec3 t = kin_v3(tu_range(&g, -2, 2), tu_range(&g, -2, 2), tu_range(&g, -2, 2));
+        kin_vec3 t = tu_v3(&g, -2, 2);
         kin_mat4 m = kin_mat4_from_tr(t, r);
         kin_dualquat q = kin_dualquat_from_mat4(&m);
-        kin_vec3 p = kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1), tu_range(&g, -1, 1));
+        kin_vec3 p = tu_v3(&g, -1, 1);
         kin_vec3 a = kin_mat4_mul_point(&m, p), b = kin_dualquat_transform(&q, p);
         NEAR(a.x, b.x, 2e-6); NEAR(a.y, b.y, 2e-6); NEAR(a.z, b.z, 2e-6);
         /* a uniform scale in the matrix is removed */
@@ -130,7 +130,9 @@ static void result_rigid_vertices_equal_lbs(void **state)
     float pos[N * 3], nrm[N * 3], w[N * 4], pl[N * 3], nl[N * 3], pd[N * 3], nd[N * 3];
     uint16_t jt[N * 4];
     for (int v = 0; v < N; v++) {
-        kin_vec3 n = kin_v3_norm(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1), 0.3f));
+        const float nx = tu_range(&g, -1, 1);   /* drawn in order (tu_kin.h) */
+        const float ny = tu_range(&g, -1, 1);
+        kin_vec3 n = kin_v3_norm(kin_v3(nx, ny, 0.3f));
         memcpy(nrm + 3 * v, &n, sizeof n);
         for (int c = 0; c < 3; c++) pos[3 * v + c] = tu_range(&g, -1, 1);
         for (int i = 0; i < 4; i++) { jt[4 * v + i] = (uint16_t)tu_int(&g, J); w[4 * v + i] = 0; }
@@ -138,8 +140,12 @@ static void result_rigid_vertices_equal_lbs(void **state)
     }
     kin_mat4 jm[J];
     kin_dualquat dq[J];
-    for (int j = 0; j < J; j++)
-        jm[j] = kin_mat4_from_tr(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1), 0), rand_q(&g));
+    for (int j = 0; j < J; j++) {
+        const float tx = tu_range(&g, -1, 1);   /* drawn in order (tu_kin.h) */
+        const float ty = tu_range(&g, -1, 1);
+        const kin_quat q = rand_q(&g);
+        jm[j] = kin_mat4_from_tr(kin_v3(tx, ty, 0), q);
+    }
     kin_skin_dq_from_matrices(jm, J, dq);
     /* antipodal quaternions describe the same joint */
     dq[2].r = (kin_quat){ -dq[2].r.x, -dq[2].r.y, -dq[2].r.z, -dq[2].r.w };
@@ -244,8 +250,9 @@ static void result_matches_normalised_kavan_in_double(void **state)
     static uint16_t jt[N * 4];
     kin_dualquat dq[J];
     for (int j = 0; j < J; j++) {
-        kin_mat4 m = kin_mat4_from_tr(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1),
-                                             tu_range(&g, -1, 1)), rand_q(&g));
+        const kin_vec3 t = tu_v3(&g, -1, 1);   /* drawn in order (tu_kin.h) */
+        const kin_quat q = rand_q(&g);
+        kin_mat4 m = kin_mat4_from_tr(t, q);
         dq[j] = kin_dualquat_from_mat4(&m);
         if (j % 2) { /* the antipodal form of the same transform */
             float *f = &dq[j].r.x;
@@ -254,8 +261,7 @@ static void result_matches_normalised_kavan_in_double(void **state)
     }
     for (int v = 0; v < N; v++) {
         float len = v % 5 == 0 ? 2.5f : 1.0f;      /* some non-unit normals */
-        kin_vec3 n = kin_v3_scale(kin_v3_norm(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1),
-                                                     tu_range(&g, -1, 1))), len);
+        kin_vec3 n = kin_v3_scale(kin_v3_norm(tu_v3(&g, -1, 1)), len);
         memcpy(nrm + 3 * v, &n, sizeof n);
         for (int c = 0; c < 3; c++) pos[3 * v + c] = tu_range(&g, -1, 1);
         int k = 1 + tu_int(&g, 4);
@@ -338,7 +344,8 @@ static void sweep_wrist_twist_volume(void **state)
                 NEAR(pd[3 * (r * K + k) + 2], pos[3 * (r * K + k) + 2], 1e-6); /* stays in plane */
             }
         }
-        vl /= RINGS; vd /= RINGS;
+        vl /= RINGS; vd /= RINGS; vw /= RINGS;
+        NEAR(vl, vw, 1e-4);
         NEAR(vd, 1.0, 1e-4);
         if (vl < worst_lbs) worst_lbs = vl;
         if (deg == 180 || deg == -180) {

@@ -1,6 +1,7 @@
 /* test_kin_fk.c - forward kinematics (kin_fk.c) and model validation
  * (kin_model.c). World positions are worked by hand for 90 degree turns. */
 #include "support/testutil.h"
+#include "support/tu_kin.h"
 #include <cmocka.h>
 
 #include <math.h>
@@ -255,9 +256,11 @@ static void result_fk_mat_agrees(void **state)
     kin_mat4 lm[N], w1[N], w2[N];
     for (int i = 0; i < N; i++) {
         parents[i] = (int16_t)(i == 0 ? KIN_NO_PARENT : tu_int(&g, i));
-        loc[i].t = kin_v3(tu_range(&g, -0.3f, 0.3f), tu_range(&g, -0.3f, 0.3f), tu_range(&g, -0.3f, 0.3f));
-        loc[i].r = kin_quat_axis_angle(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1), 1),
-                                       tu_range(&g, -PI_F, PI_F));
+        loc[i].t = tu_v3(&g, -0.3f, 0.3f);
+        const float ax = tu_range(&g, -1, 1);   /* drawn in order (tu_kin.h) */
+        const float ay = tu_range(&g, -1, 1);
+        const float angle = tu_range(&g, -PI_F, PI_F);
+        loc[i].r = kin_quat_axis_angle(kin_v3(ax, ay, 1), angle);
         loc[i].s = kin_v3(1, 1, 1);
         lm[i] = kin_mat4_from_transform(&loc[i]);
     }

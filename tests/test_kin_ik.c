@@ -5,6 +5,7 @@
  * no NaN and no jump above the bounds stated in docs/tracking.md. Also the
  * arm rig on a small model built here (names, errors, pose). */
 #include "support/testutil.h"
+#include "support/tu_kin.h"
 #include <cmocka.h>
 
 #include <math.h>
@@ -167,10 +168,8 @@ static void result_swivel_follows_hand(void **state)
      * direction alone would (gain <= 1 never overshoots) */
     tu_rng g = { 0x737769 };
     for (int it = 0; it < 500; it++) {
-        kin_quat hr = kin_quat_normalize((kin_quat){ tu_range(&g, -1, 1), tu_range(&g, -1, 1),
-                                                     tu_range(&g, -1, 1), tu_range(&g, -1, 1) });
-        kin_vec3 w = kin_v3(tu_range(&g, -0.4f, 0.4f), tu_range(&g, -0.4f, 0.4f),
-                            tu_range(&g, -0.4f, -0.1f));
+        kin_quat hr = kin_quat_normalize(tu_quat(&g, -1, 1));
+        kin_vec3 w = tu_v3b(&g, -0.4f, 0.4f, -0.4f, 0.4f, -0.4f, -0.1f);
         kin_arm_ik_job k = job_of(kin_v3(0, 0, 0), w, hr, KIN_SIDE_RIGHT), k0;
         k0 = k;
         k0.hand_gain = 1e-9f;
@@ -254,11 +253,9 @@ static void result_left_mirrors_right(void **state)
     (void)state;
     tu_rng g = { 0x6d697272 };
     for (int it = 0; it < 100; it++) {
-        kin_quat hr = kin_quat_normalize((kin_quat){ tu_range(&g, -1, 1), tu_range(&g, -1, 1),
-                                                     tu_range(&g, -1, 1), tu_range(&g, -1, 1) });
+        kin_quat hr = kin_quat_normalize(tu_quat(&g, -1, 1));
         kin_vec3 s = kin_v3(0.19f, 1.0f, 0.0f);
-        kin_vec3 w = kin_v3(tu_range(&g, -0.3f, 0.7f), tu_range(&g, 0.5f, 1.5f),
-                            tu_range(&g, -0.6f, 0.2f));
+        kin_vec3 w = tu_v3b(&g, -0.3f, 0.7f, 0.5f, 1.5f, -0.6f, 0.2f);
         kin_arm_ik_job r = job_of(s, w, hr, KIN_SIDE_RIGHT);
         kin_arm_ik_job l = job_of(kin_v3(-s.x, s.y, s.z), kin_v3(-w.x, w.y, w.z),
                                   (kin_quat){ hr.x, -hr.y, -hr.z, hr.w }, KIN_SIDE_LEFT);
@@ -316,18 +313,19 @@ static void sweep_targets_through_and_beyond_reach(void **state)
     float worst = 0.0f;
     for (int it = 0; it < 300; it++) {
         /* random lines through the reach sphere, from 1.6x reach to 1.6x */
-        kin_vec3 dir = kin_v3_norm(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1),
-                                          tu_range(&g, -1, 1)));
+        kin_vec3 dir = kin_v3_norm(tu_v3(&g, -1, 1));
         /* closest approach to the shoulder: 0.12 .. 0.5 m */
-        kin_vec3 r = kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1), tu_range(&g, -1, 1));
+        kin_vec3 r = tu_v3(&g, -1, 1);
         r = kin_v3_norm(kin_v3_sub(r, kin_v3_scale(dir, kin_v3_dot(r, dir))));
         kin_vec3 off = kin_v3_scale(r, tu_range(&g, 0.12f, 0.5f));
         kin_vec3 mid = kin_v3_add(s, off);
         kin_vec3 a = kin_v3_sub(mid, kin_v3_scale(dir, 0.9f)), b = kin_v3_add(mid, kin_v3_scale(dir, 0.9f));
-        kin_quat h0 = kin_quat_normalize((kin_quat){ tu_range(&g, -0.3f, 0.3f), tu_range(&g, -0.3f, 0.3f),
-                                                     tu_range(&g, -0.3f, 0.3f), 1.0f });
-        kin_quat h1 = kin_quat_normalize((kin_quat){ tu_range(&g, -0.3f, 0.3f), tu_range(&g, -0.3f, 0.3f),
-                                                     tu_range(&g, -0.3f, 0.3f), 1.0f });
+        kin_quat h0 = tu_quat(&g, -0.3f, 0.3f);
+        h0.w = 1.0f;
+        h0 = kin_quat_normalize(h0);
+        kin_quat h1 = tu_quat(&g, -0.3f, 0.3f);
+        h1.w = 1.0f;
+        h1 = kin_quat_normalize(h1);
         char what[64];
         snprintf(what, sizeof what, "line %d", it);
         float ratio = sweep(s, a, b, h0, h1, 900, ELBOW_GAIN, what);

@@ -2,6 +2,7 @@
  * Validity: degenerate inputs (singular inverse, zero vectors). Result:
  * analytic answers within 1e-5, seeded random matrices for the inverse. */
 #include "support/testutil.h"
+#include "support/tu_kin.h"
 #include <cmocka.h>
 
 #include <math.h>
@@ -21,7 +22,7 @@ static kin_quat random_quat(tu_rng *g)
 {
     kin_vec3 axis;
     do {
-        axis = kin_v3(tu_range(g, -1, 1), tu_range(g, -1, 1), tu_range(g, -1, 1));
+        axis = tu_v3(g, -1, 1);
     } while (kin_v3_len(axis) < 0.1f);
     return kin_quat_axis_angle(axis, tu_range(g, -PI_F, PI_F));
 }
@@ -125,7 +126,7 @@ static void result_quat_vs_matrix(void **state)
     tu_rng g = { 0x6b696e01 };
     for (int i = 0; i < 200; i++) {
         kin_quat q = random_quat(&g), q2 = random_quat(&g);
-        kin_vec3 v = kin_v3(tu_range(&g, -2, 2), tu_range(&g, -2, 2), tu_range(&g, -2, 2));
+        kin_vec3 v = tu_v3(&g, -2, 2);
         kin_mat4 m = kin_mat4_from_tr(kin_v3(0, 0, 0), q);
         kin_vec3 a = kin_quat_rotate(q, v), b = kin_mat4_mul_dir(&m, v);
         NEAR3(a, b.x, b.y, b.z, TOL);
@@ -170,9 +171,9 @@ static void result_inverse_random(void **state)
         kin_mat4 m;
         if (i & 1) { /* an affine TRS */
             kin_transform t;
-            t.t = kin_v3(tu_range(&g, -3, 3), tu_range(&g, -3, 3), tu_range(&g, -3, 3));
+            t.t = tu_v3(&g, -3, 3);
             t.r = random_quat(&g);
-            t.s = kin_v3(tu_range(&g, 0.5f, 2), tu_range(&g, 0.5f, 2), tu_range(&g, 0.5f, 2));
+            t.s = tu_v3(&g, 0.5f, 2);
             m = kin_mat4_from_transform(&t);
         } else { /* a general, diagonally dominant (so well-conditioned) one */
             for (int k = 0; k < 16; k++) m.m[k] = tu_range(&g, -1, 1);
@@ -225,8 +226,8 @@ static void result_look_at(void **state)
     (void)state;
     tu_rng g = { 0x6b696e03 };
     for (int i = 0; i < 100; i++) {
-        kin_vec3 eye = kin_v3(tu_range(&g, -5, 5), tu_range(&g, -5, 5), tu_range(&g, -5, 5));
-        kin_vec3 dir = kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1), tu_range(&g, -1, 1));
+        kin_vec3 eye = tu_v3(&g, -5, 5);
+        kin_vec3 dir = tu_v3(&g, -1, 1);
         if (kin_v3_len(dir) < 0.1f) continue;
         kin_vec3 target = kin_v3_add(eye, dir);
         kin_mat4 v = kin_mat4_look_at(eye, target, kin_v3(0, 1, 0));

@@ -14,6 +14,7 @@
  *   - the skinned mesh under IK poses stays finite (SIMD dispatch);
  *   - the generator's track.txt drives the rig onto the animation. */
 #include "support/testutil.h"
+#include "support/tu_kin.h"
 #include <cmocka.h>
 
 #include <math.h>
@@ -107,7 +108,7 @@ static float qangle(kin_quat a, kin_quat b)
 
 static kin_quat rand_rot(tu_rng *r)
 {
-    kin_quat q = { tu_range(r, -1, 1), tu_range(r, -1, 1), tu_range(r, -1, 1), tu_range(r, -1, 1) };
+    kin_quat q = tu_quat(r, -1, 1);
     return kin_quat_normalize(q);
 }
 
@@ -241,8 +242,7 @@ static void test_ik_wrists_on_targets(void **state)
         kin_track_sample s = base_sample(&p);
         /* the body turned and moved a little, as a seated user does */
         kin_quat turn = kin_quat_axis_angle(kin_v3(0, 1, 0), tu_range(&r, -0.5f, 0.5f));
-        kin_vec3 shift = kin_v3(tu_range(&r, -0.1f, 0.1f), tu_range(&r, -0.05f, 0.05f),
-                                tu_range(&r, -0.1f, 0.1f));
+        kin_vec3 shift = tu_v3b(&r, -0.1f, 0.1f, -0.05f, 0.05f, -0.1f, 0.1f);
         kin_vec3 mid = kin_v3_scale(kin_v3_add(p.shoulder[0], p.shoulder[1]), 0.5f);
         for (int k = 0; k < 2; k++)
             s.shoulder[k] = kin_v3_add(kin_v3_add(mid, shift),
@@ -254,8 +254,7 @@ static void test_ik_wrists_on_targets(void **state)
             dmax[k] = p.rig.upper_len[k] + p.rig.fore_len[k];
             /* in reach (0.45 .. 0.9 of the arm) or beyond it (1.05 .. 1.5) */
             frac[k] = it % 4 == 3 ? tu_range(&r, 1.05f, 1.5f) : tu_range(&r, 0.45f, 0.9f);
-            kin_vec3 dir = kin_v3_norm(kin_v3(tu_range(&r, -1, 1), tu_range(&r, -1, 0.8f),
-                                              tu_range(&r, -1, 0.3f)));
+            kin_vec3 dir = kin_v3_norm(tu_v3b(&r, -1, 1, -1, 0.8f, -1, 0.3f));
             if (dir.x == 0 && dir.y == 0 && dir.z == 0) dir = kin_v3(0, 0, -1);
             s.hand_pos[k] = kin_v3_add(s.shoulder[k], kin_v3_scale(dir, frac[k] * dmax[k]));
             s.hand_rot[k] = rand_rot(&r);
@@ -389,7 +388,9 @@ static void test_skin_under_ik_finite(void **state)
         kin_track_sample s = base_sample(&p);
         for (int k = 0; k < 2; k++) {
             float dmax = p.rig.upper_len[k] + p.rig.fore_len[k];
-            kin_vec3 dir = kin_v3_norm(kin_v3(tu_range(&r, -1, 1), tu_range(&r, -1, 0.5f), -0.7f));
+            const float dx = tu_range(&r, -1, 1);   /* drawn in order (tu_kin.h) */
+            const float dy = tu_range(&r, -1, 0.5f);
+            kin_vec3 dir = kin_v3_norm(kin_v3(dx, dy, -0.7f));
             s.hand_pos[k] = kin_v3_add(s.shoulder[k], kin_v3_scale(dir, tu_range(&r, 0.4f, 1.3f) * dmax));
             s.hand_rot[k] = rand_rot(&r);
         }

@@ -41,7 +41,9 @@ static void validity_identity_joints_bind_pose(void **state)
     float pos[N * 3], nrm[N * 3], w[N * 4], po[N * 3], no[N * 3];
     uint16_t jt[N * 4];
     for (int v = 0; v < N; v++) {
-        kin_vec3 n = kin_v3_norm(kin_v3(tu_range(&g, -1, 1), tu_range(&g, -1, 1), 0.5f));
+        const float nx = tu_range(&g, -1, 1);   /* drawn in order (see tu_kin.h) */
+        const float ny = tu_range(&g, -1, 1);
+        kin_vec3 n = kin_v3_norm(kin_v3(nx, ny, 0.5f));
         nrm[v * 3] = n.x; nrm[v * 3 + 1] = n.y; nrm[v * 3 + 2] = n.z;
         float s = 0;
         for (int i = 0; i < 4; i++) {

@@ -9,6 +9,7 @@
  * cases is the recorded one (so a change of the reference is seen too).
  * An ISA this CPU does not run is reported as SKIP, never as a pass. */
 #include "support/testutil.h"
+#include "support/tu_kin.h"
 #include <cmocka.h>
 
 #include <math.h>
@@ -21,7 +22,7 @@
 
 /* CRC32 of the reference's positions and normals (LBS then DQS) over all
  * NCASES cases; update it (and docs/kin.md) when the reference changes. */
-#define SKIN_CRC 0x09D4160Au
+#define SKIN_CRC 0x737C03D6u /* issue 20: inputs drawn in a defined order (before: 0x09D4160A, gcc only) */
 #define NCASES 60
 
 static void make_case(int n, tu_skin_case *k)
@@ -36,7 +37,7 @@ static void make_case(int n, tu_skin_case *k)
     tu_skin_case_begin(k, &r, nv, nj);
     for (int v = 0; v < nv; v++) {
         for (int c = 0; c < 3; c++) k->pos[3 * v + c] = tu_range(&r, -1, 1);
-        kin_vec3 nn = kin_v3_norm(kin_v3(tu_range(&r, -1, 1), tu_range(&r, -1, 1), tu_range(&r, -1, 1)));
+        kin_vec3 nn = kin_v3_norm(tu_v3(&r, -1, 1));
         memcpy(k->nrm + 3 * v, &nn, sizeof nn);
         int kind = tu_int(&r, 10), ninf = 1 + tu_int(&r, 4);
         float s = 0;

@@ -12,6 +12,7 @@
  * with hand-worked positions, parts for threads (disjoint, together the
  * whole), and rejected inputs. An ISA this CPU lacks is reported as SKIP. */
 #include "support/testutil.h"
+#include "support/tu_kin.h"
 #include <cmocka.h>
 
 #include <math.h>
@@ -39,7 +40,7 @@ static void make_case(int n, tu_skin_case *k)
     int run_n = 1;
     for (int v = 0; v < nv; v++) {
         for (int c = 0; c < 3; c++) k->pos[3 * v + c] = tu_range(&r, -1, 1);
-        kin_vec3 nn = kin_v3_norm(kin_v3(tu_range(&r, -1, 1), tu_range(&r, -1, 1), tu_range(&r, -1, 1)));
+        kin_vec3 nn = kin_v3_norm(tu_v3(&r, -1, 1));
         memcpy(k->nrm + 3 * v, &nn, sizeof nn);
         if (!grouped || v % 40 == 0) {
             run_n = 1 + tu_int(&r, 4);

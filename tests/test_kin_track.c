@@ -3,6 +3,7 @@
  * packet (byte layout, CRC, rejection of corrupt or invalid packets) and
  * the body frame, against hand-worked answers. */
 #include "support/testutil.h"
+#include "support/tu_kin.h"
 #include <cmocka.h>
 
 #include <math.h>
@@ -35,14 +36,12 @@ static kin_track_sample random_sample(tu_rng *g, double t)
     memset(&s, 0, sizeof s);
     s.t = t;
     s.valid = (uint32_t)tu_int(g, KIN_TRACK_ALL + 1);
-    s.head_pos = kin_v3(tu_range(g, -2, 2), tu_range(g, 0, 2), tu_range(g, -2, 2));
-    s.head_rot = kin_quat_normalize((kin_quat){ tu_range(g, -1, 1), tu_range(g, -1, 1),
-                                                tu_range(g, -1, 1), tu_range(g, -1, 1) });
+    s.head_pos = tu_v3b(g, -2, 2, 0, 2, -2, 2);
+    s.head_rot = kin_quat_normalize(tu_quat(g, -1, 1));
     for (int k = 0; k < 2; k++) {
-        s.shoulder[k] = kin_v3(tu_range(g, -1, 1), tu_range(g, 0, 2), tu_range(g, -1, 1));
-        s.hand_pos[k] = kin_v3(tu_range(g, -1, 1), tu_range(g, 0, 2), tu_range(g, -1, 1));
-        s.hand_rot[k] = kin_quat_normalize((kin_quat){ tu_range(g, -1, 1), tu_range(g, -1, 1),
-                                                       tu_range(g, -1, 1), tu_range(g, -1, 1) });
+        s.shoulder[k] = tu_v3b(g, -1, 1, 0, 2, -1, 1);
+        s.hand_pos[k] = tu_v3b(g, -1, 1, 0, 2, -1, 1);
+        s.hand_rot[k] = kin_quat_normalize(tu_quat(g, -1, 1));
         for (int f = 0; f < 5; f++) s.glove[k][f] = tu_unit(g);
     }
     return s;

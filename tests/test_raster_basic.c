@@ -247,7 +247,8 @@ static void test_transform_dirs(void **state)
                           (float)(-3 * sin(a)), (float)(3 * cos(a)), 0, 0,
                           0, 0, 3, 0,  9, 9, 9, 1 };
     for (int i = 0; i < 50; i++) {
-        float v[3] = { tu_range(&r, -2, 2), tu_range(&r, -2, 2), tu_range(&r, -2, 2) };
+        float v[3];
+        for (int k = 0; k < 3; k++) v[k] = tu_range(&r, -2, 2);   /* in order */
         float o[3];
         rast_transform_dirs(m, v, 1, o);
         double len = sqrt((double)v[0] * v[0] + (double)v[1] * v[1] + (double)v[2] * v[2]);

@@ -180,15 +180,21 @@ static void make_positions(tu_rng *r, int k, int W, int H, double px[3], double 
         a[2] = p + urange(r, 1.59, 1.99);
         if (tu_int(r, 2)) {
             /* one far apex, the wide side inside */
-            b[0] = -far_dist(r) * urange(r, 0.1, 1.0);
+            b[0] = -far_dist(r);   /* then the factor: drawn in order */
+            b[0] *= urange(r, 0.1, 1.0);
             b[1] = urange(r, -0.25, 2.0);
             b[2] = urange(r, -0.25, 2.0);
         } else {
             /* the tip inside, two far vertices */
             b[0] = urange(r, -0.25, 2.0);
-            b[1] = -far_dist(r) * urange(r, 0.1, 1.0);
-            b[2] = tu_int(r, 2) ? b[1] + urange(r, -1.0, 1.0)
-                                : -far_dist(r) * urange(r, 0.1, 1.0);
+            b[1] = -far_dist(r);
+            b[1] *= urange(r, 0.1, 1.0);
+            if (tu_int(r, 2)) {
+                b[2] = b[1] + urange(r, -1.0, 1.0);
+            } else {
+                b[2] = -far_dist(r);
+                b[2] *= urange(r, 0.1, 1.0);
+            }
         }
         for (int i = 0; i < 3; i++) {
             const double across = (side & 1) ? (side < 2 ? H : W) - b[i] : b[i];

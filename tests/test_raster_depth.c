@@ -36,10 +36,11 @@ static void test_depth_plane_exact(void **state)
         float clip[12];
         int big = n % 4 == 0;          /* vertices far outside the target */
         for (int i = 0; i < 3; i++) {
-            X[i] = big ? 256 * (tu_int(&r, 6 * W) - 2 * W) + tu_int(&r, 256)
-                       : 256 * tu_int(&r, W) + tu_int(&r, 256);
-            Y[i] = big ? 256 * (tu_int(&r, 6 * H) - 2 * H) + tu_int(&r, 256)
-                       : 256 * tu_int(&r, H) + tu_int(&r, 256);
+            /* pixel, then subpixel: drawn in order */
+            X[i] = big ? 256 * (tu_int(&r, 6 * W) - 2 * W) : 256 * tu_int(&r, W);
+            X[i] += tu_int(&r, 256);
+            Y[i] = big ? 256 * (tu_int(&r, 6 * H) - 2 * H) : 256 * tu_int(&r, H);
+            Y[i] += tu_int(&r, 256);
             float cw = (float)(1 << tu_int(&r, 3));
             float z = tu_range(&r, -0.99f, 0.99f);
             rt_clip_at(X[i], Y[i], W, H, z, cw, clip + 4 * i);

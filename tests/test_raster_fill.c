@@ -193,9 +193,13 @@ static void test_watertight_grid(void **state)
         int n = 2 + tu_int(&r, MAXN - 1);
         /* Square with sub-pixel offsets; cells at least 2 px. Even seeds
          * put the corners on pixel centres (edges through centres). */
-        int64_t L = 256 * (2 + tu_int(&r, 6)) + (seed % 2 ? tu_int(&r, 256) : 128);
-        int64_t T = 256 * (2 + tu_int(&r, 6)) + (seed % 2 ? tu_int(&r, 256) : 128);
-        int64_t cell = 256 * (2 + tu_int(&r, (40 / n))) + (seed % 2 ? tu_int(&r, 256) : 0);
+        /* pixel, then subpixel: drawn in order */
+        int64_t L = 256 * (2 + tu_int(&r, 6));
+        L += seed % 2 ? tu_int(&r, 256) : 128;
+        int64_t T = 256 * (2 + tu_int(&r, 6));
+        T += seed % 2 ? tu_int(&r, 256) : 128;
+        int64_t cell = 256 * (2 + tu_int(&r, (40 / n)));
+        cell += seed % 2 ? tu_int(&r, 256) : 0;
         int64_t R = L + n * cell, B = T + n * cell;
         float cw = (float)(1 << tu_int(&r, 3));
         for (int j = 0; j <= n; j++)
@@ -243,10 +247,15 @@ static void test_watertight_fan(void **state)
     static uint32_t idx[MAXP * 3];
     for (int seed = 0; seed < 24; seed++) {
         tu_rng r = { 900 + (uint64_t)seed };
-        int64_t L = 256 * (1 + tu_int(&r, 8)) + tu_int(&r, 256);
-        int64_t T = 256 * (1 + tu_int(&r, 8)) + (seed % 3 ? tu_int(&r, 256) : 128);
-        int64_t R = L + 256 * (10 + tu_int(&r, 40)) + tu_int(&r, 256);
-        int64_t B = T + 256 * (10 + tu_int(&r, 40)) + tu_int(&r, 256);
+        /* pixel, then subpixel: drawn in order */
+        int64_t L = 256 * (1 + tu_int(&r, 8));
+        L += tu_int(&r, 256);
+        int64_t T = 256 * (1 + tu_int(&r, 8));
+        T += seed % 3 ? tu_int(&r, 256) : 128;
+        int64_t R = L + 256 * (10 + tu_int(&r, 40));
+        R += tu_int(&r, 256);
+        int64_t B = T + 256 * (10 + tu_int(&r, 40));
+        B += tu_int(&r, 256);
         /* Perimeter points, clockwise on the screen from (L, T). */
         int64_t PX[MAXP], PY[MAXP];
         int np = 0;
@@ -407,8 +416,10 @@ static void test_tiny_triangles(void **state)
     tu_rng r = { 4242 };
     int hits = 0, misses = 0;
     for (int n = 0; n < 4000; n++) {
-        int64_t ox = 256 * (2 + tu_int(&r, W - 4)) + tu_int(&r, 256);
-        int64_t oy = 256 * (2 + tu_int(&r, H - 4)) + tu_int(&r, 256);
+        int64_t ox = 256 * (2 + tu_int(&r, W - 4));   /* drawn in order */
+        ox += tu_int(&r, 256);
+        int64_t oy = 256 * (2 + tu_int(&r, H - 4));
+        oy += tu_int(&r, 256);
         int64_t ccx = CENTRE(ox / 256), ccy = CENTRE(oy / 256);
         if (n % 4 == 0) {                 /* one vertex on a pixel centre */
             ox = ccx - tu_int(&r, 200);

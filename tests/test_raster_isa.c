@@ -21,6 +21,9 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
+#include "support/x86_only.h"
+
+#if EF_TEST_X86
 
 /* Recorded CRC32 of the reference output over all NCASES cases (update it
  * together with SOUP_CRC of test_raster_basic.c when a rule changes). */
@@ -154,8 +157,10 @@ static void make_case(int n, rcase *k)
             c[6] = 0.5f * fabsf(c[7]);
             break;
         case 6:   /* rarely: a NaN or infinite coordinate */
-            if (tu_int(&r, 8) == 0)
-                c[tu_int(&r, 12)] = tu_int(&r, 2) ? NAN : INFINITY;
+            if (tu_int(&r, 8) == 0) {
+                const int at = tu_int(&r, 12);   /* drawn in order */
+                c[at] = tu_int(&r, 2) ? NAN : INFINITY;
+            }
             break;
         default:
             break;
@@ -592,7 +597,7 @@ static void test_prepare_cached_equal(void **state)
  *    fills, AVX-512 rejection of 16 triangles at once), in chunks of
  *    1..40 triangles: the same set-up triangles (memcmp) and counters.
  * 3. Vertex block fills against the scalar fill (below). */
-#define SETUP_CRC 0xFA07FF57u
+#define SETUP_CRC 0x3F58FF06u /* issue 20: inputs drawn in a defined order (before: 0xFA07FF57, gcc only) */
 static void test_setup_isa_equal(void **state)
 {
     (void)state;
@@ -639,7 +644,8 @@ static void test_setup_isa_equal(void **state)
                 a.X[i][l] = (double)X[i] / 256.0;
                 a.Y[i][l] = (double)Y[i] / 256.0;
                 a.zw[i][l] = tu_int(&r, 8) ? tu_unit(&r) : tu_range(&r, -3.0f, 3.0f);
-                a.iw[i][l] = ldexp(0.5 + tu_unit(&r), tu_int(&r, 81) - 40);
+                const double m = 0.5 + tu_unit(&r);   /* drawn in order */
+                a.iw[i][l] = ldexp(m, tu_int(&r, 81) - 40);
                 xmin = X[i] < xmin ? X[i] : xmin;
                 ymin = Y[i] < ymin ? Y[i] : ymin;
             }
@@ -728,13 +734,22 @@ static void test_setup_isa_equal(void **state)
     long valid = 0, slow = 0, bad = 0;
     for (int it = 0; it < 4000; it++) {
         rast__view view;
-        rast__view_init(&view, 1 + tu_int(&r, 800), 1 + tu_int(&r, 600), 0);
+        const int vw = 1 + tu_int(&r, 800);   /* drawn in order */
+        rast__view_init(&view, vw, 1 + tu_int(&r, 600), 0);
         float clip[4 * RAST__VBLOCK];
         for (int i = 0; i < 4 * RAST__VBLOCK; i += 4) {
-            const float wv = tu_int(&r, 10) == 0 ? tu_range(&r, -1.0f, 0.01f)
-                             : tu_int(&r, 10) == 0 ? ldexpf(tu_unit(&r), -tu_int(&r, 140))
-                             : tu_int(&r, 20) == 0 ? ldexpf(1.0f + tu_unit(&r), tu_int(&r, 127))
-                                                   : tu_range(&r, 0.05f, 5.0f);
+            float wv;   /* mantissa, then exponent: drawn in order */
+            if (tu_int(&r, 10) == 0) {
+                wv = tu_range(&r, -1.0f, 0.01f);
+            } else if (tu_int(&r, 10) == 0) {
+                wv = tu_unit(&r);
+                wv = ldexpf(wv, -tu_int(&r, 140));
+            } else if (tu_int(&r, 20) == 0) {
+                wv = 1.0f + tu_unit(&r);
+                wv = ldexpf(wv, tu_int(&r, 127));
+            } else {
+                wv = tu_range(&r, 0.05f, 5.0f);
+            }
             const float reach = tu_int(&r, 4) == 0 ? 2e4f : 1.3f;
             clip[i] = tu_range(&r, -reach, reach) * wv;
             clip[i + 1] = tu_range(&r, -reach, reach) * wv;
@@ -742,9 +757,10 @@ static void test_setup_isa_equal(void **state)
             clip[i + 3] = wv;
             if (tu_int(&r, 50) == 0)
                 clip[i] = clip[i + 1] = clip[i + 2] = clip[i + 3] = 0.0f;
-            if (tu_int(&r, 40) == 0)
-                clip[i + tu_int(&r, 4)] = tu_int(&r, 3) == 0 ? NAN
-                                          : tu_int(&r, 2) ? INFINITY : -INFINITY;
+            if (tu_int(&r, 40) == 0) {
+                const int at = tu_int(&r, 4);   /* drawn in order */
+                clip[i + at] = tu_int(&r, 3) == 0 ? NAN : tu_int(&r, 2) ? INFINITY : -INFINITY;
+            }
         }
         const int count = 1 + tu_int(&r, RAST__VBLOCK);
         const uint32_t base = (uint32_t)tu_int(&r, 1 << 20) * RAST__VBLOCK;
@@ -1022,8 +1038,10 @@ static void make_mesh(int n, rcase *k)
             c[1] = (cy + ext * v) * aw;
             c[2] = tu_range(&r, zlo, zhi) * aw;
             c[3] = wv;
-            if (tu_int(&r, 400) == 0)
-                c[tu_int(&r, 4)] = tu_int(&r, 2) ? NAN : -INFINITY;
+            if (tu_int(&r, 400) == 0) {
+                const int at = tu_int(&r, 4);   /* drawn in order */
+                c[at] = tu_int(&r, 2) ? NAN : -INFINITY;
+            }
         }
     for (int i = 0; i < nv * na; i++)
         k->attr[i] = tu_range(&r, -1.0f, 1.0f);
@@ -1044,10 +1062,14 @@ static void make_mesh(int n, rcase *k)
             x[1] = x[2];
             x[2] = s;
         }
-        if (tu_int(&r, 50) == 0)
-            x[tu_int(&r, 3)] = x[tu_int(&r, 3)];
-        if (tu_int(&r, 40) == 0)
-            x[tu_int(&r, 3)] = (uint32_t)tu_int(&r, nv);
+        if (tu_int(&r, 50) == 0) {
+            const int to = tu_int(&r, 3);   /* drawn in order */
+            x[to] = x[tu_int(&r, 3)];
+        }
+        if (tu_int(&r, 40) == 0) {
+            const int to = tu_int(&r, 3);
+            x[to] = (uint32_t)tu_int(&r, nv);
+        }
     }
     if (tu_int(&r, 2))
         for (int ti = nt - 1; ti > 0; ti--) {
@@ -1202,7 +1224,7 @@ static void frontv_case(const rcase *k, const rast__setup_isa *isa, tu_rng *r, u
  * CRC changed in the ninth round of issue 3 (0x79E6CFE7 before): the
  * record grew the micro fields, and empty boxes up to 2x2 pixels (one
  * pixel before) are no longer records. */
-#define FRONTV_CRC 0xC50B16FAu
+#define FRONTV_CRC 0xDF7DA642u /* issue 20: inputs drawn in a defined order (before: 0xC50B16FA, gcc only) */
 static void test_frontv_equal(void **state)
 {
     (void)state;
@@ -1235,7 +1257,10 @@ static void test_frontv_equal(void **state)
         rast_context_desc d = { simd[i], 1 };
         rast_context *c = rast_context_create(&d);
         assert_non_null(c);
-        assert_int_equal(rast_context_isa(c), simd[i]);
+        /* EGOFUSE_ISA caps the context too (the records above call the
+         * set-up of simd[i] directly): its draws against the reference
+         * hold either way. */
+        assert_int_equal(rast_context_isa(c), ef_isa_choose((ef_isa)simd[i]));
         for (int n = 0; n < 300; n++) {
             rcase k;
             make_mesh(n, &k);
@@ -1337,3 +1362,7 @@ int main(int argc, char **argv)
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
+
+#else
+EF_TEST_X86_SKIP("the AVX2/AVX-512 raster kernels against the reference")
+#endif

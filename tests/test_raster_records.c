@@ -29,6 +29,9 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
+#include "support/x86_only.h"
+
+#if EF_TEST_X86
 
 #define PATTERN 0xA5
 
@@ -250,3 +253,7 @@ int main(void)
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
+
+#else
+EF_TEST_X86_SKIP("the vector front ends' records")
+#endif

@@ -79,8 +79,12 @@ static int make_case(int n, planes *ref, rast__tri *tri, int *ya, int *yb)
     /* A from which B lies bw px to the right (or left) and bh rows up or
      * down; A anywhere so that the box crosses every border at times. */
     const int kind = tu_int(&r, 16) < 13 ? KIND_SLIVER : tu_int(&r, 3) ? KIND_FAT : KIND_GUARD;
-    const float bw = (float)(17 + tu_int(&r, 184)) - tu_unit(&r);
-    const float bh = tu_int(&r, 4) ? (float)tu_int(&r, 300) + tu_unit(&r) : tu_unit(&r);
+    /* whole, then fraction: drawn in order */
+    const float bw_whole = (float)(17 + tu_int(&r, 184));
+    const float bw = bw_whole - tu_unit(&r);
+    float bh = 0.0f;
+    if (tu_int(&r, 4)) bh = (float)tu_int(&r, 300);
+    bh = bh + tu_unit(&r);
     const float ax = tu_range(&r, -0.5f * bw, (float)shape.width - 0.5f * bw);
     const float ay = tu_range(&r, -0.5f * bh, (float)shape.height + 0.5f * bh);
     const float sx = tu_int(&r, 2) ? 1.0f : -1.0f, sy = tu_int(&r, 2) ? 1.0f : -1.0f;

@@ -1,6 +1,15 @@
 /* cpu.c - CPU feature detection and the ISA cap. */
 #include "cpu.h"
 
+/* Big-endian machines: not supported. The SIMD paths are x86's, and the
+ * byte-for-byte claims (README, docs/portability.md) were checked on
+ * little-endian x86-64 and ARM64 only; the build refuses rather than give
+ * bytes nobody compared. EGOFUSE_ALLOW_BIG_ENDIAN builds it anyway. */
+#if defined(__BYTE_ORDER__) && defined(__ORDER_BIG_ENDIAN__) && \
+    __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__ && !defined(EGOFUSE_ALLOW_BIG_ENDIAN)
+#error "egofuse: big-endian targets are not supported (checked on little-endian x86-64 and ARM64 only, see README); -DEGOFUSE_ALLOW_BIG_ENDIAN builds it anyway, unchecked"
+#endif
+
 #include <stdlib.h>
 #include <string.h>
 

@@ -352,9 +352,12 @@ typedef struct fuse_eye {
      * without a look at V: in place (out == V) they are neither read nor
      * written, out of place they are copied. With an opaque V the bytes are
      * those of v_opaque = 0. If the promise is broken, rgb is still exact
-     * and the alpha of those pixels is V's or 255 (which one is not
-     * specified). 0 (the default): no promise, alpha 255 everywhere in the
-     * viewport (an in-place composite reads all of V to check it). */
+     * and the alpha of those pixels is V's or 255: V's in every group of
+     * 16 viewport columns whose taps all lie in blocks of 8 layer pixels
+     * that are zero (both layer rows), 255 in the others; the same bytes
+     * on every ISA, the reference included. 0 (the default): no promise,
+     * alpha 255 everywhere in the viewport (an in-place composite reads
+     * all of V to check it). */
     int v_opaque;
 } fuse_eye;
 

@@ -345,6 +345,7 @@ static void transparent(const comp_job *j, const uint8_t *v, uint8_t *o, int n)
 /* Output pixels per transparency group: a group whose taps all lie in
  * coverage blocks without a bit (both source rows) is a copy of V. */
 #define GROUP 16
+_Static_assert(FUSE__TILE % GROUP == 0, "a tile holds whole groups (comp_row_ref_opaque)");
 
 /* What the table-driven composite keeps between rows: the column table of
  * one tile; for every coverage block b of the layer, the first and the
@@ -604,6 +605,58 @@ static void comp_row_tiled(const comp_job *j, comp_scratch *s, int y, int c0, in
     comp_span(j, s, q0, q1, fy, v, o, done, n - done, 0);
 }
 
+/* 1 if a pixel of layer row q (width sw) in the coverage blocks
+ * [b0, b1] is not zero. */
+static int blocks_covered(const uint8_t *q, int sw, int b0, int b1)
+{
+    const int x1 = (b1 + 1) * FUSE__COV_BLOCK < sw ? (b1 + 1) * FUSE__COV_BLOCK : sw;
+    uint32_t acc = 0, t;
+    int x;
+    for (x = b0 * FUSE__COV_BLOCK; x < x1; x++) {
+        memcpy(&t, q + 4 * (size_t)x, 4);
+        acc |= t;
+    }
+    return acc != 0;
+}
+
+/* Output row y of the viewport by the reference with the caller's promise
+ * of an opaque V (fuse_eye.v_opaque): the same choice as the table-driven
+ * paths, written out. Per group of GROUP viewport columns (the tiles hold
+ * a whole number of groups), a group whose taps all lie in coverage blocks
+ * without a non-zero pixel (both layer rows) is transparent (out = V),
+ * every other group is blended by the reference. With an opaque V that is
+ * the bytes of no promise; with a broken promise (alpha below 255) it is
+ * still the bytes of every ISA, alpha included. */
+static void comp_row_ref_opaque(const comp_job *j, int y)
+{
+    const int sw = j->Q.width, sh = j->Q.height;
+    const int32_t pos = fuse__src_pos(y - j->vy, sh, j->vh);
+    const int iy = pos >> 16, iy1 = iy + 1 < sh ? iy + 1 : sh - 1;
+    const uint8_t *q0 = row_of(&j->Q, iy), *q1 = row_of(&j->Q, iy1);
+    const uint8_t *v = row_of(&j->V, y) + 4 * (size_t)j->vx;
+    uint8_t *o = row_of(&j->out, y) + 4 * (size_t)j->vx;
+    fuse__axis ax;
+    int c;
+    fuse__axis_init(&ax, sw, j->vw);
+    for (c = 0; c < j->vw; c += GROUP) {
+        const int n = j->vw - c < GROUP ? j->vw - c : GROUP;
+        const fuse__axis at = ax;   /* the walk at the group's first column */
+        const int lo = fuse__axis_pos(&ax) >> 16;
+        int i, hi, b0, b1;
+        for (i = 0; i < n - 1; i++) fuse__axis_next(&ax);
+        hi = fuse__axis_pos(&ax) >> 16;
+        fuse__axis_next(&ax);
+        hi = hi + 1 < sw ? hi + 1 : sw - 1;
+        b0 = lo / FUSE__COV_BLOCK;
+        b1 = hi / FUSE__COV_BLOCK;
+        if (blocks_covered(q0, sw, b0, b1) || blocks_covered(q1, sw, b0, b1))
+            fuse__composite_row_ref(q0, q1, ((uint32_t)pos >> 8) & 255u, at, sw,
+                                    v + 4 * (size_t)c, o + 4 * (size_t)c, n);
+        else
+            transparent(j, v + 4 * (size_t)c, o + 4 * (size_t)c, n);
+    }
+}
+
 /* Viewport rows [y0, y1) (already clipped to the viewport). The ISA paths
  * go through column tables of FUSE__TILE columns; the reference walks
  * fuse__axis as fuse_ref.c does. */
@@ -611,6 +664,10 @@ static void comp_vp_rows(const comp_job *j, comp_scratch *s, int y0, int y1)
 {
     const int sw = j->Q.width, sh = j->Q.height;
     int y, c0;
+    if (j->k->ref && j->v_opaque) {
+        for (y = y0; y < y1; y++) comp_row_ref_opaque(j, y);
+        return;
+    }
     if (j->k->ref) {
         fuse__axis ax;
         fuse__axis_init(&ax, sw, j->vw);

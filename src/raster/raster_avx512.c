@@ -8,6 +8,7 @@
 #include <float.h>
 #include <immintrin.h>
 #include <stddef.h>
+#include <string.h>
 
 #define SIMD_V 16
 #define SIMD_FN rast__scan_rows_avx512

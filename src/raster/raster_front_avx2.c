@@ -153,7 +153,8 @@ static inline unsigned prod_cmp(__m256i a, __m256i b, __m256i c, __m256i d, int 
                                          _mm256_cvtepi32_pd(half4(b, h)));
         const __m256d p2 = _mm256_mul_pd(_mm256_cvtepi32_pd(half4(c, h)),
                                          _mm256_cvtepi32_pd(half4(d, h)));
-        r |= (unsigned)_mm256_movemask_pd(_mm256_cmp_pd(p1, p2, gt ? _CMP_GT_OQ : _CMP_LT_OQ))
+        /* p1 < p2 as p2 > p1: the predicate stays a constant (clang, -Os) */
+        r |= (unsigned)_mm256_movemask_pd(_mm256_cmp_pd(gt ? p1 : p2, gt ? p2 : p1, _CMP_GT_OQ))
              << (4 * h);
     }
     return r;

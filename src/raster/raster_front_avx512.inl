@@ -80,7 +80,8 @@ static inline unsigned prod_cmp(__m512i a, __m512i b, __m512i c, __m512i d, int 
                                          _mm512_cvtepi32_pd(half_i(b, h)));
         const __m512d p2 = _mm512_mul_pd(_mm512_cvtepi32_pd(half_i(c, h)),
                                          _mm512_cvtepi32_pd(half_i(d, h)));
-        r |= (unsigned)_mm512_cmp_pd_mask(p1, p2, gt ? _CMP_GT_OQ : _CMP_LT_OQ) << (8 * h);
+        /* p1 < p2 as p2 > p1: the predicate stays a constant (clang, -Os) */
+        r |= (unsigned)_mm512_cmp_pd_mask(gt ? p1 : p2, gt ? p2 : p1, _CMP_GT_OQ) << (8 * h);
     }
     return r;
 }

@@ -335,6 +335,9 @@ static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, i
     vf av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
 #if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
     ATTR3_STATE a3;
+    /* Set at the first written pixel (aset) before any use; zeroed here
+     * as well, which gcc -O3 cannot see (-Wmaybe-uninitialized). */
+    memset(&a3, 0, sizeof a3);
 #endif
     for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
              drow = drow ? drow + t->depth_stride : NULL,

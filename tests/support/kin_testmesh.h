@@ -14,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "tu_kin.h"
+
 #define TU_SKIN_JOINTS 80   /* capacity; a case uses 24, 48 or 80 */
 
 typedef struct tu_skin_case {
@@ -27,8 +29,7 @@ typedef struct tu_skin_case {
 
 static inline kin_quat tu_rand_quat(tu_rng *r)
 {
-    kin_quat q = { tu_range(r, -1, 1), tu_range(r, -1, 1), tu_range(r, -1, 1),
-                   tu_range(r, -1, 1) };
+    kin_quat q = tu_quat(r, -1, 1);
     return kin_quat_normalize(q);
 }
 
@@ -46,7 +47,7 @@ static inline void tu_skin_case_begin(tu_skin_case *k, tu_rng *r, int nv, int nj
     assert_true(k->pos && k->nrm && k->w && k->jt && nj >= 3 && nj <= TU_SKIN_JOINTS);
     k->nj = nj;
     for (int j = 0; j < nj; j++) {
-        kin_vec3 t = kin_v3(tu_range(r, -2, 2), tu_range(r, -2, 2), tu_range(r, -2, 2));
+        kin_vec3 t = tu_v3(r, -2, 2);
         k->jm[j] = kin_mat4_from_tr(t, tu_rand_quat(r));
         k->dq[j] = kin_dualquat_from_mat4(&k->jm[j]);
         if (j % 3 == 1) { /* the other sign of the same transform */
