@@ -81,6 +81,11 @@ def check(path, cflags):
 
 if __name__ == "__main__":
     flags = ["-std=c11", "-D_GNU_SOURCE", "-Isrc", "-Itests"]
+    # the io tests' headers (SDL2, libdrm, libusb): where pkg-config has them
+    pc = subprocess.run(["pkg-config", "--cflags", "sdl2", "libdrm", "libusb-1.0", "libpng"],
+                        capture_output=True, text=True)
+    if pc.returncode == 0:
+        flags += pc.stdout.split()
     total = 0
     for p in sys.argv[1:]:
         n = check(p, flags)

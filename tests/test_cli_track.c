@@ -320,16 +320,18 @@ static int calib_recording(kin_track_sample *s, const kin_arm_rig *rig, const ki
         for (int k = 0; k < 2; k++) {
             float sx = k ? 1.0f : -1.0f;
             float len = TRUE_ARM * (rig->upper_len[k] + rig->fore_len[k]);
-            kin_vec3 sh = kin_v3(0.5f * width * sx + 0.002f * tu_range(&g, -1, 1), 1.0f,
-                                 0.002f * tu_range(&g, -1, 1));
+            float shx = 0.002f * tu_range(&g, -1, 1); /* draws in a defined order */
+            float shz = 0.002f * tu_range(&g, -1, 1);
+            kin_vec3 sh = kin_v3(0.5f * width * sx + shx, 1.0f, shz);
             int phase = (i / 50) % 5;
             kin_vec3 dir = phase == 0 ? kin_v3(0, 0, -1)
                          : phase == 1 ? kin_v3(sx, 0, 0) : kin_v3_norm(kin_v3(0.3f * sx, -0.5f, -1));
             float l = phase <= 1 ? len : len * tu_range(&g, 0.4f, 0.85f);
             s[n].shoulder[k] = sh;
-            s[n].hand_pos[k] = kin_v3_add(kin_v3_add(sh, kin_v3_scale(dir, l)),
-                                          kin_v3(0.002f * tu_range(&g, -1, 1), 0.002f * tu_range(&g, -1, 1),
-                                                 0.002f * tu_range(&g, -1, 1)));
+            float nx = 0.002f * tu_range(&g, -1, 1);
+            float ny = 0.002f * tu_range(&g, -1, 1);
+            float nz = 0.002f * tu_range(&g, -1, 1);
+            s[n].hand_pos[k] = kin_v3_add(kin_v3_add(sh, kin_v3_scale(dir, l)), kin_v3(nx, ny, nz));
         }
     }
     for (int i = 0; i < 300; i++, n++) {
@@ -352,10 +354,12 @@ static int calib_recording(kin_track_sample *s, const kin_arm_rig *rig, const ki
         kin_vec3 tr = kin_quat_rotate(s[n].hand_rot[1], kin_v3_scale(tip[1], TRUE_HAND));
         s[n].hand_pos[0] = kin_v3_sub(C, tl);
         s[n].hand_pos[1] = kin_v3_sub(C, tr);
-        for (int k = 0; k < 2; k++)
-            s[n].hand_pos[k] = kin_v3_add(s[n].hand_pos[k],
-                                          kin_v3(0.001f * tu_range(&g, -1, 1), 0.001f * tu_range(&g, -1, 1),
-                                                 0.001f * tu_range(&g, -1, 1)));
+        for (int k = 0; k < 2; k++) {
+            float nx = 0.001f * tu_range(&g, -1, 1);
+            float ny = 0.001f * tu_range(&g, -1, 1);
+            float nz = 0.001f * tu_range(&g, -1, 1);
+            s[n].hand_pos[k] = kin_v3_add(s[n].hand_pos[k], kin_v3(nx, ny, nz));
+        }
     }
     return n;
 }
