@@ -27,16 +27,6 @@
 #include "../src/io/io_display.h"
 #include "../src/io/io_display_impl.h"
 
-static int count_fds(void)
-{
-    DIR *d = opendir("/proc/self/fd");
-    int n = 0;
-    if (!d) return -1;
-    while (readdir(d)) n++;
-    closedir(d);
-    return n;
-}
-
 /* ------------------------------------------------------------- parser */
 
 static void test_parse(void **st)
@@ -136,13 +126,13 @@ static void expect_open_fails(const char *spec, const char *msg)
     io_display *d = (io_display *)1;
     io_error err;
     memset(&err, 0, sizeof err);
-    int fds = count_fds();
+    int fds = tu_count_fds();
     io_result r = io_display_open(&d, &c, &err);
     printf("NOTE %s -> %s\n", spec, err.msg);
     assert_int_not_equal(r, IO_OK);
     assert_null(d);
     if (!strstr(err.msg, msg)) fail_msg("'%s': '%s' lacks '%s'", spec, err.msg, msg);
-    assert_int_equal(count_fds(), fds);
+    assert_int_equal(tu_count_fds(), fds);
 }
 
 static void test_kms_refusals(void **st)
@@ -393,7 +383,7 @@ static void test_sdl_window(void **st)
     io_display_config c = {"sdl", EW, EH, 2};
     io_display *d = NULL;
     io_error err;
-    int fds = count_fds();
+    int fds = tu_count_fds();
     if (io_display_open(&d, &c, &err) != IO_OK) {
         stop_xvfb();
         fail_msg("%s", err.msg);
@@ -459,7 +449,7 @@ static void test_sdl_window(void **st)
     io_display_close(&d);
     if (h) dlclose(h);
     /* SDL's X connection is gone again */
-    int fds_after = count_fds();
+    int fds_after = tu_count_fds();
     stop_xvfb();
     assert_true(found);
     assert_int_equal(quit_esc, 1);

@@ -153,16 +153,6 @@ static int poll_fresh(io_vsrc *v, int timeout_ms)
     return fresh;
 }
 
-static int count_fds(void)
-{
-    DIR *d = opendir("/proc/self/fd");
-    int n = 0;
-    if (!d) return -1;
-    while (readdir(d)) n++;
-    closedir(d);
-    return n;
-}
-
 static void gen_rgb(int i, int x, int y, uint8_t c[3])
 {
     c[0] = (uint8_t)((4 * x + i) & 255);
@@ -373,7 +363,7 @@ static void test_egfv_bad_input(void **st)
     (void)st;
     tpipe t;
     io_vsrc_stat s;
-    int fds0 = count_fds();
+    int fds0 = tu_count_fds();
 
     /* another size mid-stream: skipped, named; the next good one taken */
     io_vsrc *v = run_scenario("badsize", &t, &s);
@@ -454,7 +444,7 @@ static void test_egfv_bad_input(void **st)
     assert_int_not_equal(io_vsrc_open(&v, &c, &err), IO_OK);
     assert_non_null(strstr(err.msg, "/dev/video99"));
     printf("NOTE v4l2 missing: %s\n", err.msg);
-    assert_int_equal(count_fds(), fds0);
+    assert_int_equal(tu_count_fds(), fds0);
 }
 
 /* A producer that stays connected but silent: poll returns within its
@@ -518,7 +508,7 @@ static void test_fifo_writers(void **st)
     uint8_t *bytes = gen("basic", &n);
     size_t fl = n / 3;
     uint64_t clock = 10000 * MS;
-    int fds0 = count_fds();
+    int fds0 = tu_count_fds();
     io_vsrc *v = open_src(spec, 32, 32, IO_VSRC_SBS, &clock);
     io_vsrc_stat s;
     assert_int_equal(poll_fresh(v, 0), 0);
@@ -552,7 +542,7 @@ static void test_fifo_writers(void **st)
     assert_non_null(strstr(s.msg, "a new writer"));
     close(w);
     io_vsrc_close(v);
-    assert_int_equal(count_fds(), fds0);
+    assert_int_equal(tu_count_fds(), fds0);
     unlink(fifo);
     free(bytes);
 }
@@ -834,7 +824,7 @@ static void test_file_cam_sequence(void **st)
     tmp("camR_%04d.png", pat[1], sizeof pat[1]);
     write_pngs(pat[0], 4, 64, 48, 0);
     write_pngs(pat[1], 4, 64, 48, 7);
-    int fds0 = count_fds();
+    int fds0 = tu_count_fds();
     uint64_t clock = 2000 * MS;
     const uint64_t P = 1000000000ull / 30;
     for (int loop = 0; loop < 2; loop++) {
@@ -916,7 +906,7 @@ static void test_file_cam_sequence(void **st)
     printf("NOTE %s\n", err.msg);
     c = io_cam_config_default("file:a_%d_%d.png");
     assert_int_equal(io_cam_open(&cam, &io_cam_file, &c, &err), IO_ERR_ARGS);
-    assert_int_equal(count_fds(), fds0);
+    assert_int_equal(tu_count_fds(), fds0);
 }
 
 /* A video: a .y4m read directly and the same frames in a lossless .mkv
@@ -932,7 +922,7 @@ static void test_file_cam_video(void **st)
              "-frames:v 5 -pix_fmt yuv420p -f yuv4mpegpipe '%s' && ffmpeg -loglevel error -y -i '%s' "
              "-c:v ffv1 '%s'", y4m, y4m, mkv);
     assert_int_equal(system(cmd), 0);
-    int fds0 = count_fds();
+    int fds0 = tu_count_fds();
     uint8_t first[2][64 * 48 * 3];
     for (int m = 0; m < 2; m++) {
         char sel[700];
@@ -975,7 +965,7 @@ static void test_file_cam_video(void **st)
         io_cam_close(&cam);
     }
     assert_memory_equal(first[0], first[1], sizeof first[0]);
-    assert_int_equal(count_fds(), fds0);
+    assert_int_equal(tu_count_fds(), fds0);
 }
 
 int main(void)

@@ -82,45 +82,37 @@ static void log_append(const char *s, size_t n)
  * screendump of what is on screen, the host takes it and answers with
  * FILE.ack; test_vm_display compares FILE with the expected image. */
 #include "vm/display_pattern.h"
-static char display_dump[1024];
+/* The guest's "VMSYNC ...-dump PATH": qemu's screendump of a device (and
+ * head, -1 for none) to PATH (heads: PATH.N.ppm), then PATH.ack with the
+ * result, which the guest waits for. The path is kept in *keep, the result
+ * in *rc. */
+static void screendump_ack(const char *path, const char *device, int heads, char *keep,
+                           size_t keep_n, int *rc, const char *qmp_sock)
+{
+    char cmd[1400], ack[1100];
+    snprintf(keep, keep_n, "%.*s", (int)strcspn(path, " \r\n"), path);
+    *rc = 0;
+    for (int head = 0; head < (heads > 0 ? heads : 1); head++) {
+        if (heads > 0)
+            snprintf(cmd, sizeof cmd, "{\"execute\":\"screendump\",\"arguments\":{\"filename\":"
+                     "\"%s.%d.ppm\",\"device\":\"%s\",\"head\":%d}}\n", keep, head, device, head);
+        else
+            snprintf(cmd, sizeof cmd, "{\"execute\":\"screendump\",\"arguments\":{\"filename\":"
+                     "\"%s\",\"device\":\"%s\"}}\n", keep, device);
+        if (qmp(qmp_sock, cmd) != 0) *rc = -1;
+    }
+    snprintf(ack, sizeof ack, "%s.ack", keep);
+    FILE *f = fopen(ack, "w");
+    if (f) {
+        fprintf(f, "%d\n", *rc);
+        fclose(f);
+    }
+}
+
+static char display_dump[1024];  /* bochs-display, side by side */
 static int display_dump_rc = -1;
-
-static void on_display_dump(const char *file, const char *qmp_sock)
-{
-    char cmd[1400], ack[1100];
-    snprintf(display_dump, sizeof display_dump, "%.*s", (int)strcspn(file, " \r\n"), file);
-    snprintf(cmd, sizeof cmd, "{\"execute\":\"screendump\",\"arguments\":{\"filename\":\"%s\","
-             "\"device\":\"display0\"}}\n", display_dump);
-    display_dump_rc = qmp(qmp_sock, cmd);
-    snprintf(ack, sizeof ack, "%s.ack", display_dump);
-    FILE *f = fopen(ack, "w");
-    if (f) {
-        fprintf(f, "%d\n", display_dump_rc);
-        fclose(f);
-    }
-}
-
-/* layout two on virtio-gpu: heads 0 and 1 to PREFIX.0.ppm, PREFIX.1.ppm */
-static char display_two[1024];
+static char display_two[1024];   /* virtio-gpu, heads 0 and 1: PREFIX.0.ppm, PREFIX.1.ppm */
 static int display_two_rc = -1;
-
-static void on_display_two_dump(const char *prefix, const char *qmp_sock)
-{
-    char cmd[1400], ack[1100];
-    snprintf(display_two, sizeof display_two, "%.*s", (int)strcspn(prefix, " \r\n"), prefix);
-    display_two_rc = 0;
-    for (int head = 0; head < 2; head++) {
-        snprintf(cmd, sizeof cmd, "{\"execute\":\"screendump\",\"arguments\":{\"filename\":\"%s.%d.ppm\","
-                 "\"device\":\"vgpu\",\"head\":%d}}\n", display_two, head, head);
-        if (qmp(qmp_sock, cmd) != 0) display_two_rc = -1;
-    }
-    snprintf(ack, sizeof ack, "%s.ack", display_two);
-    FILE *f = fopen(ack, "w");
-    if (f) {
-        fprintf(f, "%d\n", display_two_rc);
-        fclose(f);
-    }
-}
 /* ---- end display */
 
 /* ---- cockpit: `egofuse run` on the KMS display holds its last frame;
@@ -129,26 +121,17 @@ static void on_display_two_dump(const char *prefix, const char *qmp_sock)
 static char cockpit_dump[1024];
 static int cockpit_dump_rc = -1;
 
-static void on_cockpit_dump(const char *file, const char *qmp_sock)
-{
-    char cmd[1400], ack[1100];
-    snprintf(cockpit_dump, sizeof cockpit_dump, "%.*s", (int)strcspn(file, " \r\n"), file);
-    snprintf(cmd, sizeof cmd, "{\"execute\":\"screendump\",\"arguments\":{\"filename\":\"%s\","
-             "\"device\":\"display0\"}}\n", cockpit_dump);
-    cockpit_dump_rc = qmp(qmp_sock, cmd);
-    snprintf(ack, sizeof ack, "%s.ack", cockpit_dump);
-    FILE *f = fopen(ack, "w");
-    if (f) {
-        fprintf(f, "%d\n", cockpit_dump_rc);
-        fclose(f);
-    }
-}
-
 static void on_line(const char *line, const char *qmp_sock)
 {
-    if (!strncmp(line, "VMSYNC display-dump ", 20)) on_display_dump(line + 20, qmp_sock);
-    if (!strncmp(line, "VMSYNC cockpit-dump ", 20)) on_cockpit_dump(line + 20, qmp_sock);
-    if (!strncmp(line, "VMSYNC display-two-dump ", 24)) on_display_two_dump(line + 24, qmp_sock);
+    if (!strncmp(line, "VMSYNC display-dump ", 20))
+        screendump_ack(line + 20, "display0", 0, display_dump, sizeof display_dump,
+                       &display_dump_rc, qmp_sock);
+    if (!strncmp(line, "VMSYNC cockpit-dump ", 20))
+        screendump_ack(line + 20, "display0", 0, cockpit_dump, sizeof cockpit_dump,
+                       &cockpit_dump_rc, qmp_sock);
+    if (!strncmp(line, "VMSYNC display-two-dump ", 24))
+        screendump_ack(line + 24, "vgpu", 2, display_two, sizeof display_two, &display_two_rc,
+                       qmp_sock);
     if (!strncmp(line, "VMSYNC usb-unplug", 17))
         qmp(qmp_sock, "{\"execute\":\"device_del\",\"arguments\":{\"id\":\"camr\"}}\n");
     else if (!strncmp(line, "VMSYNC usb-replug", 17))

@@ -176,8 +176,6 @@ static void run_close(run_state *r)
     if (r->have_model) kin_model_free(&r->model);
 }
 
-/* The tracker: every pending sample into the filter (called whenever the
- * loop waits, so the filter sees each sample near its arrival). */
 /* Every NatNet frame accepted goes into the filter (a poll may accept
  * several and hand out only the newest). */
 static void natnet_sample(void *user, const kin_track_sample *s, const io_natnet *n)
@@ -205,6 +203,8 @@ static void sample_normalised(const kin_track_sample *in, kin_track_sample *out)
             out->hand_rot[k] = kin_quat_normalize(out->hand_rot[k]);
 }
 
+/* The tracker: the pending samples into the filter (called whenever the
+ * loop waits, so the filter sees each sample near its arrival). */
 static void track_service(run_state *r)
 {
     io_error err;

@@ -38,6 +38,9 @@ uint32_t tu_crc32(uint32_t crc, const void *data, size_t n);
  * out[out_size]; returns the exit status, or -1 if it could not start or
  * died from a signal. */
 int tu_run(char *const argv[], char *out, size_t out_size);
+/* Open descriptors of this process (entries of /proc/self/fd, its own
+ * listing's included), -1 when it cannot be read: compare before and after. */
+int tu_count_fds(void);
 
 /* Float checks against analytic answers (cmocka's fail_msg at the use
  * site): |a - b| <= tol, with both values in the message. */
