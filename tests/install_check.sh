@@ -24,6 +24,9 @@ for h in "$S$P"/include/egofuse/*.h; do
     echo "#include <egofuse/$(basename "$h")>" |
         $CC -std=c11 $(pkg-config --cflags egofuse) -Wall -Werror -x c -fsyntax-only - ||
         { echo "installed header $(basename "$h") does not compile alone"; exit 1; }
+    echo "#include <egofuse/$(basename "$h")>" |
+        ${CXX:-c++} $(pkg-config --cflags egofuse) -Wall -Werror -x c++ -fsyntax-only - ||
+        { echo "installed header $(basename "$h") does not compile alone as C++"; exit 1; }
 done
 $CC -std=c11 -Wall -Wextra -Werror -o "$T/mask_example" examples/mask_example.c \
     $(pkg-config --cflags --libs egofuse) $(pkg-config --static --cflags --libs egofuse-io) ||
