@@ -5,6 +5,8 @@
 #   make test       install what is missing, build, run every test
 #   make debug      the same tests under ASan + UBSan (build-debug/)
 #   make bench      benchmarks (they report, never pass or fail)
+#   make install    PREFIX=/usr/local DESTDIR=: the libraries, headers, pkg-config
+#                   files, plugin and program (docs/library.md); make uninstall
 #   make core-tests the core library and its tests only (no io library):
 #                   the ARM64 cross build of CI, .ci/run and docs/portability.md
 #   make clean
