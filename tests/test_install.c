@@ -27,6 +27,12 @@ static void write_file(const char *path, const void *data, size_t n)
 static void test_installed_example_matches_cli(void **state)
 {
     (void)state;
+#if defined(__SANITIZE_ADDRESS__)
+    /* make debug: the build's libraries need the sanitizer runtimes, which
+     * a program built with only pkg-config's flags does not link. */
+    printf("SKIP: a sanitizer build (make debug) is not installed for linking\n");
+    skip();
+#endif
     const char *bin = getenv("EGOFUSE_BIN");
     char build[512] = "build";
     if (bin && *bin) {
