@@ -5,6 +5,8 @@
 #   make test       install what is missing, build, run every test
 #   make debug      the same tests under ASan + UBSan (build-debug/)
 #   make bench      benchmarks (they report, never pass or fail)
+#   make install    PREFIX=/usr/local DESTDIR=: the libraries, headers, pkg-config
+#                   files, plugin and program (docs/library.md); make uninstall
 #   make core-tests the core library and its tests only (no io library):
 #                   the ARM64 cross build of CI, .ci/run and docs/portability.md
 #   make clean
@@ -229,5 +231,98 @@ bench: deps
 
 clean:
 	rm -rf build build-debug build-clang build-arm64 out
+
+# ------------------------------------------------------------ install
+# make install [PREFIX=/usr/local] [DESTDIR=]  (docs/library.md):
+#   lib/libegofuse.a, lib/libegofuse.so.$(SOVERSION) (soname libegofuse.so.0),
+#   lib/libegofuse_io.a, lib/egofuse/libegofuse_oiio.so (the OpenImageIO
+#   plugin, where the installed io library looks for it), bin/egofuse,
+#   include/egofuse/*.h (flattened: "../kin/kin.h" becomes "kin.h"),
+#   lib/pkgconfig/egofuse.pc and egofuse-io.pc.
+# The shared core is a second, position-independent object tree (build/so);
+# the installed io library and program differ from build/'s only by
+# io_image.c compiled with EGOFUSE_PLUGIN_DIR (build/inst).
+PREFIX    ?= /usr/local
+DESTDIR   ?=
+LIBDIR    ?= $(PREFIX)/lib
+INCDIR    ?= $(PREFIX)/include
+BINDIR    ?= $(PREFIX)/bin
+PLUGINDIR := $(LIBDIR)/egofuse
+SOVERSION := 0.1.0
+SOMAJOR   := 0
+SOLIB     := $(BUILD)/libegofuse.so.$(SOVERSION)
+SO_OBJ    := $(patsubst %,$(BUILD)/so/%.o,$(CORE_SRC))
+INST_IOLIB := $(BUILD)/inst/libegofuse_io.a
+INST_EGOFUSE := $(BUILD)/inst/egofuse
+INST_IO_OBJ := $(filter-out %/io_image.c.o,$(IO_OBJ)) $(BUILD)/inst/io_image.c.o
+INSTALL_HEADERS := $(filter-out src/io/%,$(HEADERS)) src/fuse/fuse_normals.h src/pipe/pipe_mask.h \
+                   $(filter src/io/%,$(HEADERS))
+
+.PHONY: install uninstall FORCE
+ifneq ($(CORE_ONLY),1)
+all: $(SOLIB) $(INST_IOLIB) $(INST_EGOFUSE)
+endif
+
+ifeq ($(X86),1)
+$(BUILD)/so/%_avx2.c.o: CFLAGS += -mavx2 -mf16c
+$(BUILD)/so/%_avx512.c.o: CFLAGS += -mavx512f -mavx512bw -mavx512dq -mavx512vl -mavx2 -mf16c
+$(BUILD)/so/%_sse41.c.o: CFLAGS += -msse4.1
+endif
+
+$(BUILD)/so/%.c.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -fPIC -c $< -o $@
+
+$(SOLIB): $(SO_OBJ)
+	$(CC) -shared $(LDFLAGS) -Wl,-soname,libegofuse.so.$(SOMAJOR) -o $@ $^ $(SYS_LIBS)
+
+# The plugin folder compiled into the installed io library: rebuilt when
+# PREFIX changes.
+$(BUILD)/inst/plugin_dir: FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(PLUGINDIR)' | cmp -s - $@ || echo '$(PLUGINDIR)' > $@
+FORCE:
+
+$(BUILD)/inst/io_image.c.o: src/io/io_image.c $(BUILD)/inst/plugin_dir
+	$(CC) $(CFLAGS) $(IO_CFLAGS) -DEGOFUSE_PLUGIN_DIR='"$(PLUGINDIR)"' -c $< -o $@
+
+$(INST_IOLIB): $(INST_IO_OBJ)
+	rm -f $@ && ar rcs $@ $^
+
+$(INST_EGOFUSE): $(CLI_OBJ) $(SAMPLESLIB) $(INST_IOLIB) $(LIB)
+	$(CXX) $(LDFLAGS) -o $@ $(CLI_OBJ) $(SAMPLESLIB) $(INST_IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
+
+install: $(LIB) $(SOLIB) $(INST_IOLIB) $(INST_EGOFUSE) $(OIIO_PLUGIN)
+	install -d $(DESTDIR)$(LIBDIR)/pkgconfig $(DESTDIR)$(PLUGINDIR) $(DESTDIR)$(INCDIR)/egofuse $(DESTDIR)$(BINDIR)
+	install -m 644 $(LIB) $(INST_IOLIB) $(DESTDIR)$(LIBDIR)/
+	install -m 755 $(SOLIB) $(DESTDIR)$(LIBDIR)/
+	ln -sf libegofuse.so.$(SOVERSION) $(DESTDIR)$(LIBDIR)/libegofuse.so.$(SOMAJOR)
+	ln -sf libegofuse.so.$(SOMAJOR) $(DESTDIR)$(LIBDIR)/libegofuse.so
+	install -m 755 $(OIIO_PLUGIN) $(DESTDIR)$(PLUGINDIR)/
+	install -m 755 $(INST_EGOFUSE) $(DESTDIR)$(BINDIR)/
+	@for h in $(INSTALL_HEADERS); do \
+	    sed 's|^#include "\.\./[a-z]*/|#include "|' $$h > $(DESTDIR)$(INCDIR)/egofuse/$$(basename $$h) || exit 1; \
+	done
+	@printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$(LIBDIR)' 'includedir=$(INCDIR)' '' \
+	    'Name: egofuse' 'Description: egofuse core: rasterizer, kinematics, compositor, pipeline (libc, libm, pthreads)' \
+	    'Version: $(SOVERSION)' 'Cflags: -I$${includedir}' 'Libs: -L$${libdir} -legofuse -lm -lpthread' \
+	    > $(DESTDIR)$(LIBDIR)/pkgconfig/egofuse.pc
+	@printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$(LIBDIR)' 'includedir=$(INCDIR)' '' \
+	    'Name: egofuse-io' 'Description: egofuse io library (static): glTF, images, devices' \
+	    'Version: $(SOVERSION)' 'Requires: egofuse' 'Requires.private: $(IO_PKGS)' \
+	    'Cflags: -I$${includedir}' 'Libs: -L$${libdir} -legofuse_io' 'Libs.private: -lmeshoptimizer -lstdc++ -ldl' \
+	    > $(DESTDIR)$(LIBDIR)/pkgconfig/egofuse-io.pc
+	@echo "installed into $(DESTDIR)$(PREFIX)"
+
+uninstall:
+	rm -f $(DESTDIR)$(LIBDIR)/libegofuse.a $(DESTDIR)$(LIBDIR)/libegofuse_io.a \
+	    $(DESTDIR)$(LIBDIR)/libegofuse.so $(DESTDIR)$(LIBDIR)/libegofuse.so.$(SOMAJOR) \
+	    $(DESTDIR)$(LIBDIR)/libegofuse.so.$(SOVERSION) $(DESTDIR)$(PLUGINDIR)/libegofuse_oiio.so \
+	    $(DESTDIR)$(BINDIR)/egofuse $(DESTDIR)$(LIBDIR)/pkgconfig/egofuse.pc \
+	    $(DESTDIR)$(LIBDIR)/pkgconfig/egofuse-io.pc
+	rm -rf $(DESTDIR)$(INCDIR)/egofuse
+	-rmdir $(DESTDIR)$(PLUGINDIR)
+# ------------------------------------------------------------ end install
+
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

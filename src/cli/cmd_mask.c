@@ -1,5 +1,6 @@
 /* cmd_mask.c - `egofuse mask`: the coverage mask of any glTF model. */
 #include "cli.h"
+#include "../pipe/pipe_mask.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -183,56 +184,27 @@ int cmd_mask(int argc, char **argv)
     }
 
     int rc = EXIT_FAIL;
-    pipe_pose ps;
-    float *clip = NULL, *vnrm = NULL;
     io_image mask = {0}, nimg = {0}, dimg = {0};
-    size_t npx = (size_t)width * (size_t)height;
-    float *depth = malloc(sizeof(float) * npx);
-    float *nrm = malloc(sizeof(float) * 3 * npx);
-    if (pipe_pose_init(&ps, &model) != 0) {
-        free(depth);
-        free(nrm);
-        kin_model_free(&model);
-        return cli_fail("out of memory for %s", model_path);
-    }
-    clip = malloc(sizeof(float) * 4 * (size_t)ps.max_vertices);
-    vnrm = malloc(sizeof(float) * 3 * (size_t)ps.max_vertices);
-    if (!depth || !nrm || !clip || !vnrm) {
-        cli_fail("out of memory for a %dx%d image of %s", width, height, model_path);
+    if (io_image_alloc(&mask, width, height, 1, IO_U8, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
+    if (out_n && io_image_alloc(&nimg, width, height, 3, IO_U8, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
+    if (out_d && io_image_alloc(&dimg, width, height, 1, IO_F32, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
+    /* The rendering itself is the library call pipe_mask_render (pipe_mask.h). */
+    pipe_mask_desc md = {0};
+    md.width = width;
+    md.height = height;
+    md.fov_y = fovy;
+    memcpy(md.eye, eye, sizeof eye);
+    memcpy(md.target, target, sizeof target);
+    memcpy(md.up, up, sizeof up);
+    md.znear = znear;
+    md.zfar = zfar;
+    md.anim = an;
+    md.time = tsec;
+    char why[256];
+    if (pipe_mask_render(&model, &md, mask.data, out_n ? nimg.data : NULL, out_d ? dimg.data : NULL,
+                         why, sizeof why) != 0) {
+        cli_fail("%s: cannot draw the model: %s", model_path, why);
         goto done;
-    }
-    if (io_image_alloc(&mask, width, height, 1, IO_U8, &err) != IO_OK) {
-        cli_fail("%s", err.msg);
-        goto done;
-    }
-    kin_camera cam = kin_camera_look_at(ve, vt, vu, fovy, width, height, znear, zfar);
-    rast_target tg = {width, height, depth, width, mask.data, width, nrm, 3 * width, 3};
-    rast_target_clear(&tg);
-    pipe_pose_anim(&ps, an, tsec);
-    rast_result rr = pipe_pose_draw(&ps, NULL, &cam, &tg, RAST_CULL_NONE, clip, vnrm, NULL);
-    if (rr != RAST_OK) {
-        cli_fail("%s: cannot draw the model: %s", model_path, rast_result_str(rr));
-        goto done;
-    }
-    if (out_n) {
-        if (io_image_alloc(&nimg, width, height, 3, IO_U8, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
-        uint8_t *np = nimg.data;
-        const uint8_t *mp = mask.data;
-        for (size_t i = 0; i < npx; i++) {
-            for (int k = 0; k < 3; k++) {
-                float v = 0.0f;
-                if (mp[i]) {
-                    kin_vec3 n = kin_v3_norm(kin_v3(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]));
-                    float comp = k == 0 ? n.x : k == 1 ? n.y : n.z;
-                    v = comp * 0.5f + 0.5f;
-                }
-                np[3 * i + k] = (uint8_t)lrintf(v * 255.0f);
-            }
-        }
-    }
-    if (out_d) {
-        if (io_image_alloc(&dimg, width, height, 1, IO_F32, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
-        memcpy(dimg.data, depth, sizeof(float) * npx);
     }
     /* Write every output only after everything has been computed. */
     if (io_image_save(out, &mask, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
@@ -243,11 +215,6 @@ done:
     io_image_free(&mask);
     io_image_free(&nimg);
     io_image_free(&dimg);
-    free(depth);
-    free(nrm);
-    free(clip);
-    free(vnrm);
-    pipe_pose_free(&ps);
     kin_model_free(&model);
     return rc;
 }
