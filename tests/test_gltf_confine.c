@@ -15,6 +15,7 @@
 #include <cmocka.h>
 #include <errno.h>
 #include <limits.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -171,6 +172,35 @@ static void outside_refused(void **state)
                    "../out.bin", "leads outside the model's folder");
 }
 
+/* A .glb with an external buffer goes the same way. */
+static void glb_external_buffer(void **state)
+{
+    (void)state;
+    const char *uris[2] = {"tri.bin", "..%2fout.bin"};
+    for (int k = 0; k < 2; k++) {
+        char json[1024];
+        int n = snprintf(json, sizeof json,
+                         "{\"asset\":{\"version\":\"2.0\"},"
+                         "\"buffers\":[{\"uri\":\"%s\",\"byteLength\":36}],"
+                         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+                         "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,"
+                         "\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]}],"
+                         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],"
+                         "\"nodes\":[{\"mesh\":0}]}",
+                         uris[k]);
+        while (n % 4) json[n++] = ' ';
+        unsigned char glb[1200];
+        uint32_t h[5] = {0x46546C67u, 2, (uint32_t)(20 + n), (uint32_t)n, 0x4E4F534Au};
+        memcpy(glb, h, 20);  /* little-endian host (x86, arm64) */
+        memcpy(glb + 20, json, (size_t)n);
+        char path[1400];
+        snprintf(path, sizeof path, "%s/ext%d.glb", M, k);
+        write_bytes(path, glb, (size_t)(20 + n));
+        if (k == 0) expect_ok(path);
+        else expect_refused(path, "buffer 0", "../out.bin", "leads outside the model's folder");
+    }
+}
+
 /* tinygltf also tries a uri against the current folder: never. */
 static void current_folder_not_searched(void **state)
 {
@@ -285,6 +315,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(inside_loads),
         cmocka_unit_test(outside_refused),
+        cmocka_unit_test(glb_external_buffer),
         cmocka_unit_test(current_folder_not_searched),
         cmocka_unit_test_teardown(opt_in_allows, teardown),
         cmocka_unit_test(cli_mask),
