@@ -12,6 +12,7 @@ static const char *usage =
     "                    --eye X,Y,Z --target X,Y,Z [--up X,Y,Z]\n"
     "                    [--anim I --time T] [--scene S] [--near N --far F]\n"
     "                    --out mask.png [--normals n.png] [--depth d.exr]\n"
+    "                    [--allow-outside]\n"
     "\n"
     "Renders the coverage mask of a skinned or unskinned glTF 2.0 model, at\n"
     "its rest pose or at time T (seconds) of animation I, exactly and\n"
@@ -46,10 +47,13 @@ static const char *usage =
     "  --anim I                animation index (default: rest pose)\n"
     "  --time T                time in seconds (clamped to the animation)\n"
     "  --scene S               draw scene S instead of the default scene\n"
+    "  --allow-outside         let buffer and image URIs name files outside\n"
+    "                          the model's folder (absolute, `..`, symlinks\n"
+    "                          out); refused by default (docs/io.md)\n"
     "  -h, --help              this text\n";
 
 enum { O_WIDTH = 256, O_HEIGHT, O_FOVY, O_EYE, O_TARGET, O_UP, O_ANIM, O_TIME,
-       O_NEAR, O_FAR, O_OUT, O_NORMALS, O_DEPTH, O_SCENE };
+       O_NEAR, O_FAR, O_OUT, O_NORMALS, O_DEPTH, O_SCENE, O_ALLOW_OUTSIDE };
 
 static const struct option opts[] = {
     {"width", required_argument, 0, O_WIDTH},
@@ -66,6 +70,7 @@ static const struct option opts[] = {
     {"normals", required_argument, 0, O_NORMALS},
     {"depth", required_argument, 0, O_DEPTH},
     {"scene", required_argument, 0, O_SCENE},
+    {"allow-outside", no_argument, 0, O_ALLOW_OUTSIDE},
     {"help", no_argument, 0, 'h'},
     {0, 0, 0, 0},
 };
@@ -123,6 +128,7 @@ int cmd_mask(int argc, char **argv)
         case O_FAR:
             if (!cli_parse_float(a, &zfar)) return cli_usage_error("mask", "--far '%s': not a number", a);
             break;
+        case O_ALLOW_OUTSIDE: io_gltf_allow_outside(1); break;
         case O_SCENE:
             if (!cli_parse_int(a, 0, 1 << 20, &scene))
                 return cli_usage_error("mask", "--scene '%s': not a scene index", a);

@@ -15,7 +15,7 @@ static const char *render_usage =
     "                      [--tone-match S] [--pose animation|tracking]\n"
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
     "                      [--refine BAND] [--smooth-normals R] [--hide PARTS]\n"
-    "                      [--prop MODEL@X,Y,Z[,YAW]]...\n"
+    "                      [--prop MODEL@X,Y,Z[,YAW]]... [--allow-outside]\n"
     "\n"
     "Composites a recorded sequence (docs/scene.md): for each frame, poses the\n"
     "mask model at t = frame / fps, renders its mask and normals from both\n"
@@ -67,6 +67,9 @@ static const char *render_usage =
     "  --smooth-normals R  sum the model's normals over a (2R+1)^2 window\n"
     "                 before lighting (1..4; default 0: off): for models of\n"
     "                 crossing parts whose shading shows seams\n"
+    "  --allow-outside  let the models' buffer and image URIs name files\n"
+    "                 outside their folder (absolute, `..`, symlinks out);\n"
+    "                 refused by default (docs/io.md)\n"
     "  -h, --help     this text\n";
 
 static const char *demo_usage =
@@ -460,7 +463,7 @@ done:
 
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
        O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
-       O_PROP, O_SMOOTH };
+       O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE };
 
 /* "MODEL@X,Y,Z[,YAW]" (the last '@' ends the path). 1, or 0 when it is
  * not of that form. */
@@ -511,6 +514,7 @@ int cmd_render(int argc, char **argv)
         {"no-filter", no_argument, 0, O_NO_FILTER},
         {"hide", required_argument, 0, O_HIDE},
         {"prop", required_argument, 0, O_PROP},
+        {"allow-outside", no_argument, 0, O_ALLOW_OUTSIDE},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
@@ -567,6 +571,7 @@ int cmd_render(int argc, char **argv)
             tracking_only = O_PREDICT;
             break;
         case O_NO_FILTER: o.no_filter = 1; tracking_only = O_NO_FILTER; break;
+        case O_ALLOW_OUTSIDE: io_gltf_allow_outside(1); break;
         case O_HIDE:
             if (pipe_parts_parse(optarg, &o.hide, why, sizeof why) != 0)
                 return cli_usage_error("render", "--hide '%s': %s", optarg, why);

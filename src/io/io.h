@@ -170,6 +170,16 @@ typedef struct io_gltf_info {
 io_result io_gltf_load_ex(const char *path, int scene, kin_model *out,
                           io_gltf_info *info, io_error *err);
 
+/* External buffer and image URIs of a model resolve only inside the
+ * model's folder (data: URIs always load): an absolute URI, or one whose
+ * percent-decoded path leads out of the folder (`..`, a symlink; checked
+ * on its realpath), is refused with IO_ERR_VALUE "arms.gltf: buffer 0: uri
+ * '../x.bin' leads outside the model's folder (/models); ...", before the
+ * file is opened. io_gltf_allow_outside(1) lifts this for every later load
+ * of the process (the CLI's --allow-outside); call it before loading, not
+ * while another thread loads. */
+void io_gltf_allow_outside(int allow);
+
 /* ---------------------------------------------------------------- scene */
 
 /* A recorded sequence to composite (`egofuse render --scene FILE`). The

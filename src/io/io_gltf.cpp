@@ -25,6 +25,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <map>
@@ -1559,6 +1560,99 @@ std::string unimplemented_required(const tinygltf::Model &g)
     return std::string();
 }
 
+/* ------------------------------------------------- confined URIs */
+
+/* External buffer and image URIs resolve only inside the model's folder
+ * unless io_gltf_allow_outside(1) (docs/io.md): tinygltf percent-decodes
+ * the URI, joins it to the base folder we give it (the model folder's
+ * realpath) and passes the result to ExpandFilePath, which we replace:
+ * an absolute URI, or one whose realpath (`..`, symlinks) is not under the
+ * folder, is recorded and expanded to "" so that nothing is opened.
+ * tinygltf's fallback of the current folder (a path not under the base)
+ * is always refused. */
+int g_allow_outside = 0;
+
+struct Confine {
+    std::string base;                 /* realpath of the model's folder */
+    bool allow;
+    std::vector<std::string> refused; /* decoded URIs refused, in order */
+    std::vector<std::string> why;
+};
+
+std::string confine_expand(const std::string &joined, void *ud)
+{
+    Confine &c = *static_cast<Confine *>(ud);
+    const std::string prefix = c.base == "/" ? c.base : c.base + "/";
+    if (joined.compare(0, prefix.size(), prefix) != 0)
+        return std::string();  /* tinygltf's "./uri" fallback */
+    std::string rel = joined.substr(prefix.size());
+    if (rel.empty()) return std::string();
+    std::string cand = rel[0] == '/' ? rel : joined;
+    if (c.allow) return cand;
+    if (rel[0] == '/' && c.base != "/") {
+        c.refused.push_back(rel);
+        c.why.push_back("is an absolute path");
+        return std::string();
+    }
+    char *rp = realpath(cand.c_str(), nullptr);
+    if (!rp) return cand;  /* missing: tinygltf says "File not found" */
+    std::string real(rp);
+    free(rp);
+    if (c.base != "/" && real.compare(0, prefix.size(), prefix) != 0) {
+        c.refused.push_back(rel);
+        c.why.push_back("leads outside the model's folder (to " + real +
+                        ")");
+        return std::string();
+    }
+    return real;
+}
+
+/* RFC 3986 percent-decoding as tinygltf does it (also '+' as a space). */
+std::string uri_decode(const std::string &s)
+{
+    std::string r;
+    for (size_t i = 0; i < s.size(); i++) {
+        if (s[i] == '+') {
+            r += ' ';
+        } else if (s[i] == '%' && i + 2 < s.size()) {
+            auto hex = [](char ch) -> int {
+                if (ch >= '0' && ch <= '9') return ch - '0';
+                if (ch >= 'a' && ch <= 'f') return ch - 'a' + 10;
+                if (ch >= 'A' && ch <= 'F') return ch - 'A' + 10;
+                return 0;
+            };
+            r += (char)((hex(s[i + 1]) << 4) | hex(s[i + 2]));
+            i += 2;
+        } else {
+            r += s[i];
+        }
+    }
+    return r;
+}
+
+/* The message for the first refused URI: an image still listed in the
+ * model by its uri (tinygltf keeps going), else the buffer that stopped
+ * the parse (buffers are parsed before images, one by one). */
+io_result confine_fail(const char *path, const Confine &c,
+                       const tinygltf::Model &g, io_error *err)
+{
+    const std::string &rel = c.refused[0];
+    for (size_t i = 0; i < g.images.size(); i++)
+        if (uri_decode(g.images[i].uri) == rel)
+            return io_fail(err, IO_ERR_VALUE,
+                           "%s: image %zu: uri '%.200s' %s; the model's folder "
+                           "is %s; the "
+                           "option --allow-outside allows it",
+                           path, i, g.images[i].uri.c_str(), c.why[0].c_str(),
+                           c.base.c_str());
+    return io_fail(err, IO_ERR_VALUE,
+                   "%s: buffer %zu: uri '%.200s' %s; the model's folder "
+                   "is %s; the "
+                   "option --allow-outside allows it",
+                   path, g.buffers.size(), rel.c_str(), c.why[0].c_str(),
+                   c.base.c_str());
+}
+
 io_result load(const char *path, int scene, kin_model *out, io_gltf_info *info,
                io_error *err)
 {
@@ -1571,7 +1665,22 @@ io_result load(const char *path, int scene, kin_model *out, io_gltf_info *info,
     tinygltf::TinyGLTF parser;
     parser.SetImageLoader(skip_image, nullptr);
     std::string terr, twarn;
-    std::string base = dir_of(path);
+    Confine confine;
+    {
+        std::string dir = dir_of(path);
+        char *rp = realpath(dir.empty() ? "." : dir.c_str(), nullptr);
+        if (!rp)
+            return io_fail(err, IO_ERR_READ, "%s: its folder: %s", path,
+                           strerror(errno));
+        confine.base = rp;
+        free(rp);
+    }
+    confine.allow = g_allow_outside != 0;
+    tinygltf::FsCallbacks fs = {&tinygltf::FileExists, &confine_expand,
+                                &tinygltf::ReadWholeFile,
+                                &tinygltf::WriteWholeFile, &confine};
+    parser.SetFsCallbacks(fs);
+    const std::string &base = confine.base;
     bool ok;
     const bool glb = bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0;
     if (glb) pad_glb_for_meshopt(bytes);
@@ -1584,6 +1693,7 @@ io_result load(const char *path, int scene, kin_model *out, io_gltf_info *info,
         ok = parser.LoadASCIIFromString(
             &g, &terr, &twarn, reinterpret_cast<const char *>(bytes.data()),
             (unsigned)bytes.size(), base);
+    if (!confine.refused.empty()) return confine_fail(path, confine, g, err);
     /* tinygltf reads extensionsRequired before the buffers, so a file it
      * cannot load (Draco, meshopt) is still refused by name. */
     std::string missing = unimplemented_required(g);
@@ -1636,6 +1746,11 @@ io_result load(const char *path, int scene, kin_model *out, io_gltf_info *info,
 }
 
 }  // namespace
+
+extern "C" void io_gltf_allow_outside(int allow)
+{
+    g_allow_outside = allow != 0;
+}
 
 extern "C" io_result io_gltf_load(const char *path, kin_model *out,
                                   io_error *err)
