@@ -41,6 +41,7 @@ const char *run_usage =
     "  --predict-ms MS  pose the mask at the camera's time stamp + MS (default 0)\n"
     "  --glove-left SEL, --glove-right SEL   5DT gloves (SEL as below, or any)\n"
     "  --calib FILE     user calibration (egofuse-calib 1, egofuse calibrate)\n"
+    "  --allow-outside  let the models read files outside their folder\n"
     "  --hide PARTS     parts not shown: left-hand,left-arm,right-hand,right-arm\n"
     "  --prop [NAME=]MODEL[@X,Y,Z[,YAW,PITCH,ROLL]][#BODY]\n"
     "                   a real object cut in like the hands (joystick, armrest):\n"
@@ -91,7 +92,7 @@ enum {
     O_TRACK, O_TRACK_ADDR, O_GLOVE_L, O_GLOVE_R, O_CALIB, O_OUT, O_RAW, O_FRAMES, O_QUIET,
     O_REFINE, O_CONFIG, O_STATS, O_PREDICT, O_HIDE, O_PROP, O_VSRC, O_VLAYOUT, O_VFPS, O_VSTALE,
     O_DISPLAY, O_NATNET, O_NN_LOCAL, O_NN_MCAST, O_NN_BODY, O_NN_UP, O_NN_UNITS, O_NN_VERSION,
-    O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD,
+    O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD, O_ALLOW_OUTSIDE,
     O_HMD_CAM, O_HMD_CAM_HFOV, O_HMD_BASE, O_HMD_OFFSET, O_HMD_DISP, O_HMD_HFOV, O_HMD_VFOV,
     O_HMD_FOCAL, O_HMD_IPD, O_DUMP
 };
@@ -141,6 +142,7 @@ static const struct option run_long_opts[] = {
     {"natnet-data-port", required_argument, 0, O_NN_DATAPORT},
     {"loop", no_argument, 0, O_LOOP},
     {"hold", no_argument, 0, O_HOLD},
+    {"allow-outside", no_argument, 0, O_ALLOW_OUTSIDE},
     {"hmd-camera", required_argument, 0, O_HMD_CAM},
     {"hmd-camera-hfov", required_argument, 0, O_HMD_CAM_HFOV},
     {"hmd-baseline", required_argument, 0, O_HMD_BASE},
@@ -308,6 +310,7 @@ int run_parse(int argc, char **argv, run_opts *o)
         case O_DV: o->dv = 1; break;
         case O_LOOP: o->loop = 1; break;
         case O_HOLD: o->hold = 1; break;
+        case O_ALLOW_OUTSIDE: io_gltf_allow_outside(1); break;
         case O_BUFFERS:
             if (!cli_parse_int(optarg, 2, IO_CAM_MAX_BUFFERS, &o->buffers))
                 BAD("--buffers '%s': 2..%d", optarg, IO_CAM_MAX_BUFFERS);

@@ -153,7 +153,7 @@ static int parse_bool(const char *v, int *out)
 /* Flags: options that take no value (a boolean in the file). */
 static int conf_is_flag(const char *opt)
 {
-    static const char *const k[] = {"raw", "quiet", "dv", "loop", NULL};
+    static const char *const k[] = {"raw", "quiet", "dv", "loop", "hold", "allow-outside", NULL};
     for (int i = 0; k[i]; i++)
         if (!strcmp(opt, k[i])) return 1;
     return 0;
