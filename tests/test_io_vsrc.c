@@ -818,8 +818,7 @@ static void write_pngs(const char *pattern, int count, int w, int h, int salt)
 static void test_file_cam_sequence(void **st)
 {
     (void)st;
-    char pat[2][600], sel[2][700];
-#pragma GCC diagnostic ignored "-Wformat-truncation"
+    char pat[2][600], sel[2][1300];
     tmp("camL_%04d.png", pat[0], sizeof pat[0]);
     tmp("camR_%04d.png", pat[1], sizeof pat[1]);
     write_pngs(pat[0], 4, 64, 48, 0);
