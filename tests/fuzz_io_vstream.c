@@ -7,7 +7,8 @@
  * the raw framing: then bytes 1-4 are width-1, height-1 (1..256 each)
  * and a format index, as "raw:WxH:FMT:" would set them. The rest is the
  * stream, read from a memfd. Every frame must lie inside the buffer; a
- * bad frame or a fatal error comes with a message. `make fuzz`, seeds in
+ * bad frame or a fatal error comes with a message. A frame larger than
+ * 64 MiB is not read (see the loop). `make fuzz`, seeds in
  * tests/fuzz/corpus/io_vstream/; docs/fuzzing.md. */
 #include <string.h>
 #include <sys/mman.h>
@@ -62,6 +63,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             break;
         } else {   /* VS_MORE */
             if (r.eof) break;
+            /* a header may ask for up to 16384 x 16384 colour + depth
+             * (2 GiB, VS_MAX_DIM): the input is at most 64 KiB, so such
+             * a frame can only end truncated; stop before the buffer
+             * would grow past libFuzzer's malloc limit */
+            if (r.pos + r.need > ((size_t)64 << 20)) break;
             long k = vs_fill(&r, fd, chunk);
             if (k < -1) break;
             if (k == -1) abort();   /* a memfd never says EAGAIN */
