@@ -219,7 +219,8 @@ check-headers:
 debug: deps
 	@$(MAKE) --no-print-directory BUILD=build-debug OPT=-O1 \
 	    SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" all
-	@ASAN_OPTIONS=detect_leaks=1 sh tests/run_tests.sh build-debug
+	@ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
+	    sh tests/run_tests.sh build-debug
 
 # libFuzzer targets tests/fuzz_*.c, one per parser (docs/fuzzing.md): clang,
 # ASan + UBSan (a UB report aborts, so the fuzzer sees it), the libraries
