@@ -3,7 +3,10 @@
 #   make            library, io library, the egofuse program, tests, tools
 #   make demo       install what is missing, generate samples, run the demo
 #   make test       install what is missing, build, run every test
-#   make debug      the same tests under ASan + UBSan (build-debug/)
+#   make debug      the same tests under ASan + UBSan (build-debug/);
+#                   EGOFUSE_VM=0 make debug skips the VM test
+#   make fuzz       libFuzzer + ASan + UBSan targets of every parser, clang
+#                   (build-fuzz/fuzz/; scripts/fuzz.sh runs them, docs/fuzzing.md)
 #   make bench      benchmarks (they report, never pass or fail)
 #   make install    PREFIX=/usr/local DESTDIR=: the libraries, headers, pkg-config
 #                   files, plugin and program (docs/library.md); make uninstall
@@ -105,7 +108,7 @@ EGOFUSE  := $(BUILD)/egofuse
 GEN      := $(BUILD)/gen_samples
 SAMPLES  := $(BUILD)/samples
 
-.PHONY: all deps demo test debug bench clean samples check-headers eval core-tests
+.PHONY: all deps demo test debug bench clean samples check-headers eval core-tests fuzz fuzz-targets
 .DEFAULT_GOAL := all
 # Keep intermediate objects (tests/support/*.o), so a second make rebuilds nothing.
 .SECONDARY:
@@ -218,7 +221,26 @@ check-headers:
 debug: deps
 	@$(MAKE) --no-print-directory BUILD=build-debug OPT=-O1 \
 	    SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" all
-	@ASAN_OPTIONS=detect_leaks=1 sh tests/run_tests.sh build-debug
+	@ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
+	    sh tests/run_tests.sh build-debug
+
+# libFuzzer targets tests/fuzz_*.c, one per parser (docs/fuzzing.md): clang,
+# ASan + UBSan (a UB report aborts, so the fuzzer sees it), the libraries
+# instrumented for coverage, everything in build-fuzz/. Linked by clang++
+# (the sanitizers' C++ runtime, the io library's C++).
+FUZZ_SRC := $(wildcard tests/fuzz_*.c)
+FUZZ_BIN := $(patsubst tests/%.c,$(BUILD)/fuzz/%,$(FUZZ_SRC))
+FUZZ_SAN := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+fuzz:
+	@$(MAKE) --no-print-directory BUILD=build-fuzz CC=clang CXX=clang++ OPT=-O1 \
+	    SAN="$(FUZZ_SAN) -fsanitize=fuzzer-no-link" fuzz-targets
+
+fuzz-targets: $(FUZZ_BIN)
+
+$(BUILD)/fuzz/%: tests/%.c tests/fuzz/fuzz_util.h $(IOLIB) $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(IO_CFLAGS) -Itests -c $< -o $@.o
+	$(CXX) $(LDFLAGS) -fsanitize=fuzzer -o $@ $@.o $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
 
 # The accuracy report (docs/accuracy.md): charts, table, summary.csv.
 eval: deps
@@ -230,7 +252,7 @@ bench: deps
 	@sh bench/run_bench.sh $(BUILD)
 
 clean:
-	rm -rf build build-debug build-clang build-arm64 out
+	rm -rf build build-debug build-clang build-arm64 build-fuzz out
 
 # ------------------------------------------------------------ install
 # make install [PREFIX=/usr/local] [DESTDIR=]  (docs/library.md):

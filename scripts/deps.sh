@@ -13,7 +13,8 @@
 # apt-get line and stops.
 #
 #   sh scripts/deps.sh              the packages above
-#   sh scripts/deps.sh ci           also CI's: clang, the ARM64 cross
+#   sh scripts/deps.sh ci           also CI's: clang and its runtimes
+#                                   (libFuzzer, sanitizers), the ARM64 cross
 #                                   compiler and qemu-user (.ci/run)
 #   sh scripts/deps.sh arm64 DIR    CI's ARM64 cross build: the arm64
 #                                   architecture added to dpkg and cmocka
@@ -40,9 +41,11 @@ libpixman-1-dev
 libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri
 ffmpeg gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good python3
 qemu-system-x86 busybox-static cpio kmod xz-utils"
-# .ci/run: a clang build, the ARM64 cross build under qemu-user, and
-# scripts/rng_order.py (clang's AST, python3).
-CI_PKGS="clang gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user-static python3"
+# .ci/run: a clang build, the ARM64 cross build under qemu-user,
+# scripts/rng_order.py (clang's AST, python3), and make fuzz: libFuzzer and
+# clang's sanitizer runtimes (libclang-rt-dev, only a Recommends of clang,
+# which apt-get install --no-install-recommends leaves out).
+CI_PKGS="clang libclang-rt-dev gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user-static python3"
 
 mode=${1:-}
 native=$(dpkg --print-architecture)

@@ -307,16 +307,17 @@ static int run_case(const ctxs *cx, int n, uint32_t *crc)
 static int skip_missing(const ctxs *cx, int i)
 {
     if (cx->isa[i][0] != NULL) return 0;
-    printf("SKIP %s: not available (cpu best %s, EGOFUSE_ISA %s)\n",
-           ef_isa_name(simd_isas[i]), ef_isa_name(ef_cpu_best()),
-           getenv("EGOFUSE_ISA") ? getenv("EGOFUSE_ISA") : "unset");
+    printf("SKIP %s: not available (cpu best %s, EGOFUSE_ISA %s); untested: "
+           "src/fuse/fuse_%s.c\n", ef_isa_name(simd_isas[i]), ef_isa_name(ef_cpu_best()),
+           getenv("EGOFUSE_ISA") ? getenv("EGOFUSE_ISA") : "unset", ef_isa_name(simd_isas[i]));
     return 1;
 }
 
 static int skip_missing_isa(ef_isa isa)
 {
-    printf("SKIP %s: not available (cpu best %s, EGOFUSE_ISA %s)\n", ef_isa_name(isa),
-           ef_isa_name(ef_cpu_best()), getenv("EGOFUSE_ISA") ? getenv("EGOFUSE_ISA") : "unset");
+    printf("SKIP %s: not available (cpu best %s, EGOFUSE_ISA %s); untested: "
+           "src/fuse/fuse_%s.c\n", ef_isa_name(isa), ef_isa_name(ef_cpu_best()),
+           getenv("EGOFUSE_ISA") ? getenv("EGOFUSE_ISA") : "unset", ef_isa_name(isa));
     return 1;
 }
 

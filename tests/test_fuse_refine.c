@@ -457,7 +457,8 @@ static uint32_t check_case(const rcase *c, ef_isa isa, int k)
 static void check_isa(ef_isa isa)
 {
     if (!ef_cpu_has(isa) || ef_isa_choose(isa) != isa) {
-        print_message("%s: not available here (or capped by EGOFUSE_ISA)\n", ef_isa_name(isa));
+        print_message("SKIP %s: not available here (or capped by EGOFUSE_ISA); untested: "
+                      "src/fuse/fuse_refine_%s.c\n", ef_isa_name(isa), ef_isa_name(isa));
         skip();
     }
     assert_int_equal(fuse_refine_isa(isa), isa);

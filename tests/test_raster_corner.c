@@ -451,7 +451,9 @@ static int open_paths(paths *p, int isa)
     memset(p, 0, sizeof *p);
     p->isa = isa;
     if (!ef_cpu_has((ef_isa)isa)) {
-        print_message("SKIP %s: not supported by this CPU\n", ef_isa_name((ef_isa)isa));
+        print_message("SKIP %s: not supported by this CPU; untested: the corner cases through "
+                      "rast_draw on %s (src/raster/raster_%s.c, raster_front_%s.c)\n", ef_isa_name((ef_isa)isa),
+                      ef_isa_name((ef_isa)isa), ef_isa_name((ef_isa)isa), ef_isa_name((ef_isa)isa));
         return 0;
     }
     rast_context_desc d1 = { isa, 1 }, d2 = { isa, 2 };

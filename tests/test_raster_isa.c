@@ -321,8 +321,8 @@ static void draw_case(rcase *k, rast__scan_rows_fn scan, rast_stats *st)
 static void soup_isa(int isa)
 {
     if (!ef_cpu_has((ef_isa)isa)) {
-        print_message("SKIP raster isa %s: this CPU does not run it\n",
-                      ef_isa_name((ef_isa)isa));
+        print_message("SKIP raster isa %s: this CPU does not run it; untested: the row scan of "
+                      "src/raster/raster_%s.c\n", ef_isa_name((ef_isa)isa), ef_isa_name((ef_isa)isa));
         skip();
     }
     rast__scan_rows_fn scan = rast__scan_for_isa(isa);
@@ -608,7 +608,8 @@ static void test_setup_isa_equal(void **state)
         have[i] = ef_cpu_has((ef_isa)simd[i]);
         nhave += have[i];
         if (!have[i])
-            print_message("SKIP setup isa %s: this CPU does not run it\n",
+            print_message("SKIP setup isa %s: this CPU does not run it; untested: "
+                          "rast__planes_%s (triangle set-up)\n", ef_isa_name((ef_isa)simd[i]),
                           ef_isa_name((ef_isa)simd[i]));
     }
     if (!nhave)
@@ -1235,8 +1236,9 @@ static void test_frontv_equal(void **state)
         if (ef_cpu_has((ef_isa)simd[i]) && isas_v[i]->vpass)
             nhave++;
         else
-            print_message("SKIP vector front end %s: this CPU does not run it\n",
-                          ef_isa_name((ef_isa)simd[i]));
+            print_message("SKIP vector front end %s: this CPU does not run it; untested: the "
+                          "vector front end of src/raster/raster_front_%s.c\n",
+                          ef_isa_name((ef_isa)simd[i]), ef_isa_name((ef_isa)simd[i]));
     }
     if (!nhave)
         skip();

@@ -232,16 +232,22 @@ static void check_isa(ef_isa which, const rast__setup_isa *isa)
 static void test_frontv_patterned_avx2(void **state)
 {
     (void)state;
-    if (!ef_cpu_has(EF_ISA_AVX2))
+    if (!ef_cpu_has(EF_ISA_AVX2)) {
+        print_message("SKIP avx2: not supported by this CPU; untested: the patterned vector "
+                      "front end of src/raster/raster_front_avx2.c\n");
         skip();
+    }
     check_isa(EF_ISA_AVX2, &rast__setup_isa_avx2);
 }
 
 static void test_frontv_patterned_avx512(void **state)
 {
     (void)state;
-    if (!ef_cpu_has(EF_ISA_AVX512))
+    if (!ef_cpu_has(EF_ISA_AVX512)) {
+        print_message("SKIP avx512: not supported by this CPU; untested: the patterned vector "
+                      "front end of src/raster/raster_front_avx512.c\n");
         skip();
+    }
     check_isa(EF_ISA_AVX512, &rast__setup_isa_avx512);
 }
 

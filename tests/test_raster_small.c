@@ -95,7 +95,8 @@ static int make_case(int n, planes *ref, rast__tri *tri, int *ya, int *yb)
 static void small_isa(int isa)
 {
     if (!ef_cpu_has((ef_isa)isa)) {
-        print_message("SKIP %s: not supported by this CPU\n", ef_isa_name((ef_isa)isa));
+        print_message("SKIP %s: not supported by this CPU; untested: small triangles through "
+                      "src/raster/raster_%s.c\n", ef_isa_name((ef_isa)isa), ef_isa_name((ef_isa)isa));
         skip();
     }
     const rast__scan_rows_fn scan = rast__scan_for_isa(isa);

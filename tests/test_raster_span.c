@@ -246,7 +246,8 @@ static void test_span_reference(void **state)
 static void span_isa(int isa)
 {
     if (!ef_cpu_has((ef_isa)isa)) {
-        print_message("SKIP %s: not supported by this CPU\n", ef_isa_name((ef_isa)isa));
+        print_message("SKIP %s: not supported by this CPU; untested: the row scan of "
+                      "src/raster/raster_%s.c\n", ef_isa_name((ef_isa)isa), ef_isa_name((ef_isa)isa));
         skip();
     }
     const rast__scan_rows_fn scan = rast__scan_for_isa(isa);

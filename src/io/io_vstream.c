@@ -422,6 +422,11 @@ int vs_parse(vs_reader *r, vs_frame *f)
 {
     if (r->framing == VS_UNKNOWN) {
         size_t avail = r->len - r->pos;
+        if (!avail) {   /* nothing read yet (r->buf may be NULL) */
+            r->need = 10;
+            if (r->eof) return bad(r, VS_FATAL, "the stream ended after 0 bytes, before a frame header");
+            return VS_MORE;
+        }
         const uint8_t *p = r->buf + r->pos;
         if (avail >= 4 && !memcmp(p, "EGFV", 4)) {
             r->framing = VS_EGFV;
