@@ -186,8 +186,11 @@ static int boot_vm(void)
     if (bin && bin[0] == '/' && !strchr(bin, ' ')) snprintf(binarg, sizeof binarg, " egofuse.bin=%.500s", bin);
     /* video=Virtual-3:e: virtio-gpu's second output counts as connected
      * (qemu enables only the first without a UI); connector names count
-     * across cards: bochs's is Virtual-1, virtio-gpu's Virtual-2 and -3 */
-    snprintf(append, sizeof append, "console=ttyS0 quiet panic=-1 video=Virtual-3:e egofuse.out=%s egofuse.root=%s%s",
+     * across cards: bochs's is Virtual-1, virtio-gpu's Virtual-2 and -3;
+     * vt.global_cursor_default=0: no blinking cursor redrawn on the
+     * consoles' framebuffers all along */
+    snprintf(append, sizeof append, "console=ttyS0 quiet panic=-1 video=Virtual-3:e vt.global_cursor_default=0 "
+             "egofuse.out=%s egofuse.root=%s%s",
              out, root, binarg);
     snprintf(fs_root, sizeof fs_root, "local,path=/,mount_tag=hostroot,security_model=none,"
              "readonly=on,multidevs=remap");
