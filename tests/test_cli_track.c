@@ -258,26 +258,10 @@ static char g_model_path[1200], g_skip[3000];
 static int group_setup(void **state)
 {
     (void)state;
-    char gen[1024], dir[1024], log[4096];
-    tu_root_path("build/samples/model/arms.glb", g_model_path, sizeof g_model_path);
-    if (!tu_exists(g_model_path)) {
-        const char *b = bin();
-        const char *slash = strrchr(b, '/');
-        if (slash) snprintf(gen, sizeof gen, "%.*s/gen_samples", (int)(slash - b), b);
-        else tu_root_path("build/gen_samples", gen, sizeof gen);
-        if (!tu_exists(gen)) {
-            snprintf(g_skip, sizeof g_skip, "SKIP calibrate: no %s and no generator %s",
-                     g_model_path, gen);
-            return 0;
-        }
-        tu_tmp_path("calib_samples", dir, sizeof dir);
-        char *argv[] = { gen, "--out", dir, "--frames", "3", NULL };
-        if (tu_run(argv, log, sizeof log) != 0) {
-            fprintf(stderr, "gen_samples failed:\n%s\n", log);
-            return -1;
-        }
-        snprintf(g_model_path, sizeof g_model_path, "%s/model/arms.glb", dir);
-    }
+    char dir[1024];
+    int r = tu_samples_dir("calib_samples", 3, dir, sizeof dir, g_skip, sizeof g_skip);
+    if (r <= 0) return r;
+    snprintf(g_model_path, sizeof g_model_path, "%s/model/arms.glb", dir);
     io_error err;
     if (io_gltf_load(g_model_path, &g_model, &err) != IO_OK) {
         fprintf(stderr, "%s\n", err.msg);
@@ -291,10 +275,7 @@ static int group_teardown(void **state)
 {
     (void)state;
     if (g_loaded) kin_model_free(&g_model);
-    char dir[1024], log[256];
-    tu_tmp_path("calib_samples", dir, sizeof dir);
-    char *argv[] = { "/bin/rm", "-rf", dir, NULL };
-    tu_run(argv, log, sizeof log);
+    tu_samples_remove("calib_samples");
     return 0;
 }
 

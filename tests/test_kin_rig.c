@@ -29,37 +29,14 @@ static int g_loaded;
 static char g_skip[3000];
 static char g_track[1200];   /* the samples' track.txt */
 
-static const char *gen_path(char *buf, size_t n)
-{
-    const char *bin = getenv("EGOFUSE_BIN");
-    const char *slash = bin ? strrchr(bin, '/') : NULL;
-    if (slash) snprintf(buf, n, "%.*s/gen_samples", (int)(slash - bin), bin);
-    else tu_root_path("build/gen_samples", buf, n);
-    return buf;
-}
-
 static int group_setup(void **state)
 {
     (void)state;
-    char path[1200], gen[1024], dir[1024], log[4096];
-    tu_root_path("build/samples/model/arms.glb", path, sizeof path);
-    tu_root_path("build/samples/track.txt", g_track, sizeof g_track);
-    if (!tu_exists(path) || !tu_exists(g_track)) {
-        gen_path(gen, sizeof gen);
-        if (!tu_exists(gen)) {
-            snprintf(g_skip, sizeof g_skip, "SKIP test_kin_rig: no %s and no generator %s "
-                     "(make build/gen_samples)", path, gen);
-            return 0;
-        }
-        tu_tmp_path("rig_samples", dir, sizeof dir);
-        char *argv[] = { gen, "--out", dir, "--frames", "3", NULL };
-        if (tu_run(argv, log, sizeof log) != 0) {
-            fprintf(stderr, "gen_samples failed:\n%s\n", log);
-            return -1;
-        }
-        snprintf(path, sizeof path, "%s/model/arms.glb", dir);
-        snprintf(g_track, sizeof g_track, "%s/track.txt", dir);
-    }
+    char dir[1024], path[1200];
+    int r = tu_samples_dir("rig_samples", 3, dir, sizeof dir, g_skip, sizeof g_skip);
+    if (r <= 0) return r;
+    snprintf(path, sizeof path, "%s/model/arms.glb", dir);
+    snprintf(g_track, sizeof g_track, "%s/track.txt", dir);
     io_error err;
     if (io_gltf_load(path, &g_model, &err) != IO_OK) {
         fprintf(stderr, "%s\n", err.msg);
@@ -73,10 +50,7 @@ static int group_teardown(void **state)
 {
     (void)state;
     if (g_loaded) kin_model_free(&g_model);
-    char dir[1024], log[256];
-    tu_tmp_path("rig_samples", dir, sizeof dir);
-    char *argv[] = { "/bin/rm", "-rf", dir, NULL };
-    tu_run(argv, log, sizeof log);
+    tu_samples_remove("rig_samples");
     return 0;
 }
 

@@ -32,35 +32,13 @@ static kin_model g_model;
 static int g_loaded;
 static char g_skip[3000];
 
-static const char *gen_path(char *buf, size_t n)
-{
-    const char *bin = getenv("EGOFUSE_BIN");
-    const char *slash = bin ? strrchr(bin, '/') : NULL;
-    if (slash) snprintf(buf, n, "%.*s/gen_samples", (int)(slash - bin), bin);
-    else tu_root_path("build/gen_samples", buf, n);
-    return buf;
-}
-
 static int group_setup(void **state)
 {
     (void)state;
-    char path[1200], gen[1024], dir[1024], log[4096];
-    tu_root_path("build/samples/model/arms.glb", path, sizeof path);
-    if (!tu_exists(path)) {
-        gen_path(gen, sizeof gen);
-        if (!tu_exists(gen)) {
-            snprintf(g_skip, sizeof g_skip, "SKIP test_pipe_parts: no %s and no generator %s "
-                     "(make build/gen_samples)", path, gen);
-            return 0;
-        }
-        tu_tmp_path("parts_samples", dir, sizeof dir);
-        char *argv[] = { gen, "--out", dir, "--frames", "1", NULL };
-        if (tu_run(argv, log, sizeof log) != 0) {
-            fprintf(stderr, "gen_samples failed:\n%s\n", log);
-            return -1;
-        }
-        snprintf(path, sizeof path, "%s/model/arms.glb", dir);
-    }
+    char dir[1024], path[1200];
+    int r = tu_samples_dir("parts_samples", 1, dir, sizeof dir, g_skip, sizeof g_skip);
+    if (r <= 0) return r;
+    snprintf(path, sizeof path, "%s/model/arms.glb", dir);
     io_error err;
     if (io_gltf_load(path, &g_model, &err) != IO_OK) {
         fprintf(stderr, "%s\n", err.msg);
@@ -74,10 +52,7 @@ static int group_teardown(void **state)
 {
     (void)state;
     if (g_loaded) kin_model_free(&g_model);
-    char dir[1024], log[256];
-    tu_tmp_path("parts_samples", dir, sizeof dir);
-    char *argv[] = { "/bin/rm", "-rf", dir, NULL };
-    tu_run(argv, log, sizeof log);
+    tu_samples_remove("parts_samples");
     return 0;
 }
 

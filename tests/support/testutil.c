@@ -86,3 +86,41 @@ int tu_count_fds(void)
     closedir(d);
     return n;
 }
+
+int tu_samples_dir(const char *name, int frames, char *dir, size_t n, char *why, size_t why_n)
+{
+    char gen[1024], own[1100], scene[1200], log[4096], nf[16];
+    const char *bin = getenv("EGOFUSE_BIN");
+    const char *slash = bin ? strrchr(bin, '/') : NULL;
+    if (slash) snprintf(gen, sizeof gen, "%.*s/gen_samples", (int)(slash - bin), bin);
+    else tu_root_path("build/gen_samples", gen, sizeof gen);
+    tu_root_path("build/samples", own, sizeof own);
+    snprintf(scene, sizeof scene, "%s/scene.txt", own);
+    struct stat sg, ss;
+    int have_gen = stat(gen, &sg) == 0;
+    if (stat(scene, &ss) == 0 && (!have_gen || ss.st_mtime >= sg.st_mtime)) {
+        snprintf(dir, n, "%s", own);
+        return 1;
+    }
+    if (!have_gen) {
+        snprintf(why, why_n, "SKIP: no generated samples (%s) and no generator %s (make build/gen_samples)",
+                 own, gen);
+        return 0;
+    }
+    tu_tmp_path(name, dir, n);
+    snprintf(nf, sizeof nf, "%d", frames);
+    char *argv[] = {gen, "--out", dir, "--frames", nf, NULL};
+    if (tu_run(argv, log, sizeof log) != 0) {
+        fprintf(stderr, "%s failed:\n%s\n", gen, log);
+        return -1;
+    }
+    return 1;
+}
+
+void tu_samples_remove(const char *name)
+{
+    char dir[1024], log[256];
+    tu_tmp_path(name, dir, sizeof dir);
+    char *argv[] = {"/bin/rm", "-rf", dir, NULL};
+    tu_run(argv, log, sizeof log);
+}

@@ -41,6 +41,14 @@ int tu_run(char *const argv[], char *out, size_t out_size);
 /* Open descriptors of this process (entries of /proc/self/fd, its own
  * listing's included), -1 when it cannot be read: compare before and after. */
 int tu_count_fds(void);
+/* The generated samples (gen_samples' output) for a test: the build's own
+ * build/samples when it is at least as new as the generator next to
+ * EGOFUSE_BIN (a stale folder from an older generator is not used), else
+ * FRAMES frames generated into the test's tmp/NAME. 1 with dir set; 0
+ * when there is no generator (why says so, for a skip); -1 when it
+ * failed. tu_samples_remove(NAME) deletes what it generated. */
+int tu_samples_dir(const char *name, int frames, char *dir, size_t n, char *why, size_t why_n);
+void tu_samples_remove(const char *name);
 
 /* Float checks against analytic answers (cmocka's fail_msg at the use
  * site): |a - b| <= tol, with both values in the message. */
