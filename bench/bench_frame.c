@@ -33,6 +33,7 @@
  *
  *   bench_frame [--samples DIR] [--out DIR] [--frames N] [--ref-frames N]
  *               [--scale-frames N] [--window N] [--quick] [--no-scaling]
+ *               [--isa I] [--threads T]   (the grid: only that ISA / thread count)
  *
  * Writes DIR/bench.csv (header + egofuse, memcpy and pixman rows),
  * DIR/frame_tris.csv, DIR/frame_cover.csv, DIR/frame_res.csv. Reports,
@@ -643,6 +644,10 @@ typedef struct budget {
     double s_best, s_other, s_ref, s_scale;               /* time boxes */
 } budget;
 
+/* --isa / --threads: only that ISA / thread count in the grid (0: all) */
+static ef_isa grid_isa = EF_ISA_DEFAULT;
+static int grid_threads = 0;
+
 static void run_grid(bench *b, const budget *bu)
 {
     const ef_isa best = ef_isa_choose(EF_ISA_DEFAULT);
@@ -656,12 +661,14 @@ static void run_grid(bench *b, const budget *bu)
     print_head();
     for (int c = 0; c < 2; c++) {
         for (int i = 0; i < 4; i++) {
+            if (grid_isa != EF_ISA_DEFAULT && grid_isa != isas[i]) continue;
             if (!ef_cpu_has(isas[i]) || ef_isa_choose(isas[i]) != isas[i]) {
                 printf("  %-8s %-7s SKIPPED: %s\n", c ? "worst" : "typical", ef_isa_name(isas[i]),
                        ef_cpu_has(isas[i]) ? "capped by EGOFUSE_ISA" : "the CPU lacks it");
                 continue;
             }
             for (int t = 1; t <= 2; t++) {
+                if (grid_threads && t != grid_threads) continue;
                 pipe_ctx *p = make_pipe(b, &b->model, isas[i], t, NULL);
                 if (!p || pipe_isa(p) != (int)isas[i]) {
                     printf("  %-8s %-7s SKIPPED: the pipe runs %s\n", c ? "worst" : "typical",
@@ -1132,12 +1139,17 @@ int main(int argc, char **argv)
             budget q = {300, 200, 5, 40, 1.0, 0.5, 0.5, 0.3};
             bu = q;
         } else if (!strcmp(o, "--no-scaling")) scaling = 0;
+        else if (!strcmp(o, "--isa") && v) {
+            grid_isa = ef_isa_parse(v), a++;
+            ok = grid_isa != EF_ISA_DEFAULT;
+        } else if (!strcmp(o, "--threads") && v) ok = parse_int(v, 1, 2, &grid_threads), a++;
         else ok = 0;
         if (!ok) {
             fprintf(stderr,
                     "usage: %s [--samples DIR] [--out DIR] [--frames N] [--ref-frames N]\n"
                     "       [--scale-frames N] [--seconds S] [--window N] [--quick] "
-                    "[--no-scaling]\n",
+                    "[--no-scaling]\n"
+                    "       [--isa ref|sse2|avx2|avx512] [--threads 1|2]   (the grid only)\n",
                     argv[0]);
             return 2;
         }

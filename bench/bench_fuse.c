@@ -20,6 +20,15 @@
  *   frame_op   frame_ip with fuse_eye.v_opaque = 1 (V is opaque: the spans
  *              the layer does not reach are neither read nor written)
  *   frame_dop  frame_dp with v_opaque = 1
+ *   dop_l2     frame_dop with the sample scene's lighting (build/samples'
+ *              scene.txt: two lights, ks 0.12, s 20), as bench_frame lights
+ *   dop_cold   frame_dop with its inputs out of the caches (64 MB written
+ *              right before the call, untimed), as in a frame whose V and
+ *              scene depth come from memory
+ *   dop_l2c    both
+ *   like_frame dop_l2c out of place (out != V, as bench_frame runs the
+ *              pipe: its V images are kept, so the transparent spans are a
+ *              copy V -> out): what the frame's fuse stage does
  *   memcpy     V -> out of both eyes (2 x 4.1 MB) with as many threads as
  *              the row (one eye per thread with 2): the memory floor
  *   pixman     single-threaded, in place on a copy of V (pixman's dst):
@@ -189,18 +198,62 @@ static double time_memcpy(eye_buf e[2], copier *c)
 typedef struct stats {
     double light, comp, frame, frame_ip, frame_dp, frame_op, frame_dop, memcpy;
     double r_frame, r_frame_ip, r_frame_dp, r_frame_op, r_frame_dop;   /* medians of x / memcpy per run */
+    double dop_l2, dop_cold, dop_l2c;   /* frame_dop: scene lighting, cold inputs, both */
+    double like_frame;                  /* dop_l2c out of place */
 } stats;
+
+/* The sample scene's lighting (samples/gen: build/samples/scene.txt), the
+ * directions taken as view-space directions (timing only). */
+static fuse_lighting scene_lighting(void)
+{
+    fuse_lighting L = fuse_lighting_default();
+    const float d[2][3] = { { -0.7884f, 0.5781f, 0.2102f }, { 0.3271f, 0.9345f, 0.1402f } };
+    const float c[2][3] = { { 0.620f, 0.700f, 0.820f }, { 0.450f, 0.380f, 0.280f } };
+    int i, k;
+    L.light_count = 2;
+    for (i = 0; i < 2; i++)
+        for (k = 0; k < 3; k++) {
+            L.lights[i].dir[k] = d[i][k];
+            L.lights[i].color[k] = c[i][k];
+        }
+    L.ambient[0] = 0.28f;
+    L.ambient[1] = 0.30f;
+    L.ambient[2] = 0.32f;
+    L.kd = 0.80f;
+    L.ks = 0.12f;
+    L.shininess = 20.0f;
+    L.kf = 0.50f;
+    L.tone[0] = 1.0f;
+    L.tone[1] = 0.98f;
+    L.tone[2] = 0.96f;
+    return L;
+}
+
+/* Writes and reads 64 MB (more than the last-level cache) so that the
+ * next call finds its inputs in memory. Untimed. */
+static volatile uint64_t evict_sink;
+static void evict_caches(void)
+{
+    static uint64_t *buf;
+    const size_t n = (64u << 20) / 8;
+    uint64_t acc = 0;
+    size_t i;
+    if (buf == NULL) buf = xmalloc(n * 8);
+    for (i = 0; i < n; i += 8) buf[i] = i;
+    for (i = 0; i < n; i += 8) acc += buf[i];
+    evict_sink = acc;
+}
 
 static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, stats *s)
 {
-    const fuse_lighting L = fuse_lighting_default();
+    const fuse_lighting L = fuse_lighting_default(), L2 = scene_lighting();
     const fuse_intrinsics K = { 532.0f, 532.0f, CW / 2.0f, CH / 2.0f };
-    double *t[13];
-    fuse_eye eyes[2], ip[2], dp[2], op[2], dop[2];
+    double *t[17];
+    fuse_eye eyes[2], ip[2], dp[2], op[2], dop[2], dop2[2], like[2];
     fuse_depth depth[2];
     copier cp;
     int k, i;
-    for (i = 0; i < 13; i++) t[i] = xmalloc(sizeof(double) * (size_t)runs);
+    for (i = 0; i < 17; i++) t[i] = xmalloc(sizeof(double) * (size_t)runs);
     for (i = 0; i < 2; i++) {
         eyes[i] = (fuse_eye){ &L, &K, { e[i].P, CW, CH, 4 * CW }, e[i].M, CW, e[i].N, 3 * CW,
                               { e[i].Q, CW, CH, 4 * CW }, NULL, { e[i].V, W, H, 4 * W },
@@ -214,10 +267,15 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
         op[i].v_opaque = 1;
         dop[i] = dp[i];
         dop[i].v_opaque = 1;
+        dop2[i] = dop[i];
+        dop2[i].lighting = &L2;
+        like[i] = dop2[i];
+        like[i].V = eyes[i].V;
+        like[i].out = eyes[i].out;
     }
     if (threads > 1) copier_start(&cp, &e[1]);
     for (k = -3; k < runs; k++) {   /* 3 warm-up runs */
-        double m, t0, t1, t2, t3, t4, t5, t6, t7;
+        double m, t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11, t12, t13, t14;
         m = time_memcpy(e, threads > 1 ? &cp : NULL);
         t0 = now_ms();
         for (i = 0; i < 2; i++)
@@ -238,7 +296,25 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
         t6 = now_ms();
         if (fuse_context_frame(ctx, dop, 2) != FUSE_OK) exit(3);
         t7 = now_ms();
+        if (fuse_context_frame(ctx, dop2, 2) != FUSE_OK) exit(3);
+        t8 = now_ms();
+        evict_caches();
+        t9 = now_ms();
+        if (fuse_context_frame(ctx, dop, 2) != FUSE_OK) exit(3);
+        t10 = now_ms();
+        evict_caches();
+        t11 = now_ms();
+        if (fuse_context_frame(ctx, dop2, 2) != FUSE_OK) exit(3);
+        t12 = now_ms();
+        evict_caches();
+        t13 = now_ms();
+        if (fuse_context_frame(ctx, like, 2) != FUSE_OK) exit(3);
+        t14 = now_ms();
         if (k < 0) continue;
+        t[16][k] = t14 - t13;
+        t[13][k] = t8 - t7;
+        t[14][k] = t10 - t9;
+        t[15][k] = t12 - t11;
         t[0][k] = t1 - t0;
         t[1][k] = t2 - t1;
         t[2][k] = t3 - t2;
@@ -255,10 +331,11 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
     }
     if (threads > 1) copier_stop(&cp);
     {   /* t[i] -> its field */
-        double *const dst[13] = { &s->light, &s->comp, &s->frame, &s->frame_ip, &s->memcpy,
+        double *const dst[17] = { &s->light, &s->comp, &s->frame, &s->frame_ip, &s->memcpy,
                                   &s->r_frame, &s->r_frame_ip, &s->frame_dp, &s->r_frame_dp,
-                                  &s->frame_op, &s->r_frame_op, &s->frame_dop, &s->r_frame_dop };
-        for (i = 0; i < 13; i++) {
+                                  &s->frame_op, &s->r_frame_op, &s->frame_dop, &s->r_frame_dop,
+                                  &s->dop_l2, &s->dop_cold, &s->dop_l2c, &s->like_frame };
+        for (i = 0; i < 17; i++) {
             *dst[i] = bench_median(t[i], runs);
             free(t[i]);
         }
@@ -402,7 +479,9 @@ int main(int argc, char **argv)
                "pixman_blend_ms,pixman_scaled_ms,pixman_scaled_mask_ms,pixman_memcpy_ms,"
                "frame_inplace_over_pixman_blend,frame_inplace_over_pixman_scaled,"
                "frame_depth_ms,frame_depth_over_memcpy,frame_opaque_ms,frame_opaque_over_memcpy,"
-               "frame_opaque_depth_ms,frame_opaque_depth_over_memcpy\n");
+               "frame_opaque_depth_ms,frame_opaque_depth_over_memcpy,"
+               "frame_opaque_depth_scene_light_ms,frame_opaque_depth_cold_ms,"
+               "frame_opaque_depth_scene_light_cold_ms,like_frame_ms\n");
     for (c = 0; c < 2; c++) {
         eye_buf e[2];
         double cov = 0;
@@ -424,11 +503,11 @@ int main(int argc, char **argv)
             printf("\n%s hand: %.1f%% of the camera pixels have M > 0\n"
                    "  pixman (1 thread, in place): blend 1:1 + a8 mask %.3f ms, layer bilinear "
                    "%.3f ms, camera + a8 mask bilinear %.3f ms (memcpy 1 thread %.3f ms)\n"
-                   "  %-7s %3s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %8s %8s %8s\n",
+                   "  %-7s %3s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %7s %8s %8s %8s %7s %7s %7s %7s\n",
                    cover_name[c], 100 * cov, pm.blend, pm.scaled, pm.scaled_mask, pm.memcpy,
                    "isa", "thr", "light", "comp", "frame", "frm_ip", "frm_dp", "frm_op", "frm_dop",
                    "memcpy", "frm/mc", "ip/mc", "dp/mc", "op/mc", "dop/mc", "ip/pm_bl", "ip/pm_sc",
-                   "ip/pm_sm");
+                   "ip/pm_sm", "dop_l2", "dop_cld", "dop_l2c", "like_fr");
         for (i = 0; i < 4; i++) {
             if (only_isa != EF_ISA_DEFAULT && only_isa != isas[i]) continue;
             if (!ef_cpu_has(isas[i]) || ef_isa_choose(isas[i]) != isas[i]) {
@@ -446,19 +525,21 @@ int main(int argc, char **argv)
                 run_stages(ctx, e, t, n, &s);
                 if (csv)
                     printf("%s,%.4f,%s,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%.4f,%.4f,%.4f,"
-                           "%.4f,%.3f,%.3f,%.4f,%.3f,%.4f,%.3f,%.4f,%.3f\n", cover_name[c], cov,
+                           "%.4f,%.3f,%.3f,%.4f,%.3f,%.4f,%.3f,%.4f,%.3f,%.4f,%.4f,%.4f,%.4f\n", cover_name[c], cov,
                            ef_isa_name(isas[i]), t,
                            s.light, s.comp, s.light + s.comp, s.frame, s.frame_ip, s.memcpy,
                            s.r_frame, s.r_frame_ip, pm.blend, pm.scaled, pm.scaled_mask, pm.memcpy,
                            s.frame_ip / pm.blend, s.frame_ip / pm.scaled, s.frame_dp, s.r_frame_dp,
-                           s.frame_op, s.r_frame_op, s.frame_dop, s.r_frame_dop);
+                           s.frame_op, s.r_frame_op, s.frame_dop, s.r_frame_dop, s.dop_l2,
+                           s.dop_cold, s.dop_l2c, s.like_frame);
                 else
                     printf("  %-7s %3d %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %7.2f %7.2f %7.2f "
-                           "%7.2f %7.2f %8.2f %8.2f %8.3f\n",
+                           "%7.2f %7.2f %8.2f %8.2f %8.3f %7.3f %7.3f %7.3f %7.3f\n",
                            ef_isa_name(isas[i]), t, s.light, s.comp, s.frame, s.frame_ip, s.frame_dp,
                            s.frame_op, s.frame_dop, s.memcpy, s.r_frame, s.r_frame_ip, s.r_frame_dp,
                            s.r_frame_op, s.r_frame_dop, s.frame_ip / pm.blend,
-                           s.frame_ip / pm.scaled, s.frame_ip / pm.scaled_mask);
+                           s.frame_ip / pm.scaled, s.frame_ip / pm.scaled_mask, s.dop_l2, s.dop_cold,
+                           s.dop_l2c, s.like_frame);
                 fuse_context_destroy(ctx);
             }
         }
@@ -473,6 +554,9 @@ int main(int argc, char **argv)
                "thread count (the floor); frm/mc, ip/mc, dp/mc, op/mc, dop/mc: medians of the\n"
                "per-run ratios to it. ip/pm_*: frm_ip over\n"
                "pixman's blend 1:1 + a8 mask, layer bilinear, camera + mask bilinear (below 1:\n"
-               "egofuse is faster). The machine is shared: compare ratios, not ms.\n");
+               "egofuse is faster). dop_l2: frm_dop with the sample scene's two lights; dop_cld:\n"
+               "frm_dop with cold inputs (64 MB written before it); dop_l2c: both (the frame's\n"
+               "conditions in place); like_fr: dop_l2c out of place, as bench_frame runs the pipe.\n"
+               "The machine is shared: compare ratios, not ms.\n");
     return 0;
 }
