@@ -19,7 +19,8 @@
  * WHAT IT DOES NOT. No dispatch (src/cpu/cpu.h picks the ISA; each room
  * keeps one dispatch table), no FMA, no estimates (rcp/rsqrt), no fast-math,
  * no gathers, no byte/16-bit lanes yet (fuse's refine and composite use
- * them; they come with the fuse port, see docs/portability.md). What one
+ * them, see docs/portability.md; bytes widen to int32 lanes with
+ * vi_load_u8, RGBA8 pixels are int32 lanes through vi_loadu). What one
  * ISA does in a way the others cannot (AVX-512 joint tables, AVX2's
  * 128-bit lane permutes) stays in that ISA's kernel file, on the layer's
  * types.
@@ -82,6 +83,8 @@
  *                            their p[l] is NOT read (may be unmapped)
  *   vf_store_bits(p, bits, a)  writes p[l] for the lanes in bits only;
  *                            nothing else is read or written
+ *   vi_load_u8(p)            lane l = p[l] (uint8_t *p, any alignment),
+ *                            zero-extended; reads exactly SIMD_W bytes
  *   vf_load3(p, &x, &y, &z)  de-interleaves 3*SIMD_W floats x y z x y z ..:
  *                            lane l of x = p[3l], y = p[3l+1], z = p[3l+2]
  *   vf_store3(p, x, y, z)    the inverse: writes p[0 .. 3*SIMD_W)

@@ -45,6 +45,11 @@ SIMD_INL __m256i simd__lanes_of(unsigned b)
 }
 
 /* vmaskmovps: masked lanes are not accessed (no fault) and load as 0 */
+SIMD_INL vint vi_load_u8(const uint8_t *p)
+{
+    return _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(const void *)p));
+}
+
 SIMD_INL vfloat vf_load_bits(const float *p, unsigned bits)
 {
     if ((bits & SIMD_FULL) == SIMD_FULL) return _mm256_loadu_ps(p);

@@ -42,6 +42,11 @@ SIMD_INL vint vi_loadu(const int32_t *p) { return _mm512_loadu_si512((const void
 SIMD_INL void vi_store(int32_t *p, vint i) { _mm512_store_si512((void *)p, i); }
 SIMD_INL void vi_storeu(int32_t *p, vint i) { _mm512_storeu_si512((void *)p, i); }
 /* masked lanes are not accessed (fault suppression) */
+SIMD_INL vint vi_load_u8(const uint8_t *p)
+{
+    return _mm512_cvtepu8_epi32(_mm_loadu_si128((const __m128i *)(const void *)p));
+}
+
 SIMD_INL vfloat vf_load_bits(const float *p, unsigned bits) { return _mm512_maskz_loadu_ps((__mmask16)bits, p); }
 SIMD_INL void vf_store_bits(float *p, unsigned bits, vfloat a) { _mm512_mask_storeu_ps(p, (__mmask16)bits, a); }
 

@@ -24,6 +24,7 @@
 
 #include <arm_neon.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "simd.h"
 
@@ -56,6 +57,14 @@ SIMD_INL vint vi_load(const int32_t *p) { return vld1q_s32(p); }
 SIMD_INL vint vi_loadu(const int32_t *p) { return vld1q_s32(p); }
 SIMD_INL void vi_store(int32_t *p, vint i) { vst1q_s32(p, i); }
 SIMD_INL void vi_storeu(int32_t *p, vint i) { vst1q_s32(p, i); }
+
+SIMD_INL vint vi_load_u8(const uint8_t *p)
+{
+    uint32_t t;
+    memcpy(&t, p, 4);
+    const uint16x8_t h = vmovl_u8(vreinterpret_u8_u32(vdup_n_u32(t)));
+    return vreinterpretq_s32_u32(vmovl_u16(vget_low_u16(h)));
+}
 
 /* lane by lane: NEON has no masked load or store */
 SIMD_INL vfloat vf_load_bits(const float *p, unsigned bits)

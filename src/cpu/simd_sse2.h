@@ -10,6 +10,7 @@
 #endif
 
 #include <emmintrin.h>
+#include <string.h>
 
 #include "simd.h"
 
@@ -38,6 +39,14 @@ SIMD_INL vint vi_load(const int32_t *p) { return _mm_load_si128((const __m128i *
 SIMD_INL vint vi_loadu(const int32_t *p) { return _mm_loadu_si128((const __m128i *)(const void *)p); }
 SIMD_INL void vi_store(int32_t *p, vint i) { _mm_store_si128((__m128i *)(void *)p, i); }
 SIMD_INL void vi_storeu(int32_t *p, vint i) { _mm_storeu_si128((__m128i *)(void *)p, i); }
+
+SIMD_INL vint vi_load_u8(const uint8_t *p)
+{
+    uint32_t t;
+    memcpy(&t, p, 4);
+    const __m128i z = _mm_setzero_si128();
+    return _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128((int)t), z), z);
+}
 
 SIMD_INL vfloat vf_load_bits(const float *p, unsigned bits)
 {

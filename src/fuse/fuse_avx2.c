@@ -2,86 +2,45 @@
  * called only when cpuid reports AVX2). The bytes are the reference's
  * (docs/fuse.md, "Rounding rules"); tests/test_fuse_isa.c checks it.
  *
- * Lighting: 8 pixels per vector, fuse_body.inl.
+ * Lighting, depth test, coverage bits, opaque copies: fuse_simd.inl on the
+ * vector layer (src/cpu/simd_avx2.h, 8 lanes); AVX2's own part there is
+ * the depth test's scene values (a window of the row and vpermps, or a
+ * gather).
  * Composite through the row cache (fuse_internal.h): fuse__hrow_avx2 once
  * per layer row, fuse__vrow_avx2 per output row. The taps of 8 consecutive
  * output pixels lie in a window of 8 source pixels when the layer is
  * enlarged (640 -> 1194: at most 5), so one load and vpermd give them;
- * otherwise (reductions, narrow layers) vpgatherdd. Depth test: 8 pixels
- * a step, the scene gathered. */
+ * otherwise (reductions, narrow layers) vpgatherdd. */
 #include "fuse_internal.h"
 
 #if defined(__AVX2__)
 #include <immintrin.h>
 
-#define LANES 8
-#define VF __m256
-#define VI __m256i
-#define VM __m256
-#define F1(c) _mm256_set1_ps(c)
-#define I1(c) _mm256_set1_epi32(c)
-#define FADD(a, b) _mm256_add_ps(a, b)
-#define FSUB(a, b) _mm256_sub_ps(a, b)
-#define FMUL(a, b) _mm256_mul_ps(a, b)
-#define FDIV(a, b) _mm256_div_ps(a, b)
-#define FSQRT(a) _mm256_sqrt_ps(a)
-#define FNEG(a) _mm256_xor_ps(a, _mm256_set1_ps(-0.0f))
-#define FMAX0(a) _mm256_max_ps(a, _mm256_setzero_ps())
-#define FMIN1(a) _mm256_min_ps(a, _mm256_set1_ps(1.0f))
-#define FGT(a, b) _mm256_cmp_ps(a, b, _CMP_GT_OQ)
-#define FGE(a, b) _mm256_cmp_ps(a, b, _CMP_GE_OQ)
-#define FLT(a, b) _mm256_cmp_ps(a, b, _CMP_LT_OQ)
-#define MAND(a, b) _mm256_and_ps(a, b)
-#define FSEL(m, a, b) _mm256_blendv_ps(b, a, m)
-#define FZERO_UNLESS(m, a) _mm256_and_ps(m, a)
-#define FFLOOR(a) _mm256_floor_ps(a)
-#define I2F(i) _mm256_cvtepi32_ps(i)
-#define F2I_TRUNC(f) _mm256_cvttps_epi32(f)
-#define FBITS(f) _mm256_castps_si256(f)
-#define IBITS(i) _mm256_castsi256_ps(i)
-#define IADD(a, b) _mm256_add_epi32(a, b)
-#define ISUB(a, b) _mm256_sub_epi32(a, b)
-#define IAND(a, b) _mm256_and_si256(a, b)
-#define IOR(a, b) _mm256_or_si256(a, b)
-#define ISRL(a, k) _mm256_srli_epi32(a, k)
-#define ISLL(a, k) _mm256_slli_epi32(a, k)
-#define LANE_INDEX _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)
-#define MASK_ZERO(p) (load_u64(p) == 0)
-#define LOAD_MASK(p) _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(const void *)(p)))
-#define LOAD_RGBA(p) _mm256_loadu_si256((const __m256i *)(const void *)(p))
-#define LOAD_NORMALS(p, x, y, z) load_normals(p, &(x), &(y), &(z))
-#define STORE_RGBA(p, v) _mm256_storeu_si256((__m256i *)(void *)(p), v)
-#define STORE_ZERO(p) _mm256_storeu_si256((__m256i *)(void *)(p), _mm256_setzero_si256())
-#define IZERO_IF_EQ0(m, v) _mm256_andnot_si256(_mm256_cmpeq_epi32(m, _mm256_setzero_si256()), v)
-#define LIGHT_ROW_NAME fuse__light_row_avx2
-#define POW_ROW_NAME fuse__pow01_row_avx2
-#define LOADF(p) _mm256_loadu_ps(p)
-#define STOREF(p, v) _mm256_storeu_ps(p, v)
+#include "../cpu/simd_avx2.h"
 
-static inline uint64_t load_u64(const uint8_t *p)
+/* The scene values of the lanes in has: when the 8 columns lie in a window
+ * of 16 (always when the layer is enlarged), two loads of the window
+ * (masked to the viewport's width: nothing beyond it is read), two vpermps
+ * and a blend; otherwise a gather. Lanes outside has are never used. */
+static inline __m256 scene_avx2(const fuse__depth_prep *p, const float *sc, __m256i ox, __m256 has)
 {
-    uint64_t v;
-    memcpy(&v, p, 8);
-    return v;
+    const int32_t c0 = _mm_cvtsi128_si32(_mm256_castsi256_si128(ox));
+    const int32_t c7 = _mm_extract_epi32(_mm256_extracti128_si256(ox, 1), 3);
+    if (c7 - c0 < 16) {
+        const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+        const __m256i left = _mm256_set1_epi32(p->vw - c0);
+        const __m256 lo = _mm256_maskload_ps(sc + c0, _mm256_cmpgt_epi32(left, lane));
+        const __m256 hi = _mm256_maskload_ps(sc + c0 + 8, _mm256_cmpgt_epi32(
+            left, _mm256_add_epi32(lane, _mm256_set1_epi32(8))));
+        const __m256i idx = _mm256_sub_epi32(ox, _mm256_set1_epi32(c0));
+        return _mm256_blendv_ps(_mm256_permutevar8x32_ps(lo, idx), _mm256_permutevar8x32_ps(hi, idx),
+                                _mm256_castsi256_ps(_mm256_cmpgt_epi32(idx, _mm256_set1_epi32(7))));
+    }
+    return _mm256_mask_i32gather_ps(_mm256_setzero_ps(), sc, ox, has, 4);
 }
+#define FUSE_SCENE_LANES(p, sc, ox, has) scene_avx2(p, sc, ox, has)
 
-/* 8 interleaved xyz normals -> x, y, z. Element k of x is at 3k; within
- * the three 8-float loads the x, y and z positions are disjoint, so two
- * blends and a vpermps sort each one. */
-static inline void load_normals(const float *p, __m256 *x, __m256 *y, __m256 *z)
-{
-    const __m256 m0 = _mm256_loadu_ps(p), m1 = _mm256_loadu_ps(p + 8),
-                 m2 = _mm256_loadu_ps(p + 16);
-    const __m256 tx = _mm256_blend_ps(_mm256_blend_ps(m0, m1, 0x92), m2, 0x24);
-    const __m256 ty = _mm256_blend_ps(_mm256_blend_ps(m0, m1, 0x24), m2, 0x49);
-    const __m256 tz = _mm256_blend_ps(_mm256_blend_ps(m0, m1, 0x49), m2, 0x92);
-    *x = _mm256_permutevar8x32_ps(tx, _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5));
-    *y = _mm256_permutevar8x32_ps(ty, _mm256_setr_epi32(1, 4, 7, 2, 5, 0, 3, 6));
-    *z = _mm256_permutevar8x32_ps(tz, _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7));
-}
-
-#include "fuse_body.inl"
-
+#include "fuse_simd.inl"
 /* ---- row-cached composite (fuse_internal.h, fuse__hrow_fn) ------------- */
 
 /* The fx of 4 pixels (int32) in each pixel's 4 u16 lanes. */
@@ -176,187 +135,11 @@ void fuse__vrow_avx2(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
     for (; i < n; i++) fuse__vpx(h0 + 4 * i, h1 + 4 * i, fy, v + 4 * i, out + 4 * i);
 }
 
-/* ---- coverage bits and opaque copies (fuse_internal.h) ----------------- */
-
-void fuse__cover_row_avx2(const uint8_t *q, int w, uint64_t *bits)
-{
-    const __m256i z = _mm256_setzero_si256();
-    const int nb = (w + 7) / 8, full = w / 8;
-    int b;
-    memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
-    for (b = 0; b < full; b++) {
-        const __m256i t = _mm256_loadu_si256((const __m256i *)(const void *)(q + 32 * (size_t)b));
-        bits[b >> 6] |= (uint64_t)(_mm256_movemask_epi8(_mm256_cmpeq_epi8(t, z)) != -1) << (b & 63);
-    }
-    if (full < nb) {
-        uint32_t acc = 0, t;
-        int x;
-        for (x = 8 * full; x < w; x++) {
-            memcpy(&t, q + 4 * (size_t)x, 4);
-            acc |= t;
-        }
-        if (acc) bits[full >> 6] |= (uint64_t)1 << (full & 63);
-    }
-}
-
-void fuse__opaque_avx2(const uint8_t *v, uint8_t *out, int n)
-{
-    const __m256i a = _mm256_set1_epi32((int)0xFF000000u);
-    int i = 0;
-    if (v == out) {
-        for (; i + 8 <= n; i += 8) {
-            const __m256i x = _mm256_loadu_si256((const __m256i *)(const void *)(v + 4 * (size_t)i));
-            if (!_mm256_testc_si256(x, a))   /* some alpha below 255 */
-                _mm256_storeu_si256((__m256i *)(void *)(out + 4 * (size_t)i), _mm256_or_si256(x, a));
-        }
-    } else {
-        for (; i + 16 <= n; i += 16) {
-            const __m256i x0 = _mm256_loadu_si256((const __m256i *)(const void *)(v + 4 * (size_t)i));
-            const __m256i x1 = _mm256_loadu_si256((const __m256i *)(const void *)(v + 4 * (size_t)i + 32));
-            _mm256_storeu_si256((__m256i *)(void *)(out + 4 * (size_t)i), _mm256_or_si256(x0, a));
-            _mm256_storeu_si256((__m256i *)(void *)(out + 4 * (size_t)i + 32), _mm256_or_si256(x1, a));
-        }
-    }
-    fuse__opaque_ref(v + 4 * (size_t)i, out + 4 * (size_t)i, n - i);
-}
-
-/* ---- depth test (fuse__depth_span_ref, 8 pixels a step) ----------------- */
-
-/* The row on the layer (bpp 4: a pixel is looked at when it is not 0) or
- * on mask bytes (bpp 1: when its byte is not 0); hidden pixels are zeroed. */
-static inline __attribute__((always_inline)) void depth_row(const fuse__depth_prep *p, uint8_t *q,
-                                                            const float *hz, const float *sc,
-                                                            int w, int bpp)
-{
-    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), two = _mm256_set1_ps(2.0f);
-    const __m256 two_fn = _mm256_set1_ps(p->two_fn), fpn = _mm256_set1_ps(p->fpn);
-    const __m256 fmn = _mm256_set1_ps(p->fmn), off = _mm256_set1_ps(p->offset);
-    /* the column walk of 8 lanes, stepped by 8 pixels: 16 vw = sq den + sr */
-    const int32_t step = 16 * p->vw;
-    const __m256i den = _mm256_set1_epi32(p->den), den1 = _mm256_set1_epi32(p->den - 1);
-    const __m256i sq = _mm256_set1_epi32(step / p->den), sr = _mm256_set1_epi32(step % p->den);
-    int32_t ox0[8], rem0[8];
-    __m256i ox, rem;
-    int x, k;
-    if (w < 8) {
-        if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, 0, w);
-        else fuse__depth_mspan_ref(p, q, hz, sc, 0, w);
-        return;
-    }
-    for (k = 0; k < 8; k++) fuse__depth_col(p, k, &ox0[k], &rem0[k]);
-    ox = _mm256_loadu_si256((const __m256i *)(const void *)ox0);
-    rem = _mm256_loadu_si256((const __m256i *)(const void *)rem0);
-    for (x = 0; x + 8 <= w; x += 8) {
-        __m256i qq;
-        uint64_t m8 = 0;
-        int any;
-        if (bpp == 4) {
-            qq = _mm256_loadu_si256((const __m256i *)(const void *)(q + 4 * (size_t)x));
-            any = !_mm256_testz_si256(qq, qq);
-        } else {
-            memcpy(&m8, q + x, 8);
-            qq = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128((long long)m8));
-            any = m8 != 0;
-        }
-        if (any) {
-            const __m256 nz = _mm256_castsi256_ps(
-                _mm256_xor_si256(_mm256_cmpeq_epi32(qq, _mm256_setzero_si256()), _mm256_set1_epi32(-1)));
-            const __m256 z = _mm256_loadu_ps(hz + x);
-            const __m256 has = _mm256_and_ps(nz, _mm256_and_ps(_mm256_cmp_ps(z, zero, _CMP_GE_OQ),
-                                                               _mm256_cmp_ps(z, one, _CMP_LT_OQ)));
-            if (_mm256_movemask_ps(has)) {
-                /* the scene values: when the 8 columns lie in a window of 16
-                 * (always when the layer is enlarged), two loads of the window
-                 * (masked to the viewport's width: nothing beyond it is read),
-                 * two vpermps and a blend; otherwise a gather. Lanes outside
-                 * has are never used. */
-                const int32_t c0 = _mm_cvtsi128_si32(_mm256_castsi256_si128(ox));
-                const int32_t c7 = _mm_extract_epi32(_mm256_extracti128_si256(ox, 1), 3);
-                __m256 s;
-                if (c7 - c0 < 16) {
-                    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-                    const __m256i left = _mm256_set1_epi32(p->vw - c0);
-                    const __m256 lo = _mm256_maskload_ps(sc + c0, _mm256_cmpgt_epi32(left, lane));
-                    const __m256 hi = _mm256_maskload_ps(sc + c0 + 8, _mm256_cmpgt_epi32(
-                        left, _mm256_add_epi32(lane, _mm256_set1_epi32(8))));
-                    const __m256i idx = _mm256_sub_epi32(ox, _mm256_set1_epi32(c0));
-                    s = _mm256_blendv_ps(_mm256_permutevar8x32_ps(lo, idx), _mm256_permutevar8x32_ps(hi, idx),
-                                         _mm256_castsi256_ps(_mm256_cmpgt_epi32(idx, _mm256_set1_epi32(7))));
-                } else {
-                    s = _mm256_mask_i32gather_ps(zero, sc, ox, has, 4);
-                }
-                const __m256 dist = _mm256_add_ps(
-                    _mm256_div_ps(two_fn, _mm256_sub_ps(fpn, _mm256_mul_ps(_mm256_sub_ps(_mm256_mul_ps(two, z), one), fmn))),
-                    off);
-                const __m256 kill = _mm256_and_ps(has, _mm256_and_ps(_mm256_cmp_ps(s, zero, _CMP_GT_OQ),
-                                                                     _mm256_cmp_ps(s, dist, _CMP_LT_OQ)));
-                const int km = _mm256_movemask_ps(kill);
-                if (km && bpp == 4)   /* the row is this thread's: rewrite the rest */
-                    _mm256_storeu_si256((__m256i *)(void *)(q + 4 * (size_t)x),
-                                        _mm256_andnot_si256(_mm256_castps_si256(kill), qq));
-                else if (km) {
-                    for (k = 0; k < 8; k++)
-                        if (km >> k & 1) q[x + k] = 0;
-                }
-            }
-        }
-        rem = _mm256_add_epi32(rem, sr);
-        {
-            const __m256i carry = _mm256_cmpgt_epi32(rem, den1);   /* rem >= den: -1 */
-            rem = _mm256_sub_epi32(rem, _mm256_and_si256(carry, den));
-            ox = _mm256_sub_epi32(_mm256_add_epi32(ox, sq), carry);
-        }
-    }
-    if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, x, w);
-    else fuse__depth_mspan_ref(p, q, hz, sc, x, w);
-}
-
-void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                          const float *sc, int w)
-{
-    depth_row(p, q, hz, sc, w, 4);
-}
-
-void fuse__depth_mrow_avx2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                           const float *sc, int w)
-{
-    depth_row(p, m, hz, sc, w, 1);
-}
-
 #else  /* not built for AVX2: never chosen by cpuid, falls back */
 
-int fuse__yuv422_row_avx2(const uint8_t *src, int width, int uyvy, uint8_t *dst)
-{
-    (void)src, (void)width, (void)uyvy, (void)dst;
-    return 0; /* the caller converts the whole row */
-}
+#define FUSE_STUB(name) name##_avx2
+#include "fuse_stub.inl"
 
-void fuse__light_row_avx2(const fuse__light_prep *p, int y, int width,
-                          const uint8_t *P, const uint8_t *mask,
-                          const float *normal, uint8_t *out)
-{
-    fuse__light_row_ref(p, y, width, P, mask, normal, out);
-}
-
-void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                          const float *sc, int w)
-{
-    fuse__depth_row_ref(p, q, hz, sc, w);
-}
-void fuse__depth_mrow_avx2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                           const float *sc, int w)
-{
-    fuse__depth_mrow_ref(p, m, hz, sc, w);
-}
-void fuse__pow01_row_avx2(const float *x, int n, float s, float *out)
-{
-    int i;
-    for (i = 0; i < n; i++) out[i] = fuse__pow01(x[i], s);
-}
-void fuse__cover_row_avx2(const uint8_t *q, int w, uint64_t *bits)
-{
-    fuse__cover_row_ref(q, w, bits);
-}
 void fuse__hrow_avx2(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
                      uint16_t *h)
 {
@@ -369,11 +152,6 @@ void fuse__vrow_avx2(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
     int i;
     for (i = 0; i < n; i++) fuse__vpx(h0 + 4 * i, h1 + 4 * i, fy, v + 4 * i, out + 4 * i);
 }
-void fuse__opaque_avx2(const uint8_t *v, uint8_t *out, int n)
-{
-    fuse__opaque_ref(v, out, n);
-}
-
 #endif
 
 #if defined(__AVX2__)

@@ -1,7 +1,8 @@
 /* fuse_ctx.c - the drivers of the fuse kernels: ISA choice, row bands on a
  * small thread pool, fuse_light / fuse_composite (which dispatch), and the
  * per-frame entry fuse_context_frame. The row kernels are in fuse_ref.c
- * (the reference) and fuse_{sse2,avx2,avx512}.c; every row is independent,
+ * (the reference), fuse_simd.inl (written once on the vector layer) and
+ * fuse_{sse2,avx2,avx512,neon}.c; every row is independent,
  * so the bytes do not depend on the ISA, the thread count or the banding. */
 #include "fuse_internal.h"
 
@@ -62,7 +63,18 @@ static kernels kernels_for(ef_isa isa)
         k.hrow = fuse__hrow_avx2;
         k.vrow = fuse__vrow_avx2;
         break;
-    case EF_ISA_NEON:   /* until fuse has NEON kernels: sse2's stand-ins there */
+    case EF_ISA_NEON:   /* fuse_simd.inl on NEON; the composite: the
+                           reference's table-driven row kernel */
+        k.ref = 0;
+        k.light = fuse__light_row_neon;
+        k.depth = fuse__depth_row_neon;
+        k.depth_mask = fuse__depth_mrow_neon;
+        k.comp = fuse__composite_cols_ref;
+        k.cover = fuse__cover_row_neon;
+        k.opaque = fuse__opaque_neon;
+        k.hrow = NULL;
+        k.vrow = NULL;
+        break;
     case EF_ISA_SSE2:
         k.ref = 0;
         k.light = fuse__light_row_sse2;

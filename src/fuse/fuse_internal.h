@@ -522,4 +522,18 @@ fuse_result fuse__composite_check(const fuse_image *Q, const fuse_image *V,
  * caller converts the rest. */
 int fuse__yuv422_row_avx2(const uint8_t *src, int width, int uyvy, uint8_t *dst);
 
+/* NEON (fuse_neon.c: fuse_simd.inl on src/cpu/simd_neon.h; on other
+ * targets the reference under these names). The composite has no NEON
+ * kernel yet: fuse_ctx.c runs the reference's per-row kernel there. */
+void fuse__light_row_neon(const fuse__light_prep *p, int y, int width,
+                          const uint8_t *P, const uint8_t *mask,
+                          const float *normal, uint8_t *out);
+void fuse__pow01_row_neon(const float *x, int n, float s, float *out);
+void fuse__depth_row_neon(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                          const float *sc, int w);
+void fuse__depth_mrow_neon(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                           const float *sc, int w);
+void fuse__cover_row_neon(const uint8_t *q, int w, uint64_t *bits);
+void fuse__opaque_neon(const uint8_t *v, uint8_t *out, int n);
+
 #endif

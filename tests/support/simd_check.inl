@@ -108,6 +108,7 @@ int SIMD_FN(tu_simd_check)(int op, const uint32_t *a, const uint32_t *b, int k, 
             st(o, vf_load(t));
             break;
         }
+        case SC_LOAD_U8: sti(o, vi_load_u8((const uint8_t *)(const void *)a + v)); break;
         case SC_LOAD_BITS: st(o, vf_load_bits((const float *)(const void *)(a + v), (unsigned)k)); break;
         case SC_STORE_BITS: vf_store_bits((float *)(void *)o, (unsigned)k, fa); break;
         default: return -1;

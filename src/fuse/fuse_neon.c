@@ -1,0 +1,22 @@
+/* fuse_neon.c - the NEON path of the fuse kernels (AArch64 Advanced SIMD,
+ * the baseline there: no flag): fuse_simd.inl on the vector layer
+ * (src/cpu/simd_neon.h, 4 lanes; the depth test's scene values lane by
+ * lane), as fuse_sse2.c does for SSE2. The bytes are the reference's:
+ * tests/test_fuse_isa.c under qemu-aarch64 (.ci/run part arm64). The
+ * composite has no NEON kernel yet (the vector layer has no 16-bit lanes):
+ * fuse_ctx.c gives NEON the reference's per-row composite. On other
+ * targets the reference stands in under these names. */
+#include "fuse_internal.h"
+
+#if defined(__aarch64__) && defined(__ARM_NEON)
+
+#include "../cpu/simd_neon.h"
+
+#include "fuse_simd.inl"
+
+#else
+
+#define FUSE_STUB(name) name##_neon
+#include "fuse_stub.inl"
+
+#endif

@@ -1,0 +1,452 @@
+/* fuse_simd.inl - the fuse kernels written once on the vector layer
+ * (src/cpu/simd.h) and compiled once per ISA: fuse_sse2.c, fuse_avx2.c,
+ * fuse_avx512.c and fuse_neon.c each include their ISA's simd_<isa>.h,
+ * define what that ISA does its own way (below), and include this file,
+ * which defines, with SIMD_FN's suffix (_sse2, _avx2, _avx512, _neon):
+ *
+ *   fuse__light_row     the lighting of one layer row (fuse__light_fn)
+ *   fuse__pow01_row     the lane power over an array (for the tests)
+ *   fuse__depth_row     the depth test on a layer row (fuse__depth_fn)
+ *   fuse__depth_mrow    the same on mask bytes (fuse__depth_mask_fn)
+ *   fuse__cover_row     coverage bits of a layer row (fuse__cover_fn)
+ *   fuse__opaque        R = V | alpha 255 (fuse__opaque_fn)
+ *
+ * Each repeats the reference (fuse_ref.c, fuse_depth.c) operation for
+ * operation, in the same order, with the same constants, so every lane
+ * gives the reference's bits: IEEE +, -, *, /, sqrt, an exact floor,
+ * compares and selects, integer bit operations (the layer's contract). No
+ * FMA (-ffp-contract=off and explicit operations), no rcp/rsqrt.
+ *
+ * What an ISA file may define before including this one (defaults here):
+ *   FUSE_SCENE_LANES(p, sc, ox, has)  the scene depths sc[ox[l]] of the
+ *       lanes in has (others: anything finite or 0, never used). Default:
+ *       a lane loop; AVX2/AVX-512 load a window of the row and permute
+ *       when the lanes' columns lie close together, else gather. */
+#include <string.h>
+
+/* 1 if the SIMD_W mask bytes at p are all 0 */
+SIMD_INL int mask_zero(const uint8_t *p)
+{
+#if SIMD_W == 4
+    uint32_t a;
+    memcpy(&a, p, 4);
+    return a == 0;
+#elif SIMD_W == 8
+    uint64_t a;
+    memcpy(&a, p, 8);
+    return a == 0;
+#else
+    uint64_t a, b;
+    memcpy(&a, p, 8);
+    memcpy(&b, p + 8, 8);
+    return (a | b) == 0;
+#endif
+}
+
+#define LANES SIMD_W
+#define VF vfloat
+#define VI vint
+#define VM vmask
+#define F1(c) vf_set1(c)
+#define I1(c) vi_set1(c)
+#define FADD(a, b) vf_add(a, b)
+#define FSUB(a, b) vf_sub(a, b)
+#define FMUL(a, b) vf_mul(a, b)
+#define FDIV(a, b) vf_div(a, b)
+#define FSQRT(a) vf_sqrt(a)
+#define FNEG(a) vf_neg(a)
+#define FMAX0(a) vf_max(a, vf_zero())        /* a > 0 ? a : +0 */
+#define FMIN1(a) vf_min(a, vf_set1(1.0f))    /* a < 1 ? a : 1 */
+#define FGT(a, b) vf_gt(a, b)
+#define FGE(a, b) vf_ge(a, b)
+#define FLT(a, b) vf_lt(a, b)
+#define MAND(a, b) vm_and(a, b)
+#define FSEL(m, a, b) vf_sel(m, a, b)
+#define FZERO_UNLESS(m, a) vf_selz(m, a)
+#define FFLOOR(a) vf_floor(a)
+#define I2F(i) vf_from_vi(i)
+#define F2I_TRUNC(f) vi_from_vf_trunc(f)
+#define FBITS(f) vf_as_vi(f)
+#define IBITS(i) vi_as_vf(i)
+#define IADD(a, b) vi_add(a, b)
+#define ISUB(a, b) vi_sub(a, b)
+#define IAND(a, b) vi_and(a, b)
+#define IOR(a, b) vi_or(a, b)
+#define ISRL(a, k) vi_srli(a, k)
+#define ISLL(a, k) vi_slli(a, k)
+#define LANE_INDEX vi_lanes()
+#define MASK_ZERO(p) mask_zero(p)
+#define LOAD_MASK(p) vi_load_u8(p)
+#define LOAD_RGBA(p) vi_loadu((const int32_t *)(const void *)(p))
+#define LOAD_NORMALS(p, x, y, z) vf_load3(p, &(x), &(y), &(z))
+#define STORE_RGBA(p, v) vi_storeu((int32_t *)(void *)(p), v)
+#define STORE_ZERO(p) vi_storeu((int32_t *)(void *)(p), vi_zero())
+#define IZERO_IF_EQ0(m, v) vi_sel(vi_eq(m, vi_zero()), vi_zero(), v)
+#define LIGHT_ROW_NAME SIMD_FN(fuse__light_row)
+#define POW_ROW_NAME SIMD_FN(fuse__pow01_row)
+#define LOADF(p) vf_loadu(p)
+#define STOREF(p, v) vf_storeu(p, v)
+
+/* The kernels below work on nu = 1 or 2 vectors at once (U_MAX at most):
+ * every step is written as a loop over the vectors (EACH), which the
+ * compiler unrolls completely, so the two vectors' long dependency chains
+ * (rsqrt, the power's polynomials) interleave and the core has independent
+ * work while one chain waits. The operations per lane are the same either
+ * way: the bytes do not depend on nu. */
+#define U_MAX 2
+#define EACH _Pragma("GCC unroll 2") for (u = 0; u < nu; u++)
+
+/* fuse__pow01 in lanes, for nu vectors x[u]; s broadcast, n =
+ * fuse__pow_int(s) (uniform: the squarings of fuse__powi01 when n > 0). */
+static inline __attribute__((always_inline)) void pow01_lanes(const VF *x, VF s, int n, int nu, VF *r)
+{
+    VI e[U_MAX];
+    VF m[U_MAX], ef[U_MAX], t[U_MAX], t2[U_MAX], p[U_MAX], y[U_MAX], k[U_MAX], f[U_MAX];
+    VM big[U_MAX];
+    int u;
+    if (n > 0) {
+        VF b[U_MAX];
+        int k = n;
+        EACH {
+            b[u] = x[u];
+            p[u] = F1(1.0f);
+        }
+        for (;;) {
+            if (k & 1) EACH p[u] = FMUL(p[u], b[u]);
+            k >>= 1;
+            if (k == 0) break;
+            EACH b[u] = FMUL(b[u], b[u]);
+        }
+        EACH {   /* the early returns of fuse__pow01 */
+            const VF q = FSEL(FGE(x[u], F1(1.0f)), F1(1.0f), p[u]);
+            r[u] = FZERO_UNLESS(FGT(x[u], F1(FUSE__POW_MIN)), q);
+        }
+        return;
+    }
+    EACH {
+        const VI bits = FBITS(x[u]);
+        e[u] = ISUB(ISRL(bits, 23), I1(127));
+        m[u] = IBITS(IOR(IAND(bits, I1(0x007fffff)), I1(0x3f800000)));
+        big[u] = FGT(m[u], F1(FUSE__SQRT2));
+        m[u] = FSEL(big[u], FMUL(m[u], F1(0.5f)), m[u]);
+        ef[u] = I2F(e[u]);
+        ef[u] = FSEL(big[u], FADD(ef[u], F1(1.0f)), ef[u]);      /* (float)(e + 1), exact */
+    }
+    EACH t[u] = FDIV(FSUB(m[u], F1(1.0f)), FADD(m[u], F1(1.0f)));
+    EACH t2[u] = FMUL(t[u], t[u]);
+    EACH p[u] = F1(FUSE__LOG2_C9);
+    EACH p[u] = FADD(FMUL(p[u], t2[u]), F1(FUSE__LOG2_C7));
+    EACH p[u] = FADD(FMUL(p[u], t2[u]), F1(FUSE__LOG2_C5));
+    EACH p[u] = FADD(FMUL(p[u], t2[u]), F1(FUSE__LOG2_C3));
+    EACH p[u] = FADD(FMUL(p[u], t2[u]), F1(FUSE__LOG2_C1));
+    EACH y[u] = FMUL(s, FADD(ef[u], FMUL(p[u], t[u])));
+    EACH k[u] = FFLOOR(FADD(y[u], F1(0.5f)));
+    EACH f[u] = FSUB(y[u], k[u]);
+    EACH p[u] = F1(FUSE__EXP2_C7);
+    EACH p[u] = FADD(FMUL(p[u], f[u]), F1(FUSE__EXP2_C6));
+    EACH p[u] = FADD(FMUL(p[u], f[u]), F1(FUSE__EXP2_C5));
+    EACH p[u] = FADD(FMUL(p[u], f[u]), F1(FUSE__EXP2_C4));
+    EACH p[u] = FADD(FMUL(p[u], f[u]), F1(FUSE__EXP2_C3));
+    EACH p[u] = FADD(FMUL(p[u], f[u]), F1(FUSE__EXP2_C2));
+    EACH p[u] = FADD(FMUL(p[u], f[u]), F1(FUSE__EXP2_C1));
+    EACH p[u] = FADD(FMUL(p[u], f[u]), F1(FUSE__EXP2_C0));
+    EACH {
+        VF q = FMUL(p[u], IBITS(ISLL(IADD(F2I_TRUNC(k[u]), I1(127)), 23)));
+        /* the early returns of fuse__pow01, last one first */
+        q = FSEL(FLT(y[u], F1(-126.0f)), F1(0.0f), q);
+        q = FSEL(FGE(x[u], F1(1.0f)), F1(1.0f), q);
+        r[u] = FZERO_UNLESS(FGT(x[u], F1(FUSE__POW_MIN)), q);
+    }
+}
+
+static inline VF clamp01_lanes(VF v)
+{
+    return FZERO_UNLESS(FGT(v, F1(0.0f)), FMIN1(v));
+}
+
+/* (int)(v * 255 + 0.5), v in [0, 1] */
+static inline VI unorm8_lanes(VF v)
+{
+    return F2I_TRUNC(FADD(FMUL(v, F1(255.0f)), F1(0.5f)));
+}
+
+/* The pixels x .. x + nu LANES - 1 of the row (fuse__light_span_ref lane
+ * by lane), stored to out. */
+static inline __attribute__((always_inline)) void light_lanes(const fuse__light_prep *p, VF py,
+                                                              int x, int nu, const uint8_t *P,
+                                                              const uint8_t *mask,
+                                                              const float *normal, uint8_t *out)
+{
+    const VF one = F1(1.0f), inv255 = F1(FUSE__INV255);
+    VI Mi[U_MAX], pix;
+    VF px[U_MAX], il[U_MAX], vx[U_MAX], vy[U_MAX], vz[U_MAX], nx[U_MAX], ny[U_MAX], nz[U_MAX];
+    VF nn[U_MAX], inv[U_MAX], ndv[U_MAX], C0[U_MAX], C1[U_MAX], C2[U_MAX];
+    VM ok[U_MAX];
+    int u, i;
+    EACH {
+        Mi[u] = LOAD_MASK(mask + x + u * LANES);
+        px[u] = FMUL(FSUB(FADD(I2F(IADD(I1(x + u * LANES), LANE_INDEX)), F1(0.5f)), F1(p->cx)),
+                     F1(p->ifx));
+    }
+    EACH il[u] = FDIV(one, FSQRT(FADD(FADD(FMUL(px[u], px[u]), FMUL(py, py)), one)));
+    EACH {
+        vx[u] = FNEG(FMUL(px[u], il[u]));
+        vy[u] = FMUL(py, il[u]);
+        vz[u] = il[u];
+    }
+    EACH {
+        LOAD_NORMALS(normal + 3 * (size_t)(x + u * LANES), nx[u], ny[u], nz[u]);
+        nn[u] = FADD(FADD(FMUL(nx[u], nx[u]), FMUL(ny[u], ny[u])), FMUL(nz[u], nz[u]));
+        ok[u] = MAND(FGT(nn[u], F1(1.0e-30f)), FLT(nn[u], F1(1.0e30f)));
+    }
+    EACH inv[u] = FDIV(one, FSQRT(nn[u]));
+    EACH {
+        nx[u] = FSEL(ok[u], FMUL(nx[u], inv[u]), vx[u]);
+        ny[u] = FSEL(ok[u], FMUL(ny[u], inv[u]), vy[u]);
+        nz[u] = FSEL(ok[u], FMUL(nz[u], inv[u]), vz[u]);
+        ndv[u] = FADD(FADD(FMUL(nx[u], vx[u]), FMUL(ny[u], vy[u])), FMUL(nz[u], vz[u]));
+        C0[u] = F1(p->ambient[0]);
+        C1[u] = F1(p->ambient[1]);
+        C2[u] = F1(p->ambient[2]);
+    }
+    for (i = 0; i < p->light_count; i++) {
+        const VF lx = F1(p->dir[i][0]), ly = F1(p->dir[i][1]), lz = F1(p->dir[i][2]);
+        VF w[U_MAX];
+        EACH w[u] = FMUL(F1(p->kd), FMAX0(FADD(FADD(FMUL(nx[u], lx), FMUL(ny[u], ly)), FMUL(nz[u], lz))));
+        if (p->ks != 0.0f) {
+            VF hh[U_MAX], ndh[U_MAX], sp[U_MAX];
+            EACH {
+                const VF hx = FADD(lx, vx[u]), hy = FADD(ly, vy[u]), hz = FADD(lz, vz[u]);
+                hh[u] = FADD(FADD(FMUL(hx, hx), FMUL(hy, hy)), FMUL(hz, hz));
+                ndh[u] = FADD(FADD(FMUL(nx[u], hx), FMUL(ny[u], hy)), FMUL(nz[u], hz));
+            }
+            EACH ndh[u] = FDIV(ndh[u], FSQRT(hh[u]));
+            pow01_lanes(ndh, F1(p->shininess), p->ipow, nu, sp);
+            EACH w[u] = FSEL(FGT(hh[u], F1(1.0e-12f)), FADD(w[u], FMUL(F1(p->ks), sp[u])), w[u]);
+        }
+        EACH {
+            C0[u] = FADD(C0[u], FMUL(F1(p->color[i][0]), w[u]));
+            C1[u] = FADD(C1[u], FMUL(F1(p->color[i][1]), w[u]));
+            C2[u] = FADD(C2[u], FMUL(F1(p->color[i][2]), w[u]));
+        }
+    }
+    EACH {
+        const VF t = clamp01_lanes(FSUB(one, ndv[u]));
+        const VF t2 = FMUL(t, t);
+        const VF fade = clamp01_lanes(FSUB(one, FMUL(F1(p->kf), FMUL(FMUL(t2, t2), t))));
+        const VF mp = FMUL(FMUL(I2F(Mi[u]), inv255), fade);
+        VF v0, v1, v2;
+        VI rgba;
+        pix = LOAD_RGBA(P + 4 * (size_t)(x + u * LANES));
+        v0 = clamp01_lanes(FMUL(FMUL(FMUL(I2F(IAND(pix, I1(255))), inv255), C0[u]), F1(p->tone[0])));
+        v1 = clamp01_lanes(FMUL(FMUL(FMUL(I2F(IAND(ISRL(pix, 8), I1(255))), inv255), C1[u]), F1(p->tone[1])));
+        v2 = clamp01_lanes(FMUL(FMUL(FMUL(I2F(IAND(ISRL(pix, 16), I1(255))), inv255), C2[u]), F1(p->tone[2])));
+        rgba = IOR(IOR(unorm8_lanes(FMUL(mp, v0)), ISLL(unorm8_lanes(FMUL(mp, v1)), 8)),
+                   IOR(ISLL(unorm8_lanes(FMUL(mp, v2)), 16), ISLL(unorm8_lanes(mp), 24)));
+        STORE_RGBA(out + 4 * (size_t)(x + u * LANES), IZERO_IF_EQ0(Mi[u], rgba));
+    }
+}
+
+/* Two vectors a step where both have mask bytes, one where only one has,
+ * a zero store where neither has (the reference's M == 0 pixels). */
+void LIGHT_ROW_NAME(const fuse__light_prep *p, int y, int width,
+                    const uint8_t *P, const uint8_t *mask,
+                    const float *normal, uint8_t *out)
+{
+    const VF py = F1((((float)y + 0.5f) - p->cy) * p->ify);
+    int x = 0;
+    for (; x + 2 * LANES <= width; x += 2 * LANES) {
+        const int z0 = MASK_ZERO(mask + x), z1 = MASK_ZERO(mask + x + LANES);
+        if (!z0 && !z1) {
+            light_lanes(p, py, x, 2, P, mask, normal, out);
+            continue;
+        }
+        if (z0) STORE_ZERO(out + 4 * (size_t)x);
+        else light_lanes(p, py, x, 1, P, mask, normal, out);
+        if (z1) STORE_ZERO(out + 4 * (size_t)(x + LANES));
+        else light_lanes(p, py, x + LANES, 1, P, mask, normal, out);
+    }
+    for (; x + LANES <= width; x += LANES) {
+        if (MASK_ZERO(mask + x)) STORE_ZERO(out + 4 * (size_t)x);
+        else light_lanes(p, py, x, 1, P, mask, normal, out);
+    }
+    if (x < width)
+        fuse__light_span_ref(p, y, x, width, P, mask, normal, out);
+}
+
+/* pow01_lanes over an array (tests compare its float bits with
+ * fuse__pow01): out[i] = pow01(x[i], s). */
+void POW_ROW_NAME(const float *x, int n, float s, float *out)
+{
+    int i = 0;
+    for (; i + LANES <= n; i += LANES) {
+        float tmp[LANES];
+        VF r;
+        VF v;
+        memcpy(tmp, x + i, sizeof tmp);
+        v = LOADF(tmp);
+        pow01_lanes(&v, F1(s), fuse__pow_int(s), 1, &r);
+        STOREF(tmp, r);
+        memcpy(out + i, tmp, sizeof tmp);
+    }
+    for (; i < n; i++) out[i] = fuse__pow01(x[i], s);
+}
+
+/* ---- depth test (fuse__depth_span_ref, SIMD_W pixels a step) ------------ */
+
+#ifndef FUSE_SCENE_LANES
+/* the scene's distances of the lanes in has, lane by lane (0 elsewhere) */
+SIMD_INL vfloat fuse_scene_lanes(const fuse__depth_prep *p, const float *sc, vint ox, vmask has)
+{
+    _Alignas(64) int32_t c[SIMD_W];
+    _Alignas(64) float s[SIMD_W];
+    const unsigned hm = vm_bits(has);
+    int l;
+    (void)p;
+    vi_store(c, ox);
+    for (l = 0; l < SIMD_W; l++) s[l] = (hm >> l) & 1u ? sc[c[l]] : 0.0f;
+    return vf_load(s);
+}
+#define FUSE_SCENE_LANES(p, sc, ox, has) fuse_scene_lanes(p, sc, ox, has)
+#endif
+
+/* The row on the layer (bpp 4: a pixel is looked at when it is not 0) or
+ * on mask bytes (bpp 1: when its byte is not 0); hidden pixels are zeroed.
+ * The column of each lane walks as fuse__depth_col's exact quotient and
+ * remainder: stepped by SIMD_W pixels, 2 SIMD_W vw = sq den + sr. */
+SIMD_INL void depth_row(const fuse__depth_prep *p, uint8_t *q, const float *hz, const float *sc,
+                        int w, int bpp)
+{
+    const vfloat zero = vf_zero(), one = vf_set1(1.0f), two = vf_set1(2.0f);
+    const vfloat two_fn = vf_set1(p->two_fn), fpn = vf_set1(p->fpn);
+    const vfloat fmn = vf_set1(p->fmn), off = vf_set1(p->offset);
+    const int32_t step = 2 * SIMD_W * p->vw;
+    const vint den = vi_set1(p->den), den1 = vi_set1(p->den - 1);
+    const vint sq = vi_set1(step / p->den), sr = vi_set1(step % p->den), one_i = vi_set1(1);
+    _Alignas(64) int32_t ox0[SIMD_W], rem0[SIMD_W];
+    vint ox, rem;
+    int x, k;
+    if (w < SIMD_W) {
+        if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, 0, w);
+        else fuse__depth_mspan_ref(p, q, hz, sc, 0, w);
+        return;
+    }
+    for (k = 0; k < SIMD_W; k++) fuse__depth_col(p, k, &ox0[k], &rem0[k]);
+    ox = vi_load(ox0);
+    rem = vi_load(rem0);
+    for (x = 0; x + SIMD_W <= w; x += SIMD_W) {
+        vint qq;
+        int any;
+        if (bpp == 4) {
+            qq = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
+            any = !vm_all(vi_eq(qq, vi_zero()));
+        } else {
+            any = !mask_zero(q + x);
+            qq = any ? vi_load_u8(q + x) : vi_zero();
+        }
+        if (any) {
+            const vmask nz = vm_not(vi_eq(qq, vi_zero()));
+            const vfloat z = vf_loadu(hz + x);
+            const vmask has = vm_and(nz, vm_and(vf_ge(z, zero), vf_lt(z, one)));
+            if (vm_any(has)) {
+                const vfloat s = FUSE_SCENE_LANES(p, sc, ox, has);
+                const vfloat dist = vf_add(
+                    vf_div(two_fn, vf_sub(fpn, vf_mul(vf_sub(vf_mul(two, z), one), fmn))), off);
+                const vmask kill = vm_and(has, vm_and(vf_gt(s, zero), vf_lt(s, dist)));
+                if (vm_any(kill)) {
+                    if (bpp == 4) {   /* the row is this thread's: rewrite the rest */
+                        vi_storeu((int32_t *)(void *)(q + 4 * (size_t)x), vi_sel(kill, vi_zero(), qq));
+                    } else {
+                        const unsigned km = vm_bits(kill);
+                        for (k = 0; k < SIMD_W; k++)
+                            if (km >> k & 1u) q[x + k] = 0;
+                    }
+                }
+            }
+        }
+        rem = vi_add(rem, sr);
+        {   /* the next SIMD_W columns: rem + sr carries at most once */
+            const vmask carry = vi_gt(rem, den1);
+            rem = vi_sel(carry, vi_sub(rem, den), rem);
+            ox = vi_add(vi_add(ox, sq), vi_sel(carry, one_i, vi_zero()));
+        }
+    }
+    if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, x, w);
+    else fuse__depth_mspan_ref(p, q, hz, sc, x, w);
+}
+
+void SIMD_FN(fuse__depth_row)(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                              const float *sc, int w)
+{
+    depth_row(p, q, hz, sc, w, 4);
+}
+
+void SIMD_FN(fuse__depth_mrow)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                               const float *sc, int w)
+{
+    depth_row(p, m, hz, sc, w, 1);
+}
+
+/* ---- coverage bits and opaque copies (fuse_internal.h) ----------------- */
+
+/* bit b set iff a byte of pixels [8b, 8b + 8) is not 0 */
+void SIMD_FN(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
+{
+    const int nb = (w + 7) / 8;
+    int b = 0, x;
+    memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
+#if SIMD_W >= 8
+    /* SIMD_W / 8 blocks per vector: the lanes' non-zero bits, 8 a block */
+    for (x = 0; x + SIMD_W <= w; x += SIMD_W, b += SIMD_W / 8) {
+        const vint t = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
+        const unsigned nzb = vm_bits(vi_eq(t, vi_zero())) ^ SIMD_FULL;
+        int j;
+        for (j = 0; j < SIMD_W / 8; j++)
+            bits[(b + j) >> 6] |= (uint64_t)(((nzb >> (8 * j)) & 0xFFu) != 0) << ((b + j) & 63);
+    }
+#else
+    /* 8 / SIMD_W vectors per block, or-ed */
+    for (x = 0; x + 8 <= w; x += 8, b++) {
+        vint t = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
+        int j;
+        for (j = SIMD_W; j < 8; j += SIMD_W)
+            t = vi_or(t, vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)(x + j))));
+        bits[b >> 6] |= (uint64_t)!vm_all(vi_eq(t, vi_zero())) << (b & 63);
+    }
+#endif
+    if (b < nb) {   /* the last w % 8 (or w % SIMD_W) pixels */
+        for (; b < nb; b++) {
+            const int x1 = 8 * b + 8 < w ? 8 * b + 8 : w;
+            uint32_t acc = 0, t;
+            for (x = 8 * b; x < x1; x++) {
+                memcpy(&t, q + 4 * (size_t)x, 4);
+                acc |= t;
+            }
+            if (acc) bits[b >> 6] |= (uint64_t)1 << (b & 63);
+        }
+    }
+}
+
+/* out = v | alpha 255; in place (v == out) only the vectors with an alpha
+ * below 255 are stored */
+void SIMD_FN(fuse__opaque)(const uint8_t *v, uint8_t *out, int n)
+{
+    const vint a = vi_set1((int32_t)0xFF000000u);
+    int i = 0;
+    if (v == out) {
+        for (; i + SIMD_W <= n; i += SIMD_W) {
+            const vint x = vi_loadu((const int32_t *)(const void *)(v + 4 * (size_t)i));
+            const vint y = vi_or(x, a);
+            if (!vm_all(vi_eq(x, y)))
+                vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i), y);
+        }
+    } else {
+        for (; i + 2 * SIMD_W <= n; i += 2 * SIMD_W) {
+            const vint x0 = vi_loadu((const int32_t *)(const void *)(v + 4 * (size_t)i));
+            const vint x1 = vi_loadu((const int32_t *)(const void *)(v + 4 * (size_t)(i + SIMD_W)));
+            vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i), vi_or(x0, a));
+            vi_storeu((int32_t *)(void *)(out + 4 * (size_t)(i + SIMD_W)), vi_or(x1, a));
+        }
+    }
+    fuse__opaque_ref(v + 4 * (size_t)i, out + 4 * (size_t)i, n - i);
+}

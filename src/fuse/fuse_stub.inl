@@ -1,0 +1,40 @@
+/* fuse_stub.inl - the kernels of fuse_simd.inl for an ISA file compiled
+ * where its ISA is not enabled (an x86 file on ARM, a NEON file on x86):
+ * the reference stands in under the ISA's names, so the dispatch table
+ * and the tests link on every target. cpuid never chooses them there.
+ * The including file defines FUSE_STUB(name) (name##_avx2, ...). */
+
+void FUSE_STUB(fuse__light_row)(const fuse__light_prep *p, int y, int width,
+                                const uint8_t *P, const uint8_t *mask,
+                                const float *normal, uint8_t *out)
+{
+    fuse__light_row_ref(p, y, width, P, mask, normal, out);
+}
+
+void FUSE_STUB(fuse__pow01_row)(const float *x, int n, float s, float *out)
+{
+    int i;
+    for (i = 0; i < n; i++) out[i] = fuse__pow01(x[i], s);
+}
+
+void FUSE_STUB(fuse__depth_row)(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                                const float *sc, int w)
+{
+    fuse__depth_row_ref(p, q, hz, sc, w);
+}
+
+void FUSE_STUB(fuse__depth_mrow)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                                 const float *sc, int w)
+{
+    fuse__depth_mrow_ref(p, m, hz, sc, w);
+}
+
+void FUSE_STUB(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
+{
+    fuse__cover_row_ref(q, w, bits);
+}
+
+void FUSE_STUB(fuse__opaque)(const uint8_t *v, uint8_t *out, int n)
+{
+    fuse__opaque_ref(v, out, n);
+}
