@@ -14,7 +14,7 @@
 #                   the ARM64 cross build of CI, .ci/run and docs/portability.md
 #   make clean
 #
-# Core (src/raster, src/kin, src/fuse): libc + libm + pthreads only, built
+# Core (src/raster, src/kin, src/fuse, src/fit, src/pipe, src/cpu): libc + libm + pthreads only, built
 # into build/libegofuse.a. src/io holds every other dependency and builds
 # into build/libegofuse_io.a. C++ only in src/io/*.cpp.
 
@@ -40,7 +40,7 @@ X86      := $(if $(filter x86_64-% i386-% i486-% i586-% i686-%,$(TARGET)),1,)
 CMOCKA_CFLAGS ?=
 CMOCKA_LIBS   ?= -lcmocka
 
-CORE_SRC := $(wildcard src/cpu/*.c src/pipe/*.c src/raster/*.c src/kin/*.c src/fuse/*.c)
+CORE_SRC := $(wildcard src/cpu/*.c src/pipe/*.c src/fit/*.c src/raster/*.c src/kin/*.c src/fuse/*.c)
 IO_SRC   := $(wildcard src/io/*.c)
 # io_image_oiio.cpp is the OpenImageIO plugin, not part of the io library.
 IO_CXX   := $(filter-out src/io/io_image_oiio.cpp,$(wildcard src/io/*.cpp))
@@ -207,7 +207,7 @@ test: deps
 	@sh tests/run_tests.sh $(BUILD)
 
 # Every public header compiles on its own as C and as C++ (sokol's rule).
-HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
+HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/pipe/pipe_pose.h src/fit/fit.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
            src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/io/io.h src/io/io_dev.h \
            src/io/io_natnet.h src/io/io_display.h src/io/io_sched.h src/io/io_live.h \
            src/io/io_vsrc.h
