@@ -45,6 +45,9 @@ IO_SRC   := $(wildcard src/io/*.c)
 # io_image_oiio.cpp is the OpenImageIO plugin, not part of the io library.
 IO_CXX   := $(filter-out src/io/io_image_oiio.cpp,$(wildcard src/io/*.cpp))
 CLI_SRC  := $(wildcard src/cli/*.c)
+# The evaluation (`egofuse eval`): linked into the program with the samples
+# library it needs, never into the core or io libraries.
+EVAL_SRC := $(wildcard src/eval/*.c)
 GEN_SRC  := $(wildcard samples/gen/*.c)
 GT_SRC   := $(wildcard samples/gt/*.c)
 TEST_SRC := $(wildcard tests/test_*.c)
@@ -58,7 +61,7 @@ LLVMPIPE_SRC := $(wildcard bench/llvmpipe/*.c)
 obj = $(patsubst %,$(BUILD)/obj/%.o,$(1))
 CORE_OBJ := $(call obj,$(CORE_SRC))
 IO_OBJ   := $(call obj,$(IO_SRC) $(IO_CXX))
-CLI_OBJ  := $(call obj,$(CLI_SRC))
+CLI_OBJ  := $(call obj,$(CLI_SRC) $(EVAL_SRC))
 GEN_OBJ  := $(call obj,$(GEN_SRC))
 # The generator's scenes and the ground truth of `egofuse eval`, shared by
 # build/gen_samples and build/egofuse.
