@@ -14,7 +14,7 @@
 #                   the ARM64 cross build of CI, .ci/run and docs/portability.md
 #   make clean
 #
-# Core (src/raster, src/kin, src/fuse): libc + libm + pthreads only, built
+# Core (src/raster, src/kin, src/fuse, src/fit, src/pipe, src/cpu): libc + libm + pthreads only, built
 # into build/libegofuse.a. src/io holds every other dependency and builds
 # into build/libegofuse_io.a. C++ only in src/io/*.cpp.
 
@@ -40,11 +40,14 @@ X86      := $(if $(filter x86_64-% i386-% i486-% i586-% i686-%,$(TARGET)),1,)
 CMOCKA_CFLAGS ?=
 CMOCKA_LIBS   ?= -lcmocka
 
-CORE_SRC := $(wildcard src/cpu/*.c src/pipe/*.c src/raster/*.c src/kin/*.c src/fuse/*.c)
+CORE_SRC := $(wildcard src/cpu/*.c src/pipe/*.c src/fit/*.c src/raster/*.c src/kin/*.c src/fuse/*.c)
 IO_SRC   := $(wildcard src/io/*.c)
 # io_image_oiio.cpp is the OpenImageIO plugin, not part of the io library.
 IO_CXX   := $(filter-out src/io/io_image_oiio.cpp,$(wildcard src/io/*.cpp))
 CLI_SRC  := $(wildcard src/cli/*.c)
+# The evaluation (`egofuse eval`): linked into the program with the samples
+# library it needs, never into the core or io libraries.
+EVAL_SRC := $(wildcard src/eval/*.c)
 GEN_SRC  := $(wildcard samples/gen/*.c)
 GT_SRC   := $(wildcard samples/gt/*.c)
 TEST_SRC := $(wildcard tests/test_*.c)
@@ -58,7 +61,7 @@ LLVMPIPE_SRC := $(wildcard bench/llvmpipe/*.c)
 obj = $(patsubst %,$(BUILD)/obj/%.o,$(1))
 CORE_OBJ := $(call obj,$(CORE_SRC))
 IO_OBJ   := $(call obj,$(IO_SRC) $(IO_CXX))
-CLI_OBJ  := $(call obj,$(CLI_SRC))
+CLI_OBJ  := $(call obj,$(CLI_SRC) $(EVAL_SRC))
 GEN_OBJ  := $(call obj,$(GEN_SRC))
 # The generator's scenes and the ground truth of `egofuse eval`, shared by
 # build/gen_samples and build/egofuse.
@@ -210,7 +213,7 @@ test: deps
 	@sh tests/run_tests.sh $(BUILD)
 
 # Every public header compiles on its own as C and as C++ (sokol's rule).
-HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
+HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/pipe/pipe_pose.h src/fit/fit.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
            src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/io/io.h src/io/io_dev.h \
            src/io/io_natnet.h src/io/io_display.h src/io/io_sched.h src/io/io_live.h \
            src/io/io_vsrc.h

@@ -247,6 +247,17 @@ static void validity_replay_args(void **state)
     char *a5[] = { (char *)bin(), "replay-track", path, "--to", "udp:127.0.0.1:9", "--speed", "0",
                    NULL };
     assert_int_equal(tu_run(a5, out, sizeof out), 2);
+    /* a malformed HOST:PORT is a command-line error (2), found before the file is read */
+    char *a6[] = { (char *)bin(), "replay-track", "/nonexistent/track.txt", "--to", "udp:127.0.0.1",
+                   NULL };
+    assert_int_equal(tu_run(a6, out, sizeof out), 2);
+    assert_non_null(strstr(out, "--to '127.0.0.1': needs HOST:PORT"));
+    char *a7[] = { (char *)bin(), "replay-track", path, "--to", "natnet:127.0.0.1:99999", NULL };
+    assert_int_equal(tu_run(a7, out, sizeof out), 2);
+    assert_non_null(strstr(out, "'99999' is not a port"));
+    char *a8[] = { (char *)bin(), "replay-track", path, "--to", "udp::9", NULL };
+    assert_int_equal(tu_run(a8, out, sizeof out), 2);
+    assert_non_null(strstr(out, "no host"));
 }
 
 /* ---------------------------------------------------------- calibrate */

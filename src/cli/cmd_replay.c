@@ -280,24 +280,39 @@ static void serve(server *s, const replay_opts *o)
     }
 }
 
-static int parse_hostport(const char *s, int need_port, int def_port, struct sockaddr_in *sa,
+/* HOST[:PORT] syntax: fills host and port, or prints a usage error and
+ * returns -1 (the command line is wrong: exit 2, checked before any file is
+ * read; a host that does not resolve is found later and exits 1). */
+static int split_hostport(const char *s, int need_port, int def_port, char host[256], int *port,
                           const char *what)
 {
-    char host[256];
     const char *colon = strrchr(s, ':');
-    int port = def_port;
+    *port = def_port;
     if (colon) {
-        if (!cli_parse_int(colon + 1, 1, 65535, &port)) {
+        if (!cli_parse_int(colon + 1, 1, 65535, port)) {
             cli_usage_error("replay-track", "%s '%s': '%s' is not a port", what, s, colon + 1);
             return -1;
         }
-        snprintf(host, sizeof host, "%.*s", (int)(colon - s), s);
+        snprintf(host, 256, "%.*s", (int)(colon - s), s);
     } else if (need_port) {
         cli_usage_error("replay-track", "%s '%s': needs HOST:PORT", what, s);
         return -1;
     } else {
-        snprintf(host, sizeof host, "%s", s);
+        snprintf(host, 256, "%s", s);
     }
+    if (!host[0]) {
+        cli_usage_error("replay-track", "%s '%s': no host", what, s);
+        return -1;
+    }
+    return 0;
+}
+
+static int parse_hostport(const char *s, int need_port, int def_port, struct sockaddr_in *sa,
+                          const char *what)
+{
+    char host[256];
+    int port;
+    if (split_hostport(s, need_port, def_port, host, &port, what) != 0) return -1;
     memset(sa, 0, sizeof *sa);
     sa->sin_family = AF_INET;
     sa->sin_port = htons((uint16_t)port);
@@ -561,5 +576,10 @@ int cmd_replay(int argc, char **argv)
                                 o.to);
     if (!o.natnet && o.multicast)
         return cli_usage_error("replay-track", "--multicast needs --to natnet:...");
+    char host[256];
+    int port;
+    if (split_hostport(o.to + (o.natnet ? 7 : 4), !o.natnet, IO_NATNET_COMMAND_PORT, host, &port,
+                       "--to") != 0)
+        return EXIT_USAGE;
     return replay(&o);
 }

@@ -8,7 +8,14 @@
  * latencies go to the status line (median, p99) and to --stats FILE.
  * A camera that fails is reopened once a second (found again by its
  * selector); meanwhile its eye holds its last image. docs/cockpit.md,
- * docs/devices.md. */
+ * docs/devices.md.
+ *
+ * Why one file of this length: one job, the live loop of `egofuse run`
+ * (run(), about 550 lines: open, then per frame wait, grab, track, pipe,
+ * show, account). Its options are parsed in run_opts.c (run.h); what is
+ * left here are that loop and the helpers that read and write its
+ * run_state (tracking service, flips, outputs, the status words), which
+ * nothing else uses. */
 #include "run.h"
 
 #include <errno.h>

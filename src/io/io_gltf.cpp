@@ -17,6 +17,15 @@
  *   views of EXT_meshopt_compression (meshopt_decodeVertexBuffer,
  *   meshopt_decodeIndexBuffer / IndexSequence and the filters) into the
  *   fallback buffer tinygltf allocated, before anything reads them.
+ *
+ * WHY ONE FILE OF THIS LENGTH
+ *   One job: one tinygltf::Model turned into one kin_model. Nodes, meshes,
+ *   skins, animations, files and confined URIs (the sections below) all
+ *   read the same tinygltf model through the same bounds-checked accessor
+ *   readers and fail through the same io_error path; split, each part would
+ *   need those C++ types in a shared header and every file would compile
+ *   <tiny_gltf.h> (nlohmann json, stb_image), the slowest header of the
+ *   build, once more.
  */
 #include <tiny_gltf.h>
 #include <meshoptimizer.h>

@@ -2,7 +2,15 @@
  * the messages as published with the NatNet SDK (documentation, the
  * PacketClient and Python client samples); every read is bounds-checked
  * against the datagram, every count against the bytes left. Behaviour and
- * configuration: docs/tracking.md, "OptiTrack NatNet". */
+ * configuration: docs/tracking.md, "OptiTrack NatNet".
+ *
+ * Why one file of this length: one job, one protocol client. The frame of
+ * data, the model definitions and the server's answers are read with one
+ * bounds-checked reader under one set of version rules (NatNet 3.x / 4.x
+ * layouts), and the sockets, the command channel and the mapping of rigid
+ * bodies and skeletons to names and tracking samples share the client's
+ * state (io_natnet, io_natnet.h) and its configuration; nothing here is
+ * used without the rest. */
 #include "io_natnet.h"
 
 #include <arpa/inet.h>

@@ -1,0 +1,801 @@
+/* eval.c - the accuracy evaluation (see eval.h).
+ *
+ * Per display frame (60 Hz): the true operator is posed and rendered into
+ * both camera images over the cockpit (with its exact silhouettes and the
+ * ideal composite); then every method configuration, with its own tracking
+ * stream (noise, latency, dropouts) and its own state (filter, last
+ * sample, previous masks, elbow fit), makes its masks and composites, which
+ * are timed and measured. A report runs several such batches (methods,
+ * knobs, tracking sweeps, other sequences), each on its own ground truth. */
+#include "eval_internal.h"
+#include "../cli/cli.h"
+
+/* The ground truth comes from samples/gt/ and the sample generator
+ * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+/* ------------------------------------------------------------ lighting */
+
+static fuse_lighting workshop_lighting(const gen_scene *ws, const kin_camera *cam)
+{
+    fuse_lighting L = fuse_lighting_default();
+    L.light_count = ws->light_count < FUSE_MAX_LIGHTS ? ws->light_count : FUSE_MAX_LIGHTS;
+    for (int i = 0; i < 3; i++) L.ambient[i] = ws->ambient[i];
+    L.kd = 0.80f;
+    L.ks = 0.12f;
+    L.shininess = 20.0f;
+    L.kf = 0.50f;
+    L.tone[0] = 1.0f;
+    L.tone[1] = 0.98f;
+    L.tone[2] = 0.96f;
+    for (int i = 0; i < L.light_count; i++) {
+        kin_vec3 d = kin_v3_norm(kin_mat4_mul_dir(
+            &cam->view, kin_v3(ws->light_dir[i][0], ws->light_dir[i][1], ws->light_dir[i][2])));
+        L.lights[i].dir[0] = d.x;
+        L.lights[i].dir[1] = d.y;
+        L.lights[i].dir[2] = d.z;
+        for (int k = 0; k < 3; k++) L.lights[i].color[k] = ws->light_color[i][k];
+    }
+    return L;
+}
+
+/* ----------------------------------------------------------- elbow fit */
+
+/* The refine method fits the elbows to the images with the library's
+ * pipe_fit (src/pipe/pipe.h: the swivel of each arm about its
+ * shoulder-wrist line whose surface falls on the most arm-coloured
+ * pixels), the same code as `egofuse render/run --refine`. */
+#define DEG2RAD 0.01745329252f
+
+/* ------------------------------------------------------------- set-up */
+
+static void ctx_free(eval_ctx *c)
+{
+    gen_frame_ctx_free(&c->gctx);
+    gen_arms_free(&c->truth);
+    gen_arms_free(&c->mask_fine);
+    gen_arms_free(&c->mask);
+    gen_scene_free(&c->cockpit);
+    gen_scene_free(&c->workshop);
+    free(c->world); free(c->jm); free(c->tlocals); free(c->tworld); free(c->dq);
+    free(c->pos); free(c->nrm); free(c->clip); free(c->vnrm);
+    free(c->cam_rgb); free(c->vdepth); free(c->vrgb);
+    for (int e = 0; e < 2; e++) {
+        free(c->P[e]); free(c->sil[e]); free(c->sil_prev[e]); free(c->tnrm[e]); free(c->V[e]); free(c->ideal[e]);
+    }
+    free(c->aa_samples);
+    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->layer); free(c->out);
+    free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
+    free(c->refine_scratch);
+    free(c->gt_depth); free(c->gt_mask);
+    memset(c, 0, sizeof *c);
+}
+
+/* The user calibration as a cockpit would make it: the true operator
+ * stretches the arms forward and sideways, then presses the middle
+ * fingertips of both hands together (gt sequence "calib", 7.7 s), the
+ * tracker records it (noise, dropouts) and kin_user_calib_estimate_tips
+ * turns it into scales: the hands' from the gesture and the mask model's
+ * fingertips (kin_user_calib_hand_tips), never from the truth's. */
+static int estimate_calib(eval_ctx *c, const gt_track_desc *track)
+{
+    gen_arms cal = c->truth;
+    if (gt_sequence_build(&c->mask, "calib", &cal) < 0) return -1;
+    c->truth.model.block = cal.model.block;   /* the same block, maybe moved */
+    int n = (int)(cal.model.anims[0].duration * track->rate_hz) + 1;
+    kin_track_sample *S = malloc(sizeof *S * (size_t)n);
+    float *scratch = malloc(sizeof(float) * (size_t)n);
+    int rc = -1;
+    kin_vec3 tips[2];
+    if (S && scratch) {
+        for (int k = 0; k < n; k++)
+            gt_track_sample(&cal, track, k, c->tlocals, c->tworld, &S[k]);
+        int have_tips = kin_user_calib_hand_tips(&c->rig, &c->mask.model, tips, c->calib_why,
+                                                 sizeof c->calib_why) == 0;
+        rc = kin_user_calib_estimate_tips(S, n, &c->rig, have_tips ? tips : NULL, scratch,
+                                          &c->calib, c->calib_why, sizeof c->calib_why);
+        c->calib_hand_fallback = rc == 1;
+        if (rc == 1) rc = 0;
+    }
+    free(S);
+    free(scratch);
+    return rc;
+}
+
+static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_track_desc *track)
+{
+    memset(c, 0, sizeof *c);
+    c->g = kin_sthmd_geometry_of(NULL);
+    c->op = gt_operator_default();
+    gt_operator_desc same = { 1, 1, 1, 1, 1, 1, 1, 1 };
+    if (gen_arms_build(&c->mask) < 0 || gt_truth_build(&c->mask, &c->op, &c->truth) < 0 ||
+        gt_truth_build(&c->mask, &same, &c->mask_fine) < 0 ||
+        gt_cockpit_build(&c->cockpit) < 0 || gen_scene_workshop(&c->workshop, &c->mask) < 0 ||
+        gen_frame_ctx_init(&c->gctx, &c->truth, &c->cockpit, &c->workshop, seed) < 0)
+        return -1;
+    char why[256];
+    if (kin_arm_rig_init(&c->rig, &c->mask.model, why, sizeof why) < 0) {
+        cli_fail("mask model: %s", why);
+        return -1;
+    }
+    const kin_model *m = &c->mask.model;
+    size_t N = (size_t)m->node_count;
+    size_t V = (size_t)c->mask_fine.model.meshes[0].vertex_count;
+    size_t J = (size_t)m->skins[0].joint_count;
+    const size_t cp = (size_t)CW * CH, vp = (size_t)GEN_VIRT_W * GEN_VIRT_H;
+    c->world = malloc(sizeof *c->world * N);
+    c->tworld = malloc(sizeof *c->tworld * N);
+    c->tlocals = malloc(sizeof *c->tlocals * N);
+    c->jm = malloc(sizeof *c->jm * J);
+    c->dq = malloc(sizeof *c->dq * J);
+    c->pos = malloc(sizeof(float) * 3 * V);
+    c->nrm = malloc(sizeof(float) * 3 * V);
+    c->clip = malloc(sizeof(float) * 4 * V);
+    c->vnrm = malloc(sizeof(float) * 3 * V);
+    c->cam_rgb = malloc((size_t)GEN_CAM_W * GEN_CAM_H * 3);
+    c->vdepth = malloc(sizeof(float) * vp);
+    c->vrgb = malloc(vp * 3);
+    int ok = c->world && c->tworld && c->tlocals && c->jm && c->dq && c->pos && c->nrm &&
+             c->clip && c->vnrm && c->cam_rgb && c->vdepth && c->vrgb;
+    for (int e = 0; e < 2 && ok; e++) {
+        c->P[e] = malloc(cp * 4);
+        c->sil[e] = malloc(cp);
+        c->sil_prev[e] = malloc(cp);
+        c->tnrm[e] = malloc(sizeof(float) * 3 * cp);
+        c->V[e] = malloc(vp * 4);
+        c->ideal[e] = malloc(vp * 4);
+        ok = c->P[e] && c->sil[e] && c->sil_prev[e] && c->tnrm[e] && c->V[e] && c->ideal[e];
+    }
+    c->mask_lo = malloc(cp);
+    c->aa_samples = malloc(sizeof(uint32_t) * cp);
+    c->mask_up = malloc(cp);
+    c->refined = malloc(cp);
+    c->layer = malloc(cp * 4);
+    c->out = malloc(vp * 4);
+    c->depth_lo = malloc(sizeof(float) * cp);
+    c->nrm_lo = malloc(sizeof(float) * 3 * cp);
+    c->mnrm = malloc(sizeof(float) * 3 * cp);
+    fuse_refine_params rp = fuse_refine_params_default();
+    rp.band = 64;
+    rp.margin = 64;
+    c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
+    c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
+    ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && c->layer && c->out && c->depth_lo &&
+         c->nrm_lo && c->mnrm && c->refine_scratch;
+    c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
+    c->gt_mask = malloc((size_t)GEN_CAM_W * GEN_CAM_H);
+    ok = ok && c->gt_depth && c->gt_mask;
+    if (!ok) return -1;
+    if (estimate_calib(c, track) < 0) {
+        cli_fail("user calibration from the calibration motion: %s", c->calib_why);
+        return -2;
+    }
+    if (gt_sequence_build(&c->mask, sequence, &c->truth) < 0) return -1;
+    return 0;
+}
+
+/* ------------------------------------------------------- ground truth */
+
+static int make_truth(eval_ctx *c, int frame, float speed, int first)
+{
+    c->have_sil_prev = !first;
+    for (int e = 0; e < 2; e++) {
+        uint8_t *tmp = c->sil_prev[e];
+        c->sil_prev[e] = c->sil[e];
+        c->sil[e] = tmp;
+    }
+    float t = (float)frame / (float)GEN_FPS * speed;
+    kin_mat4 wfh;
+    gen_pose(&c->gctx, t, &wfh);
+    for (int e = 0; e < 2; e++) {
+        kin_camera cam = kin_sthmd_camera(NULL, &wfh, (kin_eye)e);
+        c->tcam[e] = cam;
+        gt_render_eye(&c->gctx, &wfh, (kin_eye)e, frame, c->cam_rgb, c->sil[e], c->tnrm[e],
+                      c->gt_depth, c->gt_mask);
+        const uint8_t *src = c->cam_rgb + (size_t)c->g.crop_y0 * GEN_CAM_W * 3;
+        if (fuse_rgb24_to_rgba(src, GEN_CAM_W * 3, CW, CH,
+                               &(fuse_image){ c->P[e], CW, CH, 4 * CW }) != FUSE_OK)
+            return -1;
+        gen_render_virtual(&c->gctx, &wfh, (kin_eye)e, frame, c->vrgb, c->vdepth);
+        fuse_image V = { c->V[e], GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
+        if (fuse_rgb24_to_rgba(c->vrgb, GEN_VIRT_W * 3, GEN_VIRT_W, GEN_VIRT_H, &V) != FUSE_OK)
+            return -1;
+        c->L[e] = workshop_lighting(&c->workshop, &cam);
+        fuse_intrinsics K = { cam.fx, cam.fy, cam.cx, cam.cy };
+        fuse_image P = { c->P[e], CW, CH, 4 * CW }, Q = { c->layer, CW, CH, 4 * CW };
+        fuse_image I = { c->ideal[e], GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
+        if (fuse_light(&c->L[e], &K, &P, c->sil[e], CW, c->tnrm[e], 3 * CW, &Q) != FUSE_OK ||
+            fuse_composite(&Q, &V, c->g.vp_x0, c->g.vp_y0, c->g.vp_width, c->g.vp_height,
+                           &I) != FUSE_OK)
+            return -1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------ methods */
+
+static int run_init(method_run *r, const method_cfg *cfg, const eval_ctx *c)
+{
+    memset(r, 0, sizeof *r);
+    r->cfg = *cfg;
+    /* the tracker runs for a second before the first frame (the motion
+     * holds its first pose before t = 0) */
+    r->next_k = -(int)ceilf(cfg->track.rate_hz);
+    /* The filter as egofuse configures it: kin's defaults without the
+     * ramp-lag compensation (it adds the low-pass's lag times a noisy
+     * velocity: on 5 mm noise it costs IoU and triples the edge flicker,
+     * see the "lagcomp" row of the report) */
+    kin_filter_desc fd;
+    memset(&fd, 0, sizeof fd);
+    fd.no_lag_comp = !cfg->lag_comp;
+    kin_filter_init(&r->filter, &fd);
+    r->locals = malloc(sizeof *r->locals * (size_t)c->mask.model.node_count);
+    r->prev[0] = malloc((size_t)CW * CH);
+    r->prev[1] = malloc((size_t)CW * CH);
+    if (!r->locals || !r->prev[0] || !r->prev[1]) return -1;
+    if (cfg->kind == M_REFINE) {
+        r->fit = pipe_fit_create(NULL, cfg->fine ? &c->mask_fine.model : &c->mask.model,
+                                 &c->rig, CW, CH);
+        if (!r->fit) return -1;
+    }
+    kin_pose_rest(&c->mask.model, r->locals);
+    return 0;
+}
+
+static void run_free(method_run *r)
+{
+    free(r->locals);
+    free(r->prev[0]);
+    free(r->prev[1]);
+    pipe_fit_destroy(r->fit);
+}
+
+/* Copies the valid parts of s over *dst. */
+static void merge_sample(kin_track_sample *dst, const kin_track_sample *s)
+{
+    uint32_t v = s->valid;
+    dst->t = s->t;
+    if (v & KIN_TRACK_HEAD) { dst->head_pos = s->head_pos; dst->head_rot = s->head_rot; }
+    for (int k = 0; k < 2; k++) {
+        if (v & (KIN_TRACK_SHOULDER_L << k)) dst->shoulder[k] = s->shoulder[k];
+        if (v & (KIN_TRACK_HAND_L << k)) {
+            dst->hand_pos[k] = s->hand_pos[k];
+            dst->hand_rot[k] = s->hand_rot[k];
+        }
+        if (v & (KIN_TRACK_GLOVE_L << k)) memcpy(dst->glove[k], s->glove[k], sizeof s->glove[k]);
+    }
+    dst->valid |= v;
+}
+
+/* The estimated calibration (estimate_calib) with every scale times
+ * (1 + err): the calibration-error sweep. */
+static kin_user_calib calib_of(const eval_ctx *c, float err)
+{
+    kin_user_calib u = c->calib;
+    for (int s = 0; s < 2; s++) {
+        u.arm_scale[s] *= 1.0f + err;
+        u.hand_scale[s] *= 1.0f + err;
+    }
+    u.shoulder_scale *= 1.0f + err;
+    return u;
+}
+
+/* The true proportions the calibration should find (for the report). */
+void eval__true_scales(const eval_ctx *c, float *arm, float *hand, float *shoulder)
+{
+    float model = c->rig.upper_len[0] + c->rig.fore_len[0];
+    *arm = (c->rig.upper_len[0] * c->op.upper_scale + c->rig.fore_len[0] * c->op.fore_scale) / model;
+    *hand = c->op.hand_scale;
+    *shoulder = c->op.shoulder_scale;
+}
+
+/* Upsamples a w x h mask (nearest) to CW x CH, and normals likewise. */
+static void upsample(const uint8_t *lo, const float *nlo, int div, uint8_t *m, float *n)
+{
+    int w = CW / div;
+    for (int y = 0; y < CH; y++)
+        for (int x = 0; x < CW; x++) {
+            size_t s = (size_t)(y / div) * (size_t)w + (size_t)(x / div);
+            size_t d = (size_t)y * CW + (size_t)x;
+            m[d] = lo[s];
+            memcpy(&n[d * 3], &nlo[s * 3], sizeof(float) * 3);
+        }
+}
+
+/* One frame of one method: both eyes, measured. Returns -1 on failure. */
+/* DIR/<method>_<setting>_<eye>_NNNN.png: red = true silhouette, green =
+ * the method's mask, blue = the camera image's luma / 2. */
+static int dump_masks(const char *dir, const method_cfg *cfg, int frame, int eye,
+                      const uint8_t *mask, const uint8_t *sil, const uint8_t *P, uint8_t *rgb)
+{
+    for (size_t i = 0; i < (size_t)CW * CH; i++) {
+        rgb[i * 3 + 0] = sil[i];
+        rgb[i * 3 + 1] = mask[i] >= 128 ? 255 : 0;
+        rgb[i * 3 + 2] = (uint8_t)((P[i * 4] + 2 * P[i * 4 + 1] + P[i * 4 + 2]) / 8);
+    }
+    char path[IO_PATH_MAX + 128];
+    snprintf(path, sizeof path, "%s/%s_%s_%s_%04d.png", dir, kind_name[cfg->kind], cfg->setting,
+             eye ? "right" : "left", frame);
+    io_image img = { rgb, CW, CH, 3, IO_U8, (size_t)CW * 3 };
+    io_error err;
+    if (io_image_save(path, &img, &err) != IO_OK) return cli_fail("%s", err.msg);
+    return EXIT_OK;
+}
+
+/* FK and skinning of locals into c->world, c->pos, c->nrm. */
+static void pose_skin(eval_ctx *c, const method_cfg *cfg, const kin_model *m,
+                      const kin_transform *locals)
+{
+    const kin_mesh *me = &m->meshes[0];
+    kin_fk(m->parents, m->node_count, locals, NULL, c->world);
+    kin_skin_joint_matrices(&m->skins[0], c->world, c->jm);
+    if (cfg->dqs) {
+        kin_skin_dq_from_matrices(c->jm, m->skins[0].joint_count, c->dq);
+        kin_skin_dqs(me, c->dq, c->pos, c->nrm);
+    } else {
+        kin_skin_lbs(me, c->jm, c->pos, c->nrm);
+    }
+}
+
+/* Mask (and normals) of the posed model through cam at the method's
+ * resolution; *mask, *nrm point at the full-resolution result. */
+static int draw_mask(eval_ctx *c, const method_cfg *cfg, const kin_mesh *me, int posed,
+                     const kin_camera *cam, const uint8_t **mask, const float **nrm)
+{
+    int div = cfg->div, w = CW / div, h = CH / div;
+    rast_target tg = { w, h, c->depth_lo, w, c->mask_lo, w, c->nrm_lo, 3 * w, 3 };
+    rast_target_clear(&tg);
+    if (posed) {
+        rast_transform_points(cam->view_proj.m, c->pos, me->vertex_count, c->clip);
+        rast_transform_dirs(cam->view.m, c->nrm, me->vertex_count, c->vnrm);
+        rast_mesh_desc d = { c->clip, me->vertex_count, c->vnrm, 3, me->indices,
+                             me->index_count / 3, RAST_CULL_NONE };
+        if (rast_draw(&tg, &d, NULL) != RAST_OK) return -1;
+        if (cfg->aa > 1) {
+            /* the mask from cfg->aa coverage samples per pixel (depth and
+             * normals stay those of the centres) */
+            rast_aa_target at = { w, h, c->aa_samples, w, cfg->aa };
+            rast_aa_clear(&at);
+            if (rast_draw_aa(&at, &d, NULL) != RAST_OK ||
+                rast_aa_resolve(&at, c->mask_lo, w) != RAST_OK)
+                return -1;
+        }
+    }
+    if (div == 1) {
+        *mask = c->mask_lo;
+        *nrm = c->nrm_lo;
+    } else {
+        upsample(c->mask_lo, c->nrm_lo, div, c->mask_up, c->mnrm);
+        *mask = c->mask_up;
+        *nrm = c->mnrm;
+    }
+    return 0;
+}
+
+static kin_camera eye_camera(const eval_ctx *c, int e)
+{
+    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
+    return kin_sthmd_camera(&hd, &c->world[c->rig.head], (kin_eye)e);
+}
+
+/* The elbow fit of the refine method (pipe_fit): learns the colour
+ * models where the kinematic mask and the last refined mask agree, finds
+ * the swivels, turns the arms in r->locals. */
+static int fit_elbows(eval_ctx *c, method_run *r, const kin_model *m, uint32_t valid)
+{
+    const kin_mesh *me = &m->meshes[0];
+    kin_camera cam[2];
+    fuse_image P[2];
+    for (int e = 0; e < 2; e++) {
+        cam[e] = eye_camera(c, e);
+        P[e] = (fuse_image){ c->P[e], CW, CH, 4 * CW };
+        /* the colour model learned after the last frame's refinement
+         * (run_frame); only without one is the kinematic mask drawn here */
+        if (pipe_fit_learned(r->fit, e)) continue;
+        const uint8_t *m0;
+        const float *nrm;
+        if (draw_mask(c, &r->cfg, me, 1, &cam[e], &m0, &nrm) < 0) return -1;
+        if (pipe_fit_learn(r->fit, e, &P[e], m0, CW, r->have_prev ? r->prev[e] : NULL, CW) !=
+            FUSE_OK)
+            return -1;
+    }
+    unsigned sides = ((valid & KIN_TRACK_HAND_L) ? 1u : 0u) | ((valid & KIN_TRACK_HAND_R) ? 2u : 0u);
+    pipe_fit_elbows(r->fit, c->world, c->pos, cam, P, sides, r->locals, r->swivel);
+    return 0;
+}
+
+static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const char *dump)
+{
+    const method_cfg *cfg = &r->cfg;
+    double T = (double)frame / GEN_FPS;
+    double t0 = cli_now();
+    /* tracking: every sample delivered by now */
+    const double lat = cfg->track.latency_ms * 1e-3;
+    for (;;) {
+        double tc = (double)r->next_k / cfg->track.rate_hz;
+        if (tc + lat > T + 1e-9) break;
+        kin_track_sample s;
+        gt_track_sample(&c->truth, &cfg->track, r->next_k, c->tlocals, c->tworld, &s);
+        r->next_k++;
+        if (cfg->kind == M_KIN) {
+            if (!r->have_last) { r->last = s; r->have_last = 1; }
+            else merge_sample(&r->last, &s);
+        } else if (cfg->kind != M_SKIN) {
+            kin_filter_push(&r->filter, &s);
+            r->have_last = 1;
+        }
+    }
+    t0 = cli_now();   /* the tracker's simulation is not the method's time */
+    const kin_model *m = cfg->fine ? &c->mask_fine.model : &c->mask.model;
+    const kin_mesh *me = &m->meshes[0];
+    int posed = 0;
+    if (cfg->kind != M_SKIN && r->have_last) {
+        kin_track_sample s;
+        kin_user_calib cal = calib_of(c, cfg->calib_error);
+        const kin_user_calib *cp = NULL;
+        if (cfg->kind == M_KIN) {
+            s = r->last;
+        } else {
+            kin_filter_output(&r->filter, T, &s, NULL);
+            cp = &cal;
+        }
+        posed = kin_arm_rig_pose(&c->rig, m, cp, NULL, &s, r->locals, NULL);
+        if (posed) pose_skin(c, cfg, m, r->locals);
+        if (posed && cfg->kind == M_REFINE && cfg->fit) {
+            pipe_fit_shape(r->fit, c->world, c->pos);
+            if (fit_elbows(c, r, m, s.valid) < 0) return -1;
+            pose_skin(c, cfg, m, r->locals);
+            pipe_fit_shape(r->fit, c->world, c->pos);
+        }
+    }
+    double secs = cli_now() - t0;
+    for (int e = 0; e < 2; e++) {
+        t0 = cli_now();
+        kin_camera cam = posed ? eye_camera(c, e) : c->tcam[e];
+        const uint8_t *mask = c->mask_up;
+        const float *nrm = c->mnrm;
+        if (cfg->kind == M_SKIN) {
+            fuse_image P = { c->P[e], CW, CH, 4 * CW };
+            fuse_skin_params sp = fuse_skin_params_default();
+            if (fuse_skin_key(&sp, &P, c->mask_up, CW) != FUSE_OK) return -1;
+            memset(c->mnrm, 0, sizeof(float) * 3 * CW * CH);
+        } else {
+            if (draw_mask(c, cfg, me, posed, &cam, &mask, &nrm) < 0) return -1;
+            if (cfg->kind == M_REFINE) {
+                fuse_refine_params rp = fuse_refine_params_default();
+                rp.band = cfg->band;
+                fuse_image P = { c->P[e], CW, CH, 4 * CW };
+                /* the global term only once the fit has a colour model
+                 * (as pipe_frame): an all-zero one would halve the local
+                 * term */
+                fuse_refine_stats rs;
+                fuse_result fr =
+                    cfg->fit && cfg->global > 0.0f && pipe_fit_learned(r->fit, e)
+                        ? fuse_refine_mask_global(&rp, pipe_fit_colour(r->fit, e), cfg->global, &P, mask, CW, c->refined,
+                                                  CW, c->refine_scratch, c->refine_scratch_size,
+                                                  &rs)
+                        : fuse_refine_mask(&rp, &P, mask, CW, c->refined, CW, c->refine_scratch,
+                                           c->refine_scratch_size, &rs);
+                if (fr != FUSE_OK) return -1;
+                /* not from a fallback (out = M): its widths are the
+                 * model's own (as pipe_frame) */
+                if (cfg->fit && posed && rs.used_colour) {
+                    /* the next frame's fit: the colour model from this
+                     * frame's kinematic and refined masks (no extra
+                     * raster), and the limb widths (self-calibration) */
+                    if (pipe_fit_learn(r->fit, e, &P, mask, CW, c->refined, CW) != FUSE_OK)
+                        return -1;
+                    pipe_fit_measure(r->fit, e, &cam, c->world, mask, CW, c->refined, CW);
+                }
+                mask = c->refined;
+            }
+        }
+        fuse_intrinsics K = { cam.fx, cam.fy, cam.cx, cam.cy };
+        fuse_image P = { c->P[e], CW, CH, 4 * CW }, Q = { c->layer, CW, CH, 4 * CW };
+        fuse_image V = { c->V[e], GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
+        fuse_image O = { c->out, GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
+        fuse_lighting L = workshop_lighting(&c->workshop, &cam);
+        if (fuse_light(&L, &K, &P, mask, CW, nrm, 3 * CW, &Q) != FUSE_OK ||
+            fuse_composite(&Q, &V, c->g.vp_x0, c->g.vp_y0, c->g.vp_width, c->g.vp_height,
+                           &O) != FUSE_OK)
+            return -1;
+        secs += cli_now() - t0;
+
+        /* measures */
+        fuse_confusion cf;
+        fuse_mask_confusion(mask, CW, c->sil[e], CW, CW, CH, &cf);
+        double iou = fuse_confusion_iou(&cf);
+        double bf1 = fuse_boundary_f(mask, CW, c->sil[e], CW, CW, CH, 1.0f, NULL, NULL);
+        double bf3 = fuse_boundary_f(mask, CW, c->sil[e], CW, CW, CH, 3.0f, NULL, NULL);
+        size_t off = (size_t)c->g.vp_y0 * 4 * GEN_VIRT_W + (size_t)c->g.vp_x0 * 4;
+        double mse = fuse_mse(c->out + off, 4 * GEN_VIRT_W, c->ideal[e] + off, 4 * GEN_VIRT_W,
+                              c->g.vp_width, c->g.vp_height, 4, 3);
+        r->iou += iou;
+        r->bf1 += bf1;
+        r->bf3 += bf3;
+        r->fp += (double)cf.fp;
+        r->fn += (double)cf.fn;
+        r->mse += mse;
+        r->n_eye++;
+        if (per_frame) {
+            float th[2][2] = { { 1, 1 }, { 1, 1 } };
+            if (r->fit) pipe_fit_thickness(r->fit, th, NULL);
+            printf("%4d %-5s %-14s %-22s iou %.4f bf1 %.3f bf3 %.3f fp %6ld fn %6ld psnr %5.2f"
+                   " swivel %+.0f %+.0f deg thick %.3f %.3f %.3f %.3f\n",
+                   frame, e ? "right" : "left", kind_name[cfg->kind], cfg->setting, iou, bf1,
+                   bf3, cf.fp, cf.fn, fuse_psnr_of_mse(mse), (double)(r->swivel[0] / DEG2RAD),
+                   (double)(r->swivel[1] / DEG2RAD), (double)th[0][0], (double)th[0][1],
+                   (double)th[1][0], (double)th[1][1]);
+        }
+        if (dump && dump_masks(dump, cfg, frame, e, mask, c->sil[e], c->P[e], c->vrgb))
+            return -1;
+        if (r->have_prev && c->have_sil_prev) {
+            /* summed as numerator and denominator (spurious swept area over
+             * true edge length), so frames where the hand leaves the view
+             * (a few edge pixels) do not dominate the mean */
+            double fl = fuse_edge_flicker(r->prev[e], mask, c->sil_prev[e], c->sil[e], CW, CW, CH);
+            long edge = fuse_boundary_count(c->sil[e], CW, CW, CH);
+            double den = edge > 1 ? (double)edge : 1.0;
+            r->flicker += fl * den;
+            r->flicker_den += den;
+            r->n_flicker++;
+        }
+        memcpy(r->prev[e], mask, (size_t)CW * CH);
+    }
+    r->have_prev = 1;
+    r->secs += secs;
+    r->n_frames++;
+    if (r->fit && cfg->fit) {
+        pipe_fit_thickness(r->fit, r->thick, NULL);
+        r->have_thick = 1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------ configurations */
+
+static method_cfg base_cfg(const eval_opts *o, method_kind k)
+{
+    method_cfg c;
+    memset(&c, 0, sizeof c);
+    c.kind = k;
+    c.div = 1;
+    c.aa = 1;
+    c.band = o->band;
+    c.fit = k == M_REFINE;
+    c.global = o->global;
+    c.track = gt_track_default();
+    c.track.noise_mm = o->noise;
+    c.track.latency_ms = o->latency;
+    c.track.dropout = o->dropout;
+    c.track.speed = o->speed;
+    c.track.seed = (uint64_t)o->seed;
+    c.calib_error = o->calib_error;
+    snprintf(c.group, sizeof c.group, "methods");
+    snprintf(c.setting, sizeof c.setting, "default");
+    return c;
+}
+
+static int add_cfg(method_cfg *list, int n, int cap, method_cfg c)
+{
+    if (n < cap) list[n] = c;
+    return n + 1;
+}
+
+/* Phases of a report (each on its own ground truth and frame count). */
+enum { PH_METHODS, PH_KNOBS, PH_TRACK, PH_SEQ };
+
+/* A configuration of a sweep: group, swept value and setting "name=" x
+ * (x as %g) followed by unit. */
+static method_cfg named_cfg(const eval_opts *o, method_kind k, const char *group, float x,
+                            const char *name, const char *unit)
+{
+    method_cfg c = base_cfg(o, k);
+    c.x = x;
+    snprintf(c.group, sizeof c.group, "%s", group);
+    snprintf(c.setting, sizeof c.setting, "%s=%g%s", name, (double)x, unit);
+    return c;
+}
+
+/* PH_METHODS: the selected methods at the given tracking; PH_KNOBS: the
+ * same (group "knobs") with every speed knob; PH_TRACK: the tracking sweeps (and the methods at the
+ * given tracking, group "track"); PH_SEQ: the methods on sequence seq. */
+static int make_configs(const eval_opts *o, int phase, const char *seq, method_cfg *L, int cap)
+{
+    int n = 0;
+    method_cfg c;
+    if (phase == PH_METHODS || phase == PH_KNOBS || phase == PH_SEQ)
+        for (int k = 0; k < 4; k++) {
+            if (!(o->methods & (1u << k))) continue;
+            c = base_cfg(o, (method_kind)k);
+            if (phase == PH_SEQ) {
+                snprintf(c.group, sizeof c.group, "sequence");
+                snprintf(c.setting, sizeof c.setting, "seq=%s", seq);
+            } else if (phase == PH_KNOBS) {
+                snprintf(c.group, sizeof c.group, "knobs");
+            }
+            n = add_cfg(L, n, cap, c);
+        }
+    if (phase == PH_KNOBS) {
+        static const int bands[] = { 4, 8, 12, 24, 32 };
+        for (int i = 0; i < 5; i++) {
+            c = named_cfg(o, M_REFINE, "band", (float)bands[i], "band", "");
+            c.band = bands[i];
+            n = add_cfg(L, n, cap, c);
+        }
+        c = named_cfg(o, M_REFINE, "fit", 0.0f, "fit", "");
+        c.fit = 0;
+        n = add_cfg(L, n, cap, c);
+        c = named_cfg(o, M_REFINE, "global", 0.0f, "global", "");
+        c.global = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
+            c = named_cfg(o, (method_kind)k, "lagcomp", 1.0f, "lagcomp", "");
+            c.lag_comp = 1;
+            n = add_cfg(L, n, cap, c);
+        }
+        for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
+            for (int div = 2; div <= 4; div *= 2) {
+                c = named_cfg(o, (method_kind)k, "res", (float)div, "div", "");
+                snprintf(c.setting, sizeof c.setting, "mask=%dx%d", CW / div, CH / div);
+                c.div = div;
+                n = add_cfg(L, n, cap, c);
+            }
+            for (int aa = 4; aa <= 16; aa *= 2) {
+                c = named_cfg(o, (method_kind)k, "aa", (float)aa, "aa", "");
+                c.aa = aa;
+                n = add_cfg(L, n, cap, c);
+            }
+            c = named_cfg(o, (method_kind)k, "tris", 4.0f, "tris", "x");
+            c.fine = 1;
+            n = add_cfg(L, n, cap, c);
+            c = named_cfg(o, (method_kind)k, "dqs", 1.0f, "dqs", "");
+            snprintf(c.setting, sizeof c.setting, "dqs");
+            c.dqs = 1;
+            n = add_cfg(L, n, cap, c);
+        }
+    }
+    if (phase == PH_TRACK) {
+        static const float noise[] = { 0, 10, 20 };
+        static const float lat[] = { 0, 50, 100 };
+        static const float cal[] = { -0.10f, -0.05f, 0.05f, 0.10f };
+        for (int k = 0; k < 4; k++) {
+            if (k == M_SKIN || !(o->methods & (1u << k))) continue;
+            c = base_cfg(o, (method_kind)k);
+            snprintf(c.group, sizeof c.group, "track");
+            n = add_cfg(L, n, cap, c);
+            for (int i = 0; i < 3; i++) {
+                c = named_cfg(o, (method_kind)k, "noise", noise[i], "noise", "mm");
+                c.track.noise_mm = noise[i];
+                n = add_cfg(L, n, cap, c);
+            }
+            for (int i = 0; i < 3; i++) {
+                c = named_cfg(o, (method_kind)k, "latency", lat[i], "latency", "ms");
+                c.track.latency_ms = lat[i];
+                n = add_cfg(L, n, cap, c);
+            }
+            if (k == M_KIN) continue;    /* the paper's method has no calibration */
+            for (int i = 0; i < 4; i++) {
+                c = named_cfg(o, (method_kind)k, "calib", 100.0f * (o->calib_error + cal[i]),
+                              "calib", "%");
+                c.calib_error = o->calib_error + cal[i];
+                n = add_cfg(L, n, cap, c);
+            }
+        }
+    }
+    return n;
+}
+
+/* ---------------------------------------------------------------- run */
+
+/* Runs configurations cfgs[0..n) into R on `frames` frames of sequence
+ * seq (one ground truth). The context is left in *c for the caller to
+ * free. */
+static int run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames,
+                     const method_cfg *cfgs, method_run *R, int n)
+{
+    method_cfg base = base_cfg(o, M_KIN_CAL);
+    int irc = ctx_init(c, (uint64_t)o->seed, seq, &base.track);
+    if (irc < 0)
+        return irc == -2 ? EXIT_FAIL : cli_fail("cannot build the ground truth (out of memory)");
+    int rc = EXIT_FAIL;
+    int inited = 0;
+    for (; inited < n; inited++)
+        if (run_init(&R[inited], &cfgs[inited], c) < 0) { cli_fail("out of memory"); goto done; }
+    progress pr;
+    progress_start(&pr, frames);
+    if (o->quiet) pr.enabled = 0;
+    for (int f = 0; f < frames; f++) {
+        if (make_truth(c, f, o->speed, f == 0) < 0) { cli_fail("frame %d: ground truth", f); goto done; }
+        for (int i = 0; i < n; i++)
+            if (run_frame(c, &R[i], f, o->per_frame, o->dump) < 0) {
+                cli_fail("frame %d: %s %s failed", f, kind_name[R[i].cfg.kind], R[i].cfg.setting);
+                goto done;
+            }
+        char what[64];
+        snprintf(what, sizeof what, "eval %s frame", seq);
+        progress_step(&pr, f + 1, what);
+    }
+    progress_end(&pr);
+    rc = EXIT_OK;
+done:
+    for (int i = 0; i < inited; i++) run_free(&R[i]);
+    return rc;
+}
+
+int eval_run(const eval_opts *o)
+{
+    if (o->dump && cli_mkdirs(o->dump) != 0)
+        return cli_fail("%s: cannot create the folder", o->dump);
+    if (o->report && cli_mkdirs(o->report) != 0)
+        return cli_fail("%s: cannot create the report folder", o->report);
+    enum { CAP = 160 };
+    method_cfg *cfgs = calloc(CAP, sizeof *cfgs);
+    method_run *R = calloc(CAP, sizeof *R);
+    eval_ctx c;
+    memset(&c, 0, sizeof c);
+    int n = 0, rc = EXIT_FAIL;
+    if (!cfgs || !R) { cli_fail("out of memory"); goto done; }
+    /* batches: (sequence, frames, phase) */
+    const char *bseq[8];
+    int bframes[8], bphase[8], nb = 0;
+    bseq[nb] = o->sequence; bframes[nb] = o->frames; bphase[nb++] = PH_METHODS;
+    if (o->report) {
+        bseq[nb] = o->sequence; bframes[nb] = o->sweep_frames; bphase[nb++] = PH_KNOBS;
+        bseq[nb] = o->sequence; bframes[nb] = o->sweep_frames; bphase[nb++] = PH_TRACK;
+        for (int q = 0; gt_sequence_name(q) && nb < 8; q++) {
+            const char *name = gt_sequence_name(q);
+            if (!strcmp(name, o->sequence) || !strcmp(name, "calib")) continue;
+            bseq[nb] = name; bframes[nb] = o->seq_frames; bphase[nb++] = PH_SEQ;
+        }
+    }
+    for (int b = 0; b < nb; b++) {
+        int m = make_configs(o, bphase[b], bseq[b], cfgs + n, CAP - n);
+        if (n + m > CAP) { cli_fail("too many configurations"); goto done; }
+        ctx_free(&c);
+        if (run_batch(o, &c, bseq[b], bframes[b], cfgs + n, R + n, m)) goto done;
+        if (b == 0 || !o->quiet) {
+            printf("egofuse eval: sequence %s, %d frames, tracking noise %g mm, latency %g ms, "
+                   "dropout %g, calibration error %g, speed %g; means per eye (640x400 masks)\n",
+                   bseq[b], bframes[b], (double)o->noise, (double)o->latency,
+                   (double)o->dropout, (double)o->calib_error, (double)o->speed);
+            if (b == 0) eval__print_calib(stdout, &c);
+            eval__print_table(stdout, R + n, m, 0);
+            eval__print_thickness(stdout, &c, R + n, m);
+        }
+        n += m;
+    }
+    if (o->csv && eval__write_csv(o->csv, R, n)) goto done;
+    if (o->report && eval__write_report(o->report, R, n, o, &c)) goto done;
+    if (o->report) printf("egofuse eval: report in %s (summary.csv, table.md, *.png)\n", o->report);
+    rc = EXIT_OK;
+done:
+    ctx_free(&c);
+    free(R);
+    free(cfgs);
+    return rc;
+}
+
+/* "kin,refine" -> bits of method_kind; 0 when a name is unknown. */
+unsigned eval_parse_methods(const char *list)
+{
+    unsigned bits = 0;
+    const char *p = list;
+    while (*p) {
+        size_t n = strcspn(p, ",");
+        int found = 0;
+        for (int k = 0; k < 4; k++)
+            if (strlen(kind_name[k]) == n && !strncmp(p, kind_name[k], n)) {
+                bits |= 1u << k;
+                found = 1;
+            }
+        if (!found) return 0;
+        p += n;
+        if (*p == ',') p++;
+    }
+    return bits;
+}

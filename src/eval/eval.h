@@ -1,0 +1,55 @@
+/* eval.h - the accuracy evaluation of egofuse (`egofuse eval`, the report
+ * in docs/accuracy.md): the masks and composites of several methods
+ * against generated ground truth (samples/gt/, the metrics of
+ * src/fuse/fuse_metrics.h).
+ *
+ * WHAT IT DOES
+ *   eval_run(): per display frame (60 Hz) the true operator is posed and
+ *   rendered into both camera images over the cockpit (with its exact
+ *   silhouettes and the ideal composite); then every method configuration
+ *   (kin, kin-cal-pred, skin, refine and their knobs), with its own
+ *   tracking stream (noise, latency, dropouts) and its own state (filter,
+ *   last sample, previous masks, elbow fit of src/fit), makes its masks and
+ *   composites, which are timed and measured. A report runs several such
+ *   batches (methods, knobs, tracking sweeps, other sequences), each on its
+ *   own ground truth, and writes the tables (summary.csv, table.md, per
+ *   group and sequence) and the charts (*.png).
+ *
+ * WHAT IT DOES NOT
+ *   No option parsing (src/cli/cmd_eval.c does it and fills eval_opts). It
+ *   is not part of the core library: it needs the sample generator and the
+ *   ground truth (samples/gen, samples/gt, build/libegofuse_samples.a) and
+ *   is linked into the egofuse program only. Messages and the progress
+ *   line go through the program's helpers (src/cli/cli.h).
+ *
+ * USAGE
+ *   eval_opts o = ...;              // see cmd_eval.c for the defaults
+ *   o.methods = eval_parse_methods("kin,refine");
+ *   return eval_run(&o);            // EXIT_OK or EXIT_FAIL (message printed)
+ */
+#ifndef EGOFUSE_EVAL_H
+#define EGOFUSE_EVAL_H
+
+#include "../../samples/gt/gt.h"
+
+typedef struct eval_opts {
+    int frames, per_frame, quiet;
+    float noise, latency, dropout, calib_error, speed;
+    int seed;
+    const char *csv, *report, *dump;
+    unsigned methods;        /* bit k: method_kind k is run */
+    const char *sequence;    /* gt_sequence_name() */
+    int sweep_frames, seq_frames; /* report: tracking sweeps, other sequences */
+    float global;            /* refine: weight of the global colour model */
+    int band;                /* refinement band of the default refine */
+} eval_opts;
+
+/* "kin,refine" -> bits of the methods (kin, kin-cal-pred, skin, refine:
+ * bits 0..3); 0 when a name is unknown. */
+unsigned eval_parse_methods(const char *list);
+/* Runs the evaluation o describes, prints its tables, writes o->csv and
+ * the report folder o->report when set. EXIT_OK, or EXIT_FAIL with the
+ * message printed. */
+int eval_run(const eval_opts *o);
+
+#endif

@@ -1,0 +1,104 @@
+/* eval_internal.h - internal to src/eval: the method configurations, their
+ * runs (state and sums) and the shared per-frame context of the evaluation
+ * (eval.c), which the report writer (eval_report.c) reads. */
+#ifndef EGOFUSE_EVAL_INTERNAL_H
+#define EGOFUSE_EVAL_INTERNAL_H
+
+#include <stdio.h>
+
+#include "eval.h"
+#include "../fuse/fuse_metrics.h"
+#include "../fuse/fuse_refine.h"
+#include "../pipe/pipe.h"
+
+enum { CW = 640, CH = 400 };
+
+typedef enum method_kind { M_KIN, M_KIN_CAL, M_SKIN, M_REFINE } method_kind;
+static const char *kind_name[] = { "kin", "kin-cal-pred", "skin", "refine" };
+
+typedef struct method_cfg {
+    method_kind kind;
+    char setting[64];
+    char group[16];          /* methods, band, res, tris, skin, noise, ... */
+    float x;                 /* the swept value, for the charts */
+    int dqs;
+    int aa;                  /* coverage samples per pixel: 1, 4, 8, 16 */
+    int div;                 /* mask resolution divisor */
+    int fine;                /* 1: the subdivided (4x triangles) mask model */
+    int band;
+    int fit;                 /* refine: 1 = fit the elbows to the image */
+    float global;            /* refine: weight of the global colour model */
+    int lag_comp;            /* 1: the One Euro filter's ramp-lag compensation */
+    gt_track_desc track;
+    float calib_error;
+} method_cfg;
+
+/* Per-configuration state and sums. */
+typedef struct method_run {
+    method_cfg cfg;
+    int next_k;              /* next tracking sample to deliver */
+    kin_track_sample last;   /* latest delivered parts (raw methods) */
+    int have_last;
+    kin_filter filter;
+    kin_transform *locals;
+    uint8_t *prev[2];        /* previous masks per eye */
+    int have_prev;
+    float swivel[2];         /* elbow fit of the last frame, radians */
+    pipe_fit *fit;           /* refine: the elbow fit and colour models */
+    float thick[2][2];       /* refine: limb thickness measured by the fit */
+    int have_thick;
+    /* sums over frames and eyes */
+    double iou, bf1, bf3, fp, fn, mse, flicker, flicker_den, secs;
+    long n_eye, n_flicker, n_frames;
+} method_run;
+
+/* Shared per-frame buffers. */
+typedef struct eval_ctx {
+    gen_arms mask, mask_fine, truth;
+    gen_scene cockpit, workshop;
+    gen_frame_ctx gctx;
+    kin_arm_rig rig;
+    gt_operator_desc op;
+    kin_mat4 *world, *jm;
+    kin_transform *tlocals;
+    kin_mat4 *tworld;
+    kin_dualquat *dq;
+    float *pos, *nrm, *clip, *vnrm;
+    /* per eye */
+    uint8_t *cam_rgb;                       /* 640x480x3 */
+    uint8_t *P[2];                          /* 640x400 RGBA */
+    uint8_t *sil[2], *sil_prev[2];          /* true silhouettes, 640x400 */
+    int have_sil_prev;
+    float *tnrm[2];
+    uint8_t *V[2], *ideal[2];               /* 1280x800 RGBA */
+    float *vdepth;
+    uint8_t *vrgb;
+    fuse_lighting L[2];
+    kin_camera tcam[2];
+    /* method scratch */
+    uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
+    uint32_t *aa_samples;    /* anti-aliased coverage, 640x400 */
+    float *depth_lo, *nrm_lo, *mnrm;
+    void *refine_scratch;
+    size_t refine_scratch_size;
+    kin_sthmd_geometry g;
+    float *gt_depth;          /* gt_render_eye scratch, 640x480 */
+    uint8_t *gt_mask;
+    kin_user_calib calib;     /* estimated from the calibration motion */
+    char calib_why[256];
+    int calib_hand_fallback;  /* 1: no fingertip gesture, hand = arm scale */
+} eval_ctx;
+
+/* eval.c: the true operator's scales (arm, hand, shoulder width) against
+ * the mask model's. */
+void eval__true_scales(const eval_ctx *c, float *arm, float *hand, float *shoulder);
+
+/* eval_report.c: the tables, the CSV and the report folder. */
+void eval__print_calib(FILE *f, const eval_ctx *c);
+void eval__print_table(FILE *f, const method_run *R, int n, int markdown);
+void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int n);
+int eval__write_csv(const char *path, const method_run *R, int n);
+int eval__write_report(const char *dir, const method_run *R, int n, const eval_opts *o,
+                       const eval_ctx *c);
+
+#endif

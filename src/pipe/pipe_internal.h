@@ -1,0 +1,17 @@
+/* pipe_internal.h - internal to src/pipe: the steps of posing
+ * (pipe_pose.c) that the frame (pipe.c) runs on its own, one at a time or
+ * split over its two threads. Nothing here is public. */
+#ifndef EGOFUSE_PIPE_INTERNAL_H
+#define EGOFUSE_PIPE_INTERNAL_H
+
+#include "pipe_pose.h"
+
+/* FK from ps->locals and the joint matrices. */
+void pipe__pose_fk(pipe_pose *ps);
+/* Skins part `part` of `parts` of every mesh's vertices into world space
+ * (the bytes do not depend on the split); plans: per mesh, or NULL. */
+void pipe__pose_skin_part(pipe_pose *ps, const kin_skin_plan *plans, int part, int parts);
+/* ps->locals from anim at t (NULL: the rest pose) and the morph weights. */
+void pipe__pose_locals_anim(pipe_pose *ps, const kin_animation *anim, float t);
+
+#endif
