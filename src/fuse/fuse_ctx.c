@@ -1,27 +1,14 @@
 /* fuse_ctx.c - the drivers of the fuse kernels: ISA choice, row bands on a
- * small thread pool, fuse_light / fuse_composite (which dispatch), and the
+ * small thread pool (fuse_pool.c), fuse_light / fuse_composite (which dispatch), and the
  * per-frame entry fuse_context_frame. The row kernels are in fuse_ref.c
  * (the reference), fuse_simd.inl (written once on the vector layer) and
  * fuse_{sse2,avx2,avx512,neon}.c; every row is independent,
  * so the bytes do not depend on the ISA, the thread count or the banding. */
 #include "fuse_internal.h"
 
-#include <pthread.h>
-#include <stdatomic.h>
 #include <stdlib.h>
-#include <unistd.h>
 
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-#define cpu_relax() _mm_pause()
-#else
-#define cpu_relax() ((void)0)
-#endif
-
-/* Pause rounds a worker (or the caller) spins before it blocks on a
- * condition variable: a frame's stages follow each other within
- * microseconds. No spinning when there are more threads than CPUs. */
-#define SPIN_ROUNDS 2000
+#include "fuse_pool.h"
 
 typedef struct kernels {
     ef_isa isa;
@@ -102,133 +89,28 @@ static kernels kernels_for(ef_isa isa)
     return k;
 }
 
-/* ---- the thread pool --------------------------------------------------- */
-
-typedef void (*task_fn)(void *arg, int t, int n);
-
 struct fuse_context {
     kernels k;
-    int threads;
-    pthread_t th[FUSE_MAX_THREADS];
-    int started;                 /* worker threads running */
-    int spin;                    /* pause rounds before blocking */
-    pthread_mutex_t mu;
-    pthread_cond_t go, done;
-    atomic_uint gen;             /* task generation, bumped per run */
-    atomic_int pending;          /* workers still on the current task */
-    int quit;
-    task_fn task;
-    void *arg;
+    fuse__pool pool;
 };
 
-typedef struct worker_arg { fuse_context *ctx; int t; } worker_arg;
-
-static void *worker(void *p)
-{
-    fuse_context *ctx = ((worker_arg *)p)->ctx;
-    const int t = ((worker_arg *)p)->t;
-    unsigned seen = 0;
-    free(p);
-    for (;;) {
-        task_fn fn;
-        void *arg;
-        int i;
-        for (i = 0; i < ctx->spin && atomic_load(&ctx->gen) == seen; i++)
-            cpu_relax();
-        pthread_mutex_lock(&ctx->mu);
-        while (atomic_load(&ctx->gen) == seen && !ctx->quit)
-            pthread_cond_wait(&ctx->go, &ctx->mu);
-        if (ctx->quit) {
-            pthread_mutex_unlock(&ctx->mu);
-            break;
-        }
-        seen = atomic_load(&ctx->gen);
-        fn = ctx->task;
-        arg = ctx->arg;
-        pthread_mutex_unlock(&ctx->mu);
-        fn(arg, t, ctx->threads);
-        pthread_mutex_lock(&ctx->mu);
-        if (atomic_fetch_sub(&ctx->pending, 1) == 1)
-            pthread_cond_signal(&ctx->done);
-        pthread_mutex_unlock(&ctx->mu);
-    }
-    return NULL;
-}
-
 /* fn(arg, t, n) for t = 0 .. n-1, t = 0 on the calling thread. */
-static void run(fuse_context *ctx, task_fn fn, void *arg)
+static void run(fuse_context *ctx, fuse__task_fn fn, void *arg)
 {
-    int i;
-    if (ctx == NULL || ctx->threads <= 1) {
-        fn(arg, 0, 1);
-        return;
-    }
-    pthread_mutex_lock(&ctx->mu);
-    ctx->task = fn;
-    ctx->arg = arg;
-    atomic_store(&ctx->pending, ctx->threads - 1);
-    atomic_fetch_add(&ctx->gen, 1u);
-    pthread_cond_broadcast(&ctx->go);
-    pthread_mutex_unlock(&ctx->mu);
-    fn(arg, 0, ctx->threads);
-    for (i = 0; i < ctx->spin && atomic_load(&ctx->pending) > 0; i++)
-        cpu_relax();
-    pthread_mutex_lock(&ctx->mu);
-    while (atomic_load(&ctx->pending) > 0)
-        pthread_cond_wait(&ctx->done, &ctx->mu);
-    pthread_mutex_unlock(&ctx->mu);
-}
-
-static void stop_workers(fuse_context *ctx)
-{
-    int i;
-    pthread_mutex_lock(&ctx->mu);
-    ctx->quit = 1;
-    pthread_cond_broadcast(&ctx->go);
-    pthread_mutex_unlock(&ctx->mu);
-    for (i = 0; i < ctx->started; i++)
-        pthread_join(ctx->th[i], NULL);
-    ctx->started = 0;
+    fuse__pool_run(ctx != NULL ? &ctx->pool : NULL, fn, arg);
 }
 
 fuse_context *fuse_context_create(const fuse_context_desc *desc)
 {
     fuse_context_desc d = {EF_ISA_DEFAULT, 1};
     fuse_context *ctx;
-    int i;
     if (desc != NULL) d = *desc;
-    if (d.threads < 1) d.threads = 1;
-    if (d.threads > FUSE_MAX_THREADS) d.threads = FUSE_MAX_THREADS;
     if ((unsigned)d.max_isa >= EF_ISA_COUNT) d.max_isa = EF_ISA_DEFAULT;
     ctx = calloc(1, sizeof *ctx);
     if (ctx == NULL) return NULL;
     ctx->k = kernels_for(ef_isa_choose(d.max_isa));
-    ctx->threads = d.threads;
-    {
-        const long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-        ctx->spin = cpus > 0 && d.threads <= cpus ? SPIN_ROUNDS : 0;
-    }
-    atomic_init(&ctx->gen, 0u);
-    atomic_init(&ctx->pending, 0);
-    if (pthread_mutex_init(&ctx->mu, NULL) != 0) {
+    if (!fuse__pool_init(&ctx->pool, d.threads)) {
         free(ctx);
-        return NULL;
-    }
-    pthread_cond_init(&ctx->go, NULL);
-    pthread_cond_init(&ctx->done, NULL);
-    for (i = 1; i < ctx->threads; i++) {
-        worker_arg *a = malloc(sizeof *a);
-        if (a == NULL) break;
-        a->ctx = ctx;
-        a->t = i;
-        if (pthread_create(&ctx->th[ctx->started], NULL, worker, a) != 0) {
-            free(a);
-            break;
-        }
-        ctx->started++;
-    }
-    if (ctx->started != ctx->threads - 1) {
-        fuse_context_destroy(ctx);
         return NULL;
     }
     return ctx;
@@ -237,10 +119,7 @@ fuse_context *fuse_context_create(const fuse_context_desc *desc)
 void fuse_context_destroy(fuse_context *ctx)
 {
     if (ctx == NULL) return;
-    stop_workers(ctx);
-    pthread_cond_destroy(&ctx->go);
-    pthread_cond_destroy(&ctx->done);
-    pthread_mutex_destroy(&ctx->mu);
+    fuse__pool_destroy(&ctx->pool);
     free(ctx);
 }
 
@@ -251,7 +130,7 @@ ef_isa fuse_context_isa(const fuse_context *ctx)
 
 int fuse_context_threads(const fuse_context *ctx)
 {
-    return ctx != NULL ? ctx->threads : 0;
+    return ctx != NULL ? ctx->pool.threads : 0;
 }
 
 /* ---- stage bodies ------------------------------------------------------ */
@@ -1090,7 +969,7 @@ fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int coun
     }
     for (e = 0; e < count; e++)
         f.interleave[e] = may_interleave(&eyes[e]);
-    if (count % ctx->threads == 0) {
+    if (count % ctx->pool.threads == 0) {
         run(ctx, frame_whole_task, &f);
     } else {
         run(ctx, frame_light_task, &f);

@@ -21,7 +21,11 @@
  *   FUSE_SCENE_LANES(p, sc, ox, has)  the scene depths sc[ox[l]] of the
  *       lanes in has (others: anything finite or 0, never used). Default:
  *       a lane loop; AVX2/AVX-512 load a window of the row and permute
- *       when the lanes' columns lie close together, else gather. */
+ *       when the lanes' columns lie close together, else gather.
+ *   FUSE_LOAD_NORMALS(p, x, y, z)  SIMD_W interleaved normals into three
+ *       vfloat lvalues; default vf_load3. SSE2 builds each vector from
+ *       scalar loads (the layer's vf_load3 goes through a stack buffer,
+ *       which made the SSE2 lighting about 20% slower). */
 #include <string.h>
 
 /* 1 if the SIMD_W mask bytes at p are all 0 */
@@ -78,7 +82,11 @@ SIMD_INL int mask_zero(const uint8_t *p)
 #define MASK_ZERO(p) mask_zero(p)
 #define LOAD_MASK(p) vi_load_u8(p)
 #define LOAD_RGBA(p) vi_loadu((const int32_t *)(const void *)(p))
+#ifdef FUSE_LOAD_NORMALS
+#define LOAD_NORMALS(p, x, y, z) FUSE_LOAD_NORMALS(p, x, y, z)
+#else
 #define LOAD_NORMALS(p, x, y, z) vf_load3(p, &(x), &(y), &(z))
+#endif
 #define STORE_RGBA(p, v) vi_storeu((int32_t *)(void *)(p), v)
 #define STORE_ZERO(p) vi_storeu((int32_t *)(void *)(p), vi_zero())
 #define IZERO_IF_EQ0(m, v) vi_sel(vi_eq(m, vi_zero()), vi_zero(), v)

@@ -14,6 +14,13 @@
 
 #include "../cpu/simd_sse2.h"
 
+/* 4 interleaved xyz normals -> x, y, z, each vector built from its four
+ * scalars in registers (no store and reload through a buffer) */
+#define FUSE_LOAD_NORMALS(p, x, y, z) do { const float *q_ = (p); \
+        (x) = _mm_setr_ps(q_[0], q_[3], q_[6], q_[9]); \
+        (y) = _mm_setr_ps(q_[1], q_[4], q_[7], q_[10]); \
+        (z) = _mm_setr_ps(q_[2], q_[5], q_[8], q_[11]); } while (0)
+
 #include "fuse_simd.inl"
 
 static inline uint32_t load_u32(const uint8_t *p)
