@@ -23,70 +23,33 @@ typedef struct kernels {
     fuse__vrow_fn vrow;
 } kernels;
 
+/* The ISA's kernels, one row per ISA (the one dispatch table of the room):
+ * the ones of fuse_simd.inl (written once on the vector layer: light,
+ * depth, depth on the mask, cover, opaque) by ISA suffix, then the
+ * composite, which is still per ISA: SSE2 per output row, AVX2 / AVX-512
+ * through the row cache (hrow, vrow), NEON the reference's table-driven
+ * row kernel. */
+#define SIMD_KERNELS(sfx) fuse__light_row_##sfx, fuse__depth_row_##sfx, fuse__depth_mrow_##sfx
+#define SIMD_COVER(sfx) fuse__cover_row_##sfx, fuse__opaque_##sfx
+
 static kernels kernels_for(ef_isa isa)
 {
-    kernels k;
-    k.isa = isa;
+    static const kernels ref = {EF_ISA_REF, 1, SIMD_KERNELS(ref), NULL, SIMD_COVER(ref), NULL, NULL};
+    static const kernels sse2 = {EF_ISA_SSE2, 0, SIMD_KERNELS(sse2), fuse__composite_cols_sse2,
+                                 SIMD_COVER(sse2), NULL, NULL};
+    static const kernels avx2 = {EF_ISA_AVX2, 0, SIMD_KERNELS(avx2), NULL, SIMD_COVER(avx2),
+                                 fuse__hrow_avx2, fuse__vrow_avx2};
+    static const kernels avx512 = {EF_ISA_AVX512, 0, SIMD_KERNELS(avx512), NULL, SIMD_COVER(avx512),
+                                   fuse__hrow_avx512, fuse__vrow_avx512};
+    static const kernels neon = {EF_ISA_NEON, 0, SIMD_KERNELS(neon), fuse__composite_cols_ref,
+                                 SIMD_COVER(neon), NULL, NULL};
     switch (isa) {
-    case EF_ISA_AVX512:
-        k.ref = 0;
-        k.light = fuse__light_row_avx512;
-        k.depth = fuse__depth_row_avx512;
-        k.depth_mask = fuse__depth_mrow_avx512;
-        k.comp = NULL;
-        k.cover = fuse__cover_row_avx512;
-        k.opaque = fuse__opaque_avx512;
-        k.hrow = fuse__hrow_avx512;
-        k.vrow = fuse__vrow_avx512;
-        break;
-    case EF_ISA_AVX2:
-        k.ref = 0;
-        k.light = fuse__light_row_avx2;
-        k.depth = fuse__depth_row_avx2;
-        k.depth_mask = fuse__depth_mrow_avx2;
-        k.comp = NULL;
-        k.cover = fuse__cover_row_avx2;
-        k.opaque = fuse__opaque_avx2;
-        k.hrow = fuse__hrow_avx2;
-        k.vrow = fuse__vrow_avx2;
-        break;
-    case EF_ISA_NEON:   /* fuse_simd.inl on NEON; the composite: the
-                           reference's table-driven row kernel */
-        k.ref = 0;
-        k.light = fuse__light_row_neon;
-        k.depth = fuse__depth_row_neon;
-        k.depth_mask = fuse__depth_mrow_neon;
-        k.comp = fuse__composite_cols_ref;
-        k.cover = fuse__cover_row_neon;
-        k.opaque = fuse__opaque_neon;
-        k.hrow = NULL;
-        k.vrow = NULL;
-        break;
-    case EF_ISA_SSE2:
-        k.ref = 0;
-        k.light = fuse__light_row_sse2;
-        k.depth = fuse__depth_row_sse2;
-        k.depth_mask = fuse__depth_mrow_sse2;
-        k.comp = fuse__composite_cols_sse2;
-        k.cover = fuse__cover_row_sse2;
-        k.opaque = fuse__opaque_sse2;
-        k.hrow = NULL;
-        k.vrow = NULL;
-        break;
-    default:
-        k.isa = EF_ISA_REF;
-        k.ref = 1;
-        k.light = fuse__light_row_ref;
-        k.depth = fuse__depth_row_ref;
-        k.depth_mask = fuse__depth_mrow_ref;
-        k.comp = NULL;
-        k.cover = fuse__cover_row_ref;
-        k.opaque = fuse__opaque_ref;
-        k.hrow = NULL;
-        k.vrow = NULL;
-        break;
+    case EF_ISA_AVX512: return avx512;
+    case EF_ISA_AVX2: return avx2;
+    case EF_ISA_SSE2: return sse2;
+    case EF_ISA_NEON: return neon;
+    default: return ref;
     }
-    return k;
 }
 
 struct fuse_context {
