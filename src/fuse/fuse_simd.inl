@@ -408,9 +408,11 @@ void SIMD_FN(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
     for (x = 0; x + SIMD_W <= w; x += SIMD_W, b += SIMD_W / 8) {
         const vint t = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
         const unsigned nzb = vm_bits(vi_eq(t, vi_zero())) ^ SIMD_FULL;
+        unsigned pat = 0;
         int j;
-        for (j = 0; j < SIMD_W / 8; j++)
-            bits[(b + j) >> 6] |= (uint64_t)(((nzb >> (8 * j)) & 0xFFu) != 0) << ((b + j) & 63);
+        for (j = 0; j < SIMD_W / 8; j++) pat |= (unsigned)(((nzb >> (8 * j)) & 0xFFu) != 0) << j;
+        /* b is a multiple of SIMD_W / 8, which divides 64: one word */
+        bits[b >> 6] |= (uint64_t)pat << (b & 63);
     }
 #else
     /* 8 / SIMD_W vectors per block, or-ed */
@@ -455,6 +457,18 @@ void SIMD_FN(fuse__opaque)(const uint8_t *v, uint8_t *out, int n)
             vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i), vi_or(x0, a));
             vi_storeu((int32_t *)(void *)(out + 4 * (size_t)(i + SIMD_W)), vi_or(x1, a));
         }
+        if (i + SIMD_W <= n) {
+            vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i),
+                      vi_or(vi_loadu((const int32_t *)(const void *)(v + 4 * (size_t)i)), a));
+            i += SIMD_W;
+        }
     }
-    fuse__opaque_ref(v + 4 * (size_t)i, out + 4 * (size_t)i, n - i);
+    if (i < n) {   /* the last n - i < SIMD_W pixels: nothing beyond them is read or written,
+                    * and in place only when an alpha is below 255 (as above) */
+        const unsigned bits = (1u << (n - i)) - 1u;
+        const vint x = vf_as_vi(vf_load_bits((const float *)(const void *)(v + 4 * (size_t)i), bits));
+        const vint y = vi_or(x, a);
+        if (v != out || (vm_bits(vi_eq(x, y)) & bits) != bits)
+            vf_store_bits((float *)(void *)(out + 4 * (size_t)i), bits, vi_as_vf(y));
+    }
 }
