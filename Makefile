@@ -122,6 +122,9 @@ deps:
 	@sh scripts/deps.sh
 
 # Per-ISA files get their own flags; everything else stays at the baseline.
+# *_neon.c (the vector layer's src/cpu/simd_neon.h) need none: Advanced SIMD
+# is the aarch64 baseline; elsewhere they compile to nothing, as the x86
+# files do off x86.
 ifeq ($(X86),1)
 $(BUILD)/obj/%_avx2.c.o: CFLAGS += -mavx2 -mf16c
 $(BUILD)/obj/%_avx512.c.o: CFLAGS += -mavx512f -mavx512bw -mavx512dq -mavx512vl -mavx2 -mf16c

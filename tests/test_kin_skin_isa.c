@@ -1,5 +1,6 @@
 /* test_kin_skin_isa.c - the SIMD skinning kernels (kin_skin_sse2.c,
- * _avx2.c, _avx512.c) against the scalar reference: over seeded random
+ * _avx2.c, _avx512.c, _neon.c: the last under qemu-aarch64, .ci/run part
+ * arm64) against the scalar reference: over seeded random
  * meshes (vertex counts that are and are not multiples of the vector
  * widths, 1..4 influences, zero weights, weights summing to zero, negative
  * and unnormalised weights, joints with scale, shear and mirroring, a
@@ -110,6 +111,7 @@ static void isa_equal(int isa)
 static void test_sse2(void **state) { (void)state; isa_equal(EF_ISA_SSE2); }
 static void test_avx2(void **state) { (void)state; isa_equal(EF_ISA_AVX2); }
 static void test_avx512(void **state) { (void)state; isa_equal(EF_ISA_AVX512); }
+static void test_neon(void **state) { (void)state; isa_equal(EF_ISA_NEON); }
 
 /* kin_skin_lbs / kin_skin_dqs (the dispatching entry points) give the
  * reference's bytes, and kin_skin_isa() names a path the CPU runs. */
@@ -221,6 +223,7 @@ int main(void)
         cmocka_unit_test(test_sse2),
         cmocka_unit_test(test_avx2),
         cmocka_unit_test(test_avx512),
+        cmocka_unit_test(test_neon),
         cmocka_unit_test(test_dispatch_equal),
         cmocka_unit_test(test_no_normal_output),
         cmocka_unit_test(test_dqs_weight_scale),

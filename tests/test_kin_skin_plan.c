@@ -141,6 +141,7 @@ static void test_ref(void **state) { (void)state; plan_equal(EF_ISA_REF); }
 static void test_sse2(void **state) { (void)state; plan_equal(EF_ISA_SSE2); }
 static void test_avx2(void **state) { (void)state; plan_equal(EF_ISA_AVX2); }
 static void test_avx512(void **state) { (void)state; plan_equal(EF_ISA_AVX512); }
+static void test_neon(void **state) { (void)state; plan_equal(EF_ISA_NEON); }
 
 /* DQS with the weight sums at the ends of the float range (vertex v's
  * weights scaled by tu_skin_weight_scale(v), mixed within every batch):
@@ -372,6 +373,7 @@ int main(void)
         cmocka_unit_test(test_sse2),
         cmocka_unit_test(test_avx2),
         cmocka_unit_test(test_avx512),
+        cmocka_unit_test(test_neon),
         cmocka_unit_test(test_dqs_weight_scale),
         cmocka_unit_test(test_structure),
         cmocka_unit_test(test_parts),

@@ -1,7 +1,7 @@
 /* cpu.c - CPU feature detection and the ISA cap. */
 #include "cpu.h"
 
-/* Big-endian machines: not supported. The SIMD paths are x86's, and the
+/* Big-endian machines: not supported. The SIMD paths are x86's and NEON's, and the
  * byte-for-byte claims (README, docs/portability.md) were checked on
  * little-endian x86-64 and ARM64 only; the build refuses rather than give
  * bytes nobody compared. EGOFUSE_ALLOW_BIG_ENDIAN builds it anyway. */
@@ -13,7 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *names[EF_ISA_COUNT] = {"default", "ref", "sse2", "avx2", "avx512"};
+static const char *names[EF_ISA_COUNT] = {"default", "ref", "sse2", "avx2", "avx512", "neon"};
+static const int levels[EF_ISA_COUNT] = {3, 0, 1, 2, 3, 1};
 
 static ef_isa detect(void)
 {
@@ -26,8 +27,8 @@ static ef_isa detect(void)
     if (__builtin_cpu_supports("avx2")) return EF_ISA_AVX2;
     if (__builtin_cpu_supports("sse2")) return EF_ISA_SSE2;
     return EF_ISA_REF;
-#elif defined(__aarch64__)
-    return EF_ISA_SSE2; /* the portable path */
+#elif defined(__aarch64__) && defined(__ARM_NEON)
+    return EF_ISA_NEON; /* Advanced SIMD is part of every AArch64 CPU */
 #else
     return EF_ISA_REF;
 #endif
@@ -40,9 +41,38 @@ ef_isa ef_cpu_best(void)
     return (ef_isa)cached;
 }
 
+/* The ISAs of this architecture, in level order. */
+#if defined(__x86_64__) || defined(__i386__)
+#define ARCH_ISAS { EF_ISA_REF, EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512 }
+#elif defined(__aarch64__) && defined(__ARM_NEON)
+#define ARCH_ISAS { EF_ISA_REF, EF_ISA_NEON }
+#else
+#define ARCH_ISAS { EF_ISA_REF }
+#endif
+static const ef_isa arch_isas[] = ARCH_ISAS;
+#define ARCH_N ((int)(sizeof arch_isas / sizeof arch_isas[0]))
+
+int ef_isa_level(ef_isa isa)
+{
+    return (unsigned)isa < EF_ISA_COUNT ? levels[isa] : 3;
+}
+
 int ef_cpu_has(ef_isa isa)
 {
-    return isa != EF_ISA_DEFAULT && isa < EF_ISA_COUNT && isa <= ef_cpu_best();
+    if (isa == EF_ISA_DEFAULT || (unsigned)isa >= EF_ISA_COUNT) return 0;
+    const int best = ef_isa_level(ef_cpu_best());
+    for (int i = 0; i < ARCH_N; i++)
+        if (arch_isas[i] == isa) return levels[isa] <= best;
+    return 0;
+}
+
+ef_isa ef_cpu_cap(ef_isa cap)
+{
+    const int lim = ef_isa_level(cap), best = ef_isa_level(ef_cpu_best());
+    ef_isa r = EF_ISA_REF;
+    for (int i = 0; i < ARCH_N; i++)
+        if (levels[arch_isas[i]] <= lim && levels[arch_isas[i]] <= best) r = arch_isas[i];
+    return r;
 }
 
 const char *ef_isa_name(ef_isa isa)
@@ -67,9 +97,7 @@ const char *ef_isa_env_error(void)
 
 ef_isa ef_isa_choose(ef_isa cap)
 {
-    ef_isa isa = ef_cpu_best();
-    if (cap != EF_ISA_DEFAULT && cap < isa) isa = cap;
     ef_isa env = ef_isa_parse(getenv("EGOFUSE_ISA"));
-    if (env != EF_ISA_DEFAULT && env < isa) isa = env;
-    return isa;
+    if (env != EF_ISA_DEFAULT && ef_isa_level(env) < ef_isa_level(cap)) cap = env;
+    return ef_cpu_cap(cap);
 }

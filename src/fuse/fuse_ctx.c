@@ -62,6 +62,7 @@ static kernels kernels_for(ef_isa isa)
         k.hrow = fuse__hrow_avx2;
         k.vrow = fuse__vrow_avx2;
         break;
+    case EF_ISA_NEON:   /* until fuse has NEON kernels: sse2's stand-ins there */
     case EF_ISA_SSE2:
         k.ref = 0;
         k.light = fuse__light_row_sse2;

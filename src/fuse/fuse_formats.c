@@ -102,7 +102,7 @@ fuse_result fuse_frame_to_rgba(const fuse_frame *s, int y0, fuse_image *out)
 
 fuse_result fuse_frame_to_rgba_isa(const fuse_frame *s, int y0, fuse_image *out, ef_isa cap)
 {
-    const int yuv_avx2 = ef_isa_choose(cap) >= EF_ISA_AVX2;
+    const int yuv_avx2 = ef_isa_level(ef_isa_choose(cap)) >= ef_isa_level(EF_ISA_AVX2);
     static const int pats[4][4] = {
         { 0, 1, 1, 2 },   /* RGGB */
         { 1, 0, 2, 1 },   /* GRBG */

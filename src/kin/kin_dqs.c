@@ -180,6 +180,8 @@ void kin_skin_dqs_isa(const kin_mesh *mesh, const kin_dualquat *dq,
         case EF_ISA_AVX512: v = kin__skin_dqs_avx512(mesh, dq, pos_out, nrm_out, 0, n); break;
         case EF_ISA_AVX2: v = kin__skin_dqs_avx2(mesh, dq, pos_out, nrm_out, 0, n); break;
         case EF_ISA_SSE2: v = kin__skin_dqs_sse2(mesh, dq, pos_out, nrm_out, 0, n); break;
+#elif defined(__aarch64__) && defined(__ARM_NEON)
+        case EF_ISA_NEON: v = kin__skin_dqs_neon(mesh, dq, pos_out, nrm_out, 0, n); break;
 #endif
         default: break;
         }

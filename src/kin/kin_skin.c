@@ -112,8 +112,7 @@ int kin_skin_isa(void)
 int kin__skin_isa_of(int isa)
 {
     if (isa <= (int)EF_ISA_DEFAULT || isa >= (int)EF_ISA_COUNT) return (int)ef_isa_choose(EF_ISA_DEFAULT);
-    ef_isa best = ef_cpu_best();
-    return (int)((ef_isa)isa < best ? (ef_isa)isa : best);
+    return (int)ef_cpu_cap((ef_isa)isa);
 }
 
 void kin_skin_lbs_isa(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
@@ -128,6 +127,8 @@ void kin_skin_lbs_isa(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
         case EF_ISA_AVX512: v = kin__skin_lbs_avx512(mesh, jm, pos_out, nrm_out, 0, n); break;
         case EF_ISA_AVX2: v = kin__skin_lbs_avx2(mesh, jm, pos_out, nrm_out, 0, n); break;
         case EF_ISA_SSE2: v = kin__skin_lbs_sse2(mesh, jm, pos_out, nrm_out, 0, n); break;
+#elif defined(__aarch64__) && defined(__ARM_NEON)
+        case EF_ISA_NEON: v = kin__skin_lbs_neon(mesh, jm, pos_out, nrm_out, 0, n); break;
 #endif
         default: break;
         }

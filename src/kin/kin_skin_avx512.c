@@ -1,57 +1,18 @@
-/* kin_skin_avx512.c - skinning kernels, AVX-512 (16 vertices per vector)
- * with kin_skin_simd.inl. A vertex's joint matrix is one zmm (LBS), its
+/* kin_skin_avx512.c - skinning kernels, AVX-512 (16 vertices per vector):
+ * the vector layer's AVX-512 implementation, the blend below (AVX-512's
+ * own: masks, vpermt2ps joint tables) and the one body, kin_skin_simd.inl. A vertex's joint matrix is one zmm (LBS), its
  * dual quaternion one ymm (DQS); 16 blended vertices are transposed with
  * in-lane 4x4 transposes and 128-bit block shuffles. Bytes equal the
  * reference (kin_skin.c, kin_dqs.c). Built with -mavx512f/bw/dq/vl. */
 #include "kin_skin_internal.h"
 
 #if defined(__x86_64__)
-#include <immintrin.h>
 #include <math.h>
 #include <string.h>
 
-#define W 16
-#define V __m512
-#define M __mmask16
-#define SIMD_LBS kin__skin_lbs_avx512
-#define SIMD_LBS_PLAN kin__skin_lbs_plan_avx512
-#define SIMD_DQS_PLAN kin__skin_dqs_plan_avx512
-#define VLOAD(p) _mm512_load_ps(p)
-#define VNEG(x) _mm512_xor_ps(x, _mm512_set1_ps(-0.0f))
-#define SIMD_DQS kin__skin_dqs_avx512
-#define VSET1(x) _mm512_set1_ps(x)
-#define VADD(a, b) _mm512_add_ps(a, b)
-#define VSUB(a, b) _mm512_sub_ps(a, b)
-#define VMUL(a, b) _mm512_mul_ps(a, b)
-#define VDIV(a, b) _mm512_div_ps(a, b)
-#define VSQRT(a) _mm512_sqrt_ps(a)
-#define M_NE(a, b) _mm512_cmp_ps_mask(a, b, _CMP_NEQ_UQ)
-#define M_GT(a, b) _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ)
-#define M_LT(a, b) _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ)
-#define M_AND(a, b) ((__mmask16)((a) & (b)))
-#define SEL(m, t, f) _mm512_mask_blend_ps(m, f, t)
-#define SELZ(m, t) _mm512_maskz_mov_ps(m, t)
-#define NEG_IF(m, x) _mm512_mask_xor_ps(x, m, x, _mm512_set1_ps(-0.0f))
-#define M_ALL(m) ((m) == (__mmask16)0xFFFF)
-#define VMAX(a, b) _mm512_max_ps(a, b)
-#define VMIN(a, b) _mm512_min_ps(a, b)
-#define VABS(x) _mm512_and_ps(x, _mm512_castsi512_ps(_mm512_set1_epi32(0x7FFFFFFF)))
-#define VEXP2(x) _mm512_and_ps(x, _mm512_castsi512_ps(_mm512_set1_epi32(0x7F800000)))
+#include "../cpu/simd_avx512.h"
 
-/* In-lane 4x4 transposes of r0..r3: o[k] holds, in each 128-bit block,
- * element k of that block of r0, r1, r2, r3. */
-static inline void tr4(__m512 r0, __m512 r1, __m512 r2, __m512 r3, __m512 o[4])
-{
-    __m512d t0 = _mm512_castps_pd(_mm512_unpacklo_ps(r0, r1));
-    __m512d t1 = _mm512_castps_pd(_mm512_unpacklo_ps(r2, r3));
-    __m512d t2 = _mm512_castps_pd(_mm512_unpackhi_ps(r0, r1));
-    __m512d t3 = _mm512_castps_pd(_mm512_unpackhi_ps(r2, r3));
-    o[0] = _mm512_castpd_ps(_mm512_unpacklo_pd(t0, t1));
-    o[1] = _mm512_castpd_ps(_mm512_unpackhi_pd(t0, t1));
-    o[2] = _mm512_castpd_ps(_mm512_unpacklo_pd(t2, t3));
-    o[3] = _mm512_castpd_ps(_mm512_unpackhi_pd(t2, t3));
-}
-
+#define KIN_SKIN_OWN_BLOCK
 static inline void lbs_rows(const kin_mesh *mesh, const kin_mat4 *jm, int v,
                              __m512 a[12], __m512 *wsum)
 {
@@ -74,7 +35,7 @@ static inline void lbs_rows(const kin_mesh *mesh, const kin_mat4 *jm, int v,
     *wsum = _mm512_load_ps(ws);
     /* s[I][rho], block J: column J, row rho of vertices 4I..4I+3 */
     __m512 s[4][4];
-    for (int I = 0; I < 4; I++) tr4(r[4 * I], r[4 * I + 1], r[4 * I + 2], r[4 * I + 3], s[I]);
+    for (int I = 0; I < 4; I++) vf_tr4(r[4 * I], r[4 * I + 1], r[4 * I + 2], r[4 * I + 3], s[I]);
     for (int rho = 0; rho < 3; rho++) {
         __m512 abl = _mm512_shuffle_f32x4(s[0][rho], s[1][rho], 0x44);
         __m512 cdl = _mm512_shuffle_f32x4(s[2][rho], s[3][rho], 0x44);
@@ -121,7 +82,7 @@ static inline void dqs_rows(const kin_mesh *mesh, const kin_dualquat *dq, int v,
     *wsum = _mm512_load_ps(ws);
     __m512 s[2][4];
     for (int I = 0; I < 2; I++)
-        tr4(_mm512_load_ps(blk + 64 * I), _mm512_load_ps(blk + 64 * I + 16),
+        vf_tr4(_mm512_load_ps(blk + 64 * I), _mm512_load_ps(blk + 64 * I + 16),
             _mm512_load_ps(blk + 64 * I + 32), _mm512_load_ps(blk + 64 * I + 48), s[I]);
     for (int rho = 0; rho < 4; rho++) {
         b[rho] = _mm512_shuffle_f32x4(s[0][rho], s[1][rho], 0x88);
@@ -147,7 +108,7 @@ typedef struct skin_tab {
     __m512i widx[4];               /* float picks: slot i of 8 vertices */
 } skin_tab;
 
-static inline void tab_init(skin_tab *T)
+SIMD_INL void tab_init(skin_tab *T)
 {
     T->built = 0;
     _Alignas(64) short s01[32], s23[32];
@@ -308,77 +269,6 @@ static inline void dqs_block(skin_tab *T, const kin_mesh *mesh, const kin_dualqu
 #pragma GCC unroll 8
     for (int e = 0; e < 8; e++) q[e] = acc[e];
     *wsum = ws;
-}
-
-/* x y z x y z ... (48 floats) <-> three SoA vectors. Component k of
- * vertex v is float 3v + k: register (3v+k)/16, lane (3v+k)%16; the
- * lanes of one component are distinct, so two blends gather them into
- * one register and one permute puts them in vertex order. */
-typedef struct lay3 {
-    __m512i gidx[3], sidx[3];
-    __mmask16 mb[3], mc[3], sy[3], sz[3];
-} lay3;
-
-static inline void lay3_init(lay3 *L)
-{
-    for (int k = 0; k < 3; k++) {
-        _Alignas(64) int gi[16], si[16];
-        unsigned mb = 0, mc = 0, sy = 0, sz = 0;
-        for (int v = 0; v < 16; v++) {
-            int g = 3 * v + k, lane = g % 16;
-            gi[v] = lane;
-            si[lane] = v;
-            if (g >= 16 && g < 32) mb |= 1u << lane;
-            if (g >= 32) mc |= 1u << lane;
-        }
-        for (int lane = 0; lane < 16; lane++) {
-            int g = 16 * k + lane;
-            if (g % 3 == 1) sy |= 1u << lane;
-            if (g % 3 == 2) sz |= 1u << lane;
-        }
-        L->gidx[k] = _mm512_load_si512(gi);
-        L->sidx[k] = _mm512_load_si512(si);
-        L->mb[k] = (__mmask16)mb; L->mc[k] = (__mmask16)mc;
-        L->sy[k] = (__mmask16)sy; L->sz[k] = (__mmask16)sz;
-    }
-}
-
-static inline void deint3(const lay3 *L, const float *p, __m512 o[3])
-{
-    __m512 a = _mm512_loadu_ps(p), b = _mm512_loadu_ps(p + 16), c = _mm512_loadu_ps(p + 32);
-    for (int k = 0; k < 3; k++) {
-        __m512 t = _mm512_mask_blend_ps(L->mc[k], _mm512_mask_blend_ps(L->mb[k], a, b), c);
-        o[k] = _mm512_permutexvar_ps(L->gidx[k], t);
-    }
-}
-
-static inline void int3(const lay3 *L, float *p, const __m512 in[3])
-{
-    __m512 x = _mm512_permutexvar_ps(L->sidx[0], in[0]);
-    __m512 y = _mm512_permutexvar_ps(L->sidx[1], in[1]);
-    __m512 z = _mm512_permutexvar_ps(L->sidx[2], in[2]);
-    for (int r = 0; r < 3; r++)
-        _mm512_storeu_ps(p + 16 * r,
-                         _mm512_mask_blend_ps(L->sz[r], _mm512_mask_blend_ps(L->sy[r], x, y), z));
-}
-
-/* Three SoA vectors (x, y, z of 16 lanes) to out + 3 dest[l]: an in-lane
- * transpose gives each vertex's x y z (and a spare) in one 128-bit block,
- * stored with a 3-float mask. */
-static inline __attribute__((always_inline)) void scat3(float *out, const int32_t *dest, const __m512 o[3])
-{
-    __m512 t[4];
-    tr4(o[0], o[1], o[2], o[2], t);   /* t[k], block J: vertex 4J + k */
-#define KIN_SCAT(J, k)                                                             \
-    _mm_mask_storeu_ps(out + 3 * (size_t)dest[4 * (J) + (k)], 0x7,                 \
-                       _mm512_extractf32x4_ps(t[k], J));
-#define KIN_SCAT_BLOCK(J) KIN_SCAT(J, 0) KIN_SCAT(J, 1) KIN_SCAT(J, 2) KIN_SCAT(J, 3)
-    KIN_SCAT_BLOCK(0)
-    KIN_SCAT_BLOCK(1)
-    KIN_SCAT_BLOCK(2)
-    KIN_SCAT_BLOCK(3)
-#undef KIN_SCAT_BLOCK
-#undef KIN_SCAT
 }
 
 #include "kin_skin_simd.inl"

@@ -2,8 +2,9 @@
  * kin_skin_dqs (not a public header).
  *
  * The scalar reference (kin_skin.c, kin_dqs.c) defines every byte; the
- * SIMD kernels (kin_skin_sse2.c, kin_skin_avx2.c, kin_skin_avx512.c, one
- * body in kin_skin_simd.inl) compute the same operations in the same
+ * SIMD kernels (kin_skin_sse2.c, kin_skin_avx2.c, kin_skin_avx512.c,
+ * kin_skin_neon.c: one body in kin_skin_simd.inl on the vector layer
+ * src/cpu/simd.h) compute the same operations in the same
  * order lane by lane (no FMA, exact sqrt and division), so they are
  * memcmp-equal. A kernel skins the vertices [v0, v1) of a skinned mesh
  * (joints, weights and matrices present) and returns the first vertex it
@@ -67,6 +68,10 @@ int kin__skin_dqs_avx2(const kin_mesh *mesh, const kin_dualquat *dq,
                        float *pos_out, float *nrm_out, int v0, int v1);
 int kin__skin_dqs_avx512(const kin_mesh *mesh, const kin_dualquat *dq,
                          float *pos_out, float *nrm_out, int v0, int v1);
+int kin__skin_lbs_neon(const kin_mesh *mesh, const kin_mat4 *jm,
+                       float *pos_out, float *nrm_out, int v0, int v1);
+int kin__skin_dqs_neon(const kin_mesh *mesh, const kin_dualquat *dq,
+                       float *pos_out, float *nrm_out, int v0, int v1);
 
 /* ---- skin plan (kin_skin_plan.c) -----------------------------------
  * One batch: up to KIN__PLAN_W vertices that read the same joints with
@@ -94,5 +99,6 @@ typedef void kin__plan_fn(const kin__plan_batch *bt, int b0, int b1, const void 
 typedef kin__plan_fn *kin__plan_kernel;
 kin__plan_fn kin__skin_lbs_plan_sse2, kin__skin_lbs_plan_avx2, kin__skin_lbs_plan_avx512;
 kin__plan_fn kin__skin_dqs_plan_sse2, kin__skin_dqs_plan_avx2, kin__skin_dqs_plan_avx512;
+kin__plan_fn kin__skin_lbs_plan_neon, kin__skin_dqs_plan_neon;
 
 #endif

@@ -219,6 +219,8 @@ static void dqs_ref(const kin_mesh *m, const void *xf, float *pos_out, float *nr
 #define PLAN_SIMD(kind)                                                                   \
     { [EF_ISA_SSE2] = kin__skin_##kind##_plan_sse2, [EF_ISA_AVX2] = kin__skin_##kind##_plan_avx2, \
       [EF_ISA_AVX512] = kin__skin_##kind##_plan_avx512 }
+#elif defined(__aarch64__) && defined(__ARM_NEON)
+#define PLAN_SIMD(kind) { [EF_ISA_NEON] = kin__skin_##kind##_plan_neon }
 #else
 #define PLAN_SIMD(kind) { 0 }
 #endif

@@ -1,0 +1,175 @@
+/* simd.h - the thin vector layer: one contract, one header per ISA.
+ *
+ * WHAT IT DOES. Gives the SIMD kernels of egofuse (raster, fuse, kin) one
+ * vocabulary of lane operations, so a kernel is written ONCE and compiled
+ * once per ISA. A kernel file includes exactly one implementation,
+ *
+ *   simd_sse2.h    x86-64 SSE2         SIMD_W  4   (the x86-64 baseline)
+ *   simd_avx2.h    x86-64 AVX2 (+F16C) SIMD_W  8   (file built with -mavx2)
+ *   simd_avx512.h  AVX-512 F/BW/DQ/VL  SIMD_W 16   (built with -mavx512*)
+ *   simd_neon.h    AArch64 Advanced SIMD (NEON)  SIMD_W 4 (no flag: baseline)
+ *
+ * and then the kernel body (a .inl) written on the names below. Each
+ * operation's result is defined here, lane by lane, bit for bit; every
+ * implementation gives those bits (tests/test_cpu_simd.c checks each op of
+ * each ISA the machine runs against a scalar model, special values
+ * included). A kernel that keeps to these operations, in the scalar
+ * reference's order, gives the reference's bytes on every ISA.
+ *
+ * WHAT IT DOES NOT. No dispatch (src/cpu/cpu.h picks the ISA; each room
+ * keeps one dispatch table), no FMA, no estimates (rcp/rsqrt), no fast-math,
+ * no gathers, no byte/16-bit lanes yet (fuse's refine and composite use
+ * them; they come with the fuse port, see docs/portability.md). What one
+ * ISA does in a way the others cannot (AVX-512 joint tables, AVX2's
+ * 128-bit lane permutes) stays in that ISA's kernel file, on the layer's
+ * types.
+ *
+ * USAGE (a kernel file, e.g. src/kin/kin_skin_avx2.c):
+ *
+ *   #if defined(__x86_64__)
+ *   #include "../cpu/simd_avx2.h"
+ *   #include "kin_skin_simd.inl"   // defines SIMD_FN(kin__skin_lbs) ...
+ *   #endif
+ *
+ * and in the body:
+ *
+ *   void SIMD_FN(scale_row)(float *p, int n, float s)   // scale_row_avx2
+ *   {
+ *       const vfloat k = vf_set1(s);
+ *       int x = 0;
+ *       for (; n - x >= SIMD_W; x += SIMD_W)
+ *           vf_storeu(p + x, vf_mul(vf_loadu(p + x), k));
+ *       for (; x < n; x++) p[x] = p[x] * s;        // the scalar tail
+ *   }
+ *
+ * BUILD. Kernel files are compiled with -ffp-contract=off (the Makefile's
+ * CFLAGS_COMMON): a*b + c stays two roundings on every ISA. The x86 files
+ * get their -m flags by name (*_avx2.c, *_avx512.c), on x86 targets only;
+ * *_neon.c files need no flag on aarch64 (NEON is the baseline there) and
+ * compile to nothing elsewhere. Each header #errors when its ISA is not
+ * enabled for the file, so a missing flag cannot silently give wrong code.
+ *
+ * ---------------------------------------------------------------------
+ * WHAT EACH IMPLEMENTATION DEFINES
+ *
+ *   SIMD_W         lanes per vector (4, 8, 16, 4)
+ *   SIMD_ISA       the ef_isa value (EF_ISA_SSE2, EF_ISA_AVX2, ...)
+ *   SIMD_NAME      "sse2", "avx2", "avx512", "neon"
+ *   SIMD_FN(name)  name##_sse2 (_avx2, _avx512, _neon): the kernel's names
+ *   SIMD_ALIGN     bytes of a vector (the alignment vf_load/vf_store need)
+ *   SIMD_FULL      the lane bits of every lane, (1u << SIMD_W) - 1
+ *   SIMD_INL       static inline, always inlined (vectors never pass
+ *                  through memory at a call)
+ *   vfloat         SIMD_W IEEE binary32 lanes
+ *   vint           SIMD_W int32 lanes (two's complement; wrap on overflow)
+ *   vmask          SIMD_W lane flags (a vector of all-ones / all-zero
+ *                  lanes on SSE2, AVX2 and NEON, a __mmask16 on AVX-512:
+ *                  only make them with the compares and vm_* below)
+ *
+ * Lane l of a vector is element l in memory order (p[l] after vf_loadu).
+ * "bits" are an unsigned with bit l for lane l (SIMD_W <= 16).
+ *
+ * OPERATIONS (a, b: vfloat; i, j: vint; m, n: vmask; p: pointer; k: int)
+ *
+ * Memory
+ *   vf_set1(x) vi_set1(x)    every lane x
+ *   vf_zero()  vi_zero()     every lane +0.0f / 0
+ *   vi_lanes()               lane l = l
+ *   vf_load(p)  vf_store(p, a)     p aligned to SIMD_ALIGN
+ *   vf_loadu(p) vf_storeu(p, a)    any float alignment
+ *   vi_load(p) vi_store(p, i) vi_loadu(p) vi_storeu(p, i)   int32 *p
+ *   vf_load_bits(p, bits)    lanes in bits from p[l]; the others are +0 and
+ *                            their p[l] is NOT read (may be unmapped)
+ *   vf_store_bits(p, bits, a)  writes p[l] for the lanes in bits only;
+ *                            nothing else is read or written
+ *   vf_load3(p, &x, &y, &z)  de-interleaves 3*SIMD_W floats x y z x y z ..:
+ *                            lane l of x = p[3l], y = p[3l+1], z = p[3l+2]
+ *   vf_store3(p, x, y, z)    the inverse: writes p[0 .. 3*SIMD_W)
+ *   vf_scatter3(p, dest, x, y, z)  lane l to p[3*dest[l] + 0..2] (int32
+ *                            dest[SIMD_W]; the order of the lanes' stores
+ *                            is unspecified: lanes with the same dest must
+ *                            carry the same values)
+ *
+ * Float arithmetic: IEEE binary32, round to nearest even, no flush of
+ * denormals (x86: MXCSR default; aarch64: FPCR default, FZ = 0).
+ *   vf_add vf_sub vf_mul vf_div(a, b), vf_sqrt(a)   correctly rounded
+ *   vf_min(a, b)   a < b ? a : b   (x86 minps: b when either is NaN; b for
+ *                                   -0.0 vs +0.0 in either order)
+ *   vf_max(a, b)   a > b ? a : b   (x86 maxps, likewise)
+ *   vf_neg(a)      sign bit flipped (also for NaN, 0, inf)
+ *   vf_abs(a)      sign bit cleared
+ *   vf_neg_if(m, a)  sign bit flipped where m
+ *   vf_floor(a)    floorf(a) exactly, -0.0 kept, |a| >= 2^23 and inf
+ *                  unchanged; a quiet NaN gives a quiet NaN (its payload
+ *                  may differ between ISAs: do not store it)
+ *   NaN created by an operation from non-NaN inputs (0/0, inf-inf,
+ *   sqrt(-1)) is the target's default NaN: 0xFFC00000 on x86, 0x7FC00000
+ *   on aarch64, as the scalar reference gives on that target. Same-target
+ *   equality holds; bytes that must match ACROSS targets must not carry a
+ *   created NaN (the kernels select such lanes away).
+ *
+ * Compares (to vmask): ordered ones are false when a or b is NaN.
+ *   vf_eq vf_lt vf_le vf_gt vf_ge(a, b)   ordered
+ *   vf_ne(a, b)    unordered or not equal (true when either is NaN)
+ *   vi_eq(i, j)  vi_gt(i, j)   signed int32
+ *
+ * Selects and bit operations
+ *   vf_sel(m, a, b)  m ? a : b per lane (bits of a or b, NaN kept)
+ *   vf_selz(m, a)    m ? a : +0.0f
+ *   vi_sel(m, i, j)  m ? i : j
+ *   vf_and vf_or vf_xor(a, b)  bitwise on the float bits
+ *   vf_andnot(a, b)  ~a & b (x86 order)
+ *   vi_and vi_or vi_xor(i, j), vi_andnot(i, j) = ~i & j
+ *   vf_as_vi(a) vi_as_vf(i)    the same bits, other type (no conversion)
+ *
+ * Integer arithmetic (int32, wrapping)
+ *   vi_add vi_sub(i, j), vi_mullo(i, j) (low 32 bits of the product)
+ *   vi_slli(i, k) vi_srli(i, k) vi_srai(i, k)   by a CONSTANT k: slli
+ *                  0 <= k <= 31, srli/srai 1 <= k <= 31 (NEON's immediate
+ *                  right shifts do not take 0); srli fills zeros, srai signs
+ *   vi_sll(i, k) vi_srl(i, k)    by a run-time k, 0 <= k <= 31, all lanes
+ *
+ * Conversions
+ *   vf_from_vi(i)        int32 -> float, round to nearest even
+ *   vi_from_vf_trunc(a)  float -> int32 toward zero (cvttps)
+ *   vi_from_vf_round(a)  float -> int32 to nearest, ties to even (cvtps
+ *                        with the default MXCSR)
+ *                        both: NaN and lanes outside [-2^31, 2^31) give
+ *                        INT32_MIN (0x80000000), x86's "integer
+ *                        indefinite" (NEON saturates and gives 0 for NaN:
+ *                        simd_neon.h selects INT32_MIN there)
+ *
+ * Masks
+ *   vm_and vm_or(m, n), vm_andnot(m, n) = ~m & n, vm_not(m)
+ *   vm_bits(m)       unsigned, bit l set where lane l is set
+ *   vm_from_bits(b)  lane l set where bit l of b is set
+ *   vm_all(m)        1 when every lane is set, else 0
+ *   vm_any(m)        1 when some lane is set, else 0
+ *   vf_lt_bits(a, b) etc. are vm_bits(vf_lt(a, b)): write them that way;
+ *                    on NEON prefer vm_any / vm_all where only that is
+ *                    needed (one instruction; bits cost four)
+ *
+ * Shuffles
+ *   vf_tr4(a, b, c, d, o)  4x4 transpose within each 4-lane block J
+ *                          (lanes 4J .. 4J+3): lane 4J+i of o[k] is lane
+ *                          4J+k of the i-th input (o is vfloat[4]). On
+ *                          SSE2 and NEON the whole transpose.
+ *
+ * NEW ISA. Copy simd_neon.h (the plainest), keep every name, meet every
+ * line of this contract (the semantics above are x86's where the ISAs
+ * differ: min/max, conversion out of range), add the ISA to
+ * tests/test_cpu_simd.c and to the kernels' files; see
+ * docs/portability.md, "A new ISA".
+ */
+#ifndef EGOFUSE_SIMD_H
+#define EGOFUSE_SIMD_H
+
+#include <stdint.h>
+
+#include "cpu.h"
+
+#define SIMD_INL static inline __attribute__((always_inline))
+#define SIMD_CAT_(a, b) a##_##b
+#define SIMD_CAT(a, b) SIMD_CAT_(a, b)
+
+#endif

@@ -1,0 +1,188 @@
+/* simd_avx2.h - the vector layer (simd.h) on AVX2, 8 lanes (files built
+ * with -mavx2 -mf16c, no -mfma). Masks are __m256 of all-ones / all-zero
+ * lanes. Include once per file. */
+#ifndef EGOFUSE_SIMD_IMPL
+#define EGOFUSE_SIMD_IMPL "avx2"
+#if !defined(__AVX2__)
+#error "simd_avx2.h: AVX2 is not enabled for this file (-mavx2)"
+#endif
+
+#include <immintrin.h>
+
+#include "simd.h"
+
+#define SIMD_W 8
+#define SIMD_ISA EF_ISA_AVX2
+#define SIMD_NAME "avx2"
+#define SIMD_FN(name) SIMD_CAT(name, avx2)
+#define SIMD_ALIGN 32
+#define SIMD_FULL 0xFFu
+
+typedef __m256 vfloat;
+typedef __m256i vint;
+typedef __m256 vmask;
+
+/* ---- memory */
+SIMD_INL vfloat vf_set1(float x) { return _mm256_set1_ps(x); }
+SIMD_INL vint vi_set1(int32_t x) { return _mm256_set1_epi32(x); }
+SIMD_INL vfloat vf_zero(void) { return _mm256_setzero_ps(); }
+SIMD_INL vint vi_zero(void) { return _mm256_setzero_si256(); }
+SIMD_INL vint vi_lanes(void) { return _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7); }
+SIMD_INL vfloat vf_load(const float *p) { return _mm256_load_ps(p); }
+SIMD_INL vfloat vf_loadu(const float *p) { return _mm256_loadu_ps(p); }
+SIMD_INL void vf_store(float *p, vfloat a) { _mm256_store_ps(p, a); }
+SIMD_INL void vf_storeu(float *p, vfloat a) { _mm256_storeu_ps(p, a); }
+SIMD_INL vint vi_load(const int32_t *p) { return _mm256_load_si256((const __m256i *)(const void *)p); }
+SIMD_INL vint vi_loadu(const int32_t *p) { return _mm256_loadu_si256((const __m256i *)(const void *)p); }
+SIMD_INL void vi_store(int32_t *p, vint i) { _mm256_store_si256((__m256i *)(void *)p, i); }
+SIMD_INL void vi_storeu(int32_t *p, vint i) { _mm256_storeu_si256((__m256i *)(void *)p, i); }
+
+/* lane l all-ones where bit l of b is set */
+SIMD_INL __m256i simd__lanes_of(unsigned b)
+{
+    const __m256i l = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    return _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32((int)b), l), l);
+}
+
+/* vmaskmovps: masked lanes are not accessed (no fault) and load as 0 */
+SIMD_INL vfloat vf_load_bits(const float *p, unsigned bits)
+{
+    if ((bits & SIMD_FULL) == SIMD_FULL) return _mm256_loadu_ps(p);
+    return _mm256_maskload_ps(p, simd__lanes_of(bits));
+}
+
+SIMD_INL void vf_store_bits(float *p, unsigned bits, vfloat a)
+{
+    if ((bits & SIMD_FULL) == SIMD_FULL) { _mm256_storeu_ps(p, a); return; }
+    _mm256_maskstore_ps(p, simd__lanes_of(bits), a);
+}
+
+/* x y z x y z ... (24 floats) <-> SoA. Component k of vertex v is float
+ * 3v + k: register (3v+k)/8, lane (3v+k)%8; the lanes of one component
+ * are distinct, so two blends gather them into one register and one
+ * permute puts them in vertex order (lane v of the gather index:
+ * (3v+k)%8; of the scatter index: the inverse). */
+SIMD_INL void vf_load3(const float *p, vfloat *x, vfloat *y, vfloat *z)
+{
+    const __m256 a = _mm256_loadu_ps(p), b = _mm256_loadu_ps(p + 8), c = _mm256_loadu_ps(p + 16);
+    /* lanes of x in b: 1 4 7, in c: 2 5; y: b 2 5, c 0 3 6; z: b 0 3 6, c 1 4 7 */
+    *x = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(a, b, 0x92), c, 0x24),
+                                  _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5));
+    *y = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(a, b, 0x24), c, 0x49),
+                                  _mm256_setr_epi32(1, 4, 7, 2, 5, 0, 3, 6));
+    *z = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(a, b, 0x49), c, 0x92),
+                                  _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7));
+}
+
+SIMD_INL void vf_store3(float *p, vfloat x, vfloat y, vfloat z)
+{
+    x = _mm256_permutevar8x32_ps(x, _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5));
+    y = _mm256_permutevar8x32_ps(y, _mm256_setr_epi32(5, 0, 3, 6, 1, 4, 7, 2));
+    z = _mm256_permutevar8x32_ps(z, _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7));
+    /* register 0: y in lanes 1 4 7, z in 2 5; 1: y 2 5, z 0 3 6; 2: y 0 3 6, z 1 4 7 */
+    _mm256_storeu_ps(p, _mm256_blend_ps(_mm256_blend_ps(x, y, 0x92), z, 0x24));
+    _mm256_storeu_ps(p + 8, _mm256_blend_ps(_mm256_blend_ps(x, y, 0x24), z, 0x49));
+    _mm256_storeu_ps(p + 16, _mm256_blend_ps(_mm256_blend_ps(x, y, 0x49), z, 0x92));
+}
+
+/* ---- shuffles */
+SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
+{
+    const __m256d t0 = _mm256_castps_pd(_mm256_unpacklo_ps(a, b));
+    const __m256d t1 = _mm256_castps_pd(_mm256_unpacklo_ps(c, d));
+    const __m256d t2 = _mm256_castps_pd(_mm256_unpackhi_ps(a, b));
+    const __m256d t3 = _mm256_castps_pd(_mm256_unpackhi_ps(c, d));
+    o[0] = _mm256_castpd_ps(_mm256_unpacklo_pd(t0, t1));
+    o[1] = _mm256_castpd_ps(_mm256_unpackhi_pd(t0, t1));
+    o[2] = _mm256_castpd_ps(_mm256_unpacklo_pd(t2, t3));
+    o[3] = _mm256_castpd_ps(_mm256_unpackhi_pd(t2, t3));
+}
+
+/* one lane's x y z (lanes 0-2 of a) to q: 8 bytes and 4 bytes */
+SIMD_INL void simd__store3_one(float *q, __m128 a)
+{
+    _mm_storel_pi((__m64 *)(void *)q, a);
+    _mm_store_ss(q + 2, _mm_movehl_ps(a, a));
+}
+
+SIMD_INL void vf_scatter3(float *out, const int32_t *dest, vfloat x, vfloat y, vfloat z)
+{
+    __m256 t[4];
+    vf_tr4(x, y, z, z, t);   /* t[k], block J: lane 4J + k */
+#pragma GCC unroll 4
+    for (int k = 0; k < 4; k++) {
+        simd__store3_one(out + 3 * (size_t)dest[k], _mm256_castps256_ps128(t[k]));
+        simd__store3_one(out + 3 * (size_t)dest[4 + k], _mm256_extractf128_ps(t[k], 1));
+    }
+}
+
+/* ---- float arithmetic */
+SIMD_INL vfloat vf_add(vfloat a, vfloat b) { return _mm256_add_ps(a, b); }
+SIMD_INL vfloat vf_sub(vfloat a, vfloat b) { return _mm256_sub_ps(a, b); }
+SIMD_INL vfloat vf_mul(vfloat a, vfloat b) { return _mm256_mul_ps(a, b); }
+SIMD_INL vfloat vf_div(vfloat a, vfloat b) { return _mm256_div_ps(a, b); }
+SIMD_INL vfloat vf_sqrt(vfloat a) { return _mm256_sqrt_ps(a); }
+SIMD_INL vfloat vf_min(vfloat a, vfloat b) { return _mm256_min_ps(a, b); }
+SIMD_INL vfloat vf_max(vfloat a, vfloat b) { return _mm256_max_ps(a, b); }
+SIMD_INL vfloat vf_neg(vfloat a) { return _mm256_xor_ps(a, _mm256_set1_ps(-0.0f)); }
+SIMD_INL vfloat vf_abs(vfloat a) { return _mm256_and_ps(a, _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFFFFFF))); }
+SIMD_INL vfloat vf_neg_if(vmask m, vfloat a) { return _mm256_xor_ps(a, _mm256_and_ps(m, _mm256_set1_ps(-0.0f))); }
+SIMD_INL vfloat vf_floor(vfloat a) { return _mm256_round_ps(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC); }
+
+/* ---- compares (one constant predicate each: clang and gcc -Os need it) */
+SIMD_INL vmask vf_eq(vfloat a, vfloat b) { return _mm256_cmp_ps(a, b, _CMP_EQ_OQ); }
+SIMD_INL vmask vf_ne(vfloat a, vfloat b) { return _mm256_cmp_ps(a, b, _CMP_NEQ_UQ); }
+SIMD_INL vmask vf_lt(vfloat a, vfloat b) { return _mm256_cmp_ps(a, b, _CMP_LT_OQ); }
+SIMD_INL vmask vf_le(vfloat a, vfloat b) { return _mm256_cmp_ps(a, b, _CMP_LE_OQ); }
+SIMD_INL vmask vf_gt(vfloat a, vfloat b) { return _mm256_cmp_ps(a, b, _CMP_GT_OQ); }
+SIMD_INL vmask vf_ge(vfloat a, vfloat b) { return _mm256_cmp_ps(a, b, _CMP_GE_OQ); }
+SIMD_INL vmask vi_eq(vint i, vint j) { return _mm256_castsi256_ps(_mm256_cmpeq_epi32(i, j)); }
+SIMD_INL vmask vi_gt(vint i, vint j) { return _mm256_castsi256_ps(_mm256_cmpgt_epi32(i, j)); }
+
+/* ---- selects, bits (blendv reads the mask's sign bit: masks are
+ * all-ones / all-zero lanes, so that is the lane flag) */
+SIMD_INL vfloat vf_sel(vmask m, vfloat a, vfloat b) { return _mm256_blendv_ps(b, a, m); }
+SIMD_INL vfloat vf_selz(vmask m, vfloat a) { return _mm256_and_ps(m, a); }
+SIMD_INL vint vi_sel(vmask m, vint i, vint j)
+{
+    return _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(j), _mm256_castsi256_ps(i), m));
+}
+SIMD_INL vfloat vf_and(vfloat a, vfloat b) { return _mm256_and_ps(a, b); }
+SIMD_INL vfloat vf_or(vfloat a, vfloat b) { return _mm256_or_ps(a, b); }
+SIMD_INL vfloat vf_xor(vfloat a, vfloat b) { return _mm256_xor_ps(a, b); }
+SIMD_INL vfloat vf_andnot(vfloat a, vfloat b) { return _mm256_andnot_ps(a, b); }
+SIMD_INL vint vi_and(vint i, vint j) { return _mm256_and_si256(i, j); }
+SIMD_INL vint vi_or(vint i, vint j) { return _mm256_or_si256(i, j); }
+SIMD_INL vint vi_xor(vint i, vint j) { return _mm256_xor_si256(i, j); }
+SIMD_INL vint vi_andnot(vint i, vint j) { return _mm256_andnot_si256(i, j); }
+SIMD_INL vint vf_as_vi(vfloat a) { return _mm256_castps_si256(a); }
+SIMD_INL vfloat vi_as_vf(vint i) { return _mm256_castsi256_ps(i); }
+
+/* ---- integer arithmetic */
+SIMD_INL vint vi_add(vint i, vint j) { return _mm256_add_epi32(i, j); }
+SIMD_INL vint vi_sub(vint i, vint j) { return _mm256_sub_epi32(i, j); }
+SIMD_INL vint vi_mullo(vint i, vint j) { return _mm256_mullo_epi32(i, j); }
+#define vi_slli(i, k) _mm256_slli_epi32(i, k)
+#define vi_srli(i, k) _mm256_srli_epi32(i, k)
+#define vi_srai(i, k) _mm256_srai_epi32(i, k)
+SIMD_INL vint vi_sll(vint i, int k) { return _mm256_sll_epi32(i, _mm_cvtsi32_si128(k)); }
+SIMD_INL vint vi_srl(vint i, int k) { return _mm256_srl_epi32(i, _mm_cvtsi32_si128(k)); }
+
+/* ---- conversions */
+SIMD_INL vfloat vf_from_vi(vint i) { return _mm256_cvtepi32_ps(i); }
+SIMD_INL vint vi_from_vf_trunc(vfloat a) { return _mm256_cvttps_epi32(a); }
+SIMD_INL vint vi_from_vf_round(vfloat a) { return _mm256_cvtps_epi32(a); }
+
+/* ---- masks */
+SIMD_INL vmask vm_and(vmask m, vmask n) { return _mm256_and_ps(m, n); }
+SIMD_INL vmask vm_or(vmask m, vmask n) { return _mm256_or_ps(m, n); }
+SIMD_INL vmask vm_andnot(vmask m, vmask n) { return _mm256_andnot_ps(m, n); }
+SIMD_INL vmask vm_not(vmask m) { return _mm256_xor_ps(m, _mm256_castsi256_ps(_mm256_set1_epi32(-1))); }
+SIMD_INL unsigned vm_bits(vmask m) { return (unsigned)_mm256_movemask_ps(m); }
+SIMD_INL vmask vm_from_bits(unsigned b) { return _mm256_castsi256_ps(simd__lanes_of(b)); }
+SIMD_INL int vm_all(vmask m) { return _mm256_movemask_ps(m) == 0xFF; }
+SIMD_INL int vm_any(vmask m) { return _mm256_movemask_ps(m) != 0; }
+
+#else
+#error "simd_avx2.h: another implementation of the vector layer is already included"
+#endif

@@ -1,0 +1,169 @@
+/* simd_avx512.h - the vector layer (simd.h) on AVX-512 F/BW/DQ/VL, 16
+ * lanes (files built with -mavx512f -mavx512bw -mavx512dq -mavx512vl
+ * -mavx2 -mf16c, no -mfma). Masks are __mmask16: selects, masked loads
+ * and stores are one instruction. Include once per file. */
+#ifndef EGOFUSE_SIMD_IMPL
+#define EGOFUSE_SIMD_IMPL "avx512"
+#if !defined(__AVX512F__) || !defined(__AVX512BW__) || !defined(__AVX512DQ__) || \
+    !defined(__AVX512VL__)
+#error "simd_avx512.h: AVX-512 F/BW/DQ/VL is not enabled for this file (-mavx512*)"
+#endif
+
+#include <immintrin.h>
+
+#include "simd.h"
+
+#define SIMD_W 16
+#define SIMD_ISA EF_ISA_AVX512
+#define SIMD_NAME "avx512"
+#define SIMD_FN(name) SIMD_CAT(name, avx512)
+#define SIMD_ALIGN 64
+#define SIMD_FULL 0xFFFFu
+
+typedef __m512 vfloat;
+typedef __m512i vint;
+typedef __mmask16 vmask;
+
+/* ---- memory */
+SIMD_INL vfloat vf_set1(float x) { return _mm512_set1_ps(x); }
+SIMD_INL vint vi_set1(int32_t x) { return _mm512_set1_epi32(x); }
+SIMD_INL vfloat vf_zero(void) { return _mm512_setzero_ps(); }
+SIMD_INL vint vi_zero(void) { return _mm512_setzero_si512(); }
+SIMD_INL vint vi_lanes(void)
+{
+    return _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+}
+SIMD_INL vfloat vf_load(const float *p) { return _mm512_load_ps(p); }
+SIMD_INL vfloat vf_loadu(const float *p) { return _mm512_loadu_ps(p); }
+SIMD_INL void vf_store(float *p, vfloat a) { _mm512_store_ps(p, a); }
+SIMD_INL void vf_storeu(float *p, vfloat a) { _mm512_storeu_ps(p, a); }
+SIMD_INL vint vi_load(const int32_t *p) { return _mm512_load_si512((const void *)p); }
+SIMD_INL vint vi_loadu(const int32_t *p) { return _mm512_loadu_si512((const void *)p); }
+SIMD_INL void vi_store(int32_t *p, vint i) { _mm512_store_si512((void *)p, i); }
+SIMD_INL void vi_storeu(int32_t *p, vint i) { _mm512_storeu_si512((void *)p, i); }
+/* masked lanes are not accessed (fault suppression) */
+SIMD_INL vfloat vf_load_bits(const float *p, unsigned bits) { return _mm512_maskz_loadu_ps((__mmask16)bits, p); }
+SIMD_INL void vf_store_bits(float *p, unsigned bits, vfloat a) { _mm512_mask_storeu_ps(p, (__mmask16)bits, a); }
+
+/* x y z x y z ... (48 floats) <-> SoA. Component k of vertex v is float
+ * 3v + k: register (3v+k)/16, lane (3v+k)%16; two mask blends gather a
+ * component's lanes into one register, one permute orders them (the
+ * masks and indices are those lane sets, tests/test_cpu_simd.c checks
+ * every lane). */
+SIMD_INL void vf_load3(const float *p, vfloat *x, vfloat *y, vfloat *z)
+{
+    const __m512 a = _mm512_loadu_ps(p), b = _mm512_loadu_ps(p + 16), c = _mm512_loadu_ps(p + 32);
+    *x = _mm512_permutexvar_ps(_mm512_setr_epi32(0, 3, 6, 9, 12, 15, 2, 5, 8, 11, 14, 1, 4, 7, 10, 13),
+                               _mm512_mask_blend_ps(0x2492, _mm512_mask_blend_ps(0x4924, a, b), c));
+    *y = _mm512_permutexvar_ps(_mm512_setr_epi32(1, 4, 7, 10, 13, 0, 3, 6, 9, 12, 15, 2, 5, 8, 11, 14),
+                               _mm512_mask_blend_ps(0x4924, _mm512_mask_blend_ps(0x9249, a, b), c));
+    *z = _mm512_permutexvar_ps(_mm512_setr_epi32(2, 5, 8, 11, 14, 1, 4, 7, 10, 13, 0, 3, 6, 9, 12, 15),
+                               _mm512_mask_blend_ps(0x9249, _mm512_mask_blend_ps(0x2492, a, b), c));
+}
+
+SIMD_INL void vf_store3(float *p, vfloat x, vfloat y, vfloat z)
+{
+    x = _mm512_permutexvar_ps(_mm512_setr_epi32(0, 11, 6, 1, 12, 7, 2, 13, 8, 3, 14, 9, 4, 15, 10, 5), x);
+    y = _mm512_permutexvar_ps(_mm512_setr_epi32(5, 0, 11, 6, 1, 12, 7, 2, 13, 8, 3, 14, 9, 4, 15, 10), y);
+    z = _mm512_permutexvar_ps(_mm512_setr_epi32(10, 5, 0, 11, 6, 1, 12, 7, 2, 13, 8, 3, 14, 9, 4, 15), z);
+    _mm512_storeu_ps(p, _mm512_mask_blend_ps(0x4924, _mm512_mask_blend_ps(0x2492, x, y), z));
+    _mm512_storeu_ps(p + 16, _mm512_mask_blend_ps(0x2492, _mm512_mask_blend_ps(0x9249, x, y), z));
+    _mm512_storeu_ps(p + 32, _mm512_mask_blend_ps(0x9249, _mm512_mask_blend_ps(0x4924, x, y), z));
+}
+
+/* ---- shuffles */
+SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
+{
+    const __m512d t0 = _mm512_castps_pd(_mm512_unpacklo_ps(a, b));
+    const __m512d t1 = _mm512_castps_pd(_mm512_unpacklo_ps(c, d));
+    const __m512d t2 = _mm512_castps_pd(_mm512_unpackhi_ps(a, b));
+    const __m512d t3 = _mm512_castps_pd(_mm512_unpackhi_ps(c, d));
+    o[0] = _mm512_castpd_ps(_mm512_unpacklo_pd(t0, t1));
+    o[1] = _mm512_castpd_ps(_mm512_unpackhi_pd(t0, t1));
+    o[2] = _mm512_castpd_ps(_mm512_unpacklo_pd(t2, t3));
+    o[3] = _mm512_castpd_ps(_mm512_unpackhi_pd(t2, t3));
+}
+
+/* an in-block transpose gives each lane's x y z (and a spare) in one
+ * 128-bit block, stored with a 3-float mask */
+SIMD_INL void vf_scatter3(float *out, const int32_t *dest, vfloat x, vfloat y, vfloat z)
+{
+    __m512 t[4];
+    vf_tr4(x, y, z, z, t);   /* t[k], block J: lane 4J + k */
+#define SIMD__SCAT(J, k) \
+    _mm_mask_storeu_ps(out + 3 * (size_t)dest[4 * (J) + (k)], 0x7, _mm512_extractf32x4_ps(t[k], J));
+#define SIMD__SCAT_BLOCK(J) SIMD__SCAT(J, 0) SIMD__SCAT(J, 1) SIMD__SCAT(J, 2) SIMD__SCAT(J, 3)
+    SIMD__SCAT_BLOCK(0)
+    SIMD__SCAT_BLOCK(1)
+    SIMD__SCAT_BLOCK(2)
+    SIMD__SCAT_BLOCK(3)
+#undef SIMD__SCAT_BLOCK
+#undef SIMD__SCAT
+}
+
+/* ---- float arithmetic */
+SIMD_INL vfloat vf_add(vfloat a, vfloat b) { return _mm512_add_ps(a, b); }
+SIMD_INL vfloat vf_sub(vfloat a, vfloat b) { return _mm512_sub_ps(a, b); }
+SIMD_INL vfloat vf_mul(vfloat a, vfloat b) { return _mm512_mul_ps(a, b); }
+SIMD_INL vfloat vf_div(vfloat a, vfloat b) { return _mm512_div_ps(a, b); }
+SIMD_INL vfloat vf_sqrt(vfloat a) { return _mm512_sqrt_ps(a); }
+SIMD_INL vfloat vf_min(vfloat a, vfloat b) { return _mm512_min_ps(a, b); }
+SIMD_INL vfloat vf_max(vfloat a, vfloat b) { return _mm512_max_ps(a, b); }
+SIMD_INL vfloat vf_neg(vfloat a) { return _mm512_xor_ps(a, _mm512_set1_ps(-0.0f)); }
+SIMD_INL vfloat vf_abs(vfloat a) { return _mm512_and_ps(a, _mm512_castsi512_ps(_mm512_set1_epi32(0x7FFFFFFF))); }
+SIMD_INL vfloat vf_neg_if(vmask m, vfloat a) { return _mm512_mask_xor_ps(a, m, a, _mm512_set1_ps(-0.0f)); }
+SIMD_INL vfloat vf_floor(vfloat a) { return _mm512_roundscale_ps(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC); }
+
+/* ---- compares */
+SIMD_INL vmask vf_eq(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_EQ_OQ); }
+SIMD_INL vmask vf_ne(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_NEQ_UQ); }
+SIMD_INL vmask vf_lt(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ); }
+SIMD_INL vmask vf_le(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_LE_OQ); }
+SIMD_INL vmask vf_gt(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ); }
+SIMD_INL vmask vf_ge(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_GE_OQ); }
+SIMD_INL vmask vi_eq(vint i, vint j) { return _mm512_cmpeq_epi32_mask(i, j); }
+SIMD_INL vmask vi_gt(vint i, vint j) { return _mm512_cmpgt_epi32_mask(i, j); }
+
+/* ---- selects, bits */
+SIMD_INL vfloat vf_sel(vmask m, vfloat a, vfloat b) { return _mm512_mask_blend_ps(m, b, a); }
+SIMD_INL vfloat vf_selz(vmask m, vfloat a) { return _mm512_maskz_mov_ps(m, a); }
+SIMD_INL vint vi_sel(vmask m, vint i, vint j) { return _mm512_mask_blend_epi32(m, j, i); }
+SIMD_INL vfloat vf_and(vfloat a, vfloat b) { return _mm512_and_ps(a, b); }
+SIMD_INL vfloat vf_or(vfloat a, vfloat b) { return _mm512_or_ps(a, b); }
+SIMD_INL vfloat vf_xor(vfloat a, vfloat b) { return _mm512_xor_ps(a, b); }
+SIMD_INL vfloat vf_andnot(vfloat a, vfloat b) { return _mm512_andnot_ps(a, b); }
+SIMD_INL vint vi_and(vint i, vint j) { return _mm512_and_si512(i, j); }
+SIMD_INL vint vi_or(vint i, vint j) { return _mm512_or_si512(i, j); }
+SIMD_INL vint vi_xor(vint i, vint j) { return _mm512_xor_si512(i, j); }
+SIMD_INL vint vi_andnot(vint i, vint j) { return _mm512_andnot_si512(i, j); }
+SIMD_INL vint vf_as_vi(vfloat a) { return _mm512_castps_si512(a); }
+SIMD_INL vfloat vi_as_vf(vint i) { return _mm512_castsi512_ps(i); }
+
+/* ---- integer arithmetic */
+SIMD_INL vint vi_add(vint i, vint j) { return _mm512_add_epi32(i, j); }
+SIMD_INL vint vi_sub(vint i, vint j) { return _mm512_sub_epi32(i, j); }
+SIMD_INL vint vi_mullo(vint i, vint j) { return _mm512_mullo_epi32(i, j); }
+#define vi_slli(i, k) _mm512_slli_epi32(i, k)
+#define vi_srli(i, k) _mm512_srli_epi32(i, k)
+#define vi_srai(i, k) _mm512_srai_epi32(i, k)
+SIMD_INL vint vi_sll(vint i, int k) { return _mm512_sll_epi32(i, _mm_cvtsi32_si128(k)); }
+SIMD_INL vint vi_srl(vint i, int k) { return _mm512_srl_epi32(i, _mm_cvtsi32_si128(k)); }
+
+/* ---- conversions */
+SIMD_INL vfloat vf_from_vi(vint i) { return _mm512_cvtepi32_ps(i); }
+SIMD_INL vint vi_from_vf_trunc(vfloat a) { return _mm512_cvttps_epi32(a); }
+SIMD_INL vint vi_from_vf_round(vfloat a) { return _mm512_cvtps_epi32(a); }
+
+/* ---- masks */
+SIMD_INL vmask vm_and(vmask m, vmask n) { return (vmask)(m & n); }
+SIMD_INL vmask vm_or(vmask m, vmask n) { return (vmask)(m | n); }
+SIMD_INL vmask vm_andnot(vmask m, vmask n) { return (vmask)(~m & n); }
+SIMD_INL vmask vm_not(vmask m) { return (vmask)~m; }
+SIMD_INL unsigned vm_bits(vmask m) { return (unsigned)m; }
+SIMD_INL vmask vm_from_bits(unsigned b) { return (vmask)b; }
+SIMD_INL int vm_all(vmask m) { return m == (vmask)0xFFFF; }
+SIMD_INL int vm_any(vmask m) { return m != 0; }
+
+#else
+#error "simd_avx512.h: another implementation of the vector layer is already included"
+#endif

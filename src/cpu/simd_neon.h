@@ -1,0 +1,207 @@
+/* simd_neon.h - the vector layer (simd.h) on AArch64 Advanced SIMD (NEON),
+ * 4 lanes, native arm_neon.h (why not SIMDe: docs/portability.md). NEON
+ * is the aarch64 baseline: no flag. Masks are uint32x4_t of all-ones /
+ * all-zero lanes.
+ *
+ * Where NEON's own instruction differs from the contract (x86's
+ * semantics), the difference is handled here, once:
+ *   min/max     FMIN/FMAX propagate NaN and order -0 < +0; the contract's
+ *               a < b ? a : b is a compare and a bit select (2 instr.)
+ *   float->int  FCVTZS/FCVTNS saturate and give 0 for NaN; the contract
+ *               wants INT32_MIN there: a range compare and a select
+ *   div, sqrt   FDIV/FSQRT are IEEE correctly rounded on aarch64 (not the
+ *               ARMv7 estimates): used as they are
+ *   denormals   the default FPCR has FZ = 0 (no flush), like x86's MXCSR
+ *   contraction -ffp-contract=off (Makefile): no FMLA is formed from
+ *               vmulq + vaddq
+ *   default NaN 0x7FC00000 (x86: 0xFFC00000): simd.h, "NaN created"
+ * Include once per file. */
+#ifndef EGOFUSE_SIMD_IMPL
+#define EGOFUSE_SIMD_IMPL "neon"
+#if !defined(__aarch64__) || !defined(__ARM_NEON)
+#error "simd_neon.h: AArch64 NEON is not available for this file"
+#endif
+
+#include <arm_neon.h>
+#include <stddef.h>
+
+#include "simd.h"
+
+#define SIMD_W 4
+#define SIMD_ISA EF_ISA_NEON
+#define SIMD_NAME "neon"
+#define SIMD_FN(name) SIMD_CAT(name, neon)
+#define SIMD_ALIGN 16
+#define SIMD_FULL 0xFu
+
+typedef float32x4_t vfloat;
+typedef int32x4_t vint;
+typedef uint32x4_t vmask;
+
+/* ---- memory */
+SIMD_INL vfloat vf_set1(float x) { return vdupq_n_f32(x); }
+SIMD_INL vint vi_set1(int32_t x) { return vdupq_n_s32(x); }
+SIMD_INL vfloat vf_zero(void) { return vdupq_n_f32(0.0f); }
+SIMD_INL vint vi_zero(void) { return vdupq_n_s32(0); }
+SIMD_INL vint vi_lanes(void)
+{
+    static const int32_t l[4] = { 0, 1, 2, 3 };
+    return vld1q_s32(l);
+}
+SIMD_INL vfloat vf_load(const float *p) { return vld1q_f32(p); }
+SIMD_INL vfloat vf_loadu(const float *p) { return vld1q_f32(p); }
+SIMD_INL void vf_store(float *p, vfloat a) { vst1q_f32(p, a); }
+SIMD_INL void vf_storeu(float *p, vfloat a) { vst1q_f32(p, a); }
+SIMD_INL vint vi_load(const int32_t *p) { return vld1q_s32(p); }
+SIMD_INL vint vi_loadu(const int32_t *p) { return vld1q_s32(p); }
+SIMD_INL void vi_store(int32_t *p, vint i) { vst1q_s32(p, i); }
+SIMD_INL void vi_storeu(int32_t *p, vint i) { vst1q_s32(p, i); }
+
+/* lane by lane: NEON has no masked load or store */
+SIMD_INL vfloat vf_load_bits(const float *p, unsigned bits)
+{
+    if ((bits & SIMD_FULL) == SIMD_FULL) return vld1q_f32(p);
+    vfloat r = vdupq_n_f32(0.0f);
+    if (bits & 1u) r = vld1q_lane_f32(p, r, 0);
+    if (bits & 2u) r = vld1q_lane_f32(p + 1, r, 1);
+    if (bits & 4u) r = vld1q_lane_f32(p + 2, r, 2);
+    if (bits & 8u) r = vld1q_lane_f32(p + 3, r, 3);
+    return r;
+}
+
+SIMD_INL void vf_store_bits(float *p, unsigned bits, vfloat a)
+{
+    if ((bits & SIMD_FULL) == SIMD_FULL) { vst1q_f32(p, a); return; }
+    if (bits & 1u) vst1q_lane_f32(p, a, 0);
+    if (bits & 2u) vst1q_lane_f32(p + 1, a, 1);
+    if (bits & 4u) vst1q_lane_f32(p + 2, a, 2);
+    if (bits & 8u) vst1q_lane_f32(p + 3, a, 3);
+}
+
+/* LD3 / ST3: de-interleaving loads and stores are native */
+SIMD_INL void vf_load3(const float *p, vfloat *x, vfloat *y, vfloat *z)
+{
+    const float32x4x3_t t = vld3q_f32(p);
+    *x = t.val[0]; *y = t.val[1]; *z = t.val[2];
+}
+
+SIMD_INL void vf_store3(float *p, vfloat x, vfloat y, vfloat z)
+{
+    float32x4x3_t t;
+    t.val[0] = x; t.val[1] = y; t.val[2] = z;
+    vst3q_f32(p, t);
+}
+
+SIMD_INL void vf_scatter3(float *out, const int32_t *dest, vfloat x, vfloat y, vfloat z)
+{
+    float32x4x3_t t;
+    t.val[0] = x; t.val[1] = y; t.val[2] = z;
+    vst3q_lane_f32(out + 3 * (size_t)dest[0], t, 0);
+    vst3q_lane_f32(out + 3 * (size_t)dest[1], t, 1);
+    vst3q_lane_f32(out + 3 * (size_t)dest[2], t, 2);
+    vst3q_lane_f32(out + 3 * (size_t)dest[3], t, 3);
+}
+
+/* ---- float arithmetic */
+SIMD_INL vfloat vf_add(vfloat a, vfloat b) { return vaddq_f32(a, b); }
+SIMD_INL vfloat vf_sub(vfloat a, vfloat b) { return vsubq_f32(a, b); }
+SIMD_INL vfloat vf_mul(vfloat a, vfloat b) { return vmulq_f32(a, b); }
+SIMD_INL vfloat vf_div(vfloat a, vfloat b) { return vdivq_f32(a, b); }
+SIMD_INL vfloat vf_sqrt(vfloat a) { return vsqrtq_f32(a); }
+/* x86's rule, not FMIN/FMAX's */
+SIMD_INL vfloat vf_min(vfloat a, vfloat b) { return vbslq_f32(vcltq_f32(a, b), a, b); }
+SIMD_INL vfloat vf_max(vfloat a, vfloat b) { return vbslq_f32(vcgtq_f32(a, b), a, b); }
+SIMD_INL vfloat vf_neg(vfloat a) { return vnegq_f32(a); }   /* FNEG: sign flip, NaN too */
+SIMD_INL vfloat vf_abs(vfloat a) { return vabsq_f32(a); }   /* FABS: sign clear, NaN too */
+SIMD_INL vfloat vf_neg_if(vmask m, vfloat a)
+{
+    return vreinterpretq_f32_u32(veorq_u32(vreinterpretq_u32_f32(a), vandq_u32(m, vdupq_n_u32(0x80000000u))));
+}
+SIMD_INL vfloat vf_floor(vfloat a) { return vrndmq_f32(a); }   /* FRINTM: exact, keeps -0 */
+
+/* ---- compares */
+SIMD_INL vmask vf_eq(vfloat a, vfloat b) { return vceqq_f32(a, b); }
+SIMD_INL vmask vf_ne(vfloat a, vfloat b) { return vmvnq_u32(vceqq_f32(a, b)); }
+SIMD_INL vmask vf_lt(vfloat a, vfloat b) { return vcltq_f32(a, b); }
+SIMD_INL vmask vf_le(vfloat a, vfloat b) { return vcleq_f32(a, b); }
+SIMD_INL vmask vf_gt(vfloat a, vfloat b) { return vcgtq_f32(a, b); }
+SIMD_INL vmask vf_ge(vfloat a, vfloat b) { return vcgeq_f32(a, b); }
+SIMD_INL vmask vi_eq(vint i, vint j) { return vceqq_s32(i, j); }
+SIMD_INL vmask vi_gt(vint i, vint j) { return vcgtq_s32(i, j); }
+
+/* ---- selects, bits */
+SIMD_INL vfloat vf_sel(vmask m, vfloat a, vfloat b) { return vbslq_f32(m, a, b); }
+SIMD_INL vfloat vf_selz(vmask m, vfloat a)
+{
+    return vreinterpretq_f32_u32(vandq_u32(m, vreinterpretq_u32_f32(a)));
+}
+SIMD_INL vint vi_sel(vmask m, vint i, vint j) { return vbslq_s32(m, i, j); }
+#define SIMD__FBIT(op, a, b) \
+    vreinterpretq_f32_u32(op(vreinterpretq_u32_f32(a), vreinterpretq_u32_f32(b)))
+SIMD_INL vfloat vf_and(vfloat a, vfloat b) { return SIMD__FBIT(vandq_u32, a, b); }
+SIMD_INL vfloat vf_or(vfloat a, vfloat b) { return SIMD__FBIT(vorrq_u32, a, b); }
+SIMD_INL vfloat vf_xor(vfloat a, vfloat b) { return SIMD__FBIT(veorq_u32, a, b); }
+SIMD_INL vfloat vf_andnot(vfloat a, vfloat b) { return SIMD__FBIT(vbicq_u32, b, a); }   /* b & ~a */
+#undef SIMD__FBIT
+SIMD_INL vint vi_and(vint i, vint j) { return vandq_s32(i, j); }
+SIMD_INL vint vi_or(vint i, vint j) { return vorrq_s32(i, j); }
+SIMD_INL vint vi_xor(vint i, vint j) { return veorq_s32(i, j); }
+SIMD_INL vint vi_andnot(vint i, vint j) { return vbicq_s32(j, i); }   /* j & ~i */
+SIMD_INL vint vf_as_vi(vfloat a) { return vreinterpretq_s32_f32(a); }
+SIMD_INL vfloat vi_as_vf(vint i) { return vreinterpretq_f32_s32(i); }
+
+/* ---- integer arithmetic */
+SIMD_INL vint vi_add(vint i, vint j) { return vaddq_s32(i, j); }
+SIMD_INL vint vi_sub(vint i, vint j) { return vsubq_s32(i, j); }
+SIMD_INL vint vi_mullo(vint i, vint j) { return vmulq_s32(i, j); }
+#define vi_slli(i, k) vshlq_n_s32(i, k)
+#define vi_srli(i, k) vreinterpretq_s32_u32(vshrq_n_u32(vreinterpretq_u32_s32(i), k))
+#define vi_srai(i, k) vshrq_n_s32(i, k)
+SIMD_INL vint vi_sll(vint i, int k) { return vshlq_s32(i, vdupq_n_s32(k)); }
+SIMD_INL vint vi_srl(vint i, int k)
+{
+    return vreinterpretq_s32_u32(vshlq_u32(vreinterpretq_u32_s32(i), vdupq_n_s32(-k)));
+}
+
+/* ---- conversions: NaN and |a| >= 2^31 (but -2^31 itself) give INT32_MIN
+ * as on x86; FACLT (|a| < 2^31) is false for NaN */
+SIMD_INL vfloat vf_from_vi(vint i) { return vcvtq_f32_s32(i); }
+SIMD_INL vint simd__cvt_fix(vfloat a, vint r)
+{
+    return vbslq_s32(vcaltq_f32(a, vdupq_n_f32(2147483648.0f)), r, vdupq_n_s32(INT32_MIN));
+}
+SIMD_INL vint vi_from_vf_trunc(vfloat a) { return simd__cvt_fix(a, vcvtq_s32_f32(a)); }
+SIMD_INL vint vi_from_vf_round(vfloat a) { return simd__cvt_fix(a, vcvtnq_s32_f32(a)); }
+
+/* ---- masks */
+SIMD_INL vmask vm_and(vmask m, vmask n) { return vandq_u32(m, n); }
+SIMD_INL vmask vm_or(vmask m, vmask n) { return vorrq_u32(m, n); }
+SIMD_INL vmask vm_andnot(vmask m, vmask n) { return vbicq_u32(n, m); }
+SIMD_INL vmask vm_not(vmask m) { return vmvnq_u32(m); }
+SIMD_INL unsigned vm_bits(vmask m)
+{
+    static const uint32_t w[4] = { 1, 2, 4, 8 };
+    return vaddvq_u32(vandq_u32(m, vld1q_u32(w)));
+}
+SIMD_INL vmask vm_from_bits(unsigned b)
+{
+    static const uint32_t w[4] = { 1, 2, 4, 8 };
+    return vtstq_u32(vdupq_n_u32(b), vld1q_u32(w));
+}
+SIMD_INL int vm_all(vmask m) { return vminvq_u32(m) != 0; }
+SIMD_INL int vm_any(vmask m) { return vmaxvq_u32(m) != 0; }
+
+/* ---- shuffles: TRN1/TRN2 on 32- then 64-bit elements */
+SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
+{
+    const float32x4_t ab0 = vtrn1q_f32(a, b), ab1 = vtrn2q_f32(a, b);
+    const float32x4_t cd0 = vtrn1q_f32(c, d), cd1 = vtrn2q_f32(c, d);
+    o[0] = vreinterpretq_f32_f64(vtrn1q_f64(vreinterpretq_f64_f32(ab0), vreinterpretq_f64_f32(cd0)));
+    o[1] = vreinterpretq_f32_f64(vtrn1q_f64(vreinterpretq_f64_f32(ab1), vreinterpretq_f64_f32(cd1)));
+    o[2] = vreinterpretq_f32_f64(vtrn2q_f64(vreinterpretq_f64_f32(ab0), vreinterpretq_f64_f32(cd0)));
+    o[3] = vreinterpretq_f32_f64(vtrn2q_f64(vreinterpretq_f64_f32(ab1), vreinterpretq_f64_f32(cd1)));
+}
+
+#else
+#error "simd_neon.h: another implementation of the vector layer is already included"
+#endif
