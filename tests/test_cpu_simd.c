@@ -176,6 +176,10 @@ static uint32_t model(int op, const uint32_t *A, const uint32_t *B, int i, int W
     case SC_FROM_BITS: return mflag((k >> l) & 1);
     case SC_LANES: return (uint32_t)l;
     case SC_LOAD: return ua;
+    case SC_STORE2: {   /* group of 2W: out[2l] = A[l], out[2l + 1] = A[W + l] */
+        const int g = i - i % (2 * W), j = i - g;
+        return A[g + (j & 1) * W + j / 2];
+    }
     case SC_LOAD_U8: return ((const uint8_t *)(const void *)A)[v0 + l];
     case SC_LOAD_BITS: return ((unsigned)k >> l) & 1u ? ua : 0u;
     case SC_STORE_BITS: return ((unsigned)k >> l) & 1u ? ua : out_before[i];
@@ -210,7 +214,7 @@ static const char *const op_names[SC_COUNT] = {
     "i_eq", "i_gt", "i_sel", "slli3", "srli5", "srai7", "sll", "srl",
     "from_vi", "trunc", "round", "m_and", "m_or", "m_andnot", "m_not",
     "from_bits", "lanes", "load", "load_bits", "store_bits",
-    "load3", "store3", "scatter3", "tr4", "load_u8",
+    "load3", "store3", "scatter3", "tr4", "load_u8", "store2",
 };
 
 /* Both NaN inputs: any NaN. */

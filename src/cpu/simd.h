@@ -87,6 +87,9 @@
  *                            zero-extended; reads exactly SIMD_W bytes
  *   vf_load3(p, &x, &y, &z)  de-interleaves 3*SIMD_W floats x y z x y z ..:
  *                            lane l of x = p[3l], y = p[3l+1], z = p[3l+2]
+ *   vi_store2(p, i, j)       interleaves two vectors: p[2l] = i[l],
+ *                            p[2l+1] = j[l] (int32_t *p, any alignment);
+ *                            writes exactly 2 SIMD_W int32
  *   vf_store3(p, x, y, z)    the inverse: writes p[0 .. 3*SIMD_W)
  *   vf_scatter3(p, dest, x, y, z)  lane l to p[3*dest[l] + 0..2] (int32
  *                            dest[SIMD_W]; the order of the lanes' stores

@@ -50,6 +50,15 @@ SIMD_INL vint vi_load_u8(const uint8_t *p)
     return _mm256_cvtepu8_epi32(_mm_loadl_epi64((const __m128i *)(const void *)p));
 }
 
+/* unpack works per 128-bit half: lo = i0 j0 i1 j1 | i4 j4 i5 j5, hi =
+ * i2 j2 i3 j3 | i6 j6 i7 j7; the halves recombined in memory order */
+SIMD_INL void vi_store2(int32_t *p, vint i, vint j)
+{
+    const __m256i lo = _mm256_unpacklo_epi32(i, j), hi = _mm256_unpackhi_epi32(i, j);
+    _mm256_storeu_si256((__m256i *)(void *)p, _mm256_permute2x128_si256(lo, hi, 0x20));
+    _mm256_storeu_si256((__m256i *)(void *)(p + 8), _mm256_permute2x128_si256(lo, hi, 0x31));
+}
+
 SIMD_INL vfloat vf_load_bits(const float *p, unsigned bits)
 {
     if ((bits & SIMD_FULL) == SIMD_FULL) return _mm256_loadu_ps(p);

@@ -47,6 +47,14 @@ SIMD_INL vint vi_load_u8(const uint8_t *p)
     return _mm512_cvtepu8_epi32(_mm_loadu_si128((const __m128i *)(const void *)p));
 }
 
+SIMD_INL void vi_store2(int32_t *p, vint i, vint j)
+{
+    const __m512i k0 = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
+    const __m512i k1 = _mm512_setr_epi32(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
+    _mm512_storeu_si512((void *)p, _mm512_permutex2var_epi32(i, k0, j));
+    _mm512_storeu_si512((void *)(p + 16), _mm512_permutex2var_epi32(i, k1, j));
+}
+
 SIMD_INL vfloat vf_load_bits(const float *p, unsigned bits) { return _mm512_maskz_loadu_ps((__mmask16)bits, p); }
 SIMD_INL void vf_store_bits(float *p, unsigned bits, vfloat a) { _mm512_mask_storeu_ps(p, (__mmask16)bits, a); }
 

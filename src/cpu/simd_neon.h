@@ -66,6 +66,14 @@ SIMD_INL vint vi_load_u8(const uint8_t *p)
     return vreinterpretq_s32_u32(vmovl_u16(vget_low_u16(h)));
 }
 
+SIMD_INL void vi_store2(int32_t *p, vint i, vint j)
+{
+    int32x4x2_t t;
+    t.val[0] = i;
+    t.val[1] = j;
+    vst2q_s32(p, t);   /* ST2: the interleaving store */
+}
+
 /* lane by lane: NEON has no masked load or store */
 SIMD_INL vfloat vf_load_bits(const float *p, unsigned bits)
 {

@@ -48,6 +48,12 @@ SIMD_INL vint vi_load_u8(const uint8_t *p)
     return _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128((int)t), z), z);
 }
 
+SIMD_INL void vi_store2(int32_t *p, vint i, vint j)
+{
+    _mm_storeu_si128((__m128i *)(void *)p, _mm_unpacklo_epi32(i, j));
+    _mm_storeu_si128((__m128i *)(void *)(p + 4), _mm_unpackhi_epi32(i, j));
+}
+
 SIMD_INL vfloat vf_load_bits(const float *p, unsigned bits)
 {
     if ((bits & SIMD_FULL) == SIMD_FULL) return _mm_loadu_ps(p);

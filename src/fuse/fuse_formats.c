@@ -84,15 +84,20 @@ static void demosaic_row(const fuse_frame *s, const int pat[4], int y, uint8_t *
     }
 }
 
-/* The AVX2 part of a YUYV/UYVY row where the CPU has it; returns the
- * pixels done (the scalar loop does the rest). */
-static int yuv_row_fast(int avx2, const uint8_t *r, int width, int uyvy, uint8_t *d)
+/* The SIMD part of a YUYV/UYVY row on the chosen path (AVX2's 16-bit
+ * kernel from AVX2 up; SSE2 and NEON: fuse_simd.inl on the vector layer);
+ * returns the pixels done (the scalar loop does the rest). */
+static int yuv_row_fast(ef_isa isa, const uint8_t *r, int width, int uyvy, uint8_t *d)
 {
+    switch (isa) {
 #if defined(__x86_64__) || defined(__i386__)
-    if (avx2) return fuse__yuv422_row_avx2(r, width, uyvy, d);
+    case EF_ISA_AVX512:
+    case EF_ISA_AVX2: return fuse__yuv422_row_avx2(r, width, uyvy, d);
 #endif
-    (void)avx2, (void)r, (void)width, (void)uyvy, (void)d;
-    return 0;
+    case EF_ISA_SSE2: return fuse__yuv422_row_sse2(r, width, uyvy, d);
+    case EF_ISA_NEON: return fuse__yuv422_row_neon(r, width, uyvy, d);
+    default: return 0;
+    }
 }
 
 fuse_result fuse_frame_to_rgba(const fuse_frame *s, int y0, fuse_image *out)
@@ -102,7 +107,7 @@ fuse_result fuse_frame_to_rgba(const fuse_frame *s, int y0, fuse_image *out)
 
 fuse_result fuse_frame_to_rgba_isa(const fuse_frame *s, int y0, fuse_image *out, ef_isa cap)
 {
-    const int yuv_avx2 = ef_isa_level(ef_isa_choose(cap)) >= ef_isa_level(EF_ISA_AVX2);
+    const ef_isa isa = ef_isa_choose(cap);
     static const int pats[4][4] = {
         { 0, 1, 1, 2 },   /* RGGB */
         { 1, 0, 2, 1 },   /* GRBG */
@@ -137,14 +142,14 @@ fuse_result fuse_frame_to_rgba_isa(const fuse_frame *s, int y0, fuse_image *out,
         uint8_t *d = out->pixels + (size_t)y * (size_t)out->stride;
         switch (s->format) {
         case FUSE_FMT_YUYV:
-            x = yuv_row_fast(yuv_avx2, r, s->width, 0, d);
+            x = yuv_row_fast(isa, r, s->width, 0, d);
             for (r += 2 * x, d += 4 * x; x < s->width; x += 2, r += 4, d += 8) {
                 yuv_px(r[0], r[1], r[3], d);
                 yuv_px(r[2], r[1], r[3], d + 4);
             }
             break;
         case FUSE_FMT_UYVY:
-            x = yuv_row_fast(yuv_avx2, r, s->width, 1, d);
+            x = yuv_row_fast(isa, r, s->width, 1, d);
             for (r += 2 * x, d += 4 * x; x < s->width; x += 2, r += 4, d += 8) {
                 yuv_px(r[1], r[0], r[2], d);
                 yuv_px(r[3], r[0], r[2], d + 4);

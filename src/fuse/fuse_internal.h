@@ -521,6 +521,11 @@ fuse_result fuse__composite_check(const fuse_image *Q, const fuse_image *V,
  * the reference, and returns how many it did (a multiple of 16); the
  * caller converts the rest. */
 int fuse__yuv422_row_avx2(const uint8_t *src, int width, int uyvy, uint8_t *dst);
+/* the same written once on the vector layer (fuse_simd.inl, int32 lanes:
+ * one pixel pair per lane), for SSE2 and NEON; AVX2 keeps its 16-bit one
+ * (16 pixels per madd step), which AVX-512 runs too */
+int fuse__yuv422_row_sse2(const uint8_t *src, int width, int uyvy, uint8_t *dst);
+int fuse__yuv422_row_neon(const uint8_t *src, int width, int uyvy, uint8_t *dst);
 
 /* NEON (fuse_neon.c: fuse_simd.inl on src/cpu/simd_neon.h; on other
  * targets the reference under these names). The composite has no NEON

@@ -12,11 +12,13 @@
 
 #include "../cpu/simd_neon.h"
 
+#define FUSE_YUV_ON_LAYER 1
 #include "fuse_simd.inl"
 
 #else
 
 #define FUSE_STUB(name) name##_neon
+#define FUSE_YUV_ON_LAYER 1
 #include "fuse_stub.inl"
 
 #endif

@@ -472,3 +472,49 @@ void SIMD_FN(fuse__opaque)(const uint8_t *v, uint8_t *out, int n)
             vf_store_bits((float *)(void *)(out + 4 * (size_t)i), bits, vi_as_vf(y));
     }
 }
+
+#ifdef FUSE_YUV_ON_LAYER
+/* ---- camera formats: YUYV / UYVY rows (fuse_formats.c, yuv_px) ---------
+ *
+ * SIMD_W pixel pairs a step, one pair (Y0 U Y1 V, or U Y0 V Y1) per int32
+ * lane, the reference's integer formula exactly: C = Y - 16, D = U - 128,
+ * E = V - 128; R = 298 C + 409 E + 128, G = 298 C - 100 D - 208 E + 128,
+ * B = 298 C + 516 D + 128 in int32 (no overflow: |v| < 2^18), then
+ * clamp255: 0 for v < 0, else min(255, v >> 8). The two pixels of the lanes
+ * are interleaved back into memory order by vi_store2. Returns the pixels
+ * done (a multiple of 2 SIMD_W); the caller converts the rest. */
+SIMD_INL vint yuv_clamp(vint v)
+{
+    const vint t = vi_srai(v, 8);   /* v < 0 <=> t < 0 */
+    const vint k255 = vi_set1(255);
+    return vi_sel(vi_gt(vi_zero(), t), vi_zero(), vi_sel(vi_gt(t, k255), k255, t));
+}
+
+SIMD_INL vint yuv_pixel(vint c, vint rd, vint gd, vint bd)
+{
+    const vint base = vi_add(vi_mullo(c, vi_set1(298)), vi_set1(128));
+    return vi_or(vi_or(yuv_clamp(vi_add(base, rd)), vi_slli(yuv_clamp(vi_add(base, gd)), 8)),
+                 vi_or(vi_slli(yuv_clamp(vi_add(base, bd)), 16), vi_set1((int32_t)0xFF000000u)));
+}
+
+int SIMD_FN(fuse__yuv422_row)(const uint8_t *src, int width, int uyvy, uint8_t *dst)
+{
+    const vint m8 = vi_set1(255);
+    /* byte positions of Y0, U, Y1, V in the pair's word */
+    const int sy0 = uyvy ? 8 : 0, su = uyvy ? 0 : 8, sy1 = uyvy ? 24 : 16, sv = uyvy ? 16 : 24;
+    int x = 0;
+    for (; x + 2 * SIMD_W <= width; x += 2 * SIMD_W) {
+        const vint w = vi_loadu((const int32_t *)(const void *)(src + 2 * (size_t)x));
+        const vint y0 = vi_and(vi_srl(w, sy0), m8), y1 = vi_and(vi_srl(w, sy1), m8);
+        const vint d = vi_sub(vi_and(vi_srl(w, su), m8), vi_set1(128));
+        const vint e = vi_sub(vi_and(vi_srl(w, sv), m8), vi_set1(128));
+        const vint rd = vi_mullo(e, vi_set1(409));
+        const vint gd = vi_sub(vi_mullo(d, vi_set1(-100)), vi_mullo(e, vi_set1(208)));
+        const vint bd = vi_mullo(d, vi_set1(516));
+        vi_store2((int32_t *)(void *)(dst + 4 * (size_t)x),
+                  yuv_pixel(vi_sub(y0, vi_set1(16)), rd, gd, bd),
+                  yuv_pixel(vi_sub(y1, vi_set1(16)), rd, gd, bd));
+    }
+    return x;
+}
+#endif

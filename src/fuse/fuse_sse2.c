@@ -21,6 +21,7 @@
         (y) = _mm_setr_ps(q_[1], q_[4], q_[7], q_[10]); \
         (z) = _mm_setr_ps(q_[2], q_[5], q_[8], q_[11]); } while (0)
 
+#define FUSE_YUV_ON_LAYER 1
 #include "fuse_simd.inl"
 
 static inline uint32_t load_u32(const uint8_t *p)
@@ -113,6 +114,7 @@ void fuse__composite_cols_sse2(const uint8_t *q0, const uint8_t *q1, uint32_t fy
 #else  /* no SSE2 (e.g. ARM): the reference kernels */
 
 #define FUSE_STUB(name) name##_sse2
+#define FUSE_YUV_ON_LAYER 1
 #include "fuse_stub.inl"
 
 void fuse__composite_cols_sse2(const uint8_t *q0, const uint8_t *q1, uint32_t fy,

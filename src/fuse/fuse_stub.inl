@@ -34,6 +34,14 @@ void FUSE_STUB(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
     fuse__cover_row_ref(q, w, bits);
 }
 
+#ifdef FUSE_YUV_ON_LAYER
+int FUSE_STUB(fuse__yuv422_row)(const uint8_t *src, int width, int uyvy, uint8_t *dst)
+{
+    (void)src, (void)width, (void)uyvy, (void)dst;
+    return 0;   /* none: the caller's scalar loop converts the row */
+}
+#endif
+
 void FUSE_STUB(fuse__opaque)(const uint8_t *v, uint8_t *out, int n)
 {
     fuse__opaque_ref(v, out, n);

@@ -26,6 +26,7 @@ enum {
     SC_LANES, SC_LOAD, SC_LOAD_BITS, SC_STORE_BITS,          /* bits k; out = b first */
     SC_LOAD3, SC_STORE3, SC_SCATTER3, SC_TR4,
     SC_LOAD_U8,                                              /* bytes of a from lane v0 */
+    SC_STORE2,                                               /* groups of 2W: a's two vectors */
     SC_COUNT
 };
 

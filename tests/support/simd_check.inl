@@ -32,6 +32,11 @@ int SIMD_FN(tu_simd_check)(int op, const uint32_t *a, const uint32_t *b, int k, 
         }
         return W;
     }
+    if (op == SC_STORE2) {
+        for (int g = 0; g + 2 * W <= n; g += 2 * W)
+            vi_store2((int32_t *)(void *)(out + g), ldi(a + g), ldi(a + g + W));
+        return W;
+    }
     if (op == SC_TR4) {
         for (int g = 0; g + 4 * W <= n; g += 4 * W) {
             vfloat t[4];
