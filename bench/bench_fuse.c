@@ -206,26 +206,15 @@ typedef struct stats {
  * directions taken as view-space directions (timing only). */
 static fuse_lighting scene_lighting(void)
 {
-    fuse_lighting L = fuse_lighting_default();
-    const float d[2][3] = { { -0.7884f, 0.5781f, 0.2102f }, { 0.3271f, 0.9345f, 0.1402f } };
-    const float c[2][3] = { { 0.620f, 0.700f, 0.820f }, { 0.450f, 0.380f, 0.280f } };
-    int i, k;
-    L.light_count = 2;
-    for (i = 0; i < 2; i++)
-        for (k = 0; k < 3; k++) {
-            L.lights[i].dir[k] = d[i][k];
-            L.lights[i].color[k] = c[i][k];
-        }
-    L.ambient[0] = 0.28f;
-    L.ambient[1] = 0.30f;
-    L.ambient[2] = 0.32f;
-    L.kd = 0.80f;
-    L.ks = 0.12f;
-    L.shininess = 20.0f;
-    L.kf = 0.50f;
-    L.tone[0] = 1.0f;
-    L.tone[1] = 0.98f;
-    L.tone[2] = 0.96f;
+    static const fuse_lighting L = {
+        2,
+        { { { -0.7884f, 0.5781f, 0.2102f }, { 0.620f, 0.700f, 0.820f } },
+          { { 0.3271f, 0.9345f, 0.1402f }, { 0.450f, 0.380f, 0.280f } } },
+        { 0.28f, 0.30f, 0.32f },   /* ambient */
+        0.80f, 0.12f, 20.0f,        /* kd, ks, shininess */
+        0.50f,                      /* kf */
+        { 1.0f, 0.98f, 0.96f }      /* tone */
+    };
     return L;
 }
 
