@@ -113,6 +113,8 @@ static int32_t cvt_round(uint32_t u)
 }
 
 static uint32_t mflag(int c) { return c ? 0xFFFFFFFFu : 0u; }
+/* two 16-bit lanes (low, high) of a 32-bit lane, each taken mod 2^16 */
+static uint32_t h2(uint32_t lo, uint32_t hi) { return (lo & 0xFFFFu) | (hi & 0xFFFFu) << 16; }
 
 /* The model of lane i (W lanes per vector) of op. */
 static uint32_t model(int op, const uint32_t *A, const uint32_t *B, int i, int W, int k,
@@ -176,6 +178,31 @@ static uint32_t model(int op, const uint32_t *A, const uint32_t *B, int i, int W
     case SC_FROM_BITS: return mflag((k >> l) & 1);
     case SC_LANES: return (uint32_t)l;
     case SC_LOAD: return ua;
+    case SC_HADD: return h2(ua + (ub & 0xFFFFu), (ua >> 16) + (ub >> 16));
+    case SC_HSUB: return h2(ua - (ub & 0xFFFFu), (ua >> 16) - (ub >> 16));
+    case SC_HMUL: return h2((ua & 0xFFFFu) * (ub & 0xFFFFu), (ua >> 16) * (ub >> 16));
+    case SC_HSRLI5: return h2((ua & 0xFFFFu) >> 5, (ua >> 16) >> 5);
+    case SC_HSET1: return h2((uint32_t)k, (uint32_t)k);
+    case SC_HLO8: case SC_HHI8: {   /* lane l of a 4-lane block: bytes 2l', 2l'+1 */
+        const uint8_t *by = (const uint8_t *)(const void *)(A + (i - i % 4));
+        const int off = (op == SC_HHI8 ? 8 : 0) + 2 * (i % 4);
+        return h2(by[off], by[off + 1]);
+    }
+    case SC_HPACKUS: {   /* block: bytes 0-7 from a's 8 lanes, 8-15 from b's */
+        const uint32_t *src = (i % 4) < 2 ? A : B;
+        const uint16_t *h = (const uint16_t *)(const void *)(src + (i - i % 4));
+        const int m0 = 4 * ((i % 4) % 2);
+        uint32_t r = 0;
+        for (int q = 0; q < 4; q++) {
+            const int16_t v = (int16_t)h[m0 + q];
+            r |= (uint32_t)(v < 0 ? 0 : v > 255 ? 255 : v) << (8 * q);
+        }
+        return r;
+    }
+    case SC_HBCAST3: {   /* 16-bit lane 3 of the pixel: the high half of lane 2p+1 */
+        const uint32_t s = A[i - i % 2 + 1] >> 16;
+        return h2(s, s);
+    }
     case SC_STORE2: {   /* group of 2W: out[2l] = A[l], out[2l + 1] = A[W + l] */
         const int g = i - i % (2 * W), j = i - g;
         return A[g + (j & 1) * W + j / 2];
@@ -215,6 +242,8 @@ static const char *const op_names[SC_COUNT] = {
     "from_vi", "trunc", "round", "m_and", "m_or", "m_andnot", "m_not",
     "from_bits", "lanes", "load", "load_bits", "store_bits",
     "load3", "store3", "scatter3", "tr4", "load_u8", "store2",
+    "h_add", "h_sub", "h_mullo", "h_srli5", "h_set1", "h_from_u8_lo", "h_from_u8_hi", "h_packus",
+    "h_bcast3",
 };
 
 /* Both NaN inputs: any NaN. */
@@ -242,7 +271,7 @@ static void check_isa(ef_isa isa, tu_simd_check_fn *fn)
                 int k = ks[ki];
                 if ((op == SC_SLL || op == SC_SRL) && k > 31) continue;
                 if (op != SC_SLL && op != SC_SRL && op != SC_FROM_BITS && op != SC_LOAD_BITS &&
-                    op != SC_STORE_BITS && ki > 0)
+                    op != SC_STORE_BITS && op != SC_HSET1 && ki > 0)
                     break;
                 for (int i = 0; i < N; i++) out[i] = before[i] = b[i] ^ 0x5A5A5A5Au;
                 W = fn(op, a, b, k, N, out);

@@ -155,6 +155,21 @@
  *                    on NEON prefer vm_any / vm_all where only that is
  *                    needed (one instruction; bits cost four)
  *
+ * 16-bit lanes: a vint read as 2 SIMD_W uint16 lanes (lane m is bytes
+ * 2m, 2m+1 of the vector in memory order); "block": each 128-bit part
+ * (16 bytes; SSE2 and NEON have one, AVX2 two, AVX-512 four), where the
+ * x86 unpack, pack and shuffle instructions work
+ *   vh_set1(x)               every 16-bit lane x & 0xFFFF
+ *   vh_add vh_sub vh_mullo(i, j)  wrapping, the low 16 bits
+ *   vh_srli(i, k)            logical shift right by a CONSTANT 1 <= k <= 15
+ *   vh_from_u8_lo(i), vh_from_u8_hi(i)   in each block: bytes 0-7 (lo) or
+ *                            8-15 (hi) zero-extended to its 8 16-bit lanes
+ *   vh_packus(i, j)          in each block: the 8 lanes of i, then those of
+ *                            j, each read as int16 and saturated to 0..255,
+ *                            as its 16 bytes (x86 packuswb)
+ *   vh_bcast3(i)             in each group of 4 lanes (8 bytes: one RGBA
+ *                            pixel of 16-bit channels), lane 3 to all four
+ *
  * Shuffles
  *   vf_tr4(a, b, c, d, o)  4x4 transpose within each 4-lane block J
  *                          (lanes 4J .. 4J+3): lane 4J+i of o[k] is lane

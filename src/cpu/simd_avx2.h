@@ -99,6 +99,18 @@ SIMD_INL void vf_store3(float *p, vfloat x, vfloat y, vfloat z)
     _mm256_storeu_ps(p + 16, _mm256_blend_ps(_mm256_blend_ps(x, y, 0x49), z, 0x92));
 }
 
+/* ---- 16-bit lanes (simd.h, "16-bit lanes"; per 128-bit block as AVX2's
+ * unpack, pack and shuffle work) */
+SIMD_INL vint vh_set1(int x) { return _mm256_set1_epi16((short)x); }
+SIMD_INL vint vh_add(vint i, vint j) { return _mm256_add_epi16(i, j); }
+SIMD_INL vint vh_sub(vint i, vint j) { return _mm256_sub_epi16(i, j); }
+SIMD_INL vint vh_mullo(vint i, vint j) { return _mm256_mullo_epi16(i, j); }
+#define vh_srli(i, k) _mm256_srli_epi16(i, k)
+SIMD_INL vint vh_from_u8_lo(vint i) { return _mm256_unpacklo_epi8(i, _mm256_setzero_si256()); }
+SIMD_INL vint vh_from_u8_hi(vint i) { return _mm256_unpackhi_epi8(i, _mm256_setzero_si256()); }
+SIMD_INL vint vh_packus(vint i, vint j) { return _mm256_packus_epi16(i, j); }
+SIMD_INL vint vh_bcast3(vint i) { return _mm256_shufflehi_epi16(_mm256_shufflelo_epi16(i, 0xFF), 0xFF); }
+
 /* ---- shuffles */
 SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
 {

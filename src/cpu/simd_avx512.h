@@ -84,6 +84,17 @@ SIMD_INL void vf_store3(float *p, vfloat x, vfloat y, vfloat z)
     _mm512_storeu_ps(p + 32, _mm512_mask_blend_ps(0x9249, _mm512_mask_blend_ps(0x4924, x, y), z));
 }
 
+/* ---- 16-bit lanes (simd.h, "16-bit lanes"; per 128-bit block, AVX-512BW) */
+SIMD_INL vint vh_set1(int x) { return _mm512_set1_epi16((short)x); }
+SIMD_INL vint vh_add(vint i, vint j) { return _mm512_add_epi16(i, j); }
+SIMD_INL vint vh_sub(vint i, vint j) { return _mm512_sub_epi16(i, j); }
+SIMD_INL vint vh_mullo(vint i, vint j) { return _mm512_mullo_epi16(i, j); }
+#define vh_srli(i, k) _mm512_srli_epi16(i, k)
+SIMD_INL vint vh_from_u8_lo(vint i) { return _mm512_unpacklo_epi8(i, _mm512_setzero_si512()); }
+SIMD_INL vint vh_from_u8_hi(vint i) { return _mm512_unpackhi_epi8(i, _mm512_setzero_si512()); }
+SIMD_INL vint vh_packus(vint i, vint j) { return _mm512_packus_epi16(i, j); }
+SIMD_INL vint vh_bcast3(vint i) { return _mm512_shufflehi_epi16(_mm512_shufflelo_epi16(i, 0xFF), 0xFF); }
+
 /* ---- shuffles */
 SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
 {

@@ -208,6 +208,42 @@ SIMD_INL vmask vm_from_bits(unsigned b)
 SIMD_INL int vm_all(vmask m) { return vminvq_u32(m) != 0; }
 SIMD_INL int vm_any(vmask m) { return vmaxvq_u32(m) != 0; }
 
+/* ---- 16-bit lanes (simd.h, "16-bit lanes"; one 128-bit block) */
+SIMD_INL vint vh_set1(int x) { return vreinterpretq_s32_u16(vdupq_n_u16((uint16_t)x)); }
+SIMD_INL vint vh_add(vint i, vint j)
+{
+    return vreinterpretq_s32_u16(vaddq_u16(vreinterpretq_u16_s32(i), vreinterpretq_u16_s32(j)));
+}
+SIMD_INL vint vh_sub(vint i, vint j)
+{
+    return vreinterpretq_s32_u16(vsubq_u16(vreinterpretq_u16_s32(i), vreinterpretq_u16_s32(j)));
+}
+SIMD_INL vint vh_mullo(vint i, vint j)
+{
+    return vreinterpretq_s32_u16(vmulq_u16(vreinterpretq_u16_s32(i), vreinterpretq_u16_s32(j)));
+}
+#define vh_srli(i, k) vreinterpretq_s32_u16(vshrq_n_u16(vreinterpretq_u16_s32(i), k))
+SIMD_INL vint vh_from_u8_lo(vint i)
+{
+    return vreinterpretq_s32_u16(vmovl_u8(vget_low_u8(vreinterpretq_u8_s32(i))));
+}
+SIMD_INL vint vh_from_u8_hi(vint i)
+{
+    return vreinterpretq_s32_u16(vmovl_u8(vget_high_u8(vreinterpretq_u8_s32(i))));
+}
+/* x86's packus: each lane read as int16, saturated to 0..255 (SQXTUN) */
+SIMD_INL vint vh_packus(vint i, vint j)
+{
+    return vreinterpretq_s32_u8(vcombine_u8(vqmovun_s16(vreinterpretq_s16_s32(i)),
+                                            vqmovun_s16(vreinterpretq_s16_s32(j))));
+}
+SIMD_INL vint vh_bcast3(vint i)
+{
+    const uint16x8_t u = vreinterpretq_u16_s32(i);
+    return vreinterpretq_s32_u16(vcombine_u16(vdup_lane_u16(vget_low_u16(u), 3),
+                                              vdup_lane_u16(vget_high_u16(u), 3)));
+}
+
 /* ---- shuffles: TRN1/TRN2 on 32- then 64-bit elements */
 SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
 {

@@ -191,6 +191,17 @@ SIMD_INL vmask vm_from_bits(unsigned b)
 SIMD_INL int vm_all(vmask m) { return _mm_movemask_ps(m) == 0xF; }
 SIMD_INL int vm_any(vmask m) { return _mm_movemask_ps(m) != 0; }
 
+/* ---- 16-bit lanes (simd.h, "16-bit lanes") */
+SIMD_INL vint vh_set1(int x) { return _mm_set1_epi16((short)x); }
+SIMD_INL vint vh_add(vint i, vint j) { return _mm_add_epi16(i, j); }
+SIMD_INL vint vh_sub(vint i, vint j) { return _mm_sub_epi16(i, j); }
+SIMD_INL vint vh_mullo(vint i, vint j) { return _mm_mullo_epi16(i, j); }
+#define vh_srli(i, k) _mm_srli_epi16(i, k)
+SIMD_INL vint vh_from_u8_lo(vint i) { return _mm_unpacklo_epi8(i, _mm_setzero_si128()); }
+SIMD_INL vint vh_from_u8_hi(vint i) { return _mm_unpackhi_epi8(i, _mm_setzero_si128()); }
+SIMD_INL vint vh_packus(vint i, vint j) { return _mm_packus_epi16(i, j); }
+SIMD_INL vint vh_bcast3(vint i) { return _mm_shufflehi_epi16(_mm_shufflelo_epi16(i, 0xFF), 0xFF); }
+
 /* ---- shuffles */
 SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
 {

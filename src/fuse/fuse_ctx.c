@@ -26,9 +26,8 @@ typedef struct kernels {
 /* The ISA's kernels, one row per ISA (the one dispatch table of the room):
  * the ones of fuse_simd.inl (written once on the vector layer: light,
  * depth, depth on the mask, cover, opaque) by ISA suffix, then the
- * composite, which is still per ISA: SSE2 per output row, AVX2 / AVX-512
- * through the row cache (hrow, vrow), NEON the reference's table-driven
- * row kernel. */
+ * composite: SSE2 and NEON per output row (fuse_simd.inl too), AVX2 /
+ * AVX-512 through the row cache (hrow, vrow, per ISA). */
 #define SIMD_KERNELS(sfx) fuse__light_row_##sfx, fuse__depth_row_##sfx, fuse__depth_mrow_##sfx
 #define SIMD_COVER(sfx) fuse__cover_row_##sfx, fuse__opaque_##sfx
 
@@ -41,7 +40,7 @@ static kernels kernels_for(ef_isa isa)
                                  fuse__hrow_avx2, fuse__vrow_avx2};
     static const kernels avx512 = {EF_ISA_AVX512, 0, SIMD_KERNELS(avx512), NULL, SIMD_COVER(avx512),
                                    fuse__hrow_avx512, fuse__vrow_avx512};
-    static const kernels neon = {EF_ISA_NEON, 0, SIMD_KERNELS(neon), fuse__composite_cols_ref,
+    static const kernels neon = {EF_ISA_NEON, 0, SIMD_KERNELS(neon), fuse__composite_cols_neon,
                                  SIMD_COVER(neon), NULL, NULL};
     switch (isa) {
     case EF_ISA_AVX512: return avx512;

@@ -528,8 +528,8 @@ int fuse__yuv422_row_sse2(const uint8_t *src, int width, int uyvy, uint8_t *dst)
 int fuse__yuv422_row_neon(const uint8_t *src, int width, int uyvy, uint8_t *dst);
 
 /* NEON (fuse_neon.c: fuse_simd.inl on src/cpu/simd_neon.h; on other
- * targets the reference under these names). The composite has no NEON
- * kernel yet: fuse_ctx.c runs the reference's per-row kernel there. */
+ * targets the reference under these names). The composite: per output
+ * row, as SSE2 (no row cache). */
 void fuse__light_row_neon(const fuse__light_prep *p, int y, int width,
                           const uint8_t *P, const uint8_t *mask,
                           const float *normal, uint8_t *out);
@@ -539,6 +539,9 @@ void fuse__depth_row_neon(const fuse__depth_prep *p, uint8_t *q, const float *hz
 void fuse__depth_mrow_neon(const fuse__depth_prep *p, uint8_t *m, const float *hz,
                            const float *sc, int w);
 void fuse__cover_row_neon(const uint8_t *q, int w, uint64_t *bits);
+void fuse__composite_cols_neon(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
+                               const fuse__cols *cols, int c, int n, int sw,
+                               const uint8_t *v, uint8_t *out);
 void fuse__opaque_neon(const uint8_t *v, uint8_t *out, int n);
 
 #endif

@@ -1,10 +1,10 @@
 /* fuse_neon.c - the NEON path of the fuse kernels (AArch64 Advanced SIMD,
  * the baseline there: no flag): fuse_simd.inl on the vector layer
  * (src/cpu/simd_neon.h, 4 lanes; the depth test's scene values lane by
- * lane), as fuse_sse2.c does for SSE2. The bytes are the reference's:
- * tests/test_fuse_isa.c under qemu-aarch64 (.ci/run part arm64). The
- * composite has no NEON kernel yet (the vector layer has no 16-bit lanes):
- * fuse_ctx.c gives NEON the reference's per-row composite. On other
+ * lane), as fuse_sse2.c does for SSE2, the per-row composite
+ * (fuse__composite_cols_neon, 16-bit lanes) and the YUYV conversion
+ * included. The bytes are the reference's: tests/test_fuse_isa.c and
+ * test_fuse_formats.c under qemu-aarch64 (.ci/run part arm64). On other
  * targets the reference stands in under these names. */
 #include "fuse_internal.h"
 
@@ -13,12 +13,14 @@
 #include "../cpu/simd_neon.h"
 
 #define FUSE_YUV_ON_LAYER 1
+#define FUSE_COLS_ON_LAYER 1
 #include "fuse_simd.inl"
 
 #else
 
 #define FUSE_STUB(name) name##_neon
 #define FUSE_YUV_ON_LAYER 1
+#define FUSE_COLS_ON_LAYER 1
 #include "fuse_stub.inl"
 
 #endif

@@ -518,3 +518,88 @@ int SIMD_FN(fuse__yuv422_row)(const uint8_t *src, int width, int uyvy, uint8_t *
     return x;
 }
 #endif
+
+#ifdef FUSE_COLS_ON_LAYER
+/* ---- composite per output row (fuse__composite_fn), 16-bit lanes ---------
+ *
+ * SIMD_W output pixels a step, their four taps loaded one by one. Bilinear
+ * blend + over of the pixels widened to 16-bit lanes, two pixels per
+ * half-block (a, b, c, d, v: the taps and V; wx0/wx1: 256 - fx and fx per
+ * channel; wy0/wy1 the same for the row). The reference's
+ *   q = ((a wx0 + b wx1) wy0 + (c wx0 + d wx1) wy1 + 32768) >> 16
+ * is a sum of exact integer products, so it may be grouped by columns:
+ *   col0 = a wy0 + c wy1,  col1 = b wy0 + d wy1      (<= 65280: u16)
+ *   S = col0 wx0 + col1 wx1 = 256 H + Lo with
+ *   H = hi0 wx0 + hi1 wx1, Lo = lo0 wx0 + lo1 wx1 (hi = col >> 8, lo = col & 255)
+ *   q = floor((S + 32768) / 65536) = (H + (Lo >> 8) + 128) >> 8
+ * where H + (Lo >> 8) <= S / 256 <= 65280, so every step fits in u16. Over:
+ *   r = q + div255((255 - qa) v),  div255(t) = (t + 128 + ((t + 128) >> 8)) >> 8
+ * with t <= 65025; the final min(255, .) is the saturating pack. */
+SIMD_INL vint blend16(vint a, vint b, vint c, vint d, vint v, vint wx0, vint wx1, vint wy0, vint wy1)
+{
+    const vint lo8 = vh_set1(255);
+    const vint col0 = vh_add(vh_mullo(a, wy0), vh_mullo(c, wy1));
+    const vint col1 = vh_add(vh_mullo(b, wy0), vh_mullo(d, wy1));
+    const vint H = vh_add(vh_mullo(vh_srli(col0, 8), wx0), vh_mullo(vh_srli(col1, 8), wx1));
+    const vint L = vh_add(vh_mullo(vi_and(col0, lo8), wx0), vh_mullo(vi_and(col1, lo8), wx1));
+    const vint q = vh_srli(vh_add(vh_add(H, vh_srli(L, 8)), vh_set1(128)), 8);
+    vint t = vh_mullo(vh_sub(lo8, vh_bcast3(q)), v);
+    t = vh_add(t, vh_set1(128));
+    t = vh_srli(vh_add(t, vh_srli(t, 8)), 8);
+    return vh_add(q, t);
+}
+
+void SIMD_FN(fuse__composite_cols)(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
+                                   const fuse__cols *cols, int c, int n, int sw,
+                                   const uint8_t *v, uint8_t *out)
+{
+    const vint wy0 = vh_set1((int)(256 - fy)), wy1 = vh_set1((int)fy), w256 = vh_set1(256);
+    const vint opaque = vi_set1((int32_t)0xFF000000u);
+    const int32_t *ixs = cols->ix + c, *fxs = cols->fx + c;
+    int i = 0;
+    for (; i + SIMD_W <= n; i += SIMD_W) {
+        _Alignas(64) uint32_t ta[SIMD_W], tb[SIMD_W], tc[SIMD_W], td[SIMD_W];
+        _Alignas(64) int32_t fl[SIMD_W], fh[SIMD_W];
+        vint a, b, cc, d, vv, wl, wh;
+        int k;
+        for (k = 0; k < SIMD_W; k++) {
+            const int ix = ixs[i + k], ix1 = ix + 1 < sw ? ix + 1 : sw - 1;
+            memcpy(&ta[k], q0 + 4 * ix, 4);
+            memcpy(&tb[k], q0 + 4 * ix1, 4);
+            memcpy(&tc[k], q1 + 4 * ix, 4);
+            memcpy(&td[k], q1 + 4 * ix1, 4);
+        }
+        a = vi_load((const int32_t *)(const void *)ta);
+        b = vi_load((const int32_t *)(const void *)tb);
+        cc = vi_load((const int32_t *)(const void *)tc);
+        d = vi_load((const int32_t *)(const void *)td);
+        vv = vi_loadu((const int32_t *)(const void *)(v + 4 * (size_t)i));
+        if (vm_all(vi_eq(vi_or(vi_or(a, b), vi_or(cc, d)), vi_zero()))) {
+            vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i), vi_or(vv, opaque));
+            continue;
+        }
+        /* fx of each pixel in its four 16-bit lanes, in the order the
+         * blocks' low (pixels 4B, 4B + 1) and high halves (4B + 2, 4B + 3)
+         * widen to */
+        for (k = 0; k < SIMD_W; k++) {
+            const int p = 4 * (k / 4) + (k % 4) / 2;
+            const uint32_t f = (uint32_t)fxs[i + p] | (uint32_t)fxs[i + p] << 16;
+            const uint32_t g = (uint32_t)fxs[i + p + 2] | (uint32_t)fxs[i + p + 2] << 16;
+            fl[k] = (int32_t)f;
+            fh[k] = (int32_t)g;
+        }
+        wl = vi_load(fl);
+        wh = vi_load(fh);
+        vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i),
+                  vi_or(vh_packus(blend16(vh_from_u8_lo(a), vh_from_u8_lo(b), vh_from_u8_lo(cc),
+                                          vh_from_u8_lo(d), vh_from_u8_lo(vv), vh_sub(w256, wl), wl,
+                                          wy0, wy1),
+                                  blend16(vh_from_u8_hi(a), vh_from_u8_hi(b), vh_from_u8_hi(cc),
+                                          vh_from_u8_hi(d), vh_from_u8_hi(vv), vh_sub(w256, wh), wh,
+                                          wy0, wy1)),
+                        opaque));
+    }
+    for (; i < n; i++)
+        fuse__composite_px(q0, q1, fy, ixs[i], (uint32_t)fxs[i], sw, v + 4 * i, out + 4 * i);
+}
+#endif

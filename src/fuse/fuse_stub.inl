@@ -34,6 +34,15 @@ void FUSE_STUB(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
     fuse__cover_row_ref(q, w, bits);
 }
 
+#ifdef FUSE_COLS_ON_LAYER
+void FUSE_STUB(fuse__composite_cols)(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
+                                     const fuse__cols *cols, int c, int n, int sw,
+                                     const uint8_t *v, uint8_t *out)
+{
+    fuse__composite_cols_ref(q0, q1, fy, cols, c, n, sw, v, out);
+}
+#endif
+
 #ifdef FUSE_YUV_ON_LAYER
 int FUSE_STUB(fuse__yuv422_row)(const uint8_t *src, int width, int uyvy, uint8_t *dst)
 {

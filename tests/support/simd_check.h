@@ -27,6 +27,8 @@ enum {
     SC_LOAD3, SC_STORE3, SC_SCATTER3, SC_TR4,
     SC_LOAD_U8,                                              /* bytes of a from lane v0 */
     SC_STORE2,                                               /* groups of 2W: a's two vectors */
+    SC_HADD, SC_HSUB, SC_HMUL, SC_HSRLI5, SC_HSET1,          /* 16-bit lanes; HSET1: k */
+    SC_HLO8, SC_HHI8, SC_HPACKUS, SC_HBCAST3,
     SC_COUNT
 };
 

@@ -113,6 +113,15 @@ int SIMD_FN(tu_simd_check)(int op, const uint32_t *a, const uint32_t *b, int k, 
             st(o, vf_load(t));
             break;
         }
+        case SC_HADD: sti(o, vh_add(ia, ib)); break;
+        case SC_HSUB: sti(o, vh_sub(ia, ib)); break;
+        case SC_HMUL: sti(o, vh_mullo(ia, ib)); break;
+        case SC_HSRLI5: sti(o, vh_srli(ia, 5)); break;
+        case SC_HSET1: sti(o, vh_set1(k)); break;
+        case SC_HLO8: sti(o, vh_from_u8_lo(ia)); break;
+        case SC_HHI8: sti(o, vh_from_u8_hi(ia)); break;
+        case SC_HPACKUS: sti(o, vh_packus(ia, ib)); break;
+        case SC_HBCAST3: sti(o, vh_bcast3(ia)); break;
         case SC_LOAD_U8: sti(o, vi_load_u8((const uint8_t *)(const void *)a + v)); break;
         case SC_LOAD_BITS: st(o, vf_load_bits((const float *)(const void *)(a + v), (unsigned)k)); break;
         case SC_STORE_BITS: vf_store_bits((float *)(void *)o, (unsigned)k, fa); break;
