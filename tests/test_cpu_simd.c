@@ -178,6 +178,10 @@ static uint32_t model(int op, const uint32_t *A, const uint32_t *B, int i, int W
     case SC_FROM_BITS: return mflag((k >> l) & 1);
     case SC_LANES: return (uint32_t)l;
     case SC_LOAD: return ua;
+    case SC_ZIPLO: case SC_ZIPHI: {   /* block of 4: lane j from lane (hi ? 2 : 0) + j / 2 */
+        const int g = i - i % 4, j = i % 4, src = g + (op == SC_ZIPHI ? 2 : 0) + j / 2;
+        return (j & 1) ? B[src] : A[src];
+    }
     case SC_HADD: return h2(ua + (ub & 0xFFFFu), (ua >> 16) + (ub >> 16));
     case SC_HSUB: return h2(ua - (ub & 0xFFFFu), (ua >> 16) - (ub >> 16));
     case SC_HMUL: return h2((ua & 0xFFFFu) * (ub & 0xFFFFu), (ua >> 16) * (ub >> 16));
@@ -243,7 +247,7 @@ static const char *const op_names[SC_COUNT] = {
     "from_bits", "lanes", "load", "load_bits", "store_bits",
     "load3", "store3", "scatter3", "tr4", "load_u8", "store2",
     "h_add", "h_sub", "h_mullo", "h_srli5", "h_set1", "h_from_u8_lo", "h_from_u8_hi", "h_packus",
-    "h_bcast3",
+    "h_bcast3", "zip_lo", "zip_hi",
 };
 
 /* Both NaN inputs: any NaN. */

@@ -155,6 +155,10 @@
  *                    on NEON prefer vm_any / vm_all where only that is
  *                    needed (one instruction; bits cost four)
  *
+ * Zips, in each 128-bit block (4 int32 lanes; "block" as below)
+ *   vi_zip_lo(i, j)          the block's lanes i0 j0 i1 j1 (x86 unpacklo)
+ *   vi_zip_hi(i, j)          i2 j2 i3 j3 (x86 unpackhi)
+ *
  * 16-bit lanes: a vint read as 2 SIMD_W uint16 lanes (lane m is bytes
  * 2m, 2m+1 of the vector in memory order); "block": each 128-bit part
  * (16 bytes; SSE2 and NEON have one, AVX2 two, AVX-512 four), where the

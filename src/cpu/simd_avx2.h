@@ -99,6 +99,10 @@ SIMD_INL void vf_store3(float *p, vfloat x, vfloat y, vfloat z)
     _mm256_storeu_ps(p + 16, _mm256_blend_ps(_mm256_blend_ps(x, y, 0x49), z, 0x92));
 }
 
+/* ---- zips (per 128-bit block) */
+SIMD_INL vint vi_zip_lo(vint i, vint j) { return _mm256_unpacklo_epi32(i, j); }
+SIMD_INL vint vi_zip_hi(vint i, vint j) { return _mm256_unpackhi_epi32(i, j); }
+
 /* ---- 16-bit lanes (simd.h, "16-bit lanes"; per 128-bit block as AVX2's
  * unpack, pack and shuffle work) */
 SIMD_INL vint vh_set1(int x) { return _mm256_set1_epi16((short)x); }

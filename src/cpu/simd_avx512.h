@@ -84,6 +84,10 @@ SIMD_INL void vf_store3(float *p, vfloat x, vfloat y, vfloat z)
     _mm512_storeu_ps(p + 32, _mm512_mask_blend_ps(0x9249, _mm512_mask_blend_ps(0x4924, x, y), z));
 }
 
+/* ---- zips (per 128-bit block) */
+SIMD_INL vint vi_zip_lo(vint i, vint j) { return _mm512_unpacklo_epi32(i, j); }
+SIMD_INL vint vi_zip_hi(vint i, vint j) { return _mm512_unpackhi_epi32(i, j); }
+
 /* ---- 16-bit lanes (simd.h, "16-bit lanes"; per 128-bit block, AVX-512BW) */
 SIMD_INL vint vh_set1(int x) { return _mm512_set1_epi16((short)x); }
 SIMD_INL vint vh_add(vint i, vint j) { return _mm512_add_epi16(i, j); }

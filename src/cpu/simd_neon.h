@@ -208,6 +208,10 @@ SIMD_INL vmask vm_from_bits(unsigned b)
 SIMD_INL int vm_all(vmask m) { return vminvq_u32(m) != 0; }
 SIMD_INL int vm_any(vmask m) { return vmaxvq_u32(m) != 0; }
 
+/* ---- zips (one block: ZIP1/ZIP2) */
+SIMD_INL vint vi_zip_lo(vint i, vint j) { return vzip1q_s32(i, j); }
+SIMD_INL vint vi_zip_hi(vint i, vint j) { return vzip2q_s32(i, j); }
+
 /* ---- 16-bit lanes (simd.h, "16-bit lanes"; one 128-bit block) */
 SIMD_INL vint vh_set1(int x) { return vreinterpretq_s32_u16(vdupq_n_u16((uint16_t)x)); }
 SIMD_INL vint vh_add(vint i, vint j)

@@ -191,6 +191,10 @@ SIMD_INL vmask vm_from_bits(unsigned b)
 SIMD_INL int vm_all(vmask m) { return _mm_movemask_ps(m) == 0xF; }
 SIMD_INL int vm_any(vmask m) { return _mm_movemask_ps(m) != 0; }
 
+/* ---- zips (per block) */
+SIMD_INL vint vi_zip_lo(vint i, vint j) { return _mm_unpacklo_epi32(i, j); }
+SIMD_INL vint vi_zip_hi(vint i, vint j) { return _mm_unpackhi_epi32(i, j); }
+
 /* ---- 16-bit lanes (simd.h, "16-bit lanes") */
 SIMD_INL vint vh_set1(int x) { return _mm_set1_epi16((short)x); }
 SIMD_INL vint vh_add(vint i, vint j) { return _mm_add_epi16(i, j); }

@@ -559,7 +559,6 @@ void SIMD_FN(fuse__composite_cols)(const uint8_t *q0, const uint8_t *q1, uint32_
     int i = 0;
     for (; i + SIMD_W <= n; i += SIMD_W) {
         _Alignas(64) uint32_t ta[SIMD_W], tb[SIMD_W], tc[SIMD_W], td[SIMD_W];
-        _Alignas(64) int32_t fl[SIMD_W], fh[SIMD_W];
         vint a, b, cc, d, vv, wl, wh;
         int k;
         for (k = 0; k < SIMD_W; k++) {
@@ -578,18 +577,15 @@ void SIMD_FN(fuse__composite_cols)(const uint8_t *q0, const uint8_t *q1, uint32_
             vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i), vi_or(vv, opaque));
             continue;
         }
-        /* fx of each pixel in its four 16-bit lanes, in the order the
-         * blocks' low (pixels 4B, 4B + 1) and high halves (4B + 2, 4B + 3)
-         * widen to */
-        for (k = 0; k < SIMD_W; k++) {
-            const int p = 4 * (k / 4) + (k % 4) / 2;
-            const uint32_t f = (uint32_t)fxs[i + p] | (uint32_t)fxs[i + p] << 16;
-            const uint32_t g = (uint32_t)fxs[i + p + 2] | (uint32_t)fxs[i + p + 2] << 16;
-            fl[k] = (int32_t)f;
-            fh[k] = (int32_t)g;
+        {   /* fx of each pixel in its four 16-bit lanes, in the order the
+             * blocks' low (pixels 4B, 4B + 1) and high halves (4B + 2,
+             * 4B + 3) widen to */
+            const vint fx = vi_loadu(fxs + i);
+            wl = vi_zip_lo(fx, fx);
+            wh = vi_zip_hi(fx, fx);
+            wl = vi_or(wl, vi_slli(wl, 16));
+            wh = vi_or(wh, vi_slli(wh, 16));
         }
-        wl = vi_load(fl);
-        wh = vi_load(fh);
         vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i),
                   vi_or(vh_packus(blend16(vh_from_u8_lo(a), vh_from_u8_lo(b), vh_from_u8_lo(cc),
                                           vh_from_u8_lo(d), vh_from_u8_lo(vv), vh_sub(w256, wl), wl,

@@ -113,6 +113,8 @@ int SIMD_FN(tu_simd_check)(int op, const uint32_t *a, const uint32_t *b, int k, 
             st(o, vf_load(t));
             break;
         }
+        case SC_ZIPLO: sti(o, vi_zip_lo(ia, ib)); break;
+        case SC_ZIPHI: sti(o, vi_zip_hi(ia, ib)); break;
         case SC_HADD: sti(o, vh_add(ia, ib)); break;
         case SC_HSUB: sti(o, vh_sub(ia, ib)); break;
         case SC_HMUL: sti(o, vh_mullo(ia, ib)); break;
