@@ -18,9 +18,11 @@
  *
  * WHAT IT DOES NOT. No dispatch (src/cpu/cpu.h picks the ISA; each room
  * keeps one dispatch table), no FMA, no estimates (rcp/rsqrt), no fast-math,
- * no gathers, no byte/16-bit lanes yet (fuse's refine and composite use
- * them, see docs/portability.md; bytes widen to int32 lanes with
- * vi_load_u8, RGBA8 pixels are int32 lanes through vi_loadu). What one
+ * no gathers; of byte and 16-bit lanes only what the fuse's per-row
+ * composite needs (vh_*, per 128-bit block; the refinement's saturating
+ * and unsigned-compare operations are not here, docs/portability.md);
+ * bytes widen to int32 lanes with vi_load_u8, RGBA8 pixels are int32
+ * lanes through vi_loadu. What one
  * ISA does in a way the others cannot (AVX-512 joint tables, AVX2's
  * 128-bit lane permutes) stays in that ISA's kernel file, on the layer's
  * types.
