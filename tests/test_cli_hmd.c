@@ -180,8 +180,9 @@ static void run(void **st)
     tu_tmp_path("run_consumer_conf", o2, sizeof o2);
     FILE *f = fopen(conf, "w");
     assert_non_null(f);
-    fprintf(f, "scene = %s\n[cameras]\nleft = %s\nright = %s\n[hmd]\npreset = consumer\n"
-               "loop = yes\n[output]\nout = %s\nframes = 1\nquiet = yes\n", scene, left, right, o2);
+    fprintf(f, "scene = %s\n[cameras]\nleft = %s\nright = %s\nloop = yes\n[hmd]\n"
+               "preset = consumer\n[output]\nout = %s\nframes = 1\nquiet = yes\n", scene, left,
+            right, o2);
     fclose(f);
     rc = ego("run", "--config", conf, NULL);
     if (rc != 0) fail_msg("run --config ([hmd] preset = consumer): exit %d: %s", rc, out);

@@ -95,9 +95,11 @@ static int load_virt(const char *path, int w, int h, io_image *img)
     io_error err;
     if (io_image_load(path, IO_U8, 4, img, &err) != IO_OK) return cli_fail("%s", err.msg);
     if (img->width != w || img->height != h) {
+        /* the sizes before the image is freed (which zeroes them) */
+        cli_fail("%s: virtual image is %dx%d, expected %dx%d", path, img->width, img->height, w,
+                 h);
         io_image_free(img);
-        return cli_fail("%s: virtual image is %dx%d, expected %dx%d", path, img->width, img->height,
-                        w, h);
+        return EXIT_FAIL;
     }
     return EXIT_OK;
 }
