@@ -255,6 +255,9 @@ typedef struct bench {
     int cam_n, cam_w, cam_h;
     size_t cam_size;
     io_scene sc;              /* the sample scene */
+    int inplace;              /* 1: V is copied into out before each frame
+                                 (untimed) and composited in place there,
+                                 as into a renderer's fresh buffer */
     int window_frame[MAX_WINDOW]; /* sequence frame of each window slot */
     imgset base;              /* 1280x800 */
     uint8_t *out[2];          /* sized for the largest resolution */
@@ -459,6 +462,8 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
 {
     const int w = (int)(i % is->n);
     const int cw = b->cam_w, ch = b->cam_h;
+    if (b->inplace)
+        for (int e = 0; e < 2; e++) memcpy(b->out[e], is->virt[w][e], (size_t)is->w * is->h * 4);
     double t0 = now_ms();
     double t1 = now_ms();
     pipe_frame_in in = {0};
@@ -478,7 +483,7 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
         /* As the camera delivers it: each eye's thread converts its crop. */
         in.camera_raw[e] = (fuse_frame){b->cam[w % b->cam_n][e], b->cam_size, cw, ch,
                                         2 * cw, FUSE_FMT_YUYV};
-        in.virt[e] = img_of(is->virt[w][e], is->w, is->h);
+        in.virt[e] = img_of(b->inplace ? b->out[e] : is->virt[w][e], is->w, is->h);
         in.out[e] = img_of(b->out[e], is->w, is->h);
         in.virt_depth[e] = is->depth[w][e];
         in.virt_depth_stride[e] = is->w;
@@ -1202,11 +1207,13 @@ static void run_hmds(bench *b, int n, double max_s)
     FILE *f = open_csv(b, "frame_hmd.csv",
                        "hmd,cam_w,cam_h,out_w,out_h,out_mp_both,crop_w,crop_h,vp_w,vp_h,coverage,"
                        "avx2_1t_ms,avx2_2t_ms,best_isa,best_2t_ms,floor_1t_ms,floor_2t_ms,"
-                       "convert_ms,track_ms,skin_ms,raster_ms,fuse_ms");
+                       "convert_ms,track_ms,skin_ms,raster_ms,fuse_ms,avx2_2t_inplace_ms,"
+                       "best_2t_inplace_ms,inplace_fuse_ms");
     printf("\nNamed HMDs (docs/kin.md): the typical sequence at each HMD's camera and display\n"
            "sizes (camera frames remapped from the samples' by ray, virtual images resized;\n"
            "medians of up to %d frames or %.1f s per case; stage columns as above, raster and\n"
-           "fuse summed over both eyes) against the memcpy of both outputs:\n",
+           "fuse summed over both eyes) against the memcpy of both outputs; rows NAME/ip:\n"
+           "composited in place (out = V's buffer, refreshed untimed before each frame):\n",
            n, max_s);
     posesrc typical = {b->samples, b->seq_frames, NULL, 0};
     for (int k = 0; kin_sthmd_preset_name(k); k++) {
@@ -1235,25 +1242,34 @@ static void run_hmds(bench *b, int n, double max_s)
                g.crop_y0, hd.lcd_width, hd.lcd_height, 2e-6 * hd.lcd_width * hd.lcd_height,
                g.vp_width, g.vp_height, g.vp_x0, g.vp_y0);
         print_head();
-        struct { ef_isa isa; int t; } cases[3] = {{EF_ISA_AVX2, 1}, {EF_ISA_AVX2, 2}, {best, 2}};
-        double ms[3] = {NAN, NAN, NAN};
+        /* out of place (V read, out written), then in place (out = a
+         * fresh copy of V, untimed: the hand's pixels only are written) */
+        struct { ef_isa isa; int t, inplace; } cases[5] = {
+            {EF_ISA_AVX2, 1, 0}, {EF_ISA_AVX2, 2, 0}, {best, 2, 0}, {EF_ISA_AVX2, 2, 1}, {best, 2, 1}};
+        double ms[5] = {NAN, NAN, NAN, NAN, NAN}, ip_fuse = NAN;
         result r2 = {0};
-        for (int c = 0; c < 3; c++) {
-            if (c < 2 && !has_avx2) continue;
-            if (c == 2 && has_avx2 && best == EF_ISA_AVX2) {
-                ms[2] = ms[1];
+        for (int c = 0; c < 5; c++) {
+            if ((c < 2 || c == 3) && !has_avx2) continue;
+            if ((c == 2 || c == 4) && has_avx2 && best == EF_ISA_AVX2) {
+                ms[c] = ms[c - 1];
                 continue;
             }
             pipe_ctx *p = make_pipe(b, &b->model, cases[c].isa, cases[c].t, &hd);
             result r;
+            b->inplace = cases[c].inplace;
             if (p && pipe_isa(p) == (int)cases[c].isa &&
                 measure(b, p, &is, &typical, n, max_s, &r)) {
-                print_row(name, ef_isa_name(cases[c].isa), cases[c].t, &r);
-                csv_row(b, "frame_hmd", "egofuse", ef_isa_name(cases[c].isa), cases[c].t, &r, -1,
-                        hd.lcd_width, hd.lcd_height);
+                char label[32];
+                snprintf(label, sizeof label, "%s%s", name, cases[c].inplace ? "/ip" : "");
+                print_row(label, ef_isa_name(cases[c].isa), cases[c].t, &r);
+                csv_row(b, cases[c].inplace ? "frame_hmd_inplace" : "frame_hmd", "egofuse",
+                        ef_isa_name(cases[c].isa), cases[c].t, &r, -1, hd.lcd_width,
+                        hd.lcd_height);
                 ms[c] = r.total.median;
                 if (c == 1 || (c == 2 && !has_avx2)) r2 = r;
+                if (c == 3 || (c == 4 && !has_avx2)) ip_fuse = r.fuse;
             }
+            b->inplace = 0;
             pipe_destroy(p);
         }
         result fl[2];
@@ -1267,16 +1283,17 @@ static void run_hmds(bench *b, int n, double max_s)
                bytes / 1e6, fl[0].total.median, fl[1].total.median,
                bytes / fl[1].total.median / 1e6);
         if (!isnan(ms[1]))
-            printf("  frame / floor (avx2, 2 threads): %.1fx; %s / avx2: %.2fx\n",
-                   ms[1] / fl[1].total.median, ef_isa_name(best), ms[2] / ms[1]);
+            printf("  frame / floor (avx2, 2 threads): %.1fx; %s / avx2: %.2fx; in place "
+                   "(rows /ip: V composited in its own buffer) / out of place, avx2: %.2fx\n",
+                   ms[1] / fl[1].total.median, ef_isa_name(best), ms[2] / ms[1], ms[3] / ms[1]);
         if (f)
             fprintf(f, "%s,%d,%d,%d,%d,%.4f,%d,%d,%d,%d,%.4f,%.4f,%.4f,%s,%.4f,%.4f,%.4f,%.4f,%.4f,"
-                       "%.4f,%.4f,%.4f\n",
+                       "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
                     name, hd.cam_width, hd.cam_height, hd.lcd_width, hd.lcd_height,
                     2e-6 * hd.lcd_width * hd.lcd_height, g.crop_width, g.crop_height, g.vp_width,
                     g.vp_height, r2.coverage, ms[0], ms[1], ef_isa_name(best), ms[2],
                     fl[0].total.median, fl[1].total.median, r2.convert, r2.track, r2.skin,
-                    r2.raster, r2.fuse);
+                    r2.raster, r2.fuse, ms[3], ms[4], ip_fuse);
         b->cam = b->yuyv;
         b->cam_n = b->window;
         b->cam_w = b->hmd.cam_width;
