@@ -82,6 +82,15 @@ static double now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
+/* CPU time of the whole process (every thread), ms: on a shared machine
+ * the work of a frame, without the time its threads waited for a core. */
+static double cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
 static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -222,13 +231,14 @@ typedef struct posesrc {
 
 /* Per-frame times of one measured case. */
 typedef struct times {
-    double *total, *convert, *track, *skin, *raster, *fuse, *cover;
+    double *total, *convert, *track, *skin, *raster, *fuse, *cover, *cpu;
     int cap;
 } times;
 
 typedef struct result {
     summary total;
     double convert, track, skin, raster, fuse, coverage, fps;
+    double cpu;               /* median process CPU time per frame, ms */
     int frames;
 } result;
 
@@ -453,6 +463,7 @@ static void times_init(times *t, int cap)
     t->raster = xmalloc(sizeof(double) * cap);
     t->fuse = xmalloc(sizeof(double) * cap);
     t->cover = xmalloc(sizeof(double) * cap);
+    t->cpu = xmalloc(sizeof(double) * cap);
 }
 
 /* One whole stereo frame i: convert, track, pipe_frame. Fills slot k of
@@ -464,6 +475,7 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
     const int cw = b->cam_w, ch = b->cam_h;
     if (b->inplace)
         for (int e = 0; e < 2; e++) memcpy(b->out[e], is->virt[w][e], (size_t)is->w * is->h * 4);
+    double c0 = cpu_ms();
     double t0 = now_ms();
     double t1 = now_ms();
     pipe_frame_in in = {0};
@@ -494,6 +506,7 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
     char why[256];
     pipe_result r = pipe_frame(p, &in, &st, why, sizeof why);
     double t3 = now_ms();
+    double c3 = cpu_ms();
     if (r != PIPE_OK) {
         fprintf(stderr, "bench_frame: frame %ld: %s\n", i, why);
         return 0;
@@ -506,6 +519,7 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
         b->tm.raster[k] = st.ms_raster[0] + st.ms_raster[1];
         b->tm.fuse[k] = st.ms_fuse[0] + st.ms_fuse[1];
         b->tm.cover[k] = 0.5 * (st.coverage[0] + st.coverage[1]);
+        b->tm.cpu[k] = c3 - c0;
     }
     return 1;
 }
@@ -538,6 +552,7 @@ static int measure(bench *b, pipe_ctx *p, const imgset *is, const posesrc *src, 
     r->skin = median_of(b->tm.skin, n);
     r->raster = median_of(b->tm.raster, n);
     r->fuse = median_of(b->tm.fuse, n);
+    r->cpu = median_of(b->tm.cpu, n);
     double cs = 0;
     for (int k = 0; k < n; k++) cs += b->tm.cover[k];
     r->coverage = cs / n;
@@ -1208,7 +1223,8 @@ static void run_hmds(bench *b, int n, double max_s)
                        "hmd,cam_w,cam_h,out_w,out_h,out_mp_both,crop_w,crop_h,vp_w,vp_h,coverage,"
                        "avx2_1t_ms,avx2_2t_ms,best_isa,best_2t_ms,floor_1t_ms,floor_2t_ms,"
                        "convert_ms,track_ms,skin_ms,raster_ms,fuse_ms,avx2_2t_inplace_ms,"
-                       "best_2t_inplace_ms,inplace_fuse_ms");
+                       "best_2t_inplace_ms,inplace_fuse_ms,cpu_avx2_1t_ms,cpu_avx2_2t_ms,"
+                       "cpu_best_2t_ms,cpu_avx2_2t_inplace_ms,cpu_best_2t_inplace_ms");
     printf("\nNamed HMDs (docs/kin.md): the typical sequence at each HMD's camera and display\n"
            "sizes (camera frames remapped from the samples' by ray, virtual images resized;\n"
            "medians of up to %d frames or %.1f s per case; stage columns as above, raster and\n"
@@ -1246,12 +1262,13 @@ static void run_hmds(bench *b, int n, double max_s)
          * fresh copy of V, untimed: the hand's pixels only are written) */
         struct { ef_isa isa; int t, inplace; } cases[5] = {
             {EF_ISA_AVX2, 1, 0}, {EF_ISA_AVX2, 2, 0}, {best, 2, 0}, {EF_ISA_AVX2, 2, 1}, {best, 2, 1}};
-        double ms[5] = {NAN, NAN, NAN, NAN, NAN}, ip_fuse = NAN;
+        double ms[5] = {NAN, NAN, NAN, NAN, NAN}, cpu[5] = {NAN, NAN, NAN, NAN, NAN}, ip_fuse = NAN;
         result r2 = {0};
         for (int c = 0; c < 5; c++) {
             if ((c < 2 || c == 3) && !has_avx2) continue;
             if ((c == 2 || c == 4) && has_avx2 && best == EF_ISA_AVX2) {
                 ms[c] = ms[c - 1];
+                cpu[c] = cpu[c - 1];
                 continue;
             }
             pipe_ctx *p = make_pipe(b, &b->model, cases[c].isa, cases[c].t, &hd);
@@ -1262,6 +1279,9 @@ static void run_hmds(bench *b, int n, double max_s)
                 char label[32];
                 snprintf(label, sizeof label, "%s%s", name, cases[c].inplace ? "/ip" : "");
                 print_row(label, ef_isa_name(cases[c].isa), cases[c].t, &r);
+                printf("  %-8s CPU time of the process per frame (median): %.3f ms%s\n", "",
+                       r.cpu, cases[c].t == 2 ? " (both threads)" : "");
+                cpu[c] = r.cpu;
                 csv_row(b, cases[c].inplace ? "frame_hmd_inplace" : "frame_hmd", "egofuse",
                         ef_isa_name(cases[c].isa), cases[c].t, &r, -1, hd.lcd_width,
                         hd.lcd_height);
@@ -1288,12 +1308,13 @@ static void run_hmds(bench *b, int n, double max_s)
                    ms[1] / fl[1].total.median, ef_isa_name(best), ms[2] / ms[1], ms[3] / ms[1]);
         if (f)
             fprintf(f, "%s,%d,%d,%d,%d,%.4f,%d,%d,%d,%d,%.4f,%.4f,%.4f,%s,%.4f,%.4f,%.4f,%.4f,%.4f,"
-                       "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
+                       "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
                     name, hd.cam_width, hd.cam_height, hd.lcd_width, hd.lcd_height,
                     2e-6 * hd.lcd_width * hd.lcd_height, g.crop_width, g.crop_height, g.vp_width,
                     g.vp_height, r2.coverage, ms[0], ms[1], ef_isa_name(best), ms[2],
                     fl[0].total.median, fl[1].total.median, r2.convert, r2.track, r2.skin,
-                    r2.raster, r2.fuse, ms[3], ms[4], ip_fuse);
+                    r2.raster, r2.fuse, ms[3], ms[4], ip_fuse, cpu[0], cpu[1], cpu[2], cpu[3],
+                    cpu[4]);
         b->cam = b->yuyv;
         b->cam_n = b->window;
         b->cam_w = b->hmd.cam_width;
