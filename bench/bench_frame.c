@@ -38,7 +38,7 @@
  *
  *   bench_frame [--samples DIR] [--out DIR] [--frames N] [--ref-frames N]
  *               [--scale-frames N] [--window N] [--quick] [--no-scaling]
- *               [--no-hmds] [--hmds-only] [--hmd-frames N]
+ *               [--no-hmds] [--hmds-only] [--hmd-frames N] [--hmd NAME]
  *
  * Writes DIR/bench.csv (header + egofuse, memcpy and pixman rows),
  * DIR/frame_tris.csv, DIR/frame_cover.csv, DIR/frame_res.csv,
@@ -1215,7 +1215,7 @@ static int hmd_cameras(bench *b, const kin_sthmd_desc *hd, int n, uint8_t *(*yuy
  * threads, the best ISA with 2, against the memory floor of that output
  * size. Rows frame_hmd / floor_hmd of bench.csv (out_w, out_h), and
  * frame_hmd.csv for the chart. */
-static void run_hmds(bench *b, int n, double max_s)
+static void run_hmds(bench *b, int n, double max_s, const char *only)
 {
     const ef_isa best = ef_isa_choose(EF_ISA_DEFAULT);
     const int has_avx2 = ef_cpu_has(EF_ISA_AVX2) && ef_isa_choose(EF_ISA_AVX2) == EF_ISA_AVX2;
@@ -1234,6 +1234,7 @@ static void run_hmds(bench *b, int n, double max_s)
     posesrc typical = {b->samples, b->seq_frames, NULL, 0};
     for (int k = 0; kin_sthmd_preset_name(k); k++) {
         const char *name = kin_sthmd_preset_name(k);
+        if (only && strcmp(only, name)) continue;
         kin_sthmd_desc hd;
         kin_sthmd_preset(name, &hd);
         const kin_sthmd_geometry g = kin_sthmd_geometry_of(&hd);
@@ -1344,6 +1345,7 @@ int main(int argc, char **argv)
     budget bu = {3000, 1000, 30, 200, 6.0, 2.5, 2.0, 1.0};
     int window = 16, scaling = 1, hmds = 1, hmd_frames = 400;
     double hmd_s = 4.0;
+    const char *hmd_only = NULL;
     for (int a = 1; a < argc; a++) {
         const char *o = argv[a], *v = a + 1 < argc ? argv[a + 1] : NULL;
         int ok = 1, sec = 0;
@@ -1367,13 +1369,17 @@ int main(int argc, char **argv)
         else if (!strcmp(o, "--no-hmds")) hmds = 0;
         else if (!strcmp(o, "--hmds-only")) scaling = 0, hmds = 2;
         else if (!strcmp(o, "--hmd-frames") && v) ok = parse_int(v, 1, 1000000, &hmd_frames), a++;
+        else if (!strcmp(o, "--hmd") && v) {
+            hmd_only = v, a++;
+            ok = kin_sthmd_preset(v, NULL) == 0;
+        }
         else ok = 0;
         if (!ok) {
             fprintf(stderr,
                     "usage: %s [--samples DIR] [--out DIR] [--frames N] [--ref-frames N]\n"
                     "       [--scale-frames N] [--seconds S] [--window N] [--quick] "
                     "[--no-scaling]\n"
-                    "       [--no-hmds] [--hmds-only] [--hmd-frames N]\n",
+                    "       [--no-hmds] [--hmds-only] [--hmd-frames N] [--hmd NAME]\n",
                     argv[0]);
             return 2;
         }
@@ -1426,7 +1432,7 @@ int main(int argc, char **argv)
 
     ef_isa best = ef_isa_choose(EF_ISA_DEFAULT);
     if (hmds == 2) {   /* --hmds-only */
-        run_hmds(&b, hmd_frames, hmd_s);
+        run_hmds(&b, hmd_frames, hmd_s, hmd_only);
         if (b.csv) fclose(b.csv);
         helper_stop(&b.help);
         return 0;
@@ -1461,7 +1467,7 @@ int main(int argc, char **argv)
         scale_cover(&b, bu.scale_frames, bu.s_scale, best);
         scale_res(&b, bu.scale_frames, bu.s_scale, best);
     }
-    if (hmds) run_hmds(&b, hmd_frames, hmd_s);
+    if (hmds) run_hmds(&b, hmd_frames, hmd_s, hmd_only);
     if (b.csv) fclose(b.csv);
     printf("\nCSV: %s (egofuse, memcpy, pixman rows; llvmpipe_frame appends its own), "
            "frame_tris.csv, frame_cover.csv, frame_res.csv in %s/\n",
