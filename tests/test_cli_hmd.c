@@ -7,8 +7,9 @@
  *     the eq. 1 crop (957x1024: the width cut), the virtual image outside
  *     the eq. 4 viewport (1539x1647 at (262, 280)) and the hand inside;
  *   - `egofuse run --hmd-preset consumer` (and [hmd] preset = consumer in
- *     a cockpit file) on the recorded frames writes frames of that size;
- *     an option of its own overrides a field of the preset;
+ *     a cockpit file) on the recorded frames writes frames of that size,
+ *     its --dump names the HMD and renders again to its frame; an option
+ *     of its own overrides a field of the preset;
  *   - an unknown HMD name (scene key, --hmd-preset, gen_samples --hmd) is
  *     refused naming it, nothing written. */
 #include "support/testutil.h"
@@ -152,12 +153,45 @@ static void run(void **st)
     snprintf(left, sizeof left, "file:%s/cam/left_%%04d.png", seq);
     snprintf(right, sizeof right, "file:%s/cam/right_%%04d.png", seq);
     tu_tmp_path("run_consumer", o, sizeof o);
+    char d[600], rd[600], ds[700];
+    tu_tmp_path("run_consumer_dump", d, sizeof d);
+    tu_tmp_path("run_consumer_dump_render", rd, sizeof rd);
     int rc = ego("run", "--hmd-preset", "consumer", "--scene", scene, "--left", left, "--right",
-                 right, "--frames", "1", "--loop", "--out", o, "--quiet", NULL);
+                 right, "--frames", "1", "--loop", "--out", o, "--dump", d, "--quiet", NULL);
     if (rc != 0) fail_msg("run --hmd-preset consumer: exit %d: %s", rc, out);
     for (int e = 0; e < 2; e++) {
         snprintf(p, sizeof p, "%s/%s_0000.png", o, e ? "right" : "left");
         check_size(p, 2064, 2208);
+    }
+    /* the dump names the HMD; rendered again it gives run's frame (the
+     * same geometry: at most a level of difference on a few pixels, from
+     * the animation time) */
+    snprintf(ds, sizeof ds, "%s/scene.txt", d);
+    assert_true(file_has(ds, "\nhmd = consumer\n"));
+    rc = ego("render", "--scene", ds, "--out", rd, "--quiet", NULL);
+    if (rc != 0) fail_msg("render of the dump: exit %d: %s", rc, out);
+    for (int e = 0; e < 2; e++) {
+        char a[700], b[700];
+        snprintf(a, sizeof a, "%s/%s_0000.png", o, e ? "right" : "left");
+        snprintf(b, sizeof b, "%s/%s_0000.png", rd, e ? "right" : "left");
+        io_image x = load(a), y = load(b);
+        assert_int_equal(y.width, 2064);
+        assert_int_equal(y.height, 2208);
+        long differ = 0, big = 0;
+        for (int r = 0; r < x.height; r++)
+            for (int c = 0; c < x.width; c++) {
+                const uint8_t *u = (uint8_t *)x.data + (size_t)r * x.stride + 4 * (size_t)c;
+                const uint8_t *v = (uint8_t *)y.data + (size_t)r * y.stride + 4 * (size_t)c;
+                int m = 0;
+                for (int k = 0; k < 3; k++) m = abs(u[k] - v[k]) > m ? abs(u[k] - v[k]) : m;
+                differ += m > 0;
+                big += m > 1;
+            }
+        io_image_free(&x);
+        io_image_free(&y);
+        if (big || differ > 2064 * 2208 / 1000)
+            fail_msg("%s eye: run and the render of its dump differ at %ld pixels (%ld by > 1)",
+                     e ? "right" : "left", differ, big);
     }
     /* without the preset: the paper's sizes, which the images do not have */
     char o3[600];

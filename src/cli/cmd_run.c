@@ -460,6 +460,15 @@ static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
                        strrchr(dabs, '.') ? strrchr(dabs, '.') : "") < 0;
     }
     if (r->have_scene && r->sc.head_node[0]) bad |= fprintf(f, "head_node = %s\n", r->sc.head_node) < 0;
+    {
+        /* a named HMD other than the paper's (render follows the key; an
+         * HMD of other numbers has no scene key yet) */
+        const kin_sthmd_desc hd = kin_sthmd_desc_resolved(&o->hmd);
+        kin_sthmd_desc nd;
+        for (int k = 1; kin_sthmd_preset_name(k); k++)
+            if (kin_sthmd_preset(kin_sthmd_preset_name(k), &nd) == 0 && !memcmp(&hd, &nd, sizeof hd))
+                bad |= fprintf(f, "hmd = %s\n", kin_sthmd_preset_name(k)) < 0;
+    }
     if (r->have_scene && r->sc.animation[0]) bad |= fprintf(f, "animation = %s\n", r->sc.animation) < 0;
     if (r->have_scene && r->sc.has_lighting) {
         /* the lighting lines as written, so render parses the same floats */
