@@ -26,6 +26,11 @@
  *   scaling     time per frame against the triangle count (bench_mesh.h
  *               arms, 2k..100k, skinned to one joint), the covered area
  *               and the output resolution (640x400 .. 2560x1600).
+ *   HMDs        the typical sequence on the named HMDs (kin_sthmd_preset:
+ *               paper, consumer 1280x1024 -> 2x 2064x2208, highend
+ *               1920x1080 -> 2x 2880x2720), avx2 (1 and 2 threads) and
+ *               the best ISA (2), against the memcpy of those outputs:
+ *               rows frame_hmd / floor_hmd, frame_hmd.csv.
  *
  * Inputs are preloaded (a window of --window frames, camera frames turned
  * into YUYV once), so no file I/O is timed. Wall-clock times on a shared
@@ -33,10 +38,12 @@
  *
  *   bench_frame [--samples DIR] [--out DIR] [--frames N] [--ref-frames N]
  *               [--scale-frames N] [--window N] [--quick] [--no-scaling]
+ *               [--no-hmds] [--hmds-only] [--hmd-frames N] [--hmd NAME]
  *               [--isa I] [--threads T]   (the grid: only that ISA / thread count)
  *
  * Writes DIR/bench.csv (header + egofuse, memcpy and pixman rows),
- * DIR/frame_tris.csv, DIR/frame_cover.csv, DIR/frame_res.csv. Reports,
+ * DIR/frame_tris.csv, DIR/frame_cover.csv, DIR/frame_res.csv,
+ * DIR/frame_hmd.csv. Reports,
  * never passes or fails (exit 1 only when the samples cannot be read). */
 #include <math.h>
 #include <pthread.h>
@@ -73,6 +80,15 @@ static double now_ms(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+/* CPU time of the whole process (every thread), ms: on a shared machine
+ * the work of a frame, without the time its threads waited for a core. */
+static double cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
@@ -216,13 +232,14 @@ typedef struct posesrc {
 
 /* Per-frame times of one measured case. */
 typedef struct times {
-    double *total, *convert, *track, *skin, *raster, *fuse, *cover;
+    double *total, *convert, *track, *skin, *raster, *fuse, *cover, *cpu;
     int cap;
 } times;
 
 typedef struct result {
     summary total;
     double convert, track, skin, raster, fuse, coverage, fps;
+    double cpu;               /* median process CPU time per frame, ms */
     int frames;
 } result;
 
@@ -243,6 +260,16 @@ typedef struct bench {
     uint8_t *yuyv[MAX_WINDOW][2];
     size_t yuyv_size;
     uint8_t *cam_rgba[2];
+    /* the camera frames frame_step feeds (the base set above, or an HMD's
+     * in run_hmds): cam_n frames of cam_w x cam_h YUYV */
+    uint8_t *(*cam)[2];
+    int cam_n, cam_w, cam_h;
+    size_t cam_size;
+    io_scene sc;              /* the sample scene */
+    int inplace;              /* 1: V is copied into out before each frame
+                                 (untimed) and composited in place there,
+                                 as into a renderer's fresh buffer */
+    int window_frame[MAX_WINDOW]; /* sequence frame of each window slot */
     imgset base;              /* 1280x800 */
     uint8_t *out[2];          /* sized for the largest resolution */
     size_t out_bytes;
@@ -331,6 +358,7 @@ static int preload(bench *b, const char *samples_dir, int window)
     io_scene sc;
     io_error err;
     snprintf(path, sizeof path, "%s/scene.txt", samples_dir);
+    if (io_scene_load(path, &b->sc, &err) != IO_OK) memset(&b->sc, 0, sizeof b->sc);
     if (io_scene_load(path, &sc, &err) != IO_OK) {
         fprintf(stderr, "bench_frame: %s (make build/gen_samples && build/gen_samples --out %s)\n",
                 err.msg, samples_dir);
@@ -371,6 +399,7 @@ static int preload(bench *b, const char *samples_dir, int window)
     for (int f = 0; f < window; f++) {
         /* spread the window over the sequence */
         int fr = (int)((long)f * sc.frames / window);
+        b->window_frame[f] = fr;
         for (int e = 0; e < 2; e++) {
             io_image img = {0};
             io_scene_frame_path(&sc, sc.camera[e], fr, path, sizeof path);
@@ -403,7 +432,19 @@ static int preload(bench *b, const char *samples_dir, int window)
     }
     b->base.opaque = imgset_opaque(&b->base);
     for (int e = 0; e < 2; e++) b->cam_rgba[e] = xmalloc((size_t)cw * ch * 4);
+    b->cam = b->yuyv;
+    b->cam_n = b->window;
+    b->cam_w = cw;
+    b->cam_h = ch;
+    b->cam_size = b->yuyv_size;
+    /* the outputs: the largest of the resolution scaling and the HMDs */
     b->out_bytes = (size_t)2560 * 1600 * 4;
+    for (int k = 0; kin_sthmd_preset_name(k); k++) {
+        kin_sthmd_desc hd;
+        kin_sthmd_preset(kin_sthmd_preset_name(k), &hd);
+        if ((size_t)hd.lcd_width * hd.lcd_height * 4 > b->out_bytes)
+            b->out_bytes = (size_t)hd.lcd_width * hd.lcd_height * 4;
+    }
     for (int e = 0; e < 2; e++) {
         b->out[e] = xmalloc(b->out_bytes);
         memset(b->out[e], 0, b->out_bytes);
@@ -423,6 +464,7 @@ static void times_init(times *t, int cap)
     t->raster = xmalloc(sizeof(double) * cap);
     t->fuse = xmalloc(sizeof(double) * cap);
     t->cover = xmalloc(sizeof(double) * cap);
+    t->cpu = xmalloc(sizeof(double) * cap);
 }
 
 /* One whole stereo frame i: convert, track, pipe_frame. Fills slot k of
@@ -431,7 +473,10 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
                       int k)
 {
     const int w = (int)(i % is->n);
-    const int cw = b->hmd.cam_width, ch = b->hmd.cam_height;
+    const int cw = b->cam_w, ch = b->cam_h;
+    if (b->inplace)
+        for (int e = 0; e < 2; e++) memcpy(b->out[e], is->virt[w][e], (size_t)is->w * is->h * 4);
+    double c0 = cpu_ms();
     double t0 = now_ms();
     double t1 = now_ms();
     pipe_frame_in in = {0};
@@ -449,9 +494,9 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
     in.world_from_head = src->head;
     for (int e = 0; e < 2; e++) {
         /* As the camera delivers it: each eye's thread converts its crop. */
-        in.camera_raw[e] = (fuse_frame){b->yuyv[w % b->window][e], b->yuyv_size, cw, ch,
+        in.camera_raw[e] = (fuse_frame){b->cam[w % b->cam_n][e], b->cam_size, cw, ch,
                                         2 * cw, FUSE_FMT_YUYV};
-        in.virt[e] = img_of(is->virt[w][e], is->w, is->h);
+        in.virt[e] = img_of(b->inplace ? b->out[e] : is->virt[w][e], is->w, is->h);
         in.out[e] = img_of(b->out[e], is->w, is->h);
         in.virt_depth[e] = is->depth[w][e];
         in.virt_depth_stride[e] = is->w;
@@ -462,6 +507,7 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
     char why[256];
     pipe_result r = pipe_frame(p, &in, &st, why, sizeof why);
     double t3 = now_ms();
+    double c3 = cpu_ms();
     if (r != PIPE_OK) {
         fprintf(stderr, "bench_frame: frame %ld: %s\n", i, why);
         return 0;
@@ -474,6 +520,7 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
         b->tm.raster[k] = st.ms_raster[0] + st.ms_raster[1];
         b->tm.fuse[k] = st.ms_fuse[0] + st.ms_fuse[1];
         b->tm.cover[k] = 0.5 * (st.coverage[0] + st.coverage[1]);
+        b->tm.cpu[k] = c3 - c0;
     }
     return 1;
 }
@@ -506,6 +553,7 @@ static int measure(bench *b, pipe_ctx *p, const imgset *is, const posesrc *src, 
     r->skin = median_of(b->tm.skin, n);
     r->raster = median_of(b->tm.raster, n);
     r->fuse = median_of(b->tm.fuse, n);
+    r->cpu = median_of(b->tm.cpu, n);
     double cs = 0;
     for (int k = 0; k < n; k++) cs += b->tm.cover[k];
     r->coverage = cs / n;
@@ -712,39 +760,46 @@ static void result_from(result *r, double *v, int n, double wall)
     r->total = summarize(v, n);
 }
 
+/* memcpy of both outputs of is from its virtual images, t threads (one
+ * eye each with 2), n times after 5 warm-ups. */
+static void memcpy_floor(bench *b, const imgset *is, int t, int n, result *r)
+{
+    const size_t bytes = (size_t)is->w * is->h * 4;
+    double *v = xmalloc(sizeof(double) * n);
+    double w0 = 0;
+    for (int k = -5; k < n; k++) {
+        int f = (k + 5) % is->n;
+        if (k == 0) w0 = now_ms();
+        double t0 = now_ms();
+        copy_job j[2] = {{b->out[0], is->virt[f][0], bytes}, {b->out[1], is->virt[f][1], bytes}};
+        if (t == 2) {
+            helper_start(&b->help, copy_run, &j[1]);
+            copy_run(&j[0]);
+            helper_wait(&b->help);
+        } else {
+            copy_run(&j[0]);
+            copy_run(&j[1]);
+        }
+        if (k >= 0) v[k] = now_ms() - t0;
+    }
+    result_from(r, v, n, now_ms() - w0);
+    free(v);
+}
+
 /* The memory floor: both 1280x800 outputs written from the virtual
  * images (8.2 MB read, 8.2 MB written), 1 thread and 2 (one eye each). */
 static void run_memcpy(bench *b, int n)
 {
     const size_t bytes = (size_t)b->base.w * b->base.h * 4;
-    double *v = xmalloc(sizeof(double) * n);
     printf("\nmemcpy floor (both %dx%d outputs from the virtual images, 2 x %.1f MB):\n",
            b->base.w, b->base.h, bytes / 1e6);
     for (int t = 1; t <= 2; t++) {
-        double w0 = 0;
-        for (int k = -5; k < n; k++) {
-            int f = (k + 5) % b->base.n;
-            if (k == 0) w0 = now_ms();
-            double t0 = now_ms();
-            copy_job j[2] = {{b->out[0], b->base.virt[f][0], bytes},
-                             {b->out[1], b->base.virt[f][1], bytes}};
-            if (t == 2) {
-                helper_start(&b->help, copy_run, &j[1]);
-                copy_run(&j[0]);
-                helper_wait(&b->help);
-            } else {
-                copy_run(&j[0]);
-                copy_run(&j[1]);
-            }
-            if (k >= 0) v[k] = now_ms() - t0;
-        }
         result r;
-        result_from(&r, v, n, now_ms() - w0);
+        memcpy_floor(b, &b->base, t, n, &r);
         printf("  %d thread%s: median %.3f ms, p99 %.3f ms (%.1f GB/s copied)\n", t,
                t > 1 ? "s" : " ", r.total.median, r.total.p99, 2 * bytes / r.total.median / 1e6);
         csv_row(b, "memcpy_floor", "memcpy", "-", t, &r, -1, b->base.w, b->base.h);
     }
-    free(v);
 }
 
 /* The composite stage alone, egofuse (each ISA, 1 thread; the best, 2)
@@ -1104,6 +1159,181 @@ static void scale_res(bench *b, int n, double max_s, ef_isa isa)
     if (f) fclose(f);
 }
 
+/* --------------------------------------------------- the named HMDs */
+
+/* Camera frames of hd's sensor made from the sample's (the paper's camera,
+ * 640x480 at 62 deg), the frames of the window's first n slots: each
+ * pixel of hd's sensor takes the sample pixel on the same ray (nearest;
+ * mid grey where hd's wider FOV sees past the sample's), as YUYV. The
+ * arms land about where hd's camera sees them (its cameras sit a few mm
+ * elsewhere); the frame's time depends on the sizes and on the area the
+ * mask model covers, which comes from the model and hd, not from these
+ * pixels. Returns 0 when a sample image cannot be read. */
+static int hmd_cameras(bench *b, const kin_sthmd_desc *hd, int n, uint8_t *(*yuyv)[2])
+{
+    const double d2r = 3.14159265358979323846 / 180.0;
+    const int sw = b->hmd.cam_width, sh = b->hmd.cam_height;
+    const int w = hd->cam_width, h = hd->cam_height;
+    const double f0 = 0.5 * sw / tan(0.5 * b->hmd.cam_hfov_deg * d2r);
+    const double f1 = 0.5 * w / tan(0.5 * hd->cam_hfov_deg * d2r);
+    int *mx = xmalloc(sizeof(int) * (size_t)w), *my = xmalloc(sizeof(int) * (size_t)h);
+    for (int x = 0; x < w; x++) {
+        double u = 0.5 * sw + (x + 0.5 - 0.5 * w) * f0 / f1;
+        mx[x] = u >= 0 && u < sw ? (int)u : -1;
+    }
+    for (int y = 0; y < h; y++) {
+        double v = 0.5 * sh + (y + 0.5 - 0.5 * h) * f0 / f1;
+        my[y] = v >= 0 && v < sh ? (int)v : -1;
+    }
+    uint8_t *rgba = xmalloc((size_t)w * h * 4);
+    char path[IO_PATH_MAX + 64];
+    int ok = 1;
+    for (int f = 0; f < n && ok; f++)
+        for (int e = 0; e < 2 && ok; e++) {
+            io_image img = {0};
+            io_scene_frame_path(&b->sc, b->sc.camera[e], b->window_frame[f], path, sizeof path);
+            if (!load_rgba(path, sw, sh, &img)) {
+                ok = 0;
+                break;
+            }
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < w; x++) {
+                    uint8_t *d = rgba + ((size_t)y * w + x) * 4;
+                    if (mx[x] < 0 || my[y] < 0) {
+                        d[0] = d[1] = d[2] = 128;
+                        d[3] = 255;
+                    } else {
+                        memcpy(d, (uint8_t *)img.data + (size_t)my[y] * img.stride + 4 * mx[x], 4);
+                    }
+                }
+            io_image_free(&img);
+            yuyv[f][e] = xmalloc((size_t)w * h * 2);
+            bench_rgba_to_yuyv(rgba, w, h, (size_t)w * 4, yuyv[f][e]);
+        }
+    free(rgba);
+    free(mx);
+    free(my);
+    return ok;
+}
+
+/* The typical sequence on each named HMD (kin_sthmd_preset: the paper's,
+ * a consumer one with 1280x1024 cameras and 2064x2208 per eye, a high-end
+ * one with 1920x1080 cameras and 2880x2720 per eye): AVX2 with 1 and 2
+ * threads, the best ISA with 2, against the memory floor of that output
+ * size. Rows frame_hmd / floor_hmd of bench.csv (out_w, out_h), and
+ * frame_hmd.csv for the chart. */
+static void run_hmds(bench *b, int n, double max_s, const char *only)
+{
+    const ef_isa best = ef_isa_choose(EF_ISA_DEFAULT);
+    const int has_avx2 = ef_cpu_has(EF_ISA_AVX2) && ef_isa_choose(EF_ISA_AVX2) == EF_ISA_AVX2;
+    FILE *f = open_csv(b, "frame_hmd.csv",
+                       "hmd,cam_w,cam_h,out_w,out_h,out_mp_both,crop_w,crop_h,vp_w,vp_h,coverage,"
+                       "avx2_1t_ms,avx2_2t_ms,best_isa,best_2t_ms,floor_1t_ms,floor_2t_ms,"
+                       "convert_ms,track_ms,skin_ms,raster_ms,fuse_ms,avx2_2t_inplace_ms,"
+                       "best_2t_inplace_ms,inplace_fuse_ms,cpu_avx2_1t_ms,cpu_avx2_2t_ms,"
+                       "cpu_best_2t_ms,cpu_avx2_2t_inplace_ms,cpu_best_2t_inplace_ms");
+    printf("\nNamed HMDs (docs/kin.md): the typical sequence at each HMD's camera and display\n"
+           "sizes (camera frames remapped from the samples' by ray, virtual images resized;\n"
+           "medians of up to %d frames or %.1f s per case; stage columns as above, raster and\n"
+           "fuse summed over both eyes) against the memcpy of both outputs; rows NAME/ip:\n"
+           "composited in place (out = V's buffer, refreshed untimed before each frame):\n",
+           n, max_s);
+    posesrc typical = {b->samples, b->seq_frames, NULL, 0};
+    for (int k = 0; kin_sthmd_preset_name(k); k++) {
+        const char *name = kin_sthmd_preset_name(k);
+        if (only && strcmp(only, name)) continue;
+        kin_sthmd_desc hd;
+        kin_sthmd_preset(name, &hd);
+        const kin_sthmd_geometry g = kin_sthmd_geometry_of(&hd);
+        const int nf = b->window < 4 ? b->window : 4;
+        uint8_t *yuyv[MAX_WINDOW][2];
+        memset(yuyv, 0, sizeof yuyv);
+        if (!hmd_cameras(b, &hd, nf, yuyv)) {
+            printf("  %s: SKIPPED (the sample camera images cannot be read)\n", name);
+            for (int i = 0; i < nf; i++) free(yuyv[i][0]), free(yuyv[i][1]);
+            continue;
+        }
+        imgset is;
+        imgset_resized(b, &is, hd.lcd_width, hd.lcd_height, nf);
+        b->cam = yuyv;
+        b->cam_n = nf;
+        b->cam_w = hd.cam_width;
+        b->cam_h = hd.cam_height;
+        b->cam_size = (size_t)hd.cam_width * hd.cam_height * 2;
+        printf("\n  %s: camera %dx%d -> crop %dx%d at (%d, %d); display %dx%d per eye "
+               "(%.2f MP both eyes), viewport %dx%d at (%d, %d)\n",
+               name, hd.cam_width, hd.cam_height, g.crop_width, g.crop_height, g.crop_x0,
+               g.crop_y0, hd.lcd_width, hd.lcd_height, 2e-6 * hd.lcd_width * hd.lcd_height,
+               g.vp_width, g.vp_height, g.vp_x0, g.vp_y0);
+        print_head();
+        /* out of place (V read, out written), then in place (out = a
+         * fresh copy of V, untimed: the hand's pixels only are written) */
+        struct { ef_isa isa; int t, inplace; } cases[5] = {
+            {EF_ISA_AVX2, 1, 0}, {EF_ISA_AVX2, 2, 0}, {best, 2, 0}, {EF_ISA_AVX2, 2, 1}, {best, 2, 1}};
+        double ms[5] = {NAN, NAN, NAN, NAN, NAN}, cpu[5] = {NAN, NAN, NAN, NAN, NAN}, ip_fuse = NAN;
+        result r2 = {0};
+        for (int c = 0; c < 5; c++) {
+            if ((c < 2 || c == 3) && !has_avx2) continue;
+            if ((c == 2 || c == 4) && has_avx2 && best == EF_ISA_AVX2) {
+                ms[c] = ms[c - 1];
+                cpu[c] = cpu[c - 1];
+                continue;
+            }
+            pipe_ctx *p = make_pipe(b, &b->model, cases[c].isa, cases[c].t, &hd);
+            result r;
+            b->inplace = cases[c].inplace;
+            if (p && pipe_isa(p) == (int)cases[c].isa &&
+                measure(b, p, &is, &typical, n, max_s, &r)) {
+                char label[32];
+                snprintf(label, sizeof label, "%s%s", name, cases[c].inplace ? "/ip" : "");
+                print_row(label, ef_isa_name(cases[c].isa), cases[c].t, &r);
+                printf("  %-8s CPU time of the process per frame (median): %.3f ms%s\n", "",
+                       r.cpu, cases[c].t == 2 ? " (both threads)" : "");
+                cpu[c] = r.cpu;
+                csv_row(b, cases[c].inplace ? "frame_hmd_inplace" : "frame_hmd", "egofuse",
+                        ef_isa_name(cases[c].isa), cases[c].t, &r, -1, hd.lcd_width,
+                        hd.lcd_height);
+                ms[c] = r.total.median;
+                if (c == 1 || (c == 2 && !has_avx2)) r2 = r;
+                if (c == 3 || (c == 4 && !has_avx2)) ip_fuse = r.fuse;
+            }
+            b->inplace = 0;
+            pipe_destroy(p);
+        }
+        result fl[2];
+        for (int t = 1; t <= 2; t++) {
+            memcpy_floor(b, &is, t, n, &fl[t - 1]);
+            csv_row(b, "floor_hmd", "memcpy", "-", t, &fl[t - 1], -1, hd.lcd_width, hd.lcd_height);
+        }
+        const double bytes = 2.0 * 2.0 * hd.lcd_width * hd.lcd_height * 4;
+        printf("  memcpy floor (both outputs, %.1f MB read + written): 1 thread %.3f ms, "
+               "2 threads %.3f ms (%.1f GB/s)\n",
+               bytes / 1e6, fl[0].total.median, fl[1].total.median,
+               bytes / fl[1].total.median / 1e6);
+        if (!isnan(ms[1]))
+            printf("  frame / floor (avx2, 2 threads): %.1fx; %s / avx2: %.2fx; in place "
+                   "(rows /ip: V composited in its own buffer) / out of place, avx2: %.2fx\n",
+                   ms[1] / fl[1].total.median, ef_isa_name(best), ms[2] / ms[1], ms[3] / ms[1]);
+        if (f)
+            fprintf(f, "%s,%d,%d,%d,%d,%.4f,%d,%d,%d,%d,%.4f,%.4f,%.4f,%s,%.4f,%.4f,%.4f,%.4f,%.4f,"
+                       "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n",
+                    name, hd.cam_width, hd.cam_height, hd.lcd_width, hd.lcd_height,
+                    2e-6 * hd.lcd_width * hd.lcd_height, g.crop_width, g.crop_height, g.vp_width,
+                    g.vp_height, r2.coverage, ms[0], ms[1], ef_isa_name(best), ms[2],
+                    fl[0].total.median, fl[1].total.median, r2.convert, r2.track, r2.skin,
+                    r2.raster, r2.fuse, ms[3], ms[4], ip_fuse, cpu[0], cpu[1], cpu[2], cpu[3],
+                    cpu[4]);
+        b->cam = b->yuyv;
+        b->cam_n = b->window;
+        b->cam_w = b->hmd.cam_width;
+        b->cam_h = b->hmd.cam_height;
+        b->cam_size = b->yuyv_size;
+        imgset_free(&is);
+        for (int i = 0; i < nf; i++) free(yuyv[i][0]), free(yuyv[i][1]);
+    }
+    if (f) fclose(f);
+}
+
 /* -------------------------------------------------------------- main */
 
 static int parse_int(const char *s, int lo, int hi, int *out)
@@ -1120,7 +1350,9 @@ int main(int argc, char **argv)
     const char *samples = "build/samples", *outdir = "bench/out";
     /* caps: frames per case and seconds per case (the time box) */
     budget bu = {3000, 1000, 30, 200, 6.0, 2.5, 2.0, 1.0};
-    int window = 16, scaling = 1;
+    int window = 16, scaling = 1, hmds = 1, hmd_frames = 400;
+    double hmd_s = 4.0;
+    const char *hmd_only = NULL;
     for (int a = 1; a < argc; a++) {
         const char *o = argv[a], *v = a + 1 < argc ? argv[a + 1] : NULL;
         int ok = 1, sec = 0;
@@ -1138,7 +1370,16 @@ int main(int argc, char **argv)
         else if (!strcmp(o, "--quick")) {
             budget q = {300, 200, 5, 40, 1.0, 0.5, 0.5, 0.3};
             bu = q;
+            hmd_frames = 60;
+            hmd_s = 1.0;
         } else if (!strcmp(o, "--no-scaling")) scaling = 0;
+        else if (!strcmp(o, "--no-hmds")) hmds = 0;
+        else if (!strcmp(o, "--hmds-only")) scaling = 0, hmds = 2;
+        else if (!strcmp(o, "--hmd-frames") && v) ok = parse_int(v, 1, 1000000, &hmd_frames), a++;
+        else if (!strcmp(o, "--hmd") && v) {
+            hmd_only = v, a++;
+            ok = kin_sthmd_preset(v, NULL) == 0;
+        }
         else if (!strcmp(o, "--isa") && v) {
             grid_isa = ef_isa_parse(v), a++;
             ok = grid_isa != EF_ISA_DEFAULT;
@@ -1149,6 +1390,7 @@ int main(int argc, char **argv)
                     "usage: %s [--samples DIR] [--out DIR] [--frames N] [--ref-frames N]\n"
                     "       [--scale-frames N] [--seconds S] [--window N] [--quick] "
                     "[--no-scaling]\n"
+                    "       [--no-hmds] [--hmds-only] [--hmd-frames N] [--hmd NAME]\n"
                     "       [--isa ref|sse2|avx2|avx512] [--threads 1|2]   (the grid only)\n",
                     argv[0]);
             return 2;
@@ -1175,6 +1417,7 @@ int main(int argc, char **argv)
     int cap = bu.frames_best > bu.frames ? bu.frames_best : bu.frames;
     if (bu.ref_frames > cap) cap = bu.ref_frames;
     if (bu.scale_frames > cap) cap = bu.scale_frames;
+    if (hmd_frames > cap) cap = hmd_frames;
     if (cap < 16) cap = 16;
     times_init(&b.tm, cap);
     char path[1024];
@@ -1200,6 +1443,12 @@ int main(int argc, char **argv)
            bu.scale_frames, bu.s_best, bu.s_other, bu.s_ref, bu.s_scale, b.seq_frames);
 
     ef_isa best = ef_isa_choose(EF_ISA_DEFAULT);
+    if (hmds == 2) {   /* --hmds-only */
+        run_hmds(&b, hmd_frames, hmd_s, hmd_only);
+        if (b.csv) fclose(b.csv);
+        helper_stop(&b.help);
+        return 0;
+    }
     pipe_ctx *p = make_pipe(&b, &b.model, best, 2, NULL);
     if (!p) return 1;
     find_worst(&b, p);
@@ -1230,6 +1479,7 @@ int main(int argc, char **argv)
         scale_cover(&b, bu.scale_frames, bu.s_scale, best);
         scale_res(&b, bu.scale_frames, bu.s_scale, best);
     }
+    if (hmds) run_hmds(&b, hmd_frames, hmd_s, hmd_only);
     if (b.csv) fclose(b.csv);
     printf("\nCSV: %s (egofuse, memcpy, pixman rows; llvmpipe_frame appends its own), "
            "frame_tris.csv, frame_cover.csv, frame_res.csv in %s/\n",

@@ -9,6 +9,9 @@
 # and its llvmpipe peer (llvmpipe_frame, 1 and 2 threads: appends to
 # bench.csv), then the per-stage benchmarks, then the charts (gnuplot,
 # bench/plot/*.gp) and a summary with the ratios, bench/out/summary.md.
+# bench_frame also runs the named HMDs (paper, consumer 1280x1024 ->
+# 2x 2064x2208, highend 1920x1080 -> 2x 2880x2720): rows frame_hmd and
+# floor_hmd of bench.csv, frame_hmd.csv, the chart frame_hmd.png.
 # BENCH_FRAME_ARGS (e.g. "--quick", "--seconds 20"), LLVMPIPE_FRAMES and
 # STAGE_RUNS (runs of the per-stage benchmarks) and RASTER_RUNS (of
 # bench_raster and llvmpipe_raster) change the counts;
@@ -153,6 +156,21 @@ if [ -f "$OUT/bench.csv" ]; then
                      }
                      if (px != "" && cb != "") printf "- composite stage: pixman %.3f ms, egofuse (%s, 1 thread) %.3f ms; pixman / egofuse = %.1fx\n", px, ci, cb, px / cb
                  }' "$OUT/bench.csv"
+        if [ -f "$OUT/frame_hmd.csv" ]; then
+            echo
+            echo "Named HMDs (bench_frame's frame_hmd rows; kin_sthmd_preset, docs/kin.md): the typical sequence,"
+            echo "ms per stereo frame (medians), against the memcpy of both outputs (chart: frame_hmd.png):"
+            echo
+            echo "| HMD | camera | display per eye | output MP (both eyes) | crop | viewport | hands cover | avx2 1t | avx2 2t | best ISA 2t | in place: avx2 2t / best 2t | floor 2t | avx2 2t / floor | avx2 2t stages: convert / track / skin / raster / fuse ms (raster, fuse summed over the eyes) |"
+            echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+            awk -F, 'NR > 1 { printf "| %s | %dx%d | %dx%d | %.2f | %dx%d | %dx%d | %.0f%% | %.2f | %.2f | %.2f (%s) | %.2f / %.2f | %.2f | %.1fx | %.2f / %.3f / %.3f / %.2f / %.2f |\n",
+                                   $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, 100 * $11, $12, $13, $15, $14, $23, $24, $17, $13 / $17, $18, $19, $20, $21, $22 }' "$OUT/frame_hmd.csv"
+            echo
+            awk -F, 'NR > 1 && $1 == "consumer" { printf "- consumer HMD (1280x1024 cameras, 2x 2064x2208), avx2, 2 threads: %.2f ms per stereo frame - target <= 5.5 ms: %s; %s, 2 threads: %.2f ms; in place (V composited in its own buffer): avx2 %.2f ms (%s), %s %.2f ms\n",
+                                   $13, ($13 <= 5.5 ? "met" : sprintf("missed by %.1fx", $13 / 5.5)), $14, $15, $23, ($23 <= 5.5 ? "met" : sprintf("missed by %.1fx", $23 / 5.5)), $14, $24
+                                   printf "- the same on a loaded machine, from the CPU time per frame (all threads; at best half of it on 2 idle cores): avx2 2 threads %.2f ms CPU, >= %.2f ms (%s); in place %.2f ms CPU, >= %.2f ms (%s)\n",
+                                   $27, $27 / 2, ($27 / 2 <= 5.5 ? "met" : sprintf("missed by >= %.1fx", $27 / 11)), $29, $29 / 2, ($29 / 2 <= 5.5 ? "met" : sprintf("missed by >= %.1fx", $29 / 11)) }' "$OUT/frame_hmd.csv"
+        fi
         if [ -f "$OUT/llvmpipe_diff.csv" ]; then
             awk -F, 'NR > 1 { printf "- llvmpipe output vs egofuse (%d thread%s, %d stereo frames): mean |d| %.3f, max %d, %.3f%% of all pixels differ by > 8 (hand pixels: mean |d| %.2f, %.2f%% > 8)\n", $1, ($1 > 1 ? "s" : ""), $2, $3, $4, $5, $7, $8 }' "$OUT/llvmpipe_diff.csv"
         fi

@@ -153,25 +153,38 @@ typedef struct gen_frame_ctx {
     float *depth, *tattr;
     uint8_t *mask;
     size_t clip_cap;
+    kin_sthmd_desc hmd;       /* resolved: the paper's after init */
+    size_t px_cap;            /* pixels of the targets */
 } gen_frame_ctx;
 
 int  gen_frame_ctx_init(gen_frame_ctx *c, const gen_arms *arms,
                         const gen_scene *cockpit, const gen_scene *workshop,
                         uint64_t seed);
 void gen_frame_ctx_free(gen_frame_ctx *c);
+/* Renders for the HMD hd from now on (resolved; e.g. kin_sthmd_preset):
+ * camera images of its sensor (cam_width x cam_height, its FOV, the
+ * cameras at +-baseline/2 and D in front), virtual images of its display
+ * (lcd_width x lcd_height at its FOVs, the eyes at +-ipd/2). After
+ * gen_frame_ctx_init the context renders the paper's HMD (GEN_CAM_W x
+ * GEN_CAM_H, GEN_VIRT_W x GEN_VIRT_H), the same bytes as before. Returns
+ * -1 when the larger targets cannot be allocated (c keeps its old ones). */
+int  gen_frame_ctx_set_hmd(gen_frame_ctx *c, const kin_sthmd_desc *hd);
 
 /* Poses the arms at time t (seconds): FK, LBS into c->skin_pos/skin_nrm;
  * returns the head's world matrix in *world_from_head. */
 void gen_pose(gen_frame_ctx *c, float t, kin_mat4 *world_from_head);
 
 /* Renders the full 640x480 RGB sensor image of one camera (rgb: 3 bytes per
- * pixel, 640*3 per row) for frame `frame`; *coverage gets the fraction of
- * the cropped 640x400 part covered by the arms. Call gen_pose() first. */
+ * pixel, 640*3 per row; the context's HMD's sensor size with
+ * gen_frame_ctx_set_hmd) for frame `frame`; *coverage gets the fraction of
+ * the cropped 640x400 part (eq. 1's crop) covered by the arms. Call
+ * gen_pose() first. */
 void gen_render_camera(gen_frame_ctx *c, const kin_mat4 *world_from_head,
                        kin_eye eye, int frame, uint8_t *rgb, float *coverage);
 
-/* Renders the 1280x800 virtual image of one eye (rgb) and its depth
- * (view-space depth -z in metres, 1 float per pixel). */
+/* Renders the 1280x800 virtual image of one eye (rgb; the context's HMD's
+ * display size) and its depth (view-space depth -z in metres, 1 float per
+ * pixel). */
 void gen_render_virtual(gen_frame_ctx *c, const kin_mat4 *world_from_head,
                         kin_eye eye, int frame, uint8_t *rgb, float *depth);
 

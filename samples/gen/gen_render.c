@@ -196,6 +196,8 @@ int gen_frame_ctx_init(gen_frame_ctx *c, const gen_arms *arms,
     c->depth = malloc(sizeof(float) * px);
     c->tattr = malloc(sizeof(float) * GEN_ATTRS * px);
     c->mask = malloc(px);
+    c->px_cap = px;
+    c->hmd = kin_sthmd_desc_resolved(NULL);
     if (!c->locals || !c->world || !c->jm || !c->skin_pos || !c->skin_nrm ||
         !c->arm_attr || !c->clip || !c->depth || !c->tattr || !c->mask) {
         gen_frame_ctx_free(c);
@@ -209,6 +211,34 @@ int gen_frame_ctx_init(gen_frame_ctx *c, const gen_arms *arms,
         a[GEN_A_U] = arms->uv[v * 2 + 0];
         a[GEN_A_V] = arms->uv[v * 2 + 1];
     }
+    return 0;
+}
+
+int gen_frame_ctx_set_hmd(gen_frame_ctx *c, const kin_sthmd_desc *hd)
+{
+    const kin_sthmd_desc r = kin_sthmd_desc_resolved(hd);
+    size_t px = (size_t)r.cam_width * (size_t)r.cam_height;
+    if ((size_t)r.lcd_width * (size_t)r.lcd_height > px)
+        px = (size_t)r.lcd_width * (size_t)r.lcd_height;
+    if (px > c->px_cap) {
+        float *depth = malloc(sizeof(float) * px);
+        float *tattr = malloc(sizeof(float) * GEN_ATTRS * px);
+        uint8_t *mask = malloc(px);
+        if (!depth || !tattr || !mask) {
+            free(depth);
+            free(tattr);
+            free(mask);
+            return -1;
+        }
+        free(c->depth);
+        free(c->tattr);
+        free(c->mask);
+        c->depth = depth;
+        c->tattr = tattr;
+        c->mask = mask;
+        c->px_cap = px;
+    }
+    c->hmd = r;
     return 0;
 }
 
@@ -274,15 +304,18 @@ static uint64_t mix64(uint64_t z)
 void gen_render_camera(gen_frame_ctx *c, const kin_mat4 *world_from_head,
                        kin_eye eye, int frame, uint8_t *rgb, float *coverage)
 {
-    kin_camera cam = kin_sthmd_camera(NULL, world_from_head, eye);
-    kin_sthmd_geometry g = kin_sthmd_geometry_of(NULL);
-    /* the full sensor: same focal length, principal point crop_y0 lower */
-    kin_mat4 proj = gen_proj_from_intrinsics(cam.fx, cam.fy, cam.cx,
+    const int cw = c->hmd.cam_width, ch = c->hmd.cam_height;
+    kin_camera cam = kin_sthmd_camera(&c->hmd, world_from_head, eye);
+    kin_sthmd_geometry g = kin_sthmd_geometry_of(&c->hmd);
+    /* the full sensor: same focal length, principal point crop_x0 right
+     * of and crop_y0 below the crop's */
+    const float cx = cam.cx + (float)g.crop_x0;
+    kin_mat4 proj = gen_proj_from_intrinsics(cam.fx, cam.fy, cx,
                                              cam.cy + (float)g.crop_y0,
-                                             GEN_CAM_W, GEN_CAM_H,
+                                             cw, ch,
                                              GEN_CAM_ZNEAR, GEN_CAM_ZFAR);
     kin_mat4 vp = kin_mat4_mul(&proj, &cam.view);
-    rast_target t = target_of(c, GEN_CAM_W, GEN_CAM_H);
+    rast_target t = target_of(c, cw, ch);
     rast_target_clear(&t);
     draw_scene(c, &t, &vp, c->cockpit);
     draw_arms(c, &t, &vp);
@@ -290,14 +323,15 @@ void gen_render_camera(gen_frame_ctx *c, const kin_mat4 *world_from_head,
     uint64_t st = mix64(c->seed * 0x9E3779B97F4A7C15ull + (uint64_t)frame * 2u +
                         (uint64_t)eye + 1u);
     long covered = 0;
-    for (int y = 0; y < GEN_CAM_H; y++) {
-        for (int x = 0; x < GEN_CAM_W; x++) {
-            size_t i = (size_t)y * GEN_CAM_W + (size_t)x;
+    for (int y = 0; y < ch; y++) {
+        for (int x = 0; x < cw; x++) {
+            size_t i = (size_t)y * (size_t)cw + (size_t)x;
             float col[3];
             if (c->mask[i]) {
                 const float *a = &c->tattr[i * GEN_ATTRS];
                 shade(c->cockpit, a, col);
-                if (is_arm_pixel(a) && y >= g.crop_y0 && y < g.crop_y0 + g.crop_height)
+                if (is_arm_pixel(a) && y >= g.crop_y0 && y < g.crop_y0 + g.crop_height &&
+                    x >= g.crop_x0 && x < g.crop_x0 + g.crop_width)
                     covered++;
             } else {
                 col[0] = c->cockpit->sky[0];
@@ -305,7 +339,7 @@ void gen_render_camera(gen_frame_ctx *c, const kin_mat4 *world_from_head,
                 col[2] = c->cockpit->sky[2];
             }
             /* slight lens vignetting */
-            float dx = ((float)x + 0.5f - cam.cx) / cam.fx;
+            float dx = ((float)x + 0.5f - cx) / cam.fx;
             float dy = ((float)y + 0.5f - cam.cy - (float)g.crop_y0) / cam.fy;
             float vig = 1.0f - 0.12f * (dx * dx + dy * dy);
             for (int k = 0; k < 3; k++) {
@@ -327,21 +361,23 @@ void gen_render_virtual(gen_frame_ctx *c, const kin_mat4 *world_from_head,
 {
     (void)frame;
     kin_transform te = kin_transform_identity();
-    te.t.x = eye == KIN_EYE_LEFT ? -GEN_EYE_HALF_BASELINE : GEN_EYE_HALF_BASELINE;
+    const float half = 0.5f * c->hmd.ipd_m;   /* the paper: GEN_EYE_HALF_BASELINE */
+    const int vw = c->hmd.lcd_width, vh = c->hmd.lcd_height;
+    te.t.x = eye == KIN_EYE_LEFT ? -half : half;
     kin_mat4 he = kin_mat4_from_transform(&te);
     kin_mat4 world_from_eye = kin_mat4_mul(world_from_head, &he), view;
     kin_mat4_inverse(&world_from_eye, &view);
-    float fx = 0.5f * (float)GEN_VIRT_W / tanf(0.5f * GEN_HMD_HFOV_DEG * PI_F / 180.0f);
-    float fy = 0.5f * (float)GEN_VIRT_H / tanf(0.5f * GEN_HMD_VFOV_DEG * PI_F / 180.0f);
-    kin_mat4 proj = gen_proj_from_intrinsics(fx, fy, 0.5f * GEN_VIRT_W, 0.5f * GEN_VIRT_H,
-                                             GEN_VIRT_W, GEN_VIRT_H,
+    float fx = 0.5f * (float)vw / tanf(0.5f * c->hmd.hmd_hfov_deg * PI_F / 180.0f);
+    float fy = 0.5f * (float)vh / tanf(0.5f * c->hmd.hmd_vfov_deg * PI_F / 180.0f);
+    kin_mat4 proj = gen_proj_from_intrinsics(fx, fy, 0.5f * (float)vw, 0.5f * (float)vh,
+                                             vw, vh,
                                              GEN_VIRT_ZNEAR, GEN_VIRT_ZFAR);
     kin_mat4 vp = kin_mat4_mul(&proj, &view);
-    rast_target t = target_of(c, GEN_VIRT_W, GEN_VIRT_H);
+    rast_target t = target_of(c, vw, vh);
     rast_target_clear(&t);
     draw_scene(c, &t, &vp, c->workshop);
     const double n = GEN_VIRT_ZNEAR, f = GEN_VIRT_ZFAR;
-    for (size_t i = 0; i < (size_t)GEN_VIRT_W * GEN_VIRT_H; i++) {
+    for (size_t i = 0; i < (size_t)vw * (size_t)vh; i++) {
         float col[3];
         if (c->mask[i]) {
             shade(c->workshop, &c->tattr[i * GEN_ATTRS], col);

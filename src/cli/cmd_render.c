@@ -23,7 +23,8 @@ static const char *render_usage =
     "the camera images inside the mask (Blinn-Phong + Fresnel), resamples\n"
     "them into the viewport (1194x746, eq. 2-4) and composites them over the\n"
     "virtual scene: DIR/left_NNNN.png and DIR/right_NNNN.png, RGB of the\n"
-    "display's size (1280x800).\n"
+    "display's size (1280x800). A scene with an `hmd` key (docs/scene.md:\n"
+    "consumer, highend) is rendered with that HMD's sizes and eq. 1-4.\n"
     "\n"
     "  --scene FILE   the scene file\n"
     "  --out DIR      output folder (created if missing)\n"
@@ -322,6 +323,8 @@ static int render(const render_opts *o)
     pd.refine_band = o->refine;
     pd.normal_smooth = o->smooth_normals;
     pd.fit_rig = o->refine && o->pose_tracking ? &tp.rig : NULL;
+    /* the scene's HMD (its `hmd` key, checked on load), or the paper's */
+    if (sc.hmd[0]) kin_sthmd_preset(sc.hmd, &pd.hmd);
     pipe_ctx *pp = pipe_create(&pd, &model);
     kin_sthmd_desc hd = pp ? pipe_hmd(pp) : kin_sthmd_desc_resolved(&pd.hmd);
     io_image cam[2] = {{0}}, virt[2] = {{0}}, vdepth[2] = {{0}}, rgb = {0};

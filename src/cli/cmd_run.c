@@ -95,9 +95,11 @@ static int load_virt(const char *path, int w, int h, io_image *img)
     io_error err;
     if (io_image_load(path, IO_U8, 4, img, &err) != IO_OK) return cli_fail("%s", err.msg);
     if (img->width != w || img->height != h) {
+        /* the sizes before the image is freed (which zeroes them) */
+        cli_fail("%s: virtual image is %dx%d, expected %dx%d", path, img->width, img->height, w,
+                 h);
         io_image_free(img);
-        return cli_fail("%s: virtual image is %dx%d, expected %dx%d", path, img->width, img->height,
-                        w, h);
+        return EXIT_FAIL;
     }
     return EXIT_OK;
 }
@@ -458,6 +460,15 @@ static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
                        strrchr(dabs, '.') ? strrchr(dabs, '.') : "") < 0;
     }
     if (r->have_scene && r->sc.head_node[0]) bad |= fprintf(f, "head_node = %s\n", r->sc.head_node) < 0;
+    {
+        /* a named HMD other than the paper's (render follows the key; an
+         * HMD of other numbers has no scene key yet) */
+        const kin_sthmd_desc hd = kin_sthmd_desc_resolved(&o->hmd);
+        kin_sthmd_desc nd;
+        for (int k = 1; kin_sthmd_preset_name(k); k++)
+            if (kin_sthmd_preset(kin_sthmd_preset_name(k), &nd) == 0 && !memcmp(&hd, &nd, sizeof hd))
+                bad |= fprintf(f, "hmd = %s\n", kin_sthmd_preset_name(k)) < 0;
+    }
     if (r->have_scene && r->sc.animation[0]) bad |= fprintf(f, "animation = %s\n", r->sc.animation) < 0;
     if (r->have_scene && r->sc.has_lighting) {
         /* the lighting lines as written, so render parses the same floats */

@@ -62,6 +62,9 @@ const char *run_usage =
     "  --loop           recorded frames: start again at the end\n"
     "  --buffers N      mmap buffers per camera (default 4)\n"
     "the HMD (default: the paper's):\n"
+    "  --hmd-preset NAME  a named HMD (docs/kin.md): paper, consumer (1280x1024\n"
+    "                   cameras, 2064x2208 per eye), highend (1920x1080,\n"
+    "                   2880x2720); the other --hmd-* options override its fields\n"
     "  --hmd-camera WxH, --hmd-camera-hfov DEG, --hmd-baseline M (camera\n"
     "  separation), --hmd-camera-offset M (D), --hmd-display WxH (per eye),\n"
     "  --hmd-hfov DEG, --hmd-vfov DEG, --hmd-focal M, --hmd-ipd M\n"
@@ -99,7 +102,7 @@ enum {
     O_DISPLAY, O_NATNET, O_NN_LOCAL, O_NN_MCAST, O_NN_BODY, O_NN_UP, O_NN_UNITS, O_NN_VERSION,
     O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD, O_ALLOW_OUTSIDE,
     O_HMD_CAM, O_HMD_CAM_HFOV, O_HMD_BASE, O_HMD_OFFSET, O_HMD_DISP, O_HMD_HFOV, O_HMD_VFOV,
-    O_HMD_FOCAL, O_HMD_IPD, O_DUMP
+    O_HMD_FOCAL, O_HMD_IPD, O_HMD_PRESET, O_DUMP
 };
 
 static const struct option run_long_opts[] = {
@@ -157,6 +160,7 @@ static const struct option run_long_opts[] = {
     {"hmd-vfov", required_argument, 0, O_HMD_VFOV},
     {"hmd-focal", required_argument, 0, O_HMD_FOCAL},
     {"hmd-ipd", required_argument, 0, O_HMD_IPD},
+    {"hmd-preset", required_argument, 0, O_HMD_PRESET},
     {"dump", required_argument, 0, O_DUMP},
     {0, 0, 0, 0},
 };
@@ -282,6 +286,8 @@ int run_parse(int argc, char **argv, run_opts *o)
     opterr = 0;
     int c;
     static char virt_buf[2 * IO_PATH_MAX];
+    kin_sthmd_desc preset;
+    int have_preset = 0;
     while ((c = getopt_long(ac, av, "h", run_long_opts, NULL)) != -1) {
         float f;
         switch (c) {
@@ -436,12 +442,38 @@ int run_parse(int argc, char **argv, run_opts *o)
             if (!parse_range(optarg, 0.04f, 0.09f, &f)) BAD("--hmd-ipd '%s': 0.04..0.09 m", optarg);
             o->hmd.ipd_m = f;
             break;
+        case O_HMD_PRESET:
+            if (kin_sthmd_preset(optarg, &preset) != 0)
+                BAD("--hmd-preset '%s': one of paper, consumer, highend", optarg);
+            have_preset = 1;
+            break;
         case ':': BAD("option %s needs a value", av[optind - 1]);
         default: BAD("unknown option '%s'", av[optind - 1]);
         }
     }
     if (optind < ac) BAD("unexpected argument '%s'", av[optind]);
 #undef BAD
+    if (have_preset) {
+        /* the preset's fields, but for those given by their own option
+         * (in the file or on the command line, before or after it) */
+        kin_sthmd_desc *h = &o->hmd;
+#define TAKE(f) \
+    if (!(h->f > 0)) h->f = preset.f
+        TAKE(cam_width);
+        TAKE(cam_height);
+        TAKE(cam_hfov_deg);
+        TAKE(baseline_m);
+        TAKE(cam_offset_m);
+        TAKE(lcd_width);
+        TAKE(lcd_height);
+        TAKE(hmd_hfov_deg);
+        TAKE(hmd_vfov_deg);
+        TAKE(focal_m);
+        TAKE(znear);
+        TAKE(zfar);
+        TAKE(ipd_m);
+#undef TAKE
+    }
     if (!o->sel[0] != !o->sel[1]) return cli_usage_error("run", "give both --left and --right");
     for (int e = 0; e < 2; e++) {
         io_error err;

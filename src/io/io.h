@@ -206,6 +206,9 @@ typedef struct io_scene {
     int has_lighting;                 /* 0 = use fuse_lighting_default() */
     char tracking[IO_PATH_MAX];       /* recorded tracking of the sequence
                                          (docs/tracking.md), or "" */
+    char hmd[32];                     /* the named HMD that recorded it
+                                         (kin_sthmd_preset), or "": the
+                                         paper's */
 } io_scene;
 
 io_result io_scene_load(const char *path, io_scene *out, io_error *err);

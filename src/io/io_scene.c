@@ -28,7 +28,7 @@ typedef enum key_id {
     K_CAMERA_LEFT, K_CAMERA_RIGHT, K_VIRTUAL_LEFT, K_VIRTUAL_RIGHT,
     K_VIRTUAL_DEPTH_LEFT, K_VIRTUAL_DEPTH_RIGHT,
     K_AMBIENT, K_LIGHT, K_KD, K_KS, K_SHININESS, K_KF, K_TONE,
-    K_TRACKING,
+    K_TRACKING, K_HMD,
     K_COUNT
 } key_id;
 
@@ -37,7 +37,7 @@ static const char *const key_names[K_COUNT] = {
     "camera_left", "camera_right", "virtual_left", "virtual_right",
     "virtual_depth_left", "virtual_depth_right",
     "ambient", "light", "kd", "ks", "shininess", "kf", "tone",
-    "tracking",
+    "tracking", "hmd",
 };
 
 static const key_id required[] = {
@@ -250,6 +250,16 @@ static io_result set_key(const where *w, key_id k, char *value, io_scene *s)
         else s->kf = f[0];
         return IO_OK;
     }
+    case K_HMD:
+        /* a named HMD (kin_sthmd_preset): the sizes of the images */
+        if (kin_sthmd_preset(value, NULL) != 0) {
+            char names[128] = "";
+            for (int i = 0; kin_sthmd_preset_name(i); i++)
+                snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s",
+                         i ? ", " : "", kin_sthmd_preset_name(i));
+            return bad(w, IO_ERR_VALUE, "hmd: unknown HMD '%.60s' (known: %s)", value, names);
+        }
+        return copy_str(w, key, value, s->hmd, sizeof s->hmd);
     case K_TRACKING:
         /* a plain path: no frame conversion (io_scene_frame_path copies
          * it unchanged, %% becoming %) */

@@ -297,7 +297,21 @@ typedef struct kin_sthmd_desc {
                                        by default) */
 } kin_sthmd_desc;
 
-/* The derived numbers of the paper (eq. 1-4). */
+/* The derived numbers of the paper (eq. 1-4).
+ *
+ * The crop (eq. 1, generalised): the cropped camera image has the LCD's
+ * aspect and cuts whichever side of the sensor is too long for it, centred.
+ *   H = round(cam_w * lcd_h / lcd_w);
+ *   H <= cam_h: keep the width (the paper: 640 x 400, rows 40..439);
+ *   H >  cam_h: keep the height, crop_w = round(cam_h * lcd_w / lcd_h)
+ *               (a camera wider than the display's aspect: a 16:9 camera,
+ *               a display taller than wide; 1280x1024 -> 2064x2208 keeps
+ *               957 x 1024 at column 161).
+ * The crop is always inside the sensor (crop_x0 + crop_width <= cam_w,
+ * crop_y0 + crop_height <= cam_h). Eq. 2 then uses the crop's horizontal
+ * FOV; the viewport (eq. 4) is inside the LCD when ratio <= 1 (the
+ * camera's cropped FOV, seen from D in front of the eye, no wider than
+ * the display's). */
 typedef struct kin_sthmd_geometry {
     int   crop_width, crop_height;  /* eq. 1: 640 x 400 */
     int   crop_y0;                  /* first camera row kept: (480-400)/2 */
@@ -340,6 +354,15 @@ kin_camera kin_sthmd_camera(const kin_sthmd_desc *desc,
  * resolved ipd_m (NULL world_from_head: identity). */
 kin_mat4 kin_sthmd_eye(const kin_sthmd_desc *desc, const kin_mat4 *world_from_head,
                        kin_eye eye);
+/* Named HMDs (src/kin/kin_hmd.c, docs/kin.md "Named HMDs"): "paper" (the
+ * defaults: 640x480 cameras, 1280x800 per eye), "consumer" (1280x1024
+ * cameras, 2064x2208 per eye), "highend" (1920x1080 cameras, 2880x2720
+ * per eye). Fills *out (every field set) and returns 0; -1 for an
+ * unknown or NULL name (*out untouched). */
+int kin_sthmd_preset(const char *name, kin_sthmd_desc *out);
+/* The i-th preset's name (0, 1, ...), NULL past the last: for listings
+ * and error messages. */
+const char *kin_sthmd_preset_name(int i);
 /* A general look-at camera (for `egofuse mask`). */
 kin_camera kin_camera_look_at(kin_vec3 eye, kin_vec3 target, kin_vec3 up,
                               float fovy_deg, int width, int height,
