@@ -857,6 +857,7 @@ static int run(const run_opts *o)
     kin_track_sample sample;
     memset(&sample, 0, sizeof sample);
     int have_img[2] = {0, 0}, cam_lost[2] = {0, 0};
+    char reopen_msg[2][sizeof err.msg] = {"", ""};
     uint64_t t_start = mono_ns(), t_status = t_start, t_retry[2] = {0, 0};
     io_lat lat_cam, lat_pipe, lat_deq;
     io_lat_reset(&lat_cam);
@@ -900,9 +901,15 @@ static int run(const run_opts *o)
             if (o->sel[e] && !file_cams && resolve(o->sel[e], np, sizeof np, &e2) == 0) where = np;
             if (io_cam_reopen(&r->cam[e], where, &e2) == IO_OK) {
                 cam_lost[e] = 0;
+                reopen_msg[e][0] = '\0';
                 if (!o->quiet)
                     fprintf(stderr, "\negofuse run: %s camera back (%s)\n", e ? "right" : "left",
                             r->cam[e].cfg.path);
+            } else if (strcmp(e2.msg, reopen_msg[e])) { /* each new reason once */
+                snprintf(reopen_msg[e], sizeof reopen_msg[e], "%s", e2.msg);
+                if (!o->quiet)
+                    fprintf(stderr, "\negofuse run: %s camera not back: %s\n", e ? "right" : "left",
+                            e2.msg);
             }
         }
         if (file_cams && (io_cam_file_ended(&r->cam[0]) || io_cam_file_ended(&r->cam[1]))) {

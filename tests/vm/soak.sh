@@ -104,12 +104,18 @@ alive() { [ -d /proc/$RUN ] && ! grep -q '^State:.*Z' /proc/$RUN/status 2>/dev/n
 count() { tr '\r' '\n' < "$D/run.err" | grep -c "$1"; }
 # waits up to $2 s for more than $3 lines matching $1
 wait_count() {
-    w=0
-    while alive && [ "$(count "$1")" -le "$3" ] && [ $w -lt $(($2 * 5)) ]; do
-        sleep 0.2
-        w=$((w + 1))
+    wend=$(awk -v n="$(up)" -v s="$2" 'BEGIN { printf "%.2f", n + s }')
+    while alive && [ "$(count "$1")" -le "$3" ] &&
+        awk -v a="$wend" -v n="$(up)" 'BEGIN { exit !(n < a) }'; do
+        sleep 0.5
     done
     [ "$(count "$1")" -gt "$3" ]
+}
+# the camera nodes and the vivid instances behind them
+nodes() {
+    for f in /sys/class/video4linux/video*; do
+        [ -e "$f/name" ] && printf '%s=%s ' "${f##*/}" "$(cat "$f/name")"
+    done
 }
 
 # warm-up: the first composited frames (starting under TCG takes a while)
@@ -118,6 +124,7 @@ if ! wait_count ' frames, ' 300 0; then
     kill -INT $RUN 2> /dev/null
 fi
 ev warm
+echo "VMINFO $TAG nodes $(nodes)"
 T0=$(up)
 i=1
 while [ $i -le "$CYC" ] && alive; do
@@ -129,9 +136,16 @@ while [ $i -le "$CYC" ] && alive; do
         # both cameras: the driver unbound (all of vivid's nodes go), 4 s
         # away, bound again (new nodes, the same numbers once the old
         # descriptors are closed)
+        lost=$(count 'camera lost')
         ev gone $i 0 1
         echo "$PDEV" > $DRV/unbind || ev fail unbind $PDEV
         sleep 4
+        # back only once egofuse has seen both go (and closed their nodes):
+        # a node still held open keeps its number, the camera would come
+        # back as another /dev/videoN, which a /dev/videoN selector does
+        # not follow (serial: and port: selectors do, docs/devices.md);
+        # under TCG a frame can take 10 s, so this wait can be long
+        wait_count 'camera lost' 90 $((lost + 1)) || ev fail cycle $i: egofuse did not see both cameras go within 90 s
         echo "$PDEV" > $DRV/bind || ev fail bind $PDEV
         n=2
     else
@@ -144,10 +158,10 @@ while [ $i -le "$CYC" ] && alive; do
         n=1
     fi
     ev replug $i
-    if wait_count 'camera back' 60 $((backs + n - 1)); then
+    if wait_count 'camera back' 90 $((backs + n - 1)); then
         ev back $i
     else
-        ev fail cycle $i: not back within 60 s
+        ev fail cycle $i: not back within 90 s: $(nodes)
     fi
     # a V stall in cycles spread over the run (the middle of the cycle)
     if awk -v i=$i -v s="$STALLS" -v c="$CYC" \
