@@ -111,6 +111,11 @@ wait_count() {
     done
     [ "$(count "$1")" -gt "$3" ]
 }
+# frames composited so far (the newest status line)
+frames_now() {
+    f=$(tr '\r' '\n' < "$D/run.err" | sed -n 's/^egofuse run: \([0-9]*\) frames, .*/\1/p' | tail -n 1)
+    echo "${f:-0}"
+}
 # the camera nodes and the vivid instances behind them
 nodes() {
     for f in /sys/class/video4linux/video*; do
@@ -163,6 +168,14 @@ while [ $i -le "$CYC" ] && alive; do
     else
         ev fail cycle $i: not back within 90 s: $(nodes)
     fi
+    # the next cycle only after 4 more frames (soak_report.sh wants 3 from
+    # both returned cameras; under TCG a frame can take seconds)
+    f0=$(frames_now)
+    fend=$(awk -v n="$(up)" 'BEGIN { printf "%.2f", n + 120 }')
+    while alive && [ "$(frames_now)" -lt $((f0 + 4)) ] &&
+        awk -v a="$fend" -v n="$(up)" 'BEGIN { exit !(n < a) }'; do
+        sleep 0.5
+    done
     # a V stall in cycles spread over the run (the middle of the cycle)
     if awk -v i=$i -v s="$STALLS" -v c="$CYC" \
         'BEGIN { for (k = 1; k <= s; k++) if (int(k * c / (s + 1) + 0.5) == i) exit 0; exit 1 }'; then
