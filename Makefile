@@ -8,6 +8,9 @@
 #   make fuzz       libFuzzer + ASan + UBSan targets of every parser, clang
 #                   (build-fuzz/fuzz/; scripts/fuzz.sh runs them, docs/fuzzing.md)
 #   make bench      benchmarks (they report, never pass or fail)
+#   make soak       `egofuse run` for 10 minutes in the test VM, cameras
+#                   unplugged 20 times, V stalled; RSS and fds sampled
+#                   (tests/vm/soak_host.sh, docs/devices.md; not in make test)
 #   make install    PREFIX=/usr/local DESTDIR=: the libraries, headers, pkg-config
 #                   files, plugin and program (docs/library.md); make uninstall
 #   make core-tests the core library and its tests only (no io library):
@@ -111,7 +114,7 @@ EGOFUSE  := $(BUILD)/egofuse
 GEN      := $(BUILD)/gen_samples
 SAMPLES  := $(BUILD)/samples
 
-.PHONY: all deps demo test debug bench clean samples check-headers eval core-tests fuzz fuzz-targets
+.PHONY: all deps demo test debug bench clean samples check-headers eval core-tests fuzz fuzz-targets soak
 .DEFAULT_GOAL := all
 # Keep intermediate objects (tests/support/*.o), so a second make rebuilds nothing.
 .SECONDARY:
@@ -252,6 +255,11 @@ $(BUILD)/fuzz/%: tests/%.c tests/fuzz/fuzz_util.h $(IOLIB) $(LIB)
 eval: deps
 	@$(MAKE) --no-print-directory $(EGOFUSE)
 	$(EGOFUSE) eval --frames 180 --report out/eval
+
+# The soak of the live path in the VM (SOAK_SECONDS, SOAK_CYCLES, SOAK_STALLS).
+soak: deps
+	@$(MAKE) --no-print-directory $(LIB) $(IOLIB) $(OIIO_PLUGIN) $(EGOFUSE) $(GEN)
+	@sh tests/vm/soak_host.sh $(BUILD)
 
 bench: deps
 	@$(MAKE) --no-print-directory all

@@ -867,7 +867,8 @@ static int run(const run_opts *o)
         pipe_image_opaque(&in.virt[1], geo.vp_x0, geo.vp_y0, geo.vp_width, geo.vp_height);
     kin_track_sample sample;
     memset(&sample, 0, sizeof sample);
-    int have_img[2] = {0, 0};
+    int have_img[2] = {0, 0}, cam_lost[2] = {0, 0};
+    char reopen_msg[2][sizeof err.msg] = {"", ""};
     uint64_t t_start = mono_ns(), t_status = t_start, t_retry[2] = {0, 0};
     io_lat lat_cam, lat_pipe, lat_deq;
     io_lat_reset(&lat_cam);
@@ -891,8 +892,17 @@ static int run(const run_opts *o)
         int got = 0;
         io_result gr = io_stereo_grab(&st, 0, fr, &got, &err);
         now = mono_ns();
-        /* a failed camera: reopen once a second, found again by its selector */
+        /* a failed camera: said once, then reopened once a second, found
+         * again by its selector */
         for (int e = 0; e < 2; e++) {
+            if (r->cam[e].state == IO_CAM_FAILED && !cam_lost[e] &&
+                !(file_cams && io_cam_file_ended(&r->cam[e]))) {
+                cam_lost[e] = 1;
+                if (!o->quiet)
+                    fprintf(stderr, "\negofuse run: %s camera lost (%s); %s, reopening it once a second\n",
+                            e ? "right" : "left", r->cam[e].status[0] ? r->cam[e].status : "failed",
+                            have_img[e] ? "its eye holds its last image" : "no image of it yet");
+            }
             if (r->cam[e].state != IO_CAM_FAILED || now - t_retry[e] < 1000000000ull) continue;
             if (file_cams && io_cam_file_ended(&r->cam[e])) continue;
             t_retry[e] = now;
@@ -900,9 +910,18 @@ static int run(const run_opts *o)
             io_error e2;
             const char *where = NULL;
             if (o->sel[e] && !file_cams && resolve(o->sel[e], np, sizeof np, &e2) == 0) where = np;
-            if (io_cam_reopen(&r->cam[e], where, &e2) == IO_OK && !o->quiet)
-                fprintf(stderr, "\negofuse run: %s camera back (%s)\n", e ? "right" : "left",
-                        r->cam[e].cfg.path);
+            if (io_cam_reopen(&r->cam[e], where, &e2) == IO_OK) {
+                cam_lost[e] = 0;
+                reopen_msg[e][0] = '\0';
+                if (!o->quiet)
+                    fprintf(stderr, "\negofuse run: %s camera back (%s)\n", e ? "right" : "left",
+                            r->cam[e].cfg.path);
+            } else if (strcmp(e2.msg, reopen_msg[e])) { /* each new reason once */
+                snprintf(reopen_msg[e], sizeof reopen_msg[e], "%s", e2.msg);
+                if (!o->quiet)
+                    fprintf(stderr, "\negofuse run: %s camera not back: %s\n", e ? "right" : "left",
+                            e2.msg);
+            }
         }
         if (file_cams && (io_cam_file_ended(&r->cam[0]) || io_cam_file_ended(&r->cam[1]))) {
             ended = 1;
