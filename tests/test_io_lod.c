@@ -1,0 +1,420 @@
+/* test_io_lod.c - the level-of-detail chain (src/io/io_lod.h) and the
+ * level rule (src/pipe/pipe_lod.h).
+ *
+ *   - the sample arms (samples/gen, the mask model of `egofuse eval` and
+ *     `render`) and a skinned torus: levels whose triangle counts fall by
+ *     at least 10% each, errors nondecreasing, every level a chain of the
+ *     model (pipe_lod_check: the model's vertex arrays, indices in range);
+ *     every vertex a level draws is a vertex of the model, so its joints
+ *     and weights are an original vertex's; every triangle of a level lies
+ *     inside one dominant-joint group of the full model (its vertices are
+ *     vertices of that group's triangles): no triangle spans joints;
+ *   - the same chain bytes twice, and the recorded CRC of the sample
+ *     arms' chain for meshoptimizer 0.18 (skipped for another version);
+ *   - the rule at its boundaries (error * px_per_m == target: inside; the
+ *     next float above: outside; nothing in view, NaN, <= 0: level 0);
+ *   - bad inputs: NULL, no triangles, an index out of range, a NaN
+ *     position, settings out of range; a model that cannot be simplified
+ *     (one triangle; a strip whose every vertex is on its border): level
+ *     0 alone, IO_OK.
+ */
+#include "support/testutil.h"
+
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../samples/gen/gen.h"
+#include "../src/io/io_lod.h"
+
+/* ------------------------------------------------------------ helpers */
+
+/* The dominant joint of triangle t of me, as io_lod.c defines it. */
+static int dom_joint(const kin_mesh *me, const uint32_t *tri)
+{
+    double acc[256] = {0};
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 4; i++) {
+            int j = me->joints[4 * tri[k] + i];
+            float w = me->weights[4 * tri[k] + i];
+            if (w > 0.0f && j < 256) acc[j] += (double)w;
+        }
+    int best = 0;
+    for (int j = 1; j < 256; j++)
+        if (acc[j] > acc[best]) best = j;
+    return best;
+}
+
+/* Checks the chain of model: decreasing counts, sharing, groups. */
+static void check_chain(const kin_model *m, const pipe_lod *lod, int min_levels)
+{
+    char why[256];
+    assert_true(lod->level_count >= min_levels);
+    if (!pipe_lod_check(lod, m, why, sizeof why)) fail_msg("pipe_lod_check: %s", why);
+    for (int l = 1; l < lod->level_count; l++) {
+        assert_true((double)lod->level[l].triangles <= 0.9 * (double)lod->level[l - 1].triangles);
+        assert_true(lod->level[l].error_m >= lod->level[l - 1].error_m);
+        assert_true(lod->level[l].error_m > 0.0f);
+        assert_true(lod->level[l].edge_m > lod->level[l - 1].edge_m);
+    }
+    for (int i = 0; i < m->mesh_count; i++) {
+        const kin_mesh *me = &m->meshes[i];
+        if (!me->joints || !me->weights) continue;
+        /* group[j] marks the vertices of joint j's triangles (bit sets) */
+        const int nv = me->vertex_count;
+        int jn = 0;
+        for (int t = 0; t < me->index_count; t += 3) {
+            int j = dom_joint(me, me->indices + t);
+            if (j + 1 > jn) jn = j + 1;
+        }
+        unsigned char *in = calloc((size_t)jn * (size_t)nv, 1);
+        unsigned char *used = calloc((size_t)nv, 1);
+        assert_non_null(in);
+        assert_non_null(used);
+        for (int t = 0; t < me->index_count; t += 3) {
+            int j = dom_joint(me, me->indices + t);
+            for (int k = 0; k < 3; k++) in[(size_t)j * nv + me->indices[t + k]] = 1;
+            for (int k = 0; k < 3; k++) used[me->indices[t + k]] = 1;
+        }
+        for (int l = 1; l < lod->level_count; l++) {
+            const kin_mesh *lm = &lod->level[l].meshes[i];
+            for (int t = 0; t < lm->index_count; t += 3) {
+                const uint32_t *tri = lm->indices + t;
+                int ok = 0;
+                for (int j = 0; j < jn && !ok; j++)
+                    ok = in[(size_t)j * nv + tri[0]] && in[(size_t)j * nv + tri[1]] &&
+                         in[(size_t)j * nv + tri[2]];
+                if (!ok)
+                    fail_msg("level %d, triangle %d (%u %u %u) spans joint groups", l, t / 3,
+                             tri[0], tri[1], tri[2]);
+                for (int k = 0; k < 3; k++) {
+                    /* a vertex of the model's triangles: its joints and
+                     * weights are an original vertex's (the same arrays) */
+                    assert_true(used[tri[k]]);
+                    assert_ptr_equal(lm->joints, me->joints);
+                    assert_ptr_equal(lm->weights, me->weights);
+                }
+            }
+        }
+        free(in);
+        free(used);
+    }
+}
+
+static uint32_t chain_crc(const pipe_lod *lod)
+{
+    uint32_t c = 0;
+    for (int l = 0; l < lod->level_count; l++) {
+        const pipe_lod_level *L = &lod->level[l];
+        c = tu_crc32(c, &L->triangles, sizeof L->triangles);
+        c = tu_crc32(c, &L->error_m, sizeof L->error_m);
+        for (int i = 0; i < lod->mesh_count; i++)
+            c = tu_crc32(c, L->meshes[i].indices, sizeof(uint32_t) * (size_t)L->meshes[i].index_count);
+    }
+    return c;
+}
+
+/* ------------------------------------------------------- sample arms */
+
+static void test_sample_arms(void **state)
+{
+    (void)state;
+    gen_arms arms;
+    assert_int_equal(gen_arms_build(&arms), 0);
+    pipe_lod a, b;
+    io_error err;
+    assert_int_equal(io_lod_build("arms", &arms.model, NULL, &a, &err), IO_OK);
+    check_chain(&arms.model, &a, 4);
+    printf("sample arms, meshoptimizer %d:", io_lod_version());
+    for (int l = 0; l < a.level_count; l++)
+        printf(" L%d %ld tris err %.2f mm edge %.2f mm;", l, a.level[l].triangles,
+               1e3 * (double)a.level[l].error_m, 1e3 * (double)a.level[l].edge_m);
+    printf("\n");
+    /* the same bytes a second time */
+    assert_int_equal(io_lod_build("arms", &arms.model, NULL, &b, &err), IO_OK);
+    assert_int_equal(a.level_count, b.level_count);
+    uint32_t ca = chain_crc(&a);
+    assert_int_equal(ca, chain_crc(&b));
+    printf("chain crc %08x\n", ca);
+    /* the bytes of meshoptimizer 0.18 (Debian 12) on x86-64: another
+     * version or machine may simplify differently */
+#if defined(__x86_64__)
+    if (io_lod_version() == 180) assert_int_equal(ca, 0x3ce39d94u);
+#endif
+    io_lod_free(&b);
+    /* the whole-mesh variant simplifies further, across the joints */
+    io_lod_desc w = {0};
+    w.whole = 1;
+    assert_int_equal(io_lod_build("arms", &arms.model, &w, &b, &err), IO_OK);
+    assert_true(b.level_count >= 2);
+    assert_true(pipe_lod_check(&b, &arms.model, NULL, 0));
+    io_lod_free(&b);
+    io_lod_free(&a);
+    assert_null(a.block);
+    gen_arms_free(&arms);
+}
+
+/* ------------------------------------------------------------- torus */
+
+#define TR 96 /* segments around the major circle */
+#define TS 24 /* around the tube */
+
+typedef struct torus {
+    float pos[TR * TS * 3];
+    uint16_t jt[TR * TS * 4];
+    float w[TR * TS * 4];
+    uint32_t idx[TR * TS * 6];
+    kin_mesh mesh;
+    int16_t parents[4];
+    kin_transform rest[4];
+    char names[4][KIN_NAME_MAX];
+    int node_src[4];
+    int joints[3];
+    kin_mat4 ibm[3];
+    kin_skin skin;
+    kin_model model;
+} torus;
+
+/* A closed skinned torus (3 joints along the major circle, blended over
+ * 4 segments at each change). */
+static void torus_build(torus *t)
+{
+    memset(t, 0, sizeof *t);
+    for (int i = 0; i < TR; i++)
+        for (int j = 0; j < TS; j++) {
+            float u = 6.2831853f * (float)i / TR, v = 6.2831853f * (float)j / TS;
+            int k = i * TS + j;
+            t->pos[3 * k + 0] = (0.1f + 0.03f * cosf(v)) * cosf(u);
+            t->pos[3 * k + 1] = (0.1f + 0.03f * cosf(v)) * sinf(u);
+            t->pos[3 * k + 2] = 0.03f * sinf(v);
+            int seg = i * 3 / TR;              /* 0, 1, 2 */
+            int in_seg = i - seg * TR / 3;
+            t->jt[4 * k + 0] = (uint16_t)seg;
+            t->jt[4 * k + 1] = (uint16_t)((seg + 2) % 3);
+            float b = in_seg < 4 ? 0.5f + 0.125f * (float)in_seg : 1.0f;
+            t->w[4 * k + 0] = b;
+            t->w[4 * k + 1] = 1.0f - b;
+            int i1 = (i + 1) % TR, j1 = (j + 1) % TS;
+            uint32_t a = (uint32_t)k, bb = (uint32_t)(i1 * TS + j),
+                     c = (uint32_t)(i1 * TS + j1), d = (uint32_t)(i * TS + j1);
+            uint32_t *q = t->idx + 6 * k;
+            q[0] = a, q[1] = bb, q[2] = c, q[3] = a, q[4] = c, q[5] = d;
+        }
+    t->mesh.vertex_count = TR * TS;
+    t->mesh.positions = t->pos;
+    t->mesh.joints = t->jt;
+    t->mesh.weights = t->w;
+    t->mesh.index_count = TR * TS * 6;
+    t->mesh.indices = t->idx;
+    t->mesh.node = 0;
+    t->mesh.skin = 0;
+    for (int n = 0; n < 4; n++) {
+        t->parents[n] = (int16_t)(n == 0 ? KIN_NO_PARENT : 0);
+        t->rest[n].r.w = 1.0f;
+        t->rest[n].s = kin_v3(1, 1, 1);
+        snprintf(t->names[n], KIN_NAME_MAX, "n%d", n);
+        t->node_src[n] = n;
+    }
+    for (int j = 0; j < 3; j++) {
+        t->joints[j] = j + 1;
+        t->ibm[j] = kin_mat4_identity();
+    }
+    t->skin = (kin_skin){3, t->joints, t->ibm};
+    t->model.node_count = 4;
+    t->model.parents = t->parents;
+    t->model.rest = t->rest;
+    t->model.names = (const char(*)[KIN_NAME_MAX])t->names;
+    t->model.node_src = t->node_src;
+    t->model.mesh_count = 1;
+    t->model.meshes = &t->mesh;
+    t->model.skin_count = 1;
+    t->model.skins = &t->skin;
+}
+
+static void test_torus(void **state)
+{
+    (void)state;
+    static torus t;
+    torus_build(&t);
+    char why[256];
+    if (kin_model_validate(&t.model, why, sizeof why)) fail_msg("torus: %s", why);
+    pipe_lod lod;
+    io_error err;
+    io_lod_desc d = {0};
+    d.max_levels = PIPE_LOD_MAX - 1;
+    d.min_triangles = 1;
+    assert_int_equal(io_lod_build("torus", &t.model, &d, &lod, &err), IO_OK);
+    check_chain(&t.model, &lod, 3);
+    assert_true(lod.level_count <= PIPE_LOD_MAX);
+    /* ratio 0.5: each level near half of the one before (whole triangles,
+     * locked joint rings) */
+    assert_true(lod.level[1].triangles <= lod.level[0].triangles * 6 / 10);
+    io_lod_free(&lod);
+}
+
+/* ----------------------------------------------------------- the rule */
+
+static void test_choose(void **state)
+{
+    (void)state;
+    pipe_lod lod;
+    memset(&lod, 0, sizeof lod);
+    kin_mesh dummy = {0};
+    lod.level_count = 4;
+    lod.mesh_count = 0;
+    /* errors that are powers of two: error * px_per_m is exact */
+    const float e[4] = {0.0f, 1.0f / 1024.0f, 1.0f / 256.0f, 1.0f / 64.0f};
+    for (int l = 0; l < 4; l++) {
+        lod.level[l].meshes = &dummy;
+        lod.level[l].error_m = e[l];
+    }
+    /* target 1 px: level 1 needs px_per_m <= 1024, level 2 <= 256,
+     * level 3 <= 64 */
+    assert_int_equal(pipe_lod_choose(&lod, 1024.0f, 1.0f), 1);
+    assert_int_equal(pipe_lod_choose(&lod, nextafterf(1024.0f, INFINITY), 1.0f), 0);
+    assert_int_equal(pipe_lod_choose(&lod, 256.0f, 1.0f), 2);
+    assert_int_equal(pipe_lod_choose(&lod, nextafterf(256.0f, INFINITY), 1.0f), 1);
+    assert_int_equal(pipe_lod_choose(&lod, 64.0f, 1.0f), 3);
+    assert_int_equal(pipe_lod_choose(&lod, nextafterf(64.0f, INFINITY), 1.0f), 2);
+    assert_int_equal(pipe_lod_choose(&lod, 1.0f, 1.0f), 3);
+    /* the target at its boundary: 512 px/m, level 1 = 0.5 px */
+    assert_int_equal(pipe_lod_choose(&lod, 512.0f, 0.5f), 1);
+    assert_int_equal(pipe_lod_choose(&lod, 512.0f, nextafterf(0.5f, 0.0f)), 0);
+    /* target 2 px doubles the reach */
+    assert_int_equal(pipe_lod_choose(&lod, 128.0f, 2.0f), 3);
+    assert_int_equal(pipe_lod_choose(&lod, nextafterf(128.0f, INFINITY), 2.0f), 2);
+    /* nothing in view, bad inputs: level 0 */
+    assert_int_equal(pipe_lod_choose(&lod, 0.0f, 1.0f), 0);
+    assert_int_equal(pipe_lod_choose(&lod, -5.0f, 1.0f), 0);
+    assert_int_equal(pipe_lod_choose(&lod, NAN, 1.0f), 0);
+    assert_int_equal(pipe_lod_choose(&lod, INFINITY, 1.0f), 0);
+    assert_int_equal(pipe_lod_choose(&lod, 10.0f, 0.0f), 0);
+    assert_int_equal(pipe_lod_choose(&lod, 10.0f, NAN), 0);
+    assert_int_equal(pipe_lod_choose(NULL, 10.0f, 1.0f), 0);
+    /* a NaN error stops the chain there */
+    lod.level[2].error_m = NAN;
+    assert_int_equal(pipe_lod_choose(&lod, 1.0f, 1.0f), 1);
+    lod.level_count = 1;
+    assert_int_equal(pipe_lod_choose(&lod, 1.0f, 1.0f), 0);
+}
+
+static void test_px_per_m(void **state)
+{
+    (void)state;
+    /* x, y, z, w: w is the view depth */
+    float clip[5 * 4] = {
+        0.0f, 0.0f, 0.0f, 0.5f,    /* in view, 0.5 m */
+        0.9f, -0.2f, 0.0f, 0.25f,  /* x outside (|x| > w) */
+        0.1f, 0.1f, 0.0f, 0.4f,    /* in view, 0.4 m: the nearest */
+        0.0f, 0.0f, 0.0f, -0.1f,   /* behind */
+        0.2f, 0.2f, 0.0f, 0.2f,    /* on the border: in view, 0.2 m */
+    };
+    assert_float_equal(pipe_lod_px_per_m(clip, 4, 500.0f), 500.0f / 0.4f, 1e-3);
+    assert_float_equal(pipe_lod_px_per_m(clip, 5, 500.0f), 500.0f / 0.2f, 1e-3);
+    assert_float_equal(pipe_lod_px_per_m(clip + 4, 1, 500.0f), 0.0f, 0.0);
+    assert_float_equal(pipe_lod_px_per_m(clip + 12, 1, 500.0f), 0.0f, 0.0);
+    assert_float_equal(pipe_lod_px_per_m(NULL, 4, 500.0f), 0.0f, 0.0);
+    assert_float_equal(pipe_lod_px_per_m(clip, 4, NAN), 0.0f, 0.0);
+    float at_eye[4] = {0.0f, 0.0f, 0.0f, 1e-7f};
+    assert_true(isinf(pipe_lod_px_per_m(at_eye, 1, 500.0f)));
+}
+
+/* ------------------------------------------------------ bad inputs */
+
+static void test_bad_inputs(void **state)
+{
+    (void)state;
+    static torus t;
+    torus_build(&t);
+    pipe_lod lod;
+    io_error err;
+    assert_int_equal(io_lod_build("m", NULL, NULL, &lod, &err), IO_ERR_ARGS);
+    assert_int_equal(io_lod_build("m", &t.model, NULL, NULL, &err), IO_ERR_ARGS);
+    io_lod_desc d = {0};
+    d.ratio = 1.0f;
+    assert_int_equal(io_lod_build("m", &t.model, &d, &lod, &err), IO_ERR_ARGS);
+    assert_non_null(strstr(err.msg, "m: level ratio 1"));
+    d.ratio = NAN;
+    assert_int_equal(io_lod_build("m", &t.model, &d, &lod, &err), IO_ERR_ARGS);
+    d.ratio = 0.0f;
+    d.max_levels = PIPE_LOD_MAX;
+    assert_int_equal(io_lod_build("m", &t.model, &d, &lod, &err), IO_ERR_ARGS);
+    d.max_levels = -1;
+    assert_int_equal(io_lod_build("m", &t.model, &d, &lod, &err), IO_ERR_ARGS);
+    d.max_levels = 0;
+    d.min_triangles = -2;
+    assert_int_equal(io_lod_build("m", &t.model, &d, &lod, &err), IO_ERR_ARGS);
+
+    /* an index out of range */
+    t.idx[5] = TR * TS;
+    assert_int_equal(io_lod_build("bad.glb", &t.model, NULL, &lod, &err), IO_ERR_VALUE);
+    assert_non_null(strstr(err.msg, "bad.glb: "));
+    assert_null(lod.block);
+    torus_build(&t);
+    /* a NaN position */
+    t.pos[7] = NAN;
+    assert_int_equal(io_lod_build("nan.glb", &t.model, NULL, &lod, &err), IO_ERR_VALUE);
+    assert_non_null(strstr(err.msg, "nan.glb: "));
+    torus_build(&t);
+    /* no triangles */
+    t.mesh.index_count = 0;
+    assert_int_equal(io_lod_build("empty.glb", &t.model, NULL, &lod, &err), IO_ERR_VALUE);
+    assert_non_null(strstr(err.msg, "empty.glb: the model has no triangles"));
+    torus_build(&t);
+    t.model.mesh_count = 0;
+    assert_int_equal(io_lod_build("none.glb", &t.model, NULL, &lod, &err), IO_ERR_VALUE);
+
+    /* cannot be simplified: one triangle; a tetrahedron */
+    torus_build(&t);
+    t.mesh.index_count = 3;
+    assert_int_equal(io_lod_build("tri", &t.model, NULL, &lod, &err), IO_OK);
+    assert_int_equal(lod.level_count, 1);
+    assert_int_equal(lod.level[0].triangles, 1);
+    assert_true(pipe_lod_check(&lod, &t.model, NULL, 0));
+    io_lod_free(&lod);
+    /* a strip of 8 quads: every vertex is on the border, which the
+     * simplifier keeps */
+    static uint32_t strip[8 * 6];
+    for (int q = 0; q < 8; q++) {
+        uint32_t a = (uint32_t)q, b = (uint32_t)q + 1, c = (uint32_t)q + 10, d = (uint32_t)q + 9;
+        uint32_t *o = strip + 6 * q;
+        o[0] = a, o[1] = b, o[2] = c, o[3] = a, o[4] = c, o[5] = d;
+    }
+    for (int v = 0; v < 18; v++) {
+        t.pos[3 * v] = 0.01f * (float)(v % 9);
+        t.pos[3 * v + 1] = 0.01f * (float)(v / 9);
+        t.pos[3 * v + 2] = 0.0f;
+    }
+    t.mesh.vertex_count = 18;
+    t.mesh.indices = strip;
+    t.mesh.index_count = 8 * 6;
+    io_lod_desc one = {0};
+    one.min_triangles = 1;
+    assert_int_equal(io_lod_build("strip", &t.model, &one, &lod, &err), IO_OK);
+    assert_int_equal(lod.level_count, 1);
+    assert_int_equal(lod.level[0].triangles, 16);
+    assert_true(pipe_lod_check(&lod, &t.model, NULL, 0));
+    io_lod_free(&lod);
+    /* a chain that is not of this model */
+    torus_build(&t);
+    assert_int_equal(io_lod_build("torus", &t.model, NULL, &lod, &err), IO_OK);
+    static torus u;
+    torus_build(&u);
+    char why[128];
+    assert_false(pipe_lod_check(&lod, &u.model, why, sizeof why));
+    assert_non_null(strstr(why, "does not share"));
+    io_lod_free(&lod);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_choose),
+        cmocka_unit_test(test_px_per_m),
+        cmocka_unit_test(test_bad_inputs),
+        cmocka_unit_test(test_torus),
+        cmocka_unit_test(test_sample_arms),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
