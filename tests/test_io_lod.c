@@ -26,7 +26,9 @@
 #include <string.h>
 
 #include "../samples/gen/gen.h"
+#include "../src/fuse/fuse_metrics.h"
 #include "../src/io/io_lod.h"
+#include "../src/pipe/pipe.h"
 
 /* ------------------------------------------------------------ helpers */
 
@@ -152,6 +154,85 @@ static void test_sample_arms(void **state)
     io_lod_free(&b);
     io_lod_free(&a);
     assert_null(a.block);
+    gen_arms_free(&arms);
+}
+
+/* pipe_lod_draw: level 0 is pipe_pose_draw's bytes; a level draws its
+ * own index list over the same transformed vertices; the rule's level. */
+static void test_draw(void **state)
+{
+    (void)state;
+    gen_arms arms;
+    assert_int_equal(gen_arms_build(&arms), 0);
+    const kin_model *m = &arms.model;
+    pipe_lod lod;
+    io_error err;
+    assert_int_equal(io_lod_build("arms", m, NULL, &lod, &err), IO_OK);
+    pipe_pose ps;
+    assert_int_equal(pipe_pose_init(&ps, m), 0);
+    pipe_pose_anim(&ps, &m->anims[0], 1.5f);
+    const kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
+    const kin_camera cam = kin_sthmd_camera(&hd, &ps.world[arms.head], KIN_EYE_LEFT);
+    const int W = cam.width, H = cam.height;
+    const size_t np = (size_t)W * H;
+    float *buf = malloc(2 * np * 4 * sizeof(float));
+    uint8_t *mk = malloc(2 * np);
+    float *clip = malloc(sizeof(float) * 4 * (size_t)ps.max_vertices);
+    float *vn = malloc(sizeof(float) * 3 * (size_t)ps.max_vertices);
+    assert_non_null(buf);
+    assert_non_null(mk);
+    assert_non_null(clip);
+    assert_non_null(vn);
+    rast_target ta = {W, H, buf, W, mk, W, buf + np, 3 * W, 3};
+    rast_target tb = {W, H, buf + 4 * np, W, mk + np, W, buf + 5 * np, 3 * W, 3};
+    rast_target_clear(&ta);
+    assert_int_equal(pipe_pose_draw(&ps, NULL, &cam, &ta, RAST_CULL_NONE, clip, vn, NULL),
+                     RAST_OK);
+    int drawn = -1;
+    rast_target_clear(&tb);
+    assert_int_equal(pipe_lod_draw(&ps, &lod, 0, 0.0f, NULL, &cam, &tb, RAST_CULL_NONE, clip,
+                                   vn, NULL, &drawn),
+                     RAST_OK);
+    assert_int_equal(drawn, 0);
+    assert_memory_equal(buf, buf + 4 * np, 4 * np * sizeof(float));
+    assert_memory_equal(mk, mk + np, np);
+    /* level 1: its own triangles, the same silhouette within 2% IoU */
+    rast_target_clear(&tb);
+    rast_stats st = {0};
+    assert_int_equal(pipe_lod_draw(&ps, &lod, 1, 0.0f, NULL, &cam, &tb, RAST_CULL_NONE, clip,
+                                   vn, &st, &drawn),
+                     RAST_OK);
+    assert_int_equal(drawn, 1);
+    assert_int_equal(st.tris_in, lod.level[1].triangles);
+    assert_memory_not_equal(mk, mk + np, np);
+    fuse_confusion cf;
+    fuse_mask_confusion(mk + np, W, mk, W, W, H, &cf);
+    assert_true(fuse_confusion_iou(&cf) > 0.98);
+    /* a level beyond the chain is its last */
+    assert_int_equal(pipe_lod_draw(&ps, &lod, 99, 0.0f, NULL, &cam, &tb, RAST_CULL_NONE, clip,
+                                   vn, NULL, &drawn),
+                     RAST_OK);
+    assert_int_equal(drawn, lod.level_count - 1);
+    /* the rule: the level pipe_lod_choose gives for the clip coordinates */
+    rast_transform_points(cam.view_proj.m, ps.pos[0], ps.meshes[0].vertex_count, clip);
+    const float ppm = pipe_lod_px_per_m(clip, ps.meshes[0].vertex_count,
+                                        cam.fx > cam.fy ? cam.fx : cam.fy);
+    assert_true(ppm > 0.0f);
+    for (int k = 0; k < 6; k++) {
+        const float target = 0.25f * (float)(1 << k);
+        const int want = pipe_lod_choose(&lod, ppm, target);
+        assert_int_equal(pipe_lod_draw(&ps, &lod, PIPE_LOD_AUTO, target, NULL, &cam, &tb,
+                                       RAST_CULL_NONE, clip, vn, NULL, &drawn),
+                         RAST_OK);
+        assert_int_equal(drawn, want);
+        if (k == 5) assert_true(want > 0);
+    }
+    free(buf);
+    free(mk);
+    free(clip);
+    free(vn);
+    pipe_pose_free(&ps);
+    io_lod_free(&lod);
     gen_arms_free(&arms);
 }
 
@@ -415,6 +496,7 @@ int main(void)
         cmocka_unit_test(test_bad_inputs),
         cmocka_unit_test(test_torus),
         cmocka_unit_test(test_sample_arms),
+        cmocka_unit_test(test_draw),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,5 +1,6 @@
 /* pipe_lod.c - the level-of-detail rule (pipe_lod.h). */
 #include "pipe_lod.h"
+#include "pipe.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -86,4 +87,42 @@ int pipe_lod_check(const pipe_lod *lod, const kin_model *model, char *why, int w
     }
     return 1;
 #undef LOD_FAIL
+}
+
+rast_result pipe_lod_draw(const pipe_pose *ps, const pipe_lod *lod, int level, float target_px,
+                          rast_context *ctx, const kin_camera *cam, const rast_target *target,
+                          rast_cull cull, float *clip, float *vnrm, rast_stats *stats,
+                          int *drawn)
+{
+    if (drawn) *drawn = 0;
+    if (!lod || lod->level_count < 1)
+        return pipe_pose_draw(ps, ctx, cam, target, cull, clip, vnrm, stats);
+    const int with_n = target->attr_count == 3;
+    const float focal = cam->fx > cam->fy ? cam->fx : cam->fy;
+    int finest = -1;
+    for (int i = 0; i < ps->model->mesh_count && i < lod->mesh_count; i++) {
+        const kin_mesh *me = &ps->meshes[i];
+        rast_transform_points(cam->view_proj.m, ps->pos[i], me->vertex_count, clip);
+        if (with_n) rast_transform_dirs(cam->view.m, ps->nrm[i], me->vertex_count, vnrm);
+        int l = level;
+        if (l < 0)
+            l = pipe_lod_choose(lod, pipe_lod_px_per_m(clip, me->vertex_count, focal), target_px);
+        if (l >= lod->level_count) l = lod->level_count - 1;
+        const kin_mesh *lm = &lod->level[l].meshes[i];
+        if (lm->index_count > 0 && (finest < 0 || l < finest)) finest = l;
+        rast_mesh_desc d = {
+            .clip = clip,
+            .vertex_count = me->vertex_count,
+            .attr = with_n ? vnrm : NULL,
+            .attr_count = with_n ? 3 : 0,
+            .indices = l ? lm->indices : me->indices,
+            .tri_count = (l ? lm->index_count : me->index_count) / 3,
+            .cull = cull,
+        };
+        rast_result r = ctx ? rast_context_draw(ctx, target, &d, stats)
+                            : rast_draw(target, &d, stats);
+        if (r != RAST_OK) return r;
+    }
+    if (drawn) *drawn = finest < 0 ? 0 : finest;
+    return RAST_OK;
 }

@@ -36,6 +36,7 @@
 #define EGOFUSE_PIPE_LOD_H
 
 #include "../kin/kin.h"
+#include "../raster/raster.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -73,6 +74,21 @@ float pipe_lod_px_per_m(const float *clip, int n, float focal_px);
  * share the model's vertex arrays and have index lists < vertex_count,
  * level 0's meshes the model's; 0 otherwise (why gets the reason). */
 int pipe_lod_check(const pipe_lod *lod, const kin_model *model, char *why, int why_size);
+
+/* pipe_pose_draw with levels: per mesh i of the posed model, the vertices
+ * are transformed as pipe_pose_draw does, then the index list of level
+ * `level` (clamped to the chain) is drawn, or with level PIPE_LOD_AUTO
+ * the level pipe_lod_choose gives for pipe_lod_px_per_m(mesh i's clip
+ * coordinates, max(cam->fx, cam->fy)) and target_px. Level 0 draws the
+ * bytes of pipe_pose_draw. *drawn (may be NULL): the finest level drawn
+ * over the meshes that have triangles (0 without any). pose is a
+ * pipe_pose (pipe.h) of the chain's model; lod NULL: pipe_pose_draw. */
+#define PIPE_LOD_AUTO (-1)
+struct pipe_pose;
+rast_result pipe_lod_draw(const struct pipe_pose *pose, const pipe_lod *lod, int level,
+                          float target_px, rast_context *ctx, const kin_camera *cam,
+                          const rast_target *target, rast_cull cull, float *clip, float *vnrm,
+                          rast_stats *stats, int *drawn);
 
 #ifdef __cplusplus
 }
