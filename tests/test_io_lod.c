@@ -488,6 +488,103 @@ static void test_bad_inputs(void **state)
     io_lod_free(&lod);
 }
 
+/* ------------------------------------------------------------ the CLI */
+
+static const char *bin(void)
+{
+    const char *b = getenv("EGOFUSE_BIN");
+    return b && *b ? b : "build/egofuse";
+}
+
+static char out[16384];
+
+static long file_bytes(const char *path, unsigned char **data)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return -1;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    *data = malloc((size_t)n + 1);
+    if (!*data || fread(*data, 1, (size_t)n, f) != (size_t)n) n = -1;
+    fclose(f);
+    return n;
+}
+
+/* 1 when the two files hold the same bytes. */
+static int same_file(const char *a, const char *b)
+{
+    unsigned char *x = NULL, *y = NULL;
+    long n = file_bytes(a, &x), m = file_bytes(b, &y);
+    int same = n >= 0 && n == m && memcmp(x, y, (size_t)n) == 0;
+    free(x);
+    free(y);
+    return same;
+}
+
+/* render --lod: bad values exit 2 naming the option; off gives the bytes
+ * of no option; a level draws other masks; eval --lod bad values too. */
+static void test_cli(void **state)
+{
+    (void)state;
+    if (!tu_exists(bin())) {
+        printf("SKIP: %s is not built\n", bin());
+        skip();
+    }
+    char dir[1024], why[3000], scene[1200], o0[1100], o1[1100], o2[1100];
+    int r = tu_samples_dir("lod_samples", 2, dir, sizeof dir, why, sizeof why);
+    if (r == 0) {
+        printf("SKIP: %s\n", why);
+        skip();
+    }
+    assert_int_equal(r, 1);
+    snprintf(scene, sizeof scene, "%s/scene.txt", dir);
+    tu_tmp_path("lod_r0", o0, sizeof o0);
+    tu_tmp_path("lod_r1", o1, sizeof o1);
+    tu_tmp_path("lod_r2", o2, sizeof o2);
+    {
+        char *a[] = {(char *)bin(), "render", "--scene", scene, "--out", o0, "--lod", "9", NULL};
+        assert_int_equal(tu_run(a, out, sizeof out), 2);
+        assert_non_null(strstr(out, "--lod '9'"));
+        char *b[] = {(char *)bin(), "render", "--scene", scene, "--out", o0, "--lod-px", "-1",
+                     NULL};
+        assert_int_equal(tu_run(b, out, sizeof out), 2);
+        assert_non_null(strstr(out, "--lod-px '-1'"));
+        char *c[] = {(char *)bin(), "eval", "--lod", "fine", NULL};
+        assert_int_equal(tu_run(c, out, sizeof out), 2);
+        assert_non_null(strstr(out, "--lod 'fine'"));
+        char *d[] = {(char *)bin(), "run", "--lod-px", "nan", NULL};
+        assert_int_equal(tu_run(d, out, sizeof out), 2);
+        assert_non_null(strstr(out, "--lod-px 'nan'"));
+    }
+    char *a0[] = {(char *)bin(), "render", "--scene", scene, "--out", o0, "--frames", "2",
+                  "--masks", "--quiet", NULL};
+    char *a1[] = {(char *)bin(), "render", "--scene", scene, "--out", o1, "--frames", "2",
+                  "--masks", "--quiet", "--lod", "off", NULL};
+    char *a2[] = {(char *)bin(), "render", "--scene", scene, "--out", o2, "--frames", "2",
+                  "--masks", "--lod", "2", NULL};
+    assert_int_equal(tu_run(a0, out, sizeof out), 0);
+    assert_int_equal(tu_run(a1, out, sizeof out), 0);
+    assert_int_equal(tu_run(a2, out, sizeof out), 0);
+    assert_non_null(strstr(out, "levels of detail L2"));
+    assert_non_null(strstr(out, "mean level drawn 2.00"));
+    char p0[1200], p1[1200], p2[1200];
+    for (int f = 0; f < 2; f++) {
+        snprintf(p0, sizeof p0, "%s/mask_left_%04d.png", o0, f);
+        snprintf(p1, sizeof p1, "%s/mask_left_%04d.png", o1, f);
+        snprintf(p2, sizeof p2, "%s/mask_left_%04d.png", o2, f);
+        assert_true(same_file(p0, p1));
+        assert_false(same_file(p0, p2));
+        snprintf(p0, sizeof p0, "%s/right_%04d.png", o0, f);
+        snprintf(p1, sizeof p1, "%s/right_%04d.png", o1, f);
+        assert_true(same_file(p0, p1));
+    }
+    char cmd[4000];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s' '%s' '%s'", o0, o1, o2);
+    assert_int_equal(system(cmd), 0);
+    tu_samples_remove("lod_samples");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -497,6 +594,7 @@ int main(void)
         cmocka_unit_test(test_torus),
         cmocka_unit_test(test_sample_arms),
         cmocka_unit_test(test_draw),
+        cmocka_unit_test(test_cli),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
