@@ -19,19 +19,75 @@ void io_lod_free(pipe_lod *lod)
     memset(lod, 0, sizeof *lod);
 }
 
-/* One mesh's triangles sorted into groups (by dominant joint). */
+/* One mesh's triangles sorted into groups (by dominant joint), each group
+ * compacted: its own vertices (the meshoptimizer calls then cost the
+ * group's size, not the mesh's). */
 typedef struct mesh_groups {
     int count;                /* groups */
     int *start;               /* count + 1 offsets into idx (in indices) */
     uint32_t *idx;            /* the mesh's index list, grouped */
-    float scale;              /* meshopt_simplifyScale of the positions */
+    uint32_t *lidx;           /* the same, as indices into the group's
+                                 vertices */
+    int *vstart;              /* count + 1 offsets into gv */
+    uint32_t *gv;             /* per group, its vertices (mesh indices), in
+                                 order of first use */
+    float *gpos;              /* their positions, 3 per entry of gv */
+    float *scale;             /* per group: meshopt_simplifyScale of its
+                                 positions (metres per unit of error) */
 } mesh_groups;
 
 static void groups_free(mesh_groups *g)
 {
     free(g->start);
     free(g->idx);
+    free(g->lidx);
+    free(g->vstart);
+    free(g->gv);
+    free(g->gpos);
+    free(g->scale);
     memset(g, 0, sizeof *g);
+}
+
+/* The groups' own vertices (lidx, vstart, gv, gpos, scale) from start and
+ * idx. 0, or -1 when out of memory. */
+static int groups_compact(const kin_mesh *me, mesh_groups *g)
+{
+    const size_t ni = (size_t)g->start[g->count];
+    g->lidx = malloc(sizeof *g->lidx * (ni ? ni : 1));
+    g->vstart = malloc(sizeof *g->vstart * (size_t)(g->count + 1));
+    g->gv = malloc(sizeof *g->gv * (ni ? ni : 1));
+    g->scale = malloc(sizeof *g->scale * (size_t)g->count);
+    int32_t *map = malloc(sizeof *map * (size_t)(me->vertex_count ? me->vertex_count : 1));
+    if (!g->lidx || !g->vstart || !g->gv || !g->scale || !map) {
+        free(map);
+        return -1;
+    }
+    for (int v = 0; v < me->vertex_count; v++) map[v] = -1;
+    size_t nv = 0;
+    for (int gi = 0; gi < g->count; gi++) {
+        g->vstart[gi] = (int)nv;
+        for (int k = g->start[gi]; k < g->start[gi + 1]; k++) {
+            uint32_t v = g->idx[k];
+            if (map[v] < 0) {
+                map[v] = (int32_t)(nv - (size_t)g->vstart[gi]);
+                g->gv[nv++] = v;
+            }
+            g->lidx[k] = (uint32_t)map[v];
+        }
+        for (size_t k = (size_t)g->vstart[gi]; k < nv; k++) map[g->gv[k]] = -1;
+    }
+    g->vstart[g->count] = (int)nv;
+    free(map);
+    g->gpos = malloc(sizeof *g->gpos * 3 * (nv ? nv : 1));
+    if (!g->gpos) return -1;
+    for (size_t k = 0; k < nv; k++) memcpy(g->gpos + 3 * k, me->positions + 3 * (size_t)g->gv[k],
+                                           3 * sizeof(float));
+    for (int gi = 0; gi < g->count; gi++) {
+        size_t a = (size_t)g->vstart[gi], b = (size_t)g->vstart[gi + 1];
+        g->scale[gi] = b > a ? meshopt_simplifyScale(g->gpos + 3 * a, b - a, 3 * sizeof(float))
+                             : 0.0f;
+    }
+    return 0;
 }
 
 /* The dominant joint of triangle t: the largest summed weight (double,
@@ -75,10 +131,6 @@ static int groups_build(const kin_mesh *me, int whole, mesh_groups *g)
     const int tris = me->index_count / 3;
     g->idx = malloc(sizeof *g->idx * (size_t)(me->index_count ? me->index_count : 1));
     if (!g->idx) return -1;
-    g->scale = me->vertex_count > 0
-                   ? meshopt_simplifyScale(me->positions, (size_t)me->vertex_count,
-                                           3 * sizeof(float))
-                   : 0.0f;
     const int skinned = !whole && me->joints && me->weights &&
                         (me->extra_sets == 0 || (me->joints_extra && me->weights_extra));
     if (!skinned || tris == 0) {
@@ -88,7 +140,7 @@ static int groups_build(const kin_mesh *me, int whole, mesh_groups *g)
         g->start[0] = 0;
         g->start[1] = me->index_count;
         if (me->index_count) memcpy(g->idx, me->indices, sizeof *g->idx * (size_t)me->index_count);
-        return 0;
+        return groups_compact(me, g);
     }
     const int jcount = 65536; /* uint16_t joint indices */
     double *acc = calloc((size_t)jcount, sizeof *acc);
@@ -121,7 +173,7 @@ static int groups_build(const kin_mesh *me, int whole, mesh_groups *g)
         memcpy(g->idx + 3 * (size_t)d, me->indices + 3 * (size_t)t, 3 * sizeof(uint32_t));
     }
     free(at);
-    rc = 0;
+    rc = groups_compact(me, g);
 done:
     free(acc);
     free(touched);
@@ -230,14 +282,18 @@ io_result io_lod_build(const char *name, const kin_model *model, const io_lod_de
                     memcpy(tmp, G[i].idx + s, sizeof *tmp * c);
                     got = c;
                 } else {
-                    got = meshopt_simplify(tmp, G[i].idx + s, c, me->positions,
-                                           (size_t)me->vertex_count, 3 * sizeof(float), target,
-                                           1.0f, d.whole ? 0u : (unsigned)meshopt_SimplifyLockBorder,
+                    /* on the group's own vertices, mapped back */
+                    const size_t v0 = (size_t)G[i].vstart[gi];
+                    const size_t nv = (size_t)G[i].vstart[gi + 1] - v0;
+                    got = meshopt_simplify(tmp, G[i].lidx + s, c, G[i].gpos + 3 * v0, nv,
+                                           3 * sizeof(float), target, 1.0f,
+                                           d.whole ? 0u : (unsigned)meshopt_SimplifyLockBorder,
                                            &e);
+                    for (size_t k = 0; k < got; k++) tmp[k] = G[i].gv[v0 + tmp[k]];
                 }
                 memcpy(cat + n, tmp, sizeof *cat * got);
                 n += got;
-                float ae = e * G[i].scale;
+                float ae = e * G[i].scale[gi];
                 if (ae > lerr) lerr = ae;
             }
             uint32_t *idx = kin_block_alloc(&lod->block, sizeof *idx * (n ? n : 1));
