@@ -488,6 +488,106 @@ static void test_bad_inputs(void **state)
     io_lod_free(&lod);
 }
 
+/* ------------------------------------------------------- pipe_set_lod */
+
+/* One stereo frame of the sample arms at t = 1.5 s into grey images;
+ * returns the CRC of both outputs and masks, *lvl the levels drawn. */
+static uint32_t pipe_crc(pipe_ctx *p, const gen_arms *arms, int lvl[2])
+{
+    const kin_sthmd_desc hd = pipe_hmd(p);
+    const size_t cb = (size_t)hd.cam_width * hd.cam_height * 4;
+    const size_t vb = (size_t)hd.lcd_width * hd.lcd_height * 4;
+    uint8_t *cam = malloc(cb), *out[2] = {malloc(vb), malloc(vb)};
+    assert_non_null(cam);
+    assert_non_null(out[0]);
+    assert_non_null(out[1]);
+    for (size_t i = 0; i < cb; i++) cam[i] = (uint8_t)(i % 4 == 3 ? 255 : 100 + (i / 4) % 97);
+    pipe_frame_in in;
+    memset(&in, 0, sizeof in);
+    in.anim = &arms->model.anims[0];
+    in.time = 1.5f;
+    in.head_node = arms->head;
+    in.lighting = pipe_lighting_default();
+    for (int e = 0; e < 2; e++) {
+        memset(out[e], 40, vb);
+        in.camera[e] = (fuse_image){cam, hd.cam_width, hd.cam_height, 4 * hd.cam_width};
+        in.virt[e] = (fuse_image){out[e], hd.lcd_width, hd.lcd_height, 4 * hd.lcd_width};
+        in.out[e] = in.virt[e];
+    }
+    pipe_frame_stats st;
+    char why[200] = "";
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    uint32_t c = 0;
+    for (int e = 0; e < 2; e++) {
+        int w, h;
+        const uint8_t *m = pipe_mask(p, e, &w, &h);
+        c = tu_crc32(c, m, (size_t)w * h);
+        c = tu_crc32(c, out[e], vb);
+        lvl[e] = st.lod_level[e];
+    }
+    free(cam);
+    free(out[0]);
+    free(out[1]);
+    return c;
+}
+
+static void test_pipe(void **state)
+{
+    (void)state;
+    gen_arms arms;
+    assert_int_equal(gen_arms_build(&arms), 0);
+    pipe_lod lod;
+    io_error err;
+    assert_int_equal(io_lod_build("arms", &arms.model, NULL, &lod, &err), IO_OK);
+    pipe_desc d = {0};
+    pipe_ctx *p = pipe_create(&d, &arms.model);
+    assert_non_null(p);
+    int lv[2];
+    const uint32_t full = pipe_crc(p, &arms, lv);
+    assert_int_equal(lv[0], 0);
+    /* level 2 for both eyes: other bytes */
+    assert_int_equal(pipe_set_lod(p, &lod, 2, 0.0f), 0);
+    const uint32_t l2 = pipe_crc(p, &arms, lv);
+    assert_int_equal(lv[0], 2);
+    assert_int_equal(lv[1], 2);
+    assert_int_not_equal(l2, full);
+    /* the rule: the level pipe_lod_draw picks; at 1000 px everything goes */
+    assert_int_equal(pipe_set_lod(p, &lod, PIPE_LOD_AUTO, 1000.0f), 0);
+    pipe_crc(p, &arms, lv);
+    assert_int_equal(lv[0], lod.level_count - 1);
+    /* level 0, or no chain: the bytes of a pipe without levels */
+    assert_int_equal(pipe_set_lod(p, &lod, 0, 0.0f), 0);
+    assert_int_equal(pipe_crc(p, &arms, lv), full);
+    assert_int_equal(pipe_set_lod(p, &lod, 2, 0.0f), 0);
+    assert_int_equal(pipe_set_lod(p, NULL, 0, 0.0f), 0);
+    assert_int_equal(pipe_crc(p, &arms, lv), full);
+    /* refused, nothing changed */
+    assert_int_equal(pipe_set_lod(p, &lod, 2, 0.0f), 0);
+    assert_int_equal(pipe_set_lod(p, &lod, PIPE_LOD_AUTO, 0.0f), -1);
+    assert_int_equal(pipe_set_lod(p, &lod, PIPE_LOD_AUTO, NAN), -1);
+    assert_int_equal(pipe_set_lod(p, &lod, -2, 1.0f), -1);
+    assert_int_equal(pipe_set_lod(NULL, &lod, 1, 1.0f), -1);
+    gen_arms other;
+    assert_int_equal(gen_arms_build(&other), 0);
+    pipe_lod lo2;
+    assert_int_equal(io_lod_build("other", &other.model, NULL, &lo2, &err), IO_OK);
+    assert_int_equal(pipe_set_lod(p, &lo2, 1, 0.0f), -1);
+    assert_int_equal(pipe_crc(p, &arms, lv), l2);
+    /* two threads and one: the same bytes with levels */
+    pipe_desc d1 = {0};
+    d1.threads = 1;
+    pipe_ctx *p1 = pipe_create(&d1, &arms.model);
+    assert_non_null(p1);
+    assert_int_equal(pipe_set_lod(p1, &lod, 2, 0.0f), 0);
+    assert_int_equal(pipe_crc(p1, &arms, lv), l2);
+    pipe_destroy(p1);
+    pipe_destroy(p);
+    io_lod_free(&lo2);
+    gen_arms_free(&other);
+    io_lod_free(&lod);
+    gen_arms_free(&arms);
+}
+
 /* ------------------------------------------------------------ the CLI */
 
 static const char *bin(void)
@@ -594,6 +694,7 @@ int main(void)
         cmocka_unit_test(test_torus),
         cmocka_unit_test(test_sample_arms),
         cmocka_unit_test(test_draw),
+        cmocka_unit_test(test_pipe),
         cmocka_unit_test(test_cli),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
