@@ -12,7 +12,9 @@
  * pipe_lod.h (pipe_lod_choose on pipe_lod_px_per_m of the eye's clip
  * coordinates) at targets of 0.5, 1, 2 and 4 px. Per configuration, cull
  * none (the pipe's default) and cull back: the median over --runs passes
- * of the stage time per eye and of its draw, the triangles submitted and
+ * of the stage time per eye and of its draw (the configurations
+ * interleaved: each run times one pass of every configuration in turn, so
+ * the machine's load falls on all alike), the triangles submitted and
  * scanned per eye, and the mask's IoU and boundary F (1 px) against the
  * full model's mask (level 0, same cull) over all poses and eyes (mean,
  * and the worst IoU). Times are thread CPU time (CLOCK_THREAD_CPUTIME_ID),
@@ -211,7 +213,7 @@ int main(int argc, char **argv)
     }
     /* reference masks: level 0 of every pose and eye */
     uint8_t *ref = malloc(plane * (size_t)np * 2);
-    double *ts = malloc(sizeof(double) * (size_t)runs * 2);
+    double *ts = malloc(sizeof(double) * (size_t)runs * 2 * (PIPE_LOD_MAX + 4));
     if (!ref || !ts) exit(1);
     printf("%s%d poses over '%s', both eyes, %dx%d per eye, cache cold (%d MB), median of %d "
            "runs\n", pfx, np, anim ? anim->name : "rest", b.W, b.H, cold, runs);
@@ -233,60 +235,70 @@ int main(int argc, char **argv)
             rast_context_desc cd = {isa, 1};
             for (int e = 0; e < 2; e++)
                 if (!(b.ctx[e] = rast_context_create(&cd))) exit(1);
+            /* accuracy and counts: one pass per configuration */
+            double iou[PIPE_LOD_MAX + 4], iou_min[PIPE_LOD_MAX + 4], bf[PIPE_LOD_MAX + 4],
+                lsum[PIPE_LOD_MAX + 4];
+            long tris[PIPE_LOD_MAX + 4], scanned[PIPE_LOD_MAX + 4];
+            int level[PIPE_LOD_MAX + 4];
+            float target[PIPE_LOD_MAX + 4];
             for (int c = 0; c < nconf; c++) {
-                const int level = c < lod.level_count ? c : -1;
-                const float target = level < 0 ? targets[c - lod.level_count] : 0.0f;
-                /* accuracy and counts: one pass */
-                double iou = 0, iou_min = 1, bf = 0, lsum = 0;
-                long tris = 0, scanned = 0;
+                level[c] = c < lod.level_count ? c : -1;
+                target[c] = level[c] < 0 ? targets[c - lod.level_count] : 0.0f;
+                iou[c] = 0, iou_min[c] = 1, bf[c] = 0, lsum[c] = 0, tris[c] = 0, scanned[c] = 0;
                 for (int p = 0; p < np; p++)
                     for (int e = 0; e < 2; e++) {
                         double a = 0, d = 0;
                         rast_stats st = {0};
-                        int l = stage(&b, p, e, level, target, cull, &a, &d, &st);
-                        lsum += l;
+                        int l = stage(&b, p, e, level[c], target[c], cull, &a, &d, &st);
+                        lsum[c] += l;
                         for (int i = 0; i < b.nm; i++)
-                            tris += lod.level[l].meshes[i].index_count / 3;
-                        scanned += st.tris_drawn;
+                            tris[c] += lod.level[l].meshes[i].index_count / 3;
+                        scanned[c] += st.tris_drawn;
                         uint8_t *r = ref + plane * (size_t)(2 * p + e);
                         if (c == 0) memcpy(r, b.tg[e].mask, plane);
                         fuse_confusion cf;
                         fuse_mask_confusion(b.tg[e].mask, b.W, r, b.W, b.W, b.H, &cf);
                         double u = fuse_confusion_iou(&cf);
-                        iou += u;
-                        if (u < iou_min) iou_min = u;
-                        bf += fuse_boundary_f(b.tg[e].mask, b.W, r, b.W, b.W, b.H, 1.0f, NULL,
-                                              NULL);
+                        iou[c] += u;
+                        if (u < iou_min[c]) iou_min[c] = u;
+                        bf[c] += fuse_boundary_f(b.tg[e].mask, b.W, r, b.W, b.W, b.H, 1.0f, NULL,
+                                                 NULL);
                     }
-                const double n2 = 2.0 * np;
-                for (int r = -2; r < runs; r++) {
+            }
+            /* times: the configurations interleaved, one pass each per run,
+             * so that the machine's load falls on all of them alike */
+            const double n2 = 2.0 * np;
+            for (int r = -2; r < runs; r++)
+                for (int c = 0; c < nconf; c++) {
                     double t_stage = 0, t_draw = 0;
                     for (int p = 0; p < np; p++) {
                         evict(b.junk, cold, r * np + p);
                         for (int e = 0; e < 2; e++)
-                            stage(&b, p, e, level, target, cull, &t_stage, &t_draw, NULL);
+                            stage(&b, p, e, level[c], target[c], cull, &t_stage, &t_draw, NULL);
                     }
                     if (r >= 0) {
-                        ts[r] = t_stage / n2;
-                        ts[runs + r] = t_draw / n2;
+                        ts[(size_t)c * 2 * runs + r] = t_stage / n2;
+                        ts[(size_t)c * 2 * runs + runs + r] = t_draw / n2;
                     }
                 }
-                double ms_stage = bench_median(ts, runs), ms_draw = bench_median(ts + runs, runs);
+            for (int c = 0; c < nconf; c++) {
+                double ms_stage = bench_median(ts + (size_t)c * 2 * runs, runs);
+                double ms_draw = bench_median(ts + (size_t)c * 2 * runs + runs, runs);
                 char name[32];
-                if (level >= 0) snprintf(name, sizeof name, "L%d", level);
-                else snprintf(name, sizeof name, "auto@%gpx", (double)target);
+                if (level[c] >= 0) snprintf(name, sizeof name, "L%d", level[c]);
+                else snprintf(name, sizeof name, "auto@%gpx", (double)target[c]);
                 if (csv)
                     printf("lod,%s,%d,%g,%s,%s,%.0f,%.0f,%.4f,%.4f,%.5f,%.5f,%.5f,%.3f\n", name,
-                           level, (double)target, ef_isa_name((ef_isa)isa),
-                           ci ? "back" : "none", (double)tris / n2, (double)scanned / n2,
-                           ms_stage, ms_draw, iou / n2, iou_min, bf / n2, lsum / n2);
+                           level[c], (double)target[c], ef_isa_name((ef_isa)isa),
+                           ci ? "back" : "none", (double)tris[c] / n2, (double)scanned[c] / n2,
+                           ms_stage, ms_draw, iou[c] / n2, iou_min[c], bf[c] / n2, lsum[c] / n2);
                 else
                     printf("%-10s %-6s %-4s %8.0f %8.0f %9.4f %9.4f %8.5f %8.5f %8.5f %6.2f\n",
                            name, ef_isa_name((ef_isa)isa), ci ? "back" : "none",
-                           (double)tris / n2, (double)scanned / n2, ms_stage, ms_draw, iou / n2,
-                           iou_min, bf / n2, lsum / n2);
-                fflush(stdout);
+                           (double)tris[c] / n2, (double)scanned[c] / n2, ms_stage, ms_draw,
+                           iou[c] / n2, iou_min[c], bf[c] / n2, lsum[c] / n2);
             }
+            fflush(stdout);
             for (int e = 0; e < 2; e++) rast_context_destroy(b.ctx[e]);
         }
     }
