@@ -319,13 +319,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
         "set xlabel 'band half width, px'\nset ylabel 'IoU, BF(3 px)'\n"
         "plot '%s/band.dat' index 3 using 1:2 with linespoints lw 2 title 'IoU', \\\n"
         "     '%s/band.dat' index 3 using 1:3 with linespoints lw 2 title 'BF 3px'\n"
-        "set output '%s/sequences.png'.sfx\nset title 'Mask IoU per sequence and method'\n"
-        "set style data histograms\nset style histogram clustered gap 1\n"
-        "set style fill solid 0.8 border -1\nset yrange [0:1.15]\nset key top center horizontal\n"
-        "set xlabel 'sequence'\nset ylabel 'mask IoU'\n"
-        "plot '%s/sequences.dat' using 2:xtic(1) title 'kin', '' using 3 title 'kin-cal-pred', "
-        "'' using 4 title 'skin', '' using 5 title 'refine'\n"
-        "unset style\nset style data points\nset autoscale y\nset key bottom right\n"
+        "set key bottom right\n"
         "set terminal pngcairo noenhanced size 1400,600 font ',10'\n"
         "set output '%s/lod.png'.sfx\n"
         "set multiplot layout 1,2 title 'Levels of detail of the mask model (labels: level, "
@@ -341,7 +335,14 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
         "plot '%s/lod.dat' index 0 using 1:2 with points pt 7 ps 1.3 title 'kin-cal-pred', \\\n"
         "     '%s/lod.dat' index 1 using 1:2 with points pt 9 ps 1.3 title 'refine', \\\n"
         "     '%s/lod.dat' index 0 using 1:2:7 with labels offset 0,0.8 font ',7' notitle\n"
-        "unset multiplot\n",
+        "unset multiplot\nunset logscale x\n"
+        "set terminal pngcairo noenhanced size 900,600 font ',10'\n"
+        "set output '%s/sequences.png'.sfx\nset title 'Mask IoU per sequence and method'\n"
+        "set style data histograms\nset style histogram clustered gap 1\n"
+        "set style fill solid 0.8 border -1\nset yrange [0:1.15]\nset key top center horizontal\n"
+        "set xlabel 'sequence'\nset ylabel 'mask IoU'\n"
+        "plot '%s/sequences.dat' using 2:xtic(1) title 'kin', '' using 3 title 'kin-cal-pred', "
+        "'' using 4 title 'skin', '' using 5 title 'refine'\n",
         dir, dir, dir, dir, dir, dir, dir, (double)o->latency, dir, dir, (double)o->noise, dir,
         dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir);
     if (out_commit(&of)) return EXIT_FAIL;
