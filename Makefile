@@ -185,7 +185,7 @@ $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(TEST_IOLIB) $(LIB) | $(TEST_PLU
 	    $(CMOCKA_LIBS) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
 # Tests on the generated samples' scenes also link the generator.
-$(BUILD)/tests/test_occlusion: tests/test_occlusion.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
+$(BUILD)/tests/test_occlusion $(BUILD)/tests/test_io_lod: $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) \
 	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
@@ -216,10 +216,10 @@ test: deps
 	@sh tests/run_tests.sh $(BUILD)
 
 # Every public header compiles on its own as C and as C++ (sokol's rule).
-HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/pipe/pipe_pose.h src/fit/fit.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
+HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/pipe/pipe_pose.h src/pipe/pipe_lod.h src/fit/fit.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
            src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/io/io.h src/io/io_dev.h \
            src/io/io_natnet.h src/io/io_display.h src/io/io_sched.h src/io/io_live.h \
-           src/io/io_vsrc.h
+           src/io/io_vsrc.h src/io/io_lod.h
 check-headers:
 	@for h in $(HEADERS); do \
 	    echo "#include \"$$h\"" | $(CC) -std=c99 -Wall -Wextra -Werror -x c -fsyntax-only - || exit 1; \

@@ -2,6 +2,7 @@
  * stereo sequence: pose -> skin -> raster per eye -> lighting layer ->
  * resample into the viewport -> composite over the virtual scene. */
 #include "cli.h"
+#include "cli_lod.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -16,6 +17,7 @@ static const char *render_usage =
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
     "                      [--refine BAND] [--smooth-normals R] [--hide PARTS]\n"
     "                      [--prop MODEL@X,Y,Z[,YAW]]... [--allow-outside]\n"
+    "                      [--lod MODE] [--lod-px PX]\n"
     "\n"
     "Composites a recorded sequence (docs/scene.md): for each frame, poses the\n"
     "mask model at t = frame / fps, renders its mask and normals from both\n"
@@ -68,6 +70,7 @@ static const char *render_usage =
     "  --smooth-normals R  sum the model's normals over a (2R+1)^2 window\n"
     "                 before lighting (1..4; default 0: off): for models of\n"
     "                 crossing parts whose shading shows seams\n"
+    CLI_LOD_USAGE
     "  --allow-outside  let the models' buffer and image URIs name files\n"
     "                 outside their folder (absolute, `..`, symlinks out);\n"
     "                 refused by default (docs/io.md)\n"
@@ -108,6 +111,8 @@ typedef struct render_opts {
         float at[3], yaw_deg;
     } props[RENDER_MAX_PROPS];
     int smooth_normals;    /* fuse_normal_smooth radius; 0 = off */
+    int lod;               /* --lod: a level, PIPE_LOD_AUTO; 0 = off */
+    float lod_px;          /* --lod-px */
 } render_opts;
 
 /* The pose from tracking: the recording, the rig, the filter and the
@@ -326,6 +331,7 @@ static int render(const render_opts *o)
     /* the scene's HMD (its `hmd` key, checked on load), or the paper's */
     if (sc.hmd[0]) kin_sthmd_preset(sc.hmd, &pd.hmd);
     pipe_ctx *pp = pipe_create(&pd, &model);
+    pipe_lod lod = {0};
     kin_sthmd_desc hd = pp ? pipe_hmd(pp) : kin_sthmd_desc_resolved(&pd.hmd);
     io_image cam[2] = {{0}}, virt[2] = {{0}}, vdepth[2] = {{0}}, rgb = {0};
     kin_model props[RENDER_MAX_PROPS];
@@ -340,6 +346,7 @@ static int render(const render_opts *o)
             cli_fail("cannot start the pipeline: out of memory or no thread");
         goto done;
     }
+    if (cli_lod_setup(model_path, &model, o->lod, o->lod_px, pp, &lod) != EXIT_OK) goto done;
     if (render_props(o, pp, props, &props_loaded, prop_world, prop_ptr) != EXIT_OK) goto done;
     if (o->hide & ~pipe_parts_present(pp))
         fprintf(stderr, "egofuse: --hide: %s has no triangles of some of these parts (found: "
@@ -367,6 +374,7 @@ static int render(const render_opts *o)
     in.prop_count = props_loaded;
     static const char *eye_name[2] = {"left", "right"};
     pipe_frame_stats st, sum = {0};
+    long lod_sum = 0;
     progress pr;
     progress_start(&pr, count);
     if (o->quiet) pr.enabled = 0;
@@ -419,6 +427,7 @@ static int render(const render_opts *o)
         for (int e = 0; e < 2; e++) {
             sum.ms_raster[e] += st.ms_raster[e];
             sum.ms_fuse[e] += st.ms_fuse[e];
+            lod_sum += st.lod_level[e];
         }
         for (int e = 0; e < 2; e++) {
             snprintf(path, sizeof path, "%s/%s_%04d.png", o->out, eye_name[e], f);
@@ -443,6 +452,14 @@ static int render(const render_opts *o)
                o->threads == 1 ? 1 : 2, o->threads == 1 ? "" : "s", sum.ms_total / count,
                sum.ms_pose / count, (sum.ms_raster[0] + sum.ms_raster[1]) / (2.0 * count),
                (sum.ms_fuse[0] + sum.ms_fuse[1]) / (2.0 * count), 1e3 * wall / count);
+        if (o->lod) {
+            char ln[32];
+            printf("egofuse: levels of detail %s: %d levels (", cli_lod_name(o->lod, o->lod_px,
+                   ln, sizeof ln), lod.level_count);
+            for (int l = 0; l < lod.level_count; l++)
+                printf("%s%ld", l ? ", " : "", lod.level[l].triangles);
+            printf(" triangles), mean level drawn %.2f\n", (double)lod_sum / (2.0 * count));
+        }
         if (o->pose_tracking)
             printf("egofuse: pose from tracking (%d samples, %s, prediction %.0f ms%s%s)%s\n",
                    tp.count, o->no_filter ? "raw" : "One Euro filter", (double)o->predict_ms,
@@ -458,6 +475,7 @@ done:
     }
     io_image_free(&rgb);
     pipe_destroy(pp);
+    io_lod_free(&lod);
     for (int k = 0; k < props_loaded; k++) kin_model_free(&props[k]);
     track_pose_free(&tp);
     kin_model_free(&model);
@@ -466,7 +484,7 @@ done:
 
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
        O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
-       O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE };
+       O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE, O_LOD, O_LOD_PX };
 
 /* "MODEL@X,Y,Z[,YAW]" (the last '@' ends the path). 1, or 0 when it is
  * not of that form. */
@@ -509,6 +527,8 @@ int cmd_render(int argc, char **argv)
         {"no-depth", no_argument, 0, O_NO_DEPTH},
         {"cull-back", no_argument, 0, O_CULL},
         {"refine", required_argument, 0, O_REFINE},
+        {"lod", required_argument, 0, O_LOD},
+        {"lod-px", required_argument, 0, O_LOD_PX},
         {"smooth-normals", required_argument, 0, O_SMOOTH},
         {"tone-match", required_argument, 0, O_TONE},
         {"pose", required_argument, 0, O_POSE},
@@ -522,6 +542,8 @@ int cmd_render(int argc, char **argv)
         {0, 0, 0, 0},
     };
     render_opts o = {0};
+    o.lod = CLI_LOD_DEFAULT;
+    o.lod_px = CLI_LOD_PX_DEFAULT;
     char why[200];
     int tracking_only = 0;   /* an option that needs --pose tracking */
     optind = 1;
@@ -548,6 +570,16 @@ int cmd_render(int argc, char **argv)
             break;
         case O_NO_DEPTH: o.no_depth = 1; break;
         case O_CULL: o.cull_back = 1; break;
+        case O_LOD:
+            if (!cli_lod_parse(optarg, &o.lod))
+                return cli_usage_error("render", "--lod '%s': off, auto or a level 0..%d",
+                                       optarg, PIPE_LOD_MAX - 1);
+            break;
+        case O_LOD_PX:
+            if (!cli_lod_parse_px(optarg, &o.lod_px))
+                return cli_usage_error("render", "--lod-px '%s': pixels, > 0 and <= 1000",
+                                       optarg);
+            break;
         case O_REFINE:
             if (!cli_parse_int(optarg, 1, 64, &o.refine))
                 return cli_usage_error("render", "--refine '%s': a band of 1..64 px", optarg);
@@ -611,6 +643,8 @@ int cmd_demo(int argc, char **argv)
     };
     const char *samples = "build/samples";
     render_opts o = {0};
+    o.lod = CLI_LOD_DEFAULT;
+    o.lod_px = CLI_LOD_PX_DEFAULT;
     o.out = "out/demo";
     o.cull_back = 1; /* the sample arms are closed: same masks, half the setups */
     optind = 1;

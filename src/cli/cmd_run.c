@@ -17,6 +17,7 @@
  * run_state (tracking service, flips, outputs, the status words), which
  * nothing else uses. */
 #include "run.h"
+#include "cli_lod.h"
 
 #include <errno.h>
 #include <math.h>
@@ -131,6 +132,7 @@ typedef struct run_state {
     int have_model;
     char model_path[IO_PATH_MAX + 64];
     pipe_ctx *pipe;
+    pipe_lod lod;             /* --lod: the model's levels of detail */
     io_image virt[2], outimg[2], camimg[2];
     io_image vdepth[2];       /* the still virtual images' depth, if any */
     char vdepth_path[2][IO_PATH_MAX + 64];
@@ -181,6 +183,7 @@ static void run_close(run_state *r)
     free(r->locals);
     free(r->rawbuf);
     if (r->pipe) pipe_destroy(r->pipe);
+    io_lod_free(&r->lod);
     for (int k = 0; k < r->props_loaded; k++) kin_model_free(&r->props[k]);
     if (r->have_model) kin_model_free(&r->model);
 }
@@ -519,6 +522,9 @@ static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
             bad |= fprintf(f, " --prop %s@%.9g,%.9g,%.9g,%.9g", p->model, (double)p->at[0],
                            (double)p->at[1], (double)p->at[2], (double)p->rot_deg[0]) < 0;
     }
+    if (o->lod == PIPE_LOD_AUTO)
+        bad |= fprintf(f, " --lod auto --lod-px %.9g", (double)o->lod_px) < 0;
+    else if (o->lod) bad |= fprintf(f, " --lod %d", o->lod) < 0;
     if (o->refine) bad |= fprintf(f, " --refine %d # the elbow fit's learned state differs", o->refine) < 0;
     bad |= fputc('\n', f) == EOF;
     bad |= fclose(f) != 0;
@@ -789,6 +795,8 @@ static int run(const run_opts *o)
                             : "cannot start the pipeline (out of memory or no thread)");
         goto done;
     }
+    if (cli_lod_setup(model_path, model, o->lod, o->lod_px, r->pipe, &r->lod) != EXIT_OK)
+        goto done;
     unsigned parts = pipe_parts_present(r->pipe);
     if ((o->hide & ~parts) && !o->quiet)
         fprintf(stderr, "egofuse run: --hide: %s has no such part (its parts: %s%s%s%s)\n",

@@ -34,6 +34,8 @@ typedef struct run_opts {
     int loop;                 /* file cameras: start again at the end */
     int hold;                 /* --display: keep the last frame shown until Ctrl-C */
     int refine;               /* refinement band, px; 0 = off */
+    int lod;                  /* --lod: a level, PIPE_LOD_AUTO; 0 = off */
+    float lod_px;             /* --lod-px */
     float predict_ms;         /* pose time = camera time + this */
     unsigned hide;            /* PIPE_PART_* bits hidden */
     kin_sthmd_desc hmd;       /* zero fields = the paper's */

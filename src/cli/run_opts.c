@@ -3,6 +3,7 @@
  * into options), so that one file starts a cockpit and every option still
  * works on the command line. docs/cockpit.md. */
 #include "run.h"
+#include "cli_lod.h"
 
 #include <getopt.h>
 #include <stdarg.h>
@@ -89,6 +90,10 @@ const char *run_usage =
     "  --dump DIR       with --frames: the last frame's inputs as a scene that\n"
     "                   egofuse render composites to the same bytes\n"
     "  --refine BAND    refine the masks by colour in a band of BAND px (1..64)\n"
+    "  --lod MODE       levels of detail of the mask model: off (default), a\n"
+    "                   level 1..7, or auto (per frame and eye, the coarsest\n"
+    "                   level whose error is <= --lod-px px; docs/bench.md)\n"
+    "  --lod-px PX      the error auto allows, pixels (default 2)\n"
     "  --quiet          no status line\n"
     "  -h, --help       this text\n"
     "\n"
@@ -102,7 +107,7 @@ enum {
     O_DISPLAY, O_NATNET, O_NN_LOCAL, O_NN_MCAST, O_NN_BODY, O_NN_UP, O_NN_UNITS, O_NN_VERSION,
     O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD, O_ALLOW_OUTSIDE,
     O_HMD_CAM, O_HMD_CAM_HFOV, O_HMD_BASE, O_HMD_OFFSET, O_HMD_DISP, O_HMD_HFOV, O_HMD_VFOV,
-    O_HMD_FOCAL, O_HMD_IPD, O_HMD_PRESET, O_DUMP
+    O_HMD_FOCAL, O_HMD_IPD, O_HMD_PRESET, O_DUMP, O_LOD, O_LOD_PX
 };
 
 static const struct option run_long_opts[] = {
@@ -127,6 +132,8 @@ static const struct option run_long_opts[] = {
     {"quiet", no_argument, 0, O_QUIET},
     {"help", no_argument, 0, 'h'},
     {"refine", required_argument, 0, O_REFINE},
+    {"lod", required_argument, 0, O_LOD},
+    {"lod-px", required_argument, 0, O_LOD_PX},
     {"config", required_argument, 0, O_CONFIG},
     {"stats", required_argument, 0, O_STATS},
     {"predict-ms", required_argument, 0, O_PREDICT},
@@ -252,6 +259,8 @@ int run_parse(int argc, char **argv, run_opts *o)
     o->input = -1;
     o->buffers = 4;
     o->virt_stale_ms = 200;
+    o->lod = CLI_LOD_DEFAULT;
+    o->lod_px = CLI_LOD_PX_DEFAULT;
 
     /* ---- --config first: its options go before the command line's */
     const char *config = NULL;
@@ -344,6 +353,14 @@ int run_parse(int argc, char **argv, run_opts *o)
         case O_REFINE:
             if (!cli_parse_int(optarg, 1, 64, &o->refine))
                 BAD("--refine '%s': a band of 1..64 px", optarg);
+            break;
+        case O_LOD:
+            if (!cli_lod_parse(optarg, &o->lod))
+                BAD("--lod '%s': off, auto or a level 0..%d", optarg, PIPE_LOD_MAX - 1);
+            break;
+        case O_LOD_PX:
+            if (!cli_lod_parse_px(optarg, &o->lod_px))
+                BAD("--lod-px '%s': pixels, > 0 and <= 1000", optarg);
             break;
         case O_STATS: o->stats = optarg; break;
         case O_DUMP: o->dump = optarg; break;

@@ -201,7 +201,7 @@ static int write_sequences(const char *dir, const method_run *R, int n, const ev
 static int write_charts(const char *dir)
 {
     static const char *const charts[] = {"speed_iou", "speed_bf", "noise", "latency",
-                                         "calib", "band", "sequences"};
+                                         "calib", "band", "sequences", "lod"};
     enum { NCHART = sizeof charts / sizeof charts[0] };
     char cmd[3 * IO_PATH_MAX], tmp[IO_PATH_MAX + 96], path[IO_PATH_MAX + 64];
     long pid = (long)getpid();
@@ -285,6 +285,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
     for (int g = 0; g < 4; g++)
         if (write_group(dir, groups[g], R, n, o)) return EXIT_FAIL;
     if (write_sequences(dir, R, n, o)) return EXIT_FAIL;
+    if (eval__write_lod(dir, R, n)) return EXIT_FAIL;
     snprintf(path, sizeof path, "%s/charts.gp", dir);
     f = out_open(&of, path);
     if (!f) return EXIT_FAIL;
@@ -318,6 +319,24 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
         "set xlabel 'band half width, px'\nset ylabel 'IoU, BF(3 px)'\n"
         "plot '%s/band.dat' index 3 using 1:2 with linespoints lw 2 title 'IoU', \\\n"
         "     '%s/band.dat' index 3 using 1:3 with linespoints lw 2 title 'BF 3px'\n"
+        "set key bottom right\n"
+        "set terminal pngcairo noenhanced size 1400,600 font ',10'\n"
+        "set output '%s/lod.png'.sfx\n"
+        "set multiplot layout 1,2 title 'Levels of detail of the mask model (labels: level, "
+        "or the rule at a target in px)'\n"
+        "set title 'Mask accuracy against the triangles drawn'\n"
+        "set xlabel 'triangles drawn per eye (mean)'\nset ylabel 'IoU'\nset logscale x\n"
+        "plot '%s/lod.dat' index 0 using 1:3 with points pt 7 ps 1.3 title 'kin-cal-pred: kinematic mask vs the full model', \\\n"
+        "     '%s/lod.dat' index 0 using 1:4 with points pt 5 ps 1.3 title 'kin-cal-pred: vs the ground truth', \\\n"
+        "     '%s/lod.dat' index 1 using 1:4 with points pt 9 ps 1.3 title 'refine: vs the ground truth', \\\n"
+        "     '%s/lod.dat' index 0 using 1:3:7 with labels offset 0,0.8 font ',7' notitle\n"
+        "set title 'Raster time against the triangles drawn'\n"
+        "set ylabel 'raster ms per eye (transforms + draw, thread CPU time)'\n"
+        "plot '%s/lod.dat' index 0 using 1:2 with points pt 7 ps 1.3 title 'kin-cal-pred', \\\n"
+        "     '%s/lod.dat' index 1 using 1:2 with points pt 9 ps 1.3 title 'refine', \\\n"
+        "     '%s/lod.dat' index 0 using 1:2:7 with labels offset 0,0.8 font ',7' notitle\n"
+        "unset multiplot\nunset logscale x\n"
+        "set terminal pngcairo noenhanced size 900,600 font ',10'\n"
         "set output '%s/sequences.png'.sfx\nset title 'Mask IoU per sequence and method'\n"
         "set style data histograms\nset style histogram clustered gap 1\n"
         "set style fill solid 0.8 border -1\nset yrange [0:1.15]\nset key top center horizontal\n"
@@ -325,7 +344,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
         "plot '%s/sequences.dat' using 2:xtic(1) title 'kin', '' using 3 title 'kin-cal-pred', "
         "'' using 4 title 'skin', '' using 5 title 'refine'\n",
         dir, dir, dir, dir, dir, dir, dir, (double)o->latency, dir, dir, (double)o->noise, dir,
-        dir, dir, dir, dir, dir, dir, dir);
+        dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir);
     if (out_commit(&of)) return EXIT_FAIL;
     return write_charts(dir);
 }

@@ -34,6 +34,7 @@ typedef struct eye_state {
     pipe_result result;
     char why[160];
     double ms_raster, ms_convert, ms_fuse, coverage;
+    int lod_level;            /* the level drawn */
 } eye_state;
 
 struct pipe_ctx {
@@ -57,6 +58,10 @@ struct pipe_ctx {
     int fit_no_prev;          /* pipe_reset_fit: the refined masks are of
                                  before it, not to be learned from */
     pipe__cockpit *ck;        /* hidden parts and props (pipe_parts.c) */
+    const kin_model *model;
+    const pipe_lod *lod;      /* pipe_set_lod, or NULL */
+    int lod_level;            /* a level, or PIPE_LOD_AUTO */
+    float lod_px;             /* the rule's target, pixels */
 };
 
 enum { JOB_SKIN, JOB_EYE };
@@ -113,11 +118,15 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
     rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
     rast_context_clear(e->rast, &tg); /* only what the last frame drew */
+    e->lod_level = 0;
     rast_result rr = pipe__cockpit_active(p->ck)
                          ? pipe__cockpit_draw(p->ck, &p->pose, e->eye, e->rast, &e->cam, &tg,
                                               p->desc.cull, e->clip, e->vnrm)
-                         : pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, p->desc.cull,
-                                          e->clip, e->vnrm, NULL);
+                     : p->lod ? pipe_lod_draw(&p->pose, p->lod, p->lod_level, p->lod_px, e->rast,
+                                              &e->cam, &tg, p->desc.cull, e->clip, e->vnrm, NULL,
+                                              &e->lod_level)
+                              : pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, p->desc.cull,
+                                               e->clip, e->vnrm, NULL);
     double t1 = now_ms();
     e->ms_raster = t1 - t0;
     if (rr != RAST_OK) {
@@ -357,6 +366,7 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
     if (desc) p->desc = *desc;
+    p->model = model;
     p->hmd = kin_sthmd_desc_resolved(&p->desc.hmd);
     p->geo = kin_sthmd_geometry_of(&p->hmd);
     if (pipe_pose_init(&p->pose, model) != 0) {
@@ -592,6 +602,7 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
             stats->ms_convert[e] = p->eye[e].ms_convert;
             stats->ms_fuse[e] = p->eye[e].ms_fuse;
             stats->coverage[e] = p->eye[e].coverage;
+            stats->lod_level[e] = p->eye[e].lod_level;
         }
         stats->ms_total = now_ms() - t0;
     }
@@ -632,6 +643,17 @@ kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }
 
 kin_sthmd_desc pipe_hmd(const pipe_ctx *p) { return p->hmd; }
+
+int pipe_set_lod(pipe_ctx *p, const pipe_lod *lod, int level, float target_px)
+{
+    if (!p || level < PIPE_LOD_AUTO) return -1;
+    if (lod && !pipe_lod_check(lod, p->model, NULL, 0)) return -1;
+    if (level == PIPE_LOD_AUTO && (!(target_px > 0.0f) || !isfinite(target_px))) return -1;
+    p->lod = level == 0 ? NULL : lod;
+    p->lod_level = level;
+    p->lod_px = target_px;
+    return 0;
+}
 
 unsigned pipe_parts_present(const pipe_ctx *p) { return p ? pipe__cockpit_present(p->ck) : 0; }
 

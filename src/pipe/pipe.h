@@ -41,6 +41,7 @@
 #include "../fuse/fuse_refine.h"
 #include "../kin/kin.h"
 #include "../raster/raster.h"
+#include "pipe_lod.h"
 #include "pipe_pose.h"
 
 #ifdef __cplusplus
@@ -159,6 +160,8 @@ typedef struct pipe_frame_stats {
     double ms_fuse[2];        /* per eye: lighting, resampling, composite */
     double ms_total;          /* wall time of pipe_frame */
     double coverage[2];       /* fraction of camera pixels in the mask */
+    int lod_level[2];         /* per eye: the level of detail drawn
+                                 (pipe_set_lod; 0 = the full model) */
 } pipe_frame_stats;
 
 typedef enum pipe_result {
@@ -206,6 +209,20 @@ const char *pipe_result_str(pipe_result r);
 /* The resolved HMD description the pipe uses (pipe_desc.hmd with its
  * defaults filled in): the sizes of pipe_frame_in's images. */
 kin_sthmd_desc pipe_hmd(const pipe_ctx *p);
+
+/* Levels of detail of the pipe's model (pipe_lod.h; built by
+ * io_lod_build when the model is loaded). From the next frame on, each
+ * eye draws level `level` of lod (clamped to the chain), or with level
+ * PIPE_LOD_AUTO the level of the rule of pipe_lod.h for target_px
+ * (pixels, > 0), per eye and per mesh (pipe_lod_draw). lod NULL or level
+ * 0: the full model, the bytes of a pipe without levels (the default).
+ * The chain must be of the pipe's model (pipe_lod_check) and outlive the
+ * pipe or the next pipe_set_lod. Frames that hide a part or draw a prop
+ * (the operator's cockpit, below) and the elbow fit's own drawing use the
+ * full model. Returns 0, or -1 (nothing changed) for p NULL, a chain not
+ * of the model, a level < PIPE_LOD_AUTO, or PIPE_LOD_AUTO with target_px
+ * not > 0 and finite. Not during pipe_frame. */
+int pipe_set_lod(pipe_ctx *p, const pipe_lod *lod, int level, float target_px);
 
 /* ------------------------------------------------ the operator's cockpit
  *
