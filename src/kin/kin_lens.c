@@ -173,7 +173,8 @@ int kin_lens_distorts(const kin_lens *L)
 kin_lens kin_lens_scaled(const kin_lens *lens, int width, int height)
 {
     kin_lens L = *lens;
-    if (lens->width > 0 && lens->height > 0 && width > 0 && height > 0) {
+    if (lens->width > 0 && lens->height > 0 && width > 0 && height > 0 &&
+        (width != lens->width || height != lens->height)) {
         double sx = (double)width / lens->width, sy = (double)height / lens->height;
         L.fx *= sx;
         L.skew *= sx;
