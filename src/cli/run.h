@@ -39,6 +39,7 @@ typedef struct run_opts {
     float predict_ms;         /* pose time = camera time + this */
     unsigned hide;            /* PIPE_PART_* bits hidden */
     kin_sthmd_desc hmd;       /* zero fields = the paper's */
+    const char *hmd_calib[3]; /* --hmd-calibration, -left, -right (docs/lens.md) */
     run_prop prop[RUN_MAX_PROPS];
     int prop_count;
     char *storage;            /* owned strings (config values) */

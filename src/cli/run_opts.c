@@ -69,6 +69,10 @@ const char *run_usage =
     "  --hmd-camera WxH, --hmd-camera-hfov DEG, --hmd-baseline M (camera\n"
     "  separation), --hmd-camera-offset M (D), --hmd-display WxH (per eye),\n"
     "  --hmd-hfov DEG, --hmd-vfov DEG, --hmd-focal M, --hmd-ipd M\n"
+    "  --hmd-calibration FILE   the cameras' lenses from an OpenCV calibration\n"
+    "                   file (YAML/XML; a stereo file: M1/D1 left, M2/D2 right);\n"
+    "  --hmd-calibration-left FILE, --hmd-calibration-right FILE  one each\n"
+    "                   (docs/lens.md; the masks are drawn through the lens)\n"
     "virtual scene:\n"
     "  --virt L,R       still virtual images (default: the scene's, or grey)\n"
     "  --virt-source SPEC  live: v4l2:/dev/videoN[,/dev/videoM], stream:PATH|-\n"
@@ -107,7 +111,8 @@ enum {
     O_DISPLAY, O_NATNET, O_NN_LOCAL, O_NN_MCAST, O_NN_BODY, O_NN_UP, O_NN_UNITS, O_NN_VERSION,
     O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD, O_ALLOW_OUTSIDE,
     O_HMD_CAM, O_HMD_CAM_HFOV, O_HMD_BASE, O_HMD_OFFSET, O_HMD_DISP, O_HMD_HFOV, O_HMD_VFOV,
-    O_HMD_FOCAL, O_HMD_IPD, O_HMD_PRESET, O_DUMP, O_LOD, O_LOD_PX
+    O_HMD_FOCAL, O_HMD_IPD, O_HMD_PRESET, O_DUMP, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
+    O_HMD_CALIB_R
 };
 
 static const struct option run_long_opts[] = {
@@ -168,6 +173,9 @@ static const struct option run_long_opts[] = {
     {"hmd-focal", required_argument, 0, O_HMD_FOCAL},
     {"hmd-ipd", required_argument, 0, O_HMD_IPD},
     {"hmd-preset", required_argument, 0, O_HMD_PRESET},
+    {"hmd-calibration", required_argument, 0, O_HMD_CALIB},
+    {"hmd-calibration-left", required_argument, 0, O_HMD_CALIB_L},
+    {"hmd-calibration-right", required_argument, 0, O_HMD_CALIB_R},
     {"dump", required_argument, 0, O_DUMP},
     {0, 0, 0, 0},
 };
@@ -464,6 +472,9 @@ int run_parse(int argc, char **argv, run_opts *o)
                 BAD("--hmd-preset '%s': one of paper, consumer, highend", optarg);
             have_preset = 1;
             break;
+        case O_HMD_CALIB: o->hmd_calib[0] = optarg; break;
+        case O_HMD_CALIB_L: o->hmd_calib[1] = optarg; break;
+        case O_HMD_CALIB_R: o->hmd_calib[2] = optarg; break;
         case ':': BAD("option %s needs a value", av[optind - 1]);
         default: BAD("unknown option '%s'", av[optind - 1]);
         }
@@ -512,5 +523,9 @@ int run_parse(int argc, char **argv, run_opts *o)
         if (o->prop[i].body[0] && !o->natnet)
             return cli_usage_error("run", "--prop %s#%s: a prop posed by a rigid body needs --natnet",
                                    o->prop[i].name, o->prop[i].body);
+    if (o->hmd_calib[0] || o->hmd_calib[1] || o->hmd_calib[2]) {
+        int rc = cli_lens_load(o->hmd_calib[0], o->hmd_calib[1], o->hmd_calib[2], &o->hmd);
+        if (rc != EXIT_OK) return rc;
+    }
     return -1;
 }
