@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "../src/kin/kin.h"
+#include "../src/pipe/pipe.h"
 #include "../src/pipe/pipe_lens.h"
 #include "../src/raster/raster.h"
 
@@ -341,6 +342,125 @@ static void validity_bad_maps(void **state)
     pipe_lens_map_free(&m);
 }
 
+/* A head node and an unskinned quad [x0,x1]x[y0,y1] at depth z, facing +Z. */
+static void quad_model(kin_model *m, float x0, float x1, float y0, float y1, float z)
+{
+    memset(m, 0, sizeof *m);
+    int16_t *parents = kin_block_alloc(&m->block, 2 * sizeof(int16_t));
+    kin_transform *rest = kin_block_alloc(&m->block, 2 * sizeof(kin_transform));
+    char(*names)[KIN_NAME_MAX] = kin_block_alloc(&m->block, 2 * KIN_NAME_MAX);
+    float *pos = kin_block_alloc(&m->block, 12 * sizeof(float));
+    float *nrm = kin_block_alloc(&m->block, 12 * sizeof(float));
+    uint32_t *idx = kin_block_alloc(&m->block, 6 * sizeof(uint32_t));
+    kin_mesh *mesh = kin_block_alloc(&m->block, sizeof(kin_mesh));
+    assert_non_null(mesh);
+    parents[0] = KIN_NO_PARENT;
+    parents[1] = 0;
+    rest[0] = rest[1] = kin_transform_identity();
+    strcpy(names[0], "head");
+    strcpy(names[1], "quad");
+    const float p[12] = {x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z};
+    memcpy(pos, p, sizeof p);
+    memset(nrm, 0, 12 * sizeof(float));
+    for (int i = 0; i < 4; i++) nrm[3 * i + 2] = 1.0f;
+    const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(idx, ix, sizeof ix);
+    *mesh = (kin_mesh){.vertex_count = 4, .positions = pos, .normals = nrm, .index_count = 6,
+                       .indices = idx, .node = 1, .skin = -1};
+    m->node_count = 2;
+    m->parents = parents;
+    m->rest = rest;
+    m->names = (const char(*)[KIN_NAME_MAX])names;
+    m->mesh_count = 1;
+    m->meshes = mesh;
+}
+
+/* pipe_frame with a calibrated barrel lens on the paper's 640x480 camera:
+ * each eye's mask (the crop of eq. 1, 640x400) is the quad's exact
+ * silhouette through that eye's lens within the documented distance of
+ * its outline; the lens differs per eye (a stereo calibration); one or
+ * two threads give the same bytes. */
+static void result_pipe_frame_through_lens(void **state)
+{
+    (void)state;
+    const float X0 = -0.21f, X1 = 0.17f, Y0 = -0.12f, Y1 = 0.15f, Z = -0.45f;
+    kin_model m;
+    quad_model(&m, X0, X1, Y0, Y1, Z);
+    pipe_desc pd = {0};
+    pd.hmd.lens[0] = barrel();
+    pd.hmd.lens[1] = barrel();
+    pd.hmd.lens[1].k[0] = -0.25;
+    pd.hmd.lens[1].cx = 322.9;
+    assert_true(kin_lens_check(&pd.hmd.lens[1], NULL, 0));
+    uint8_t *masks[2][2];
+    for (int th = 1; th <= 2; th++) {
+        pd.threads = th;
+        pipe_ctx *p = pipe_create(&pd, &m);
+        assert_non_null(p);
+        kin_sthmd_desc hd = pipe_hmd(p);
+        assert_int_equal(hd.cam_width, 640);
+        NEAR(hd.cam_hfov_deg, 2.0 * atan(320.0 / 531.8) * 180.0 / 3.14159265358979, 1e-4);
+        pipe_frame_in in;
+        memset(&in, 0, sizeof in);
+        uint8_t *cam = calloc((size_t)640 * 480 * 4, 1), *virt = calloc((size_t)1280 * 800 * 4, 1),
+                *out[2];
+        assert_non_null(cam), assert_non_null(virt);
+        for (int e = 0; e < 2; e++) {
+            out[e] = malloc((size_t)1280 * 800 * 4);
+            assert_non_null(out[e]);
+            in.camera[e] = (fuse_image){cam, 640, 480, 640 * 4};
+            in.virt[e] = (fuse_image){virt, 1280, 800, 1280 * 4};
+            in.out[e] = (fuse_image){out[e], 1280, 800, 1280 * 4};
+        }
+        in.head_node = -1;
+        in.lighting = pipe_lighting_default();
+        char why[300] = "";
+        if (pipe_frame(p, &in, NULL, why, sizeof why) != PIPE_OK) fail_msg("pipe_frame: %s", why);
+        for (int e = 0; e < 2; e++) {
+            int mw, mh;
+            const uint8_t *pm = pipe_mask(p, e, &mw, &mh);
+            assert_int_equal(mw, 640);
+            assert_int_equal(mh, 400);
+            masks[th - 1][e] = malloc((size_t)mw * mh);
+            memcpy(masks[th - 1][e], pm, (size_t)mw * mh);
+            kin_camera c = pipe_camera(p, e);
+            assert_int_equal(c.lens.model, KIN_LENS_BROWN);
+            NEAR(c.lens.cy, pd.hmd.lens[e].cy - 40.0, 1e-12); /* the crop's rows */
+            /* the camera sits at (+-baseline/2, 0, -D): the quad in its view space */
+            double ox = (e ? 0.5 : -0.5) * hd.baseline_m, zc = Z + hd.cam_offset_m;
+            long truth_n = 0, differ = 0;
+            for (int y = 0; y < mh; y++)
+                for (int x = 0; x < mw; x++) {
+                    double r[3];
+                    assert_true(kin_lens_unproject(&c.lens, x + 0.5, y + 0.5, r));
+                    double t = zc / r[2], a = t * r[0] + ox, b = t * r[1];
+                    int truth = a >= X0 && a <= X1 && b >= Y0 && b <= Y1;
+                    int got = pm[(size_t)y * mw + x] != 0;
+                    truth_n += truth;
+                    if (got == truth) continue;
+                    differ++;
+                    /* distance to the outline in the pinhole render (fx px) */
+                    double d = fmin(fmin(fabs(a - X0), fabs(a - X1)) * c.lens.fx / -zc,
+                                    fmin(fabs(b - Y0), fabs(b - Y1)) * c.lens.fy / -zc);
+                    if (!(d <= 0.5 * sqrt(2.0) + 1.0 / 64))
+                        fail_msg("eye %d pixel (%d, %d) differs %.3f px from the outline", e, x, y, d);
+                }
+            if (th == 1)
+                print_message("pipe_frame, %s eye: quad %ld px, %ld differ from the exact "
+                              "silhouette through the lens\n", e ? "right" : "left", truth_n, differ);
+            assert_true(truth_n > 40000);
+            assert_true(differ < truth_n / 100);
+        }
+        pipe_destroy(p);
+        free(cam), free(virt), free(out[0]), free(out[1]);
+    }
+    for (int e = 0; e < 2; e++) {
+        assert_memory_equal(masks[0][e], masks[1][e], (size_t)640 * 400);
+        free(masks[0][e]), free(masks[1][e]);
+    }
+    kin_model_free(&m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -348,6 +468,7 @@ int main(void)
         cmocka_unit_test(result_fisheye_silhouette),
         cmocka_unit_test(result_attributes),
         cmocka_unit_test(validity_bad_maps),
+        cmocka_unit_test(result_pipe_frame_through_lens),
     };
     return cmocka_run_group_tests_name("pipe_lens", tests, NULL, NULL);
 }

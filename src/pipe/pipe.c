@@ -3,6 +3,7 @@
 #include "pipe_morph.h"
 #include "pipe_parts.h"
 #include "pipe_internal.h"
+#include "pipe_lens.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -27,6 +28,7 @@ typedef struct eye_state {
     int converted;            /* cam_rgba already holds this frame's crop */
     rast_context *rast;
     fuse_context *fuse;
+    pipe_lens_map *lens;      /* a distorting lens: the mask through it */
     kin_camera cam;
     /* per-frame job */
     const pipe_frame_in *in;
@@ -109,6 +111,35 @@ static fuse_image raw_rows(const pipe_ctx *p, uint8_t *buf)
     return (fuse_image){buf, p->hmd.cam_width, p->geo.crop_height, 4 * p->hmd.cam_width};
 }
 
+/* Draws the posed model (parts: with the cockpit's hidden parts and
+ * props) into tg through cam: straight for a pinhole, else through the
+ * eye's lens map (pipe_lens.h), which writes every pixel of tg. Returns
+ * the raster's result; *covered: the mask pixels set. */
+static rast_result eye_draw(pipe_ctx *p, eye_state *e, const kin_camera *cam,
+                            const rast_target *tg, int parts, long *covered)
+{
+    kin_camera pc;
+    rast_target it = *tg;
+    if (e->lens) {
+        pc = pipe_lens_pinhole(e->lens, cam);
+        cam = &pc;
+        it = pipe_lens_target(e->lens);
+    }
+    rast_context_clear(e->rast, &it); /* only what the last frame drew */
+    rast_result rr = parts && pipe__cockpit_active(p->ck)
+                         ? pipe__cockpit_draw(p->ck, &p->pose, e->eye, e->rast, cam, &it,
+                                              p->desc.cull, e->clip, e->vnrm)
+                     : parts && p->lod
+                         ? pipe_lod_draw(&p->pose, p->lod, p->lod_level, p->lod_px, e->rast, cam,
+                                         &it, p->desc.cull, e->clip, e->vnrm, NULL, &e->lod_level)
+                         : pipe_pose_draw(&p->pose, e->rast, cam, &it, p->desc.cull, e->clip,
+                                          e->vnrm, NULL);
+    if (rr != RAST_OK) return rr;
+    /* Only the tiles the draws marked are read (the rest is clear). */
+    *covered = e->lens ? pipe_lens_warp(e->lens, tg) : rast_context_count(e->rast, &it);
+    return RAST_OK;
+}
+
 static void run_eye(pipe_ctx *p, eye_state *e)
 {
     const pipe_frame_in *in = e->in;
@@ -117,16 +148,9 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     e->result = PIPE_OK;
     e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
     rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
-    rast_context_clear(e->rast, &tg); /* only what the last frame drew */
+    long covered = 0;
     e->lod_level = 0;
-    rast_result rr = pipe__cockpit_active(p->ck)
-                         ? pipe__cockpit_draw(p->ck, &p->pose, e->eye, e->rast, &e->cam, &tg,
-                                              p->desc.cull, e->clip, e->vnrm)
-                     : p->lod ? pipe_lod_draw(&p->pose, p->lod, p->lod_level, p->lod_px, e->rast,
-                                              &e->cam, &tg, p->desc.cull, e->clip, e->vnrm, NULL,
-                                              &e->lod_level)
-                              : pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, p->desc.cull,
-                                               e->clip, e->vnrm, NULL);
+    rast_result rr = eye_draw(p, e, &e->cam, &tg, 1, &covered);
     double t1 = now_ms();
     e->ms_raster = t1 - t0;
     if (rr != RAST_OK) {
@@ -135,8 +159,6 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                  e->eye ? "right" : "left", rast_result_str(rr));
         return;
     }
-    /* Only the tiles the draws marked are read (the rest is clear). */
-    const long covered = rast_context_count(e->rast, &tg);
     e->coverage = (double)covered / (double)(cw * ch);
 
     /* Lights from world space into this camera's view space. */
@@ -320,6 +342,8 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].refine_scratch);
         rast_context_destroy(p->eye[e].rast);
         fuse_context_destroy(p->eye[e].fuse);
+        pipe_lens_map_free(p->eye[e].lens);
+        free(p->eye[e].lens);
     }
     pipe_fit_destroy(p->fit);
     p->fit = NULL;
@@ -392,6 +416,14 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         s->fuse = fuse_context_create(&fd);
         ok = ok && s->depth && s->nrm && s->mask && s->layer && s->cam_rgba && s->clip && s->vnrm &&
              s->rast && s->fuse;
+        if (ok) {
+            /* a calibrated, distorting lens: the mask through it */
+            kin_camera c0 = kin_sthmd_camera(&p->hmd, NULL, (kin_eye)e);
+            if (kin_lens_distorts(&c0.lens)) {
+                s->lens = calloc(1, sizeof *s->lens);
+                ok = s->lens && pipe_lens_map_init(s->lens, &c0.lens, 1, 3, NULL, 0) == 0;
+            }
+        }
         if (ok && p->desc.normal_smooth > 0) {
             s->snrm = malloc(sizeof(float) * 3 * px);
             ok = s->snrm != NULL;
@@ -494,9 +526,8 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
          * is one; else this frame's kinematic mask is drawn for it */
         if (pipe_fit_learned(p->fit, e)) continue;
         rast_target tg = {cw, ch, s->depth, cw, s->mask, cw, s->nrm, 3 * cw, 3};
-        rast_context_clear(s->rast, &tg);
-        rast_result rr = pipe_pose_draw(&p->pose, s->rast, &cam[e], &tg, p->desc.cull, s->clip,
-                                        s->vnrm, NULL);
+        long covered;
+        rast_result rr = eye_draw(p, s, &cam[e], &tg, 0, &covered);
         const uint8_t *prev = s->have_refined && !p->fit_no_prev ? s->refined : NULL;
         fuse_result lr =
             rr == RAST_OK ? pipe_fit_learn(p->fit, e, &P[e], s->mask, cw, prev, cw) : FUSE_OK;
