@@ -18,6 +18,8 @@ static const char *render_usage =
     "                      [--refine BAND] [--smooth-normals R] [--hide PARTS]\n"
     "                      [--prop MODEL@X,Y,Z[,YAW]]... [--allow-outside]\n"
     "                      [--lod MODE] [--lod-px PX]\n"
+    "                      [--hmd-calibration FILE | --hmd-calibration-left FILE\n"
+    "                       --hmd-calibration-right FILE]\n"
     "\n"
     "Composites a recorded sequence (docs/scene.md): for each frame, poses the\n"
     "mask model at t = frame / fps, renders its mask and normals from both\n"
@@ -52,6 +54,11 @@ static const char *render_usage =
     "                 camera frame's time (processing latency), 0..100,\n"
     "                 default 0\n"
     "  --no-filter    with --pose tracking: the newest raw sample, no filter\n"
+    "  --hmd-calibration FILE  the cameras' lenses from an OpenCV calibration\n"
+    "                 file (YAML/XML; a stereo file: M1/D1 left, M2/D2 right), or\n"
+    "                 --hmd-calibration-left / -right FILE one each: the masks are\n"
+    "                 drawn through the lens (docs/lens.md); the camera images\n"
+    "                 are then of the calibration's size\n"
     "\n"
     "EGOFUSE_ISA=ref|sse2|avx2|avx512 caps the instruction set (same bytes).\n"
     "  --refine BAND  refine the masks by colour in a band of BAND px (1..64,\n"
@@ -113,6 +120,8 @@ typedef struct render_opts {
     int smooth_normals;    /* fuse_normal_smooth radius; 0 = off */
     int lod;               /* --lod: a level, PIPE_LOD_AUTO; 0 = off */
     float lod_px;          /* --lod-px */
+    const char *hmd_calib[3]; /* --hmd-calibration, -left, -right */
+    kin_sthmd_desc hmd;    /* zero = the paper's; lenses from hmd_calib */
 } render_opts;
 
 /* The pose from tracking: the recording, the rig, the filter and the
@@ -322,6 +331,7 @@ static int render(const render_opts *o)
 
     int rc = EXIT_FAIL;
     pipe_desc pd = {0};
+    pd.hmd = o->hmd;
     pd.threads = o->threads;
     pd.tone_match = o->tone_match;
     pd.cull = o->cull_back ? RAST_CULL_BACK : RAST_CULL_NONE;
@@ -484,7 +494,8 @@ done:
 
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
        O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
-       O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE, O_LOD, O_LOD_PX };
+       O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
+       O_HMD_CALIB_R };
 
 /* "MODEL@X,Y,Z[,YAW]" (the last '@' ends the path). 1, or 0 when it is
  * not of that form. */
@@ -538,6 +549,9 @@ int cmd_render(int argc, char **argv)
         {"hide", required_argument, 0, O_HIDE},
         {"prop", required_argument, 0, O_PROP},
         {"allow-outside", no_argument, 0, O_ALLOW_OUTSIDE},
+        {"hmd-calibration", required_argument, 0, O_HMD_CALIB},
+        {"hmd-calibration-left", required_argument, 0, O_HMD_CALIB_L},
+        {"hmd-calibration-right", required_argument, 0, O_HMD_CALIB_R},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
@@ -618,6 +632,9 @@ int cmd_render(int argc, char **argv)
                 return cli_usage_error("render", "--prop '%s': MODEL@X,Y,Z or MODEL@X,Y,Z,YAW "
                                        "(metres, degrees)", optarg);
             break;
+        case O_HMD_CALIB: o.hmd_calib[0] = optarg; break;
+        case O_HMD_CALIB_L: o.hmd_calib[1] = optarg; break;
+        case O_HMD_CALIB_R: o.hmd_calib[2] = optarg; break;
         case ':': return cli_usage_error("render", "option %s needs a value", argv[optind - 1]);
         default: return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);
         }
@@ -629,6 +646,10 @@ int cmd_render(int argc, char **argv)
         return cli_usage_error("render", "%s needs --pose tracking",
                                tracking_only == O_CALIB ? "--calib"
                                : tracking_only == O_PREDICT ? "--predict" : "--no-filter");
+    if (o.hmd_calib[0] || o.hmd_calib[1] || o.hmd_calib[2]) {
+        int rc = cli_lens_load(o.hmd_calib[0], o.hmd_calib[1], o.hmd_calib[2], &o.hmd);
+        if (rc != EXIT_OK) return rc;
+    }
     return render(&o);
 }
 

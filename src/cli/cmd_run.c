@@ -504,6 +504,10 @@ static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
     bad = fprintf(f, "egofuse render --scene %s/scene.txt --out OUT%s%s%s", o->dump,
                   tracked ? " --pose tracking --no-filter" : "", o->calib ? " --calib " : "",
                   o->calib ? o->calib : "") < 0;
+    /* the lenses: render draws the masks through the same ones */
+    static const char *const calib_opt[3] = {"", "-left", "-right"};
+    for (int k = 0; k < 3; k++)
+        if (o->hmd_calib[k]) bad |= fprintf(f, " --hmd-calibration%s %s", calib_opt[k], o->hmd_calib[k]) < 0;
     if (o->hide) {
         static const char *const part[4] = {"left-hand", "left-arm", "right-hand", "right-arm"};
         int first = 1;
