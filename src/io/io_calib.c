@@ -151,11 +151,13 @@ static io_result yaml_read(cal_doc *d, const char *text, size_t len, io_error *e
             y_to_eol(&c);
             continue;
         }
-        if (indent == 0 && (ch == '%' || !strncmp(c.p, "---", 3))) {
+        /* (the input is not NUL-terminated: compare within it) */
+        int three = c.end - c.p >= 3;
+        if (indent == 0 && (ch == '%' || (three && !memcmp(c.p, "---", 3)))) {
             y_to_eol(&c);
             continue;
         }
-        if (indent == 0 && !strncmp(c.p, "...", 3)) break;
+        if (indent == 0 && three && !memcmp(c.p, "...", 3)) break;
         (void)ls;
         if (indent == 0 && ch != '-') {
             /* a top-level "key: value" */
@@ -173,9 +175,12 @@ static io_result yaml_read(cal_doc *d, const char *text, size_t len, io_error *e
                     break;
                 }
             }
-            if (!colon)
-                return io_fail(err, IO_ERR_FORMAT, "%s:%d: expected 'key: value', got '%.40s'",
-                               d->name, c.line, k);
+            if (!colon) {
+                int n = 0; /* the input is not NUL-terminated: up to the line's end */
+                while (n < 40 && k + n < c.end && k[n] != '\n' && k[n] != '\r') n++;
+                return io_fail(err, IO_ERR_FORMAT, "%s:%d: expected 'key: value', got '%.*s'",
+                               d->name, c.line, n, k);
+            }
             size_t klen = (size_t)(colon - k);
             while (klen && (k[klen - 1] == ' ' || k[klen - 1] == '\t')) klen--;
             if (klen >= 2 && (k[0] == '"' || k[0] == '\'') && k[klen - 1] == k[0]) k++, klen -= 2;
