@@ -170,6 +170,15 @@ int kin_lens_distorts(const kin_lens *L)
     return 0;
 }
 
+/* The valid region depends on the model and the distortion only: kept
+ * from a checked lens (no new scan: these run per frame), found for one
+ * that was not. */
+static void recheck(kin_lens *L, const kin_lens *src)
+{
+    if (src->r_max > 0.0 && src->theta_max > 0.0 && src->rd_max > 0.0) return;
+    kin_lens_check(L, NULL, 0);
+}
+
 kin_lens kin_lens_scaled(const kin_lens *lens, int width, int height)
 {
     kin_lens L = *lens;
@@ -184,7 +193,7 @@ kin_lens kin_lens_scaled(const kin_lens *lens, int width, int height)
         L.width = width;
         L.height = height;
     }
-    kin_lens_check(&L, NULL, 0);
+    recheck(&L, lens);
     return L;
 }
 
@@ -195,7 +204,7 @@ kin_lens kin_lens_cropped(const kin_lens *lens, int x0, int y0, int width, int h
     L.cy -= y0;
     L.width = width;
     L.height = height;
-    kin_lens_check(&L, NULL, 0);
+    recheck(&L, lens);
     return L;
 }
 

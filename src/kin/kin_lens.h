@@ -117,7 +117,8 @@ int kin_lens_distorts(const kin_lens *lens);
  * sx = width / lens->width, fy, cy by sy (cx about the pixel edge:
  * (cx + 0.5) sx - 0.5); the distortion (in normalized coordinates) is
  * unchanged. And the lens for a crop whose top-left pixel is (x0, y0) of
- * the image: cx - x0, cy - y0, size width x height. Both re-check. */
+ * the image: cx - x0, cy - y0, size width x height. The valid region is
+ * kept from a checked lens (cheap enough per frame), found for another. */
 kin_lens kin_lens_scaled(const kin_lens *lens, int width, int height);
 kin_lens kin_lens_cropped(const kin_lens *lens, int x0, int y0, int width, int height);
 
