@@ -301,6 +301,7 @@ static void result_attributes(void **state)
     float *depth = malloc(sizeof(float) * n), *attr = malloc(sizeof(float) * 3 * n);
     assert_non_null(mask), assert_non_null(depth), assert_non_null(attr);
     rast_target out = {L.width, L.height, depth, L.width, mask, L.width, attr, 3 * L.width, 3};
+    rast_target_clear(&out);
     assert_true(pipe_lens_warp(&m, &out) > 10000);
     /* window depth of z = -0.6 with the camera's projection */
     const float *P = cam.proj.m;
@@ -315,6 +316,27 @@ static void result_attributes(void **state)
         NEAR(attr[3 * i + 2], 1.0, 0);
         NEAR(depth[i], want, 1e-6);
     }
+    /* frame after frame: a second draw warped over the first equals the
+     * same draw warped into a cleared target (the warp writes only what
+     * changes) */
+    poly q = make_poly(0.1, -0.05, -0.5, 0.05, 0.12, 0.3, 0.2, 6);
+    rast_target_clear(&it);
+    for (int i = 0; i < NV; i++) poly_point(&q, q.px[i], q.py[i], pos + 3 * (i + 1));
+    poly_point(&q, 0, 0, pos);
+    rast_transform_points(pc.view_proj.m, pos, NV + 1, clip);
+    assert_int_equal(rast_draw(&it, &d, NULL), RAST_OK);
+    long n2 = pipe_lens_warp(&m, &out);
+    uint8_t *mask2 = malloc(n);
+    float *depth2 = malloc(sizeof(float) * n), *attr2 = malloc(sizeof(float) * 3 * n);
+    assert_non_null(mask2), assert_non_null(depth2), assert_non_null(attr2);
+    rast_target out2 = {L.width, L.height, depth2, L.width, mask2, L.width, attr2, 3 * L.width, 3};
+    rast_target_clear(&out2);
+    assert_int_equal(pipe_lens_warp(&m, &out2), n2);
+    assert_true(n2 > 1000);
+    assert_memory_equal(mask, mask2, n);
+    assert_memory_equal(depth, depth2, sizeof(float) * n);
+    assert_memory_equal(attr, attr2, sizeof(float) * 3 * n);
+    free(mask2), free(depth2), free(attr2);
     free(mask), free(depth), free(attr);
     pipe_lens_map_free(&m);
 }

@@ -422,6 +422,12 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
             if (kin_lens_distorts(&c0.lens)) {
                 s->lens = calloc(1, sizeof *s->lens);
                 ok = s->lens && pipe_lens_map_init(s->lens, &c0.lens, 1, 3, NULL, 0) == 0;
+                if (ok) { /* the warp writes only what changes: start clear */
+                    rast_target t0 = {p->geo.crop_width, p->geo.crop_height, s->depth,
+                                      p->geo.crop_width, s->mask, p->geo.crop_width, s->nrm,
+                                      3 * p->geo.crop_width, 3};
+                    rast_target_clear(&t0);
+                }
             }
         }
         if (ok && p->desc.normal_smooth > 0) {

@@ -180,7 +180,9 @@ long pipe_lens_warp(const pipe_lens_map *m, const rast_target *dst)
         float *at = dst->attr && ac ? dst->attr + (size_t)y * dst->attr_stride : NULL;
         for (int x = 0; x < m->width; x++) {
             int32_t i = src[x];
-            if (i < 0) {
+            if (i < 0 || m->mask[i] == 0) {
+                /* nothing here: a pixel already clear stays untouched */
+                if (mk[x] == 0) continue;
                 mk[x] = 0;
                 if (dp) dp[x] = 1.0f;
                 if (at)
@@ -188,7 +190,7 @@ long pipe_lens_warp(const pipe_lens_map *m, const rast_target *dst)
                 continue;
             }
             mk[x] = m->mask[i];
-            set += m->mask[i] != 0;
+            set++;
             if (dp) dp[x] = m->depth[i];
             if (at)
                 for (int k = 0; k < ac; k++) at[x * ac + k] = m->attr[(size_t)i * ac + k];

@@ -79,8 +79,13 @@ void pipe_lens_map_free(pipe_lens_map *m);
 kin_camera pipe_lens_pinhole(const pipe_lens_map *m, const kin_camera *cam);
 /* The map's pinhole planes as a raster target (clear it before drawing). */
 rast_target pipe_lens_target(const pipe_lens_map *m);
-/* Fills every pixel of dst (m->width x m->height, the same attr_count) from
- * the pinhole planes. Returns the number of mask pixels set. */
+/* Fills dst (m->width x m->height, the same attr_count) from the pinhole
+ * planes: every pixel equals the nearest pinhole sample's mask, depth and
+ * attributes, or is clear (mask 0, depth 1, attributes 0). Pixels clear
+ * before and after are not written (most of the image: the cost is the
+ * model's pixels), so dst must start cleared (rast_target_clear) and hold
+ * a clear pixel wherever its mask is 0 between calls, the rasterizer's
+ * own contract for rast_context_clear. Returns the mask pixels set. */
 long pipe_lens_warp(const pipe_lens_map *m, const rast_target *dst);
 
 #ifdef __cplusplus
