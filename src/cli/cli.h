@@ -39,6 +39,10 @@ int cli_usage_error(const char *cmd, const char *fmt, ...)
  * kin_sthmd_desc_resolved scales). EXIT_OK, or EXIT_FAIL with the file
  * and the reason printed. cli_lens.c, docs/lens.md. */
 int cli_lens_load(const char *both, const char *left, const char *right, kin_sthmd_desc *hmd);
+/* 1 if hmd's lenses (when given, with a size) have its camera's aspect;
+ * else 0 with a sentence in why (e.g. a scene's named HMD, known only
+ * after the options). */
+int cli_lens_fits(const kin_sthmd_desc *hmd, char *why, size_t why_size);
 
 /* Strict parsers: the whole string must be the number(s); finite. */
 int cli_parse_int(const char *s, int lo, int hi, int *out);

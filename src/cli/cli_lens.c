@@ -33,3 +33,18 @@ int cli_lens_load(const char *both, const char *left, const char *right, kin_sth
     }
     return EXIT_OK;
 }
+
+int cli_lens_fits(const kin_sthmd_desc *hmd, char *why, size_t why_size)
+{
+    for (int e = 0; e < 2; e++) {
+        const kin_lens *l = &hmd->lens[e];
+        if (!(l->fx > 0) || l->width <= 0 || hmd->cam_width <= 0) continue;
+        if ((long)l->width * hmd->cam_height != (long)l->height * hmd->cam_width) {
+            snprintf(why, why_size, "the %s camera's calibration is for %dx%d images, the HMD's "
+                     "camera is %dx%d (another aspect ratio)", e ? "right" : "left", l->width,
+                     l->height, hmd->cam_width, hmd->cam_height);
+            return 0;
+        }
+    }
+    return 1;
+}

@@ -339,7 +339,11 @@ static int render(const render_opts *o)
     pd.normal_smooth = o->smooth_normals;
     pd.fit_rig = o->refine && o->pose_tracking ? &tp.rig : NULL;
     /* the scene's HMD (its `hmd` key, checked on load), or the paper's */
-    if (sc.hmd[0]) kin_sthmd_preset(sc.hmd, &pd.hmd);
+    if (sc.hmd[0]) {
+        kin_sthmd_preset(sc.hmd, &pd.hmd);
+        pd.hmd.lens[0] = o->hmd.lens[0]; /* --hmd-calibration: on that HMD */
+        pd.hmd.lens[1] = o->hmd.lens[1];
+    }
     pipe_ctx *pp = pipe_create(&pd, &model);
     pipe_lod lod = {0};
     kin_sthmd_desc hd = pp ? pipe_hmd(pp) : kin_sthmd_desc_resolved(&pd.hmd);
@@ -355,6 +359,13 @@ static int render(const render_opts *o)
         else
             cli_fail("cannot start the pipeline: out of memory or no thread");
         goto done;
+    }
+    {
+        char lw[300];
+        if (!cli_lens_fits(&pd.hmd, lw, sizeof lw)) {
+            cli_fail("%s: %s", o->scene, lw);
+            goto done;
+        }
     }
     if (cli_lod_setup(model_path, &model, o->lod, o->lod_px, pp, &lod) != EXIT_OK) goto done;
     if (render_props(o, pp, props, &props_loaded, prop_world, prop_ptr) != EXIT_OK) goto done;
