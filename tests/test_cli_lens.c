@@ -241,12 +241,71 @@ static void validity_run_bad_calibration(void **state)
     assert_int_equal(system(sub), 0);
 }
 
+static void write_solid(const char *path, int w, int h)
+{
+    io_image img;
+    io_error err;
+    assert_int_equal(io_image_alloc(&img, w, h, 3, IO_U8, &err), IO_OK);
+    memset(img.data, 90, (size_t)w * h * 3);
+    assert_int_equal(io_image_save(path, &img, &err), IO_OK);
+    io_image_free(&img);
+}
+
+/* render on a scene of a named HMD (hmd = consumer: 1280x1024 cameras):
+ * the sample 640x480 calibration is refused with the scene and the sizes
+ * named, nothing written; a 1280x1024 one of the same lens renders. */
+static void validity_render_named_hmd(void **state)
+{
+    (void)state;
+    char dir[512], p[1200], cmd[1200], out_dir[700];
+    tu_tmp_path("lens_named", dir, sizeof dir);
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s/cam' '%s/v'", dir, dir);
+    assert_int_equal(system(cmd), 0);
+    snprintf(p, sizeof p, "%s/quad.gltf", dir);
+    write_quad(p, -0.2f, 0.2f, -0.2f, 0.2f, -0.6f);
+    snprintf(p, sizeof p, "%s/cam/l_0000.png", dir);
+    write_solid(p, 1280, 1024);
+    snprintf(p, sizeof p, "%s/cam/r_0000.png", dir);
+    write_solid(p, 1280, 1024);
+    snprintf(p, sizeof p, "%s/v/l_0000.png", dir);
+    write_solid(p, 2064, 2208);
+    snprintf(p, sizeof p, "%s/v/r_0000.png", dir);
+    write_solid(p, 2064, 2208);
+    char scene[700];
+    snprintf(scene, sizeof scene, "%s/scene.txt", dir);
+    write_text(scene, "egofuse-scene 1\nmodel = quad.gltf\nframes = 1\nfps = 60\nhmd = consumer\n"
+                      "camera_left = cam/l_%04d.png\ncamera_right = cam/r_%04d.png\n"
+                      "virtual_left = v/l_%04d.png\nvirtual_right = v/r_%04d.png\n");
+    char cal[512];
+    tu_root_path("samples/calib/hmd_left.yml", cal, sizeof cal);
+    snprintf(out_dir, sizeof out_dir, "%s/out", dir);
+    assert_int_equal(run("render", "--scene", scene, "--out", out_dir, "--quiet",
+                         "--hmd-calibration", cal, NULL), 1);
+    assert_non_null(strstr(out, "scene.txt: the left camera's calibration is for 640x480 images, "
+                                "the HMD's camera is 1280x1024"));
+    snprintf(p, sizeof p, "%s/left_0000.png", out_dir);
+    assert_false(tu_exists(p));
+    /* the same lens calibrated at 1280x1024 (a 5:4 sensor) */
+    char cal2[700];
+    snprintf(cal2, sizeof cal2, "%s/c.yml", dir);
+    write_text(cal2, "%YAML:1.0\nimage_width: 1280\nimage_height: 1024\n"
+                     "camera_matrix: [ 540., 0., 639.5, 0., 540., 511.5, 0., 0., 1. ]\n"
+                     "distortion_coefficients: [ -0.25, 0.07, 0., 0., -0.01 ]\n");
+    int rc = run("render", "--scene", scene, "--out", out_dir, "--quiet", "--masks",
+                 "--hmd-calibration", cal2, NULL);
+    if (rc != 0) fail_msg("rc %d: %s", rc, out);
+    assert_true(tu_exists(p));
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(result_mask_through_barrel),
         cmocka_unit_test(validity_mask_bad_calibration),
         cmocka_unit_test(validity_run_bad_calibration),
+        cmocka_unit_test(validity_render_named_hmd),
     };
     return cmocka_run_group_tests_name("cli_lens", tests, NULL, NULL);
 }
