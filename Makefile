@@ -62,8 +62,9 @@ CMOCKA_LIBS   ?= -lcmocka
 
 CORE_SRC := $(wildcard src/cpu/*.c src/pipe/*.c src/fit/*.c src/raster/*.c src/kin/*.c src/fuse/*.c)
 IO_SRC   := $(wildcard src/io/*.c)
-# io_image_oiio.cpp is the OpenImageIO plugin, not part of the io library.
-IO_CXX   := $(filter-out src/io/io_image_oiio.cpp,$(wildcard src/io/*.cpp))
+# io_image_oiio.cpp and io_image_exr.cpp are the image plugin, not part of
+# the io library.
+IO_CXX   := $(filter-out src/io/io_image_oiio.cpp src/io/io_image_exr.cpp,$(wildcard src/io/*.cpp))
 CLI_SRC  := $(wildcard src/cli/*.c)
 # The evaluation (`egofuse eval`): linked into the program with the samples
 # library it needs, never into the core or io libraries.
@@ -114,12 +115,25 @@ endif
 # with dlopen only when a file is neither PNG nor PPM/PGM (docs/io.md), so
 # no command pays for its ~260 libraries unless it reads or writes such a
 # file. It is found next to the program (or its parent folder).
-OIIO_PKGS := OpenImageIO
+# Where OpenImageIO is missing but OpenEXR is there (make demo installs
+# only OpenEXR: the samples' depth is EXR), the plugin is built from
+# io_image_exr.cpp and serves EXR alone; it is rebuilt with OpenImageIO
+# once that is installed (make test). With OpenEXR, build/exr/ also holds
+# that EXR-only plugin, which tests/test_io_exr_plugin.c compares with
+# OpenImageIO's.
+HAVE_OIIO := $(shell pkg-config --exists OpenImageIO 2>/dev/null && echo 1)
+HAVE_EXR := $(shell pkg-config --exists OpenEXR 2>/dev/null && echo 1)
+PLUGIN_KIND := $(if $(HAVE_OIIO),oiio,$(if $(HAVE_EXR),exr,oiio))
+OIIO_PKGS := $(if $(filter exr,$(PLUGIN_KIND)),OpenEXR,OpenImageIO)
 OIIO_CFLAGS := $(shell pkg-config --cflags $(OIIO_PKGS) 2>/dev/null)
 OIIO_LIBS := $(shell pkg-config --libs $(OIIO_PKGS) 2>/dev/null)
 OIIO_PLUGIN := $(BUILD)/libegofuse_oiio.so
-OIIO_PLUGIN_SRC := src/io/io_image_oiio.cpp src/io/io_common.c src/io/io_image_mem.c
+OIIO_PLUGIN_SRC := src/io/io_image_$(PLUGIN_KIND).cpp src/io/io_common.c src/io/io_image_mem.c
 OIIO_PLUGIN_OBJ := $(patsubst %,$(BUILD)/pic/%.o,$(OIIO_PLUGIN_SRC))
+EXR_CFLAGS := $(shell pkg-config --cflags OpenEXR 2>/dev/null)
+EXR_LIBS := $(shell pkg-config --libs OpenEXR 2>/dev/null)
+EXR_PLUGIN := $(if $(HAVE_EXR),$(BUILD)/exr/libegofuse_oiio.so)
+EXR_PLUGIN_OBJ := $(patsubst %,$(BUILD)/pic/%.o,src/io/io_image_exr.cpp src/io/io_common.c src/io/io_image_mem.c)
 SYS_LIBS := -lm -lpthread
 # Peers measured by the benchmarks: pixman (compositing), Mesa llvmpipe
 # through EGL + GLES (the same frame as GL shaders).
@@ -141,7 +155,7 @@ SAMPLES  := $(BUILD)/samples
 
 all: test-bins $(BENCH_BIN)
 # Everything make test (and make debug) runs: all but the benchmarks.
-test-bins: $(LIB) $(IOLIB) $(OIIO_PLUGIN) $(EGOFUSE) $(GEN) $(TEST_BIN)
+test-bins: $(LIB) $(IOLIB) $(OIIO_PLUGIN) $(EXR_PLUGIN) $(EGOFUSE) $(GEN) $(TEST_BIN)
 
 # Each command installs only what it needs (scripts/deps.sh).
 deps:
@@ -194,8 +208,18 @@ $(BUILD)/pic/%.cpp.o: %.cpp
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) -Wno-unused-parameter -fPIC -fvisibility=hidden -c $< -o $@
 
-$(OIIO_PLUGIN): $(OIIO_PLUGIN_OBJ)
-	$(CXX) -shared $(LDFLAGS) -Wl,-soname,libegofuse_oiio.so -o $@ $^ $(OIIO_LIBS) -lm
+$(BUILD)/pic/src/io/io_image_exr.cpp.o: OIIO_CFLAGS := $(EXR_CFLAGS)
+
+# Rebuilt when the library behind it changes (OpenEXR, then OpenImageIO).
+$(OIIO_PLUGIN): $(OIIO_PLUGIN_OBJ) $(BUILD)/cfg/plugin
+	$(CXX) -shared $(LDFLAGS) -Wl,-soname,libegofuse_oiio.so -o $@ $(OIIO_PLUGIN_OBJ) $(OIIO_LIBS) -lm
+$(BUILD)/cfg/plugin: FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(PLUGIN_KIND)' | cmp -s - $@ || echo '$(PLUGIN_KIND)' > $@
+
+$(BUILD)/exr/libegofuse_oiio.so: $(EXR_PLUGIN_OBJ)
+	@mkdir -p $(dir $@)
+	$(CXX) -shared $(LDFLAGS) -Wl,-soname,libegofuse_oiio.so -o $@ $^ $(EXR_LIBS) -lm
 
 $(LIB): $(CORE_OBJ)
 	@mkdir -p $(dir $@)

@@ -35,15 +35,19 @@ set -eu
 
 # The program and its samples (make demo): the compiler, pkg-config (the
 # Makefile asks it for every library's flags), the io library's libraries,
-# and OpenImageIO for the OpenImageIO plugin (the samples' depth is EXR).
+# and OpenEXR (the samples' depth is EXR): without OpenImageIO the image
+# plugin is built with OpenEXR alone (src/io/io_image_exr.cpp), which spares
+# the demo OpenImageIO and the ~230 packages behind it (OpenCV, GDAL,
+# OpenVDB, ffmpeg's libraries...).
 # No SDL2 headers: without them the SDL window output is built as a stub
 # that says so (src/io/io_display_sdl.c), and the Makefile rebuilds it once
 # make test has installed them.
 BUILD_PKGS="build-essential pkg-config
 libpng-dev libtinygltf-dev libmeshoptimizer-dev
 libv4l-dev libusb-1.0-0-dev libdrm-dev
-libopenimageio-dev"
-# make test: cmocka; libsdl2-dev (the SDL window output's headers, its
+libopenexr-dev"
+# make test: OpenImageIO (the image plugin for every format; the tests
+# compare it with the EXR-only one); cmocka; libsdl2-dev (the SDL window output's headers, its
 # library is loaded at run time); xvfb + x11-apps: the window's test, a
 # virtual X server and xwd; ffmpeg, gst-launch-1.0 and python3: the real
 # producers and the framing generator of tests/test_io_vsrc.c, the NatNet
@@ -54,7 +58,7 @@ libopenimageio-dev"
 # tests the camera, USB, glove and display code against the Linux kernel's
 # own drivers, tests/vm/ (the kernel itself is fetched by tests/vm/prepare.sh
 # with apt-get download, not installed).
-TEST_PKGS="$BUILD_PKGS
+TEST_PKGS="$BUILD_PKGS libopenimageio-dev
 libcmocka-dev libsdl2-dev openimageio-tools gltfpack
 xvfb x11-apps libegl-mesa0 libgl1-mesa-dri gnuplot-nox
 ffmpeg gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good python3
