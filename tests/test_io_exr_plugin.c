@@ -19,7 +19,7 @@
 #include "../src/io/io_image_plugin.h"
 
 static const io_oiio_plugin *exr_p, *oiio_p;
-static char skip_why[512];
+static char skip_why[2048];
 
 static const io_oiio_plugin *open_plugin(const char *path, char *why, size_t n)
 {

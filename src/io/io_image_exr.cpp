@@ -29,6 +29,7 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImathBox.h>
+#include <half.h>
 
 #include <algorithm>
 #include <climits>
@@ -216,25 +217,26 @@ io_result save(const char *path, FILE *f, int fd, const io_image *img, io_error 
     hd.compression() = Imf::ZIP_COMPRESSION;
     for (int c = 0; c < ch; c++) hd.channels().insert(chan[ch - 1][c], Imf::Channel(file_type));
 
-    /* float pixels as given; 8-bit ones as v / 255 */
-    std::vector<float> conv;
+    /* float pixels as given; 8-bit ones as halves of v / 255 (the
+     * frame buffer must have the file's pixel type) */
+    std::vector<Imath::half> conv;
     const char *base = static_cast<const char *>(img->data);
-    size_t ystride = img->stride;
+    size_t ystride = img->stride, size = sizeof(float);
     if (img->type == IO_U8) {
         conv.resize((size_t)w * (size_t)h * (size_t)ch);
         for (int y = 0; y < h; y++) {
             const unsigned char *s = static_cast<const unsigned char *>(img->data) + (size_t)y * img->stride;
             for (size_t i = 0; i < (size_t)w * (size_t)ch; i++)
-                conv[(size_t)y * (size_t)w * (size_t)ch + i] = (float)s[i] / 255.0f;
+                conv[(size_t)y * (size_t)w * (size_t)ch + i] = Imath::half((float)s[i] / 255.0f);
         }
         base = reinterpret_cast<const char *>(conv.data());
-        ystride = sizeof(float) * (size_t)w * (size_t)ch;
+        size = sizeof(Imath::half);
+        ystride = size * (size_t)w * (size_t)ch;
     }
     Imf::FrameBuffer fb;
     for (int c = 0; c < ch; c++)
-        fb.insert(chan[ch - 1][c],
-                  Imf::Slice(Imf::FLOAT, const_cast<char *>(base) + sizeof(float) * (size_t)c,
-                             sizeof(float) * (size_t)ch, ystride));
+        fb.insert(chan[ch - 1][c], Imf::Slice(file_type, const_cast<char *>(base) + size * (size_t)c,
+                                              size * (size_t)ch, ystride));
     MemOut mem;
     {
         Imf::OutputFile out(mem, hd);
