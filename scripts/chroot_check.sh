@@ -14,7 +14,8 @@
 # and a copy of ../shared beside it (the tests read ../shared/gltf), and the
 # command runs there, timed. One line per command:
 #
-#   make demo: 512 s, passed; 310 packages installed, 250.1 MB downloaded
+#   make demo: 512 s, passed; 310 packages installed, 250.1 MB downloaded;
+#   load average 2.1 before, 3.0 after
 #
 # with the log in DIR/COMMAND.log (the test counts line is shown). The copy
 # is removed afterwards unless KEEP=1.
@@ -123,6 +124,7 @@ for c in $CMDS; do
     n0=$(npkgs "$r")
     log=$DIR/$c.log
     echo "make $c: running in $r (log $log)"
+    l0=$(cut -d' ' -f1 /proc/loadavg)
     t0=$(now)
     set +e
     run_in "$r" "make $c" >"$log" 2>&1
@@ -133,8 +135,9 @@ for c in $CMDS; do
     # apt keeps every .deb it downloaded (the base's were cleaned)
     kb=$(find "$r/var/cache/apt/archives" -name '*.deb' -exec du -k {} + 2>/dev/null | awk '{s += $1} END {print s + 0}')
     if [ "$rc" = 0 ]; then res=passed; else res="FAILED (exit $rc)"; fi
-    line=$(printf 'make %s: %d s, %s; %d packages installed, %d.%d MB downloaded' "$c" $((t1 - t0)) \
-        "$res" $((n1 - n0)) $((kb / 1024)) $((kb % 1024 * 10 / 1024)))
+    line=$(printf 'make %s: %d s, %s; %d packages installed, %d.%d MB downloaded; load average %s before, %s after' \
+        "$c" $((t1 - t0)) "$res" $((n1 - n0)) $((kb / 1024)) $((kb % 1024 * 10 / 1024)) \
+        "$l0" "$(cut -d' ' -f1 /proc/loadavg)")
     counts=$(grep -E '^[0-9]+ passed, [0-9]+ failed, [0-9]+ skipped$' "$log" | tail -1 || true)
     [ -n "$counts" ] && line="$line; $counts"
     echo "$line"
