@@ -119,6 +119,10 @@ for c in $CMDS; do
     r=$DIR/run-$c
     rm -rf "$r"
     cp -a "$base" "$r"
+    # /etc/hosts as the Debian installer writes it (debootstrap writes
+    # none, and without it "localhost" does not resolve)
+    [ -e "$r/etc/hosts" ] || printf '%s\n' '127.0.0.1	localhost' \
+        '::1		localhost ip6-localhost ip6-loopback' >"$r/etc/hosts"
     mkdir -p "$r/root/egofuse"
     cp -a "$src/egofuse" "$src/shared" "$r/root/egofuse/"
     n0=$(npkgs "$r")

@@ -54,12 +54,14 @@ libopenexr-dev"
 # sender of tests/test_io_natnet.c, and the independent PNG codec of
 # tests/test_io_png.c; gltfpack: the quantized and meshopt variants of
 # tests/test_gltf_samples.c; gnuplot: the charts of eval --report
-# (tests/test_cli_output.c); the last line: the virtual machine that
-# tests the camera, USB, glove and display code against the Linux kernel's
+# (tests/test_cli_output.c); libjpeg-dev: tests/test_install.c links a
+# program with `pkg-config --static --libs egofuse-io`, whose libv4l2 asks
+# for -ljpeg (libv4lconvert's Libs.private); the last line: the virtual
+# machine that tests the camera, USB, glove and display code against the Linux kernel's
 # own drivers, tests/vm/ (the kernel itself is fetched by tests/vm/prepare.sh
 # with apt-get download, not installed).
 TEST_PKGS="$BUILD_PKGS libopenimageio-dev
-libcmocka-dev libsdl2-dev openimageio-tools gltfpack
+libcmocka-dev libsdl2-dev openimageio-tools gltfpack libjpeg-dev
 xvfb x11-apps libegl-mesa0 libgl1-mesa-dri gnuplot-nox
 ffmpeg gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good python3
 qemu-system-x86 busybox-static cpio kmod xz-utils"
