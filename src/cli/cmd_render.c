@@ -14,7 +14,7 @@ static const char *render_usage =
     "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
     "                      [--tone-match S] [--pose animation|tracking]\n"
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
-    "                      [--refine BAND] [--smooth-normals R] [--hide PARTS]\n"
+    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--hide PARTS]\n"
     "                      [--prop MODEL@X,Y,Z[,YAW]]... [--allow-outside]\n"
     "\n"
     "Composites a recorded sequence (docs/scene.md): for each frame, poses the\n"
@@ -64,6 +64,9 @@ static const char *render_usage =
     "                 cut in a real object like the hands: the glTF MODEL in its\n"
     "                 rest pose, placed at (X, Y, Z) metres in the world frame and\n"
     "                 turned YAW degrees about +Y (default 0); up to 8 props\n"
+    "  --aa N         anti-aliased silhouettes: the mask is the coverage of N\n"
+    "                 samples per pixel (4, 8 or 16; 0: off, the binary mask of\n"
+    "                 the pixel centres); default 0\n"
     "  --smooth-normals R  sum the model's normals over a (2R+1)^2 window\n"
     "                 before lighting (1..4; default 0: off): for models of\n"
     "                 crossing parts whose shading shows seams\n"
@@ -107,6 +110,7 @@ typedef struct render_opts {
         float at[3], yaw_deg;
     } props[RENDER_MAX_PROPS];
     int smooth_normals;    /* fuse_normal_smooth radius; 0 = off */
+    int aa;                /* coverage samples per pixel; 0 = off */
 } render_opts;
 
 /* The pose from tracking: the recording, the rig, the filter and the
@@ -321,6 +325,7 @@ static int render(const render_opts *o)
     pd.cull = o->cull_back ? RAST_CULL_BACK : RAST_CULL_NONE;
     pd.refine_band = o->refine;
     pd.normal_smooth = o->smooth_normals;
+    pd.aa_samples = o->aa;
     pd.fit_rig = o->refine && o->pose_tracking ? &tp.rig : NULL;
     pipe_ctx *pp = pipe_create(&pd, &model);
     kin_sthmd_desc hd = pp ? pipe_hmd(pp) : kin_sthmd_desc_resolved(&pd.hmd);
@@ -463,7 +468,16 @@ done:
 
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
        O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
-       O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE };
+       O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE, O_AA };
+
+/* --aa N: 0 (off), 4, 8 or 16 samples per pixel. 1, or 0 for another. */
+static int parse_aa(const char *s, int *aa)
+{
+    int v;
+    if (!cli_parse_int(s, 0, 16, &v) || (v != 0 && v != 4 && v != 8 && v != 16)) return 0;
+    *aa = v;
+    return 1;
+}
 
 /* "MODEL@X,Y,Z[,YAW]" (the last '@' ends the path). 1, or 0 when it is
  * not of that form. */
@@ -507,6 +521,7 @@ int cmd_render(int argc, char **argv)
         {"cull-back", no_argument, 0, O_CULL},
         {"refine", required_argument, 0, O_REFINE},
         {"smooth-normals", required_argument, 0, O_SMOOTH},
+        {"aa", required_argument, 0, O_AA},
         {"tone-match", required_argument, 0, O_TONE},
         {"pose", required_argument, 0, O_POSE},
         {"calib", required_argument, 0, O_CALIB},
@@ -553,6 +568,11 @@ int cmd_render(int argc, char **argv)
             if (!cli_parse_int(optarg, 1, FUSE_NORMAL_SMOOTH_MAX, &o.smooth_normals))
                 return cli_usage_error("render", "--smooth-normals '%s': a radius of 1..%d px",
                                        optarg, FUSE_NORMAL_SMOOTH_MAX);
+            break;
+        case O_AA:
+            if (!parse_aa(optarg, &o.aa))
+                return cli_usage_error("render", "--aa '%s': 0 (off), 4, 8 or 16 samples per "
+                                       "pixel", optarg);
             break;
         case O_TONE:
             if (!cli_parse_float(optarg, &o.tone_match) || o.tone_match < 0.0f || o.tone_match > 1.0f)

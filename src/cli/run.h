@@ -34,6 +34,7 @@ typedef struct run_opts {
     int loop;                 /* file cameras: start again at the end */
     int hold;                 /* --display: keep the last frame shown until Ctrl-C */
     int refine;               /* refinement band, px; 0 = off */
+    int aa;                   /* coverage samples per pixel (--aa); 0 = off */
     float predict_ms;         /* pose time = camera time + this */
     unsigned hide;            /* PIPE_PART_* bits hidden */
     kin_sthmd_desc hmd;       /* zero fields = the paper's */
