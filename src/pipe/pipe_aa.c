@@ -138,14 +138,29 @@ rast_result pipe__aa_draw_pose(pipe__aa *a, const pipe_pose *ps, rast_context *c
     return RAST_OK;
 }
 
+/* Bits set in a byte (a table: the portable builds have no popcnt
+ * instruction and __builtin_popcount becomes a library call). */
+#define B2(k) k, k + 1, k + 1, k + 2
+#define B4(k) B2(k), B2(k + 1), B2(k + 1), B2(k + 2)
+#define B6(k) B4(k), B4(k + 1), B4(k + 1), B4(k + 2)
+static const uint8_t bits8[256] = {B6(0), B6(1), B6(1), B6(2)};
+
 void pipe__aa_resolve(pipe__aa *a)
 {
     const int *b = a->box;
     if (box_is_empty(b)) return;
-    rast_aa_target t = {b[2] - b[0], b[3] - b[1],
-                        a->samples + (size_t)b[1] * (size_t)a->width + (size_t)b[0], a->width,
-                        a->count};
-    rast_aa_resolve(&t, a->cov + (size_t)b[1] * (size_t)a->width + (size_t)b[0], a->width);
+    /* rast_aa_resolve's rule: round(255 covered / n), halves up */
+    const unsigned n = (unsigned)a->count, mask = (1u << n) - 1u;
+    uint8_t lut[17];
+    for (unsigned c = 0; c <= n; c++) lut[c] = (uint8_t)((510u * c + n) / (2u * n));
+    for (int y = b[1]; y < b[3]; y++) {
+        const uint32_t *s = a->samples + (size_t)y * (size_t)a->width;
+        uint8_t *o = a->cov + (size_t)y * (size_t)a->width;
+        for (int x = b[0]; x < b[2]; x++) {
+            const uint32_t v = s[x] & mask;
+            o[x] = v ? lut[bits8[v & 255u] + bits8[v >> 8]] : 0;
+        }
+    }
 }
 
 void pipe__aa_refined(pipe__aa *a, const uint8_t *mask, const uint8_t *refined, int band)
