@@ -20,6 +20,7 @@
  *                 small case: the model's coverage where the refinement
  *                 agrees in the 3x3 window, the box filter of the refined
  *                 mask elsewhere;
+ *   aa_resolve    the pipe's resolve gives rast_aa_resolve's bytes;
  *   aa_args       aa_samples other than 0, 4, 8, 16: pipe_create NULL.
  * The depth test with AA on (occlusion never broken, every method) is in
  * test_occlusion.c. */
@@ -449,6 +450,32 @@ static void aa_refined(void **state)
     pipe__aa_free(&a);
 }
 
+/* pipe__aa_resolve (a byte table) gives rast_aa_resolve's bytes, inside
+ * the box only, for every sample count. */
+static void aa_resolve(void **state)
+{
+    (void)state;
+    enum { W = 37, H = 23 };
+    tu_rng r = {99};
+    const int counts[3] = {4, 8, 16};
+    for (int c = 0; c < 3; c++) {
+        pipe__aa a;
+        assert_int_equal(pipe__aa_init(&a, counts[c], W, H, 0), 0);
+        for (int i = 0; i < W * H; i++) a.samples[i] = (uint32_t)tu_next(&r);
+        a.box[0] = 3, a.box[1] = 2, a.box[2] = 30, a.box[3] = 21;
+        pipe__aa_resolve(&a);
+        uint8_t ref[W * H];
+        rast_aa_target t = {W, H, a.samples, W, counts[c]};
+        assert_int_equal(rast_aa_resolve(&t, ref, W), RAST_OK);
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                const int in = x >= 3 && x < 30 && y >= 2 && y < 21;
+                assert_int_equal(a.cov[y * W + x], in ? ref[y * W + x] : 0);
+            }
+        pipe__aa_free(&a);
+    }
+}
+
 static void aa_args(void **state)
 {
     (void)state;
@@ -476,7 +503,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(aa_area),     cmocka_unit_test(aa_interior),
         cmocka_unit_test(aa_state),    cmocka_unit_test(aa_refined),
-        cmocka_unit_test(aa_args),
+        cmocka_unit_test(aa_resolve),  cmocka_unit_test(aa_args),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
