@@ -266,7 +266,7 @@ static int write_charts(const char *dir)
  * of places around its point (right, left, above, below, then farther up
  * and down with a thin leader line) where its box overlaps no label
  * placed before and no point; failing all, to the right. Text boxes are
- * estimated at 7.6 px per character and 15 px high (font size 10). */
+ * estimated at 8.4 px per character and 16 px high (font size 10). */
 enum { SPW = 900, SPH = 640 };
 #define SP_L 0.08
 #define SP_R 0.97
@@ -312,7 +312,7 @@ static void sp_labels(FILE *f, const sp_pt *p, int np, const double rg[4])
     for (int i = 0; i < np; i++) {
         double px, py;
         sp_to_px(p[i].x, p[i].y, rg, &px, &py);
-        const double w = 7.6 * (double)strlen(p[i].label) + 4.0, h = 15.0;
+        const double w = 8.4 * (double)strlen(p[i].label) + 6.0, h = 16.0;
         int best = 0;
         double bx[4] = {0, 0, 0, 0};
         for (int c = 0; c < NC; c++) {
