@@ -253,6 +253,12 @@ $(BUILD)/tests/test_occlusion $(BUILD)/tests/test_io_lod: $(BUILD)/tests/%: test
 	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) \
 	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
+# The AA study runs on the generated operator: it links the samples library.
+$(BUILD)/bench/bench_aa: bench/bench_aa.c $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(SAMPLESLIB) $(IOLIB) $(LIB) \
+	    $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
+
 $(BUILD)/bench/%: bench/%.c $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) $(BENCH_CFLAGS) -o $@ $< $(IOLIB) $(LIB) \

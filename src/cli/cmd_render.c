@@ -15,7 +15,7 @@ static const char *render_usage =
     "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
     "                      [--tone-match S] [--pose animation|tracking]\n"
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
-    "                      [--refine BAND] [--smooth-normals R] [--hide PARTS]\n"
+    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--hide PARTS]\n"
     "                      [--prop MODEL@X,Y,Z[,YAW]]... [--allow-outside]\n"
     "                      [--lod MODE] [--lod-px PX]\n"
     "                      [--hmd-calibration FILE | --hmd-calibration-left FILE\n"
@@ -74,6 +74,9 @@ static const char *render_usage =
     "                 cut in a real object like the hands: the glTF MODEL in its\n"
     "                 rest pose, placed at (X, Y, Z) metres in the world frame and\n"
     "                 turned YAW degrees about +Y (default 0); up to 8 props\n"
+    "  --aa N         anti-aliased silhouettes: the mask is the coverage of N\n"
+    "                 samples per pixel (4, 8 or 16; 0: off, the binary mask of\n"
+    "                 the pixel centres); default 0\n"
     "  --smooth-normals R  sum the model's normals over a (2R+1)^2 window\n"
     "                 before lighting (1..4; default 0: off): for models of\n"
     "                 crossing parts whose shading shows seams\n"
@@ -122,6 +125,7 @@ typedef struct render_opts {
     float lod_px;          /* --lod-px */
     const char *hmd_calib[3]; /* --hmd-calibration, -left, -right */
     kin_sthmd_desc hmd;    /* zero = the paper's; lenses from hmd_calib */
+    int aa;                /* coverage samples per pixel; 0 = off */
 } render_opts;
 
 /* The pose from tracking: the recording, the rig, the filter and the
@@ -337,6 +341,7 @@ static int render(const render_opts *o)
     pd.cull = o->cull_back ? RAST_CULL_BACK : RAST_CULL_NONE;
     pd.refine_band = o->refine;
     pd.normal_smooth = o->smooth_normals;
+    pd.aa_samples = o->aa;
     pd.fit_rig = o->refine && o->pose_tracking ? &tp.rig : NULL;
     /* the scene's HMD (its `hmd` key, checked on load), or the paper's */
     if (sc.hmd[0]) {
@@ -506,7 +511,16 @@ done:
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
        O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
        O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
-       O_HMD_CALIB_R };
+       O_HMD_CALIB_R, O_AA };
+
+/* --aa N: 0 (off), 4, 8 or 16 samples per pixel. 1, or 0 for another. */
+static int parse_aa(const char *s, int *aa)
+{
+    int v;
+    if (!cli_parse_int(s, 0, 16, &v) || (v != 0 && v != 4 && v != 8 && v != 16)) return 0;
+    *aa = v;
+    return 1;
+}
 
 /* "MODEL@X,Y,Z[,YAW]" (the last '@' ends the path). 1, or 0 when it is
  * not of that form. */
@@ -552,6 +566,7 @@ int cmd_render(int argc, char **argv)
         {"lod", required_argument, 0, O_LOD},
         {"lod-px", required_argument, 0, O_LOD_PX},
         {"smooth-normals", required_argument, 0, O_SMOOTH},
+        {"aa", required_argument, 0, O_AA},
         {"tone-match", required_argument, 0, O_TONE},
         {"pose", required_argument, 0, O_POSE},
         {"calib", required_argument, 0, O_CALIB},
@@ -613,6 +628,11 @@ int cmd_render(int argc, char **argv)
             if (!cli_parse_int(optarg, 1, FUSE_NORMAL_SMOOTH_MAX, &o.smooth_normals))
                 return cli_usage_error("render", "--smooth-normals '%s': a radius of 1..%d px",
                                        optarg, FUSE_NORMAL_SMOOTH_MAX);
+            break;
+        case O_AA:
+            if (!parse_aa(optarg, &o.aa))
+                return cli_usage_error("render", "--aa '%s': 0 (off), 4, 8 or 16 samples per "
+                                       "pixel", optarg);
             break;
         case O_TONE:
             if (!cli_parse_float(optarg, &o.tone_match) || o.tone_match < 0.0f || o.tone_match > 1.0f)

@@ -529,6 +529,7 @@ static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
     if (o->lod == PIPE_LOD_AUTO)
         bad |= fprintf(f, " --lod auto --lod-px %.9g", (double)o->lod_px) < 0;
     else if (o->lod) bad |= fprintf(f, " --lod %d", o->lod) < 0;
+    if (o->aa) bad |= fprintf(f, " --aa %d", o->aa) < 0;
     if (o->refine) bad |= fprintf(f, " --refine %d # the elbow fit's learned state differs", o->refine) < 0;
     bad |= fputc('\n', f) == EOF;
     bad |= fclose(f) != 0;
@@ -792,6 +793,7 @@ static int run(const run_opts *o)
             goto done;
         }
     pd.refine_band = o->refine;
+    pd.aa_samples = o->aa;
     pd.fit_rig = o->refine && tracked ? &r->rig : NULL;
     if (!(r->pipe = pipe_create(&pd, model))) {
         cli_fail(pd.fit_rig ? "cannot start the pipeline (out of memory, no thread, or the elbow "

@@ -98,6 +98,8 @@ const char *run_usage =
     "                   level 1..7, or auto (per frame and eye, the coarsest\n"
     "                   level whose error is <= --lod-px px; docs/bench.md)\n"
     "  --lod-px PX      the error auto allows, pixels (default 2)\n"
+    "  --aa N           anti-aliased silhouettes: N coverage samples per pixel\n"
+    "                   (4, 8 or 16; 0: off, the binary mask); default 0\n"
     "  --quiet          no status line\n"
     "  -h, --help       this text\n"
     "\n"
@@ -109,7 +111,7 @@ enum {
     O_TRACK, O_TRACK_ADDR, O_GLOVE_L, O_GLOVE_R, O_CALIB, O_OUT, O_RAW, O_FRAMES, O_QUIET,
     O_REFINE, O_CONFIG, O_STATS, O_PREDICT, O_HIDE, O_PROP, O_VSRC, O_VLAYOUT, O_VFPS, O_VSTALE,
     O_DISPLAY, O_NATNET, O_NN_LOCAL, O_NN_MCAST, O_NN_BODY, O_NN_UP, O_NN_UNITS, O_NN_VERSION,
-    O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD, O_ALLOW_OUTSIDE,
+    O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD, O_ALLOW_OUTSIDE, O_AA,
     O_HMD_CAM, O_HMD_CAM_HFOV, O_HMD_BASE, O_HMD_OFFSET, O_HMD_DISP, O_HMD_HFOV, O_HMD_VFOV,
     O_HMD_FOCAL, O_HMD_IPD, O_HMD_PRESET, O_DUMP, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
     O_HMD_CALIB_R
@@ -139,6 +141,7 @@ static const struct option run_long_opts[] = {
     {"refine", required_argument, 0, O_REFINE},
     {"lod", required_argument, 0, O_LOD},
     {"lod-px", required_argument, 0, O_LOD_PX},
+    {"aa", required_argument, 0, O_AA},
     {"config", required_argument, 0, O_CONFIG},
     {"stats", required_argument, 0, O_STATS},
     {"predict-ms", required_argument, 0, O_PREDICT},
@@ -370,6 +373,13 @@ int run_parse(int argc, char **argv, run_opts *o)
             if (!cli_lod_parse_px(optarg, &o->lod_px))
                 BAD("--lod-px '%s': pixels, > 0 and <= 1000", optarg);
             break;
+        case O_AA: {
+            int v;
+            if (!cli_parse_int(optarg, 0, 16, &v) || (v != 0 && v != 4 && v != 8 && v != 16))
+                BAD("--aa '%s': 0 (off), 4, 8 or 16 samples per pixel", optarg);
+            o->aa = v;
+            break;
+        }
         case O_STATS: o->stats = optarg; break;
         case O_DUMP: o->dump = optarg; break;
         case O_PREDICT:

@@ -626,7 +626,7 @@ static int add_cfg(method_cfg *list, int n, int cap, method_cfg c)
 }
 
 /* Phases of a report (each on its own ground truth and frame count). */
-enum { PH_METHODS, PH_KNOBS, PH_TRACK, PH_SEQ, PH_LOD };
+enum { PH_METHODS, PH_KNOBS, PH_TRACK, PH_SEQ, PH_SPEED, PH_LOD };
 
 /* A configuration of a sweep: group, swept value and setting "name=" x
  * (x as %g) followed by unit. */
@@ -643,10 +643,18 @@ static method_cfg named_cfg(const eval_opts *o, method_kind k, const char *group
 /* PH_METHODS: the selected methods at the given tracking; PH_KNOBS: the
  * same (group "knobs") with every speed knob; PH_TRACK: the tracking sweeps (and the methods at the
  * given tracking, group "track"); PH_SEQ: the methods on sequence seq. */
-static int make_configs(const eval_opts *o, int phase, const char *seq, method_cfg *L, int cap)
+static int make_configs(const eval_opts *o, int phase, const char *seq, float speed,
+                        method_cfg *L, int cap)
 {
     int n = 0;
     method_cfg c;
+    if (phase == PH_SPEED)   /* the methods on the motion played at another speed */
+        for (int k = 0; k < 4; k++) {
+            if (k == M_SKIN || !(o->methods & (1u << k))) continue;
+            c = named_cfg(o, (method_kind)k, "handspeed", speed, "speed", "x");
+            c.track.speed = speed;
+            n = add_cfg(L, n, cap, c);
+        }
     if (phase == PH_METHODS || phase == PH_KNOBS || phase == PH_SEQ)
         for (int k = 0; k < 4; k++) {
             if (!(o->methods & (1u << k))) continue;
@@ -738,6 +746,12 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, method_c
                 c.track.latency_ms = lat[i];
                 n = add_cfg(L, n, cap, c);
             }
+            static const float drop[] = { 0.0f, 0.1f, 0.3f };
+            for (int i = 0; i < 3; i++) {
+                c = named_cfg(o, (method_kind)k, "dropout", 100.0f * drop[i], "dropout", "%");
+                c.track.dropout = drop[i];
+                n = add_cfg(L, n, cap, c);
+            }
             if (k == M_KIN) continue;    /* the paper's method has no calibration */
             for (int i = 0; i < 4; i++) {
                 c = named_cfg(o, (method_kind)k, "calib", 100.0f * (o->calib_error + cal[i]),
@@ -755,7 +769,7 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, method_c
 /* Runs configurations cfgs[0..n) into R on `frames` frames of sequence
  * seq (one ground truth). The context is left in *c for the caller to
  * free. */
-static int run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames,
+static int run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames, float speed,
                      const method_cfg *cfgs, method_run *R, int n)
 {
     method_cfg base = base_cfg(o, M_KIN_CAL);
@@ -772,7 +786,7 @@ static int run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frame
     progress_start(&pr, frames);
     if (o->quiet) pr.enabled = 0;
     for (int f = 0; f < frames; f++) {
-        if (make_truth(c, f, o->speed, f == 0) < 0) { cli_fail("frame %d: ground truth", f); goto done; }
+        if (make_truth(c, f, speed, f == 0) < 0) { cli_fail("frame %d: ground truth", f); goto done; }
         for (int i = 0; i < n; i++)
             if (run_frame(c, &R[i], f, o->per_frame, o->dump) < 0) {
                 cli_fail("frame %d: %s %s failed", f, kind_name[R[i].cfg.kind], R[i].cfg.setting);
@@ -803,12 +817,20 @@ int eval_run(const eval_opts *o)
     int n = 0, rc = EXIT_FAIL;
     if (!cfgs || !R) { cli_fail("out of memory"); goto done; }
     /* batches: (sequence, frames, phase) */
-    const char *bseq[10];
-    int bframes[10], bphase[10], nb = 0;
+    enum { NB = 14 };
+    const char *bseq[NB];
+    int bframes[NB], bphase[NB], nb = 0;
+    float bspeed[NB];
+    for (int b = 0; b < NB; b++) bspeed[b] = o->speed;
     bseq[nb] = o->sequence; bframes[nb] = o->frames; bphase[nb++] = PH_METHODS;
     if (o->report) {
         bseq[nb] = o->sequence; bframes[nb] = o->sweep_frames; bphase[nb++] = PH_KNOBS;
         bseq[nb] = o->sequence; bframes[nb] = o->sweep_frames; bphase[nb++] = PH_TRACK;
+        static const float speeds[] = { 0.5f, 2.0f };   /* x the given speed */
+        for (int i = 0; i < 2; i++) {
+            bseq[nb] = o->sequence; bframes[nb] = o->sweep_frames; bphase[nb] = PH_SPEED;
+            bspeed[nb++] = o->speed * speeds[i];
+        }
     }
     if (o->report || o->lod_sweep) {
         bseq[nb] = o->sequence;
@@ -816,22 +838,22 @@ int eval_run(const eval_opts *o)
         bphase[nb++] = PH_LOD;
     }
     if (o->report) {
-        for (int q = 0; gt_sequence_name(q) && nb < 10; q++) {
+        for (int q = 0; gt_sequence_name(q) && nb < NB; q++) {
             const char *name = gt_sequence_name(q);
             if (!strcmp(name, o->sequence) || !strcmp(name, "calib")) continue;
             bseq[nb] = name; bframes[nb] = o->seq_frames; bphase[nb++] = PH_SEQ;
         }
     }
     for (int b = 0; b < nb; b++) {
-        int m = make_configs(o, bphase[b], bseq[b], cfgs + n, CAP - n);
+        int m = make_configs(o, bphase[b], bseq[b], bspeed[b], cfgs + n, CAP - n);
         if (n + m > CAP) { cli_fail("too many configurations"); goto done; }
         ctx_free(&c);
-        if (run_batch(o, &c, bseq[b], bframes[b], cfgs + n, R + n, m)) goto done;
+        if (run_batch(o, &c, bseq[b], bframes[b], bspeed[b], cfgs + n, R + n, m)) goto done;
         if (b == 0 || !o->quiet || bphase[b] == PH_LOD) {
             printf("egofuse eval: sequence %s, %d frames, tracking noise %g mm, latency %g ms, "
                    "dropout %g, calibration error %g, speed %g; means per eye (640x400 masks)\n",
                    bseq[b], bframes[b], (double)o->noise, (double)o->latency,
-                   (double)o->dropout, (double)o->calib_error, (double)o->speed);
+                   (double)o->dropout, (double)o->calib_error, (double)bspeed[b]);
             if (b == 0) eval__print_calib(stdout, &c);
             eval__print_table(stdout, R + n, m, 0);
             eval__print_thickness(stdout, &c, R + n, m);

@@ -1,5 +1,6 @@
 /* pipe.c - one stereo frame, end to end (see pipe.h). */
 #include "pipe.h"
+#include "pipe_aa.h"
 #include "pipe_morph.h"
 #include "pipe_parts.h"
 #include "pipe_internal.h"
@@ -25,6 +26,8 @@ typedef struct eye_state {
     void *refine_scratch;
     size_t refine_scratch_size;
     int have_refined;         /* refined holds the last frame's mask */
+    pipe__aa aa;              /* anti-aliased coverage (aa_samples) */
+    const uint8_t *shown;     /* the mask composited last frame */
     int converted;            /* cam_rgba already holds this frame's crop */
     rast_context *rast;
     fuse_context *fuse;
@@ -151,6 +154,14 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     long covered = 0;
     e->lod_level = 0;
     rast_result rr = eye_draw(p, e, &e->cam, &tg, 1, &covered);
+    if (rr == RAST_OK && e->aa.count) { /* no lens here: refused at pipe_create */
+        pipe__aa_begin(&e->aa);
+        rr = pipe__cockpit_active(p->ck)
+                 ? pipe__cockpit_draw_aa(p->ck, &p->pose, e->eye, e->rast, &e->cam, &e->aa,
+                                         p->desc.cull, e->clip)
+                 : pipe__aa_draw_pose(&e->aa, &p->pose, e->rast, &e->cam, p->desc.cull, e->clip);
+        pipe__aa_resolve(&e->aa);
+    }
     double t1 = now_ms();
     e->ms_raster = t1 - t0;
     if (rr != RAST_OK) {
@@ -193,7 +204,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     } else {
         fe.P = crop_cols(p, fuse_image_rows(&in->camera[e->eye], p->geo.crop_y0, ch));
     }
-    fe.mask = e->mask;
+    fe.mask = e->aa.count ? e->aa.cov : e->mask;
     fe.mask_stride = cw;
     if (p->desc.refine_band > 0) {
         fuse_refine_params rp = fuse_refine_params_default();
@@ -219,6 +230,10 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                             cw, p->desc.refine_band, e->clip);
         e->have_refined = 1;
         fe.mask = e->refined;
+        if (e->aa.count) {
+            pipe__aa_refined(&e->aa, e->mask, e->refined, p->desc.refine_band);
+            fe.mask = e->aa.soft;
+        }
         if (p->fit && in->locals && rs.used_colour) {
             /* the next frame's fit: its colour model from this frame's
              * kinematic and refined masks, and the limb widths; not when
@@ -234,8 +249,12 @@ static void run_eye(pipe_ctx *p, eye_state *e)
             pipe_fit_measure(p->fit, e->eye, &e->cam, p->pose.world, e->mask, cw, e->refined, cw);
         }
     }
+    e->shown = fe.mask;
     fe.normal = e->nrm;
     fe.normal_stride = 3 * cw;
+    /* coverage beyond the model's pixel centres: its neighbours' normals */
+    if (e->aa.count && p->desc.normal_smooth == 0)
+        pipe__aa_fill_normals(&e->aa, fe.mask, e->mask, e->nrm);
     if (p->desc.normal_smooth > 0 &&
         fuse_normal_smooth(fe.mask, fe.mask_stride, e->nrm, 3 * cw, e->snrm, 3 * cw, cw, ch,
                            p->desc.normal_smooth) == FUSE_OK)
@@ -256,10 +275,15 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                           fe.V.width, fe.V.height};
         fe.depth = &dt;
         /* refined pixels outside the model have no depth: they take the
-         * model's beside them, so the depth test hides them too */
+         * model's beside them, so the depth test hides them too; the same
+         * for the anti-aliased coverage beyond the pixel centres */
         if (fe.mask == e->refined) {
             const int b = p->desc.refine_band;
             fuse_depth_fill(e->refined, cw, e->depth, cw, cw, ch, b + b / 8 + 2, filled);
+        } else if (e->aa.count) {
+            const int b = p->desc.refine_band;
+            fuse_depth_fill(fe.mask, cw, e->depth, cw, cw, ch, b > 0 ? b + b / 8 + 3 : 2,
+                            filled);
         }
     }
     fuse_result fr = FUSE_OK;
@@ -274,6 +298,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     for (int y = filled[1]; y < filled[3]; y++)
         for (int x = filled[0]; x < filled[2]; x++)
             if (e->mask[(size_t)y * cw + x] == 0) e->depth[(size_t)y * cw + x] = 1.0f;
+    if (e->aa.count) pipe__aa_unfill(&e->aa, e->mask, e->nrm);
     e->ms_fuse = now_ms() - t1 - e->ms_convert;
     if (fr != FUSE_OK) {
         e->result = PIPE_ERR_FUSE;
@@ -340,6 +365,7 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].cam_rgba);
         free(p->eye[e].refined);
         free(p->eye[e].refine_scratch);
+        pipe__aa_free(&p->eye[e].aa);
         rast_context_destroy(p->eye[e].rast);
         fuse_context_destroy(p->eye[e].fuse);
         pipe_lens_map_free(p->eye[e].lens);
@@ -386,6 +412,9 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
 {
     if (!model) return NULL;
     if (desc && (desc->normal_smooth < 0 || desc->normal_smooth > FUSE_NORMAL_SMOOTH_MAX))
+        return NULL;
+    if (desc && desc->aa_samples != 0 && desc->aa_samples != 4 && desc->aa_samples != 8 &&
+        desc->aa_samples != 16)
         return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
@@ -445,6 +474,12 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
                                     : NULL;
             ok = s->refined && s->refine_scratch;
         }
+        /* coverage samples are drawn through the pinhole: not with a
+         * distorting lens (pipe.h ANTI-ALIASED EDGES) */
+        if (ok && p->desc.aa_samples && s->lens) ok = 0;
+        if (ok && p->desc.aa_samples)
+            ok = pipe__aa_init(&s->aa, p->desc.aa_samples, p->geo.crop_width,
+                               p->geo.crop_height, p->desc.refine_band > 0) == 0;
     }
     if (ok && p->desc.refine_band > 0 && p->desc.fit_rig) {
         p->fit_rig = *p->desc.fit_rig;
@@ -665,6 +700,7 @@ const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
     if (width) *width = p->geo.crop_width;
     if (height) *height = p->geo.crop_height;
     const eye_state *e = &p->eye[eye ? 1 : 0];
+    if (e->aa.count && e->shown) return e->shown;
     return e->have_refined ? e->refined : e->mask;
 }
 
