@@ -1,22 +1,45 @@
 # egofuse - build, test, demo.
 #
 #   make            library, io library, the egofuse program, tests, tools
-#   make demo       install what is missing, generate samples, run the demo
-#   make test       install what is missing, build, run every test
+#   make demo       install what the demo is missing, generate samples, run it
+#   make test       install what the tests are missing, build, run every test
 #   make debug      the same tests under ASan + UBSan (build-debug/);
 #                   EGOFUSE_VM=0 make debug skips the VM test
 #   make fuzz       libFuzzer + ASan + UBSan targets of every parser, clang
 #                   (build-fuzz/fuzz/; scripts/fuzz.sh runs them, docs/fuzzing.md)
-#   make bench      benchmarks (they report, never pass or fail)
+#   make bench      install the peers, benchmarks (they report, never pass or fail)
+#   make deps       install what demo, test and bench need (scripts/deps.sh)
+#   make soak       `egofuse run` for 10 minutes in the test VM, cameras
+#                   unplugged 20 times, V stalled; RSS and fds sampled
+#                   (tests/vm/soak_host.sh, docs/devices.md; not in make test)
 #   make install    PREFIX=/usr/local DESTDIR=: the libraries, headers, pkg-config
 #                   files, plugin and program (docs/library.md); make uninstall
 #   make core-tests the core library and its tests only (no io library):
 #                   the ARM64 cross build of CI, .ci/run and docs/portability.md
 #   make clean
 #
+# Parallel by default: as many jobs as cores (nproc), unless the command
+# line or the environment gives -j (make -j1 builds one thing at a time).
+#
 # Core (src/raster, src/kin, src/fuse, src/fit, src/pipe, src/cpu): libc + libm + pthreads only, built
 # into build/libegofuse.a. src/io holds every other dependency and builds
 # into build/libegofuse_io.a. C++ only in src/io/*.cpp.
+
+# Parallel by default: -j$(nproc) when neither the command line nor the
+# environment's MAKEFLAGS gives -j. Only in the top make: a recursive make
+# ($(MAKE) below) shares its parent's job slots. GNU make 4.3 shows a
+# command-line -j in MAKEFLAGS only after reading the makefile, but its
+# command line overrides the value set here; make 4.4 shows it at once.
+ifeq ($(MAKELEVEL),0)
+ifeq ($(findstring j,$(filter-out --%,$(MAKEFLAGS) $(shell printf '%s' "$$MAKEFLAGS"))),)
+MAKEFLAGS += -j$(shell nproc 2>/dev/null || echo 1)
+endif
+# Goals that install packages and run a make of their own: one after the
+# other (make demo test), each building in parallel underneath.
+ifneq ($(filter deps deps-% demo test debug bench eval samples fuzz,$(MAKECMDGOALS)),)
+.NOTPARALLEL:
+endif
+endif
 
 BUILD    ?= build
 CC       ?= cc
@@ -42,8 +65,9 @@ CMOCKA_LIBS   ?= -lcmocka
 
 CORE_SRC := $(wildcard src/cpu/*.c src/pipe/*.c src/fit/*.c src/raster/*.c src/kin/*.c src/fuse/*.c)
 IO_SRC   := $(wildcard src/io/*.c)
-# io_image_oiio.cpp is the OpenImageIO plugin, not part of the io library.
-IO_CXX   := $(filter-out src/io/io_image_oiio.cpp,$(wildcard src/io/*.cpp))
+# io_image_oiio.cpp and io_image_exr.cpp are the image plugin, not part of
+# the io library.
+IO_CXX   := $(filter-out src/io/io_image_oiio.cpp src/io/io_image_exr.cpp,$(wildcard src/io/*.cpp))
 CLI_SRC  := $(wildcard src/cli/*.c)
 # The evaluation (`egofuse eval`): linked into the program with the samples
 # library it needs, never into the core or io libraries.
@@ -82,7 +106,10 @@ TEST_PLUGIN :=
 else
 # SDL2: headers only; src/io/io_display_sdl.c loads libSDL2 with dlopen when
 # a window is opened, so the program does not link it.
-IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) sdl2 2>/dev/null)
+IO_CFLAGS := $(shell pkg-config --cflags $(IO_PKGS) 2>/dev/null)
+# SDL2's headers (make test installs them, make demo does not): without
+# them io_display_sdl.c builds as a stub that says so.
+SDL2_CFLAGS := $(shell pkg-config --cflags sdl2 2>/dev/null || echo -DEGOFUSE_NO_SDL2)
 IO_LIBS  := $(shell pkg-config --libs $(IO_PKGS) 2>/dev/null) -lmeshoptimizer -lstdc++ -ldl
 TEST_IOLIB = $(IOLIB)
 TEST_PLUGIN = $(OIIO_PLUGIN)
@@ -91,12 +118,25 @@ endif
 # with dlopen only when a file is neither PNG nor PPM/PGM (docs/io.md), so
 # no command pays for its ~260 libraries unless it reads or writes such a
 # file. It is found next to the program (or its parent folder).
-OIIO_PKGS := OpenImageIO
+# Where OpenImageIO is missing but OpenEXR is there (make demo installs
+# only OpenEXR: the samples' depth is EXR), the plugin is built from
+# io_image_exr.cpp and serves EXR alone; it is rebuilt with OpenImageIO
+# once that is installed (make test). With OpenEXR, build/exr/ also holds
+# that EXR-only plugin, which tests/test_io_exr_plugin.c compares with
+# OpenImageIO's.
+HAVE_OIIO := $(shell pkg-config --exists OpenImageIO 2>/dev/null && echo 1)
+HAVE_EXR := $(shell pkg-config --exists OpenEXR 2>/dev/null && echo 1)
+PLUGIN_KIND := $(if $(HAVE_OIIO),oiio,$(if $(HAVE_EXR),exr,oiio))
+OIIO_PKGS := $(if $(filter exr,$(PLUGIN_KIND)),OpenEXR,OpenImageIO)
 OIIO_CFLAGS := $(shell pkg-config --cflags $(OIIO_PKGS) 2>/dev/null)
 OIIO_LIBS := $(shell pkg-config --libs $(OIIO_PKGS) 2>/dev/null)
 OIIO_PLUGIN := $(BUILD)/libegofuse_oiio.so
-OIIO_PLUGIN_SRC := src/io/io_image_oiio.cpp src/io/io_common.c src/io/io_image_mem.c
+OIIO_PLUGIN_SRC := src/io/io_image_$(PLUGIN_KIND).cpp src/io/io_common.c src/io/io_image_mem.c
 OIIO_PLUGIN_OBJ := $(patsubst %,$(BUILD)/pic/%.o,$(OIIO_PLUGIN_SRC))
+EXR_CFLAGS := $(shell pkg-config --cflags OpenEXR 2>/dev/null)
+EXR_LIBS := $(shell pkg-config --libs OpenEXR 2>/dev/null)
+EXR_PLUGIN := $(if $(HAVE_EXR),$(BUILD)/exr/libegofuse_oiio.so)
+EXR_PLUGIN_OBJ := $(patsubst %,$(BUILD)/pic/%.o,src/io/io_image_exr.cpp src/io/io_common.c src/io/io_image_mem.c)
 SYS_LIBS := -lm -lpthread
 # Peers measured by the benchmarks: pixman (compositing), Mesa llvmpipe
 # through EGL + GLES (the same frame as GL shaders).
@@ -111,15 +151,24 @@ EGOFUSE  := $(BUILD)/egofuse
 GEN      := $(BUILD)/gen_samples
 SAMPLES  := $(BUILD)/samples
 
-.PHONY: all deps demo test debug bench clean samples check-headers eval core-tests fuzz fuzz-targets
+.PHONY: all test-bins deps deps-demo deps-test deps-bench demo test debug bench clean samples check-headers eval core-tests fuzz fuzz-targets soak
 .DEFAULT_GOAL := all
 # Keep intermediate objects (tests/support/*.o), so a second make rebuilds nothing.
 .SECONDARY:
 
-all: $(LIB) $(IOLIB) $(OIIO_PLUGIN) $(EGOFUSE) $(GEN) $(TEST_BIN) $(BENCH_BIN)
+all: test-bins $(BENCH_BIN)
+# Everything make test (and make debug) runs: all but the benchmarks.
+test-bins: $(LIB) $(IOLIB) $(OIIO_PLUGIN) $(EXR_PLUGIN) $(EGOFUSE) $(GEN) $(TEST_BIN)
 
+# Each command installs only what it needs (scripts/deps.sh).
 deps:
 	@sh scripts/deps.sh
+deps-demo:
+	@sh scripts/deps.sh demo
+deps-test:
+	@sh scripts/deps.sh test
+deps-bench:
+	@sh scripts/deps.sh bench
 
 # Per-ISA files get their own flags; everything else stays at the baseline.
 # *_neon.c (the vector layer's src/cpu/simd_neon.h) need none: Advanced SIMD
@@ -138,6 +187,13 @@ core-tests: $(LIB) $(CORE_TEST_BIN)
 
 $(BUILD)/obj/src/io/%.o: CFLAGS += $(IO_CFLAGS)
 $(BUILD)/obj/src/io/%.o: CXXFLAGS += $(IO_CFLAGS) -Wno-unused-parameter
+# Rebuilt when SDL2's headers come or go (make demo, then make test).
+$(BUILD)/obj/src/io/io_display_sdl.c.o: CFLAGS += $(SDL2_CFLAGS)
+$(BUILD)/obj/src/io/io_display_sdl.c.o: $(BUILD)/cfg/sdl2
+$(BUILD)/tests/test_io_display: CFLAGS += $(SDL2_CFLAGS)
+$(BUILD)/cfg/sdl2: FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(SDL2_CFLAGS)' | cmp -s - $@ || echo '$(SDL2_CFLAGS)' > $@
 
 $(BUILD)/obj/%.c.o: %.c
 	@mkdir -p $(dir $@)
@@ -155,8 +211,18 @@ $(BUILD)/pic/%.cpp.o: %.cpp
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS) $(OIIO_CFLAGS) -Wno-unused-parameter -fPIC -fvisibility=hidden -c $< -o $@
 
-$(OIIO_PLUGIN): $(OIIO_PLUGIN_OBJ)
-	$(CXX) -shared $(LDFLAGS) -Wl,-soname,libegofuse_oiio.so -o $@ $^ $(OIIO_LIBS) -lm
+$(BUILD)/pic/src/io/io_image_exr.cpp.o: OIIO_CFLAGS := $(EXR_CFLAGS)
+
+# Rebuilt when the library behind it changes (OpenEXR, then OpenImageIO).
+$(OIIO_PLUGIN): $(OIIO_PLUGIN_OBJ) $(BUILD)/cfg/plugin
+	$(CXX) -shared $(LDFLAGS) -Wl,-soname,libegofuse_oiio.so -o $@ $(OIIO_PLUGIN_OBJ) $(OIIO_LIBS) -lm
+$(BUILD)/cfg/plugin: FORCE
+	@mkdir -p $(dir $@)
+	@echo '$(PLUGIN_KIND)' | cmp -s - $@ || echo '$(PLUGIN_KIND)' > $@
+
+$(BUILD)/exr/libegofuse_oiio.so: $(EXR_PLUGIN_OBJ)
+	@mkdir -p $(dir $@)
+	$(CXX) -shared $(LDFLAGS) -Wl,-soname,libegofuse_oiio.so -o $@ $^ $(EXR_LIBS) -lm
 
 $(LIB): $(CORE_OBJ)
 	@mkdir -p $(dir $@)
@@ -182,10 +248,16 @@ $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(TEST_IOLIB) $(LIB) | $(TEST_PLU
 	    $(CMOCKA_LIBS) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
 # Tests on the generated samples' scenes also link the generator.
-$(BUILD)/tests/test_occlusion: tests/test_occlusion.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
+$(BUILD)/tests/test_occlusion $(BUILD)/tests/test_io_lod: $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) \
 	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
+
+# The AA study runs on the generated operator: it links the samples library.
+$(BUILD)/bench/bench_aa: bench/bench_aa.c $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(SAMPLESLIB) $(IOLIB) $(LIB) \
+	    $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
 $(BUILD)/bench/%: bench/%.c $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
@@ -201,22 +273,23 @@ $(BUILD)/bench/%: bench/llvmpipe/%.c $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 $(SAMPLES)/scene.txt: $(GEN)
 	$(GEN) --out $(SAMPLES)
 
-samples: deps
+samples: deps-demo
 	@$(MAKE) --no-print-directory $(SAMPLES)/scene.txt
 
-demo: deps
+demo: deps-demo
 	@$(MAKE) --no-print-directory $(EGOFUSE) $(SAMPLES)/scene.txt
 	$(EGOFUSE) demo --samples $(SAMPLES) --out out/demo
 
-test: deps
-	@$(MAKE) --no-print-directory all check-headers
+# make test builds everything but the benchmarks (make bench: their peers).
+test: deps-test
+	@$(MAKE) --no-print-directory test-bins check-headers
 	@sh tests/run_tests.sh $(BUILD)
 
 # Every public header compiles on its own as C and as C++ (sokol's rule).
-HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/pipe/pipe_pose.h src/fit/fit.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
+HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/pipe/pipe_pose.h src/pipe/pipe_lod.h src/fit/fit.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
            src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/io/io.h src/io/io_dev.h \
            src/io/io_natnet.h src/io/io_display.h src/io/io_sched.h src/io/io_live.h \
-           src/io/io_vsrc.h
+           src/io/io_vsrc.h src/io/io_lod.h src/kin/kin_lens.h src/pipe/pipe_lens.h src/io/io_calib.h
 check-headers:
 	@for h in $(HEADERS); do \
 	    echo "#include \"$$h\"" | $(CC) -std=c99 -Wall -Wextra -Werror -x c -fsyntax-only - || exit 1; \
@@ -224,9 +297,9 @@ check-headers:
 	done
 
 # Tests under AddressSanitizer and UndefinedBehaviorSanitizer.
-debug: deps
+debug: deps-test
 	@$(MAKE) --no-print-directory BUILD=build-debug OPT=-O1 \
-	    SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" all
+	    SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" test-bins
 	@ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
 	    sh tests/run_tests.sh build-debug
 
@@ -249,12 +322,17 @@ $(BUILD)/fuzz/%: tests/%.c tests/fuzz/fuzz_util.h $(IOLIB) $(LIB)
 	$(CXX) $(LDFLAGS) -fsanitize=fuzzer -o $@ $@.o $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
 
 # The accuracy report (docs/accuracy.md): charts, table, summary.csv.
-eval: deps
+eval: deps-demo
 	@$(MAKE) --no-print-directory $(EGOFUSE)
 	$(EGOFUSE) eval --frames 180 --report out/eval
 
-bench: deps
-	@$(MAKE) --no-print-directory all
+# The soak of the live path in the VM (SOAK_SECONDS, SOAK_CYCLES, SOAK_STALLS).
+soak: deps-test
+	@$(MAKE) --no-print-directory $(LIB) $(IOLIB) $(OIIO_PLUGIN) $(EGOFUSE) $(GEN)
+	@sh tests/vm/soak_host.sh $(BUILD)
+
+bench: deps-bench
+	@$(MAKE) --no-print-directory $(BENCH_BIN) $(GEN) $(OIIO_PLUGIN)
 	@sh bench/run_bench.sh $(BUILD)
 
 clean:
@@ -288,7 +366,7 @@ INSTALL_HEADERS := $(filter-out src/io/%,$(HEADERS)) src/fuse/fuse_normals.h src
 
 .PHONY: install uninstall FORCE
 ifneq ($(CORE_ONLY),1)
-all: $(SOLIB) $(INST_IOLIB) $(INST_EGOFUSE)
+test-bins: $(SOLIB) $(INST_IOLIB) $(INST_EGOFUSE)
 endif
 
 ifeq ($(X86),1)

@@ -142,6 +142,17 @@ static void usage_errors(void **state)
     assert_non_null(strstr(out, "--refine BAND"));
     assert_int_equal(run("run", "--refine", "x", NULL), 2);
     assert_non_null(strstr(out, "--refine 'x'"));
+    /* --aa N: 0, 4, 8 or 16 samples per pixel */
+    assert_int_equal(run("render", "--help", NULL), 0);
+    assert_non_null(strstr(out, "--aa N"));
+    assert_int_equal(run("render", "--scene", "s.txt", "--out", "o", "--aa", "3", NULL), 2);
+    assert_non_null(strstr(out, "--aa '3'"));
+    assert_int_equal(run("render", "--scene", "s.txt", "--out", "o", "--aa", "32", NULL), 2);
+    assert_non_null(strstr(out, "--aa '32'"));
+    assert_int_equal(run("run", "--help", NULL), 0);
+    assert_non_null(strstr(out, "--aa N"));
+    assert_int_equal(run("run", "--aa", "x", NULL), 2);
+    assert_non_null(strstr(out, "--aa 'x'"));
 }
 
 /* ------------------------------------------------------------- mask */

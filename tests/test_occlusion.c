@@ -26,6 +26,8 @@
  *     least 300 differing output pixels per eye and frame: the test is not
  *     vacuous);
  *   - every ISA gives the reference's bytes (outputs and layers).
+ * The pipe methods run again with anti-aliased silhouettes
+ * (pipe_desc.aa_samples 4, 8 or 16: occl_*_aa), the same checks.
  * Before fuse_depth_fill (the refined pixels outside the model had no
  * depth and were kept) refine and refine-anim drew hundreds of hand
  * pixels inside the band per frame (with the fill disabled: refine 25,913,
@@ -70,6 +72,8 @@ typedef struct world {
 } world;
 
 static world W;
+/* pipe_desc.aa_samples of the pipe methods (0: binary masks) */
+static int g_aa;
 
 /* The band of BAND_W output columns holding the most silhouette pixels. */
 static int best_band(const uint8_t *sil, const kin_sthmd_geometry *g)
@@ -233,6 +237,7 @@ static long run_pipe(int m, ef_isa isa, int with_depth, uint64_t crc[NF], long *
     pipe_desc d = {0};
     d.threads = 2;
     d.max_isa = (int)isa;
+    d.aa_samples = g_aa;
     if (m == M_REFINE || m == M_REFINE_ANIM) d.refine_band = 16;
     if (m == M_REFINE) d.fit_rig = &W.rig;
     pipe_ctx *p = pipe_create(&d, &W.mask.model);
@@ -370,7 +375,7 @@ static void method_case(int m)
            method_name[m], shown);
     assert_true(shown >= MIN_SHOWN);
     long bad = run_method(m, EF_ISA_REF, 1, ref_crc, &shown);
-    printf("%-11s ref: %ld hand pixels behind the object\n", method_name[m], bad);
+    printf("%-11s aa %d ref: %ld hand pixels behind the object\n", method_name[m], g_aa, bad);
     assert_int_equal(bad, 0);
     for (int isa = EF_ISA_SSE2; isa < EF_ISA_COUNT; isa++) {
         if (!ef_cpu_has((ef_isa)isa)) continue;
@@ -387,6 +392,19 @@ static void occl_kin_pred(void **state) { (void)state; method_case(M_KIN_PRED); 
 static void occl_refine(void **state) { (void)state; method_case(M_REFINE); }
 static void occl_refine_anim(void **state) { (void)state; method_case(M_REFINE_ANIM); }
 static void occl_skin(void **state) { (void)state; method_case(M_SKIN); }
+/* The same with anti-aliased silhouettes (pipe_desc.aa_samples): the
+ * coverage beyond the model's pixel centres takes the model's depth
+ * beside it. The skin method has no model (no coverage samples). */
+static void aa_case(int m, int aa)
+{
+    g_aa = aa;
+    method_case(m);
+    g_aa = 0;
+}
+static void occl_kin_aa(void **state) { (void)state; aa_case(M_KIN, 16); }
+static void occl_kin_pred_aa(void **state) { (void)state; aa_case(M_KIN_PRED, 4); }
+static void occl_refine_aa(void **state) { (void)state; aa_case(M_REFINE, 8); }
+static void occl_refine_anim_aa(void **state) { (void)state; aa_case(M_REFINE_ANIM, 16); }
 
 /* fuse_depth_fill's rule on small cases: nearest known depth, ties to
  * the upper row then the left column, sources only the depths before the
@@ -461,6 +479,10 @@ int main(void)
         cmocka_unit_test(occl_refine),
         cmocka_unit_test(occl_refine_anim),
         cmocka_unit_test(occl_skin),
+        cmocka_unit_test(occl_kin_aa),
+        cmocka_unit_test(occl_kin_pred_aa),
+        cmocka_unit_test(occl_refine_aa),
+        cmocka_unit_test(occl_refine_anim_aa),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -54,16 +54,19 @@ enum {
 };
 #define GEN_PATTERN_STRIDE 100.0f
 
-/* Surface patterns (procedural detail, see gen_render.c). */
+/* Surface patterns (procedural detail, see gen_render.c). The arms' two
+ * come first and next to each other: across a triangle where skin meets
+ * sleeve (the cuff) the code interpolates between theirs, and a pattern
+ * numbered between them would show as coloured specks on the cuff. */
 typedef enum gen_pattern {
     GEN_PAT_SKIN = 0,      /* arms: fine skin mottling */
+    GEN_PAT_FABRIC,        /* arms: sleeve weave */
     GEN_PAT_PLAIN,         /* painted metal / plastic */
     GEN_PAT_TILES,         /* floor tiles */
     GEN_PAT_SCREEN,        /* console display with bars */
     GEN_PAT_WOOD,          /* wood grain */
     GEN_PAT_BUTTONS,       /* panel with a grid of buttons */
     GEN_PAT_WINDOW,        /* bright window panes */
-    GEN_PAT_FABRIC,        /* arms: sleeve weave */
     GEN_PAT_COUNT
 } gen_pattern;
 

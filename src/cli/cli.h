@@ -32,6 +32,18 @@ int cli_fail(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 int cli_usage_error(const char *cmd, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 
+/* Reads OpenCV calibration files (io_calib.h) into hmd->lens: both for
+ * both cameras (a stereo file: its first camera left, its second right),
+ * left / right for one each (they win over both); NULL = none. Checks the
+ * image size against hmd's camera size when that is set (the same aspect;
+ * kin_sthmd_desc_resolved scales). EXIT_OK, or EXIT_FAIL with the file
+ * and the reason printed. cli_lens.c, docs/lens.md. */
+int cli_lens_load(const char *both, const char *left, const char *right, kin_sthmd_desc *hmd);
+/* 1 if hmd's lenses (when given, with a size) have its camera's aspect;
+ * else 0 with a sentence in why (e.g. a scene's named HMD, known only
+ * after the options). */
+int cli_lens_fits(const kin_sthmd_desc *hmd, char *why, size_t why_size);
+
 /* Strict parsers: the whole string must be the number(s); finite. */
 int cli_parse_int(const char *s, int lo, int hi, int *out);
 int cli_parse_float(const char *s, float *out);

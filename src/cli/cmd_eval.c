@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "../eval/eval.h"
+#include "cli_lod.h"
 
 static const char *eval_usage =
     "usage: egofuse eval [--sequence NAME] [--frames N] [--noise MM] [--latency MS]\n"
@@ -14,6 +15,7 @@ static const char *eval_usage =
     "                    [--methods LIST] [--band PX] [--global W] [--per-frame]\n"
     "                    [--csv FILE] [--report DIR] [--sweep-frames N]\n"
     "                    [--seq-frames N] [--dump DIR] [--quiet]\n"
+    "                    [--lod MODE] [--lod-px PX] [--lod-sweep]\n"
     "\n"
     "Generates ground truth (a true operator whose bones and limbs differ from\n"
     "the mask model, filmed over a cockpit with skin-coloured objects, camera\n"
@@ -59,11 +61,20 @@ static const char *eval_usage =
     "  --dump DIR       write every mask: DIR/METHOD_SETTING_EYE_NNNN.png (red:\n"
     "                   true silhouette, green: the method's mask)\n"
     "  --quiet          no progress line\n"
+    "  --lod MODE       the mask model's level of detail for every method:\n"
+    "                   off (default), a level 1..7, or auto (per frame and eye,\n"
+    "                   the coarsest level whose error is <= --lod-px px)\n"
+    "  --lod-px PX      the error auto allows, pixels (default 2)\n"
+    "  --lod-sweep      also run kin-cal-pred and refine at levels 0..4 and auto\n"
+    "                   at 1, 2, 4, 8 px on --frames frames (group lod: level\n"
+    "                   and triangles drawn, raster ms per eye, the kinematic\n"
+    "                   mask's IoU and BF1 against the full model's; a report\n"
+    "                   runs it on --sweep-frames and writes DIR/lod.csv)\n"
     "  -h, --help       this text\n";
 
 enum { O_FRAMES = 256, O_NOISE, O_LATENCY, O_DROPOUT, O_CALIB, O_SPEED, O_SEED, O_PERFRAME,
        O_CSV, O_REPORT, O_QUIET, O_DUMP, O_METHODS, O_BAND, O_SEQUENCE, O_SWEEP_FRAMES,
-       O_SEQ_FRAMES, O_GLOBAL };
+       O_SEQ_FRAMES, O_GLOBAL, O_LOD, O_LOD_PX, O_LOD_SWEEP };
 
 int cmd_eval(int argc, char **argv)
 {
@@ -86,11 +97,14 @@ int cmd_eval(int argc, char **argv)
         {"sweep-frames", required_argument, 0, O_SWEEP_FRAMES},
         {"seq-frames", required_argument, 0, O_SEQ_FRAMES},
         {"global", required_argument, 0, O_GLOBAL},
+        {"lod", required_argument, 0, O_LOD},
+        {"lod-px", required_argument, 0, O_LOD_PX},
+        {"lod-sweep", no_argument, 0, O_LOD_SWEEP},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
     eval_opts o = { 60, 0, 0, 5.0f, 20.0f, 0.02f, 0.0f, 1.0f, 1, NULL, NULL, NULL, 15u,
-                    GEN_ANIM_NAME, 60, 90, 0.5f, 16 };
+                    GEN_ANIM_NAME, 60, 90, 0.5f, 16, CLI_LOD_DEFAULT, CLI_LOD_PX_DEFAULT, 0 };
     optind = 1;
     opterr = 0;
     int ch;
@@ -156,6 +170,16 @@ int cmd_eval(int argc, char **argv)
             if (!cli_parse_int(optarg, 1, 100000, &o.sweep_frames))
                 return cli_usage_error("eval", "--sweep-frames '%s': not a positive count", optarg);
             break;
+        case O_LOD:
+            if (!cli_lod_parse(optarg, &o.lod))
+                return cli_usage_error("eval", "--lod '%s': off, auto or a level 0..%d", optarg,
+                                       PIPE_LOD_MAX - 1);
+            break;
+        case O_LOD_PX:
+            if (!cli_lod_parse_px(optarg, &o.lod_px))
+                return cli_usage_error("eval", "--lod-px '%s': pixels, > 0 and <= 1000", optarg);
+            break;
+        case O_LOD_SWEEP: o.lod_sweep = 1; break;
         case O_GLOBAL:
             if (!cli_parse_float(optarg, &v) || v < 0.0f || v > 1.0f)
                 return cli_usage_error("eval", "--global '%s': not in 0..1", optarg);

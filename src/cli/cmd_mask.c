@@ -1,5 +1,6 @@
 /* cmd_mask.c - `egofuse mask`: the coverage mask of any glTF model. */
 #include "cli.h"
+#include "../io/io_calib.h"
 #include "../pipe/pipe_mask.h"
 
 #include <getopt.h>
@@ -12,7 +13,7 @@ static const char *usage =
     "                    --eye X,Y,Z --target X,Y,Z [--up X,Y,Z]\n"
     "                    [--anim I --time T] [--scene S] [--near N --far F]\n"
     "                    --out mask.png [--normals n.png] [--depth d.exr]\n"
-    "                    [--allow-outside]\n"
+    "                    [--allow-outside] [--calibration FILE]\n"
     "\n"
     "Renders the coverage mask of a skinned or unskinned glTF 2.0 model, at\n"
     "its rest pose or at time T (seconds) of animation I, exactly and\n"
@@ -47,13 +48,17 @@ static const char *usage =
     "  --anim I                animation index (default: rest pose)\n"
     "  --time T                time in seconds (clamped to the animation)\n"
     "  --scene S               draw scene S instead of the default scene\n"
+    "  --calibration FILE      an OpenCV calibration file (YAML/XML, docs/lens.md):\n"
+    "                          the camera's intrinsics and lens distortion instead\n"
+    "                          of --fov-y; the size defaults to the file's (a\n"
+    "                          --width/--height of another size scales it)\n"
     "  --allow-outside         let buffer and image URIs name files outside\n"
     "                          the model's folder (absolute, `..`, symlinks\n"
     "                          out); refused by default (docs/io.md)\n"
     "  -h, --help              this text\n";
 
 enum { O_WIDTH = 256, O_HEIGHT, O_FOVY, O_EYE, O_TARGET, O_UP, O_ANIM, O_TIME,
-       O_NEAR, O_FAR, O_OUT, O_NORMALS, O_DEPTH, O_SCENE, O_ALLOW_OUTSIDE };
+       O_NEAR, O_FAR, O_OUT, O_NORMALS, O_DEPTH, O_SCENE, O_ALLOW_OUTSIDE, O_CALIBRATION };
 
 static const struct option opts[] = {
     {"width", required_argument, 0, O_WIDTH},
@@ -71,6 +76,7 @@ static const struct option opts[] = {
     {"depth", required_argument, 0, O_DEPTH},
     {"scene", required_argument, 0, O_SCENE},
     {"allow-outside", no_argument, 0, O_ALLOW_OUTSIDE},
+    {"calibration", required_argument, 0, O_CALIBRATION},
     {"help", no_argument, 0, 'h'},
     {0, 0, 0, 0},
 };
@@ -81,7 +87,7 @@ int cmd_mask(int argc, char **argv)
     float fovy = 0.0f, tsec = 0.0f, znear = 0.01f, zfar = 100.0f;
     float eye[3], target[3], up[3] = {0.0f, 1.0f, 0.0f};
     int have_eye = 0, have_target = 0;
-    const char *out = NULL, *out_n = NULL, *out_d = NULL;
+    const char *out = NULL, *out_n = NULL, *out_d = NULL, *calib = NULL;
 
     optind = 1;
     opterr = 0;
@@ -133,6 +139,7 @@ int cmd_mask(int argc, char **argv)
             if (!cli_parse_int(a, 0, 1 << 20, &scene))
                 return cli_usage_error("mask", "--scene '%s': not a scene index", a);
             break;
+        case O_CALIBRATION: calib = a; break;
         case O_OUT: out = a; break;
         case O_NORMALS: out_n = a; break;
         case O_DEPTH: out_d = a; break;
@@ -145,8 +152,12 @@ int cmd_mask(int argc, char **argv)
     if (optind >= argc) return cli_usage_error("mask", "no model file given");
     if (optind + 1 < argc) return cli_usage_error("mask", "unexpected argument '%s'", argv[optind + 1]);
     const char *model_path = argv[optind];
-    if (!width || !height) return cli_usage_error("mask", "--width and --height are required");
-    if (fovy == 0.0f) return cli_usage_error("mask", "--fov-y is required");
+    if (calib && fovy != 0.0f)
+        return cli_usage_error("mask", "--calibration and --fov-y exclude each other (the file "
+                               "gives the camera's intrinsics)");
+    if (!width != !height) return cli_usage_error("mask", "give both --width and --height");
+    if (!calib && !width) return cli_usage_error("mask", "--width and --height are required");
+    if (!calib && fovy == 0.0f) return cli_usage_error("mask", "--fov-y is required");
     if (!have_eye || !have_target) return cli_usage_error("mask", "--eye and --target are required");
     if (!out) return cli_usage_error("mask", "--out is required");
     if (!(zfar > znear)) return cli_usage_error("mask", "--far (%g) must be greater than --near (%g)", zfar, znear);
@@ -171,6 +182,17 @@ int cmd_mask(int argc, char **argv)
         return cli_usage_error("mask", "--up is zero or parallel to the view direction");
 
     io_error err;
+    kin_lens lens;
+    if (calib) {
+        if (io_calib_load(calib, 0, &lens, &err) != IO_OK) return cli_fail("%s", err.msg);
+        if (!width && !lens.width)
+            return cli_fail("%s: no image size in the file (image_width, image_height): give "
+                            "--width and --height", calib);
+        if (!width) width = lens.width, height = lens.height;
+        if (lens.width > RAST_MAX_DIM || lens.height > RAST_MAX_DIM)
+            return cli_fail("%s: image size %dx%d above %d", calib, lens.width, lens.height,
+                            RAST_MAX_DIM);
+    }
     kin_model model;
     io_gltf_info info;
     if (io_gltf_load_ex(model_path, scene, &model, &info, &err) != IO_OK) return cli_fail("%s", err.msg);
@@ -206,6 +228,7 @@ int cmd_mask(int argc, char **argv)
     md.zfar = zfar;
     md.anim = an;
     md.time = tsec;
+    md.lens = calib ? &lens : NULL;
     char why[256];
     if (pipe_mask_render(&model, &md, mask.data, out_n ? nimg.data : NULL, out_d ? dimg.data : NULL,
                          why, sizeof why) != 0) {

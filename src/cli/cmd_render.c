@@ -2,6 +2,7 @@
  * stereo sequence: pose -> skin -> raster per eye -> lighting layer ->
  * resample into the viewport -> composite over the virtual scene. */
 #include "cli.h"
+#include "cli_lod.h"
 
 #include <getopt.h>
 #include <math.h>
@@ -14,8 +15,11 @@ static const char *render_usage =
     "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
     "                      [--tone-match S] [--pose animation|tracking]\n"
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
-    "                      [--refine BAND] [--smooth-normals R] [--hide PARTS]\n"
+    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--hide PARTS]\n"
     "                      [--prop MODEL@X,Y,Z[,YAW]]... [--allow-outside]\n"
+    "                      [--lod MODE] [--lod-px PX]\n"
+    "                      [--hmd-calibration FILE | --hmd-calibration-left FILE\n"
+    "                       --hmd-calibration-right FILE]\n"
     "\n"
     "Composites a recorded sequence (docs/scene.md): for each frame, poses the\n"
     "mask model at t = frame / fps, renders its mask and normals from both\n"
@@ -50,6 +54,11 @@ static const char *render_usage =
     "                 camera frame's time (processing latency), 0..100,\n"
     "                 default 0\n"
     "  --no-filter    with --pose tracking: the newest raw sample, no filter\n"
+    "  --hmd-calibration FILE  the cameras' lenses from an OpenCV calibration\n"
+    "                 file (YAML/XML; a stereo file: M1/D1 left, M2/D2 right), or\n"
+    "                 --hmd-calibration-left / -right FILE one each: the masks are\n"
+    "                 drawn through the lens (docs/lens.md); the camera images\n"
+    "                 are then of the calibration's size\n"
     "\n"
     "EGOFUSE_ISA=ref|sse2|avx2|avx512 caps the instruction set (same bytes).\n"
     "  --refine BAND  refine the masks by colour in a band of BAND px (1..64,\n"
@@ -65,9 +74,13 @@ static const char *render_usage =
     "                 cut in a real object like the hands: the glTF MODEL in its\n"
     "                 rest pose, placed at (X, Y, Z) metres in the world frame and\n"
     "                 turned YAW degrees about +Y (default 0); up to 8 props\n"
+    "  --aa N         anti-aliased silhouettes: the mask is the coverage of N\n"
+    "                 samples per pixel (4, 8 or 16; 0: off, the binary mask of\n"
+    "                 the pixel centres); default 0\n"
     "  --smooth-normals R  sum the model's normals over a (2R+1)^2 window\n"
     "                 before lighting (1..4; default 0: off): for models of\n"
     "                 crossing parts whose shading shows seams\n"
+    CLI_LOD_USAGE
     "  --allow-outside  let the models' buffer and image URIs name files\n"
     "                 outside their folder (absolute, `..`, symlinks out);\n"
     "                 refused by default (docs/io.md)\n"
@@ -108,6 +121,11 @@ typedef struct render_opts {
         float at[3], yaw_deg;
     } props[RENDER_MAX_PROPS];
     int smooth_normals;    /* fuse_normal_smooth radius; 0 = off */
+    int lod;               /* --lod: a level, PIPE_LOD_AUTO; 0 = off */
+    float lod_px;          /* --lod-px */
+    const char *hmd_calib[3]; /* --hmd-calibration, -left, -right */
+    kin_sthmd_desc hmd;    /* zero = the paper's; lenses from hmd_calib */
+    int aa;                /* coverage samples per pixel; 0 = off */
 } render_opts;
 
 /* The pose from tracking: the recording, the rig, the filter and the
@@ -317,15 +335,22 @@ static int render(const render_opts *o)
 
     int rc = EXIT_FAIL;
     pipe_desc pd = {0};
+    pd.hmd = o->hmd;
     pd.threads = o->threads;
     pd.tone_match = o->tone_match;
     pd.cull = o->cull_back ? RAST_CULL_BACK : RAST_CULL_NONE;
     pd.refine_band = o->refine;
     pd.normal_smooth = o->smooth_normals;
+    pd.aa_samples = o->aa;
     pd.fit_rig = o->refine && o->pose_tracking ? &tp.rig : NULL;
     /* the scene's HMD (its `hmd` key, checked on load), or the paper's */
-    if (sc.hmd[0]) kin_sthmd_preset(sc.hmd, &pd.hmd);
+    if (sc.hmd[0]) {
+        kin_sthmd_preset(sc.hmd, &pd.hmd);
+        pd.hmd.lens[0] = o->hmd.lens[0]; /* --hmd-calibration: on that HMD */
+        pd.hmd.lens[1] = o->hmd.lens[1];
+    }
     pipe_ctx *pp = pipe_create(&pd, &model);
+    pipe_lod lod = {0};
     kin_sthmd_desc hd = pp ? pipe_hmd(pp) : kin_sthmd_desc_resolved(&pd.hmd);
     io_image cam[2] = {{0}}, virt[2] = {{0}}, vdepth[2] = {{0}}, rgb = {0};
     kin_model props[RENDER_MAX_PROPS];
@@ -340,6 +365,14 @@ static int render(const render_opts *o)
             cli_fail("cannot start the pipeline: out of memory or no thread");
         goto done;
     }
+    {
+        char lw[300];
+        if (!cli_lens_fits(&pd.hmd, lw, sizeof lw)) {
+            cli_fail("%s: %s", o->scene, lw);
+            goto done;
+        }
+    }
+    if (cli_lod_setup(model_path, &model, o->lod, o->lod_px, pp, &lod) != EXIT_OK) goto done;
     if (render_props(o, pp, props, &props_loaded, prop_world, prop_ptr) != EXIT_OK) goto done;
     if (o->hide & ~pipe_parts_present(pp))
         fprintf(stderr, "egofuse: --hide: %s has no triangles of some of these parts (found: "
@@ -367,6 +400,7 @@ static int render(const render_opts *o)
     in.prop_count = props_loaded;
     static const char *eye_name[2] = {"left", "right"};
     pipe_frame_stats st, sum = {0};
+    long lod_sum = 0;
     progress pr;
     progress_start(&pr, count);
     if (o->quiet) pr.enabled = 0;
@@ -419,6 +453,7 @@ static int render(const render_opts *o)
         for (int e = 0; e < 2; e++) {
             sum.ms_raster[e] += st.ms_raster[e];
             sum.ms_fuse[e] += st.ms_fuse[e];
+            lod_sum += st.lod_level[e];
         }
         for (int e = 0; e < 2; e++) {
             snprintf(path, sizeof path, "%s/%s_%04d.png", o->out, eye_name[e], f);
@@ -443,6 +478,14 @@ static int render(const render_opts *o)
                o->threads == 1 ? 1 : 2, o->threads == 1 ? "" : "s", sum.ms_total / count,
                sum.ms_pose / count, (sum.ms_raster[0] + sum.ms_raster[1]) / (2.0 * count),
                (sum.ms_fuse[0] + sum.ms_fuse[1]) / (2.0 * count), 1e3 * wall / count);
+        if (o->lod) {
+            char ln[32];
+            printf("egofuse: levels of detail %s: %d levels (", cli_lod_name(o->lod, o->lod_px,
+                   ln, sizeof ln), lod.level_count);
+            for (int l = 0; l < lod.level_count; l++)
+                printf("%s%ld", l ? ", " : "", lod.level[l].triangles);
+            printf(" triangles), mean level drawn %.2f\n", (double)lod_sum / (2.0 * count));
+        }
         if (o->pose_tracking)
             printf("egofuse: pose from tracking (%d samples, %s, prediction %.0f ms%s%s)%s\n",
                    tp.count, o->no_filter ? "raw" : "One Euro filter", (double)o->predict_ms,
@@ -458,6 +501,7 @@ done:
     }
     io_image_free(&rgb);
     pipe_destroy(pp);
+    io_lod_free(&lod);
     for (int k = 0; k < props_loaded; k++) kin_model_free(&props[k]);
     track_pose_free(&tp);
     kin_model_free(&model);
@@ -466,7 +510,17 @@ done:
 
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
        O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
-       O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE };
+       O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
+       O_HMD_CALIB_R, O_AA };
+
+/* --aa N: 0 (off), 4, 8 or 16 samples per pixel. 1, or 0 for another. */
+static int parse_aa(const char *s, int *aa)
+{
+    int v;
+    if (!cli_parse_int(s, 0, 16, &v) || (v != 0 && v != 4 && v != 8 && v != 16)) return 0;
+    *aa = v;
+    return 1;
+}
 
 /* "MODEL@X,Y,Z[,YAW]" (the last '@' ends the path). 1, or 0 when it is
  * not of that form. */
@@ -509,7 +563,10 @@ int cmd_render(int argc, char **argv)
         {"no-depth", no_argument, 0, O_NO_DEPTH},
         {"cull-back", no_argument, 0, O_CULL},
         {"refine", required_argument, 0, O_REFINE},
+        {"lod", required_argument, 0, O_LOD},
+        {"lod-px", required_argument, 0, O_LOD_PX},
         {"smooth-normals", required_argument, 0, O_SMOOTH},
+        {"aa", required_argument, 0, O_AA},
         {"tone-match", required_argument, 0, O_TONE},
         {"pose", required_argument, 0, O_POSE},
         {"calib", required_argument, 0, O_CALIB},
@@ -518,10 +575,15 @@ int cmd_render(int argc, char **argv)
         {"hide", required_argument, 0, O_HIDE},
         {"prop", required_argument, 0, O_PROP},
         {"allow-outside", no_argument, 0, O_ALLOW_OUTSIDE},
+        {"hmd-calibration", required_argument, 0, O_HMD_CALIB},
+        {"hmd-calibration-left", required_argument, 0, O_HMD_CALIB_L},
+        {"hmd-calibration-right", required_argument, 0, O_HMD_CALIB_R},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
     render_opts o = {0};
+    o.lod = CLI_LOD_DEFAULT;
+    o.lod_px = CLI_LOD_PX_DEFAULT;
     char why[200];
     int tracking_only = 0;   /* an option that needs --pose tracking */
     optind = 1;
@@ -548,6 +610,16 @@ int cmd_render(int argc, char **argv)
             break;
         case O_NO_DEPTH: o.no_depth = 1; break;
         case O_CULL: o.cull_back = 1; break;
+        case O_LOD:
+            if (!cli_lod_parse(optarg, &o.lod))
+                return cli_usage_error("render", "--lod '%s': off, auto or a level 0..%d",
+                                       optarg, PIPE_LOD_MAX - 1);
+            break;
+        case O_LOD_PX:
+            if (!cli_lod_parse_px(optarg, &o.lod_px))
+                return cli_usage_error("render", "--lod-px '%s': pixels, > 0 and <= 1000",
+                                       optarg);
+            break;
         case O_REFINE:
             if (!cli_parse_int(optarg, 1, 64, &o.refine))
                 return cli_usage_error("render", "--refine '%s': a band of 1..64 px", optarg);
@@ -556,6 +628,11 @@ int cmd_render(int argc, char **argv)
             if (!cli_parse_int(optarg, 1, FUSE_NORMAL_SMOOTH_MAX, &o.smooth_normals))
                 return cli_usage_error("render", "--smooth-normals '%s': a radius of 1..%d px",
                                        optarg, FUSE_NORMAL_SMOOTH_MAX);
+            break;
+        case O_AA:
+            if (!parse_aa(optarg, &o.aa))
+                return cli_usage_error("render", "--aa '%s': 0 (off), 4, 8 or 16 samples per "
+                                       "pixel", optarg);
             break;
         case O_TONE:
             if (!cli_parse_float(optarg, &o.tone_match) || o.tone_match < 0.0f || o.tone_match > 1.0f)
@@ -586,6 +663,9 @@ int cmd_render(int argc, char **argv)
                 return cli_usage_error("render", "--prop '%s': MODEL@X,Y,Z or MODEL@X,Y,Z,YAW "
                                        "(metres, degrees)", optarg);
             break;
+        case O_HMD_CALIB: o.hmd_calib[0] = optarg; break;
+        case O_HMD_CALIB_L: o.hmd_calib[1] = optarg; break;
+        case O_HMD_CALIB_R: o.hmd_calib[2] = optarg; break;
         case ':': return cli_usage_error("render", "option %s needs a value", argv[optind - 1]);
         default: return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);
         }
@@ -597,6 +677,10 @@ int cmd_render(int argc, char **argv)
         return cli_usage_error("render", "%s needs --pose tracking",
                                tracking_only == O_CALIB ? "--calib"
                                : tracking_only == O_PREDICT ? "--predict" : "--no-filter");
+    if (o.hmd_calib[0] || o.hmd_calib[1] || o.hmd_calib[2]) {
+        int rc = cli_lens_load(o.hmd_calib[0], o.hmd_calib[1], o.hmd_calib[2], &o.hmd);
+        if (rc != EXIT_OK) return rc;
+    }
     return render(&o);
 }
 
@@ -611,6 +695,8 @@ int cmd_demo(int argc, char **argv)
     };
     const char *samples = "build/samples";
     render_opts o = {0};
+    o.lod = CLI_LOD_DEFAULT;
+    o.lod_px = CLI_LOD_PX_DEFAULT;
     o.out = "out/demo";
     o.cull_back = 1; /* the sample arms are closed: same masks, half the setups */
     optind = 1;

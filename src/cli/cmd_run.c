@@ -17,6 +17,7 @@
  * run_state (tracking service, flips, outputs, the status words), which
  * nothing else uses. */
 #include "run.h"
+#include "cli_lod.h"
 
 #include <errno.h>
 #include <math.h>
@@ -131,6 +132,7 @@ typedef struct run_state {
     int have_model;
     char model_path[IO_PATH_MAX + 64];
     pipe_ctx *pipe;
+    pipe_lod lod;             /* --lod: the model's levels of detail */
     io_image virt[2], outimg[2], camimg[2];
     io_image vdepth[2];       /* the still virtual images' depth, if any */
     char vdepth_path[2][IO_PATH_MAX + 64];
@@ -181,6 +183,7 @@ static void run_close(run_state *r)
     free(r->locals);
     free(r->rawbuf);
     if (r->pipe) pipe_destroy(r->pipe);
+    io_lod_free(&r->lod);
     for (int k = 0; k < r->props_loaded; k++) kin_model_free(&r->props[k]);
     if (r->have_model) kin_model_free(&r->model);
 }
@@ -501,6 +504,10 @@ static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
     bad = fprintf(f, "egofuse render --scene %s/scene.txt --out OUT%s%s%s", o->dump,
                   tracked ? " --pose tracking --no-filter" : "", o->calib ? " --calib " : "",
                   o->calib ? o->calib : "") < 0;
+    /* the lenses: render draws the masks through the same ones */
+    static const char *const calib_opt[3] = {"", "-left", "-right"};
+    for (int k = 0; k < 3; k++)
+        if (o->hmd_calib[k]) bad |= fprintf(f, " --hmd-calibration%s %s", calib_opt[k], o->hmd_calib[k]) < 0;
     if (o->hide) {
         static const char *const part[4] = {"left-hand", "left-arm", "right-hand", "right-arm"};
         int first = 1;
@@ -519,6 +526,10 @@ static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
             bad |= fprintf(f, " --prop %s@%.9g,%.9g,%.9g,%.9g", p->model, (double)p->at[0],
                            (double)p->at[1], (double)p->at[2], (double)p->rot_deg[0]) < 0;
     }
+    if (o->lod == PIPE_LOD_AUTO)
+        bad |= fprintf(f, " --lod auto --lod-px %.9g", (double)o->lod_px) < 0;
+    else if (o->lod) bad |= fprintf(f, " --lod %d", o->lod) < 0;
+    if (o->aa) bad |= fprintf(f, " --aa %d", o->aa) < 0;
     if (o->refine) bad |= fprintf(f, " --refine %d # the elbow fit's learned state differs", o->refine) < 0;
     bad |= fputc('\n', f) == EOF;
     bad |= fclose(f) != 0;
@@ -782,6 +793,7 @@ static int run(const run_opts *o)
             goto done;
         }
     pd.refine_band = o->refine;
+    pd.aa_samples = o->aa;
     pd.fit_rig = o->refine && tracked ? &r->rig : NULL;
     if (!(r->pipe = pipe_create(&pd, model))) {
         cli_fail(pd.fit_rig ? "cannot start the pipeline (out of memory, no thread, or the elbow "
@@ -789,6 +801,8 @@ static int run(const run_opts *o)
                             : "cannot start the pipeline (out of memory or no thread)");
         goto done;
     }
+    if (cli_lod_setup(model_path, model, o->lod, o->lod_px, r->pipe, &r->lod) != EXIT_OK)
+        goto done;
     unsigned parts = pipe_parts_present(r->pipe);
     if ((o->hide & ~parts) && !o->quiet)
         fprintf(stderr, "egofuse run: --hide: %s has no such part (its parts: %s%s%s%s)\n",
@@ -867,7 +881,8 @@ static int run(const run_opts *o)
         pipe_image_opaque(&in.virt[1], geo.vp_x0, geo.vp_y0, geo.vp_width, geo.vp_height);
     kin_track_sample sample;
     memset(&sample, 0, sizeof sample);
-    int have_img[2] = {0, 0};
+    int have_img[2] = {0, 0}, cam_lost[2] = {0, 0};
+    char reopen_msg[2][sizeof err.msg] = {"", ""};
     uint64_t t_start = mono_ns(), t_status = t_start, t_retry[2] = {0, 0};
     io_lat lat_cam, lat_pipe, lat_deq;
     io_lat_reset(&lat_cam);
@@ -891,8 +906,17 @@ static int run(const run_opts *o)
         int got = 0;
         io_result gr = io_stereo_grab(&st, 0, fr, &got, &err);
         now = mono_ns();
-        /* a failed camera: reopen once a second, found again by its selector */
+        /* a failed camera: said once, then reopened once a second, found
+         * again by its selector */
         for (int e = 0; e < 2; e++) {
+            if (r->cam[e].state == IO_CAM_FAILED && !cam_lost[e] &&
+                !(file_cams && io_cam_file_ended(&r->cam[e]))) {
+                cam_lost[e] = 1;
+                if (!o->quiet)
+                    fprintf(stderr, "\negofuse run: %s camera lost (%s); %s, reopening it once a second\n",
+                            e ? "right" : "left", r->cam[e].status[0] ? r->cam[e].status : "failed",
+                            have_img[e] ? "its eye holds its last image" : "no image of it yet");
+            }
             if (r->cam[e].state != IO_CAM_FAILED || now - t_retry[e] < 1000000000ull) continue;
             if (file_cams && io_cam_file_ended(&r->cam[e])) continue;
             t_retry[e] = now;
@@ -900,9 +924,18 @@ static int run(const run_opts *o)
             io_error e2;
             const char *where = NULL;
             if (o->sel[e] && !file_cams && resolve(o->sel[e], np, sizeof np, &e2) == 0) where = np;
-            if (io_cam_reopen(&r->cam[e], where, &e2) == IO_OK && !o->quiet)
-                fprintf(stderr, "\negofuse run: %s camera back (%s)\n", e ? "right" : "left",
-                        r->cam[e].cfg.path);
+            if (io_cam_reopen(&r->cam[e], where, &e2) == IO_OK) {
+                cam_lost[e] = 0;
+                reopen_msg[e][0] = '\0';
+                if (!o->quiet)
+                    fprintf(stderr, "\negofuse run: %s camera back (%s)\n", e ? "right" : "left",
+                            r->cam[e].cfg.path);
+            } else if (strcmp(e2.msg, reopen_msg[e])) { /* each new reason once */
+                snprintf(reopen_msg[e], sizeof reopen_msg[e], "%s", e2.msg);
+                if (!o->quiet)
+                    fprintf(stderr, "\negofuse run: %s camera not back: %s\n", e ? "right" : "left",
+                            e2.msg);
+            }
         }
         if (file_cams && (io_cam_file_ended(&r->cam[0]) || io_cam_file_ended(&r->cam[1]))) {
             ended = 1;

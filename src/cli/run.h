@@ -34,9 +34,13 @@ typedef struct run_opts {
     int loop;                 /* file cameras: start again at the end */
     int hold;                 /* --display: keep the last frame shown until Ctrl-C */
     int refine;               /* refinement band, px; 0 = off */
+    int lod;                  /* --lod: a level, PIPE_LOD_AUTO; 0 = off */
+    float lod_px;             /* --lod-px */
+    int aa;                   /* coverage samples per pixel (--aa); 0 = off */
     float predict_ms;         /* pose time = camera time + this */
     unsigned hide;            /* PIPE_PART_* bits hidden */
     kin_sthmd_desc hmd;       /* zero fields = the paper's */
+    const char *hmd_calib[3]; /* --hmd-calibration, -left, -right (docs/lens.md) */
     run_prop prop[RUN_MAX_PROPS];
     int prop_count;
     char *storage;            /* owned strings (config values) */

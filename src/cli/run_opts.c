@@ -3,6 +3,7 @@
  * into options), so that one file starts a cockpit and every option still
  * works on the command line. docs/cockpit.md. */
 #include "run.h"
+#include "cli_lod.h"
 
 #include <getopt.h>
 #include <stdarg.h>
@@ -68,6 +69,10 @@ const char *run_usage =
     "  --hmd-camera WxH, --hmd-camera-hfov DEG, --hmd-baseline M (camera\n"
     "  separation), --hmd-camera-offset M (D), --hmd-display WxH (per eye),\n"
     "  --hmd-hfov DEG, --hmd-vfov DEG, --hmd-focal M, --hmd-ipd M\n"
+    "  --hmd-calibration FILE   the cameras' lenses from an OpenCV calibration\n"
+    "                   file (YAML/XML; a stereo file: M1/D1 left, M2/D2 right);\n"
+    "  --hmd-calibration-left FILE, --hmd-calibration-right FILE  one each\n"
+    "                   (docs/lens.md; the masks are drawn through the lens)\n"
     "virtual scene:\n"
     "  --virt L,R       still virtual images (default: the scene's, or grey)\n"
     "  --virt-source SPEC  live: v4l2:/dev/videoN[,/dev/videoM], stream:PATH|-\n"
@@ -89,6 +94,12 @@ const char *run_usage =
     "  --dump DIR       with --frames: the last frame's inputs as a scene that\n"
     "                   egofuse render composites to the same bytes\n"
     "  --refine BAND    refine the masks by colour in a band of BAND px (1..64)\n"
+    "  --lod MODE       levels of detail of the mask model: off (default), a\n"
+    "                   level 1..7, or auto (per frame and eye, the coarsest\n"
+    "                   level whose error is <= --lod-px px; docs/bench.md)\n"
+    "  --lod-px PX      the error auto allows, pixels (default 2)\n"
+    "  --aa N           anti-aliased silhouettes: N coverage samples per pixel\n"
+    "                   (4, 8 or 16; 0: off, the binary mask); default 0\n"
     "  --quiet          no status line\n"
     "  -h, --help       this text\n"
     "\n"
@@ -100,9 +111,10 @@ enum {
     O_TRACK, O_TRACK_ADDR, O_GLOVE_L, O_GLOVE_R, O_CALIB, O_OUT, O_RAW, O_FRAMES, O_QUIET,
     O_REFINE, O_CONFIG, O_STATS, O_PREDICT, O_HIDE, O_PROP, O_VSRC, O_VLAYOUT, O_VFPS, O_VSTALE,
     O_DISPLAY, O_NATNET, O_NN_LOCAL, O_NN_MCAST, O_NN_BODY, O_NN_UP, O_NN_UNITS, O_NN_VERSION,
-    O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD, O_ALLOW_OUTSIDE,
+    O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD, O_ALLOW_OUTSIDE, O_AA,
     O_HMD_CAM, O_HMD_CAM_HFOV, O_HMD_BASE, O_HMD_OFFSET, O_HMD_DISP, O_HMD_HFOV, O_HMD_VFOV,
-    O_HMD_FOCAL, O_HMD_IPD, O_HMD_PRESET, O_DUMP
+    O_HMD_FOCAL, O_HMD_IPD, O_HMD_PRESET, O_DUMP, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
+    O_HMD_CALIB_R
 };
 
 static const struct option run_long_opts[] = {
@@ -127,6 +139,9 @@ static const struct option run_long_opts[] = {
     {"quiet", no_argument, 0, O_QUIET},
     {"help", no_argument, 0, 'h'},
     {"refine", required_argument, 0, O_REFINE},
+    {"lod", required_argument, 0, O_LOD},
+    {"lod-px", required_argument, 0, O_LOD_PX},
+    {"aa", required_argument, 0, O_AA},
     {"config", required_argument, 0, O_CONFIG},
     {"stats", required_argument, 0, O_STATS},
     {"predict-ms", required_argument, 0, O_PREDICT},
@@ -161,6 +176,9 @@ static const struct option run_long_opts[] = {
     {"hmd-focal", required_argument, 0, O_HMD_FOCAL},
     {"hmd-ipd", required_argument, 0, O_HMD_IPD},
     {"hmd-preset", required_argument, 0, O_HMD_PRESET},
+    {"hmd-calibration", required_argument, 0, O_HMD_CALIB},
+    {"hmd-calibration-left", required_argument, 0, O_HMD_CALIB_L},
+    {"hmd-calibration-right", required_argument, 0, O_HMD_CALIB_R},
     {"dump", required_argument, 0, O_DUMP},
     {0, 0, 0, 0},
 };
@@ -252,6 +270,8 @@ int run_parse(int argc, char **argv, run_opts *o)
     o->input = -1;
     o->buffers = 4;
     o->virt_stale_ms = 200;
+    o->lod = CLI_LOD_DEFAULT;
+    o->lod_px = CLI_LOD_PX_DEFAULT;
 
     /* ---- --config first: its options go before the command line's */
     const char *config = NULL;
@@ -345,6 +365,21 @@ int run_parse(int argc, char **argv, run_opts *o)
             if (!cli_parse_int(optarg, 1, 64, &o->refine))
                 BAD("--refine '%s': a band of 1..64 px", optarg);
             break;
+        case O_LOD:
+            if (!cli_lod_parse(optarg, &o->lod))
+                BAD("--lod '%s': off, auto or a level 0..%d", optarg, PIPE_LOD_MAX - 1);
+            break;
+        case O_LOD_PX:
+            if (!cli_lod_parse_px(optarg, &o->lod_px))
+                BAD("--lod-px '%s': pixels, > 0 and <= 1000", optarg);
+            break;
+        case O_AA: {
+            int v;
+            if (!cli_parse_int(optarg, 0, 16, &v) || (v != 0 && v != 4 && v != 8 && v != 16))
+                BAD("--aa '%s': 0 (off), 4, 8 or 16 samples per pixel", optarg);
+            o->aa = v;
+            break;
+        }
         case O_STATS: o->stats = optarg; break;
         case O_DUMP: o->dump = optarg; break;
         case O_PREDICT:
@@ -447,6 +482,9 @@ int run_parse(int argc, char **argv, run_opts *o)
                 BAD("--hmd-preset '%s': one of paper, consumer, highend", optarg);
             have_preset = 1;
             break;
+        case O_HMD_CALIB: o->hmd_calib[0] = optarg; break;
+        case O_HMD_CALIB_L: o->hmd_calib[1] = optarg; break;
+        case O_HMD_CALIB_R: o->hmd_calib[2] = optarg; break;
         case ':': BAD("option %s needs a value", av[optind - 1]);
         default: BAD("unknown option '%s'", av[optind - 1]);
         }
@@ -495,5 +533,9 @@ int run_parse(int argc, char **argv, run_opts *o)
         if (o->prop[i].body[0] && !o->natnet)
             return cli_usage_error("run", "--prop %s#%s: a prop posed by a rigid body needs --natnet",
                                    o->prop[i].name, o->prop[i].body);
+    if (o->hmd_calib[0] || o->hmd_calib[1] || o->hmd_calib[2]) {
+        int rc = cli_lens_load(o->hmd_calib[0], o->hmd_calib[1], o->hmd_calib[2], &o->hmd);
+        if (rc != EXIT_OK) return rc;
+    }
     return -1;
 }

@@ -9,6 +9,7 @@
  * knobs, tracking sweeps, other sequences), each on its own ground truth. */
 #include "eval_internal.h"
 #include "../cli/cli.h"
+#include "../io/io_lod.h"
 
 /* The ground truth comes from samples/gt/ and the sample generator
  * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
@@ -16,6 +17,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 /* ------------------------------------------------------------ lighting */
@@ -55,6 +57,7 @@ static fuse_lighting workshop_lighting(const gen_scene *ws, const kin_camera *ca
 
 static void ctx_free(eval_ctx *c)
 {
+    eval__lod_free(c); /* before the model it points into */
     gen_frame_ctx_free(&c->gctx);
     gen_arms_free(&c->truth);
     gen_arms_free(&c->mask_fine);
@@ -352,8 +355,12 @@ static int draw_mask(eval_ctx *c, const method_cfg *cfg, const kin_mesh *me, int
     if (posed) {
         rast_transform_points(cam->view_proj.m, c->pos, me->vertex_count, c->clip);
         rast_transform_dirs(cam->view.m, c->nrm, me->vertex_count, c->vnrm);
-        rast_mesh_desc d = { c->clip, me->vertex_count, c->vnrm, 3, me->indices,
-                             me->index_count / 3, RAST_CULL_NONE };
+        /* the method's level of detail (eval_lod.c): its index list
+         * over the same vertices */
+        c->lod_drawn = eval__lod_level(c, cfg, c->clip, me->vertex_count, cam);
+        const kin_mesh *lm = c->lod_drawn ? &c->lod.level[c->lod_drawn].meshes[0] : me;
+        rast_mesh_desc d = { c->clip, me->vertex_count, c->vnrm, 3, lm->indices,
+                             lm->index_count / 3, RAST_CULL_NONE };
         if (rast_draw(&tg, &d, NULL) != RAST_OK) return -1;
         if (cfg->aa > 1) {
             /* the mask from cfg->aa coverage samples per pixel (depth and
@@ -464,7 +471,20 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             if (fuse_skin_key(&sp, &P, c->mask_up, CW) != FUSE_OK) return -1;
             memset(c->mnrm, 0, sizeof(float) * 3 * CW * CH);
         } else {
+            /* the raster's own time: this thread's CPU time (the
+                 * machine may be shared; the wall clock counts the others) */
+            struct timespec tr0, tr1;
+            clock_gettime(CLOCK_THREAD_CPUTIME_ID, &tr0);
             if (draw_mask(c, cfg, me, posed, &cam, &mask, &nrm) < 0) return -1;
+            clock_gettime(CLOCK_THREAD_CPUTIME_ID, &tr1);
+            if (posed) {
+                r->raster_secs += (double)(tr1.tv_sec - tr0.tv_sec) +
+                                  1e-9 * (double)(tr1.tv_nsec - tr0.tv_nsec);
+                r->n_raster++;
+                r->lod_sum += c->lod_drawn;
+                r->tris_sum += (c->lod_drawn ? c->lod.level[c->lod_drawn].meshes[0].index_count
+                                             : me->index_count) / 3;
+            }
             if (cfg->kind == M_REFINE) {
                 fuse_refine_params rp = fuse_refine_params_default();
                 rp.band = cfg->band;
@@ -504,6 +524,23 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                            &O) != FUSE_OK)
             return -1;
         secs += cli_now() - t0;
+        if (cfg->lod != 0 && posed && c->full_mask && cfg->div == 1 && !cfg->fine &&
+            cfg->kind != M_SKIN) {
+            /* the kinematic mask (c->mask_lo) against the full model's in
+             * the same pose (not timed) */
+            rast_target ft = { CW, CH, c->full_depth, CW, c->full_mask, CW, NULL, 0, 0 };
+            rast_target_clear(&ft);
+            rast_transform_points(cam.view_proj.m, c->pos, me->vertex_count, c->clip);
+            rast_mesh_desc d = { c->clip, me->vertex_count, NULL, 0, me->indices,
+                                 me->index_count / 3, RAST_CULL_NONE };
+            if (rast_draw(&ft, &d, NULL) != RAST_OK) return -1;
+            fuse_confusion fc;
+            fuse_mask_confusion(c->mask_lo, CW, c->full_mask, CW, CW, CH, &fc);
+            r->iou_full += fuse_confusion_iou(&fc);
+            r->bf1_full += fuse_boundary_f(c->mask_lo, CW, c->full_mask, CW, CW, CH, 1.0f, NULL,
+                                           NULL);
+            r->n_full++;
+        }
 
         /* measures */
         fuse_confusion cf;
@@ -575,6 +612,8 @@ static method_cfg base_cfg(const eval_opts *o, method_kind k)
     c.track.speed = o->speed;
     c.track.seed = (uint64_t)o->seed;
     c.calib_error = o->calib_error;
+    c.lod = o->lod;
+    c.lod_px = o->lod_px;
     snprintf(c.group, sizeof c.group, "methods");
     snprintf(c.setting, sizeof c.setting, "default");
     return c;
@@ -587,7 +626,7 @@ static int add_cfg(method_cfg *list, int n, int cap, method_cfg c)
 }
 
 /* Phases of a report (each on its own ground truth and frame count). */
-enum { PH_METHODS, PH_KNOBS, PH_TRACK, PH_SEQ };
+enum { PH_METHODS, PH_KNOBS, PH_TRACK, PH_SEQ, PH_SPEED, PH_LOD };
 
 /* A configuration of a sweep: group, swept value and setting "name=" x
  * (x as %g) followed by unit. */
@@ -604,10 +643,18 @@ static method_cfg named_cfg(const eval_opts *o, method_kind k, const char *group
 /* PH_METHODS: the selected methods at the given tracking; PH_KNOBS: the
  * same (group "knobs") with every speed knob; PH_TRACK: the tracking sweeps (and the methods at the
  * given tracking, group "track"); PH_SEQ: the methods on sequence seq. */
-static int make_configs(const eval_opts *o, int phase, const char *seq, method_cfg *L, int cap)
+static int make_configs(const eval_opts *o, int phase, const char *seq, float speed,
+                        method_cfg *L, int cap)
 {
     int n = 0;
     method_cfg c;
+    if (phase == PH_SPEED)   /* the methods on the motion played at another speed */
+        for (int k = 0; k < 4; k++) {
+            if (k == M_SKIN || !(o->methods & (1u << k))) continue;
+            c = named_cfg(o, (method_kind)k, "handspeed", speed, "speed", "x");
+            c.track.speed = speed;
+            n = add_cfg(L, n, cap, c);
+        }
     if (phase == PH_METHODS || phase == PH_KNOBS || phase == PH_SEQ)
         for (int k = 0; k < 4; k++) {
             if (!(o->methods & (1u << k))) continue;
@@ -659,6 +706,27 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, method_c
             n = add_cfg(L, n, cap, c);
         }
     }
+    if (phase == PH_LOD) {
+        /* kin-cal-pred and refine at every level of the mask model's chain
+         * (levels past its last draw its last) and at the rule's targets */
+        static const float px[] = { 1, 2, 4, 8 };
+        for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
+            if (!(o->methods & (1u << k))) continue;
+            for (int l = 0; l < 5; l++) {
+                c = named_cfg(o, (method_kind)k, "lod", (float)l, "L", "");
+                snprintf(c.setting, sizeof c.setting, "L%d", l);
+                c.lod = l;
+                n = add_cfg(L, n, cap, c);
+            }
+            for (int i = 0; i < 4; i++) {
+                c = named_cfg(o, (method_kind)k, "lod", px[i], "auto", "px");
+                snprintf(c.setting, sizeof c.setting, "auto@%gpx", (double)px[i]);
+                c.lod = PIPE_LOD_AUTO;
+                c.lod_px = px[i];
+                n = add_cfg(L, n, cap, c);
+            }
+        }
+    }
     if (phase == PH_TRACK) {
         static const float noise[] = { 0, 10, 20 };
         static const float lat[] = { 0, 50, 100 };
@@ -678,6 +746,12 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, method_c
                 c.track.latency_ms = lat[i];
                 n = add_cfg(L, n, cap, c);
             }
+            static const float drop[] = { 0.0f, 0.1f, 0.3f };
+            for (int i = 0; i < 3; i++) {
+                c = named_cfg(o, (method_kind)k, "dropout", 100.0f * drop[i], "dropout", "%");
+                c.track.dropout = drop[i];
+                n = add_cfg(L, n, cap, c);
+            }
             if (k == M_KIN) continue;    /* the paper's method has no calibration */
             for (int i = 0; i < 4; i++) {
                 c = named_cfg(o, (method_kind)k, "calib", 100.0f * (o->calib_error + cal[i]),
@@ -695,7 +769,7 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, method_c
 /* Runs configurations cfgs[0..n) into R on `frames` frames of sequence
  * seq (one ground truth). The context is left in *c for the caller to
  * free. */
-static int run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames,
+static int run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames, float speed,
                      const method_cfg *cfgs, method_run *R, int n)
 {
     method_cfg base = base_cfg(o, M_KIN_CAL);
@@ -704,13 +778,15 @@ static int run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frame
         return irc == -2 ? EXIT_FAIL : cli_fail("cannot build the ground truth (out of memory)");
     int rc = EXIT_FAIL;
     int inited = 0;
+    for (int i = 0; i < n; i++)
+        if (cfgs[i].lod != 0 && eval__lod_init(c) < 0) return EXIT_FAIL;
     for (; inited < n; inited++)
         if (run_init(&R[inited], &cfgs[inited], c) < 0) { cli_fail("out of memory"); goto done; }
     progress pr;
     progress_start(&pr, frames);
     if (o->quiet) pr.enabled = 0;
     for (int f = 0; f < frames; f++) {
-        if (make_truth(c, f, o->speed, f == 0) < 0) { cli_fail("frame %d: ground truth", f); goto done; }
+        if (make_truth(c, f, speed, f == 0) < 0) { cli_fail("frame %d: ground truth", f); goto done; }
         for (int i = 0; i < n; i++)
             if (run_frame(c, &R[i], f, o->per_frame, o->dump) < 0) {
                 cli_fail("frame %d: %s %s failed", f, kind_name[R[i].cfg.kind], R[i].cfg.setting);
@@ -741,31 +817,54 @@ int eval_run(const eval_opts *o)
     int n = 0, rc = EXIT_FAIL;
     if (!cfgs || !R) { cli_fail("out of memory"); goto done; }
     /* batches: (sequence, frames, phase) */
-    const char *bseq[8];
-    int bframes[8], bphase[8], nb = 0;
+    enum { NB = 14 };
+    const char *bseq[NB];
+    int bframes[NB], bphase[NB], nb = 0;
+    float bspeed[NB];
+    for (int b = 0; b < NB; b++) bspeed[b] = o->speed;
     bseq[nb] = o->sequence; bframes[nb] = o->frames; bphase[nb++] = PH_METHODS;
     if (o->report) {
         bseq[nb] = o->sequence; bframes[nb] = o->sweep_frames; bphase[nb++] = PH_KNOBS;
         bseq[nb] = o->sequence; bframes[nb] = o->sweep_frames; bphase[nb++] = PH_TRACK;
-        for (int q = 0; gt_sequence_name(q) && nb < 8; q++) {
+        static const float speeds[] = { 0.5f, 2.0f };   /* x the given speed */
+        for (int i = 0; i < 2; i++) {
+            bseq[nb] = o->sequence; bframes[nb] = o->sweep_frames; bphase[nb] = PH_SPEED;
+            bspeed[nb++] = o->speed * speeds[i];
+        }
+    }
+    if (o->report || o->lod_sweep) {
+        bseq[nb] = o->sequence;
+        bframes[nb] = o->report ? o->sweep_frames : o->frames;
+        bphase[nb++] = PH_LOD;
+    }
+    if (o->report) {
+        for (int q = 0; gt_sequence_name(q) && nb < NB; q++) {
             const char *name = gt_sequence_name(q);
             if (!strcmp(name, o->sequence) || !strcmp(name, "calib")) continue;
             bseq[nb] = name; bframes[nb] = o->seq_frames; bphase[nb++] = PH_SEQ;
         }
     }
     for (int b = 0; b < nb; b++) {
-        int m = make_configs(o, bphase[b], bseq[b], cfgs + n, CAP - n);
+        int m = make_configs(o, bphase[b], bseq[b], bspeed[b], cfgs + n, CAP - n);
         if (n + m > CAP) { cli_fail("too many configurations"); goto done; }
         ctx_free(&c);
-        if (run_batch(o, &c, bseq[b], bframes[b], cfgs + n, R + n, m)) goto done;
-        if (b == 0 || !o->quiet) {
+        if (run_batch(o, &c, bseq[b], bframes[b], bspeed[b], cfgs + n, R + n, m)) goto done;
+        if (b == 0 || !o->quiet || bphase[b] == PH_LOD) {
             printf("egofuse eval: sequence %s, %d frames, tracking noise %g mm, latency %g ms, "
                    "dropout %g, calibration error %g, speed %g; means per eye (640x400 masks)\n",
                    bseq[b], bframes[b], (double)o->noise, (double)o->latency,
-                   (double)o->dropout, (double)o->calib_error, (double)o->speed);
+                   (double)o->dropout, (double)o->calib_error, (double)bspeed[b]);
             if (b == 0) eval__print_calib(stdout, &c);
             eval__print_table(stdout, R + n, m, 0);
             eval__print_thickness(stdout, &c, R + n, m);
+            if (bphase[b] == PH_LOD) {
+                printf("levels of detail of the mask model (meshoptimizer %d):", io_lod_version());
+                for (int l = 0; l < c.lod.level_count; l++)
+                    printf(" L%d %ld triangles, error %.2f mm;", l, c.lod.level[l].triangles,
+                           1e3 * (double)c.lod.level[l].error_m);
+                printf("\n");
+                eval__print_lod(stdout, R + n, m, 0);
+            }
         }
         n += m;
     }

@@ -42,6 +42,12 @@ typedef struct eval_opts {
     int sweep_frames, seq_frames; /* report: tracking sweeps, other sequences */
     float global;            /* refine: weight of the global colour model */
     int band;                /* refinement band of the default refine */
+    int lod;                 /* level of detail of the mask model for every
+                                method: 0 = the full model, a level, or
+                                PIPE_LOD_AUTO (src/pipe/pipe_lod.h) */
+    float lod_px;            /* the rule's target with PIPE_LOD_AUTO */
+    int lod_sweep;           /* 1: also the levels batch (group "lod"; a
+                                report always runs it) */
 } eval_opts;
 
 /* "kin,refine" -> bits of the methods (kin, kin-cal-pred, skin, refine:

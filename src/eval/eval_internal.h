@@ -31,6 +31,9 @@ typedef struct method_cfg {
     int lag_comp;            /* 1: the One Euro filter's ramp-lag compensation */
     gt_track_desc track;
     float calib_error;
+    int lod;                 /* level of detail: 0 = full, a level, or
+                                PIPE_LOD_AUTO (eval_lod.c) */
+    float lod_px;            /* the rule's target, px */
 } method_cfg;
 
 /* Per-configuration state and sums. */
@@ -50,6 +53,10 @@ typedef struct method_run {
     /* sums over frames and eyes */
     double iou, bf1, bf3, fp, fn, mse, flicker, flicker_den, secs;
     long n_eye, n_flicker, n_frames;
+    /* levels of detail (cfg.lod != 0): the kinematic mask against the
+     * full model's in the same pose, the level drawn, the raster's time */
+    double iou_full, bf1_full, lod_sum, tris_sum, raster_secs;
+    long n_full, n_raster;
 } method_run;
 
 /* Shared per-frame buffers. */
@@ -87,11 +94,27 @@ typedef struct eval_ctx {
     kin_user_calib calib;     /* estimated from the calibration motion */
     char calib_why[256];
     int calib_hand_fallback;  /* 1: no fingertip gesture, hand = arm scale */
+    /* levels of detail of c->mask (eval_lod.c), when a method uses them */
+    pipe_lod lod;
+    int lod_drawn;            /* the level the last draw_mask drew */
+    uint8_t *full_mask;       /* the full model's mask, 640x400 */
+    float *full_depth;
 } eval_ctx;
 
 /* eval.c: the true operator's scales (arm, hand, shoulder width) against
  * the mask model's. */
 void eval__true_scales(const eval_ctx *c, float *arm, float *hand, float *shoulder);
+
+/* eval_lod.c: levels of detail. The chain of c->mask and the full
+ * model's scratch (0, or -1 with the message printed); the level a
+ * method draws for an eye whose clip coordinates are clip (n vertices);
+ * the table of the "lod" group; DIR/lod.csv and DIR/lod.dat. */
+int eval__lod_init(eval_ctx *c);
+void eval__lod_free(eval_ctx *c);
+int eval__lod_level(const eval_ctx *c, const method_cfg *cfg, const float *clip, int n,
+                    const kin_camera *cam);
+void eval__print_lod(FILE *f, const method_run *R, int n, int markdown);
+int eval__write_lod(const char *dir, const method_run *R, int n);
 
 /* eval_report.c: the tables, the CSV and the report folder. */
 void eval__print_calib(FILE *f, const eval_ctx *c);

@@ -94,21 +94,21 @@ void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int 
 void eval__print_table(FILE *f, const method_run *R, int n, int markdown)
 {
     if (markdown)
-        fprintf(f, "| method | setting | IoU | BF 1px | BF 3px | FP px | FN px | PSNR dB | "
-                   "flicker px | ms/stereo frame |\n|---|---|---|---|---|---|---|---|---|---|\n");
+        fprintf(f, "| method | group | setting | IoU | BF 1px | BF 3px | FP px | FN px | PSNR dB | "
+                   "flicker px | ms/stereo frame |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
     else
-        fprintf(f, "%-13s %-16s %7s %6s %6s %8s %8s %6s %7s %8s\n", "method", "setting", "IoU",
-                "BF1", "BF3", "FP px", "FN px", "PSNR", "flicker", "ms/frame");
+        fprintf(f, "%-13s %-9s %-16s %7s %6s %6s %8s %8s %6s %7s %8s\n", "method", "group",
+                "setting", "IoU", "BF1", "BF3", "FP px", "FN px", "PSNR", "flicker", "ms/frame");
     for (int i = 0; i < n; i++) {
         summary s = summarise(&R[i]);
         if (markdown)
-            fprintf(f, "| %s | %s | %.4f | %.3f | %.3f | %.0f | %.0f | %.2f | %.3f | %.2f |\n",
-                    kind_name[R[i].cfg.kind], R[i].cfg.setting, s.iou, s.bf1, s.bf3, s.fp,
-                    s.fn, s.psnr, s.flicker, s.ms);
+            fprintf(f, "| %s | %s | %s | %.4f | %.3f | %.3f | %.0f | %.0f | %.2f | %.3f | %.2f |\n",
+                    kind_name[R[i].cfg.kind], R[i].cfg.group, R[i].cfg.setting, s.iou, s.bf1,
+                    s.bf3, s.fp, s.fn, s.psnr, s.flicker, s.ms);
         else
-            fprintf(f, "%-13s %-16s %7.4f %6.3f %6.3f %8.0f %8.0f %6.2f %7.3f %8.2f\n",
-                    kind_name[R[i].cfg.kind], R[i].cfg.setting, s.iou, s.bf1, s.bf3, s.fp,
-                    s.fn, s.psnr, s.flicker, s.ms);
+            fprintf(f, "%-13s %-9s %-16s %7.4f %6.3f %6.3f %8.0f %8.0f %6.2f %7.3f %8.2f\n",
+                    kind_name[R[i].cfg.kind], R[i].cfg.group, R[i].cfg.setting, s.iou, s.bf1,
+                    s.bf3, s.fp, s.fn, s.psnr, s.flicker, s.ms);
     }
 }
 
@@ -116,9 +116,18 @@ void eval__print_table(FILE *f, const method_run *R, int n, int markdown)
  * sorted by x; the method at the given tracking (group "track") is the
  * point at the given value of a tracking curve, the default refine (group
  * "knobs") the default band's point. */
+/* Per method of a sweep chart: whether it has points, and the swept value
+ * where its IoU first falls below 0.9 (linear between the points; NAN
+ * when it never does, -INFINITY when already at the first point). */
+typedef struct sweep_info {
+    int has[4];
+    double below[4];
+} sweep_info;
+
 static int write_group(const char *dir, const char *group, const method_run *R, int n,
-                       const eval_opts *o)
+                       const eval_opts *o, sweep_info *si)
 {
+    memset(si, 0, sizeof *si);
     char path[IO_PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/%s.dat", dir, group);
     io_out of;
@@ -139,15 +148,26 @@ static int write_group(const char *dir, const char *group, const method_run *R, 
                 x = 100.0f * o->calib_error;
             else if (!strcmp(c->group, "knobs") && !strcmp(group, "band") && k == M_REFINE)
                 x = (float)o->band;
+            else if (!strcmp(c->group, "track") && !strcmp(group, "dropout"))
+                x = 100.0f * o->dropout;
+            else if (!strcmp(c->group, "track") && !strcmp(group, "handspeed")) x = o->speed;
             else continue;
             int j = m++;
             while (j > 0 && xs[j - 1] > x) { xs[j] = xs[j - 1]; idx[j] = idx[j - 1]; j--; }
             xs[j] = x;
             idx[j] = i;
         }
+        si->has[k] = m > 0;
+        si->below[k] = NAN;
+        double px = 0.0, piou = 0.0;
         for (int j = 0; j < m; j++) {
             summary s = summarise(&R[idx[j]]);
             fprintf(f, "%g %.5f %.5f %.3f %.3f\n", (double)xs[j], s.iou, s.bf3, s.ms, s.psnr);
+            if (isnan(si->below[k]) && s.iou < 0.9)
+                si->below[k] = j == 0 ? -INFINITY
+                                      : px + (0.9 - piou) * ((double)xs[j] - px) / (s.iou - piou);
+            px = (double)xs[j];
+            piou = s.iou;
         }
         if (!m) fprintf(f, "nan nan nan nan nan\n");
         fprintf(f, "\n\n");
@@ -200,8 +220,9 @@ static int write_sequences(const char *dir, const method_run *R, int n, const ev
  * a chart written incomplete: removed, an error. */
 static int write_charts(const char *dir)
 {
-    static const char *const charts[] = {"speed_iou", "speed_bf", "noise", "latency",
-                                         "calib", "band", "sequences"};
+    static const char *const charts[] = {"speed_iou", "speed_bf", "noise",  "latency",
+                                         "calib",     "dropout",  "handspeed", "band",
+                                         "sequences", "lod"};
     enum { NCHART = sizeof charts / sizeof charts[0] };
     char cmd[3 * IO_PATH_MAX], tmp[IO_PATH_MAX + 96], path[IO_PATH_MAX + 64];
     long pid = (long)getpid();
@@ -238,6 +259,176 @@ static int write_charts(const char *dir)
     return bad ? EXIT_FAIL : EXIT_OK;
 }
 
+/* ---- the speed-accuracy charts: labels that do not overlap ----------
+ *
+ * The chart's geometry is fixed here (size, margins, ranges), so every
+ * point's pixel position is known: each label goes to the first of a list
+ * of places around its point (right, left, above, below, then farther up
+ * and down with a thin leader line) where its box overlaps no label
+ * placed before and no point; failing all, to the right. Text boxes are
+ * estimated at 8.4 px per character and 16 px high (font size 10). */
+enum { SPW = 900, SPH = 640 };
+#define SP_L 0.08
+#define SP_R 0.97
+#define SP_B 0.10
+#define SP_T 0.92
+
+typedef struct sp_pt { double x, y; int kind; const char *label; } sp_pt;
+
+static void sp_to_px(double x, double y, const double rg[4], double *px, double *py)
+{
+    const double pw = (SP_R - SP_L) * SPW, ph = (SP_T - SP_B) * SPH;
+    *px = SP_L * SPW + (log10(x) - log10(rg[0])) / (log10(rg[1]) - log10(rg[0])) * pw;
+    *py = (1.0 - SP_B) * SPH - (y - rg[2]) / (rg[3] - rg[2]) * ph;   /* down */
+}
+
+static void sp_from_px(double px, double py, const double rg[4], double *x, double *y)
+{
+    const double pw = (SP_R - SP_L) * SPW, ph = (SP_T - SP_B) * SPH;
+    *x = pow(10.0, log10(rg[0]) + (px - SP_L * SPW) / pw * (log10(rg[1]) - log10(rg[0])));
+    *y = rg[2] + ((1.0 - SP_B) * SPH - py) / ph * (rg[3] - rg[2]);
+}
+
+static int box_hit(const double a[4], const double b[4])
+{
+    return a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3];
+}
+
+/* "set label" (and "set arrow") lines for the points p[0..np). */
+static void sp_labels(FILE *f, const sp_pt *p, int np, const double rg[4])
+{
+    static const double cand[][2] = {{10, 0}, {-10, 0}, {0, -15}, {0, 15}, {10, -14}, {10, 14},
+                                     {-10, -14}, {-10, 14}, {0, -30}, {0, 30}, {30, -22},
+                                     {30, 20}, {-30, -20}, {-30, 20}, {0, -44}, {0, 44},
+                                     {50, 0}, {-50, 0}, {40, -36}, {40, 36}, {-40, -36},
+                                     {-40, 36}, {0, -60}, {0, 60}, {60, -60}, {60, 60},
+                                     {-60, -60}, {-60, 60}, {0, -80}, {0, 80}, {90, -40},
+                                     {90, 40}, {-90, -40}, {-90, 40}, {80, -85}, {80, 85},
+                                     {-80, -85}, {-80, 85}, {0, -105}, {0, 105}};
+    enum { NC = sizeof cand / sizeof cand[0] };
+    double (*placed)[4] = malloc(sizeof *placed * (size_t)(np > 0 ? np : 1));
+    if (!placed) return;
+    int nplaced = 0;
+    for (int i = 0; i < np; i++) {
+        double px, py;
+        sp_to_px(p[i].x, p[i].y, rg, &px, &py);
+        const double w = 8.4 * (double)strlen(p[i].label) + 6.0, h = 16.0;
+        int best = 0;
+        double bx[4] = {0, 0, 0, 0};
+        for (int c = 0; c < NC; c++) {
+            const double dx = cand[c][0], dy = cand[c][1];
+            /* anchored left of the box when dx >= 0, right when dx < 0 */
+            const double x0 = dx > 0 ? px + dx : dx < 0 ? px + dx - w : px - w / 2;
+            double b[4] = {x0, py + dy - h / 2, x0 + w, py + dy + h / 2};
+            int ok = b[0] >= SP_L * SPW && b[2] <= SP_R * SPW && b[1] >= (1.0 - SP_T) * SPH &&
+                     b[3] <= (1.0 - SP_B) * SPH;
+            for (int j = 0; ok && j < nplaced; j++) ok = !box_hit(b, placed[j]);
+            for (int j = 0; ok && j < np; j++) {
+                double qx, qy;
+                sp_to_px(p[j].x, p[j].y, rg, &qx, &qy);
+                const double pb[4] = {qx - 7, qy - 7, qx + 7, qy + 7};
+                ok = !box_hit(b, pb);
+            }
+            if (ok) {
+                best = c;
+                memcpy(bx, b, sizeof bx);
+                break;
+            }
+            if (c == NC - 1) {
+                best = 0;
+                const double b0[4] = {px + 9, py - h / 2, px + 9 + w, py + h / 2};
+                memcpy(bx, b0, sizeof bx);
+            }
+        }
+        memcpy(placed[nplaced++], bx, sizeof bx);
+        double lx, ly;
+        sp_from_px(bx[0] + 2.0, (bx[1] + bx[3]) / 2, rg, &lx, &ly);
+        fprintf(f, "set label %d \"%s\" at %.6g,%.6g left font ',10' tc lt %d front\n", i + 1,
+                p[i].label, lx, ly, p[i].kind + 1);
+        if (fabs(cand[best][0]) > 11 || fabs(cand[best][1]) > 16) {
+            /* a leader from the box's nearer side to the point */
+            const double ex = cand[best][0] >= 0 ? bx[0] : bx[2], ey = (bx[1] + bx[3]) / 2;
+            double ax, ay;
+            sp_from_px(ex, ey, rg, &ax, &ay);
+            fprintf(f, "set arrow %d from %.6g,%.6g to %.6g,%.6g nohead lw 0.5 lc rgb '#909090' "
+                       "back\n", i + 1, ax, ay, p[i].x, p[i].y);
+        }
+    }
+    free(placed);
+}
+
+/* One speed chart (ycol: 2 IoU, 3 BF) with its labels. */
+static void sp_chart(FILE *f, const char *dir, const char *name, const char *title,
+                     const char *ylabel, int ycol, const sp_pt *p, int np)
+{
+    double rg[4] = {1e30, -1e30, 1e30, -1e30};
+    for (int i = 0; i < np; i++) {
+        if (p[i].x < rg[0]) rg[0] = p[i].x;
+        if (p[i].x > rg[1]) rg[1] = p[i].x;
+        if (p[i].y < rg[2]) rg[2] = p[i].y;
+        if (p[i].y > rg[3]) rg[3] = p[i].y;
+    }
+    if (np == 0 || !(rg[0] > 0.0)) {
+        rg[0] = 1.0, rg[1] = 10.0, rg[2] = 0.0, rg[3] = 1.0;
+    }
+    rg[0] /= 1.35;
+    rg[1] *= 1.6;
+    const double span = rg[3] - rg[2] > 0.05 ? rg[3] - rg[2] : 0.05;
+    rg[2] -= 0.06 * span;
+    rg[3] += 0.08 * span;
+    fprintf(f, "set terminal pngcairo noenhanced size %d,%d font ',11'\n", SPW, SPH);
+    fprintf(f, "set lmargin at screen %.2f\nset rmargin at screen %.2f\n"
+               "set bmargin at screen %.2f\nset tmargin at screen %.2f\n",
+            SP_L, SP_R, SP_B, SP_T);
+    fprintf(f, "set logscale x\nset xrange [%.6g:%.6g]\nset yrange [%.6g:%.6g]\n", rg[0], rg[1],
+            rg[2], rg[3]);
+    fprintf(f, "set output '%s/%s.png'.sfx\nset title '%s'\nset ylabel '%s'\n", dir, name, title,
+            ylabel);
+    fprintf(f, "set xlabel 'ms per stereo frame (pose, skin, raster, refine, light, composite; "
+               "1 thread)'\nset key bottom right box opaque\n");
+    sp_labels(f, p, np, rg);
+    fprintf(f, "plot for [i=0:3] '%s/speed.dat' index i using 1:%d with points pt 7 ps 1.4 lc i+1 "
+               "title word(titles, i+1)\n", dir, ycol);
+    fprintf(f, "unset label\nunset arrow\nunset logscale x\nset autoscale\n"
+               "set lmargin\nset rmargin\nset bmargin\nset tmargin\n");
+}
+
+/* A sweep chart of the methods that have points, with the IoU 0.9 line
+ * and, per method, the swept value where it falls below (a circle and
+ * the value; "< first" when below from the start). */
+static void sweep_chart(FILE *f, const char *dir, const char *group, const char *title,
+                        const char *xlabel, const sweep_info *si)
+{
+    static const char *const tn[4] = {"kin", "kin-cal-pred", "skin", "refine"};
+    fprintf(f, "set terminal pngcairo noenhanced size 900,600 font ',11'\n");
+    fprintf(f, "set output '%s/%s.png'.sfx\nset title '%s'\nset xlabel '%s'\n"
+               "set ylabel 'mask IoU'\nset key bottom left box opaque\n",
+            dir, group, title, xlabel);
+    int lab = 1;
+    for (int k = 0; k < 4; k++) {
+        if (!si->has[k] || isnan(si->below[k])) continue;
+        if (isinf(si->below[k]))
+            fprintf(f, "set label %d '%s: below 0.9 throughout' at graph 0.98, graph %.2f right "
+                       "tc lt %d font ',9'\n", lab++, tn[k], 0.30 + 0.06 * k, k + 1);
+        else
+            fprintf(f, "set label %d '%s < 0.9 from %.3g' at %.6g,0.9 point pt 6 ps 2.5 lc %d "
+                       "offset 0.8,%d tc lt %d font ',9'\n", lab++, tn[k], si->below[k],
+                    si->below[k], k + 1, k % 2 ? -1 : 1, k + 1);
+    }
+    fprintf(f, "set arrow 90 from graph 0, first 0.9 to graph 1, first 0.9 nohead dt 2 "
+               "lc rgb '#808080'\n");
+    int first = 1;
+    fprintf(f, "plot ");
+    for (int k = 0; k < 4; k++) {
+        if (!si->has[k]) continue;
+        fprintf(f, "%s'%s/%s.dat' index %d using 1:2 with linespoints lw 2 pt 7 lc %d title '%s'",
+                first ? "" : ", \\\n     ", dir, group, k, k + 1, tn[k]);
+        first = 0;
+    }
+    if (first) fprintf(f, "NaN notitle");
+    fprintf(f, "\nunset label\nunset arrow\n");
+}
+
 int eval__write_report(const char *dir, const method_run *R, int n, const eval_opts *o,
                        const eval_ctx *c)
 {
@@ -265,6 +456,15 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
     snprintf(path, sizeof path, "%s/speed.dat", dir);
     f = out_open(&of, path);
     if (!f) return EXIT_FAIL;
+    sp_pt *piou = malloc(sizeof *piou * (size_t)(n > 0 ? n : 1));
+    sp_pt *pbf = malloc(sizeof *pbf * (size_t)(n > 0 ? n : 1));
+    int np = 0;
+    if (!piou || !pbf) {
+        free(piou);
+        free(pbf);
+        io_out_abort(&of);
+        return cli_fail("out of memory");
+    }
     for (int k = 0; k < 4; k++) {
         fprintf(f, "# %s\n", kind_name[k]);
         for (int i = 0; i < n; i++) {
@@ -277,55 +477,88 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
                 continue;
             summary s = summarise(&R[i]);
             fprintf(f, "%.3f %.5f %.5f \"%s\"\n", s.ms, s.iou, s.bf3, cf->setting);
+            piou[np] = (sp_pt){s.ms, s.iou, k, cf->setting};
+            pbf[np++] = (sp_pt){s.ms, s.bf3, k, cf->setting};
         }
         fprintf(f, "\n\n");
     }
-    if (out_commit(&of)) return EXIT_FAIL;
-    static const char *groups[] = { "noise", "latency", "calib", "band" };
-    for (int g = 0; g < 4; g++)
-        if (write_group(dir, groups[g], R, n, o)) return EXIT_FAIL;
-    if (write_sequences(dir, R, n, o)) return EXIT_FAIL;
+    if (out_commit(&of)) {
+        free(piou);
+        free(pbf);
+        return EXIT_FAIL;
+    }
+    static const char *groups[] = { "noise", "latency", "calib", "band", "dropout", "handspeed" };
+    enum { NG = sizeof groups / sizeof groups[0] };
+    sweep_info si[NG];
+    for (int g = 0; g < NG; g++)
+        if (write_group(dir, groups[g], R, n, o, &si[g])) {
+            free(piou);
+            free(pbf);
+            return EXIT_FAIL;
+        }
+    if (write_sequences(dir, R, n, o) || eval__write_lod(dir, R, n)) {
+        free(piou);
+        free(pbf);
+        return EXIT_FAIL;
+    }
     snprintf(path, sizeof path, "%s/charts.gp", dir);
     f = out_open(&of, path);
-    if (!f) return EXIT_FAIL;
+    if (!f) {
+        free(piou);
+        free(pbf);
+        return EXIT_FAIL;
+    }
+    fprintf(f, "if (!exists('sfx')) sfx = ''\nset grid\n"
+               "titles = 'kin kin-cal-pred skin refine'\n");
+    sp_chart(f, dir, "speed_iou", "Speed against accuracy: mask IoU (labels: setting)",
+             "mask IoU", 2, piou, np);
+    sp_chart(f, dir, "speed_bf", "Speed against accuracy: boundary F-score within 3 px",
+             "BF (3 px)", 3, pbf, np);
+    free(piou);
+    free(pbf);
+    char t[160];
+    snprintf(t, sizeof t, "Accuracy against tracking noise (latency %g ms)", (double)o->latency);
+    sweep_chart(f, dir, "noise", t, "RMS position noise, mm", &si[0]);
+    snprintf(t, sizeof t, "Accuracy against tracking latency (noise %g mm)", (double)o->noise);
+    sweep_chart(f, dir, "latency", t, "latency, ms", &si[1]);
+    sweep_chart(f, dir, "calib", "Accuracy against calibration error (on top of the estimate)",
+                "error of the arm, hand and shoulder scales, %", &si[2]);
+    sweep_chart(f, dir, "dropout", "Accuracy against tracking dropouts (hands lost)",
+                "samples that lose the hands, %", &si[4]);
+    sweep_chart(f, dir, "handspeed", "Accuracy against hand speed (the motion played faster)",
+                "speed, x the recorded motion", &si[5]);
     fprintf(f,
-        "if (!exists('sfx')) sfx = ''\n"
-        "set terminal pngcairo noenhanced size 900,600 font ',10'\n"
-        "set grid\nset key bottom right\n"
-        "titles = 'kin kin-cal-pred skin refine'\n"
-        "set output '%s/speed_iou.png'.sfx\n"
-        "set title 'Speed against accuracy: mask IoU (labels: setting)'\n"
-        "set xlabel 'ms per stereo frame (pose, skin, raster, refine, light, composite; 1 thread)'\n"
-        "set ylabel 'mask IoU'\nset logscale x\n"
-        "plot for [i=0:3] '%s/speed.dat' index i using 1:2 with points pt 7 ps 1.3 title word(titles, i+1), \\\n"
-        "     for [i=0:3] '%s/speed.dat' index i using 1:2:4 with labels offset 0,0.8 font ',7' notitle\n"
-        "set output '%s/speed_bf.png'.sfx\n"
-        "set title 'Speed against accuracy: boundary F-score within 3 px'\n"
-        "set ylabel 'BF (3 px)'\n"
-        "plot for [i=0:3] '%s/speed.dat' index i using 1:3 with points pt 7 ps 1.3 title word(titles, i+1), \\\n"
-        "     for [i=0:3] '%s/speed.dat' index i using 1:3:4 with labels offset 0,0.8 font ',7' notitle\n"
-        "unset logscale x\n"
-        "set output '%s/noise.png'.sfx\nset title 'Accuracy against tracking noise (latency %g ms)'\n"
-        "set xlabel 'RMS position noise, mm'\nset ylabel 'mask IoU'\n"
-        "plot for [i=0:3] '%s/noise.dat' index i using 1:2 with linespoints lw 2 title word(titles, i+1)\n"
-        "set output '%s/latency.png'.sfx\nset title 'Accuracy against tracking latency (noise %g mm)'\n"
-        "set xlabel 'latency, ms'\n"
-        "plot for [i=0:3] '%s/latency.dat' index i using 1:2 with linespoints lw 2 title word(titles, i+1)\n"
-        "set output '%s/calib.png'.sfx\nset title 'Accuracy against calibration error (on top of the estimate)'\n"
-        "set xlabel 'error of the arm, hand and shoulder scales, %%'\n"
-        "plot for [i=0:3] '%s/calib.dat' index i using 1:2 with linespoints lw 2 title word(titles, i+1)\n"
+        "set terminal pngcairo noenhanced size 900,600 font ',11'\n"
+        "set key bottom right box opaque\n"
         "set output '%s/band.png'.sfx\nset title 'Refinement band width'\n"
         "set xlabel 'band half width, px'\nset ylabel 'IoU, BF(3 px)'\n"
         "plot '%s/band.dat' index 3 using 1:2 with linespoints lw 2 title 'IoU', \\\n"
         "     '%s/band.dat' index 3 using 1:3 with linespoints lw 2 title 'BF 3px'\n"
+        "set key bottom right\n"
+        "set terminal pngcairo noenhanced size 1400,600 font ',10'\n"
+        "set output '%s/lod.png'.sfx\n"
+        "set multiplot layout 1,2 title 'Levels of detail of the mask model (labels: level, "
+        "or the rule at a target in px)'\n"
+        "set title 'Mask accuracy against the triangles drawn'\n"
+        "set xlabel 'triangles drawn per eye (mean)'\nset ylabel 'IoU'\nset logscale x\n"
+        "plot '%s/lod.dat' index 0 using 1:3 with points pt 7 ps 1.3 title 'kin-cal-pred: kinematic mask vs the full model', \\\n"
+        "     '%s/lod.dat' index 0 using 1:4 with points pt 5 ps 1.3 title 'kin-cal-pred: vs the ground truth', \\\n"
+        "     '%s/lod.dat' index 1 using 1:4 with points pt 9 ps 1.3 title 'refine: vs the ground truth', \\\n"
+        "     '%s/lod.dat' index 0 using 1:3:7 with labels offset 0,0.8 font ',7' notitle\n"
+        "set title 'Raster time against the triangles drawn'\n"
+        "set ylabel 'raster ms per eye (transforms + draw, thread CPU time)'\n"
+        "plot '%s/lod.dat' index 0 using 1:2 with points pt 7 ps 1.3 title 'kin-cal-pred', \\\n"
+        "     '%s/lod.dat' index 1 using 1:2 with points pt 9 ps 1.3 title 'refine', \\\n"
+        "     '%s/lod.dat' index 0 using 1:2:7 with labels offset 0,0.8 font ',7' notitle\n"
+        "unset multiplot\nunset logscale x\n"
+        "set terminal pngcairo noenhanced size 900,600 font ',10'\n"
         "set output '%s/sequences.png'.sfx\nset title 'Mask IoU per sequence and method'\n"
         "set style data histograms\nset style histogram clustered gap 1\n"
         "set style fill solid 0.8 border -1\nset yrange [0:1.15]\nset key top center horizontal\n"
         "set xlabel 'sequence'\nset ylabel 'mask IoU'\n"
         "plot '%s/sequences.dat' using 2:xtic(1) title 'kin', '' using 3 title 'kin-cal-pred', "
         "'' using 4 title 'skin', '' using 5 title 'refine'\n",
-        dir, dir, dir, dir, dir, dir, dir, (double)o->latency, dir, dir, (double)o->noise, dir,
-        dir, dir, dir, dir, dir, dir, dir);
+        dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir);
     if (out_commit(&of)) return EXIT_FAIL;
     return write_charts(dir);
 }

@@ -6,6 +6,20 @@
  * stays loaded once opened (X11 libraries do not like being unloaded). */
 #include "io_display_impl.h"
 
+#ifdef EGOFUSE_NO_SDL2
+/* Built where SDL2's headers were missing (the Makefile defines
+ * EGOFUSE_NO_SDL2 when pkg-config finds no sdl2: `make demo` does not
+ * install libsdl2-dev, scripts/deps.sh). The Makefile recompiles this file
+ * once the headers are there. */
+io_result io_display_sdl_open(io_display *d, const io_display_spec *sp, io_error *err)
+{
+    (void)d;
+    (void)sp;
+    return io_fail(err, IO_ERR_DEVICE, "sdl: this egofuse was built without SDL2's headers "
+                   "(Debian: libsdl2-dev, installed by 'make test'); install them and run make again");
+}
+#else
+
 #include <dlfcn.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -197,3 +211,4 @@ fail:
     free(s);
     return r;
 }
+#endif /* EGOFUSE_NO_SDL2 */

@@ -61,7 +61,9 @@ static void conf_resolve(const conf_builder *b, const char *v, char *out, size_t
 /* Options whose values are paths relative to the configuration file. */
 static int conf_is_path_key(const char *opt)
 {
-    static const char *const k[] = {"scene", "model", "calib", "stats", "out", "dump", NULL};
+    static const char *const k[] = {"scene", "model", "calib", "stats", "out", "dump",
+                                    "hmd-calibration", "hmd-calibration-left",
+                                    "hmd-calibration-right", NULL};
     for (int i = 0; k[i]; i++)
         if (!strcmp(opt, k[i])) return 1;
     return 0;

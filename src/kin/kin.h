@@ -46,6 +46,8 @@
 #include <stdint.h>
 #include <stddef.h>
 
+#include "kin_lens.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -295,6 +297,18 @@ typedef struct kin_sthmd_desc {
     float ipd_m;                    /* eye separation (interpupillary
                                        distance); 0 = baseline_m (so 0.065
                                        by default) */
+    kin_lens lens[2];               /* per camera (KIN_EYE_LEFT, _RIGHT):
+                                       a calibrated lens (kin_lens.h,
+                                       io_calib.h), or all zero (fx == 0):
+                                       the paper's pinhole of cam_hfov_deg.
+                                       A lens without an image size is
+                                       taken to be for the camera's; one
+                                       for another size is scaled to it.
+                                       With a lens of the left camera,
+                                       cam_hfov_deg is resolved to its
+                                       pinhole part 2 atan(w / 2 fx), and
+                                       a zero camera size to the lens's
+                                       (docs/lens.md) */
 } kin_sthmd_desc;
 
 /* The derived numbers of the paper (eq. 1-4).
@@ -336,7 +350,15 @@ typedef struct kin_camera {
     kin_mat4 world_from_cam;  /* inverse of view */
     int width, height;        /* image size (the cropped camera image) */
     float fx, fy, cx, cy;     /* pixels; ray of pixel centre (x+.5, y+.5) is
-                                 ((x+.5-cx)/fx, -(y+.5-cy)/fy, -1) */
+                                 ((x+.5-cx)/fx, -(y+.5-cy)/fy, -1) for a
+                                 pinhole lens; with a distorting lens these
+                                 are its pinhole part (proj draws it) and
+                                 the true ray is kin_lens_unproject(&lens) */
+    kin_lens lens;            /* the lens of this image (its size, the crop
+                                 applied; OpenCV pixel convention, so
+                                 lens.cx = cx - 0.5 for the pinhole of the
+                                 paper): project and unproject through it
+                                 (kin_lens_project, kin_lens_unproject) */
 } kin_camera;
 
 /* Fills in the defaults (zero fields) of a desc. */
@@ -363,6 +385,13 @@ int kin_sthmd_preset(const char *name, kin_sthmd_desc *out);
 /* The i-th preset's name (0, 1, ...), NULL past the last: for listings
  * and error messages. */
 const char *kin_sthmd_preset_name(int i);
+/* The OpenGL projection of a pinhole of intrinsics fx, fy, cx, cy (egofuse
+ * pixels, kin_camera's convention) and skew (u += skew * (-Y)/(-Z), as
+ * camera_matrix(0,1)) on a w x h image, near n, far f: with the
+ * rasterizer's viewport it images view-space points exactly at
+ * u = cx + (fx X - skew Y) / -Z, v = cy - fy Y / -Z. */
+kin_mat4 kin_proj_from_intrinsics(double fx, double fy, double cx, double cy, double skew,
+                                  int w, int h, double n, double f);
 /* A general look-at camera (for `egofuse mask`). */
 kin_camera kin_camera_look_at(kin_vec3 eye, kin_vec3 target, kin_vec3 up,
                               float fovy_deg, int width, int height,

@@ -18,6 +18,7 @@
 
 static float def_f(float v, float d) { return (v > 0.0f && isfinite(v)) ? v : d; }
 static int def_i(int v, int d) { return v > 0 ? v : d; }
+static int lens_given(const kin_lens *l) { return l->fx > 0.0 && isfinite(l->fx); }
 
 kin_sthmd_desc kin_sthmd_desc_resolved(const kin_sthmd_desc *desc)
 {
@@ -25,6 +26,7 @@ kin_sthmd_desc kin_sthmd_desc_resolved(const kin_sthmd_desc *desc)
     memset(&z, 0, sizeof z);
     const kin_sthmd_desc *d = desc ? desc : &z;
     kin_sthmd_desc r;
+    memset(&r, 0, sizeof r); /* padding too: resolved descs compare with memcmp */
     r.cam_width = def_i(d->cam_width, 640);
     r.cam_height = def_i(d->cam_height, 480);
     r.cam_hfov_deg = def_f(d->cam_hfov_deg, 62.0f);
@@ -38,6 +40,24 @@ kin_sthmd_desc kin_sthmd_desc_resolved(const kin_sthmd_desc *desc)
     r.znear = def_f(d->znear, 0.01f);
     r.zfar = def_f(d->zfar, 100.0f);
     r.ipd_m = def_f(d->ipd_m, r.baseline_m);
+    /* calibrated lenses: the camera's size from the lens when not given,
+     * each lens at the camera's size, the FOV of eq. 2 from the left one */
+    memset(r.lens, 0, sizeof r.lens);
+    if (lens_given(&d->lens[0]) && d->cam_width <= 0 && d->lens[0].width > 0) {
+        r.cam_width = d->lens[0].width;
+        r.cam_height = d->lens[0].height;
+    }
+    for (int e = 0; e < 2; e++) {
+        if (!lens_given(&d->lens[e])) continue;
+        kin_lens l = d->lens[e];
+        if (l.width <= 0 || l.height <= 0) {
+            l.width = r.cam_width;
+            l.height = r.cam_height;
+        }
+        r.lens[e] = kin_lens_scaled(&l, r.cam_width, r.cam_height);
+    }
+    if (lens_given(&r.lens[0]))
+        r.cam_hfov_deg = (float)(2.0 * atan(0.5 * r.cam_width / r.lens[0].fx) / DEG2RAD);
     return r;
 }
 
@@ -96,8 +116,8 @@ kin_sthmd_geometry kin_sthmd_geometry_of(const kin_sthmd_desc *desc)
  * w x h image (see the top of the file):
  *   x_clip = 2fx/w X + (1 - 2cx/w) Z,   y_clip = 2fy/h Y + (2cy/h - 1) Z,
  *   z_clip = (f+n)/(n-f) Z + 2fn/(n-f), w_clip = -Z. */
-static kin_mat4 proj_from_intrinsics(double fx, double fy, double cx, double cy,
-                                     int w, int h, double n, double f)
+kin_mat4 kin_proj_from_intrinsics(double fx, double fy, double cx, double cy, double skew,
+                                  int w, int h, double n, double f)
 {
     kin_mat4 p;
     memset(&p, 0, sizeof p);
@@ -108,7 +128,24 @@ static kin_mat4 proj_from_intrinsics(double fx, double fy, double cx, double cy,
     p.m[10] = (float)((f + n) / (n - f));
     p.m[11] = -1.0f;
     p.m[14] = (float)(2.0 * f * n / (n - f));
+    if (skew != 0.0) p.m[4] = (float)(-2.0 * skew / w);
     return p;
+}
+
+/* The pinhole kin_lens of kin_camera intrinsics (egofuse pixels). */
+static kin_lens pinhole_lens(double fx, double fy, double cx, double cy, int w, int h)
+{
+    kin_lens l;
+    memset(&l, 0, sizeof l);
+    l.model = KIN_LENS_PINHOLE;
+    l.width = w;
+    l.height = h;
+    l.fx = fx;
+    l.fy = fy;
+    l.cx = cx - 0.5;
+    l.cy = cy - 0.5;
+    kin_lens_check(&l, NULL, 0);
+    return l;
 }
 
 kin_camera kin_sthmd_camera(const kin_sthmd_desc *desc,
@@ -141,7 +178,23 @@ kin_camera kin_sthmd_camera(const kin_sthmd_desc *desc,
     c.cx = g.crop_width != r.cam_width ? 0.5f * (float)r.cam_width - (float)g.crop_x0
                                        : 0.5f * (float)g.crop_width;
     c.cy = 0.5f * (float)r.cam_height - (float)g.crop_y0;
-    c.proj = proj_from_intrinsics(f, f, c.cx, c.cy, c.width, c.height, r.znear, r.zfar);
+    if (lens_given(&r.lens[eye == KIN_EYE_RIGHT])) {
+        /* a calibrated lens, in the crop; the projection draws its pinhole
+         * part (a distorting lens is applied to the mask by the pipeline,
+         * src/pipe/pipe_lens.h) */
+        c.lens = kin_lens_cropped(&r.lens[eye == KIN_EYE_RIGHT], g.crop_x0, g.crop_y0, c.width,
+                                  c.height);
+        c.fx = (float)c.lens.fx;
+        c.fy = (float)c.lens.fy;
+        c.cx = (float)(c.lens.cx + 0.5);
+        c.cy = (float)(c.lens.cy + 0.5);
+        c.proj = kin_proj_from_intrinsics(c.lens.fx, c.lens.fy, c.lens.cx + 0.5, c.lens.cy + 0.5,
+                                          c.lens.skew, c.width, c.height, r.znear, r.zfar);
+    } else {
+        c.proj = kin_proj_from_intrinsics(f, f, c.cx, c.cy, 0.0, c.width, c.height, r.znear,
+                                          r.zfar);
+        c.lens = pinhole_lens(f, f, c.cx, c.cy, c.width, c.height);
+    }
     c.view_proj = kin_mat4_mul(&c.proj, &c.view);
     return c;
 }
@@ -182,6 +235,7 @@ kin_camera kin_camera_look_at(kin_vec3 eye, kin_vec3 target, kin_vec3 up,
     c.cy = 0.5f * (float)c.height;
     c.proj = kin_mat4_perspective((float)fovy, (float)c.width / (float)c.height,
                                   znear, zfar);
+    c.lens = pinhole_lens(fy, fy, c.cx, c.cy, c.width, c.height);
     c.view_proj = kin_mat4_mul(&c.proj, &c.view);
     return c;
 }

@@ -1,8 +1,10 @@
 /* pipe.c - one stereo frame, end to end (see pipe.h). */
 #include "pipe.h"
+#include "pipe_aa.h"
 #include "pipe_morph.h"
 #include "pipe_parts.h"
 #include "pipe_internal.h"
+#include "pipe_lens.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -24,9 +26,12 @@ typedef struct eye_state {
     void *refine_scratch;
     size_t refine_scratch_size;
     int have_refined;         /* refined holds the last frame's mask */
+    pipe__aa aa;              /* anti-aliased coverage (aa_samples) */
+    const uint8_t *shown;     /* the mask composited last frame */
     int converted;            /* cam_rgba already holds this frame's crop */
     rast_context *rast;
     fuse_context *fuse;
+    pipe_lens_map *lens;      /* a distorting lens: the mask through it */
     kin_camera cam;
     /* per-frame job */
     const pipe_frame_in *in;
@@ -34,6 +39,7 @@ typedef struct eye_state {
     pipe_result result;
     char why[160];
     double ms_raster, ms_convert, ms_fuse, coverage;
+    int lod_level;            /* the level drawn */
 } eye_state;
 
 struct pipe_ctx {
@@ -57,6 +63,10 @@ struct pipe_ctx {
     int fit_no_prev;          /* pipe_reset_fit: the refined masks are of
                                  before it, not to be learned from */
     pipe__cockpit *ck;        /* hidden parts and props (pipe_parts.c) */
+    const kin_model *model;
+    const pipe_lod *lod;      /* pipe_set_lod, or NULL */
+    int lod_level;            /* a level, or PIPE_LOD_AUTO */
+    float lod_px;             /* the rule's target, pixels */
 };
 
 enum { JOB_SKIN, JOB_EYE };
@@ -104,6 +114,35 @@ static fuse_image raw_rows(const pipe_ctx *p, uint8_t *buf)
     return (fuse_image){buf, p->hmd.cam_width, p->geo.crop_height, 4 * p->hmd.cam_width};
 }
 
+/* Draws the posed model (parts: with the cockpit's hidden parts and
+ * props) into tg through cam: straight for a pinhole, else through the
+ * eye's lens map (pipe_lens.h), which writes every pixel of tg. Returns
+ * the raster's result; *covered: the mask pixels set. */
+static rast_result eye_draw(pipe_ctx *p, eye_state *e, const kin_camera *cam,
+                            const rast_target *tg, int parts, long *covered)
+{
+    kin_camera pc;
+    rast_target it = *tg;
+    if (e->lens) {
+        pc = pipe_lens_pinhole(e->lens, cam);
+        cam = &pc;
+        it = pipe_lens_target(e->lens);
+    }
+    rast_context_clear(e->rast, &it); /* only what the last frame drew */
+    rast_result rr = parts && pipe__cockpit_active(p->ck)
+                         ? pipe__cockpit_draw(p->ck, &p->pose, e->eye, e->rast, cam, &it,
+                                              p->desc.cull, e->clip, e->vnrm)
+                     : parts && p->lod
+                         ? pipe_lod_draw(&p->pose, p->lod, p->lod_level, p->lod_px, e->rast, cam,
+                                         &it, p->desc.cull, e->clip, e->vnrm, NULL, &e->lod_level)
+                         : pipe_pose_draw(&p->pose, e->rast, cam, &it, p->desc.cull, e->clip,
+                                          e->vnrm, NULL);
+    if (rr != RAST_OK) return rr;
+    /* Only the tiles the draws marked are read (the rest is clear). */
+    *covered = e->lens ? pipe_lens_warp(e->lens, tg) : rast_context_count(e->rast, &it);
+    return RAST_OK;
+}
+
 static void run_eye(pipe_ctx *p, eye_state *e)
 {
     const pipe_frame_in *in = e->in;
@@ -112,12 +151,17 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     e->result = PIPE_OK;
     e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
     rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
-    rast_context_clear(e->rast, &tg); /* only what the last frame drew */
-    rast_result rr = pipe__cockpit_active(p->ck)
-                         ? pipe__cockpit_draw(p->ck, &p->pose, e->eye, e->rast, &e->cam, &tg,
-                                              p->desc.cull, e->clip, e->vnrm)
-                         : pipe_pose_draw(&p->pose, e->rast, &e->cam, &tg, p->desc.cull,
-                                          e->clip, e->vnrm, NULL);
+    long covered = 0;
+    e->lod_level = 0;
+    rast_result rr = eye_draw(p, e, &e->cam, &tg, 1, &covered);
+    if (rr == RAST_OK && e->aa.count) { /* no lens here: refused at pipe_create */
+        pipe__aa_begin(&e->aa);
+        rr = pipe__cockpit_active(p->ck)
+                 ? pipe__cockpit_draw_aa(p->ck, &p->pose, e->eye, e->rast, &e->cam, &e->aa,
+                                         p->desc.cull, e->clip)
+                 : pipe__aa_draw_pose(&e->aa, &p->pose, e->rast, &e->cam, p->desc.cull, e->clip);
+        pipe__aa_resolve(&e->aa);
+    }
     double t1 = now_ms();
     e->ms_raster = t1 - t0;
     if (rr != RAST_OK) {
@@ -126,8 +170,6 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                  e->eye ? "right" : "left", rast_result_str(rr));
         return;
     }
-    /* Only the tiles the draws marked are read (the rest is clear). */
-    const long covered = rast_context_count(e->rast, &tg);
     e->coverage = (double)covered / (double)(cw * ch);
 
     /* Lights from world space into this camera's view space. */
@@ -162,7 +204,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     } else {
         fe.P = crop_cols(p, fuse_image_rows(&in->camera[e->eye], p->geo.crop_y0, ch));
     }
-    fe.mask = e->mask;
+    fe.mask = e->aa.count ? e->aa.cov : e->mask;
     fe.mask_stride = cw;
     if (p->desc.refine_band > 0) {
         fuse_refine_params rp = fuse_refine_params_default();
@@ -188,6 +230,10 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                             cw, p->desc.refine_band, e->clip);
         e->have_refined = 1;
         fe.mask = e->refined;
+        if (e->aa.count) {
+            pipe__aa_refined(&e->aa, e->mask, e->refined, p->desc.refine_band);
+            fe.mask = e->aa.soft;
+        }
         if (p->fit && in->locals && rs.used_colour) {
             /* the next frame's fit: its colour model from this frame's
              * kinematic and refined masks, and the limb widths; not when
@@ -203,8 +249,12 @@ static void run_eye(pipe_ctx *p, eye_state *e)
             pipe_fit_measure(p->fit, e->eye, &e->cam, p->pose.world, e->mask, cw, e->refined, cw);
         }
     }
+    e->shown = fe.mask;
     fe.normal = e->nrm;
     fe.normal_stride = 3 * cw;
+    /* coverage beyond the model's pixel centres: its neighbours' normals */
+    if (e->aa.count && p->desc.normal_smooth == 0)
+        pipe__aa_fill_normals(&e->aa, fe.mask, e->mask, e->nrm);
     if (p->desc.normal_smooth > 0 &&
         fuse_normal_smooth(fe.mask, fe.mask_stride, e->nrm, 3 * cw, e->snrm, 3 * cw, cw, ch,
                            p->desc.normal_smooth) == FUSE_OK)
@@ -225,10 +275,15 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                           fe.V.width, fe.V.height};
         fe.depth = &dt;
         /* refined pixels outside the model have no depth: they take the
-         * model's beside them, so the depth test hides them too */
+         * model's beside them, so the depth test hides them too; the same
+         * for the anti-aliased coverage beyond the pixel centres */
         if (fe.mask == e->refined) {
             const int b = p->desc.refine_band;
             fuse_depth_fill(e->refined, cw, e->depth, cw, cw, ch, b + b / 8 + 2, filled);
+        } else if (e->aa.count) {
+            const int b = p->desc.refine_band;
+            fuse_depth_fill(fe.mask, cw, e->depth, cw, cw, ch, b > 0 ? b + b / 8 + 3 : 2,
+                            filled);
         }
     }
     fuse_result fr = FUSE_OK;
@@ -243,6 +298,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     for (int y = filled[1]; y < filled[3]; y++)
         for (int x = filled[0]; x < filled[2]; x++)
             if (e->mask[(size_t)y * cw + x] == 0) e->depth[(size_t)y * cw + x] = 1.0f;
+    if (e->aa.count) pipe__aa_unfill(&e->aa, e->mask, e->nrm);
     e->ms_fuse = now_ms() - t1 - e->ms_convert;
     if (fr != FUSE_OK) {
         e->result = PIPE_ERR_FUSE;
@@ -309,8 +365,11 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].cam_rgba);
         free(p->eye[e].refined);
         free(p->eye[e].refine_scratch);
+        pipe__aa_free(&p->eye[e].aa);
         rast_context_destroy(p->eye[e].rast);
         fuse_context_destroy(p->eye[e].fuse);
+        pipe_lens_map_free(p->eye[e].lens);
+        free(p->eye[e].lens);
     }
     pipe_fit_destroy(p->fit);
     p->fit = NULL;
@@ -354,9 +413,13 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
     if (!model) return NULL;
     if (desc && (desc->normal_smooth < 0 || desc->normal_smooth > FUSE_NORMAL_SMOOTH_MAX))
         return NULL;
+    if (desc && desc->aa_samples != 0 && desc->aa_samples != 4 && desc->aa_samples != 8 &&
+        desc->aa_samples != 16)
+        return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
     if (desc) p->desc = *desc;
+    p->model = model;
     p->hmd = kin_sthmd_desc_resolved(&p->desc.hmd);
     p->geo = kin_sthmd_geometry_of(&p->hmd);
     if (pipe_pose_init(&p->pose, model) != 0) {
@@ -382,6 +445,20 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         s->fuse = fuse_context_create(&fd);
         ok = ok && s->depth && s->nrm && s->mask && s->layer && s->cam_rgba && s->clip && s->vnrm &&
              s->rast && s->fuse;
+        if (ok) {
+            /* a calibrated, distorting lens: the mask through it */
+            kin_camera c0 = kin_sthmd_camera(&p->hmd, NULL, (kin_eye)e);
+            if (kin_lens_distorts(&c0.lens)) {
+                s->lens = calloc(1, sizeof *s->lens);
+                ok = s->lens && pipe_lens_map_init(s->lens, &c0.lens, 1, 3, NULL, 0) == 0;
+                if (ok) { /* the warp writes only what changes: start clear */
+                    rast_target t0 = {p->geo.crop_width, p->geo.crop_height, s->depth,
+                                      p->geo.crop_width, s->mask, p->geo.crop_width, s->nrm,
+                                      3 * p->geo.crop_width, 3};
+                    rast_target_clear(&t0);
+                }
+            }
+        }
         if (ok && p->desc.normal_smooth > 0) {
             s->snrm = malloc(sizeof(float) * 3 * px);
             ok = s->snrm != NULL;
@@ -397,6 +474,12 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
                                     : NULL;
             ok = s->refined && s->refine_scratch;
         }
+        /* coverage samples are drawn through the pinhole: not with a
+         * distorting lens (pipe.h ANTI-ALIASED EDGES) */
+        if (ok && p->desc.aa_samples && s->lens) ok = 0;
+        if (ok && p->desc.aa_samples)
+            ok = pipe__aa_init(&s->aa, p->desc.aa_samples, p->geo.crop_width,
+                               p->geo.crop_height, p->desc.refine_band > 0) == 0;
     }
     if (ok && p->desc.refine_band > 0 && p->desc.fit_rig) {
         p->fit_rig = *p->desc.fit_rig;
@@ -484,9 +567,8 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
          * is one; else this frame's kinematic mask is drawn for it */
         if (pipe_fit_learned(p->fit, e)) continue;
         rast_target tg = {cw, ch, s->depth, cw, s->mask, cw, s->nrm, 3 * cw, 3};
-        rast_context_clear(s->rast, &tg);
-        rast_result rr = pipe_pose_draw(&p->pose, s->rast, &cam[e], &tg, p->desc.cull, s->clip,
-                                        s->vnrm, NULL);
+        long covered;
+        rast_result rr = eye_draw(p, s, &cam[e], &tg, 0, &covered);
         const uint8_t *prev = s->have_refined && !p->fit_no_prev ? s->refined : NULL;
         fuse_result lr =
             rr == RAST_OK ? pipe_fit_learn(p->fit, e, &P[e], s->mask, cw, prev, cw) : FUSE_OK;
@@ -592,6 +674,7 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
             stats->ms_convert[e] = p->eye[e].ms_convert;
             stats->ms_fuse[e] = p->eye[e].ms_fuse;
             stats->coverage[e] = p->eye[e].coverage;
+            stats->lod_level[e] = p->eye[e].lod_level;
         }
         stats->ms_total = now_ms() - t0;
     }
@@ -617,6 +700,7 @@ const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
     if (width) *width = p->geo.crop_width;
     if (height) *height = p->geo.crop_height;
     const eye_state *e = &p->eye[eye ? 1 : 0];
+    if (e->aa.count && e->shown) return e->shown;
     return e->have_refined ? e->refined : e->mask;
 }
 
@@ -632,6 +716,17 @@ kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }
 
 kin_sthmd_desc pipe_hmd(const pipe_ctx *p) { return p->hmd; }
+
+int pipe_set_lod(pipe_ctx *p, const pipe_lod *lod, int level, float target_px)
+{
+    if (!p || level < PIPE_LOD_AUTO) return -1;
+    if (lod && !pipe_lod_check(lod, p->model, NULL, 0)) return -1;
+    if (level == PIPE_LOD_AUTO && (!(target_px > 0.0f) || !isfinite(target_px))) return -1;
+    p->lod = level == 0 ? NULL : lod;
+    p->lod_level = level;
+    p->lod_px = target_px;
+    return 0;
+}
 
 unsigned pipe_parts_present(const pipe_ctx *p) { return p ? pipe__cockpit_present(p->ck) : 0; }
 

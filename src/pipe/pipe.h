@@ -41,6 +41,7 @@
 #include "../fuse/fuse_refine.h"
 #include "../kin/kin.h"
 #include "../raster/raster.h"
+#include "pipe_lod.h"
 #include "pipe_pose.h"
 
 #ifdef __cplusplus
@@ -89,7 +90,39 @@ typedef struct pipe_desc {
                                  crossing parts with their own normals,
                                  whose shading seams become ramps. Out of
                                  range: pipe_create returns NULL. */
+    int aa_samples;           /* 0 = off (default): the binary mask of the
+                                 pixel centres, the bytes of before; 4, 8
+                                 or 16: anti-aliased edges, the mask is
+                                 the coverage of that many samples per
+                                 pixel (see "ANTI-ALIASED EDGES" below).
+                                 Another value, or with a distorting lens
+                                 (hmd.lens; the samples are drawn through
+                                 the pinhole): pipe_create returns NULL.
+                                 With a level of detail the samples still
+                                 draw the full model. */
 } pipe_desc;
+
+/* ANTI-ALIASED EDGES (pipe_desc.aa_samples = n). Each eye's model is drawn
+ * a second time into n coverage samples per pixel (rast_draw_aa, the
+ * standard Direct3D positions; the G-buffer's depth and normals stay those
+ * of the pixel centres) and the mask composited is their resolve
+ * M = round(255 covered / n), so R = M P' + (1 - M) V with fractional M
+ * (fuse_light and fuse_composite take any M). Pixels that the coverage
+ * reaches but whose centre the model misses get
+ *   a normal: the sum of the normals of their 3x3 neighbours inside the
+ *             model (none: 0, lit as facing the camera), unless
+ *             normal_smooth (which already sums over its window);
+ *   a depth:  fuse_depth_fill's (the nearest model pixel's, radius 2; with
+ *             the refinement band + band / 8 + 3), so the depth test
+ *             against the virtual scene hides them as it hides the model
+ *             beside them: occlusion is never weaker than without AA.
+ * With refine_band the refinement still decides on the binary G-buffer
+ * mask (its bytes do not change); the mask composited is then the refined
+ * coverage: M = the coverage above where the refined mask agrees with the
+ * model in the pixel's 3x3 window, else round(255 k / 9) for k refined
+ * pixels in that window (a colour-decided edge gets a one-pixel ramp).
+ * The tone match, the elbow fit and pipe_frame_stats.coverage use the
+ * binary masks. pipe_mask returns the mask composited. */
 
 typedef struct pipe_ctx pipe_ctx;
 
@@ -159,6 +192,8 @@ typedef struct pipe_frame_stats {
     double ms_fuse[2];        /* per eye: lighting, resampling, composite */
     double ms_total;          /* wall time of pipe_frame */
     double coverage[2];       /* fraction of camera pixels in the mask */
+    int lod_level[2];         /* per eye: the level of detail drawn
+                                 (pipe_set_lod; 0 = the full model) */
 } pipe_frame_stats;
 
 typedef enum pipe_result {
@@ -184,7 +219,8 @@ void  pipe_reset_fit(pipe_ctx *p);
 pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
                        pipe_frame_stats *stats, char *why, int why_size);
 /* The last frame's mask of one eye (valid until the next frame): the
- * refined one with pipe_desc.refine_band, else the G-buffer's. */
+ * refined one with pipe_desc.refine_band, else the G-buffer's; with
+ * pipe_desc.aa_samples the coverage mask composited (0..255). */
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The last frame's lit layer of one eye (premultiplied RGBA8, the
  * mask's size, 4 * width bytes per row; valid until the next frame):
@@ -206,6 +242,20 @@ const char *pipe_result_str(pipe_result r);
 /* The resolved HMD description the pipe uses (pipe_desc.hmd with its
  * defaults filled in): the sizes of pipe_frame_in's images. */
 kin_sthmd_desc pipe_hmd(const pipe_ctx *p);
+
+/* Levels of detail of the pipe's model (pipe_lod.h; built by
+ * io_lod_build when the model is loaded). From the next frame on, each
+ * eye draws level `level` of lod (clamped to the chain), or with level
+ * PIPE_LOD_AUTO the level of the rule of pipe_lod.h for target_px
+ * (pixels, > 0), per eye and per mesh (pipe_lod_draw). lod NULL or level
+ * 0: the full model, the bytes of a pipe without levels (the default).
+ * The chain must be of the pipe's model (pipe_lod_check) and outlive the
+ * pipe or the next pipe_set_lod. Frames that hide a part or draw a prop
+ * (the operator's cockpit, below) and the elbow fit's own drawing use the
+ * full model. Returns 0, or -1 (nothing changed) for p NULL, a chain not
+ * of the model, a level < PIPE_LOD_AUTO, or PIPE_LOD_AUTO with target_px
+ * not > 0 and finite. Not during pipe_frame. */
+int pipe_set_lod(pipe_ctx *p, const pipe_lod *lod, int level, float target_px);
 
 /* ------------------------------------------------ the operator's cockpit
  *

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "pipe.h"
+#include "pipe_lens.h"
 
 static int fail(char *why, int why_size, const char *fmt, ...)
 {
@@ -34,7 +35,7 @@ int pipe_mask_render(const kin_model *model, const pipe_mask_desc *d,
     int width = d->width, height = d->height;
     if (width < 1 || width > RAST_MAX_DIM || height < 1 || height > RAST_MAX_DIM)
         return fail(why, why_size, "size %dx%d: width and height must be in 1..%d", width, height, RAST_MAX_DIM);
-    if (!(d->fov_y > 0.0f && d->fov_y < 180.0f))
+    if (!d->lens && !(d->fov_y > 0.0f && d->fov_y < 180.0f))
         return fail(why, why_size, "fov_y %g: not a number of degrees in (0, 180)", (double)d->fov_y);
     float znear = d->znear == 0.0f ? 0.01f : d->znear;
     float zfar = d->zfar == 0.0f ? 100.0f : d->zfar;
@@ -64,6 +65,8 @@ int pipe_mask_render(const kin_model *model, const pipe_mask_desc *d,
     pipe_pose ps;
     if (pipe_pose_init(&ps, model) != 0) return fail(why, why_size, "out of memory for the model");
     int rc = -1;
+    pipe_lens_map lm;
+    memset(&lm, 0, sizeof lm);
     float *dep = malloc(sizeof(float) * npx);
     float *nrm = malloc(sizeof(float) * 3 * npx);
     uint8_t *msk = malloc(npx);
@@ -73,11 +76,43 @@ int pipe_mask_render(const kin_model *model, const pipe_mask_desc *d,
         fail(why, why_size, "out of memory for a %dx%d image", width, height);
         goto done;
     }
-    kin_camera cam = kin_camera_look_at(ve, vt, vu, d->fov_y, width, height, znear, zfar);
+    kin_camera cam = kin_camera_look_at(ve, vt, vu, d->lens ? 60.0f : d->fov_y, width, height,
+                                        znear, zfar);
+    if (d->lens) {
+        /* the calibrated lens at this size: its pinhole part draws, a
+         * distortion is applied by the gather of pipe_lens */
+        kin_lens l = *d->lens;
+        char lw[160];
+        if (!kin_lens_check(&l, lw, sizeof lw)) {
+            fail(why, why_size, "lens: %s", lw);
+            goto done;
+        }
+        if (l.width <= 0) l.width = width, l.height = height;
+        cam.lens = kin_lens_scaled(&l, width, height);
+        cam.fx = (float)cam.lens.fx, cam.fy = (float)cam.lens.fy;
+        cam.cx = (float)(cam.lens.cx + 0.5), cam.cy = (float)(cam.lens.cy + 0.5);
+        cam.proj = kin_proj_from_intrinsics(cam.lens.fx, cam.lens.fy, cam.lens.cx + 0.5,
+                                            cam.lens.cy + 0.5, cam.lens.skew, width, height,
+                                            znear, zfar);
+        cam.view_proj = kin_mat4_mul(&cam.proj, &cam.view);
+        if (kin_lens_distorts(&cam.lens) &&
+            pipe_lens_map_init(&lm, &cam.lens, 1, 3, lw, sizeof lw) != 0) {
+            fail(why, why_size, "lens: %s", lw);
+            goto done;
+        }
+    }
     rast_target tg = {width, height, dep, width, msk, width, nrm, 3 * width, 3};
     rast_target_clear(&tg);
     pipe_pose_anim(&ps, d->anim, d->time);
-    rast_result rr = pipe_pose_draw(&ps, NULL, &cam, &tg, RAST_CULL_NONE, clip, vnrm, NULL);
+    rast_result rr;
+    if (lm.src) {
+        kin_camera pc = pipe_lens_pinhole(&lm, &cam);
+        rast_target it = pipe_lens_target(&lm);
+        rr = pipe_pose_draw(&ps, NULL, &pc, &it, RAST_CULL_NONE, clip, vnrm, NULL);
+        if (rr == RAST_OK) pipe_lens_warp(&lm, &tg);
+    } else {
+        rr = pipe_pose_draw(&ps, NULL, &cam, &tg, RAST_CULL_NONE, clip, vnrm, NULL);
+    }
     if (rr != RAST_OK) {
         fail(why, why_size, "cannot draw the model: %s", rast_result_str(rr));
         goto done;
@@ -105,6 +140,7 @@ done:
     free(msk);
     free(clip);
     free(vnrm);
+    pipe_lens_map_free(&lm);
     pipe_pose_free(&ps);
     return rc;
 }

@@ -95,6 +95,13 @@ typedef struct pipe_mask_desc {
     float znear, zfar;        /* clip planes; 0 = 0.01 and 100 */
     const kin_animation *anim;/* NULL: rest pose; else one of model->anims */
     float time;               /* seconds into anim (clamped to it) */
+    const kin_lens *lens;     /* NULL: the symmetric perspective of fov_y.
+                                 Else a checked lens (kin_lens.h, e.g. from
+                                 io_calib_load) replaces it: its intrinsics
+                                 and distortion, scaled to width x height
+                                 when it has another size (fov_y unused);
+                                 a distorting lens is applied exactly as
+                                 the pipeline does (pipe_lens.h) */
 } pipe_mask_desc;
 
 /* Renders model through the camera of d into mask (required, width*height

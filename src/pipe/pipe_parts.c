@@ -539,6 +539,38 @@ rast_result pipe__cockpit_draw(pipe__cockpit *c, const pipe_pose *ps, int eye,
     return RAST_OK;
 }
 
+rast_result pipe__cockpit_draw_aa(pipe__cockpit *c, const pipe_pose *ps, int eye,
+                                  rast_context *ctx, const kin_camera *cam, pipe__aa *aa,
+                                  rast_cull cull, float *clip)
+{
+    const kin_model *m = ps->model;
+    for (int i = 0; i < m->mesh_count; i++) {
+        const kin_mesh *me = &ps->meshes[i];
+        const uint32_t *ix = me->indices;
+        int nt = me->index_count / 3;
+        if (c->set) {
+            ix = c->lists[c->set][i];
+            nt = c->nvis[c->set][i];
+        }
+        if (nt <= 0) continue;
+        rast_transform_points(cam->view_proj.m, ps->pos[i], me->vertex_count, clip);
+        rast_result r = pipe__aa_draw(aa, ctx, clip, me->vertex_count, ix, nt, cull);
+        if (r != RAST_OK) return r;
+    }
+    for (int k = 0; k < c->nprops; k++) {
+        const prop *pr = &c->props[k];
+        if (!pr->visible) continue;
+        for (int i = 0; i < pr->model->mesh_count; i++) {
+            const kin_mesh *me = &pr->pose.meshes[i];
+            rast_transform_points(cam->view_proj.m, pr->pos[i], me->vertex_count, c->pclip[eye]);
+            rast_result r = pipe__aa_draw(aa, ctx, c->pclip[eye], me->vertex_count, me->indices,
+                                          me->index_count / 3, RAST_CULL_NONE);
+            if (r != RAST_OK) return r;
+        }
+    }
+    return RAST_OK;
+}
+
 /* dst = 1 where src (w x h, >= 128 inside) has a set pixel within b px
  * along the rows; sum: w + 1 ints. Transposed access by strides. */
 static void dilate_line(const uint8_t *src, long sstep, uint8_t *dst, long dstep, int n, int b,

@@ -12,6 +12,7 @@
 #define EGOFUSE_PIPE_PARTS_H
 
 #include "pipe.h"
+#include "pipe_aa.h"
 
 typedef struct pipe__cockpit pipe__cockpit;
 
@@ -41,6 +42,11 @@ rast_result pipe__cockpit_draw(pipe__cockpit *c, const pipe_pose *ps, int eye,
                                rast_context *ctx, const kin_camera *cam,
                                const rast_target *target, rast_cull cull, float *clip,
                                float *vnrm);
+/* pipe__cockpit_draw's visible triangles and props into the eye's
+ * anti-aliased coverage (pipe_aa.h) instead of a G-buffer. */
+rast_result pipe__cockpit_draw_aa(pipe__cockpit *c, const pipe_pose *ps, int eye,
+                                  rast_context *ctx, const kin_camera *cam, pipe__aa *aa,
+                                  rast_cull cull, float *clip);
 /* After the refinement of eye's mask: where a part is hidden, the refined
  * mask keeps no pixel outside the kinematic mask within band px
  * (chessboard distance) of the hidden triangles' silhouette. Nothing

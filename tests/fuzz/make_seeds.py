@@ -22,6 +22,23 @@ OUT = os.path.join(ROOT, "tests", "fuzz", "corpus")
 SHARED = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "..", "shared")
 
 
+CALIB_STEREO = """%YAML:1.0
+---
+M1: !!opencv-matrix
+   rows: 3
+   cols: 3
+   dt: d
+   data: [ 500., 0., 320., 0., 501., 240., 0., 0., 1. ]
+D1: !!opencv-matrix
+   rows: 1
+   cols: 8
+   dt: d
+   data: [ 0.1, 0.01, 0., 0., 0.001, 0.2, 0.02, 0.002 ]
+M2: [ 510., 0., 330., 0., 511., 250., 0., 0., 1. ]
+D2: [ 0.2, 0.02, 0., 0., 0.002 ]
+"""
+
+
 def put(name, file, data):
     d = os.path.join(OUT, name)
     os.makedirs(d, exist_ok=True)
@@ -117,6 +134,10 @@ def main():
     with open(os.path.join(ROOT, "samples", "cockpit.conf"), "rb") as f:
         put("io_conf", "cockpit.conf", f.read())
     put("io_conf", "small.conf", "scene = a/scene.txt\n[prop]\nmodel = \"b c.glb\"\n")
+    for f in ("hmd_left.yml", "hmd_right.xml", "fisheye_KD.yml"):
+        with open(os.path.join(ROOT, "samples", "calib", f), "rb") as fh:
+            put("io_calib", f, fh.read())
+    put("io_calib", "stereo.yml", CALIB_STEREO)
     p = packet(0x7f, 7, 1.5, pose_floats())
     put("kin_packet", "full.bin", p)
     put("kin_packet", "full_crc_fixed.bin", p + b"\x01")   # harness writes the CRC

@@ -85,7 +85,7 @@ PKGC=$(pkg-config --cflags libusb-1.0 libv4l2)
 cc -std=c11 -O2 -g -Wall -Wextra -D_GNU_SOURCE -ffp-contract=off $PKGC -o "$VM/vm_devices" \
     "$ROOT/tests/vm/vm_devices.c" "$ROOT"/src/io/io_v4l2.c "$ROOT"/src/io/io_dummy.c \
     "$ROOT"/src/io/io_usb.c "$ROOT"/src/io/io_glove.c "$ROOT"/src/io/io_common.c \
-    "$ROOT"/src/io/io_vsrc.c "$ROOT"/src/io/io_vstream.c \
+    "$ROOT"/src/io/io_vsrc.c "$ROOT"/src/io/io_vstream.c "$ROOT"/src/io/io_pixfmt.c \
     "$ROOT/$BUILD/libegofuse.a" $PKGL -lm -lpthread
 # ---- the guest display test (KMS through libdrm on the bochs driver)
 DRMC=$(pkg-config --cflags libdrm sdl2)

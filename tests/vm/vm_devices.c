@@ -11,8 +11,14 @@
  *   vm_devices glove HIDG SEL       writes reports to /dev/hidgN, reads
  *                                   them back over libusb
  *   vm_devices vsrc                 the V source (io_vsrc) on video2 +
- *                                   video3: formats, side by side, unplug */
+ *                                   video3: formats, side by side, unplug
+ *   vm_devices vivid-disconnect DEV presses vivid's "Disconnect" button on
+ *                                   DEV: that one device fails as if
+ *                                   unplugged (ENODEV) until the driver is
+ *                                   bound again (tests/vm/soak.sh) */
 #include <dirent.h>
+#include <linux/videodev2.h>
+#include <sys/ioctl.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdarg.h>
@@ -620,6 +626,39 @@ static int cmd_vsrc(void)
     return failures ? 1 : 0;
 }
 
+/* vivid's "Disconnect" button (a driver-private control, found by name). */
+static int cmd_vivid_disconnect(const char *dev)
+{
+    int fd = open(dev, O_RDWR | O_NONBLOCK);
+    if (fd < 0) {
+        fprintf(stderr, "%s: %s\n", dev, strerror(errno));
+        return 1;
+    }
+    struct v4l2_queryctrl q;
+    memset(&q, 0, sizeof q);
+    q.id = V4L2_CTRL_FLAG_NEXT_CTRL;
+    int found = 0;
+    while (ioctl(fd, VIDIOC_QUERYCTRL, &q) == 0) {
+        if (!strcmp((const char *)q.name, "Disconnect")) {
+            found = 1;
+            break;
+        }
+        q.id |= V4L2_CTRL_FLAG_NEXT_CTRL;
+    }
+    int rc = 1;
+    if (!found) {
+        fprintf(stderr, "%s: no \"Disconnect\" control\n", dev);
+    } else {
+        struct v4l2_control c = {q.id, 1};
+        if (ioctl(fd, VIDIOC_S_CTRL, &c) != 0)
+            fprintf(stderr, "%s: VIDIOC_S_CTRL Disconnect: %s\n", dev, strerror(errno));
+        else
+            rc = 0;
+    }
+    close(fd);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     setvbuf(stdout, NULL, _IOLBF, 0);
@@ -630,6 +669,7 @@ int main(int argc, char **argv)
     if (argc >= 4 && !strcmp(argv[1], "usb-watch")) return cmd_usb_watch(atoi(argv[2]), argv[3]);
     if (argc >= 4 && !strcmp(argv[1], "glove")) return cmd_glove(argv[2], argv[3]);
     if (argc >= 2 && !strcmp(argv[1], "vsrc")) return cmd_vsrc();
+    if (argc >= 3 && !strcmp(argv[1], "vivid-disconnect")) return cmd_vivid_disconnect(argv[2]);
     fprintf(stderr, "usage: vm_devices capture | usb-list [FILE] | usb-assign SEL_L SEL_R "
                     "SERIAL_L SERIAL_R | usb-watch MS WHAT | glove /dev/hidgN SELECTOR | vsrc\n");
     return 2;

@@ -1,0 +1,249 @@
+/* pipe_aa.c - the anti-aliased coverage mask of an eye (pipe_aa.h). */
+#include "pipe_aa.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static void box_empty(int b[4])
+{
+    b[0] = b[1] = b[2] = b[3] = 0;
+}
+
+static int box_is_empty(const int b[4])
+{
+    return b[0] >= b[2] || b[1] >= b[3];
+}
+
+/* b grown by the rectangle x0, y0, x1, y1 (exclusive), clamped to w x h. */
+static void box_add(int b[4], int x0, int y0, int x1, int y1, int w, int h)
+{
+    if (x0 < 0) x0 = 0;
+    if (y0 < 0) y0 = 0;
+    if (x1 > w) x1 = w;
+    if (y1 > h) y1 = h;
+    if (x0 >= x1 || y0 >= y1) return;
+    if (box_is_empty(b)) {
+        b[0] = x0, b[1] = y0, b[2] = x1, b[3] = y1;
+        return;
+    }
+    if (x0 < b[0]) b[0] = x0;
+    if (y0 < b[1]) b[1] = y0;
+    if (x1 > b[2]) b[2] = x1;
+    if (y1 > b[3]) b[3] = y1;
+}
+
+int pipe__aa_init(pipe__aa *a, int count, int width, int height, int with_soft)
+{
+    memset(a, 0, sizeof *a);
+    if ((count != 4 && count != 8 && count != 16) || width < 1 || height < 1) return -1;
+    const size_t px = (size_t)width * (size_t)height;
+    a->count = count;
+    a->width = width;
+    a->height = height;
+    a->samples = calloc(px, sizeof *a->samples);
+    a->cov = calloc(px, 1);
+    a->colsum = calloc((size_t)width + 2, sizeof *a->colsum);
+    a->colflip = calloc((size_t)width + 2, 1);
+    if (with_soft) a->soft = calloc(px, 1);
+    if (!a->samples || !a->cov || !a->colsum || !a->colflip || (with_soft && !a->soft)) return -1;
+    return 0;
+}
+
+void pipe__aa_free(pipe__aa *a)
+{
+    free(a->samples);
+    free(a->cov);
+    free(a->soft);
+    free(a->colsum);
+    free(a->colflip);
+    memset(a, 0, sizeof *a);
+}
+
+void pipe__aa_begin(pipe__aa *a)
+{
+    const int *b = a->box;
+    for (int y = b[1]; y < b[3]; y++) {
+        memset(a->samples + (size_t)y * (size_t)a->width + b[0], 0,
+               sizeof *a->samples * (size_t)(b[2] - b[0]));
+        memset(a->cov + (size_t)y * (size_t)a->width + b[0], 0, (size_t)(b[2] - b[0]));
+    }
+    box_empty(a->box);
+    b = a->soft_box;
+    for (int y = b[1]; a->soft && y < b[3]; y++)
+        memset(a->soft + (size_t)y * (size_t)a->width + b[0], 0, (size_t)(b[2] - b[0]));
+    box_empty(a->soft_box);
+}
+
+rast_result pipe__aa_draw(pipe__aa *a, rast_context *ctx, const float *clip, int vertex_count,
+                          const uint32_t *indices, int tri_count, rast_cull cull)
+{
+    if (tri_count <= 0) return RAST_OK;
+    /* the vertices' pixel box: every covered sample lies in the convex
+     * hull of the projected vertices when all are in front of the eye
+     * (clipping only cuts the triangles); 2 px for the snapping */
+    float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
+    int all = 0;
+    for (int i = 0; i < vertex_count && !all; i++) {
+        const float *v = clip + 4 * (size_t)i;
+        if (!(v[3] > 1e-6f)) {
+            all = 1;
+            break;
+        }
+        const float sx = (v[0] / v[3] * 0.5f + 0.5f) * (float)a->width;
+        const float sy = (0.5f - v[1] / v[3] * 0.5f) * (float)a->height;
+        if (!(sx == sx) || !(sy == sy)) {
+            all = 1;
+            break;
+        }
+        if (sx < x0) x0 = sx;
+        if (sx > x1) x1 = sx;
+        if (sy < y0) y0 = sy;
+        if (sy > y1) y1 = sy;
+    }
+    if (all)
+        box_add(a->box, 0, 0, a->width, a->height, a->width, a->height);
+    else if (x0 <= x1) {
+        const float W = (float)a->width, H = (float)a->height;
+        /* clamped in float first: huge values do not overflow an int */
+        x0 = x0 < -4.0f ? -4.0f : x0 > W + 4.0f ? W + 4.0f : x0;
+        x1 = x1 < -4.0f ? -4.0f : x1 > W + 4.0f ? W + 4.0f : x1;
+        y0 = y0 < -4.0f ? -4.0f : y0 > H + 4.0f ? H + 4.0f : y0;
+        y1 = y1 < -4.0f ? -4.0f : y1 > H + 4.0f ? H + 4.0f : y1;
+        box_add(a->box, (int)x0 - 2, (int)y0 - 2, (int)x1 + 3, (int)y1 + 3, a->width,
+                a->height);
+    }
+    rast_aa_target t = {a->width, a->height, a->samples, a->width, a->count};
+    rast_mesh_desc d = {
+        .clip = clip,
+        .vertex_count = vertex_count,
+        .attr = NULL,
+        .attr_count = 0,
+        .indices = indices,
+        .tri_count = tri_count,
+        .cull = cull,
+    };
+    return ctx ? rast_context_draw_aa(ctx, &t, &d, NULL) : rast_draw_aa(&t, &d, NULL);
+}
+
+rast_result pipe__aa_draw_pose(pipe__aa *a, const pipe_pose *ps, rast_context *ctx,
+                               const kin_camera *cam, rast_cull cull, float *clip)
+{
+    for (int i = 0; i < ps->model->mesh_count; i++) {
+        const kin_mesh *me = &ps->meshes[i];
+        rast_transform_points(cam->view_proj.m, ps->pos[i], me->vertex_count, clip);
+        rast_result r = pipe__aa_draw(a, ctx, clip, me->vertex_count, me->indices,
+                                      me->index_count / 3, cull);
+        if (r != RAST_OK) return r;
+    }
+    return RAST_OK;
+}
+
+/* Bits set in a byte (a table: the portable builds have no popcnt
+ * instruction and __builtin_popcount becomes a library call). */
+#define B2(k) k, k + 1, k + 1, k + 2
+#define B4(k) B2(k), B2(k + 1), B2(k + 1), B2(k + 2)
+#define B6(k) B4(k), B4(k + 1), B4(k + 1), B4(k + 2)
+static const uint8_t bits8[256] = {B6(0), B6(1), B6(1), B6(2)};
+
+void pipe__aa_resolve(pipe__aa *a)
+{
+    const int *b = a->box;
+    if (box_is_empty(b)) return;
+    /* rast_aa_resolve's rule: round(255 covered / n), halves up */
+    const unsigned n = (unsigned)a->count, mask = (1u << n) - 1u;
+    uint8_t lut[17];
+    for (unsigned c = 0; c <= n; c++) lut[c] = (uint8_t)((510u * c + n) / (2u * n));
+    for (int y = b[1]; y < b[3]; y++) {
+        const uint32_t *s = a->samples + (size_t)y * (size_t)a->width;
+        uint8_t *o = a->cov + (size_t)y * (size_t)a->width;
+        for (int x = b[0]; x < b[2]; x++) {
+            const uint32_t v = s[x] & mask;
+            o[x] = v ? lut[bits8[v & 255u] + bits8[v >> 8]] : 0;
+        }
+    }
+}
+
+void pipe__aa_refined(pipe__aa *a, const uint8_t *mask, const uint8_t *refined, int band)
+{
+    const int W = a->width, H = a->height;
+    int b[4] = {0, 0, 0, 0};
+    if (box_is_empty(a->box)) return;
+    box_add(b, a->box[0] - band - 2, a->box[1] - band - 2, a->box[2] + band + 2,
+            a->box[3] + band + 2, W, H);
+    memcpy(a->soft_box, b, sizeof b);
+    /* colsum[x + 1] = refined pixels (>= 128) of rows y-1..y+1 in column x,
+     * colflip[x + 1] = 1 when one of them differs from the mask; columns
+     * outside the image count 0 (colsum[0], colsum[W + 1]). */
+    int *cs = a->colsum;
+    uint8_t *cf = a->colflip;
+    const int x0 = b[0] > 0 ? b[0] - 1 : 0, x1 = b[2] < W ? b[2] + 1 : W;
+    for (int y = b[1]; y < b[3]; y++) {
+        memset(cs + x0, 0, sizeof *cs * (size_t)(x1 - x0 + 2));
+        memset(cf + x0, 0, (size_t)(x1 - x0 + 2));
+        for (int yy = y - 1; yy <= y + 1; yy++) {
+            if (yy < 0 || yy >= H) continue;
+            const uint8_t *r = refined + (size_t)yy * (size_t)W;
+            const uint8_t *m = mask + (size_t)yy * (size_t)W;
+            for (int x = x0; x < x1; x++) {
+                const int in = r[x] >= 128;
+                cs[x + 1] += in;
+                cf[x + 1] |= (uint8_t)(in != (m[x] >= 128));
+            }
+        }
+        const uint8_t *cov = a->cov + (size_t)y * (size_t)W;
+        uint8_t *o = a->soft + (size_t)y * (size_t)W;
+        for (int x = b[0]; x < b[2]; x++) {
+            if (cf[x] | cf[x + 1] | cf[x + 2]) {
+                /* round(255 n / 9) */
+                const int n = cs[x] + cs[x + 1] + cs[x + 2];
+                o[x] = (uint8_t)((510 * n + 9) / 18);
+            } else {
+                o[x] = cov[x];
+            }
+        }
+    }
+}
+
+void pipe__aa_fill_normals(pipe__aa *a, const uint8_t *m, const uint8_t *mask, float *nrm)
+{
+    const int W = a->width, H = a->height;
+    const int *b = a->soft && m == a->soft ? a->soft_box : a->box;
+    box_empty(a->nbox);
+    for (int y = b[1]; y < b[3]; y++) {
+        const uint8_t *mr = m + (size_t)y * (size_t)W;
+        const uint8_t *kr = mask + (size_t)y * (size_t)W;
+        for (int x = b[0]; x < b[2]; x++) {
+            if (mr[x] == 0 || kr[x] != 0) continue;
+            float s[3] = {0.0f, 0.0f, 0.0f};
+            for (int yy = y - 1; yy <= y + 1; yy++) {
+                if (yy < 0 || yy >= H) continue;
+                for (int xx = x - 1; xx <= x + 1; xx++) {
+                    if (xx < 0 || xx >= W || mask[(size_t)yy * (size_t)W + (size_t)xx] == 0)
+                        continue;
+                    const float *n = nrm + 3 * ((size_t)yy * (size_t)W + (size_t)xx);
+                    s[0] = s[0] + n[0];
+                    s[1] = s[1] + n[1];
+                    s[2] = s[2] + n[2];
+                }
+            }
+            float *o = nrm + 3 * ((size_t)y * (size_t)W + (size_t)x);
+            o[0] = s[0];
+            o[1] = s[1];
+            o[2] = s[2];
+            box_add(a->nbox, x, y, x + 1, y + 1, W, H);
+        }
+    }
+}
+
+void pipe__aa_unfill(pipe__aa *a, const uint8_t *mask, float *nrm)
+{
+    const int W = a->width;
+    const int *b = a->nbox;
+    for (int y = b[1]; y < b[3]; y++)
+        for (int x = b[0]; x < b[2]; x++)
+            if (mask[(size_t)y * (size_t)W + (size_t)x] == 0) {
+                float *o = nrm + 3 * ((size_t)y * (size_t)W + (size_t)x);
+                o[0] = o[1] = o[2] = 0.0f;
+            }
+    box_empty(a->nbox);
+}
