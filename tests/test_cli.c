@@ -4,6 +4,7 @@
 #include "support/testutil.h"
 
 #include <cmocka.h>
+#include "support/files.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,26 +13,8 @@
 
 static char out[65536];
 
-static const char *bin(void)
-{
-    const char *b = getenv("EGOFUSE_BIN");
-    return b && *b ? b : "build/egofuse";
-}
-
-/* Runs egofuse with up to 30 arguments (NULL-terminated list). */
-static int run(const char *a0, ...)
-{
-    char *argv[32];
-    int n = 0;
-    argv[n++] = (char *)bin();
-    va_list ap;
-    va_start(ap, a0);
-    for (const char *a = a0; a && n < 31; a = va_arg(ap, const char *))
-        argv[n++] = (char *)a;
-    va_end(ap);
-    argv[n] = NULL;
-    return tu_run(argv, out, sizeof out);
-}
+/* Runs egofuse with a NULL-terminated argument list; output in out. */
+#define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
 
 static void b64(const uint8_t *in, size_t n, char *o)
 {
@@ -79,14 +62,6 @@ static void write_quad_gltf(const char *path, float x0, float x1, float y0, floa
             "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
             "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}\n",
             enc, fin(x0), fin(y0), fin(z), fin(x1), fin(y1), fin(z));
-    fclose(f);
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
     fclose(f);
 }
 
@@ -159,7 +134,7 @@ static void mask_bad_models(void **state)
     assert_false(tu_exists(png));
 
     tu_tmp_path("corrupt.gltf", model, sizeof model);
-    write_file(model, "{\"asset\":{\"version\":\"2.0\"}, \"nodes\": [ {\"mesh\": 0 } ");
+    tu_write_text(model, "{\"asset\":{\"version\":\"2.0\"}, \"nodes\": [ {\"mesh\": 0 } ");
     assert_int_equal(run("mask", model, "--width", "32", "--height", "32", "--fov-y", "60",
                          "--eye", "0,0,2", "--target", "0,0,0", "--out", png, NULL), 1);
     assert_non_null(strstr(out, "corrupt.gltf"));
@@ -282,7 +257,7 @@ static void write_scene(const char *dir, int cam_w, int cam_h)
     snprintf(p, sizeof p, "%s/virt_r_0.png", dir);
     write_solid(p, 1280, 800, 10, 40, 90);
     snprintf(p, sizeof p, "%s/scene.txt", dir);
-    write_file(p, "egofuse-scene 1\n"
+    tu_write_text(p, "egofuse-scene 1\n"
                   "model = quad.gltf\n"
                   "head_node = head\n"
                   "frames = 1\n"
@@ -444,7 +419,7 @@ static void render_pose_options(void **state)
 
     /* a tracking file that is missing, then malformed (file and line) */
     snprintf(p, sizeof p, "%s/scene.txt", dir);
-    write_file(p, "egofuse-scene 1\n"
+    tu_write_text(p, "egofuse-scene 1\n"
                   "model = quad.gltf\n"
                   "head_node = head\n"
                   "frames = 1\n"
@@ -458,13 +433,13 @@ static void render_pose_options(void **state)
                          "--quiet", NULL), 1);
     assert_non_null(strstr(out, "track.txt"));
     snprintf(p, sizeof p, "%s/track.txt", dir);
-    write_file(p, "egofuse-track 1\nt 0 SL 0 1\n");
+    tu_write_text(p, "egofuse-track 1\nt 0 SL 0 1\n");
     assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",
                          "--quiet", NULL), 1);
     assert_non_null(strstr(out, "track.txt:2:"));
 
     /* a good recording, a missing calibration file */
-    write_file(p, "egofuse-track 1\nt 0 SL -0.2 1 0 SR 0.2 1 0\n");
+    tu_write_text(p, "egofuse-track 1\nt 0 SL -0.2 1 0 SR 0.2 1 0\n");
     char calib[700];
     snprintf(calib, sizeof calib, "%s/no_calib.txt", dir);
     assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",

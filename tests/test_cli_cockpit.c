@@ -12,6 +12,7 @@
 #include "support/testutil.h"
 
 #include <cmocka.h>
+#include "support/files.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,25 +21,8 @@
 
 static char out[65536];
 
-static const char *bin(void)
-{
-    const char *b = getenv("EGOFUSE_BIN");
-    return b && *b ? b : "build/egofuse";
-}
-
-/* Runs egofuse with up to 30 arguments (NULL-terminated list). */
-static int run(const char *a0, ...)
-{
-    char *argv[32];
-    int n = 0;
-    argv[n++] = (char *)bin();
-    va_list ap;
-    va_start(ap, a0);
-    for (const char *a = a0; a && n < 31; a = va_arg(ap, const char *)) argv[n++] = (char *)a;
-    va_end(ap);
-    argv[n] = NULL;
-    return tu_run(argv, out, sizeof out);
-}
+/* Runs egofuse with a NULL-terminated argument list; output in out. */
+#define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
 
 static void b64(const uint8_t *in, size_t n, char *o)
 {
@@ -93,14 +77,6 @@ static void write_mesh_gltf(const char *path, const char *name, const float *pos
     free(buf);
 }
 
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
 static void write_solid(const char *path, int w, int h, uint8_t r, uint8_t g, uint8_t b)
 {
     io_image img;
@@ -147,7 +123,7 @@ static int group_setup(void **state)
     snprintf(p, sizeof p, "%s/virt_r_0.png", g_dir);
     write_solid(p, 1280, 800, 10, 40, 90);
     snprintf(g_scene, sizeof g_scene, "%s/scene.txt", g_dir);
-    write_file(g_scene, "egofuse-scene 1\n"
+    tu_write_text(g_scene, "egofuse-scene 1\n"
                         "model = hand.gltf\n"
                         "head_node = head\n"
                         "frames = 1\n"

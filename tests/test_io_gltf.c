@@ -4,6 +4,7 @@
  * data URI, .gltf + .bin, .glb) and broken files. */
 #include "support/testutil.h"
 #include <cmocka.h>
+#include "support/files.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -21,29 +22,6 @@ static int shared_model(const char *rel, char *buf, size_t n)
         return 0;
     }
     return 1;
-}
-
-static void write_bytes(const char *path, const void *data, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(data, 1, n, f), n);
-    assert_int_equal(fclose(f), 0);
-}
-
-static unsigned char *read_bytes(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *p = malloc((size_t)len + 1);
-    assert_non_null(p);
-    assert_int_equal(fread(p, 1, (size_t)len, f), (size_t)len);
-    fclose(f);
-    *n = (size_t)len;
-    return p;
 }
 
 static int all_zero(const void *p, size_t n)
@@ -444,7 +422,7 @@ static void write_syn_gltf(const char *path, unsigned flags)
     strcpy(uri, "data:application/octet-stream;base64,");
     base64(bin, SYN_BYTES, uri + strlen(uri));
     char *j = syn_json(flags, uri);
-    write_bytes(path, j, strlen(j));
+    tu_write_bytes(path, j, strlen(j));
     free(j);
 }
 
@@ -469,7 +447,7 @@ static void write_syn_glb(const char *path, unsigned flags)
     put_u32(g, 20 + jp, SYN_BYTES);
     memcpy(g + 24 + jp, "BIN\0", 4);
     memcpy(g + 28 + jp, bin, SYN_BYTES);
-    write_bytes(path, g, total);
+    tu_write_bytes(path, g, total);
     free(g);
     free(j);
 }
@@ -574,10 +552,10 @@ static void synthetic_loads_in_every_container(void **state)
     unsigned char data[SYN_BYTES];
     syn_buffer(data, 0);
     tu_tmp_path("syn_ext.bin", bin, sizeof bin);
-    write_bytes(bin, data, SYN_BYTES);
+    tu_write_bytes(bin, data, SYN_BYTES);
     tu_tmp_path("syn_ext.gltf", path, sizeof path);
     char *j = syn_json(0, "syn_ext.bin");
-    write_bytes(path, j, strlen(j));
+    tu_write_bytes(path, j, strlen(j));
     free(j);
     assert_int_equal(io_gltf_load(path, &m, &err), IO_OK);
     check_syn(&m, 0);
@@ -616,10 +594,10 @@ static void missing_and_empty_files(void **state)
     tu_tmp_path("does_not_exist.glb", path, sizeof path);
     expect_fail(path, IO_ERR_NOT_FOUND, NULL);
     tu_tmp_path("empty.gltf", path, sizeof path);
-    write_bytes(path, "", 0);
+    tu_write_bytes(path, "", 0);
     expect_fail(path, IO_ERR_FORMAT, NULL);
     tu_tmp_path("empty.glb", path, sizeof path);
-    write_bytes(path, "", 0);
+    tu_write_bytes(path, "", 0);
     expect_fail(path, IO_ERR_FORMAT, NULL);
 
     kin_model m;
@@ -635,17 +613,17 @@ static void truncated_glb(void **state)
     size_t n;
     tu_tmp_path("whole.glb", path, sizeof path);
     write_syn_glb(path, 0);
-    unsigned char *b = read_bytes(path, &n);
+    unsigned char *b = tu_read_file(path, &n);
     tu_tmp_path("half_syn.glb", cut, sizeof cut);
-    write_bytes(cut, b, n / 2);
+    tu_write_bytes(cut, b, n / 2);
     free(b);
     expect_fail(cut, IO_ERR_FORMAT, NULL);
 
     if (!shared_model("gltf/RiggedSimple/RiggedSimple.glb", path, sizeof path))
         return;
-    b = read_bytes(path, &n);
+    b = tu_read_file(path, &n);
     tu_tmp_path("half_rigged.glb", cut, sizeof cut);
-    write_bytes(cut, b, n / 2);
+    tu_write_bytes(cut, b, n / 2);
     free(b);
     expect_fail(cut, IO_ERR_FORMAT, NULL);
 }
@@ -657,12 +635,12 @@ static void corrupt_json(void **state)
     char *j = syn_json(0, "x.bin");
     j[strlen(j) * 2 / 3] = '\0';
     tu_tmp_path("corrupt.gltf", path, sizeof path);
-    write_bytes(path, j, strlen(j));
+    tu_write_bytes(path, j, strlen(j));
     free(j);
     expect_fail(path, IO_ERR_FORMAT, NULL);
 
     tu_tmp_path("garbage.gltf", path, sizeof path);
-    write_bytes(path, "\x01\x02garbage{{", 11);
+    tu_write_bytes(path, "\x01\x02garbage{{", 11);
     expect_fail(path, IO_ERR_FORMAT, NULL);
 }
 
@@ -673,7 +651,7 @@ static void json_without_meshes(void **state)
     tu_tmp_path("nomesh.gltf", path, sizeof path);
     const char *j = "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"name\":\"a\"}],"
                     "\"scenes\":[{\"nodes\":[0]}]}";
-    write_bytes(path, j, strlen(j));
+    tu_write_bytes(path, j, strlen(j));
     expect_fail(path, IO_ERR_MISSING, "no triangle primitives");
 
     /* only a LINES primitive: nothing drawable */
@@ -716,7 +694,7 @@ static void flipped_bytes_never_crash(void **state)
     size_t n;
     tu_tmp_path("flip_src.glb", path, sizeof path);
     write_syn_glb(path, 0);
-    unsigned char *orig = read_bytes(path, &n);
+    unsigned char *orig = tu_read_file(path, &n);
     unsigned char *b = malloc(n);
     assert_non_null(b);
     tu_rng rng = {0x5eedf11bull};
@@ -729,7 +707,7 @@ static void flipped_bytes_never_crash(void **state)
             const int at = tu_int(&rng, (int)n);   /* drawn in order (tu_kin.h) */
             b[at] ^= (unsigned char)(1 + tu_int(&rng, 255));
         }
-        write_bytes(path, b, n);
+        tu_write_bytes(path, b, n);
         kin_model m;
         io_error err;
         if (io_gltf_load(path, &m, &err) == IO_OK) {

@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "../src/pipe/pipe.h"
+#include "support/pipe_frames.h"
 
 #define D2R 0.017453292519943295
 
@@ -262,37 +263,7 @@ static kin_sthmd_desc small_desc(void)
 
 /* A head node at the origin and an unskinned quad [-s,s]^2 at depth z,
  * turned about +Y. */
-static void quad_model(kin_model *m, float s, float z)
-{
-    memset(m, 0, sizeof *m);
-    int16_t *parents = kin_block_alloc(&m->block, 2 * sizeof(int16_t));
-    kin_transform *rest = kin_block_alloc(&m->block, 2 * sizeof(kin_transform));
-    char(*names)[KIN_NAME_MAX] = kin_block_alloc(&m->block, 2 * KIN_NAME_MAX);
-    float *pos = kin_block_alloc(&m->block, 12 * sizeof(float));
-    float *nrm = kin_block_alloc(&m->block, 12 * sizeof(float));
-    uint32_t *idx = kin_block_alloc(&m->block, 6 * sizeof(uint32_t));
-    kin_mesh *mesh = kin_block_alloc(&m->block, sizeof(kin_mesh));
-    assert_non_null(mesh);
-    parents[0] = KIN_NO_PARENT;
-    parents[1] = 0;
-    rest[0] = rest[1] = kin_transform_identity();
-    rest[1].r = kin_quat_axis_angle(kin_v3(0, 1, 0), 0.3f);
-    strcpy(names[0], "head");
-    strcpy(names[1], "quad");
-    const float p[12] = {-s, -s, z, s, -s, z, s, s, z, -s, s, z};
-    memcpy(pos, p, sizeof p);
-    for (int i = 0; i < 4; i++) nrm[3 * i + 2] = 1.0f;
-    const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(idx, ix, sizeof ix);
-    *mesh = (kin_mesh){.vertex_count = 4, .positions = pos, .normals = nrm, .index_count = 6,
-                       .indices = idx, .node = 1, .skin = -1};
-    m->node_count = 2;
-    m->parents = parents;
-    m->rest = rest;
-    m->names = (const char(*)[KIN_NAME_MAX])names;
-    m->mesh_count = 1;
-    m->meshes = mesh;
-}
+static void quad_model(kin_model *m, float s, float z) { tu_quad_model(m, s, z, 0.3f, "quad"); }
 
 static void small_portrait_frame(void **state)
 {
@@ -351,37 +322,18 @@ static void small_portrait_frame(void **state)
 
     /* the stages by hand on the crop (columns 20..139) and the viewport */
     const int cw = g.crop_width, ch = g.crop_height;
-    float *depth = malloc(sizeof(float) * (size_t)cw * ch), *nrm = malloc(sizeof(float) * 3 * (size_t)cw * ch);
-    uint8_t *mask = malloc((size_t)cw * ch), *layer = malloc((size_t)4 * cw * ch);
+    tu_stages s;
+    tu_stages_make(&s, cw, ch);
     uint8_t *expect = malloc((size_t)LCDW * LCDH * 4);
     assert_non_null(expect);
     for (int e = 0; e < 2; e++) {
         kin_camera c = kin_sthmd_camera(&hd, &head, (kin_eye)e);
         assert_int_equal(c.width, cw);
         assert_int_equal(c.height, ch);
-        rast_target t = {cw, ch, depth, cw, mask, cw, nrm, cw * 3, 3};
-        rast_target_clear(&t);
-        float clip[16], vn[12], wpos[12], wn[12];
-        kin_mat4 qw = kin_mat4_from_transform(&m.rest[1]);
-        kin_mesh_transform(&m.meshes[0], &qw, wpos, wn);
-        rast_transform_points(c.view_proj.m, wpos, 4, clip);
-        rast_transform_dirs(c.view.m, wn, 4, vn);
-        rast_mesh_desc md = {clip, 4, vn, 3, m.meshes[0].indices, 2, RAST_CULL_NONE};
-        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
-        fuse_lighting L = fuse_lighting_default();
-        kin_vec3 ld = kin_v3_norm(kin_mat4_mul_dir(
-            &c.view, kin_v3(L.lights[0].dir[0], L.lights[0].dir[1], L.lights[0].dir[2])));
-        L.lights[0].dir[0] = ld.x;
-        L.lights[0].dir[1] = ld.y;
-        L.lights[0].dir[2] = ld.z;
-        fuse_intrinsics K = {c.fx, c.fy, c.cx, c.cy};
         fuse_image P = {cam[e] + 20 * 4, cw, ch, CAMW * 4};
-        fuse_image Q = {layer, cw, ch, cw * 4};
         fuse_image V = {virt[e], LCDW, LCDH, LCDW * 4};
         fuse_image R = {expect, LCDW, LCDH, LCDW * 4};
-        assert_int_equal(fuse_light(&L, &K, &P, mask, cw, nrm, cw * 3, &Q), FUSE_OK);
-        assert_int_equal(fuse_composite(&Q, &V, g.vp_x0, g.vp_y0, g.vp_width, g.vp_height, &R),
-                         FUSE_OK);
+        tu_quad_stages(&m, &c, &s, &P, &V, g.vp_x0, g.vp_y0, g.vp_width, g.vp_height, &R);
         assert_memory_equal(expect, out[0][e], (size_t)LCDW * LCDH * 4);
         long differs = 0;
         for (int y = 0; y < LCDH; y++)
@@ -397,10 +349,7 @@ static void small_portrait_frame(void **state)
         /* the hand is in the output */
         assert_true(differs > (long)(0.05 * g.vp_width * g.vp_height));
     }
-    free(depth);
-    free(nrm);
-    free(mask);
-    free(layer);
+    tu_stages_free(&s);
     free(expect);
     for (int e = 0; e < 2; e++) {
         free(cam[e]);
