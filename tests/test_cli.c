@@ -10,28 +10,12 @@
 #include <string.h>
 
 #include "../src/io/io.h"
+#include "support/io_images.h"
 
 static char out[65536];
 
 /* Runs egofuse with a NULL-terminated argument list; output in out. */
 #define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
-
-static void b64(const uint8_t *in, size_t n, char *o)
-{
-    static const char *t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t i = 0;
-    for (; i + 2 < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (uint32_t)in[i + 1] << 8 | in[i + 2];
-        *o++ = t[v >> 18]; *o++ = t[(v >> 12) & 63]; *o++ = t[(v >> 6) & 63]; *o++ = t[v & 63];
-    }
-    if (i < n) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0);
-        *o++ = t[v >> 18]; *o++ = t[(v >> 12) & 63];
-        *o++ = i + 1 < n ? t[(v >> 6) & 63] : '=';
-        *o++ = '=';
-    }
-    *o = 0;
-}
 
 static double fin(float v) { return isfinite(v) ? v : 0.0; }
 
@@ -47,7 +31,7 @@ static void write_quad_gltf(const char *path, float x0, float x1, float y0, floa
     memcpy(buf + 48, nrm, 48);
     memcpy(buf + 96, idx, 12);
     char enc[200];
-    b64(buf, sizeof buf, enc);
+    tu_b64(buf, sizeof buf, enc);
     FILE *f = fopen(path, "w");
     assert_non_null(f);
     fprintf(f,
@@ -65,16 +49,17 @@ static void write_quad_gltf(const char *path, float x0, float x1, float y0, floa
     fclose(f);
 }
 
-static void write_solid(const char *path, int w, int h, uint8_t r, uint8_t g, uint8_t b)
-{
-    io_image img;
-    io_error err;
-    assert_int_equal(io_image_alloc(&img, w, h, 3, IO_U8, &err), IO_OK);
-    uint8_t *p = img.data;
-    for (int i = 0; i < w * h; i++) { p[3 * i] = r; p[3 * i + 1] = g; p[3 * i + 2] = b; }
-    assert_int_equal(io_image_save(path, &img, &err), IO_OK);
-    io_image_free(&img);
-}
+/* The scene of one frame around quad.gltf and the solid images. */
+#define QUAD_SCENE                       \
+    "egofuse-scene 1\n"                  \
+    "model = quad.gltf\n"                \
+    "head_node = head\n"                 \
+    "frames = 1\n"                       \
+    "fps = 60\n"                         \
+    "camera_left = cam_l_%d.png\n"       \
+    "camera_right = cam_r_%d.png\n"      \
+    "virtual_left = virt_l_%d.png\n"     \
+    "virtual_right = virt_r_%d.png\n"
 
 /* ------------------------------------------------------------- usage */
 
@@ -249,23 +234,15 @@ static void write_scene(const char *dir, int cam_w, int cam_h)
     /* 0.2 m square, 0.6 m in front of the head: both cameras see it. */
     write_quad_gltf(p, -0.1f, 0.1f, -0.1f, 0.1f, -0.6f);
     snprintf(p, sizeof p, "%s/cam_l_0.png", dir);
-    write_solid(p, cam_w, cam_h, 200, 150, 120);
+    tu_write_solid(p, cam_w, cam_h, 200, 150, 120);
     snprintf(p, sizeof p, "%s/cam_r_0.png", dir);
-    write_solid(p, cam_w, cam_h, 200, 150, 120);
+    tu_write_solid(p, cam_w, cam_h, 200, 150, 120);
     snprintf(p, sizeof p, "%s/virt_l_0.png", dir);
-    write_solid(p, 1280, 800, 10, 40, 90);
+    tu_write_solid(p, 1280, 800, 10, 40, 90);
     snprintf(p, sizeof p, "%s/virt_r_0.png", dir);
-    write_solid(p, 1280, 800, 10, 40, 90);
+    tu_write_solid(p, 1280, 800, 10, 40, 90);
     snprintf(p, sizeof p, "%s/scene.txt", dir);
-    tu_write_text(p, "egofuse-scene 1\n"
-                  "model = quad.gltf\n"
-                  "head_node = head\n"
-                  "frames = 1\n"
-                  "fps = 60\n"
-                  "camera_left = cam_l_%d.png\n"
-                  "camera_right = cam_r_%d.png\n"
-                  "virtual_left = virt_l_%d.png\n"
-                  "virtual_right = virt_r_%d.png\n");
+    tu_write_text(p, QUAD_SCENE);
 }
 
 static void render_end_to_end(void **state)
@@ -419,16 +396,7 @@ static void render_pose_options(void **state)
 
     /* a tracking file that is missing, then malformed (file and line) */
     snprintf(p, sizeof p, "%s/scene.txt", dir);
-    tu_write_text(p, "egofuse-scene 1\n"
-                  "model = quad.gltf\n"
-                  "head_node = head\n"
-                  "frames = 1\n"
-                  "fps = 60\n"
-                  "camera_left = cam_l_%d.png\n"
-                  "camera_right = cam_r_%d.png\n"
-                  "virtual_left = virt_l_%d.png\n"
-                  "virtual_right = virt_r_%d.png\n"
-                  "tracking = track.txt\n");
+    tu_write_text(p, QUAD_SCENE "tracking = track.txt\n");
     assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",
                          "--quiet", NULL), 1);
     assert_non_null(strstr(out, "track.txt"));

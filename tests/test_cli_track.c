@@ -345,19 +345,26 @@ static int calib_recording(kin_track_sample *s, const kin_arm_rig *rig, const ki
     return n;
 }
 
-static void result_calibrate(void **state)
+/* The sample model's arm rig and hand tips (the test skipped without
+ * the model). */
+static void calib_rig(kin_arm_rig *rig, kin_vec3 tip[2])
 {
-    (void)state;
     if (g_skip[0]) {
         printf("%s\n", g_skip);
         skip();
     }
-    kin_arm_rig rig;
     char why[256];
-    if (kin_arm_rig_init(&rig, &g_model, why, sizeof why)) fail_msg("%s", why);
+    if (kin_arm_rig_init(rig, &g_model, why, sizeof why)) fail_msg("%s", why);
+    if (kin_user_calib_hand_tips(rig, &g_model, tip, why, sizeof why)) fail_msg("%s", why);
+}
+
+static void result_calibrate(void **state)
+{
+    (void)state;
+    kin_arm_rig rig;
     kin_vec3 tip[2];
-    if (kin_user_calib_hand_tips(&rig, &g_model, tip, why, sizeof why)) fail_msg("%s", why);
     static kin_track_sample s[800];
+    calib_rig(&rig, tip);
     int n = calib_recording(s, &rig, tip);
     char rec[512], cal[512], glove[512];
     tu_tmp_path("calib_rec.txt", rec, sizeof rec);
@@ -400,16 +407,10 @@ static void result_calibrate(void **state)
 static void validity_calibrate(void **state)
 {
     (void)state;
-    if (g_skip[0]) {
-        printf("%s\n", g_skip);
-        skip();
-    }
     kin_arm_rig rig;
-    char why[256];
-    if (kin_arm_rig_init(&rig, &g_model, why, sizeof why)) fail_msg("%s", why);
     kin_vec3 tip[2];
-    if (kin_user_calib_hand_tips(&rig, &g_model, tip, why, sizeof why)) fail_msg("%s", why);
     static kin_track_sample s[800];
+    calib_rig(&rig, tip);
     calib_recording(s, &rig, tip);
     char rec[512], cal[512], glove[512];
     tu_tmp_path("calib_short.txt", rec, sizeof rec);

@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 #include "../src/io/io.h"
+#include "support/io_images.h"
 
 static char D[1024];        /* scratch folder */
 static char M[1200];        /* D/m, the models' folder */
@@ -255,24 +256,14 @@ static void cli_mask(void **state)
     assert_true(tu_exists(png));
 }
 
-static void write_solid_png(const char *path, int w, int h)
-{
-    io_image img;
-    io_error err;
-    assert_int_equal(io_image_alloc(&img, w, h, 3, IO_U8, &err), IO_OK);
-    memset(img.data, 120, (size_t)w * (size_t)h * 3);
-    assert_int_equal(io_image_save(path, &img, &err), IO_OK);
-    io_image_free(&img);
-}
-
 static void cli_render(void **state)
 {
     (void)state;
     char scene[1400], odir[1200], text[2000];
     snprintf(scene, sizeof scene, "%s/cam_0.png", M);
-    write_solid_png(scene, 640, 480);
+    tu_write_solid(scene, 640, 480, 120, 120, 120);
     snprintf(scene, sizeof scene, "%s/virt_0.png", M);
-    write_solid_png(scene, 1280, 800);
+    tu_write_solid(scene, 1280, 800, 120, 120, 120);
     write_model("cli_render", "link.bin", 36, NULL);
     snprintf(scene, sizeof scene, "%s/scene.txt", M);
     snprintf(text, sizeof text,

@@ -319,23 +319,6 @@ static void syn_buffer(unsigned char *b, unsigned flags)
         for (int c = 0; c < 3; c++) put_f(b, 364 + (size_t)(v * 16 + c * 4), pos[v * 3 + c]);
 }
 
-static const char *b64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-
-static void base64(const unsigned char *in, size_t n, char *out)
-{
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16;
-        if (i + 1 < n) v |= (uint32_t)in[i + 1] << 8;
-        if (i + 2 < n) v |= in[i + 2];
-        out[o++] = b64[(v >> 18) & 63];
-        out[o++] = b64[(v >> 12) & 63];
-        out[o++] = i + 1 < n ? b64[(v >> 6) & 63] : '=';
-        out[o++] = i + 2 < n ? b64[v & 63] : '=';
-    }
-    out[o] = '\0';
-}
-
 /* The JSON of the synthetic model. Source nodes are listed children
  * first, so sorting has work to do:
  *   0 (unnamed) translation (0,1,0); 1 "j0" children [0], matrix;
@@ -420,7 +403,7 @@ static void write_syn_gltf(const char *path, unsigned flags)
     syn_buffer(bin, flags);
     char uri[1024];
     strcpy(uri, "data:application/octet-stream;base64,");
-    base64(bin, SYN_BYTES, uri + strlen(uri));
+    tu_b64(bin, SYN_BYTES, uri + strlen(uri));
     char *j = syn_json(flags, uri);
     tu_write_bytes(path, j, strlen(j));
     free(j);

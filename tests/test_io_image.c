@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "../src/io/io.h"
-#include "support/io_same.h"
+#include "support/io_images.h"
 
 static void fill_random(io_image *img, tu_rng *rng)
 {

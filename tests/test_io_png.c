@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "../src/io/io.h"
-#include "support/io_same.h"
+#include "support/io_images.h"
 
 static int have_ffmpeg(void)
 {
