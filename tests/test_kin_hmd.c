@@ -119,6 +119,29 @@ static void presets(void **state)
     }
 }
 
+/* The preset `name` into *d and its geometry: check_geo, then the figures
+ * quoted in docs/kin.md, want = crop width, height, x0, y0, viewport
+ * width, height, x0, y0; note: printed as a NOTE. */
+static kin_sthmd_geometry preset_geo(const char *name, kin_sthmd_desc *d, const int want[8],
+                                     int note)
+{
+    assert_int_equal(kin_sthmd_preset(name, d), 0);
+    kin_sthmd_geometry g = kin_sthmd_geometry_of(d);
+    check_geo(d, &g);
+    const int got[8] = {g.crop_width, g.crop_height, g.crop_x0, g.crop_y0,
+                        g.vp_width,   g.vp_height,   g.vp_x0,   g.vp_y0};
+    static const char *const what[8] = {"crop_width", "crop_height", "crop_x0", "crop_y0",
+                                        "vp_width",   "vp_height",   "vp_x0",   "vp_y0"};
+    for (int i = 0; i < 8; i++)
+        if (got[i] != want[i]) fail_msg("%s: %s = %d, expected %d", name, what[i], got[i], want[i]);
+    if (note)
+        print_message("NOTE %s: crop %dx%d at (%d, %d), W1 %.1f mm, W2 %.1f mm, ratio %.4f, "
+                      "viewport %dx%d at (%d, %d)\n", name, g.crop_width, g.crop_height,
+                      g.crop_x0, g.crop_y0, g.w1_mm, g.w2_mm, g.ratio, g.vp_width, g.vp_height,
+                      g.vp_x0, g.vp_y0);
+    return g;
+}
+
 /* The three HMDs: eq. 1-4 from the equations, and the figures quoted in
  * docs/kin.md. */
 static void three_hmds(void **state)
@@ -127,37 +150,14 @@ static void three_hmds(void **state)
     kin_sthmd_desc d;
     kin_sthmd_geometry g;
     /* the paper: keeps the width, 640 x 400 at row 40; 1194 x 746 at (43, 27) */
-    assert_int_equal(kin_sthmd_preset("paper", &d), 0);
-    g = kin_sthmd_geometry_of(&d);
-    check_geo(&d, &g);
-    assert_int_equal(g.crop_width, 640);
-    assert_int_equal(g.crop_height, 400);
-    assert_int_equal(g.crop_x0, 0);
-    assert_int_equal(g.crop_y0, 40);
-    assert_int_equal(g.vp_width, 1194);
-    assert_int_equal(g.vp_height, 746);
-    assert_int_equal(g.vp_x0, 43);
-    assert_int_equal(g.vp_y0, 27);
+    g = preset_geo("paper", &d, (const int[8]){640, 400, 0, 40, 1194, 746, 43, 27}, 0);
     NEAR(g.ratio, 0.93335, 1e-5);
 
     /* consumer: keeping the width needs round(1280 * 2208 / 2064) = 1369
      * rows of 1024: the height is kept, the width cut to
      * round(1024 * 2064 / 2208) = 957 at column (1280 - 957) / 2 = 161 */
-    assert_int_equal(kin_sthmd_preset("consumer", &d), 0);
+    g = preset_geo("consumer", &d, (const int[8]){957, 1024, 161, 0, 1539, 1647, 262, 280}, 1);
     assert_true(d.lcd_height > d.lcd_width);
-    g = kin_sthmd_geometry_of(&d);
-    check_geo(&d, &g);
-    assert_int_equal(g.crop_width, 957);
-    assert_int_equal(g.crop_height, 1024);
-    assert_int_equal(g.crop_x0, 161);
-    assert_int_equal(g.crop_y0, 0);
-    assert_int_equal(g.vp_width, 1539);
-    assert_int_equal(g.vp_height, 1647);
-    assert_int_equal(g.vp_x0, 262);
-    assert_int_equal(g.vp_y0, 280);
-    print_message("NOTE consumer: crop %dx%d at (%d, %d), W1 %.1f mm, W2 %.1f mm, ratio %.4f, "
-                  "viewport %dx%d at (%d, %d)\n", g.crop_width, g.crop_height, g.crop_x0,
-                  g.crop_y0, g.w1_mm, g.w2_mm, g.ratio, g.vp_width, g.vp_height, g.vp_x0, g.vp_y0);
     /* the camera images the crop; its principal point is the sensor's centre */
     kin_camera c = kin_sthmd_camera(&d, NULL, KIN_EYE_LEFT);
     assert_int_equal(c.width, 957);
@@ -168,20 +168,7 @@ static void three_hmds(void **state)
 
     /* high-end: round(1920 * 2720 / 2880) = 1813 rows of 1080: the width is
      * cut to round(1080 * 2880 / 2720) = 1144 at column 388 */
-    assert_int_equal(kin_sthmd_preset("highend", &d), 0);
-    g = kin_sthmd_geometry_of(&d);
-    check_geo(&d, &g);
-    assert_int_equal(g.crop_width, 1144);
-    assert_int_equal(g.crop_height, 1080);
-    assert_int_equal(g.crop_x0, 388);
-    assert_int_equal(g.crop_y0, 0);
-    assert_int_equal(g.vp_width, 1891);
-    assert_int_equal(g.vp_height, 1786);
-    assert_int_equal(g.vp_x0, 494);
-    assert_int_equal(g.vp_y0, 467);
-    print_message("NOTE highend: crop %dx%d at (%d, %d), W1 %.1f mm, W2 %.1f mm, ratio %.4f, "
-                  "viewport %dx%d at (%d, %d)\n", g.crop_width, g.crop_height, g.crop_x0,
-                  g.crop_y0, g.w1_mm, g.w2_mm, g.ratio, g.vp_width, g.vp_height, g.vp_x0, g.vp_y0);
+    g = preset_geo("highend", &d, (const int[8]){1144, 1080, 388, 0, 1891, 1786, 494, 467}, 1);
 
     /* the same consumer display held landscape (2208x2064): the height is
      * cut instead, round(1280 * 2064 / 2208) = 1197 > 1024 still: width */
