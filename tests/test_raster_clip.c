@@ -262,6 +262,29 @@ static void test_huge_triangles(void **state)
     }
 }
 
+/* The (n+1) x (n+1) grid of clip-space vertices, two triangles a quad,
+ * each drawn alone with CULL_NONE: count[] := how many covered each
+ * pixel. */
+static void count_grid(rast_target *t, int n, const float *clip, int *count)
+{
+    memset(count, 0, sizeof(int) * W * H);
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            int a = j * (n + 1) + i, b = a + 1, cc = a + n + 1, d = cc + 1;
+            const int tris[2][3] = { { a, b, d }, { a, d, cc } };
+            for (int k = 0; k < 2; k++) {
+                float tc[12];
+                for (int m = 0; m < 3; m++)
+                    memcpy(tc + 4 * m, clip + 4 * tris[k][m], 4 * sizeof(float));
+                rast_target_clear(t);
+                assert_int_equal(rt_draw_tri(t, tc, NULL, RAST_CULL_NONE, NULL), RAST_OK);
+                for (int y = 0; y < H; y++)
+                    for (int x = 0; x < W; x++)
+                        count[y * W + x] += t->mask[y * t->mask_stride + x] == 255;
+            }
+        }
+}
+
 /* A grid mesh in eye space given by a point function; drawn triangle by
  * triangle with CULL_NONE into a count buffer. */
 static void grid_count(const cam *c, rast_target *t, int n, double x0, double x1,
@@ -281,22 +304,7 @@ static void grid_count(const cam *c, rast_target *t, int n, double x0, double x1
             p[2] = (float)(z0 + (z1 - z0) * v);
         }
     rast_transform_points(c->proj, pos, (n + 1) * (n + 1), clip);
-    memset(count, 0, sizeof(int) * W * H);
-    for (int j = 0; j < n; j++)
-        for (int i = 0; i < n; i++) {
-            int a = j * (n + 1) + i, b = a + 1, cc = a + n + 1, d = cc + 1;
-            const int tris[2][3] = { { a, b, d }, { a, d, cc } };
-            for (int k = 0; k < 2; k++) {
-                float tc[12];
-                for (int m = 0; m < 3; m++)
-                    memcpy(tc + 4 * m, clip + 4 * tris[k][m], 4 * sizeof(float));
-                rast_target_clear(t);
-                assert_int_equal(rt_draw_tri(t, tc, NULL, RAST_CULL_NONE, NULL), RAST_OK);
-                for (int y = 0; y < H; y++)
-                    for (int x = 0; x < W; x++)
-                        count[y * W + x] += t->mask[y * t->mask_stride + x] == 255;
-            }
-        }
+    count_grid(t, n, clip, count);
 }
 
 static void test_clipped_grids_watertight(void **state)
@@ -336,22 +344,7 @@ static void test_clipped_grids_watertight(void **state)
             p[2] = -2.0f;
         }
     rast_transform_points(c.proj, pos, (n + 1) * (n + 1), clip);
-    memset(count, 0, sizeof(int) * W * H);
-    for (int j = 0; j < n; j++)
-        for (int i = 0; i < n; i++) {
-            int a = j * (n + 1) + i, b = a + 1, cc = a + n + 1, d = cc + 1;
-            const int tris[2][3] = { { a, b, d }, { a, d, cc } };
-            for (int k = 0; k < 2; k++) {
-                float tc[12];
-                for (int m = 0; m < 3; m++)
-                    memcpy(tc + 4 * m, clip + 4 * tris[k][m], 4 * sizeof(float));
-                rast_target_clear(&t);
-                rt_draw_tri(&t, tc, NULL, RAST_CULL_NONE, NULL);
-                for (int y = 0; y < H; y++)
-                    for (int x = 0; x < W; x++)
-                        count[y * W + x] += t.mask[y * t.mask_stride + x] == 255;
-            }
-        }
+    count_grid(&t, n, clip, count);
     for (int i = 0; i < W * H; i++)
         if (count[i] != 1)
             fail_msg("wall: pixel (%d,%d) covered %d times", i % W, i / W, count[i]);
