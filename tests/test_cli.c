@@ -245,17 +245,24 @@ static void write_scene(const char *dir, int cam_w, int cam_h)
     tu_write_text(p, QUAD_SCENE);
 }
 
+/* A fresh folder tmp/name in dir[512] (created), its scene.txt in
+ * scene[600] and its out folder in odir[600]. */
+static void scene_dir(const char *name, char *dir, char *scene, char *odir)
+{
+    tu_tmp_path(name, dir, 512);
+    char cmd[700];
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+    snprintf(scene, 600, "%s/scene.txt", dir);
+    snprintf(odir, 600, "%s/out", dir);
+}
+
 static void render_end_to_end(void **state)
 {
     (void)state;
     char dir[512], scene[600], odir[600], png[700];
-    tu_tmp_path("scene_ok", dir, sizeof dir);
-    char cmd[700];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
-    assert_int_equal(system(cmd), 0);
+    scene_dir("scene_ok", dir, scene, odir);
     write_scene(dir, 640, 480);
-    snprintf(scene, sizeof scene, "%s/scene.txt", dir);
-    snprintf(odir, sizeof odir, "%s/out", dir);
     int rc = run("render", "--scene", scene, "--out", odir, "--quiet", NULL);
     if (rc != 0) fprintf(stderr, "%s\n", out);
     assert_int_equal(rc, 0);
@@ -287,12 +294,7 @@ static void render_bad_inputs(void **state)
 {
     (void)state;
     char dir[512], scene[600], odir[600], png[700];
-    tu_tmp_path("scene_bad", dir, sizeof dir);
-    char cmd[700];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
-    assert_int_equal(system(cmd), 0);
-    snprintf(scene, sizeof scene, "%s/scene.txt", dir);
-    snprintf(odir, sizeof odir, "%s/out", dir);
+    scene_dir("scene_bad", dir, scene, odir);
 
     /* Missing scene file. */
     assert_int_equal(run("render", "--scene", scene, "--out", odir, NULL), 1);
@@ -366,13 +368,8 @@ static void render_pose_options(void **state)
 {
     (void)state;
     char dir[512], scene[600], odir[600], p[700], png[700];
-    tu_tmp_path("scene_pose", dir, sizeof dir);
-    char cmd[700];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
-    assert_int_equal(system(cmd), 0);
+    scene_dir("scene_pose", dir, scene, odir);
     write_scene(dir, 640, 480);
-    snprintf(scene, sizeof scene, "%s/scene.txt", dir);
-    snprintf(odir, sizeof odir, "%s/out", dir);
 
     /* usage errors (exit 2) */
     assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "bogus", NULL), 2);
