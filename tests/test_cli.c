@@ -4,51 +4,18 @@
 #include "support/testutil.h"
 
 #include <cmocka.h>
+#include "support/files.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "../src/io/io.h"
+#include "support/io_images.h"
 
 static char out[65536];
 
-static const char *bin(void)
-{
-    const char *b = getenv("EGOFUSE_BIN");
-    return b && *b ? b : "build/egofuse";
-}
-
-/* Runs egofuse with up to 30 arguments (NULL-terminated list). */
-static int run(const char *a0, ...)
-{
-    char *argv[32];
-    int n = 0;
-    argv[n++] = (char *)bin();
-    va_list ap;
-    va_start(ap, a0);
-    for (const char *a = a0; a && n < 31; a = va_arg(ap, const char *))
-        argv[n++] = (char *)a;
-    va_end(ap);
-    argv[n] = NULL;
-    return tu_run(argv, out, sizeof out);
-}
-
-static void b64(const uint8_t *in, size_t n, char *o)
-{
-    static const char *t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t i = 0;
-    for (; i + 2 < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (uint32_t)in[i + 1] << 8 | in[i + 2];
-        *o++ = t[v >> 18]; *o++ = t[(v >> 12) & 63]; *o++ = t[(v >> 6) & 63]; *o++ = t[v & 63];
-    }
-    if (i < n) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0);
-        *o++ = t[v >> 18]; *o++ = t[(v >> 12) & 63];
-        *o++ = i + 1 < n ? t[(v >> 6) & 63] : '=';
-        *o++ = '=';
-    }
-    *o = 0;
-}
+/* Runs egofuse with a NULL-terminated argument list; output in out. */
+#define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
 
 static double fin(float v) { return isfinite(v) ? v : 0.0; }
 
@@ -64,7 +31,7 @@ static void write_quad_gltf(const char *path, float x0, float x1, float y0, floa
     memcpy(buf + 48, nrm, 48);
     memcpy(buf + 96, idx, 12);
     char enc[200];
-    b64(buf, sizeof buf, enc);
+    tu_b64(buf, sizeof buf, enc);
     FILE *f = fopen(path, "w");
     assert_non_null(f);
     fprintf(f,
@@ -82,24 +49,17 @@ static void write_quad_gltf(const char *path, float x0, float x1, float y0, floa
     fclose(f);
 }
 
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
-static void write_solid(const char *path, int w, int h, uint8_t r, uint8_t g, uint8_t b)
-{
-    io_image img;
-    io_error err;
-    assert_int_equal(io_image_alloc(&img, w, h, 3, IO_U8, &err), IO_OK);
-    uint8_t *p = img.data;
-    for (int i = 0; i < w * h; i++) { p[3 * i] = r; p[3 * i + 1] = g; p[3 * i + 2] = b; }
-    assert_int_equal(io_image_save(path, &img, &err), IO_OK);
-    io_image_free(&img);
-}
+/* The scene of one frame around quad.gltf and the solid images. */
+#define QUAD_SCENE                       \
+    "egofuse-scene 1\n"                  \
+    "model = quad.gltf\n"                \
+    "head_node = head\n"                 \
+    "frames = 1\n"                       \
+    "fps = 60\n"                         \
+    "camera_left = cam_l_%d.png\n"       \
+    "camera_right = cam_r_%d.png\n"      \
+    "virtual_left = virt_l_%d.png\n"     \
+    "virtual_right = virt_r_%d.png\n"
 
 /* ------------------------------------------------------------- usage */
 
@@ -170,7 +130,7 @@ static void mask_bad_models(void **state)
     assert_false(tu_exists(png));
 
     tu_tmp_path("corrupt.gltf", model, sizeof model);
-    write_file(model, "{\"asset\":{\"version\":\"2.0\"}, \"nodes\": [ {\"mesh\": 0 } ");
+    tu_write_text(model, "{\"asset\":{\"version\":\"2.0\"}, \"nodes\": [ {\"mesh\": 0 } ");
     assert_int_equal(run("mask", model, "--width", "32", "--height", "32", "--fov-y", "60",
                          "--eye", "0,0,2", "--target", "0,0,0", "--out", png, NULL), 1);
     assert_non_null(strstr(out, "corrupt.gltf"));
@@ -285,36 +245,35 @@ static void write_scene(const char *dir, int cam_w, int cam_h)
     /* 0.2 m square, 0.6 m in front of the head: both cameras see it. */
     write_quad_gltf(p, -0.1f, 0.1f, -0.1f, 0.1f, -0.6f);
     snprintf(p, sizeof p, "%s/cam_l_0.png", dir);
-    write_solid(p, cam_w, cam_h, 200, 150, 120);
+    tu_write_solid(p, cam_w, cam_h, 200, 150, 120);
     snprintf(p, sizeof p, "%s/cam_r_0.png", dir);
-    write_solid(p, cam_w, cam_h, 200, 150, 120);
+    tu_write_solid(p, cam_w, cam_h, 200, 150, 120);
     snprintf(p, sizeof p, "%s/virt_l_0.png", dir);
-    write_solid(p, 1280, 800, 10, 40, 90);
+    tu_write_solid(p, 1280, 800, 10, 40, 90);
     snprintf(p, sizeof p, "%s/virt_r_0.png", dir);
-    write_solid(p, 1280, 800, 10, 40, 90);
+    tu_write_solid(p, 1280, 800, 10, 40, 90);
     snprintf(p, sizeof p, "%s/scene.txt", dir);
-    write_file(p, "egofuse-scene 1\n"
-                  "model = quad.gltf\n"
-                  "head_node = head\n"
-                  "frames = 1\n"
-                  "fps = 60\n"
-                  "camera_left = cam_l_%d.png\n"
-                  "camera_right = cam_r_%d.png\n"
-                  "virtual_left = virt_l_%d.png\n"
-                  "virtual_right = virt_r_%d.png\n");
+    tu_write_text(p, QUAD_SCENE);
+}
+
+/* A fresh folder tmp/name in dir[512] (created), its scene.txt in
+ * scene[600] and its out folder in odir[600]. */
+static void scene_dir(const char *name, char *dir, char *scene, char *odir)
+{
+    tu_tmp_path(name, dir, 512);
+    char cmd[700];
+    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+    snprintf(scene, 600, "%s/scene.txt", dir);
+    snprintf(odir, 600, "%s/out", dir);
 }
 
 static void render_end_to_end(void **state)
 {
     (void)state;
     char dir[512], scene[600], odir[600], png[700];
-    tu_tmp_path("scene_ok", dir, sizeof dir);
-    char cmd[700];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
-    assert_int_equal(system(cmd), 0);
+    scene_dir("scene_ok", dir, scene, odir);
     write_scene(dir, 640, 480);
-    snprintf(scene, sizeof scene, "%s/scene.txt", dir);
-    snprintf(odir, sizeof odir, "%s/out", dir);
     int rc = run("render", "--scene", scene, "--out", odir, "--quiet", NULL);
     if (rc != 0) fprintf(stderr, "%s\n", out);
     assert_int_equal(rc, 0);
@@ -346,12 +305,7 @@ static void render_bad_inputs(void **state)
 {
     (void)state;
     char dir[512], scene[600], odir[600], png[700];
-    tu_tmp_path("scene_bad", dir, sizeof dir);
-    char cmd[700];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
-    assert_int_equal(system(cmd), 0);
-    snprintf(scene, sizeof scene, "%s/scene.txt", dir);
-    snprintf(odir, sizeof odir, "%s/out", dir);
+    scene_dir("scene_bad", dir, scene, odir);
 
     /* Missing scene file. */
     assert_int_equal(run("render", "--scene", scene, "--out", odir, NULL), 1);
@@ -425,13 +379,8 @@ static void render_pose_options(void **state)
 {
     (void)state;
     char dir[512], scene[600], odir[600], p[700], png[700];
-    tu_tmp_path("scene_pose", dir, sizeof dir);
-    char cmd[700];
-    snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
-    assert_int_equal(system(cmd), 0);
+    scene_dir("scene_pose", dir, scene, odir);
     write_scene(dir, 640, 480);
-    snprintf(scene, sizeof scene, "%s/scene.txt", dir);
-    snprintf(odir, sizeof odir, "%s/out", dir);
 
     /* usage errors (exit 2) */
     assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "bogus", NULL), 2);
@@ -455,27 +404,18 @@ static void render_pose_options(void **state)
 
     /* a tracking file that is missing, then malformed (file and line) */
     snprintf(p, sizeof p, "%s/scene.txt", dir);
-    write_file(p, "egofuse-scene 1\n"
-                  "model = quad.gltf\n"
-                  "head_node = head\n"
-                  "frames = 1\n"
-                  "fps = 60\n"
-                  "camera_left = cam_l_%d.png\n"
-                  "camera_right = cam_r_%d.png\n"
-                  "virtual_left = virt_l_%d.png\n"
-                  "virtual_right = virt_r_%d.png\n"
-                  "tracking = track.txt\n");
+    tu_write_text(p, QUAD_SCENE "tracking = track.txt\n");
     assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",
                          "--quiet", NULL), 1);
     assert_non_null(strstr(out, "track.txt"));
     snprintf(p, sizeof p, "%s/track.txt", dir);
-    write_file(p, "egofuse-track 1\nt 0 SL 0 1\n");
+    tu_write_text(p, "egofuse-track 1\nt 0 SL 0 1\n");
     assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",
                          "--quiet", NULL), 1);
     assert_non_null(strstr(out, "track.txt:2:"));
 
     /* a good recording, a missing calibration file */
-    write_file(p, "egofuse-track 1\nt 0 SL -0.2 1 0 SR 0.2 1 0\n");
+    tu_write_text(p, "egofuse-track 1\nt 0 SL -0.2 1 0 SR 0.2 1 0\n");
     char calib[700];
     snprintf(calib, sizeof calib, "%s/no_calib.txt", dir);
     assert_int_equal(run("render", "--scene", scene, "--out", odir, "--pose", "tracking",

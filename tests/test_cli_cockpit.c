@@ -12,50 +12,18 @@
 #include "support/testutil.h"
 
 #include <cmocka.h>
+#include "support/files.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "../src/io/io.h"
+#include "support/io_images.h"
 
 static char out[65536];
 
-static const char *bin(void)
-{
-    const char *b = getenv("EGOFUSE_BIN");
-    return b && *b ? b : "build/egofuse";
-}
-
-/* Runs egofuse with up to 30 arguments (NULL-terminated list). */
-static int run(const char *a0, ...)
-{
-    char *argv[32];
-    int n = 0;
-    argv[n++] = (char *)bin();
-    va_list ap;
-    va_start(ap, a0);
-    for (const char *a = a0; a && n < 31; a = va_arg(ap, const char *)) argv[n++] = (char *)a;
-    va_end(ap);
-    argv[n] = NULL;
-    return tu_run(argv, out, sizeof out);
-}
-
-static void b64(const uint8_t *in, size_t n, char *o)
-{
-    static const char *t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t i = 0;
-    for (; i + 2 < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (uint32_t)in[i + 1] << 8 | in[i + 2];
-        *o++ = t[v >> 18]; *o++ = t[(v >> 12) & 63]; *o++ = t[(v >> 6) & 63]; *o++ = t[v & 63];
-    }
-    if (i < n) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0);
-        *o++ = t[v >> 18]; *o++ = t[(v >> 12) & 63];
-        *o++ = i + 1 < n ? t[(v >> 6) & 63] : '=';
-        *o++ = '=';
-    }
-    *o = 0;
-}
+/* Runs egofuse with a NULL-terminated argument list; output in out. */
+#define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
 
 /* A glTF of one unskinned mesh: nv positions (no normals) and nt
  * triangles, under a node "head" (a root) and a node `name`. */
@@ -68,7 +36,7 @@ static void write_mesh_gltf(const char *path, const char *name, const float *pos
     assert_non_null(enc);
     memcpy(buf, pos, pb);
     memcpy(buf + pb, idx, ib);
-    b64(buf, pb + ib, enc);
+    tu_b64(buf, pb + ib, enc);
     float mn[3] = {1e9f, 1e9f, 1e9f}, mx[3] = {-1e9f, -1e9f, -1e9f};
     for (int i = 0; i < nv; i++)
         for (int k = 0; k < 3; k++) {
@@ -91,25 +59,6 @@ static void write_mesh_gltf(const char *path, const char *name, const float *pos
     fclose(f);
     free(enc);
     free(buf);
-}
-
-static void write_file(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
-static void write_solid(const char *path, int w, int h, uint8_t r, uint8_t g, uint8_t b)
-{
-    io_image img;
-    io_error err;
-    assert_int_equal(io_image_alloc(&img, w, h, 3, IO_U8, &err), IO_OK);
-    uint8_t *p = img.data;
-    for (int i = 0; i < w * h; i++) { p[3 * i] = r; p[3 * i + 1] = g; p[3 * i + 2] = b; }
-    assert_int_equal(io_image_save(path, &img, &err), IO_OK);
-    io_image_free(&img);
 }
 
 static char g_dir[512], g_scene[600], g_box[600];
@@ -139,15 +88,15 @@ static int group_setup(void **state)
     snprintf(g_box, sizeof g_box, "%s/box.gltf", g_dir);
     write_mesh_gltf(g_box, "box", box, 8, bi, 12);
     snprintf(p, sizeof p, "%s/cam_l_0.png", g_dir);
-    write_solid(p, 640, 480, 200, 150, 120);
+    tu_write_solid(p, 640, 480, 200, 150, 120);
     snprintf(p, sizeof p, "%s/cam_r_0.png", g_dir);
-    write_solid(p, 640, 480, 200, 150, 120);
+    tu_write_solid(p, 640, 480, 200, 150, 120);
     snprintf(p, sizeof p, "%s/virt_l_0.png", g_dir);
-    write_solid(p, 1280, 800, 10, 40, 90);
+    tu_write_solid(p, 1280, 800, 10, 40, 90);
     snprintf(p, sizeof p, "%s/virt_r_0.png", g_dir);
-    write_solid(p, 1280, 800, 10, 40, 90);
+    tu_write_solid(p, 1280, 800, 10, 40, 90);
     snprintf(g_scene, sizeof g_scene, "%s/scene.txt", g_dir);
-    write_file(g_scene, "egofuse-scene 1\n"
+    tu_write_text(g_scene, "egofuse-scene 1\n"
                         "model = hand.gltf\n"
                         "head_node = head\n"
                         "frames = 1\n"

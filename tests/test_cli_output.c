@@ -9,6 +9,7 @@
 #include "support/testutil.h"
 
 #include <cmocka.h>
+#include "support/files.h"
 #include <dirent.h>
 #include <errno.h>
 #include <signal.h>
@@ -23,12 +24,6 @@
 
 static char out[65536];
 
-static const char *bin(void)
-{
-    const char *b = getenv("EGOFUSE_BIN");
-    return b && *b ? b : "build/egofuse";
-}
-
 enum { XFSZ_IGNORE = 0, XFSZ_KILL = 1 };
 
 /* Runs egofuse with argv (NULL-terminated, argv[0] is set here) under a
@@ -38,43 +33,10 @@ static int run_limited(long limit, int xfsz, const char **args)
 {
     char *argv[40];
     int n = 0;
-    argv[n++] = (char *)bin();
+    argv[n++] = (char *)tu_bin();
     for (int i = 0; args[i] && n < 39; i++) argv[n++] = (char *)args[i];
     argv[n] = NULL;
-    int fd[2];
-    if (pipe(fd) != 0) return -1000;
-    pid_t pid = fork();
-    if (pid < 0) return -1000;
-    if (pid == 0) {
-        struct rlimit core = {0, 0};
-        setrlimit(RLIMIT_CORE, &core);
-        if (limit >= 0) {
-            struct rlimit r = {(rlim_t)limit, (rlim_t)limit};
-            setrlimit(RLIMIT_FSIZE, &r);
-        }
-        signal(SIGXFSZ, xfsz == XFSZ_IGNORE ? SIG_IGN : SIG_DFL);  /* kept by exec */
-        dup2(fd[1], 1);
-        dup2(fd[1], 2);
-        close(fd[0]);
-        close(fd[1]);
-        execv(argv[0], argv);
-        _exit(127);
-    }
-    close(fd[1]);
-    size_t len = 0;
-    ssize_t r;
-    char tmp[4096];
-    while ((r = read(fd[0], tmp, sizeof tmp)) > 0) {
-        size_t k = (size_t)r;
-        if (len + k >= sizeof out) k = sizeof out - 1 - len;
-        memcpy(out + len, tmp, k);
-        len += k;
-    }
-    out[len] = 0;
-    close(fd[0]);
-    int st;
-    if (waitpid(pid, &st, 0) < 0) return -1000;
-    return WIFEXITED(st) ? WEXITSTATUS(st) : WIFSIGNALED(st) ? -WTERMSIG(st) : -1000;
+    return tu_run_limited(argv, out, sizeof out, limit, xfsz);
 }
 
 static void make_dir(const char *name, char *dir, size_t n)
@@ -112,14 +74,6 @@ static int files_in(const char *dir, const char *ext)
     }
     closedir(d);
     return n;
-}
-
-static void write_text(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    fputs(text, f);
-    assert_int_equal(fclose(f), 0);
 }
 
 static int file_is(const char *path, const char *text)
@@ -227,7 +181,7 @@ static void mask_write_fails_cleanly(void **state)
     assert_int_equal(temps_in(dir), 0);
 
     /* an existing file is not touched by a failed overwrite */
-    write_text(nrm, "precious");
+    tu_write_text(nrm, "precious");
     rc = run_limited(limit, XFSZ_IGNORE, a);
     assert_int_equal(rc, 1);
     assert_true(file_is(nrm, "precious"));
@@ -342,7 +296,7 @@ static void render_write_fails_cleanly(void **state)
     snprintf(p, sizeof p, "%s/virt_0.png", dir);
     write_solid_png(p, 1280, 800, 10, 40, 90);
     snprintf(p, sizeof p, "%s/scene.txt", dir);
-    write_text(p, "egofuse-scene 1\nmodel = quad.glb\nhead_node = head\nframes = 1\n"
+    tu_write_text(p, "egofuse-scene 1\nmodel = quad.glb\nhead_node = head\nframes = 1\n"
                   "fps = 60\ncamera_left = cam_%d.png\ncamera_right = cam_%d.png\n"
                   "virtual_left = virt_%d.png\nvirtual_right = virt_%d.png\n");
     snprintf(odir, sizeof odir, "%s/out", dir);
@@ -503,7 +457,7 @@ static void unwritable_folder_says_why(void **state)
     assert_non_null(strstr(out, "does not exist"));
 
     snprintf(file, sizeof file, "%s/plain_file", dir);
-    write_text(file, "x");
+    tu_write_text(file, "x");
     snprintf(mask, sizeof mask, "%s/mask.png", file);
     mask_args(a, model, mask, NULL);
     assert_int_equal(run_limited(-1, XFSZ_IGNORE, a), 1);
@@ -524,8 +478,8 @@ static void unwritable_folder_says_why(void **state)
 
 int main(void)
 {
-    if (!tu_exists(bin())) {
-        printf("SKIP: %s not built\n", bin());
+    if (!tu_exists(tu_bin())) {
+        printf("SKIP: %s not built\n", tu_bin());
         return 0;
     }
     const struct CMUnitTest tests[] = {

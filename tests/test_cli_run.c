@@ -28,8 +28,7 @@ static char gen_path[700];  /* gen_samples next to it */
 static int setup(void **st)
 {
     (void)st;
-    const char *b = getenv("EGOFUSE_BIN");
-    snprintf(bin_path, sizeof bin_path, "%s", b && *b ? b : "build/egofuse");
+    snprintf(bin_path, sizeof bin_path, "%s", tu_bin());
     const char *slash = strrchr(bin_path, '/');
     snprintf(gen_path, sizeof gen_path, "%.*s/gen_samples", slash ? (int)(slash - bin_path) : 1,
              slash ? bin_path : ".");
@@ -43,19 +42,8 @@ static int setup(void **st)
     return 0;
 }
 
-/* Runs egofuse with a NULL-terminated argument list. */
-static int ego(const char *a0, ...)
-{
-    char *argv[48];
-    int n = 0;
-    argv[n++] = bin_path;
-    va_list ap;
-    va_start(ap, a0);
-    for (const char *a = a0; a && n < 47; a = va_arg(ap, const char *)) argv[n++] = (char *)a;
-    va_end(ap);
-    argv[n] = NULL;
-    return tu_run(argv, out, sizeof out);
-}
+/* Runs egofuse with a NULL-terminated argument list; output in out. */
+#define ego(...) tu_runl(out, sizeof out, bin_path, __VA_ARGS__)
 
 /* `egofuse replay-track` as a NatNet server on 127.0.0.1:port, looping. */
 static pid_t start_replay(int port)

@@ -24,14 +24,9 @@
 #include <unistd.h>
 
 #include "../src/io/io_natnet.h"
+#include "support/sample_model.h"
 
 static char out[65536];
-
-static const char *bin(void)
-{
-    const char *b = getenv("EGOFUSE_BIN");
-    return b && *b ? b : "build/egofuse";
-}
 
 static double now_s(void)
 {
@@ -134,7 +129,7 @@ static void replay_natnet(const char *version, int z_mm)
     memset(&r, 0, sizeof r);
     n.on_sample = on_sample;
     n.user = &r;
-    char *argv[] = { (char *)bin(), "replay-track", path, "--to", to, "--speed", "20",
+    char *argv[] = { (char *)tu_bin(), "replay-track", path, "--to", to, "--speed", "20",
                      "--natnet-version", (char *)version, "--natnet-up", z_mm ? "z" : "y",
                      "--natnet-units", z_mm ? "mm" : "m", "--wait", "10", NULL };
     pid_t pid = spawn(argv, log);
@@ -199,7 +194,7 @@ static void result_replay_udp(void **state)
     assert_int_equal(io_track_udp_listen(&u, "127.0.0.1", 0, &err), IO_OK);
     char to[64];
     snprintf(to, sizeof to, "udp:127.0.0.1:%d", u.port);
-    char *argv[] = { (char *)bin(), "replay-track", path, "--to", to, "--speed", "50", NULL };
+    char *argv[] = { (char *)tu_bin(), "replay-track", path, "--to", to, "--speed", "50", NULL };
     if (tu_run(argv, out, sizeof out) != 0) fail_msg("%s", out);
     assert_non_null(strstr(out, "sent 40 samples (1 pass) to udp 127.0.0.1:"));
     kin_track_sample got;
@@ -226,17 +221,17 @@ static void validity_replay_args(void **state)
     tu_tmp_path("replay_args.txt", path, sizeof path);
     kin_track_sample s[NS];
     make_recording(path, s);
-    char *a1[] = { (char *)bin(), "replay-track", path, "--to", "tcp:x:1", NULL };
+    char *a1[] = { (char *)tu_bin(), "replay-track", path, "--to", "tcp:x:1", NULL };
     assert_int_equal(tu_run(a1, out, sizeof out), 2);
     assert_non_null(strstr(out, "--to 'tcp:x:1': udp:HOST:PORT or natnet:ADDR[:PORT]"));
-    char *a2[] = { (char *)bin(), "replay-track", "/nonexistent/track.txt", "--to", "udp:127.0.0.1:9",
+    char *a2[] = { (char *)tu_bin(), "replay-track", "/nonexistent/track.txt", "--to", "udp:127.0.0.1:9",
                    NULL };
     assert_int_equal(tu_run(a2, out, sizeof out), 1);
     assert_non_null(strstr(out, "/nonexistent/track.txt: No such file"));
-    char *a3[] = { (char *)bin(), "replay-track", path, "--to", "natnet:no-such-host.invalid", NULL };
+    char *a3[] = { (char *)tu_bin(), "replay-track", path, "--to", "natnet:no-such-host.invalid", NULL };
     assert_int_equal(tu_run(a3, out, sizeof out), 1);
     assert_non_null(strstr(out, "'no-such-host.invalid' is neither an IPv4 address nor a known host"));
-    char *a4[] = { (char *)bin(), "replay-track", path, "--to", "natnet:127.0.0.1:1", "--wait",
+    char *a4[] = { (char *)tu_bin(), "replay-track", path, "--to", "natnet:127.0.0.1:1", "--wait",
                    "0.2", NULL };
     int port = free_port();
     char to[64];
@@ -244,18 +239,18 @@ static void validity_replay_args(void **state)
     a4[4] = to;
     assert_int_equal(tu_run(a4, out, sizeof out), 1);
     assert_non_null(strstr(out, "no NatNet client connected within 0.2 s"));
-    char *a5[] = { (char *)bin(), "replay-track", path, "--to", "udp:127.0.0.1:9", "--speed", "0",
+    char *a5[] = { (char *)tu_bin(), "replay-track", path, "--to", "udp:127.0.0.1:9", "--speed", "0",
                    NULL };
     assert_int_equal(tu_run(a5, out, sizeof out), 2);
     /* a malformed HOST:PORT is a command-line error (2), found before the file is read */
-    char *a6[] = { (char *)bin(), "replay-track", "/nonexistent/track.txt", "--to", "udp:127.0.0.1",
+    char *a6[] = { (char *)tu_bin(), "replay-track", "/nonexistent/track.txt", "--to", "udp:127.0.0.1",
                    NULL };
     assert_int_equal(tu_run(a6, out, sizeof out), 2);
     assert_non_null(strstr(out, "--to '127.0.0.1': needs HOST:PORT"));
-    char *a7[] = { (char *)bin(), "replay-track", path, "--to", "natnet:127.0.0.1:99999", NULL };
+    char *a7[] = { (char *)tu_bin(), "replay-track", path, "--to", "natnet:127.0.0.1:99999", NULL };
     assert_int_equal(tu_run(a7, out, sizeof out), 2);
     assert_non_null(strstr(out, "'99999' is not a port"));
-    char *a8[] = { (char *)bin(), "replay-track", path, "--to", "udp::9", NULL };
+    char *a8[] = { (char *)tu_bin(), "replay-track", path, "--to", "udp::9", NULL };
     assert_int_equal(tu_run(a8, out, sizeof out), 2);
     assert_non_null(strstr(out, "no host"));
 }
@@ -270,14 +265,9 @@ static int group_setup(void **state)
 {
     (void)state;
     char dir[1024];
-    int r = tu_samples_dir("calib_samples", 3, dir, sizeof dir, g_skip, sizeof g_skip);
+    int r = tu_sample_model_load("calib_samples", 3, &g_model, dir, sizeof dir, g_model_path,
+                                 sizeof g_model_path, g_skip, sizeof g_skip);
     if (r <= 0) return r;
-    snprintf(g_model_path, sizeof g_model_path, "%s/model/arms.glb", dir);
-    io_error err;
-    if (io_gltf_load(g_model_path, &g_model, &err) != IO_OK) {
-        fprintf(stderr, "%s\n", err.msg);
-        return -1;
-    }
     g_loaded = 1;
     return 0;
 }
@@ -285,8 +275,7 @@ static int group_setup(void **state)
 static int group_teardown(void **state)
 {
     (void)state;
-    if (g_loaded) kin_model_free(&g_model);
-    tu_samples_remove("calib_samples");
+    tu_sample_model_free("calib_samples", &g_model, g_loaded);
     return 0;
 }
 
@@ -356,19 +345,26 @@ static int calib_recording(kin_track_sample *s, const kin_arm_rig *rig, const ki
     return n;
 }
 
-static void result_calibrate(void **state)
+/* The sample model's arm rig and hand tips (the test skipped without
+ * the model). */
+static void calib_rig(kin_arm_rig *rig, kin_vec3 tip[2])
 {
-    (void)state;
     if (g_skip[0]) {
         printf("%s\n", g_skip);
         skip();
     }
-    kin_arm_rig rig;
     char why[256];
-    if (kin_arm_rig_init(&rig, &g_model, why, sizeof why)) fail_msg("%s", why);
+    if (kin_arm_rig_init(rig, &g_model, why, sizeof why)) fail_msg("%s", why);
+    if (kin_user_calib_hand_tips(rig, &g_model, tip, why, sizeof why)) fail_msg("%s", why);
+}
+
+static void result_calibrate(void **state)
+{
+    (void)state;
+    kin_arm_rig rig;
     kin_vec3 tip[2];
-    if (kin_user_calib_hand_tips(&rig, &g_model, tip, why, sizeof why)) fail_msg("%s", why);
     static kin_track_sample s[800];
+    calib_rig(&rig, tip);
     int n = calib_recording(s, &rig, tip);
     char rec[512], cal[512], glove[512];
     tu_tmp_path("calib_rec.txt", rec, sizeof rec);
@@ -385,7 +381,7 @@ static void result_calibrate(void **state)
     }
     fclose(f);
     remove(cal);
-    char *argv[] = { (char *)bin(), "calibrate", "--model", g_model_path, "--recording", rec,
+    char *argv[] = { (char *)tu_bin(), "calibrate", "--model", g_model_path, "--recording", rec,
                      "--glove-left", glove, "--out", cal, NULL };
     if (tu_run(argv, out, sizeof out) != 0) fail_msg("%s", out);
     assert_non_null(strstr(out, "(fingertip gesture)"));
@@ -411,16 +407,10 @@ static void result_calibrate(void **state)
 static void validity_calibrate(void **state)
 {
     (void)state;
-    if (g_skip[0]) {
-        printf("%s\n", g_skip);
-        skip();
-    }
     kin_arm_rig rig;
-    char why[256];
-    if (kin_arm_rig_init(&rig, &g_model, why, sizeof why)) fail_msg("%s", why);
     kin_vec3 tip[2];
-    if (kin_user_calib_hand_tips(&rig, &g_model, tip, why, sizeof why)) fail_msg("%s", why);
     static kin_track_sample s[800];
+    calib_rig(&rig, tip);
     calib_recording(s, &rig, tip);
     char rec[512], cal[512], glove[512];
     tu_tmp_path("calib_short.txt", rec, sizeof rec);
@@ -429,7 +419,7 @@ static void validity_calibrate(void **state)
     /* too few samples: named, nothing written */
     assert_int_equal(io_track_save(rec, s, 10, &err), IO_OK);
     remove(cal);
-    char *a1[] = { (char *)bin(), "calibrate", "--model", g_model_path, "--recording", rec,
+    char *a1[] = { (char *)tu_bin(), "calibrate", "--model", g_model_path, "--recording", rec,
                    "--out", cal, NULL };
     assert_int_equal(tu_run(a1, out, sizeof out), 1);
     assert_non_null(strstr(out, "calib_short.txt: left arm: 10 samples with shoulder and hand, "
@@ -438,7 +428,7 @@ static void validity_calibrate(void **state)
     /* a folder that does not exist: the write fails, named */
     tu_tmp_path("calib_rec_ok.txt", rec, sizeof rec);
     assert_int_equal(io_track_save(rec, s, 800, &err), IO_OK);
-    char *a2[] = { (char *)bin(), "calibrate", "--model", g_model_path, "--recording", rec,
+    char *a2[] = { (char *)tu_bin(), "calibrate", "--model", g_model_path, "--recording", rec,
                    "--out", "/nonexistent-dir/calib.txt", NULL };
     assert_int_equal(tu_run(a2, out, sizeof out), 1);
     assert_non_null(strstr(out, "/nonexistent-dir/calib.txt"));
@@ -447,13 +437,13 @@ static void validity_calibrate(void **state)
     FILE *f = fopen(glove, "w");
     fprintf(f, "0.1 0.2 0.3 0.4 0.5\n0.1 0.2 x\n");
     fclose(f);
-    char *a3[] = { (char *)bin(), "calibrate", "--model", g_model_path, "--recording", rec,
+    char *a3[] = { (char *)tu_bin(), "calibrate", "--model", g_model_path, "--recording", rec,
                    "--glove-right", glove, "--out", cal, NULL };
     assert_int_equal(tu_run(a3, out, sizeof out), 1);
     assert_non_null(strstr(out, "calib_glove_bad.txt:2: reading 3: needs 5 numbers"));
     assert_false(tu_exists(cal));
     /* missing options */
-    char *a4[] = { (char *)bin(), "calibrate", "--recording", rec, "--out", cal, NULL };
+    char *a4[] = { (char *)tu_bin(), "calibrate", "--recording", rec, "--out", cal, NULL };
     assert_int_equal(tu_run(a4, out, sizeof out), 2);
     assert_non_null(strstr(out, "give --model or --scene"));
 }

@@ -13,6 +13,7 @@
 #include "support/testutil.h"
 
 #include <cmocka.h>
+#include "support/files.h"
 #include <errno.h>
 #include <limits.h>
 #include <stdint.h>
@@ -22,6 +23,7 @@
 #include <unistd.h>
 
 #include "../src/io/io.h"
+#include "support/io_images.h"
 
 static char D[1024];        /* scratch folder */
 static char M[1200];        /* D/m, the models' folder */
@@ -29,20 +31,6 @@ static char MREAL[PATH_MAX];/* its realpath (named in the messages) */
 static char out[65536];     /* output of the CLI */
 
 static const float TRI[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
-
-static const char *bin(void)
-{
-    const char *b = getenv("EGOFUSE_BIN");
-    return b && *b ? b : "build/egofuse";
-}
-
-static void write_bytes(const char *path, const void *p, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(p, 1, n, f), n);
-    assert_int_equal(fclose(f), 0);
-}
 
 /* D/m/<name>.gltf: one triangle read from a buffer of byte_length bytes at
  * buffer_uri; with image_uri, also an image (not drawn) at that uri. */
@@ -64,7 +52,7 @@ static const char *write_model(const char *name, const char *buffer_uri,
              "\"scenes\":[{\"nodes\":[0,1]}],\"scene\":0}",
              image, buffer_uri, byte_length);
     snprintf(path, sizeof path, "%s/%s.gltf", M, name);
-    write_bytes(path, text, strlen(text));
+    tu_write_bytes(path, text, strlen(text));
     return path;
 }
 
@@ -78,16 +66,16 @@ static int setup(void **state)
     snprintf(M, sizeof M, "%s/m", D);
     if (!realpath(M, MREAL)) return -1;
     snprintf(p, sizeof p, "%s/out.bin", D);
-    write_bytes(p, TRI, sizeof TRI);
+    tu_write_bytes(p, TRI, sizeof TRI);
     snprintf(p, sizeof p, "%s/tri.bin", M);
-    write_bytes(p, TRI, sizeof TRI);
+    tu_write_bytes(p, TRI, sizeof TRI);
     snprintf(p, sizeof p, "%s/sub/tri.bin", M);
-    write_bytes(p, TRI, sizeof TRI);
+    tu_write_bytes(p, TRI, sizeof TRI);
     snprintf(p, sizeof p, "%s/link.bin", M);
     if (symlink("../out.bin", p) != 0) return -1;
     /* an image file inside (its bytes do not matter: images are skipped) */
     snprintf(p, sizeof p, "%s/tex.png", M);
-    write_bytes(p, "not a png", 9);
+    tu_write_bytes(p, "not a png", 9);
     return 0;
 }
 
@@ -195,7 +183,7 @@ static void glb_external_buffer(void **state)
         memcpy(glb + 20, json, (size_t)n);
         char path[1400];
         snprintf(path, sizeof path, "%s/ext%d.glb", M, k);
-        write_bytes(path, glb, (size_t)(20 + n));
+        tu_write_bytes(path, glb, (size_t)(20 + n));
         if (k == 0) expect_ok(path);
         else expect_refused(path, "buffer 0", "../out.bin", "leads outside the model's folder");
     }
@@ -239,7 +227,7 @@ static int run(const char **args)
 {
     char *argv[40];
     int n = 0;
-    argv[n++] = (char *)bin();
+    argv[n++] = (char *)tu_bin();
     for (int i = 0; args[i] && n < 39; i++) argv[n++] = (char *)args[i];
     argv[n] = NULL;
     return tu_run(argv, out, sizeof out);
@@ -268,31 +256,21 @@ static void cli_mask(void **state)
     assert_true(tu_exists(png));
 }
 
-static void write_solid_png(const char *path, int w, int h)
-{
-    io_image img;
-    io_error err;
-    assert_int_equal(io_image_alloc(&img, w, h, 3, IO_U8, &err), IO_OK);
-    memset(img.data, 120, (size_t)w * (size_t)h * 3);
-    assert_int_equal(io_image_save(path, &img, &err), IO_OK);
-    io_image_free(&img);
-}
-
 static void cli_render(void **state)
 {
     (void)state;
     char scene[1400], odir[1200], text[2000];
     snprintf(scene, sizeof scene, "%s/cam_0.png", M);
-    write_solid_png(scene, 640, 480);
+    tu_write_solid(scene, 640, 480, 120, 120, 120);
     snprintf(scene, sizeof scene, "%s/virt_0.png", M);
-    write_solid_png(scene, 1280, 800);
+    tu_write_solid(scene, 1280, 800, 120, 120, 120);
     write_model("cli_render", "link.bin", 36, NULL);
     snprintf(scene, sizeof scene, "%s/scene.txt", M);
     snprintf(text, sizeof text,
              "egofuse-scene 1\nmodel = cli_render.gltf\nhead_node = head\nframes = 1\n"
              "fps = 60\ncamera_left = cam_%%d.png\ncamera_right = cam_%%d.png\n"
              "virtual_left = virt_%%d.png\nvirtual_right = virt_%%d.png\n");
-    write_bytes(scene, text, strlen(text));
+    tu_write_bytes(scene, text, strlen(text));
     snprintf(odir, sizeof odir, "%s/render_out", D);
     const char *a[] = {"render", "--scene", scene, "--out", odir, "--quiet", NULL, NULL};
     int rc = run(a);

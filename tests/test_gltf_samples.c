@@ -21,6 +21,7 @@
 #include "support/testutil.h"
 
 #include <cmocka.h>
+#include "support/files.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -604,23 +605,6 @@ static void gltfpack_variants(void **state)
 
 /* ------------------------------------------------------ bad input */
 
-static const char *b64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-
-static void base64(const unsigned char *in, size_t n, char *out)
-{
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16;
-        if (i + 1 < n) v |= (uint32_t)in[i + 1] << 8;
-        if (i + 2 < n) v |= in[i + 2];
-        out[o++] = b64[(v >> 18) & 63];
-        out[o++] = b64[(v >> 12) & 63];
-        out[o++] = i + 1 < n ? b64[(v >> 6) & 63] : '=';
-        out[o++] = i + 2 < n ? b64[v & 63] : '=';
-    }
-    out[o] = '\0';
-}
-
 /* A small buffer: 4 float positions (48 B) at 0, 4 int16 positions
  * (4 x 8 B, padded) at 48, 4 int8 normals (4 x 4 B) at 80, 6 u16
  * indices at 96, 2 u16 indices at 108; 112 bytes. Accessors:
@@ -646,7 +630,7 @@ static void write_model(const char *path, const char *extra_json, const char *me
     static const uint16_t idx[8] = {0, 1, 2, 0, 2, 3, 0, 1};
     memcpy(buf + 96, idx, sizeof idx);
     char data[200];
-    base64(buf, sizeof buf, data);
+    tu_b64(buf, sizeof buf, data);
     /* extra_json "\"@views\":0," (dropped from the file) adds buffer 1
      * (48 zero bytes) and view 4, an EXT_meshopt_compression view into it
      * that reads buffer 0's first 48 bytes as its meshopt stream */
@@ -899,7 +883,7 @@ static void write_instanced(const char *path)
     static const float sc[9] = {1, 1, 1, 0.5f, 0.5f, 0.5f, 1, 2, 1};
     for (int i = 0; i < 9; i++) put32(b, 120 + (size_t)i * 4, sc[i]);
     char data[260];
-    base64(b, sizeof b, data);
+    tu_b64(b, sizeof b, data);
     FILE *f = fopen(path, "w");
     assert_non_null(f);
     fprintf(f,
@@ -956,7 +940,7 @@ static void write_two_sets(const char *path)
         put32(b, 408 + (size_t)v * 16 + 4, k / 20.0f * sum);
     }
     char data[800];
-    base64(b, sizeof b, data);
+    tu_b64(b, sizeof b, data);
     FILE *f = fopen(path, "w");
     assert_non_null(f);
     fprintf(f,

@@ -15,14 +15,7 @@
 #include <unistd.h>
 
 #include <cmocka.h>
-
-static void write_file(const char *path, const void *data, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(data, 1, n, f), n);
-    assert_int_equal(fclose(f), 0);
-}
+#include "support/files.h"
 
 static void test_installed_example_matches_cli(void **state)
 {
@@ -46,7 +39,7 @@ static void test_installed_example_matches_cli(void **state)
     const float pos[9] = {-1.0f, -0.7f, 0.0f, 1.0f, -0.7f, 0.0f, 0.2f, 0.9f, 0.3f};
     char p[600], model[600], cmd[2048];
     snprintf(p, sizeof p, "%s/tri.bin", dir);
-    write_file(p, pos, sizeof pos);
+    tu_write_bytes(p, pos, sizeof pos);
     const char *gltf =
         "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"uri\":\"tri.bin\",\"byteLength\":36}],"
         "\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],\"accessors\":[{\"bufferView\":0,"
@@ -54,7 +47,7 @@ static void test_installed_example_matches_cli(void **state)
         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],\"nodes\":[{\"mesh\":0}],"
         "\"scenes\":[{\"nodes\":[0]}],\"scene\":0}";
     snprintf(model, sizeof model, "%s/tri.gltf", dir);
-    write_file(model, gltf, strlen(gltf));
+    tu_write_bytes(model, gltf, strlen(gltf));
     snprintf(cmd, sizeof cmd, "sh tests/install_check.sh '%s' '%s' '%s'", build, model, dir);
     int st = system(cmd);
     int rc = WIFEXITED(st) ? WEXITSTATUS(st) : 255;

@@ -4,6 +4,7 @@
  * data URI, .gltf + .bin, .glb) and broken files. */
 #include "support/testutil.h"
 #include <cmocka.h>
+#include "support/files.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -21,29 +22,6 @@ static int shared_model(const char *rel, char *buf, size_t n)
         return 0;
     }
     return 1;
-}
-
-static void write_bytes(const char *path, const void *data, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(data, 1, n, f), n);
-    assert_int_equal(fclose(f), 0);
-}
-
-static unsigned char *read_bytes(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *p = malloc((size_t)len + 1);
-    assert_non_null(p);
-    assert_int_equal(fread(p, 1, (size_t)len, f), (size_t)len);
-    fclose(f);
-    *n = (size_t)len;
-    return p;
 }
 
 static int all_zero(const void *p, size_t n)
@@ -341,23 +319,6 @@ static void syn_buffer(unsigned char *b, unsigned flags)
         for (int c = 0; c < 3; c++) put_f(b, 364 + (size_t)(v * 16 + c * 4), pos[v * 3 + c]);
 }
 
-static const char *b64 = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-
-static void base64(const unsigned char *in, size_t n, char *out)
-{
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16;
-        if (i + 1 < n) v |= (uint32_t)in[i + 1] << 8;
-        if (i + 2 < n) v |= in[i + 2];
-        out[o++] = b64[(v >> 18) & 63];
-        out[o++] = b64[(v >> 12) & 63];
-        out[o++] = i + 1 < n ? b64[(v >> 6) & 63] : '=';
-        out[o++] = i + 2 < n ? b64[v & 63] : '=';
-    }
-    out[o] = '\0';
-}
-
 /* The JSON of the synthetic model. Source nodes are listed children
  * first, so sorting has work to do:
  *   0 (unnamed) translation (0,1,0); 1 "j0" children [0], matrix;
@@ -442,9 +403,9 @@ static void write_syn_gltf(const char *path, unsigned flags)
     syn_buffer(bin, flags);
     char uri[1024];
     strcpy(uri, "data:application/octet-stream;base64,");
-    base64(bin, SYN_BYTES, uri + strlen(uri));
+    tu_b64(bin, SYN_BYTES, uri + strlen(uri));
     char *j = syn_json(flags, uri);
-    write_bytes(path, j, strlen(j));
+    tu_write_bytes(path, j, strlen(j));
     free(j);
 }
 
@@ -469,7 +430,7 @@ static void write_syn_glb(const char *path, unsigned flags)
     put_u32(g, 20 + jp, SYN_BYTES);
     memcpy(g + 24 + jp, "BIN\0", 4);
     memcpy(g + 28 + jp, bin, SYN_BYTES);
-    write_bytes(path, g, total);
+    tu_write_bytes(path, g, total);
     free(g);
     free(j);
 }
@@ -574,10 +535,10 @@ static void synthetic_loads_in_every_container(void **state)
     unsigned char data[SYN_BYTES];
     syn_buffer(data, 0);
     tu_tmp_path("syn_ext.bin", bin, sizeof bin);
-    write_bytes(bin, data, SYN_BYTES);
+    tu_write_bytes(bin, data, SYN_BYTES);
     tu_tmp_path("syn_ext.gltf", path, sizeof path);
     char *j = syn_json(0, "syn_ext.bin");
-    write_bytes(path, j, strlen(j));
+    tu_write_bytes(path, j, strlen(j));
     free(j);
     assert_int_equal(io_gltf_load(path, &m, &err), IO_OK);
     check_syn(&m, 0);
@@ -616,10 +577,10 @@ static void missing_and_empty_files(void **state)
     tu_tmp_path("does_not_exist.glb", path, sizeof path);
     expect_fail(path, IO_ERR_NOT_FOUND, NULL);
     tu_tmp_path("empty.gltf", path, sizeof path);
-    write_bytes(path, "", 0);
+    tu_write_bytes(path, "", 0);
     expect_fail(path, IO_ERR_FORMAT, NULL);
     tu_tmp_path("empty.glb", path, sizeof path);
-    write_bytes(path, "", 0);
+    tu_write_bytes(path, "", 0);
     expect_fail(path, IO_ERR_FORMAT, NULL);
 
     kin_model m;
@@ -635,17 +596,17 @@ static void truncated_glb(void **state)
     size_t n;
     tu_tmp_path("whole.glb", path, sizeof path);
     write_syn_glb(path, 0);
-    unsigned char *b = read_bytes(path, &n);
+    unsigned char *b = tu_read_file(path, &n);
     tu_tmp_path("half_syn.glb", cut, sizeof cut);
-    write_bytes(cut, b, n / 2);
+    tu_write_bytes(cut, b, n / 2);
     free(b);
     expect_fail(cut, IO_ERR_FORMAT, NULL);
 
     if (!shared_model("gltf/RiggedSimple/RiggedSimple.glb", path, sizeof path))
         return;
-    b = read_bytes(path, &n);
+    b = tu_read_file(path, &n);
     tu_tmp_path("half_rigged.glb", cut, sizeof cut);
-    write_bytes(cut, b, n / 2);
+    tu_write_bytes(cut, b, n / 2);
     free(b);
     expect_fail(cut, IO_ERR_FORMAT, NULL);
 }
@@ -657,12 +618,12 @@ static void corrupt_json(void **state)
     char *j = syn_json(0, "x.bin");
     j[strlen(j) * 2 / 3] = '\0';
     tu_tmp_path("corrupt.gltf", path, sizeof path);
-    write_bytes(path, j, strlen(j));
+    tu_write_bytes(path, j, strlen(j));
     free(j);
     expect_fail(path, IO_ERR_FORMAT, NULL);
 
     tu_tmp_path("garbage.gltf", path, sizeof path);
-    write_bytes(path, "\x01\x02garbage{{", 11);
+    tu_write_bytes(path, "\x01\x02garbage{{", 11);
     expect_fail(path, IO_ERR_FORMAT, NULL);
 }
 
@@ -673,7 +634,7 @@ static void json_without_meshes(void **state)
     tu_tmp_path("nomesh.gltf", path, sizeof path);
     const char *j = "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"name\":\"a\"}],"
                     "\"scenes\":[{\"nodes\":[0]}]}";
-    write_bytes(path, j, strlen(j));
+    tu_write_bytes(path, j, strlen(j));
     expect_fail(path, IO_ERR_MISSING, "no triangle primitives");
 
     /* only a LINES primitive: nothing drawable */
@@ -716,7 +677,7 @@ static void flipped_bytes_never_crash(void **state)
     size_t n;
     tu_tmp_path("flip_src.glb", path, sizeof path);
     write_syn_glb(path, 0);
-    unsigned char *orig = read_bytes(path, &n);
+    unsigned char *orig = tu_read_file(path, &n);
     unsigned char *b = malloc(n);
     assert_non_null(b);
     tu_rng rng = {0x5eedf11bull};
@@ -729,7 +690,7 @@ static void flipped_bytes_never_crash(void **state)
             const int at = tu_int(&rng, (int)n);   /* drawn in order (tu_kin.h) */
             b[at] ^= (unsigned char)(1 + tu_int(&rng, 255));
         }
-        write_bytes(path, b, n);
+        tu_write_bytes(path, b, n);
         kin_model m;
         io_error err;
         if (io_gltf_load(path, &m, &err) == IO_OK) {

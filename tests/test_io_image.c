@@ -2,6 +2,7 @@
  * type conversion, errors, and the atomic write (temp file + rename). */
 #include "support/testutil.h"
 #include <cmocka.h>
+#include "support/files.h"
 
 #include <dirent.h>
 #include <math.h>
@@ -11,6 +12,7 @@
 #include <unistd.h>
 
 #include "../src/io/io.h"
+#include "support/io_images.h"
 
 static void fill_random(io_image *img, tu_rng *rng)
 {
@@ -29,18 +31,6 @@ static void fill_random(io_image *img, tu_rng *rng)
     }
 }
 
-static void assert_same_pixels(const io_image *a, const io_image *b)
-{
-    assert_int_equal(a->width, b->width);
-    assert_int_equal(a->height, b->height);
-    assert_int_equal(a->channels, b->channels);
-    assert_int_equal(a->type, b->type);
-    size_t row = (size_t)a->width * (size_t)a->channels * (a->type == IO_F32 ? 4 : 1);
-    for (int y = 0; y < a->height; y++)
-        assert_memory_equal((const unsigned char *)a->data + (size_t)y * a->stride,
-                            (const unsigned char *)b->data + (size_t)y * b->stride, row);
-}
-
 static void round_trip(const char *name, int w, int h, int ch, io_type t,
                        uint64_t seed)
 {
@@ -57,11 +47,11 @@ static void round_trip(const char *name, int w, int h, int ch, io_type t,
     r = io_image_load(path, t, 0, &back, &err);
     if (r != IO_OK) fprintf(stderr, "%s\n", err.msg);
     assert_int_equal(r, IO_OK);
-    assert_same_pixels(&img, &back);
+    tu_same_image(&img, &back);
     io_image_free(&back);
     /* asking for the same channel count explicitly gives the same bytes */
     assert_int_equal(io_image_load(path, t, ch, &back, &err), IO_OK);
-    assert_same_pixels(&img, &back);
+    tu_same_image(&img, &back);
     io_image_free(&back);
     io_image_free(&img);
     assert_null(img.data);
@@ -214,7 +204,7 @@ static void padded_stride_is_honoured(void **state)
     view.width = 7;  /* a 7-pixel view of 10-pixel rows */
     assert_int_equal(io_image_save(path, &view, &err), IO_OK);
     assert_int_equal(io_image_load(path, IO_U8, 3, &back, &err), IO_OK);
-    assert_same_pixels(&view, &back);
+    tu_same_image(&view, &back);
     io_image_free(&back);
     io_image_free(&big);
 }
@@ -258,14 +248,6 @@ static int temp_files_in(const char *dir)
     return n;
 }
 
-static void write_text(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
 static int file_is(const char *path, const char *text)
 {
     FILE *f = fopen(path, "rb");
@@ -301,7 +283,7 @@ static void save_errors_leave_files_untouched(void **state)
 
     /* an existing file and a bad image: untouched */
     snprintf(path, sizeof path, "%s/keep.png", dir);
-    write_text(path, "precious");
+    tu_write_text(path, "precious");
     io_image bad = img;
     bad.channels = 0;
     assert_int_equal(io_image_save(path, &bad, &err), IO_ERR_ARGS);
@@ -318,7 +300,7 @@ static void save_errors_leave_files_untouched(void **state)
     snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
     assert_int_equal(mkdir(tmp, 0777), 0);
     snprintf(sub, sizeof sub, "%s/x", tmp);
-    write_text(sub, "x");
+    tu_write_text(sub, "x");
     assert_int_equal(io_image_save(path, &img, &err), IO_ERR_WRITE);
     assert_true(file_is(path, "precious"));
     remove(sub);
@@ -329,7 +311,7 @@ static void save_errors_leave_files_untouched(void **state)
     snprintf(path, sizeof path, "%s/folder.png", dir);
     assert_int_equal(mkdir(path, 0777), 0);
     snprintf(sub, sizeof sub, "%s/x", path);
-    write_text(sub, "x");
+    tu_write_text(sub, "x");
     assert_int_equal(io_image_save(path, &img, &err), IO_ERR_WRITE);
     assert_non_null(strstr(err.msg, "folder.png"));
     assert_int_equal(temp_files_in(dir), 0);

@@ -5,6 +5,7 @@
  * leaves no file). */
 #include "support/testutil.h"
 #include <cmocka.h>
+#include "support/files.h"
 
 #include <math.h>
 #include <signal.h>
@@ -15,21 +16,13 @@
 
 #include "../src/io/io_live.h"
 
-static void write_text(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
 static void conf_options(void **state)
 {
     (void)state;
     char path[512], dir[512];
     tu_tmp_path("cockpit.conf", path, sizeof path);
     snprintf(dir, sizeof dir, "%.*s", (int)(strrchr(path, '/') - path), path);
-    write_text(path,
+    tu_write_text(path,
                "# a cockpit\n"
                "scene = samples/scene.txt   # relative to this file\n"
                "display = kms,connector=HDMI-A-1\n"
@@ -107,7 +100,7 @@ static void conf_errors(void **state)
     char path[512];
     tu_tmp_path("bad.conf", path, sizeof path);
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        write_text(path, cases[i].text);
+        tu_write_text(path, cases[i].text);
         io_conf_args a;
         io_error err;
         assert_int_not_equal(io_conf_load(path, &a, &err), IO_OK);

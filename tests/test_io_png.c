@@ -5,10 +5,12 @@
 #include "support/testutil.h"
 
 #include <cmocka.h>
+#include "support/files.h"
 #include <stdlib.h>
 #include <string.h>
 
 #include "../src/io/io.h"
+#include "support/io_images.h"
 
 static int have_ffmpeg(void)
 {
@@ -20,34 +22,6 @@ static int sh(const char *cmd)
     int rc = system(cmd);
     if (rc != 0) fprintf(stderr, "failed (%d): %s\n", rc, cmd);
     return rc;
-}
-
-/* Whole file into a malloc'ed buffer. */
-static unsigned char *slurp(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    unsigned char *b = malloc((size_t)len + 1);
-    assert_non_null(b);
-    assert_int_equal(fread(b, 1, (size_t)len, f), (size_t)len);
-    fclose(f);
-    *n = (size_t)len;
-    return b;
-}
-
-static void same_image(const io_image *a, const io_image *b)
-{
-    assert_int_equal(a->width, b->width);
-    assert_int_equal(a->height, b->height);
-    assert_int_equal(a->channels, b->channels);
-    assert_int_equal(a->type, b->type);
-    size_t row = (size_t)a->width * (size_t)a->channels * (a->type == IO_F32 ? 4 : 1);
-    for (int y = 0; y < a->height; y++)
-        assert_memory_equal((const unsigned char *)a->data + (size_t)y * a->stride,
-                            (const unsigned char *)b->data + (size_t)y * b->stride, row);
 }
 
 /* Ours against the OpenImageIO plugin on one file, every conversion. */
@@ -65,7 +39,7 @@ static void same_as_oiio(const char *path)
             unsetenv("EGOFUSE_IMAGE");
             if (r != IO_OK) fprintf(stderr, "%s\n", err.msg);
             assert_int_equal(r, IO_OK);
-            same_image(&a, &b);
+            tu_same_image(&a, &b);
             io_image_free(&a);
             io_image_free(&b);
         }
@@ -107,7 +81,7 @@ static void reads_what_ffmpeg_writes(void **state)
                  kinds[k].bits == 16 ? "rgba64le" : "rgba", raw);
         assert_int_equal(sh(cmd), 0);
         size_t n;
-        unsigned char *want = slurp(raw, &n);
+        unsigned char *want = tu_read_file(raw, &n);
         assert_int_equal(n, (size_t)W * H * 4 * (kinds[k].bits / 8));
         io_image img;
         io_error err;
@@ -177,7 +151,7 @@ static void ffmpeg_reads_what_we_write(void **state)
                          path, fmts[ch], raw);
                 assert_int_equal(sh(cmd), 0);
                 size_t got;
-                unsigned char *r = slurp(raw, &got);
+                unsigned char *r = tu_read_file(raw, &got);
                 assert_int_equal(got, n);
                 assert_memory_equal(r, expect, n);
                 free(r);
@@ -216,7 +190,7 @@ static void float_conversion_matches_oiio(void **state)
     io_image x, y;
     assert_int_equal(io_image_load(a, IO_U8, 0, &x, &err), IO_OK);
     assert_int_equal(io_image_load(b, IO_U8, 0, &y, &err), IO_OK);
-    same_image(&x, &y);
+    tu_same_image(&x, &y);
     io_image_free(&x);
     io_image_free(&y);
     io_image_free(&img);
@@ -235,7 +209,7 @@ static void truncated_png_says_so(void **state)
     assert_int_equal(io_image_save(path, &img, &err), IO_OK);
     io_image_free(&img);
     size_t n;
-    unsigned char *b = slurp(path, &n);
+    unsigned char *b = tu_read_file(path, &n);
     FILE *f = fopen(path, "wb");
     assert_non_null(f);
     assert_int_equal(fwrite(b, 1, n / 2, f), n / 2);

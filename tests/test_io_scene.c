@@ -3,6 +3,7 @@
  * optional `tracking` key. */
 #include "support/testutil.h"
 #include <cmocka.h>
+#include "support/files.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -10,14 +11,6 @@
 #include <unistd.h>
 
 #include "../src/io/io.h"
-
-static void write_text(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
 
 static const char *full_scene =
     "egofuse-scene 1\n"
@@ -52,7 +45,7 @@ static void full_file_parses(void **state)
     snprintf(cmd, sizeof cmd, "mkdir -p '%s'", dir);
     assert_int_equal(system(cmd), 0);
     snprintf(path, sizeof path, "%s/scene.txt", dir);
-    write_text(path, full_scene);
+    tu_write_text(path, full_scene);
 
     io_scene s;
     io_error err;
@@ -116,7 +109,7 @@ static void minimal_file_and_lighting_defaults(void **state)
         "camera_right=r%d.png\n"
         "virtual_left=vl%d.png\n"
         "virtual_right=vr%d.png\n";
-    write_text(path, base);
+    tu_write_text(path, base);
     assert_int_equal(io_scene_load(path, &s, &err), IO_OK);
     assert_int_equal(s.has_lighting, 0);
     assert_int_equal(s.light_count, 0);
@@ -126,7 +119,7 @@ static void minimal_file_and_lighting_defaults(void **state)
     /* one lighting key: the rest takes fuse_lighting_default()'s values */
     char text[1024];
     snprintf(text, sizeof text, "%sks = 0.5\n", base);
-    write_text(path, text);
+    tu_write_text(path, text);
     assert_int_equal(io_scene_load(path, &s, &err), IO_OK);
     assert_int_equal(s.has_lighting, 1);
     assert_true(s.ks == 0.5f);
@@ -152,7 +145,7 @@ static void relative_scene_path(void **state)
     assert_non_null(getcwd(cwd, sizeof cwd));
     tu_tmp_path("", path, sizeof path);
     assert_int_equal(chdir(path), 0);
-    write_text("local_scene.txt",
+    tu_write_text("local_scene.txt",
                "egofuse-scene 1\nmodel = a.glb\nframes = 2\nfps = 1e1\n"
                "camera_left = x/%d.png\ncamera_right = y/%d.png\n"
                "virtual_left = %%_%d.png\nvirtual_right = v%d.png\n");
@@ -220,7 +213,7 @@ static void errors_name_file_and_line(void **state)
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         char text[2048], want[64];
         snprintf(text, sizeof text, "%s%s", head, cases[i].line);
-        write_text(path, text);
+        tu_write_text(path, text);
         io_scene s;
         io_error err;
         memset(&s, 0x33, sizeof s);
@@ -253,7 +246,7 @@ static void frames_and_fps_checks(void **state)
                  "camera_left = l%%d.png\ncamera_right = r%%d.png\n"
                  "virtual_left = vl%%d.png\nvirtual_right = vr%%d.png\n",
                  bad_values[i], is_frames ? "fps = 30" : "frames = 3");
-        write_text(path, text);
+        tu_write_text(path, text);
         io_scene s;
         io_error err;
         io_result r = io_scene_load(path, &s, &err);
@@ -274,14 +267,14 @@ static void header_and_file_errors(void **state)
         "\negofuse-scene 1\n", "",
     };
     for (size_t i = 0; i < sizeof headers / sizeof headers[0]; i++) {
-        write_text(path, headers[i]);
+        tu_write_text(path, headers[i]);
         assert_int_equal(io_scene_load(path, &s, &err), IO_ERR_FORMAT);
         assert_non_null(strstr(err.msg, "hdr.txt:1: "));
     }
     /* nine lights */
     char text[2048] = "egofuse-scene 1\n";
     for (int i = 0; i < 9; i++) strcat(text, "light = 0 1 0 1 1 1\n");
-    write_text(path, text);
+    tu_write_text(path, text);
     assert_int_equal(io_scene_load(path, &s, &err), IO_ERR_VALUE);
     assert_non_null(strstr(err.msg, "hdr.txt:10: "));
 
@@ -309,12 +302,12 @@ static void tracking_key(void **state)
         "camera_right = r%d.png\n"
         "virtual_left = vl%d.png\n"
         "virtual_right = vr%d.png\n";
-    write_text(path, base);
+    tu_write_text(path, base);
     assert_int_equal(io_scene_load(path, &s, &err), IO_OK);
     assert_string_equal(s.tracking, "");
 
     snprintf(text, sizeof text, "%stracking = rec/track.txt   # the true motion\n", base);
-    write_text(path, text);
+    tu_write_text(path, text);
     io_result r = io_scene_load(path, &s, &err);
     if (r != IO_OK) fprintf(stderr, "%s\n", err.msg);
     assert_int_equal(r, IO_OK);
@@ -326,7 +319,7 @@ static void tracking_key(void **state)
 
     /* a literal percent sign */
     snprintf(text, sizeof text, "%stracking = /abs/100%%%%.txt\n", base);
-    write_text(path, text);
+    tu_write_text(path, text);
     assert_int_equal(io_scene_load(path, &s, &err), IO_OK);
     assert_string_equal(s.tracking, "/abs/100%%.txt");
     io_scene_frame_path(&s, s.tracking, 7, out, sizeof out);
@@ -342,7 +335,7 @@ static void tracking_key(void **state)
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         snprintf(text, sizeof text, "%s%s", base, bad[i].line);
-        write_text(path, text);
+        tu_write_text(path, text);
         r = io_scene_load(path, &s, &err);
         if (r != bad[i].code || !strstr(err.msg, bad[i].needle))
             fprintf(stderr, "case %zu: %s: %s\n", i, io_result_str(r), err.msg);

@@ -5,6 +5,7 @@
  * pose kept and reported. */
 #include "support/testutil.h"
 #include <cmocka.h>
+#include "support/files.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -26,14 +27,6 @@ static kin_track_sample sample_at(double t, float x)
     return s;
 }
 
-static void write_text(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
-
 /* ------------------------------------------------------------ validity */
 
 static void validity_file_errors(void **state)
@@ -41,7 +34,7 @@ static void validity_file_errors(void **state)
     (void)state;
     char path[512];
     tu_tmp_path("bad_track.txt", path, sizeof path);
-    write_text(path, "egofuse-track 1\nt 0 SL 0 1 0\nt 0.1 SL 0 1\n");
+    tu_write_text(path, "egofuse-track 1\nt 0 SL 0 1 0\nt 0.1 SL 0 1\n");
     kin_track_sample *s = NULL;
     int n = -1;
     io_error err;
@@ -55,7 +48,7 @@ static void validity_file_errors(void **state)
     assert_int_equal(io_track_load(path, &s, &n, &err), IO_ERR_NOT_FOUND);
 
     tu_tmp_path("bad_calib.txt", path, sizeof path);
-    write_text(path, "egofuse-calib 1\narm_scale 1 1\nhand_scale 1 1\nshoulder_scale 7\n");
+    tu_write_text(path, "egofuse-calib 1\narm_scale 1 1\nhand_scale 1 1\nshoulder_scale 7\n");
     kin_user_calib c;
     assert_int_equal(io_user_calib_load(path, &c, &err), IO_ERR_FORMAT);
     snprintf(want, sizeof want, "%s:4:", path);

@@ -10,6 +10,7 @@
  * the VM (tests/vm, vm_devices vsrc). */
 #include "support/testutil.h"
 #include <cmocka.h>
+#include "support/files.h"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -75,21 +76,6 @@ static uint8_t *gen(const char *scenario, size_t *n)
     tu_root_path("tests/support/vstream_gen.py", script, sizeof script);
     snprintf(cmd, sizeof cmd, "python3 '%s' %s", script, scenario);
     return run_out(cmd, n);
-}
-
-static uint8_t *read_file(const char *path, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) fail_msg("%s: cannot open", path);
-    fseek(f, 0, SEEK_END);
-    long l = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    uint8_t *b = malloc((size_t)l + 1);
-    assert_non_null(b);
-    assert_int_equal(fread(b, 1, (size_t)l, f), (size_t)l);
-    fclose(f);
-    *n = (size_t)l;
-    return b;
 }
 
 /* A pipe: *wfd is the writer; the spec names the reader by /dev/fd. */
@@ -567,7 +553,7 @@ static io_vsrc *feed(const char *prefix, const char *path, int ew, int eh, int l
                      size_t chunk, io_vsrc_stat *s)
 {
     size_t n;
-    uint8_t *b = read_file(path, &n);
+    uint8_t *b = tu_read_file(path, &n);
     tpipe t;
     tpipe_open(&t, prefix);
     io_vsrc *v = open_src(t.spec, ew, eh, layout, NULL);
@@ -588,7 +574,7 @@ static io_vsrc *feed(const char *prefix, const char *path, int ew, int eh, int l
 static int compare_rgb(io_vsrc *v, const char *ref, int w, int h, int k, int tol, int *over)
 {
     size_t n, stride;
-    uint8_t *r = read_file(ref, &n);
+    uint8_t *r = tu_read_file(ref, &n);
     assert_true(n >= (size_t)(k + 1) * (size_t)w * (size_t)h * 3);
     const uint8_t *im = io_vsrc_eye(v, 0, &stride);
     assert_non_null(im);
@@ -712,7 +698,7 @@ static void test_raw_ffmpeg(void **st)
         assert_int_equal(s.frames + s.skipped, 3);
         /* compare both eyes with the reference's halves */
         size_t n, stride;
-        uint8_t *r = read_file(ref, &n);
+        uint8_t *r = tu_read_file(ref, &n);
         const uint8_t *fr = r + 2 * 128 * 48 * 3;
         int maxd = 0, over = 0;
         for (int e = 0; e < 2; e++) {

@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "../src/pipe/pipe.h"
+#include "support/pipe_frames.h"
 
 #define D2R 0.017453292519943295
 
@@ -118,6 +119,29 @@ static void presets(void **state)
     }
 }
 
+/* The preset `name` into *d and its geometry: check_geo, then the figures
+ * quoted in docs/kin.md, want = crop width, height, x0, y0, viewport
+ * width, height, x0, y0; note: printed as a NOTE. */
+static kin_sthmd_geometry preset_geo(const char *name, kin_sthmd_desc *d, const int want[8],
+                                     int note)
+{
+    assert_int_equal(kin_sthmd_preset(name, d), 0);
+    kin_sthmd_geometry g = kin_sthmd_geometry_of(d);
+    check_geo(d, &g);
+    const int got[8] = {g.crop_width, g.crop_height, g.crop_x0, g.crop_y0,
+                        g.vp_width,   g.vp_height,   g.vp_x0,   g.vp_y0};
+    static const char *const what[8] = {"crop_width", "crop_height", "crop_x0", "crop_y0",
+                                        "vp_width",   "vp_height",   "vp_x0",   "vp_y0"};
+    for (int i = 0; i < 8; i++)
+        if (got[i] != want[i]) fail_msg("%s: %s = %d, expected %d", name, what[i], got[i], want[i]);
+    if (note)
+        print_message("NOTE %s: crop %dx%d at (%d, %d), W1 %.1f mm, W2 %.1f mm, ratio %.4f, "
+                      "viewport %dx%d at (%d, %d)\n", name, g.crop_width, g.crop_height,
+                      g.crop_x0, g.crop_y0, g.w1_mm, g.w2_mm, g.ratio, g.vp_width, g.vp_height,
+                      g.vp_x0, g.vp_y0);
+    return g;
+}
+
 /* The three HMDs: eq. 1-4 from the equations, and the figures quoted in
  * docs/kin.md. */
 static void three_hmds(void **state)
@@ -126,37 +150,14 @@ static void three_hmds(void **state)
     kin_sthmd_desc d;
     kin_sthmd_geometry g;
     /* the paper: keeps the width, 640 x 400 at row 40; 1194 x 746 at (43, 27) */
-    assert_int_equal(kin_sthmd_preset("paper", &d), 0);
-    g = kin_sthmd_geometry_of(&d);
-    check_geo(&d, &g);
-    assert_int_equal(g.crop_width, 640);
-    assert_int_equal(g.crop_height, 400);
-    assert_int_equal(g.crop_x0, 0);
-    assert_int_equal(g.crop_y0, 40);
-    assert_int_equal(g.vp_width, 1194);
-    assert_int_equal(g.vp_height, 746);
-    assert_int_equal(g.vp_x0, 43);
-    assert_int_equal(g.vp_y0, 27);
+    g = preset_geo("paper", &d, (const int[8]){640, 400, 0, 40, 1194, 746, 43, 27}, 0);
     NEAR(g.ratio, 0.93335, 1e-5);
 
     /* consumer: keeping the width needs round(1280 * 2208 / 2064) = 1369
      * rows of 1024: the height is kept, the width cut to
      * round(1024 * 2064 / 2208) = 957 at column (1280 - 957) / 2 = 161 */
-    assert_int_equal(kin_sthmd_preset("consumer", &d), 0);
+    g = preset_geo("consumer", &d, (const int[8]){957, 1024, 161, 0, 1539, 1647, 262, 280}, 1);
     assert_true(d.lcd_height > d.lcd_width);
-    g = kin_sthmd_geometry_of(&d);
-    check_geo(&d, &g);
-    assert_int_equal(g.crop_width, 957);
-    assert_int_equal(g.crop_height, 1024);
-    assert_int_equal(g.crop_x0, 161);
-    assert_int_equal(g.crop_y0, 0);
-    assert_int_equal(g.vp_width, 1539);
-    assert_int_equal(g.vp_height, 1647);
-    assert_int_equal(g.vp_x0, 262);
-    assert_int_equal(g.vp_y0, 280);
-    print_message("NOTE consumer: crop %dx%d at (%d, %d), W1 %.1f mm, W2 %.1f mm, ratio %.4f, "
-                  "viewport %dx%d at (%d, %d)\n", g.crop_width, g.crop_height, g.crop_x0,
-                  g.crop_y0, g.w1_mm, g.w2_mm, g.ratio, g.vp_width, g.vp_height, g.vp_x0, g.vp_y0);
     /* the camera images the crop; its principal point is the sensor's centre */
     kin_camera c = kin_sthmd_camera(&d, NULL, KIN_EYE_LEFT);
     assert_int_equal(c.width, 957);
@@ -167,20 +168,7 @@ static void three_hmds(void **state)
 
     /* high-end: round(1920 * 2720 / 2880) = 1813 rows of 1080: the width is
      * cut to round(1080 * 2880 / 2720) = 1144 at column 388 */
-    assert_int_equal(kin_sthmd_preset("highend", &d), 0);
-    g = kin_sthmd_geometry_of(&d);
-    check_geo(&d, &g);
-    assert_int_equal(g.crop_width, 1144);
-    assert_int_equal(g.crop_height, 1080);
-    assert_int_equal(g.crop_x0, 388);
-    assert_int_equal(g.crop_y0, 0);
-    assert_int_equal(g.vp_width, 1891);
-    assert_int_equal(g.vp_height, 1786);
-    assert_int_equal(g.vp_x0, 494);
-    assert_int_equal(g.vp_y0, 467);
-    print_message("NOTE highend: crop %dx%d at (%d, %d), W1 %.1f mm, W2 %.1f mm, ratio %.4f, "
-                  "viewport %dx%d at (%d, %d)\n", g.crop_width, g.crop_height, g.crop_x0,
-                  g.crop_y0, g.w1_mm, g.w2_mm, g.ratio, g.vp_width, g.vp_height, g.vp_x0, g.vp_y0);
+    g = preset_geo("highend", &d, (const int[8]){1144, 1080, 388, 0, 1891, 1786, 494, 467}, 1);
 
     /* the same consumer display held landscape (2208x2064): the height is
      * cut instead, round(1280 * 2064 / 2208) = 1197 > 1024 still: width */
@@ -262,37 +250,7 @@ static kin_sthmd_desc small_desc(void)
 
 /* A head node at the origin and an unskinned quad [-s,s]^2 at depth z,
  * turned about +Y. */
-static void quad_model(kin_model *m, float s, float z)
-{
-    memset(m, 0, sizeof *m);
-    int16_t *parents = kin_block_alloc(&m->block, 2 * sizeof(int16_t));
-    kin_transform *rest = kin_block_alloc(&m->block, 2 * sizeof(kin_transform));
-    char(*names)[KIN_NAME_MAX] = kin_block_alloc(&m->block, 2 * KIN_NAME_MAX);
-    float *pos = kin_block_alloc(&m->block, 12 * sizeof(float));
-    float *nrm = kin_block_alloc(&m->block, 12 * sizeof(float));
-    uint32_t *idx = kin_block_alloc(&m->block, 6 * sizeof(uint32_t));
-    kin_mesh *mesh = kin_block_alloc(&m->block, sizeof(kin_mesh));
-    assert_non_null(mesh);
-    parents[0] = KIN_NO_PARENT;
-    parents[1] = 0;
-    rest[0] = rest[1] = kin_transform_identity();
-    rest[1].r = kin_quat_axis_angle(kin_v3(0, 1, 0), 0.3f);
-    strcpy(names[0], "head");
-    strcpy(names[1], "quad");
-    const float p[12] = {-s, -s, z, s, -s, z, s, s, z, -s, s, z};
-    memcpy(pos, p, sizeof p);
-    for (int i = 0; i < 4; i++) nrm[3 * i + 2] = 1.0f;
-    const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(idx, ix, sizeof ix);
-    *mesh = (kin_mesh){.vertex_count = 4, .positions = pos, .normals = nrm, .index_count = 6,
-                       .indices = idx, .node = 1, .skin = -1};
-    m->node_count = 2;
-    m->parents = parents;
-    m->rest = rest;
-    m->names = (const char(*)[KIN_NAME_MAX])names;
-    m->mesh_count = 1;
-    m->meshes = mesh;
-}
+static void quad_model(kin_model *m, float s, float z) { tu_quad_model(m, s, z, 0.3f, "quad"); }
 
 static void small_portrait_frame(void **state)
 {
@@ -351,37 +309,18 @@ static void small_portrait_frame(void **state)
 
     /* the stages by hand on the crop (columns 20..139) and the viewport */
     const int cw = g.crop_width, ch = g.crop_height;
-    float *depth = malloc(sizeof(float) * (size_t)cw * ch), *nrm = malloc(sizeof(float) * 3 * (size_t)cw * ch);
-    uint8_t *mask = malloc((size_t)cw * ch), *layer = malloc((size_t)4 * cw * ch);
+    tu_stages s;
+    tu_stages_make(&s, cw, ch);
     uint8_t *expect = malloc((size_t)LCDW * LCDH * 4);
     assert_non_null(expect);
     for (int e = 0; e < 2; e++) {
         kin_camera c = kin_sthmd_camera(&hd, &head, (kin_eye)e);
         assert_int_equal(c.width, cw);
         assert_int_equal(c.height, ch);
-        rast_target t = {cw, ch, depth, cw, mask, cw, nrm, cw * 3, 3};
-        rast_target_clear(&t);
-        float clip[16], vn[12], wpos[12], wn[12];
-        kin_mat4 qw = kin_mat4_from_transform(&m.rest[1]);
-        kin_mesh_transform(&m.meshes[0], &qw, wpos, wn);
-        rast_transform_points(c.view_proj.m, wpos, 4, clip);
-        rast_transform_dirs(c.view.m, wn, 4, vn);
-        rast_mesh_desc md = {clip, 4, vn, 3, m.meshes[0].indices, 2, RAST_CULL_NONE};
-        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
-        fuse_lighting L = fuse_lighting_default();
-        kin_vec3 ld = kin_v3_norm(kin_mat4_mul_dir(
-            &c.view, kin_v3(L.lights[0].dir[0], L.lights[0].dir[1], L.lights[0].dir[2])));
-        L.lights[0].dir[0] = ld.x;
-        L.lights[0].dir[1] = ld.y;
-        L.lights[0].dir[2] = ld.z;
-        fuse_intrinsics K = {c.fx, c.fy, c.cx, c.cy};
         fuse_image P = {cam[e] + 20 * 4, cw, ch, CAMW * 4};
-        fuse_image Q = {layer, cw, ch, cw * 4};
         fuse_image V = {virt[e], LCDW, LCDH, LCDW * 4};
         fuse_image R = {expect, LCDW, LCDH, LCDW * 4};
-        assert_int_equal(fuse_light(&L, &K, &P, mask, cw, nrm, cw * 3, &Q), FUSE_OK);
-        assert_int_equal(fuse_composite(&Q, &V, g.vp_x0, g.vp_y0, g.vp_width, g.vp_height, &R),
-                         FUSE_OK);
+        tu_quad_stages(&m, &c, &s, &P, &V, g.vp_x0, g.vp_y0, g.vp_width, g.vp_height, &R);
         assert_memory_equal(expect, out[0][e], (size_t)LCDW * LCDH * 4);
         long differs = 0;
         for (int y = 0; y < LCDH; y++)
@@ -397,10 +336,7 @@ static void small_portrait_frame(void **state)
         /* the hand is in the output */
         assert_true(differs > (long)(0.05 * g.vp_width * g.vp_height));
     }
-    free(depth);
-    free(nrm);
-    free(mask);
-    free(layer);
+    tu_stages_free(&s);
     free(expect);
     for (int e = 0; e < 2; e++) {
         free(cam[e]);

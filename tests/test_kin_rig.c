@@ -23,6 +23,7 @@
 
 #include "../src/io/io.h"
 #include "../src/kin/kin.h"
+#include "support/sample_model.h"
 
 static kin_model g_model;
 static int g_loaded;
@@ -33,15 +34,10 @@ static int group_setup(void **state)
 {
     (void)state;
     char dir[1024], path[1200];
-    int r = tu_samples_dir("rig_samples", 3, dir, sizeof dir, g_skip, sizeof g_skip);
+    int r = tu_sample_model_load("rig_samples", 3, &g_model, dir, sizeof dir, path, sizeof path,
+                                 g_skip, sizeof g_skip);
     if (r <= 0) return r;
-    snprintf(path, sizeof path, "%s/model/arms.glb", dir);
     snprintf(g_track, sizeof g_track, "%s/track.txt", dir);
-    io_error err;
-    if (io_gltf_load(path, &g_model, &err) != IO_OK) {
-        fprintf(stderr, "%s\n", err.msg);
-        return -1;
-    }
     g_loaded = 1;
     return 0;
 }
@@ -49,18 +45,11 @@ static int group_setup(void **state)
 static int group_teardown(void **state)
 {
     (void)state;
-    if (g_loaded) kin_model_free(&g_model);
-    tu_samples_remove("rig_samples");
+    tu_sample_model_free("rig_samples", &g_model, g_loaded);
     return 0;
 }
 
-#define NEED_MODEL()                                                        \
-    do {                                                                    \
-        if (!g_loaded) {                                                    \
-            print_message("%s\n", g_skip);                                 \
-            skip();                                                         \
-        }                                                                   \
-    } while (0)
+#define NEED_MODEL() TU_NEED_MODEL(g_loaded, g_skip)
 
 static kin_vec3 wpos(const kin_mat4 *m) { return kin_v3(m->m[12], m->m[13], m->m[14]); }
 

@@ -18,64 +18,22 @@
 #include <string.h>
 
 #include "../src/pipe/pipe.h"
+#include "support/pipe_frames.h"
 #include "support/pipe_testrig.h"
 
 /* A model of one node ("head" at the origin) and one unskinned quad
  * [-s,s]^2 at depth z (metres, in front of the head), normals +Z. */
-static void quad_model(kin_model *m, float s, float z)
-{
-    memset(m, 0, sizeof *m);
-    int16_t *parents = kin_block_alloc(&m->block, 2 * sizeof(int16_t));
-    kin_transform *rest = kin_block_alloc(&m->block, 2 * sizeof(kin_transform));
-    char(*names)[KIN_NAME_MAX] = kin_block_alloc(&m->block, 2 * KIN_NAME_MAX);
-    float *pos = kin_block_alloc(&m->block, 12 * sizeof(float));
-    float *nrm = kin_block_alloc(&m->block, 12 * sizeof(float));
-    uint32_t *idx = kin_block_alloc(&m->block, 6 * sizeof(uint32_t));
-    kin_mesh *mesh = kin_block_alloc(&m->block, sizeof(kin_mesh));
-    assert_non_null(mesh);
-    parents[0] = KIN_NO_PARENT;
-    parents[1] = 0;
-    rest[0] = rest[1] = kin_transform_identity();
-    strcpy(names[0], "head");
-    strcpy(names[1], "quad");
-    const float p[12] = {-s, -s, z, s, -s, z, s, s, z, -s, s, z};
-    memcpy(pos, p, sizeof p);
-    for (int i = 0; i < 4; i++) nrm[3 * i + 2] = 1.0f;
-    const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(idx, ix, sizeof ix);
-    *mesh = (kin_mesh){.vertex_count = 4, .positions = pos, .normals = nrm,
-                       .index_count = 6, .indices = idx, .node = 1, .skin = -1};
-    m->node_count = 2;
-    m->parents = parents;
-    m->rest = rest;
-    m->names = (const char(*)[KIN_NAME_MAX])names;
-    m->mesh_count = 1;
-    m->meshes = mesh;
-    char why[200];
-    assert_int_equal(kin_model_validate(m, why, sizeof why), 0);
-}
+static void quad_model(kin_model *m, float s, float z) { tu_quad_model(m, s, z, 0.0f, "quad"); }
 
 /* A model like quad_model but tessellated as an n x n grid of vertices
  * (unskinned), large enough for the pipe to split the skinning. */
 static void grid_model(kin_model *m, int n, float s, float z)
 {
-    memset(m, 0, sizeof *m);
     int nv = n * n, nt = 2 * (n - 1) * (n - 1);
-    int16_t *parents = kin_block_alloc(&m->block, 2 * sizeof(int16_t));
-    kin_transform *rest = kin_block_alloc(&m->block, 2 * sizeof(kin_transform));
-    char(*names)[KIN_NAME_MAX] = kin_block_alloc(&m->block, 2 * KIN_NAME_MAX);
-    float *pos = kin_block_alloc(&m->block, 3 * sizeof(float) * (size_t)nv);
-    float *nrm = kin_block_alloc(&m->block, 3 * sizeof(float) * (size_t)nv);
-    uint32_t *idx = kin_block_alloc(&m->block, 3 * sizeof(uint32_t) * (size_t)nt);
-    kin_mesh *mesh = kin_block_alloc(&m->block, sizeof(kin_mesh));
-    assert_non_null(mesh);
-    parents[0] = KIN_NO_PARENT;
-    parents[1] = 0;
-    rest[0] = kin_transform_identity();
-    rest[1] = kin_transform_identity();
-    rest[1].r = kin_quat_axis_angle(kin_v3(1, 0, 0), 0.3f); /* tilted: varied normals */
-    strcpy(names[0], "head");
-    strcpy(names[1], "grid");
+    tu_mesh_parts g = tu_mesh_model(m, "head", "grid", nv, 3 * nt, 1);
+    g.rest[1].r = kin_quat_axis_angle(kin_v3(1, 0, 0), 0.3f); /* tilted: varied normals */
+    float *pos = g.pos, *nrm = g.nrm;
+    uint32_t *idx = g.idx;
     for (int y = 0; y < n; y++)
         for (int x = 0; x < n; x++) {
             float *p = pos + 3 * (y * n + x);
@@ -91,19 +49,9 @@ static void grid_model(kin_model *m, int n, float s, float z)
             idx[k++] = a; idx[k++] = b; idx[k++] = d;
             idx[k++] = a; idx[k++] = d; idx[k++] = c;
         }
-    *mesh = (kin_mesh){.vertex_count = nv, .positions = pos, .normals = nrm,
-                       .index_count = 3 * nt, .indices = idx, .node = 1, .skin = -1};
-    m->node_count = 2;
-    m->parents = parents;
-    m->rest = rest;
-    m->names = (const char(*)[KIN_NAME_MAX])names;
-    m->mesh_count = 1;
-    m->meshes = mesh;
 }
 
-typedef struct frame_bufs {
-    uint8_t *cam[2], *virt[2], *out[2];
-} frame_bufs;
+typedef tu_frame_bufs frame_bufs;
 
 static void fill_random(uint8_t *p, size_t n, tu_rng *r)
 {
@@ -112,32 +60,10 @@ static void fill_random(uint8_t *p, size_t n, tu_rng *r)
 
 static void make_frame(frame_bufs *b, pipe_frame_in *in, uint64_t seed)
 {
-    tu_rng r = {seed};
-    memset(in, 0, sizeof *in);
-    for (int e = 0; e < 2; e++) {
-        b->cam[e] = malloc(640 * 480 * 4);
-        b->virt[e] = malloc(1280 * 800 * 4);
-        b->out[e] = malloc(1280 * 800 * 4);
-        assert_non_null(b->out[e]);
-        fill_random(b->cam[e], 640 * 480 * 4, &r);
-        fill_random(b->virt[e], 1280 * 800 * 4, &r);
-        memset(b->out[e], 0xAB, 1280 * 800 * 4);
-        in->camera[e] = (fuse_image){b->cam[e], 640, 480, 640 * 4};
-        in->virt[e] = (fuse_image){b->virt[e], 1280, 800, 1280 * 4};
-        in->out[e] = (fuse_image){b->out[e], 1280, 800, 1280 * 4};
-    }
-    in->head_node = 0;
-    in->lighting = pipe_lighting_default();
+    tu_frame_make(b, in, seed, 640, 480, 1280, 800);
 }
 
-static void free_frame(frame_bufs *b)
-{
-    for (int e = 0; e < 2; e++) {
-        free(b->cam[e]);
-        free(b->virt[e]);
-        free(b->out[e]);
-    }
-}
+static void free_frame(frame_bufs *b) { tu_frame_free(b); }
 
 /* The pipe equals the stages called by hand: camera of each eye, raster of
  * the cropped 640x400 view, lights turned into view space, lighting of rows
@@ -166,38 +92,22 @@ static void frame_equals_stages(void **state)
 
     kin_sthmd_geometry g = kin_sthmd_geometry_of(NULL);
     assert_int_equal(g.crop_y0, 40);
-    static float depth[640 * 400], nrm[640 * 400 * 3];
-    static uint8_t mask[640 * 400], layer[640 * 400 * 4];
+    tu_stages s;
+    tu_stages_make(&s, 640, 400);
     uint8_t *expect = malloc(1280 * 800 * 4);
     for (int e = 0; e < 2; e++) {
         kin_camera cam = kin_sthmd_camera(NULL, &head, (kin_eye)e);
         kin_camera pc = pipe_camera(p, e);
         assert_memory_equal(&cam.view_proj, &pc.view_proj, sizeof cam.view_proj);
-        rast_target t = {640, 400, depth, 640, mask, 640, nrm, 640 * 3, 3};
-        rast_target_clear(&t);
-        float clip[16], vn[12], wpos[12];
-        memcpy(wpos, m.meshes[0].positions, sizeof wpos);
-        rast_transform_points(cam.view_proj.m, wpos, 4, clip);
-        rast_transform_dirs(cam.view.m, m.meshes[0].normals, 4, vn);
-        rast_mesh_desc md = {clip, 4, vn, 3, m.meshes[0].indices, 2, RAST_CULL_NONE};
-        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
-        int mw, mh;
-        assert_memory_equal(pipe_mask(p, e, &mw, &mh), mask, sizeof mask);
-        fuse_lighting L = fuse_lighting_default();
-        kin_vec3 ld = kin_v3_norm(kin_mat4_mul_dir(
-            &cam.view, kin_v3(L.lights[0].dir[0], L.lights[0].dir[1], L.lights[0].dir[2])));
-        L.lights[0].dir[0] = ld.x;
-        L.lights[0].dir[1] = ld.y;
-        L.lights[0].dir[2] = ld.z;
-        fuse_intrinsics K = {cam.fx, cam.fy, cam.cx, cam.cy};
         fuse_image P = {b.cam[e] + 40 * 640 * 4, 640, 400, 640 * 4};
-        fuse_image Q = {layer, 640, 400, 640 * 4};
         fuse_image V = {b.virt[e], 1280, 800, 1280 * 4};
         fuse_image R = {expect, 1280, 800, 1280 * 4};
-        assert_int_equal(fuse_light(&L, &K, &P, mask, 640, nrm, 640 * 3, &Q), FUSE_OK);
-        assert_int_equal(fuse_composite(&Q, &V, 43, 27, 1194, 746, &R), FUSE_OK);
+        tu_quad_stages(&m, &cam, &s, &P, &V, 43, 27, 1194, 746, &R);
+        int mw, mh;
+        assert_memory_equal(pipe_mask(p, e, &mw, &mh), s.mask, 640 * 400);
         assert_memory_equal(expect, b.out[e], 1280 * 800 * 4);
     }
+    tu_stages_free(&s);
     free(expect);
     free_frame(&b);
     pipe_destroy(p);

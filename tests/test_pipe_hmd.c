@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "../src/pipe/pipe.h"
+#include "support/pipe_frames.h"
 
 enum { CAMW = 1280, CAMH = 720, LCDW = 1440, LCDH = 1600 };
 #define D2R 0.017453292519943295
@@ -46,37 +47,7 @@ static kin_sthmd_desc vr_desc(void)
 }
 
 /* A head node at the origin and an unskinned quad [-s,s]^2 at depth z. */
-static void quad_model(kin_model *m, float s, float z)
-{
-    memset(m, 0, sizeof *m);
-    int16_t *parents = kin_block_alloc(&m->block, 2 * sizeof(int16_t));
-    kin_transform *rest = kin_block_alloc(&m->block, 2 * sizeof(kin_transform));
-    char(*names)[KIN_NAME_MAX] = kin_block_alloc(&m->block, 2 * KIN_NAME_MAX);
-    float *pos = kin_block_alloc(&m->block, 12 * sizeof(float));
-    float *nrm = kin_block_alloc(&m->block, 12 * sizeof(float));
-    uint32_t *idx = kin_block_alloc(&m->block, 6 * sizeof(uint32_t));
-    kin_mesh *mesh = kin_block_alloc(&m->block, sizeof(kin_mesh));
-    assert_non_null(mesh);
-    parents[0] = KIN_NO_PARENT;
-    parents[1] = 0;
-    rest[0] = rest[1] = kin_transform_identity();
-    rest[1].r = kin_quat_axis_angle(kin_v3(0, 1, 0), 0.4f);
-    strcpy(names[0], "head");
-    strcpy(names[1], "quad");
-    const float p[12] = {-s, -s, z, s, -s, z, s, s, z, -s, s, z};
-    memcpy(pos, p, sizeof p);
-    for (int i = 0; i < 4; i++) nrm[3 * i + 2] = 1.0f;
-    const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(idx, ix, sizeof ix);
-    *mesh = (kin_mesh){.vertex_count = 4, .positions = pos, .normals = nrm, .index_count = 6,
-                       .indices = idx, .node = 1, .skin = -1};
-    m->node_count = 2;
-    m->parents = parents;
-    m->rest = rest;
-    m->names = (const char(*)[KIN_NAME_MAX])names;
-    m->mesh_count = 1;
-    m->meshes = mesh;
-}
+static void quad_model(kin_model *m, float s, float z) { tu_quad_model(m, s, z, 0.4f, "quad"); }
 
 /* Eq. 1-4 for vr_desc, from the equations (docs/kin.md). */
 static void geometry_numbers(void **state)
@@ -160,38 +131,14 @@ static void cameras_and_eyes(void **state)
     NEAR(r.ipd_m, 0.065f, 0);
 }
 
-typedef struct bufs {
-    uint8_t *cam[2], *virt[2], *out[2];
-} bufs;
+typedef tu_frame_bufs bufs;
 
 static void bufs_make(bufs *b, pipe_frame_in *in, uint64_t seed)
 {
-    tu_rng r = {seed};
-    memset(in, 0, sizeof *in);
-    for (int e = 0; e < 2; e++) {
-        b->cam[e] = malloc((size_t)CAMW * CAMH * 4);
-        b->virt[e] = malloc((size_t)LCDW * LCDH * 4);
-        b->out[e] = malloc((size_t)LCDW * LCDH * 4);
-        assert_non_null(b->out[e]);
-        for (size_t i = 0; i < (size_t)CAMW * CAMH * 4; i++) b->cam[e][i] = (uint8_t)tu_next(&r);
-        for (size_t i = 0; i < (size_t)LCDW * LCDH * 4; i++) b->virt[e][i] = (uint8_t)tu_next(&r);
-        memset(b->out[e], 0xAB, (size_t)LCDW * LCDH * 4);
-        in->camera[e] = (fuse_image){b->cam[e], CAMW, CAMH, CAMW * 4};
-        in->virt[e] = (fuse_image){b->virt[e], LCDW, LCDH, LCDW * 4};
-        in->out[e] = (fuse_image){b->out[e], LCDW, LCDH, LCDW * 4};
-    }
-    in->head_node = 0;
-    in->lighting = pipe_lighting_default();
+    tu_frame_make(b, in, seed, CAMW, CAMH, LCDW, LCDH);
 }
 
-static void bufs_free(bufs *b)
-{
-    for (int e = 0; e < 2; e++) {
-        free(b->cam[e]);
-        free(b->virt[e]);
-        free(b->out[e]);
-    }
-}
+static void bufs_free(bufs *b) { tu_frame_free(b); }
 
 /* pipe_frame with vr_desc equals its stages called by hand. */
 static void frame_end_to_end(void **state)
@@ -221,9 +168,8 @@ static void frame_end_to_end(void **state)
     if (pipe_frame(p, &in, &st, why, sizeof why) != PIPE_OK) fail_msg("pipe_frame: %s", why);
     assert_true(st.coverage[0] > 0.02 && st.coverage[0] < 0.6);
 
-    const int cw = g.crop_width, ch = g.crop_height;
-    float *depth = malloc(sizeof(float) * (size_t)cw * ch), *nrm = malloc(sizeof(float) * 3 * (size_t)cw * ch);
-    uint8_t *mask = malloc((size_t)cw * ch), *layer = malloc((size_t)4 * cw * ch);
+    tu_stages s;
+    tu_stages_make(&s, g.crop_width, g.crop_height);
     uint8_t *expect = malloc((size_t)LCDW * LCDH * 4);
     for (int e = 0; e < 2; e++) {
         int mw, mh;
@@ -233,31 +179,12 @@ static void frame_end_to_end(void **state)
         kin_camera cam = kin_sthmd_camera(&pd.hmd, &head, (kin_eye)e);
         kin_camera pc = pipe_camera(p, e);
         assert_memory_equal(&cam.view_proj, &pc.view_proj, sizeof cam.view_proj);
-        rast_target t = {cw, ch, depth, cw, mask, cw, nrm, cw * 3, 3};
-        rast_target_clear(&t);
-        float clip[16], vn[12], wpos[12], wn[12];
-        kin_mat4 qw = kin_mat4_from_transform(&m.rest[1]);
-        kin_mesh_transform(&m.meshes[0], &qw, wpos, wn);
-        rast_transform_points(cam.view_proj.m, wpos, 4, clip);
-        rast_transform_dirs(cam.view.m, wn, 4, vn);
-        rast_mesh_desc md = {clip, 4, vn, 3, m.meshes[0].indices, 2, RAST_CULL_NONE};
-        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
-        assert_memory_equal(pm, mask, (size_t)cw * ch);
-        fuse_lighting L = fuse_lighting_default();
-        kin_vec3 ld = kin_v3_norm(kin_mat4_mul_dir(
-            &cam.view, kin_v3(L.lights[0].dir[0], L.lights[0].dir[1], L.lights[0].dir[2])));
-        L.lights[0].dir[0] = ld.x;
-        L.lights[0].dir[1] = ld.y;
-        L.lights[0].dir[2] = ld.z;
-        fuse_intrinsics K = {cam.fx, cam.fy, cam.cx, cam.cy};
         /* the crop: rows 0..719, columns 316..963 */
         fuse_image P = {b.cam[e] + 316 * 4, 648, 720, CAMW * 4};
-        fuse_image Q = {layer, cw, ch, cw * 4};
         fuse_image V = {b.virt[e], LCDW, LCDH, LCDW * 4};
         fuse_image R = {expect, LCDW, LCDH, LCDW * 4};
-        assert_int_equal(fuse_light(&L, &K, &P, mask, cw, nrm, cw * 3, &Q), FUSE_OK);
-        assert_int_equal(fuse_composite(&Q, &V, g.vp_x0, g.vp_y0, g.vp_width, g.vp_height, &R),
-                         FUSE_OK);
+        tu_quad_stages(&m, &cam, &s, &P, &V, g.vp_x0, g.vp_y0, g.vp_width, g.vp_height, &R);
+        assert_memory_equal(pm, s.mask, (size_t)s.w * s.h);
         assert_memory_equal(expect, b.out[e], (size_t)LCDW * LCDH * 4);
         /* outside the viewport: V */
         for (int y = 0; y < LCDH; y++)
@@ -270,10 +197,7 @@ static void frame_end_to_end(void **state)
                     fail_msg("eye %d pixel (%d, %d) outside the viewport is not V's", e, x, y);
             }
     }
-    free(depth);
-    free(nrm);
-    free(mask);
-    free(layer);
+    tu_stages_free(&s);
     free(expect);
 
     /* the paper's sizes are refused, naming the expected ones */

@@ -27,6 +27,8 @@
 
 #include "../src/io/io.h"
 #include "../src/pipe/pipe.h"
+#include "support/pipe_frames.h"
+#include "support/sample_model.h"
 
 static kin_model g_model;
 static int g_loaded;
@@ -36,14 +38,9 @@ static int group_setup(void **state)
 {
     (void)state;
     char dir[1024], path[1200];
-    int r = tu_samples_dir("parts_samples", 1, dir, sizeof dir, g_skip, sizeof g_skip);
+    int r = tu_sample_model_load("parts_samples", 1, &g_model, dir, sizeof dir, path, sizeof path,
+                                 g_skip, sizeof g_skip);
     if (r <= 0) return r;
-    snprintf(path, sizeof path, "%s/model/arms.glb", dir);
-    io_error err;
-    if (io_gltf_load(path, &g_model, &err) != IO_OK) {
-        fprintf(stderr, "%s\n", err.msg);
-        return -1;
-    }
     g_loaded = 1;
     return 0;
 }
@@ -51,54 +48,24 @@ static int group_setup(void **state)
 static int group_teardown(void **state)
 {
     (void)state;
-    if (g_loaded) kin_model_free(&g_model);
-    tu_samples_remove("parts_samples");
+    tu_sample_model_free("parts_samples", &g_model, g_loaded);
     return 0;
 }
 
-#define NEED_MODEL()                                                        \
-    do {                                                                    \
-        if (!g_loaded) {                                                    \
-            print_message("%s\n", g_skip);                                 \
-            skip();                                                         \
-        }                                                                   \
-    } while (0)
+#define NEED_MODEL() TU_NEED_MODEL(g_loaded, g_skip)
 
 /* ------------------------------------------------------------ frames */
 
 enum { CW = 640, CH = 480, LW = 1280, LH = 800, MW = 640, MH = 400, MY0 = 40 };
 
-typedef struct bufs {
-    uint8_t *cam[2], *virt[2], *out[2];
-} bufs;
+typedef tu_frame_bufs bufs;
 
 static void bufs_make(bufs *b, pipe_frame_in *in, uint64_t seed)
 {
-    tu_rng r = {seed};
-    memset(in, 0, sizeof *in);
-    for (int e = 0; e < 2; e++) {
-        b->cam[e] = malloc(CW * CH * 4);
-        b->virt[e] = malloc(LW * LH * 4);
-        b->out[e] = malloc(LW * LH * 4);
-        assert_non_null(b->out[e]);
-        for (int i = 0; i < CW * CH * 4; i++) b->cam[e][i] = (uint8_t)tu_next(&r);
-        for (int i = 0; i < LW * LH * 4; i++) b->virt[e][i] = (uint8_t)tu_next(&r);
-        memset(b->out[e], 0xAB, LW * LH * 4);
-        in->camera[e] = (fuse_image){b->cam[e], CW, CH, CW * 4};
-        in->virt[e] = (fuse_image){b->virt[e], LW, LH, LW * 4};
-        in->out[e] = (fuse_image){b->out[e], LW, LH, LW * 4};
-    }
-    in->lighting = pipe_lighting_default();
+    tu_frame_make(b, in, seed, CW, CH, LW, LH);
 }
 
-static void bufs_free(bufs *b)
-{
-    for (int e = 0; e < 2; e++) {
-        free(b->cam[e]);
-        free(b->virt[e]);
-        free(b->out[e]);
-    }
-}
+static void bufs_free(bufs *b) { tu_frame_free(b); }
 
 /* The sample's reach_grasp at t with the head node's cameras. */
 static void sample_pose(pipe_frame_in *in, float t)
@@ -672,73 +639,23 @@ static void hidden_not_refined_back(void **state)
  * placed at `at` (so the prop's rest pose is not the identity). */
 static void cube_model(kin_model *m, kin_vec3 at)
 {
-    memset(m, 0, sizeof *m);
-    int16_t *parents = kin_block_alloc(&m->block, 2 * sizeof(int16_t));
-    kin_transform *rest = kin_block_alloc(&m->block, 2 * sizeof(kin_transform));
-    char(*names)[KIN_NAME_MAX] = kin_block_alloc(&m->block, 2 * KIN_NAME_MAX);
-    float *pos = kin_block_alloc(&m->block, 24 * sizeof(float));
-    uint32_t *idx = kin_block_alloc(&m->block, 36 * sizeof(uint32_t));
-    kin_mesh *mesh = kin_block_alloc(&m->block, sizeof(kin_mesh));
-    assert_non_null(mesh);
-    parents[0] = KIN_NO_PARENT;
-    parents[1] = 0;
-    rest[0] = kin_transform_identity();
-    rest[0].t = at;
-    rest[1] = kin_transform_identity();
-    strcpy(names[0], "prop");
-    strcpy(names[1], "cube");
+    tu_mesh_parts c = tu_mesh_model(m, "prop", "cube", 8, 36, 0);
+    c.rest[0].t = at;
     for (int i = 0; i < 8; i++) {
-        pos[3 * i + 0] = (i & 1) ? 0.5f : -0.5f;
-        pos[3 * i + 1] = (i & 2) ? 0.5f : -0.5f;
-        pos[3 * i + 2] = (i & 4) ? 0.5f : -0.5f;
+        c.pos[3 * i + 0] = (i & 1) ? 0.5f : -0.5f;
+        c.pos[3 * i + 1] = (i & 2) ? 0.5f : -0.5f;
+        c.pos[3 * i + 2] = (i & 4) ? 0.5f : -0.5f;
     }
     static const uint32_t f[36] = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
                                    2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
-    memcpy(idx, f, sizeof f);
-    *mesh = (kin_mesh){.vertex_count = 8, .positions = pos, .index_count = 36, .indices = idx,
-                       .node = 1, .skin = -1};
-    m->node_count = 2;
-    m->parents = parents;
-    m->rest = rest;
-    m->names = (const char(*)[KIN_NAME_MAX])names;
-    m->mesh_count = 1;
-    m->meshes = mesh;
+    memcpy(c.idx, f, sizeof f);
     char why[200];
     assert_int_equal(kin_model_validate(m, why, sizeof why), 0);
 }
 
 /* An "arm": one unskinned quad [-s,s]^2 at depth z facing +Z, with a
  * head node at the origin (node 0). */
-static void quad_arm(kin_model *m, float s, float z)
-{
-    memset(m, 0, sizeof *m);
-    int16_t *parents = kin_block_alloc(&m->block, 2 * sizeof(int16_t));
-    kin_transform *rest = kin_block_alloc(&m->block, 2 * sizeof(kin_transform));
-    char(*names)[KIN_NAME_MAX] = kin_block_alloc(&m->block, 2 * KIN_NAME_MAX);
-    float *pos = kin_block_alloc(&m->block, 12 * sizeof(float));
-    float *nrm = kin_block_alloc(&m->block, 12 * sizeof(float));
-    uint32_t *idx = kin_block_alloc(&m->block, 6 * sizeof(uint32_t));
-    kin_mesh *mesh = kin_block_alloc(&m->block, sizeof(kin_mesh));
-    assert_non_null(mesh);
-    parents[0] = KIN_NO_PARENT;
-    parents[1] = 0;
-    rest[0] = rest[1] = kin_transform_identity();
-    strcpy(names[0], "head");
-    strcpy(names[1], "R_forearm");
-    const float p[12] = {-s, -s, z, s, -s, z, s, s, z, -s, s, z};
-    memcpy(pos, p, sizeof p);
-    for (int i = 0; i < 4; i++) nrm[3 * i + 2] = 1.0f;
-    const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(idx, ix, sizeof ix);
-    *mesh = (kin_mesh){.vertex_count = 4, .positions = pos, .normals = nrm, .index_count = 6,
-                       .indices = idx, .node = 1, .skin = -1};
-    m->node_count = 2;
-    m->parents = parents;
-    m->rest = rest;
-    m->names = (const char(*)[KIN_NAME_MAX])names;
-    m->mesh_count = 1;
-    m->meshes = mesh;
-}
+static void quad_arm(kin_model *m, float s, float z) { tu_quad_model(m, s, z, 0.0f, "R_forearm"); }
 
 /* world_from_prop: turned by yaw about Y and pitch about X, scaled by s,
  * at t. */

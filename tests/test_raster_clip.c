@@ -136,24 +136,37 @@ static void rand_eye(tu_rng *r, double zlo, double zhi, double spread, double p[
     p[2] = -z;
 }
 
+/* 300 triangles of seed: 1 or 2 vertices (alternately) in front of z in
+ * [zlo, zhi] with spread, the others at 0.6..8 (spread 0.6), each checked
+ * with check_eye_tri (index n0 + n). Pixels covered; near-edge
+ * differences and the farthest distance added up. */
+static long clip_sweep(cam *c, rast_target *t, uint64_t seed, double zlo, double zhi,
+                       double spread, int n0, long *near_diff, double *max_dist)
+{
+    tu_rng r = { seed };
+    long covered = 0;
+    for (int n = 0; n < 300; n++) {
+        double e[3][3];
+        int first = 1 + n % 2;
+        for (int i = 0; i < 3; i++) {
+            if (i < first) rand_eye(&r, zlo, zhi, spread, e[i]);
+            else rand_eye(&r, 0.6, 8.0, 0.6, e[i]);
+        }
+        covered += check_eye_tri(c, t, e, near_diff, max_dist, n0 + n);
+    }
+    return covered;
+}
+
 static void test_near_plane_crossing(void **state)
 {
     (void)state;
     cam c;
     cam_init(&c);
     rast_target t = rt_make(W, H, 1, 0, 0);
-    tu_rng r = { 31337 };
-    long near_diff = 0, covered = 0;
+    long near_diff = 0;
     double max_dist = 0;
-    for (int n = 0; n < 300; n++) {
-        double e[3][3];
-        int in_front = 1 + n % 2;      /* 1 or 2 vertices before the near plane */
-        for (int i = 0; i < 3; i++) {
-            if (i < in_front) rand_eye(&r, 0.01, 0.45, 0.6, e[i]);
-            else rand_eye(&r, 0.6, 8.0, 0.6, e[i]);
-        }
-        covered += check_eye_tri(&c, &t, e, &near_diff, &max_dist, n);
-    }
+    /* 1 or 2 vertices before the near plane */
+    long covered = clip_sweep(&c, &t, 31337, 0.01, 0.45, 0.6, 0, &near_diff, &max_dist);
     print_message("NOTE near plane: %ld pixels covered, %ld within %.4f px of an "
                   "edge differ (farthest %.5f px)\n", covered, near_diff, EDGE_TOL,
                   max_dist);
@@ -168,18 +181,10 @@ static void test_vertex_behind_camera(void **state)
     cam c;
     cam_init(&c);
     rast_target t = rt_make(W, H, 1, 0, 0);
-    tu_rng r = { 4711 };
-    long near_diff = 0, covered = 0;
+    long near_diff = 0;
     double max_dist = 0;
-    for (int n = 0; n < 300; n++) {
-        double e[3][3];
-        int behind = 1 + n % 2;        /* w < 0 for 1 or 2 vertices */
-        for (int i = 0; i < 3; i++) {
-            if (i < behind) rand_eye(&r, -6.0, -0.05, 0.8, e[i]);
-            else rand_eye(&r, 0.6, 8.0, 0.6, e[i]);
-        }
-        covered += check_eye_tri(&c, &t, e, &near_diff, &max_dist, 1000 + n);
-    }
+    /* w < 0 for 1 or 2 vertices */
+    long covered = clip_sweep(&c, &t, 4711, -6.0, -0.05, 0.8, 1000, &near_diff, &max_dist);
     print_message("NOTE behind: %ld pixels covered, %ld near-edge differences "
                   "(farthest %.5f px)\n", covered, near_diff, max_dist);
     assert_true(covered > 20000);
@@ -257,6 +262,29 @@ static void test_huge_triangles(void **state)
     }
 }
 
+/* The (n+1) x (n+1) grid of clip-space vertices, two triangles a quad,
+ * each drawn alone with CULL_NONE: count[] := how many covered each
+ * pixel. */
+static void count_grid(rast_target *t, int n, const float *clip, int *count)
+{
+    memset(count, 0, sizeof(int) * W * H);
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            int a = j * (n + 1) + i, b = a + 1, cc = a + n + 1, d = cc + 1;
+            const int tris[2][3] = { { a, b, d }, { a, d, cc } };
+            for (int k = 0; k < 2; k++) {
+                float tc[12];
+                for (int m = 0; m < 3; m++)
+                    memcpy(tc + 4 * m, clip + 4 * tris[k][m], 4 * sizeof(float));
+                rast_target_clear(t);
+                assert_int_equal(rt_draw_tri(t, tc, NULL, RAST_CULL_NONE, NULL), RAST_OK);
+                for (int y = 0; y < H; y++)
+                    for (int x = 0; x < W; x++)
+                        count[y * W + x] += t->mask[y * t->mask_stride + x] == 255;
+            }
+        }
+}
+
 /* A grid mesh in eye space given by a point function; drawn triangle by
  * triangle with CULL_NONE into a count buffer. */
 static void grid_count(const cam *c, rast_target *t, int n, double x0, double x1,
@@ -276,22 +304,7 @@ static void grid_count(const cam *c, rast_target *t, int n, double x0, double x1
             p[2] = (float)(z0 + (z1 - z0) * v);
         }
     rast_transform_points(c->proj, pos, (n + 1) * (n + 1), clip);
-    memset(count, 0, sizeof(int) * W * H);
-    for (int j = 0; j < n; j++)
-        for (int i = 0; i < n; i++) {
-            int a = j * (n + 1) + i, b = a + 1, cc = a + n + 1, d = cc + 1;
-            const int tris[2][3] = { { a, b, d }, { a, d, cc } };
-            for (int k = 0; k < 2; k++) {
-                float tc[12];
-                for (int m = 0; m < 3; m++)
-                    memcpy(tc + 4 * m, clip + 4 * tris[k][m], 4 * sizeof(float));
-                rast_target_clear(t);
-                assert_int_equal(rt_draw_tri(t, tc, NULL, RAST_CULL_NONE, NULL), RAST_OK);
-                for (int y = 0; y < H; y++)
-                    for (int x = 0; x < W; x++)
-                        count[y * W + x] += t->mask[y * t->mask_stride + x] == 255;
-            }
-        }
+    count_grid(t, n, clip, count);
 }
 
 static void test_clipped_grids_watertight(void **state)
@@ -331,22 +344,7 @@ static void test_clipped_grids_watertight(void **state)
             p[2] = -2.0f;
         }
     rast_transform_points(c.proj, pos, (n + 1) * (n + 1), clip);
-    memset(count, 0, sizeof(int) * W * H);
-    for (int j = 0; j < n; j++)
-        for (int i = 0; i < n; i++) {
-            int a = j * (n + 1) + i, b = a + 1, cc = a + n + 1, d = cc + 1;
-            const int tris[2][3] = { { a, b, d }, { a, d, cc } };
-            for (int k = 0; k < 2; k++) {
-                float tc[12];
-                for (int m = 0; m < 3; m++)
-                    memcpy(tc + 4 * m, clip + 4 * tris[k][m], 4 * sizeof(float));
-                rast_target_clear(&t);
-                rt_draw_tri(&t, tc, NULL, RAST_CULL_NONE, NULL);
-                for (int y = 0; y < H; y++)
-                    for (int x = 0; x < W; x++)
-                        count[y * W + x] += t.mask[y * t.mask_stride + x] == 255;
-            }
-        }
+    count_grid(&t, n, clip, count);
     for (int i = 0; i < W * H; i++)
         if (count[i] != 1)
             fail_msg("wall: pixel (%d,%d) covered %d times", i % W, i / W, count[i]);

@@ -1,9 +1,12 @@
 #include "testutil.h"
 
 #include <dirent.h>
+#include <signal.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -49,13 +52,27 @@ uint32_t tu_crc32(uint32_t crc, const void *data, size_t n)
     return ~crc;
 }
 
-int tu_run(char *const argv[], char *out, size_t out_size)
+/* Runs argv with stdout+stderr captured into out[out_size]; limited: no
+ * core file, a file size limit of `limit` bytes (< 0: none) and SIGXFSZ
+ * ignored or default (xfsz_kill). 0 with the wait status in *st, -1 when
+ * it could not start. */
+static int run_capture(char *const argv[], char *out, size_t out_size, int limited, long limit,
+                       int xfsz_kill, int *st)
 {
     int fd[2];
     if (pipe(fd) != 0) return -1;
     pid_t pid = fork();
     if (pid < 0) return -1;
     if (pid == 0) {
+        if (limited) {
+            struct rlimit core = {0, 0};
+            setrlimit(RLIMIT_CORE, &core);
+            if (limit >= 0) {
+                struct rlimit r = {(rlim_t)limit, (rlim_t)limit};
+                setrlimit(RLIMIT_FSIZE, &r);
+            }
+            signal(SIGXFSZ, xfsz_kill ? SIG_DFL : SIG_IGN); /* kept by exec */
+        }
         dup2(fd[1], 1); dup2(fd[1], 2);
         close(fd[0]); close(fd[1]);
         execv(argv[0], argv);
@@ -72,9 +89,40 @@ int tu_run(char *const argv[], char *out, size_t out_size)
     }
     if (out_size) out[len] = 0;
     close(fd[0]);
+    return waitpid(pid, st, 0) < 0 ? -1 : 0;
+}
+
+int tu_run(char *const argv[], char *out, size_t out_size)
+{
     int st;
-    if (waitpid(pid, &st, 0) < 0) return -1;
+    if (run_capture(argv, out, out_size, 0, -1, 0, &st) != 0) return -1;
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+int tu_run_limited(char *const argv[], char *out, size_t out_size, long limit, int xfsz_kill)
+{
+    int st;
+    if (run_capture(argv, out, out_size, 1, limit, xfsz_kill, &st) != 0) return -1000;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : WIFSIGNALED(st) ? -WTERMSIG(st) : -1000;
+}
+
+const char *tu_bin(void)
+{
+    const char *b = getenv("EGOFUSE_BIN");
+    return b && *b ? b : "build/egofuse";
+}
+
+int tu_runl(char *out, size_t out_size, const char *prog, const char *a0, ...)
+{
+    char *argv[48];
+    int n = 0;
+    argv[n++] = (char *)prog;
+    va_list ap;
+    va_start(ap, a0);
+    for (const char *a = a0; a && n < 47; a = va_arg(ap, const char *)) argv[n++] = (char *)a;
+    va_end(ap);
+    argv[n] = NULL;
+    return tu_run(argv, out, out_size);
 }
 
 int tu_count_fds(void)

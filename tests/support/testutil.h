@@ -38,6 +38,15 @@ uint32_t tu_crc32(uint32_t crc, const void *data, size_t n);
  * out[out_size]; returns the exit status, or -1 if it could not start or
  * died from a signal. */
 int tu_run(char *const argv[], char *out, size_t out_size);
+/* tu_run with no core file, a file size limit of `limit` bytes (< 0:
+ * none) and SIGXFSZ ignored (xfsz_kill 0) or default (1). Returns the exit
+ * status, -signal when killed, or -1000 when it could not start. */
+int tu_run_limited(char *const argv[], char *out, size_t out_size, long limit, int xfsz_kill);
+/* The egofuse binary: EGOFUSE_BIN, else build/egofuse. */
+const char *tu_bin(void);
+/* tu_run of prog with the arguments a0, ... (NULL-terminated, at most
+ * 46 are passed). */
+int tu_runl(char *out, size_t out_size, const char *prog, const char *a0, ...);
 /* Open descriptors of this process (entries of /proc/self/fd, its own
  * listing's included), -1 when it cannot be read: compare before and after. */
 int tu_count_fds(void);
