@@ -1,10 +1,19 @@
 /* raster_internal.h - the parts of the rasterizer shared by the scalar
  * reference (raster_ref.c) and any SIMD scan path (raster_<isa>.c).
  *
+ * Layers, each calling only those below it (function pointers chosen by
+ * the context go downwards too):
+ *   raster_context.c  ISA dispatch (the only file naming per-ISA kernels),
+ *                     threads, rast_draw / rast_draw_aa / transforms
+ *   raster_draw.c     the draw driver (chunks through set-up and a scan),
+ *   raster_aa.c       the anti-aliased draw driver and reference scan
+ *   per-ISA kernels   raster_ref.c, raster_<isa>.c, raster_front_<isa>.c
+ *   raster_setup.c    the scalar per-triangle set-up they share
+ *
  * Split of the work (docs/raster.md has the full rules):
  *   raster_setup.c  validation, clipping, perspective divide, viewport,
  *                   sub-pixel snapping, culling, edge and plane setup, and
- *                   the per-triangle driver rast__draw_with(). Scalar; it
+ *                   the per-range set-up rast__prepare_range(). Scalar; it
  *                   defines the set-up's bits. Three parts of it have SIMD
  *                   versions that give the same bits (rast__setup_isa:
  *                   raster_planes.inl, raster_avx2.c, raster_avx512.c):
@@ -163,7 +172,8 @@ rast_result rast__validate_desc(const rast_target *t, const rast_mesh_desc *m);
 rast_result rast__validate_indices(const rast_mesh_desc *m);
 
 /* rast_draw on the calling thread with a given row scan (the reference
- * or a SIMD one). */
+ * or a SIMD one) and the set-up kernels of its ISA (raster_context.c,
+ * the dispatch). */
 rast_result rast__draw_with(const rast_target *t, const rast_mesh_desc *m,
                             rast_stats *stats, rast__scan_rows_fn scan);
 
@@ -178,11 +188,15 @@ typedef struct rast__tiles {
 /* Marks the tiles of pixels x0..x1 x ya..yb (inclusive, not empty). */
 void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1);
 
-/* The body of rast__draw_with for validated arguments. When tiles is not
- * NULL, the pixel box of every scanned triangle is marked in it (every
- * pixel the draw may have written lies in a marked tile). */
+/* The body of rast__draw_with for validated arguments (raster_draw.c),
+ * with the set-up kernels isa (those of the scan's ISA, or
+ * &rast__setup_isa_ref). When tiles is not NULL, the pixel box of every
+ * scanned triangle is marked in it (every pixel the draw may have written
+ * lies in a marked tile). */
+struct rast__setup_isa;
 void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
-                      rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles);
+                      rast_stats *stats, rast__scan_rows_fn scan,
+                      const struct rast__setup_isa *isa, rast__tiles *tiles);
 /* Scans the n set-up triangles tri in order into t (micro: micro records
  * may occur, their pixels are written as the scan would write them);
  * marks the tiles of every triangle that may write a pixel in tiles
@@ -190,13 +204,14 @@ void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
  * {1, 0, 1, 0} before the first call). Returns the pixels written. */
 long rast__scan_list(const rast_target *t, const rast__tri *tri, int n,
                      rast__scan_rows_fn scan, rast__tiles *tiles, int last[4], int micro);
-/* The same with a vertex buffer: when the scan's set-up ISA has a vector
- * front end and the mesh fits (vertex_count <= vb->cap), the draw runs
- * it with micro records (same bytes and counters); otherwise (or vb NULL)
+/* The same with a vertex buffer: when isa has a vector front end and
+ * the mesh fits (vertex_count <= vb->cap), the draw runs it with micro
+ * records (same bytes and counters); otherwise (or vb NULL)
  * rast__draw_valid. */
 struct rast__vbuf;
 void rast__draw_valid_vb(const rast_target *t, const rast_mesh_desc *m,
-                         rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles,
+                         rast_stats *stats, rast__scan_rows_fn scan,
+                         const struct rast__setup_isa *isa, rast__tiles *tiles,
                          struct rast__vbuf *vb);
 
 /* Fetch, clip, snap and set up submitted triangle ti of m (indices already
