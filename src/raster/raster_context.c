@@ -101,19 +101,26 @@ static const isa_kernels kernels_avx512 = {
     points_avx512, dirs_avx512
 };
 #endif
+#if defined(__aarch64__) && defined(__ARM_NEON)
+static const isa_kernels kernels_neon = {
+    rast__scan_rows_neon, rast__scan_aa_neon, &rast__setup_isa_ref,
+    rast__transform_points_ref, rast__transform_dirs_ref
+};
+#endif
 
 static const isa_kernels *kernels_for(int isa)
 {
-#if defined(__x86_64__)
     switch (isa) {
+#if defined(__x86_64__)
     case EF_ISA_AVX512: return &kernels_avx512;
     case EF_ISA_AVX2:   return &kernels_avx2;
     case EF_ISA_SSE2:   return &kernels_sse2;
+#endif
+#if defined(__aarch64__) && defined(__ARM_NEON)
+    case EF_ISA_NEON:   return &kernels_neon;
+#endif
     default:            break;
     }
-#else
-    (void)isa;
-#endif
     return &kernels_ref;
 }
 
@@ -132,6 +139,9 @@ const rast__setup_isa *rast__setup_for_scan(rast__scan_rows_fn scan)
     static const isa_kernels *const all[] = {
 #if defined(__x86_64__)
         &kernels_avx512, &kernels_avx2, &kernels_sse2,
+#endif
+#if defined(__aarch64__) && defined(__ARM_NEON)
+        &kernels_neon,
 #endif
         &kernels_ref
     };

@@ -416,6 +416,7 @@ long rast__scan_aa_ref(const rast_aa_target *t, const rast__tri *tri, int ya, in
 long rast__scan_aa_sse2(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
 long rast__scan_aa_avx2(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
 long rast__scan_aa_avx512(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
+long rast__scan_aa_neon(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
 rast__scan_aa_fn rast__scan_aa_for_isa(int isa);
 /* rast_draw_aa with a given scan. */
 rast_result rast__draw_aa_with(const rast_aa_target *t, const rast_mesh_desc *m,
@@ -432,8 +433,8 @@ long rast__scan_ref(const rast_target *t, const rast__tri *tri);
 long rast__scan_rows_ref(const rast_target *t, const rast__tri *tri, int ya,
                          int yb);
 
-/* SIMD scans (raster_sse2.c, raster_avx2.c, raster_avx512.c; one body,
- * raster_simd.inl). Each gives the bytes of rast__scan_ref. They may only
+/* SIMD scans (raster_sse2.c, raster_avx2.c, raster_avx512.c,
+ * raster_neon.c; one body, raster_simd.inl on src/cpu's vector layer). Each gives the bytes of rast__scan_ref. They may only
  * be called when ef_cpu_has() says the CPU runs the ISA. */
 long rast__scan_rows_sse2(const rast_target *t, const rast__tri *tri, int ya,
                           int yb);
@@ -441,6 +442,8 @@ long rast__scan_rows_avx2(const rast_target *t, const rast__tri *tri, int ya,
                           int yb);
 long rast__scan_rows_avx512(const rast_target *t, const rast__tri *tri,
                             int ya, int yb);
+long rast__scan_rows_neon(const rast_target *t, const rast__tri *tri, int ya,
+                          int yb);
 /* The vertex transforms of raster.h: the scalar reference (raster_ref.c)
  * and the AVX-512 version (raster_avx512.c, same bytes; call only when the
  * CPU runs AVX-512). rast_transform_points / _dirs use the AVX-512 one when

@@ -1,0 +1,23 @@
+/* raster_neon.c - the NEON scan (AArch64 Advanced SIMD, 4 lanes):
+ * raster_simd.inl on the vector layer's NEON implementation
+ * (src/cpu/simd_neon.h), and the anti-aliased sample scan (raster_aa.inl,
+ * 2 double lanes in vector extensions). Bytes equal rast__scan_rows_ref
+ * and rast__scan_aa_ref (checked under qemu-aarch64 by the raster tests).
+ * Compiles to nothing off aarch64. */
+#include "raster_internal.h"
+
+#if defined(__aarch64__) && defined(__ARM_NEON)
+#include <stddef.h>
+#include <string.h>
+
+#include "../cpu/simd_neon.h"
+#include "raster_simd.inl"
+
+/* Anti-aliased coverage: 2 double lanes. */
+#define AA_V 2
+#define AA_FN rast__scan_aa_neon
+#include "raster_aa.inl"
+
+#else
+typedef int rast__neon_unused;   /* not aarch64: the dispatcher never names it */
+#endif
