@@ -208,6 +208,21 @@ SIMD_INL void vf_store3_bits(float *p, unsigned bits, vfloat x, vfloat y, vfloat
     }
 }
 
+
+/* doubles (raster's plane set-up): VD_W = 4 lanes */
+#define VD_W 4
+typedef __m256d vdouble;
+SIMD_INL vdouble vd_set1(double x) { return _mm256_set1_pd(x); }
+SIMD_INL vdouble vd_loadu(const double *p) { return _mm256_loadu_pd(p); }
+SIMD_INL void vd_storeu(double *p, vdouble a) { _mm256_storeu_pd(p, a); }
+SIMD_INL vdouble vd_add(vdouble a, vdouble b) { return _mm256_add_pd(a, b); }
+SIMD_INL vdouble vd_sub(vdouble a, vdouble b) { return _mm256_sub_pd(a, b); }
+SIMD_INL vdouble vd_mul(vdouble a, vdouble b) { return _mm256_mul_pd(a, b); }
+SIMD_INL vdouble vd_div(vdouble a, vdouble b) { return _mm256_div_pd(a, b); }
+SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return _mm256_max_pd(a, b); }
+SIMD_INL vdouble vd_load_f(const float *p) { return _mm256_cvtps_pd(_mm_loadu_ps(p)); }
+SIMD_INL void vd_store_f(float *p, vdouble a) { _mm_storeu_ps(p, _mm256_cvtpd_ps(a)); }
+
 #else
 #error "simd_avx2.h: another implementation of the vector layer is already included"
 #endif

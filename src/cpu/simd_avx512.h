@@ -196,6 +196,21 @@ SIMD_INL void vf_store3_bits(float *p, unsigned bits, vfloat x, vfloat y, vfloat
                           _mm512_mask_blend_ps(0x9249, _mm512_mask_blend_ps(0x4924, x, y), z));
 }
 
+
+/* doubles (raster's plane set-up): VD_W = 8 lanes */
+#define VD_W 8
+typedef __m512d vdouble;
+SIMD_INL vdouble vd_set1(double x) { return _mm512_set1_pd(x); }
+SIMD_INL vdouble vd_loadu(const double *p) { return _mm512_loadu_pd(p); }
+SIMD_INL void vd_storeu(double *p, vdouble a) { _mm512_storeu_pd(p, a); }
+SIMD_INL vdouble vd_add(vdouble a, vdouble b) { return _mm512_add_pd(a, b); }
+SIMD_INL vdouble vd_sub(vdouble a, vdouble b) { return _mm512_sub_pd(a, b); }
+SIMD_INL vdouble vd_mul(vdouble a, vdouble b) { return _mm512_mul_pd(a, b); }
+SIMD_INL vdouble vd_div(vdouble a, vdouble b) { return _mm512_div_pd(a, b); }
+SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return _mm512_max_pd(a, b); }
+SIMD_INL vdouble vd_load_f(const float *p) { return _mm512_cvtps_pd(_mm256_loadu_ps(p)); }
+SIMD_INL void vd_store_f(float *p, vdouble a) { _mm256_storeu_ps(p, _mm512_cvtpd_ps(a)); }
+
 #else
 #error "simd_avx512.h: another implementation of the vector layer is already included"
 #endif

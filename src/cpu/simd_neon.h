@@ -228,6 +228,22 @@ SIMD_INL void vf_store3_bits(float *p, unsigned bits, vfloat x, vfloat y, vfloat
     if (bits & 8u) vst3q_lane_f32(p + 9, t, 3);
 }
 
+
+/* doubles (raster's plane set-up): VD_W = 2 lanes */
+#define VD_W 2
+typedef float64x2_t vdouble;
+SIMD_INL vdouble vd_set1(double x) { return vdupq_n_f64(x); }
+SIMD_INL vdouble vd_loadu(const double *p) { return vld1q_f64(p); }
+SIMD_INL void vd_storeu(double *p, vdouble a) { vst1q_f64(p, a); }
+SIMD_INL vdouble vd_add(vdouble a, vdouble b) { return vaddq_f64(a, b); }
+SIMD_INL vdouble vd_sub(vdouble a, vdouble b) { return vsubq_f64(a, b); }
+SIMD_INL vdouble vd_mul(vdouble a, vdouble b) { return vmulq_f64(a, b); }
+SIMD_INL vdouble vd_div(vdouble a, vdouble b) { return vdivq_f64(a, b); }
+/* x86's maxpd: a > b ? a : b (b when either is NaN, b for +-0) */
+SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return vbslq_f64(vcgtq_f64(a, b), a, b); }
+SIMD_INL vdouble vd_load_f(const float *p) { return vcvt_f64_f32(vld1_f32(p)); }
+SIMD_INL void vd_store_f(float *p, vdouble a) { vst1_f32(p, vcvt_f32_f64(a)); }
+
 #else
 #error "simd_neon.h: another implementation of the vector layer is already included"
 #endif

@@ -259,36 +259,8 @@ void rast__transform_dirs_avx512(const float m[16], const float *v, int n, float
 #define AA_FN rast__scan_aa_avx512
 #include "raster_aa.inl"
 
-/* Batched set-up (raster_planes.inl): planes in 8 double lanes, vertex fills. */
-#define PD_V 8
-#define PLANES_FN rast__planes_avx512
-typedef __m512d vd;
-#define PD_LOAD(p) _mm512_load_pd(p)
-#define PD_SET1(x) _mm512_set1_pd(x)
-#define PD_ADD(a, b) _mm512_add_pd(a, b)
-#define PD_SUB(a, b) _mm512_sub_pd(a, b)
-#define PD_MUL(a, b) _mm512_mul_pd(a, b)
-#define PD_DIV(a, b) _mm512_div_pd(a, b)
-#define PD_MAX(a, b) _mm512_max_pd(a, b)
-#define PD_STORE_F(p, v) _mm256_storeu_ps(p, _mm512_cvtpd_ps(v))
-#define PS_V 16
-#define VFILL_FN rast__vfill_avx512
-#define SETUP_ISA rast__setup_isa_avx512
-typedef __m512 vs;
-#define PS_LOAD(p) _mm512_load_ps(p)
-#define PS_SET1(x) _mm512_set1_ps(x)
-#define PS_ADD(a, b) _mm512_add_ps(a, b)
-#define PS_SUB(a, b) _mm512_sub_ps(a, b)
-#define PS_MUL(a, b) _mm512_mul_ps(a, b)
-#define PS_DIV(a, b) _mm512_div_ps(a, b)
-#define PS_MAX(a, b) _mm512_max_ps(a, b)
-#define PS_MIN(a, b) _mm512_min_ps(a, b)
-#define PS_LT_BITS(a, b) ((unsigned)_mm512_cmp_ps_mask(a, b, _CMP_LT_OQ))
-#define PS_LE_BITS(a, b) ((unsigned)_mm512_cmp_ps_mask(a, b, _CMP_LE_OQ))
-#define PS_GT_BITS(a, b) ((unsigned)_mm512_cmp_ps_mask(a, b, _CMP_GT_OQ))
-#define PS_CVT_STORE(p, v) _mm512_store_si512((void *)(p), _mm512_cvtps_epi32(v))
-#define PD_LOAD_F(p) _mm512_cvtps_pd(_mm256_load_ps(p))
-#define PD_STORE(p, v) _mm512_store_pd(p, v)
+/* Batched set-up (raster_planes.inl, 8 double lanes): the de-interleave of
+ * a vertex block, the 16-lane rejection, then the one body. */
 /* 16 vertices xyzw: per pair of input vectors one two-source permute puts
  * x (low half) and y (high half), another z and w; 128-bit shuffles join
  * the halves of the two pairs. */

@@ -74,7 +74,7 @@ static const isa_kernels kernels_ref = {
 };
 #if defined(__x86_64__)
 static const isa_kernels kernels_sse2 = {
-    rast__scan_rows_sse2, rast__scan_aa_sse2, &rast__setup_isa_ref,
+    rast__scan_rows_sse2, rast__scan_aa_sse2, &rast__setup_isa_sse2,
     rast__transform_points_ref, rast__transform_dirs_ref
 };
 static const isa_kernels kernels_avx2 = {
@@ -103,7 +103,7 @@ static const isa_kernels kernels_avx512 = {
 #endif
 #if defined(__aarch64__) && defined(__ARM_NEON)
 static const isa_kernels kernels_neon = {
-    rast__scan_rows_neon, rast__scan_aa_neon, &rast__setup_isa_ref,
+    rast__scan_rows_neon, rast__scan_aa_neon, &rast__setup_isa_neon,
     rast__transform_points_ref, rast__transform_dirs_ref
 };
 #endif

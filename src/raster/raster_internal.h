@@ -278,6 +278,8 @@ typedef void (*rast__planes_fn)(rast__pbatch *b);
 void rast__planes_ref(rast__pbatch *b);
 void rast__planes_avx2(rast__pbatch *b);
 void rast__planes_avx512(rast__pbatch *b);
+void rast__planes_sse2(rast__pbatch *b);
+void rast__planes_neon(rast__pbatch *b);
 
 /* Vertex cache fill of a block: e[l] = the entry of vertex base + l for
  * l < count (count 1..RAST__VBLOCK; clip: the mesh's clip coordinates),
@@ -292,6 +294,10 @@ void rast__vfill_avx2(const rast__view *v, const float *clip, uint32_t base, int
                       rast__vc_entry *e);
 void rast__vfill_avx512(const rast__view *v, const float *clip, uint32_t base, int count,
                         rast__vc_entry *e);
+void rast__vfill_sse2(const rast__view *v, const float *clip, uint32_t base, int count,
+                      rast__vc_entry *e);
+void rast__vfill_neon(const rast__view *v, const float *clip, uint32_t base, int count,
+                      rast__vc_entry *e);
 
 /* The set-up kernels of an ISA for rast__prepare_range: planes in
  * batches, and vertex cache misses filled RAST__VBLOCK aligned vertices
@@ -373,10 +379,10 @@ typedef struct rast__setup_isa {
     rast__vpass_fn vpass;     /* NULL (with frontv): no vector front end */
     rast__frontv_fn frontv;
 } rast__setup_isa;
-extern const rast__setup_isa rast__setup_isa_ref, rast__setup_isa_avx2,
-    rast__setup_isa_avx512;
+extern const rast__setup_isa rast__setup_isa_ref, rast__setup_isa_sse2, rast__setup_isa_avx2,
+    rast__setup_isa_avx512, rast__setup_isa_neon;
 /* The set-up kernels that go with a row scan (those of the scan's ISA;
- * the scalar ones for the reference and SSE2). */
+ * the scalar ones for the reference). */
 const rast__setup_isa *rast__setup_for_scan(rast__scan_rows_fn scan);
 
 /* rast__prepare_cached for submitted triangles ti0 .. ti1-1 in order,

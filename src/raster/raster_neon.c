@@ -1,7 +1,8 @@
 /* raster_neon.c - the NEON scan (AArch64 Advanced SIMD, 4 lanes):
  * raster_simd.inl on the vector layer's NEON implementation
- * (src/cpu/simd_neon.h), and the anti-aliased sample scan (raster_aa.inl,
- * 2 double lanes in vector extensions). Bytes equal rast__scan_rows_ref
+ * (src/cpu/simd_neon.h), the anti-aliased sample scan (raster_aa.inl,
+ * 2 double lanes in vector extensions) and the batched set-up
+ * (raster_planes.inl, 2 double lanes). Bytes equal rast__scan_rows_ref
  * and rast__scan_aa_ref (checked under qemu-aarch64 by the raster tests).
  * Compiles to nothing off aarch64. */
 #include "raster_internal.h"
@@ -17,6 +18,10 @@
 #define AA_V 2
 #define AA_FN rast__scan_aa_neon
 #include "raster_aa.inl"
+
+/* Batched set-up: planes in 2 double lanes, vertex fills in 4 float lanes. */
+#include <float.h>
+#include "raster_planes.inl"
 
 #else
 typedef int rast__neon_unused;   /* not aarch64: the dispatcher never names it */

@@ -1,7 +1,9 @@
-/* raster_sse2.c - the SSE2 scan (x86-64 baseline, 4 lanes): raster_simd.inl
- * on the vector layer's SSE2 implementation (src/cpu/simd_sse2.h), whose
- * partial vectors go through scalar lane loops, so no access ever leaves
- * the scanned pixels. Bytes equal rast__scan_rows_ref. */
+/* raster_sse2.c - the SSE2 kernels (x86-64 baseline): the scan
+ * (raster_simd.inl, 4 lanes), the sample scan (raster_aa.inl) and the
+ * batched set-up (raster_planes.inl, 2 double lanes) on the vector layer's
+ * SSE2 implementation (src/cpu/simd_sse2.h), whose partial vectors go
+ * through scalar lane loops, so no access ever leaves the scanned pixels.
+ * Bytes equal the reference's. */
 #include "raster_internal.h"
 
 #if defined(__x86_64__) || (defined(__i386__) && defined(__SSE2__))
@@ -12,6 +14,10 @@
 #define AA_V 2
 #define AA_FN rast__scan_aa_sse2
 #include "raster_aa.inl"
+
+/* Batched set-up: planes in 2 double lanes, vertex fills in 4 float lanes. */
+#include <float.h>
+#include "raster_planes.inl"
 
 #else
 typedef int rast__sse2_unused;   /* not x86: the dispatcher uses the reference */
