@@ -19,8 +19,16 @@
 #define AA_FN rast__scan_aa_neon
 #include "raster_aa.inl"
 
-/* Batched set-up: planes in 2 double lanes, vertex fills in 4 float lanes. */
+/* Batched set-up: vertex fills in 4 float lanes; planes in 2 double lanes
+ * compiled (and checked against the reference by test_raster_isa on x86)
+ * but the table keeps the scalar planes: with 2 double lanes, one
+ * triangle per lane costs more than the scalar set-up, whose planes of one
+ * triangle run in 4 double lanes of vector extensions (cachegrind, the
+ * sample model and bench scene through bench_raster --isa sse2: planes
+ * 234M instructions against 65M scalar; vertex fills 201M against 258M).
+ * NEON has the same 2 double lanes. */
 #include <float.h>
+#define SETUP_PLANES rast__planes_ref
 #include "raster_planes.inl"
 
 #else

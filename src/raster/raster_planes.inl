@@ -188,5 +188,10 @@ void SIMD_FN(rast__vfill)(const rast__view *v, const float *clip, uint32_t base,
 #define VPASS_FN NULL
 #define FRONTV_FN NULL
 #endif
-const rast__setup_isa SIMD_FN(rast__setup_isa) = { SIMD_FN(rast__planes), SIMD_FN(rast__vfill), FRONT_FN,
+/* SETUP_PLANES: the planes function of the table (default: the one above;
+ * raster_sse2.c and raster_neon.c keep the scalar one, see there). */
+#ifndef SETUP_PLANES
+#define SETUP_PLANES SIMD_FN(rast__planes)
+#endif
+const rast__setup_isa SIMD_FN(rast__setup_isa) = { SETUP_PLANES, SIMD_FN(rast__vfill), FRONT_FN,
                                                    VPASS_FN, FRONTV_FN };
