@@ -15,16 +15,9 @@
 
 #include "../cpu/simd_avx512.h"
 
-/* Lane f of sel3[o] holds the bit of the pixel that float 16*o + f
- * belongs to: 1 << ((16*o + f) / 3). */
-static const int32_t sel3[3][16] __attribute__((aligned(64))) = {
-    { 1 << 0, 1 << 0, 1 << 0, 1 << 1, 1 << 1, 1 << 1, 1 << 2, 1 << 2,
-      1 << 2, 1 << 3, 1 << 3, 1 << 3, 1 << 4, 1 << 4, 1 << 4, 1 << 5 },
-    { 1 << 5, 1 << 5, 1 << 6, 1 << 6, 1 << 6, 1 << 7, 1 << 7, 1 << 7,
-      1 << 8, 1 << 8, 1 << 8, 1 << 9, 1 << 9, 1 << 9, 1 << 10, 1 << 10 },
-    { 1 << 10, 1 << 11, 1 << 11, 1 << 11, 1 << 12, 1 << 12, 1 << 12, 1 << 13,
-      1 << 13, 1 << 13, 1 << 14, 1 << 14, 1 << 14, 1 << 15, 1 << 15, 1 << 15 },
-};
+/* simd__sel3 (the layer's vf_store3_bits table): lane f of simd__sel3[o]
+ * holds the bit of the pixel that float 16*o + f belongs to,
+ * 1 << ((16*o + f) / 3). */
 
 /* The pixels in bits only (masked stores: other floats are not touched),
  * bits within the first `lanes` lanes. Only the output vectors those lanes
@@ -49,7 +42,7 @@ static inline void attr3_store_m(float *p, unsigned bits, int lanes, __m512 a, _
     const __m512i pb = _mm512_set1_epi32((int)bits);
     const int nout = lanes >= 16 ? 3 : (3 * lanes + 15) >> 4;
     for (int o = 0; o < nout; o++) {
-        const __mmask16 k = _mm512_test_epi32_mask(pb, _mm512_load_si512(sel3[o]));
+        const __mmask16 k = _mm512_test_epi32_mask(pb, _mm512_load_si512(simd__sel3[o]));
         __m512 v = _mm512_permutex2var_ps(a, _mm512_load_si512(idx_ab[o]), b);
         v = _mm512_mask_permutexvar_ps(v, mc[o], _mm512_load_si512(idx_c[o]), c);
         _mm512_mask_storeu_ps(p + 16 * o, k, v);
@@ -101,7 +94,7 @@ static inline void attr3_out(float *p, __m512i pb, const attr3_state *st, int o,
     const __m512 b2o = _mm512_permutexvar_ps(pix, b2);
     const __m512 a = _mm512_add_ps(_mm512_add_ps(st->a0[o], _mm512_mul_ps(b1o, st->d1[o])),
                                    _mm512_mul_ps(b2o, st->d2[o]));
-    const __mmask16 k = _mm512_test_epi32_mask(pb, _mm512_load_si512(sel3[o]));
+    const __mmask16 k = _mm512_test_epi32_mask(pb, _mm512_load_si512(simd__sel3[o]));
     _mm512_mask_storeu_ps(p + 16 * o, k, a);
 }
 
