@@ -351,9 +351,9 @@ static void test_isa_equal(void **state)
 {
     (void)state;
     enum { CASES = 1500 };
-    const int isas[3] = { EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512 };
+    const int isas[4] = { EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512, EF_ISA_NEON };
     uint32_t crc = 0;
-    long pixels = 0, compared[3] = { 0, 0, 0 };
+    long pixels = 0, compared[4] = { 0, 0, 0, 0 };
     for (int k = 0; k < CASES; k++) {
         rast_aa_target t;
         rast_mesh_desc m;
@@ -372,7 +372,7 @@ static void test_isa_equal(void **state)
         long sv[3] = { sr.tris_drawn, sr.pixels_written, sr.tris_clipped_away };
         crc = tu_crc32(crc, sv, sizeof sv);
         pixels += sr.pixels_written;
-        for (int i = 0; i < 3; i++) {
+        for (int i = 0; i < 4; i++) {
             if (!ef_cpu_has((ef_isa)isas[i]))
                 continue;
             memset(t.samples, 0x5A, bytes);
@@ -391,14 +391,14 @@ static void test_isa_equal(void **state)
         free(clip);
         free(idx);
     }
-    for (int i = 0; i < 3; i++)
+    for (int i = 0; i < 4; i++)
         if (!compared[i])
             print_message("SKIP AA %s: this CPU does not run it; untested: the AA scan of "
                           "src/raster/raster_%s.c\n", ef_isa_name((ef_isa)isas[i]),
                           ef_isa_name((ef_isa)isas[i]));
-    print_message("NOTE AA soup: %d cases, %ld pixels touched, sse2/avx2/avx512 compared "
-                  "%ld/%ld/%ld; CRC32 0x%08X (recorded 0x%08X)\n", CASES, pixels,
-                  compared[0], compared[1], compared[2], crc, AA_CRC);
+    print_message("NOTE AA soup: %d cases, %ld pixels touched, sse2/avx2/avx512/neon "
+                  "compared %ld/%ld/%ld/%ld; CRC32 0x%08X (recorded 0x%08X)\n", CASES, pixels,
+                  compared[0], compared[1], compared[2], compared[3], crc, AA_CRC);
     assert_true(pixels > 100000);
     assert_int_equal(crc, AA_CRC);
     if (!compared[0] || !compared[1] || !compared[2])

@@ -608,6 +608,8 @@ static void test_corner_ref(void **state) { (void)state; corner_isa(EF_ISA_REF);
 static void test_corner_sse2(void **state) { (void)state; corner_isa(EF_ISA_SSE2); }
 static void test_corner_avx2(void **state) { (void)state; corner_isa(EF_ISA_AVX2); }
 static void test_corner_avx512(void **state) { (void)state; corner_isa(EF_ISA_AVX512); }
+static void test_fixed_neon(void **state) { (void)state; fixed_case(EF_ISA_NEON); }
+static void test_corner_neon(void **state) { (void)state; corner_isa(EF_ISA_NEON); }
 
 int main(void)
 {
@@ -616,6 +618,7 @@ int main(void)
         cmocka_unit_test(test_fixed_avx2),   cmocka_unit_test(test_fixed_avx512),
         cmocka_unit_test(test_corner_ref),   cmocka_unit_test(test_corner_sse2),
         cmocka_unit_test(test_corner_avx2),  cmocka_unit_test(test_corner_avx512),
+        cmocka_unit_test(test_fixed_neon),   cmocka_unit_test(test_corner_neon),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -601,10 +601,11 @@ static void test_prepare_cached_equal(void **state)
 static void test_setup_isa_equal(void **state)
 {
     (void)state;
-    static const int simd[2] = { EF_ISA_AVX2, EF_ISA_AVX512 };
-    const rast__planes_fn fns[2] = { rast__planes_avx2, rast__planes_avx512 };
-    int have[2], nhave = 0;
-    for (int i = 0; i < 2; i++) {
+    static const int simd[3] = { EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512 };
+    const rast__planes_fn fns[3] = { rast__planes_sse2, rast__planes_avx2,
+                                     rast__planes_avx512 };
+    int have[3], nhave = 0;
+    for (int i = 0; i < 3; i++) {
         have[i] = ef_cpu_has((ef_isa)simd[i]);
         nhave += have[i];
         if (!have[i])
@@ -662,7 +663,7 @@ static void test_setup_isa_equal(void **state)
         for (int l = 0; l < b.n; l++)
             crc = tu_crc32(crc, &ta[l].z, 4 * sizeof(rast__plane));
         lanes += b.n;
-        for (int i = 0; i < 2; i++) {
+        for (int i = 0; i < 3; i++) {
             if (!have[i])
                 continue;
             rast__pbatch c = b;
@@ -681,9 +682,9 @@ static void test_setup_isa_equal(void **state)
     assert_int_equal(crc, SETUP_CRC);
 
     /* 2. The front end with every planes function. */
-    const int nf = 4;
-    const rast__setup_isa *pf[4] = { NULL, &rast__setup_isa_ref, &rast__setup_isa_avx2,
-                                     &rast__setup_isa_avx512 };
+    const int nf = 5;
+    const rast__setup_isa *pf[5] = { NULL, &rast__setup_isa_ref, &rast__setup_isa_sse2,
+                                     &rast__setup_isa_avx2, &rast__setup_isa_avx512 };
     long batched = 0;
     for (int n = 0; n < NCASES; n++) {
         rcase k;
@@ -691,9 +692,9 @@ static void test_setup_isa_equal(void **state)
         rast__view view;
         rast__view_init(&view, k.t.width, k.t.height, rast__draw_na(&k.t, &k.m));
         const size_t cap = (size_t)k.m.tri_count * RAST__MAX_FAN;
-        rast__tri *out[4];
-        rast_stats st[4];
-        int cnt[4];
+        rast__tri *out[5];
+        rast_stats st[5];
+        int cnt[5];
         const int chunk = 1 + tu_int(&r, 40);
         for (int f = 0; f < nf; f++) {
             out[f] = calloc(cap, sizeof(rast__tri));
@@ -731,7 +732,8 @@ static void test_setup_isa_equal(void **state)
      * band, behind the eye, w = 0, at the clip-space origin, tiny and huge
      * w, NaN and infinities), every block length, SIMD entries equal to
      * the scalar ones (tag and flags always, the values where valid). */
-    static const rast__vfill_fn vf[2] = { rast__vfill_avx2, rast__vfill_avx512 };
+    static const rast__vfill_fn vf[3] = { rast__vfill_sse2, rast__vfill_avx2,
+                                           rast__vfill_avx512 };
     long valid = 0, slow = 0, bad = 0;
     for (int it = 0; it < 4000; it++) {
         rast__view view;
@@ -772,7 +774,7 @@ static void test_setup_isa_equal(void **state)
             slow += (want[l].flags & RAST__VF_SLOW) != 0;
             bad += (want[l].flags & RAST__VF_NONFINITE) != 0;
         }
-        for (int i = 0; i < 2; i++) {
+        for (int i = 0; i < 3; i++) {
             if (!have[i])
                 continue;
             memset(got, 0xA5, sizeof got);

@@ -141,6 +141,7 @@ static void small_isa(int isa)
 static void test_small_sse2(void **state) { (void)state; small_isa(EF_ISA_SSE2); }
 static void test_small_avx2(void **state) { (void)state; small_isa(EF_ISA_AVX2); }
 static void test_small_avx512(void **state) { (void)state; small_isa(EF_ISA_AVX512); }
+static void test_small_neon(void **state) { (void)state; small_isa(EF_ISA_NEON); }
 
 int main(void)
 {
@@ -148,6 +149,7 @@ int main(void)
         cmocka_unit_test(test_small_sse2),
         cmocka_unit_test(test_small_avx2),
         cmocka_unit_test(test_small_avx512),
+        cmocka_unit_test(test_small_neon),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

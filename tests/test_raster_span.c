@@ -273,6 +273,7 @@ static void span_isa(int isa)
 static void test_span_sse2(void **state) { (void)state; span_isa(EF_ISA_SSE2); }
 static void test_span_avx2(void **state) { (void)state; span_isa(EF_ISA_AVX2); }
 static void test_span_avx512(void **state) { (void)state; span_isa(EF_ISA_AVX512); }
+static void test_span_neon(void **state) { (void)state; span_isa(EF_ISA_NEON); }
 
 int main(void)
 {
@@ -281,6 +282,7 @@ int main(void)
         cmocka_unit_test(test_span_sse2),
         cmocka_unit_test(test_span_avx2),
         cmocka_unit_test(test_span_avx512),
+        cmocka_unit_test(test_span_neon),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -101,3 +101,12 @@ ef_isa ef_isa_choose(ef_isa cap)
     if (env != EF_ISA_DEFAULT && ef_isa_level(env) < ef_isa_level(cap)) cap = env;
     return ef_cpu_cap(cap);
 }
+
+void ef_cpu_relax(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#elif defined(__aarch64__)
+    __asm__ __volatile__("yield");
+#endif
+}

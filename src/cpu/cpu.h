@@ -60,6 +60,10 @@ ef_isa ef_isa_parse(const char *name);
 /* The EGOFUSE_ISA value when it is set but not a known name, else NULL. */
 const char *ef_isa_env_error(void);
 
+/* One pause of a spin-wait loop (x86 PAUSE, AArch64 YIELD, else nothing):
+ * the rooms' thread pools spin through it without intrinsics of their own. */
+void ef_cpu_relax(void);
+
 #ifdef __cplusplus
 }
 #endif

@@ -182,6 +182,23 @@
  *                          4J+k of the i-th input (o is vfloat[4]). On
  *                          SSE2 and NEON the whole transpose.
  *
+ * RASTER OPS (added for src/raster's scan; a separate block at the end of
+ * each implementation)
+ *   vi_sign_bits(i)          bits of the lanes whose sign bit is set (the
+ *                            edge test's E < 0; vm_bits(vi_gt(0, i)))
+ *   vb_store_bits(p, bits)   p[l] = 0xFF for the lanes in bits (uint8_t *p;
+ *                            no other byte is read or written)
+ *   vf_store3_bits(p, bits, x, y, z)  vf_store3 for the lanes in bits only:
+ *                            p[3l .. 3l+2] = x, y, z of lane l; no other
+ *                            float is read or written
+ *   VD_W, vdouble            SIMD_W / 2 IEEE binary64 lanes (2, 4, 8, 2)
+ *   vd_set1(x) vd_loadu(p) vd_storeu(p, a)      double *p, any alignment
+ *   vd_add vd_sub vd_mul vd_div(a, b)  correctly rounded
+ *   vd_max(a, b)             a > b ? a : b (x86 maxpd, as vf_max)
+ *   vd_load_f(p)             VD_W floats p[0 .. VD_W) converted (exactly)
+ *   vd_store_f(p, a)         the lanes rounded to float (nearest even) and
+ *                            stored to p[0 .. VD_W)
+ *
  * NEW ISA. Copy simd_neon.h (the plainest), keep every name, meet every
  * line of this contract (the semantics above are x86's where the ISAs
  * differ: min/max, conversion out of range), add the ISA to

@@ -192,6 +192,53 @@ SIMD_INL vmask vm_from_bits(unsigned b) { return (vmask)b; }
 SIMD_INL int vm_all(vmask m) { return m == (vmask)0xFFFF; }
 SIMD_INL int vm_any(vmask m) { return m != 0; }
 
+
+/* ---- raster ops (src/raster's scan; simd.h "RASTER OPS") */
+SIMD_INL unsigned vi_sign_bits(vint i) { return (unsigned)_mm512_movepi32_mask(i); }
+SIMD_INL void vb_store_bits(uint8_t *p, unsigned bits)
+{
+    _mm_mask_storeu_epi8(p, (__mmask16)bits, _mm_set1_epi8((char)-1));
+}
+/* vf_store3's interleave, each output vector stored under the mask of the
+ * pixels its floats belong to (float f of vector o: pixel (16o + f) / 3),
+ * made by one vptestmd against a table of those pixels' bits. */
+static const int32_t simd__sel3[3][16] __attribute__((aligned(64))) = {
+    { 1 << 0, 1 << 0, 1 << 0, 1 << 1, 1 << 1, 1 << 1, 1 << 2, 1 << 2,
+      1 << 2, 1 << 3, 1 << 3, 1 << 3, 1 << 4, 1 << 4, 1 << 4, 1 << 5 },
+    { 1 << 5, 1 << 5, 1 << 6, 1 << 6, 1 << 6, 1 << 7, 1 << 7, 1 << 7,
+      1 << 8, 1 << 8, 1 << 8, 1 << 9, 1 << 9, 1 << 9, 1 << 10, 1 << 10 },
+    { 1 << 10, 1 << 11, 1 << 11, 1 << 11, 1 << 12, 1 << 12, 1 << 12, 1 << 13,
+      1 << 13, 1 << 13, 1 << 14, 1 << 14, 1 << 14, 1 << 15, 1 << 15, 1 << 15 },
+};
+SIMD_INL void vf_store3_bits(float *p, unsigned bits, vfloat x, vfloat y, vfloat z)
+{
+    const __m512i pb = _mm512_set1_epi32((int)(bits & SIMD_FULL));
+    x = _mm512_permutexvar_ps(_mm512_setr_epi32(0, 11, 6, 1, 12, 7, 2, 13, 8, 3, 14, 9, 4, 15, 10, 5), x);
+    y = _mm512_permutexvar_ps(_mm512_setr_epi32(5, 0, 11, 6, 1, 12, 7, 2, 13, 8, 3, 14, 9, 4, 15, 10), y);
+    z = _mm512_permutexvar_ps(_mm512_setr_epi32(10, 5, 0, 11, 6, 1, 12, 7, 2, 13, 8, 3, 14, 9, 4, 15), z);
+    _mm512_mask_storeu_ps(p, _mm512_test_epi32_mask(pb, _mm512_load_si512(simd__sel3[0])),
+                          _mm512_mask_blend_ps(0x4924, _mm512_mask_blend_ps(0x2492, x, y), z));
+    _mm512_mask_storeu_ps(p + 16, _mm512_test_epi32_mask(pb, _mm512_load_si512(simd__sel3[1])),
+                          _mm512_mask_blend_ps(0x2492, _mm512_mask_blend_ps(0x9249, x, y), z));
+    _mm512_mask_storeu_ps(p + 32, _mm512_test_epi32_mask(pb, _mm512_load_si512(simd__sel3[2])),
+                          _mm512_mask_blend_ps(0x9249, _mm512_mask_blend_ps(0x4924, x, y), z));
+}
+
+
+/* doubles (raster's plane set-up): VD_W = 8 lanes */
+#define VD_W 8
+typedef __m512d vdouble;
+SIMD_INL vdouble vd_set1(double x) { return _mm512_set1_pd(x); }
+SIMD_INL vdouble vd_loadu(const double *p) { return _mm512_loadu_pd(p); }
+SIMD_INL void vd_storeu(double *p, vdouble a) { _mm512_storeu_pd(p, a); }
+SIMD_INL vdouble vd_add(vdouble a, vdouble b) { return _mm512_add_pd(a, b); }
+SIMD_INL vdouble vd_sub(vdouble a, vdouble b) { return _mm512_sub_pd(a, b); }
+SIMD_INL vdouble vd_mul(vdouble a, vdouble b) { return _mm512_mul_pd(a, b); }
+SIMD_INL vdouble vd_div(vdouble a, vdouble b) { return _mm512_div_pd(a, b); }
+SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return _mm512_max_pd(a, b); }
+SIMD_INL vdouble vd_load_f(const float *p) { return _mm512_cvtps_pd(_mm256_loadu_ps(p)); }
+SIMD_INL void vd_store_f(float *p, vdouble a) { _mm256_storeu_ps(p, _mm512_cvtpd_ps(a)); }
+
 #else
 #error "simd_avx512.h: another implementation of the vector layer is already included"
 #endif

@@ -259,6 +259,48 @@ SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
     o[3] = vreinterpretq_f32_f64(vtrn2q_f64(vreinterpretq_f64_f32(ab1), vreinterpretq_f64_f32(cd1)));
 }
 
+
+/* ---- raster ops (src/raster's scan; simd.h "RASTER OPS") */
+SIMD_INL unsigned vi_sign_bits(vint i)
+{
+    static const uint32_t w[4] = { 1, 2, 4, 8 };
+    return vaddvq_u32(vandq_u32(vreinterpretq_u32_s32(vshrq_n_s32(i, 31)), vld1q_u32(w)));
+}
+SIMD_INL void vb_store_bits(uint8_t *p, unsigned bits)
+{
+    if ((bits & SIMD_FULL) == SIMD_FULL) {
+        const uint32_t ones = ~(uint32_t)0;
+        __builtin_memcpy(p, &ones, 4);
+        return;
+    }
+    for (bits &= SIMD_FULL; bits; bits &= bits - 1) p[__builtin_ctz(bits)] = 0xFF;
+}
+SIMD_INL void vf_store3_bits(float *p, unsigned bits, vfloat x, vfloat y, vfloat z)
+{
+    float32x4x3_t t;
+    t.val[0] = x; t.val[1] = y; t.val[2] = z;
+    if (bits & 1u) vst3q_lane_f32(p, t, 0);
+    if (bits & 2u) vst3q_lane_f32(p + 3, t, 1);
+    if (bits & 4u) vst3q_lane_f32(p + 6, t, 2);
+    if (bits & 8u) vst3q_lane_f32(p + 9, t, 3);
+}
+
+
+/* doubles (raster's plane set-up): VD_W = 2 lanes */
+#define VD_W 2
+typedef float64x2_t vdouble;
+SIMD_INL vdouble vd_set1(double x) { return vdupq_n_f64(x); }
+SIMD_INL vdouble vd_loadu(const double *p) { return vld1q_f64(p); }
+SIMD_INL void vd_storeu(double *p, vdouble a) { vst1q_f64(p, a); }
+SIMD_INL vdouble vd_add(vdouble a, vdouble b) { return vaddq_f64(a, b); }
+SIMD_INL vdouble vd_sub(vdouble a, vdouble b) { return vsubq_f64(a, b); }
+SIMD_INL vdouble vd_mul(vdouble a, vdouble b) { return vmulq_f64(a, b); }
+SIMD_INL vdouble vd_div(vdouble a, vdouble b) { return vdivq_f64(a, b); }
+/* x86's maxpd: a > b ? a : b (b when either is NaN, b for +-0) */
+SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return vbslq_f64(vcgtq_f64(a, b), a, b); }
+SIMD_INL vdouble vd_load_f(const float *p) { return vcvt_f64_f32(vld1_f32(p)); }
+SIMD_INL void vd_store_f(float *p, vdouble a) { vst1_f32(p, vcvt_f32_f64(a)); }
+
 #else
 #error "simd_neon.h: another implementation of the vector layer is already included"
 #endif

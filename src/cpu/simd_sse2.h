@@ -213,6 +213,49 @@ SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
     o[0] = a; o[1] = b; o[2] = c; o[3] = d;
 }
 
+
+/* ---- raster ops (src/raster's scan; simd.h "RASTER OPS") */
+SIMD_INL unsigned vi_sign_bits(vint i) { return (unsigned)_mm_movemask_ps(_mm_castsi128_ps(i)); }
+SIMD_INL void vb_store_bits(uint8_t *p, unsigned bits)
+{
+    if ((bits & SIMD_FULL) == SIMD_FULL) {
+        const uint32_t ones = ~(uint32_t)0;
+        __builtin_memcpy(p, &ones, 4);
+        return;
+    }
+    for (bits &= SIMD_FULL; bits; bits &= bits - 1) p[__builtin_ctz(bits)] = 0xFF;
+}
+SIMD_INL void vf_store3_bits(float *p, unsigned bits, vfloat x, vfloat y, vfloat z)
+{
+    _Alignas(16) float t[3][4];
+    _mm_store_ps(t[0], x); _mm_store_ps(t[1], y); _mm_store_ps(t[2], z);
+    for (bits &= SIMD_FULL; bits; bits &= bits - 1) {
+        const int l = __builtin_ctz(bits);
+        p[3 * l] = t[0][l]; p[3 * l + 1] = t[1][l]; p[3 * l + 2] = t[2][l];
+    }
+}
+
+
+/* doubles (raster's plane set-up): VD_W = 2 lanes */
+#define VD_W 2
+typedef __m128d vdouble;
+SIMD_INL vdouble vd_set1(double x) { return _mm_set1_pd(x); }
+SIMD_INL vdouble vd_loadu(const double *p) { return _mm_loadu_pd(p); }
+SIMD_INL void vd_storeu(double *p, vdouble a) { _mm_storeu_pd(p, a); }
+SIMD_INL vdouble vd_add(vdouble a, vdouble b) { return _mm_add_pd(a, b); }
+SIMD_INL vdouble vd_sub(vdouble a, vdouble b) { return _mm_sub_pd(a, b); }
+SIMD_INL vdouble vd_mul(vdouble a, vdouble b) { return _mm_mul_pd(a, b); }
+SIMD_INL vdouble vd_div(vdouble a, vdouble b) { return _mm_div_pd(a, b); }
+SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return _mm_max_pd(a, b); }
+SIMD_INL vdouble vd_load_f(const float *p)
+{
+    return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)(const void *)p)));
+}
+SIMD_INL void vd_store_f(float *p, vdouble a)
+{
+    _mm_storel_epi64((__m128i *)(void *)p, _mm_castps_si128(_mm_cvtpd_ps(a)));
+}
+
 #else
 #error "simd_sse2.h: another implementation of the vector layer is already included"
 #endif

@@ -1,32 +1,13 @@
-/* raster_aa.c - anti-aliased coverage: the standard sample patterns, the
- * scalar reference sample scan, rast_draw_aa, clear and resolve. The SIMD
- * sample scans (raster_aa.inl) give the bits of rast__scan_aa_ref. */
+/* raster_aa.c - anti-aliased coverage: the sample positions, the scalar
+ * reference sample scan, the draw driver with a given sample scan
+ * (rast_draw_aa in raster_context.c chooses it), clear and resolve. The
+ * SIMD sample scans (raster_aa.inl) give the bits of rast__scan_aa_ref;
+ * the sample patterns are in raster_setup.c, which the set-up and the
+ * scans share. */
 #include "raster_internal.h"
-
-#include "../cpu/cpu.h"
 
 #include <stddef.h>
 #include <string.h>
-
-/* Direct3D standard multisample positions, 1/16 px from the pixel centre
- * (x right, y down). */
-static const int8_t pattern4[4][2] = { { -2, -6 }, { 6, -2 }, { -6, 2 }, { 2, 6 } };
-static const int8_t pattern8[8][2] = { { 1, -3 }, { -1, 3 }, { 5, 1 },  { -3, -5 },
-                                       { -5, 5 }, { -7, -1 }, { 3, 7 }, { 7, -7 } };
-static const int8_t pattern16[16][2] = {
-    { 1, 1 },   { -1, -3 }, { -3, 2 },  { 4, -1 }, { -5, -2 }, { 2, 5 },  { 5, 3 },   { 3, -5 },
-    { -2, 6 },  { 0, -7 },  { -4, -6 }, { -6, 4 }, { -8, 0 },  { 7, -4 }, { 6, 7 },   { -7, -8 },
-};
-
-const int8_t (*rast__aa_pattern(int count))[2]
-{
-    switch (count) {
-    case 4:  return pattern4;
-    case 8:  return pattern8;
-    case 16: return pattern16;
-    default: return NULL;
-    }
-}
 
 int rast_aa_positions(int count, int xy[2 * RAST_AA_MAX_SAMPLES])
 {
@@ -77,21 +58,6 @@ long rast__scan_aa_ref(const rast_aa_target *t, const rast__tri *tri, int ya, in
     return touched;
 }
 
-rast__scan_aa_fn rast__scan_aa_for_isa(int isa)
-{
-#if defined(__x86_64__)
-    switch (isa) {
-    case EF_ISA_AVX512: return rast__scan_aa_avx512;
-    case EF_ISA_AVX2:   return rast__scan_aa_avx2;
-    case EF_ISA_SSE2:   return rast__scan_aa_sse2;
-    default:            break;
-    }
-#else
-    (void)isa;
-#endif
-    return rast__scan_aa_ref;
-}
-
 static rast_result validate_aa(const rast_aa_target *t, const rast_mesh_desc *m)
 {
     if (!t || !m || !t->samples || !rast__aa_pattern(t->count))
@@ -122,12 +88,6 @@ rast_result rast__draw_aa_with(const rast_aa_target *t, const rast_mesh_desc *m,
     if (stats)
         rast__stats_add(stats, &st);
     return RAST_OK;
-}
-
-rast_result rast_draw_aa(const rast_aa_target *t, const rast_mesh_desc *m,
-                         rast_stats *stats)
-{
-    return rast__draw_aa_with(t, m, stats, rast__scan_aa_for_isa(rast_draw_isa()));
 }
 
 void rast_aa_clear(const rast_aa_target *t)

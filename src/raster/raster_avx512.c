@@ -1,7 +1,10 @@
 /* raster_avx512.c - the AVX-512 scan (16 lanes, F+BW+DQ+VL): raster_simd.inl
- * with AVX-512 lane macros; masked loads and stores never touch disabled
- * lanes. Called only when cpuid reports AVX-512 (raster_context.c). Bytes
- * equal rast__scan_rows_ref. */
+ * on the vector layer's AVX-512 implementation (src/cpu/simd_avx512.h),
+ * plus what only AVX-512 does (below: attributes stored through
+ * permutes and lane masks per output vector, a division on 8 lanes);
+ * masked loads and stores never touch disabled lanes. Called only when
+ * cpuid reports AVX-512 (raster_context.c). Bytes equal
+ * rast__scan_rows_ref. */
 #include "raster_internal.h"
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -10,76 +13,11 @@
 #include <stddef.h>
 #include <string.h>
 
-#define SIMD_V 16
-#define SIMD_FN rast__scan_rows_avx512
-typedef __m512 vf;
-typedef __m512i vi;
+#include "../cpu/simd_avx512.h"
 
-#define VF_SET1(x) _mm512_set1_ps(x)
-#define VF_ADD(a, b) _mm512_add_ps(a, b)
-#define VF_MUL(a, b) _mm512_mul_ps(a, b)
-#define VF_DIV(a, b) _mm512_div_ps(a, b)
-#define VF_MAX(a, b) _mm512_max_ps(a, b)
-#define VF_MIN(a, b) _mm512_min_ps(a, b)
-#define VF_CVT(v) _mm512_cvtepi32_ps(v)
-#define VI_SET1(x) _mm512_set1_epi32(x)
-#define VI_ADD(a, b) _mm512_add_epi32(a, b)
-#define VI_OR(a, b) _mm512_or_si512(a, b)
-#define VI_LOADU(p) _mm512_loadu_si512((const void *)(p))
-#define VI_LANES() \
-    _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
-#define VI_LANE_MUL(lanes, s) _mm512_mullo_epi32(lanes, _mm512_set1_epi32(s))
-#define VI_NEG_BITS(v) ((unsigned)_mm512_movepi32_mask(v))
-#define VF_LT_BITS(a, b) ((unsigned)_mm512_cmp_ps_mask(a, b, _CMP_LT_OQ))
-#define VF_STOREA(p, v) _mm512_store_ps(p, v)
-#define VF_LOAD_M(p, bits, full) _mm512_maskz_loadu_ps((__mmask16)(bits), p)
-#define VF_STORE_M(p, bits, full, v) _mm512_mask_storeu_ps(p, (__mmask16)(bits), v)
-#define MASK_STORE_M(p, bits, full) \
-    _mm_mask_storeu_epi8(p, (__mmask16)(bits), _mm_set1_epi8((char)-1))
-
-/* 16 pixels x 3 attributes, planar -> interleaved, with two-source
- * permutes: output vector o holds floats 16*o .. 16*o+15, float f being
- * attribute f % 3 of pixel f / 3. */
-static inline void attr3_interleave(__m512 a, __m512 b, __m512 c, __m512 r[3])
-{
-    /* Index tables: (source << 4) | lane, source 0 = a/b pair, c merged
-     * after. First permutex2var(a, idx_ab, b) places a and b floats, then a
-     * masked permutexvar places c. */
-    static const int32_t idx_ab[3][16] = {
-        { 0, 16, 0, 1, 17, 0, 2, 18, 0, 3, 19, 0, 4, 20, 0, 5 },
-        { 21, 0, 6, 22, 0, 7, 23, 0, 8, 24, 0, 9, 25, 0, 10, 26 },
-        { 0, 11, 27, 0, 12, 28, 0, 13, 29, 0, 14, 30, 0, 15, 31, 0 },
-    };
-    static const int32_t idx_c[3][16] = {
-        { 0, 0, 0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0, 4, 0 },
-        { 0, 5, 0, 0, 6, 0, 0, 7, 0, 0, 8, 0, 0, 9, 0, 0 },
-        { 10, 0, 0, 11, 0, 0, 12, 0, 0, 13, 0, 0, 14, 0, 0, 15 },
-    };
-    static const __mmask16 mc[3] = { 0x4924, 0x2492, 0x9249 };
-    for (int o = 0; o < 3; o++) {
-        __m512 v = _mm512_permutex2var_ps(a, _mm512_loadu_si512(idx_ab[o]), b);
-        r[o] = _mm512_mask_permutexvar_ps(v, mc[o], _mm512_loadu_si512(idx_c[o]), c);
-    }
-}
-
-static inline void attr3_store(float *p, __m512 a, __m512 b, __m512 c)
-{
-    __m512 r[3];
-    attr3_interleave(a, b, c, r);
-    for (int o = 0; o < 3; o++)
-        _mm512_storeu_ps(p + 16 * o, r[o]);
-}
-
-/* Lane f of sel3[o] holds the bit of the pixel that float 16*o + f
- * belongs to: 1 << ((16*o + f) / 3). */
-static const int32_t sel3[3][16] __attribute__((aligned(64))) = {
-    { 1 << 0, 1 << 0, 1 << 0, 1 << 1, 1 << 1, 1 << 1, 1 << 2, 1 << 2,
-      1 << 2, 1 << 3, 1 << 3, 1 << 3, 1 << 4, 1 << 4, 1 << 4, 1 << 5 },
-    { 1 << 5, 1 << 5, 1 << 6, 1 << 6, 1 << 6, 1 << 7, 1 << 7, 1 << 7,
-      1 << 8, 1 << 8, 1 << 8, 1 << 9, 1 << 9, 1 << 9, 1 << 10, 1 << 10 },
-    { 1 << 10, 1 << 11, 1 << 11, 1 << 11, 1 << 12, 1 << 12, 1 << 12, 1 << 13,
-      1 << 13, 1 << 13, 1 << 14, 1 << 14, 1 << 14, 1 << 15, 1 << 15, 1 << 15 },
-};
+/* simd__sel3 (the layer's vf_store3_bits table): lane f of simd__sel3[o]
+ * holds the bit of the pixel that float 16*o + f belongs to,
+ * 1 << ((16*o + f) / 3). */
 
 /* The pixels in bits only (masked stores: other floats are not touched),
  * bits within the first `lanes` lanes. Only the output vectors those lanes
@@ -104,14 +42,13 @@ static inline void attr3_store_m(float *p, unsigned bits, int lanes, __m512 a, _
     const __m512i pb = _mm512_set1_epi32((int)bits);
     const int nout = lanes >= 16 ? 3 : (3 * lanes + 15) >> 4;
     for (int o = 0; o < nout; o++) {
-        const __mmask16 k = _mm512_test_epi32_mask(pb, _mm512_load_si512(sel3[o]));
+        const __mmask16 k = _mm512_test_epi32_mask(pb, _mm512_load_si512(simd__sel3[o]));
         __m512 v = _mm512_permutex2var_ps(a, _mm512_load_si512(idx_ab[o]), b);
         v = _mm512_mask_permutexvar_ps(v, mc[o], _mm512_load_si512(idx_c[o]), c);
         _mm512_mask_storeu_ps(p + 16 * o, k, v);
     }
 }
 #define ATTR3_STORE_M(p, bits, lanes, a, b, c) attr3_store_m(p, bits, lanes, a, b, c)
-#define ATTR3_STORE_FULL(p, a, b, c) attr3_store(p, a, b, c)
 
 /* The attributes of a one-vector row computed in the interleaved layout:
  * lane f of output vector o is attribute (16*o + f) % 3 of pixel
@@ -157,7 +94,7 @@ static inline void attr3_out(float *p, __m512i pb, const attr3_state *st, int o,
     const __m512 b2o = _mm512_permutexvar_ps(pix, b2);
     const __m512 a = _mm512_add_ps(_mm512_add_ps(st->a0[o], _mm512_mul_ps(b1o, st->d1[o])),
                                    _mm512_mul_ps(b2o, st->d2[o]));
-    const __mmask16 k = _mm512_test_epi32_mask(pb, _mm512_load_si512(sel3[o]));
+    const __mmask16 k = _mm512_test_epi32_mask(pb, _mm512_load_si512(simd__sel3[o]));
     _mm512_mask_storeu_ps(p + 16 * o, k, a);
 }
 
@@ -304,7 +241,7 @@ void rast__transform_dirs_avx512(const float m[16], const float *v, int n, float
         __m512 o[3];
         for (int k = 0; k < 3; k++)
             o[k] = _mm512_insertf32x8(_mm512_castps256_ps512(lo[k]), hi[k], 1);
-        attr3_store(out + 3 * (size_t)i, o[0], o[1], o[2]);
+        vf_store3(out + 3 * (size_t)i, o[0], o[1], o[2]);
     }
     if (i < n)
         rast__transform_dirs_ref(m, v + 3 * (size_t)i, n - i, out + 3 * (size_t)i);
@@ -315,36 +252,8 @@ void rast__transform_dirs_avx512(const float m[16], const float *v, int n, float
 #define AA_FN rast__scan_aa_avx512
 #include "raster_aa.inl"
 
-/* Batched set-up (raster_planes.inl): planes in 8 double lanes, vertex fills. */
-#define PD_V 8
-#define PLANES_FN rast__planes_avx512
-typedef __m512d vd;
-#define PD_LOAD(p) _mm512_load_pd(p)
-#define PD_SET1(x) _mm512_set1_pd(x)
-#define PD_ADD(a, b) _mm512_add_pd(a, b)
-#define PD_SUB(a, b) _mm512_sub_pd(a, b)
-#define PD_MUL(a, b) _mm512_mul_pd(a, b)
-#define PD_DIV(a, b) _mm512_div_pd(a, b)
-#define PD_MAX(a, b) _mm512_max_pd(a, b)
-#define PD_STORE_F(p, v) _mm256_storeu_ps(p, _mm512_cvtpd_ps(v))
-#define PS_V 16
-#define VFILL_FN rast__vfill_avx512
-#define SETUP_ISA rast__setup_isa_avx512
-typedef __m512 vs;
-#define PS_LOAD(p) _mm512_load_ps(p)
-#define PS_SET1(x) _mm512_set1_ps(x)
-#define PS_ADD(a, b) _mm512_add_ps(a, b)
-#define PS_SUB(a, b) _mm512_sub_ps(a, b)
-#define PS_MUL(a, b) _mm512_mul_ps(a, b)
-#define PS_DIV(a, b) _mm512_div_ps(a, b)
-#define PS_MAX(a, b) _mm512_max_ps(a, b)
-#define PS_MIN(a, b) _mm512_min_ps(a, b)
-#define PS_LT_BITS(a, b) ((unsigned)_mm512_cmp_ps_mask(a, b, _CMP_LT_OQ))
-#define PS_LE_BITS(a, b) ((unsigned)_mm512_cmp_ps_mask(a, b, _CMP_LE_OQ))
-#define PS_GT_BITS(a, b) ((unsigned)_mm512_cmp_ps_mask(a, b, _CMP_GT_OQ))
-#define PS_CVT_STORE(p, v) _mm512_store_si512((void *)(p), _mm512_cvtps_epi32(v))
-#define PD_LOAD_F(p) _mm512_cvtps_pd(_mm256_load_ps(p))
-#define PD_STORE(p, v) _mm512_store_pd(p, v)
+/* Batched set-up (raster_planes.inl, 8 double lanes): the de-interleave of
+ * a vertex block, the 16-lane rejection, then the one body. */
 /* 16 vertices xyzw: per pair of input vectors one two-source permute puts
  * x (low half) and y (high half), another z and w; 128-bit shuffles join
  * the halves of the two pairs. */

@@ -1,6 +1,19 @@
-/* raster_context.c - ISA dispatch, rast_draw, and the context: an ISA cap,
- * parallel drawing with a small thread pool, and clearing only what the
- * context's draws touched.
+/* raster_context.c - the top of the raster room: the ISA dispatch (the
+ * one place that names per-ISA kernels), the public entry points that
+ * choose them (rast_draw, rast_draw_aa, rast_transform_points/dirs), and
+ * the context: an ISA cap, parallel drawing with a small thread pool, and
+ * clearing only what the context's draws touched.
+ *
+ * Layers (each calls only the ones below it; docs/raster.md section 1):
+ *   raster_context.c   dispatch, threads, public draws
+ *   raster_draw.c, raster_aa.c
+ *                      drivers: a mesh through set-up and a given scan
+ *   raster_<isa>.c, raster_front_<isa>.c, raster_ref.c
+ *                      kernels: row scans, sample scans, vector set-up,
+ *                      transforms (intrinsics only here, via src/cpu's
+ *                      vector layer or the ISA's own header)
+ *   raster_setup.c     the scalar per-triangle set-up the kernels and
+ *                      drivers share (clip, snap, edges, planes, cache)
  *
  * Two parallel modes (the bytes never depend on the thread count):
  *
@@ -34,12 +47,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-#define cpu_relax() _mm_pause()
-#else
-#define cpu_relax() ((void)0)
-#endif
+#define cpu_relax() ef_cpu_relax()
 
 enum {
     BAND_ROWS = RAST__TILE, /* rows per band: one row of dirty tiles */
@@ -50,31 +58,96 @@ enum {
 
 /* ---- dispatch ----------------------------------------------------------- */
 
-rast__scan_rows_fn rast__scan_for_isa(int isa)
-{
+/* The kernels of one ISA. Every function pointer of a row gives the
+ * bytes of the reference row (EF_ISA_REF). */
+typedef struct isa_kernels {
+    rast__scan_rows_fn scan;
+    rast__scan_aa_fn scan_aa;
+    const rast__setup_isa *setup;
+    void (*points)(const float mvp[16], const float *pos, int n, float *clip);
+    void (*dirs)(const float m[16], const float *v, int n, float *out);
+} isa_kernels;
+
+static const isa_kernels kernels_ref = {
+    rast__scan_rows_ref, rast__scan_aa_ref, &rast__setup_isa_ref,
+    rast__transform_points_ref, rast__transform_dirs_ref
+};
 #if defined(__x86_64__)
+static const isa_kernels kernels_sse2 = {
+    rast__scan_rows_sse2, rast__scan_aa_sse2, &rast__setup_isa_sse2,
+    rast__transform_points_ref, rast__transform_dirs_ref
+};
+static const isa_kernels kernels_avx2 = {
+    rast__scan_rows_avx2, rast__scan_aa_avx2, &rast__setup_isa_avx2,
+    rast__transform_points_ref, rast__transform_dirs_ref
+};
+/* The AVX-512 transforms take 16 vertices per step (fewer: the reference). */
+static void points_avx512(const float mvp[16], const float *pos, int n, float *clip)
+{
+    if (n >= 16)
+        rast__transform_points_avx512(mvp, pos, n, clip);
+    else
+        rast__transform_points_ref(mvp, pos, n, clip);
+}
+static void dirs_avx512(const float m[16], const float *v, int n, float *out)
+{
+    if (n >= 16)
+        rast__transform_dirs_avx512(m, v, n, out);
+    else
+        rast__transform_dirs_ref(m, v, n, out);
+}
+static const isa_kernels kernels_avx512 = {
+    rast__scan_rows_avx512, rast__scan_aa_avx512, &rast__setup_isa_avx512,
+    points_avx512, dirs_avx512
+};
+#endif
+#if defined(__aarch64__) && defined(__ARM_NEON)
+static const isa_kernels kernels_neon = {
+    rast__scan_rows_neon, rast__scan_aa_neon, &rast__setup_isa_neon,
+    rast__transform_points_ref, rast__transform_dirs_ref
+};
+#endif
+
+static const isa_kernels *kernels_for(int isa)
+{
     switch (isa) {
-    case EF_ISA_AVX512: return rast__scan_rows_avx512;
-    case EF_ISA_AVX2:   return rast__scan_rows_avx2;
-    case EF_ISA_SSE2:   return rast__scan_rows_sse2;
+#if defined(__x86_64__)
+    case EF_ISA_AVX512: return &kernels_avx512;
+    case EF_ISA_AVX2:   return &kernels_avx2;
+    case EF_ISA_SSE2:   return &kernels_sse2;
+#endif
+#if defined(__aarch64__) && defined(__ARM_NEON)
+    case EF_ISA_NEON:   return &kernels_neon;
+#endif
     default:            break;
     }
-#else
-    (void)isa;
-#endif
-    return rast__scan_rows_ref;
+    return &kernels_ref;
+}
+
+rast__scan_rows_fn rast__scan_for_isa(int isa)
+{
+    return kernels_for(isa)->scan;
+}
+
+rast__scan_aa_fn rast__scan_aa_for_isa(int isa)
+{
+    return kernels_for(isa)->scan_aa;
 }
 
 const rast__setup_isa *rast__setup_for_scan(rast__scan_rows_fn scan)
 {
+    static const isa_kernels *const all[] = {
 #if defined(__x86_64__)
-    if (scan == rast__scan_rows_avx512)
-        return &rast__setup_isa_avx512;
-    if (scan == rast__scan_rows_avx2)
-        return &rast__setup_isa_avx2;
-#else
-    (void)scan;
+        &kernels_avx512, &kernels_avx2, &kernels_sse2,
 #endif
+#if defined(__aarch64__) && defined(__ARM_NEON)
+        &kernels_neon,
+#endif
+        &kernels_ref
+    };
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+        if (all[i]->scan == scan)
+            return all[i]->setup;
     return &rast__setup_isa_ref;
 }
 
@@ -83,10 +156,37 @@ int rast_draw_isa(void)
     return (int)ef_isa_choose(EF_ISA_DEFAULT);
 }
 
+rast_result rast__draw_with(const rast_target *t, const rast_mesh_desc *m,
+                            rast_stats *stats, rast__scan_rows_fn scan)
+{
+    rast_result r = rast__validate(t, m);
+    if (r != RAST_OK)
+        return r;
+    rast__draw_valid(t, m, stats, scan, rast__setup_for_scan(scan), NULL);
+    return RAST_OK;
+}
+
 rast_result rast_draw(const rast_target *t, const rast_mesh_desc *mesh,
                       rast_stats *stats)
 {
     return rast__draw_with(t, mesh, stats, rast__scan_for_isa(rast_draw_isa()));
+}
+
+rast_result rast_draw_aa(const rast_aa_target *t, const rast_mesh_desc *m,
+                         rast_stats *stats)
+{
+    return rast__draw_aa_with(t, m, stats, rast__scan_aa_for_isa(rast_draw_isa()));
+}
+
+void rast_transform_points(const float mvp[16], const float *pos, int n,
+                           float *clip)
+{
+    kernels_for(rast_draw_isa())->points(mvp, pos, n, clip);
+}
+
+void rast_transform_dirs(const float m[16], const float *v, int n, float *out)
+{
+    kernels_for(rast_draw_isa())->dirs(m, v, n, out);
 }
 
 /* ---- context ------------------------------------------------------------ */
@@ -222,7 +322,7 @@ static void run_draw(rast_context *c, int tid)
     const int nj = c->njobs;
     if (nj >= 2) {
         for (int j = tid; j < nj; j += c->threads)
-            rast__draw_valid_vb(c->jt[j], c->jm[j], &me->st, c->scan, c->jtiles[j],
+            rast__draw_valid_vb(c->jt[j], c->jm[j], &me->st, c->scan, c->setup, c->jtiles[j],
                                 c->vb[tid]);
         barrier(c);
     } else if (nj == 1) {
@@ -491,20 +591,18 @@ static long count_nonzero(const uint8_t *m, size_t n)
 {
     size_t i = 0;
     long zeros = 0;
-#if defined(__SSE2__)
-    const __m128i z = _mm_setzero_si128(), one = _mm_set1_epi8(1);
+    /* 16 byte counters, at most 255 steps each, then summed: the
+     * compilers make the inner loop one byte compare and subtract per 16
+     * bytes (the SSE2 code this file had by hand). */
     while (i + 16 <= n) {
-        /* Up to 255 steps into 8-bit lanes, then summed by psadbw. */
-        size_t end = n - i >= 255 * 16 ? i + 255 * 16 : i + ((n - i) & ~(size_t)15);
-        __m128i acc = z;
-        for (; i < end; i += 16) {
-            const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)(m + i));
-            acc = _mm_add_epi8(acc, _mm_and_si128(_mm_cmpeq_epi8(v, z), one));
-        }
-        const __m128i s = _mm_sad_epu8(acc, z);
-        zeros += _mm_cvtsi128_si32(s) + _mm_cvtsi128_si32(_mm_srli_si128(s, 8));
+        const size_t end = n - i >= 255 * 16 ? i + 255 * 16 : i + ((n - i) & ~(size_t)15);
+        uint8_t acc[16] = { 0 };
+        for (; i < end; i += 16)
+            for (int k = 0; k < 16; k++)
+                acc[k] = (uint8_t)(acc[k] + (m[i + (size_t)k] == 0));
+        for (int k = 0; k < 16; k++)
+            zeros += acc[k];
     }
-#endif
     for (; i < n; i++)
         zeros += m[i] == 0;
     return (long)n - zeros;
@@ -611,7 +709,7 @@ rast_result rast_context_draw_jobs(rast_context *c, int n, const rast_target *co
     }
     if (c->threads == 1 || n == 0) {
         for (int i = 0; i < n; i++)
-            rast__draw_valid_vb(t[i], mesh[i], &st, c->scan, c->jtiles[i], c->vb[0]);
+            rast__draw_valid_vb(t[i], mesh[i], &st, c->scan, c->setup, c->jtiles[i], c->vb[0]);
     } else {
         c->njobs = n;
         c->jt = t;

@@ -1,10 +1,19 @@
 /* raster_internal.h - the parts of the rasterizer shared by the scalar
  * reference (raster_ref.c) and any SIMD scan path (raster_<isa>.c).
  *
+ * Layers, each calling only those below it (function pointers chosen by
+ * the context go downwards too):
+ *   raster_context.c  ISA dispatch (the only file naming per-ISA kernels),
+ *                     threads, rast_draw / rast_draw_aa / transforms
+ *   raster_draw.c     the draw driver (chunks through set-up and a scan),
+ *   raster_aa.c       the anti-aliased draw driver and reference scan
+ *   per-ISA kernels   raster_ref.c, raster_<isa>.c, raster_front_<isa>.c
+ *   raster_setup.c    the scalar per-triangle set-up they share
+ *
  * Split of the work (docs/raster.md has the full rules):
  *   raster_setup.c  validation, clipping, perspective divide, viewport,
  *                   sub-pixel snapping, culling, edge and plane setup, and
- *                   the per-triangle driver rast__draw_with(). Scalar; it
+ *                   the per-range set-up rast__prepare_range(). Scalar; it
  *                   defines the set-up's bits. Three parts of it have SIMD
  *                   versions that give the same bits (rast__setup_isa:
  *                   raster_planes.inl, raster_avx2.c, raster_avx512.c):
@@ -163,7 +172,8 @@ rast_result rast__validate_desc(const rast_target *t, const rast_mesh_desc *m);
 rast_result rast__validate_indices(const rast_mesh_desc *m);
 
 /* rast_draw on the calling thread with a given row scan (the reference
- * or a SIMD one). */
+ * or a SIMD one) and the set-up kernels of its ISA (raster_context.c,
+ * the dispatch). */
 rast_result rast__draw_with(const rast_target *t, const rast_mesh_desc *m,
                             rast_stats *stats, rast__scan_rows_fn scan);
 
@@ -178,11 +188,15 @@ typedef struct rast__tiles {
 /* Marks the tiles of pixels x0..x1 x ya..yb (inclusive, not empty). */
 void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1);
 
-/* The body of rast__draw_with for validated arguments. When tiles is not
- * NULL, the pixel box of every scanned triangle is marked in it (every
- * pixel the draw may have written lies in a marked tile). */
+/* The body of rast__draw_with for validated arguments (raster_draw.c),
+ * with the set-up kernels isa (those of the scan's ISA, or
+ * &rast__setup_isa_ref). When tiles is not NULL, the pixel box of every
+ * scanned triangle is marked in it (every pixel the draw may have written
+ * lies in a marked tile). */
+struct rast__setup_isa;
 void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
-                      rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles);
+                      rast_stats *stats, rast__scan_rows_fn scan,
+                      const struct rast__setup_isa *isa, rast__tiles *tiles);
 /* Scans the n set-up triangles tri in order into t (micro: micro records
  * may occur, their pixels are written as the scan would write them);
  * marks the tiles of every triangle that may write a pixel in tiles
@@ -190,13 +204,14 @@ void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
  * {1, 0, 1, 0} before the first call). Returns the pixels written. */
 long rast__scan_list(const rast_target *t, const rast__tri *tri, int n,
                      rast__scan_rows_fn scan, rast__tiles *tiles, int last[4], int micro);
-/* The same with a vertex buffer: when the scan's set-up ISA has a vector
- * front end and the mesh fits (vertex_count <= vb->cap), the draw runs
- * it with micro records (same bytes and counters); otherwise (or vb NULL)
+/* The same with a vertex buffer: when isa has a vector front end and
+ * the mesh fits (vertex_count <= vb->cap), the draw runs it with micro
+ * records (same bytes and counters); otherwise (or vb NULL)
  * rast__draw_valid. */
 struct rast__vbuf;
 void rast__draw_valid_vb(const rast_target *t, const rast_mesh_desc *m,
-                         rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles,
+                         rast_stats *stats, rast__scan_rows_fn scan,
+                         const struct rast__setup_isa *isa, rast__tiles *tiles,
                          struct rast__vbuf *vb);
 
 /* Fetch, clip, snap and set up submitted triangle ti of m (indices already
@@ -263,6 +278,8 @@ typedef void (*rast__planes_fn)(rast__pbatch *b);
 void rast__planes_ref(rast__pbatch *b);
 void rast__planes_avx2(rast__pbatch *b);
 void rast__planes_avx512(rast__pbatch *b);
+void rast__planes_sse2(rast__pbatch *b);
+void rast__planes_neon(rast__pbatch *b);
 
 /* Vertex cache fill of a block: e[l] = the entry of vertex base + l for
  * l < count (count 1..RAST__VBLOCK; clip: the mesh's clip coordinates),
@@ -277,6 +294,10 @@ void rast__vfill_avx2(const rast__view *v, const float *clip, uint32_t base, int
                       rast__vc_entry *e);
 void rast__vfill_avx512(const rast__view *v, const float *clip, uint32_t base, int count,
                         rast__vc_entry *e);
+void rast__vfill_sse2(const rast__view *v, const float *clip, uint32_t base, int count,
+                      rast__vc_entry *e);
+void rast__vfill_neon(const rast__view *v, const float *clip, uint32_t base, int count,
+                      rast__vc_entry *e);
 
 /* The set-up kernels of an ISA for rast__prepare_range: planes in
  * batches, and vertex cache misses filled RAST__VBLOCK aligned vertices
@@ -358,10 +379,10 @@ typedef struct rast__setup_isa {
     rast__vpass_fn vpass;     /* NULL (with frontv): no vector front end */
     rast__frontv_fn frontv;
 } rast__setup_isa;
-extern const rast__setup_isa rast__setup_isa_ref, rast__setup_isa_avx2,
-    rast__setup_isa_avx512;
+extern const rast__setup_isa rast__setup_isa_ref, rast__setup_isa_sse2, rast__setup_isa_avx2,
+    rast__setup_isa_avx512, rast__setup_isa_neon;
 /* The set-up kernels that go with a row scan (those of the scan's ISA;
- * the scalar ones for the reference and SSE2). */
+ * the scalar ones for the reference). */
 const rast__setup_isa *rast__setup_for_scan(rast__scan_rows_fn scan);
 
 /* rast__prepare_cached for submitted triangles ti0 .. ti1-1 in order,
@@ -401,6 +422,7 @@ long rast__scan_aa_ref(const rast_aa_target *t, const rast__tri *tri, int ya, in
 long rast__scan_aa_sse2(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
 long rast__scan_aa_avx2(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
 long rast__scan_aa_avx512(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
+long rast__scan_aa_neon(const rast_aa_target *t, const rast__tri *tri, int ya, int yb);
 rast__scan_aa_fn rast__scan_aa_for_isa(int isa);
 /* rast_draw_aa with a given scan. */
 rast_result rast__draw_aa_with(const rast_aa_target *t, const rast_mesh_desc *m,
@@ -417,8 +439,8 @@ long rast__scan_ref(const rast_target *t, const rast__tri *tri);
 long rast__scan_rows_ref(const rast_target *t, const rast__tri *tri, int ya,
                          int yb);
 
-/* SIMD scans (raster_sse2.c, raster_avx2.c, raster_avx512.c; one body,
- * raster_simd.inl). Each gives the bytes of rast__scan_ref. They may only
+/* SIMD scans (raster_sse2.c, raster_avx2.c, raster_avx512.c,
+ * raster_neon.c; one body, raster_simd.inl on src/cpu's vector layer). Each gives the bytes of rast__scan_ref. They may only
  * be called when ef_cpu_has() says the CPU runs the ISA. */
 long rast__scan_rows_sse2(const rast_target *t, const rast__tri *tri, int ya,
                           int yb);
@@ -426,6 +448,8 @@ long rast__scan_rows_avx2(const rast_target *t, const rast__tri *tri, int ya,
                           int yb);
 long rast__scan_rows_avx512(const rast_target *t, const rast__tri *tri,
                             int ya, int yb);
+long rast__scan_rows_neon(const rast_target *t, const rast__tri *tri, int ya,
+                          int yb);
 /* The vertex transforms of raster.h: the scalar reference (raster_ref.c)
  * and the AVX-512 version (raster_avx512.c, same bytes; call only when the
  * CPU runs AVX-512). rast_transform_points / _dirs use the AVX-512 one when

@@ -1,21 +1,17 @@
-/* raster_planes.inl - the batched plane set-up (rast__planes_fn) shared by
- * raster_avx2.c (4 double lanes) and raster_avx512.c (8 double lanes):
+/* raster_planes.inl - the batched plane set-up (rast__planes_fn) and the
+ * vertex cache block fill (rast__vfill_fn) shared by raster_sse2.c and
+ * raster_neon.c (2 double lanes), raster_avx2.c (4) and raster_avx512.c (8):
  * one triangle per lane, every lane running the IEEE double operations of
  * the scalar set-up (planes_one in raster_setup.c) in its order, so each
  * plane gets the bits of rast__planes_ref (no contraction into FMA:
  * -ffp-contract=off).
  *
- * Lane macros:
- *   PD_V                   double lanes
- *   PLANES_FN              name of the exported function
- *   vd                     the double vector type
- *   PD_LOAD(p)             aligned load of PD_V doubles
- *   PD_SET1(x)
- *   PD_ADD PD_SUB PD_MUL PD_DIV   one IEEE op per lane
- *   PD_MAX(a, b)           a > b ? a : b (the x86 max; NaN cannot occur)
- *   PD_STORE_F(p, v)       the lanes converted to float (round to
- *                          nearest, as the scalar conversion), stored to
- *                          PD_V floats at p
+ * Written on the vector layer (src/cpu/simd.h; vdouble: VD_W = SIMD_W / 2
+ * double lanes, vd_max the x86 max, NaN cannot occur here, vd_store_f the
+ * rounding of the scalar conversion). The including file includes one
+ * implementation and then this file, which defines SIMD_FN(rast__planes),
+ * SIMD_FN(rast__vfill) and the table SIMD_FN(rast__setup_isa) (with
+ * FRONT_FN, VPASS_FN, FRONTV_FN when the file defines them).
  *
  * Per lane (scalar reference: planes_one, docs/raster.md section 6.1):
  *   qmax = max(iw2, max(iw1, max(iw0, 0)))     (the loop "if (iw > qmax)")
@@ -29,22 +25,22 @@
  *     c = (f0 + gx*ox) + gy*oy;   stored as float c, dx = gx, dy = gy.
  */
 
-static inline void planes_lane(vd f0, vd f1, vd f2, vd ex1, vd ey1, vd ex2, vd ey2,
-                               vd ox, vd oy, vd area, float *c, float *gxo, float *gyo)
+static inline void planes_lane(vdouble f0, vdouble f1, vdouble f2, vdouble ex1, vdouble ey1, vdouble ex2, vdouble ey2,
+                               vdouble ox, vdouble oy, vdouble area, float *c, float *gxo, float *gyo)
 {
-    const vd df1 = PD_SUB(f1, f0), df2 = PD_SUB(f2, f0);
-    const vd gx = PD_DIV(PD_SUB(PD_MUL(df1, ey2), PD_MUL(df2, ey1)), area);
-    const vd gy = PD_DIV(PD_SUB(PD_MUL(df2, ex1), PD_MUL(df1, ex2)), area);
-    const vd cc = PD_ADD(PD_ADD(f0, PD_MUL(gx, ox)), PD_MUL(gy, oy));
-    PD_STORE_F(c, cc);
-    PD_STORE_F(gxo, gx);
-    PD_STORE_F(gyo, gy);
+    const vdouble df1 = vd_sub(f1, f0), df2 = vd_sub(f2, f0);
+    const vdouble gx = vd_div(vd_sub(vd_mul(df1, ey2), vd_mul(df2, ey1)), area);
+    const vdouble gy = vd_div(vd_sub(vd_mul(df2, ex1), vd_mul(df1, ex2)), area);
+    const vdouble cc = vd_add(vd_add(f0, vd_mul(gx, ox)), vd_mul(gy, oy));
+    vd_store_f(c, cc);
+    vd_store_f(gxo, gx);
+    vd_store_f(gyo, gy);
 }
 
-void PLANES_FN(rast__pbatch *b)
+void SIMD_FN(rast__planes)(rast__pbatch *b)
 {
     const int n = b->n;
-    const int ng = (n + PD_V - 1) / PD_V * PD_V;
+    const int ng = (n + VD_W - 1) / VD_W * VD_W;
     /* Harmless values in the unused lanes of the last group. */
     for (int i = n; i < ng; i++) {
         for (int k = 0; k < 3; k++) {
@@ -57,19 +53,19 @@ void PLANES_FN(rast__pbatch *b)
     /* out[plane * 3 + {c, dx, dy}][lane]: the floats of rast__plane z, q,
      * b1, b2 in struct order. */
     _Alignas(64) float out[12][RAST__PBATCH];
-    const vd zero = PD_SET1(0.0);
-    for (int i = 0; i < ng; i += PD_V) {
-        const vd X0 = PD_LOAD(b->X[0] + i), X1 = PD_LOAD(b->X[1] + i), X2 = PD_LOAD(b->X[2] + i);
-        const vd Y0 = PD_LOAD(b->Y[0] + i), Y1 = PD_LOAD(b->Y[1] + i), Y2 = PD_LOAD(b->Y[2] + i);
-        const vd iw0 = PD_LOAD(b->iw[0] + i), iw1 = PD_LOAD(b->iw[1] + i),
-                 iw2 = PD_LOAD(b->iw[2] + i);
-        const vd area = PD_LOAD(b->area + i);
-        const vd qmax = PD_MAX(iw2, PD_MAX(iw1, PD_MAX(iw0, zero)));
-        const vd q0 = PD_DIV(iw0, qmax), q1 = PD_DIV(iw1, qmax), q2 = PD_DIV(iw2, qmax);
-        const vd ex1 = PD_SUB(X1, X0), ey1 = PD_SUB(Y1, Y0);
-        const vd ex2 = PD_SUB(X2, X0), ey2 = PD_SUB(Y2, Y0);
-        const vd ox = PD_SUB(PD_LOAD(b->cx + i), X0), oy = PD_SUB(PD_LOAD(b->cy + i), Y0);
-        planes_lane(PD_LOAD(b->zw[0] + i), PD_LOAD(b->zw[1] + i), PD_LOAD(b->zw[2] + i), ex1,
+    const vdouble zero = vd_set1(0.0);
+    for (int i = 0; i < ng; i += VD_W) {
+        const vdouble X0 = vd_loadu(b->X[0] + i), X1 = vd_loadu(b->X[1] + i), X2 = vd_loadu(b->X[2] + i);
+        const vdouble Y0 = vd_loadu(b->Y[0] + i), Y1 = vd_loadu(b->Y[1] + i), Y2 = vd_loadu(b->Y[2] + i);
+        const vdouble iw0 = vd_loadu(b->iw[0] + i), iw1 = vd_loadu(b->iw[1] + i),
+                 iw2 = vd_loadu(b->iw[2] + i);
+        const vdouble area = vd_loadu(b->area + i);
+        const vdouble qmax = vd_max(iw2, vd_max(iw1, vd_max(iw0, zero)));
+        const vdouble q0 = vd_div(iw0, qmax), q1 = vd_div(iw1, qmax), q2 = vd_div(iw2, qmax);
+        const vdouble ex1 = vd_sub(X1, X0), ey1 = vd_sub(Y1, Y0);
+        const vdouble ex2 = vd_sub(X2, X0), ey2 = vd_sub(Y2, Y0);
+        const vdouble ox = vd_sub(vd_loadu(b->cx + i), X0), oy = vd_sub(vd_loadu(b->cy + i), Y0);
+        planes_lane(vd_loadu(b->zw[0] + i), vd_loadu(b->zw[1] + i), vd_loadu(b->zw[2] + i), ex1,
                     ey1, ex2, ey2, ox, oy, area, out[0] + i, out[1] + i, out[2] + i);
         planes_lane(q0, q1, q2, ex1, ey1, ex2, ey2, ox, oy, area, out[3] + i, out[4] + i,
                     out[5] + i);
@@ -100,19 +96,12 @@ void PLANES_FN(rast__pbatch *b)
  * iw = 1 / w. Lanes of vertices that are not finite or need clipping
  * compute garbage that is never stored as valid (flags say so).
  *
- * More lane macros:
- *   PS_V                   float lanes; vs the float vector type
- *   PS_LOAD(p) PS_SET1(x) PS_ADD PS_SUB PS_MUL PS_DIV
- *   PS_MAX(a, b), PS_MIN(a, b)   the x86 max / min (a > b ? a : b, ...)
- *   PS_LT_BITS(a, b), PS_LE_BITS(a, b), PS_GT_BITS(a, b)  ordered compares
- *   PS_CVT_STORE(p, v)     round to int32 (nearest even) and store PS_V
- *   PD_LOAD_F(p)           PD_V floats from p converted to double
- *   PD_STORE(p, v)
+ * Float lanes: vfloat of the layer (vf_max / vf_min the x86 ones).
  * Optional:
  *   LOAD_BLOCK_XYZW(c, x, y, z, w)  de-interleave 16 vertices (x, y, z, w
  *                          each) at c into the aligned arrays x, y, z, w
  */
-void VFILL_FN(const rast__view *v, const float *clip, uint32_t base, int count,
+void SIMD_FN(rast__vfill)(const rast__view *v, const float *clip, uint32_t base, int count,
               rast__vc_entry *e)
 {
     _Alignas(64) float x[RAST__VBLOCK], y[RAST__VBLOCK], z[RAST__VBLOCK], w[RAST__VBLOCK];
@@ -136,37 +125,37 @@ void VFILL_FN(const rast__view *v, const float *clip, uint32_t base, int count,
         }
     }
     unsigned fin = 0, wpos = 0, ob[RAST__PLANE_COUNT] = { 0, 0, 0, 0, 0, 0 };
-    const vs zero = PS_SET1(0.0f), half = PS_SET1(0.5f), fix = PS_SET1((float)RAST__FIX_ONE);
-    const vs big = PS_SET1(FLT_MAX), nbig = PS_SET1(-FLT_MAX);
-    const vs gx = PS_SET1(v->gx), gy = PS_SET1(v->gy);
-    const vs fw = PS_SET1((float)v->width), fh = PS_SET1((float)v->height);
-    const vs lox = PS_SET1((float)v->min_x), hix = PS_SET1((float)v->max_x);
-    const vs loy = PS_SET1((float)v->min_y), hiy = PS_SET1((float)v->max_y);
-    for (int i = 0; i < RAST__VBLOCK; i += PS_V) {
-        const vs vx = PS_LOAD(x + i), vy = PS_LOAD(y + i), vz = PS_LOAD(z + i),
-                 vw = PS_LOAD(w + i);
-        fin |= (PS_LE_BITS(vx, big) & PS_LE_BITS(nbig, vx) & PS_LE_BITS(vy, big) &
-                PS_LE_BITS(nbig, vy) & PS_LE_BITS(vz, big) & PS_LE_BITS(nbig, vz) &
-                PS_LE_BITS(vw, big) & PS_LE_BITS(nbig, vw)) << i;
-        const vs gxw = PS_MUL(gx, vw), gyw = PS_MUL(gy, vw);
-        ob[RAST__PLANE_NEAR] |= PS_LT_BITS(PS_ADD(vz, vw), zero) << i;
-        ob[RAST__PLANE_FAR] |= PS_LT_BITS(PS_SUB(vw, vz), zero) << i;
-        ob[RAST__PLANE_LEFT] |= PS_LT_BITS(PS_ADD(gxw, vx), zero) << i;
-        ob[RAST__PLANE_RIGHT] |= PS_LT_BITS(PS_SUB(gxw, vx), zero) << i;
-        ob[RAST__PLANE_BOTTOM] |= PS_LT_BITS(PS_ADD(gyw, vy), zero) << i;
-        ob[RAST__PLANE_TOP] |= PS_LT_BITS(PS_SUB(gyw, vy), zero) << i;
-        wpos |= PS_GT_BITS(vw, zero) << i;
-        const vs nx = PS_DIV(vx, vw), ny = PS_DIV(vy, vw);
-        const vs sx = PS_MUL(PS_ADD(PS_MUL(nx, half), half), fw);
-        const vs sy = PS_MUL(PS_SUB(half, PS_MUL(ny, half)), fh);
-        PS_CVT_STORE(X + i, PS_MIN(PS_MAX(PS_MUL(sx, fix), lox), hix));
-        PS_CVT_STORE(Y + i, PS_MIN(PS_MAX(PS_MUL(sy, fix), loy), hiy));
+    const vfloat zero = vf_set1(0.0f), half = vf_set1(0.5f), fix = vf_set1((float)RAST__FIX_ONE);
+    const vfloat big = vf_set1(FLT_MAX), nbig = vf_set1(-FLT_MAX);
+    const vfloat gx = vf_set1(v->gx), gy = vf_set1(v->gy);
+    const vfloat fw = vf_set1((float)v->width), fh = vf_set1((float)v->height);
+    const vfloat lox = vf_set1((float)v->min_x), hix = vf_set1((float)v->max_x);
+    const vfloat loy = vf_set1((float)v->min_y), hiy = vf_set1((float)v->max_y);
+    for (int i = 0; i < RAST__VBLOCK; i += SIMD_W) {
+        const vfloat vx = vf_load(x + i), vy = vf_load(y + i), vz = vf_load(z + i),
+                 vw = vf_load(w + i);
+        fin |= (vm_bits(vf_le(vx, big)) & vm_bits(vf_le(nbig, vx)) & vm_bits(vf_le(vy, big)) &
+                vm_bits(vf_le(nbig, vy)) & vm_bits(vf_le(vz, big)) & vm_bits(vf_le(nbig, vz)) &
+                vm_bits(vf_le(vw, big)) & vm_bits(vf_le(nbig, vw))) << i;
+        const vfloat gxw = vf_mul(gx, vw), gyw = vf_mul(gy, vw);
+        ob[RAST__PLANE_NEAR] |= vm_bits(vf_lt(vf_add(vz, vw), zero)) << i;
+        ob[RAST__PLANE_FAR] |= vm_bits(vf_lt(vf_sub(vw, vz), zero)) << i;
+        ob[RAST__PLANE_LEFT] |= vm_bits(vf_lt(vf_add(gxw, vx), zero)) << i;
+        ob[RAST__PLANE_RIGHT] |= vm_bits(vf_lt(vf_sub(gxw, vx), zero)) << i;
+        ob[RAST__PLANE_BOTTOM] |= vm_bits(vf_lt(vf_add(gyw, vy), zero)) << i;
+        ob[RAST__PLANE_TOP] |= vm_bits(vf_lt(vf_sub(gyw, vy), zero)) << i;
+        wpos |= vm_bits(vf_gt(vw, zero)) << i;
+        const vfloat nx = vf_div(vx, vw), ny = vf_div(vy, vw);
+        const vfloat sx = vf_mul(vf_add(vf_mul(nx, half), half), fw);
+        const vfloat sy = vf_mul(vf_sub(half, vf_mul(ny, half)), fh);
+        vi_store(X + i, vi_from_vf_round(vf_min(vf_max(vf_mul(sx, fix), lox), hix)));
+        vi_store(Y + i, vi_from_vf_round(vf_min(vf_max(vf_mul(sy, fix), loy), hiy)));
     }
-    const vd dhalf = PD_SET1(0.5), done = PD_SET1(1.0);
-    for (int i = 0; i < RAST__VBLOCK; i += PD_V) {
-        const vd dz = PD_LOAD_F(z + i), dw = PD_LOAD_F(w + i);
-        PD_STORE(zw + i, PD_ADD(PD_MUL(PD_DIV(dz, dw), dhalf), dhalf));
-        PD_STORE(iw + i, PD_DIV(done, dw));
+    const vdouble dhalf = vd_set1(0.5), done = vd_set1(1.0);
+    for (int i = 0; i < RAST__VBLOCK; i += VD_W) {
+        const vdouble dz = vd_load_f(z + i), dw = vd_load_f(w + i);
+        vd_storeu(zw + i, vd_add(vd_mul(vd_div(dz, dw), dhalf), dhalf));
+        vd_storeu(iw + i, vd_div(done, dw));
     }
     /* Outcodes per lane from the per-plane lane bits (mostly all zero). */
     uint8_t oc[RAST__VBLOCK] = { 0 };
@@ -199,4 +188,10 @@ void VFILL_FN(const rast__view *v, const float *clip, uint32_t base, int count,
 #define VPASS_FN NULL
 #define FRONTV_FN NULL
 #endif
-const rast__setup_isa SETUP_ISA = { PLANES_FN, VFILL_FN, FRONT_FN, VPASS_FN, FRONTV_FN };
+/* SETUP_PLANES: the planes function of the table (default: the one above;
+ * raster_sse2.c and raster_neon.c keep the scalar one, see there). */
+#ifndef SETUP_PLANES
+#define SETUP_PLANES SIMD_FN(rast__planes)
+#endif
+const rast__setup_isa SIMD_FN(rast__setup_isa) = { SETUP_PLANES, SIMD_FN(rast__vfill), FRONT_FN,
+                                                   VPASS_FN, FRONTV_FN };

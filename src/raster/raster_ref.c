@@ -1,10 +1,8 @@
-/* raster_ref.c - the scalar reference: per-pixel scan of a set-up triangle,
- * rast_draw, target clear, vertex transforms. The output of this file
+/* raster_ref.c - the scalar reference kernels: per-pixel scan of a set-up
+ * triangle, vertex transforms; and target clear. The output of this file
  * defines the rasterizer's bytes; SIMD scans must match it (the per-pixel
  * op order is in raster_internal.h and docs/raster.md). */
 #include "raster_internal.h"
-
-#include "../cpu/cpu.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -113,31 +111,6 @@ void rast__transform_dirs_ref(const float m[16], const float *v, int n, float *o
         for (int k = 0; k < 3; k++)
             out[3 * i + k] = len > 0.0 ? (float)((double)r[k] / len) : 0.0f;
     }
-}
-
-/* The transforms run 16 vertices per step with AVX-512 (same bytes,
- * raster_avx512.c); the reference elsewhere. */
-void rast_transform_points(const float mvp[16], const float *pos, int n,
-                           float *clip)
-{
-#if defined(__x86_64__)
-    if (n >= 16 && rast_draw_isa() >= EF_ISA_AVX512) {
-        rast__transform_points_avx512(mvp, pos, n, clip);
-        return;
-    }
-#endif
-    rast__transform_points_ref(mvp, pos, n, clip);
-}
-
-void rast_transform_dirs(const float m[16], const float *v, int n, float *out)
-{
-#if defined(__x86_64__)
-    if (n >= 16 && rast_draw_isa() >= EF_ISA_AVX512) {
-        rast__transform_dirs_avx512(m, v, n, out);
-        return;
-    }
-#endif
-    rast__transform_dirs_ref(m, v, n, out);
 }
 
 const char *rast_result_str(rast_result r)

@@ -1,6 +1,10 @@
 /* raster_setup.c - per-triangle work shared by every scan path: validation,
- * homogeneous clipping, viewport, snapping, culling, edge and plane setup.
- * The rules and their bounds are written down in docs/raster.md. */
+ * homogeneous clipping, viewport, snapping, culling, edge and plane setup,
+ * the vertex cache and the set-up of a range of submitted triangles (with
+ * the set-up kernels of an ISA it is given), the anti-aliasing sample
+ * patterns. The bottom layer of the room: it calls no other raster file
+ * (the draw driver is raster_draw.c, the dispatch raster_context.c). The
+ * rules and their bounds are written down in docs/raster.md. */
 #include "raster_internal.h"
 
 #include <float.h>
@@ -8,8 +12,11 @@
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
-#if defined(__SSE2__)
-#include <emmintrin.h>
+
+/* The magic-number rounding of snap_axis needs float arithmetic in float
+ * (no x87 excess precision). */
+#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
+#error "raster_setup.c needs FLT_EVAL_METHOD == 0 (SSE2 or NEON float arithmetic)"
 #endif
 
 /* ---- constants --------------------------------------------------------- */
@@ -131,13 +138,14 @@ static int32_t snap_axis(float s, int32_t lo, int32_t hi)
     float f = s * (float)RAST__FIX_ONE;
     if (f < (float)lo) f = (float)lo;
     if (f > (float)hi) f = (float)hi;
-#if defined(__SSE2__)
-    /* cvtss2si rounds in the current mode (half to even by default), as
-     * lrintf does, without a libm call. f is in range (clamped above). */
-    return (int32_t)_mm_cvtss_si32(_mm_set_ss(f));
-#else
-    return (int32_t)lrintf(f);   /* round half to even (default mode) */
-#endif
+    /* Round half to even (the default mode), as lrintf and cvtss2si do,
+     * without a libm call or an intrinsic: |f| <= 2^22 after the clamp
+     * (lo >= -2^21, hi <= 2^22, section 2 of docs/raster.md), and for
+     * |f| <= 2^22 the sum f + 1.5 * 2^23 lies in [2^23, 2^24], where the
+     * float grid is 1, so the addition rounds f to an integer in the
+     * current mode and the subtraction is exact. */
+    const float magic = 12582912.0f; /* 1.5 * 2^23 */
+    return (int32_t)((f + magic) - magic);
 }
 
 static inline void snap_inl(const rast__view *v, const rast__vert *p, int32_t *fx,
@@ -493,8 +501,7 @@ rast_result rast__validate_desc(const rast_target *t, const rast_mesh_desc *m)
 rast_result rast__validate_indices(const rast_mesh_desc *m)
 {
     /* Every index below the vertex count, without a branch per index
-     * (4 at a time with SSE2: unsigned idx > nv - 1 as a signed compare
-     * of both sides biased by 2^31). */
+     * (unsigned idx > nv - 1). */
     const size_t ni = 3 * (size_t)m->tri_count;
     if (ni == 0)
         return RAST_OK;
@@ -503,16 +510,14 @@ rast_result rast__validate_indices(const rast_mesh_desc *m)
     const uint32_t last = (uint32_t)m->vertex_count - 1u;
     uint32_t bad = 0;
     size_t i = 0;
-#if defined(__SSE2__)
-    const __m128i bias = _mm_set1_epi32(INT32_MIN);
-    const __m128i lim = _mm_set1_epi32((int32_t)(last ^ 0x80000000u));
-    __m128i acc = _mm_setzero_si128();
-    for (; i + 4 <= ni; i += 4) {
-        const __m128i v = _mm_loadu_si128((const __m128i *)(const void *)(m->indices + i));
-        acc = _mm_or_si128(acc, _mm_cmpgt_epi32(_mm_xor_si128(v, bias), lim));
-    }
-    bad = (uint32_t)_mm_movemask_epi8(acc);
-#endif
+    /* Four lanes of or-ed compares: the compilers turn the inner loop
+     * into one vector compare per four indices (the SSE2 code this file
+     * had by hand), and any other target gets the scalar loop. */
+    uint32_t acc[4] = { 0, 0, 0, 0 };
+    for (; i + 4 <= ni; i += 4)
+        for (int k = 0; k < 4; k++)
+            acc[k] |= (uint32_t)-(uint32_t)(m->indices[i + (size_t)k] > last);
+    bad = acc[0] | acc[1] | acc[2] | acc[3];
     for (; i < ni; i++)
         bad |= (uint32_t)(m->indices[i] > last);
     return bad ? RAST_ERR_INDEX : RAST_OK;
@@ -858,184 +863,24 @@ int rast__prepare_aa(const rast__view *view, const rast_mesh_desc *m, int ti,
     return made;
 }
 
-void rast__stats_add(rast_stats *dst, const rast_stats *s)
-{
-    dst->tris_in += s->tris_in;
-    dst->tris_nonfinite += s->tris_nonfinite;
-    dst->tris_clipped_away += s->tris_clipped_away;
-    dst->tris_degenerate += s->tris_degenerate;
-    dst->tris_culled += s->tris_culled;
-    dst->tris_drawn += s->tris_drawn;
-    dst->pixels_written += s->pixels_written;
-}
+/* ---- anti-aliasing sample patterns ------------------------------------ */
 
-int rast__draw_na(const rast_target *t, const rast_mesh_desc *m)
-{
-    /* Attributes go through clipping only if both sides have them. */
-    return (t->attr && m->attr) ? m->attr_count : 0;
-}
+/* Direct3D standard multisample positions, 1/16 px from the pixel centre
+ * (x right, y down). */
+static const int8_t pattern4[4][2] = { { -2, -6 }, { 6, -2 }, { -6, 2 }, { 2, 6 } };
+static const int8_t pattern8[8][2] = { { 1, -3 }, { -1, 3 }, { 5, 1 },  { -3, -5 },
+                                       { -5, 5 }, { -7, -1 }, { 3, 7 }, { 7, -7 } };
+static const int8_t pattern16[16][2] = {
+    { 1, 1 },   { -1, -3 }, { -3, 2 },  { 4, -1 }, { -5, -2 }, { 2, 5 },  { 5, 3 },   { 3, -5 },
+    { -2, 6 },  { 0, -7 },  { -4, -6 }, { -6, 4 }, { -8, 0 },  { 7, -4 }, { 6, 7 },   { -7, -8 },
+};
 
-void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1)
+const int8_t (*rast__aa_pattern(int count))[2]
 {
-    const int t0 = x0 / RAST__TILE, t1 = x1 / RAST__TILE;
-    if (t0 / 64 == t1 / 64) {   /* the usual case: one word per tile row */
-        const int w = t0 / 64, lo = t0 % 64, hi = t1 % 64;
-        const uint64_t bits = (hi == 63 ? ~(uint64_t)0 : ((uint64_t)1 << (hi + 1)) - 1u) &
-                              ~(((uint64_t)1 << lo) - 1u);
-        for (int ty = ya / RAST__TILE; ty <= yb / RAST__TILE; ty++)
-            tl->bits[ty][w] |= bits;
-        return;
+    switch (count) {
+    case 4:  return pattern4;
+    case 8:  return pattern8;
+    case 16: return pattern16;
+    default: return NULL;
     }
-    for (int ty = ya / RAST__TILE; ty <= yb / RAST__TILE; ty++)
-        for (int w = t0 / 64; w <= t1 / 64; w++) {
-            const int lo = w * 64 > t0 ? 0 : t0 - w * 64;
-            const int hi = w * 64 + 63 < t1 ? 63 : t1 - w * 64;
-            const uint64_t upto = hi == 63 ? ~(uint64_t)0 : ((uint64_t)1 << (hi + 1)) - 1u;
-            tl->bits[ty][w] |= upto & ~(((uint64_t)1 << lo) - 1u);
-        }
-}
-
-/* The pixels of a micro record (r->micro != 0): the depth test and the
- * stores of the scan (rast__scan_rows_ref) for its covered pixels, from
- * the values the front end computed with the scan's operations. */
-static long micro_apply(const rast_target *t, const rast__tri *r)
-{
-    long n = 0;
-    const int na = t->attr ? r->attr_count : 0;
-    for (unsigned bits = (unsigned)r->micro & 15u; bits; bits &= bits - 1) {
-        const int p = __builtin_ctz(bits);
-        const int x = r->x0 + (p & 1), y = r->y0 + (p >> 1);
-        const float z = r->mz[p];
-        if (t->depth) {
-            float *d = t->depth + (size_t)y * (size_t)t->depth_stride + x;
-            if (!(z < *d))
-                continue;
-            *d = z;
-        }
-        t->mask[(size_t)y * (size_t)t->mask_stride + x] = 255;
-        n++;
-        if (na) {
-            const float b1 = r->mb1[p], b2 = r->mb2[p];
-            float *a = t->attr + (size_t)y * (size_t)t->attr_stride + (size_t)x * (size_t)na;
-            for (int k = 0; k < na; k++)
-                a[k] = (r->a0[k] + b1 * r->d1[k]) + b2 * r->d2[k];
-        }
-    }
-    return n;
-}
-
-long rast__scan_list(const rast_target *t, const rast__tri *tri, int n,
-                     rast__scan_rows_fn scan, rast__tiles *tiles, int last[4], int micro)
-{
-    long px = 0;
-    for (int i = 0; i < n; i++) {
-        const rast__tri *r = &tri[i];
-        if (micro && r->micro) {
-            /* Defensive: the empty test drops boxes up to 2x2 with no
-             * covered centre before they get a record. */
-            if (!(r->micro & 15))
-                continue;
-            px += micro_apply(t, r);
-        } else {
-            px += scan(t, r, r->y0, r->y1);
-        }
-        if (!tiles)
-            continue;
-        /* Neighbouring triangles mostly lie in the tiles just marked:
-         * skip the marking when the tile rectangle is inside the last
-         * one marked (those bits are set already). */
-        const int tx0 = r->x0 / RAST__TILE, tx1 = r->x1 / RAST__TILE;
-        const int ty0 = r->y0 / RAST__TILE, ty1 = r->y1 / RAST__TILE;
-        if (tx0 >= last[0] && tx1 <= last[1] && ty0 >= last[2] && ty1 <= last[3])
-            continue;
-        rast__tiles_add(tiles, r->y0, r->y1, r->x0, r->x1);
-        last[0] = tx0;
-        last[1] = tx1;
-        last[2] = ty0;
-        last[3] = ty1;
-    }
-    return px;
-}
-
-void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
-                      rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles)
-{
-    rast__view view;
-    rast__view_init(&view, t->width, t->height, rast__draw_na(t, m));
-    rast_stats st = { 0 };
-    st.tris_in = m->tri_count;
-    /* Front end over chunks of submitted triangles, then the scans of
-     * the chunk's triangles in submission order. */
-    enum { CHUNK = 16 };
-    rast__tri tri[CHUNK * RAST__MAX_FAN];
-    rast__vcache vc;
-    rast__vcache_reset(&vc);
-    const rast__setup_isa *isa = rast__setup_for_scan(scan);
-    int last[4] = { 1, 0, 1, 0 };   /* tiles marked last: x0, x1, y0, y1 (none) */
-    for (int ti = 0; ti < m->tri_count; ti += CHUNK) {
-        const int te = m->tri_count - ti > CHUNK ? ti + CHUNK : m->tri_count;
-        const int n = rast__prepare_range(&view, m, ti, te, &vc, tri, &st, isa);
-        st.pixels_written += rast__scan_list(t, tri, n, scan, tiles, last, 0);
-    }
-    if (stats)
-        rast__stats_add(stats, &st);
-}
-
-void rast__draw_valid_vb(const rast_target *t, const rast_mesh_desc *m,
-                         rast_stats *stats, rast__scan_rows_fn scan, rast__tiles *tiles,
-                         rast__vbuf *vb)
-{
-    const rast__setup_isa *isa = rast__setup_for_scan(scan);
-    if (!vb || !isa->vpass || !isa->frontv || m->vertex_count > vb->cap) {
-        rast__draw_valid(t, m, stats, scan, tiles);
-        return;
-    }
-    rast__view view;
-    rast__view_init(&view, t->width, t->height, rast__draw_na(t, m));
-    rast_stats st = { 0 };
-    st.tris_in = m->tri_count;
-    isa->vpass(&view, m->clip, m->vertex_count, vb);
-    int last[4] = { 1, 0, 1, 0 };
-    for (int ti = 0; ti < m->tri_count; ti += RAST__VX_CHUNK) {
-        const int te = m->tri_count - ti > RAST__VX_CHUNK ? ti + RAST__VX_CHUNK : m->tri_count;
-        const int n = isa->frontv(&view, m, vb, ti, te, vb->out, &st, 1);
-        st.pixels_written += rast__scan_list(t, vb->out, n, scan, tiles, last, 1);
-    }
-    if (stats)
-        rast__stats_add(stats, &st);
-}
-
-rast__vbuf *rast__vbuf_alloc(int cap)
-{
-    if (cap < 0 || cap > (1 << 24))
-        return NULL;
-    const size_t c = ((size_t)cap + 15u) & ~(size_t)15u;
-    const size_t head = 64, nout = (size_t)RAST__VX_CHUNK * RAST__MAX_FAN;
-    const size_t size = head + c * (2 * sizeof(int32_t) + 2 * sizeof(double)) +
-                        ((nout * sizeof(rast__tri) + 63u) & ~(size_t)63u);
-    char *p = aligned_alloc(64, (size + 63u) & ~(size_t)63u);
-    if (!p)
-        return NULL;
-    rast__vbuf *vb = (rast__vbuf *)(void *)p;
-    vb->cap = (int)c;
-    vb->xy = (int32_t *)(void *)(p + head);
-    vb->zw = (double *)(void *)(p + head + c * 2 * sizeof(int32_t));
-    vb->iw = vb->zw + c;
-    vb->out = (rast__tri *)(void *)(vb->iw + c);
-    return vb;
-}
-
-void rast__vbuf_free(rast__vbuf *vb)
-{
-    free(vb);
-}
-
-rast_result rast__draw_with(const rast_target *t, const rast_mesh_desc *m,
-                            rast_stats *stats, rast__scan_rows_fn scan)
-{
-    rast_result r = rast__validate(t, m);
-    if (r != RAST_OK)
-        return r;
-    rast__draw_valid(t, m, stats, scan, NULL);
-    return RAST_OK;
 }

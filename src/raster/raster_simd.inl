@@ -4,34 +4,19 @@
  * rast__scan_rows_ref (raster_ref.c): the same integer coverage test and,
  * per lane, the same IEEE float operations in the same order.
  *
- * Lane macros (bits = unsigned, bit l for lane l):
- *   SIMD_V                 lanes (4, 8 or 16)
- *   SIMD_FN                name of the exported row scan
- *   vf, vi                 float and int32 vector types
- *   VF_SET1 VF_ADD VF_MUL VF_DIV   one IEEE op per lane
- *   VF_MAX(a, b), VF_MIN(a, b)     a > b ? a : b and a < b ? a : b (the
- *                          x86 semantics; used as max(0, z), min(1, z),
- *                          which equal the reference's selects, -0.0 and
- *                          NaN included)
- *   VF_CVT(vi)             int32 -> float (exact here: |i| < 2^24)
- *   VI_SET1 VI_ADD VI_OR VI_LOADU(p)
- *   VI_LANES()             the vector 0, 1, ..., SIMD_V-1
- *   VI_LANE_MUL(lanes, s)  lane l = l * s (int32; |l*s| < 2^27 here)
- *   VI_NEG_BITS(v)         lanes whose sign bit is set
- *   VF_LT_BITS(a, b)       lanes with a < b (ordered)
- *   VF_LOAD_M(p, bits, full)       load the lanes in bits (full: all);
- *                          other lanes are not accessed (value: anything)
- *   VF_STORE_M(p, bits, full, v)   store the lanes in bits
- *   MASK_STORE_M(p, bits, full)    write 255 to the bytes in bits
- *   VF_STOREA(p, v)        store to a SIMD_V-float aligned array
- * Optional:
- *   ATTR3_STORE_FULL(p, a0, a1, a2)  interleave three attribute vectors of
- *                          SIMD_V pixels into p[3*SIMD_V] (all lanes).
- *   ATTR3_STORE_M(p, bits, lanes, a0, a1, a2)  the same for the pixels in
- *                          bits only (no other float is accessed); bits lie
- *                          in the first `lanes` lanes (the box width of a
- *                          one-vector row, the lanes left in a wider one),
- *                          so the outputs needed are known per triangle.
+ * Written on the vector layer (src/cpu/simd.h): the including file
+ * includes one implementation (simd_sse2.h, simd_avx2.h, simd_avx512.h,
+ * simd_neon.h) and then this file, which defines SIMD_FN(rast__scan_rows)
+ * (rast__scan_rows_sse2, ...). vf_max(0, z) and vf_min(1, z) have the x86
+ * semantics on every ISA (simd.h), which equal the reference's selects,
+ * -0.0 and NaN included; vf_from_vi is exact here (|i| < 2^24). Besides
+ * the layer (its raster ops: vi_sign_bits, vb_store_bits, vf_store3_bits),
+ * an including file may define what its ISA does better:
+ *   ATTR3_STORE_M(p, bits, lanes, a0, a1, a2)  vf_store3_bits for the
+ *                          pixels in bits, which lie in the first `lanes`
+ *                          lanes (the box width of a one-vector row, the
+ *                          lanes left in a wider one), so the outputs
+ *                          needed are known per triangle.
  *   ATTR3_STATE, ATTR3_PREP(st, tri, lanes), ATTR3_STORE_P(p, bits, st, b1, b2)
  *                          three attributes of a one-vector row from the
  *                          pixels' barycentrics b1, b2: PREP fills the
@@ -40,10 +25,11 @@
  *                          p[3*lanes] as (a0 + b1*d1) + b2*d2 per float.
  *   ATTR3_STORE_PL(p, bits, lanes, st, b1, b2)  as ATTR3_STORE_P for a run
  *                          vector of `lanes` pixels of a wider row (bits
- *                          within them; st prepared with SIMD_V lanes).
+ *                          within them; st prepared with SIMD_W lanes).
  *   VF_DIV_LANES(a, b, lanes)  a / b in the first `lanes` lanes (the
  *                          others: any value; nothing derived from them is
  *                          stored).
+ * (raster_avx512.c defines them with AVX-512 permutes and masks.)
  *
  * COVERAGE. The reference tests E >= 0 with int64 E stepped by multiples of
  * 256 (e_dx = -dy*256, e_dy = dx*256). Since floor((E + 256k)/256) =
@@ -51,7 +37,7 @@
  * reduced value E' = floor(E/256) stepped by -dy and dx, the same sign for
  * every pixel. Bounds: |dx|, |dy| < 2^23 (docs/raster.md section 2).
  *   * Fast path (int32 throughout): when the bound |c| + rows*|sy| +
- *     cols*|sx| of |E'| over the scanned rows x [0, nvec*SIMD_V) (at least
+ *     cols*|sx| of |E'| over the scanned rows x [0, nvec*SIMD_W) (at least
  *     the largest corner value, E' being affine) lies below 2^30, every
  *     value and every step difference fits int32: int32 adds give the
  *     exact integers. Triangles one vector wide (most of a fine mesh)
@@ -61,7 +47,7 @@
  *     pixel. Wider ones test a row's
  *     coverage vectors first (from the left, up to the end of the row's
  *     one run of covered pixels) and then do the float work on vectors
- *     that start at the run's first pixel: a run of at most SIMD_V
+ *     that start at the run's first pixel: a run of at most SIMD_W
  *     pixels costs one vector wherever it lies (long thin slivers).
  *   * Otherwise (huge triangles, vertices far in the guard band): E' of the
  *     first lane of each vector is computed in int64 and clamped to
@@ -70,7 +56,22 @@
  *     lane: 2^29 - 2^27 > 0. Lanes with an unclamped start are exact.
  */
 
-#define SIMD_FULL ((1u << SIMD_V) - 1u)
+#ifndef ATTR3_STORE_M
+#define ATTR3_STORE_M(p, bits, lanes, a, b, c) vf_store3_bits(p, bits, a, b, c)
+#endif
+#define ATTR3_STORE_FULL(p, a, b, c) vf_store3(p, a, b, c)
+
+/* Lanes l with a < b (ordered), as bits. */
+SIMD_INL unsigned simd_lt_bits(vfloat a, vfloat b)
+{
+    return vm_bits(vf_lt(a, b));
+}
+
+/* Lane l = l * s (int32; |l*s| < 2^27 here). */
+SIMD_INL vint simd_lane_mul(vint lanes, int32_t s)
+{
+    return vi_mullo(lanes, vi_set1(s));
+}
 #define SIMD_LIM30 ((int64_t)(1 << 30) - 1)
 #define SIMD_LIM29 ((int64_t)1 << 29)
 
@@ -108,22 +109,22 @@ static inline int simd_popcount(unsigned v)
 }
 
 /* The attributes of the lanes in pass, written interleaved to dst. */
-static inline void simd_attr_store(float *dst, int na, unsigned pass, int lanes, vf b1,
-                                   vf b2, const vf *av0, const vf *av1, const vf *av2)
+static inline void simd_attr_store(float *dst, int na, unsigned pass, int lanes, vfloat b1,
+                                   vfloat b2, const vfloat *av0, const vfloat *av1, const vfloat *av2)
 {
     (void)lanes;
 #ifdef ATTR3_STORE_M
     if (na == 3) {
         ATTR3_STORE_M(dst, pass, lanes,
-            VF_ADD(VF_ADD(av0[0], VF_MUL(b1, av1[0])), VF_MUL(b2, av2[0])),
-            VF_ADD(VF_ADD(av0[1], VF_MUL(b1, av1[1])), VF_MUL(b2, av2[1])),
-            VF_ADD(VF_ADD(av0[2], VF_MUL(b1, av1[2])), VF_MUL(b2, av2[2])));
+            vf_add(vf_add(av0[0], vf_mul(b1, av1[0])), vf_mul(b2, av2[0])),
+            vf_add(vf_add(av0[1], vf_mul(b1, av1[1])), vf_mul(b2, av2[1])),
+            vf_add(vf_add(av0[2], vf_mul(b1, av1[2])), vf_mul(b2, av2[2])));
         return;
     }
 #endif
-    _Alignas(64) float a[RAST_MAX_ATTRS][SIMD_V];
+    _Alignas(64) float a[RAST_MAX_ATTRS][SIMD_W];
     for (int k = 0; k < na; k++)
-        VF_STOREA(a[k], VF_ADD(VF_ADD(av0[k], VF_MUL(b1, av1[k])), VF_MUL(b2, av2[k])));
+        vf_store(a[k], vf_add(vf_add(av0[k], vf_mul(b1, av1[k])), vf_mul(b2, av2[k])));
     for (unsigned bits = pass; bits; bits &= bits - 1) {
         const int l = __builtin_ctz(bits);
         float *p = dst + (size_t)l * (size_t)na;
@@ -134,7 +135,7 @@ static inline void simd_attr_store(float *dst, int na, unsigned pass, int lanes,
 
 /* One pixel (x, y) of the box: the reference's scalar expressions for
  * that pixel (fi, fj are the same floats, every op the same IEEE op),
- * without the vector set-up of SIMD_FN. Used for boxes of one or two
+ * without the vector set-up of the row scan. Used for boxes of one or two
  * pixels (1x1, 2x1, 1x2), whose vector set-up costs more than their
  * pixels. (Drawn through a context with the vector front end, such boxes
  * come as micro records instead and are not scanned.) */
@@ -170,7 +171,7 @@ static inline long simd_scan_pixel(const rast_target *t, const rast__tri *tri, i
 
 /* Row state of the one-vector loop. */
 typedef struct simd_vec1 {
-    vi e0, e1, e2;                /* reduced edges of the current row */
+    vint e0, e1, e2;                /* reduced edges of the current row */
     uint8_t *mrow;
     float *drow, *arow;           /* NULL without depth / attributes */
     long written;
@@ -179,27 +180,27 @@ typedef struct simd_vec1 {
 /* Coverage, depth and mask of row y (the reference's z per lane), the
  * edges stepped to the next row; returns the lanes written. */
 static inline unsigned simd_vec1_row(simd_vec1 *s, const rast__tri *tri, int y,
-                                     unsigned valid, vi dy0, vi dy1, vi dy2, vf zfi)
+                                     unsigned valid, vint dy0, vint dy1, vint dy2, vfloat zfi)
 {
-    const unsigned cov = ~VI_NEG_BITS(VI_OR(VI_OR(s->e0, s->e1), s->e2)) & valid;
-    s->e0 = VI_ADD(s->e0, dy0);
-    s->e1 = VI_ADD(s->e1, dy1);
-    s->e2 = VI_ADD(s->e2, dy2);
+    const unsigned cov = ~vi_sign_bits(vi_or(vi_or(s->e0, s->e1), s->e2)) & valid;
+    s->e0 = vi_add(s->e0, dy0);
+    s->e1 = vi_add(s->e1, dy1);
+    s->e2 = vi_add(s->e2, dy2);
     if (!cov)
         return 0;
     const float fj = (float)(y - tri->y0);
-    vf z = VF_ADD(VF_SET1(tri->z.c + tri->z.dy * fj), zfi);
-    z = VF_MAX(VF_SET1(0.0f), z);
-    z = VF_MIN(VF_SET1(1.0f), z);
+    vfloat z = vf_add(vf_set1(tri->z.c + tri->z.dy * fj), zfi);
+    z = vf_max(vf_set1(0.0f), z);
+    z = vf_min(vf_set1(1.0f), z);
     unsigned pass = cov;
     if (s->drow) {
-        const vf d = VF_LOAD_M(s->drow, cov, cov == SIMD_FULL);
-        pass = cov & VF_LT_BITS(z, d);
+        const vfloat d = vf_load_bits(s->drow, cov);
+        pass = cov & simd_lt_bits(z, d);
         if (!pass)
             return 0;
-        VF_STORE_M(s->drow, pass, pass == SIMD_FULL, z);
+        vf_store_bits(s->drow, pass, z);
     }
-    MASK_STORE_M(s->mrow, pass, pass == SIMD_FULL);
+    vb_store_bits(s->mrow, pass);
     s->written += simd_popcount(pass);
     return pass;
 }
@@ -213,7 +214,7 @@ static inline void simd_vec1_next(simd_vec1 *s, const rast_target *t)
         s->arow += t->attr_stride;
 }
 
-/* Triangles one vector wide (nx <= SIMD_V; most of a fine mesh), int32
+/* Triangles one vector wide (nx <= SIMD_W; most of a fine mesh), int32
  * coverage (the caller checked the bound, see COVERAGE): c, sx, sy are the
  * reduced edge values at (x0, ys) and their steps. Coverage first, the
  * float work only for rows with covered pixels, and nothing is set up for
@@ -225,20 +226,20 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
                            int32_t sx0, int32_t sx1, int32_t sx2, int32_t sy0,
                            int32_t sy1, int32_t sy2)
 {
-    const unsigned valid = nx >= SIMD_V ? SIMD_FULL : (1u << nx) - 1u;
-    const vi lanev = VI_LANES();
+    const unsigned valid = nx >= SIMD_W ? SIMD_FULL : (1u << nx) - 1u;
+    const vint lanev = vi_lanes();
     simd_vec1 s;
-    s.e0 = VI_ADD(VI_SET1(c0), VI_LANE_MUL(lanev, sx0));
-    s.e1 = VI_ADD(VI_SET1(c1), VI_LANE_MUL(lanev, sx1));
-    s.e2 = VI_ADD(VI_SET1(c2), VI_LANE_MUL(lanev, sx2));
+    s.e0 = vi_add(vi_set1(c0), simd_lane_mul(lanev, sx0));
+    s.e1 = vi_add(vi_set1(c1), simd_lane_mul(lanev, sx1));
+    s.e2 = vi_add(vi_set1(c2), simd_lane_mul(lanev, sx2));
     s.written = 0;
     s.mrow = t->mask + (size_t)ys * (size_t)t->mask_stride + tri->x0;
     s.drow = t->depth ? t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0 : NULL;
     s.arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride + (size_t)tri->x0 * (size_t)na
                 : NULL;
-    const vi dy0 = VI_SET1(sy0), dy1 = VI_SET1(sy1), dy2 = VI_SET1(sy2);
-    const vf fi = VF_CVT(lanev);
-    const vf zfi = VF_MUL(VF_SET1(tri->z.dx), fi);
+    const vint dy0 = vi_set1(sy0), dy1 = vi_set1(sy1), dy2 = vi_set1(sy2);
+    const vfloat fi = vf_from_vi(lanev);
+    const vfloat zfi = vf_mul(vf_set1(tri->z.dx), fi);
     int y = ys;
     unsigned pass = 0;
     for (; y <= ye; y++, simd_vec1_next(&s, t))
@@ -248,11 +249,11 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
         return s.written;
 
     /* Row y wrote pixels (pass) and there are attributes. */
-    const vf one = VF_SET1(1.0f);
-    const vf qfi = VF_MUL(VF_SET1(tri->q.dx), fi);
-    const vf b1fi = VF_MUL(VF_SET1(tri->b1.dx), fi);
-    const vf b2fi = VF_MUL(VF_SET1(tri->b2.dx), fi);
-    vf av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
+    const vfloat one = vf_set1(1.0f);
+    const vfloat qfi = vf_mul(vf_set1(tri->q.dx), fi);
+    const vfloat b1fi = vf_mul(vf_set1(tri->b1.dx), fi);
+    const vfloat b2fi = vf_mul(vf_set1(tri->b2.dx), fi);
+    vfloat av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
 #ifdef ATTR3_PREP
     ATTR3_STATE a3;
     if (na == 3)
@@ -260,9 +261,9 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
     else
 #endif
         for (int k = 0; k < na; k++) {
-            av0[k] = VF_SET1(tri->a0[k]);
-            av1[k] = VF_SET1(tri->d1[k]);
-            av2[k] = VF_SET1(tri->d2[k]);
+            av0[k] = vf_set1(tri->a0[k]);
+            av1[k] = vf_set1(tri->d1[k]);
+            av2[k] = vf_set1(tri->d2[k]);
         }
     for (;;) {
         const float fj = (float)(y - tri->y0);
@@ -270,12 +271,12 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
         const float b1r = tri->b1.c + tri->b1.dy * fj;
         const float b2r = tri->b2.c + tri->b2.dy * fj;
 #ifdef VF_DIV_LANES
-        const vf r = VF_DIV_LANES(one, VF_ADD(VF_SET1(qr), qfi), nx);
+        const vfloat r = VF_DIV_LANES(one, vf_add(vf_set1(qr), qfi), nx);
 #else
-        const vf r = VF_DIV(one, VF_ADD(VF_SET1(qr), qfi));
+        const vfloat r = vf_div(one, vf_add(vf_set1(qr), qfi));
 #endif
-        const vf b1 = VF_MUL(VF_ADD(VF_SET1(b1r), b1fi), r);
-        const vf b2 = VF_MUL(VF_ADD(VF_SET1(b2r), b2fi), r);
+        const vfloat b1 = vf_mul(vf_add(vf_set1(b1r), b1fi), r);
+        const vfloat b2 = vf_mul(vf_add(vf_set1(b2r), b2fi), r);
 #ifdef ATTR3_PREP
         if (na == 3)
             ATTR3_STORE_P(s.arow, pass, &a3, b1, b2);
@@ -291,7 +292,7 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
 }
 
 /* Rows wider than one vector, int32 coverage (the caller checked the
- * bound over rows ys..ye x [0, nvec*SIMD_V), see COVERAGE): c, sx, sy are
+ * bound over rows ys..ye x [0, nvec*SIMD_W), see COVERAGE): c, sx, sy are
  * the reduced edge values at (x0, ys) and their steps. The covered pixels
  * of a row are one run: each E'_k is affine in i, so E'_k >= 0 holds on a
  * half-line of i and the three intersect in an interval (the box one too).
@@ -300,7 +301,7 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
  * vector whose last lane is not covered. Then the float work runs on
  * vectors starting at the run's first pixel (lane l = pixel xf + l,
  * fi = (float)(xf + l): the same ops per pixel), so a run of at most
- * SIMD_V pixels takes one vector however it straddles the aligned ones
+ * SIMD_W pixels takes one vector however it straddles the aligned ones
  * (the slivers of capsule sides: runs of 4-10 pixels in boxes up to
  * hundreds wide). Loads and stores are masked to the run; no other pixel
  * is accessed. As in simd_scan_vec1, the attribute set-up waits for the
@@ -312,16 +313,16 @@ static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, i
                            int nx, int nvec, int na, const int64_t *c, const int32_t *sx,
                            const int32_t *sy)
 {
-    const vi lanev = VI_LANES();
-    const unsigned lastvalid = SIMD_FULL >> (nvec * SIMD_V - nx);
-    const vi st0 = VI_SET1((int32_t)(SIMD_V * sx[0]));
-    const vi st1 = VI_SET1((int32_t)(SIMD_V * sx[1]));
-    const vi st2 = VI_SET1((int32_t)(SIMD_V * sx[2]));
-    const vi sy0 = VI_SET1(sy[0]), sy1 = VI_SET1(sy[1]), sy2 = VI_SET1(sy[2]);
-    vi r0 = VI_ADD(VI_SET1((int32_t)c[0]), VI_LANE_MUL(lanev, sx[0]));
-    vi r1 = VI_ADD(VI_SET1((int32_t)c[1]), VI_LANE_MUL(lanev, sx[1]));
-    vi r2 = VI_ADD(VI_SET1((int32_t)c[2]), VI_LANE_MUL(lanev, sx[2]));
-    const vf zdx = VF_SET1(tri->z.dx);
+    const vint lanev = vi_lanes();
+    const unsigned lastvalid = SIMD_FULL >> (nvec * SIMD_W - nx);
+    const vint st0 = vi_set1((int32_t)(SIMD_W * sx[0]));
+    const vint st1 = vi_set1((int32_t)(SIMD_W * sx[1]));
+    const vint st2 = vi_set1((int32_t)(SIMD_W * sx[2]));
+    const vint sy0 = vi_set1(sy[0]), sy1 = vi_set1(sy[1]), sy2 = vi_set1(sy[2]);
+    vint r0 = vi_add(vi_set1((int32_t)c[0]), simd_lane_mul(lanev, sx[0]));
+    vint r1 = vi_add(vi_set1((int32_t)c[1]), simd_lane_mul(lanev, sx[1]));
+    vint r2 = vi_add(vi_set1((int32_t)c[2]), simd_lane_mul(lanev, sx[2]));
+    const vfloat zdx = vf_set1(tri->z.dx);
     long written = 0;
     uint8_t *mrow = t->mask + (size_t)ys * (size_t)t->mask_stride + tri->x0;
     float *drow = t->depth ? t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0
@@ -331,8 +332,8 @@ static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, i
                      : NULL;
     /* Attribute state, set up at the first pixel written (aset). */
     int aset = 0;
-    vf qdx = VF_SET1(0.0f), b1dx = qdx, b2dx = qdx;
-    vf av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
+    vfloat qdx = vf_set1(0.0f), b1dx = qdx, b2dx = qdx;
+    vfloat av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
 #if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
     ATTR3_STATE a3;
     /* Set at the first written pixel (aset) before any use; zeroed here
@@ -342,93 +343,93 @@ static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, i
     for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
              drow = drow ? drow + t->depth_stride : NULL,
              arow = arow ? arow + t->attr_stride : NULL) {
-        vi e0 = r0, e1 = r1, e2 = r2;
-        r0 = VI_ADD(r0, sy0);
-        r1 = VI_ADD(r1, sy1);
-        r2 = VI_ADD(r2, sy2);
+        vint e0 = r0, e1 = r1, e2 = r2;
+        r0 = vi_add(r0, sy0);
+        r1 = vi_add(r1, sy1);
+        r2 = vi_add(r2, sy2);
         int v = 0;
         unsigned cov;
         for (;;) {
-            cov = ~VI_NEG_BITS(VI_OR(VI_OR(e0, e1), e2)) &
+            cov = ~vi_sign_bits(vi_or(vi_or(e0, e1), e2)) &
                   (v == nvec - 1 ? lastvalid : SIMD_FULL);
             if (cov || v == nvec - 1)
                 break;
             v++;
-            e0 = VI_ADD(e0, st0);
-            e1 = VI_ADD(e1, st1);
-            e2 = VI_ADD(e2, st2);
+            e0 = vi_add(e0, st0);
+            e1 = vi_add(e1, st1);
+            e2 = vi_add(e2, st2);
         }
         if (!cov)
             continue;
-        const int xf = v * SIMD_V + __builtin_ctz(cov);
-        while ((cov >> (SIMD_V - 1)) && v < nvec - 1) {
-            e0 = VI_ADD(e0, st0);
-            e1 = VI_ADD(e1, st1);
-            e2 = VI_ADD(e2, st2);
-            const unsigned nc = ~VI_NEG_BITS(VI_OR(VI_OR(e0, e1), e2)) &
+        const int xf = v * SIMD_W + __builtin_ctz(cov);
+        while ((cov >> (SIMD_W - 1)) && v < nvec - 1) {
+            e0 = vi_add(e0, st0);
+            e1 = vi_add(e1, st1);
+            e2 = vi_add(e2, st2);
+            const unsigned nc = ~vi_sign_bits(vi_or(vi_or(e0, e1), e2)) &
                                 (v + 1 == nvec - 1 ? lastvalid : SIMD_FULL);
             if (!nc)
                 break;
             cov = nc;
             v++;
         }
-        const int xe = v * SIMD_V + 32 - __builtin_clz(cov);   /* last + 1 */
+        const int xe = v * SIMD_W + 32 - __builtin_clz(cov);   /* last + 1 */
 
         /* Row bases: the reference's scalar expressions (the attribute
          * ones at the row's first vector that writes). */
         const float fj = (float)(y - tri->y0);
-        const vf zrv = VF_SET1(tri->z.c + tri->z.dy * fj);
-        vf qrv = zrv, b1rv = zrv, b2rv = zrv;
+        const vfloat zrv = vf_set1(tri->z.c + tri->z.dy * fj);
+        vfloat qrv = zrv, b1rv = zrv, b2rv = zrv;
         int rowset = 0;
-        for (int i0 = xf; i0 < xe; i0 += SIMD_V) {
+        for (int i0 = xf; i0 < xe; i0 += SIMD_W) {
             const int rem = xe - i0;
-            const int lanes = rem < SIMD_V ? rem : SIMD_V;
-            const unsigned run = rem >= SIMD_V ? SIMD_FULL : (1u << rem) - 1u;
-            const vf fi = VF_CVT(VI_ADD(VI_SET1(i0), lanev));
-            vf z = VF_ADD(zrv, VF_MUL(zdx, fi));
-            z = VF_MAX(VF_SET1(0.0f), z);
-            z = VF_MIN(VF_SET1(1.0f), z);
+            const int lanes = rem < SIMD_W ? rem : SIMD_W;
+            const unsigned run = rem >= SIMD_W ? SIMD_FULL : (1u << rem) - 1u;
+            const vfloat fi = vf_from_vi(vi_add(vi_set1(i0), lanev));
+            vfloat z = vf_add(zrv, vf_mul(zdx, fi));
+            z = vf_max(vf_set1(0.0f), z);
+            z = vf_min(vf_set1(1.0f), z);
             unsigned pass = run;
             if (drow) {
-                const vf d = VF_LOAD_M(drow + i0, run, run == SIMD_FULL);
-                pass = run & VF_LT_BITS(z, d);
+                const vfloat d = vf_load_bits(drow + i0, run);
+                pass = run & simd_lt_bits(z, d);
                 if (!pass)
                     continue;
-                VF_STORE_M(drow + i0, pass, pass == SIMD_FULL, z);
+                vf_store_bits(drow + i0, pass, z);
             }
-            MASK_STORE_M(mrow + i0, pass, pass == SIMD_FULL);
+            vb_store_bits(mrow + i0, pass);
             written += simd_popcount(pass);
             if (!na)
                 continue;
             if (!aset) {
                 aset = 1;
-                qdx = VF_SET1(tri->q.dx);
-                b1dx = VF_SET1(tri->b1.dx);
-                b2dx = VF_SET1(tri->b2.dx);
+                qdx = vf_set1(tri->q.dx);
+                b1dx = vf_set1(tri->b1.dx);
+                b2dx = vf_set1(tri->b2.dx);
 #if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
                 if (na == 3)
-                    ATTR3_PREP(&a3, tri, SIMD_V);
+                    ATTR3_PREP(&a3, tri, SIMD_W);
                 else
 #endif
                     for (int k = 0; k < na; k++) {
-                        av0[k] = VF_SET1(tri->a0[k]);
-                        av1[k] = VF_SET1(tri->d1[k]);
-                        av2[k] = VF_SET1(tri->d2[k]);
+                        av0[k] = vf_set1(tri->a0[k]);
+                        av1[k] = vf_set1(tri->d1[k]);
+                        av2[k] = vf_set1(tri->d2[k]);
                     }
             }
             if (!rowset) {
                 rowset = 1;
-                qrv = VF_SET1(tri->q.c + tri->q.dy * fj);
-                b1rv = VF_SET1(tri->b1.c + tri->b1.dy * fj);
-                b2rv = VF_SET1(tri->b2.c + tri->b2.dy * fj);
+                qrv = vf_set1(tri->q.c + tri->q.dy * fj);
+                b1rv = vf_set1(tri->b1.c + tri->b1.dy * fj);
+                b2rv = vf_set1(tri->b2.c + tri->b2.dy * fj);
             }
 #ifdef VF_DIV_LANES
-            const vf r = VF_DIV_LANES(VF_SET1(1.0f), VF_ADD(qrv, VF_MUL(qdx, fi)), lanes);
+            const vfloat r = VF_DIV_LANES(vf_set1(1.0f), vf_add(qrv, vf_mul(qdx, fi)), lanes);
 #else
-            const vf r = VF_DIV(VF_SET1(1.0f), VF_ADD(qrv, VF_MUL(qdx, fi)));
+            const vfloat r = vf_div(vf_set1(1.0f), vf_add(qrv, vf_mul(qdx, fi)));
 #endif
-            const vf b1 = VF_MUL(VF_ADD(b1rv, VF_MUL(b1dx, fi)), r);
-            const vf b2 = VF_MUL(VF_ADD(b2rv, VF_MUL(b2dx, fi)), r);
+            const vfloat b1 = vf_mul(vf_add(b1rv, vf_mul(b1dx, fi)), r);
+            const vfloat b2 = vf_mul(vf_add(b2rv, vf_mul(b2dx, fi)), r);
             float *dst = arow + (size_t)i0 * (size_t)na;
 #if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
             if (na == 3) {
@@ -438,9 +439,9 @@ static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, i
 #elif defined(ATTR3_STORE_FULL)
             if (na == 3 && pass == SIMD_FULL) {
                 ATTR3_STORE_FULL(dst,
-                    VF_ADD(VF_ADD(av0[0], VF_MUL(b1, av1[0])), VF_MUL(b2, av2[0])),
-                    VF_ADD(VF_ADD(av0[1], VF_MUL(b1, av1[1])), VF_MUL(b2, av2[1])),
-                    VF_ADD(VF_ADD(av0[2], VF_MUL(b1, av1[2])), VF_MUL(b2, av2[2])));
+                    vf_add(vf_add(av0[0], vf_mul(b1, av1[0])), vf_mul(b2, av2[0])),
+                    vf_add(vf_add(av0[1], vf_mul(b1, av1[1])), vf_mul(b2, av2[1])),
+                    vf_add(vf_add(av0[2], vf_mul(b1, av1[2])), vf_mul(b2, av2[2])));
                 continue;
             }
 #endif
@@ -450,7 +451,7 @@ static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, i
     return written;
 }
 
-long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
+long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya, int yb)
 {
     const int ys = ya > tri->y0 ? ya : tri->y0;
     const int ye = yb < tri->y1 ? yb : tri->y1;
@@ -466,9 +467,9 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
     }
     const int na = t->attr ? tri->attr_count : 0;
     const int nx = tri->x1 - tri->x0 + 1;
-    if (nx <= SIMD_V) {
+    if (nx <= SIMD_W) {
         /* One vector wide: the int32 bound over rows ys..ye and the
-         * SIMD_V lanes (as below with nvec = 1); when it fails, the int64
+         * SIMD_W lanes (as below with nvec = 1); when it fails, the int64
          * loop below. */
         const int64_t dj = ys - tri->y0, rows = ye - ys;
         const int64_t c0 = simd_floor256(tri->e_c[0] + dj * tri->e_dy[0]);
@@ -477,14 +478,14 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
         const int32_t sx0 = (int32_t)(tri->e_dx[0] >> 8), sy0 = (int32_t)(tri->e_dy[0] >> 8);
         const int32_t sx1 = (int32_t)(tri->e_dx[1] >> 8), sy1 = (int32_t)(tri->e_dy[1] >> 8);
         const int32_t sx2 = (int32_t)(tri->e_dx[2] >> 8), sy2 = (int32_t)(tri->e_dy[2] >> 8);
-        const int64_t cols = SIMD_V - 1;
+        const int64_t cols = SIMD_W - 1;
         if (simd_abs64(c0) + rows * simd_abs64(sy0) + cols * simd_abs64(sx0) <= SIMD_LIM30 &&
             simd_abs64(c1) + rows * simd_abs64(sy1) + cols * simd_abs64(sx1) <= SIMD_LIM30 &&
             simd_abs64(c2) + rows * simd_abs64(sy2) + cols * simd_abs64(sx2) <= SIMD_LIM30)
             return simd_scan_vec1(t, tri, ys, ye, nx, na, (int32_t)c0, (int32_t)c1,
                                   (int32_t)c2, sx0, sx1, sx2, sy0, sy1, sy2);
     }
-    const int nvec = (nx + SIMD_V - 1) / SIMD_V;
+    const int nvec = (nx + SIMD_W - 1) / SIMD_W;
     const int64_t rows = ye - ys;
 
     /* Reduced edges, relative to (x0, ys). sx, sy are the snapped edge
@@ -495,7 +496,7 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
     int64_t c[3];
     int32_t sx[3], sy[3];
     int fits = 1;
-    const int64_t cols = (int64_t)nvec * SIMD_V - 1;
+    const int64_t cols = (int64_t)nvec * SIMD_W - 1;
     for (int k = 0; k < 3; k++) {
         c[k] = simd_floor256(tri->e_c[k] + (int64_t)(ys - tri->y0) * tri->e_dy[k]);
         sx[k] = (int32_t)(tri->e_dx[k] >> 8);      /* exact: multiples of 256 */
@@ -505,17 +506,17 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
     }
     if (fits)
         return simd_scan_wide(t, tri, ys, ye, nx, nvec, na, c, sx, sy);
-    const vi lanev = VI_LANES();
-    const vi off0 = VI_LANE_MUL(lanev, sx[0]), off1 = VI_LANE_MUL(lanev, sx[1]),
-             off2 = VI_LANE_MUL(lanev, sx[2]);
+    const vint lanev = vi_lanes();
+    const vint off0 = simd_lane_mul(lanev, sx[0]), off1 = simd_lane_mul(lanev, sx[1]),
+             off2 = simd_lane_mul(lanev, sx[2]);
 
-    const vf zero = VF_SET1(0.0f), one = VF_SET1(1.0f);
-    const vf zdx = VF_SET1(tri->z.dx);
-    vf av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
+    const vfloat zero = vf_set1(0.0f), one = vf_set1(1.0f);
+    const vfloat zdx = vf_set1(tri->z.dx);
+    vfloat av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
     for (int k = 0; k < na; k++) {
-        av0[k] = VF_SET1(tri->a0[k]);
-        av1[k] = VF_SET1(tri->d1[k]);
-        av2[k] = VF_SET1(tri->d2[k]);
+        av0[k] = vf_set1(tri->a0[k]);
+        av1[k] = vf_set1(tri->d1[k]);
+        av2[k] = vf_set1(tri->d2[k]);
     }
 
     long written = 0;
@@ -525,8 +526,8 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
     float *arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride +
                            (size_t)tri->x0 * (size_t)na
                      : NULL;
-    const vf qdx = VF_SET1(tri->q.dx);
-    const vf b1dx = VF_SET1(tri->b1.dx), b2dx = VF_SET1(tri->b2.dx);
+    const vfloat qdx = vf_set1(tri->q.dx);
+    const vfloat b1dx = vf_set1(tri->b1.dx), b2dx = vf_set1(tri->b2.dx);
 
     /* Int64 coverage (clamped starts, see COVERAGE): vectors aligned at
      * x0, every vector of every row tested. */
@@ -540,48 +541,48 @@ long SIMD_FN(const rast_target *t, const rast__tri *tri, int ya, int yb)
         const float qr = tri->q.c + tri->q.dy * fj;
         const float b1r = tri->b1.c + tri->b1.dy * fj;
         const float b2r = tri->b2.c + tri->b2.dy * fj;
-        const vf zrv = VF_SET1(zr);
+        const vfloat zrv = vf_set1(zr);
         int64_t eb0 = rb[0], eb1 = rb[1], eb2 = rb[2];
         for (int v = 0; v < nvec; v++) {
-            const int i0 = v * SIMD_V;
+            const int i0 = v * SIMD_W;
             const int rem = nx - i0;
-            const unsigned valid = rem >= SIMD_V ? SIMD_FULL : (1u << rem) - 1u;
-            const vi t0 = VI_ADD(VI_SET1(simd_clamp29(eb0)), off0);
-            const vi t1 = VI_ADD(VI_SET1(simd_clamp29(eb1)), off1);
-            const vi t2 = VI_ADD(VI_SET1(simd_clamp29(eb2)), off2);
-            const unsigned neg = VI_NEG_BITS(VI_OR(VI_OR(t0, t1), t2));
-            eb0 += SIMD_V * (int64_t)sx[0];
-            eb1 += SIMD_V * (int64_t)sx[1];
-            eb2 += SIMD_V * (int64_t)sx[2];
+            const unsigned valid = rem >= SIMD_W ? SIMD_FULL : (1u << rem) - 1u;
+            const vint t0 = vi_add(vi_set1(simd_clamp29(eb0)), off0);
+            const vint t1 = vi_add(vi_set1(simd_clamp29(eb1)), off1);
+            const vint t2 = vi_add(vi_set1(simd_clamp29(eb2)), off2);
+            const unsigned neg = vi_sign_bits(vi_or(vi_or(t0, t1), t2));
+            eb0 += SIMD_W * (int64_t)sx[0];
+            eb1 += SIMD_W * (int64_t)sx[1];
+            eb2 += SIMD_W * (int64_t)sx[2];
             const unsigned cov = ~neg & valid;
             if (!cov)
                 continue;
-            const vf fi = VF_CVT(VI_ADD(VI_SET1(i0), lanev));
-            vf z = VF_ADD(zrv, VF_MUL(zdx, fi));
-            z = VF_MAX(zero, z);
-            z = VF_MIN(one, z);
+            const vfloat fi = vf_from_vi(vi_add(vi_set1(i0), lanev));
+            vfloat z = vf_add(zrv, vf_mul(zdx, fi));
+            z = vf_max(zero, z);
+            z = vf_min(one, z);
             unsigned pass = cov;
             if (drow) {
-                const vf d = VF_LOAD_M(drow + i0, cov, cov == SIMD_FULL);
-                pass = cov & VF_LT_BITS(z, d);
+                const vfloat d = vf_load_bits(drow + i0, cov);
+                pass = cov & simd_lt_bits(z, d);
                 if (!pass)
                     continue;
-                VF_STORE_M(drow + i0, pass, pass == SIMD_FULL, z);
+                vf_store_bits(drow + i0, pass, z);
             }
-            MASK_STORE_M(mrow + i0, pass, pass == SIMD_FULL);
+            vb_store_bits(mrow + i0, pass);
             written += simd_popcount(pass);
             if (!na)
                 continue;
-            const vf r = VF_DIV(one, VF_ADD(VF_SET1(qr), VF_MUL(qdx, fi)));
-            const vf b1 = VF_MUL(VF_ADD(VF_SET1(b1r), VF_MUL(b1dx, fi)), r);
-            const vf b2 = VF_MUL(VF_ADD(VF_SET1(b2r), VF_MUL(b2dx, fi)), r);
+            const vfloat r = vf_div(one, vf_add(vf_set1(qr), vf_mul(qdx, fi)));
+            const vfloat b1 = vf_mul(vf_add(vf_set1(b1r), vf_mul(b1dx, fi)), r);
+            const vfloat b2 = vf_mul(vf_add(vf_set1(b2r), vf_mul(b2dx, fi)), r);
             float *dst = arow + (size_t)i0 * (size_t)na;
 #ifdef ATTR3_STORE_FULL
             if (na == 3 && pass == SIMD_FULL) {
                 ATTR3_STORE_FULL(dst,
-                    VF_ADD(VF_ADD(av0[0], VF_MUL(b1, av1[0])), VF_MUL(b2, av2[0])),
-                    VF_ADD(VF_ADD(av0[1], VF_MUL(b1, av1[1])), VF_MUL(b2, av2[1])),
-                    VF_ADD(VF_ADD(av0[2], VF_MUL(b1, av1[2])), VF_MUL(b2, av2[2])));
+                    vf_add(vf_add(av0[0], vf_mul(b1, av1[0])), vf_mul(b2, av2[0])),
+                    vf_add(vf_add(av0[1], vf_mul(b1, av1[1])), vf_mul(b2, av2[1])),
+                    vf_add(vf_add(av0[2], vf_mul(b1, av1[2])), vf_mul(b2, av2[2])));
                 continue;
             }
 #endif

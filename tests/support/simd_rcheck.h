@@ -1,0 +1,27 @@
+/* simd_rcheck.h - runs the raster ops of the vector layer (src/cpu/simd.h,
+ * "RASTER OPS") of one ISA over arrays, for tests/test_cpu_simd_raster.c,
+ * which compares the results with a scalar model of the contract.
+ * simd_rcheck.inl is the one body; simd_rcheck_<isa>.c compile it once per
+ * ISA (kept apart from simd_check.* so that the fuse port can add its ops
+ * there without touching these files). */
+#ifndef EGOFUSE_TU_SIMD_RCHECK_H
+#define EGOFUSE_TU_SIMD_RCHECK_H
+
+#include <stdint.h>
+
+enum {
+    RC_SIGN_BITS,     /* a: int lanes; out[l] = bit l of vi_sign_bits (out[v] = 0xBAD
+                       * when a bit above the lanes is set) */
+    RC_VB_STORE_BITS, /* out: bytes, vb_store_bits per SIMD_W bytes with bits k */
+    RC_STORE3_BITS,   /* out: floats, vf_store3_bits per 3*SIMD_W floats of a (x, y,
+                       * z vectors one after the other) with bits k */
+    RC_COUNT
+};
+
+/* n: a multiple of 3 * 16 (floats, ints or, for bytes, bytes). Returns
+ * the lanes (SIMD_W), 0 when this build does not have the ISA. */
+typedef int tu_simd_rcheck_fn(int op, const uint32_t *a, unsigned k, int n, void *out);
+tu_simd_rcheck_fn tu_simd_rcheck_sse2, tu_simd_rcheck_avx2, tu_simd_rcheck_avx512,
+    tu_simd_rcheck_neon;
+
+#endif
