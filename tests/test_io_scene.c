@@ -21,6 +21,7 @@ static const char *full_scene =
     "head_node = head\n"
     "frames = 120\n"
     "fps = 59.94\n"
+    "animation_start = 1.25\n"
     "camera_left  = cam/left_%04d.png\n"
     "camera_right = cam/right_%04d.png\n"
     "virtual_left = /abs/virt/l_%d.png\n"
@@ -58,6 +59,7 @@ static void full_file_parses(void **state)
     assert_string_equal(s.head_node, "head");
     assert_int_equal(s.frames, 120);
     assert_true(s.fps == 59.94f);
+    assert_true(s.anim_start == 1.25f);
     assert_string_equal(s.camera[0], "cam/left_%04d.png");
     assert_string_equal(s.camera[1], "cam/right_%04d.png");
     assert_string_equal(s.virt[0], "/abs/virt/l_%d.png");
@@ -114,6 +116,7 @@ static void minimal_file_and_lighting_defaults(void **state)
     assert_int_equal(s.has_lighting, 0);
     assert_int_equal(s.light_count, 0);
     assert_string_equal(s.animation, "");
+    assert_true(s.anim_start == 0.0f);
     assert_string_equal(s.virt_depth[0], "");
 
     /* one lighting key: the rest takes fuse_lighting_default()'s values */
@@ -235,6 +238,7 @@ static void frames_and_fps_checks(void **state)
     static const char *const bad_values[] = {
         "frames = 0", "frames = -3", "frames = 1.5", "frames = 99999999999",
         "frames = ", "fps = 0", "fps = -1", "fps = 3O",
+        "animation_start = -1", "animation_start = nan", "animation_start = 2e6",
     };
     char path[1024];
     tu_tmp_path("bad_numbers.txt", path, sizeof path);

@@ -436,7 +436,7 @@ static int render(const render_opts *o)
                                            geo.vp_height) &&
                          pipe_image_opaque(&in.virt[1], geo.vp_x0, geo.vp_y0, geo.vp_width,
                                            geo.vp_height);
-        in.time = (float)f / sc.fps;
+        in.time = sc.anim_start + (float)f / sc.fps;
         if (o->pose_tracking) {
             track_pose_at(&tp, o, &model, (double)f / (double)sc.fps);
             in.locals = tp.locals;

@@ -473,6 +473,9 @@ static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
                 bad |= fprintf(f, "hmd = %s\n", kin_sthmd_preset_name(k)) < 0;
     }
     if (r->have_scene && r->sc.animation[0]) bad |= fprintf(f, "animation = %s\n", r->sc.animation) < 0;
+    /* posed by the animation at the run's clock: that time (%.9g gives the
+     * float back exactly; render poses frame 0 at it) */
+    if (!tracked && in->anim) bad |= fprintf(f, "animation_start = %.9g\n", (double)in->time) < 0;
     if (r->have_scene && r->sc.has_lighting) {
         /* the lighting lines as written, so render parses the same floats */
         FILE *in = fopen(o->scene, "r");

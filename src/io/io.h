@@ -192,6 +192,7 @@ typedef struct io_scene {
     char head_node[KIN_NAME_MAX];     /* node whose world matrix is the head */
     int frames;                       /* number of frames */
     float fps;                        /* frames per second */
+    float anim_start;                 /* animation time of frame 0, s (default 0) */
     char camera[2][IO_PATH_MAX];      /* printf patterns (%d of the frame),
                                          left and right camera images */
     char virt[2][IO_PATH_MAX];        /* virtual scene colour, per eye */

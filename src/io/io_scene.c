@@ -28,7 +28,7 @@ typedef enum key_id {
     K_CAMERA_LEFT, K_CAMERA_RIGHT, K_VIRTUAL_LEFT, K_VIRTUAL_RIGHT,
     K_VIRTUAL_DEPTH_LEFT, K_VIRTUAL_DEPTH_RIGHT,
     K_AMBIENT, K_LIGHT, K_KD, K_KS, K_SHININESS, K_KF, K_TONE,
-    K_TRACKING, K_HMD,
+    K_TRACKING, K_HMD, K_ANIM_START,
     K_COUNT
 } key_id;
 
@@ -37,7 +37,7 @@ static const char *const key_names[K_COUNT] = {
     "camera_left", "camera_right", "virtual_left", "virtual_right",
     "virtual_depth_left", "virtual_depth_right",
     "ambient", "light", "kd", "ks", "shininess", "kf", "tone",
-    "tracking", "hmd",
+    "tracking", "hmd", "animation_start",
 };
 
 static const key_id required[] = {
@@ -199,6 +199,12 @@ static io_result set_key(const where *w, key_id k, char *value, io_scene *s)
         if ((r = parse_float(w, key, value, &s->fps)) != IO_OK) return r;
         if (!(s->fps > 0.0f))
             return bad(w, IO_ERR_VALUE, "fps: %g must be > 0", (double)s->fps);
+        return IO_OK;
+    case K_ANIM_START:
+        if ((r = parse_float(w, key, value, &s->anim_start)) != IO_OK) return r;
+        if (!(s->anim_start >= 0.0f && s->anim_start <= 1e6f))
+            return bad(w, IO_ERR_VALUE, "animation_start: %g s must be in [0, 1e6]",
+                       (double)s->anim_start);
         return IO_OK;
     case K_CAMERA_LEFT: case K_CAMERA_RIGHT:
     case K_VIRTUAL_LEFT: case K_VIRTUAL_RIGHT:
