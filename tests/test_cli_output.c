@@ -339,7 +339,7 @@ static void eval_report_write_fails_cleanly(void **state)
     make_dir("out_eval", dir, sizeof dir);
     const char *a[] = {"eval", "--frames", "2", "--sweep-frames", "1", "--seq-frames", "1",
                        "--quiet", "--report", dir, NULL};
-    int rc = run_limited(12000, XFSZ_IGNORE, a);
+    int rc = run_limited(15000, XFSZ_IGNORE, a); /* charts.gp ~13 KB fits, no PNG does */
     snprintf(p, sizeof p, "%s/summary.csv", dir);
     int csv_lines = lines_of(p);
     assert_true(csv_lines > 10);
