@@ -8,7 +8,7 @@
  * colour model (fuse_colour_model_learn): its log-likelihood ratios on
  * colours whose counts are known, the pixels it leaves out, and the
  * refinement that mixes it in; the band-only paths (portable, AVX2,
- * AVX-512: fuse_refine_mask_isa) byte for byte and stat for stat against
+ * AVX-512, NEON under qemu-aarch64: fuse_refine_mask_isa) byte for byte and stat for stat against
  * the scalar reference on 400 seeded random cases each (skipped where the
  * CPU lacks the ISA), and the reference's CRC on the disc scene. */
 #include "support/testutil.h"
@@ -491,6 +491,7 @@ static void check_isa(ef_isa isa)
 static void test_fast_c(void **state) { (void)state; check_isa(EF_ISA_SSE2); }
 static void test_fast_avx2(void **state) { (void)state; check_isa(EF_ISA_AVX2); }
 static void test_fast_avx512(void **state) { (void)state; check_isa(EF_ISA_AVX512); }
+static void test_fast_neon(void **state) { (void)state; check_isa(EF_ISA_NEON); }
 
 /* The disc scene with a shifted kinematic mask (defaults, band 5 and 16):
  * the reference's bytes as a constant (the result of the whole-image
@@ -539,6 +540,7 @@ int main(void)
         cmocka_unit_test(test_refine_global),
         cmocka_unit_test(test_fast_c),
         cmocka_unit_test(test_fast_avx2),
+        cmocka_unit_test(test_fast_neon),
         cmocka_unit_test(test_fast_avx512),
         cmocka_unit_test(test_refine_crc),
     };

@@ -285,6 +285,7 @@ ef_isa fuse_refine_isa(ef_isa isa)
     ef_isa c = ef_isa_choose(isa);
     if (c == EF_ISA_AVX512 && !fuse__refine_kern_avx512()) c = EF_ISA_AVX2;
     if (c == EF_ISA_AVX2 && !fuse__refine_kern_avx2()) c = EF_ISA_SSE2;
+    if (c == EF_ISA_NEON && !fuse__refine_kern_neon()) c = EF_ISA_SSE2;
     return c;
 }
 
@@ -303,6 +304,7 @@ fuse_result fuse_refine_mask_isa(const fuse_refine_params *p, const fuse_colour_
         return refine(p, g, weight, P, mask, mask_stride, out, out_stride, scratch, stats);
     case EF_ISA_AVX512: k = fuse__refine_kern_avx512(); break;
     case EF_ISA_AVX2: k = fuse__refine_kern_avx2(); break;
+    case EF_ISA_NEON: k = fuse__refine_kern_neon(); break;
     default: k = &fuse__refine_kern_c; break;
     }
     return fuse__refine_fast(k, p, g, weight, P, mask, mask_stride, out, out_stride, scratch,

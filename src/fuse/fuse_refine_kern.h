@@ -102,6 +102,7 @@ extern const fuse__refine_kern fuse__refine_kern_c;
 /* The SIMD kernels; NULL when this build has no such path. */
 const fuse__refine_kern *fuse__refine_kern_avx2(void);
 const fuse__refine_kern *fuse__refine_kern_avx512(void);
+const fuse__refine_kern *fuse__refine_kern_neon(void);   /* aarch64 */
 
 /* The band-only path with kernels k. Arguments checked by the caller. */
 fuse_result fuse__refine_fast(const fuse__refine_kern *k, const fuse_refine_params *p,
