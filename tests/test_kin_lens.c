@@ -287,7 +287,10 @@ static void result_pinhole_is_kin_camera(void **state)
     kin_lens C = kin_lens_cropped(&P, 0, 40, 640, 400);
     tu_rng g = {0x70696e68};
     for (int i = 0; i < 200; i++) {
-        double p[3] = {tu_range(&g, -1, 1), tu_range(&g, -1, 1), tu_range(&g, -5, -0.3f)}, u, v;
+        double p[3], u, v; /* drawn in a defined order */
+        p[0] = tu_range(&g, -1, 1);
+        p[1] = tu_range(&g, -1, 1);
+        p[2] = tu_range(&g, -5, -0.3f);
         assert_true(kin_lens_project(&C, p, &u, &v));
         NEAR(u, c.cx + c.fx * p[0] / -p[2], 2e-3);
         NEAR(v, c.cy - c.fy * p[1] / -p[2], 2e-3);
@@ -307,7 +310,10 @@ static void result_scaled_and_cropped(void **state)
     kin_lens C = kin_lens_cropped(&B, 0, 40, 640, 400);
     tu_rng g = {0x7363616c};
     for (int i = 0; i < 200; i++) {
-        double p[3] = {tu_range(&g, -0.3f, 0.3f), tu_range(&g, -0.3f, 0.3f), tu_range(&g, -2, -0.5f)};
+        double p[3]; /* drawn in a defined order */
+        p[0] = tu_range(&g, -0.3f, 0.3f);
+        p[1] = tu_range(&g, -0.3f, 0.3f);
+        p[2] = tu_range(&g, -2, -0.5f);
         double u, v, uh, vh, uc, vc;
         assert_true(kin_lens_project(&B, p, &u, &v));
         assert_true(kin_lens_project(&H, p, &uh, &vh));
