@@ -295,6 +295,15 @@ static void validity_render_named_hmd(void **state)
                  "--hmd-calibration", cal2, NULL);
     if (rc != 0) fail_msg("rc %d: %s", rc, out);
     assert_true(tu_exists(p));
+    /* anti-aliased edges are drawn through the pinhole: refused with a
+     * distorting lens, nothing written */
+    char out2[760], p2[800];
+    snprintf(out2, sizeof out2, "%s/out_aa", dir);
+    assert_int_equal(run("render", "--scene", scene, "--out", out2, "--quiet", "--aa", "4",
+                         "--hmd-calibration", cal2, NULL), 1);
+    assert_non_null(strstr(out, "--aa 4: anti-aliased edges are drawn through the pinhole"));
+    snprintf(p2, sizeof p2, "%s/left_0000.png", out2);
+    assert_false(tu_exists(p2));
     snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
     assert_int_equal(system(cmd), 0);
 }

@@ -358,7 +358,10 @@ static int render(const render_opts *o)
     const kin_mat4 *prop_ptr[RENDER_MAX_PROPS];
     int props_loaded = 0;
     if (!pp) {
-        if (pd.fit_rig)
+        if (o->aa && (kin_lens_distorts(&pd.hmd.lens[0]) || kin_lens_distorts(&pd.hmd.lens[1])))
+            cli_fail("--aa %d: anti-aliased edges are drawn through the pinhole and cannot be used "
+                     "with a distorting lens (--hmd-calibration)", o->aa);
+        else if (pd.fit_rig)
             cli_fail("cannot start the pipeline: out of memory, no thread, or the elbow fit "
                      "cannot use %s (mesh 0's skin, the arms' node chains)", model_path);
         else

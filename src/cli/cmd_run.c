@@ -799,7 +799,10 @@ static int run(const run_opts *o)
     pd.aa_samples = o->aa;
     pd.fit_rig = o->refine && tracked ? &r->rig : NULL;
     if (!(r->pipe = pipe_create(&pd, model))) {
-        cli_fail(pd.fit_rig ? "cannot start the pipeline (out of memory, no thread, or the elbow "
+        if (o->aa && (kin_lens_distorts(&pd.hmd.lens[0]) || kin_lens_distorts(&pd.hmd.lens[1])))
+            cli_fail("--aa %d: anti-aliased edges are drawn through the pinhole and cannot be used "
+                     "with a distorting lens (the calibration of the cockpit's HMD)", o->aa);
+        else cli_fail(pd.fit_rig ? "cannot start the pipeline (out of memory, no thread, or the elbow "
                               "fit cannot use the model: mesh 0's skin, the arms' node chains)"
                             : "cannot start the pipeline (out of memory or no thread)");
         goto done;
