@@ -29,9 +29,7 @@ static int setup(void **st)
 {
     (void)st;
     snprintf(bin_path, sizeof bin_path, "%s", tu_bin());
-    const char *slash = strrchr(bin_path, '/');
-    snprintf(gen_path, sizeof gen_path, "%.*s/gen_samples", slash ? (int)(slash - bin_path) : 1,
-             slash ? bin_path : ".");
+    tu_gen_path(gen_path, sizeof gen_path);
     tu_tmp_path("seq", seq, sizeof seq);
     char *argv[] = {gen_path, "--out", seq, "--frames", "3", NULL};
     int rc = tu_run(argv, out, sizeof out);

@@ -14,4 +14,10 @@ void pipe__pose_skin_part(pipe_pose *ps, const kin_skin_plan *plans, int part, i
 /* ps->locals from anim at t (NULL: the rest pose) and the morph weights. */
 void pipe__pose_locals_anim(pipe_pose *ps, const kin_animation *anim, float t);
 
+/* Writes the printf-style message into why[why_size] (when why is not
+ * NULL) and returns -1: the error path of the room's checked calls
+ * (pipe_mask.c, pipe_lens.c). */
+int pipe__fail(char *why, int why_size, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
 #endif

@@ -1,23 +1,12 @@
 /* pipe_lens.c - the mask through a distorting lens: a pinhole render and a
  * per-pixel gather (pipe_lens.h). */
 #include "pipe_lens.h"
+#include "pipe_internal.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static int fail(char *why, int why_size, const char *fmt, ...)
-{
-    if (why && why_size > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(why, (size_t)why_size, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
 
 void pipe_lens_map_free(pipe_lens_map *m)
 {
@@ -50,11 +39,11 @@ int pipe_lens_map_init(pipe_lens_map *m, const kin_lens *lens, int supersample, 
     memset(m, 0, sizeof *m);
     if (!lens || lens->width < 1 || lens->height < 1 || lens->width > RAST_MAX_DIM ||
         lens->height > RAST_MAX_DIM)
-        return fail(why, why_size, "the lens has no image size in 1..%d", RAST_MAX_DIM);
+        return pipe__fail(why, why_size, "the lens has no image size in 1..%d", RAST_MAX_DIM);
     if (supersample < 1 || supersample > 4)
-        return fail(why, why_size, "supersample %d: 1..4", supersample);
+        return pipe__fail(why, why_size, "supersample %d: 1..4", supersample);
     if (attr_count < 0 || attr_count > RAST_MAX_ATTRS)
-        return fail(why, why_size, "attr_count %d: 0..%d", attr_count, RAST_MAX_ATTRS);
+        return pipe__fail(why, why_size, "attr_count %d: 0..%d", attr_count, RAST_MAX_ATTRS);
     const int W = lens->width, H = lens->height;
     const size_t n = (size_t)W * (size_t)H;
     double *xy = malloc(sizeof(double) * 2 * n);
@@ -62,7 +51,7 @@ int pipe_lens_map_init(pipe_lens_map *m, const kin_lens *lens, int supersample, 
     if (!xy || !m->src) {
         free(xy);
         pipe_lens_map_free(m);
-        return fail(why, why_size, "out of memory for a %dx%d lens map", W, H);
+        return pipe__fail(why, why_size, "out of memory for a %dx%d lens map", W, H);
     }
     /* every pixel centre's ray, as the pinhole's normalized (X/-Z, Y/-Z) */
     double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
@@ -125,7 +114,7 @@ int pipe_lens_map_init(pipe_lens_map *m, const kin_lens *lens, int supersample, 
     m->attr = attr_count ? malloc(sizeof(float) * (size_t)attr_count * pn) : NULL;
     if (!m->depth || !m->mask || (attr_count && !m->attr)) {
         pipe_lens_map_free(m);
-        return fail(why, why_size, "out of memory for a %dx%d pinhole render", m->pin_width,
+        return pipe__fail(why, why_size, "out of memory for a %dx%d pinhole render", m->pin_width,
                     m->pin_height);
     }
     rast_target t = pipe_lens_target(m);

@@ -112,6 +112,13 @@ const char *tu_bin(void)
     return b && *b ? b : "build/egofuse";
 }
 
+void tu_gen_path(char *out, size_t n)
+{
+    const char *bin = tu_bin();
+    const char *slash = strrchr(bin, '/');
+    snprintf(out, n, "%.*s/gen_samples", slash ? (int)(slash - bin) : 1, slash ? bin : ".");
+}
+
 int tu_runl(char *out, size_t out_size, const char *prog, const char *a0, ...)
 {
     char *argv[48];

@@ -24,6 +24,9 @@ static inline float tu_unit(tu_rng *r) { return (float)(tu_next(r) >> 40) * (1.0
 static inline float tu_range(tu_rng *r, float lo, float hi) { return lo + (hi - lo) * tu_unit(r); }
 static inline int tu_int(tu_rng *r, int n) { return (int)(tu_next(r) % (uint64_t)n); }
 
+/* The sample generator next to the egofuse under test (tu_bin()). */
+void tu_gen_path(char *out, size_t n);
+
 /* Folder of the shared glTF models (EGOFUSE_SHARED/gltf); path of a file. */
 const char *tu_shared_path(const char *rel, char *buf, size_t n);
 /* A scratch path (EGOFUSE_TMP or /tmp) unique to this process. */
