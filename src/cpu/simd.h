@@ -199,6 +199,18 @@
  *   vd_store_f(p, a)         the lanes rounded to float (nearest even) and
  *                            stored to p[0 .. VD_W)
  *
+ * RASTER FRONT-END OPS (src/raster's vector front end, raster_frontv.inl:
+ * the vertex pass, the rejection and the double plane set-up of survivors;
+ * a block after the raster ops; h is a constant 0 or 1, "half h" the lanes
+ * h*VD_W .. h*VD_W + VD_W - 1)
+ *   vi_min(i, j) vi_max(i, j)  signed int32 minimum / maximum
+ *   vd_from_vf(a, h)         the float lanes of half h of a as doubles (exact)
+ *   vd_from_vi(i, h)         the int32 lanes of half h of i as doubles (exact)
+ *   vf_from_vd(lo, hi)       lanes 0 .. VD_W-1 = lo, VD_W .. = hi, each
+ *                            rounded to float (nearest even; x86 cvtpd2ps)
+ *   vd_gt_bits(a, b)         bits (VD_W of them) of the lanes with a > b,
+ *                            ordered (false when either is NaN)
+ *
  * NEW ISA. Copy simd_neon.h (the plainest), keep every name, meet every
  * line of this contract (the semantics above are x86's where the ISAs
  * differ: min/max, conversion out of range), add the ISA to

@@ -253,6 +253,27 @@ SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return _mm256_max_pd(a, b); }
 SIMD_INL vdouble vd_load_f(const float *p) { return _mm256_cvtps_pd(_mm_loadu_ps(p)); }
 SIMD_INL void vd_store_f(float *p, vdouble a) { _mm_storeu_ps(p, _mm256_cvtpd_ps(a)); }
 
+
+/* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
+SIMD_INL vint vi_min(vint i, vint j) { return _mm256_min_epi32(i, j); }
+SIMD_INL vint vi_max(vint i, vint j) { return _mm256_max_epi32(i, j); }
+SIMD_INL vdouble vd_from_vf(vfloat a, int h)
+{
+    return _mm256_cvtps_pd(h ? _mm256_extractf128_ps(a, 1) : _mm256_castps256_ps128(a));
+}
+SIMD_INL vdouble vd_from_vi(vint i, int h)
+{
+    return _mm256_cvtepi32_pd(h ? _mm256_extracti128_si256(i, 1) : _mm256_castsi256_si128(i));
+}
+SIMD_INL vfloat vf_from_vd(vdouble lo, vdouble hi)
+{
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm256_cvtpd_ps(lo)), _mm256_cvtpd_ps(hi), 1);
+}
+SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
+{
+    return (unsigned)_mm256_movemask_pd(_mm256_cmp_pd(a, b, _CMP_GT_OQ));
+}
+
 #else
 #error "simd_avx2.h: another implementation of the vector layer is already included"
 #endif

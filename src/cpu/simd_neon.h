@@ -301,6 +301,20 @@ SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return vbslq_f64(vcgtq_f64(a, b)
 SIMD_INL vdouble vd_load_f(const float *p) { return vcvt_f64_f32(vld1_f32(p)); }
 SIMD_INL void vd_store_f(float *p, vdouble a) { vst1_f32(p, vcvt_f32_f64(a)); }
 
+
+/* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
+SIMD_INL vint vi_min(vint i, vint j) { return vminq_s32(i, j); }
+SIMD_INL vint vi_max(vint i, vint j) { return vmaxq_s32(i, j); }
+SIMD_INL vdouble vd_from_vf(vfloat a, int h) { return vcvt_f64_f32(h ? vget_high_f32(a) : vget_low_f32(a)); }
+/* int32 -> int64 -> double: exact (|i| < 2^31 < 2^53) */
+SIMD_INL vdouble vd_from_vi(vint i, int h) { return vcvtq_f64_s64(vmovl_s32(h ? vget_high_s32(i) : vget_low_s32(i))); }
+SIMD_INL vfloat vf_from_vd(vdouble lo, vdouble hi) { return vcombine_f32(vcvt_f32_f64(lo), vcvt_f32_f64(hi)); }
+SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
+{
+    const uint64x2_t g = vcgtq_f64(a, b);
+    return (unsigned)(vgetq_lane_u64(g, 0) & 1u) | ((unsigned)(vgetq_lane_u64(g, 1) & 1u) << 1);
+}
+
 #else
 #error "simd_neon.h: another implementation of the vector layer is already included"
 #endif

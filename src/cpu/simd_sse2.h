@@ -256,6 +256,15 @@ SIMD_INL void vd_store_f(float *p, vdouble a)
     _mm_storel_epi64((__m128i *)(void *)p, _mm_castps_si128(_mm_cvtpd_ps(a)));
 }
 
+
+/* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
+SIMD_INL vint vi_min(vint i, vint j) { const __m128i g = _mm_cmpgt_epi32(i, j); return _mm_or_si128(_mm_and_si128(g, j), _mm_andnot_si128(g, i)); }
+SIMD_INL vint vi_max(vint i, vint j) { const __m128i g = _mm_cmpgt_epi32(i, j); return _mm_or_si128(_mm_and_si128(g, i), _mm_andnot_si128(g, j)); }
+SIMD_INL vdouble vd_from_vf(vfloat a, int h) { return _mm_cvtps_pd(h ? _mm_movehl_ps(a, a) : a); }
+SIMD_INL vdouble vd_from_vi(vint i, int h) { return _mm_cvtepi32_pd(h ? _mm_shuffle_epi32(i, 0xEE) : i); }
+SIMD_INL vfloat vf_from_vd(vdouble lo, vdouble hi) { return _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi)); }
+SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b) { return (unsigned)_mm_movemask_pd(_mm_cmpgt_pd(a, b)); }
+
 #else
 #error "simd_sse2.h: another implementation of the vector layer is already included"
 #endif
