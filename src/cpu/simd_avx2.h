@@ -253,6 +253,20 @@ SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return _mm256_max_pd(a, b); }
 SIMD_INL vdouble vd_load_f(const float *p) { return _mm256_cvtps_pd(_mm_loadu_ps(p)); }
 SIMD_INL void vd_store_f(float *p, vdouble a) { _mm_storeu_ps(p, _mm256_cvtpd_ps(a)); }
 
+
+/* ---- row-cache ops (src/fuse's composite; simd.h "ROW-CACHE OPS") */
+SIMD_INL vint vi_min(vint i, vint j) { return _mm256_min_epi32(i, j); }
+SIMD_INL vint vi_permute(vint i, vint idx) { return _mm256_permutevar8x32_epi32(i, idx); }
+SIMD_INL vint vi_gather(const int32_t *p, vint idx)
+{
+    return _mm256_i32gather_epi32((const int *)(const void *)p, idx, 4);
+}
+SIMD_INL vint vh_zip_lo(vint i, vint j) { return _mm256_unpacklo_epi16(i, j); }
+SIMD_INL vint vh_zip_hi(vint i, vint j) { return _mm256_unpackhi_epi16(i, j); }
+SIMD_INL vint vh_madd(vint i, vint j) { return _mm256_madd_epi16(i, j); }
+SIMD_INL vint vh_packus32(vint i, vint j) { return _mm256_packus_epi32(i, j); }
+SIMD_INL vint vh_mulhi(vint i, vint j) { return _mm256_mulhi_epu16(i, j); }
+
 #else
 #error "simd_avx2.h: another implementation of the vector layer is already included"
 #endif
