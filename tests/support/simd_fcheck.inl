@@ -1,8 +1,16 @@
-/* simd_fcheck.inl - the body of tu_simd_fcheck_<isa> (simd_fcheck.h), on
- * the vector layer included before it. */
+/* simd_fcheck.inl - the body of tu_simd_fcheck_<isa> (simd_fcheck.h), named
+ * FC_NAME, on the vector layer included before it; without one (the ISA
+ * is not this target's) a stub that returns 0. */
 #include "simd_fcheck.h"
 
-int SIMD_FN(tu_simd_fcheck)(int op, const uint32_t *a, const uint32_t *b, int n, uint32_t *out)
+#ifndef SIMD_W
+int FC_NAME(int op, const uint32_t *a, const uint32_t *b, int n, uint32_t *out)
+{
+    (void)op, (void)a, (void)b, (void)n, (void)out;
+    return 0;
+}
+#else
+int FC_NAME(int op, const uint32_t *a, const uint32_t *b, int n, uint32_t *out)
 {
     for (int v = 0; v + SIMD_W <= n; v += SIMD_W) {
         const vint i = vi_loadu((const int32_t *)(const void *)(a + v));
@@ -23,3 +31,4 @@ int SIMD_FN(tu_simd_fcheck)(int op, const uint32_t *a, const uint32_t *b, int n,
     }
     return SIMD_W;
 }
+#endif
