@@ -155,22 +155,25 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
                 outside++;
                 continue;
             }
+            /* a camera pixel shows this point when the camera's model is
+             * there no nearer than the point minus the slack: as a window
+             * depth of the camera's projection, zmin */
+            const float dp = -pz, dmin = dp - (PIPE_REPROJ_TOL_M + PIPE_REPROJ_TOL_REL * dp);
+            const float zmin = dmin > n ? 0.5f * ((f + n) - 2.0f * f * n / dmin) / (f - n) + 0.5f
+                                        : 0.0f;
             /* the nearest camera pixel: does the camera see this point? */
             int iu = (int)u, iv = (int)v;
             if (iu > cw - 1) iu = cw - 1;
             if (iv > ch - 1) iv = ch - 1;
-            int seen = cmask[(size_t)iv * (size_t)cmask_stride + (size_t)iu] != 0;
-            if (seen) {
-                float cd = lin_depth(cdepth[(size_t)iv * (size_t)cdepth_stride + (size_t)iu], n, f);
-                float dp = -pz;
-                seen = !(cd < dp - (PIPE_REPROJ_TOL_M + PIPE_REPROJ_TOL_REL * dp));
-            }
+            int seen = cmask[(size_t)iv * (size_t)cmask_stride + (size_t)iu] != 0 &&
+                       !(cdepth[(size_t)iv * (size_t)cdepth_stride + (size_t)iu] < zmin);
             if (!seen) {
                 Po[4 * x + 3] = ST_FILL;
                 filled++;
                 continue;
             }
-            /* bilinear, the taps inside the camera's mask, renormalised */
+            /* bilinear, the taps that show the point (the camera's mask,
+             * the same surface), renormalised */
             float sx = (float)u - 0.5f, sy = (float)v - 0.5f;
             if (sx < 0.0f) sx = 0.0f;
             if (sy < 0.0f) sy = 0.0f;
@@ -184,7 +187,9 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
                                fx8 * fy8};
             uint32_t acc[3] = {0, 0, 0}, ws = 0;
             for (int k = 0; k < 4; k++) {
-                if (!wt[k] || !cmask[(size_t)ty[k] * (size_t)cmask_stride + (size_t)tx[k]]) continue;
+                if (!wt[k] || !cmask[(size_t)ty[k] * (size_t)cmask_stride + (size_t)tx[k]] ||
+                    cdepth[(size_t)ty[k] * (size_t)cdepth_stride + (size_t)tx[k]] < zmin)
+                    continue;
                 const uint8_t *c = P->pixels + (size_t)ty[k] * (size_t)P->stride + 4 * (size_t)tx[k];
                 for (int j = 0; j < 3; j++) acc[j] += (uint32_t)wt[k] * c[j];
                 ws += (uint32_t)wt[k];
@@ -238,9 +243,16 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         for (int x = 0; x < w; x++) {
             if (!em[x] || !M[x] || Po[4 * x + 3] != ST_FILL) continue;
             done++;
-            int l = left[x], rr = right[x], src = -1;
-            if (l >= 0 && (rr < 0 || x - l <= rr - x)) src = l;
-            else if (rr >= 0) src = rr;
+            /* of the nearest sampled pixels left and right, the one on
+             * the same surface: its eye distance nearer to this pixel's */
+            int l = left[x], rr = right[x], src = l >= 0 ? l : rr;
+            if (l >= 0 && rr >= 0) {
+                const float *ed = r->depth + (size_t)y * (size_t)w;
+                float d0 = lin_depth(ed[x], n, f);
+                float dl = fabsf(lin_depth(ed[l], n, f) - d0);
+                float dr = fabsf(lin_depth(ed[rr], n, f) - d0);
+                if (dr < dl) src = rr;
+            }
             if (src >= 0) {
                 for (int j = 0; j < 3; j++) Po[4 * x + j] = Po[4 * src + j];
             } else if (sampled) {
