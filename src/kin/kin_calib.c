@@ -280,16 +280,8 @@ int kin_user_calib_parse(const char *text, size_t len, kin_user_calib *out, int 
         buf[l] = '\0';
         if (memchr(buf, '\0', l)) return fail(why, why_size, "NUL byte in line");
         char *tok[16];
-        int nt = 0;
-        char *p = buf;
-        for (;;) {
-            while (*p == ' ' || *p == '\t' || *p == '\r') p++;
-            if (!*p || *p == '#') break;
-            if (nt == 16) return fail(why, why_size, "too many fields");
-            tok[nt++] = p;
-            while (*p && *p != ' ' && *p != '\t' && *p != '\r') p++;
-            if (*p) *p++ = '\0';
-        }
+        int nt = kin__tokens(buf, tok, 16);
+        if (nt < 0) return fail(why, why_size, "too many fields");
         if (!have_header) {
             if (nt != 2 || strcmp(tok[0], "egofuse-calib") != 0 || strcmp(tok[1], "1") != 0)
                 return fail(why, why_size, "first line must be 'egofuse-calib 1'");

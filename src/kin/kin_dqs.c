@@ -128,10 +128,9 @@ void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
         float wsum = 0.0f;
         const kin_quat *r0 = NULL;
         for (int set = 0; skinned && set <= extra; set++) {
-            const uint16_t *j = set ? mesh->joints_extra + ((size_t)v * (size_t)extra + (size_t)(set - 1)) * 4
-                                    : mesh->joints + (size_t)v * 4;
-            const float *w = set ? mesh->weights_extra + ((size_t)v * (size_t)extra + (size_t)(set - 1)) * 4
-                                 : mesh->weights + (size_t)v * 4;
+            const uint16_t *j;
+            const float *w;
+            kin__influences(mesh, extra, v, set, &j, &w);
             for (int i = 0; i < 4; i++) {
                 if (w[i] == 0.0f) continue;
                 const kin_dualquat *q = &dq[j[i]];
@@ -149,8 +148,7 @@ void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
             sq = dq_sq(b);
         }
         if (wsum == 0.0f || !(sq > 0.0f)) {
-            po[0] = p[0]; po[1] = p[1]; po[2] = p[2];
-            if (do_n) { no[0] = n[0]; no[1] = n[1]; no[2] = n[2]; }
+            kin__bind_pose(p, po, n, no);
             continue;
         }
         const float k = 2.0f / sq, w = b[3], dw = b[7];
@@ -173,20 +171,8 @@ void kin_skin_dqs_isa(const kin_mesh *mesh, const kin_dualquat *dq,
                       float *pos_out, float *nrm_out, int isa)
 {
     if (!mesh || !pos_out) return;
-    int v = 0, n = mesh->vertex_count;
-    if (mesh->joints && mesh->weights && dq && mesh->extra_sets == 0) {
-        switch ((ef_isa)kin__skin_isa_of(isa)) {
-#if defined(__x86_64__)
-        case EF_ISA_AVX512: v = kin__skin_dqs_avx512(mesh, dq, pos_out, nrm_out, 0, n); break;
-        case EF_ISA_AVX2: v = kin__skin_dqs_avx2(mesh, dq, pos_out, nrm_out, 0, n); break;
-        case EF_ISA_SSE2: v = kin__skin_dqs_sse2(mesh, dq, pos_out, nrm_out, 0, n); break;
-#elif defined(__aarch64__) && defined(__ARM_NEON)
-        case EF_ISA_NEON: v = kin__skin_dqs_neon(mesh, dq, pos_out, nrm_out, 0, n); break;
-#endif
-        default: break;
-        }
-    }
-    kin__skin_dqs_ref(mesh, dq, pos_out, nrm_out, v, n);
+    int v = kin__skin_simd(mesh, dq, 1, pos_out, nrm_out, isa);
+    kin__skin_dqs_ref(mesh, dq, pos_out, nrm_out, v, mesh->vertex_count);
 }
 
 void kin_skin_dqs(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out, float *nrm_out)

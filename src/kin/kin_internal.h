@@ -25,4 +25,17 @@ void kin__put(kin__sink *k, const char *fmt, ...) KIN__PRINTF(2, 3);
  * finite value, or -1. */
 int kin__parse_number(const char *tok, double *out);
 
+/* Splits a line in place into tokens separated by spaces, tabs and CRs,
+ * up to a '#' comment (each token NUL-terminated, tok[] pointing into
+ * buf); the number of tokens, or -1 when there are more than cap. The
+ * line formats of kin_calib.c and kin_track.c. */
+int kin__tokens(char *buf, char **tok, int cap);
+
+struct kin_channel;
+/* The value of an animation channel at time t (kin_anim.c): ch->comps
+ * floats into out; clamped to the first and last key, STEP, LINEAR
+ * (slerp for rotations, not renormalised), CUBICSPLINE (glTF appendix
+ * C). The caller has checked key_count >= 1, times and values. */
+void kin__channel_value(const struct kin_channel *ch, float t, float *out);
+
 #endif
