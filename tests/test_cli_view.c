@@ -4,8 +4,9 @@
  * renders with either view, the reprojected hand smaller than the
  * cropped one (the eye is D behind the camera) and the output of the
  * display's size; bad options (an unknown view, an IPD or a camera offset
- * out of range, reprojection with --aa) exit 2 with the option and the
- * range named and write nothing. */
+ * out of range, reprojection with --aa), on the command line or in the
+ * cockpit file ([run] view, [hmd] ipd / camera-offset), exit 2 with the
+ * option and the range named and write nothing. */
 #include "support/testutil.h"
 #include <cmocka.h>
 
@@ -225,6 +226,25 @@ static void validity_bad_options(void **state)
                  5);
     const char *a7[] = {"run", "--view", "sideways"};
     expect_usage("--view 'sideways'", o, a7, 3);
+    /* the cockpit file's key: [run] view = ... is --view */
+    char conf[700];
+    snprintf(conf, sizeof conf, "%s/cockpit.conf", dir);
+    FILE *f = fopen(conf, "w");
+    assert_non_null(f);
+    fputs("[run]\nview = sideways\n", f);
+    fclose(f);
+    const char *a8[] = {"run", "--config", conf};
+    expect_usage("--view 'sideways'", o, a8, 3);
+    f = fopen(conf, "w");
+    assert_non_null(f);
+    fputs("[run]\nview = reproject\n[hmd]\nipd = 0.1\n", f);
+    fclose(f);
+    expect_usage("--hmd-ipd '0.1': 0.04..0.09 m", o, a8, 3);
+    f = fopen(conf, "w");
+    assert_non_null(f);
+    fputs("[run]\nview = reproject\n[hmd]\ncamera-offset = 0.3\n", f);
+    fclose(f);
+    expect_usage("(--hmd-camera-offset) 0.3 m is outside 0..0.25 m", o, a8, 3);
 }
 
 int main(void)

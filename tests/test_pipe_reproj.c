@@ -7,7 +7,9 @@
  *   - a point at a known depth lands where the geometry says: the camera
  *     image is a ramp of its own pixel position, so the colour each eye
  *     pixel took names the camera position it was sampled at, checked
- *     against the ray from the eye to the plane and on into the camera;
+ *     against the ray from the eye to the plane and on into the camera
+ *     (the paper's pinhole, and a distorting Brown lens: no undistort
+ *     pass, the lens applied where the image is sampled);
  *   - disocclusion: a small quad in front of a large one; the ring of the
  *     back quad the eye sees around the front one but the camera does not
  *     is filled from the back quad (green), never the front one's red;
@@ -196,34 +198,56 @@ static void ramp_image(uint8_t *img, int xoff, int yoff)
 }
 
 /* Each eye pixel of the quad at depth 0.35 m took the camera colour at
- * the point the geometry gives: eye ray -> plane -> camera pinhole. */
-static void result_point_lands_by_geometry(void **state)
+ * the point the geometry gives: eye ray -> plane -> camera (its lens:
+ * kin_lens_project of the camera's view-space point; for the paper's
+ * pinhole u = cx + fx X / -Z). k1 != 0: both cameras through a Brown
+ * lens, the camera images then in its distorted pixels. */
+static void point_lands(double k1)
 {
-    (void)state;
     kin_model m;
     const float s[1] = {0.05f}, z[1] = {-0.35f};
     quads_model(&m, 1, s, z);
-    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 1, 0);
+    pipe_desc d;
+    memset(&d, 0, sizeof d);
+    d.eye_view = PIPE_VIEW_REPROJECT;
+    d.threads = 1;
+    if (k1 != 0.0) {
+        for (int e = 0; e < 2; e++) {
+            kin_lens *l = &d.hmd.lens[e];
+            l->model = KIN_LENS_BROWN;
+            l->width = CAMW;
+            l->height = CAMH;
+            l->fx = l->fy = 540.0;
+            l->cx = 319.5;
+            l->cy = 239.5;
+            l->k[0] = k1;
+            assert_int_equal(kin_lens_check(l, NULL, 0), 1);
+        }
+    }
+    pipe_ctx *p = pipe_create(&d, &m);
+    assert_non_null(p);
     tu_frame_bufs b;
     pipe_frame_in in;
     tu_frame_make(&b, &in, 12, CAMW, CAMH, LCDW, LCDH);
     in.lighting = pass_through();
+    const kin_sthmd_desc hd = pipe_hmd(p);
     /* the ramps centred on where each camera sees the quad's centre */
     int xoff[2];
     for (int e = 0; e < 2; e++) {
-        kin_camera c = kin_sthmd_camera(NULL, NULL, (kin_eye)e);
-        double uc = c.cx + c.fx * (0.0 - c.world_from_cam.m[12]) / (0.35 + c.world_from_cam.m[14]);
-        xoff[e] = (int)lround(uc) - 128;
+        kin_camera c = kin_sthmd_camera(&hd, NULL, (kin_eye)e);
+        double pc[3] = {-c.world_from_cam.m[12], 0.0, -0.35 - c.world_from_cam.m[14]}, u, v;
+        assert_int_equal(kin_lens_project(&c.lens, pc, &u, &v), 1);
+        xoff[e] = (int)lround(u) - 128;
         ramp_image(b.cam[e], xoff[e], 112);
     }
     pipe_frame_stats st;
     char why[200];
     assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
-    const kin_sthmd_desc hd = pipe_hmd(p);
     for (int e = 0; e < 2; e++) {
         const uint8_t *Q = pipe_layer(p, e, NULL, NULL);
         const uint8_t *M = pipe_view_mask(p, e, NULL, NULL);
         kin_camera ec = eye_cam(e), cc = pipe_camera(p, e);
+        assert_int_equal(kin_lens_distorts(&cc.lens), k1 != 0.0);
         const double ex = ec.world_from_cam.m[12];
         const double cx = cc.world_from_cam.m[12], cz = cc.world_from_cam.m[14];
         long checked = 0;
@@ -236,10 +260,15 @@ static void result_point_lands_by_geometry(void **state)
                 double rx = (x + 0.5 - ec.cx) / ec.fx, ry = -(y + 0.5 - ec.cy) / ec.fy;
                 double X = ex + 0.35 * rx, Y = 0.35 * ry;
                 if (fabs(X) > 0.048 || fabs(Y) > 0.048) continue; /* away from the edge */
-                /* into the camera (same orientation), its pinhole */
-                double dz = -0.35 - cz;
-                double u = cc.cx + cc.fx * (X - cx) / -dz, v = cc.cy - cc.fy * Y / -dz;
+                /* into the camera (same orientation) and through its lens */
+                double pc[3] = {X - cx, Y, -0.35 - cz}, u, v;
+                assert_int_equal(kin_lens_project(&cc.lens, pc, &u, &v), 1);
+                if (k1 == 0.0) { /* the pinhole by hand */
+                    NEAR(u, cc.cx + cc.fx * (X - cx) / (0.35 + cz), 1e-3);
+                    NEAR(v, cc.cy - cc.fy * Y / (0.35 + cz), 1e-3);
+                }
                 double eu = u - 0.5 - xoff[e], ev = v - 0.5 + CROP_Y0 - 112.0;
+                if (eu < 1.0 || eu > 254.0 || ev < 1.0 || ev > 254.0) continue; /* the ramp */
                 double du = fabs(Q[4 * i] - eu), dv = fabs(Q[4 * i + 1] - ev);
                 if (du > worst) worst = du;
                 if (dv > worst) worst = dv;
@@ -248,14 +277,26 @@ static void result_point_lands_by_geometry(void **state)
                 assert_int_equal(Q[4 * i + 2], 77);
                 checked++;
             }
-        print_message("NOTE eye %d: %ld pixels checked, worst %.3f camera px off the geometry "
-                      "(D %.3f m, IPD %.3f m)\n", e, checked, worst, (double)hd.cam_offset_m,
-                      (double)hd.ipd_m);
+        print_message("NOTE k1 %.2f, eye %d: %ld pixels checked, worst %.3f camera px off the "
+                      "geometry (D %.3f m, IPD %.3f m)\n", k1, e, checked, worst,
+                      (double)hd.cam_offset_m, (double)hd.ipd_m);
         assert_true(checked > 5000);
     }
     tu_frame_free(&b);
     pipe_destroy(p);
     kin_model_free(&m);
+}
+
+static void result_point_lands_by_geometry(void **state)
+{
+    (void)state;
+    point_lands(0.0);
+}
+
+static void result_point_lands_through_lens(void **state)
+{
+    (void)state;
+    point_lands(-0.2);
 }
 
 /* Front quad (red in the camera) before a back quad (green): the ring of
@@ -560,6 +601,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(result_mask_equals_eye_draw),
         cmocka_unit_test(result_point_lands_by_geometry),
+        cmocka_unit_test(result_point_lands_through_lens),
         cmocka_unit_test(result_disocclusion_fill),
         cmocka_unit_test(result_border_fade),
         cmocka_unit_test(determinism_isa_threads),

@@ -99,7 +99,10 @@ int pipe_view_parse(const char *name, int *view);
 /* "crop", "reproject", or "?" */
 const char *pipe_view_name(int view);
 /* The resolved ipd_m and cam_offset_m of hmd within the ranges above: 0,
- * or -1 with a sentence naming the field, its value and the range. */
+ * or -1 with a sentence naming the field, its value and the range. Zero
+ * is the default (65 mm, 85 mm); a negative or NaN value, which
+ * kin_sthmd_desc_resolved would also take as the default, is refused
+ * here: for the reprojection it is a mistake, not a wish. */
 int pipe_view_check(const kin_sthmd_desc *hmd, char *why, int why_size);
 
 /* ---------------------------------------- internal to src/pipe (pipe.c) */
