@@ -248,7 +248,7 @@ $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(TEST_IOLIB) $(LIB) | $(TEST_PLU
 	    $(CMOCKA_LIBS) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
 # Tests on the generated samples' scenes also link the generator.
-$(BUILD)/tests/test_occlusion $(BUILD)/tests/test_io_lod: $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
+$(BUILD)/tests/test_occlusion $(BUILD)/tests/test_io_lod $(BUILD)/tests/test_eval_eye: $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) \
 	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
