@@ -5,6 +5,7 @@
 #include "pipe_parts.h"
 #include "pipe_internal.h"
 #include "pipe_lens.h"
+#include "pipe_reproj.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -40,6 +41,9 @@ typedef struct eye_state {
     char why[160];
     double ms_raster, ms_convert, ms_fuse, coverage;
     int lod_level;            /* the level drawn */
+    pipe__reproj rp;          /* eye_view REPROJECT: the eye's view */
+    int view_used;            /* this frame: PIPE_VIEW_* */
+    long fallbacks;           /* reprojecting frames that fell back */
 } eye_state;
 
 struct pipe_ctx {
@@ -118,15 +122,16 @@ static fuse_image raw_rows(const pipe_ctx *p, uint8_t *buf)
  * props) into tg through cam: straight for a pinhole, else through the
  * eye's lens map (pipe_lens.h), which writes every pixel of tg. Returns
  * the raster's result; *covered: the mask pixels set. */
-static rast_result eye_draw(pipe_ctx *p, eye_state *e, const kin_camera *cam,
-                            const rast_target *tg, int parts, long *covered)
+static rast_result eye_draw(pipe_ctx *p, eye_state *e, const pipe_lens_map *lens,
+                            const kin_camera *cam, const rast_target *tg, int parts,
+                            long *covered)
 {
     kin_camera pc;
     rast_target it = *tg;
-    if (e->lens) {
-        pc = pipe_lens_pinhole(e->lens, cam);
+    if (lens) {
+        pc = pipe_lens_pinhole(lens, cam);
         cam = &pc;
-        it = pipe_lens_target(e->lens);
+        it = pipe_lens_target(lens);
     }
     rast_context_clear(e->rast, &it); /* only what the last frame drew */
     rast_result rr = parts && pipe__cockpit_active(p->ck)
@@ -139,8 +144,42 @@ static rast_result eye_draw(pipe_ctx *p, eye_state *e, const kin_camera *cam,
                                           e->vnrm, NULL);
     if (rr != RAST_OK) return rr;
     /* Only the tiles the draws marked are read (the rest is clear). */
-    *covered = e->lens ? pipe_lens_warp(e->lens, tg) : rast_context_count(e->rast, &it);
+    *covered = lens ? pipe_lens_warp(lens, tg) : rast_context_count(e->rast, &it);
     return RAST_OK;
+}
+
+/* Reprojection (pipe_reproj.h): the model drawn from the eye, the camera
+ * image sampled through the eye's depths; fe then lights and composites
+ * the eye's view. 1 when fe was switched to it, 0 for the fallback to the
+ * crop (the eye inside the model), -1 on a raster error (e->why set). */
+static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *K)
+{
+    pipe__reproj *r = &e->rp;
+    const int w = r->width, h = r->height, cw = p->geo.crop_width;
+    r->cam = kin_sthmd_eye_camera(&p->hmd, &e->head, (kin_eye)e->eye, w, h);
+    rast_target tg = {w, h, r->depth, w, r->mask, w, r->nrm, 3 * w, 3};
+    long covered = 0;
+    int level = e->lod_level;
+    rast_result rr = eye_draw(p, e, NULL, &r->cam, &tg, 1, &covered);
+    e->lod_level = level;
+    if (rr != RAST_OK) {
+        e->result = PIPE_ERR_RASTER;
+        snprintf(e->why, sizeof e->why, "%s eye: rasterizer (eye view): %s",
+                 e->eye ? "right" : "left", rast_result_str(rr));
+        return -1;
+    }
+    if (pipe__reproj_sample(r, &e->cam, &fe->P, e->mask, cw, e->depth, cw, p->hmd.znear,
+                            p->hmd.zfar)) {
+        e->fallbacks++;
+        return 0;
+    }
+    fe->P = (fuse_image){r->P, w, h, 4 * w};
+    fe->mask = r->M;
+    fe->mask_stride = w;
+    *K = (fuse_intrinsics){r->cam.fx, r->cam.fy, r->cam.cx, r->cam.cy};
+    fe->intrinsics = K;
+    e->view_used = PIPE_VIEW_REPROJECT;
+    return 1;
 }
 
 static void run_eye(pipe_ctx *p, eye_state *e)
@@ -153,7 +192,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
     long covered = 0;
     e->lod_level = 0;
-    rast_result rr = eye_draw(p, e, &e->cam, &tg, 1, &covered);
+    rast_result rr = eye_draw(p, e, e->lens, &e->cam, &tg, 1, &covered);
     if (rr == RAST_OK && e->aa.count) { /* no lens here: refused at pipe_create */
         pipe__aa_begin(&e->aa);
         rr = pipe__cockpit_active(p->ck)
@@ -249,27 +288,39 @@ static void run_eye(pipe_ctx *p, eye_state *e)
             pipe_fit_measure(p->fit, e->eye, &e->cam, p->pose.world, e->mask, cw, e->refined, cw);
         }
     }
+    /* the eye's view instead of the camera's crop (pipe_reproj.h) */
+    const fuse_image Pcam = fe.P;
+    fuse_intrinsics EK;
+    e->view_used = PIPE_VIEW_CROP;
+    if (p->desc.eye_view == PIPE_VIEW_REPROJECT && reproj_eye(p, e, &fe, &EK) < 0) return;
+    const int rp = e->view_used == PIPE_VIEW_REPROJECT;
     e->shown = fe.mask;
-    fe.normal = e->nrm;
+    fe.normal = rp ? e->rp.nrm : e->nrm;
     fe.normal_stride = 3 * cw;
     /* coverage beyond the model's pixel centres: its neighbours' normals */
     if (e->aa.count && p->desc.normal_smooth == 0)
         pipe__aa_fill_normals(&e->aa, fe.mask, e->mask, e->nrm);
     if (p->desc.normal_smooth > 0 &&
-        fuse_normal_smooth(fe.mask, fe.mask_stride, e->nrm, 3 * cw, e->snrm, 3 * cw, cw, ch,
+        fuse_normal_smooth(fe.mask, fe.mask_stride, fe.normal, 3 * cw, e->snrm, 3 * cw, cw, ch,
                            p->desc.normal_smooth) == FUSE_OK)
         fe.normal = e->snrm;
     fe.Q = (fuse_image){e->layer, cw, ch, 4 * cw};
     fe.V = in->virt[e->eye];
-    fe.vp_x0 = p->geo.vp_x0;
-    fe.vp_y0 = p->geo.vp_y0;
-    fe.vp_w = p->geo.vp_width;
-    fe.vp_h = p->geo.vp_height;
+    fe.vp_x0 = rp ? 0 : p->geo.vp_x0;
+    fe.vp_y0 = rp ? 0 : p->geo.vp_y0;
+    fe.vp_w = rp ? p->hmd.lcd_width : p->geo.vp_width;
+    fe.vp_h = rp ? p->hmd.lcd_height : p->geo.vp_height;
     fe.out = in->out[e->eye];
     fe.v_opaque = in->virt_opaque != 0;
     fuse_depth dt;
     int filled[4] = {0, 0, 0, 0};
-    if (in->virt_depth[e->eye]) {
+    if (in->virt_depth[e->eye] && rp) {
+        /* the eye's own depths: the scene's distances are the eye's */
+        dt = (fuse_depth){e->rp.depth, cw, p->hmd.znear, p->hmd.zfar, 0.0f,
+                          in->virt_depth[e->eye], in->virt_depth_stride[e->eye],
+                          fe.V.width, fe.V.height};
+        fe.depth = &dt;
+    } else if (in->virt_depth[e->eye]) {
         dt = (fuse_depth){e->depth, cw, p->hmd.znear, p->hmd.zfar, p->hmd.cam_offset_m,
                           in->virt_depth[e->eye], in->virt_depth_stride[e->eye],
                           fe.V.width, fe.V.height};
@@ -289,7 +340,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     fuse_result fr = FUSE_OK;
     if (p->desc.tone_match > 0.0f) {
         float tone[3];
-        fr = fuse_tone_match(&fe.P, e->mask, cw, &fe.V, fe.vp_x0, fe.vp_y0, fe.vp_w,
+        fr = fuse_tone_match(&Pcam, e->mask, cw, &fe.V, fe.vp_x0, fe.vp_y0, fe.vp_w,
                              fe.vp_h, p->desc.tone_match, tone);
         for (int k = 0; k < 3; k++) L.tone[k] *= tone[k];
     }
@@ -366,6 +417,7 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].refined);
         free(p->eye[e].refine_scratch);
         pipe__aa_free(&p->eye[e].aa);
+        pipe__reproj_free(&p->eye[e].rp);
         rast_context_destroy(p->eye[e].rast);
         fuse_context_destroy(p->eye[e].fuse);
         pipe_lens_map_free(p->eye[e].lens);
@@ -415,6 +467,10 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         return NULL;
     if (desc && desc->aa_samples != 0 && desc->aa_samples != 4 && desc->aa_samples != 8 &&
         desc->aa_samples != 16)
+        return NULL;
+    if (desc && desc->eye_view != PIPE_VIEW_CROP &&
+        (desc->eye_view != PIPE_VIEW_REPROJECT || desc->aa_samples != 0 ||
+         pipe_view_check(&desc->hmd, NULL, 0) != 0))
         return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
@@ -477,6 +533,8 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         /* coverage samples are drawn through the pinhole: not with a
          * distorting lens (pipe.h ANTI-ALIASED EDGES) */
         if (ok && p->desc.aa_samples && s->lens) ok = 0;
+        if (ok && p->desc.eye_view == PIPE_VIEW_REPROJECT)
+            ok = pipe__reproj_init(&s->rp, p->geo.crop_width, p->geo.crop_height) == 0;
         if (ok && p->desc.aa_samples)
             ok = pipe__aa_init(&s->aa, p->desc.aa_samples, p->geo.crop_width,
                                p->geo.crop_height, p->desc.refine_band > 0) == 0;
@@ -568,7 +626,7 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
         if (pipe_fit_learned(p->fit, e)) continue;
         rast_target tg = {cw, ch, s->depth, cw, s->mask, cw, s->nrm, 3 * cw, 3};
         long covered;
-        rast_result rr = eye_draw(p, s, &cam[e], &tg, 0, &covered);
+        rast_result rr = eye_draw(p, s, s->lens, &cam[e], &tg, 0, &covered);
         const uint8_t *prev = s->have_refined && !p->fit_no_prev ? s->refined : NULL;
         fuse_result lr =
             rr == RAST_OK ? pipe_fit_learn(p->fit, e, &P[e], s->mask, cw, prev, cw) : FUSE_OK;
@@ -675,7 +733,13 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
             stats->ms_fuse[e] = p->eye[e].ms_fuse;
             stats->coverage[e] = p->eye[e].coverage;
             stats->lod_level[e] = p->eye[e].lod_level;
+            int rp = p->eye[e].view_used == PIPE_VIEW_REPROJECT;
+            stats->view[e] = p->eye[e].view_used;
+            stats->view_sampled[e] = rp ? p->eye[e].rp.sampled : 0;
+            stats->view_filled[e] = rp ? p->eye[e].rp.filled : 0;
+            stats->view_outside[e] = rp ? p->eye[e].rp.outside : 0;
         }
+        stats->view_fallbacks = p->eye[0].fallbacks + p->eye[1].fallbacks;
         stats->ms_total = now_ms() - t0;
     }
     for (int e = 0; e < 2; e++) {
@@ -712,6 +776,20 @@ const uint8_t *pipe_layer(const pipe_ctx *p, int eye, int *width, int *height)
 }
 
 kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].cam; }
+
+kin_camera pipe_view_camera(const pipe_ctx *p, int eye)
+{
+    const eye_state *e = &p->eye[eye ? 1 : 0];
+    return e->view_used == PIPE_VIEW_REPROJECT ? e->rp.cam : e->cam;
+}
+
+const uint8_t *pipe_view_mask(const pipe_ctx *p, int eye, int *width, int *height)
+{
+    const eye_state *e = &p->eye[eye ? 1 : 0];
+    if (width) *width = e->rp.width;
+    if (height) *height = e->rp.height;
+    return e->view_used == PIPE_VIEW_REPROJECT ? e->rp.M : NULL;
+}
 
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }
 

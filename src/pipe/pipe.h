@@ -43,6 +43,7 @@
 #include "../raster/raster.h"
 #include "pipe_lod.h"
 #include "pipe_pose.h"
+#include "pipe_reproj.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -100,6 +101,16 @@ typedef struct pipe_desc {
                                  the pinhole): pipe_create returns NULL.
                                  With a level of detail the samples still
                                  draw the full model. */
+    int eye_view;             /* PIPE_VIEW_CROP = 0 (default): the paper's
+                                 crop and scale (eq. 1-4), the bytes of
+                                 before; PIPE_VIEW_REPROJECT: each eye's
+                                 hands reprojected from its camera by the
+                                 model's depth, composited into the whole
+                                 display (pipe_reproj.h, docs/eyeview.md).
+                                 Another value, reprojection with
+                                 aa_samples, or hmd.ipd_m / cam_offset_m
+                                 out of range (pipe_view_check):
+                                 pipe_create returns NULL. */
 } pipe_desc;
 
 /* ANTI-ALIASED EDGES (pipe_desc.aa_samples = n). Each eye's model is drawn
@@ -194,6 +205,17 @@ typedef struct pipe_frame_stats {
     double coverage[2];       /* fraction of camera pixels in the mask */
     int lod_level[2];         /* per eye: the level of detail drawn
                                  (pipe_set_lod; 0 = the full model) */
+    int view[2];              /* per eye: the method used, PIPE_VIEW_*
+                                 (CROP when a reprojecting eye fell back:
+                                 the eye inside the model) */
+    long view_sampled[2];     /* reprojection, per eye: eye pixels sampled
+                                 from the camera, filled (seen by the eye,
+                                 not by the camera) and outside the
+                                 camera's image (pipe_reproj.h) */
+    long view_filled[2];
+    long view_outside[2];
+    long view_fallbacks;      /* reprojection: eye-frames that fell back
+                                 to the crop, since pipe_create */
 } pipe_frame_stats;
 
 typedef enum pipe_result {
@@ -228,6 +250,15 @@ const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
 const uint8_t *pipe_layer(const pipe_ctx *p, int eye, int *width, int *height);
 /* The camera of one eye in the last frame. */
 kin_camera pipe_camera(const pipe_ctx *p, int eye);
+/* With pipe_desc.eye_view = PIPE_VIEW_REPROJECT: the eye's own camera of
+ * the last frame (kin_sthmd_eye_camera at the layer's size, which
+ * pipe_layer then has), and the eye-view mask composited (0..255: the
+ * border fade, 0 outside the camera's view; width x height = the crop's
+ * size, covering the whole display). pipe_view_mask is NULL, and
+ * pipe_view_camera the camera's, for the crop method and for an eye that
+ * fell back to it in the last frame. */
+kin_camera pipe_view_camera(const pipe_ctx *p, int eye);
+const uint8_t *pipe_view_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The ISA that raster and fuse use (an ef_isa value). */
 int pipe_isa(const pipe_ctx *p);
 /* The derived HMD numbers in use (crop, viewport). */
