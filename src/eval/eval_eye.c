@@ -65,6 +65,7 @@ typedef struct eye_run {
     /* sums over frames and eyes */
     double pos, size, size_abs, height, iou, mse, secs, depth;
     long n_shape, n_eye, n_frames, n_depth;
+    long fallbacks;          /* reprojection: eye-frames that fell back */
 } eye_run;
 
 typedef struct eye_ctx {
@@ -84,13 +85,18 @@ typedef struct eye_ctx {
     double hand_depth[2];
     float *vdepth, *enrm, *scratch;
     uint8_t *vrgb, *eye_rgba;
+    uint8_t *cam_full[2];        /* the camera images, RGBA 640x480 */
+    /* the methods: one pipe each (pipe_desc.eye_view), one thread */
+    pipe_ctx *pipe[EM_COUNT];
+    pipe_lighting light;
     /* method scratch */
-    uint8_t *mask_c, *hmask_c, *layer, *out, *disp, *disp_sil, *disp_hand, *black, *white;
+    uint8_t *mask_c, *hmask_c, *layer, *out[2], *disp, *disp_sil, *disp_hand, *black, *white;
     float *depth_c, *nrm_c;
 } eye_ctx;
 
 static void ctx_free(eye_ctx *c)
 {
+    for (int k = 0; k < EM_COUNT; k++) pipe_destroy(c->pipe[k]);
     gen_frame_ctx_free(&c->g);
     gen_arms_free(&c->truth);
     gen_arms_free(&c->mask);
@@ -102,9 +108,10 @@ static void ctx_free(eye_ctx *c)
     free(c->cam_rgb); free(c->gt_mask); free(c->gt_depth);
     for (int e = 0; e < 2; e++) {
         free(c->P[e]); free(c->V[e]); free(c->ideal[e]); free(c->sil[e]); free(c->hand[e]);
+        free(c->cam_full[e]); free(c->out[e]);
     }
     free(c->vdepth); free(c->enrm); free(c->scratch); free(c->vrgb); free(c->eye_rgba);
-    free(c->mask_c); free(c->hmask_c); free(c->layer); free(c->out); free(c->disp);
+    free(c->mask_c); free(c->hmask_c); free(c->layer); free(c->disp);
     free(c->disp_sil); free(c->disp_hand); free(c->black); free(c->white);
     free(c->depth_c); free(c->nrm_c);
     memset(c, 0, sizeof *c);
@@ -150,7 +157,10 @@ static int ctx_init(eye_ctx *c, uint64_t seed, const char *seq)
         c->ideal[e] = malloc(dp * 4);
         c->sil[e] = malloc(dp);
         c->hand[e] = malloc(dp);
-        ok = c->P[e] && c->V[e] && c->ideal[e] && c->sil[e] && c->hand[e];
+        c->cam_full[e] = malloc((size_t)GEN_CAM_W * GEN_CAM_H * 4);
+        c->out[e] = malloc(dp * 4);
+        ok = c->P[e] && c->V[e] && c->ideal[e] && c->sil[e] && c->hand[e] && c->cam_full[e] &&
+             c->out[e];
     }
     c->vdepth = malloc(sizeof(float) * dp);
     c->enrm = malloc(sizeof(float) * 3 * dp);
@@ -160,7 +170,6 @@ static int ctx_init(eye_ctx *c, uint64_t seed, const char *seq)
     c->mask_c = malloc(cp);
     c->hmask_c = malloc(cp);
     c->layer = malloc(dp * 4);
-    c->out = malloc(dp * 4);
     c->disp = malloc(dp * 4);
     c->disp_hand = malloc(dp);
     c->disp_sil = malloc(dp);
@@ -169,9 +178,23 @@ static int ctx_init(eye_ctx *c, uint64_t seed, const char *seq)
     c->depth_c = malloc(sizeof(float) * cp);
     c->nrm_c = malloc(sizeof(float) * 3 * cp);
     ok = ok && c->vdepth && c->enrm && c->scratch && c->vrgb && c->eye_rgba && c->mask_c &&
-         c->hmask_c && c->layer && c->out && c->disp && c->disp_sil && c->disp_hand && c->black && c->white &&
+         c->hmask_c && c->layer && c->disp && c->disp_sil && c->disp_hand && c->black && c->white &&
          c->depth_c && c->nrm_c;
     if (!ok) return cli_fail("out of memory");
+    for (int k = 0; k < EM_COUNT; k++) {
+        pipe_desc pd;
+        memset(&pd, 0, sizeof pd);
+        pd.threads = 1;
+        pd.eye_view = k == EM_CROP ? PIPE_VIEW_CROP : PIPE_VIEW_REPROJECT;
+        c->pipe[k] = pipe_create(&pd, m);
+        if (!c->pipe[k]) return cli_fail("the %s pipeline: cannot create it", em_name[k]);
+    }
+    /* the workshop's lights in world space (pipe_frame turns them into
+     * each view's space) */
+    kin_camera id;
+    memset(&id, 0, sizeof id);
+    id.view = kin_mat4_identity();
+    c->light.light = eval__lighting(&c->workshop, &id);
     for (size_t i = 0; i < dp; i++) {
         c->black[i * 4 + 0] = c->black[i * 4 + 1] = c->black[i * 4 + 2] = 0;
         c->black[i * 4 + 3] = 255;
@@ -192,7 +215,10 @@ static int make_truth(eye_ctx *c, int fi)
                       c->gt_mask);
         const uint8_t *src = c->cam_rgb + (size_t)c->geo.crop_y0 * GEN_CAM_W * 3;
         if (fuse_rgb24_to_rgba(src, GEN_CAM_W * 3, CW, CH,
-                               &(fuse_image){ c->P[e], CW, CH, 4 * CW }) != FUSE_OK)
+                               &(fuse_image){ c->P[e], CW, CH, 4 * CW }) != FUSE_OK ||
+            fuse_rgb24_to_rgba(c->cam_rgb, GEN_CAM_W * 3, GEN_CAM_W, GEN_CAM_H,
+                               &(fuse_image){ c->cam_full[e], GEN_CAM_W, GEN_CAM_H,
+                                              4 * GEN_CAM_W }) != FUSE_OK)
             return -1;
         gen_render_virtual(&c->g, &wfh, (kin_eye)e, fi, c->vrgb, c->vdepth);
         fuse_image V = { c->V[e], DW, DH, 4 * DW };
@@ -221,19 +247,19 @@ static double thread_secs(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* The crop method's display silhouette of a camera-space mask: the mask as
- * a premultiplied white layer, composited into the viewport over opaque
- * black by the pipeline's own resampling (fuse_composite); 255 where the
- * result is >= 128. dst: DW x DH bytes. */
-static int crop_to_display(eye_ctx *c, const uint8_t *mask, uint8_t *dst)
+/* The display silhouette of a view layer's mask (w x h) composited into
+ * the display at (x0, y0, vw, vh) (the crop: the viewport; the
+ * reprojection: the whole display): the mask as a premultiplied white
+ * layer over opaque black, by the pipeline's own resampling
+ * (fuse_composite); 255 where the result is >= 128. dst: DW x DH bytes. */
+static int layer_to_display(eye_ctx *c, const uint8_t *mask, int w, int h, int x0, int y0,
+                            int vw, int vh, uint8_t *dst)
 {
-    for (size_t i = 0; i < (size_t)CW * CH; i++)
+    for (size_t i = 0; i < (size_t)w * h; i++)
         memset(&c->white[i * 4], mask[i], 4);
-    fuse_image Q = { c->white, CW, CH, 4 * CW }, B = { c->black, DW, DH, 4 * DW };
+    fuse_image Q = { c->white, w, h, 4 * w }, B = { c->black, DW, DH, 4 * DW };
     fuse_image O = { c->disp, DW, DH, 4 * DW };
-    if (fuse_composite(&Q, &B, c->geo.vp_x0, c->geo.vp_y0, c->geo.vp_width, c->geo.vp_height,
-                       &O) != FUSE_OK)
-        return -1;
+    if (fuse_composite(&Q, &B, x0, y0, vw, vh, &O) != FUSE_OK) return -1;
     for (size_t i = 0; i < (size_t)DW * DH; i++) dst[i] = c->disp[i * 4] >= 128 ? 255 : 0;
     return 0;
 }
@@ -287,7 +313,6 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
     }
     const kin_model *m = &c->mask.model;
     const kin_mesh *me = &m->meshes[0];
-    double t0 = thread_secs();
     int posed = 0;
     if (r->noise == 0.0f) {
         /* perfect tracking: the true pose (the view's error alone) */
@@ -303,57 +328,69 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
             for (int j = GEN_J_THUMB_1; j < GEN_SIDE_JOINTS; j++)
                 r->locals[c->mask.joint[sd][j]] = c->g.locals[c->mask.joint[sd][j]];
     }
-    if (posed) {
-        kin_fk(m->parents, m->node_count, r->locals, NULL, c->world);
-        kin_skin_joint_matrices(&m->skins[0], c->world, c->jm);
-        kin_skin_lbs(me, c->jm, c->pos, c->nrm);
-    }
-    double secs = thread_secs() - t0;
+    /* the method: one stereo frame of the pipeline, timed (this thread's
+     * CPU time: pipe_desc.threads 1, the machine may be shared) */
+    pipe_ctx *p = c->pipe[r->method];
+    pipe_frame_in in;
+    memset(&in, 0, sizeof in);
+    in.locals = r->locals;
+    in.head_node = c->mask.head;
+    in.lighting = c->light;
     for (int e = 0; e < 2; e++) {
-        t0 = thread_secs();
-        kin_camera cam = kin_sthmd_camera(NULL, posed ? &c->world[c->rig.head] : NULL, (kin_eye)e);
-        rast_target tg = { CW, CH, c->depth_c, CW, c->mask_c, CW, c->nrm_c, 3 * CW, 3 };
-        rast_target_clear(&tg);
-        if (posed) {
-            rast_transform_points(cam.view_proj.m, c->pos, me->vertex_count, c->clip);
-            rast_transform_dirs(cam.view.m, c->nrm, me->vertex_count, c->vnrm);
-            rast_mesh_desc d = { c->clip, me->vertex_count, c->vnrm, 3, me->indices,
-                                 me->index_count / 3, RAST_CULL_NONE };
-            if (rast_draw(&tg, &d, NULL) != RAST_OK) return -1;
-        }
-        fuse_intrinsics K = { cam.fx, cam.fy, cam.cx, cam.cy };
-        fuse_image P = { c->P[e], CW, CH, 4 * CW }, Q = { c->layer, CW, CH, 4 * CW };
-        fuse_image V = { c->V[e], DW, DH, 4 * DW }, O = { c->out, DW, DH, 4 * DW };
-        fuse_lighting L = eval__lighting(&c->workshop, &cam);
-        if (r->method == EM_CROP) {
-            if (fuse_light(&L, &K, &P, c->mask_c, CW, c->nrm_c, 3 * CW, &Q) != FUSE_OK ||
-                fuse_composite(&Q, &V, c->geo.vp_x0, c->geo.vp_y0, c->geo.vp_width,
-                               c->geo.vp_height, &O) != FUSE_OK)
-                return -1;
+        in.camera[e] = (fuse_image){ c->cam_full[e], GEN_CAM_W, GEN_CAM_H, 4 * GEN_CAM_W };
+        in.virt[e] = (fuse_image){ c->V[e], DW, DH, 4 * DW };
+        in.out[e] = (fuse_image){ c->out[e], DW, DH, 4 * DW };
+    }
+    pipe_frame_stats st;
+    char why[256];
+    double t0 = thread_secs();
+    if (pipe_frame(p, &in, &st, why, sizeof why) != PIPE_OK) return cli_fail("%s", why);
+    double secs = thread_secs() - t0;
+    r->fallbacks = st.view_fallbacks;
+    /* the posed model, for its fingertip (not timed) */
+    kin_fk(m->parents, m->node_count, r->locals, NULL, c->world);
+    kin_skin_joint_matrices(&m->skins[0], c->world, c->jm);
+    kin_skin_lbs(me, c->jm, c->pos, c->nrm);
+    (void)posed;
+    for (int e = 0; e < 2; e++) {
+        /* the view layer's mask and camera, and where it goes */
+        int w = 0, h = 0, x0 = 0, y0 = 0, vw = DW, vh = DH;
+        const uint8_t *M;
+        kin_camera cam;
+        if (st.view[e] == PIPE_VIEW_REPROJECT) {
+            M = pipe_view_mask(p, e, &w, &h);
+            cam = pipe_view_camera(p, e);
         } else {
-            return -1;   /* the reprojection: not merged yet */
+            M = pipe_mask(p, e, &w, &h);
+            cam = pipe_camera(p, e);
+            x0 = c->geo.vp_x0;
+            y0 = c->geo.vp_y0;
+            vw = c->geo.vp_width;
+            vh = c->geo.vp_height;
         }
-        secs += thread_secs() - t0;
-        /* the output's silhouette and its hands' part (not timed) */
+        if (!M || w != CW || h != CH) return cli_fail("the %s pipeline: no mask", em_name[r->method]);
         uint8_t *sil = c->disp_sil;
-        if (crop_to_display(c, c->mask_c, sil) < 0) return -1;
+        if (layer_to_display(c, M, w, h, x0, y0, vw, vh, sil) < 0) return -1;
         fuse_confusion cf;
         fuse_mask_confusion(sil, DW, c->sil[e], DW, DW, DH, &cf);
         double iou = fuse_confusion_iou(&cf);
+        /* the fingertip's part of the layer: the model's fingertip drawn
+         * through the layer's camera, where the layer shows the hand */
         rast_target th = { CW, CH, c->depth_c, CW, c->hmask_c, CW, NULL, 0, 0 };
         rast_target_clear(&th);
-        if (posed) {
-            rast_mesh_desc dh = { c->clip, me->vertex_count, NULL, 0, c->hand_m, c->ntri_m,
-                                  RAST_CULL_NONE };
-            if (rast_draw(&th, &dh, NULL) != RAST_OK) return -1;
-        }
-        if (crop_to_display(c, c->hmask_c, c->disp_hand) < 0) return -1;
+        rast_transform_points(cam.view_proj.m, c->pos, me->vertex_count, c->clip);
+        rast_mesh_desc dh = { c->clip, me->vertex_count, NULL, 0, c->hand_m, c->ntri_m,
+                              RAST_CULL_NONE };
+        if (rast_draw(&th, &dh, NULL) != RAST_OK) return -1;
+        for (size_t i = 0; i < (size_t)CW * CH; i++)
+            c->hmask_c[i] = c->hmask_c[i] && M[i] >= 128 ? 255 : 0;
+        if (layer_to_display(c, c->hmask_c, CW, CH, x0, y0, vw, vh, c->disp_hand) < 0) return -1;
         fuse_moments mm, mt;
         fuse_mask_moments(c->disp_hand, DW, DW, DH, &mm);
         fuse_mask_moments(c->hand[e], DW, DW, DH, &mt);
         fuse_shape_error se;
         int have_shape = fuse_shape_compare(&mm, &mt, MIN_HAND_PX, &se);
-        double mse = fuse_mse(c->out, 4 * DW, c->ideal[e], 4 * DW, DW, DH, 4, 3);
+        double mse = fuse_mse(c->out[e], 4 * DW, c->ideal[e], 4 * DW, DW, DH, 4, 3);
         if (dump && dump_view(dump, r, fi, e, c->sil[e], sil, c->hand[e], c->disp_hand, c->vrgb))
             return -1;
         if (have_shape) {
@@ -372,11 +409,13 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
         r->n_eye++;
         if (per_frame)
             printf("%4d %-5s %-6s d=%2dcm noise %4.1fmm hand depth %.3f m pos %6.2f px size %+6.2f%%"
-                   " height %+6.2f%% iou %.4f psnr %5.2f\n",
+                   " height %+6.2f%% iou %.4f psnr %5.2f%s\n",
                    fi, e ? "right" : "left", em_name[r->method], r->dist, (double)r->noise,
                    c->hand_depth[e], have_shape ? se.pos_px : NAN,
                    have_shape ? 100.0 * se.size : NAN, have_shape ? 100.0 * se.height : NAN, iou,
-                   fuse_psnr_of_mse(mse));
+                   fuse_psnr_of_mse(mse),
+                   st.view[e] != (r->method == EM_CROP ? PIPE_VIEW_CROP : PIPE_VIEW_REPROJECT)
+                       ? " (fell back to the crop)" : "");
     }
     r->secs += secs;
     r->n_frames++;
@@ -554,7 +593,7 @@ int eval_eye_run(const eval_opts *o)
         return cli_fail("%s: cannot create the report folder", o->report);
     if (o->dump && cli_mkdirs(o->dump) != 0)
         return cli_fail("%s: cannot create the folder", o->dump);
-    int methods[EM_COUNT] = { 1, 0 };  /* the reprojection once merged */
+    int methods[EM_COUNT] = { 1, 1 };
     int nm = 0;
     for (int k = 0; k < EM_COUNT; k++) nm += methods[k];
     const int n = NDIST * NNOISE * nm;
