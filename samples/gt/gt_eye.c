@@ -138,3 +138,26 @@ void gt_render_view(gen_frame_ctx *c, const kin_camera *cam, const uint32_t *han
         *hand_depth = n ? sum / (double)n : 0.0;
     }
 }
+
+void gt_view_seen_by(const gen_frame_ctx *c, const kin_camera *eye, float znear, float zfar,
+                     const kin_camera *cam, const uint8_t *sil, uint8_t *out)
+{
+    const int w = eye->width, h = eye->height;
+    const double n = znear, f = zfar;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * (size_t)w + (size_t)x;
+            out[i] = 0;
+            if (!sil[i]) continue;
+            /* the view-space point of the pixel centre at its depth */
+            double zn = 2.0 * (double)c->depth[i] - 1.0;
+            double d = 2.0 * f * n / ((f + n) - zn * (f - n));
+            kin_vec3 pv = kin_v3((float)(((double)x + 0.5 - eye->cx) / eye->fx * d),
+                                 (float)(-((double)y + 0.5 - eye->cy) / eye->fy * d), (float)-d);
+            kin_vec3 pw = kin_mat4_mul_point(&eye->world_from_cam, pv);
+            kin_vec3 pc = kin_mat4_mul_point(&cam->view, pw);
+            if (!(pc.z < 0.0f)) continue;
+            double u = cam->cx + cam->fx * pc.x / -pc.z, v = cam->cy - cam->fy * pc.y / -pc.z;
+            if (u >= 0.0 && u < cam->width && v >= 0.0 && v < cam->height) out[i] = 255;
+        }
+}

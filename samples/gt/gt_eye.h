@@ -58,4 +58,13 @@ void gt_render_view(gen_frame_ctx *c, const kin_camera *cam, const uint32_t *han
                     int hand_tris, uint8_t *rgba, uint8_t *sil, uint8_t *hand, float *nrm,
                     float *scratch_depth, double *hand_depth);
 
+/* The pixels of sil (the silhouette of the last gt_render_view through
+ * eye, whose depths the context still holds; the projection's near and far
+ * znear, zfar: GEN_VIRT_ZNEAR, GEN_VIRT_ZFAR for gt_eye_camera) whose
+ * surface point projects inside cam's image (in front of it; occlusion
+ * not considered): 255 there, 0 elsewhere, into out (eye's size). What a
+ * method showing the camera's pixels can show at best. */
+void gt_view_seen_by(const gen_frame_ctx *c, const kin_camera *eye, float znear, float zfar,
+                     const kin_camera *cam, const uint8_t *sil, uint8_t *out);
+
 #endif

@@ -63,7 +63,7 @@ typedef struct eye_run {
     kin_filter filter;
     kin_transform *locals;
     /* sums over frames and eyes */
-    double pos, size, size_abs, height, iou, mse, secs, depth;
+    double pos, size, size_abs, height, iou, iou_seen, mse, secs, depth;
     long n_shape, n_eye, n_frames, n_depth;
     long fallbacks;          /* reprojection: eye-frames that fell back */
 } eye_run;
@@ -81,7 +81,7 @@ typedef struct eye_ctx {
     float *pos, *nrm, *clip, *vnrm;
     uint8_t *cam_rgb, *gt_mask;
     float *gt_depth;
-    uint8_t *P[2], *V[2], *ideal[2], *sil[2], *hand[2];
+    uint8_t *P[2], *V[2], *ideal[2], *sil[2], *hand[2], *seen[2];
     double hand_depth[2];
     float *vdepth, *enrm, *scratch;
     uint8_t *vrgb, *eye_rgba;
@@ -108,7 +108,7 @@ static void ctx_free(eye_ctx *c)
     free(c->cam_rgb); free(c->gt_mask); free(c->gt_depth);
     for (int e = 0; e < 2; e++) {
         free(c->P[e]); free(c->V[e]); free(c->ideal[e]); free(c->sil[e]); free(c->hand[e]);
-        free(c->cam_full[e]); free(c->out[e]);
+        free(c->cam_full[e]); free(c->out[e]); free(c->seen[e]);
     }
     free(c->vdepth); free(c->enrm); free(c->scratch); free(c->vrgb); free(c->eye_rgba);
     free(c->mask_c); free(c->hmask_c); free(c->layer); free(c->disp);
@@ -159,7 +159,8 @@ static int ctx_init(eye_ctx *c, uint64_t seed, const char *seq)
         c->hand[e] = malloc(dp);
         c->cam_full[e] = malloc((size_t)GEN_CAM_W * GEN_CAM_H * 4);
         c->out[e] = malloc(dp * 4);
-        ok = c->P[e] && c->V[e] && c->ideal[e] && c->sil[e] && c->hand[e] && c->cam_full[e] &&
+        c->seen[e] = malloc(dp);
+        ok = c->seen[e] && c->P[e] && c->V[e] && c->ideal[e] && c->sil[e] && c->hand[e] && c->cam_full[e] &&
              c->out[e];
     }
     c->vdepth = malloc(sizeof(float) * dp);
@@ -227,6 +228,8 @@ static int make_truth(eye_ctx *c, int fi)
         kin_camera ec = gt_eye_camera(NULL, &wfh, (kin_eye)e);
         gt_render_view(&c->g, &ec, c->hand_t, c->ntri_t, c->eye_rgba, c->sil[e], c->hand[e],
                        c->enrm, c->scratch, &c->hand_depth[e]);
+        kin_camera tc = kin_sthmd_camera(NULL, &wfh, (kin_eye)e);
+        gt_view_seen_by(&c->g, &ec, GEN_VIRT_ZNEAR, GEN_VIRT_ZFAR, &tc, c->sil[e], c->seen[e]);
         fuse_lighting L = eval__lighting(&c->workshop, &ec);
         fuse_intrinsics K = { ec.fx, ec.fy, ec.cx, ec.cy };
         fuse_image P = { c->eye_rgba, DW, DH, 4 * DW }, Q = { c->layer, DW, DH, 4 * DW };
@@ -374,6 +377,8 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
         fuse_confusion cf;
         fuse_mask_confusion(sil, DW, c->sil[e], DW, DW, DH, &cf);
         double iou = fuse_confusion_iou(&cf);
+        fuse_mask_confusion(sil, DW, c->seen[e], DW, DW, DH, &cf);
+        double iou_seen = fuse_confusion_iou(&cf);
         /* the fingertip's part of the layer: the model's fingertip drawn
          * through the layer's camera, where the layer shows the hand */
         rast_target th = { CW, CH, c->depth_c, CW, c->hmask_c, CW, NULL, 0, 0 };
@@ -405,6 +410,7 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
             r->n_depth++;
         }
         r->iou += iou;
+        r->iou_seen += iou_seen;
         r->mse += mse;
         r->n_eye++;
         if (per_frame)
@@ -425,7 +431,7 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
 /* ------------------------------------------------------------- report */
 
 typedef struct eye_sum {
-    double pos, size, size_abs, height, iou, psnr, ms, depth_cm;
+    double pos, size, size_abs, height, iou, iou_seen, psnr, ms, depth_cm;
 } eye_sum;
 
 static eye_sum summarise(const eye_run *r)
@@ -438,6 +444,7 @@ static eye_sum summarise(const eye_run *r)
     s.size_abs = 100.0 * r->size_abs / ns;
     s.height = 100.0 * r->height / ns;
     s.iou = r->iou / ne;
+    s.iou_seen = r->iou_seen / ne;
     s.psnr = fuse_psnr_of_mse(r->mse / ne);
     s.ms = r->n_frames ? 1e3 * r->secs / (double)r->n_frames : NAN;
     s.depth_cm = r->n_depth ? 100.0 * r->depth / (double)r->n_depth : NAN;
@@ -465,24 +472,25 @@ static void print_table(FILE *f, const eye_ctx *c, const eye_run *R, int n, int 
 {
     if (markdown)
         fprintf(f, "| hand at | hand depth | method | noise mm | position error px | size error %% "
-                   "| abs size error %% | height error %% | crop geometry %% | IoU | PSNR dB | "
-                   "ms/stereo frame |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+                   "| abs size error %% | height error %% | crop geometry %% | IoU | IoU camera's view | "
+                   "PSNR dB | ms/stereo frame |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     else
-        fprintf(f, "%-7s %-9s %-6s %5s %9s %9s %9s %9s %9s %7s %7s %8s\n", "hand at", "depth cm",
-                "method", "noise", "pos px", "size %", "|size| %", "height %", "geom %", "IoU",
-                "PSNR", "ms");
+        fprintf(f, "%-7s %-9s %-6s %5s %9s %9s %9s %9s %9s %7s %7s %7s %8s\n", "hand at",
+                "depth cm", "method", "noise", "pos px", "size %", "|size| %", "height %",
+                "geom %", "IoU", "IoU cam", "PSNR", "ms");
     for (int i = 0; i < n; i++) {
         eye_sum s = summarise(&R[i]);
         double g = crop_predicted(c, s.depth_cm / 100.0);
         if (markdown)
             fprintf(f, "| %d cm | %.1f cm | %s | %g | %.2f | %+.1f | %.1f | %+.1f | %+.1f | %.4f | "
-                       "%.2f | %.2f |\n",
+                       "%.4f | %.2f | %.2f |\n",
                     R[i].dist, s.depth_cm, em_name[R[i].method], (double)R[i].noise, s.pos, s.size,
-                    s.size_abs, s.height, g, s.iou, s.psnr, s.ms);
+                    s.size_abs, s.height, g, s.iou, s.iou_seen, s.psnr, s.ms);
         else
-            fprintf(f, "%4d cm %9.1f %-6s %5g %9.2f %+9.1f %9.1f %+9.1f %+9.1f %7.4f %7.2f %8.2f\n",
+            fprintf(f, "%4d cm %9.1f %-6s %5g %9.2f %+9.1f %9.1f %+9.1f %+9.1f %7.4f %7.4f %7.2f "
+                       "%8.2f\n",
                     R[i].dist, s.depth_cm, em_name[R[i].method], (double)R[i].noise, s.pos,
-                    s.size, s.size_abs, s.height, g, s.iou, s.psnr, s.ms);
+                    s.size, s.size_abs, s.height, g, s.iou, s.iou_seen, s.psnr, s.ms);
     }
 }
 
@@ -492,14 +500,14 @@ static int write_csv(const char *path, const eye_ctx *c, const eye_run *R, int n
     io_error err;
     if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
     fprintf(of.f, "distance_cm,hand_depth_cm,method,noise_mm,pos_px,size_pct,size_abs_pct,"
-                  "height_pct,crop_geometry_pct,iou,psnr_db,ms_per_stereo_frame,frames,"
-                  "eyes_with_hand\n");
+                  "height_pct,crop_geometry_pct,iou,iou_camera_view,psnr_db,ms_per_stereo_frame,"
+                  "frames,eyes_with_hand,fallbacks\n");
     for (int i = 0; i < n; i++) {
         eye_sum s = summarise(&R[i]);
-        fprintf(of.f, "%d,%.2f,%s,%g,%.3f,%.2f,%.2f,%.2f,%.2f,%.5f,%.3f,%.3f,%ld,%ld\n",
+        fprintf(of.f, "%d,%.2f,%s,%g,%.3f,%.2f,%.2f,%.2f,%.2f,%.5f,%.5f,%.3f,%.3f,%ld,%ld,%ld\n",
                 R[i].dist, s.depth_cm, em_name[R[i].method], (double)R[i].noise, s.pos, s.size,
-                s.size_abs, s.height, crop_predicted(c, s.depth_cm / 100.0), s.iou, s.psnr, s.ms,
-                R[i].n_frames, R[i].n_shape);
+                s.size_abs, s.height, crop_predicted(c, s.depth_cm / 100.0), s.iou, s.iou_seen,
+                s.psnr, s.ms, R[i].n_frames, R[i].n_shape, R[i].fallbacks);
     }
     if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
     return EXIT_OK;
@@ -541,8 +549,9 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
                 if (!any) fprintf(of.f, "# %s noise %g mm\n", em_name[mth], (double)noise_mm[k]);
                 any = 1;
                 eye_sum s = summarise(&R[i]);
-                fprintf(of.f, "%d %.4f %.4f %.5f %.4f %.4f %.4f\n", R[i].dist, s.pos, s.size,
-                        s.iou, s.psnr, crop_predicted(c, s.depth_cm / 100.0), s.size_abs);
+                fprintf(of.f, "%d %.4f %.4f %.5f %.4f %.4f %.4f %.5f\n", R[i].dist, s.pos, s.size,
+                        s.iou, s.psnr, crop_predicted(c, s.depth_cm / 100.0), s.size_abs,
+                        s.iou_seen);
             }
             if (!any) continue;
             snprintf(titles[blocks++], sizeof titles[0], "%s, noise %g mm", em_name[mth],
@@ -553,21 +562,27 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
     snprintf(path, sizeof path, "%s/eyeview.gp", dir);
     if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
     FILE *f = of.f;
-    static const char *const charts[] = { "eyeview_pos", "eyeview_size", "eyeview_iou" };
-    static const char *const ylab[] = { "hand position error, display px (1280x800)",
-                                        "hand size error, % (sqrt of the area ratio - 1)",
-                                        "IoU against the eye-view silhouette" };
-    static const char *const ttl[] = { "Hand position error against distance from the eye",
-                                       "Hand size error against distance from the eye",
-                                       "Silhouette IoU (eye view) against distance" };
-    static const int col[] = { 2, 3, 4 };
+    static const char *const charts[] = { "eyeview_pos", "eyeview_size", "eyeview_iou",
+                                          "eyeview_psnr" };
+    enum { NCH = sizeof charts / sizeof charts[0] };
+    static const char *const ylab[NCH] = {
+        "fingertip position error, display px (1280x800)",
+        "fingertip size error, % (sqrt of the area ratio - 1)",
+        "IoU against the eye-view silhouette where the camera sees",
+        "composite PSNR against the ideal eye-view composite, dB" };
+    static const char *const ttl[NCH] = {
+        "Hand position error against distance from the eye",
+        "Hand size error against distance from the eye",
+        "Silhouette IoU (eye view, within the camera field of view) against distance",
+        "Composite PSNR (eye view) against distance" };
+    static const int col[NCH] = { 2, 3, 8, 5 };
     fprintf(f, "if (!exists('sfx')) sfx = ''\nset grid\n");
-    for (int ch = 0; ch < 3; ch++) {
+    for (int ch = 0; ch < NCH; ch++) {
         fprintf(f, "set terminal pngcairo noenhanced size 900,600 font ',11'\n"
                    "set output '%s/%s.png'.sfx\nset title '%s'\nset xlabel 'hand distance from "
                    "the eyes, cm'\nset ylabel '%s'\nset key top right box opaque\nset xrange [12:43]\n"
-                   "set xtics (15, 20, 30, 40)\n",
-                dir, charts[ch], ttl[ch], ylab[ch]);
+                   "set xtics (15, 20, 30, 40)\nset key %s right box opaque\n",
+                dir, charts[ch], ttl[ch], ylab[ch], ch >= 2 ? "bottom" : "top");
         fprintf(f, "plot ");
         for (int b = 0; b < blocks; b++)
             fprintf(f, "%s'%s/eyeview.dat' index %d using 1:%d with linespoints lw 2 pt %d "
@@ -575,14 +590,14 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
                     b ? ", \\\n     " : "", dir, b, col[ch], 7 + (b / NNOISE) * 2,
                     1 + b / NNOISE, 1 + b % NNOISE, titles[b]);
         if (ch == 1 && blocks > 0)
-            fprintf(f, ", \\\n     '%s/eyeview.dat' index 0 using 1:6 with lines lw 1 lc rgb "
-                       "'#808080' dt 3 title 'crop: geometry (eq. 2-4 exact at 1 m)'",
+            fprintf(f, ", \\\n     '%s/eyeview.dat' index 0 using 1:6 with lines lw 2 lc rgb "
+                       "'#000000' dt 2 title 'crop: geometry (eq. 2-4 exact at 1 m)'",
                     dir);
         if (!blocks) fprintf(f, "NaN notitle");
         fprintf(f, "\n");
     }
     if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
-    return eval__gnuplot(dir, "eyeview.gp", charts, 3);
+    return eval__gnuplot(dir, "eyeview.gp", charts, NCH);
 }
 
 /* ---------------------------------------------------------------- run */
@@ -652,7 +667,7 @@ int eval_eye_run(const eval_opts *o)
     print_table(stdout, &c, R, n, 0);
     if (o->csv && write_csv(o->csv, &c, R, n)) goto done;
     if (o->report && write_report(o->report, &c, R, n, o)) goto done;
-    if (o->report) printf("egofuse eval --eyeview: report in %s (eyeview.csv, eyeview.md, eyeview_*.png)\n", o->report);
+    if (o->report) printf("egofuse eval --eyeview: report in %s (eyeview.csv, eyeview.md, eyeview_pos/size/iou/psnr.png)\n", o->report);
     rc = EXIT_OK;
 done:
     for (int j = 0; j < n; j++) free(R[j].locals);
