@@ -22,6 +22,14 @@
  *                    distance asked, and the position error must be the
  *                    scale's: (s - 1) times the true offset from the
  *                    display's centre (within 15 %).
+ *   cli_eyeview      `egofuse eval --eyeview --frames 1 --csv`: every row,
+ *                    the crop's size error equal to the geometry's column
+ *                    (20-40 cm), the reprojection exact with perfect
+ *                    tracking (position < 2 px, size < 2 %) and its
+ *                    position and size errors several times below the
+ *                    crop's at 15-20 cm; no fallbacks.
+ *   cli_eyeview_bad  --frames beyond the sequence (exit 2, the message),
+ *                    a report folder that cannot be made (exit 1, named).
  * Seeded (the generator's fixed seed), no timings. */
 #include "support/testutil.h"
 
@@ -240,6 +248,108 @@ static void hold_names(void **state)
     gen_arms_free(&mask);
 }
 
+/* ------------------------------------------------ egofuse eval --eyeview */
+
+static char out[1 << 16];
+
+/* One row of eyeview.csv: distance, method, noise -> the fields. */
+typedef struct csv_row {
+    int dist;
+    char method[16];
+    double noise, depth, pos, size, size_abs, height, geom, iou, iou_cam, psnr, ms;
+    long frames, eyes, fallbacks;
+} csv_row;
+
+static int read_csv(const char *path, csv_row *rows, int cap)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) return -1;
+    char line[512];
+    int n = 0;
+    if (!fgets(line, sizeof line, f)) { fclose(f); return -1; }
+    while (n < cap && fgets(line, sizeof line, f)) {
+        csv_row *r = &rows[n];
+        if (sscanf(line, "%d,%lf,%15[^,],%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%ld,%ld,%ld",
+                   &r->dist, &r->depth, r->method, &r->noise, &r->pos, &r->size, &r->size_abs,
+                   &r->height, &r->geom, &r->iou, &r->iou_cam, &r->psnr, &r->ms, &r->frames,
+                   &r->eyes, &r->fallbacks) != 16)
+            break;
+        n++;
+    }
+    fclose(f);
+    return n;
+}
+
+static const csv_row *find(const csv_row *rows, int n, int dist, const char *method, double noise)
+{
+    for (int i = 0; i < n; i++)
+        if (rows[i].dist == dist && !strcmp(rows[i].method, method) && rows[i].noise == noise)
+            return &rows[i];
+    fail_msg("eyeview.csv: no row %d cm %s %g mm", dist, method, noise);
+    return NULL;
+}
+
+/* One frame per distance: every row there, the crop's size error as the
+ * geometry's column, the reprojection exact with perfect tracking (the
+ * model is the truth's) and several times better than the crop at 15-20
+ * cm (issue 18's expectation, here a check that the two views are told
+ * apart: swapping them fails). */
+static void cli_eyeview(void **state)
+{
+    (void)state;
+    char csv[512];
+    tu_tmp_path("eyeview.csv", csv, sizeof csv);
+    remove(csv);
+    int rc = tu_runl(out, sizeof out, tu_bin(), "eval", "--eyeview", "--frames", "1", "--quiet",
+                     "--csv", csv, NULL);
+    if (rc != 0) fail_msg("egofuse eval --eyeview: exit %d: %s", rc, out);
+    assert_non_null(strstr(out, "reproj"));
+    csv_row rows[64];
+    int n = read_csv(csv, rows, 64);
+    assert_int_equal(n, 32);   /* 4 distances x 2 methods x 4 noise levels */
+    static const int dist[] = { 15, 20, 30, 40 };
+    for (int d = 0; d < 4; d++) {
+        const csv_row *c = find(rows, n, dist[d], "crop", 0);
+        const csv_row *r = find(rows, n, dist[d], "reproj", 0);
+        print_message("%d cm: crop pos %.1f px size %+.1f %% (geometry %+.1f %%); reproj pos %.2f px "
+                      "size %+.2f %%\n", dist[d], c->pos, c->size, c->geom, r->pos, r->size);
+        assert_true(fabs(c->depth - dist[d]) < 1.0);
+        assert_int_equal(c->eyes, 2);
+        if (dist[d] >= 20) {
+            assert_true(fabs(c->size - c->geom) < 3.0);
+            assert_true(fabs(r->size) < 2.0);
+            assert_true(r->pos < 2.0);
+        }
+        if (dist[d] <= 20) {
+            assert_true(c->pos > 3.0 * (r->pos + 1.0));
+            assert_true(c->size_abs > 3.0 * r->size_abs);
+        }
+        assert_int_equal(r->fallbacks, 0);
+    }
+    remove(csv);
+}
+
+static void cli_eyeview_bad(void **state)
+{
+    (void)state;
+    int rc = tu_runl(out, sizeof out, tu_bin(), "eval", "--eyeview", "--frames", "181", NULL);
+    assert_int_equal(rc, 2);
+    assert_non_null(strstr(out, "--frames 181"));
+    assert_non_null(strstr(out, "at most 180"));
+    char path[512];
+    tu_tmp_path("eyeview_not_a_dir", path, sizeof path);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fclose(f);
+    char rep[600];
+    snprintf(rep, sizeof rep, "%s/sub", path);
+    rc = tu_runl(out, sizeof out, tu_bin(), "eval", "--eyeview", "--frames", "1", "--report", rep,
+                 NULL);
+    assert_int_equal(rc, 1);
+    assert_non_null(strstr(out, rep));
+    remove(path);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -247,6 +357,8 @@ int main(void)
         cmocka_unit_test(hold_names),
         cmocka_unit_test(crop_geometry_20cm),
         cmocka_unit_test(crop_geometry_40cm),
+        cmocka_unit_test(cli_eyeview_bad),
+        cmocka_unit_test(cli_eyeview),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
