@@ -527,14 +527,17 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
     io_error err;
     snprintf(path, sizeof path, "%s/eyeview.md", dir);
     if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
-    fprintf(of.f, "Eye viewpoint: sequences hold15/20/30/40, %d frames each (every %dth display "
-                  "frame of 3 s), seed %d; tracking noise 0/5/10/20 mm, no latency, no dropouts. "
-                  "Position and size: the hand's part of the output silhouette against the true "
+    int fr = o->frames < 180 ? o->frames : 180;
+    fprintf(of.f, "Eye viewpoint: sequences hold15/20/30/40, %d frames each (one display frame "
+                  "in %d of the 3 s), seed %d; tracking noise 0 (the true pose), 5, 10, 20 mm (One "
+                  "Euro filter, arm IK, the true fingers), no latency, no dropouts. Position and "
+                  "size: the middle fingertip's part of the output silhouette against the true "
                   "eye-view one (display px, 1280x800); IoU: the output silhouette against the "
-                  "true eye-view silhouette of the arms; PSNR: against the ideal eye-view "
-                  "composite; crop geometry: the crop's size error predicted for a point at the "
-                  "measured hand depth.\n\n",
-            o->frames, 180 / o->frames > 0 ? 180 / o->frames : 1, o->seed);
+                  "true eye-view silhouette of the arms, and against its part that the camera "
+                  "sees; PSNR: against the ideal eye-view composite (whole display); crop "
+                  "geometry: the crop's size error predicted for a point at the measured "
+                  "fingertip depth; ms: pipe_frame, one thread, thread CPU time.\n\n",
+            fr, 180 / fr, o->seed);
     print_table(of.f, c, R, n, 1);
     if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
     snprintf(path, sizeof path, "%s/eyeview.dat", dir);
