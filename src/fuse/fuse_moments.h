@@ -13,6 +13,10 @@
 
 #include <stdint.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct fuse_moments {
     long area;               /* pixels inside */
     double cx, cy;           /* centroid, pixels (0, 0 when area is 0) */
@@ -35,4 +39,7 @@ typedef struct fuse_shape_error {
 int fuse_shape_compare(const fuse_moments *a, const fuse_moments *truth, long min_area,
                        fuse_shape_error *out);
 
+#ifdef __cplusplus
+}
+#endif
 #endif
