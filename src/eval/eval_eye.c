@@ -65,7 +65,7 @@ typedef struct eye_run {
     /* sums over frames and eyes */
     double pos, size, size_abs, height, iou, iou_seen, mse, secs, depth;
     long n_shape, n_eye, n_frames, n_depth;
-    long fallbacks;          /* reprojection: eye-frames that fell back */
+    long fallbacks;          /* reprojection: eye-frames that fell back to the crop */
 } eye_run;
 
 typedef struct eye_ctx {
@@ -349,7 +349,6 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
     double t0 = thread_secs();
     if (pipe_frame(p, &in, &st, why, sizeof why) != PIPE_OK) return cli_fail("%s", why);
     double secs = thread_secs() - t0;
-    r->fallbacks = st.view_fallbacks;
     /* the posed model, for its fingertip (not timed) */
     kin_fk(m->parents, m->node_count, r->locals, NULL, c->world);
     kin_skin_joint_matrices(&m->skins[0], c->world, c->jm);
@@ -360,6 +359,8 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
         int w = 0, h = 0, x0 = 0, y0 = 0, vw = DW, vh = DH;
         const uint8_t *M;
         kin_camera cam;
+        if (st.view[e] != (r->method == EM_CROP ? PIPE_VIEW_CROP : PIPE_VIEW_REPROJECT))
+            r->fallbacks++;   /* the eye inside the model: the crop this frame */
         if (st.view[e] == PIPE_VIEW_REPROJECT) {
             M = pipe_view_mask(p, e, &w, &h);
             cam = pipe_view_camera(p, e);
