@@ -71,6 +71,9 @@ for b in "$BUILD"/bench/bench_*; do
     case $name in
         bench_kin) # its own figures and CSVs into bench/out; no --csv, no --runs
             "$b" || echo "($name exited with status $?)" ;;
+        bench_reproj) # the eye reprojection against the crop on the samples'
+            # frames, side by side (docs/eyeview.md)
+            "$b" --samples "$SAMPLES" --runs "$STAGE_RUNS" || echo "($name exited with status $?)" ;;
         bench_vsrc) # a V source's own speed needs a live source; here the
             # conversion of each frame format (median of 30 runs)
             "$b" --convert || echo "($name exited with status $?)" ;;

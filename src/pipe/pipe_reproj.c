@@ -55,7 +55,7 @@ int pipe__reproj_init(pipe__reproj *r, int width, int height)
     r->mask = malloc(px);
     r->P = calloc(px, 4);
     r->M = calloc(px, 1);
-    r->row = malloc(sizeof(int32_t) * 2 * (size_t)width);
+    r->row = malloc(sizeof(int32_t) * 3 * (size_t)width + (size_t)height);
     if (!r->depth || !r->nrm || !r->mask || !r->P || !r->M || !r->row) {
         pipe__reproj_free(r);
         return -1;
@@ -100,6 +100,10 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
     long covered = 0, back = 0, sampled = 0, filled = 0, outside = 0;
     float mind = INFINITY;
     uint64_t sum[3] = {0, 0, 0};
+    /* the eye rays' x per column, and per row: a fill pixel in it */
+    float *rxs = (float *)(r->row + 2 * w);
+    uint8_t *row_fill = (uint8_t *)(r->row + 3 * w);
+    for (int x = 0; x < w; x++) rxs[x] = ((float)x + 0.5f - ecx) / efx;
     for (int y = 0; y < h; y++) {
         const uint8_t *em = r->mask + (size_t)y * (size_t)w;
         uint8_t *M = r->M + (size_t)y * (size_t)w;
@@ -107,13 +111,17 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         const float *ed = r->depth + (size_t)y * (size_t)w;
         const float *en = r->nrm + (size_t)y * (size_t)w * 3;
         const float ry = -((float)y + 0.5f - ecy) / efy;
+        const long filled0 = filled;
+        memset(M, 0, (size_t)w);
         for (int x = 0; x < w; x++) {
             if (!em[x]) {
-                M[x] = 0;
+                /* 8 empty mask bytes at a time */
+                uint64_t word;
+                while (x + 9 <= w && (memcpy(&word, em + x + 1, 8), word == 0)) x += 8;
                 continue;
             }
             covered++;
-            const float rx = ((float)x + 0.5f - ecx) / efx;
+            const float rx = rxs[x];
             const float *nv = en + 3 * x;
             if (nv[0] * rx + nv[1] * ry - nv[2] > 0.0f) back++;
             float dist = lin_depth(ed[x], n, f);
@@ -123,30 +131,30 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
             float px = a[0] * ex + a[4] * ey + a[8] * ez + a[12];
             float py = a[1] * ex + a[5] * ey + a[9] * ez + a[13];
             float pz = a[2] * ex + a[6] * ey + a[10] * ez + a[14];
-            double u, v;
+            float fu = 0.0f, fv = 0.0f;
             int ok;
             if (pinhole) {
                 ok = pz < -1e-6f;
                 if (ok) {
                     float iz = 1.0f / -pz;
-                    u = (double)(ccx + cfx * px * iz);
-                    v = (double)(ccy - cfy * py * iz);
+                    fu = ccx + cfx * px * iz;
+                    fv = ccy - cfy * py * iz;
                 }
             } else {
-                double pc[3] = {px, py, pz};
+                double pc[3] = {px, py, pz}, u, v;
                 ok = kin_lens_project(&cam->lens, pc, &u, &v);
+                fu = (float)u;
+                fv = (float)v;
             }
             /* distance to the camera image's border, camera pixels */
             float b = 0.0f;
             if (ok) {
-                float fu = (float)u, fv = (float)v;
                 b = fu;
                 if ((float)cw - fu < b) b = (float)cw - fu;
                 if (fv < b) b = fv;
                 if ((float)ch - fv < b) b = (float)ch - fv;
             }
             if (!ok || !(b > 0.0f)) {
-                M[x] = 0;
                 outside++;
                 continue;
             }
@@ -155,53 +163,63 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
                 outside++;
                 continue;
             }
+            /* a camera pixel shows this point when the camera's model is
+             * there no nearer than the point minus the slack: as a window
+             * depth of the camera's projection, zmin */
+            const float dp = -pz, dmin = dp - (PIPE_REPROJ_TOL_M + PIPE_REPROJ_TOL_REL * dp);
+            const float zmin = dmin > n ? 0.5f * ((f + n) - 2.0f * f * n / dmin) / (f - n) + 0.5f
+                                        : 0.0f;
             /* the nearest camera pixel: does the camera see this point? */
-            int iu = (int)u, iv = (int)v;
+            int iu = (int)fu, iv = (int)fv;
             if (iu > cw - 1) iu = cw - 1;
             if (iv > ch - 1) iv = ch - 1;
-            int seen = cmask[(size_t)iv * (size_t)cmask_stride + (size_t)iu] != 0;
-            if (seen) {
-                float cd = lin_depth(cdepth[(size_t)iv * (size_t)cdepth_stride + (size_t)iu], n, f);
-                float dp = -pz;
-                seen = !(cd < dp - (PIPE_REPROJ_TOL_M + PIPE_REPROJ_TOL_REL * dp));
-            }
+            int seen = cmask[(size_t)iv * (size_t)cmask_stride + (size_t)iu] != 0 &&
+                       !(cdepth[(size_t)iv * (size_t)cdepth_stride + (size_t)iu] < zmin);
             if (!seen) {
                 Po[4 * x + 3] = ST_FILL;
                 filled++;
                 continue;
             }
-            /* bilinear, the taps inside the camera's mask, renormalised */
-            float sx = (float)u - 0.5f, sy = (float)v - 0.5f;
+            /* bilinear, the taps that show the point (the camera's mask,
+             * the same surface), renormalised */
+            float sx = fu - 0.5f, sy = fv - 0.5f;
             if (sx < 0.0f) sx = 0.0f;
             if (sy < 0.0f) sy = 0.0f;
             if (sx > (float)(cw - 1)) sx = (float)(cw - 1);
             if (sy > (float)(ch - 1)) sy = (float)(ch - 1);
-            int x0 = (int)sx, y0 = (int)sy;
-            int fx8 = (int)((sx - (float)x0) * 256.0f), fy8 = (int)((sy - (float)y0) * 256.0f);
-            int x1 = x0 + 1 < cw ? x0 + 1 : x0, y1 = y0 + 1 < ch ? y0 + 1 : y0;
-            const int tx[4] = {x0, x1, x0, x1}, ty[4] = {y0, y0, y1, y1};
-            const int wt[4] = {(256 - fx8) * (256 - fy8), fx8 * (256 - fy8), (256 - fx8) * fy8,
-                               fx8 * fy8};
-            uint32_t acc[3] = {0, 0, 0}, ws = 0;
-            for (int k = 0; k < 4; k++) {
-                if (!wt[k] || !cmask[(size_t)ty[k] * (size_t)cmask_stride + (size_t)tx[k]]) continue;
-                const uint8_t *c = P->pixels + (size_t)ty[k] * (size_t)P->stride + 4 * (size_t)tx[k];
-                for (int j = 0; j < 3; j++) acc[j] += (uint32_t)wt[k] * c[j];
-                ws += (uint32_t)wt[k];
-            }
+            const int x0 = (int)sx, y0 = (int)sy;
+            const int fx8 = (int)((sx - (float)x0) * 256.0f), fy8 = (int)((sy - (float)y0) * 256.0f);
+            const int dx = x0 + 1 < cw ? 1 : 0, y1 = y0 + 1 < ch ? y0 + 1 : y0;
+            const uint8_t *m0 = cmask + (size_t)y0 * (size_t)cmask_stride + (size_t)x0;
+            const uint8_t *m1 = cmask + (size_t)y1 * (size_t)cmask_stride + (size_t)x0;
+            const float *d0 = cdepth + (size_t)y0 * (size_t)cdepth_stride + (size_t)x0;
+            const float *d1 = cdepth + (size_t)y1 * (size_t)cdepth_stride + (size_t)x0;
+            /* a tap counts with its weight when it shows the point */
+            const uint32_t w00 = (m0[0] != 0 && !(d0[0] < zmin)) ? (uint32_t)((256 - fx8) * (256 - fy8)) : 0u;
+            const uint32_t w01 = (m0[dx] != 0 && !(d0[dx] < zmin)) ? (uint32_t)(fx8 * (256 - fy8)) : 0u;
+            const uint32_t w10 = (m1[0] != 0 && !(d1[0] < zmin)) ? (uint32_t)((256 - fx8) * fy8) : 0u;
+            const uint32_t w11 = (m1[dx] != 0 && !(d1[dx] < zmin)) ? (uint32_t)(fx8 * fy8) : 0u;
+            const uint8_t *p0 = P->pixels + (size_t)y0 * (size_t)P->stride + 4 * (size_t)x0;
+            const uint8_t *p1 = P->pixels + (size_t)y1 * (size_t)P->stride + 4 * (size_t)x0;
+            const int d4 = 4 * dx;
+            uint32_t acc[3], ws = w00 + w01 + w10 + w11;
+            for (int j = 0; j < 3; j++)
+                acc[j] = w00 * p0[j] + w01 * p0[d4 + j] + w10 * p1[j] + w11 * p1[d4 + j];
             if (ws == 0) { /* only the nearest pixel is the model's */
                 const uint8_t *c = P->pixels + (size_t)iv * (size_t)P->stride + 4 * (size_t)iu;
                 for (int j = 0; j < 3; j++) acc[j] = c[j];
                 ws = 1;
             }
             for (int j = 0; j < 3; j++) {
-                uint8_t c = (uint8_t)((acc[j] + ws / 2) / ws);
+                uint8_t c = ws == 65536u ? (uint8_t)((acc[j] + 32768u) >> 16)
+                                         : (uint8_t)((acc[j] + ws / 2) / ws);
                 Po[4 * x + j] = c;
                 sum[j] += c;
             }
             Po[4 * x + 3] = ST_SAMPLED;
             sampled++;
         }
+        row_fill[y] = filled != filled0;
     }
     r->sampled = sampled;
     r->outside = outside;
@@ -217,6 +235,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
             mean[j] = (uint8_t)((sum[j] + (uint64_t)sampled / 2) / (uint64_t)sampled);
     long done = 0;
     for (int y = 0; y < h && done < filled; y++) {
+        if (!row_fill[y]) continue;
         const uint8_t *em = r->mask + (size_t)y * (size_t)w;
         uint8_t *M = r->M + (size_t)y * (size_t)w;
         uint8_t *Po = r->P + (size_t)y * (size_t)w * 4;
@@ -238,9 +257,16 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         for (int x = 0; x < w; x++) {
             if (!em[x] || !M[x] || Po[4 * x + 3] != ST_FILL) continue;
             done++;
-            int l = left[x], rr = right[x], src = -1;
-            if (l >= 0 && (rr < 0 || x - l <= rr - x)) src = l;
-            else if (rr >= 0) src = rr;
+            /* of the nearest sampled pixels left and right, the one on
+             * the same surface: its eye distance nearer to this pixel's */
+            int l = left[x], rr = right[x], src = l >= 0 ? l : rr;
+            if (l >= 0 && rr >= 0) {
+                const float *ed = r->depth + (size_t)y * (size_t)w;
+                float d0 = lin_depth(ed[x], n, f);
+                float dl = fabsf(lin_depth(ed[l], n, f) - d0);
+                float dr = fabsf(lin_depth(ed[rr], n, f) - d0);
+                if (dr < dl) src = rr;
+            }
             if (src >= 0) {
                 for (int j = 0; j < 3; j++) Po[4 * x + j] = Po[4 * src + j];
             } else if (sampled) {

@@ -13,8 +13,9 @@
  *        depth, projects it into the real camera (pipe_camera(), through
  *        its lens: kin_lens_project, so no undistort pass) and samples
  *        the cropped camera image there (bilinear, only the taps inside
- *        the camera's own mask, renormalised, so the room behind the hand
- *        does not bleed into its edge);
+ *        the camera's own mask that show the same surface (the occlusion
+ *        test below), renormalised, so neither the room behind the hand
+ *        nor a part in front of the point bleeds into it);
  *     3. hands that eye-view image, mask and normals to the unchanged fuse
  *        stage (lighting in the eye's view, depth test against the virtual
  *        scene with the EYE's depths, offset 0), composited into the
@@ -32,8 +33,13 @@
  *     filled   it projects inside the camera image but the camera does not
  *              see it (hidden behind another part: a finger behind the
  *              palm, the disocclusion at a hand's edge): it takes the
- *              colour of the nearest sampled pixel of its own eye row
- *              (the left one on a tie); a row without any takes the mean
+ *              colour of a sampled pixel of its own eye row on the same
+ *              surface: of the nearest sampled pixel to its left and the
+ *              nearest to its right, the one whose eye distance is nearer
+ *              to its own (the left one on a tie; the one there is when
+ *              only one side has any), so the background that a
+ *              disocclusion reveals is filled from the background, not
+ *              from the hand in front; a row without any takes the mean
  *              colour of all sampled pixels of the eye; an eye without
  *              any is not shown (mask 0);
  *     outside  its point projects outside the camera image (or behind
@@ -93,7 +99,10 @@ int pipe_view_parse(const char *name, int *view);
 /* "crop", "reproject", or "?" */
 const char *pipe_view_name(int view);
 /* The resolved ipd_m and cam_offset_m of hmd within the ranges above: 0,
- * or -1 with a sentence naming the field, its value and the range. */
+ * or -1 with a sentence naming the field, its value and the range. Zero
+ * is the default (65 mm, 85 mm); a negative or NaN value, which
+ * kin_sthmd_desc_resolved would also take as the default, is refused
+ * here: for the reprojection it is a mistake, not a wish. */
 int pipe_view_check(const kin_sthmd_desc *hmd, char *why, int why_size);
 
 /* ---------------------------------------- internal to src/pipe (pipe.c) */
