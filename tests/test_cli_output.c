@@ -76,16 +76,6 @@ static int files_in(const char *dir, const char *ext)
     return n;
 }
 
-static int file_is(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    char buf[256] = {0};
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    return n == strlen(text) && memcmp(buf, text, n) == 0;
-}
-
 /* A binary glTF (.glb) of one square [-1,1]^2 at z = 0 facing +Z, with a
  * node "head"; returns its size. */
 static size_t make_glb(unsigned char *glb, size_t cap)
@@ -191,7 +181,7 @@ static void mask_write_fails_cleanly(void **state)
     tu_write_text(nrm, "precious");
     rc = run_limited(limit, XFSZ_IGNORE, a);
     assert_int_equal(rc, 1);
-    assert_true(file_is(nrm, "precious"));
+    assert_true(tu_file_is(nrm, "precious"));
     assert_int_equal(temps_in(dir), 0);
 
     /* the same with named temporaries (file systems without O_TMPFILE) */
@@ -200,7 +190,7 @@ static void mask_write_fails_cleanly(void **state)
     unsetenv("EGOFUSE_NO_TMPFILE");
     assert_int_equal(rc, 1);
     assert_non_null(strstr(out, strerror(EFBIG)));
-    assert_true(file_is(nrm, "precious"));
+    assert_true(tu_file_is(nrm, "precious"));
     assert_int_equal(temps_in(dir), 0);
 }
 

@@ -61,39 +61,35 @@ static void to_ego(const double P[3], double p[3])
     p[2] = -P[2];
 }
 
-static kin_lens brown_lens(const double K[4], const double *d, int nd, int w, int h)
+/* A lens of the model with K = {fx, fy, cx, cy}, skew, nk coefficients
+ * k and the image size; kin_lens_check must accept it. */
+static kin_lens make_lens(kin_lens_model model, const double K[4], double skew,
+                          const double *k, int nk, int w, int h)
 {
     kin_lens L;
     memset(&L, 0, sizeof L);
-    L.model = KIN_LENS_BROWN;
+    L.model = model;
     L.width = w;
     L.height = h;
     L.fx = K[0];
     L.fy = K[1];
     L.cx = K[2];
     L.cy = K[3];
-    for (int i = 0; i < nd; i++) L.k[i] = d[i];
+    L.skew = skew;
+    for (int i = 0; i < nk; i++) L.k[i] = k[i];
     char why[200];
     if (!kin_lens_check(&L, why, sizeof why)) fail_msg("lens refused: %s", why);
     return L;
 }
 
+static kin_lens brown_lens(const double K[4], const double *d, int nd, int w, int h)
+{
+    return make_lens(KIN_LENS_BROWN, K, 0.0, d, nd, w, h);
+}
+
 static kin_lens fisheye_lens(const double K[4], double alpha, const double *k, int w, int h)
 {
-    kin_lens L;
-    memset(&L, 0, sizeof L);
-    L.model = KIN_LENS_FISHEYE;
-    L.width = w;
-    L.height = h;
-    L.fx = K[0];
-    L.fy = K[1];
-    L.cx = K[2];
-    L.cy = K[3];
-    L.skew = alpha * K[0];
-    for (int i = 0; i < 4; i++) L.k[i] = k[i];
-    char why[200];
-    if (!kin_lens_check(&L, why, sizeof why)) fail_msg("lens refused: %s", why);
-    return L;
+    return make_lens(KIN_LENS_FISHEYE, K, alpha * K[0], k, 4, w, h);
 }
 
 /* A realistic narrow lens (Brown, 5 coefficients, VGA). */

@@ -267,11 +267,9 @@ int kin_user_calib_parse(const char *text, size_t len, kin_user_calib *out, int 
     int seen[K_COUNT] = { 0 };
     size_t pos = 0;
     int line_no = 0, have_header = 0;
-    while (pos < len) {
-        const char *ln = text + pos;
-        const char *nl = memchr(ln, '\n', len - pos);
-        size_t l = nl ? (size_t)(nl - ln) : len - pos;
-        pos += l + (nl ? 1 : 0);
+    const char *ln;
+    size_t l;
+    while ((ln = kin__next_line(text, len, &pos, &l))) {
         line_no++;
         *err_line = line_no;
         char buf[512];

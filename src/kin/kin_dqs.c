@@ -115,15 +115,12 @@ static void dq_fit(float b[8])
 void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
                        float *pos_out, float *nrm_out, int v0, int v1)
 {
-    const int do_n = mesh->normals && nrm_out;
     const int skinned = mesh->joints && mesh->weights && dq;
-    const int extra = mesh->joints_extra && mesh->weights_extra && mesh->extra_sets > 0
-                      ? mesh->extra_sets : 0;
+    const int extra = kin__extra_sets(mesh);
     for (int v = v0; v < v1; v++) {
-        const float *p = mesh->positions + (size_t)v * 3;
-        float *po = pos_out + (size_t)v * 3;
-        const float *n = do_n ? mesh->normals + (size_t)v * 3 : NULL;
-        float *no = do_n ? nrm_out + (size_t)v * 3 : NULL;
+        const float *p, *n;
+        float *po, *no;
+        kin__vertex(mesh, pos_out, nrm_out, v, &p, &po, &n, &no);
         float b[8] = { 0 };
         float wsum = 0.0f;
         const kin_quat *r0 = NULL;
@@ -158,7 +155,7 @@ void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
         for (int c = 0; c < 3; c++) e[c] = e[c] + b[4 + c];
         cross3(u, e, g);
         for (int c = 0; c < 3; c++) po[c] = p[c] + k * ((w * e[c] + g[c]) - dw * u[c]);
-        if (do_n) {
+        if (n) {
             float f[3];
             cross3(u, n, f);
             cross3(u, f, g);

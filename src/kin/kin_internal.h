@@ -3,6 +3,7 @@
 #define EGOFUSE_KIN_INTERNAL_H
 
 #include <stddef.h>
+#include <string.h>
 
 #if defined(__GNUC__)
 #define KIN__PRINTF(f, a) __attribute__((format(printf, f, a)))
@@ -37,5 +38,18 @@ struct kin_channel;
  * (slerp for rotations, not renormalised), CUBICSPLINE (glTF appendix
  * C). The caller has checked key_count >= 1, times and values. */
 void kin__channel_value(const struct kin_channel *ch, float t, float *out);
+
+/* The next line of text[0, len) at *pos: its start (NULL at the end), its
+ * length without the '\n' in *l; *pos moves past it. The line formats of
+ * kin_calib.c and kin_track.c. */
+static inline const char *kin__next_line(const char *text, size_t len, size_t *pos, size_t *l)
+{
+    if (*pos >= len) return NULL;
+    const char *ln = text + *pos;
+    const char *nl = memchr(ln, '\n', len - *pos);
+    *l = nl ? (size_t)(nl - ln) : len - *pos;
+    *pos += *l + (nl ? 1 : 0);
+    return ln;
+}
 
 #endif

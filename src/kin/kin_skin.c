@@ -64,15 +64,12 @@ static void xform_normal(const affine *b, const float *n, float *o)
 void kin__skin_lbs_ref(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
                        float *nrm_out, int v0, int v1)
 {
-    const int do_n = mesh->normals && nrm_out;
     const int skinned = mesh->joints && mesh->weights && jm;
-    const int extra = mesh->joints_extra && mesh->weights_extra && mesh->extra_sets > 0
-                      ? mesh->extra_sets : 0;
+    const int extra = kin__extra_sets(mesh);
     for (int v = v0; v < v1; v++) {
-        const float *p = mesh->positions + (size_t)v * 3;
-        float *po = pos_out + (size_t)v * 3;
-        const float *n = do_n ? mesh->normals + (size_t)v * 3 : NULL;
-        float *no = do_n ? nrm_out + (size_t)v * 3 : NULL;
+        const float *p, *n;
+        float *po, *no;
+        kin__vertex(mesh, pos_out, nrm_out, v, &p, &po, &n, &no);
 
         affine b = { { 0 } };
         float wsum = 0.0f;
@@ -94,7 +91,7 @@ void kin__skin_lbs_ref(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
             continue;
         }
         xform_point(&b, p, po);
-        if (do_n) xform_normal(&b, n, no);
+        if (n) xform_normal(&b, n, no);
     }
 }
 

@@ -172,7 +172,6 @@ SIMD_INL void blend_slots(const skin_tab *T, const blk16 *b, const int WIDE, con
                           __m512 acc[12], __m512 *wsum)
 {
     const __m512 zero = _mm512_setzero_ps();
-    const int n = DQS ? 8 : 12;
     __m512 ws = zero, r0[4] = { zero, zero, zero, zero };
     __mmask16 have = 0;   /* DQS: lanes whose first influence is known */
     for (int i = 0; i < 4; i++) {
@@ -180,22 +179,27 @@ SIMD_INL void blend_slots(const skin_tab *T, const blk16 *b, const int WIDE, con
         const __mmask16 k = b->k[i];
         if (!k) continue;
         __mmask16 hi = _mm512_test_epi32_mask(b->j[i], _mm512_set1_epi32(32));
-        __m512 x[12], sw = b->w[i];
+        if (!DQS) {   /* LBS: each element looked up and added at once */
 #pragma GCC unroll 12
-        for (int e = 0; e < n; e++) x[e] = lookup(T->t[e], b->j[i], WIDE, hi);
-        if (DQS) {
-            __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_add_ps(
-                             _mm512_mul_ps(x[0], r0[0]), _mm512_mul_ps(x[1], r0[1])),
-                             _mm512_mul_ps(x[2], r0[2])), _mm512_mul_ps(x[3], r0[3]));
-            __mmask16 neg = _mm512_mask_cmp_ps_mask(have, dot, zero, _CMP_LT_OQ);
-            sw = _mm512_mask_xor_ps(b->w[i], neg, b->w[i], _mm512_set1_ps(-0.0f));
-            __mmask16 first = (__mmask16)(k & ~have);
-#pragma GCC unroll 4
-            for (int e = 0; e < 4; e++) r0[e] = _mm512_mask_mov_ps(r0[e], first, x[e]);
-            have = (__mmask16)(have | k);
+            for (int e = 0; e < 12; e++)
+                acc[e] = _mm512_add_ps(acc[e], _mm512_maskz_mul_ps(
+                    k, b->w[i], lookup(T->t[e], b->j[i], WIDE, hi)));
+            continue;
         }
-#pragma GCC unroll 12
-        for (int e = 0; e < n; e++) acc[e] = _mm512_add_ps(acc[e], _mm512_maskz_mul_ps(k, sw, x[e]));
+        __m512 x[8];
+#pragma GCC unroll 8
+        for (int e = 0; e < 8; e++) x[e] = lookup(T->t[e], b->j[i], WIDE, hi);
+        __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_add_ps(
+                         _mm512_mul_ps(x[0], r0[0]), _mm512_mul_ps(x[1], r0[1])),
+                         _mm512_mul_ps(x[2], r0[2])), _mm512_mul_ps(x[3], r0[3]));
+        __mmask16 neg = _mm512_mask_cmp_ps_mask(have, dot, zero, _CMP_LT_OQ);
+        __m512 sw = _mm512_mask_xor_ps(b->w[i], neg, b->w[i], _mm512_set1_ps(-0.0f));
+        __mmask16 first = (__mmask16)(k & ~have);
+#pragma GCC unroll 4
+        for (int e = 0; e < 4; e++) r0[e] = _mm512_mask_mov_ps(r0[e], first, x[e]);
+        have = (__mmask16)(have | k);
+#pragma GCC unroll 8
+        for (int e = 0; e < 8; e++) acc[e] = _mm512_add_ps(acc[e], _mm512_maskz_mul_ps(k, sw, x[e]));
     }
     *wsum = ws;
 }

@@ -34,9 +34,28 @@ static inline unsigned kin__nonzero4(const float *w)
 }
 #endif
 
-/* The references' per-vertex parts (kin_skin.c, kin_dqs.c). Influence
- * set `set` of vertex v: 0 is JOINTS_0/WEIGHTS_0, then the mesh's extra
- * sets in order (extra: how many the reference reads); its 4 joints and
+/* The references' per-vertex parts (kin_skin.c, kin_dqs.c). How many
+ * extra influence sets they read (0 unless the mesh has them all). */
+static inline int kin__extra_sets(const kin_mesh *mesh)
+{
+    return mesh->joints_extra && mesh->weights_extra && mesh->extra_sets > 0
+           ? mesh->extra_sets : 0;
+}
+
+/* Vertex v's bind position p and its output po; with normals (nrm_out
+ * and the mesh's), its normal n and output no, else both NULL. */
+static inline void kin__vertex(const kin_mesh *mesh, float *pos_out, float *nrm_out, int v,
+                               const float **p, float **po, const float **n, float **no)
+{
+    const int do_n = mesh->normals && nrm_out;
+    *p = mesh->positions + (size_t)v * 3;
+    *po = pos_out + (size_t)v * 3;
+    *n = do_n ? mesh->normals + (size_t)v * 3 : NULL;
+    *no = do_n ? nrm_out + (size_t)v * 3 : NULL;
+}
+
+/* Influence set `set` of vertex v: 0 is JOINTS_0/WEIGHTS_0, then the
+ * mesh's extra sets in order (extra: kin__extra_sets); its 4 joints and
  * weights. */
 static inline void kin__influences(const kin_mesh *mesh, int extra, int v, int set,
                                    const uint16_t **j, const float **w)

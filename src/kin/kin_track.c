@@ -180,11 +180,9 @@ int kin_track_parse(const char *text, size_t text_len, kin_track_sample *out, in
     size_t pos = 0;
     int line_no = 0, n = 0, have_header = 0;
     double last_t = 0.0;
-    while (pos < text_len) {
-        const char *ln = text + pos;
-        const char *nl = memchr(ln, '\n', text_len - pos);
-        size_t len = nl ? (size_t)(nl - ln) : text_len - pos;
-        pos += len + (nl ? 1 : 0);
+    const char *ln;
+    size_t len;
+    while ((ln = kin__next_line(text, text_len, &pos, &len))) {
         line_no++;
         if (!have_header) {
             size_t l = len;

@@ -135,6 +135,16 @@ int tu_runl(char *out, size_t out_size, const char *prog, const char *a0, ...)
 
 int tu_count_fds(void) { return tu_fd_count(); }
 
+int tu_file_is(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    char buf[256] = {0};
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    return n == strlen(text) && memcmp(buf, text, n) == 0;
+}
+
 int tu_samples_dir(const char *name, int frames, char *dir, size_t n, char *why, size_t why_n)
 {
     char gen[1024], own[1100], scene[1200], log[4096], nf[16];
