@@ -143,6 +143,17 @@ static rast_result eye_draw(pipe_ctx *p, eye_state *e, const kin_camera *cam,
     return RAST_OK;
 }
 
+int pipe__edge_fade_px(const pipe_desc *d)
+{
+    return d->edge_fade == 0 ? PIPE_EDGE_FADE_DEFAULT : d->edge_fade < 0 ? 0 : d->edge_fade;
+}
+
+unsigned pipe__edge_sides(int vx, int vy, int vw, int vh, int ow, int oh)
+{
+    return (vx > 0 ? FUSE_EDGE_LEFT : 0u) | (vx + vw < ow ? FUSE_EDGE_RIGHT : 0u) |
+           (vy > 0 ? FUSE_EDGE_TOP : 0u) | (vy + vh < oh ? FUSE_EDGE_BOTTOM : 0u);
+}
+
 static void run_eye(pipe_ctx *p, eye_state *e)
 {
     const pipe_frame_in *in = e->in;
@@ -267,6 +278,10 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     fe.vp_h = p->geo.vp_height;
     fe.out = in->out[e->eye];
     fe.v_opaque = in->virt_opaque != 0;
+    /* soft edges on the viewport's sides inside the output (pipe_desc.edge_fade) */
+    fe.edge_fade = pipe__edge_fade_px(&p->desc);
+    fe.edge_sides = pipe__edge_sides(fe.vp_x0, fe.vp_y0, fe.vp_w, fe.vp_h, fe.out.width,
+                                     fe.out.height);
     fuse_depth dt;
     int filled[4] = {0, 0, 0, 0};
     if (in->virt_depth[e->eye]) {
@@ -416,6 +431,7 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
     if (desc && desc->aa_samples != 0 && desc->aa_samples != 4 && desc->aa_samples != 8 &&
         desc->aa_samples != 16)
         return NULL;
+    if (desc && (desc->edge_fade < -1 || desc->edge_fade > FUSE_EDGE_FADE_MAX)) return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
     if (desc) p->desc = *desc;

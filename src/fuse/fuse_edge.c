@@ -1,0 +1,76 @@
+/* fuse_edge.c - the edge fade (fuse_edge.h). */
+#include "fuse_edge.h"
+
+#include <stddef.h>
+
+float fuse_edge_weight(float sx, float sy, int w, int h, int k, unsigned sides)
+{
+    float d = 1e30f, t;
+    if (w < 1 || h < 1) return 0.0f;
+    if (!(sx == sx) || !(sy == sy)) return 0.0f;
+    if (k < 1 || (sides & FUSE_EDGE_ALL) == 0) return 1.0f;
+    if (sides & FUSE_EDGE_LEFT) d = sx < d ? sx : d;
+    if (sides & FUSE_EDGE_RIGHT) d = (float)w - sx < d ? (float)w - sx : d;
+    if (sides & FUSE_EDGE_TOP) d = sy < d ? sy : d;
+    if (sides & FUSE_EDGE_BOTTOM) d = (float)h - sy < d ? (float)h - sy : d;
+    if (d <= 0.0f) return 0.0f;
+    t = d / (float)k;
+    return t < 1.0f ? t : 1.0f;
+}
+
+/* q' = (q t + k) / (2k) for the four bytes of a pixel */
+static void fade_px(uint8_t *p, unsigned t, unsigned k)
+{
+    const unsigned den = 2u * k;
+    p[0] = (uint8_t)((p[0] * t + k) / den);
+    p[1] = (uint8_t)((p[1] * t + k) / den);
+    p[2] = (uint8_t)((p[2] * t + k) / den);
+    p[3] = (uint8_t)((p[3] * t + k) / den);
+}
+
+/* pixels from the nearest faded side of column x, at most cap */
+static int col_dist(int x, int w, int cap, unsigned sides)
+{
+    int i = cap;
+    if ((sides & FUSE_EDGE_LEFT) && x < i) i = x;
+    if ((sides & FUSE_EDGE_RIGHT) && w - 1 - x < i) i = w - 1 - x;
+    return i;
+}
+
+void fuse_edge_fade_row(uint8_t *row, int y, int w, int h, int k, unsigned sides)
+{
+    int iy = k, x, xl, xr;   /* iy: pixels from the nearest faded side, rows only */
+    if (k < 1 || (sides & FUSE_EDGE_ALL) == 0 || row == NULL || w < 1 || y < 0 || y >= h) return;
+    if ((sides & FUSE_EDGE_TOP) && y < iy) iy = y;
+    if ((sides & FUSE_EDGE_BOTTOM) && h - 1 - y < iy) iy = h - 1 - y;
+    /* the columns to visit: all in a top or bottom strip, else [0, xl) and
+     * [xr, w), the left and right strips (each pixel once) */
+    xl = iy < k ? w : (sides & FUSE_EDGE_LEFT) ? (k < w ? k : w) : 0;
+    xr = iy < k ? w : (sides & FUSE_EDGE_RIGHT) ? (w - k > xl ? w - k : xl) : w;
+    for (x = 0; x < xl; x++) {
+        const int i = col_dist(x, w, iy, sides);
+        if (i < k) fade_px(row + 4 * (size_t)x, 2u * (unsigned)i + 1u, (unsigned)k);
+    }
+    for (x = xr; x < w; x++) {
+        const int i = col_dist(x, w, iy, sides);
+        if (i < k) fade_px(row + 4 * (size_t)x, 2u * (unsigned)i + 1u, (unsigned)k);
+    }
+}
+
+fuse_result fuse_edge_fade(fuse_image *Q, int k, unsigned sides)
+{
+    int y;
+    if (Q == NULL || Q->pixels == NULL || Q->width < 1 || Q->height < 1 ||
+        Q->width > FUSE_MAX_DIM || Q->height > FUSE_MAX_DIM || Q->stride < 4 * Q->width ||
+        k < 0 || k > FUSE_EDGE_FADE_MAX || (sides & ~FUSE_EDGE_ALL) != 0)
+        return FUSE_ERR_ARGS;
+    if (k == 0 || sides == 0) return FUSE_OK;
+    for (y = 0; y < Q->height; y++) {
+        const int strip = ((sides & FUSE_EDGE_TOP) && y < k) ||
+                          ((sides & FUSE_EDGE_BOTTOM) && Q->height - 1 - y < k);
+        if (!strip && (sides & (FUSE_EDGE_LEFT | FUSE_EDGE_RIGHT)) == 0) continue;
+        fuse_edge_fade_row(Q->pixels + (size_t)y * (size_t)Q->stride, y, Q->width, Q->height, k,
+                           sides);
+    }
+    return FUSE_OK;
+}
