@@ -1,7 +1,8 @@
 /* test_fuse_edge.c - soft viewport edges (src/fuse/fuse_edge.h, issue 18
  * item 4): the ramp against a double-precision reference on seeded
  * layers (every size down to 1x1, ramps wider than the layer, every side
- * set), only the border strips touched, r, g, b <= a kept; the float
+ * set), only the border strips touched, r, g, b <= a kept; every width
+ * and byte value against the integer division (exact_every_width); the float
  * weight at pixel centres; fuse_context_frame with edge_fade giving the
  * bytes of light -> fade -> depth -> composite by hand on every ISA and
  * thread count; bad arguments refused; and the pipeline's default: an
@@ -74,6 +75,24 @@ static void against_reference(void **state)
         free(q);
         free(q0);
     }
+}
+
+/* Every width 1..FUSE_EDGE_FADE_MAX, every pixel distance and byte value:
+ * a row of 2k pixels faded from the left holds q t / 2k rounded half up
+ * at its pixel i (t = 2i + 1; the division is done by a multiplication). */
+static void exact_every_width(void **state)
+{
+    (void)state;
+    static uint8_t row[4 * 2 * FUSE_EDGE_FADE_MAX];
+    for (int k = 1; k <= FUSE_EDGE_FADE_MAX; k++)
+        for (int q = 0; q < 256; q++) {
+            memset(row, q, sizeof row);
+            fuse_edge_fade_row(row, 0, 2 * k, 1, k, FUSE_EDGE_LEFT);
+            for (int i = 0; i < 2 * k; i++) {
+                const int want = i < k ? (q * (2 * i + 1) + k) / (2 * k) : q;
+                for (int c = 0; c < 4; c++) assert_int_equal(row[4 * i + c], want);
+            }
+        }
 }
 
 static void weight_at_centres(void **state)
@@ -334,6 +353,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(against_reference),
+        cmocka_unit_test(exact_every_width),
         cmocka_unit_test(weight_at_centres),
         cmocka_unit_test(bad_args),
         cmocka_unit_test(frame_every_isa),

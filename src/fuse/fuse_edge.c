@@ -18,14 +18,18 @@ float fuse_edge_weight(float sx, float sy, int w, int h, int k, unsigned sides)
     return t < 1.0f ? t : 1.0f;
 }
 
-/* q' = (q t + k) / (2k) for the four bytes of a pixel */
-static void fade_px(uint8_t *p, unsigned t, unsigned k)
+/* q' = (q t + k) / (2k) for the four bytes of a pixel. The division is a
+ * multiplication by m = floor((2^32 - 1) / 2k) + 1 and a shift by 32:
+ * exact for every numerator below 2^32 / 2k (here below 2^15, 2k <= 128),
+ * since the product's error n (m 2k - 2^32) / 2^32 / 2k < n / 2^32 stays
+ * below 1 / 2k. A zero pixel (most of the strips) stays zero. */
+static void fade_px(uint8_t *p, unsigned t, unsigned k, uint64_t m)
 {
-    const unsigned den = 2u * k;
-    p[0] = (uint8_t)((p[0] * t + k) / den);
-    p[1] = (uint8_t)((p[1] * t + k) / den);
-    p[2] = (uint8_t)((p[2] * t + k) / den);
-    p[3] = (uint8_t)((p[3] * t + k) / den);
+    if ((p[0] | p[1] | p[2] | p[3]) == 0) return;
+    p[0] = (uint8_t)(((uint64_t)(p[0] * t + k) * m) >> 32);
+    p[1] = (uint8_t)(((uint64_t)(p[1] * t + k) * m) >> 32);
+    p[2] = (uint8_t)(((uint64_t)(p[2] * t + k) * m) >> 32);
+    p[3] = (uint8_t)(((uint64_t)(p[3] * t + k) * m) >> 32);
 }
 
 /* pixels from the nearest faded side of column x, at most cap */
@@ -40,7 +44,10 @@ static int col_dist(int x, int w, int cap, unsigned sides)
 void fuse_edge_fade_row(uint8_t *row, int y, int w, int h, int k, unsigned sides)
 {
     int iy = k, x, xl, xr;   /* iy: pixels from the nearest faded side, rows only */
-    if (k < 1 || (sides & FUSE_EDGE_ALL) == 0 || row == NULL || w < 1 || y < 0 || y >= h) return;
+    if (k < 1 || k > FUSE_EDGE_FADE_MAX || (sides & FUSE_EDGE_ALL) == 0 || row == NULL || w < 1 ||
+        y < 0 || y >= h)
+        return;
+    const uint64_t m = 0xFFFFFFFFu / (2u * (unsigned)k) + 1u;
     if ((sides & FUSE_EDGE_TOP) && y < iy) iy = y;
     if ((sides & FUSE_EDGE_BOTTOM) && h - 1 - y < iy) iy = h - 1 - y;
     /* the columns to visit: all in a top or bottom strip, else [0, xl) and
@@ -49,11 +56,11 @@ void fuse_edge_fade_row(uint8_t *row, int y, int w, int h, int k, unsigned sides
     xr = iy < k ? w : (sides & FUSE_EDGE_RIGHT) ? (w - k > xl ? w - k : xl) : w;
     for (x = 0; x < xl; x++) {
         const int i = col_dist(x, w, iy, sides);
-        if (i < k) fade_px(row + 4 * (size_t)x, 2u * (unsigned)i + 1u, (unsigned)k);
+        if (i < k) fade_px(row + 4 * (size_t)x, 2u * (unsigned)i + 1u, (unsigned)k, m);
     }
     for (x = xr; x < w; x++) {
         const int i = col_dist(x, w, iy, sides);
-        if (i < k) fade_px(row + 4 * (size_t)x, 2u * (unsigned)i + 1u, (unsigned)k);
+        if (i < k) fade_px(row + 4 * (size_t)x, 2u * (unsigned)i + 1u, (unsigned)k, m);
     }
 }
 

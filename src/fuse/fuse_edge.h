@@ -61,7 +61,7 @@ extern "C" {
 float fuse_edge_weight(float sx, float sy, int w, int h, int k, unsigned sides);
 
 /* Fades row y of a premultiplied RGBA8 layer of w x h pixels in place
- * (row: 4 w bytes). k < 1 or no side: nothing. Only the pixels within k of
+ * (row: 4 w bytes). k < 1 (or above FUSE_EDGE_FADE_MAX) or no side: nothing. Only the pixels within k of
  * a faded side are touched. No checks (the caller's are fuse_edge_fade's). */
 void fuse_edge_fade_row(uint8_t *row, int y, int w, int h, int k, unsigned sides);
 
