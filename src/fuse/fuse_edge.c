@@ -2,6 +2,7 @@
 #include "fuse_edge.h"
 
 #include <stddef.h>
+#include <string.h>
 
 float fuse_edge_weight(float sx, float sy, int w, int h, int k, unsigned sides)
 {
@@ -25,7 +26,9 @@ float fuse_edge_weight(float sx, float sy, int w, int h, int k, unsigned sides)
  * below 1 / 2k. A zero pixel (most of the strips) stays zero. */
 static void fade_px(uint8_t *p, unsigned t, unsigned k, uint64_t m)
 {
-    if ((p[0] | p[1] | p[2] | p[3]) == 0) return;
+    uint32_t v;
+    memcpy(&v, p, 4);
+    if (v == 0) return;
     p[0] = (uint8_t)(((uint64_t)(p[0] * t + k) * m) >> 32);
     p[1] = (uint8_t)(((uint64_t)(p[1] * t + k) * m) >> 32);
     p[2] = (uint8_t)(((uint64_t)(p[2] * t + k) * m) >> 32);
@@ -50,14 +53,17 @@ void fuse_edge_fade_row(uint8_t *row, int y, int w, int h, int k, unsigned sides
     const uint64_t m = 0xFFFFFFFFu / (2u * (unsigned)k) + 1u;
     if ((sides & FUSE_EDGE_TOP) && y < iy) iy = y;
     if ((sides & FUSE_EDGE_BOTTOM) && h - 1 - y < iy) iy = h - 1 - y;
-    /* the columns to visit: all in a top or bottom strip, else [0, xl) and
-     * [xr, w), the left and right strips (each pixel once) */
-    xl = iy < k ? w : (sides & FUSE_EDGE_LEFT) ? (k < w ? k : w) : 0;
-    xr = iy < k ? w : (sides & FUSE_EDGE_RIGHT) ? (w - k > xl ? w - k : xl) : w;
+    /* the left strip [0, xl), the middle [xl, xr), the right strip [xr, w)
+     * (each pixel once); the middle is faded only in a top or bottom strip,
+     * where its pixels are all iy from the nearest side */
+    xl = (sides & FUSE_EDGE_LEFT) ? (k < w ? k : w) : 0;
+    xr = (sides & FUSE_EDGE_RIGHT) ? (w - k > xl ? w - k : xl) : w;
     for (x = 0; x < xl; x++) {
         const int i = col_dist(x, w, iy, sides);
         if (i < k) fade_px(row + 4 * (size_t)x, 2u * (unsigned)i + 1u, (unsigned)k, m);
     }
+    if (iy < k)
+        for (x = xl; x < xr; x++) fade_px(row + 4 * (size_t)x, 2u * (unsigned)iy + 1u, (unsigned)k, m);
     for (x = xr; x < w; x++) {
         const int i = col_dist(x, w, iy, sides);
         if (i < k) fade_px(row + 4 * (size_t)x, 2u * (unsigned)i + 1u, (unsigned)k, m);
