@@ -15,7 +15,7 @@ static const char *render_usage =
     "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
     "                      [--tone-match S] [--pose animation|tracking]\n"
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
-    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--hide PARTS]\n"
+    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--edge-fade K] [--hide PARTS]\n"
     "                      [--prop MODEL@X,Y,Z[,YAW]]... [--allow-outside]\n"
     "                      [--lod MODE] [--lod-px PX] [--view crop|reproject]\n"
     "                      [--hmd-ipd M] [--hmd-camera-offset M]\n"
@@ -90,6 +90,9 @@ static const char *render_usage =
     "  --smooth-normals R  sum the model's normals over a (2R+1)^2 window\n"
     "                 before lighting (1..4; default 0: off): for models of\n"
     "                 crossing parts whose shading shows seams\n"
+    "  --edge-fade K  soft viewport edges: where the camera image ends inside\n"
+    "                 the display, the hands fade over its last K pixels\n"
+    "                 (1..64; 0: off, a hard cut); default 4\n"
     CLI_LOD_USAGE
     "  --allow-outside  let the models' buffer and image URIs name files\n"
     "                 outside their folder (absolute, `..`, symlinks out);\n"
@@ -138,6 +141,7 @@ typedef struct render_opts {
     int aa;                /* coverage samples per pixel; 0 = off */
     int view;              /* --view: PIPE_VIEW_CROP (default), _REPROJECT */
     float ipd_m, cam_offset_m; /* --hmd-ipd, --hmd-camera-offset; 0 = the HMD's */
+    int edge_fade;         /* pipe_desc.edge_fade: 0 default, -1 off */
 } render_opts;
 
 /* The pose from tracking: the recording, the rig, the filter and the
@@ -354,6 +358,7 @@ static int render(const render_opts *o)
     pd.refine_band = o->refine;
     pd.normal_smooth = o->smooth_normals;
     pd.aa_samples = o->aa;
+    pd.edge_fade = o->edge_fade;
     pd.fit_rig = o->refine && o->pose_tracking ? &tp.rig : NULL;
     /* the scene's HMD (its `hmd` key, checked on load), or the paper's */
     if (sc.hmd[0]) {
@@ -538,7 +543,7 @@ done:
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
        O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
        O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
-       O_HMD_CALIB_R, O_AA, O_VIEW, O_HMD_IPD, O_HMD_OFFSET };
+       O_HMD_CALIB_R, O_AA, O_VIEW, O_HMD_IPD, O_HMD_OFFSET, O_EDGE_FADE };
 
 /* --aa N: 0 (off), 4, 8 or 16 samples per pixel. 1, or 0 for another. */
 static int parse_aa(const char *s, int *aa)
@@ -594,6 +599,7 @@ int cmd_render(int argc, char **argv)
         {"lod-px", required_argument, 0, O_LOD_PX},
         {"smooth-normals", required_argument, 0, O_SMOOTH},
         {"aa", required_argument, 0, O_AA},
+        {"edge-fade", required_argument, 0, O_EDGE_FADE},
         {"tone-match", required_argument, 0, O_TONE},
         {"pose", required_argument, 0, O_POSE},
         {"calib", required_argument, 0, O_CALIB},
@@ -658,6 +664,12 @@ int cmd_render(int argc, char **argv)
             if (!cli_parse_int(optarg, 1, FUSE_NORMAL_SMOOTH_MAX, &o.smooth_normals))
                 return cli_usage_error("render", "--smooth-normals '%s': a radius of 1..%d px",
                                        optarg, FUSE_NORMAL_SMOOTH_MAX);
+            break;
+        case O_EDGE_FADE:
+            if (!cli_parse_int(optarg, 0, FUSE_EDGE_FADE_MAX, &o.edge_fade))
+                return cli_usage_error("render", "--edge-fade '%s': 0 (off) or a width of "
+                                       "1..%d px", optarg, FUSE_EDGE_FADE_MAX);
+            if (o.edge_fade == 0) o.edge_fade = -1;
             break;
         case O_AA:
             if (!parse_aa(optarg, &o.aa))

@@ -533,6 +533,7 @@ static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
         bad |= fprintf(f, " --lod auto --lod-px %.9g", (double)o->lod_px) < 0;
     else if (o->lod) bad |= fprintf(f, " --lod %d", o->lod) < 0;
     if (o->aa) bad |= fprintf(f, " --aa %d", o->aa) < 0;
+    if (o->edge_fade) bad |= fprintf(f, " --edge-fade %d", o->edge_fade < 0 ? 0 : o->edge_fade) < 0;
     if (o->refine) bad |= fprintf(f, " --refine %d # the elbow fit's learned state differs", o->refine) < 0;
     bad |= fputc('\n', f) == EOF;
     bad |= fclose(f) != 0;
@@ -798,6 +799,7 @@ static int run(const run_opts *o)
     pd.refine_band = o->refine;
     pd.aa_samples = o->aa;
     pd.eye_view = o->view;
+    pd.edge_fade = o->edge_fade;
     pd.fit_rig = o->refine && tracked ? &r->rig : NULL;
     if (!(r->pipe = pipe_create(&pd, model))) {
         if (o->aa && (kin_lens_distorts(&pd.hmd.lens[0]) || kin_lens_distorts(&pd.hmd.lens[1])))

@@ -104,6 +104,8 @@ const char *run_usage =
     "  --lod-px PX      the error auto allows, pixels (default 2)\n"
     "  --aa N           anti-aliased silhouettes: N coverage samples per pixel\n"
     "                   (4, 8 or 16; 0: off, the binary mask); default 0\n"
+    "  --edge-fade K    soft viewport edges: the hands fade over the last K\n"
+    "                   camera pixels (1..64; 0: off, a hard cut); default 4\n"
     "  --quiet          no status line\n"
     "  -h, --help       this text\n"
     "\n"
@@ -118,7 +120,7 @@ enum {
     O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD, O_ALLOW_OUTSIDE, O_AA,
     O_HMD_CAM, O_HMD_CAM_HFOV, O_HMD_BASE, O_HMD_OFFSET, O_HMD_DISP, O_HMD_HFOV, O_HMD_VFOV,
     O_HMD_FOCAL, O_HMD_IPD, O_HMD_PRESET, O_DUMP, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
-    O_HMD_CALIB_R, O_VIEW
+    O_HMD_CALIB_R, O_VIEW, O_EDGE_FADE
 };
 
 static const struct option run_long_opts[] = {
@@ -146,6 +148,7 @@ static const struct option run_long_opts[] = {
     {"lod", required_argument, 0, O_LOD},
     {"lod-px", required_argument, 0, O_LOD_PX},
     {"aa", required_argument, 0, O_AA},
+    {"edge-fade", required_argument, 0, O_EDGE_FADE},
     {"config", required_argument, 0, O_CONFIG},
     {"stats", required_argument, 0, O_STATS},
     {"predict-ms", required_argument, 0, O_PREDICT},
@@ -383,6 +386,14 @@ int run_parse(int argc, char **argv, run_opts *o)
             if (!cli_parse_int(optarg, 0, 16, &v) || (v != 0 && v != 4 && v != 8 && v != 16))
                 BAD("--aa '%s': 0 (off), 4, 8 or 16 samples per pixel", optarg);
             o->aa = v;
+            break;
+        }
+        case O_EDGE_FADE: {
+            int v;
+            if (!cli_parse_int(optarg, 0, FUSE_EDGE_FADE_MAX, &v))
+                BAD("--edge-fade '%s': 0 (off) or a width of 1..%d px", optarg,
+                    FUSE_EDGE_FADE_MAX);
+            o->edge_fade = v == 0 ? -1 : v;
             break;
         }
         case O_STATS: o->stats = optarg; break;

@@ -30,7 +30,7 @@ static fuse_lighting workshop_lighting(const gen_scene *ws, const kin_camera *ca
     L.kd = 0.80f;
     L.ks = 0.12f;
     L.shininess = 20.0f;
-    L.kf = 0.50f;
+    L.kf = 0.0f;   /* the samples' (gen_main.c): the best against the opaque ideal (eval_kf.c) */
     L.tone[0] = 1.0f;
     L.tone[1] = 0.98f;
     L.tone[2] = 0.96f;
@@ -211,10 +211,15 @@ static int make_truth(eval_ctx *c, int frame, float speed, int first)
         fuse_intrinsics K = { cam.fx, cam.fy, cam.cx, cam.cy };
         fuse_image P = { c->P[e], CW, CH, 4 * CW }, Q = { c->layer, CW, CH, 4 * CW };
         fuse_image I = { c->ideal[e], GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
-        if (fuse_light(&c->L[e], &K, &P, c->sil[e], CW, c->tnrm[e], 3 * CW, &Q) != FUSE_OK ||
+        fuse_lighting Li = c->L[e];
+        if (c->light.opaque_ideal) Li.kf = 0.0f;   /* the Fresnel sweep: a real hand is opaque */
+        if (fuse_light(&Li, &K, &P, c->sil[e], CW, c->tnrm[e], 3 * CW, &Q) != FUSE_OK ||
             fuse_composite(&Q, &V, c->g.vp_x0, c->g.vp_y0, c->g.vp_width, c->g.vp_height,
                            &I) != FUSE_OK)
             return -1;
+        /* the lighting-mismatch sweep: the methods see the cockpit under
+         * another light than the ideal composite was made from */
+        if (c->light.on && eval__light_render(c, &wfh, e, frame) < 0) return -1;
     }
     return 0;
 }
@@ -519,6 +524,14 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         fuse_image V = { c->V[e], GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
         fuse_image O = { c->out, GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
         fuse_lighting L = workshop_lighting(&c->workshop, &cam);
+        if (cfg->kf_set) L.kf = cfg->kf;
+        if (cfg->tone > 0.0f) {   /* as pipe_desc.tone_match */
+            float tone[3];
+            if (fuse_tone_match(&P, mask, CW, &V, c->g.vp_x0, c->g.vp_y0, c->g.vp_width,
+                                c->g.vp_height, cfg->tone, tone) != FUSE_OK)
+                return -1;
+            for (int k = 0; k < 3; k++) L.tone[k] *= tone[k];
+        }
         if (fuse_light(&L, &K, &P, mask, CW, nrm, 3 * CW, &Q) != FUSE_OK ||
             fuse_composite(&Q, &V, c->g.vp_x0, c->g.vp_y0, c->g.vp_width, c->g.vp_height,
                            &O) != FUSE_OK)
@@ -626,7 +639,7 @@ static int add_cfg(method_cfg *list, int n, int cap, method_cfg c)
 }
 
 /* Phases of a report (each on its own ground truth and frame count). */
-enum { PH_METHODS, PH_KNOBS, PH_TRACK, PH_SEQ, PH_SPEED, PH_LOD };
+enum { PH_METHODS, PH_KNOBS, PH_TRACK, PH_SEQ, PH_SPEED, PH_LOD, PH_LIGHT, PH_KF };
 
 /* A configuration of a sweep: group, swept value and setting "name=" x
  * (x as %g) followed by unit. */
@@ -644,10 +657,16 @@ static method_cfg named_cfg(const eval_opts *o, method_kind k, const char *group
  * same (group "knobs") with every speed knob; PH_TRACK: the tracking sweeps (and the methods at the
  * given tracking, group "track"); PH_SEQ: the methods on sequence seq. */
 static int make_configs(const eval_opts *o, int phase, const char *seq, float speed,
-                        method_cfg *L, int cap)
+                        const eval_light *light, method_cfg *L, int cap)
 {
     int n = 0;
     method_cfg c;
+    if (phase == PH_LIGHT || phase == PH_KF) {   /* eval_light.c, eval_kf.c */
+        method_cfg base[4];
+        for (int k = 0; k < 4; k++) base[k] = base_cfg(o, (method_kind)k);
+        return phase == PH_KF ? eval__kf_configs(base, L, cap)
+                              : eval__light_configs(base, light, L, cap);
+    }
     if (phase == PH_SPEED)   /* the methods on the motion played at another speed */
         for (int k = 0; k < 4; k++) {
             if (k == M_SKIN || !(o->methods & (1u << k))) continue;
@@ -770,12 +789,13 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
  * seq (one ground truth). The context is left in *c for the caller to
  * free. */
 static int run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames, float speed,
-                     const method_cfg *cfgs, method_run *R, int n)
+                     const eval_light *light, const method_cfg *cfgs, method_run *R, int n)
 {
     method_cfg base = base_cfg(o, M_KIN_CAL);
     int irc = ctx_init(c, (uint64_t)o->seed, seq, &base.track);
     if (irc < 0)
         return irc == -2 ? EXIT_FAIL : cli_fail("cannot build the ground truth (out of memory)");
+    if (light) c->light = *light;
     int rc = EXIT_FAIL;
     int inited = 0;
     for (int i = 0; i < n; i++)
@@ -809,7 +829,9 @@ int eval_run(const eval_opts *o)
         return cli_fail("%s: cannot create the folder", o->dump);
     if (o->report && cli_mkdirs(o->report) != 0)
         return cli_fail("%s: cannot create the report folder", o->report);
-    enum { CAP = 160 };
+    if (o->light_dir && cli_mkdirs(o->light_dir) != 0)
+        return cli_fail("%s: cannot create the folder", o->light_dir);
+    enum { CAP = 300 };
     method_cfg *cfgs = calloc(CAP, sizeof *cfgs);
     method_run *R = calloc(CAP, sizeof *R);
     eval_ctx c;
@@ -817,10 +839,12 @@ int eval_run(const eval_opts *o)
     int n = 0, rc = EXIT_FAIL;
     if (!cfgs || !R) { cli_fail("out of memory"); goto done; }
     /* batches: (sequence, frames, phase) */
-    enum { NB = 14 };
+    enum { NB = 30 };
     const char *bseq[NB];
     int bframes[NB], bphase[NB], nb = 0;
     float bspeed[NB];
+    eval_light blight[NB];
+    memset(blight, 0, sizeof blight);
     for (int b = 0; b < NB; b++) bspeed[b] = o->speed;
     bseq[nb] = o->sequence; bframes[nb] = o->frames; bphase[nb++] = PH_METHODS;
     if (o->report) {
@@ -844,12 +868,32 @@ int eval_run(const eval_opts *o)
             bseq[nb] = name; bframes[nb] = o->seq_frames; bphase[nb++] = PH_SEQ;
         }
     }
+    if (o->report || o->light_sweep) {   /* the lighting mismatch (eval_light.c) */
+        eval_light lv[16];
+        const int nl = eval__light_levels(lv, 16);
+        for (int i = 0; i < nl && nb < NB; i++) {
+            bseq[nb] = o->sequence;
+            bframes[nb] = o->report ? o->sweep_frames : o->frames;
+            blight[nb] = lv[i];
+            bphase[nb++] = PH_LIGHT;
+        }
+    }
+    if ((o->report || o->kf_sweep) && nb < NB) {   /* the Fresnel fade (eval_kf.c) */
+        bseq[nb] = o->sequence;
+        bframes[nb] = o->report ? o->sweep_frames : o->frames;
+        blight[nb].opaque_ideal = 1;
+        bphase[nb++] = PH_KF;
+    }
     for (int b = 0; b < nb; b++) {
-        int m = make_configs(o, bphase[b], bseq[b], bspeed[b], cfgs + n, CAP - n);
+        int m = make_configs(o, bphase[b], bseq[b], bspeed[b], &blight[b], cfgs + n, CAP - n);
         if (n + m > CAP) { cli_fail("too many configurations"); goto done; }
         ctx_free(&c);
-        if (run_batch(o, &c, bseq[b], bframes[b], bspeed[b], cfgs + n, R + n, m)) goto done;
-        if (b == 0 || !o->quiet || bphase[b] == PH_LOD) {
+        if (run_batch(o, &c, bseq[b], bframes[b], bspeed[b],
+                      bphase[b] == PH_LIGHT || bphase[b] == PH_KF ? &blight[b] : NULL, cfgs + n,
+                      R + n, m))
+            goto done;
+        if (b == 0 || (!o->quiet && bphase[b] != PH_LIGHT && bphase[b] != PH_KF) ||
+            bphase[b] == PH_LOD) {
             printf("egofuse eval: sequence %s, %d frames, tracking noise %g mm, latency %g ms, "
                    "dropout %g, calibration error %g, speed %g; means per eye (640x400 masks)\n",
                    bseq[b], bframes[b], (double)o->noise, (double)o->latency,
@@ -870,6 +914,8 @@ int eval_run(const eval_opts *o)
     }
     if (o->csv && eval__write_csv(o->csv, R, n)) goto done;
     if (o->report && eval__write_report(o->report, R, n, o, &c)) goto done;
+    if ((o->report || o->light_sweep) && eval__write_light(o->report ? o->report : o->light_dir, R, n)) goto done;
+    if ((o->report || o->kf_sweep) && eval__write_kf(o->report, R, n)) goto done;
     if (o->report) printf("egofuse eval: report in %s (summary.csv, table.md, *.png)\n", o->report);
     rc = EXIT_OK;
 done:

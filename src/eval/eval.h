@@ -49,6 +49,15 @@ typedef struct eval_opts {
     int lod_sweep;           /* 1: also the levels batch (group "lod"; a
                                 report always runs it) */
     int eyeview;             /* 1: `egofuse eval --eyeview` (eval_eye_run) */
+    int light_sweep;         /* 1: also the lighting-mismatch sweep (group
+                                "light", eval_light.c; a report always
+                                runs it, on sweep_frames) */
+    const char *light_dir;   /* with light_sweep and no report: the folder
+                                of its table, data and chart (NULL: the
+                                table on stdout only) */
+    int kf_sweep;            /* 1: also the Fresnel fade kf 0..1 against the
+                                opaque ideal composite (group "kf",
+                                eval_kf.c; a report always runs it) */
 } eval_opts;
 
 /* "kin,refine" -> bits of the methods (kin, kin-cal-pred, skin, refine:

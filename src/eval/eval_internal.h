@@ -34,6 +34,12 @@ typedef struct method_cfg {
     int lod;                 /* level of detail: 0 = full, a level, or
                                 PIPE_LOD_AUTO (eval_lod.c) */
     float lod_px;            /* the rule's target, px */
+    float tone;              /* > 0: gray-world tone matching of this
+                                strength (fuse_tone_match, as
+                                pipe_desc.tone_match) before lighting */
+    int kf_set;              /* 1: the Fresnel fade kf below instead of the
+                                workshop lighting's 0.5 (eval_kf.c) */
+    float kf;
 } method_cfg;
 
 /* Per-configuration state and sums. */
@@ -58,6 +64,19 @@ typedef struct method_run {
     double iou_full, bf1_full, lod_sum, tris_sum, raster_secs;
     long n_full, n_raster;
 } method_run;
+
+/* A lighting mismatch between the cockpit (the camera images) and the
+ * virtual scene (eval_light.c): the cockpit's lights and ambient times
+ * gain, tinted to the colour temperature kelvin (6500: no tint, the
+ * luma kept), the lights' directions turned by roll_deg about the world's
+ * forward axis (0: from above as built; 90: from the side). on 0: none.
+ * opaque_ideal 1: the ideal composite without the Fresnel fade (kf 0: a
+ * real hand is opaque; the Fresnel sweep, eval_kf.c). */
+typedef struct eval_light {
+    int on;
+    float gain, kelvin, roll_deg;
+    int opaque_ideal;
+} eval_light;
 
 /* Shared per-frame buffers. */
 typedef struct eval_ctx {
@@ -99,6 +118,10 @@ typedef struct eval_ctx {
     int lod_drawn;            /* the level the last draw_mask drew */
     uint8_t *full_mask;       /* the full model's mask, 640x400 */
     float *full_depth;
+    /* the lighting-mismatch sweep (eval_light.c): the ideal composite is
+     * made from the camera images under the cockpit's own light, the
+     * methods get the images under the mismatched light */
+    eval_light light;
 } eval_ctx;
 
 /* eval.c: the true operator's scales (arm, hand, shoulder width) against
@@ -124,6 +147,29 @@ int eval__lod_level(const eval_ctx *c, const method_cfg *cfg, const float *clip,
                     const kin_camera *cam);
 void eval__print_lod(FILE *f, const method_run *R, int n, int markdown);
 int eval__write_lod(const char *dir, const method_run *R, int n);
+
+/* eval_light.c: the lighting-mismatch sweep. The levels (the first the
+ * matched one; at most cap), written into L, their count returned; each
+ * level's x and its axis ("gain", "kelvin", "roll"): an axis's points
+ * are the matched level and the levels of that axis. */
+int eval__light_levels(eval_light *L, int cap);
+float eval__light_x(const eval_light *l, const char *axis);
+/* The camera image of eye e under c->light into c->P[e] (make_truth calls
+ * it after the ideal composite when c->light.on). 0, or -1. */
+int eval__light_render(eval_ctx *c, const kin_mat4 *world_from_head, int e, int frame);
+/* The methods of a level: kin-cal-pred, skin, refine, and refine with
+ * full tone matching ("refine+tone"), group "light" (base: the method's
+ * default configuration of o, in kind order). */
+int eval__light_configs(const method_cfg base[4], const eval_light *l, method_cfg *L, int cap);
+/* The table (stdout and DIR/light.md), DIR/light.dat and the chart
+ * DIR/light.png (gnuplot; missing: a warning). */
+int eval__write_light(const char *dir, const method_run *R, int n);
+
+/* eval_kf.c: the Fresnel fade against the opaque ideal composite: the
+ * configurations (kin-cal-pred and refine at kf 0 .. 1, group "kf"), and
+ * the table (stdout and DIR/kf.md when dir is set). */
+int eval__kf_configs(const method_cfg base[4], method_cfg *L, int cap);
+int eval__write_kf(const char *dir, const method_run *R, int n);
 
 /* eval_report.c: the tables, the CSV and the report folder. */
 void eval__print_calib(FILE *f, const eval_ctx *c);

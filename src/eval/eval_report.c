@@ -100,6 +100,10 @@ void eval__print_table(FILE *f, const method_run *R, int n, int markdown)
         fprintf(f, "%-13s %-9s %-16s %7s %6s %6s %8s %8s %6s %7s %8s\n", "method", "group",
                 "setting", "IoU", "BF1", "BF3", "FP px", "FN px", "PSNR", "flicker", "ms/frame");
     for (int i = 0; i < n; i++) {
+        /* the lighting and Fresnel sweeps have tables of their own
+         * (light.md, kf.md: eval_light.c, eval_kf.c) */
+        if (markdown && (!strcmp(R[i].cfg.group, "light") || !strcmp(R[i].cfg.group, "kf")))
+            continue;
         summary s = summarise(&R[i]);
         if (markdown)
             fprintf(f, "| %s | %s | %s | %.4f | %.3f | %.3f | %.0f | %.0f | %.2f | %.3f | %.2f |\n",
@@ -447,7 +451,8 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
                "calibration error %g, speed %g, seed %d. Frames: %d for the methods (group "
                "methods), %d for the speed knobs (groups knobs, band, fit, global, lagcomp, "
                "res, aa, tris, dqs) and the tracking sweeps (groups track, noise, latency, calib), "
-               "%d per other sequence (group sequence).\n\n",
+               "%d per other sequence (group sequence). The lighting-mismatch and Fresnel sweeps "
+               "(groups light, kf; summary.csv) have their tables in light.md and kf.md.\n\n",
             o->sequence, (double)o->noise, (double)o->latency, (double)o->dropout,
             (double)o->calib_error, (double)o->speed, o->seed, o->frames, o->sweep_frames,
             o->seq_frames);

@@ -8,6 +8,7 @@
 
 #include <stdlib.h>
 
+#include "fuse_edge.h"
 #include "fuse_pool.h"
 
 typedef struct kernels {
@@ -718,6 +719,8 @@ typedef struct eye_job {
     light_job light;
     comp_job comp;
     const fuse_depth *depth;
+    int edge_fade;            /* fuse_eye.edge_fade, edge_sides */
+    unsigned edge_sides;
 } eye_job;
 
 typedef struct frame_job {
@@ -731,7 +734,22 @@ typedef struct frame_job {
  * before lighting, so hidden pixels are never lit; the bytes are those of
  * lighting and then testing the layer (fuse_internal.h,
  * fuse__depth_mask_fn), which the reference does. */
+static void eye_light_depth_rows(const eye_job *e, int y0, int y1);
+
+/* ... and faded towards the sides that end inside the display (fuse_edge.h:
+ * one scalar pass over the border strips, once a row is final). */
 static void eye_light_depth(const eye_job *e, int y0, int y1)
+{
+    const int k = e->edge_fade, w = e->light.out.width, h = e->light.out.height;
+    int y;
+    eye_light_depth_rows(e, y0, y1);
+    if (k < 1 || e->edge_sides == 0) return;
+    for (y = y0; y < y1; y++)
+        if ((e->edge_sides & (FUSE_EDGE_LEFT | FUSE_EDGE_RIGHT)) || y < k || h - 1 - y < k)
+            fuse_edge_fade_row(row_of(&e->light.out, y), y, w, h, k, e->edge_sides);
+}
+
+static void eye_light_depth_rows(const eye_job *e, int y0, int y1)
 {
     const light_job *j = &e->light;
     const int w = j->P.width, sh = j->P.height;
@@ -904,12 +922,17 @@ fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int coun
             r = FUSE_ERR_SIZE;
         if (r == FUSE_OK && fuse__same_image(&s->P, &s->Q))
             r = FUSE_ERR_ARGS;   /* Q is a scratch layer of its own */
+        if (r == FUSE_OK && (s->edge_fade < 0 || s->edge_fade > FUSE_EDGE_FADE_MAX ||
+                             (s->edge_sides & ~FUSE_EDGE_ALL) != 0))
+            r = FUSE_ERR_ARGS;
         if (r != FUSE_OK) return r;
         light_job_set(&j->light, &ctx->k, &s->P, s->mask, s->mask_stride, s->normal,
                       s->normal_stride, &s->Q);
         comp_job_set(&j->comp, &ctx->k, &s->Q, &s->V, s->vp_x0, s->vp_y0, s->vp_w, s->vp_h,
                      &s->out, s->v_opaque != 0);
         j->depth = s->depth;
+        j->edge_fade = s->edge_fade;
+        j->edge_sides = s->edge_sides;
     }
     /* one eye's writes must not land in another eye's inputs */
     for (e = 0; e < count; e++) {

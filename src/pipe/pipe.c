@@ -180,6 +180,15 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
     fe->intrinsics = K;
     e->view_used = PIPE_VIEW_REPROJECT;
     return 1;
+int pipe__edge_fade_px(const pipe_desc *d)
+{
+    return d->edge_fade == 0 ? PIPE_EDGE_FADE_DEFAULT : d->edge_fade < 0 ? 0 : d->edge_fade;
+}
+
+unsigned pipe__edge_sides(int vx, int vy, int vw, int vh, int ow, int oh)
+{
+    return (vx > 0 ? FUSE_EDGE_LEFT : 0u) | (vx + vw < ow ? FUSE_EDGE_RIGHT : 0u) |
+           (vy > 0 ? FUSE_EDGE_TOP : 0u) | (vy + vh < oh ? FUSE_EDGE_BOTTOM : 0u);
 }
 
 static void run_eye(pipe_ctx *p, eye_state *e)
@@ -312,6 +321,10 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     fe.vp_h = rp ? p->hmd.lcd_height : p->geo.vp_height;
     fe.out = in->out[e->eye];
     fe.v_opaque = in->virt_opaque != 0;
+    /* soft edges on the viewport's sides inside the output (pipe_desc.edge_fade) */
+    fe.edge_fade = pipe__edge_fade_px(&p->desc);
+    fe.edge_sides = pipe__edge_sides(fe.vp_x0, fe.vp_y0, fe.vp_w, fe.vp_h, fe.out.width,
+                                     fe.out.height);
     fuse_depth dt;
     int filled[4] = {0, 0, 0, 0};
     if (in->virt_depth[e->eye] && rp) {
@@ -472,6 +485,7 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         (desc->eye_view != PIPE_VIEW_REPROJECT || desc->aa_samples != 0 ||
          pipe_view_check(&desc->hmd, NULL, 0) != 0))
         return NULL;
+    if (desc && (desc->edge_fade < -1 || desc->edge_fade > FUSE_EDGE_FADE_MAX)) return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
     if (desc) p->desc = *desc;

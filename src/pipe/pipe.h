@@ -37,6 +37,7 @@
 
 #include "../fit/fit.h"
 #include "../fuse/fuse.h"
+#include "../fuse/fuse_edge.h"
 #include "../fuse/fuse_normals.h"
 #include "../fuse/fuse_refine.h"
 #include "../kin/kin.h"
@@ -111,7 +112,21 @@ typedef struct pipe_desc {
                                  aa_samples, or hmd.ipd_m / cam_offset_m
                                  out of range (pipe_view_check):
                                  pipe_create returns NULL. */
+    int edge_fade;            /* soft viewport edges (issue 18, fuse_edge.h):
+                                 where the camera image ends inside the
+                                 display (the viewport's sides that do not
+                                 touch the output's border), the hands fade
+                                 over the last k camera pixels of the
+                                 layer. 0 = the default,
+                                 PIPE_EDGE_FADE_DEFAULT pixels; 1..
+                                 FUSE_EDGE_FADE_MAX: k; -1: off (the hard
+                                 cut, the bytes of before). Other values:
+                                 pipe_create returns NULL. */
 } pipe_desc;
+
+/* The default width of the soft viewport edges, in camera pixels (about
+ * 7.5 display pixels with the paper's viewport). */
+#define PIPE_EDGE_FADE_DEFAULT 4
 
 /* ANTI-ALIASED EDGES (pipe_desc.aa_samples = n). Each eye's model is drawn
  * a second time into n coverage samples per pixel (rast_draw_aa, the
