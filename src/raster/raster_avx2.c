@@ -1,7 +1,8 @@
 /* raster_avx2.c - the AVX2 kernels: the scan (raster_simd.inl, 8 lanes),
  * the batched set-up (raster_planes.inl, 4 double lanes) and the sample
  * scan (raster_aa.inl), on the vector layer's AVX2 implementation
- * (src/cpu/simd_avx2.h); the vector front end is raster_front_avx2.c.
+ * (src/cpu/simd_avx2.h), the vertex transforms (raster_xform.inl); the
+ * vector front end is raster_front_avx2.c.
  * Built with -mavx2 -mf16c (Makefile); called only when cpuid reports
  * AVX2 (raster_context.c). Bytes equal the reference's. */
 #include "raster_internal.h"
@@ -119,6 +120,20 @@ static inline __attribute__((always_inline)) void attr3_store_pl(float *p, unsig
 #define ATTR3_STORE_PL(p, bits, lanes, st, b1, b2) attr3_store_pl(p, bits, lanes, st, b1, b2)
 
 #include "raster_simd.inl"
+
+/* The vertex transforms (raster_xform.inl): four component vectors
+ * interleaved as 8 xyzw vertices, by 4x4 transposes of each 128-bit half
+ * (vf_tr4) and 128-bit lane joins. */
+SIMD_INL void xf_store4(float *p, vfloat c0, vfloat c1, vfloat c2, vfloat c3)
+{
+    vfloat o[4];   /* o[k]: vertex k (low half), vertex 4 + k (high half) */
+    vf_tr4(c0, c1, c2, c3, o);
+    _mm256_storeu_ps(p, _mm256_permute2f128_ps(o[0], o[1], 0x20));
+    _mm256_storeu_ps(p + 8, _mm256_permute2f128_ps(o[2], o[3], 0x20));
+    _mm256_storeu_ps(p + 16, _mm256_permute2f128_ps(o[0], o[1], 0x31));
+    _mm256_storeu_ps(p + 24, _mm256_permute2f128_ps(o[2], o[3], 0x31));
+}
+#include "raster_xform.inl"
 
 /* Anti-aliased coverage: 4 double lanes. */
 #define AA_V 4
