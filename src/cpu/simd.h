@@ -202,6 +202,7 @@
  *
  * RASTER FRONT-END OPS (src/raster's vector front end, raster_frontv.inl:
  * the vertex pass, the rejection and the double plane set-up of survivors;
+ * and the vertex transforms, raster_xform.inl;
  * a block after the raster ops; h is a constant 0 or 1, "half h" the lanes
  * h*VD_W .. h*VD_W + VD_W - 1)
  *   vi_min(i, j) vi_max(i, j)  signed int32 minimum / maximum
@@ -211,6 +212,8 @@
  *                            rounded to float (nearest even; x86 cvtpd2ps)
  *   vd_gt_bits(a, b)         bits (VD_W of them) of the lanes with a > b,
  *                            ordered (false when either is NaN)
+ *   vd_sqrt(a)               square root, correctly rounded (the vertex
+ *                            transforms' normal length, raster_xform.inl)
  * ROW-CACHE OPS (added for src/fuse's row-cached composite, fuse_simd.inl
  * fuse__hrow / fuse__vrow; a separate block at the end of each
  * implementation; tests/test_cpu_simd_fuse.c)

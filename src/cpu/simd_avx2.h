@@ -255,6 +255,7 @@ SIMD_INL void vd_store_f(float *p, vdouble a) { _mm_storeu_ps(p, _mm256_cvtpd_ps
 
 
 /* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
+SIMD_INL vdouble vd_sqrt(vdouble a) { return _mm256_sqrt_pd(a); }
 SIMD_INL vint vi_min(vint i, vint j) { return _mm256_min_epi32(i, j); }
 SIMD_INL vint vi_max(vint i, vint j) { return _mm256_max_epi32(i, j); }
 SIMD_INL vdouble vd_from_vf(vfloat a, int h)

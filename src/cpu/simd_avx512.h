@@ -241,6 +241,7 @@ SIMD_INL void vd_store_f(float *p, vdouble a) { _mm256_storeu_ps(p, _mm512_cvtpd
 
 
 /* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
+SIMD_INL vdouble vd_sqrt(vdouble a) { return _mm512_sqrt_pd(a); }
 SIMD_INL vint vi_min(vint i, vint j) { return _mm512_min_epi32(i, j); }
 SIMD_INL vint vi_max(vint i, vint j) { return _mm512_max_epi32(i, j); }
 SIMD_INL vdouble vd_from_vf(vfloat a, int h)

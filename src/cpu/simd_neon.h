@@ -303,6 +303,7 @@ SIMD_INL void vd_store_f(float *p, vdouble a) { vst1_f32(p, vcvt_f32_f64(a)); }
 
 
 /* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
+SIMD_INL vdouble vd_sqrt(vdouble a) { return vsqrtq_f64(a); }
 SIMD_INL vint vi_min(vint i, vint j) { return vminq_s32(i, j); }
 SIMD_INL vint vi_max(vint i, vint j) { return vmaxq_s32(i, j); }
 SIMD_INL vdouble vd_from_vf(vfloat a, int h) { return vcvt_f64_f32(h ? vget_high_f32(a) : vget_low_f32(a)); }

@@ -258,6 +258,7 @@ SIMD_INL void vd_store_f(float *p, vdouble a)
 
 
 /* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
+SIMD_INL vdouble vd_sqrt(vdouble a) { return _mm_sqrt_pd(a); }
 SIMD_INL vint vi_min(vint i, vint j) { const __m128i g = _mm_cmpgt_epi32(i, j); return _mm_or_si128(_mm_and_si128(g, j), _mm_andnot_si128(g, i)); }
 SIMD_INL vint vi_max(vint i, vint j) { const __m128i g = _mm_cmpgt_epi32(i, j); return _mm_or_si128(_mm_and_si128(g, i), _mm_andnot_si128(g, j)); }
 SIMD_INL vdouble vd_from_vf(vfloat a, int h) { return _mm_cvtps_pd(h ? _mm_movehl_ps(a, a) : a); }

@@ -162,7 +162,7 @@ static inline __attribute__((always_inline)) void copy16(void *d, const void *s)
  * micro_lanes): the covered pixels (bit i + 2j of cov[l]) by the int64
  * edge test of the scan (E as in flush), and the clamped depth and the
  * barycentrics of the box's four pixels by the scan's float operations
- * per lane (P as planes8), lane l's as quads (mz, mb1, mb2 of its record)
+ * per lane (P as fv_planes), lane l's as quads (mz, mb1, mb2 of its record)
  * at mq + QUAD_AT(l), mq + 32 + QUAD_AT(l), mq + 64 + QUAD_AT(l). Returns
  * the micro lanes (of L). */
 static inline __attribute__((always_inline)) unsigned micro_lanes(const __m256i *qf, unsigned L,

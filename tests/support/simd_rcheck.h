@@ -24,6 +24,7 @@ enum {
     RC_VD_GT_BITS,    /* a: n/2 doubles, blocks of 2*VD_W (x, y); out[block + l] =
                        * bit l of vd_gt_bits(x, y), out[block + VD_W + l] = 0
                        * (0xBAD in out[block] when a bit above VD_W is set) */
+    RC_VD_SQRT,       /* a: n/2 doubles; out: n/2 doubles, vd_sqrt */
     RC_COUNT
 };
 

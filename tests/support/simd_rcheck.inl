@@ -68,6 +68,12 @@ int SIMD_FN(tu_simd_rcheck)(int op, const uint32_t *a, unsigned k, int n, void *
         }
         return W;
     }
+    case RC_VD_SQRT: {
+        double *o = out;
+        const double *d = (const double *)(const void *)a;
+        for (int v = 0; v + VD_W <= n / 2; v += VD_W) vd_storeu(o + v, vd_sqrt(vd_loadu(d + v)));
+        return W;
+    }
     default: return -1;
     }
 }
