@@ -316,6 +316,21 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     }
 }
 
+/* With p->mu held: runs the eyes of the current JOB_EYE that no thread
+ * has taken yet on this thread (0 the caller's, 1 the worker), each
+ * with the lock released; returns with it held. */
+static void take_eyes(pipe_ctx *p, int thread)
+{
+    while (p->eye_next < 2) {
+        eye_state *e = &p->eye[p->eye_next++];
+        pthread_mutex_unlock(&p->mu);
+        e->thread = thread;
+        run_eye(p, e);
+        pthread_mutex_lock(&p->mu);
+        p->eye_done++;
+    }
+}
+
 static void *worker_main(void *arg)
 {
     pipe_ctx *p = arg;
@@ -328,14 +343,7 @@ static void *worker_main(void *arg)
         if (p->job_kind == JOB_EYE) {
             /* the eyes not yet taken by the caller's thread (none when it
              * was faster than this thread's wake-up) */
-            while (p->eye_next < 2) {
-                eye_state *e = &p->eye[p->eye_next++];
-                pthread_mutex_unlock(&p->mu);
-                e->thread = 1;
-                run_eye(p, e);
-                pthread_mutex_lock(&p->mu);
-                p->eye_done++;
-            }
+            take_eyes(p, 1);
         } else {
             pthread_mutex_unlock(&p->mu);
             pipe__pose_skin_part(&p->pose, p->plans, 1, 2);
@@ -693,14 +701,7 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
         run_eye(p, &p->eye[0]);
         pthread_mutex_lock(&p->mu);
         p->eye_done++;
-        while (p->eye_next < 2) {
-            eye_state *e = &p->eye[p->eye_next++];
-            pthread_mutex_unlock(&p->mu);
-            e->thread = 0;
-            run_eye(p, e);
-            pthread_mutex_lock(&p->mu);
-            p->eye_done++;
-        }
+        take_eyes(p, 0);
         while (p->eye_done < 2) pthread_cond_wait(&p->cv, &p->mu);
         pthread_mutex_unlock(&p->mu);
     } else {
