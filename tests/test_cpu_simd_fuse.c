@@ -104,18 +104,23 @@ static void check_isa(ef_isa isa, tu_simd_fcheck_fn *fn)
     assert_int_equal(bad, 0);
 }
 
-static void test_sse2(void **state) { (void)state; check_isa(EF_ISA_SSE2, tu_simd_fcheck_sse2); }
-static void test_avx2(void **state) { (void)state; check_isa(EF_ISA_AVX2, tu_simd_fcheck_avx2); }
-static void test_avx512(void **state) { (void)state; check_isa(EF_ISA_AVX512, tu_simd_fcheck_avx512); }
-static void test_neon(void **state) { (void)state; check_isa(EF_ISA_NEON, tu_simd_fcheck_neon); }
+/* one test per ISA, its index as the state */
+static const ef_isa isas[4] = { EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512, EF_ISA_NEON };
+static tu_simd_fcheck_fn *const fns[4] = { tu_simd_fcheck_sse2, tu_simd_fcheck_avx2,
+                                           tu_simd_fcheck_avx512, tu_simd_fcheck_neon };
+static int idx[4] = { 0, 1, 2, 3 };
+
+static void test_isa(void **state)
+{
+    const int i = *(const int *)*state;
+    check_isa(isas[i], fns[i]);
+}
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_sse2),
-        cmocka_unit_test(test_avx2),
-        cmocka_unit_test(test_avx512),
-        cmocka_unit_test(test_neon),
+        cmocka_unit_test_prestate(test_isa, &idx[0]), cmocka_unit_test_prestate(test_isa, &idx[1]),
+        cmocka_unit_test_prestate(test_isa, &idx[2]), cmocka_unit_test_prestate(test_isa, &idx[3]),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

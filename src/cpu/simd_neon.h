@@ -351,12 +351,12 @@ SIMD_INL vint vh_packus32(vint i, vint j)
 {
     return vreinterpretq_s32_u16(vcombine_u16(vqmovun_s32(i), vqmovun_s32(j)));
 }
+/* the 32-bit products narrowed by 16 (SHRN) */
 SIMD_INL vint vh_mulhi(vint i, vint j)
 {
     const uint16x8_t a = vreinterpretq_u16_s32(i), b = vreinterpretq_u16_s32(j);
-    const uint32x4_t lo = vmull_u16(vget_low_u16(a), vget_low_u16(b));
-    const uint32x4_t hi = vmull_high_u16(a, b);
-    return vreinterpretq_s32_u16(vuzp2q_u16(vreinterpretq_u16_u32(lo), vreinterpretq_u16_u32(hi)));
+    return vreinterpretq_s32_u16(vcombine_u16(vshrn_n_u32(vmull_u16(vget_low_u16(a), vget_low_u16(b)), 16),
+                                              vshrn_n_u32(vmull_high_u16(a, b), 16)));
 }
 
 #else

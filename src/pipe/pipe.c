@@ -44,6 +44,8 @@ typedef struct eye_state {
     pipe__reproj rp;          /* eye_view REPROJECT: the eye's view */
     int view_used;            /* this frame: PIPE_VIEW_* */
     long fallbacks;           /* reprojecting frames that fell back */
+    int thread;               /* 0 the caller's thread, 1 the worker */
+    double t_start;           /* now_ms() at the eye's start */
 } eye_state;
 
 struct pipe_ctx {
@@ -59,6 +61,8 @@ struct pipe_ctx {
     pthread_cond_t cv;
     int job_seq, done_seq, quit;
     int job_kind;             /* JOB_SKIN or JOB_EYE */
+    int eye_next, eye_done;   /* JOB_EYE: the next eye to take (2: none
+                                 left), the eyes finished */
     int skin_split;           /* skin on both threads (large models) */
     kin_skin_plan *plans;     /* per mesh: the skin plan of a skinned mesh */
     void **plan_mem;          /* per mesh: its memory, or NULL */
@@ -80,10 +84,14 @@ enum { JOB_SKIN, JOB_EYE };
  * split over two. AVX-512 skins about 160k vertices per ms. */
 #define PIPE_SPLIT_SKIN_VERTICES 65536
 
+/* The clock of pipe_frame_stats: wall time, or with pipe_set_stats_clock
+ * the calling thread's CPU time. */
+static int stats_cpu_clock;
+
 static double now_ms(void)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(stats_cpu_clock ? CLOCK_THREAD_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
     return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
 }
 
@@ -196,6 +204,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     const pipe_frame_in *in = e->in;
     const int cw = p->geo.crop_width, ch = p->geo.crop_height;
     double t0 = now_ms();
+    e->t_start = t0;
     e->result = PIPE_OK;
     e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
     rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
@@ -371,6 +380,21 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     }
 }
 
+/* With p->mu held: runs the eyes of the current JOB_EYE that no thread
+ * has taken yet on this thread (0 the caller's, 1 the worker), each
+ * with the lock released; returns with it held. */
+static void take_eyes(pipe_ctx *p, int thread)
+{
+    while (p->eye_next < 2) {
+        eye_state *e = &p->eye[p->eye_next++];
+        pthread_mutex_unlock(&p->mu);
+        e->thread = thread;
+        run_eye(p, e);
+        pthread_mutex_lock(&p->mu);
+        p->eye_done++;
+    }
+}
+
 static void *worker_main(void *arg)
 {
     pipe_ctx *p = arg;
@@ -380,11 +404,15 @@ static void *worker_main(void *arg)
         while (p->job_seq == seen && !p->quit) pthread_cond_wait(&p->cv, &p->mu);
         if (p->quit) break;
         seen = p->job_seq;
-        int kind = p->job_kind;
-        pthread_mutex_unlock(&p->mu);
-        if (kind == JOB_SKIN) pipe__pose_skin_part(&p->pose, p->plans, 1, 2);
-        else run_eye(p, &p->eye[1]);
-        pthread_mutex_lock(&p->mu);
+        if (p->job_kind == JOB_EYE) {
+            /* the eyes not yet taken by the caller's thread (none when it
+             * was faster than this thread's wake-up) */
+            take_eyes(p, 1);
+        } else {
+            pthread_mutex_unlock(&p->mu);
+            pipe__pose_skin_part(&p->pose, p->plans, 1, 2);
+            pthread_mutex_lock(&p->mu);
+        }
         p->done_seq = seen;
         pthread_cond_broadcast(&p->cv);
     }
@@ -732,13 +760,28 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
         p->eye[e].head = head;
     }
     if (p->threaded) {
-        int job = post_job(p, JOB_EYE);
+        /* Eye 0 here, eye 1 on whichever thread is free first: the worker
+         * when it has woken, else this one (no wait for a late wake-up). */
+        pthread_mutex_lock(&p->mu);
+        p->eye_next = 1;
+        p->eye_done = 0;
+        p->job_kind = JOB_EYE;
+        ++p->job_seq;
+        pthread_cond_broadcast(&p->cv);
+        pthread_mutex_unlock(&p->mu);
+        p->eye[0].thread = 0;
         run_eye(p, &p->eye[0]);
-        wait_job(p, job);
+        pthread_mutex_lock(&p->mu);
+        p->eye_done++;
+        take_eyes(p, 0);
+        while (p->eye_done < 2) pthread_cond_wait(&p->cv, &p->mu);
+        pthread_mutex_unlock(&p->mu);
     } else {
+        p->eye[0].thread = p->eye[1].thread = 0;
         run_eye(p, &p->eye[0]);
         run_eye(p, &p->eye[1]);
     }
+    double t2 = now_ms();
     if (stats) {
         stats->ms_pose = t1 - t0;
         for (int e = 0; e < 2; e++) {
@@ -752,8 +795,11 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
             stats->view_sampled[e] = rp ? p->eye[e].rp.sampled : 0;
             stats->view_filled[e] = rp ? p->eye[e].rp.filled : 0;
             stats->view_outside[e] = rp ? p->eye[e].rp.outside : 0;
+            stats->eye_thread[e] = p->eye[e].thread;
+            stats->ms_eye_start[e] = p->eye[e].t_start - t1;
         }
         stats->view_fallbacks = p->eye[0].fallbacks + p->eye[1].fallbacks;
+        stats->ms_eyes = t2 - t1;
         stats->ms_total = now_ms() - t0;
     }
     for (int e = 0; e < 2; e++) {
@@ -842,6 +888,8 @@ int pipe_image_opaque(const fuse_image *im, int x0, int y0, int w, int h)
     }
     return 1;
 }
+
+void pipe_set_stats_clock(int thread_cpu) { stats_cpu_clock = thread_cpu != 0; }
 
 int pipe_isa(const pipe_ctx *p) { return rast_context_isa(p->eye[0].rast); }
 

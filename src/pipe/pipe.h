@@ -231,6 +231,12 @@ typedef struct pipe_frame_stats {
     long view_outside[2];
     long view_fallbacks;      /* reprojection: eye-frames that fell back
                                  to the crop, since pipe_create */
+    /* Where the eyes ran (threads 2: each eye is taken by whichever
+     * thread is free first, so the caller's thread runs both when the
+     * worker has not woken by the time it finished its first) */
+    int eye_thread[2];        /* per eye: 0 the caller's thread, 1 the worker */
+    double ms_eye_start[2];   /* per eye: ms from the eyes' hand-off to its start */
+    double ms_eyes;           /* wall time from the hand-off to both eyes done */
 } pipe_frame_stats;
 
 typedef enum pipe_result {
@@ -276,6 +282,13 @@ kin_camera pipe_view_camera(const pipe_ctx *p, int eye);
 const uint8_t *pipe_view_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The ISA that raster and fuse use (an ef_isa value). */
 int pipe_isa(const pipe_ctx *p);
+
+/* The clock of every pipe_frame_stats time, for all contexts: 0 (the
+ * default) wall time (CLOCK_MONOTONIC), 1 the CPU time of the thread that
+ * runs the stage (CLOCK_THREAD_CPUTIME_ID: for benchmarks on a shared
+ * machine, where wall time measures the neighbours; a thread's waits do
+ * not count). Set it before any pipe_frame runs. */
+void pipe_set_stats_clock(int thread_cpu);
 /* The derived HMD numbers in use (crop, viewport). */
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p);
 /* 1 when every pixel of the rectangle (x0, y0, w, h) of the RGBA8 image
