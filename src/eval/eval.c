@@ -10,6 +10,7 @@
 #include "eval_internal.h"
 #include "../cli/cli.h"
 #include "../io/io_lod.h"
+#include "../fit/fit_band.h"
 
 /* The ground truth comes from samples/gt/ and the sample generator
  * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
@@ -71,7 +72,7 @@ static void ctx_free(eval_ctx *c)
         free(c->P[e]); free(c->sil[e]); free(c->sil_prev[e]); free(c->tnrm[e]); free(c->V[e]); free(c->ideal[e]);
     }
     free(c->aa_samples);
-    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->layer); free(c->out);
+    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->refined_wide); free(c->band_region); free(c->mask_prior); free(c->layer); free(c->out);
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
     free(c->gt_depth); free(c->gt_mask);
@@ -157,6 +158,9 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->aa_samples = malloc(sizeof(uint32_t) * cp);
     c->mask_up = malloc(cp);
     c->refined = malloc(cp);
+    c->refined_wide = malloc(cp);
+    c->band_region = malloc(cp);
+    c->mask_prior = malloc(cp);
     c->layer = malloc(cp * 4);
     c->out = malloc(vp * 4);
     c->depth_lo = malloc(sizeof(float) * cp);
@@ -167,7 +171,8 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     rp.margin = 64;
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
-    ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && c->layer && c->out && c->depth_lo &&
+    ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && c->refined_wide &&
+         c->band_region && c->mask_prior && c->layer && c->out && c->depth_lo &&
          c->nrm_lo && c->mnrm && c->refine_scratch;
     c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
     c->gt_mask = malloc((size_t)GEN_CAM_W * GEN_CAM_H);
@@ -415,6 +420,17 @@ static int fit_elbows(eval_ctx *c, method_run *r, const kin_model *m, uint32_t v
     return 0;
 }
 
+static pipe_fit_band_desc band_desc(const method_cfg *cfg)
+{
+    pipe_fit_band_desc bd = pipe_fit_band_desc_default();
+    bd.sigma = cfg->band_sigma;
+    bd.tau = cfg->band_tau;
+    bd.band_min = cfg->band;
+    bd.band_max = cfg->band_max;
+    if (getenv("ACC_HAND_R")) bd.hand_radius = (float)atof(getenv("ACC_HAND_R"));
+    return bd;
+}
+
 static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const char *dump)
 {
     const method_cfg *cfg = &r->cfg;
@@ -447,10 +463,18 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         if (cfg->kind == M_KIN) {
             s = r->last;
         } else {
-            kin_filter_output(&r->filter, T, &s, NULL);
+            /* the hands' lag compensated by their speed (fit_band.h;
+             * v1 0: kin_filter_output) */
+            pipe_fit_filter_output(&r->filter, T, cfg->lag_adapt_v0, cfg->lag_adapt_v1, &s, NULL);
             cp = &cal;
         }
         posed = kin_arm_rig_pose(&c->rig, m, cp, NULL, &s, r->locals, NULL);
+        r->sides = ((s.valid & KIN_TRACK_HAND_L) ? 1u : 0u) | ((s.valid & KIN_TRACK_HAND_R) ? 2u : 0u);
+        for (int k = 0; k < 2; k++) {
+            /* the wrist's speed: the filter's velocity (raw methods: 0) */
+            const kin_vec3 v = cfg->kind == M_KIN ? kin_v3(0, 0, 0) : r->filter.part[3 + k].dx;
+            r->speed[k] = sqrtf(v.x * v.x + v.y * v.y + v.z * v.z);
+        }
         if (posed) pose_skin(c, cfg, m, r->locals);
         if (posed && cfg->kind == M_REFINE && cfg->fit) {
             pipe_fit_shape(r->fit, c->world, c->pos);
@@ -488,7 +512,27 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             if (cfg->kind == M_REFINE) {
                 fuse_refine_params rp = fuse_refine_params_default();
                 rp.band = cfg->band;
+                int wide = rp.band;
+                if (cfg->band_auto && posed) {
+                    /* the band from the projected uncertainty (fit_band.h):
+                     * mode 1 the whole mask, mode 2 the hands only */
+                    pipe_fit_band_desc bd = band_desc(cfg);
+                    wide = pipe_fit_band(&bd, &cam, c->world, &c->rig, r->sides, r->speed);
+                    if (cfg->band_auto == 1) rp.band = wide;
+                }
+                r->band_sum += wide;
+                r->n_band++;
                 fuse_image P = { c->P[e], CW, CH, 4 * CW };
+                const uint8_t *kmask = mask;   /* the kinematic mask */
+                if (cfg->prior_radius > 0.0f && posed && r->have_prev) {
+                    /* the previous refined mask as the input around the
+                     * slow hands (fit_band.h) */
+                    pipe_fit_band_desc bd = band_desc(cfg);
+                    bd.hand_radius = cfg->prior_radius;
+                    mask = pipe_fit_prior(&bd, &cam, c->world, &c->rig, r->sides, r->speed,
+                                          cfg->prior_speed, mask, r->prev[e], c->band_region,
+                                          c->mask_prior, CW);
+                }
                 /* the global term only once the fit has a colour model
                  * (as pipe_frame): an all-zero one would halve the local
                  * term */
@@ -501,15 +545,35 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                         : fuse_refine_mask(&rp, &P, mask, CW, c->refined, CW, c->refine_scratch,
                                            c->refine_scratch_size, &rs);
                 if (fr != FUSE_OK) return -1;
+                if (cfg->band_auto && posed && wide > rp.band) {
+                    /* the hands' part of the image with the wide band */
+                    pipe_fit_band_desc bd = band_desc(cfg);
+                    fuse_refine_params wp = rp;
+                    wp.band = wide;
+                    fuse_refine_stats ws;
+                    fr = cfg->fit && cfg->global > 0.0f && pipe_fit_learned(r->fit, e)
+                             ? fuse_refine_mask_global(&wp, pipe_fit_colour(r->fit, e), cfg->global,
+                                                       &P, mask, CW, c->refined_wide, CW,
+                                                       c->refine_scratch, c->refine_scratch_size,
+                                                       &ws)
+                             : fuse_refine_mask(&wp, &P, mask, CW, c->refined_wide, CW,
+                                                c->refine_scratch, c->refine_scratch_size, &ws);
+                    if (fr != FUSE_OK) return -1;
+                    if (ws.used_colour &&
+                        pipe_fit_band_region(&bd, &cam, c->world, &c->rig, r->sides, wide,
+                                             c->band_region, CW) > 0)
+                        pipe_fit_band_merge(c->refined, c->refined_wide, c->band_region,
+                                            c->refined, CW, CW, CH);
+                }
                 /* not from a fallback (out = M): its widths are the
                  * model's own (as pipe_frame) */
                 if (cfg->fit && posed && rs.used_colour) {
                     /* the next frame's fit: the colour model from this
                      * frame's kinematic and refined masks (no extra
                      * raster), and the limb widths (self-calibration) */
-                    if (pipe_fit_learn(r->fit, e, &P, mask, CW, c->refined, CW) != FUSE_OK)
+                    if (pipe_fit_learn(r->fit, e, &P, kmask, CW, c->refined, CW) != FUSE_OK)
                         return -1;
-                    pipe_fit_measure(r->fit, e, &cam, c->world, mask, CW, c->refined, CW);
+                    pipe_fit_measure(r->fit, e, &cam, c->world, kmask, CW, c->refined, CW);
                 }
                 mask = c->refined;
             }
@@ -605,6 +669,14 @@ static method_cfg base_cfg(const eval_opts *o, method_kind k)
     c.band = o->band;
     c.fit = k == M_REFINE;
     c.global = o->global;
+    c.band_auto = getenv("ACC_BAND_AUTO") ? atoi(getenv("ACC_BAND_AUTO")) : 0;
+    c.band_sigma = getenv("ACC_BAND_SIGMA") ? (float)atof(getenv("ACC_BAND_SIGMA")) : 0.02f;
+    c.band_tau = getenv("ACC_BAND_TAU") ? (float)atof(getenv("ACC_BAND_TAU")) : 0.0f;
+    c.band_max = getenv("ACC_BAND_MAX") ? atoi(getenv("ACC_BAND_MAX")) : 64;
+    c.prior_radius = getenv("ACC_PRIOR_R") ? (float)atof(getenv("ACC_PRIOR_R")) : 0.0f;
+    c.prior_speed = getenv("ACC_PRIOR_V") ? (float)atof(getenv("ACC_PRIOR_V")) : 0.3f;
+    c.lag_adapt_v0 = getenv("ACC_LAG_V0") ? (float)atof(getenv("ACC_LAG_V0")) : 0.0f;
+    c.lag_adapt_v1 = getenv("ACC_LAG_V1") ? (float)atof(getenv("ACC_LAG_V1")) : 0.0f;
     c.track = gt_track_default();
     c.track.noise_mm = o->noise;
     c.track.latency_ms = o->latency;

@@ -34,6 +34,17 @@ typedef struct method_cfg {
     int lod;                 /* level of detail: 0 = full, a level, or
                                 PIPE_LOD_AUTO (eval_lod.c) */
     float lod_px;            /* the rule's target, px */
+    int band_auto;           /* refine: band from the projected uncertainty
+                                (pipe_fit_band, band = its minimum) */
+    float band_sigma, band_tau;
+    int band_max;
+    float prior_radius;      /* refine: the last refined mask is the input
+                                within this many metres of slow hands (0 off) */
+    float prior_speed;       /* m/s: slower hands use it */
+    float lag_adapt_v0, lag_adapt_v1;   /* refine, kin-cal-pred: lag
+                                           compensation of the hands from
+                                           speed v0 (none) to v1 (full), m/s;
+                                           v1 0 = off */
 } method_cfg;
 
 /* Per-configuration state and sums. */
@@ -50,6 +61,10 @@ typedef struct method_run {
     pipe_fit *fit;           /* refine: the elbow fit and colour models */
     float thick[2][2];       /* refine: limb thickness measured by the fit */
     int have_thick;
+    unsigned sides;          /* tracked hands of the frame (bit 0 left) */
+    float speed[2];          /* the filter's wrist speeds, m/s */
+    double band_sum;         /* refine: the bands used, summed over eyes */
+    long n_band;
     /* sums over frames and eyes */
     double iou, bf1, bf3, fp, fn, mse, flicker, flicker_den, secs;
     long n_eye, n_flicker, n_frames;
@@ -84,6 +99,7 @@ typedef struct eval_ctx {
     kin_camera tcam[2];
     /* method scratch */
     uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
+    uint8_t *refined_wide, *band_region, *mask_prior;   /* refine: the hands' wide band (fit_band.h) */
     uint32_t *aa_samples;    /* anti-aliased coverage, 640x400 */
     float *depth_lo, *nrm_lo, *mnrm;
     void *refine_scratch;

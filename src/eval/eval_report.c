@@ -87,6 +87,9 @@ void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int 
                    "(true %.2f)\n",
                 (double)R[i].thick[0][1], (double)R[i].thick[1][1], (double)c->op.fore_thick,
                 (double)R[i].thick[0][0], (double)R[i].thick[1][0], (double)c->op.upper_thick);
+        if (R[i].cfg.band_auto && R[i].n_band > 0)
+            fprintf(f, "refine's band from the projected uncertainty: mean %.1f px\n",
+                    R[i].band_sum / (double)R[i].n_band);
         return;
     }
 }
