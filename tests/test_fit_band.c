@@ -158,7 +158,7 @@ static double run_frames(scene *s, int n, int with_prior, float speed, int *used
     for (int i = 0; i < n; i++) {
         const uint8_t *in = s->kin;
         if (with_prior)
-            in = pipe_fit_prior(&d, &cam, world, &rig, 3u, sp, 0.3f, s->kin,
+            in = pipe_fit_prior(&d, &cam, world, &rig, 3u, sp, 0.3f, NULL, s->kin,
                                 have_prev ? s->prev : NULL, s->region, s->prior, W);
         if (in != s->kin) (*used_prior)++;
         fuse_refine_stats st;
@@ -255,9 +255,9 @@ static void region_and_merge(void **state)
     assert_int_equal(o[0], 1);
     /* no prior without a last mask, or with an untracked hand */
     const float sp[2] = { 0, 0 };
-    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, a, NULL, reg, o, W), a);
-    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 0u, sp, 0.3f, a, b, reg, o, W), a);
-    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, a, b, reg, o, W), o);
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, NULL, a, NULL, reg, o, W), a);
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 0u, sp, 0.3f, NULL, a, b, reg, o, W), a);
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, NULL, a, b, reg, o, W), o);
     free(reg); free(a); free(b); free(o);
 }
 

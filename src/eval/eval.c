@@ -72,7 +72,7 @@ static void ctx_free(eval_ctx *c)
         free(c->P[e]); free(c->sil[e]); free(c->sil_prev[e]); free(c->tnrm[e]); free(c->V[e]); free(c->ideal[e]);
     }
     free(c->aa_samples);
-    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->refined_wide); free(c->band_region); free(c->mask_prior); free(c->layer); free(c->out);
+    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->band_region); free(c->mask_prior); free(c->layer); free(c->out);
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
     free(c->gt_depth); free(c->gt_mask);
@@ -158,7 +158,6 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->aa_samples = malloc(sizeof(uint32_t) * cp);
     c->mask_up = malloc(cp);
     c->refined = malloc(cp);
-    c->refined_wide = malloc(cp);
     c->band_region = malloc(cp);
     c->mask_prior = malloc(cp);
     c->layer = malloc(cp * 4);
@@ -171,7 +170,7 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     rp.margin = 64;
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
-    ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && c->refined_wide &&
+    ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && 
          c->band_region && c->mask_prior && c->layer && c->out && c->depth_lo &&
          c->nrm_lo && c->mnrm && c->refine_scratch;
     c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
@@ -427,7 +426,6 @@ static pipe_fit_band_desc band_desc(const method_cfg *cfg)
     bd.tau = cfg->band_tau;
     bd.band_min = cfg->band;
     bd.band_max = cfg->band_max;
-    if (getenv("ACC_HAND_R")) bd.hand_radius = (float)atof(getenv("ACC_HAND_R"));
     return bd;
 }
 
@@ -512,26 +510,24 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             if (cfg->kind == M_REFINE) {
                 fuse_refine_params rp = fuse_refine_params_default();
                 rp.band = cfg->band;
-                int wide = rp.band;
                 if (cfg->band_auto && posed) {
-                    /* the band from the projected uncertainty (fit_band.h):
-                     * mode 1 the whole mask, mode 2 the hands only */
+                    /* the band from the projected uncertainty (fit_band.h),
+                     * at least --band */
                     pipe_fit_band_desc bd = band_desc(cfg);
-                    wide = pipe_fit_band(&bd, &cam, c->world, &c->rig, r->sides, r->speed);
-                    if (cfg->band_auto == 1) rp.band = wide;
+                    rp.band = pipe_fit_band(&bd, &cam, c->world, &c->rig, r->sides, r->speed);
                 }
-                r->band_sum += wide;
+                r->band_sum += rp.band;
                 r->n_band++;
                 fuse_image P = { c->P[e], CW, CH, 4 * CW };
                 const uint8_t *kmask = mask;   /* the kinematic mask */
                 if (cfg->prior_radius > 0.0f && posed && r->have_prev) {
-                    /* the previous refined mask as the input around the
-                     * slow hands (fit_band.h) */
+                    /* the last refined mask as the input around the slow
+                     * hands (fit_band.h) */
                     pipe_fit_band_desc bd = band_desc(cfg);
                     bd.hand_radius = cfg->prior_radius;
                     mask = pipe_fit_prior(&bd, &cam, c->world, &c->rig, r->sides, r->speed,
-                                          cfg->prior_speed, mask, r->prev[e], c->band_region,
-                                          c->mask_prior, CW);
+                                          cfg->prior_speed, NULL, mask, r->prev[e],
+                                          c->band_region, c->mask_prior, CW);
                 }
                 /* the global term only once the fit has a colour model
                  * (as pipe_frame): an all-zero one would halve the local
@@ -545,26 +541,6 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                         : fuse_refine_mask(&rp, &P, mask, CW, c->refined, CW, c->refine_scratch,
                                            c->refine_scratch_size, &rs);
                 if (fr != FUSE_OK) return -1;
-                if (cfg->band_auto && posed && wide > rp.band) {
-                    /* the hands' part of the image with the wide band */
-                    pipe_fit_band_desc bd = band_desc(cfg);
-                    fuse_refine_params wp = rp;
-                    wp.band = wide;
-                    fuse_refine_stats ws;
-                    fr = cfg->fit && cfg->global > 0.0f && pipe_fit_learned(r->fit, e)
-                             ? fuse_refine_mask_global(&wp, pipe_fit_colour(r->fit, e), cfg->global,
-                                                       &P, mask, CW, c->refined_wide, CW,
-                                                       c->refine_scratch, c->refine_scratch_size,
-                                                       &ws)
-                             : fuse_refine_mask(&wp, &P, mask, CW, c->refined_wide, CW,
-                                                c->refine_scratch, c->refine_scratch_size, &ws);
-                    if (fr != FUSE_OK) return -1;
-                    if (ws.used_colour &&
-                        pipe_fit_band_region(&bd, &cam, c->world, &c->rig, r->sides, wide,
-                                             c->band_region, CW) > 0)
-                        pipe_fit_band_merge(c->refined, c->refined_wide, c->band_region,
-                                            c->refined, CW, CW, CH);
-                }
                 /* not from a fallback (out = M): its widths are the
                  * model's own (as pipe_frame) */
                 if (cfg->fit && posed && rs.used_colour) {
@@ -669,14 +645,18 @@ static method_cfg base_cfg(const eval_opts *o, method_kind k)
     c.band = o->band;
     c.fit = k == M_REFINE;
     c.global = o->global;
-    c.band_auto = getenv("ACC_BAND_AUTO") ? atoi(getenv("ACC_BAND_AUTO")) : 0;
-    c.band_sigma = getenv("ACC_BAND_SIGMA") ? (float)atof(getenv("ACC_BAND_SIGMA")) : 0.02f;
-    c.band_tau = getenv("ACC_BAND_TAU") ? (float)atof(getenv("ACC_BAND_TAU")) : 0.0f;
-    c.band_max = getenv("ACC_BAND_MAX") ? atoi(getenv("ACC_BAND_MAX")) : 64;
-    c.prior_radius = getenv("ACC_PRIOR_R") ? (float)atof(getenv("ACC_PRIOR_R")) : 0.0f;
-    c.prior_speed = getenv("ACC_PRIOR_V") ? (float)atof(getenv("ACC_PRIOR_V")) : 0.3f;
-    c.lag_adapt_v0 = getenv("ACC_LAG_V0") ? (float)atof(getenv("ACC_LAG_V0")) : 0.0f;
-    c.lag_adapt_v1 = getenv("ACC_LAG_V1") ? (float)atof(getenv("ACC_LAG_V1")) : 0.0f;
+    if (k == M_REFINE) {
+        /* docs/accuracy.md, issue 14 item 2: the last refined mask as the
+         * prior within 6 cm of hands slower than 0.5 m/s; the hands' lag
+         * compensated from 0.2 to 0.8 m/s; the band from the projected
+         * uncertainty measured, off */
+        c.prior_radius = EVAL_PRIOR_RADIUS;
+        c.prior_speed = EVAL_PRIOR_SPEED;
+        c.lag_adapt_v0 = EVAL_LAG_V0;
+        c.lag_adapt_v1 = EVAL_LAG_V1;
+    }
+    c.band_sigma = 0.007f;
+    c.band_max = 64;
     c.track = gt_track_default();
     c.track.noise_mm = o->noise;
     c.track.latency_ms = o->latency;
@@ -751,6 +731,18 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
         n = add_cfg(L, n, cap, c);
         c = named_cfg(o, M_REFINE, "global", 0.0f, "global", "");
         c.global = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        /* issue 14 item 2: refine without the prior, without the adaptive
+         * lag compensation, and with the band from the projected
+         * uncertainty (docs/accuracy.md) */
+        c = named_cfg(o, M_REFINE, "prior", 0.0f, "prior", "");
+        c.prior_radius = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        c = named_cfg(o, M_REFINE, "lagadapt", 0.0f, "lagadapt", "");
+        c.lag_adapt_v1 = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        c = named_cfg(o, M_REFINE, "bandauto", 1.0f, "bandauto", "");
+        c.band_auto = 1;
         n = add_cfg(L, n, cap, c);
         for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
             c = named_cfg(o, (method_kind)k, "lagcomp", 1.0f, "lagcomp", "");

@@ -35,7 +35,7 @@ typedef struct method_cfg {
                                 PIPE_LOD_AUTO (eval_lod.c) */
     float lod_px;            /* the rule's target, px */
     int band_auto;           /* refine: band from the projected uncertainty
-                                (pipe_fit_band, band = its minimum) */
+                                (pipe_fit_band, band = its minimum); 0 off */
     float band_sigma, band_tau;
     int band_max;
     float prior_radius;      /* refine: the last refined mask is the input
@@ -46,6 +46,12 @@ typedef struct method_cfg {
                                            speed v0 (none) to v1 (full), m/s;
                                            v1 0 = off */
 } method_cfg;
+
+/* refine's defaults (docs/accuracy.md, issue 14 item 2) */
+#define EVAL_PRIOR_RADIUS 0.06f
+#define EVAL_PRIOR_SPEED 0.5f
+#define EVAL_LAG_V0 0.2f
+#define EVAL_LAG_V1 0.8f
 
 /* Per-configuration state and sums. */
 typedef struct method_run {
@@ -99,7 +105,7 @@ typedef struct eval_ctx {
     kin_camera tcam[2];
     /* method scratch */
     uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
-    uint8_t *refined_wide, *band_region, *mask_prior;   /* refine: the hands' wide band (fit_band.h) */
+    uint8_t *band_region, *mask_prior;   /* refine: the prior (fit_band.h) */
     uint32_t *aa_samples;    /* anti-aliased coverage, 640x400 */
     float *depth_lo, *nrm_lo, *mnrm;
     void *refine_scratch;

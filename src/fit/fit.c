@@ -350,12 +350,6 @@ fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint
                                             f->scratch[eye], f->scratch_size);
     if (r != FUSE_OK) return r;
     f->learned[eye] = f->cm[eye].fg_samples >= 64 && f->cm[eye].bg_samples >= 64;
-    if (f->learned[eye] && getenv("ACC_CHROMA")) {
-        static _Thread_local uint32_t cs[2 * 1024 + 1024];
-        r = fuse_colour_model_chroma(&f->cm[eye], P, learn, stride, 4, 2, 3.0f, 64,
-                                     (float)atof(getenv("ACC_CHROMA")), 60.0f, cs, sizeof cs);
-        if (r != FUSE_OK) return r;
-    }
     return FUSE_OK;
 }
 

@@ -122,17 +122,64 @@ void pipe_fit_band_merge(const uint8_t *narrow, const uint8_t *wide, const uint8
 
 const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *d, const kin_camera *cam,
                               const kin_mat4 *world, const kin_arm_rig *rig, unsigned sides,
-                              const float speed[2], float max_speed, const uint8_t *kin,
-                              const uint8_t *prev, uint8_t *region, uint8_t *out, int stride)
+                              const float speed[2], float max_speed, const float shift[2][2],
+                              const uint8_t *kin, const uint8_t *prev, uint8_t *region,
+                              uint8_t *out, int stride)
 {
-    if (!kin || !prev || !region || !out || !cam || !world || !rig || !speed) return kin;
-    unsigned slow = 0;
-    for (int k = 0; k < 2; k++)
-        if ((sides & (1u << k)) && speed[k] < max_speed) slow |= 1u << k;
-    if (!slow || pipe_fit_band_region(d, cam, world, rig, slow, 0, region, stride) <= 0)
+    if (!kin || !prev || !region || !out || !cam || !world || !rig || !speed ||
+        stride < cam->width)
         return kin;
-    pipe_fit_band_merge(kin, prev, region, out, stride, cam->width, cam->height);
-    return out;
+    const int W = cam->width, H = cam->height;
+    int any = 0;
+    for (int k = 0; k < 2; k++) {
+        if (!(sides & (1u << k)) || !(speed[k] < max_speed)) continue;
+        if (pipe_fit_band_region(d, cam, world, rig, 1u << k, 0, region, stride) <= 0) continue;
+        if (!any) {
+            for (int y = 0; y < H; y++)
+                memcpy(out + (size_t)y * (size_t)stride, kin + (size_t)y * (size_t)stride,
+                       (size_t)W);
+            any = 1;
+        }
+        int sx = 0, sy = 0;
+        if (shift && isfinite(shift[k][0]) && isfinite(shift[k][1]) &&
+            fabsf(shift[k][0]) < (float)W && fabsf(shift[k][1]) < (float)H) {
+            sx = (int)lrintf(shift[k][0]);
+            sy = (int)lrintf(shift[k][1]);
+        }
+        for (int y = 0; y < H; y++) {
+            const uint8_t *r = region + (size_t)y * (size_t)stride;
+            uint8_t *o = out + (size_t)y * (size_t)stride;
+            const int ys = y - sy;
+            for (int x = 0; x < W; x++) {
+                if (!r[x]) continue;
+                const int xs = x - sx;
+                if (ys < 0 || ys >= H || xs < 0 || xs >= W) continue;   /* kin stays */
+                o[x] = prev[(size_t)ys * (size_t)stride + (size_t)xs];
+            }
+        }
+    }
+    return any ? out : kin;
+}
+
+int pipe_fit_hand_px(const kin_camera *cam, const kin_mat4 *world, const kin_arm_rig *rig,
+                     int side, float xy[2])
+{
+    if (!cam || !world || !rig || !xy || side < 0 || side > 1) return 0;
+    double sx = 0.0, sy = 0.0;
+    int n = 0;
+    for (int j = KIN_RIG_HAND; j < KIN_RIG_SIDE_JOINTS; j++) {
+        const int node = rig->joint[side][j];
+        if (node < 0) return 0;
+        float x, y, z;
+        if (!joint_px(cam, &world[node], INFINITY, &x, &y, &z)) continue;
+        sx += x;
+        sy += y;
+        n++;
+    }
+    if (!n) return 0;
+    xy[0] = (float)(sx / n);
+    xy[1] = (float)(sy / n);
+    return 1;
 }
 
 void pipe_fit_filter_output(const kin_filter *f, double display_t, float v0, float v1,

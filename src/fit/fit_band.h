@@ -72,23 +72,31 @@ void pipe_fit_band_merge(const uint8_t *narrow, const uint8_t *wide, const uint8
  * (docs/accuracy.md): the band refinement can move the edge only `band`
  * pixels from its input mask, and a hand whose fingers reach farther
  * beyond the model (a near hand: 1 cm is 80 px at 10 cm) is never filled
- * from the kinematic mask alone. Around the hands that move slowly the
- * input is the last refined mask instead, so that the edge keeps what the
- * colour found and moves on from there frame by frame:
+ * from the kinematic mask alone. Around the hands the input is the last
+ * refined mask instead, moved with the hand, so that the edge keeps what
+ * the colour found and moves on from there frame by frame:
  *   sides' = the tracked sides (bit 0 left) whose wrist speed is below
- *            max_speed (m/s): the last mask is where the hand still is
- *            (motion compensation by gating: a faster hand keeps the
- *            kinematic mask);
- *   region = pipe_fit_band_region(d, ..., sides', band 0) (within
- *            f * d->hand_radius / z of each hand joint in view);
- *   out    = prev inside the region, kin elsewhere.
- * Returns out, or kin when no side qualifies, the region is empty or an
+ *            max_speed (m/s);
+ *   per side s of sides': region_s = pipe_fit_band_region(d, ..., 1 << s,
+ *            band 0) (within f * d->hand_radius / z of each hand joint
+ *            in view); out = prev(x - shift[s]) there (shift: the hand's
+ *            motion in the image since the last frame, pipe_fit_hand_px;
+ *            NULL = no motion; rounded to whole pixels; kin where the
+ *            source is outside the image), the right hand's last;
+ *   out    = kin elsewhere.
+ * Returns out, or kin when no side qualifies, the regions are empty or an
  * argument is bad (prev NULL included: the first frame). kin, prev,
  * region and out: cam's image size, the same stride. */
 const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *d, const kin_camera *cam,
                               const kin_mat4 *world, const kin_arm_rig *rig, unsigned sides,
-                              const float speed[2], float max_speed, const uint8_t *kin,
-                              const uint8_t *prev, uint8_t *region, uint8_t *out, int stride);
+                              const float speed[2], float max_speed, const float shift[2][2],
+                              const uint8_t *kin, const uint8_t *prev, uint8_t *region,
+                              uint8_t *out, int stride);
+
+/* The mean image position (pixels) of side's hand joints (hand, palm,
+ * fingers) that are in front of cam; 0 when none is (or bad arguments). */
+int pipe_fit_hand_px(const kin_camera *cam, const kin_mat4 *world, const kin_arm_rig *rig,
+                     int side, float xy[2]);
 
 /* Adaptive lag compensation of the hands (docs/accuracy.md): the One
  * Euro filter's prediction without lag compensation (f->desc.no_lag_comp

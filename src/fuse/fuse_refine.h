@@ -166,22 +166,6 @@ fuse_result fuse_refine_mask_global(const fuse_refine_params *p,
                                     size_t scratch_size,
                                     fuse_refine_stats *stats);
 
-/* A shading-invariant term mixed into a learned model (after
- * fuse_colour_model_learn, from the same mask and rules): the two classes'
- * histograms of chromaticity (r, g) / (r + g + b), 32 x 32 bins, of the
- * pixels with r + g + b >= dark, as a clamped log-likelihood ratio like
- * the model's; every RGB bin whose centre colour has r + g + b >= dark
- * becomes (1 - weight) llr + weight chroma_llr (a shadowed palm scores
- * like the lit one). Too few samples (min_samples) or weight 0: cm
- * unchanged. scratch: fuse_colour_model_chroma_scratch_size() bytes,
- * 4-byte aligned. FUSE_ERR_ARGS for NULL pointers, bad sizes or
- * parameters. (fuse_refine_chroma.c) */
-size_t fuse_colour_model_chroma_scratch_size(void);
-fuse_result fuse_colour_model_chroma(fuse_colour_model *cm, const fuse_image *P,
-                                     const uint8_t *mask, int mask_stride, int margin, int step,
-                                     float clamp, long min_samples, float weight, float dark,
-                                     void *scratch, size_t scratch_size);
-
 /* ------------------------------------- refined pixels and the depth test
  *
  * The depth test against the virtual scene (fuse_depth, fuse_eye.depth)
