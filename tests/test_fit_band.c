@@ -12,7 +12,8 @@
  *     nearer = 4x wider; a hand out of view or untracked: band_min; the
  *     speed term.
  *   - region: the pixels within f r / z + band of the joints, none for
- *     untracked sides; merge picks wide inside, narrow outside.
+ *     untracked sides; merge picks wide inside, narrow outside; the prior
+ *     moved by a shift; the hand's image position.
  *   - adaptive lag compensation: a hand moving at 2 m/s is predicted
  *     closer to its true position than by the uncompensated filter (which
  *     trails it), a hand at rest exactly as by kin_filter_output.
@@ -258,6 +259,18 @@ static void region_and_merge(void **state)
     assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, NULL, a, NULL, reg, o, W), a);
     assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 0u, sp, 0.3f, NULL, a, b, reg, o, W), a);
     assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, NULL, a, b, reg, o, W), o);
+    /* moved with the hand: the last mask shifted by 10 px right, 4 down
+     * inside the region; the hand's image position */
+    float xy[2];
+    assert_int_equal(pipe_fit_hand_px(&cam, world, &rig, 0, xy), 1);
+    assert_true(fabsf(xy[0] - 160.0f) < 1e-3f && fabsf(xy[1] - 120.0f) < 1e-3f);
+    assert_int_equal(pipe_fit_hand_px(&cam, world, &rig, 2, xy), 0);
+    disc(a, 160.0f, 120.0f, 10.0f);
+    disc(b, 150.0f, 116.0f, 20.0f);
+    const float sh[2][2] = { { 10.0f, 4.0f }, { 0, 0 } };
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, sh, a, b, reg, o, W), o);
+    disc(a, 160.0f, 120.0f, 20.0f);
+    assert_memory_equal(o, a, W * H);
     free(reg); free(a); free(b); free(o);
 }
 
