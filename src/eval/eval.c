@@ -525,10 +525,24 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                      * hands (fit_band.h) */
                     pipe_fit_band_desc bd = band_desc(cfg);
                     bd.hand_radius = cfg->prior_radius;
+                    /* moved with the hand: its image motion since the
+                     * last frame (the kinematic pose's, lag and all) */
+                    float shift[2][2] = { { 0, 0 }, { 0, 0 } };
+                    for (int k = 0; k < 2; k++)
+                        if (cfg->prior_mc && r->have_hand_px[e][k] &&
+                            pipe_fit_hand_px(&cam, c->world, &c->rig, k, shift[k])) {
+                            shift[k][0] -= r->hand_px[e][k][0];
+                            shift[k][1] -= r->hand_px[e][k][1];
+                        } else {
+                            shift[k][0] = shift[k][1] = 0.0f;
+                        }
                     mask = pipe_fit_prior(&bd, &cam, c->world, &c->rig, r->sides, r->speed,
-                                          cfg->prior_speed, NULL, mask, r->prev[e],
+                                          cfg->prior_speed, shift, mask, r->prev[e],
                                           c->band_region, c->mask_prior, CW);
                 }
+                for (int k = 0; k < 2; k++)
+                    r->have_hand_px[e][k] =
+                        posed && pipe_fit_hand_px(&cam, c->world, &c->rig, k, r->hand_px[e][k]);
                 /* the global term only once the fit has a colour model
                  * (as pipe_frame): an all-zero one would halve the local
                  * term */
@@ -647,11 +661,13 @@ static method_cfg base_cfg(const eval_opts *o, method_kind k)
     c.global = o->global;
     if (k == M_REFINE) {
         /* docs/accuracy.md, issue 14 item 2: the last refined mask as the
-         * prior within 6 cm of hands slower than 0.5 m/s; the hands' lag
+         * prior within 6 cm of hands slower than 0.5 m/s, moved with the
+         * hand's image motion; the hands' lag
          * compensated from 0.2 to 0.8 m/s; the band from the projected
          * uncertainty measured, off */
         c.prior_radius = EVAL_PRIOR_RADIUS;
         c.prior_speed = EVAL_PRIOR_SPEED;
+        c.prior_mc = 1;
         c.lag_adapt_v0 = EVAL_LAG_V0;
         c.lag_adapt_v1 = EVAL_LAG_V1;
     }
@@ -737,6 +753,9 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
          * uncertainty (docs/accuracy.md) */
         c = named_cfg(o, M_REFINE, "prior", 0.0f, "prior", "");
         c.prior_radius = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        c = named_cfg(o, M_REFINE, "priormc", 0.0f, "priormc", "");
+        c.prior_mc = 0;
         n = add_cfg(L, n, cap, c);
         c = named_cfg(o, M_REFINE, "lagadapt", 0.0f, "lagadapt", "");
         c.lag_adapt_v1 = 0.0f;

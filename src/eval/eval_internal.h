@@ -41,6 +41,7 @@ typedef struct method_cfg {
     float prior_radius;      /* refine: the last refined mask is the input
                                 within this many metres of slow hands (0 off) */
     float prior_speed;       /* m/s: slower hands use it */
+    int prior_mc;            /* 1: moved with the hand (pipe_fit_hand_px) */
     float lag_adapt_v0, lag_adapt_v1;   /* refine, kin-cal-pred: lag
                                            compensation of the hands from
                                            speed v0 (none) to v1 (full), m/s;
@@ -69,6 +70,8 @@ typedef struct method_run {
     int have_thick;
     unsigned sides;          /* tracked hands of the frame (bit 0 left) */
     float speed[2];          /* the filter's wrist speeds, m/s */
+    float hand_px[2][2][2];  /* [eye][side]: the hand in the image, last frame */
+    int have_hand_px[2][2];
     double band_sum;         /* refine: the bands used, summed over eyes */
     long n_band;
     /* sums over frames and eyes */
