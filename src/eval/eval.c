@@ -419,6 +419,15 @@ static int fit_elbows(eval_ctx *c, method_run *r, const kin_model *m, uint32_t v
     return 0;
 }
 
+/* This thread's CPU time, seconds (the method's time on a shared
+ * machine, where the wall clock counts the other processes). */
+static double thread_cpu(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 static pipe_fit_band_desc band_desc(const method_cfg *cfg)
 {
     pipe_fit_band_desc bd = pipe_fit_band_desc_default();
@@ -451,6 +460,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         }
     }
     t0 = cli_now();   /* the tracker's simulation is not the method's time */
+    double c0 = thread_cpu();   /* and the same as this thread's CPU time */
     const kin_model *m = cfg->fine ? &c->mask_fine.model : &c->mask.model;
     const kin_mesh *me = &m->meshes[0];
     int posed = 0;
@@ -481,9 +491,10 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             pipe_fit_shape(r->fit, c->world, c->pos);
         }
     }
-    double secs = cli_now() - t0;
+    double secs = cli_now() - t0, cpu = thread_cpu() - c0;
     for (int e = 0; e < 2; e++) {
         t0 = cli_now();
+        c0 = thread_cpu();
         kin_camera cam = posed ? eye_camera(c, e) : c->tcam[e];
         const uint8_t *mask = c->mask_up;
         const float *nrm = c->mnrm;
@@ -578,6 +589,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                            &O) != FUSE_OK)
             return -1;
         secs += cli_now() - t0;
+        cpu += thread_cpu() - c0;
         if (cfg->lod != 0 && posed && c->full_mask && cfg->div == 1 && !cfg->fine &&
             cfg->kind != M_SKIN) {
             /* the kinematic mask (c->mask_lo) against the full model's in
@@ -639,6 +651,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
     }
     r->have_prev = 1;
     r->secs += secs;
+    r->cpu_secs += cpu;
     r->n_frames++;
     if (r->fit && cfg->fit) {
         pipe_fit_thickness(r->fit, r->thick, NULL);

@@ -72,6 +72,7 @@ typedef struct method_run {
     float speed[2];          /* the filter's wrist speeds, m/s */
     float hand_px[2][2][2];  /* [eye][side]: the hand in the image, last frame */
     int have_hand_px[2][2];
+    double cpu_secs;         /* the method's thread CPU time (ms/frame is wall) */
     double band_sum;         /* refine: the bands used, summed over eyes */
     long n_band;
     /* sums over frames and eyes */
