@@ -10,6 +10,7 @@
 #include "eval_internal.h"
 #include "../cli/cli.h"
 #include "../io/io_lod.h"
+#include "../fit/fit_band.h"
 
 /* The ground truth comes from samples/gt/ and the sample generator
  * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
@@ -71,7 +72,7 @@ static void ctx_free(eval_ctx *c)
         free(c->P[e]); free(c->sil[e]); free(c->sil_prev[e]); free(c->tnrm[e]); free(c->V[e]); free(c->ideal[e]);
     }
     free(c->aa_samples);
-    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->layer); free(c->out);
+    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->band_region); free(c->mask_prior); free(c->layer); free(c->out);
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
     free(c->gt_depth); free(c->gt_mask);
@@ -157,6 +158,8 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->aa_samples = malloc(sizeof(uint32_t) * cp);
     c->mask_up = malloc(cp);
     c->refined = malloc(cp);
+    c->band_region = malloc(cp);
+    c->mask_prior = malloc(cp);
     c->layer = malloc(cp * 4);
     c->out = malloc(vp * 4);
     c->depth_lo = malloc(sizeof(float) * cp);
@@ -167,7 +170,8 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     rp.margin = 64;
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
-    ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && c->layer && c->out && c->depth_lo &&
+    ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && 
+         c->band_region && c->mask_prior && c->layer && c->out && c->depth_lo &&
          c->nrm_lo && c->mnrm && c->refine_scratch;
     c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
     c->gt_mask = malloc((size_t)GEN_CAM_W * GEN_CAM_H);
@@ -420,6 +424,25 @@ static int fit_elbows(eval_ctx *c, method_run *r, const kin_model *m, uint32_t v
     return 0;
 }
 
+/* This thread's CPU time, seconds (the method's time on a shared
+ * machine, where the wall clock counts the other processes). */
+static double thread_cpu(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static pipe_fit_band_desc band_desc(const method_cfg *cfg)
+{
+    pipe_fit_band_desc bd = pipe_fit_band_desc_default();
+    bd.sigma = cfg->band_sigma;
+    bd.tau = cfg->band_tau;
+    bd.band_min = cfg->band;
+    bd.band_max = cfg->band_max;
+    return bd;
+}
+
 static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const char *dump)
 {
     const method_cfg *cfg = &r->cfg;
@@ -442,6 +465,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         }
     }
     t0 = cli_now();   /* the tracker's simulation is not the method's time */
+    double c0 = thread_cpu();   /* and the same as this thread's CPU time */
     const kin_model *m = cfg->fine ? &c->mask_fine.model : &c->mask.model;
     const kin_mesh *me = &m->meshes[0];
     int posed = 0;
@@ -452,10 +476,18 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         if (cfg->kind == M_KIN) {
             s = r->last;
         } else {
-            kin_filter_output(&r->filter, T, &s, NULL);
+            /* the hands' lag compensated by their speed (fit_band.h;
+             * v1 0: kin_filter_output) */
+            pipe_fit_filter_output(&r->filter, T, cfg->lag_adapt_v0, cfg->lag_adapt_v1, &s, NULL);
             cp = &cal;
         }
         posed = kin_arm_rig_pose(&c->rig, m, cp, NULL, &s, r->locals, NULL);
+        r->sides = ((s.valid & KIN_TRACK_HAND_L) ? 1u : 0u) | ((s.valid & KIN_TRACK_HAND_R) ? 2u : 0u);
+        for (int k = 0; k < 2; k++) {
+            /* the wrist's speed: the filter's velocity (raw methods: 0) */
+            const kin_vec3 v = cfg->kind == M_KIN ? kin_v3(0, 0, 0) : r->filter.part[3 + k].dx;
+            r->speed[k] = sqrtf(v.x * v.x + v.y * v.y + v.z * v.z);
+        }
         if (posed) pose_skin(c, cfg, m, r->locals);
         if (posed && cfg->kind == M_REFINE && cfg->fit) {
             pipe_fit_shape(r->fit, c->world, c->pos);
@@ -464,9 +496,10 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             pipe_fit_shape(r->fit, c->world, c->pos);
         }
     }
-    double secs = cli_now() - t0;
+    double secs = cli_now() - t0, cpu = thread_cpu() - c0;
     for (int e = 0; e < 2; e++) {
         t0 = cli_now();
+        c0 = thread_cpu();
         kin_camera cam = posed ? eye_camera(c, e) : c->tcam[e];
         const uint8_t *mask = c->mask_up;
         const float *nrm = c->mnrm;
@@ -493,7 +526,39 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             if (cfg->kind == M_REFINE) {
                 fuse_refine_params rp = fuse_refine_params_default();
                 rp.band = cfg->band;
+                if (cfg->band_auto && posed) {
+                    /* the band from the projected uncertainty (fit_band.h),
+                     * at least --band */
+                    pipe_fit_band_desc bd = band_desc(cfg);
+                    rp.band = pipe_fit_band(&bd, &cam, c->world, &c->rig, r->sides, r->speed);
+                }
+                r->band_sum += rp.band;
+                r->n_band++;
                 fuse_image P = { c->P[e], CW, CH, 4 * CW };
+                const uint8_t *kmask = mask;   /* the kinematic mask */
+                if (cfg->prior_radius > 0.0f && posed && r->have_prev) {
+                    /* the last refined mask as the input around the slow
+                     * hands (fit_band.h) */
+                    pipe_fit_band_desc bd = band_desc(cfg);
+                    bd.hand_radius = cfg->prior_radius;
+                    /* moved with the hand: its image motion since the
+                     * last frame (the kinematic pose's, lag and all) */
+                    float shift[2][2] = { { 0, 0 }, { 0, 0 } };
+                    for (int k = 0; k < 2; k++)
+                        if (cfg->prior_mc && r->have_hand_px[e][k] &&
+                            pipe_fit_hand_px(&cam, c->world, &c->rig, k, shift[k])) {
+                            shift[k][0] -= r->hand_px[e][k][0];
+                            shift[k][1] -= r->hand_px[e][k][1];
+                        } else {
+                            shift[k][0] = shift[k][1] = 0.0f;
+                        }
+                    mask = pipe_fit_prior(&bd, &cam, c->world, &c->rig, r->sides, r->speed,
+                                          cfg->prior_speed, shift, mask, r->prev[e],
+                                          c->band_region, c->mask_prior, CW);
+                }
+                for (int k = 0; k < 2; k++)
+                    r->have_hand_px[e][k] =
+                        posed && pipe_fit_hand_px(&cam, c->world, &c->rig, k, r->hand_px[e][k]);
                 /* the global term only once the fit has a colour model
                  * (as pipe_frame): an all-zero one would halve the local
                  * term */
@@ -512,9 +577,9 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                     /* the next frame's fit: the colour model from this
                      * frame's kinematic and refined masks (no extra
                      * raster), and the limb widths (self-calibration) */
-                    if (pipe_fit_learn(r->fit, e, &P, mask, CW, c->refined, CW) != FUSE_OK)
+                    if (pipe_fit_learn(r->fit, e, &P, kmask, CW, c->refined, CW) != FUSE_OK)
                         return -1;
-                    pipe_fit_measure(r->fit, e, &cam, c->world, mask, CW, c->refined, CW);
+                    pipe_fit_measure(r->fit, e, &cam, c->world, kmask, CW, c->refined, CW);
                 }
                 mask = c->refined;
             }
@@ -537,6 +602,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                            &O) != FUSE_OK)
             return -1;
         secs += cli_now() - t0;
+        cpu += thread_cpu() - c0;
         if (cfg->lod != 0 && posed && c->full_mask && cfg->div == 1 && !cfg->fine &&
             cfg->kind != M_SKIN) {
             /* the kinematic mask (c->mask_lo) against the full model's in
@@ -598,6 +664,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
     }
     r->have_prev = 1;
     r->secs += secs;
+    r->cpu_secs += cpu;
     r->n_frames++;
     if (r->fit && cfg->fit) {
         pipe_fit_thickness(r->fit, r->thick, NULL);
@@ -618,6 +685,20 @@ static method_cfg base_cfg(const eval_opts *o, method_kind k)
     c.band = o->band;
     c.fit = k == M_REFINE;
     c.global = o->global;
+    if (k == M_REFINE) {
+        /* docs/accuracy.md, issue 14 item 2: the last refined mask as the
+         * prior within 6 cm of hands slower than 0.5 m/s, moved with the
+         * hand's image motion; the hands' lag
+         * compensated from 0.2 to 0.8 m/s; the band from the projected
+         * uncertainty measured, off */
+        c.prior_radius = EVAL_PRIOR_RADIUS;
+        c.prior_speed = EVAL_PRIOR_SPEED;
+        c.prior_mc = 1;
+        c.lag_adapt_v0 = EVAL_LAG_V0;
+        c.lag_adapt_v1 = EVAL_LAG_V1;
+    }
+    c.band_sigma = 0.007f;
+    c.band_max = 64;
     c.track = gt_track_default();
     c.track.noise_mm = o->noise;
     c.track.latency_ms = o->latency;
@@ -698,6 +779,21 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
         n = add_cfg(L, n, cap, c);
         c = named_cfg(o, M_REFINE, "global", 0.0f, "global", "");
         c.global = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        /* issue 14 item 2: refine without the prior, without the adaptive
+         * lag compensation, and with the band from the projected
+         * uncertainty (docs/accuracy.md) */
+        c = named_cfg(o, M_REFINE, "prior", 0.0f, "prior", "");
+        c.prior_radius = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        c = named_cfg(o, M_REFINE, "priormc", 0.0f, "priormc", "");
+        c.prior_mc = 0;
+        n = add_cfg(L, n, cap, c);
+        c = named_cfg(o, M_REFINE, "lagadapt", 0.0f, "lagadapt", "");
+        c.lag_adapt_v1 = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        c = named_cfg(o, M_REFINE, "bandauto", 1.0f, "bandauto", "");
+        c.band_auto = 1;
         n = add_cfg(L, n, cap, c);
         for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
             c = named_cfg(o, (method_kind)k, "lagcomp", 1.0f, "lagcomp", "");

@@ -40,7 +40,25 @@ typedef struct method_cfg {
     int kf_set;              /* 1: the Fresnel fade kf below instead of the
                                 workshop lighting's 0.5 (eval_kf.c) */
     float kf;
+    int band_auto;           /* refine: band from the projected uncertainty
+                                (pipe_fit_band, band = its minimum); 0 off */
+    float band_sigma, band_tau;
+    int band_max;
+    float prior_radius;      /* refine: the last refined mask is the input
+                                within this many metres of slow hands (0 off) */
+    float prior_speed;       /* m/s: slower hands use it */
+    int prior_mc;            /* 1: moved with the hand (pipe_fit_hand_px) */
+    float lag_adapt_v0, lag_adapt_v1;   /* refine, kin-cal-pred: lag
+                                           compensation of the hands from
+                                           speed v0 (none) to v1 (full), m/s;
+                                           v1 0 = off */
 } method_cfg;
+
+/* refine's defaults (docs/accuracy.md, issue 14 item 2) */
+#define EVAL_PRIOR_RADIUS 0.06f
+#define EVAL_PRIOR_SPEED 0.5f
+#define EVAL_LAG_V0 0.2f
+#define EVAL_LAG_V1 0.8f
 
 /* Per-configuration state and sums. */
 typedef struct method_run {
@@ -56,6 +74,13 @@ typedef struct method_run {
     pipe_fit *fit;           /* refine: the elbow fit and colour models */
     float thick[2][2];       /* refine: limb thickness measured by the fit */
     int have_thick;
+    unsigned sides;          /* tracked hands of the frame (bit 0 left) */
+    float speed[2];          /* the filter's wrist speeds, m/s */
+    float hand_px[2][2][2];  /* [eye][side]: the hand in the image, last frame */
+    int have_hand_px[2][2];
+    double cpu_secs;         /* the method's thread CPU time (ms/frame is wall) */
+    double band_sum;         /* refine: the bands used, summed over eyes */
+    long n_band;
     /* sums over frames and eyes */
     double iou, bf1, bf3, fp, fn, mse, flicker, flicker_den, secs;
     long n_eye, n_flicker, n_frames;
@@ -103,6 +128,7 @@ typedef struct eval_ctx {
     kin_camera tcam[2];
     /* method scratch */
     uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
+    uint8_t *band_region, *mask_prior;   /* refine: the prior (fit_band.h) */
     uint32_t *aa_samples;    /* anti-aliased coverage, 640x400 */
     float *depth_lo, *nrm_lo, *mnrm;
     void *refine_scratch;

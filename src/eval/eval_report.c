@@ -80,6 +80,13 @@ int eval__write_csv(const char *path, const method_run *R, int n)
  * from the images (pipe_fit_measure), against the truth's. */
 void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int n)
 {
+    /* the methods' own CPU time (the ms/frame column is the wall clock,
+     * which a shared machine inflates) */
+    if (n > 0) fprintf(f, "CPU ms per stereo frame (the method's thread):");
+    for (int i = 0; i < n; i++)
+        fprintf(f, " %s %s %.2f%s", kind_name[R[i].cfg.kind], R[i].cfg.setting,
+                1e3 * R[i].cpu_secs / (R[i].n_frames > 0 ? (double)R[i].n_frames : 1.0),
+                i + 1 < n ? "," : "\n");
     for (int i = 0; i < n; i++) {
         if (R[i].cfg.kind != M_REFINE || !R[i].have_thick) continue;
         fprintf(f, "refine's limb thickness from the images (pipe_fit, only thinner is "
@@ -87,6 +94,9 @@ void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int 
                    "(true %.2f)\n",
                 (double)R[i].thick[0][1], (double)R[i].thick[1][1], (double)c->op.fore_thick,
                 (double)R[i].thick[0][0], (double)R[i].thick[1][0], (double)c->op.upper_thick);
+        if (R[i].cfg.band_auto && R[i].n_band > 0)
+            fprintf(f, "refine's band from the projected uncertainty: mean %.1f px\n",
+                    R[i].band_sum / (double)R[i].n_band);
         return;
     }
 }
