@@ -188,6 +188,8 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
     fe->intrinsics = K;
     e->view_used = PIPE_VIEW_REPROJECT;
     return 1;
+}
+
 int pipe__edge_fade_px(const pipe_desc *d)
 {
     return d->edge_fade == 0 ? PIPE_EDGE_FADE_DEFAULT : d->edge_fade < 0 ? 0 : d->edge_fade;
