@@ -25,6 +25,12 @@
  *   bench_raster [--csv] [--runs N] [--tris N,N,...] [--size WxH]
  *                [--isa ref|sse2|avx2|avx512] [--threads 1|2]
  *                [--samples DIR|none] [--cold MB] [--no-pipe]
+ *                [--sample-only] [--cull back|none]
+ *
+ * --sample-only skips the bench scene (its draw rows and pipe rows), --cull
+ * runs one cull mode of the pipe rows: for counting instructions of the
+ * sample model's stage alone (valgrind --tool=callgrind
+ * --toggle-collect=rast_context_draw, docs/bench.md raster section).
  *
  * The same scene through Mesa llvmpipe, with the ratio, is
  * bench/llvmpipe/llvmpipe_raster (built separately: it needs EGL/GLES). */
@@ -145,6 +151,8 @@ static void pipe_print_row(int csv, const char *model, int tris, int isa, rast_c
 /* The pipe rows of one scene: poses[p] (np of them) are the per-pose
  * scenes, vp[p][e] / view[p][e] the eyes' matrices. Medians over runs of
  * whole passes through the poses (ms per eye: the pass time / (2 np)). */
+static int only_cull = -1;   /* --cull: RAST_CULL_BACK or RAST_CULL_NONE, -1 both */
+
 static void pipe_rows(int csv, const char *model, int tris, const pipe_scene *poses, int np,
                       float (*vp)[2][16], float (*view)[2][16], int W, int H, int runs,
                       int only_isa, int cold, uint8_t *junk)
@@ -175,6 +183,8 @@ static void pipe_rows(int csv, const char *model, int tris, const pipe_scene *po
         if (!ef_cpu_has((ef_isa)isa) || (only_isa && isa != only_isa))
             continue;
         for (int ci = 0; ci < 2; ci++) {
+            if (only_cull >= 0 && (int)culls[ci] != only_cull)
+                continue;
             rast_context_desc d = { isa, 1 };
             for (int e = 0; e < 2; e++)
                 if (!(eye[e].ctx = rast_context_create(&d)))
@@ -359,6 +369,17 @@ int main(int argc, char **argv)
             csv = 1;
         else if (!strcmp(argv[i], "--no-pipe"))
             pipe = 0;
+        else if (!strcmp(argv[i], "--sample-only"))
+            ntl = 0;
+        else if (!strcmp(argv[i], "--cull") && i + 1 < argc) {
+            i++;
+            only_cull = !strcmp(argv[i], "back") ? (int)RAST_CULL_BACK
+                        : !strcmp(argv[i], "none") ? (int)RAST_CULL_NONE : -2;
+            if (only_cull == -2) {
+                fprintf(stderr, "--cull: back or none, not '%s'\n", argv[i]);
+                return 2;
+            }
+        }
         else if (!strcmp(argv[i], "--samples") && i + 1 < argc)
             samples = argv[++i];
         else if (!strcmp(argv[i], "--cold") && i + 1 < argc)
@@ -378,7 +399,7 @@ int main(int argc, char **argv)
         } else {
             fprintf(stderr, "usage: %s [--csv] [--runs N] [--tris N,N,...] [--size WxH] "
                             "[--isa NAME] [--threads N] [--samples DIR|none] [--cold MB] "
-                            "[--no-pipe]\n",
+                            "[--no-pipe] [--sample-only] [--cull back|none]\n",
                     argv[0]);
             return 2;
         }

@@ -1,6 +1,7 @@
 /* test_raster_xform.c - the vertex transforms of raster.h
- * (rast_transform_points, rast_transform_dirs): the AVX-512 versions (16
- * vertices per step, the last n % 16 by the reference) against the scalar
+ * (rast_transform_points, rast_transform_dirs): the AVX2 and AVX-512
+ * versions (raster_xform.inl: 8 or 16 vertices per step, the rest by the
+ * reference) against the scalar
  * reference, byte for byte, and the public entry points against the
  * reference.
  *
@@ -173,9 +174,9 @@ static void check(xform_fn fn, const float *m, const float *in, int n, int comps
     }
 }
 
-/* All cases; with avx512 set, the AVX-512 versions are checked too.
- * Returns the CRC of the reference outputs. */
-static uint32_t run_cases(int avx512)
+/* All cases; with pts and drs set, those versions (AVX2, AVX-512) are
+ * checked too. Returns the CRC of the reference outputs. */
+static uint32_t run_cases(xform_fn pts, xform_fn drs, const char *isa)
 {
     tu_rng r = { 0x7F0A11CEull };
     float *in = malloc(3 * (size_t)MAXN * sizeof(float));
@@ -193,15 +194,13 @@ static uint32_t run_cases(int avx512)
         rast__transform_points_ref(m, in, n, ref);
         crc = tu_crc32(crc, ref, 4 * (size_t)n * sizeof(float));
         check(rast_transform_points, m, in, n, 4, ref, buf, "rast_transform_points", c);
-        if (avx512)
-            check(rast__transform_points_avx512, m, in, n, 4, ref, buf,
-                  "rast__transform_points_avx512", c);
+        if (pts)
+            check(pts, m, in, n, 4, ref, buf, isa, c);
         rast__transform_dirs_ref(m, in, n, ref);
         crc = tu_crc32(crc, ref, 3 * (size_t)n * sizeof(float));
         check(rast_transform_dirs, m, in, n, 3, ref, buf, "rast_transform_dirs", c);
-        if (avx512)
-            check(rast__transform_dirs_avx512, m, in, n, 3, ref, buf,
-                  "rast__transform_dirs_avx512", c);
+        if (drs)
+            check(drs, m, in, n, 3, ref, buf, isa, c);
     }
     free(in);
     free(ref);
@@ -214,7 +213,7 @@ static uint32_t run_cases(int avx512)
 static void test_xform_public(void **state)
 {
     (void)state;
-    const uint32_t crc = run_cases(0);
+    const uint32_t crc = run_cases(NULL, NULL, NULL);
     if (crc != XFORM_CRC)
         fail_msg("reference CRC 0x%08X, recorded 0x%08X", crc, XFORM_CRC);
 }
@@ -227,7 +226,19 @@ static void test_xform_avx512(void **state)
                       "transforms (src/raster/raster_avx512.c)\n");
         skip();
     }
-    run_cases(1);
+    run_cases(rast__transform_points_avx512, rast__transform_dirs_avx512,
+              "rast__transform_*_avx512");
+}
+
+static void test_xform_avx2(void **state)
+{
+    (void)state;
+    if (!ef_cpu_has(EF_ISA_AVX2)) {
+        print_message("SKIP avx2: not supported by this CPU; untested: the AVX2 vertex "
+                      "transforms (src/raster/raster_xform.inl)\n");
+        skip();
+    }
+    run_cases(rast__transform_points_avx2, rast__transform_dirs_avx2, "rast__transform_*_avx2");
 }
 
 /* Directions: unit length within float rounding, and a zero vector stays
@@ -267,6 +278,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_xform_public),
         cmocka_unit_test(test_xform_avx512),
+        cmocka_unit_test(test_xform_avx2),
         cmocka_unit_test(test_dirs_contract),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

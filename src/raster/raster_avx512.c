@@ -143,109 +143,28 @@ static inline __m512 div_lanes(__m512 a, __m512 b, int lanes)
 
 #include "raster_simd.inl"
 
-/* ---- vertex transforms (rast_transform_points / rast_transform_dirs) ----
- * 16 vertices per step: the 48 floats of 16 (x, y, z) triples are split
- * into x, y and z vectors by two-source permutes, each lane then runs the
- * reference's expressions (raster_ref.c) in the same order with the same
- * IEEE operations (no contraction), and the results are interleaved back.
- * The last n % 16 vertices take the reference. */
-
-/* Lane i of deint3[k][0] picks float 3i + k of (v0, v1) where it lies
- * there (indices 0..31); deint3[k][1] keeps those lanes (index i) and
- * takes the others from v2 (16 + 3i + k - 32). */
-static const int32_t deint3[3][2][16] __attribute__((aligned(64))) = {
-    { { 0, 3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 0, 0, 0, 0, 0 },
-      { 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 17, 20, 23, 26, 29 } },
-    { { 1, 4, 7, 10, 13, 16, 19, 22, 25, 28, 31, 0, 0, 0, 0, 0 },
-      { 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 18, 21, 24, 27, 30 } },
-    { { 2, 5, 8, 11, 14, 17, 20, 23, 26, 29, 0, 0, 0, 0, 0, 0 },
-      { 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 16, 19, 22, 25, 28, 31 } },
-};
-
-static inline void load_xyz16(const float *p, __m512 xyz[3])
+/* ---- vertex transforms (rast_transform_points / rast_transform_dirs):
+ * raster_xform.inl on the layer, 16 vertices per step; the four component
+ * vectors interleaved by two-source permutes: output o of 4, float f is
+ * component f % 4 of vertex 4o + f / 4; (c0, c1) and (c2, c3) are permuted
+ * with the same index, then blended (components 2 and 3: mask 0xCCCC). */
+SIMD_INL void xf_store4(float *p, vfloat c0, vfloat c1, vfloat c2, vfloat c3)
 {
-    const __m512 v0 = _mm512_loadu_ps(p), v1 = _mm512_loadu_ps(p + 16),
-                 v2 = _mm512_loadu_ps(p + 32);
-    for (int k = 0; k < 3; k++) {
-        const __m512 t = _mm512_permutex2var_ps(v0, _mm512_load_si512(deint3[k][0]), v1);
-        xyz[k] = _mm512_permutex2var_ps(t, _mm512_load_si512(deint3[k][1]), v2);
-    }
-}
-
-/* ((m[r]*x + m[4+r]*y) + m[8+r]*z), the reference's order. */
-static inline __m512 xform_row(const float *m, int r, __m512 x, __m512 y, __m512 z)
-{
-    return _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(_mm512_set1_ps(m[r]), x),
-                                       _mm512_mul_ps(_mm512_set1_ps(m[4 + r]), y)),
-                         _mm512_mul_ps(_mm512_set1_ps(m[8 + r]), z));
-}
-
-void rast__transform_points_avx512(const float mvp[16], const float *pos, int n, float *clip)
-{
-    /* Output o of 4: float f is component f % 4 of vertex 4o + f / 4;
-     * (c0, c1) and (c2, c3) are permuted with the same index, then
-     * blended (components 2 and 3: mask 0xCCCC). */
     static const int32_t inter4[4][16] __attribute__((aligned(64))) = {
         { 0, 16, 0, 16, 1, 17, 1, 17, 2, 18, 2, 18, 3, 19, 3, 19 },
         { 4, 20, 4, 20, 5, 21, 5, 21, 6, 22, 6, 22, 7, 23, 7, 23 },
         { 8, 24, 8, 24, 9, 25, 9, 25, 10, 26, 10, 26, 11, 27, 11, 27 },
         { 12, 28, 12, 28, 13, 29, 13, 29, 14, 30, 14, 30, 15, 31, 15, 31 },
     };
-    int i = 0;
-    for (; i + 16 <= n; i += 16) {
-        __m512 v[3];
-        load_xyz16(pos + 3 * (size_t)i, v);
-        __m512 c[4];
-        for (int r = 0; r < 4; r++)
-            c[r] = _mm512_add_ps(xform_row(mvp, r, v[0], v[1], v[2]),
-                                 _mm512_set1_ps(mvp[12 + r]));
-        float *dst = clip + 4 * (size_t)i;
-        for (int o = 0; o < 4; o++) {
-            const __m512i idx = _mm512_load_si512(inter4[o]);
-            const __m512 a = _mm512_permutex2var_ps(c[0], idx, c[1]);
-            const __m512 b = _mm512_permutex2var_ps(c[2], idx, c[3]);
-            _mm512_storeu_ps(dst + 16 * o, _mm512_mask_blend_ps((__mmask16)0xCCCC, a, b));
-        }
+#pragma GCC unroll 4
+    for (int o = 0; o < 4; o++) {
+        const __m512i idx = _mm512_load_si512(inter4[o]);
+        const __m512 a = _mm512_permutex2var_ps(c0, idx, c1);
+        const __m512 b = _mm512_permutex2var_ps(c2, idx, c3);
+        _mm512_storeu_ps(p + 16 * o, _mm512_mask_blend_ps((__mmask16)0xCCCC, a, b));
     }
-    if (i < n)
-        rast__transform_points_ref(mvp, pos + 3 * (size_t)i, n - i, clip + 4 * (size_t)i);
 }
-
-/* len = sqrt((r0*r0 + r1*r1) + r2*r2) in double, out_k = (float)(r_k / len)
- * where len > 0, else 0 (NaN lengths included): 8 lanes (one half of 16). */
-static inline void dirs_half(__m256 r0, __m256 r1, __m256 r2, __m256 out[3])
-{
-    const __m512d d0 = _mm512_cvtps_pd(r0), d1 = _mm512_cvtps_pd(r1), d2 = _mm512_cvtps_pd(r2);
-    const __m512d len = _mm512_sqrt_pd(_mm512_add_pd(
-        _mm512_add_pd(_mm512_mul_pd(d0, d0), _mm512_mul_pd(d1, d1)), _mm512_mul_pd(d2, d2)));
-    const __mmask8 pos = _mm512_cmp_pd_mask(len, _mm512_setzero_pd(), _CMP_GT_OQ);
-    out[0] = _mm512_cvtpd_ps(_mm512_maskz_div_pd(pos, d0, len));
-    out[1] = _mm512_cvtpd_ps(_mm512_maskz_div_pd(pos, d1, len));
-    out[2] = _mm512_cvtpd_ps(_mm512_maskz_div_pd(pos, d2, len));
-}
-
-void rast__transform_dirs_avx512(const float m[16], const float *v, int n, float *out)
-{
-    int i = 0;
-    for (; i + 16 <= n; i += 16) {
-        __m512 p[3];
-        load_xyz16(v + 3 * (size_t)i, p);
-        __m512 r[3];
-        for (int k = 0; k < 3; k++)
-            r[k] = xform_row(m, k, p[0], p[1], p[2]);
-        __m256 lo[3], hi[3];
-        dirs_half(_mm512_castps512_ps256(r[0]), _mm512_castps512_ps256(r[1]),
-                  _mm512_castps512_ps256(r[2]), lo);
-        dirs_half(_mm512_extractf32x8_ps(r[0], 1), _mm512_extractf32x8_ps(r[1], 1),
-                  _mm512_extractf32x8_ps(r[2], 1), hi);
-        __m512 o[3];
-        for (int k = 0; k < 3; k++)
-            o[k] = _mm512_insertf32x8(_mm512_castps256_ps512(lo[k]), hi[k], 1);
-        vf_store3(out + 3 * (size_t)i, o[0], o[1], o[2]);
-    }
-    if (i < n)
-        rast__transform_dirs_ref(m, v + 3 * (size_t)i, n - i, out + 3 * (size_t)i);
-}
+#include "raster_xform.inl"
 
 /* Anti-aliased coverage: 8 double lanes. */
 #define AA_V 8

@@ -77,28 +77,15 @@ static const isa_kernels kernels_sse2 = {
     rast__scan_rows_sse2, rast__scan_aa_sse2, &rast__setup_isa_sse2,
     rast__transform_points_ref, rast__transform_dirs_ref
 };
+/* The vector transforms take 8 (AVX2) or 16 (AVX-512) vertices per step,
+ * the rest by the reference (raster_xform.inl). */
 static const isa_kernels kernels_avx2 = {
     rast__scan_rows_avx2, rast__scan_aa_avx2, &rast__setup_isa_avx2,
-    rast__transform_points_ref, rast__transform_dirs_ref
+    rast__transform_points_avx2, rast__transform_dirs_avx2
 };
-/* The AVX-512 transforms take 16 vertices per step (fewer: the reference). */
-static void points_avx512(const float mvp[16], const float *pos, int n, float *clip)
-{
-    if (n >= 16)
-        rast__transform_points_avx512(mvp, pos, n, clip);
-    else
-        rast__transform_points_ref(mvp, pos, n, clip);
-}
-static void dirs_avx512(const float m[16], const float *v, int n, float *out)
-{
-    if (n >= 16)
-        rast__transform_dirs_avx512(m, v, n, out);
-    else
-        rast__transform_dirs_ref(m, v, n, out);
-}
 static const isa_kernels kernels_avx512 = {
     rast__scan_rows_avx512, rast__scan_aa_avx512, &rast__setup_isa_avx512,
-    points_avx512, dirs_avx512
+    rast__transform_points_avx512, rast__transform_dirs_avx512
 };
 #endif
 #if defined(__aarch64__) && defined(__ARM_NEON)

@@ -451,11 +451,14 @@ long rast__scan_rows_avx512(const rast_target *t, const rast__tri *tri,
 long rast__scan_rows_neon(const rast_target *t, const rast__tri *tri, int ya,
                           int yb);
 /* The vertex transforms of raster.h: the scalar reference (raster_ref.c)
- * and the AVX-512 version (raster_avx512.c, same bytes; call only when the
- * CPU runs AVX-512). rast_transform_points / _dirs use the AVX-512 one when
- * rast_draw_isa() allows it. */
+ * and the AVX2 and AVX-512 versions (raster_xform.inl compiled by
+ * raster_avx2.c and raster_avx512.c, same bytes; call only when the CPU
+ * runs that ISA). rast_transform_points / _dirs use the best one
+ * rast_draw_isa() allows. */
 void rast__transform_points_ref(const float mvp[16], const float *pos, int n, float *clip);
 void rast__transform_dirs_ref(const float m[16], const float *v, int n, float *out);
+void rast__transform_points_avx2(const float mvp[16], const float *pos, int n, float *clip);
+void rast__transform_dirs_avx2(const float m[16], const float *v, int n, float *out);
 void rast__transform_points_avx512(const float mvp[16], const float *pos, int n, float *clip);
 void rast__transform_dirs_avx512(const float m[16], const float *v, int n, float *out);
 /* The row scan for an ISA (an ef_isa value); the reference for

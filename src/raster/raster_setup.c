@@ -590,8 +590,27 @@ static int clip_snap(const rast__view *view, const rast_mesh_desc *m, int ti,
     return n;
 }
 
-int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
-                  rast__tri *out, rast_stats *st)
+static int count_setup(int r, rast_stats *st)
+{
+    switch (r) {
+    case RAST__SETUP_OK:         st->tris_drawn++; return 1;
+    case RAST__SETUP_EMPTY:      st->tris_drawn++; return 0;
+    case RAST__SETUP_DEGENERATE: st->tris_degenerate++; return 0;
+    case RAST__SETUP_CULLED:     st->tris_culled++; return 0;
+    default:                     st->tris_clipped_away++; return 0;
+    }
+}
+
+static int setup_aa(const rast__view *v, const int32_t fx[3], const int32_t fy[3],
+                    rast_cull cull, rast__tri *tri);
+
+/* The fan of one submitted triangle after clip_snap, each piece set up by
+ * rast__setup_tri (aa = 0) or setup_aa (aa = 1, the sample scan's set-up)
+ * and counted; returns the records made. */
+static inline __attribute__((always_inline)) int prepare_fan(const rast__view *view,
+                                                             const rast_mesh_desc *m, int ti,
+                                                             rast__tri *out, rast_stats *st,
+                                                             int aa)
 {
     rast__vert poly[RAST__MAX_POLY];
     int32_t fx[RAST__MAX_POLY], fy[RAST__MAX_POLY];
@@ -601,18 +620,17 @@ int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
         const rast__vert *pv[3] = { &poly[0], &poly[i], &poly[i + 1] };
         int32_t tx[3] = { fx[0], fx[i], fx[i + 1] };
         int32_t ty[3] = { fy[0], fy[i], fy[i + 1] };
-        switch (rast__setup_tri(view, pv, tx, ty, m->cull, &out[made])) {
-        case RAST__SETUP_OK:
-            st->tris_drawn++;
-            made++;
-            break;
-        case RAST__SETUP_EMPTY:      st->tris_drawn++; break;
-        case RAST__SETUP_DEGENERATE: st->tris_degenerate++; break;
-        case RAST__SETUP_CULLED:     st->tris_culled++; break;
-        default:                     st->tris_clipped_away++; break;
-        }
+        made += count_setup(aa ? setup_aa(view, tx, ty, m->cull, &out[made])
+                               : rast__setup_tri(view, pv, tx, ty, m->cull, &out[made]),
+                            st);
     }
     return made;
+}
+
+int rast__prepare(const rast__view *view, const rast_mesh_desc *m, int ti,
+                  rast__tri *out, rast_stats *st)
+{
+    return prepare_fan(view, m, ti, out, st, 0);
 }
 
 void rast__vcache_reset(rast__vcache *c)
@@ -686,17 +704,6 @@ static inline const rast__vc_entry *vc_get(const rast__view *view,
             vc_fill(view, m, e, idx);
     }
     return e;
-}
-
-static int count_setup(int r, rast_stats *st)
-{
-    switch (r) {
-    case RAST__SETUP_OK:         st->tris_drawn++; return 1;
-    case RAST__SETUP_EMPTY:      st->tris_drawn++; return 0;
-    case RAST__SETUP_DEGENERATE: st->tris_degenerate++; return 0;
-    case RAST__SETUP_CULLED:     st->tris_culled++; return 0;
-    default:                     st->tris_clipped_away++; return 0;
-    }
 }
 
 #if defined(__GNUC__) || defined(__clang__)
@@ -851,16 +858,7 @@ static int setup_aa(const rast__view *v, const int32_t fx[3], const int32_t fy[3
 int rast__prepare_aa(const rast__view *view, const rast_mesh_desc *m, int ti,
                      rast__tri *out, rast_stats *st)
 {
-    rast__vert poly[RAST__MAX_POLY];
-    int32_t fx[RAST__MAX_POLY], fy[RAST__MAX_POLY];
-    const int n = clip_snap(view, m, ti, poly, fx, fy, st);
-    int made = 0;
-    for (int i = 1; i + 1 < n; i++) {
-        const int32_t tx[3] = { fx[0], fx[i], fx[i + 1] };
-        const int32_t ty[3] = { fy[0], fy[i], fy[i + 1] };
-        made += count_setup(setup_aa(view, tx, ty, m->cull, &out[made]), st);
-    }
-    return made;
+    return prepare_fan(view, m, ti, out, st, 1);
 }
 
 /* ---- anti-aliasing sample patterns ------------------------------------ */
