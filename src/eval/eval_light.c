@@ -341,7 +341,7 @@ int eval__write_light(const char *dir, const method_run *R, int n)
                     fprintf(f, "set label %d '%s: below throughout' at graph 0.98, graph %.2f right "
                                "tc lt %d font ',9'\n", lab++, curve_name[q], 0.55 + 0.07 * q, q + 1);
                 else
-                    fprintf(f, "set label %d '%s: %.3g' at %.6g,%.6g point pt 6 ps 2.5 lc %d "
+                    fprintf(f, "set label %d '%s: %.4g' at %.6g,%.6g point pt 6 ps 2.5 lc %d "
                                "offset 0.8,%d tc lt %d font ',9'\n", lab++, curve_name[q], b, b,
                             yv, q + 1, q % 2 ? -1 : 1, q + 1);
             }
