@@ -246,7 +246,9 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The last frame's lit layer of one eye (premultiplied RGBA8, the
  * mask's size, 4 * width bytes per row; valid until the next frame):
- * alpha 0 wherever the mask was 0 or the depth test hid the hand. */
+ * alpha 0 wherever the mask was 0 or the depth test hid the hand. With
+ * PIPE_VIEW_REPROJECT the eye view's layer (of pipe_view_mask; the same
+ * size), unless the eye fell back to the crop in that frame. */
 const uint8_t *pipe_layer(const pipe_ctx *p, int eye, int *width, int *height);
 /* The camera of one eye in the last frame. */
 kin_camera pipe_camera(const pipe_ctx *p, int eye);
