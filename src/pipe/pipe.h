@@ -200,7 +200,9 @@ typedef struct pipe_frame_stats {
     double ms_pose;           /* posing + skinning */
     double ms_raster[2];      /* per eye: camera, G-buffer */
     double ms_convert[2];     /* per eye: camera format conversion (raw) */
-    double ms_fuse[2];        /* per eye: lighting, resampling, composite */
+    double ms_fuse[2];        /* per eye: lighting, resampling, composite
+                                 (with PIPE_VIEW_REPROJECT also the eye's
+                                 raster and the sampling of the camera) */
     double ms_total;          /* wall time of pipe_frame */
     double coverage[2];       /* fraction of camera pixels in the mask */
     int lod_level[2];         /* per eye: the level of detail drawn
