@@ -248,7 +248,7 @@ $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(TEST_IOLIB) $(LIB) | $(TEST_PLU
 	    $(CMOCKA_LIBS) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
 # Tests on the generated samples' scenes also link the generator.
-$(BUILD)/tests/test_occlusion $(BUILD)/tests/test_io_lod: $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
+$(BUILD)/tests/test_occlusion $(BUILD)/tests/test_io_lod $(BUILD)/tests/test_eval_eye: $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) \
 	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
@@ -322,10 +322,12 @@ $(BUILD)/fuzz/%: tests/%.c tests/fuzz/fuzz_util.h $(IOLIB) $(LIB)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) -Itests -c $< -o $@.o
 	$(CXX) $(LDFLAGS) -fsanitize=fuzzer -o $@ $@.o $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
 
-# The accuracy report (docs/accuracy.md): charts, table, summary.csv.
+# The accuracy report (docs/accuracy.md): charts, table, summary.csv; then
+# the eye's viewpoint (eval --eyeview: eyeview.csv, eyeview.md, eyeview_*.png).
 eval: deps-demo
 	@$(MAKE) --no-print-directory $(EGOFUSE)
 	$(EGOFUSE) eval --frames 180 --report out/eval
+	$(EGOFUSE) eval --eyeview --frames 60 --report out/eval
 
 # The soak of the live path in the VM (SOAK_SECONDS, SOAK_CYCLES, SOAK_STALLS).
 soak: deps-test

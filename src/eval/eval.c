@@ -898,3 +898,9 @@ unsigned eval_parse_methods(const char *list)
     }
     return bits;
 }
+
+/* The workshop's lighting in cam's view space (eval_eye.c). */
+fuse_lighting eval__lighting(const gen_scene *ws, const kin_camera *cam)
+{
+    return workshop_lighting(ws, cam);
+}

@@ -48,6 +48,7 @@ typedef struct eval_opts {
     float lod_px;            /* the rule's target with PIPE_LOD_AUTO */
     int lod_sweep;           /* 1: also the levels batch (group "lod"; a
                                 report always runs it) */
+    int eyeview;             /* 1: `egofuse eval --eyeview` (eval_eye_run) */
 } eval_opts;
 
 /* "kin,refine" -> bits of the methods (kin, kin-cal-pred, skin, refine:
@@ -57,5 +58,13 @@ unsigned eval_parse_methods(const char *list);
  * the report folder o->report when set. EXIT_OK, or EXIT_FAIL with the
  * message printed. */
 int eval_run(const eval_opts *o);
+
+/* The eye's viewpoint (src/eval/eval_eye.c, docs/accuracy.md): the hand
+ * held 15, 20, 30, 40 cm from the eyes, tracking noise 0-20 mm, per view
+ * method (crop, reproj) the hand's position and size error, the IoU and
+ * PSNR against ground truth from the true eye, the ms per stereo frame.
+ * Uses frames (per distance, at most 180), seed, csv, report, quiet,
+ * per_frame. EXIT_OK, or EXIT_FAIL with the message printed. */
+int eval_eye_run(const eval_opts *o);
 
 #endif

@@ -14,7 +14,7 @@
 enum { CW = 640, CH = 400 };
 
 typedef enum method_kind { M_KIN, M_KIN_CAL, M_SKIN, M_REFINE } method_kind;
-static const char *kind_name[] = { "kin", "kin-cal-pred", "skin", "refine" };
+static const char *kind_name[] __attribute__((unused)) = { "kin", "kin-cal-pred", "skin", "refine" };
 
 typedef struct method_cfg {
     method_kind kind;
@@ -104,6 +104,15 @@ typedef struct eval_ctx {
 /* eval.c: the true operator's scales (arm, hand, shoulder width) against
  * the mask model's. */
 void eval__true_scales(const eval_ctx *c, float *arm, float *hand, float *shoulder);
+
+/* eval.c: the workshop's lighting (the composite's) in cam's view space. */
+fuse_lighting eval__lighting(const gen_scene *ws, const kin_camera *cam);
+
+/* eval_report.c: runs gnuplot on DIR/script, whose charts write
+ * "DIR/<chart>.png".sfx, and names each chart once it decodes whole
+ * (gnuplot missing or failing: a warning, EXIT_OK; a chart incomplete:
+ * removed, EXIT_FAIL). */
+int eval__gnuplot(const char *dir, const char *script, const char *const *charts, int n);
 
 /* eval_lod.c: levels of detail. The chain of c->mask and the full
  * model's scratch (0, or -1 with the message printed); the level a

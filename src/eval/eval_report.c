@@ -223,10 +223,14 @@ static int write_charts(const char *dir)
     static const char *const charts[] = {"speed_iou", "speed_bf", "noise",  "latency",
                                          "calib",     "dropout",  "handspeed", "band",
                                          "sequences", "lod"};
-    enum { NCHART = sizeof charts / sizeof charts[0] };
+    return eval__gnuplot(dir, "charts.gp", charts, (int)(sizeof charts / sizeof charts[0]));
+}
+
+int eval__gnuplot(const char *dir, const char *script, const char *const *charts, int NCHART)
+{
     char cmd[3 * IO_PATH_MAX], tmp[IO_PATH_MAX + 96], path[IO_PATH_MAX + 64];
     long pid = (long)getpid();
-    snprintf(cmd, sizeof cmd, "gnuplot -e \"sfx='.tmp.%ld'\" '%s/charts.gp'", pid, dir);
+    snprintf(cmd, sizeof cmd, "gnuplot -e \"sfx='.tmp.%ld'\" '%s/%s'", pid, dir, script);
     int rc = system(cmd);
     int bad = 0;
     for (int i = 0; i < NCHART; i++) {
@@ -255,7 +259,7 @@ static int write_charts(const char *dir)
     }
     if (rc != 0)
         fprintf(stderr, "egofuse eval: gnuplot failed (status %d): the data files and "
-                        "%s/charts.gp are written, the PNG charts are not\n", rc, dir);
+                        "%s/%s are written, the PNG charts are not\n", rc, dir, script);
     return bad ? EXIT_FAIL : EXIT_OK;
 }
 
