@@ -3,7 +3,9 @@
  * vf_store3_bits) of every implementation this machine runs (sse2, avx2,
  * avx512 on x86-64; neon on aarch64, under qemu-aarch64 in CI) against a
  * scalar model of the contract: the bits, and that no byte or float
- * outside the lanes in bits is written. Seeded inputs; every lane subset
+ * outside the lanes in bits is written; and the raster front-end ops
+ * (vi_min, vi_max, vd_from_vf, vd_from_vi, vf_from_vd, vd_gt_bits) against
+ * their scalar definitions. Seeded inputs; every lane subset
  * for 4 and 8 lanes, seeded subsets (and the empty and full ones) for 16.
  * An ISA the machine does not run is reported as SKIP, never as a pass.
  * (A test of its own so that test_cpu_simd.c stays the fuse port's.) */
@@ -25,6 +27,131 @@ static uint32_t rnd(uint64_t *s)
     return (uint32_t)(*s >> 16);
 }
 
+/* A seeded float: random bits (finite), or a special value. */
+static float rnd_float(uint64_t *s)
+{
+    static const uint32_t sp[] = { 0x00000000u, 0x80000000u, 0x7F800000u, 0xFF800000u,
+                                   0x00000001u, 0x807FFFFFu, 0x7F7FFFFFu, 0x3F800000u };
+    uint32_t b = rnd(s) * 2654435761u ^ rnd(s);
+    if ((rnd(s) & 7) == 0)
+        b = sp[rnd(s) % 8];
+    else if ((b & 0x7F800000u) == 0x7F800000u)
+        b &= 0xBFFFFFFFu;   /* no NaN: its payload is not part of the contract */
+    float f;
+    memcpy(&f, &b, 4);
+    return f;
+}
+
+/* A seeded double: around the float range (rounding, overflow, underflow
+ * to float denormals), exact ties, signed zeros, infinities, NaN. */
+static double rnd_double(uint64_t *s)
+{
+    const uint32_t r = rnd(s) % 16;
+    if (r == 0) {
+        static const double sp[] = { 0.0, -0.0, 1.0 / 0.0, -1.0 / 0.0, 0.0 / 0.0,
+                                     3.4028235677973366e38, 1.401298464324817e-45,
+                                     1.0 + 0x1p-24 };
+        return sp[rnd(s) % 8];
+    }
+    const double m = (double)(int32_t)(rnd(s) * 2654435761u ^ rnd(s)) * 0x1p-31 +
+                     (double)rnd(s) * 0x1p-55;
+    const int e = (int)(rnd(s) % 300) - 150;
+    return r == 1 ? (double)(rnd(s) % 5) - 2.0 : __builtin_ldexp(m, e);
+}
+
+/* The raster front-end ops (vi_min, vi_max, vd_from_vf, vd_from_vi,
+ * vf_from_vd, vd_gt_bits) against their scalar definitions. */
+static void check_front_ops(ef_isa isa, tu_simd_rcheck_fn *fn, int W, uint64_t *s,
+                            long *checked, long *bad)
+{
+    static _Alignas(64) uint32_t a[N], out[N];
+    const int VD = W / 2;
+    for (int round = 0; round < 8; round++) {
+        /* vi_min / vi_max */
+        for (int i = 0; i < N; i++)
+            a[i] = (rnd(s) & 3) == 0 ? (uint32_t[]){ 0u, 0x80000000u, 0x7FFFFFFFu,
+                                                    0xFFFFFFFFu }[rnd(s) % 4]
+                                     : rnd(s) * 2654435761u;
+        if (round & 1)   /* equal pairs too */
+            for (int i = 0; i < N; i += 2 * W) a[i + W] = a[i];
+        assert_int_equal(fn(RC_VI_MINMAX, a, 0, N, out), W);
+        for (int v = 0; v < N; v += 2 * W)
+            for (int l = 0; l < W; l++) {
+                const int32_t x = (int32_t)a[v + l], y = (int32_t)a[v + W + l];
+                const int32_t mn = x < y ? x : y, mx = x > y ? x : y;
+                *checked += 2;
+                if (((int32_t)out[v + l] != mn || (int32_t)out[v + W + l] != mx) &&
+                    (*bad)++ < 8)
+                    print_message("FAIL %s vi_min/vi_max lane %d: %d %d -> %d %d\n",
+                                  ef_isa_name(isa), l, x, y, (int32_t)out[v + l],
+                                  (int32_t)out[v + W + l]);
+            }
+        /* vd_from_vf, vd_from_vi */
+        for (int i = 0; i < N / 2; i++) {
+            const float f = rnd_float(s);
+            memcpy(&a[i], &f, 4);
+        }
+        assert_int_equal(fn(RC_VD_FROM_VF, a, 0, N, out), W);
+        for (int i = 0; i < N / 2; i++) {
+            float f;
+            double got;
+            memcpy(&f, &a[i], 4);
+            memcpy(&got, &out[2 * i], 8);
+            const double want = (double)f;
+            (*checked)++;
+            if (memcmp(&got, &want, 8) != 0 && (*bad)++ < 8)
+                print_message("FAIL %s vd_from_vf %d: %a -> %a\n", ef_isa_name(isa), i,
+                              (double)f, got);
+        }
+        for (int i = 0; i < N / 2; i++)
+            a[i] = (rnd(s) & 7) == 0 ? 0x80000000u : rnd(s) * 2654435761u;
+        assert_int_equal(fn(RC_VD_FROM_VI, a, 0, N, out), W);
+        for (int i = 0; i < N / 2; i++) {
+            double got;
+            memcpy(&got, &out[2 * i], 8);
+            const double want = (double)(int32_t)a[i];
+            (*checked)++;
+            if (memcmp(&got, &want, 8) != 0 && (*bad)++ < 8)
+                print_message("FAIL %s vd_from_vi %d: %d -> %a\n", ef_isa_name(isa), i,
+                              (int32_t)a[i], got);
+        }
+        /* vf_from_vd (no NaN: only its bits would differ between targets) */
+        for (int i = 0; i < N / 2; i++) {
+            double d = rnd_double(s);
+            if (d != d) d = 1.5;
+            memcpy(&a[2 * i], &d, 8);
+        }
+        assert_int_equal(fn(RC_VF_FROM_VD, a, 0, N, out), W);
+        for (int i = 0; i < N / 2; i++) {
+            double d;
+            memcpy(&d, &a[2 * i], 8);
+            const float want = (float)d;
+            (*checked)++;
+            if (memcmp(&out[i], &want, 4) != 0 && (*bad)++ < 8)
+                print_message("FAIL %s vf_from_vd %d: %a -> 0x%08X\n", ef_isa_name(isa), i, d,
+                              out[i]);
+        }
+        /* vd_gt_bits: pairs, a third of them equal */
+        for (int i = 0; i < N / 2; i++) {
+            double d = rnd_double(s);
+            if (i % (2 * VD) >= VD && rnd(s) % 3 == 0)
+                memcpy(&d, &a[2 * (i - VD)], 8);
+            memcpy(&a[2 * i], &d, 8);
+        }
+        assert_int_equal(fn(RC_VD_GT_BITS, a, 0, N, out), W);
+        for (int g = 0; g < N / 2; g += 2 * VD)
+            for (int l = 0; l < VD; l++) {
+                double x, y;
+                memcpy(&x, &a[2 * (g + l)], 8);
+                memcpy(&y, &a[2 * (g + VD + l)], 8);
+                (*checked)++;
+                if ((out[g + l] != (uint32_t)(x > y) || out[g + VD + l] != 0) && (*bad)++ < 8)
+                    print_message("FAIL %s vd_gt_bits lane %d: %a > %a -> %u\n",
+                                  ef_isa_name(isa), l, x, y, out[g + l]);
+            }
+    }
+}
+
 static void check_isa(ef_isa isa, tu_simd_rcheck_fn *fn)
 {
     if (!ef_cpu_has(isa)) {
@@ -33,7 +160,7 @@ static void check_isa(ef_isa isa, tu_simd_rcheck_fn *fn)
                       ef_isa_name(isa), ef_isa_name(isa));
         skip();
     }
-    static uint32_t a[N], out[N], before[N];
+    static _Alignas(64) uint32_t a[N], out[N], before[N];
     static uint8_t ob[N], bb[N];
     long checked = 0, bad = 0;
     uint64_t s = 0x9E3779B97F4A7C15ull;
@@ -81,6 +208,7 @@ static void check_isa(ef_isa isa, tu_simd_rcheck_fn *fn)
             }
         }
     }
+    check_front_ops(isa, fn, W, &s, &checked, &bad);
     print_message("NOTE cpu simd raster %s: %d lanes, %ld results equal to the scalar model\n",
                   ef_isa_name(isa), W, checked - bad);
     assert_int_equal(bad, 0);

@@ -18,8 +18,9 @@
  *
  * WHAT IT DOES NOT. No dispatch (src/cpu/cpu.h picks the ISA; each room
  * keeps one dispatch table), no FMA, no estimates (rcp/rsqrt), no fast-math,
- * no gathers; of byte and 16-bit lanes only what the fuse's per-row
- * composite needs (vh_*, per 128-bit block; the refinement's saturating
+ * no float gathers (vi_gather: int32, the row cache's fallback); of byte
+ * and 16-bit lanes only what the fuse's composites need (vh_*, per 128-bit
+ * block; the refinement's saturating
  * and unsigned-compare operations are not here, docs/portability.md);
  * bytes widen to int32 lanes with vi_load_u8, RGBA8 pixels are int32
  * lanes through vi_loadu. What one
@@ -198,6 +199,39 @@
  *   vd_load_f(p)             VD_W floats p[0 .. VD_W) converted (exactly)
  *   vd_store_f(p, a)         the lanes rounded to float (nearest even) and
  *                            stored to p[0 .. VD_W)
+ *
+ * RASTER FRONT-END OPS (src/raster's vector front end, raster_frontv.inl:
+ * the vertex pass, the rejection and the double plane set-up of survivors;
+ * a block after the raster ops; h is a constant 0 or 1, "half h" the lanes
+ * h*VD_W .. h*VD_W + VD_W - 1)
+ *   vi_min(i, j) vi_max(i, j)  signed int32 minimum / maximum
+ *   vd_from_vf(a, h)         the float lanes of half h of a as doubles (exact)
+ *   vd_from_vi(i, h)         the int32 lanes of half h of i as doubles (exact)
+ *   vf_from_vd(lo, hi)       lanes 0 .. VD_W-1 = lo, VD_W .. = hi, each
+ *                            rounded to float (nearest even; x86 cvtpd2ps)
+ *   vd_gt_bits(a, b)         bits (VD_W of them) of the lanes with a > b,
+ *                            ordered (false when either is NaN)
+ * ROW-CACHE OPS (added for src/fuse's row-cached composite, fuse_simd.inl
+ * fuse__hrow / fuse__vrow; a separate block at the end of each
+ * implementation; tests/test_cpu_simd_fuse.c)
+ *   (vi_min: see RASTER FRONT-END OPS)
+ *   vi_permute(i, idx)       lane l = lane (idx[l] & (SIMD_W - 1)) of i
+ *                            (AVX2 vpermd, AVX-512 vpermd, NEON TBL; SSE2
+ *                            through memory)
+ *   vi_gather(p, idx)        lane l = p[idx[l]] (const int32_t *p; every
+ *                            p[idx[l]] must be readable); SSE2 and NEON
+ *                            lane by lane
+ *   vh_zip_lo(i, j), vh_zip_hi(i, j)   16-bit lanes, in each block: lanes
+ *                            i0 j0 i1 j1 .. i3 j3 (lo) or i4 j4 .. i7 j7 (hi)
+ *                            (x86 punpcklwd / punpckhwd)
+ *   vh_madd(i, j)            int32 lane l = i[2l] j[2l] + i[2l+1] j[2l+1],
+ *                            the 16-bit lanes read as int16, the sum
+ *                            wrapping (x86 pmaddwd)
+ *   vh_packus32(i, j)        in each block: the 4 int32 lanes of i, then
+ *                            those of j, each saturated to 0..65535, as its
+ *                            8 16-bit lanes (x86 packusdw)
+ *   vh_mulhi(i, j)           16-bit lanes: (i j) >> 16, unsigned (x86
+ *                            pmulhuw)
  *
  * NEW ISA. Copy simd_neon.h (the plainest), keep every name, meet every
  * line of this contract (the semantics above are x86's where the ISAs

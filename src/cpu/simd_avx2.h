@@ -253,6 +253,38 @@ SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return _mm256_max_pd(a, b); }
 SIMD_INL vdouble vd_load_f(const float *p) { return _mm256_cvtps_pd(_mm_loadu_ps(p)); }
 SIMD_INL void vd_store_f(float *p, vdouble a) { _mm_storeu_ps(p, _mm256_cvtpd_ps(a)); }
 
+
+/* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
+SIMD_INL vint vi_min(vint i, vint j) { return _mm256_min_epi32(i, j); }
+SIMD_INL vint vi_max(vint i, vint j) { return _mm256_max_epi32(i, j); }
+SIMD_INL vdouble vd_from_vf(vfloat a, int h)
+{
+    return _mm256_cvtps_pd(h ? _mm256_extractf128_ps(a, 1) : _mm256_castps256_ps128(a));
+}
+SIMD_INL vdouble vd_from_vi(vint i, int h)
+{
+    return _mm256_cvtepi32_pd(h ? _mm256_extracti128_si256(i, 1) : _mm256_castsi256_si128(i));
+}
+SIMD_INL vfloat vf_from_vd(vdouble lo, vdouble hi)
+{
+    return _mm256_insertf128_ps(_mm256_castps128_ps256(_mm256_cvtpd_ps(lo)), _mm256_cvtpd_ps(hi), 1);
+}
+SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
+{
+    return (unsigned)_mm256_movemask_pd(_mm256_cmp_pd(a, b, _CMP_GT_OQ));
+}
+/* ---- row-cache ops (src/fuse's composite; simd.h "ROW-CACHE OPS") */
+SIMD_INL vint vi_permute(vint i, vint idx) { return _mm256_permutevar8x32_epi32(i, idx); }
+SIMD_INL vint vi_gather(const int32_t *p, vint idx)
+{
+    return _mm256_i32gather_epi32((const int *)(const void *)p, idx, 4);
+}
+SIMD_INL vint vh_zip_lo(vint i, vint j) { return _mm256_unpacklo_epi16(i, j); }
+SIMD_INL vint vh_zip_hi(vint i, vint j) { return _mm256_unpackhi_epi16(i, j); }
+SIMD_INL vint vh_madd(vint i, vint j) { return _mm256_madd_epi16(i, j); }
+SIMD_INL vint vh_packus32(vint i, vint j) { return _mm256_packus_epi32(i, j); }
+SIMD_INL vint vh_mulhi(vint i, vint j) { return _mm256_mulhi_epu16(i, j); }
+
 #else
 #error "simd_avx2.h: another implementation of the vector layer is already included"
 #endif

@@ -239,6 +239,38 @@ SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return _mm512_max_pd(a, b); }
 SIMD_INL vdouble vd_load_f(const float *p) { return _mm512_cvtps_pd(_mm256_loadu_ps(p)); }
 SIMD_INL void vd_store_f(float *p, vdouble a) { _mm256_storeu_ps(p, _mm512_cvtpd_ps(a)); }
 
+
+/* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
+SIMD_INL vint vi_min(vint i, vint j) { return _mm512_min_epi32(i, j); }
+SIMD_INL vint vi_max(vint i, vint j) { return _mm512_max_epi32(i, j); }
+SIMD_INL vdouble vd_from_vf(vfloat a, int h)
+{
+    return _mm512_cvtps_pd(h ? _mm512_extractf32x8_ps(a, 1) : _mm512_castps512_ps256(a));
+}
+SIMD_INL vdouble vd_from_vi(vint i, int h)
+{
+    return _mm512_cvtepi32_pd(h ? _mm512_extracti32x8_epi32(i, 1) : _mm512_castsi512_si256(i));
+}
+SIMD_INL vfloat vf_from_vd(vdouble lo, vdouble hi)
+{
+    return _mm512_insertf32x8(_mm512_castps256_ps512(_mm512_cvtpd_ps(lo)), _mm512_cvtpd_ps(hi), 1);
+}
+SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
+{
+    return (unsigned)_mm512_cmp_pd_mask(a, b, _CMP_GT_OQ);
+}
+/* ---- row-cache ops (src/fuse's composite; simd.h "ROW-CACHE OPS") */
+SIMD_INL vint vi_permute(vint i, vint idx) { return _mm512_permutexvar_epi32(idx, i); }
+SIMD_INL vint vi_gather(const int32_t *p, vint idx)
+{
+    return _mm512_i32gather_epi32(idx, (const void *)p, 4);
+}
+SIMD_INL vint vh_zip_lo(vint i, vint j) { return _mm512_unpacklo_epi16(i, j); }
+SIMD_INL vint vh_zip_hi(vint i, vint j) { return _mm512_unpackhi_epi16(i, j); }
+SIMD_INL vint vh_madd(vint i, vint j) { return _mm512_madd_epi16(i, j); }
+SIMD_INL vint vh_packus32(vint i, vint j) { return _mm512_packus_epi32(i, j); }
+SIMD_INL vint vh_mulhi(vint i, vint j) { return _mm512_mulhi_epu16(i, j); }
+
 #else
 #error "simd_avx512.h: another implementation of the vector layer is already included"
 #endif

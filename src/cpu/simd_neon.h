@@ -301,6 +301,63 @@ SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return vbslq_f64(vcgtq_f64(a, b)
 SIMD_INL vdouble vd_load_f(const float *p) { return vcvt_f64_f32(vld1_f32(p)); }
 SIMD_INL void vd_store_f(float *p, vdouble a) { vst1_f32(p, vcvt_f32_f64(a)); }
 
+
+/* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
+SIMD_INL vint vi_min(vint i, vint j) { return vminq_s32(i, j); }
+SIMD_INL vint vi_max(vint i, vint j) { return vmaxq_s32(i, j); }
+SIMD_INL vdouble vd_from_vf(vfloat a, int h) { return vcvt_f64_f32(h ? vget_high_f32(a) : vget_low_f32(a)); }
+/* int32 -> int64 -> double: exact (|i| < 2^31 < 2^53) */
+SIMD_INL vdouble vd_from_vi(vint i, int h) { return vcvtq_f64_s64(vmovl_s32(h ? vget_high_s32(i) : vget_low_s32(i))); }
+SIMD_INL vfloat vf_from_vd(vdouble lo, vdouble hi) { return vcombine_f32(vcvt_f32_f64(lo), vcvt_f32_f64(hi)); }
+SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
+{
+    const uint64x2_t g = vcgtq_f64(a, b);
+    return (unsigned)(vgetq_lane_u64(g, 0) & 1u) | ((unsigned)(vgetq_lane_u64(g, 1) & 1u) << 1);
+/* ---- row-cache ops (src/fuse's composite; simd.h "ROW-CACHE OPS") */
+/* TBL on bytes: lane l's four bytes from 4 (idx[l] & 3) + 0..3 */
+SIMD_INL vint vi_permute(vint i, vint idx)
+{
+    const uint32x4_t b = vmlaq_n_u32(vdupq_n_u32(0x03020100u),
+                                     vandq_u32(vreinterpretq_u32_s32(idx), vdupq_n_u32(3)),
+                                     0x04040404u);
+    return vreinterpretq_s32_u8(vqtbl1q_u8(vreinterpretq_u8_s32(i), vreinterpretq_u8_u32(b)));
+}
+SIMD_INL vint vi_gather(const int32_t *p, vint idx)
+{
+    int32x4_t r = vdupq_n_s32(p[vgetq_lane_s32(idx, 0)]);
+    r = vsetq_lane_s32(p[vgetq_lane_s32(idx, 1)], r, 1);
+    r = vsetq_lane_s32(p[vgetq_lane_s32(idx, 2)], r, 2);
+    return vsetq_lane_s32(p[vgetq_lane_s32(idx, 3)], r, 3);
+}
+SIMD_INL vint vh_zip_lo(vint i, vint j)
+{
+    return vreinterpretq_s32_u16(vzip1q_u16(vreinterpretq_u16_s32(i), vreinterpretq_u16_s32(j)));
+}
+SIMD_INL vint vh_zip_hi(vint i, vint j)
+{
+    return vreinterpretq_s32_u16(vzip2q_u16(vreinterpretq_u16_s32(i), vreinterpretq_u16_s32(j)));
+}
+/* pmaddwd: the products of the int16 pairs, added in pairs (wrapping) */
+SIMD_INL vint vh_madd(vint i, vint j)
+{
+    const int16x8_t a = vreinterpretq_s16_s32(i), b = vreinterpretq_s16_s32(j);
+    const int32x4_t lo = vmull_s16(vget_low_s16(a), vget_low_s16(b));
+    const int32x4_t hi = vmull_high_s16(a, b);
+    return vreinterpretq_s32_u32(vreinterpretq_u32_s32(vpaddq_s32(lo, hi)));
+}
+/* packusdw: each int32 saturated to 0..65535 (SQXTUN) */
+SIMD_INL vint vh_packus32(vint i, vint j)
+{
+    return vreinterpretq_s32_u16(vcombine_u16(vqmovun_s32(i), vqmovun_s32(j)));
+}
+SIMD_INL vint vh_mulhi(vint i, vint j)
+{
+    const uint16x8_t a = vreinterpretq_u16_s32(i), b = vreinterpretq_u16_s32(j);
+    const uint32x4_t lo = vmull_u16(vget_low_u16(a), vget_low_u16(b));
+    const uint32x4_t hi = vmull_high_u16(a, b);
+    return vreinterpretq_s32_u16(vuzp2q_u16(vreinterpretq_u16_u32(lo), vreinterpretq_u16_u32(hi)));
+}
+
 #else
 #error "simd_neon.h: another implementation of the vector layer is already included"
 #endif

@@ -187,6 +187,27 @@ typedef struct comp_job {
     int v_opaque;       /* fuse_eye.v_opaque: transparent spans are out = V */
 } comp_job;
 
+/* The jobs' inputs (fuse_light, fuse_composite, fuse_context_frame). */
+static void light_job_set(light_job *j, const kernels *k, const fuse_image *P,
+                          const uint8_t *mask, int mask_stride, const float *normal,
+                          int normal_stride, const fuse_image *out)
+{
+    j->k = k;
+    j->P = *P;
+    j->out = *out;
+    j->mask = mask;
+    j->normal = normal;
+    j->mask_stride = mask_stride;
+    j->normal_stride = normal_stride;
+}
+
+static void comp_job_set(comp_job *j, const kernels *k, const fuse_image *Q, const fuse_image *V,
+                         int vp_x0, int vp_y0, int vp_w, int vp_h, const fuse_image *out,
+                         int v_opaque)
+{
+    *j = (comp_job){k, *Q, *V, *out, vp_x0, vp_y0, vp_w, vp_h, fuse__same_image(out, V), v_opaque};
+}
+
 /* n pixels that the layer does not reach: out = V with alpha 255. With the
  * caller's promise that V is opaque that is V itself: nothing to do in
  * place, a copy otherwise. */
@@ -590,13 +611,7 @@ static fuse_result light_with(fuse_context *ctx, const kernels *k,
     fuse_result r = fuse__light_check(L, K, P, mask, mask_stride, normal,
                                       normal_stride, out, &j.prep);
     if (r != FUSE_OK) return r;
-    j.k = k;
-    j.P = *P;
-    j.out = *out;
-    j.mask = mask;
-    j.normal = normal;
-    j.mask_stride = mask_stride;
-    j.normal_stride = normal_stride;
+    light_job_set(&j, k, P, mask, mask_stride, normal, normal_stride, out);
     run(ctx, light_task, &j);
     return FUSE_OK;
 }
@@ -609,16 +624,7 @@ static fuse_result comp_with(fuse_context *ctx, const kernels *k,
     comp_job j;
     fuse_result r = fuse__composite_check(Q, V, vp_x0, vp_y0, vp_w, vp_h, out);
     if (r != FUSE_OK) return r;
-    j.k = k;
-    j.Q = *Q;
-    j.V = *V;
-    j.out = *out;
-    j.vx = vp_x0;
-    j.vy = vp_y0;
-    j.vw = vp_w;
-    j.vh = vp_h;
-    j.in_place = fuse__same_image(out, V);
-    j.v_opaque = 0;
+    comp_job_set(&j, k, Q, V, vp_x0, vp_y0, vp_w, vp_h, out, 0);
     run(ctx, comp_task, &j);
     return FUSE_OK;
 }
@@ -899,23 +905,10 @@ fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int coun
         if (r == FUSE_OK && fuse__same_image(&s->P, &s->Q))
             r = FUSE_ERR_ARGS;   /* Q is a scratch layer of its own */
         if (r != FUSE_OK) return r;
-        j->light.k = &ctx->k;
-        j->light.P = s->P;
-        j->light.out = s->Q;
-        j->light.mask = s->mask;
-        j->light.normal = s->normal;
-        j->light.mask_stride = s->mask_stride;
-        j->light.normal_stride = s->normal_stride;
-        j->comp.k = &ctx->k;
-        j->comp.Q = s->Q;
-        j->comp.V = s->V;
-        j->comp.out = s->out;
-        j->comp.vx = s->vp_x0;
-        j->comp.vy = s->vp_y0;
-        j->comp.vw = s->vp_w;
-        j->comp.vh = s->vp_h;
-        j->comp.in_place = fuse__same_image(&s->out, &s->V);
-        j->comp.v_opaque = s->v_opaque != 0;
+        light_job_set(&j->light, &ctx->k, &s->P, s->mask, s->mask_stride, s->normal,
+                      s->normal_stride, &s->Q);
+        comp_job_set(&j->comp, &ctx->k, &s->Q, &s->V, s->vp_x0, s->vp_y0, s->vp_w, s->vp_h,
+                     &s->out, s->v_opaque != 0);
         j->depth = s->depth;
     }
     /* one eye's writes must not land in another eye's inputs */

@@ -1,20 +1,21 @@
-/* raster_front_avx2.c - the vector front end with AVX2 (8 lanes): the
- * port of raster_front_avx512.c (same steps, same operations per lane,
- * same bytes as rast__prepare_range with the scalar set-up; docs/raster.md
- * section 11, sixth round). Groups of 8 submitted triangles; survivors
- * are compressed into the queue by a vpermd index built from the lane
- * bits and set up 8 at a time (edges in 4 int64 lanes, planes in 4 double
- * lanes). Built with -mavx2 -mf16c; called only when cpuid reports AVX2.
+/* raster_front_avx2.c - the vector front end with AVX2 (8 lanes): what
+ * AVX2 does its own way around the steps written once on the vector layer
+ * (raster_front.inl: rejection; raster_frontv.inl: vertex pass
+ * rast__vpass_avx2, plane set-up, micro values), same bytes as
+ * rast__prepare_range with the scalar set-up (docs/raster.md section 11,
+ * sixth round). Groups of 8 submitted triangles; survivors are compressed
+ * into the queue by a vpermd index built from the lane bits and set up 8
+ * at a time (edges in 4 int64 lanes, planes in 4 double lanes). Built with
+ * -mavx2 -mf16c; called only when cpuid reports AVX2.
  *
- * Speed (issue 3, tenth round, the AVX-512 file's changes where they pay
- * on Zen 4): vertices loaded by 16-byte loads and a transpose instead of
- * gathers; the survivor queue kept in vectors (survivors merged in by one
- * permutation and blend per field, no unaligned store reloaded by flush);
- * flush keeps the edges and planes in vectors (planes8: the two halves
- * joined in registers) and writes each record by 16-byte copies from
- * lane-transposed stack layouts (quads, pairs) instead of a scalar copy
- * per field; the small loops unrolled (GCC -O2 left them rolled, with
- * the vectors going through the stack). */
+ * Here (issue 3, tenth round): vertices loaded by 16-byte loads and a
+ * transpose instead of gathers (fv_load_xyzw); the survivor queue kept in
+ * vectors (survivors merged in by one permutation and blend per field, no
+ * unaligned store reloaded by flush); flush keeps the edges and planes in
+ * vectors and writes each record by 16-byte copies from lane-transposed
+ * stack layouts (quads, pairs) instead of a scalar copy per field; the
+ * small loops unrolled (GCC -O2 left them rolled, with the vectors going
+ * through the stack). */
 #include "raster_internal.h"
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -23,14 +24,16 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "../cpu/simd_avx2.h"
+
 /* ---- vertex pass -------------------------------------------------------- */
 
 /* cnt (1..8) vertices xyzw at c, de-interleaved; lanes past cnt 0. Eight
  * 16-byte loads (masked loads for a partial block: no float past the last
  * vertex is read) and a 4x4 transpose per 128-bit half, instead of four
  * vgatherdps (the vertex pass's hottest spot: 0.4 of its samples). */
-static inline __attribute__((always_inline)) void load_xyzw(const float *c, int cnt, __m256 *x,
-                                                            __m256 *y, __m256 *z, __m256 *w)
+static inline __attribute__((always_inline)) void fv_load_xyzw(const float *c, int cnt, vfloat *x,
+                                                               vfloat *y, vfloat *z, vfloat *w)
 {
     __m256 r[4];   /* r[i] = vertex i in the low half, vertex i + 4 in the high half */
     if (cnt == 8) {
@@ -60,78 +63,6 @@ static inline __attribute__((always_inline)) void load_xyzw(const float *c, int 
     *w = _mm256_shuffle_ps(t2, t3, _MM_SHUFFLE(3, 2, 3, 2));
 }
 
-void rast__vpass_avx2(const rast__view *v, const float *clip, int count, rast__vbuf *vb)
-{
-    const __m256 zero = _mm256_setzero_ps(), half = _mm256_set1_ps(0.5f);
-    const __m256 fix = _mm256_set1_ps((float)RAST__FIX_ONE);
-    const __m256 big = _mm256_set1_ps(FLT_MAX), nbig = _mm256_set1_ps(-FLT_MAX);
-    const __m256 gx = _mm256_set1_ps(v->gx), gy = _mm256_set1_ps(v->gy);
-    const __m256 fw = _mm256_set1_ps((float)v->width), fh = _mm256_set1_ps((float)v->height);
-    const __m256 lox = _mm256_set1_ps((float)v->min_x), hix = _mm256_set1_ps((float)v->max_x);
-    const __m256 loy = _mm256_set1_ps((float)v->min_y), hiy = _mm256_set1_ps((float)v->max_y);
-    const __m256i mark = _mm256_set1_epi32(RAST__VX_SPECIAL);
-    const __m256d dhalf = _mm256_set1_pd(0.5), done = _mm256_set1_pd(1.0);
-    for (int base = 0; base < count; base += 8) {
-        const int cnt = count - base < 8 ? count - base : 8;
-        const float *c = clip + 4 * (size_t)base;
-        __m256 x, y, z, w;
-        load_xyzw(c, cnt, &x, &y, &z, &w);
-        const __m256 fin = _mm256_and_ps(
-            _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(x, big, _CMP_LE_OQ),
-                                        _mm256_cmp_ps(nbig, x, _CMP_LE_OQ)),
-                          _mm256_and_ps(_mm256_cmp_ps(y, big, _CMP_LE_OQ),
-                                        _mm256_cmp_ps(nbig, y, _CMP_LE_OQ))),
-            _mm256_and_ps(_mm256_and_ps(_mm256_cmp_ps(z, big, _CMP_LE_OQ),
-                                        _mm256_cmp_ps(nbig, z, _CMP_LE_OQ)),
-                          _mm256_and_ps(_mm256_cmp_ps(w, big, _CMP_LE_OQ),
-                                        _mm256_cmp_ps(nbig, w, _CMP_LE_OQ))));
-        const __m256 gxw = _mm256_mul_ps(gx, w), gyw = _mm256_mul_ps(gy, w);
-        /* outcode_inl, plane by plane (the same float expressions) */
-        const __m256 ob[6] = { _mm256_cmp_ps(_mm256_add_ps(z, w), zero, _CMP_LT_OQ),
-                               _mm256_cmp_ps(_mm256_sub_ps(w, z), zero, _CMP_LT_OQ),
-                               _mm256_cmp_ps(_mm256_add_ps(gxw, x), zero, _CMP_LT_OQ),
-                               _mm256_cmp_ps(_mm256_sub_ps(gxw, x), zero, _CMP_LT_OQ),
-                               _mm256_cmp_ps(_mm256_add_ps(gyw, y), zero, _CMP_LT_OQ),
-                               _mm256_cmp_ps(_mm256_sub_ps(gyw, y), zero, _CMP_LT_OQ) };
-        const __m256 out = _mm256_or_ps(_mm256_or_ps(_mm256_or_ps(ob[0], ob[1]),
-                                                     _mm256_or_ps(ob[2], ob[3])),
-                                        _mm256_or_ps(ob[4], ob[5]));
-        /* Y of a marked vertex: its outcode | RAST__VX_NONFINITE */
-        __m256i oc = _mm256_andnot_si256(_mm256_castps_si256(fin),
-                                         _mm256_set1_epi32(RAST__VX_NONFINITE));
-#pragma GCC unroll 6
-        for (int b = 0; b < 6; b++)
-            oc = _mm256_or_si256(oc, _mm256_and_si256(_mm256_castps_si256(ob[b]),
-                                                      _mm256_set1_epi32(1 << b)));
-        const __m256 wpos = _mm256_cmp_ps(w, zero, _CMP_GT_OQ);
-        /* special = !fin | out | !(w > 0) */
-        const __m256 ok = _mm256_andnot_ps(out, _mm256_and_ps(fin, wpos));
-        const __m256 nx = _mm256_div_ps(x, w), ny = _mm256_div_ps(y, w);
-        const __m256 sx = _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(nx, half), half), fw);
-        const __m256 sy = _mm256_mul_ps(_mm256_sub_ps(half, _mm256_mul_ps(ny, half)), fh);
-        __m256i X = _mm256_cvtps_epi32(_mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(sx, fix), lox), hix));
-        __m256i Y =
-            _mm256_cvtps_epi32(_mm256_min_ps(_mm256_max_ps(_mm256_mul_ps(sy, fix), loy), hiy));
-        X = _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(mark),
-                                                 _mm256_castsi256_ps(X), ok));
-        Y = _mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(oc),
-                                                 _mm256_castsi256_ps(Y), ok));
-        const __m256i lo = _mm256_unpacklo_epi32(X, Y), hi = _mm256_unpackhi_epi32(X, Y);
-        int32_t *xy = vb->xy + 2 * (size_t)base;
-        _mm256_store_si256((__m256i *)(void *)xy, _mm256_permute2x128_si256(lo, hi, 0x20));
-        _mm256_store_si256((__m256i *)(void *)(xy + 8), _mm256_permute2x128_si256(lo, hi, 0x31));
-        for (int h = 0; h < 2; h++) {
-            const __m256d dz = _mm256_cvtps_pd(h ? _mm256_extractf128_ps(z, 1)
-                                                 : _mm256_castps256_ps128(z));
-            const __m256d dw = _mm256_cvtps_pd(h ? _mm256_extractf128_ps(w, 1)
-                                                 : _mm256_castps256_ps128(w));
-            _mm256_store_pd(vb->zw + base + 4 * h,
-                            _mm256_add_pd(_mm256_mul_pd(_mm256_div_pd(dz, dw), dhalf), dhalf));
-            _mm256_store_pd(vb->iw + base + 4 * h, _mm256_div_pd(done, dw));
-        }
-    }
-}
-
 /* ---- helpers ------------------------------------------------------------ */
 
 static inline unsigned bits8(__m256i m)
@@ -144,42 +75,6 @@ static inline __m128i half4(__m256i v, int h)
     return h ? _mm256_extracti128_si256(v, 1) : _mm256_castsi256_si128(v);
 }
 
-/* Lanes with a*b > c*d (gt) or a*b < c*d (!gt), exact in double. */
-static inline unsigned prod_cmp(__m256i a, __m256i b, __m256i c, __m256i d, int gt)
-{
-    unsigned r = 0;
-    for (int h = 0; h < 2; h++) {
-        const __m256d p1 = _mm256_mul_pd(_mm256_cvtepi32_pd(half4(a, h)),
-                                         _mm256_cvtepi32_pd(half4(b, h)));
-        const __m256d p2 = _mm256_mul_pd(_mm256_cvtepi32_pd(half4(c, h)),
-                                         _mm256_cvtepi32_pd(half4(d, h)));
-        /* p1 < p2 as p2 > p1: the predicate stays a constant (clang, -Os) */
-        r |= (unsigned)_mm256_movemask_pd(_mm256_cmp_pd(gt ? p1 : p2, gt ? p2 : p1, _CMP_GT_OQ))
-             << (4 * h);
-    }
-    return r;
-}
-
-/* All ones in the lanes whose edge keeps E == 0 (top-left rule). */
-static inline __m256i top_left(__m256i dx, __m256i dy)
-{
-    const __m256i zero = _mm256_setzero_si256();
-    return _mm256_or_si256(_mm256_cmpgt_epi32(zero, dy),
-                           _mm256_and_si256(_mm256_cmpeq_epi32(dy, zero),
-                                            _mm256_cmpgt_epi32(dx, zero)));
-}
-
-/* Biased edge value in int32 (boxes of at most 2x2 pixels only). */
-static inline __m256i front_edge32(__m256i xa, __m256i ya, __m256i xb, __m256i yb,
-                                   __m256i cx, __m256i cy)
-{
-    const __m256i dx = _mm256_sub_epi32(xb, xa), dy = _mm256_sub_epi32(yb, ya);
-    const __m256i e = _mm256_sub_epi32(_mm256_mullo_epi32(dx, _mm256_sub_epi32(cy, ya)),
-                                       _mm256_mullo_epi32(dy, _mm256_sub_epi32(cx, xa)));
-    /* e - 1 where not top-left: e + (tl ? 0 : -1) = e + ~tl */
-    return _mm256_add_epi32(e, _mm256_xor_si256(top_left(dx, dy), _mm256_set1_epi32(-1)));
-}
-
 static inline __m256i blend8(__m256i a, __m256i b, __m256i m)
 {
     return _mm256_castps_si256(
@@ -187,7 +82,7 @@ static inline __m256i blend8(__m256i a, __m256i b, __m256i m)
 }
 
 /* Lane mask vector of bits. */
-static inline __m256i vmask(unsigned bits)
+static inline __m256i lanes8(unsigned bits)
 {
     const __m256i sel = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
     return _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32((int)bits), sel), sel);
@@ -205,40 +100,23 @@ static inline __m256i compress_idx(unsigned b)
                             _mm256_set1_epi32(7));
 }
 
-/* p[lane of half h of v] where lh, else d, by four scalar
- * loads and a blend instead of a masked vgatherdpd (12 per flush: the
+/* p[lane of half h of V] by four scalar loads (fv_gather_d of
+ * raster_frontv.inl) instead of a masked vgatherdpd (12 per flush: the
  * front end took 0.98-0.99 of the time with these, one process,
- * alternating). Every lane of v must index a readable double: flush
+ * alternating). Every lane of V must index a readable double: flush
  * masks its vertex indices with the lanes in use (unused lanes read
  * vertex 0, which every mesh with a triangle has). */
-static inline __m256d gather4(__m256d d, const double *p, __m256i v, int h, __m256d lh)
+static inline __attribute__((always_inline)) vdouble fv_gather_d(const double *p, vint V, int h)
 {
-    const __m128i i = half4(v, h);
-    const __m256d g = _mm256_setr_pd(p[_mm_cvtsi128_si32(i)], p[_mm_extract_epi32(i, 1)],
-                                     p[_mm_extract_epi32(i, 2)], p[_mm_extract_epi32(i, 3)]);
-    return _mm256_blendv_pd(d, g, lh);
+    const __m128i i = half4(V, h);
+    return _mm256_setr_pd(p[_mm_cvtsi128_si32(i)], p[_mm_extract_epi32(i, 1)],
+                          p[_mm_extract_epi32(i, 2)], p[_mm_extract_epi32(i, 3)]);
 }
 
-/* Lane macros of raster_front.inl (8 int32 lanes). */
-#define FRONT_V 8
-typedef __m256i fvi;
-#define FI_ZERO() _mm256_setzero_si256()
-#define FI_SET1(x) _mm256_set1_epi32(x)
-#define FI_ADD(a, b) _mm256_add_epi32(a, b)
-#define FI_SUB(a, b) _mm256_sub_epi32(a, b)
-#define FI_OR(a, b) _mm256_or_si256(a, b)
-#define FI_MIN(a, b) _mm256_min_epi32(a, b)
-#define FI_MAX(a, b) _mm256_max_epi32(a, b)
-#define FI_SRAI(v, n) _mm256_srai_epi32(v, n)
-#define FI_SLLI(v, n) _mm256_slli_epi32(v, n)
-typedef __m256i fvm;
-#define FI_GT(a, b) _mm256_cmpgt_epi32(a, b)
-#define FI_EQ(a, b) _mm256_cmpeq_epi32(a, b)
-#define FM_OR(a, b) _mm256_or_si256(a, b)
-#define FM_AND(a, b) _mm256_and_si256(a, b)
-#define FM_BITS(m) bits8(m)
-#define FI_NEG_BITS(v) bits8(v)
+/* The steps written on the vector layer (raster_front.inl: rejection;
+ * raster_frontv.inl: vertex pass rast__vpass_avx2, planes, micro values). */
 #include "raster_front.inl"
+#include "raster_frontv.inl"
 
 /* ---- survivor set-up ---------------------------------------------------- */
 
@@ -279,82 +157,6 @@ static inline __attribute__((always_inline)) void copy16(void *d, const void *s)
 }
 
 #include "raster_front_rec.inl"
-
-/* front_plane with the results as vectors: c, dx, dy of 4 lanes. */
-static inline __attribute__((always_inline)) void plane4(__m256d f0, __m256d f1, __m256d f2,
-                                                         __m256d ex1, __m256d ey1,
-                                                         __m256d ex2, __m256d ey2,
-                                                         __m256d ox, __m256d oy,
-                                                         __m256d area, __m128 *r)
-{
-    const __m256d df1 = _mm256_sub_pd(f1, f0), df2 = _mm256_sub_pd(f2, f0);
-    const __m256d gx = _mm256_div_pd(
-        _mm256_sub_pd(_mm256_mul_pd(df1, ey2), _mm256_mul_pd(df2, ey1)), area);
-    const __m256d gy = _mm256_div_pd(
-        _mm256_sub_pd(_mm256_mul_pd(df2, ex1), _mm256_mul_pd(df1, ex2)), area);
-    const __m256d cc =
-        _mm256_add_pd(_mm256_add_pd(f0, _mm256_mul_pd(gx, ox)), _mm256_mul_pd(gy, oy));
-    r[0] = _mm256_cvtpd_ps(cc);
-    r[1] = _mm256_cvtpd_ps(gx);
-    r[2] = _mm256_cvtpd_ps(gy);
-}
-
-/* planes_one (raster_setup.c) per lane: the planes z, q, b1, b2 of the 8
- * queue lanes as vectors P[plane * 3 + {c, dx, dy}] (the same operations
- * per lane; the halves joined in registers: 16-byte stores reloaded as
- * 32 bytes cannot be forwarded). L: the lanes in use (the first k); with
- * k <= 4 the upper half is not computed (its lanes copy the lower's). */
-static inline __attribute__((always_inline)) void planes8(const __m256i X[3], const __m256i Y[3],
-                                                          const __m256i V[3], __m256i bx0,
-                                                          __m256i by0, __m256i L, int k,
-                                                          const rast__vbuf *vb, __m256 P[12])
-{
-    const __m256d inv256 = _mm256_set1_pd(1.0 / RAST__FIX_ONE), dzero = _mm256_setzero_pd();
-    const __m256d dhalf = _mm256_set1_pd(0.5), done = _mm256_set1_pd(1.0);
-    __m128 r[2][12];
-#pragma GCC unroll 2
-    for (int h = 0; h < 2; h++) {
-        if (h && k <= 4) {
-#pragma GCC unroll 12
-            for (int j = 0; j < 12; j++)
-                r[1][j] = r[0][j];
-            break;
-        }
-        const __m256d lh = _mm256_castsi256_pd(_mm256_cvtepi32_epi64(half4(L, h)));
-        __m256d Xd[3], Yd[3], zw[3], iw[3];
-#pragma GCC unroll 3
-        for (int i = 0; i < 3; i++) {
-            zw[i] = gather4(dzero, vb->zw, V[i], h, lh);
-            iw[i] = gather4(done, vb->iw, V[i], h, lh);
-        }
-#pragma GCC unroll 3
-        for (int i = 0; i < 3; i++) {
-            /* (double)X / 256: exact, as a multiplication by 2^-8 */
-            Xd[i] = _mm256_mul_pd(_mm256_cvtepi32_pd(half4(X[i], h)), inv256);
-            Yd[i] = _mm256_mul_pd(_mm256_cvtepi32_pd(half4(Y[i], h)), inv256);
-        }
-        const __m256d ex1 = _mm256_sub_pd(Xd[1], Xd[0]), ey1 = _mm256_sub_pd(Yd[1], Yd[0]);
-        const __m256d ex2 = _mm256_sub_pd(Xd[2], Xd[0]), ey2 = _mm256_sub_pd(Yd[2], Yd[0]);
-        /* |snapped area| / 65536, exact (raster_front.inl); unused lanes 1 */
-        const __m256d area = _mm256_blendv_pd(
-            done, _mm256_sub_pd(_mm256_mul_pd(ex1, ey2), _mm256_mul_pd(ey1, ex2)), lh);
-        const __m256d ocx = _mm256_add_pd(_mm256_cvtepi32_pd(half4(bx0, h)), dhalf);
-        const __m256d ocy = _mm256_add_pd(_mm256_cvtepi32_pd(half4(by0, h)), dhalf);
-        const __m256d ox = _mm256_sub_pd(ocx, Xd[0]), oy = _mm256_sub_pd(ocy, Yd[0]);
-        /* max(a, b) = a > b ? a : b, as the scalar loop */
-        const __m256d qmax =
-            _mm256_max_pd(iw[2], _mm256_max_pd(iw[1], _mm256_max_pd(iw[0], dzero)));
-        const __m256d q0 = _mm256_div_pd(iw[0], qmax), q1 = _mm256_div_pd(iw[1], qmax);
-        const __m256d q2 = _mm256_div_pd(iw[2], qmax);
-        plane4(zw[0], zw[1], zw[2], ex1, ey1, ex2, ey2, ox, oy, area, r[h]);
-        plane4(q0, q1, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 3);
-        plane4(dzero, q1, dzero, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 6);
-        plane4(dzero, dzero, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 9);
-    }
-#pragma GCC unroll 12
-    for (int j = 0; j < 12; j++)
-        P[j] = _mm256_insertf128_ps(_mm256_castps128_ps256(r[0][j]), r[1][j], 1);
-}
 
 /* Micro lanes (clamped box at most 2x2 pixels; raster_front_avx512.c,
  * micro_lanes): the covered pixels (bit i + 2j of cov[l]) by the int64
@@ -402,33 +204,14 @@ static inline __attribute__((always_inline)) unsigned micro_lanes(const __m256i 
     cv[3] &= mic & wide & tall;
     if (!(cv[0] | cv[1] | cv[2] | cv[3]))
         return mic;
-    __m256i cb = _mm256_and_si256(vmask(cv[0]), one);
+    __m256i cb = _mm256_and_si256(lanes8(cv[0]), one);
 #pragma GCC unroll 3
     for (int p = 1; p < 4; p++)
-        cb = _mm256_or_si256(cb, _mm256_and_si256(vmask(cv[p]), _mm256_set1_epi32(1 << p)));
+        cb = _mm256_or_si256(cb, _mm256_and_si256(lanes8(cv[p]), _mm256_set1_epi32(1 << p)));
     _mm256_store_si256((__m256i *)(void *)cov, cb);
     /* The values (the scan's expressions; unused lanes compute garbage). */
-    const __m256 zero = _mm256_setzero_ps(), fone = _mm256_set1_ps(1.0f);
     __m256 Z[4], B1[4], B2[4];
-#pragma GCC unroll 2
-    for (int j = 0; j < 2; j++) {
-        const __m256 fj = j ? fone : zero;
-        const __m256 zr = _mm256_add_ps(P[0], _mm256_mul_ps(P[2], fj));
-        const __m256 qr = _mm256_add_ps(P[3], _mm256_mul_ps(P[5], fj));
-        const __m256 b1r = _mm256_add_ps(P[6], _mm256_mul_ps(P[8], fj));
-        const __m256 b2r = _mm256_add_ps(P[9], _mm256_mul_ps(P[11], fj));
-#pragma GCC unroll 2
-        for (int i = 0; i < 2; i++) {
-            const int p = i + 2 * j;
-            const __m256 fi = i ? fone : zero;
-            __m256 z = _mm256_add_ps(zr, _mm256_mul_ps(P[1], fi));
-            z = _mm256_max_ps(zero, z);
-            Z[p] = _mm256_min_ps(fone, z);
-            const __m256 r = _mm256_div_ps(fone, _mm256_add_ps(qr, _mm256_mul_ps(P[4], fi)));
-            B1[p] = _mm256_mul_ps(_mm256_add_ps(b1r, _mm256_mul_ps(P[7], fi)), r);
-            B2[p] = _mm256_mul_ps(_mm256_add_ps(b2r, _mm256_mul_ps(P[10], fi)), r);
-        }
-    }
+    fv_micro_values(P, Z, B1, B2);
     quads(Z[0], Z[1], Z[2], Z[3], mq);
     quads(B1[0], B1[1], B1[2], B1[3], mq + 32);
     quads(B2[0], B2[1], B2[2], B2[3], mq + 64);
@@ -526,7 +309,7 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
     for (int e = 0; e < 3; e++) {
         const int a = ea[e], b = eb[e];
         const __m256i dx = _mm256_sub_epi32(X[b], X[a]), dy = _mm256_sub_epi32(Y[b], Y[a]);
-        const __m256i bias = _mm256_andnot_si256(top_left(dx, dy), one);
+        const __m256i bias = _mm256_andnot_si256(vf_as_vi(top_left(dx, dy)), one);
         const __m256i oy = _mm256_sub_epi32(cy, Y[a]), ox = _mm256_sub_epi32(cx, X[a]);
 #pragma GCC unroll 2
         for (int h = 0; h < 2; h++) {
@@ -543,7 +326,7 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
 
     /* planes_one per lane. */
     __m256 P[12];
-    planes8(X, Y, V, bx0, by0, L, k, vb, P);
+    fv_planes(X, Y, V, bx0, by0, k, vb, P);
 
     /* The records: lane l -> out[slot l]. */
     const unsigned Lb = (1u << k) - 1u;
@@ -640,14 +423,12 @@ int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__
     const long long *xyb = (const long long *)(const void *)vb->xy;
     const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     const __m256i seven = _mm256_set1_epi32(7);
-    const __m256i mark = _mm256_set1_epi32(RAST__VX_SPECIAL);
-    const __m256i zero = _mm256_setzero_si256();
     const int vw = v->width, vh = v->height;   /* kept in registers */
     for (int ti = ti0; ti < ti1; ti += 8) {
         const int cnt = ti1 - ti < 8 ? ti1 - ti : 8;
         const unsigned L = (1u << cnt) - 1u;
         /* Indices, de-interleaved (lanes past cnt: vertex 0). */
-        __m256i iv[3], X[3], Y[3], spec = zero;
+        __m256i iv[3], X[3], Y[3];
         const uint32_t *ix = m->indices + 3 * (size_t)ti;
         load_tris(ix, cnt, iv);
         uint32_t pad[24];
@@ -668,27 +449,10 @@ int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__
             Y[k] = _mm256_permute4x64_epi64(
                 _mm256_castps_si256(_mm256_shuffle_ps(s0, s1, _MM_SHUFFLE(3, 1, 3, 1))),
                 _MM_SHUFFLE(3, 1, 2, 0));
-            spec = _mm256_or_si256(spec, _mm256_cmpeq_epi32(X[k], mark));
         }
-        const unsigned marked = bits8(spec) & L;   /* lanes with a marked vertex */
-        unsigned special0 = marked;
-        const unsigned all3 = marked & bits8(_mm256_cmpeq_epi32(X[0], mark)) &
-                              bits8(_mm256_cmpeq_epi32(X[1], mark)) &
-                              bits8(_mm256_cmpeq_epi32(X[2], mark));
-        if (all3) {
-            /* As raster_front_avx512.c: three marked vertices, a
-             * non-finite one or an outcode bit shared by the three. */
-            const __m256i yo = _mm256_or_si256(_mm256_or_si256(Y[0], Y[1]), Y[2]);
-            const __m256i ya = _mm256_and_si256(_mm256_and_si256(Y[0], Y[1]), Y[2]);
-            const __m256i z8 = _mm256_setzero_si256();
-            const unsigned nf = all3 & ~bits8(_mm256_cmpeq_epi32(
-                _mm256_and_si256(yo, _mm256_set1_epi32(RAST__VX_NONFINITE)), z8));
-            const unsigned away = all3 & ~nf & ~bits8(_mm256_cmpeq_epi32(
-                _mm256_and_si256(ya, _mm256_set1_epi32(RAST__VX_OUTCODE)), z8));
-            ls.tris_nonfinite += __builtin_popcount(nf);
-            ls.tris_clipped_away += __builtin_popcount(away);
-            special0 &= ~(nf | away);
-        }
+        /* lanes with a marked vertex; those needing the scalar path */
+        unsigned marked;
+        const unsigned special0 = fv_marked(X, Y, L, &ls, &marked);
         /* prepare_cached_one: area sign, degenerate, culling. */
         unsigned pos, neg;
         front_area_signs(X, Y, &pos, &neg);
@@ -700,7 +464,7 @@ int rast__frontv_avx2(const rast__view *v, const rast_mesh_desc *m, const rast__
         const unsigned odd = csmall & ~b.usmall;
         const unsigned special = special0 | odd;
         const unsigned live2 = c.live & ~b.off & ~odd;
-        const __m256i sw = vmask(neg);
+        const __m256i sw = lanes8(neg);
         const __m256i x1 = blend8(X[1], X[2], sw), x2 = blend8(X[2], X[1], sw);
         const __m256i y1 = blend8(Y[1], Y[2], sw), y2 = blend8(Y[2], Y[1], sw);
         const unsigned small = csmall & b.usmall;

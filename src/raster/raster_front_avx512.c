@@ -16,12 +16,17 @@
  *                 for boxes of at most 2x2 pixels, micro records instead
  *                 (micro_lanes: the scan's per-pixel values, in lanes).
  * Triangles with a vertex that is not finite, outside a clip plane or at
- * w <= 0 go through rast__prepare at their place in the order.
+ * w <= 0 go through rast__prepare at their place in the order. The vertex
+ * pass, the rejection's steps, the planes and the micro values are written
+ * once on the vector layer (raster_front.inl, raster_frontv.inl); this file
+ * keeps what AVX-512 does with mask registers and two-source permutes (the
+ * index de-interleave, the queue's masked permutes, the int64 edges, the
+ * record layouts).
  *
  * Speed (issue 3, tenth round; Zen 4): the survivor queue stays in
  * registers (survivors merged in by one masked permutation per field, no
  * unaligned store reloaded by flush); flush keeps the edges and planes in
- * vectors (planes16, the loops written out or unrolled so that no vector
+ * vectors (fv_planes, the loops written out or unrolled so that no vector
  * goes through the stack) and writes each record by 16-byte copies from
  * lane-transposed stack layouts (quads, pairs) instead of a scalar copy
  * per field; the positions are loaded with the indices read from the mesh. */
@@ -33,11 +38,14 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "../cpu/simd_avx512.h"
+
 /* ---- vertex pass -------------------------------------------------------- */
 
 /* count (1..16) vertices xyzw at c, de-interleaved; lanes past count 0. */
-static inline void load_xyzw(const float *c, int count, __m512 *x, __m512 *y, __m512 *z,
-                             __m512 *w)
+static inline __attribute__((always_inline)) void fv_load_xyzw(const float *c, int count,
+                                                               vfloat *x, vfloat *y,
+                                                               vfloat *z, vfloat *w)
 {
     __m512 v[4];
     for (int i = 0; i < 4; i++) {
@@ -62,75 +70,20 @@ static inline void load_xyzw(const float *c, int count, __m512 *x, __m512 *y, __
     *w = _mm512_shuffle_f32x4(zw01, zw23, 0xEE);
 }
 
-void rast__vpass_avx512(const rast__view *v, const float *clip, int count, rast__vbuf *vb)
+/* The rejection helpers of AVX-512 and raster_front.inl (the rejection on
+ * the vector layer). */
+#include "raster_front_avx512.inl"
+
+/* p[V[l]] for the lanes l of half h (fv_gather_d of raster_frontv.inl):
+ * every lane, flush masks V to vertex 0 where unused. */
+static inline __attribute__((always_inline)) vdouble fv_gather_d(const double *p, vint V, int h)
 {
-    const __m512 zero = _mm512_setzero_ps(), half = _mm512_set1_ps(0.5f);
-    const __m512 fix = _mm512_set1_ps((float)RAST__FIX_ONE);
-    const __m512 big = _mm512_set1_ps(FLT_MAX), nbig = _mm512_set1_ps(-FLT_MAX);
-    const __m512 gx = _mm512_set1_ps(v->gx), gy = _mm512_set1_ps(v->gy);
-    const __m512 fw = _mm512_set1_ps((float)v->width), fh = _mm512_set1_ps((float)v->height);
-    const __m512 lox = _mm512_set1_ps((float)v->min_x), hix = _mm512_set1_ps((float)v->max_x);
-    const __m512 loy = _mm512_set1_ps((float)v->min_y), hiy = _mm512_set1_ps((float)v->max_y);
-    const __m512i mark = _mm512_set1_epi32(RAST__VX_SPECIAL);
-    const __m512i ilo = _mm512_setr_epi32(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7,
-                                          23);
-    const __m512i ihi = _mm512_add_epi32(ilo, _mm512_set1_epi32(8));
-    const __m512d dhalf = _mm512_set1_pd(0.5), done = _mm512_set1_pd(1.0);
-    for (int base = 0; base < count; base += 16) {
-        const int cnt = count - base < 16 ? count - base : 16;
-        __m512 x, y, z, w;
-        load_xyzw(clip + 4 * (size_t)base, cnt, &x, &y, &z, &w);
-        /* vc_fill_one: finite (|c| <= FLT_MAX), outcode 0, w > 0. */
-        const __mmask16 fin =
-            _mm512_cmp_ps_mask(x, big, _CMP_LE_OQ) & _mm512_cmp_ps_mask(nbig, x, _CMP_LE_OQ) &
-            _mm512_cmp_ps_mask(y, big, _CMP_LE_OQ) & _mm512_cmp_ps_mask(nbig, y, _CMP_LE_OQ) &
-            _mm512_cmp_ps_mask(z, big, _CMP_LE_OQ) & _mm512_cmp_ps_mask(nbig, z, _CMP_LE_OQ) &
-            _mm512_cmp_ps_mask(w, big, _CMP_LE_OQ) & _mm512_cmp_ps_mask(nbig, w, _CMP_LE_OQ);
-        const __m512 gxw = _mm512_mul_ps(gx, w), gyw = _mm512_mul_ps(gy, w);
-        /* outcode_inl, plane by plane (the same float expressions) */
-        const __mmask16 o0 = _mm512_cmp_ps_mask(_mm512_add_ps(z, w), zero, _CMP_LT_OQ);
-        const __mmask16 o1 = _mm512_cmp_ps_mask(_mm512_sub_ps(w, z), zero, _CMP_LT_OQ);
-        const __mmask16 o2 = _mm512_cmp_ps_mask(_mm512_add_ps(gxw, x), zero, _CMP_LT_OQ);
-        const __mmask16 o3 = _mm512_cmp_ps_mask(_mm512_sub_ps(gxw, x), zero, _CMP_LT_OQ);
-        const __mmask16 o4 = _mm512_cmp_ps_mask(_mm512_add_ps(gyw, y), zero, _CMP_LT_OQ);
-        const __mmask16 o5 = _mm512_cmp_ps_mask(_mm512_sub_ps(gyw, y), zero, _CMP_LT_OQ);
-        const __mmask16 out = (__mmask16)(o0 | o1 | o2 | o3 | o4 | o5);
-        const __mmask16 wpos = _mm512_cmp_ps_mask(w, zero, _CMP_GT_OQ);
-        const __mmask16 special = (__mmask16)(~fin | out | ~wpos);
-        /* Y of a marked vertex: its outcode | RAST__VX_NONFINITE */
-        __m512i oc =
-            _mm512_maskz_mov_epi32((__mmask16)~fin, _mm512_set1_epi32(RAST__VX_NONFINITE));
-        const __mmask16 ob[6] = { o0, o1, o2, o3, o4, o5 };
-#pragma GCC unroll 6
-        for (int b = 0; b < 6; b++)
-            oc = _mm512_mask_or_epi32(oc, ob[b], oc, _mm512_set1_epi32(1 << b));
-        /* snap_inl */
-        const __m512 nx = _mm512_div_ps(x, w), ny = _mm512_div_ps(y, w);
-        const __m512 sx = _mm512_mul_ps(_mm512_add_ps(_mm512_mul_ps(nx, half), half), fw);
-        const __m512 sy = _mm512_mul_ps(_mm512_sub_ps(half, _mm512_mul_ps(ny, half)), fh);
-        __m512i X = _mm512_cvtps_epi32(_mm512_min_ps(_mm512_max_ps(_mm512_mul_ps(sx, fix), lox), hix));
-        __m512i Y =
-            _mm512_cvtps_epi32(_mm512_min_ps(_mm512_max_ps(_mm512_mul_ps(sy, fix), loy), hiy));
-        X = _mm512_mask_blend_epi32(special, X, mark);
-        Y = _mm512_mask_blend_epi32(special, Y, oc);
-        int32_t *xy = vb->xy + 2 * (size_t)base;
-        _mm512_store_si512((void *)xy, _mm512_permutex2var_epi32(X, ilo, Y));
-        _mm512_store_si512((void *)(xy + 16), _mm512_permutex2var_epi32(X, ihi, Y));
-        /* vert_zw, vert_iw in double */
-        for (int h = 0; h < 2; h++) {
-            const __m512d dz = _mm512_cvtps_pd(h ? _mm512_extractf32x8_ps(z, 1)
-                                                 : _mm512_castps512_ps256(z));
-            const __m512d dw = _mm512_cvtps_pd(h ? _mm512_extractf32x8_ps(w, 1)
-                                                 : _mm512_castps512_ps256(w));
-            _mm512_store_pd(vb->zw + base + 8 * h,
-                            _mm512_add_pd(_mm512_mul_pd(_mm512_div_pd(dz, dw), dhalf), dhalf));
-            _mm512_store_pd(vb->iw + base + 8 * h, _mm512_div_pd(done, dw));
-        }
-    }
+    return _mm512_i32gather_pd(half_i(V, h), p, 8);
 }
 
-/* Lane macros, the rejection helpers and raster_front.inl. */
-#include "raster_front_avx512.inl"
+/* The vertex pass rast__vpass_avx512, the planes and the micro values,
+ * written once on the vector layer. */
+#include "raster_frontv.inl"
 
 /* The (X, Y) pairs p64[ix[s * l]] of the 16 lanes l, by scalar 64-bit
  * loads (gather_pairs without vpgatherdq), split into X (low dwords) and
@@ -189,78 +142,6 @@ static inline void copy16(void *d, const void *s)
 
 #include "raster_front_rec.inl"
 
-/* front_plane with the results as vectors: c, dx, dy of 8 lanes. */
-static inline __attribute__((always_inline)) void plane8(__m512d f0, __m512d f1, __m512d f2,
-                                                         __m512d ex1, __m512d ey1,
-                                                         __m512d ex2, __m512d ey2,
-                                                         __m512d ox, __m512d oy,
-                                                         __m512d area, __m256 *r)
-{
-    const __m512d df1 = _mm512_sub_pd(f1, f0), df2 = _mm512_sub_pd(f2, f0);
-    const __m512d gx = _mm512_div_pd(
-        _mm512_sub_pd(_mm512_mul_pd(df1, ey2), _mm512_mul_pd(df2, ey1)), area);
-    const __m512d gy = _mm512_div_pd(
-        _mm512_sub_pd(_mm512_mul_pd(df2, ex1), _mm512_mul_pd(df1, ex2)), area);
-    const __m512d cc =
-        _mm512_add_pd(_mm512_add_pd(f0, _mm512_mul_pd(gx, ox)), _mm512_mul_pd(gy, oy));
-    r[0] = _mm512_cvtpd_ps(cc);
-    r[1] = _mm512_cvtpd_ps(gx);
-    r[2] = _mm512_cvtpd_ps(gy);
-}
-
-/* planes_one (raster_setup.c) per lane: the planes z, q, b1, b2 of the 16
- * queue lanes as vectors P[plane * 3 + {c, dx, dy}] (the same operations
- * per lane; written out so that nothing goes through memory). */
-static inline __attribute__((always_inline)) void planes16(const __m512i X[3],
-                                                           const __m512i Y[3],
-                                                           const __m512i V[3], __m512i bx0,
-                                                           __m512i by0, __mmask16 L,
-                                                           const rast__vbuf *vb, __m512 P[12])
-{
-    const __m512d inv256 = _mm512_set1_pd(1.0 / RAST__FIX_ONE), dzero = _mm512_setzero_pd();
-    const __m512d dhalf = _mm512_set1_pd(0.5), done = _mm512_set1_pd(1.0);
-    __m256 r[2][12];
-#pragma GCC unroll 2
-    for (int h = 0; h < 2; h++) {
-        const __mmask8 lh = (__mmask8)(L >> (8 * h));
-        if (h && !lh) {   /* no lane in use: the values of the first half */
-#pragma GCC unroll 12
-            for (int j = 0; j < 12; j++)
-                r[1][j] = r[0][j];
-            break;
-        }
-        __m512d Xd[3], Yd[3], zw[3], iw[3];
-#pragma GCC unroll 3
-        for (int i = 0; i < 3; i++) {
-            zw[i] = _mm512_mask_i32gather_pd(dzero, lh, half_i(V[i], h), vb->zw, 8);
-            iw[i] = _mm512_mask_i32gather_pd(done, lh, half_i(V[i], h), vb->iw, 8);
-        }
-#pragma GCC unroll 3
-        for (int i = 0; i < 3; i++) {
-            Xd[i] = _mm512_mul_pd(_mm512_cvtepi32_pd(half_i(X[i], h)), inv256);
-            Yd[i] = _mm512_mul_pd(_mm512_cvtepi32_pd(half_i(Y[i], h)), inv256);
-        }
-        const __m512d ex1 = _mm512_sub_pd(Xd[1], Xd[0]), ey1 = _mm512_sub_pd(Yd[1], Yd[0]);
-        const __m512d ex2 = _mm512_sub_pd(Xd[2], Xd[0]), ey2 = _mm512_sub_pd(Yd[2], Yd[0]);
-        const __m512d area = _mm512_mask_blend_pd(
-            lh, done, _mm512_sub_pd(_mm512_mul_pd(ex1, ey2), _mm512_mul_pd(ey1, ex2)));
-        const __m512d ocx = _mm512_add_pd(_mm512_cvtepi32_pd(half_i(bx0, h)), dhalf);
-        const __m512d ocy = _mm512_add_pd(_mm512_cvtepi32_pd(half_i(by0, h)), dhalf);
-        const __m512d ox = _mm512_sub_pd(ocx, Xd[0]), oy = _mm512_sub_pd(ocy, Yd[0]);
-        const __m512d qmax =
-            _mm512_max_pd(iw[2], _mm512_max_pd(iw[1], _mm512_max_pd(iw[0], dzero)));
-        const __m512d q0 = _mm512_div_pd(iw[0], qmax), q1 = _mm512_div_pd(iw[1], qmax);
-        const __m512d q2 = _mm512_div_pd(iw[2], qmax);
-        plane8(zw[0], zw[1], zw[2], ex1, ey1, ex2, ey2, ox, oy, area, r[h]);
-        plane8(q0, q1, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 3);
-        plane8(dzero, q1, dzero, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 6);
-        plane8(dzero, dzero, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 9);
-    }
-#pragma GCC unroll 12
-    for (int j = 0; j < 12; j++)
-        P[j] = _mm512_insertf32x8(_mm512_castps256_ps512(r[0][j]), r[1][j], 1);
-}
-
 /* Micro lanes (clamped box at most 2x2 pixels): the covered pixels and,
  * for each of the box's four pixels (i, j), the scan's values: the clamped
  * depth z and the barycentrics b1, b2, computed per lane with the float
@@ -317,27 +198,8 @@ static inline __attribute__((always_inline)) unsigned micro_lanes(const __m512i 
         cb = _mm512_mask_or_epi32(cb, cv[p], cb, _mm512_slli_epi32(bit, p));
     _mm_storeu_si128((__m128i *)(void *)cov, _mm512_cvtepi32_epi8(cb));
     /* The values (the scan's expressions; unused lanes compute garbage). */
-    const __m512 zero = _mm512_setzero_ps(), fone = _mm512_set1_ps(1.0f);
     __m512 Z[4], B1[4], B2[4];
-#pragma GCC unroll 2
-    for (int j = 0; j < 2; j++) {
-        const __m512 fj = j ? fone : zero;
-        const __m512 zr = _mm512_add_ps(P[0], _mm512_mul_ps(P[2], fj));
-        const __m512 qr = _mm512_add_ps(P[3], _mm512_mul_ps(P[5], fj));
-        const __m512 b1r = _mm512_add_ps(P[6], _mm512_mul_ps(P[8], fj));
-        const __m512 b2r = _mm512_add_ps(P[9], _mm512_mul_ps(P[11], fj));
-#pragma GCC unroll 2
-        for (int i = 0; i < 2; i++) {
-            const int p = i + 2 * j;
-            const __m512 fi = i ? fone : zero;
-            __m512 z = _mm512_add_ps(zr, _mm512_mul_ps(P[1], fi));
-            z = _mm512_max_ps(zero, z);
-            Z[p] = _mm512_min_ps(fone, z);
-            const __m512 r = _mm512_div_ps(fone, _mm512_add_ps(qr, _mm512_mul_ps(P[4], fi)));
-            B1[p] = _mm512_mul_ps(_mm512_add_ps(b1r, _mm512_mul_ps(P[7], fi)), r);
-            B2[p] = _mm512_mul_ps(_mm512_add_ps(b2r, _mm512_mul_ps(P[10], fi)), r);
-        }
-    }
+    fv_micro_values(P, Z, B1, B2);
     quads(Z[0], Z[1], Z[2], Z[3], mq);
     quads(B1[0], B1[1], B1[2], B1[3], mq + 64);
     quads(B2[0], B2[1], B2[2], B2[3], mq + 128);
@@ -396,7 +258,7 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
 
     /* planes_one per lane. */
     __m512 P[12];
-    planes16(X, Y, V, bx0, by0, L, vb, P);
+    fv_planes(X, Y, V, bx0, by0, k, vb, P);
 
     /* The records: lane l -> out[slot l]. */
     _Alignas(64) uint8_t cov[16] = { 0 };
@@ -464,7 +326,6 @@ int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast
     int n = 0;
     const long long *xyb = (const long long *)(const void *)vb->xy;
     const __m512i iota = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
-    const __m512i mark = _mm512_set1_epi32(RAST__VX_SPECIAL);
     const __m512i zero = _mm512_setzero_si512();
     const int vw = v->width, vh = v->height;   /* kept in registers */
     for (int ti = ti0; ti < ti1; ti += 16) {
@@ -500,31 +361,9 @@ int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast
             for (int k = 0; k < 3; k++)
                 load_xy(xyb, ivs[k], 1, &X[k], &Y[k]);
         }
-        __mmask16 spec = 0, all3 = (__mmask16)L;
-#pragma GCC unroll 3
-        for (int k = 0; k < 3; k++) {
-            const __mmask16 mk = _mm512_cmpeq_epi32_mask(X[k], mark);
-            spec |= mk;
-            all3 &= mk;
-        }
-        const unsigned marked = spec & L;   /* lanes with a marked vertex */
-        unsigned special0 = marked;
-        if (all3) {
-            /* clip_snap's first steps for triangles of three marked
-             * vertices (Y: outcode | RAST__VX_NONFINITE): a non-finite
-             * vertex drops the triangle as non-finite, else an outcode
-             * bit shared by the three as clipped away; the rest (to be
-             * clipped) take the scalar path. */
-            const __m512i yo = _mm512_or_si512(_mm512_or_si512(Y[0], Y[1]), Y[2]);
-            const __m512i ya = _mm512_and_si512(_mm512_and_si512(Y[0], Y[1]), Y[2]);
-            const __mmask16 nf =
-                _mm512_mask_test_epi32_mask(all3, yo, _mm512_set1_epi32(RAST__VX_NONFINITE));
-            const __mmask16 away = (__mmask16)(
-                _mm512_mask_test_epi32_mask(all3, ya, _mm512_set1_epi32(RAST__VX_OUTCODE)) & ~nf);
-            ls.tris_nonfinite += __builtin_popcount(nf);
-            ls.tris_clipped_away += __builtin_popcount(away);
-            special0 &= ~(unsigned)(nf | away);
-        }
+        /* lanes with a marked vertex; those needing the scalar path */
+        unsigned marked;
+        const unsigned special0 = fv_marked(X, Y, L, &ls, &marked);
         /* prepare_cached_one: area sign, degenerate, culling. */
         unsigned pos, neg;
         front_area_signs(X, Y, &pos, &neg);

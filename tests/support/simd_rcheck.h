@@ -15,6 +15,15 @@ enum {
     RC_VB_STORE_BITS, /* out: bytes, vb_store_bits per SIMD_W bytes with bits k */
     RC_STORE3_BITS,   /* out: floats, vf_store3_bits per 3*SIMD_W floats of a (x, y,
                        * z vectors one after the other) with bits k */
+    /* the raster front-end ops (simd.h "RASTER FRONT-END OPS") */
+    RC_VI_MINMAX,     /* a: int lanes, blocks of 2*SIMD_W (i, j); out: vi_min(i, j)
+                       * then vi_max(i, j) at the block's place */
+    RC_VD_FROM_VF,    /* a: n/2 floats; out: n/2 doubles, vd_from_vf per half */
+    RC_VD_FROM_VI,    /* a: n/2 int32; out: n/2 doubles, vd_from_vi per half */
+    RC_VF_FROM_VD,    /* a: n/2 doubles; out: n/2 floats, vf_from_vd(lo, hi) */
+    RC_VD_GT_BITS,    /* a: n/2 doubles, blocks of 2*VD_W (x, y); out[block + l] =
+                       * bit l of vd_gt_bits(x, y), out[block + VD_W + l] = 0
+                       * (0xBAD in out[block] when a bit above VD_W is set) */
     RC_COUNT
 };
 

@@ -27,6 +27,47 @@ int SIMD_FN(tu_simd_rcheck)(int op, const uint32_t *a, unsigned k, int n, void *
             vf_store3_bits(o + g, k, vf_loadu(p + g), vf_loadu(p + g + W), vf_loadu(p + g + 2 * W));
         return W;
     }
+    case RC_VI_MINMAX: {
+        int32_t *o = out;
+        const int32_t *p = (const int32_t *)(const void *)a;
+        for (int v = 0; v + 2 * W <= n; v += 2 * W) {
+            const vint i = vi_loadu(p + v), j = vi_loadu(p + v + W);
+            vi_storeu(o + v, vi_min(i, j));
+            vi_storeu(o + v + W, vi_max(i, j));
+        }
+        return W;
+    }
+    case RC_VD_FROM_VF:
+    case RC_VD_FROM_VI: {
+        double *o = out;
+        for (int v = 0; v + W <= n / 2; v += W) {
+            const vfloat f = vf_loadu((const float *)(const void *)(a + v));
+            const vint i = vi_loadu((const int32_t *)(const void *)(a + v));
+            vd_storeu(o + v, op == RC_VD_FROM_VF ? vd_from_vf(f, 0) : vd_from_vi(i, 0));
+            vd_storeu(o + v + VD_W, op == RC_VD_FROM_VF ? vd_from_vf(f, 1) : vd_from_vi(i, 1));
+        }
+        return W;
+    }
+    case RC_VF_FROM_VD: {
+        float *o = out;
+        const double *d = (const double *)(const void *)a;
+        for (int v = 0; v + W <= n / 2; v += W)
+            vf_storeu(o + v, vf_from_vd(vd_loadu(d + v), vd_loadu(d + v + VD_W)));
+        return W;
+    }
+    case RC_VD_GT_BITS: {
+        uint32_t *o = out;
+        const double *d = (const double *)(const void *)a;
+        for (int g = 0; g + 2 * VD_W <= n / 2; g += 2 * VD_W) {
+            const unsigned bits = vd_gt_bits(vd_loadu(d + g), vd_loadu(d + g + VD_W));
+            for (int l = 0; l < VD_W; l++) {
+                o[g + l] = (bits >> l) & 1u;
+                o[g + VD_W + l] = 0;
+            }
+            if (bits >> VD_W) o[g] = 0xBAD;
+        }
+        return W;
+    }
     default: return -1;
     }
 }

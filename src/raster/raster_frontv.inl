@@ -1,0 +1,212 @@
+/* raster_frontv.inl - the vector front end's steps written once on the
+ * vector layer (src/cpu/simd.h) and compiled per ISA by
+ * raster_front_avx2.c (8 lanes) and raster_front_avx512.c (16 lanes)
+ * (issue 19 item 4; docs/raster.md sections 1 and 11):
+ *
+ *   SIMD_FN(rast__vpass)   the vertex pass (rast__vpass_fn): vc_fill_one per
+ *                          lane (finiteness, outcode, w > 0, snap, zw, iw);
+ *   fv_marked              the triangles with a marked vertex, and those of
+ *                          three marked vertices dropped as non-finite or
+ *                          clipped away (clip_snap's first steps);
+ *   fv_planes              planes_one per lane (the double plane set-up of
+ *                          section 6.1, one triangle per double lane);
+ *   fv_micro_values        the scan's per-pixel values of the micro records
+ *                          (boxes of at most 2x2 pixels).
+ *
+ * Every lane runs the scalar path's operations in its order (no
+ * contraction: -ffp-contract=off), so the bytes equal rast__prepare_range
+ * with the scalar set-up at every lane width. What stays in the ISA files
+ * is what the layer does not have: the de-interleaving loads of vertices,
+ * indices and (X, Y) pairs, the survivor queue's compressing permutes, the
+ * int64 edges and the record layouts (AVX-512: mask registers).
+ *
+ * Included after one layer implementation, raster_front.inl and the
+ * includer's two helpers:
+ *   void fv_load_xyzw(const float *c, int cnt, vfloat *x, *y, *z, *w)
+ *        cnt (1..SIMD_W) vertices xyzw at c de-interleaved, lanes past cnt
+ *        0, no float past the last vertex read;
+ *   vdouble fv_gather_d(const double *p, vint V, int h)
+ *        p[V[l]] for the lanes l of half h (every lane of V indexes a
+ *        readable double). */
+
+/* ---- vertex pass -------------------------------------------------------- */
+
+void SIMD_FN(rast__vpass)(const rast__view *v, const float *clip, int count, rast__vbuf *vb)
+{
+    const vfloat zero = vf_zero(), half = vf_set1(0.5f);
+    const vfloat fix = vf_set1((float)RAST__FIX_ONE);
+    const vfloat big = vf_set1(FLT_MAX), nbig = vf_set1(-FLT_MAX);
+    const vfloat gx = vf_set1(v->gx), gy = vf_set1(v->gy);
+    const vfloat fw = vf_set1((float)v->width), fh = vf_set1((float)v->height);
+    const vfloat lox = vf_set1((float)v->min_x), hix = vf_set1((float)v->max_x);
+    const vfloat loy = vf_set1((float)v->min_y), hiy = vf_set1((float)v->max_y);
+    const vint mark = vi_set1(RAST__VX_SPECIAL);
+    const vdouble dhalf = vd_set1(0.5), done = vd_set1(1.0);
+    for (int base = 0; base < count; base += SIMD_W) {
+        const int cnt = count - base < SIMD_W ? count - base : SIMD_W;
+        vfloat x, y, z, w;
+        fv_load_xyzw(clip + 4 * (size_t)base, cnt, &x, &y, &z, &w);
+        /* vc_fill_one: finite (|c| <= FLT_MAX), outcode 0, w > 0. */
+        const vmask fin = vm_and(vm_and(vm_and(vf_le(x, big), vf_le(nbig, x)),
+                                        vm_and(vf_le(y, big), vf_le(nbig, y))),
+                                 vm_and(vm_and(vf_le(z, big), vf_le(nbig, z)),
+                                        vm_and(vf_le(w, big), vf_le(nbig, w))));
+        const vfloat gxw = vf_mul(gx, w), gyw = vf_mul(gy, w);
+        /* outcode_inl, plane by plane (the same float expressions) */
+        const vmask ob[6] = { vf_lt(vf_add(z, w), zero),   vf_lt(vf_sub(w, z), zero),
+                              vf_lt(vf_add(gxw, x), zero), vf_lt(vf_sub(gxw, x), zero),
+                              vf_lt(vf_add(gyw, y), zero), vf_lt(vf_sub(gyw, y), zero) };
+        const vmask out =
+            vm_or(vm_or(vm_or(ob[0], ob[1]), vm_or(ob[2], ob[3])), vm_or(ob[4], ob[5]));
+        /* Y of a marked vertex: its outcode | RAST__VX_NONFINITE */
+        vint oc = vf_as_vi(vf_selz(vm_not(fin), vi_as_vf(vi_set1(RAST__VX_NONFINITE))));
+#pragma GCC unroll 6
+        for (int b = 0; b < 6; b++)
+            oc = vi_or(oc, vf_as_vi(vf_selz(ob[b], vi_as_vf(vi_set1(1 << b)))));
+        /* special = !fin | out | !(w > 0) */
+        const vmask ok = vm_andnot(out, vm_and(fin, vf_gt(w, zero)));
+        /* snap_inl */
+        const vfloat nx = vf_div(x, w), ny = vf_div(y, w);
+        const vfloat sx = vf_mul(vf_add(vf_mul(nx, half), half), fw);
+        const vfloat sy = vf_mul(vf_sub(half, vf_mul(ny, half)), fh);
+        vint X = vi_from_vf_round(vf_min(vf_max(vf_mul(sx, fix), lox), hix));
+        vint Y = vi_from_vf_round(vf_min(vf_max(vf_mul(sy, fix), loy), hiy));
+        X = vi_sel(ok, X, mark);
+        Y = vi_sel(ok, Y, oc);
+        vi_store2(vb->xy + 2 * (size_t)base, X, Y);
+        /* vert_zw, vert_iw in double */
+#pragma GCC unroll 2
+        for (int h = 0; h < 2; h++) {
+            const vdouble dz = vd_from_vf(z, h), dw = vd_from_vf(w, h);
+            vd_storeu(vb->zw + base + VD_W * h,
+                      vd_add(vd_mul(vd_div(dz, dw), dhalf), dhalf));
+            vd_storeu(vb->iw + base + VD_W * h, vd_div(done, dw));
+        }
+    }
+}
+
+/* ---- rejection ---------------------------------------------------------- */
+
+/* The lanes (of L) with a marked vertex (X == RAST__VX_SPECIAL) to
+ * *marked; returns those of them that need the scalar path: of the
+ * triangles whose three vertices are marked (Y: outcode |
+ * RAST__VX_NONFINITE), a non-finite vertex drops the triangle as
+ * non-finite, else an outcode bit shared by the three as clipped away
+ * (counted in st); the rest (to be clipped) take the scalar path. */
+SIMD_INL unsigned fv_marked(const vint X[3], const vint Y[3], unsigned L, rast_stats *st,
+                            unsigned *marked)
+{
+    const vint mark = vi_set1(RAST__VX_SPECIAL);
+    const vmask m0 = vi_eq(X[0], mark), m1 = vi_eq(X[1], mark), m2 = vi_eq(X[2], mark);
+    const unsigned mk = vm_bits(vm_or(vm_or(m0, m1), m2)) & L;
+    *marked = mk;
+    const unsigned all3 = mk & vm_bits(vm_and(vm_and(m0, m1), m2));
+    if (!all3)
+        return mk;
+    const vint yo = vi_or(vi_or(Y[0], Y[1]), Y[2]);
+    const vint ya = vi_and(vi_and(Y[0], Y[1]), Y[2]);
+    const vint z = vi_zero();
+    const unsigned nf =
+        all3 & ~vm_bits(vi_eq(vi_and(yo, vi_set1(RAST__VX_NONFINITE)), z));
+    const unsigned away =
+        all3 & ~nf & ~vm_bits(vi_eq(vi_and(ya, vi_set1(RAST__VX_OUTCODE)), z));
+    st->tris_nonfinite += __builtin_popcount(nf);
+    st->tris_clipped_away += __builtin_popcount(away);
+    return mk & ~(nf | away);
+}
+
+/* ---- survivor set-up ---------------------------------------------------- */
+
+/* front_plane per double lane: c, dx, dy to r[0 .. 2]. */
+SIMD_INL void fv_plane(vdouble f0, vdouble f1, vdouble f2, vdouble ex1, vdouble ey1,
+                       vdouble ex2, vdouble ey2, vdouble ox, vdouble oy, vdouble area,
+                       vdouble *r)
+{
+    const vdouble df1 = vd_sub(f1, f0), df2 = vd_sub(f2, f0);
+    const vdouble gx = vd_div(vd_sub(vd_mul(df1, ey2), vd_mul(df2, ey1)), area);
+    const vdouble gy = vd_div(vd_sub(vd_mul(df2, ex1), vd_mul(df1, ex2)), area);
+    r[0] = vd_add(vd_add(f0, vd_mul(gx, ox)), vd_mul(gy, oy));
+    r[1] = gx;
+    r[2] = gy;
+}
+
+/* planes_one (raster_setup.c) per lane: the planes z, q, b1, b2 of the
+ * queue lanes 0 .. k-1 as vectors P[plane * 3 + {c, dx, dy}] (the same
+ * operations per lane; rounded to float once, at the end, both halves
+ * joined in registers). Lanes past k compute garbage (never stored); with
+ * k <= VD_W the upper half is not computed (its lanes copy the lower's). */
+SIMD_INL void fv_planes(const vint X[3], const vint Y[3], const vint V[3], vint bx0, vint by0,
+                        int k, const rast__vbuf *vb, vfloat P[12])
+{
+    const vdouble inv256 = vd_set1(1.0 / RAST__FIX_ONE), dzero = vd_set1(0.0);
+    const vdouble dhalf = vd_set1(0.5);
+    vdouble r[2][12];
+#pragma GCC unroll 2
+    for (int h = 0; h < 2; h++) {
+        if (h && k <= VD_W) {
+#pragma GCC unroll 12
+            for (int j = 0; j < 12; j++)
+                r[1][j] = r[0][j];
+            break;
+        }
+        vdouble Xd[3], Yd[3], zw[3], iw[3];
+#pragma GCC unroll 3
+        for (int i = 0; i < 3; i++) {
+            zw[i] = fv_gather_d(vb->zw, V[i], h);
+            iw[i] = fv_gather_d(vb->iw, V[i], h);
+        }
+#pragma GCC unroll 3
+        for (int i = 0; i < 3; i++) {
+            /* (double)X / 256: exact, as a multiplication by 2^-8 */
+            Xd[i] = vd_mul(vd_from_vi(X[i], h), inv256);
+            Yd[i] = vd_mul(vd_from_vi(Y[i], h), inv256);
+        }
+        const vdouble ex1 = vd_sub(Xd[1], Xd[0]), ey1 = vd_sub(Yd[1], Yd[0]);
+        const vdouble ex2 = vd_sub(Xd[2], Xd[0]), ey2 = vd_sub(Yd[2], Yd[0]);
+        /* |snapped area| / 65536, exact (raster_front.inl) */
+        const vdouble area = vd_sub(vd_mul(ex1, ey2), vd_mul(ey1, ex2));
+        const vdouble ocx = vd_add(vd_from_vi(bx0, h), dhalf);
+        const vdouble ocy = vd_add(vd_from_vi(by0, h), dhalf);
+        const vdouble ox = vd_sub(ocx, Xd[0]), oy = vd_sub(ocy, Yd[0]);
+        /* max(a, b) = a > b ? a : b, as the scalar loop */
+        const vdouble qmax = vd_max(iw[2], vd_max(iw[1], vd_max(iw[0], dzero)));
+        const vdouble q0 = vd_div(iw[0], qmax), q1 = vd_div(iw[1], qmax);
+        const vdouble q2 = vd_div(iw[2], qmax);
+        fv_plane(zw[0], zw[1], zw[2], ex1, ey1, ex2, ey2, ox, oy, area, r[h]);
+        fv_plane(q0, q1, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 3);
+        fv_plane(dzero, q1, dzero, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 6);
+        fv_plane(dzero, dzero, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 9);
+    }
+#pragma GCC unroll 12
+    for (int j = 0; j < 12; j++)
+        P[j] = vf_from_vd(r[0][j], r[1][j]);
+}
+
+/* The scan's values at the four pixels (i, j) of a micro record's box,
+ * p = i + 2j: the clamped depth Z[p] and the barycentrics B1[p], B2[p],
+ * per lane with the float operations of rast__scan_rows_ref in its order
+ * (fi, fj are 0.0f or 1.0f, multiplied as the scan multiplies them; P as
+ * fv_planes; lanes that are not micro compute garbage). */
+SIMD_INL void fv_micro_values(const vfloat *P, vfloat Z[4], vfloat B1[4], vfloat B2[4])
+{
+    const vfloat zero = vf_zero(), fone = vf_set1(1.0f);
+#pragma GCC unroll 2
+    for (int j = 0; j < 2; j++) {
+        const vfloat fj = j ? fone : zero;
+        const vfloat zr = vf_add(P[0], vf_mul(P[2], fj));
+        const vfloat qr = vf_add(P[3], vf_mul(P[5], fj));
+        const vfloat b1r = vf_add(P[6], vf_mul(P[8], fj));
+        const vfloat b2r = vf_add(P[9], vf_mul(P[11], fj));
+#pragma GCC unroll 2
+        for (int i = 0; i < 2; i++) {
+            const int p = i + 2 * j;
+            const vfloat fi = i ? fone : zero;
+            vfloat z = vf_add(zr, vf_mul(P[1], fi));
+            z = vf_max(zero, z);
+            Z[p] = vf_min(fone, z);
+            const vfloat r = vf_div(fone, vf_add(qr, vf_mul(P[4], fi)));
+            B1[p] = vf_mul(vf_add(b1r, vf_mul(P[7], fi)), r);
+            B2[p] = vf_mul(vf_add(b2r, vf_mul(P[10], fi)), r);
+        }
+    }
+}
