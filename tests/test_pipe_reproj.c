@@ -3,7 +3,8 @@
  * generated scenes whose geometry is known (the paper's HMD, the head at
  * the origin looking down -Z, quads facing the eyes):
  *   - the eye-view mask equals the model drawn directly from the eye
- *     (kin_sthmd_eye_camera) pixel for pixel, 255 inside;
+ *     (kin_sthmd_eye_camera) pixel for pixel, 255 inside (the paper's HMD
+ *     and the consumer preset's portrait display and column crop);
  *   - a point at a known depth lands where the geometry says: the camera
  *     image is a ramp of its own pixel position, so the colour each eye
  *     pixel took names the camera position it was sampled at, checked
@@ -125,6 +126,67 @@ static long draw_from_eye(const kin_model *m, int e, uint8_t *mask)
     free(depth);
     free(clip);
     return n;
+}
+
+/* The same on the "consumer" HMD (kin_sthmd_preset: 1280x1024 cameras
+ * cropped to 957x1024 columns, a 2064x2208 portrait display of 96 x 100
+ * degrees): the eye's layer has the crop's size and covers the display;
+ * its mask equals the quad drawn from kin_sthmd_eye_camera at that size. */
+static void result_mask_other_hmd(void **state)
+{
+    (void)state;
+    kin_model m;
+    const float s[1] = {0.05f}, z[1] = {-0.3f};
+    quads_model(&m, 1, s, z);
+    pipe_desc d;
+    memset(&d, 0, sizeof d);
+    assert_int_equal(kin_sthmd_preset("consumer", &d.hmd), 0);
+    d.eye_view = PIPE_VIEW_REPROJECT;
+    pipe_ctx *p = pipe_create(&d, &m);
+    assert_non_null(p);
+    const kin_sthmd_desc hd = pipe_hmd(p);
+    const kin_sthmd_geometry g = pipe_geometry(p);
+    tu_frame_bufs b;
+    pipe_frame_in in;
+    tu_frame_make(&b, &in, 17, hd.cam_width, hd.cam_height, hd.lcd_width, hd.lcd_height);
+    pipe_frame_stats st;
+    char why[200];
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    const int w = g.crop_width, h = g.crop_height;
+    uint8_t *ref = malloc((size_t)w * h);
+    float *depth = malloc(sizeof(float) * (size_t)w * h);
+    float clip[16];
+    assert_non_null(ref);
+    assert_non_null(depth);
+    for (int e = 0; e < 2; e++) {
+        assert_int_equal(st.view[e], PIPE_VIEW_REPROJECT);
+        int mw, mh;
+        const uint8_t *M = pipe_view_mask(p, e, &mw, &mh);
+        assert_int_equal(mw, w);
+        assert_int_equal(mh, h);
+        kin_camera c = kin_sthmd_eye_camera(&hd, NULL, (kin_eye)e, w, h);
+        rast_target t = {w, h, depth, w, ref, w, NULL, 0, 0};
+        rast_target_clear(&t);
+        rast_transform_points(c.view_proj.m, m.meshes[0].positions, 4, clip);
+        rast_mesh_desc md = {clip, 4, NULL, 0, m.meshes[0].indices, 2, RAST_CULL_NONE};
+        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
+        long n = 0, diff = 0, full = 0;
+        for (size_t i = 0; i < (size_t)w * h; i++) {
+            n += ref[i] != 0;
+            diff += (M[i] != 0) != (ref[i] != 0);
+            full += M[i] == 255;
+        }
+        print_message("NOTE consumer HMD, eye %d: layer %dx%d, %ld eye pixels, %ld differ, "
+                      "%ld filled\n", e, w, h, n, diff, st.view_filled[e]);
+        assert_true(n > 20000);
+        assert_int_equal(diff, 0);
+        assert_int_equal(full, n);
+    }
+    free(ref);
+    free(depth);
+    tu_frame_free(&b);
+    pipe_destroy(p);
+    kin_model_free(&m);
 }
 
 /* The eye-view mask of a quad in full view of the camera equals the quad
@@ -600,6 +662,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(result_mask_equals_eye_draw),
+        cmocka_unit_test(result_mask_other_hmd),
         cmocka_unit_test(result_point_lands_by_geometry),
         cmocka_unit_test(result_point_lands_through_lens),
         cmocka_unit_test(result_disocclusion_fill),

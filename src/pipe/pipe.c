@@ -176,6 +176,7 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
                  e->eye ? "right" : "left", rast_result_str(rr));
         return -1;
     }
+    r->isa = rast_context_isa(e->rast);
     if (pipe__reproj_sample(r, &e->cam, &fe->P, e->mask, cw, e->depth, cw, p->hmd.znear,
                             p->hmd.zfar)) {
         e->fallbacks++;

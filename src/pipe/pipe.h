@@ -215,7 +215,9 @@ typedef struct pipe_frame_stats {
     double ms_pose;           /* posing + skinning */
     double ms_raster[2];      /* per eye: camera, G-buffer */
     double ms_convert[2];     /* per eye: camera format conversion (raw) */
-    double ms_fuse[2];        /* per eye: lighting, resampling, composite */
+    double ms_fuse[2];        /* per eye: lighting, resampling, composite
+                                 (with PIPE_VIEW_REPROJECT also the eye's
+                                 raster and the sampling of the camera) */
     double ms_total;          /* wall time of pipe_frame */
     double coverage[2];       /* fraction of camera pixels in the mask */
     int lod_level[2];         /* per eye: the level of detail drawn
@@ -267,7 +269,9 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The last frame's lit layer of one eye (premultiplied RGBA8, the
  * mask's size, 4 * width bytes per row; valid until the next frame):
- * alpha 0 wherever the mask was 0 or the depth test hid the hand. */
+ * alpha 0 wherever the mask was 0 or the depth test hid the hand. With
+ * PIPE_VIEW_REPROJECT the eye view's layer (of pipe_view_mask; the same
+ * size), unless the eye fell back to the crop in that frame. */
 const uint8_t *pipe_layer(const pipe_ctx *p, int eye, int *width, int *height);
 /* The camera of one eye in the last frame. */
 kin_camera pipe_camera(const pipe_ctx *p, int eye);

@@ -2,6 +2,8 @@
  * the model's depth (see pipe_reproj.h). */
 #include "pipe_reproj.h"
 
+#include "../cpu/cpu.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -56,7 +58,8 @@ int pipe__reproj_init(pipe__reproj *r, int width, int height)
     r->P = calloc(px, 4);
     r->M = calloc(px, 1);
     r->row = malloc(sizeof(int32_t) * 3 * (size_t)width + (size_t)height);
-    if (!r->depth || !r->nrm || !r->mask || !r->P || !r->M || !r->row) {
+    r->lanes = malloc(sizeof(int32_t) * 8 * ((size_t)width + 16));
+    if (!r->depth || !r->nrm || !r->mask || !r->P || !r->M || !r->row || !r->lanes) {
         pipe__reproj_free(r);
         return -1;
     }
@@ -71,6 +74,7 @@ void pipe__reproj_free(pipe__reproj *r)
     free(r->P);
     free(r->M);
     free(r->row);
+    free(r->lanes);
     memset(r, 0, sizeof *r);
 }
 
@@ -83,6 +87,90 @@ static float lin_depth(float z, float n, float f)
 
 enum { ST_NONE = 0, ST_SAMPLED = 1, ST_FILL = 2 };
 
+/* The scalar reference of the geometry pass (pipe_reproj_simd.inl is
+ * this, lane by lane): columns [x, w) of one eye row, the covered ones. */
+static void row_ref(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
+                    const float *en, float ry, int x, int w, const pipe__reproj_lanes *o,
+                    long *back, float *mind)
+{
+    const float *a = g->a; /* column-major: x' = a0 x + a4 y + a8 z + a12 */
+    const float fade = PIPE_REPROJ_FADE_PX, n = g->n;
+    for (; x < w; x++) {
+        if (!em[x]) continue;
+        const float rx = g->rxs[x];
+        const float *nv = en + 3 * x;
+        if (nv[0] * rx + nv[1] * ry - nv[2] > 0.0f) (*back)++;
+        const float zn = 2.0f * ed[x] - 1.0f;
+        const float dist = g->two_fn / (g->fpn - zn * g->fmn);
+        if (dist < *mind) *mind = dist;
+        /* the eye-view point (rx, ry, -1) * dist in the camera's view */
+        float ex = rx * dist, ey = ry * dist, ez = -dist;
+        float px = a[0] * ex + a[4] * ey + a[8] * ez + a[12];
+        float py = a[1] * ex + a[5] * ey + a[9] * ez + a[13];
+        float pz = a[2] * ex + a[6] * ey + a[10] * ez + a[14];
+        float fu = 0.0f, fv = 0.0f;
+        int ok;
+        if (g->pinhole) {
+            ok = pz < -1e-6f;
+            if (ok) {
+                float iz = 1.0f / -pz;
+                fu = g->ccx + g->cfx * px * iz;
+                fv = g->ccy - g->cfy * py * iz;
+            }
+        } else {
+            double pc[3] = {px, py, pz}, u, v;
+            ok = kin_lens_project(g->lens, pc, &u, &v);
+            fu = (float)u;
+            fv = (float)v;
+        }
+        /* distance to the camera image's border, camera pixels */
+        float b = 0.0f;
+        if (ok) {
+            b = fu;
+            if (g->cw - fu < b) b = g->cw - fu;
+            if (fv < b) b = fv;
+            if (g->ch - fv < b) b = g->ch - fv;
+        }
+        if (!ok || !(b > 0.0f)) {
+            o->mv[x] = 0;
+            continue;
+        }
+        o->mv[x] = b >= fade ? 255 : (int32_t)(255.0f * (b / fade) + 0.5f);
+        /* a camera pixel shows this point when the camera's model is
+         * there no nearer than the point minus the slack: as a window
+         * depth of the camera's projection, zmin */
+        const float dp = -pz, dmin = dp - (PIPE_REPROJ_TOL_M + PIPE_REPROJ_TOL_REL * dp);
+        o->zmin[x] = dmin > n ? 0.5f * (g->fpn - g->two_fn / dmin) / g->fmn + 0.5f : 0.0f;
+        int iu = (int)fu, iv = (int)fv;
+        o->iu[x] = iu > g->icw1 ? g->icw1 : iu;
+        o->iv[x] = iv > g->ich1 ? g->ich1 : iv;
+        float sx = fu - 0.5f, sy = fv - 0.5f;
+        if (sx < 0.0f) sx = 0.0f;
+        if (sy < 0.0f) sy = 0.0f;
+        if (sx > g->cw1) sx = g->cw1;
+        if (sy > g->ch1) sy = g->ch1;
+        const int x0 = (int)sx, y0 = (int)sy;
+        o->tx[x] = x0;
+        o->ty[x] = y0;
+        o->fx[x] = (int)((sx - (float)x0) * 256.0f);
+        o->fy[x] = (int)((sy - (float)y0) * 256.0f);
+    }
+}
+
+static pipe__reproj_row_fn row_kernel(int isa)
+{
+    switch ((ef_isa)isa) {
+#if defined(__x86_64__)
+    case EF_ISA_AVX512: return pipe__reproj_row_avx512;
+    case EF_ISA_AVX2: return pipe__reproj_row_avx2;
+    case EF_ISA_SSE2: return pipe__reproj_row_sse2;
+#elif defined(__aarch64__) && defined(__ARM_NEON)
+    case EF_ISA_NEON: return pipe__reproj_row_neon;
+#endif
+    default: return NULL;
+    }
+}
+
 int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image *P,
                         const uint8_t *cmask, int cmask_stride, const float *cdepth,
                         int cdepth_stride, float n, float f)
@@ -92,11 +180,20 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
     const kin_camera *ec = &r->cam;
     /* eye view -> camera view */
     kin_mat4 m = kin_mat4_mul(&cam->view, &ec->world_from_cam);
-    const float *a = m.m; /* column-major: x' = a0 x + a4 y + a8 z + a12 */
-    const int pinhole = !kin_lens_distorts(&cam->lens) && cam->lens.skew == 0.0;
-    const float cfx = cam->fx, cfy = cam->fy, ccx = cam->cx, ccy = cam->cy;
+    pipe__reproj_geo g;
+    memcpy(g.a, m.m, sizeof g.a);
+    g.pinhole = !kin_lens_distorts(&cam->lens) && cam->lens.skew == 0.0;
+    g.lens = &cam->lens;
+    g.cfx = cam->fx, g.cfy = cam->fy, g.ccx = cam->cx, g.ccy = cam->cy;
+    g.cw = (float)cw, g.ch = (float)ch, g.cw1 = (float)(cw - 1), g.ch1 = (float)(ch - 1);
+    g.icw1 = cw - 1, g.ich1 = ch - 1;
+    g.n = n, g.f = f, g.fpn = f + n, g.fmn = f - n, g.two_fn = 2.0f * f * n;
     const float efx = ec->fx, efy = ec->fy, ecx = ec->cx, ecy = ec->cy;
-    const float fade = PIPE_REPROJ_FADE_PX;
+    const pipe__reproj_row_fn kernel = g.pinhole ? row_kernel(r->isa) : NULL;
+    const size_t lw = (size_t)w + 16;
+    const pipe__reproj_lanes o = {r->lanes,          r->lanes + lw,     r->lanes + 2 * lw,
+                                  r->lanes + 3 * lw, r->lanes + 4 * lw, r->lanes + 5 * lw,
+                                  r->lanes + 6 * lw, (float *)(r->lanes + 7 * lw)};
     long covered = 0, back = 0, sampled = 0, filled = 0, outside = 0;
     float mind = INFINITY;
     uint64_t sum[3] = {0, 0, 0};
@@ -104,6 +201,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
     float *rxs = (float *)(r->row + 2 * w);
     uint8_t *row_fill = (uint8_t *)(r->row + 3 * w);
     for (int x = 0; x < w; x++) rxs[x] = ((float)x + 0.5f - ecx) / efx;
+    g.rxs = rxs;
     for (int y = 0; y < h; y++) {
         const uint8_t *em = r->mask + (size_t)y * (size_t)w;
         uint8_t *M = r->M + (size_t)y * (size_t)w;
@@ -113,6 +211,9 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         const float ry = -((float)y + 0.5f - ecy) / efy;
         const long filled0 = filled;
         memset(M, 0, (size_t)w);
+        /* the geometry of the row's covered pixels (vector, then the tail) */
+        int x1 = kernel ? kernel(&g, em, ed, en, ry, w, &o, &back, &mind) : 0;
+        row_ref(&g, em, ed, en, ry, x1, w, &o, &back, &mind);
         for (int x = 0; x < w; x++) {
             if (!em[x]) {
                 /* 8 empty mask bytes at a time */
@@ -121,58 +222,14 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
                 continue;
             }
             covered++;
-            const float rx = rxs[x];
-            const float *nv = en + 3 * x;
-            if (nv[0] * rx + nv[1] * ry - nv[2] > 0.0f) back++;
-            float dist = lin_depth(ed[x], n, f);
-            if (dist < mind) mind = dist;
-            /* the eye-view point (rx, ry, -1) * dist in the camera's view */
-            float ex = rx * dist, ey = ry * dist, ez = -dist;
-            float px = a[0] * ex + a[4] * ey + a[8] * ez + a[12];
-            float py = a[1] * ex + a[5] * ey + a[9] * ez + a[13];
-            float pz = a[2] * ex + a[6] * ey + a[10] * ez + a[14];
-            float fu = 0.0f, fv = 0.0f;
-            int ok;
-            if (pinhole) {
-                ok = pz < -1e-6f;
-                if (ok) {
-                    float iz = 1.0f / -pz;
-                    fu = ccx + cfx * px * iz;
-                    fv = ccy - cfy * py * iz;
-                }
-            } else {
-                double pc[3] = {px, py, pz}, u, v;
-                ok = kin_lens_project(&cam->lens, pc, &u, &v);
-                fu = (float)u;
-                fv = (float)v;
-            }
-            /* distance to the camera image's border, camera pixels */
-            float b = 0.0f;
-            if (ok) {
-                b = fu;
-                if ((float)cw - fu < b) b = (float)cw - fu;
-                if (fv < b) b = fv;
-                if ((float)ch - fv < b) b = (float)ch - fv;
-            }
-            if (!ok || !(b > 0.0f)) {
+            if (!o.mv[x]) {
                 outside++;
                 continue;
             }
-            M[x] = b >= fade ? 255 : (uint8_t)(255.0f * (b / fade) + 0.5f);
-            if (M[x] == 0) {
-                outside++;
-                continue;
-            }
-            /* a camera pixel shows this point when the camera's model is
-             * there no nearer than the point minus the slack: as a window
-             * depth of the camera's projection, zmin */
-            const float dp = -pz, dmin = dp - (PIPE_REPROJ_TOL_M + PIPE_REPROJ_TOL_REL * dp);
-            const float zmin = dmin > n ? 0.5f * ((f + n) - 2.0f * f * n / dmin) / (f - n) + 0.5f
-                                        : 0.0f;
+            M[x] = (uint8_t)o.mv[x];
+            const float zmin = o.zmin[x];
             /* the nearest camera pixel: does the camera see this point? */
-            int iu = (int)fu, iv = (int)fv;
-            if (iu > cw - 1) iu = cw - 1;
-            if (iv > ch - 1) iv = ch - 1;
+            const int iu = o.iu[x], iv = o.iv[x];
             int seen = cmask[(size_t)iv * (size_t)cmask_stride + (size_t)iu] != 0 &&
                        !(cdepth[(size_t)iv * (size_t)cdepth_stride + (size_t)iu] < zmin);
             if (!seen) {
@@ -182,13 +239,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
             }
             /* bilinear, the taps that show the point (the camera's mask,
              * the same surface), renormalised */
-            float sx = fu - 0.5f, sy = fv - 0.5f;
-            if (sx < 0.0f) sx = 0.0f;
-            if (sy < 0.0f) sy = 0.0f;
-            if (sx > (float)(cw - 1)) sx = (float)(cw - 1);
-            if (sy > (float)(ch - 1)) sy = (float)(ch - 1);
-            const int x0 = (int)sx, y0 = (int)sy;
-            const int fx8 = (int)((sx - (float)x0) * 256.0f), fy8 = (int)((sy - (float)y0) * 256.0f);
+            const int x0 = o.tx[x], y0 = o.ty[x], fx8 = o.fx[x], fy8 = o.fy[x];
             const int dx = x0 + 1 < cw ? 1 : 0, y1 = y0 + 1 < ch ? y0 + 1 : y0;
             const uint8_t *m0 = cmask + (size_t)y0 * (size_t)cmask_stride + (size_t)x0;
             const uint8_t *m1 = cmask + (size_t)y1 * (size_t)cmask_stride + (size_t)x0;

@@ -76,6 +76,7 @@
 
 #include "../fuse/fuse.h"
 #include "../kin/kin.h"
+#include "../kin/kin_lens.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -114,10 +115,54 @@ typedef struct pipe__reproj {
     uint8_t *P;               /* RGBA8: camera colours seen from the eye */
     uint8_t *M;               /* the mask composited (fade, fill) */
     int32_t *row;             /* 2 * width: the fill's scan */
+    int32_t *lanes;           /* 8 * width: one row's geometry (pipe__reproj_lanes) */
+    int isa;                  /* the geometry pass's ISA (ef_isa; pipe.c sets it) */
     kin_camera cam;           /* this frame's eye camera */
     long sampled, filled, outside; /* this frame's pixels of each kind */
     int inside;               /* this frame: the eye is inside the model */
 } pipe__reproj;
+
+/* One eye row's per-pixel geometry, for the covered pixels (the others
+ * are not written): mv the mask (0: outside the camera image, else the
+ * faded 1..255), zmin the occlusion bound as a window depth of the
+ * camera, iu/iv the nearest camera pixel, tx/ty the bilinear's top-left
+ * tap, fx/fy its 8-bit fractions. */
+typedef struct pipe__reproj_lanes {
+    int32_t *mv, *iu, *iv, *tx, *ty, *fx, *fy;
+    float *zmin;
+} pipe__reproj_lanes;
+
+/* What the geometry pass needs of the frame (the eye view -> camera view
+ * matrix, column-major, the camera's pinhole, the image's size, the depth
+ * range). */
+typedef struct pipe__reproj_geo {
+    float a[16];
+    float cfx, cfy, ccx, ccy;
+    float cw, ch, cw1, ch1; /* the sampled image's size and size - 1 */
+    int icw1, ich1;
+    float n, f, fpn, fmn, two_fn; /* near, far, f + n, f - n, 2 f n */
+    int pinhole;
+    const kin_lens *lens;   /* !pinhole: kin_lens_project */
+    const float *rxs;       /* the eye rays' x per column */
+} pipe__reproj_geo;
+
+/* The vector geometry pass per ISA (pipe_reproj_simd.inl): the first
+ * column it did not do. The pinhole camera only. */
+typedef int (*pipe__reproj_row_fn)(const pipe__reproj_geo *g, const uint8_t *em,
+                                   const float *ed, const float *en, float ry, int w,
+                                   const pipe__reproj_lanes *o, long *back, float *mind);
+int pipe__reproj_row_sse2(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
+                          const float *en, float ry, int w, const pipe__reproj_lanes *o,
+                          long *back, float *mind);
+int pipe__reproj_row_avx2(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
+                          const float *en, float ry, int w, const pipe__reproj_lanes *o,
+                          long *back, float *mind);
+int pipe__reproj_row_avx512(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
+                            const float *en, float ry, int w, const pipe__reproj_lanes *o,
+                            long *back, float *mind);
+int pipe__reproj_row_neon(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
+                          const float *en, float ry, int w, const pipe__reproj_lanes *o,
+                          long *back, float *mind);
 
 int pipe__reproj_init(pipe__reproj *r, int width, int height);
 void pipe__reproj_free(pipe__reproj *r);
