@@ -258,10 +258,23 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
             const int dx = x0 + 1 < cw ? 1 : 0, y1 = y0 + 1 < ch ? y0 + 1 : y0;
             /* a tap counts with its weight when it shows the point */
             const int gx = x0 - ox, gy0 = y0 - oy, gy1 = y1 - oy;
-            const int s00 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx, gy0, gw, gh, zmin);
-            const int s01 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx + dx, gy0, gw, gh, zmin);
-            const int s10 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx, gy1, gw, gh, zmin);
-            const int s11 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx + dx, gy1, gw, gh, zmin);
+            int s00, s01, s10, s11;
+            if (gx >= 0 && gx + dx < gw && gy0 >= 0 && gy1 < gh) {
+                /* all four taps inside the G-buffer (the common case) */
+                const uint8_t *m0 = cmask + (size_t)gy0 * (size_t)cmask_stride + (size_t)gx;
+                const uint8_t *m1 = cmask + (size_t)gy1 * (size_t)cmask_stride + (size_t)gx;
+                const float *d0 = cdepth + (size_t)gy0 * (size_t)cdepth_stride + (size_t)gx;
+                const float *d1 = cdepth + (size_t)gy1 * (size_t)cdepth_stride + (size_t)gx;
+                s00 = m0[0] != 0 && !(d0[0] < zmin);
+                s01 = m0[dx] != 0 && !(d0[dx] < zmin);
+                s10 = m1[0] != 0 && !(d1[0] < zmin);
+                s11 = m1[dx] != 0 && !(d1[dx] < zmin);
+            } else {
+                s00 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx, gy0, gw, gh, zmin);
+                s01 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx + dx, gy0, gw, gh, zmin);
+                s10 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx, gy1, gw, gh, zmin);
+                s11 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx + dx, gy1, gw, gh, zmin);
+            }
             const uint32_t w00 = s00 ? (uint32_t)((256 - fx8) * (256 - fy8)) : 0u;
             const uint32_t w01 = s01 ? (uint32_t)(fx8 * (256 - fy8)) : 0u;
             const uint32_t w10 = s10 ? (uint32_t)((256 - fx8) * fy8) : 0u;
