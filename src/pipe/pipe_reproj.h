@@ -59,9 +59,18 @@
  *   it: the frame shows what else is in front, never garbage.
  *
  * NUMBERS
- *   Scalar C on the eye's thread (float, fixed operation order, the
- *   lens in double), integer bilinear weights (8-bit fractions as
- *   fuse_composite): the same bytes on every ISA and thread count.
+ *   On the eye's thread: the per-pixel geometry on the vector layer
+ *   (pipe_reproj_simd.inl, 4/8/16 lanes; a distorting lens in scalar
+ *   double), equal lane by lane to the scalar reference row_ref (float,
+ *   fixed operation order); the taps scalar, integer bilinear weights
+ *   (8-bit fractions as fuse_composite): the same bytes on every ISA and
+ *   thread count.
+ *
+ * THE WHOLE SENSOR
+ *   The image sampled is the whole camera image (pipe_frame_in.camera[e]
+ *   of the HMD's camera size, or camera_raw[e] converted whole), not only
+ *   the crop of eq. 1; the camera's G-buffer covers the crop only, and
+ *   beyond it the camera is taken to see the point (every tap counts).
  *
  * LIMITS
  *   pipe_desc.aa_samples is refused with reprojection (pipe_create NULL).
