@@ -434,7 +434,8 @@ static void result_disocclusion_fill(void **state)
  * camera, 85 mm nearer, 21-23 degrees below (sensor rows about 443-468:
  * below the crop's 400 rows, 40..439, inside the 480 of the sensor). Those
  * rows of the camera image are one colour: every eye pixel of the band is
- * sampled (none filled, none outside) and takes it. */
+ * sampled (none filled, none outside) and takes it; the same from raw
+ * RGB24 frames. */
 static void result_full_sensor(void **state)
 {
     (void)state;
@@ -485,6 +486,28 @@ static void result_full_sensor(void **state)
         assert_int_equal(full, n);
         assert_int_equal(colour, n);
     }
+    /* the same frame from raw RGB24 camera frames (the pipe converts the
+     * rows beyond the crop itself): the same layers */
+    uint8_t *layer0 = malloc((size_t)CW * CH * 4 * 2);
+    uint8_t *rgb = malloc((size_t)CAMW * CAMH * 3 * 2);
+    assert_non_null(layer0);
+    assert_non_null(rgb);
+    for (int e = 0; e < 2; e++) {
+        memcpy(layer0 + (size_t)e * CW * CH * 4, pipe_layer(p, e, NULL, NULL), (size_t)CW * CH * 4);
+        uint8_t *r3 = rgb + (size_t)e * CAMW * CAMH * 3;
+        for (size_t i = 0; i < (size_t)CAMW * CAMH; i++)
+            for (int k = 0; k < 3; k++) r3[3 * i + k] = b.cam[e][4 * i + k];
+        in.camera_raw[e] = (fuse_frame){r3, (size_t)CAMW * CAMH * 3, CAMW, CAMH, 3 * CAMW,
+                                         FUSE_FMT_RGB24};
+    }
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) {
+        assert_int_equal(st.view_outside[e], 0);
+        assert_memory_equal(pipe_layer(p, e, NULL, NULL), layer0 + (size_t)e * CW * CH * 4,
+                            (size_t)CW * CH * 4);
+    }
+    free(layer0);
+    free(rgb);
     free(ref);
     tu_frame_free(&b);
     pipe_destroy(p);
