@@ -429,6 +429,91 @@ static void result_disocclusion_fill(void **state)
     kin_model_free(&m);
 }
 
+/* A band below the crop of eq. 1: at z = -0.3 m, y from -0.092 to -0.082
+ * m, the eye sees it 15-17 degrees below its axis (inside its 20), the
+ * camera, 85 mm nearer, 21-23 degrees below (sensor rows about 443-468:
+ * below the crop's 400 rows, 40..439, inside the 480 of the sensor). Those
+ * rows of the camera image are one colour: every eye pixel of the band is
+ * sampled (none filled, none outside) and takes it; the same from raw
+ * RGB24 frames. */
+static void result_full_sensor(void **state)
+{
+    (void)state;
+    kin_model m;
+    tu_mesh_parts t = tu_mesh_model(&m, "head", "band", 4, 6, 1);
+    const float x0 = -0.05f, x1 = 0.05f, y0 = -0.092f, y1 = -0.082f, z = -0.3f;
+    const float pos[12] = {x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z};
+    memcpy(t.pos, pos, sizeof pos);
+    for (int i = 0; i < 4; i++) t.nrm[3 * i + 2] = 1.0f;
+    const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(t.idx, ix, sizeof ix);
+    char why[200];
+    assert_int_equal(kin_model_validate(&m, why, sizeof why), 0);
+    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
+    tu_frame_bufs b;
+    pipe_frame_in in;
+    tu_frame_make(&b, &in, 15, CAMW, CAMH, LCDW, LCDH);
+    in.lighting = pass_through();
+    for (int e = 0; e < 2; e++)
+        for (int y = CROP_Y0 + CH; y < CAMH; y++)
+            for (int x = 0; x < CAMW; x++) {
+                uint8_t *q = b.cam[e] + 4 * ((size_t)y * CAMW + (size_t)x);
+                q[0] = 200, q[1] = 30, q[2] = 90, q[3] = 255;
+            }
+    pipe_frame_stats st;
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    uint8_t *ref = malloc(CW * CH);
+    assert_non_null(ref);
+    for (int e = 0; e < 2; e++) {
+        assert_int_equal(st.view[e], PIPE_VIEW_REPROJECT);
+        const long n = draw_from_eye(&m, e, ref);
+        const uint8_t *M = pipe_view_mask(p, e, NULL, NULL);
+        const uint8_t *Q = pipe_layer(p, e, NULL, NULL);
+        long full = 0, colour = 0;
+        for (size_t i = 0; i < (size_t)CW * CH; i++) {
+            if (!M[i]) continue;
+            full += M[i] == 255;
+            colour += abs(Q[4 * i] - 200) <= 1 && abs(Q[4 * i + 1] - 30) <= 1 &&
+                      abs(Q[4 * i + 2] - 90) <= 1;
+        }
+        print_message("NOTE full sensor, eye %d: %ld eye pixels of the band, %ld sampled, %ld "
+                      "filled, %ld outside; %ld at 255, %ld of the sensor rows' colour\n", e, n,
+                      st.view_sampled[e], st.view_filled[e], st.view_outside[e], full, colour);
+        assert_true(n > 1000);
+        assert_int_equal(st.view_sampled[e], n);
+        assert_int_equal(st.view_filled[e], 0);
+        assert_int_equal(st.view_outside[e], 0);
+        assert_int_equal(full, n);
+        assert_int_equal(colour, n);
+    }
+    /* the same frame from raw RGB24 camera frames (the pipe converts the
+     * rows beyond the crop itself): the same layers */
+    uint8_t *layer0 = malloc((size_t)CW * CH * 4 * 2);
+    uint8_t *rgb = malloc((size_t)CAMW * CAMH * 3 * 2);
+    assert_non_null(layer0);
+    assert_non_null(rgb);
+    for (int e = 0; e < 2; e++) {
+        memcpy(layer0 + (size_t)e * CW * CH * 4, pipe_layer(p, e, NULL, NULL), (size_t)CW * CH * 4);
+        uint8_t *r3 = rgb + (size_t)e * CAMW * CAMH * 3;
+        for (size_t i = 0; i < (size_t)CAMW * CAMH; i++)
+            for (int k = 0; k < 3; k++) r3[3 * i + k] = b.cam[e][4 * i + k];
+        in.camera_raw[e] = (fuse_frame){r3, (size_t)CAMW * CAMH * 3, CAMW, CAMH, 3 * CAMW,
+                                         FUSE_FMT_RGB24};
+    }
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) {
+        assert_int_equal(st.view_outside[e], 0);
+        assert_memory_equal(pipe_layer(p, e, NULL, NULL), layer0 + (size_t)e * CW * CH * 4,
+                            (size_t)CW * CH * 4);
+    }
+    free(layer0);
+    free(rgb);
+    free(ref);
+    tu_frame_free(&b);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
 /* A quad wider than the camera's view at 0.25 m: the eye's mask is 0
  * where the camera does not see, 255 well inside, and ramps between. */
 static void result_border_fade(void **state)
@@ -501,7 +586,7 @@ static uint32_t frame_crc(const kin_model *m, int view, int threads, int isa)
     return crc;
 }
 
-#define REPROJ_CRC 0x9b5bac78u
+#define REPROJ_CRC 0xda19e5c9u
 
 static void determinism_isa_threads(void **state)
 {
@@ -667,6 +752,7 @@ int main(void)
         cmocka_unit_test(result_point_lands_through_lens),
         cmocka_unit_test(result_disocclusion_fill),
         cmocka_unit_test(result_border_fade),
+        cmocka_unit_test(result_full_sensor),
         cmocka_unit_test(determinism_isa_threads),
         cmocka_unit_test(validity_bad_desc),
         cmocka_unit_test(validity_eye_inside_model),

@@ -123,6 +123,10 @@ static fuse_image crop_cols(const pipe_ctx *p, fuse_image v)
  * at the sensor's width. */
 static fuse_image raw_rows(const pipe_ctx *p, uint8_t *buf)
 {
+    /* the reprojection samples the whole sensor: buf holds all its rows,
+     * the crop's at their place (reproj_eye converts the others) */
+    if (p->desc.eye_view == PIPE_VIEW_REPROJECT)
+        buf += (size_t)4 * (size_t)p->hmd.cam_width * (size_t)p->geo.crop_y0;
     return (fuse_image){buf, p->hmd.cam_width, p->geo.crop_height, 4 * p->hmd.cam_width};
 }
 
@@ -163,7 +167,7 @@ static rast_result eye_draw(pipe_ctx *p, eye_state *e, const pipe_lens_map *lens
 static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *K)
 {
     pipe__reproj *r = &e->rp;
-    const int w = r->width, h = r->height, cw = p->geo.crop_width;
+    const int w = r->width, h = r->height, cw = p->geo.crop_width, ch = p->geo.crop_height;
     r->cam = kin_sthmd_eye_camera(&p->hmd, &e->head, (kin_eye)e->eye, w, h);
     rast_target tg = {w, h, r->depth, w, r->mask, w, r->nrm, 3 * w, 3};
     long covered = 0;
@@ -177,8 +181,32 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
         return -1;
     }
     r->isa = rast_context_isa(e->rast);
-    if (pipe__reproj_sample(r, &e->cam, &fe->P, e->mask, cw, e->depth, cw, p->hmd.znear,
-                            p->hmd.zfar)) {
+    /* the whole sensor (the rows above and below the crop of eq. 1 too):
+     * the RGBA image as given, or the raw frame's other rows converted
+     * around the crop's; else (an image of another size) the crop */
+    const pipe_frame_in *in = e->in;
+    const int cam_w = p->hmd.cam_width, cam_h = p->hmd.cam_height, y0 = p->geo.crop_y0;
+    fuse_image S = fe->P;
+    int ox = 0, oy = 0;
+    if (in->camera_raw[e->eye].data) {
+        fuse_image top = {e->cam_rgba, cam_w, y0, 4 * cam_w};
+        fuse_image bot = {e->cam_rgba + (size_t)4 * cam_w * (size_t)(y0 + ch), cam_w,
+                          cam_h - y0 - ch, 4 * cam_w};
+        ef_isa isa = (ef_isa)p->desc.max_isa;
+        if ((top.height <= 0 || fuse_frame_to_rgba_isa(&in->camera_raw[e->eye], 0, &top, isa) ==
+                                    FUSE_OK) &&
+            (bot.height <= 0 || fuse_frame_to_rgba_isa(&in->camera_raw[e->eye], y0 + ch, &bot,
+                                                       isa) == FUSE_OK)) {
+            S = (fuse_image){e->cam_rgba, cam_w, cam_h, 4 * cam_w};
+            ox = p->geo.crop_x0, oy = y0;
+        }
+    } else if (in->camera[e->eye].pixels && in->camera[e->eye].width == cam_w &&
+               in->camera[e->eye].height == cam_h) {
+        S = in->camera[e->eye];
+        ox = p->geo.crop_x0, oy = y0;
+    }
+    if (pipe__reproj_sample(r, &e->cam, &S, ox, oy, e->mask, cw, e->depth, cw, cw, ch,
+                            p->hmd.znear, p->hmd.zfar)) {
         e->fallbacks++;
         return 0;
     }
@@ -537,7 +565,10 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         s->nrm = malloc(sizeof(float) * 3 * px);
         s->mask = malloc(px);
         s->layer = malloc(4 * px);
-        s->cam_rgba = malloc(4 * (size_t)p->hmd.cam_width * (size_t)p->geo.crop_height);
+        s->cam_rgba = malloc(4 * (size_t)p->hmd.cam_width *
+                             (size_t)(p->desc.eye_view == PIPE_VIEW_REPROJECT
+                                          ? p->hmd.cam_height
+                                          : p->geo.crop_height));
         s->clip = malloc(sizeof(float) * 4 * nv);
         s->vnrm = malloc(sizeof(float) * 3 * nv);
         rast_context_desc rd = {p->desc.max_isa, 1};

@@ -120,8 +120,8 @@ static void row_ref(const pipe__reproj_geo *g, const uint8_t *em, const float *e
         } else {
             double pc[3] = {px, py, pz}, u, v;
             ok = kin_lens_project(g->lens, pc, &u, &v);
-            fu = (float)u;
-            fv = (float)v;
+            fu = (float)u + g->ox;
+            fv = (float)v + g->oy;
         }
         /* distance to the camera image's border, camera pixels */
         float b = 0.0f;
@@ -171,9 +171,20 @@ static pipe__reproj_row_fn row_kernel(int isa)
     }
 }
 
-int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image *P,
-                        const uint8_t *cmask, int cmask_stride, const float *cdepth,
-                        int cdepth_stride, float n, float f)
+/* Does the camera's G-buffer show the point (window depth bound zmin) at
+ * image pixel (x, y)? Outside the G-buffer (the sensor beyond the crop)
+ * there is nothing to test against: yes. */
+static inline int shows(const uint8_t *cmask, int cms, const float *cdepth, int cds, int gx,
+                        int gy, int gw, int gh, float zmin)
+{
+    if ((unsigned)gx >= (unsigned)gw || (unsigned)gy >= (unsigned)gh) return 1;
+    return cmask[(size_t)gy * (size_t)cms + (size_t)gx] != 0 &&
+           !(cdepth[(size_t)gy * (size_t)cds + (size_t)gx] < zmin);
+}
+
+int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image *P, int ox,
+                        int oy, const uint8_t *cmask, int cmask_stride, const float *cdepth,
+                        int cdepth_stride, int gw, int gh, float n, float f)
 {
     const int w = r->width, h = r->height;
     const int cw = P->width, ch = P->height;
@@ -184,7 +195,11 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
     memcpy(g.a, m.m, sizeof g.a);
     g.pinhole = !kin_lens_distorts(&cam->lens) && cam->lens.skew == 0.0;
     g.lens = &cam->lens;
-    g.cfx = cam->fx, g.cfy = cam->fy, g.ccx = cam->cx, g.ccy = cam->cy;
+    /* the camera's intrinsics are the crop's: the image's pixels are
+     * (ox, oy) further (0, 0 when the image is the crop) */
+    g.ox = (float)ox, g.oy = (float)oy;
+    g.cfx = cam->fx, g.cfy = cam->fy;
+    g.ccx = (float)cam->cx + g.ox, g.ccy = (float)cam->cy + g.oy;
     g.cw = (float)cw, g.ch = (float)ch, g.cw1 = (float)(cw - 1), g.ch1 = (float)(ch - 1);
     g.icw1 = cw - 1, g.ich1 = ch - 1;
     g.n = n, g.f = f, g.fpn = f + n, g.fmn = f - n, g.two_fn = 2.0f * f * n;
@@ -230,8 +245,8 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
             const float zmin = o.zmin[x];
             /* the nearest camera pixel: does the camera see this point? */
             const int iu = o.iu[x], iv = o.iv[x];
-            int seen = cmask[(size_t)iv * (size_t)cmask_stride + (size_t)iu] != 0 &&
-                       !(cdepth[(size_t)iv * (size_t)cdepth_stride + (size_t)iu] < zmin);
+            int seen = shows(cmask, cmask_stride, cdepth, cdepth_stride, iu - ox, iv - oy, gw, gh,
+                             zmin);
             if (!seen) {
                 Po[4 * x + 3] = ST_FILL;
                 filled++;
@@ -241,15 +256,29 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
              * the same surface), renormalised */
             const int x0 = o.tx[x], y0 = o.ty[x], fx8 = o.fx[x], fy8 = o.fy[x];
             const int dx = x0 + 1 < cw ? 1 : 0, y1 = y0 + 1 < ch ? y0 + 1 : y0;
-            const uint8_t *m0 = cmask + (size_t)y0 * (size_t)cmask_stride + (size_t)x0;
-            const uint8_t *m1 = cmask + (size_t)y1 * (size_t)cmask_stride + (size_t)x0;
-            const float *d0 = cdepth + (size_t)y0 * (size_t)cdepth_stride + (size_t)x0;
-            const float *d1 = cdepth + (size_t)y1 * (size_t)cdepth_stride + (size_t)x0;
             /* a tap counts with its weight when it shows the point */
-            const uint32_t w00 = (m0[0] != 0 && !(d0[0] < zmin)) ? (uint32_t)((256 - fx8) * (256 - fy8)) : 0u;
-            const uint32_t w01 = (m0[dx] != 0 && !(d0[dx] < zmin)) ? (uint32_t)(fx8 * (256 - fy8)) : 0u;
-            const uint32_t w10 = (m1[0] != 0 && !(d1[0] < zmin)) ? (uint32_t)((256 - fx8) * fy8) : 0u;
-            const uint32_t w11 = (m1[dx] != 0 && !(d1[dx] < zmin)) ? (uint32_t)(fx8 * fy8) : 0u;
+            const int gx = x0 - ox, gy0 = y0 - oy, gy1 = y1 - oy;
+            int s00, s01, s10, s11;
+            if (gx >= 0 && gx + dx < gw && gy0 >= 0 && gy1 < gh) {
+                /* all four taps inside the G-buffer (the common case) */
+                const uint8_t *m0 = cmask + (size_t)gy0 * (size_t)cmask_stride + (size_t)gx;
+                const uint8_t *m1 = cmask + (size_t)gy1 * (size_t)cmask_stride + (size_t)gx;
+                const float *d0 = cdepth + (size_t)gy0 * (size_t)cdepth_stride + (size_t)gx;
+                const float *d1 = cdepth + (size_t)gy1 * (size_t)cdepth_stride + (size_t)gx;
+                s00 = m0[0] != 0 && !(d0[0] < zmin);
+                s01 = m0[dx] != 0 && !(d0[dx] < zmin);
+                s10 = m1[0] != 0 && !(d1[0] < zmin);
+                s11 = m1[dx] != 0 && !(d1[dx] < zmin);
+            } else {
+                s00 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx, gy0, gw, gh, zmin);
+                s01 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx + dx, gy0, gw, gh, zmin);
+                s10 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx, gy1, gw, gh, zmin);
+                s11 = shows(cmask, cmask_stride, cdepth, cdepth_stride, gx + dx, gy1, gw, gh, zmin);
+            }
+            const uint32_t w00 = s00 ? (uint32_t)((256 - fx8) * (256 - fy8)) : 0u;
+            const uint32_t w01 = s01 ? (uint32_t)(fx8 * (256 - fy8)) : 0u;
+            const uint32_t w10 = s10 ? (uint32_t)((256 - fx8) * fy8) : 0u;
+            const uint32_t w11 = s11 ? (uint32_t)(fx8 * fy8) : 0u;
             const uint8_t *p0 = P->pixels + (size_t)y0 * (size_t)P->stride + 4 * (size_t)x0;
             const uint8_t *p1 = P->pixels + (size_t)y1 * (size_t)P->stride + 4 * (size_t)x0;
             const int d4 = 4 * dx;

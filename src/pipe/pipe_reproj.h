@@ -59,9 +59,18 @@
  *   it: the frame shows what else is in front, never garbage.
  *
  * NUMBERS
- *   Scalar C on the eye's thread (float, fixed operation order, the
- *   lens in double), integer bilinear weights (8-bit fractions as
- *   fuse_composite): the same bytes on every ISA and thread count.
+ *   On the eye's thread: the per-pixel geometry on the vector layer
+ *   (pipe_reproj_simd.inl, 4/8/16 lanes; a distorting lens in scalar
+ *   double), equal lane by lane to the scalar reference row_ref (float,
+ *   fixed operation order); the taps scalar, integer bilinear weights
+ *   (8-bit fractions as fuse_composite): the same bytes on every ISA and
+ *   thread count.
+ *
+ * THE WHOLE SENSOR
+ *   The image sampled is the whole camera image (pipe_frame_in.camera[e]
+ *   of the HMD's camera size, or camera_raw[e] converted whole), not only
+ *   the crop of eq. 1; the camera's G-buffer covers the crop only, and
+ *   beyond it the camera is taken to see the point (every tap counts).
  *
  * LIMITS
  *   pipe_desc.aa_samples is refused with reprojection (pipe_create NULL).
@@ -139,6 +148,7 @@ typedef struct pipe__reproj_geo {
     float a[16];
     float cfx, cfy, ccx, ccy;
     float cw, ch, cw1, ch1; /* the sampled image's size and size - 1 */
+    float ox, oy;           /* the crop's (the G-buffer's) origin in the image */
     int icw1, ich1;
     float n, f, fpn, fmn, two_fn; /* near, far, f + n, f - n, 2 f n */
     int pinhole;
@@ -167,12 +177,16 @@ int pipe__reproj_row_neon(const pipe__reproj_geo *g, const uint8_t *em, const fl
 int pipe__reproj_init(pipe__reproj *r, int width, int height);
 void pipe__reproj_free(pipe__reproj *r);
 /* From the eye's G-buffer (drawn through r->cam), the camera (cam, its
- * lens), its cropped image P and its G-buffer (cmask, cdepth; window
- * depths of cam's projection, near n, far f): r->P and r->M, the counts and
- * r->inside. Returns r->inside. */
-int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image *P,
-                        const uint8_t *cmask, int cmask_stride, const float *cdepth,
-                        int cdepth_stride, float n, float f);
+ * lens, its intrinsics those of the crop), the camera image P sampled
+ * (the whole sensor, or the crop itself), the crop's origin (ox, oy) in
+ * P, and the camera's G-buffer of the crop (gw x gh: cmask, cdepth;
+ * window depths of cam's projection, near n, far f): r->P and r->M, the
+ * counts and r->inside. Returns r->inside. Where P reaches beyond the
+ * G-buffer (the sensor rows above and below the crop of eq. 1) the
+ * camera is taken to see the point: every tap there counts. */
+int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image *P, int ox,
+                        int oy, const uint8_t *cmask, int cmask_stride, const float *cdepth,
+                        int cdepth_stride, int gw, int gh, float n, float f);
 
 #ifdef __cplusplus
 }
