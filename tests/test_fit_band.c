@@ -160,7 +160,7 @@ static double run_frames(scene *s, int n, int with_prior, float speed, int *used
         const uint8_t *in = s->kin;
         if (with_prior)
             in = pipe_fit_prior(&d, &cam, world, &rig, 3u, sp, 0.3f, NULL, s->kin,
-                                have_prev ? s->prev : NULL, s->region, s->prior, W);
+                                have_prev ? s->prev : NULL, s->prior, W);
         if (in != s->kin) (*used_prior)++;
         fuse_refine_stats st;
         assert_int_equal(fuse_refine_mask_global(&s->rp, &s->g, 1.0f, &P, in, W, s->out, W,
@@ -256,9 +256,9 @@ static void region_and_merge(void **state)
     assert_int_equal(o[0], 1);
     /* no prior without a last mask, or with an untracked hand */
     const float sp[2] = { 0, 0 };
-    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, NULL, a, NULL, reg, o, W), a);
-    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 0u, sp, 0.3f, NULL, a, b, reg, o, W), a);
-    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, NULL, a, b, reg, o, W), o);
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, NULL, a, NULL, o, W), a);
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 0u, sp, 0.3f, NULL, a, b, o, W), a);
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, NULL, a, b, o, W), o);
     /* moved with the hand: the last mask shifted by 10 px right, 4 down
      * inside the region; the hand's image position */
     float xy[2];
@@ -268,7 +268,7 @@ static void region_and_merge(void **state)
     disc(a, 160.0f, 120.0f, 10.0f);
     disc(b, 150.0f, 116.0f, 20.0f);
     const float sh[2][2] = { { 10.0f, 4.0f }, { 0, 0 } };
-    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, sh, a, b, reg, o, W), o);
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, sh, a, b, o, W), o);
     disc(a, 160.0f, 120.0f, 20.0f);
     assert_memory_equal(o, a, W * H);
     free(reg); free(a); free(b); free(o);

@@ -72,7 +72,7 @@ static void ctx_free(eval_ctx *c)
         free(c->P[e]); free(c->sil[e]); free(c->sil_prev[e]); free(c->tnrm[e]); free(c->V[e]); free(c->ideal[e]);
     }
     free(c->aa_samples);
-    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->band_region); free(c->mask_prior); free(c->layer); free(c->out);
+    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->mask_prior); free(c->layer); free(c->out);
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
     free(c->gt_depth); free(c->gt_mask);
@@ -158,7 +158,6 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->aa_samples = malloc(sizeof(uint32_t) * cp);
     c->mask_up = malloc(cp);
     c->refined = malloc(cp);
-    c->band_region = malloc(cp);
     c->mask_prior = malloc(cp);
     c->layer = malloc(cp * 4);
     c->out = malloc(vp * 4);
@@ -171,7 +170,7 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
     ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && 
-         c->band_region && c->mask_prior && c->layer && c->out && c->depth_lo &&
+         c->mask_prior && c->layer && c->out && c->depth_lo &&
          c->nrm_lo && c->mnrm && c->refine_scratch;
     c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
     c->gt_mask = malloc((size_t)GEN_CAM_W * GEN_CAM_H);
@@ -554,7 +553,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                         }
                     mask = pipe_fit_prior(&bd, &cam, c->world, &c->rig, r->sides, r->speed,
                                           cfg->prior_speed, shift, mask, r->prev[e],
-                                          c->band_region, c->mask_prior, CW);
+                                          c->mask_prior, CW);
                 }
                 for (int k = 0; k < 2; k++)
                     r->have_hand_px[e][k] =
@@ -687,7 +686,7 @@ static method_cfg base_cfg(const eval_opts *o, method_kind k)
     c.global = o->global;
     if (k == M_REFINE) {
         /* docs/accuracy.md, issue 14 item 2: the last refined mask as the
-         * prior within 6 cm of hands slower than 0.5 m/s, moved with the
+         * prior within 3 cm of hands slower than 0.3 m/s, moved with the
          * hand's image motion; the hands' lag
          * compensated from 0.2 to 0.8 m/s; the band from the projected
          * uncertainty measured, off */

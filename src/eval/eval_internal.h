@@ -55,8 +55,8 @@ typedef struct method_cfg {
 } method_cfg;
 
 /* refine's defaults (docs/accuracy.md, issue 14 item 2) */
-#define EVAL_PRIOR_RADIUS 0.06f
-#define EVAL_PRIOR_SPEED 0.5f
+#define EVAL_PRIOR_RADIUS 0.03f
+#define EVAL_PRIOR_SPEED 0.3f
 #define EVAL_LAG_V0 0.2f
 #define EVAL_LAG_V1 0.8f
 
@@ -128,7 +128,7 @@ typedef struct eval_ctx {
     kin_camera tcam[2];
     /* method scratch */
     uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
-    uint8_t *band_region, *mask_prior;   /* refine: the prior (fit_band.h) */
+    uint8_t *mask_prior;     /* refine: the prior (fit_band.h) */
     uint32_t *aa_samples;    /* anti-aliased coverage, 640x400 */
     float *depth_lo, *nrm_lo, *mnrm;
     void *refine_scratch;

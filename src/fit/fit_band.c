@@ -66,6 +66,49 @@ int pipe_fit_band(const pipe_fit_band_desc *dp, const kin_camera *cam, const kin
     return b >= (float)hi ? hi : b <= (float)lo ? lo : (int)b;
 }
 
+/* The discs of side's hand joints in view: centre and radius
+ * f * hand_radius / z + band, pixels; their count (at most
+ * KIN_RIG_SIDE_JOINTS), -1 for a joint index < 0. */
+typedef struct disc { float x, y, r; } disc;
+
+static int side_discs(const pipe_fit_band_desc *d, const kin_camera *cam, const kin_mat4 *world,
+                      const kin_arm_rig *rig, int side, int band, disc *out)
+{
+    const int W = cam->width, H = cam->height;
+    const float f = 0.5f * (cam->fx + cam->fy);
+    int n = 0;
+    for (int j = KIN_RIG_HAND; j < KIN_RIG_SIDE_JOINTS; j++) {
+        const int node = rig->joint[side][j];
+        if (node < 0) return -1;
+        float x, y, z;
+        if (!joint_px(cam, &world[node], d->reach, &x, &y, &z)) continue;
+        float r = f * d->hand_radius / z + (float)band;
+        if (r > (float)(W + H)) r = (float)(W + H);
+        out[n++] = (disc){ x, y, r };
+    }
+    return n;
+}
+
+/* Columns [*x0, *x1] of row y covered by the union of the discs' spans
+ * from the leftmost to the rightmost (the row's hull); 0 when none. */
+static int row_span(const disc *D, int n, int y, int W, int *x0, int *x1)
+{
+    int a = W, b = -1;
+    for (int i = 0; i < n; i++) {
+        const float dy = (float)y + 0.5f - D[i].y, h2 = D[i].r * D[i].r - dy * dy;
+        if (h2 < 0.0f) continue;
+        const float hw = sqrtf(h2);
+        int l = (int)ceilf(D[i].x - hw - 0.5f), r = (int)floorf(D[i].x + hw - 0.5f);
+        if (l < a) a = l;
+        if (r > b) b = r;
+    }
+    if (a < 0) a = 0;
+    if (b >= W) b = W - 1;
+    *x0 = a;
+    *x1 = b;
+    return a <= b;
+}
+
 long pipe_fit_band_region(const pipe_fit_band_desc *dp, const kin_camera *cam,
                           const kin_mat4 *world, const kin_arm_rig *rig, unsigned sides,
                           int band, uint8_t *region, int stride)
@@ -76,33 +119,22 @@ long pipe_fit_band_region(const pipe_fit_band_desc *dp, const kin_camera *cam,
         !(d.reach >= 0.0f) || !(d.hand_radius >= 0.0f))
         return 0;
     const int W = cam->width, H = cam->height;
-    for (int y = 0; y < H; y++) memset(region + (size_t)y * (size_t)stride, 0, (size_t)W);
-    const float f = 0.5f * (cam->fx + cam->fy);
-    long n_set = 0;
+    disc D[2 * KIN_RIG_SIDE_JOINTS];
+    int n = 0;
     for (int s = 0; s < 2; s++) {
         if (!(sides & (1u << s))) continue;
-        for (int j = KIN_RIG_HAND; j < KIN_RIG_SIDE_JOINTS; j++) {
-            const int n = rig->joint[s][j];
-            if (n < 0) return n_set;
-            float x, y, z;
-            if (!joint_px(cam, &world[n], d.reach, &x, &y, &z)) continue;
-            float r = f * d.hand_radius / z + (float)band;
-            if (r > (float)(W + H)) r = (float)(W + H);
-            const int y0 = (int)floorf(y - r) < 0 ? 0 : (int)floorf(y - r);
-            const int y1 = (int)ceilf(y + r) >= H ? H - 1 : (int)ceilf(y + r);
-            for (int yy = y0; yy <= y1; yy++) {
-                const float dy = (float)yy + 0.5f - y, h2 = r * r - dy * dy;
-                if (h2 < 0.0f) continue;
-                const float hw = sqrtf(h2);
-                int x0 = (int)ceilf(x - hw - 0.5f), x1 = (int)floorf(x + hw - 0.5f);
-                if (x0 < 0) x0 = 0;
-                if (x1 >= W) x1 = W - 1;
-                uint8_t *row = region + (size_t)yy * (size_t)stride;
-                for (int xx = x0; xx <= x1; xx++) {
-                    n_set += row[xx] == 0;
-                    row[xx] = 255;
-                }
-            }
+        int m = side_discs(&d, cam, world, rig, s, band, D + n);
+        if (m < 0) m = 0;
+        n += m;
+    }
+    long n_set = 0;
+    for (int y = 0; y < H; y++) {
+        uint8_t *row = region + (size_t)y * (size_t)stride;
+        memset(row, 0, (size_t)W);
+        int x0, x1;
+        if (n && row_span(D, n, y, W, &x0, &x1)) {
+            memset(row + x0, 255, (size_t)(x1 - x0 + 1));
+            n_set += x1 - x0 + 1;
         }
     }
     return n_set;
@@ -120,26 +152,24 @@ void pipe_fit_band_merge(const uint8_t *narrow, const uint8_t *wide, const uint8
     }
 }
 
-const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *d, const kin_camera *cam,
+const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *dp, const kin_camera *cam,
                               const kin_mat4 *world, const kin_arm_rig *rig, unsigned sides,
                               const float speed[2], float max_speed, const float shift[2][2],
-                              const uint8_t *kin, const uint8_t *prev, uint8_t *region,
-                              uint8_t *out, int stride)
+                              const uint8_t *kin, const uint8_t *prev, uint8_t *out,
+                              int stride)
 {
-    if (!kin || !prev || !region || !out || !cam || !world || !rig || !speed ||
-        stride < cam->width)
+    if (!kin || !prev || !out || !cam || !world || !rig || !speed ||
+        stride < cam->width || cam->width < 1 || cam->height < 1)
         return kin;
+    pipe_fit_band_desc d = dp ? *dp : pipe_fit_band_desc_default();
+    if (!(d.reach >= 0.0f) || !(d.hand_radius >= 0.0f)) return kin;
     const int W = cam->width, H = cam->height;
     int any = 0;
     for (int k = 0; k < 2; k++) {
         if (!(sides & (1u << k)) || !(speed[k] < max_speed)) continue;
-        if (pipe_fit_band_region(d, cam, world, rig, 1u << k, 0, region, stride) <= 0) continue;
-        if (!any) {
-            for (int y = 0; y < H; y++)
-                memcpy(out + (size_t)y * (size_t)stride, kin + (size_t)y * (size_t)stride,
-                       (size_t)W);
-            any = 1;
-        }
+        disc D[KIN_RIG_SIDE_JOINTS];
+        const int n = side_discs(&d, cam, world, rig, k, 0, D);
+        if (n <= 0) continue;
         int sx = 0, sy = 0;
         if (shift && isfinite(shift[k][0]) && isfinite(shift[k][1]) &&
             fabsf(shift[k][0]) < (float)W && fabsf(shift[k][1]) < (float)H) {
@@ -147,15 +177,22 @@ const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *d, const kin_camera *cam
             sy = (int)lrintf(shift[k][1]);
         }
         for (int y = 0; y < H; y++) {
-            const uint8_t *r = region + (size_t)y * (size_t)stride;
-            uint8_t *o = out + (size_t)y * (size_t)stride;
+            int x0, x1;
+            if (!row_span(D, n, y, W, &x0, &x1)) continue;
             const int ys = y - sy;
-            for (int x = 0; x < W; x++) {
-                if (!r[x]) continue;
-                const int xs = x - sx;
-                if (ys < 0 || ys >= H || xs < 0 || xs >= W) continue;   /* kin stays */
-                o[x] = prev[(size_t)ys * (size_t)stride + (size_t)xs];
+            if (ys < 0 || ys >= H) continue;   /* kin stays */
+            /* the source columns inside the image */
+            if (x0 - sx < 0) x0 = sx;
+            if (x1 - sx >= W) x1 = W - 1 + sx;
+            if (x0 > x1) continue;
+            if (!any) {
+                for (int yy = 0; yy < H; yy++)
+                    memcpy(out + (size_t)yy * (size_t)stride, kin + (size_t)yy * (size_t)stride,
+                           (size_t)W);
+                any = 1;
             }
+            memcpy(out + (size_t)y * (size_t)stride + (size_t)x0,
+                   prev + (size_t)ys * (size_t)stride + (size_t)(x0 - sx), (size_t)(x1 - x0 + 1));
         }
     }
     return any ? out : kin;

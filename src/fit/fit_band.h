@@ -52,18 +52,21 @@ pipe_fit_band_desc pipe_fit_band_desc_default(void);
 int pipe_fit_band(const pipe_fit_band_desc *d, const kin_camera *cam, const kin_mat4 *world,
                   const kin_arm_rig *rig, unsigned sides, const float speed[2]);
 
-/* The hands' part of the image where the wide band applies: region
- * (width x height = cam's image, stride bytes per row) is set to 255
- * within radius_px(j) = f * d->hand_radius / z_j + band of each hand joint
- * j of a tracked side that counts in pipe_fit_band (in front, within reach
- * of the image), 0 elsewhere. Returns the number of pixels set (0 when
- * none, and for bad arguments: nothing written then only if region is
- * NULL). band: the wide band (pipe_fit_band's result). */
+/* The hands' part of the image: region (width x height = cam's image,
+ * stride bytes per row) is set to 255, per row, from the leftmost to the
+ * rightmost column covered by a disc of radius
+ * f * d->hand_radius / z_j + band around a hand joint j (hand, palm,
+ * fingers) of a tracked side (bit 0 left) that counts in pipe_fit_band
+ * (in front, within reach of the image); 0 elsewhere. A few memsets per
+ * row (the discs of 17 joints overlap heavily; painting each cost about
+ * as much as the refinement). Returns the number of pixels set (0 for
+ * none and for bad arguments; nothing is written when region is NULL or
+ * an argument is bad). */
 long pipe_fit_band_region(const pipe_fit_band_desc *d, const kin_camera *cam,
                           const kin_mat4 *world, const kin_arm_rig *rig, unsigned sides,
                           int band, uint8_t *region, int stride);
 
-/* out = where region is set, wide; elsewhere narrow (three masks of
+/* out = where region is set, wide; elsewhere narrow (four masks of
  * width x height, the same stride; out may be narrow). */
 void pipe_fit_band_merge(const uint8_t *narrow, const uint8_t *wide, const uint8_t *region,
                          uint8_t *out, int stride, int width, int height);
@@ -72,26 +75,27 @@ void pipe_fit_band_merge(const uint8_t *narrow, const uint8_t *wide, const uint8
  * (docs/accuracy.md): the band refinement can move the edge only `band`
  * pixels from its input mask, and a hand whose fingers reach farther
  * beyond the model (a near hand: 1 cm is 80 px at 10 cm) is never filled
- * from the kinematic mask alone. Around the hands the input is the last
- * refined mask instead, moved with the hand, so that the edge keeps what
- * the colour found and moves on from there frame by frame:
+ * from the kinematic mask alone. Around the hands that move slowly the
+ * input is the last refined mask instead, moved with the hand, so that
+ * the edge keeps what the colour found and moves on from there frame by
+ * frame:
  *   sides' = the tracked sides (bit 0 left) whose wrist speed is below
  *            max_speed (m/s);
- *   per side s of sides': region_s = pipe_fit_band_region(d, ..., 1 << s,
- *            band 0) (within f * d->hand_radius / z of each hand joint
- *            in view); out = prev(x - shift[s]) there (shift: the hand's
- *            motion in the image since the last frame, pipe_fit_hand_px;
- *            NULL = no motion; rounded to whole pixels; kin where the
- *            source is outside the image), the right hand's last;
+ *   per side s of sides', in its region (pipe_fit_band_region of that
+ *            side alone, band 0): out(x) = prev(x - shift[s]) (shift: the
+ *            hand's motion in the image since the last frame,
+ *            pipe_fit_hand_px; NULL = none; rounded to whole pixels; kin
+ *            where the source is outside the image); the right hand's
+ *            region last;
  *   out    = kin elsewhere.
  * Returns out, or kin when no side qualifies, the regions are empty or an
- * argument is bad (prev NULL included: the first frame). kin, prev,
- * region and out: cam's image size, the same stride. */
+ * argument is bad (prev NULL included: the first frame). kin, prev and
+ * out: cam's image size, the same stride; out must not overlap them. */
 const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *d, const kin_camera *cam,
                               const kin_mat4 *world, const kin_arm_rig *rig, unsigned sides,
                               const float speed[2], float max_speed, const float shift[2][2],
-                              const uint8_t *kin, const uint8_t *prev, uint8_t *region,
-                              uint8_t *out, int stride);
+                              const uint8_t *kin, const uint8_t *prev, uint8_t *out,
+                              int stride);
 
 /* The mean image position (pixels) of side's hand joints (hand, palm,
  * fingers) that are in front of cam; 0 when none is (or bad arguments). */
