@@ -248,7 +248,7 @@ $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(TEST_IOLIB) $(LIB) | $(TEST_PLU
 	    $(CMOCKA_LIBS) $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
 
 # Tests on the generated samples' scenes also link the generator.
-$(BUILD)/tests/test_occlusion $(BUILD)/tests/test_io_lod: $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
+$(BUILD)/tests/test_occlusion $(BUILD)/tests/test_io_lod $(BUILD)/tests/test_eval_eye: $(BUILD)/tests/%: tests/%.c $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) | $(OIIO_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) -o $@ $< $(TEST_SHARED_OBJ) $(SAMPLESLIB) $(IOLIB) $(LIB) \
 	    -lcmocka $(IO_LIBS) $(SYS_LIBS) $(LDFLAGS)
@@ -287,9 +287,10 @@ test: deps-test
 
 # Every public header compiles on its own as C and as C++ (sokol's rule).
 HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/pipe/pipe_pose.h src/pipe/pipe_lod.h src/fit/fit.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
-           src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/io/io.h src/io/io_dev.h \
+           src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/fuse/fuse_edge.h src/io/io.h src/io/io_dev.h \
            src/io/io_natnet.h src/io/io_display.h src/io/io_sched.h src/io/io_live.h \
-           src/io/io_vsrc.h src/io/io_lod.h src/kin/kin_lens.h src/pipe/pipe_lens.h src/io/io_calib.h
+           src/io/io_vsrc.h src/io/io_lod.h src/kin/kin_lens.h src/pipe/pipe_lens.h src/io/io_calib.h \
+           src/pipe/pipe_reproj.h
 check-headers:
 	@for h in $(HEADERS); do \
 	    echo "#include \"$$h\"" | $(CC) -std=c99 -Wall -Wextra -Werror -x c -fsyntax-only - || exit 1; \
@@ -321,10 +322,12 @@ $(BUILD)/fuzz/%: tests/%.c tests/fuzz/fuzz_util.h $(IOLIB) $(LIB)
 	$(CC) $(CFLAGS) $(IO_CFLAGS) -Itests -c $< -o $@.o
 	$(CXX) $(LDFLAGS) -fsanitize=fuzzer -o $@ $@.o $(IOLIB) $(LIB) $(IO_LIBS) $(SYS_LIBS)
 
-# The accuracy report (docs/accuracy.md): charts, table, summary.csv.
+# The accuracy report (docs/accuracy.md): charts, table, summary.csv; then
+# the eye's viewpoint (eval --eyeview: eyeview.csv, eyeview.md, eyeview_*.png).
 eval: deps-demo
 	@$(MAKE) --no-print-directory $(EGOFUSE)
 	$(EGOFUSE) eval --frames 180 --report out/eval
+	$(EGOFUSE) eval --eyeview --frames 60 --report out/eval
 
 # The soak of the live path in the VM (SOAK_SECONDS, SOAK_CYCLES, SOAK_STALLS).
 soak: deps-test

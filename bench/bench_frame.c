@@ -40,6 +40,9 @@
  *               [--scale-frames N] [--window N] [--quick] [--no-scaling]
  *               [--no-hmds] [--hmds-only] [--hmd-frames N] [--hmd NAME]
  *               [--isa I] [--threads T]   (the grid: only that ISA / thread count)
+ *               [--inplace]  (the grid composites in place, V copied into the
+ *                             output untimed before each frame)
+ *               [--cpu-time] (frame and stage times in thread CPU time)
  *
  * Writes DIR/bench.csv (header + egofuse, memcpy and pixman rows),
  * DIR/frame_tris.csv, DIR/frame_cover.csv, DIR/frame_res.csv,
@@ -72,7 +75,9 @@
 #define MAX_WINDOW 64
 #define CSV_HEADER                                                                    \
     "case,impl,isa,threads,median_ms,p99_ms,max_ms,mean_ms,frames,fps,headroom_ms,"   \
-    "coverage,convert_ms,track_ms,skin_ms,raster_ms,fuse_ms,tris,out_w,out_h"
+    "coverage,convert_ms,track_ms,skin_ms,raster_ms,fuse_ms,tris,out_w,out_h,"          \
+    "path_ms,outside_ms,raster_l_ms,raster_r_ms,fuse_l_ms,fuse_r_ms,convert_l_ms,"      \
+    "convert_r_ms,handoff_ms,eye1_worker,inplace"
 
 /* ------------------------------------------------------------- helpers */
 
@@ -233,6 +238,11 @@ typedef struct posesrc {
 /* Per-frame times of one measured case. */
 typedef struct times {
     double *total, *convert, *track, *skin, *raster, *fuse, *cover, *cpu;
+    /* the breakdown (issue 17 item 1), per frame: the stages on the
+     * critical path (track + pose + the larger of the two threads' sums of
+     * their eyes' stages), the rest of the frame's wall time, each eye's
+     * stages, the worker's start after the hand-off, eye 1 on the worker */
+    double *path, *outside, *eye[2][3], *handoff, *eye1w;
     int cap;
 } times;
 
@@ -240,6 +250,10 @@ typedef struct result {
     summary total;
     double convert, track, skin, raster, fuse, coverage, fps;
     double cpu;               /* median process CPU time per frame, ms */
+    double path, outside;     /* medians of the per-frame path and rest */
+    double eye[2][3];         /* medians per eye: raster, convert, fuse */
+    double handoff, eye1w;    /* median hand-off (frames with a worker eye),
+                                 share of frames with eye 1 on the worker */
     int frames;
 } result;
 
@@ -465,6 +479,23 @@ static void times_init(times *t, int cap)
     t->fuse = xmalloc(sizeof(double) * cap);
     t->cover = xmalloc(sizeof(double) * cap);
     t->cpu = xmalloc(sizeof(double) * cap);
+    t->path = xmalloc(sizeof(double) * cap);
+    t->outside = xmalloc(sizeof(double) * cap);
+    for (int e = 0; e < 2; e++)
+        for (int k = 0; k < 3; k++) t->eye[e][k] = xmalloc(sizeof(double) * cap);
+    t->handoff = xmalloc(sizeof(double) * cap);
+    t->eye1w = xmalloc(sizeof(double) * cap);
+}
+
+/* --cpu-time: the frame's times (and pipe_frame_stats', pipe_set_stats_clock)
+ * are the CPU time of the thread that runs each part, not wall time */
+static int frame_cpu_clock = 0;
+
+static double frame_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(frame_cpu_clock ? CLOCK_THREAD_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
+    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
 }
 
 /* One whole stereo frame i: convert, track, pipe_frame. Fills slot k of
@@ -477,8 +508,8 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
     if (b->inplace)
         for (int e = 0; e < 2; e++) memcpy(b->out[e], is->virt[w][e], (size_t)is->w * is->h * 4);
     double c0 = cpu_ms();
-    double t0 = now_ms();
-    double t1 = now_ms();
+    double t0 = frame_ms();
+    double t1 = frame_ms();
     pipe_frame_in in = {0};
     if (!src->rest) {
         kin_track_sample s = src->samples[i % src->count], o;
@@ -489,7 +520,7 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
         kin_arm_rig_pose(&b->rig, &b->model, NULL, NULL, &o, b->locals, NULL);
         in.locals = b->locals;
     }
-    double t2 = now_ms();
+    double t2 = frame_ms();
     in.head_node = src->head || src->rest ? -1 : b->rig.head;
     in.world_from_head = src->head;
     for (int e = 0; e < 2; e++) {
@@ -506,7 +537,7 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
     pipe_frame_stats st;
     char why[256];
     pipe_result r = pipe_frame(p, &in, &st, why, sizeof why);
-    double t3 = now_ms();
+    double t3 = frame_ms();
     double c3 = cpu_ms();
     if (r != PIPE_OK) {
         fprintf(stderr, "bench_frame: frame %ld: %s\n", i, why);
@@ -521,6 +552,22 @@ static int frame_step(bench *b, pipe_ctx *p, const imgset *is, const posesrc *sr
         b->tm.fuse[k] = st.ms_fuse[0] + st.ms_fuse[1];
         b->tm.cover[k] = 0.5 * (st.coverage[0] + st.coverage[1]);
         b->tm.cpu[k] = c3 - c0;
+        /* the critical path: per thread the stages of the eyes it ran */
+        double thr[2] = {0, 0}, hand = -1;
+        for (int e = 0; e < 2; e++) {
+            b->tm.eye[e][0][k] = st.ms_raster[e];
+            b->tm.eye[e][1][k] = st.ms_convert[e];
+            b->tm.eye[e][2][k] = st.ms_fuse[e];
+            thr[st.eye_thread[e] ? 1 : 0] += st.ms_raster[e] + st.ms_convert[e] + st.ms_fuse[e];
+            if (st.eye_thread[e]) hand = st.ms_eye_start[e];
+        }
+        /* (--cpu-time: the frame's time is the caller's thread's CPU time,
+         * so its path is that thread's own stages; no hand-off) */
+        if (frame_cpu_clock) thr[1] = 0, hand = -1;
+        b->tm.path[k] = (t2 - t1) + st.ms_pose + (thr[0] > thr[1] ? thr[0] : thr[1]);
+        b->tm.outside[k] = (t3 - t0) - b->tm.path[k];
+        b->tm.handoff[k] = hand;
+        b->tm.eye1w[k] = st.eye_thread[1] ? 1.0 : 0.0;
     }
     return 1;
 }
@@ -554,6 +601,20 @@ static int measure(bench *b, pipe_ctx *p, const imgset *is, const posesrc *src, 
     r->raster = median_of(b->tm.raster, n);
     r->fuse = median_of(b->tm.fuse, n);
     r->cpu = median_of(b->tm.cpu, n);
+    r->path = median_of(b->tm.path, n);
+    r->outside = median_of(b->tm.outside, n);
+    for (int e = 0; e < 2; e++)
+        for (int q = 0; q < 3; q++) r->eye[e][q] = median_of(b->tm.eye[e][q], n);
+    {   /* the hand-off over the frames where the worker ran an eye */
+        int m = 0;
+        double w = 0;
+        for (int k = 0; k < n; k++) {
+            w += b->tm.eye1w[k];
+            if (b->tm.handoff[k] >= 0) b->tm.handoff[m++] = b->tm.handoff[k];
+        }
+        r->handoff = m ? median_of(b->tm.handoff, m) : 0;
+        r->eye1w = w / n;
+    }
     double cs = 0;
     for (int k = 0; k < n; k++) cs += b->tm.cover[k];
     r->coverage = cs / n;
@@ -566,10 +627,13 @@ static void csv_row(bench *b, const char *cs, const char *impl, const char *isa,
 {
     if (!b->csv) return;
     fprintf(b->csv,
-            "%s,%s,%s,%d,%.4f,%.4f,%.4f,%.4f,%d,%.1f,%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%d,%d\n",
+            "%s,%s,%s,%d,%.4f,%.4f,%.4f,%.4f,%d,%.1f,%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d,%d,%d,"
+            "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%d\n",
             cs, impl, isa, threads, r->total.median, r->total.p99, r->total.max, r->total.mean,
             r->frames, r->fps, BUDGET_MS - r->total.p99, r->coverage, r->convert, r->track,
-            r->skin, r->raster, r->fuse, tris, ow, oh);
+            r->skin, r->raster, r->fuse, tris, ow, oh, r->path, r->outside, r->eye[0][0],
+            r->eye[1][0], r->eye[0][2], r->eye[1][2], r->eye[0][1], r->eye[1][1], r->handoff,
+            r->eye1w, b->inplace);
     fflush(b->csv);
 }
 
@@ -687,6 +751,22 @@ static void print_row(const char *cs, const char *isa, int thr, const result *r)
            r->fuse, r->frames);
 }
 
+/* Where the frame's time goes (issue 17 item 1), one line under the row. */
+static void print_breakdown(const result *r, int threads)
+{
+    printf("  %-8s per eye L/R: raster %.3f/%.3f convert %.3f/%.3f fuse %.3f/%.3f; stages on "
+           "the path %.3f, outside them %.3f (%.1f%% of the path)",
+           "", r->eye[0][0], r->eye[1][0], r->eye[0][1], r->eye[1][1], r->eye[0][2], r->eye[1][2],
+           r->path, r->outside, r->path > 0 ? 100.0 * r->outside / r->path : 0.0);
+    if (threads > 1 && frame_cpu_clock)
+        printf("; eye 1 on the worker in %.0f%% of the frames (path: the caller's thread)",
+               100.0 * r->eye1w);
+    else if (threads > 1)
+        printf("; eye 1 on the worker in %.0f%% of the frames, its start %.3f ms after the "
+               "hand-off", 100.0 * r->eye1w, r->handoff);
+    printf("\n");
+}
+
 typedef struct budget {
     int frames_best, frames, ref_frames, scale_frames;   /* caps */
     double s_best, s_other, s_ref, s_scale;               /* time boxes */
@@ -695,6 +775,9 @@ typedef struct budget {
 /* --isa / --threads: only that ISA / thread count in the grid (0: all) */
 static ef_isa grid_isa = EF_ISA_DEFAULT;
 static int grid_threads = 0;
+/* --inplace: the grid composites in place (V copied into out before each
+ * frame, untimed: the renderer's fresh buffer) */
+static int grid_inplace = 0;
 
 static void run_grid(bench *b, const budget *bu)
 {
@@ -706,7 +789,11 @@ static void run_grid(bench *b, const budget *bu)
            "both eyes, which run in parallel with 2 threads; raster = context clear + vertex\n"
            "transforms + draw with normals, back faces culled, as bench_raster's \"pipe\" rows;\n"
            "headroom = 16.67 - p99):\n");
+    if (grid_inplace)
+        printf("(in place: V copied into the output before each frame, untimed, as a renderer's "
+               "fresh buffer)\n");
     print_head();
+    b->inplace = grid_inplace;
     for (int c = 0; c < 2; c++) {
         for (int i = 0; i < 4; i++) {
             if (grid_isa != EF_ISA_DEFAULT && grid_isa != isas[i]) continue;
@@ -733,6 +820,7 @@ static void run_grid(bench *b, const budget *bu)
                                                  : bu->s_other;
                 if (measure(b, p, &b->base, c ? &worst : &typical, n, s, &r)) {
                     print_row(c ? "worst" : "typical", ef_isa_name(isas[i]), t, &r);
+                    print_breakdown(&r, t);
                     if (isas[i] == best) b->lat[c][t - 1] = r;
                     csv_row(b, c ? "frame_worst" : "frame_typical", "egofuse", ef_isa_name(isas[i]),
                             t, &r, -1, b->hmd.lcd_width, b->hmd.lcd_height);
@@ -741,6 +829,7 @@ static void run_grid(bench *b, const budget *bu)
             }
         }
     }
+    b->inplace = 0;
 }
 
 /* ----------------------------------------------- memcpy and pixman */
@@ -1384,6 +1473,8 @@ int main(int argc, char **argv)
             grid_isa = ef_isa_parse(v), a++;
             ok = grid_isa != EF_ISA_DEFAULT;
         } else if (!strcmp(o, "--threads") && v) ok = parse_int(v, 1, 2, &grid_threads), a++;
+        else if (!strcmp(o, "--inplace")) grid_inplace = 1;
+        else if (!strcmp(o, "--cpu-time")) frame_cpu_clock = 1;
         else ok = 0;
         if (!ok) {
             fprintf(stderr,
@@ -1391,13 +1482,17 @@ int main(int argc, char **argv)
                     "       [--scale-frames N] [--seconds S] [--window N] [--quick] "
                     "[--no-scaling]\n"
                     "       [--no-hmds] [--hmds-only] [--hmd-frames N] [--hmd NAME]\n"
-                    "       [--isa ref|sse2|avx2|avx512] [--threads 1|2]   (the grid only)\n",
+                    "       [--isa ref|sse2|avx2|avx512] [--threads 1|2] [--inplace] [--cpu-time]\n",
                     argv[0]);
             return 2;
         }
     }
     static bench b;
     setvbuf(stdout, NULL, _IOLBF, 0);
+    pipe_set_stats_clock(frame_cpu_clock);
+    if (frame_cpu_clock)
+        printf("--cpu-time: every frame and stage time below is the CPU time of the thread that "
+               "ran it (waits do not count; the memcpy and composite peers stay wall time)\n");
     (void)bm_eye_mvp; /* bench_mesh.h: the cameras here are the HMD's */
     b.outdir = outdir;
     mkdir(outdir, 0755);

@@ -71,6 +71,9 @@ for b in "$BUILD"/bench/bench_*; do
     case $name in
         bench_kin) # its own figures and CSVs into bench/out; no --csv, no --runs
             "$b" || echo "($name exited with status $?)" ;;
+        bench_reproj) # the eye reprojection against the crop on the samples'
+            # frames, side by side (docs/eyeview.md)
+            "$b" --samples "$SAMPLES" --runs "$STAGE_RUNS" || echo "($name exited with status $?)" ;;
         bench_vsrc) # a V source's own speed needs a live source; here the
             # conversion of each frame format (median of 30 runs)
             "$b" --convert || echo "($name exited with status $?)" ;;
@@ -130,6 +133,17 @@ if [ -f "$OUT/bench.csv" ]; then
                      print "|---|---|---|---|---|---|---|---|"
                      for (i = 0; i < n; i++) { k = order[i];
                          printf "| %s | %.2f | %.2f | %.2f | %.2f | %.0f / %.0f | %s |\n", k, tm[k], tp[k], wm[k], wp[k], 1000 / tm[k], (wm[k] > 0 ? 1000 / wm[k] : 0), st[k] } }' "$OUT/bench.csv"
+        echo
+        echo "Where the frame's time goes (issue 17 item 1; bench.csv path_ms, outside_ms: per frame, the stages on"
+        echo "the critical path and the rest of the frame, medians; docs/bench.md \"Where the frame's time goes\"):"
+        echo
+        awk -F, 'NR > 1 && $2 == "egofuse" && ($1 == "frame_typical" || $1 == "frame_worst") && NF >= 31 {
+                     if (!hd) { hd = 1
+                         print "| case | ISA | threads | frame ms | stages on the path ms | outside ms (% of the path) | raster L / R | fuse L / R | eye 1 on the worker |"
+                         print "|---|---|---|---|---|---|---|---|---|" }
+                     printf "| %s | %s | %s | %.3f | %.3f | %.3f (%.1f%%) | %.3f / %.3f | %.3f / %.3f | %s |\n",
+                            $1, $3, $4, $5, $21, $22, ($21 > 0 ? 100 * $22 / $21 : 0), $23, $24, $25, $26,
+                            ($4 > 1 ? sprintf("%.0f%%", 100 * $30) : "") }' "$OUT/bench.csv"
         echo
         echo "Every row of bench.csv but the scaling points:"
         echo

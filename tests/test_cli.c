@@ -19,6 +19,27 @@ static char out[65536];
 
 static double fin(float v) { return isfinite(v) ? v : 0.0; }
 
+/* A number option of render and run: both show `help` in --help;
+ * render refuses bad0 and bad1, run refuses 'x', each with exit 2 and a
+ * message that names the option and the value. */
+static void number_option(const char *opt, const char *help, const char *bad0, const char *bad1)
+{
+    char want[64];
+    const char *bad[2] = {bad0, bad1};
+    assert_int_equal(run("render", "--help", NULL), 0);
+    assert_non_null(strstr(out, help));
+    for (int i = 0; i < 2; i++) {
+        assert_int_equal(run("render", "--scene", "s.txt", "--out", "o", opt, bad[i], NULL), 2);
+        snprintf(want, sizeof want, "%s '%s'", opt, bad[i]);
+        assert_non_null(strstr(out, want));
+    }
+    assert_int_equal(run("run", "--help", NULL), 0);
+    assert_non_null(strstr(out, help));
+    assert_int_equal(run("run", opt, "x", NULL), 2);
+    snprintf(want, sizeof want, "%s 'x'", opt);
+    assert_non_null(strstr(out, want));
+}
+
 /* A glTF with a node "head" and an unskinned quad [x0,x1]x[y0,y1] at depth
  * z facing +Z, normals +Z. */
 static void write_quad_gltf(const char *path, float x0, float x1, float y0, float y1, float z)
@@ -92,27 +113,9 @@ static void usage_errors(void **state)
     assert_non_null(strstr(out, "--out is required"));
     assert_int_equal(run("render", "--bogus", NULL), 2);
     /* --refine BAND: 1..64 px */
-    assert_int_equal(run("render", "--help", NULL), 0);
-    assert_non_null(strstr(out, "--refine BAND"));
-    assert_int_equal(run("render", "--scene", "s.txt", "--out", "o", "--refine", "0", NULL), 2);
-    assert_non_null(strstr(out, "--refine '0'"));
-    assert_int_equal(run("render", "--scene", "s.txt", "--out", "o", "--refine", "65", NULL), 2);
-    assert_non_null(strstr(out, "--refine '65'"));
-    assert_int_equal(run("run", "--help", NULL), 0);
-    assert_non_null(strstr(out, "--refine BAND"));
-    assert_int_equal(run("run", "--refine", "x", NULL), 2);
-    assert_non_null(strstr(out, "--refine 'x'"));
+    number_option("--refine", "--refine BAND", "0", "65");
     /* --aa N: 0, 4, 8 or 16 samples per pixel */
-    assert_int_equal(run("render", "--help", NULL), 0);
-    assert_non_null(strstr(out, "--aa N"));
-    assert_int_equal(run("render", "--scene", "s.txt", "--out", "o", "--aa", "3", NULL), 2);
-    assert_non_null(strstr(out, "--aa '3'"));
-    assert_int_equal(run("render", "--scene", "s.txt", "--out", "o", "--aa", "32", NULL), 2);
-    assert_non_null(strstr(out, "--aa '32'"));
-    assert_int_equal(run("run", "--help", NULL), 0);
-    assert_non_null(strstr(out, "--aa N"));
-    assert_int_equal(run("run", "--aa", "x", NULL), 2);
-    assert_non_null(strstr(out, "--aa 'x'"));
+    number_option("--aa", "--aa N", "3", "32");
 }
 
 /* ------------------------------------------------------------- mask */

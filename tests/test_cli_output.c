@@ -76,16 +76,6 @@ static int files_in(const char *dir, const char *ext)
     return n;
 }
 
-static int file_is(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    char buf[256] = {0};
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    return n == strlen(text) && memcmp(buf, text, n) == 0;
-}
-
 /* A binary glTF (.glb) of one square [-1,1]^2 at z = 0 facing +Z, with a
  * node "head"; returns its size. */
 static size_t make_glb(unsigned char *glb, size_t cap)
@@ -128,6 +118,16 @@ static void write_glb(const char *path)
     assert_int_equal(fclose(f), 0);
 }
 
+/* A fresh folder tmp/NAME (dir) holding the quad model (model: its
+ * quad.glb); mask: DIR/mask.png, not written. */
+static void quad_files(const char *name, char dir[1024], char model[1100], char mask[1100])
+{
+    make_dir(name, dir, 1024);
+    snprintf(model, 1100, "%s/quad.glb", dir);
+    snprintf(mask, 1100, "%s/mask.png", dir);
+    write_glb(model);
+}
+
 /* ------------------------------------------------------------- mask */
 
 static void mask_args(const char **a, const char *model, const char *mask, const char *nrm)
@@ -145,11 +145,8 @@ static void mask_write_fails_cleanly(void **state)
 {
     (void)state;
     char dir[1024], model[1100], mask[1100], nrm[1100];
-    make_dir("out_mask", dir, sizeof dir);
-    snprintf(model, sizeof model, "%s/quad.glb", dir);
-    snprintf(mask, sizeof mask, "%s/mask.png", dir);
+    quad_files("out_mask", dir, model, mask);
     snprintf(nrm, sizeof nrm, "%s/normals.png", dir);
-    write_glb(model);
     const char *a[40];
     mask_args(a, model, mask, nrm);
 
@@ -184,7 +181,7 @@ static void mask_write_fails_cleanly(void **state)
     tu_write_text(nrm, "precious");
     rc = run_limited(limit, XFSZ_IGNORE, a);
     assert_int_equal(rc, 1);
-    assert_true(file_is(nrm, "precious"));
+    assert_true(tu_file_is(nrm, "precious"));
     assert_int_equal(temps_in(dir), 0);
 
     /* the same with named temporaries (file systems without O_TMPFILE) */
@@ -193,7 +190,7 @@ static void mask_write_fails_cleanly(void **state)
     unsetenv("EGOFUSE_NO_TMPFILE");
     assert_int_equal(rc, 1);
     assert_non_null(strstr(out, strerror(EFBIG)));
-    assert_true(file_is(nrm, "precious"));
+    assert_true(tu_file_is(nrm, "precious"));
     assert_int_equal(temps_in(dir), 0);
 }
 
@@ -203,12 +200,9 @@ static void plugin_write_fails_cleanly(void **state)
 {
     (void)state;
     char dir[1024], model[1100], mask[1100], depth[1100], tif[1100];
-    make_dir("out_plugin", dir, sizeof dir);
-    snprintf(model, sizeof model, "%s/quad.glb", dir);
-    snprintf(mask, sizeof mask, "%s/mask.png", dir);
+    quad_files("out_plugin", dir, model, mask);
     snprintf(depth, sizeof depth, "%s/depth.exr", dir);
     snprintf(tif, sizeof tif, "%s/normals.tif", dir);
-    write_glb(model);
     const char *a[40];
     mask_args(a, model, mask, tif);
     int n = 0;
@@ -255,10 +249,7 @@ static void mask_killed_leaves_nothing(void **state)
 {
     (void)state;
     char dir[1024], model[1100], mask[1100];
-    make_dir("out_kill", dir, sizeof dir);
-    snprintf(model, sizeof model, "%s/quad.glb", dir);
-    snprintf(mask, sizeof mask, "%s/mask.png", dir);
-    write_glb(model);
+    quad_files("out_kill", dir, model, mask);
     const char *a[40];
     mask_args(a, model, mask, NULL);
     int rc = run_limited(100, XFSZ_KILL, a);
@@ -371,10 +362,7 @@ static void eye_overflow_names_eye(void **state)
 {
     (void)state;
     char dir[1024], model[1100], mask[1100];
-    make_dir("msg_eye", dir, sizeof dir);
-    snprintf(model, sizeof model, "%s/quad.glb", dir);
-    snprintf(mask, sizeof mask, "%s/mask.png", dir);
-    write_glb(model);
+    quad_files("msg_eye", dir, model, mask);
     const char *a[40];
     mask_args(a, model, mask, NULL);
     a[9] = "1e30,1,0";  /* --eye */

@@ -171,74 +171,125 @@ static void bad(const char *body, const char *f1, const char *f2)
     parse_bad(body, "cam.yml", frag);
 }
 
+/* The refused inputs of validity_bad_inputs: the file is pre, then
+ * GOOD_K (K), post, then GOOD_D (D); its message names cam.yml, f1 and
+ * f2. */
+#define YAML "%YAML:1.0\n"
+enum { K = 1, D = 1 };
+static const struct bad_case {
+    const char *pre;
+    int k;
+    const char *post;
+    int d;
+    const char *f1, *f2;
+} BAD[] = {
+    { YAML "image_width: 640\n",
+      0, "", 0,
+      "no camera matrix", "camera_matrix" },
+    { YAML,
+      K, "", 0,
+      "camera_matrix", "no distortion" },
+    { YAML "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+        "   data: [ 500., 0., 320., 0., 500., 240., 0., 0. ]\n",
+      0, "", 0,
+      "cam.yml:6: camera_matrix", "8 numbers" },
+    { YAML "camera_matrix: !!opencv-matrix\n   rows: 2\n   cols: 3\n   dt: d\n"
+        "   data: [ 500., 0., 320., 0., 500., 240. ]\n",
+      0, "", 0,
+      "camera_matrix", "3 x 3" },
+    { YAML "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: \"2f\"\n"
+        "   data: [ 1, 2, 3, 4, 5, 6, 7, 8, 9 ]\n",
+      0, "", D,
+      "camera_matrix", "dt '2f'" },
+    { YAML "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+        "   data: [ 500., 0., 320., 0., .Nan, 240., 0., 0., 1. ]\n",
+      0, "", D,
+      "cam.yml:6: camera_matrix", "'.Nan' is not a number" },
+    { YAML "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+        "   data: [ 500., 0., 320., 0., 500., 240., 0.1, 0., 1. ]\n",
+      0, "", D,
+      "camera_matrix", "not a camera matrix" },
+    { YAML "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+        "   data: [ -500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n",
+      0, "", D,
+      "camera_matrix", "fx = -500" },
+    { YAML "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
+        "   data: [ 500., 0., 320., 0., 500., 240.,\n  0., 0., 1.\n",
+      0, "", D,
+      "cam.yml:6: camera_matrix", "without its ']'" },
+    { YAML "camera_matrix: !!opencv-matrix\n   rows: 3\n   dt: d\n"
+        "   data: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n",
+      0, "", D,
+      "camera_matrix", "cols is missing" },
+    { YAML,
+      K, "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 6\n   dt: d\n"
+        "   data: [ 1, 2, 3, 4, 5, 6 ]\n", 0,
+      "distortion_coefficients", "6 coefficients" },
+    { YAML,
+      K, "distortion_coefficients: !!opencv-matrix\n   rows: 2\n   cols: 2\n   dt: d\n"
+        "   data: [ 1, 2, 3, 4 ]\n", 0,
+      "distortion_coefficients", "1 x N" },
+    { YAML,
+      K, "distortion_coefficients: [ 0.1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.01, 0 ]\n", 0,
+      "tilted-sensor", "tauX = 0.01" },
+    { YAML "fisheye_model: 1\n",
+      K, "", D,
+      "distortion_coefficients", "a fisheye lens has 4" },
+    { YAML "fisheye_model: 2\n",
+      K, "", D,
+      "cam.yml:2: fisheye_model", "0..1" },
+    { YAML "distortion_model: omnidir\n",
+      K, "", D,
+      "distortion_model", "'omnidir' is not a lens model" },
+    { YAML "image_width: 640\n",
+      K, "", D,
+      "image_width without image_height", "cam.yml:2" },
+    { YAML "image_width: 0\nimage_height: 480\n",
+      K, "", D,
+      "image_width", "'0' is not an integer" },
+    { YAML,
+      K, "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 1\n   dt: d\n"
+        "   data: [ 1 ]\n", 0,
+      "distortion_coefficients", "1 coefficients" },
+    { YAML,
+      K, "distortion_coefficients: !!opencv-matrix\n   rows: 1\n   cols: 4\n   dt: d\n"
+        "   data: [ -1e7, 0, 0, 0 ]\n", 0,
+      "distortion_coefficients", "folds over" },
+    { YAML "this line has no colon\n",
+      0, "", 0,
+      "cam.yml:2", "expected 'key: value'" },
+    { "   \n\n",
+      0, "", 0,
+      "cam.yml", "empty file" },
+    { "<?xml version=\"1.0\"?>\n<storage></storage>\n",
+      0, "", 0,
+      "cam.yml:2", "not <opencv_storage>" },
+    { "<?xml version=\"1.0\"?>\n<opencv_storage>\n"
+        "<camera_matrix type_id=\"opencv-matrix\">\n"
+        "<rows>3</rows><cols>3</cols><dt>d</dt><data>1 0 0 0 1 0 0 0 1</data>\n"
+        "</opencv_storage>\n",
+      0, "", 0,
+      "camera_matrix", "not closed" },
+    { "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>640</image_width>\n",
+      0, "", 0,
+      "cam.yml:2", "<opencv_storage> is not closed" },
+    { "<?xml version=\"1.0\"?>\n<opencv_storage>\n"
+        "<camera_matrix type_id=\"opencv-matrix\">"
+        "<rows>3</rows><cols>3</cols><dt>d</dt><data>1 0 0 0 1 0 0 0 1 7</data></camera_matrix>\n"
+        "<D>0 0 0 0 0</D></opencv_storage>\n",
+      0, "", 0,
+      "camera_matrix", "10 numbers" },
+};
+
 static void validity_bad_inputs(void **state)
 {
     (void)state;
     char b[2048];
-    bad("%YAML:1.0\nimage_width: 640\n", "no camera matrix", "camera_matrix");
-    snprintf(b, sizeof b, "%%YAML:1.0\n%s", GOOD_K);
-    bad(b, "camera_matrix", "no distortion");
-    bad("%YAML:1.0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
-        "   data: [ 500., 0., 320., 0., 500., 240., 0., 0. ]\n",
-        "cam.yml:6: camera_matrix", "8 numbers");
-    bad("%YAML:1.0\ncamera_matrix: !!opencv-matrix\n   rows: 2\n   cols: 3\n   dt: d\n"
-        "   data: [ 500., 0., 320., 0., 500., 240. ]\n",
-        "camera_matrix", "3 x 3");
-    snprintf(b, sizeof b, "%%YAML:1.0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n"
-                          "   dt: \"2f\"\n   data: [ 1, 2, 3, 4, 5, 6, 7, 8, 9 ]\n%s", GOOD_D);
-    bad(b, "camera_matrix", "dt '2f'");
-    snprintf(b, sizeof b, "%%YAML:1.0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n"
-                          "   dt: d\n   data: [ 500., 0., 320., 0., .Nan, 240., 0., 0., 1. ]\n%s", GOOD_D);
-    bad(b, "cam.yml:6: camera_matrix", "'.Nan' is not a number");
-    snprintf(b, sizeof b, "%%YAML:1.0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n"
-                          "   dt: d\n   data: [ 500., 0., 320., 0., 500., 240., 0.1, 0., 1. ]\n%s", GOOD_D);
-    bad(b, "camera_matrix", "not a camera matrix");
-    snprintf(b, sizeof b, "%%YAML:1.0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n"
-                          "   dt: d\n   data: [ -500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n%s", GOOD_D);
-    bad(b, "camera_matrix", "fx = -500");
-    snprintf(b, sizeof b, "%%YAML:1.0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n"
-                          "   dt: d\n   data: [ 500., 0., 320., 0., 500., 240.,\n  0., 0., 1.\n%s", GOOD_D);
-    bad(b, "cam.yml:6: camera_matrix", "without its ']'");
-    snprintf(b, sizeof b, "%%YAML:1.0\ncamera_matrix: !!opencv-matrix\n   rows: 3\n   dt: d\n"
-                          "   data: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n%s", GOOD_D);
-    bad(b, "camera_matrix", "cols is missing");
-    snprintf(b, sizeof b, "%%YAML:1.0\n%sdistortion_coefficients: !!opencv-matrix\n   rows: 1\n"
-                          "   cols: 6\n   dt: d\n   data: [ 1, 2, 3, 4, 5, 6 ]\n", GOOD_K);
-    bad(b, "distortion_coefficients", "6 coefficients");
-    snprintf(b, sizeof b, "%%YAML:1.0\n%sdistortion_coefficients: !!opencv-matrix\n   rows: 2\n"
-                          "   cols: 2\n   dt: d\n   data: [ 1, 2, 3, 4 ]\n", GOOD_K);
-    bad(b, "distortion_coefficients", "1 x N");
-    snprintf(b, sizeof b, "%%YAML:1.0\n%sdistortion_coefficients: [ 0.1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.01, 0 ]\n",
-             GOOD_K);
-    bad(b, "tilted-sensor", "tauX = 0.01");
-    snprintf(b, sizeof b, "%%YAML:1.0\nfisheye_model: 1\n%s%s", GOOD_K, GOOD_D);
-    bad(b, "distortion_coefficients", "a fisheye lens has 4");
-    snprintf(b, sizeof b, "%%YAML:1.0\nfisheye_model: 2\n%s%s", GOOD_K, GOOD_D);
-    bad(b, "cam.yml:2: fisheye_model", "0..1");
-    snprintf(b, sizeof b, "%%YAML:1.0\ndistortion_model: omnidir\n%s%s", GOOD_K, GOOD_D);
-    bad(b, "distortion_model", "'omnidir' is not a lens model");
-    snprintf(b, sizeof b, "%%YAML:1.0\nimage_width: 640\n%s%s", GOOD_K, GOOD_D);
-    bad(b, "image_width without image_height", "cam.yml:2");
-    snprintf(b, sizeof b, "%%YAML:1.0\nimage_width: 0\nimage_height: 480\n%s%s", GOOD_K, GOOD_D);
-    bad(b, "image_width", "'0' is not an integer");
-    snprintf(b, sizeof b, "%%YAML:1.0\n%sdistortion_coefficients: !!opencv-matrix\n   rows: 1\n"
-                          "   cols: 1\n   dt: d\n   data: [ 1 ]\n", GOOD_K);
-    bad(b, "distortion_coefficients", "1 coefficients");
-    snprintf(b, sizeof b, "%%YAML:1.0\n%sdistortion_coefficients: !!opencv-matrix\n   rows: 1\n"
-                          "   cols: 4\n   dt: d\n   data: [ -1e7, 0, 0, 0 ]\n", GOOD_K);
-    bad(b, "distortion_coefficients", "folds over");
-    bad("%YAML:1.0\nthis line has no colon\n", "cam.yml:2", "expected 'key: value'");
-    bad("   \n\n", "cam.yml", "empty file");
-    bad("<?xml version=\"1.0\"?>\n<storage></storage>\n", "cam.yml:2", "not <opencv_storage>");
-    bad("<?xml version=\"1.0\"?>\n<opencv_storage>\n<camera_matrix type_id=\"opencv-matrix\">\n"
-        "<rows>3</rows><cols>3</cols><dt>d</dt><data>1 0 0 0 1 0 0 0 1</data>\n</opencv_storage>\n",
-        "camera_matrix", "not closed");
-    bad("<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>640</image_width>\n",
-        "cam.yml:2", "<opencv_storage> is not closed");
-    bad("<?xml version=\"1.0\"?>\n<opencv_storage>\n<camera_matrix type_id=\"opencv-matrix\">"
-        "<rows>3</rows><cols>3</cols><dt>d</dt><data>1 0 0 0 1 0 0 0 1 7</data></camera_matrix>\n"
-        "<D>0 0 0 0 0</D></opencv_storage>\n",
-        "camera_matrix", "10 numbers");
+    for (size_t i = 0; i < sizeof BAD / sizeof BAD[0]; i++) {
+        const struct bad_case *c = &BAD[i];
+        snprintf(b, sizeof b, "%s%s%s%s", c->pre, c->k ? GOOD_K : "", c->post, c->d ? GOOD_D : "");
+        bad(b, c->f1, c->f2);
+    }
     /* NUL bytes */
     kin_lens L;
     io_error err;

@@ -248,16 +248,6 @@ static int temp_files_in(const char *dir)
     return n;
 }
 
-static int file_is(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    char buf[256] = {0};
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    return n == strlen(text) && memcmp(buf, text, n) == 0;
-}
-
 static void save_errors_leave_files_untouched(void **state)
 {
     (void)state;
@@ -293,7 +283,7 @@ static void save_errors_leave_files_untouched(void **state)
     bad = img;
     bad.data = NULL;
     assert_int_equal(io_image_save(path, &bad, &err), IO_ERR_ARGS);
-    assert_true(file_is(path, "precious"));
+    assert_true(tu_file_is(path, "precious"));
 
     /* the temp file cannot be created (a non-empty folder has its name):
      * the existing file stays as it was */
@@ -302,7 +292,7 @@ static void save_errors_leave_files_untouched(void **state)
     snprintf(sub, sizeof sub, "%s/x", tmp);
     tu_write_text(sub, "x");
     assert_int_equal(io_image_save(path, &img, &err), IO_ERR_WRITE);
-    assert_true(file_is(path, "precious"));
+    assert_true(tu_file_is(path, "precious"));
     remove(sub);
     remove(tmp);
 
@@ -321,7 +311,7 @@ static void save_errors_leave_files_untouched(void **state)
     /* and a good save replaces the file */
     snprintf(path, sizeof path, "%s/keep.png", dir);
     assert_int_equal(io_image_save(path, &img, &err), IO_OK);
-    assert_false(file_is(path, "precious"));
+    assert_false(tu_file_is(path, "precious"));
     assert_int_equal(temp_files_in(dir), 0);
     io_image_free(&img);
 }

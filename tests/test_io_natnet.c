@@ -159,6 +159,18 @@ static void handshake(server *s, io_natnet *n, const char *v)
     assert_true(n->have_server_info);
 }
 
+/* A fake server and a client of the default configuration connected to
+ * it, past the version 4.1 handshake. */
+static void connected(server *s, io_natnet *n)
+{
+    server_open(s);
+    io_natnet_config c;
+    client_config(&c, s);
+    io_error err;
+    assert_int_equal(io_natnet_open(n, &c, &err), IO_OK);
+    handshake(s, n, "4.1");
+}
+
 /* The point k of s against body id of file (identity axes, metres). */
 static void check_point(const kin_track_sample *s, int k, const char *file, int id, double tol)
 {
@@ -423,13 +435,9 @@ static void validity_bad_packets(void **state)
     (void)state;
     NEED_GEN();
     server s;
-    server_open(&s);
-    io_natnet_config c;
-    client_config(&c, &s);
-    io_error err;
     io_natnet n;
-    assert_int_equal(io_natnet_open(&n, &c, &err), IO_OK);
-    handshake(&s, &n, "4.1");
+    io_error err;
+    connected(&s, &n);
     server_send(&s, "modeldef_4.1.bin");
     server_send(&s, "frame_4.1_1.bin");
     kin_track_sample good;
@@ -469,6 +477,7 @@ static void validity_bad_packets(void **state)
 
     /* frames before any server info, no version configured: refused, named */
     server_open(&s);
+    io_natnet_config c;
     client_config(&c, &s);
     assert_int_equal(io_natnet_open(&n, &c, &err), IO_OK);
     server_expect(&s, IO_NATNET_CONNECT);
@@ -499,13 +508,9 @@ static void validity_unknown_names(void **state)
     (void)state;
     NEED_GEN();
     server s;
-    server_open(&s);
-    io_natnet_config c;
-    client_config(&c, &s);
-    io_error err;
     io_natnet n;
-    assert_int_equal(io_natnet_open(&n, &c, &err), IO_OK);
-    handshake(&s, &n, "4.1");
+    io_error err;
+    connected(&s, &n);
     server_send(&s, "modeldef_nohands_4.1.bin");
     pump(&n, 1, NULL);
     assert_int_equal(io_natnet_wait_ready(&n, 100, &err), IO_ERR_MISSING);

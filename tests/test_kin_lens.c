@@ -61,39 +61,35 @@ static void to_ego(const double P[3], double p[3])
     p[2] = -P[2];
 }
 
-static kin_lens brown_lens(const double K[4], const double *d, int nd, int w, int h)
+/* A lens of the model with K = {fx, fy, cx, cy}, skew, nk coefficients
+ * k and the image size; kin_lens_check must accept it. */
+static kin_lens make_lens(kin_lens_model model, const double K[4], double skew,
+                          const double *k, int nk, int w, int h)
 {
     kin_lens L;
     memset(&L, 0, sizeof L);
-    L.model = KIN_LENS_BROWN;
+    L.model = model;
     L.width = w;
     L.height = h;
     L.fx = K[0];
     L.fy = K[1];
     L.cx = K[2];
     L.cy = K[3];
-    for (int i = 0; i < nd; i++) L.k[i] = d[i];
+    L.skew = skew;
+    for (int i = 0; i < nk; i++) L.k[i] = k[i];
     char why[200];
     if (!kin_lens_check(&L, why, sizeof why)) fail_msg("lens refused: %s", why);
     return L;
 }
 
+static kin_lens brown_lens(const double K[4], const double *d, int nd, int w, int h)
+{
+    return make_lens(KIN_LENS_BROWN, K, 0.0, d, nd, w, h);
+}
+
 static kin_lens fisheye_lens(const double K[4], double alpha, const double *k, int w, int h)
 {
-    kin_lens L;
-    memset(&L, 0, sizeof L);
-    L.model = KIN_LENS_FISHEYE;
-    L.width = w;
-    L.height = h;
-    L.fx = K[0];
-    L.fy = K[1];
-    L.cx = K[2];
-    L.cy = K[3];
-    L.skew = alpha * K[0];
-    for (int i = 0; i < 4; i++) L.k[i] = k[i];
-    char why[200];
-    if (!kin_lens_check(&L, why, sizeof why)) fail_msg("lens refused: %s", why);
-    return L;
+    return make_lens(KIN_LENS_FISHEYE, K, alpha * K[0], k, 4, w, h);
 }
 
 /* A realistic narrow lens (Brown, 5 coefficients, VGA). */
@@ -173,6 +169,19 @@ static void result_fisheye_matches_opencv_formula(void **state)
     }
 }
 
+/* Each of the three cases {x, y, z, u, v}: the point projects to pixel
+ * centre (u, v) within 1e-9 px. */
+static void check_projections(const kin_lens *L, const double cases[3][5])
+{
+    for (int i = 0; i < 3; i++) {
+        double p[3], u, v;
+        to_ego(cases[i], p);
+        assert_true(kin_lens_project(L, p, &u, &v));
+        NEAR(u - 0.5, cases[i][3], 1e-9);
+        NEAR(v - 0.5, cases[i][4], 1e-9);
+    }
+}
+
 /* Constants computed by hand (python, from the documented formulas), and
  * one that fits on paper: k1 = -0.3 at x = 0.5: 0.5 (1 - 0.3 * 0.25) = 0.4625. */
 static void result_hand_computed_values(void **state)
@@ -184,26 +193,14 @@ static void result_hand_computed_values(void **state)
         {-0.3, 0.2, 0.8, 105.97214069366456, 384.18313589096067},
         {0.25, -0.4, 1.5, 416.5599304951989, 81.48313750558759},
     };
-    for (int i = 0; i < 3; i++) {
-        double p[3], u, v;
-        to_ego(cases[i], p);
-        assert_true(kin_lens_project(&L, p, &u, &v));
-        NEAR(u - 0.5, cases[i][3], 1e-9);
-        NEAR(v - 0.5, cases[i][4], 1e-9);
-    }
+    check_projections(&L, cases);
     kin_lens F = fisheye_lens(K_F, 0.0, D_F, 848, 800);
     static const double fe[3][5] = {
         {0.1, 0.05, 1.0, 448.54931621034063, 418.1346158637318},
         {-1.0, 0.5, 0.6, 145.01457943669863, 541.5389949930834},
         {0.7, -0.9, 0.3, 643.2334219984975, 116.8133415949128},
     };
-    for (int i = 0; i < 3; i++) {
-        double p[3], u, v;
-        to_ego(fe[i], p);
-        assert_true(kin_lens_project(&F, p, &u, &v));
-        NEAR(u - 0.5, fe[i][3], 1e-9);
-        NEAR(v - 0.5, fe[i][4], 1e-9);
-    }
+    check_projections(&F, fe);
     const double K1[4] = {100, 100, 0, 0}, d1[1] = {-0.3};
     kin_lens S = brown_lens(K1, d1, 1, 0, 0);
     double xd, yd;

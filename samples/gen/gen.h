@@ -191,6 +191,12 @@ void gen_render_camera(gen_frame_ctx *c, const kin_mat4 *world_from_head,
 void gen_render_virtual(gen_frame_ctx *c, const kin_mat4 *world_from_head,
                         kin_eye eye, int frame, uint8_t *rgb, float *depth);
 
+/* The colour (display values 0..1, unclamped) of a surface point with
+ * the interpolated attributes attr (GEN_ATTRS) under the lights of sc: the
+ * shading of gen_render_camera and gen_render_virtual, for renders from
+ * other viewpoints (samples/gt/gt_eye.c). */
+void gen_shade(const gen_scene *sc, const float *attr, float out[3]);
+
 /* Projection for a pinhole camera with intrinsics (pixels, the ray of pixel
  * centre (x+.5, y+.5) is ((x+.5-cx)/fx, -(y+.5-cy)/fy, -1)) rendering a
  * width x height image through rast_draw (OpenGL clip space). */

@@ -189,7 +189,11 @@ static int write_scene(const char *dir, int frames, const gen_scene *ws, const j
                 (double)ws->light_dir[i][0], (double)ws->light_dir[i][1],
                 (double)ws->light_dir[i][2], (double)ws->light_color[i][0],
                 (double)ws->light_color[i][1], (double)ws->light_color[i][2]);
-    fprintf(f, "kd = 0.80\nks = 0.12\nshininess = 20\nkf = 0.50\ntone = 1.00 0.98 0.96\n");
+    /* kf 0: the Fresnel fade measured against the opaque ideal composite
+     * (egofuse eval --kf-sweep, docs/fuse.md): every fade costs PSNR */
+    fprintf(f, "kd = 0.80\nks = 0.12\nshininess = 20\n"
+               "# no Fresnel edge fade: the best against the ideal composite (egofuse eval --kf-sweep)\n"
+               "kf = 0.00\ntone = 1.00 0.98 0.96\n");
     if (j->hmd_name)
         fprintf(f, "# the HMD (docs/kin.md, named HMDs): camera %dx%d, display %dx%d per eye\n"
                    "hmd = %s\n",

@@ -392,3 +392,8 @@ void gen_render_virtual(gen_frame_ctx *c, const kin_mat4 *world_from_head,
         for (int k = 0; k < 3; k++) rgb[i * 3 + (size_t)k] = to_u8(col[k]);
     }
 }
+
+void gen_shade(const gen_scene *sc, const float *attr, float out[3])
+{
+    shade(sc, attr, out);
+}

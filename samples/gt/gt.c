@@ -840,6 +840,75 @@ static void seq_arm(kin_vec3 S, float L1, float L2, const float *c, float s, kin
 
 static kin_quat qconj(kin_quat q) { kin_quat c = { -q.x, -q.y, -q.z, q.w }; return c; }
 
+/* "holdNN" (NN = 10..60 cm): the right hand held up NN cm in front of the
+ * eyes, palm towards them, fingers straight along the head's up axis, the
+ * middle fingertip midway between the eyes, 2 deg below their view axis
+ * (so in view of both cameras at 15 cm: 6.5 cm from them), swaying
+ * +-0.5 cm sideways and 1.5 cm up and back in the plane at that depth
+ * (keys at 0, 0.75, 1.5, 2.25, 3 s); the left hand down by the side, out
+ * of view. The head holds HEAD0. Keys from the mask model's head: the eyes'
+ * midpoint (the head node) and axes at that pitch. -1 for another name. */
+static int hold_desc(const gen_arms *mask, const char *name, seq_desc *sq)
+{
+    int cm = 0, used = 0;
+    if (sscanf(name, "hold%d%n", &cm, &used) != 1 || name[used] || cm < 10 || cm > 60)
+        return -1;
+    const kin_model *m = &mask->model;
+    kin_transform *L = malloc(sizeof *L * (size_t)m->node_count);
+    kin_mat4 *W = malloc(sizeof *W * (size_t)m->node_count);
+    if (!L || !W) {
+        free(L);
+        free(W);
+        return -1;
+    }
+    memcpy(L, m->rest, sizeof *L * (size_t)m->node_count);
+    static const float head0[2] = HEAD0;
+    L[mask->head].r = kin_quat_mul(kin_quat_axis_angle(kin_v3(0, 1, 0), head0[0] * PI_F / 180.0f),
+                                   kin_quat_axis_angle(kin_v3(1, 0, 0), head0[1] * PI_F / 180.0f));
+    kin_fk(m->parents, m->node_count, L, NULL, W);
+    const kin_mat4 *H = &W[mask->head];
+    kin_vec3 E = mat_t(H);
+    kin_vec3 xh = kin_v3_norm(kin_v3(H->m[0], H->m[1], H->m[2]));
+    kin_vec3 yh = kin_v3_norm(kin_v3(H->m[4], H->m[5], H->m[6]));
+    kin_vec3 zh = kin_v3_norm(kin_v3(H->m[8], H->m[9], H->m[10]));
+    free(L);
+    free(W);
+    const float d = 0.01f * (float)cm;
+    static const float sway[5][2] = { { 0, 0 }, { 0.005f, 0.01f }, { 0, 0.015f },
+                                      { -0.005f, 0.01f }, { 0, 0 } };
+    memset(sq, 0, sizeof *sq);
+    sq->name = "hold";
+    sq->duration = 3.0f;
+    seq_side *r = &sq->side[1], *l = &sq->side[0];
+    r->n = 5;
+    for (int k = 0; k < 5; k++) {
+        r->t[k] = 0.75f * (float)k;
+        float x = sway[k][0];
+        float y = -d * tanf(2.0f * PI_F / 180.0f) + sway[k][1];
+        r->tip[k] = 1;
+        kin_vec3 w = kin_v3_add(E, kin_v3_add(kin_v3_scale(xh, x),
+                                              kin_v3_add(kin_v3_scale(yh, y), kin_v3_scale(zh, -d))));
+        float *v = r->v[k];
+        v[0] = w.x; v[1] = w.y; v[2] = w.z;
+        v[3] = yh.x; v[4] = yh.y; v[5] = yh.z;       /* fingers up */
+        v[6] = -zh.x; v[7] = -zh.y; v[8] = -zh.z;    /* back of the hand away */
+        v[9] = -0.2f;                                /* fingers nearly straight */
+    }
+    static const float lhang[SEQ_DIM] = { -0.240f, 0.880f, -0.200f, 0.25f, -0.5f, -1.0f,
+                                          -0.35f, 1.0f, 0.0f, 0.1f };
+    l->n = 2;
+    l->t[0] = 0.0f;
+    l->t[1] = 3.0f;
+    memcpy(l->v[0], lhang, sizeof lhang);
+    memcpy(l->v[1], lhang, sizeof lhang);
+    sq->nh = 2;
+    sq->ht[0] = 0.0f;
+    sq->ht[1] = 3.0f;
+    memcpy(sq->hv[0], head0, sizeof head0);
+    memcpy(sq->hv[1], head0, sizeof head0);
+    return 0;
+}
+
 int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
 {
     if (!strcmp(name, GEN_ANIM_NAME)) {
@@ -850,6 +919,8 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
     const seq_desc *sq = NULL;
     for (size_t i = 0; i < sizeof sequences / sizeof sequences[0]; i++)
         if (!strcmp(sequences[i].name, name)) sq = &sequences[i];
+    seq_desc hold;
+    if (!sq && hold_desc(mask, name, &hold) == 0) sq = &hold;
     if (!sq) return -1;
     const kin_model *m = &mask->model;
     kin_model *t = &truth->model;
@@ -954,7 +1025,7 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
             memcpy(&v[k * 4], &r, sizeof r);
         }
     }
-    snprintf(an->name, KIN_NAME_MAX, "%s", sq->name);
+    snprintf(an->name, KIN_NAME_MAX, "%s", name);
     an->channel_count = nch;
     an->channels = ch;
     an->duration = times[keys - 1];

@@ -67,7 +67,11 @@ int gt_truth_build(const gen_arms *mask, const gt_operator_desc *d,
  * hands pressed together: the calibration motion of
  * kin_user_calib_estimate_tips, solved for the true operator's own bones
  * so that its fingertips touch; not meant to be rendered). NULL past the
- * last. */
+ * last. Not listed, for the eye-view evaluation (docs/accuracy.md):
+ * "holdNN", NN = 10..60, the right hand held NN cm in front of the eyes,
+ * palm towards them, the middle fingertip midway between the eyes,
+ * swaying 0.5-1.5 cm in the plane at that depth, the left hand down out
+ * of view (gt_sequence_build takes these names). */
 const char *gt_sequence_name(int i);
 
 /* Makes truth move through sequence `name`: its animation (joint angles

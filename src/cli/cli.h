@@ -44,6 +44,17 @@ int cli_lens_load(const char *both, const char *left, const char *right, kin_sth
  * after the options). */
 int cli_lens_fits(const kin_sthmd_desc *hmd, char *why, size_t why_size);
 
+/* --view of render and run (cli_view.c, docs/eyeview.md): "crop" or
+ * "reproject" into *view (PIPE_VIEW_*), EXIT_OK, else EXIT_USAGE with a
+ * message. cli_view_check: with PIPE_VIEW_REPROJECT, no --aa and the
+ * resolved IPD and camera offset D in pipe_view_check's ranges, else
+ * EXIT_USAGE naming the option and the range. cli_hmd_len_parse: a
+ * length option --OPT in lo..hi metres (EXIT_USAGE otherwise). */
+int cli_view_parse(const char *cmd, const char *arg, int *view);
+int cli_view_check(const char *cmd, int view, int aa, const kin_sthmd_desc *hmd);
+int cli_hmd_len_parse(const char *cmd, const char *opt, const char *arg, float lo, float hi,
+                      float *out);
+
 /* Strict parsers: the whole string must be the number(s); finite. */
 int cli_parse_int(const char *s, int lo, int hi, int *out);
 int cli_parse_float(const char *s, float *out);

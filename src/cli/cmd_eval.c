@@ -15,7 +15,9 @@ static const char *eval_usage =
     "                    [--methods LIST] [--band PX] [--global W] [--per-frame]\n"
     "                    [--csv FILE] [--report DIR] [--sweep-frames N]\n"
     "                    [--seq-frames N] [--dump DIR] [--quiet]\n"
-    "                    [--lod MODE] [--lod-px PX] [--lod-sweep]\n"
+    "                    [--lod MODE] [--lod-px PX] [--lod-sweep] [--light-sweep[=DIR]]\n"
+    "                    [--kf-sweep]\n"
+    "       egofuse eval --eyeview [--frames N] [--seed S] [--csv FILE] [--report DIR]\n"
     "\n"
     "Generates ground truth (a true operator whose bones and limbs differ from\n"
     "the mask model, filmed over a cockpit with skin-coloured objects, camera\n"
@@ -70,11 +72,32 @@ static const char *eval_usage =
     "                   and triangles drawn, raster ms per eye, the kinematic\n"
     "                   mask's IoU and BF1 against the full model's; a report\n"
     "                   runs it on --sweep-frames and writes DIR/lod.csv)\n"
+    "  --eyeview        instead: the eye's viewpoint (the cameras sit 85 mm in\n"
+    "                   front of the eyes): the right hand held 15, 20, 30, 40 cm\n"
+    "                   from the eyes, tracking noise 0, 5, 10, 20 mm; per view\n"
+    "                   method (crop: the paper's crop and scale; reproj: the\n"
+    "                   reprojection to the eye) the hand's position error (px)\n"
+    "                   and size error (%) in the display, IoU and PSNR against\n"
+    "                   ground truth rendered from the true eye, ms per stereo\n"
+    "                   frame; --frames per distance (at most 180); the report:\n"
+    "                   DIR/eyeview.csv, eyeview.md, eyeview_*.png\n"
+    "  --light-sweep[=DIR]  also run the lighting mismatch between the cockpit and\n"
+    "                   the virtual scene (the cockpit's light x0.5..x2, tinted\n"
+    "                   3000..10000 K, turned 30..90 degrees to the side) for\n"
+    "                   kin-cal-pred, skin, refine and refine with tone matching\n"
+    "                   on --frames frames (group light; a report runs it on\n"
+    "                   --sweep-frames and writes DIR/light.md, light_*.dat,\n"
+    "                   light.png; without a report: into =DIR when given)\n"
+    "  --kf-sweep       also run kin-cal-pred and refine with the Fresnel fade kf\n"
+    "                   0, 0.25, 0.5, 0.75, 1 against the opaque ideal composite\n"
+    "                   (a real hand has no fade) on --frames frames (group kf;\n"
+    "                   a report runs it on --sweep-frames, DIR/kf.md)\n"
     "  -h, --help       this text\n";
 
 enum { O_FRAMES = 256, O_NOISE, O_LATENCY, O_DROPOUT, O_CALIB, O_SPEED, O_SEED, O_PERFRAME,
        O_CSV, O_REPORT, O_QUIET, O_DUMP, O_METHODS, O_BAND, O_SEQUENCE, O_SWEEP_FRAMES,
-       O_SEQ_FRAMES, O_GLOBAL, O_LOD, O_LOD_PX, O_LOD_SWEEP };
+       O_SEQ_FRAMES, O_GLOBAL, O_LOD, O_LOD_PX, O_LOD_SWEEP, O_EYEVIEW,
+       O_LIGHT_SWEEP, O_KF_SWEEP };
 
 int cmd_eval(int argc, char **argv)
 {
@@ -100,11 +123,14 @@ int cmd_eval(int argc, char **argv)
         {"lod", required_argument, 0, O_LOD},
         {"lod-px", required_argument, 0, O_LOD_PX},
         {"lod-sweep", no_argument, 0, O_LOD_SWEEP},
+        {"eyeview", no_argument, 0, O_EYEVIEW},
+        {"light-sweep", optional_argument, 0, O_LIGHT_SWEEP},
+        {"kf-sweep", no_argument, 0, O_KF_SWEEP},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
     eval_opts o = { 60, 0, 0, 5.0f, 20.0f, 0.02f, 0.0f, 1.0f, 1, NULL, NULL, NULL, 15u,
-                    GEN_ANIM_NAME, 60, 90, 0.5f, 16, CLI_LOD_DEFAULT, CLI_LOD_PX_DEFAULT, 0 };
+                    GEN_ANIM_NAME, 60, 90, 0.5f, 16, CLI_LOD_DEFAULT, CLI_LOD_PX_DEFAULT, 0, 0, 0, NULL, 0 };
     optind = 1;
     opterr = 0;
     int ch;
@@ -180,6 +206,12 @@ int cmd_eval(int argc, char **argv)
                 return cli_usage_error("eval", "--lod-px '%s': pixels, > 0 and <= 1000", optarg);
             break;
         case O_LOD_SWEEP: o.lod_sweep = 1; break;
+        case O_EYEVIEW: o.eyeview = 1; break;
+        case O_LIGHT_SWEEP:
+            o.light_sweep = 1;
+            o.light_dir = optarg;
+            break;
+        case O_KF_SWEEP: o.kf_sweep = 1; break;
         case O_GLOBAL:
             if (!cli_parse_float(optarg, &v) || v < 0.0f || v > 1.0f)
                 return cli_usage_error("eval", "--global '%s': not in 0..1", optarg);
@@ -198,6 +230,9 @@ int cmd_eval(int argc, char **argv)
         }
     }
     if (optind < argc) return cli_usage_error("eval", "unexpected argument '%s'", argv[optind]);
-    return eval_run(&o);
+    if (o.eyeview && o.frames > 180)
+        return cli_usage_error("eval", "--eyeview --frames %d: at most 180 (the 3 s of a "
+                               "sequence)", o.frames);
+    return o.eyeview ? eval_eye_run(&o) : eval_run(&o);
 }
 

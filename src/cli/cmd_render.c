@@ -15,9 +15,10 @@ static const char *render_usage =
     "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
     "                      [--tone-match S] [--pose animation|tracking]\n"
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
-    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--hide PARTS]\n"
+    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--edge-fade K] [--hide PARTS]\n"
     "                      [--prop MODEL@X,Y,Z[,YAW]]... [--allow-outside]\n"
-    "                      [--lod MODE] [--lod-px PX]\n"
+    "                      [--lod MODE] [--lod-px PX] [--view crop|reproject]\n"
+    "                      [--hmd-ipd M] [--hmd-camera-offset M]\n"
     "                      [--hmd-calibration FILE | --hmd-calibration-left FILE\n"
     "                       --hmd-calibration-right FILE]\n"
     "\n"
@@ -31,6 +32,15 @@ static const char *render_usage =
     "consumer, highend) is rendered with that HMD's sizes and eq. 1-4.\n"
     "\n"
     "  --scene FILE   the scene file\n"
+    "  --view V       crop (default): the paper's crop and scale into the\n"
+    "                 viewport (eq. 1-4); reproject: the hands as the eye sees\n"
+    "                 them, the model drawn from the eye and the camera image\n"
+    "                 sampled through its depth, over the whole display\n"
+    "                 (docs/eyeview.md; not with --aa)\n"
+    "  --hmd-ipd M    the eyes' separation, 0.04..0.09 m (default: the HMD's,\n"
+    "                 65 mm for the paper's): places the eyes of --view reproject\n"
+    "  --hmd-camera-offset M  D, the cameras in front of the eyes, 0..0.25 m\n"
+    "                 (default: the HMD's, 85 mm for the paper's)\n"
     "  --out DIR      output folder (created if missing)\n"
     "  --first K      first frame (default 0)\n"
     "  --frames N     number of frames (default: all of the scene)\n"
@@ -80,6 +90,9 @@ static const char *render_usage =
     "  --smooth-normals R  sum the model's normals over a (2R+1)^2 window\n"
     "                 before lighting (1..4; default 0: off): for models of\n"
     "                 crossing parts whose shading shows seams\n"
+    "  --edge-fade K  soft viewport edges: where the camera image ends inside\n"
+    "                 the display, the hands fade over its last K pixels\n"
+    "                 (1..64; 0: off, a hard cut); default 4\n"
     CLI_LOD_USAGE
     "  --allow-outside  let the models' buffer and image URIs name files\n"
     "                 outside their folder (absolute, `..`, symlinks out);\n"
@@ -126,6 +139,9 @@ typedef struct render_opts {
     const char *hmd_calib[3]; /* --hmd-calibration, -left, -right */
     kin_sthmd_desc hmd;    /* zero = the paper's; lenses from hmd_calib */
     int aa;                /* coverage samples per pixel; 0 = off */
+    int view;              /* --view: PIPE_VIEW_CROP (default), _REPROJECT */
+    float ipd_m, cam_offset_m; /* --hmd-ipd, --hmd-camera-offset; 0 = the HMD's */
+    int edge_fade;         /* pipe_desc.edge_fade: 0 default, -1 off */
 } render_opts;
 
 /* The pose from tracking: the recording, the rig, the filter and the
@@ -342,6 +358,7 @@ static int render(const render_opts *o)
     pd.refine_band = o->refine;
     pd.normal_smooth = o->smooth_normals;
     pd.aa_samples = o->aa;
+    pd.edge_fade = o->edge_fade;
     pd.fit_rig = o->refine && o->pose_tracking ? &tp.rig : NULL;
     /* the scene's HMD (its `hmd` key, checked on load), or the paper's */
     if (sc.hmd[0]) {
@@ -349,6 +366,9 @@ static int render(const render_opts *o)
         pd.hmd.lens[0] = o->hmd.lens[0]; /* --hmd-calibration: on that HMD */
         pd.hmd.lens[1] = o->hmd.lens[1];
     }
+    if (o->ipd_m > 0.0f) pd.hmd.ipd_m = o->ipd_m;
+    if (o->cam_offset_m > 0.0f) pd.hmd.cam_offset_m = o->cam_offset_m;
+    pd.eye_view = o->view;
     pipe_ctx *pp = pipe_create(&pd, &model);
     pipe_lod lod = {0};
     kin_sthmd_desc hd = pp ? pipe_hmd(pp) : kin_sthmd_desc_resolved(&pd.hmd);
@@ -393,7 +413,12 @@ static int render(const render_opts *o)
         goto done;
     }
 
-    const kin_sthmd_geometry geo = pipe_geometry(pp);
+    kin_sthmd_geometry geo = pipe_geometry(pp);
+    if (o->view == PIPE_VIEW_REPROJECT) { /* the eye's view: the whole display */
+        geo.vp_x0 = geo.vp_y0 = 0;
+        geo.vp_width = hd.lcd_width;
+        geo.vp_height = hd.lcd_height;
+    }
     pipe_frame_in in = {0};
     in.anim = anim;
     in.head_node = head;
@@ -489,6 +514,10 @@ static int render(const render_opts *o)
                 printf("%s%ld", l ? ", " : "", lod.level[l].triangles);
             printf(" triangles), mean level drawn %.2f\n", (double)lod_sum / (2.0 * count));
         }
+        if (o->view == PIPE_VIEW_REPROJECT)
+            printf("egofuse: view reproject (docs/eyeview.md): %ld eye-frame%s fell back to the "
+                   "crop (the eye inside the model)\n", st.view_fallbacks,
+                   st.view_fallbacks == 1 ? "" : "s");
         if (o->pose_tracking)
             printf("egofuse: pose from tracking (%d samples, %s, prediction %.0f ms%s%s)%s\n",
                    tp.count, o->no_filter ? "raw" : "One Euro filter", (double)o->predict_ms,
@@ -514,7 +543,7 @@ done:
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
        O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
        O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
-       O_HMD_CALIB_R, O_AA };
+       O_HMD_CALIB_R, O_AA, O_VIEW, O_HMD_IPD, O_HMD_OFFSET, O_EDGE_FADE };
 
 /* --aa N: 0 (off), 4, 8 or 16 samples per pixel. 1, or 0 for another. */
 static int parse_aa(const char *s, int *aa)
@@ -570,6 +599,7 @@ int cmd_render(int argc, char **argv)
         {"lod-px", required_argument, 0, O_LOD_PX},
         {"smooth-normals", required_argument, 0, O_SMOOTH},
         {"aa", required_argument, 0, O_AA},
+        {"edge-fade", required_argument, 0, O_EDGE_FADE},
         {"tone-match", required_argument, 0, O_TONE},
         {"pose", required_argument, 0, O_POSE},
         {"calib", required_argument, 0, O_CALIB},
@@ -581,6 +611,9 @@ int cmd_render(int argc, char **argv)
         {"hmd-calibration", required_argument, 0, O_HMD_CALIB},
         {"hmd-calibration-left", required_argument, 0, O_HMD_CALIB_L},
         {"hmd-calibration-right", required_argument, 0, O_HMD_CALIB_R},
+        {"view", required_argument, 0, O_VIEW},
+        {"hmd-ipd", required_argument, 0, O_HMD_IPD},
+        {"hmd-camera-offset", required_argument, 0, O_HMD_OFFSET},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
@@ -632,6 +665,12 @@ int cmd_render(int argc, char **argv)
                 return cli_usage_error("render", "--smooth-normals '%s': a radius of 1..%d px",
                                        optarg, FUSE_NORMAL_SMOOTH_MAX);
             break;
+        case O_EDGE_FADE:
+            if (!cli_parse_int(optarg, 0, FUSE_EDGE_FADE_MAX, &o.edge_fade))
+                return cli_usage_error("render", "--edge-fade '%s': 0 (off) or a width of "
+                                       "1..%d px", optarg, FUSE_EDGE_FADE_MAX);
+            if (o.edge_fade == 0) o.edge_fade = -1;
+            break;
         case O_AA:
             if (!parse_aa(optarg, &o.aa))
                 return cli_usage_error("render", "--aa '%s': 0 (off), 4, 8 or 16 samples per "
@@ -669,6 +708,23 @@ int cmd_render(int argc, char **argv)
         case O_HMD_CALIB: o.hmd_calib[0] = optarg; break;
         case O_HMD_CALIB_L: o.hmd_calib[1] = optarg; break;
         case O_HMD_CALIB_R: o.hmd_calib[2] = optarg; break;
+        case O_VIEW: {
+            int vr = cli_view_parse("render", optarg, &o.view);
+            if (vr != EXIT_OK) return vr;
+            break;
+        }
+        case O_HMD_IPD: {
+            int vr = cli_hmd_len_parse("render", "hmd-ipd", optarg, PIPE_IPD_MIN_M,
+                                       PIPE_IPD_MAX_M, &o.ipd_m);
+            if (vr != EXIT_OK) return vr;
+            break;
+        }
+        case O_HMD_OFFSET: {
+            int vr = cli_hmd_len_parse("render", "hmd-camera-offset", optarg, 0.0f,
+                                       PIPE_CAM_OFFSET_MAX_M, &o.cam_offset_m);
+            if (vr != EXIT_OK) return vr;
+            break;
+        }
         case ':': return cli_usage_error("render", "option %s needs a value", argv[optind - 1]);
         default: return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);
         }
@@ -683,6 +739,13 @@ int cmd_render(int argc, char **argv)
     if (o.hmd_calib[0] || o.hmd_calib[1] || o.hmd_calib[2]) {
         int rc = cli_lens_load(o.hmd_calib[0], o.hmd_calib[1], o.hmd_calib[2], &o.hmd);
         if (rc != EXIT_OK) return rc;
+    }
+    {
+        kin_sthmd_desc h = o.hmd;
+        h.ipd_m = o.ipd_m;
+        h.cam_offset_m = o.cam_offset_m;
+        int vr = cli_view_check("render", o.view, o.aa, &h);
+        if (vr != EXIT_OK) return vr;
     }
     return render(&o);
 }

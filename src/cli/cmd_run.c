@@ -533,6 +533,7 @@ static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
         bad |= fprintf(f, " --lod auto --lod-px %.9g", (double)o->lod_px) < 0;
     else if (o->lod) bad |= fprintf(f, " --lod %d", o->lod) < 0;
     if (o->aa) bad |= fprintf(f, " --aa %d", o->aa) < 0;
+    if (o->edge_fade) bad |= fprintf(f, " --edge-fade %d", o->edge_fade < 0 ? 0 : o->edge_fade) < 0;
     if (o->refine) bad |= fprintf(f, " --refine %d # the elbow fit's learned state differs", o->refine) < 0;
     bad |= fputc('\n', f) == EOF;
     bad |= fclose(f) != 0;
@@ -797,6 +798,8 @@ static int run(const run_opts *o)
         }
     pd.refine_band = o->refine;
     pd.aa_samples = o->aa;
+    pd.eye_view = o->view;
+    pd.edge_fade = o->edge_fade;
     pd.fit_rig = o->refine && tracked ? &r->rig : NULL;
     if (!(r->pipe = pipe_create(&pd, model))) {
         if (o->aa && (kin_lens_distorts(&pd.hmd.lens[0]) || kin_lens_distorts(&pd.hmd.lens[1])))
@@ -881,7 +884,12 @@ static int run(const run_opts *o)
     /* Still virtual images: checked once. Opaque (the grey fallback is),
      * the composite copies V where the hand is not without reading its
      * alpha. A live source's eyes are opaque by construction. */
-    const kin_sthmd_geometry geo = pipe_geometry(r->pipe);
+    kin_sthmd_geometry geo = pipe_geometry(r->pipe);
+    if (o->view == PIPE_VIEW_REPROJECT) { /* the eye's view: the whole display */
+        geo.vp_x0 = geo.vp_y0 = 0;
+        geo.vp_width = W;
+        geo.vp_height = H;
+    }
     const int still_opaque =
         pipe_image_opaque(&in.virt[0], geo.vp_x0, geo.vp_y0, geo.vp_width, geo.vp_height) &&
         pipe_image_opaque(&in.virt[1], geo.vp_x0, geo.vp_y0, geo.vp_width, geo.vp_height);

@@ -69,6 +69,10 @@ const char *run_usage =
     "  --hmd-camera WxH, --hmd-camera-hfov DEG, --hmd-baseline M (camera\n"
     "  separation), --hmd-camera-offset M (D), --hmd-display WxH (per eye),\n"
     "  --hmd-hfov DEG, --hmd-vfov DEG, --hmd-focal M, --hmd-ipd M\n"
+    "  --view V         crop (default: the paper's crop and scale, eq. 1-4) or\n"
+    "                   reproject: the hands as the eye sees them, reprojected\n"
+    "                   from the cameras by the model's depth (docs/eyeview.md;\n"
+    "                   IPD 0.04..0.09 m, D 0..0.25 m, not with --aa)\n"
     "  --hmd-calibration FILE   the cameras' lenses from an OpenCV calibration\n"
     "                   file (YAML/XML; a stereo file: M1/D1 left, M2/D2 right);\n"
     "  --hmd-calibration-left FILE, --hmd-calibration-right FILE  one each\n"
@@ -100,6 +104,8 @@ const char *run_usage =
     "  --lod-px PX      the error auto allows, pixels (default 2)\n"
     "  --aa N           anti-aliased silhouettes: N coverage samples per pixel\n"
     "                   (4, 8 or 16; 0: off, the binary mask); default 0\n"
+    "  --edge-fade K    soft viewport edges: the hands fade over the last K\n"
+    "                   camera pixels (1..64; 0: off, a hard cut); default 4\n"
     "  --quiet          no status line\n"
     "  -h, --help       this text\n"
     "\n"
@@ -114,7 +120,7 @@ enum {
     O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD, O_ALLOW_OUTSIDE, O_AA,
     O_HMD_CAM, O_HMD_CAM_HFOV, O_HMD_BASE, O_HMD_OFFSET, O_HMD_DISP, O_HMD_HFOV, O_HMD_VFOV,
     O_HMD_FOCAL, O_HMD_IPD, O_HMD_PRESET, O_DUMP, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
-    O_HMD_CALIB_R
+    O_HMD_CALIB_R, O_VIEW, O_EDGE_FADE
 };
 
 static const struct option run_long_opts[] = {
@@ -142,6 +148,7 @@ static const struct option run_long_opts[] = {
     {"lod", required_argument, 0, O_LOD},
     {"lod-px", required_argument, 0, O_LOD_PX},
     {"aa", required_argument, 0, O_AA},
+    {"edge-fade", required_argument, 0, O_EDGE_FADE},
     {"config", required_argument, 0, O_CONFIG},
     {"stats", required_argument, 0, O_STATS},
     {"predict-ms", required_argument, 0, O_PREDICT},
@@ -180,6 +187,7 @@ static const struct option run_long_opts[] = {
     {"hmd-calibration-left", required_argument, 0, O_HMD_CALIB_L},
     {"hmd-calibration-right", required_argument, 0, O_HMD_CALIB_R},
     {"dump", required_argument, 0, O_DUMP},
+    {"view", required_argument, 0, O_VIEW},
     {0, 0, 0, 0},
 };
 
@@ -380,6 +388,14 @@ int run_parse(int argc, char **argv, run_opts *o)
             o->aa = v;
             break;
         }
+        case O_EDGE_FADE: {
+            int v;
+            if (!cli_parse_int(optarg, 0, FUSE_EDGE_FADE_MAX, &v))
+                BAD("--edge-fade '%s': 0 (off) or a width of 1..%d px", optarg,
+                    FUSE_EDGE_FADE_MAX);
+            o->edge_fade = v == 0 ? -1 : v;
+            break;
+        }
         case O_STATS: o->stats = optarg; break;
         case O_DUMP: o->dump = optarg; break;
         case O_PREDICT:
@@ -485,6 +501,11 @@ int run_parse(int argc, char **argv, run_opts *o)
         case O_HMD_CALIB: o->hmd_calib[0] = optarg; break;
         case O_HMD_CALIB_L: o->hmd_calib[1] = optarg; break;
         case O_HMD_CALIB_R: o->hmd_calib[2] = optarg; break;
+        case O_VIEW:
+            if (pipe_view_parse(optarg, &o->view) != 0)
+                BAD("--view '%s': crop (the paper's crop and scale, the default) or reproject "
+                    "(to the eye by depth)", optarg);
+            break;
         case ':': BAD("option %s needs a value", av[optind - 1]);
         default: BAD("unknown option '%s'", av[optind - 1]);
         }
@@ -511,6 +532,10 @@ int run_parse(int argc, char **argv, run_opts *o)
         TAKE(zfar);
         TAKE(ipd_m);
 #undef TAKE
+    }
+    {
+        int vr = cli_view_check("run", o->view, o->aa, &o->hmd);
+        if (vr != EXIT_OK) return vr;
     }
     if (!o->sel[0] != !o->sel[1]) return cli_usage_error("run", "give both --left and --right");
     for (int e = 0; e < 2; e++) {

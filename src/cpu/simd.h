@@ -18,8 +18,9 @@
  *
  * WHAT IT DOES NOT. No dispatch (src/cpu/cpu.h picks the ISA; each room
  * keeps one dispatch table), no FMA, no estimates (rcp/rsqrt), no fast-math,
- * no gathers; of byte and 16-bit lanes only what the fuse's per-row
- * composite needs (vh_*, per 128-bit block; the refinement's saturating
+ * no float gathers (vi_gather: int32, the row cache's fallback); of byte
+ * and 16-bit lanes only what the fuse's composites need (vh_*, per 128-bit
+ * block; the refinement's saturating
  * and unsigned-compare operations are not here, docs/portability.md);
  * bytes widen to int32 lanes with vi_load_u8, RGBA8 pixels are int32
  * lanes through vi_loadu. What one
@@ -213,6 +214,27 @@
  *                            ordered (false when either is NaN)
  *   vd_sqrt(a)               square root, correctly rounded (the vertex
  *                            transforms' normal length, raster_xform.inl)
+ * ROW-CACHE OPS (added for src/fuse's row-cached composite, fuse_simd.inl
+ * fuse__hrow / fuse__vrow; a separate block at the end of each
+ * implementation; tests/test_cpu_simd_fuse.c)
+ *   (vi_min: see RASTER FRONT-END OPS)
+ *   vi_permute(i, idx)       lane l = lane (idx[l] & (SIMD_W - 1)) of i
+ *                            (AVX2 vpermd, AVX-512 vpermd, NEON TBL; SSE2
+ *                            through memory)
+ *   vi_gather(p, idx)        lane l = p[idx[l]] (const int32_t *p; every
+ *                            p[idx[l]] must be readable); SSE2 and NEON
+ *                            lane by lane
+ *   vh_zip_lo(i, j), vh_zip_hi(i, j)   16-bit lanes, in each block: lanes
+ *                            i0 j0 i1 j1 .. i3 j3 (lo) or i4 j4 .. i7 j7 (hi)
+ *                            (x86 punpcklwd / punpckhwd)
+ *   vh_madd(i, j)            int32 lane l = i[2l] j[2l] + i[2l+1] j[2l+1],
+ *                            the 16-bit lanes read as int16, the sum
+ *                            wrapping (x86 pmaddwd)
+ *   vh_packus32(i, j)        in each block: the 4 int32 lanes of i, then
+ *                            those of j, each saturated to 0..65535, as its
+ *                            8 16-bit lanes (x86 packusdw)
+ *   vh_mulhi(i, j)           16-bit lanes: (i j) >> 16, unsigned (x86
+ *                            pmulhuw)
  *
  * NEW ISA. Copy simd_neon.h (the plainest), keep every name, meet every
  * line of this contract (the semantics above are x86's where the ISAs

@@ -274,6 +274,17 @@ SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
 {
     return (unsigned)_mm256_movemask_pd(_mm256_cmp_pd(a, b, _CMP_GT_OQ));
 }
+/* ---- row-cache ops (src/fuse's composite; simd.h "ROW-CACHE OPS") */
+SIMD_INL vint vi_permute(vint i, vint idx) { return _mm256_permutevar8x32_epi32(i, idx); }
+SIMD_INL vint vi_gather(const int32_t *p, vint idx)
+{
+    return _mm256_i32gather_epi32((const int *)(const void *)p, idx, 4);
+}
+SIMD_INL vint vh_zip_lo(vint i, vint j) { return _mm256_unpacklo_epi16(i, j); }
+SIMD_INL vint vh_zip_hi(vint i, vint j) { return _mm256_unpackhi_epi16(i, j); }
+SIMD_INL vint vh_madd(vint i, vint j) { return _mm256_madd_epi16(i, j); }
+SIMD_INL vint vh_packus32(vint i, vint j) { return _mm256_packus_epi32(i, j); }
+SIMD_INL vint vh_mulhi(vint i, vint j) { return _mm256_mulhi_epu16(i, j); }
 
 #else
 #error "simd_avx2.h: another implementation of the vector layer is already included"

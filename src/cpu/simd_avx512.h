@@ -260,6 +260,17 @@ SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
 {
     return (unsigned)_mm512_cmp_pd_mask(a, b, _CMP_GT_OQ);
 }
+/* ---- row-cache ops (src/fuse's composite; simd.h "ROW-CACHE OPS") */
+SIMD_INL vint vi_permute(vint i, vint idx) { return _mm512_permutexvar_epi32(idx, i); }
+SIMD_INL vint vi_gather(const int32_t *p, vint idx)
+{
+    return _mm512_i32gather_epi32(idx, (const void *)p, 4);
+}
+SIMD_INL vint vh_zip_lo(vint i, vint j) { return _mm512_unpacklo_epi16(i, j); }
+SIMD_INL vint vh_zip_hi(vint i, vint j) { return _mm512_unpackhi_epi16(i, j); }
+SIMD_INL vint vh_madd(vint i, vint j) { return _mm512_madd_epi16(i, j); }
+SIMD_INL vint vh_packus32(vint i, vint j) { return _mm512_packus_epi32(i, j); }
+SIMD_INL vint vh_mulhi(vint i, vint j) { return _mm512_mulhi_epu16(i, j); }
 
 #else
 #error "simd_avx512.h: another implementation of the vector layer is already included"

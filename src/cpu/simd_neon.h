@@ -314,6 +314,49 @@ SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
 {
     const uint64x2_t g = vcgtq_f64(a, b);
     return (unsigned)(vgetq_lane_u64(g, 0) & 1u) | ((unsigned)(vgetq_lane_u64(g, 1) & 1u) << 1);
+/* ---- row-cache ops (src/fuse's composite; simd.h "ROW-CACHE OPS") */
+/* TBL on bytes: lane l's four bytes from 4 (idx[l] & 3) + 0..3 */
+SIMD_INL vint vi_permute(vint i, vint idx)
+{
+    const uint32x4_t b = vmlaq_n_u32(vdupq_n_u32(0x03020100u),
+                                     vandq_u32(vreinterpretq_u32_s32(idx), vdupq_n_u32(3)),
+                                     0x04040404u);
+    return vreinterpretq_s32_u8(vqtbl1q_u8(vreinterpretq_u8_s32(i), vreinterpretq_u8_u32(b)));
+}
+SIMD_INL vint vi_gather(const int32_t *p, vint idx)
+{
+    int32x4_t r = vdupq_n_s32(p[vgetq_lane_s32(idx, 0)]);
+    r = vsetq_lane_s32(p[vgetq_lane_s32(idx, 1)], r, 1);
+    r = vsetq_lane_s32(p[vgetq_lane_s32(idx, 2)], r, 2);
+    return vsetq_lane_s32(p[vgetq_lane_s32(idx, 3)], r, 3);
+}
+SIMD_INL vint vh_zip_lo(vint i, vint j)
+{
+    return vreinterpretq_s32_u16(vzip1q_u16(vreinterpretq_u16_s32(i), vreinterpretq_u16_s32(j)));
+}
+SIMD_INL vint vh_zip_hi(vint i, vint j)
+{
+    return vreinterpretq_s32_u16(vzip2q_u16(vreinterpretq_u16_s32(i), vreinterpretq_u16_s32(j)));
+}
+/* pmaddwd: the products of the int16 pairs, added in pairs (wrapping) */
+SIMD_INL vint vh_madd(vint i, vint j)
+{
+    const int16x8_t a = vreinterpretq_s16_s32(i), b = vreinterpretq_s16_s32(j);
+    const int32x4_t lo = vmull_s16(vget_low_s16(a), vget_low_s16(b));
+    const int32x4_t hi = vmull_high_s16(a, b);
+    return vreinterpretq_s32_u32(vreinterpretq_u32_s32(vpaddq_s32(lo, hi)));
+}
+/* packusdw: each int32 saturated to 0..65535 (SQXTUN) */
+SIMD_INL vint vh_packus32(vint i, vint j)
+{
+    return vreinterpretq_s32_u16(vcombine_u16(vqmovun_s32(i), vqmovun_s32(j)));
+}
+/* the 32-bit products narrowed by 16 (SHRN) */
+SIMD_INL vint vh_mulhi(vint i, vint j)
+{
+    const uint16x8_t a = vreinterpretq_u16_s32(i), b = vreinterpretq_u16_s32(j);
+    return vreinterpretq_s32_u16(vcombine_u16(vshrn_n_u32(vmull_u16(vget_low_u16(a), vget_low_u16(b)), 16),
+                                              vshrn_n_u32(vmull_high_u16(a, b), 16)));
 }
 
 #else

@@ -265,6 +265,35 @@ SIMD_INL vdouble vd_from_vf(vfloat a, int h) { return _mm_cvtps_pd(h ? _mm_moveh
 SIMD_INL vdouble vd_from_vi(vint i, int h) { return _mm_cvtepi32_pd(h ? _mm_shuffle_epi32(i, 0xEE) : i); }
 SIMD_INL vfloat vf_from_vd(vdouble lo, vdouble hi) { return _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi)); }
 SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b) { return (unsigned)_mm_movemask_pd(_mm_cmpgt_pd(a, b)); }
+/* ---- row-cache ops (src/fuse's composite; simd.h "ROW-CACHE OPS"): SSE2
+ * has no pminsd, no variable permute, no gather and no packusdw */
+SIMD_INL vint vi_permute(vint i, vint idx)
+{
+    _Alignas(16) int32_t s[4], x[4], r[4];
+    _mm_store_si128((__m128i *)(void *)s, i);
+    _mm_store_si128((__m128i *)(void *)x, idx);
+    for (int l = 0; l < 4; l++) r[l] = s[x[l] & 3];
+    return _mm_load_si128((const __m128i *)(const void *)r);
+}
+SIMD_INL vint vi_gather(const int32_t *p, vint idx)
+{
+    _Alignas(16) int32_t x[4];
+    _mm_store_si128((__m128i *)(void *)x, idx);
+    return _mm_setr_epi32(p[x[0]], p[x[1]], p[x[2]], p[x[3]]);
+}
+SIMD_INL vint vh_zip_lo(vint i, vint j) { return _mm_unpacklo_epi16(i, j); }
+SIMD_INL vint vh_zip_hi(vint i, vint j) { return _mm_unpackhi_epi16(i, j); }
+SIMD_INL vint vh_madd(vint i, vint j) { return _mm_madd_epi16(i, j); }
+/* clamp to 0..65535, then the low 16 bits sign-extended: packssdw is exact */
+SIMD_INL vint vh_packus32(vint i, vint j)
+{
+    const vint lo = vi_zero(), hi = vi_set1(65535);
+    i = vi_min(vi_sel(vi_gt(lo, i), lo, i), hi);
+    j = vi_min(vi_sel(vi_gt(lo, j), lo, j), hi);
+    return _mm_packs_epi32(_mm_srai_epi32(_mm_slli_epi32(i, 16), 16),
+                           _mm_srai_epi32(_mm_slli_epi32(j, 16), 16));
+}
+SIMD_INL vint vh_mulhi(vint i, vint j) { return _mm_mulhi_epu16(i, j); }
 
 #else
 #error "simd_sse2.h: another implementation of the vector layer is already included"

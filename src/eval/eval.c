@@ -10,6 +10,7 @@
 #include "eval_internal.h"
 #include "../cli/cli.h"
 #include "../io/io_lod.h"
+#include "../fit/fit_band.h"
 
 /* The ground truth comes from samples/gt/ and the sample generator
  * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
@@ -30,7 +31,7 @@ static fuse_lighting workshop_lighting(const gen_scene *ws, const kin_camera *ca
     L.kd = 0.80f;
     L.ks = 0.12f;
     L.shininess = 20.0f;
-    L.kf = 0.50f;
+    L.kf = 0.0f;   /* the samples' (gen_main.c): the best against the opaque ideal (eval_kf.c) */
     L.tone[0] = 1.0f;
     L.tone[1] = 0.98f;
     L.tone[2] = 0.96f;
@@ -71,7 +72,7 @@ static void ctx_free(eval_ctx *c)
         free(c->P[e]); free(c->sil[e]); free(c->sil_prev[e]); free(c->tnrm[e]); free(c->V[e]); free(c->ideal[e]);
     }
     free(c->aa_samples);
-    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->layer); free(c->out);
+    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->band_region); free(c->mask_prior); free(c->layer); free(c->out);
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
     free(c->gt_depth); free(c->gt_mask);
@@ -157,6 +158,8 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->aa_samples = malloc(sizeof(uint32_t) * cp);
     c->mask_up = malloc(cp);
     c->refined = malloc(cp);
+    c->band_region = malloc(cp);
+    c->mask_prior = malloc(cp);
     c->layer = malloc(cp * 4);
     c->out = malloc(vp * 4);
     c->depth_lo = malloc(sizeof(float) * cp);
@@ -167,7 +170,8 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     rp.margin = 64;
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
-    ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && c->layer && c->out && c->depth_lo &&
+    ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && 
+         c->band_region && c->mask_prior && c->layer && c->out && c->depth_lo &&
          c->nrm_lo && c->mnrm && c->refine_scratch;
     c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
     c->gt_mask = malloc((size_t)GEN_CAM_W * GEN_CAM_H);
@@ -211,10 +215,15 @@ static int make_truth(eval_ctx *c, int frame, float speed, int first)
         fuse_intrinsics K = { cam.fx, cam.fy, cam.cx, cam.cy };
         fuse_image P = { c->P[e], CW, CH, 4 * CW }, Q = { c->layer, CW, CH, 4 * CW };
         fuse_image I = { c->ideal[e], GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
-        if (fuse_light(&c->L[e], &K, &P, c->sil[e], CW, c->tnrm[e], 3 * CW, &Q) != FUSE_OK ||
+        fuse_lighting Li = c->L[e];
+        if (c->light.opaque_ideal) Li.kf = 0.0f;   /* the Fresnel sweep: a real hand is opaque */
+        if (fuse_light(&Li, &K, &P, c->sil[e], CW, c->tnrm[e], 3 * CW, &Q) != FUSE_OK ||
             fuse_composite(&Q, &V, c->g.vp_x0, c->g.vp_y0, c->g.vp_width, c->g.vp_height,
                            &I) != FUSE_OK)
             return -1;
+        /* the lighting-mismatch sweep: the methods see the cockpit under
+         * another light than the ideal composite was made from */
+        if (c->light.on && eval__light_render(c, &wfh, e, frame) < 0) return -1;
     }
     return 0;
 }
@@ -415,6 +424,25 @@ static int fit_elbows(eval_ctx *c, method_run *r, const kin_model *m, uint32_t v
     return 0;
 }
 
+/* This thread's CPU time, seconds (the method's time on a shared
+ * machine, where the wall clock counts the other processes). */
+static double thread_cpu(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static pipe_fit_band_desc band_desc(const method_cfg *cfg)
+{
+    pipe_fit_band_desc bd = pipe_fit_band_desc_default();
+    bd.sigma = cfg->band_sigma;
+    bd.tau = cfg->band_tau;
+    bd.band_min = cfg->band;
+    bd.band_max = cfg->band_max;
+    return bd;
+}
+
 static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const char *dump)
 {
     const method_cfg *cfg = &r->cfg;
@@ -437,6 +465,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         }
     }
     t0 = cli_now();   /* the tracker's simulation is not the method's time */
+    double c0 = thread_cpu();   /* and the same as this thread's CPU time */
     const kin_model *m = cfg->fine ? &c->mask_fine.model : &c->mask.model;
     const kin_mesh *me = &m->meshes[0];
     int posed = 0;
@@ -447,10 +476,18 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         if (cfg->kind == M_KIN) {
             s = r->last;
         } else {
-            kin_filter_output(&r->filter, T, &s, NULL);
+            /* the hands' lag compensated by their speed (fit_band.h;
+             * v1 0: kin_filter_output) */
+            pipe_fit_filter_output(&r->filter, T, cfg->lag_adapt_v0, cfg->lag_adapt_v1, &s, NULL);
             cp = &cal;
         }
         posed = kin_arm_rig_pose(&c->rig, m, cp, NULL, &s, r->locals, NULL);
+        r->sides = ((s.valid & KIN_TRACK_HAND_L) ? 1u : 0u) | ((s.valid & KIN_TRACK_HAND_R) ? 2u : 0u);
+        for (int k = 0; k < 2; k++) {
+            /* the wrist's speed: the filter's velocity (raw methods: 0) */
+            const kin_vec3 v = cfg->kind == M_KIN ? kin_v3(0, 0, 0) : r->filter.part[3 + k].dx;
+            r->speed[k] = sqrtf(v.x * v.x + v.y * v.y + v.z * v.z);
+        }
         if (posed) pose_skin(c, cfg, m, r->locals);
         if (posed && cfg->kind == M_REFINE && cfg->fit) {
             pipe_fit_shape(r->fit, c->world, c->pos);
@@ -459,9 +496,10 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             pipe_fit_shape(r->fit, c->world, c->pos);
         }
     }
-    double secs = cli_now() - t0;
+    double secs = cli_now() - t0, cpu = thread_cpu() - c0;
     for (int e = 0; e < 2; e++) {
         t0 = cli_now();
+        c0 = thread_cpu();
         kin_camera cam = posed ? eye_camera(c, e) : c->tcam[e];
         const uint8_t *mask = c->mask_up;
         const float *nrm = c->mnrm;
@@ -488,7 +526,39 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             if (cfg->kind == M_REFINE) {
                 fuse_refine_params rp = fuse_refine_params_default();
                 rp.band = cfg->band;
+                if (cfg->band_auto && posed) {
+                    /* the band from the projected uncertainty (fit_band.h),
+                     * at least --band */
+                    pipe_fit_band_desc bd = band_desc(cfg);
+                    rp.band = pipe_fit_band(&bd, &cam, c->world, &c->rig, r->sides, r->speed);
+                }
+                r->band_sum += rp.band;
+                r->n_band++;
                 fuse_image P = { c->P[e], CW, CH, 4 * CW };
+                const uint8_t *kmask = mask;   /* the kinematic mask */
+                if (cfg->prior_radius > 0.0f && posed && r->have_prev) {
+                    /* the last refined mask as the input around the slow
+                     * hands (fit_band.h) */
+                    pipe_fit_band_desc bd = band_desc(cfg);
+                    bd.hand_radius = cfg->prior_radius;
+                    /* moved with the hand: its image motion since the
+                     * last frame (the kinematic pose's, lag and all) */
+                    float shift[2][2] = { { 0, 0 }, { 0, 0 } };
+                    for (int k = 0; k < 2; k++)
+                        if (cfg->prior_mc && r->have_hand_px[e][k] &&
+                            pipe_fit_hand_px(&cam, c->world, &c->rig, k, shift[k])) {
+                            shift[k][0] -= r->hand_px[e][k][0];
+                            shift[k][1] -= r->hand_px[e][k][1];
+                        } else {
+                            shift[k][0] = shift[k][1] = 0.0f;
+                        }
+                    mask = pipe_fit_prior(&bd, &cam, c->world, &c->rig, r->sides, r->speed,
+                                          cfg->prior_speed, shift, mask, r->prev[e],
+                                          c->band_region, c->mask_prior, CW);
+                }
+                for (int k = 0; k < 2; k++)
+                    r->have_hand_px[e][k] =
+                        posed && pipe_fit_hand_px(&cam, c->world, &c->rig, k, r->hand_px[e][k]);
                 /* the global term only once the fit has a colour model
                  * (as pipe_frame): an all-zero one would halve the local
                  * term */
@@ -507,9 +577,9 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                     /* the next frame's fit: the colour model from this
                      * frame's kinematic and refined masks (no extra
                      * raster), and the limb widths (self-calibration) */
-                    if (pipe_fit_learn(r->fit, e, &P, mask, CW, c->refined, CW) != FUSE_OK)
+                    if (pipe_fit_learn(r->fit, e, &P, kmask, CW, c->refined, CW) != FUSE_OK)
                         return -1;
-                    pipe_fit_measure(r->fit, e, &cam, c->world, mask, CW, c->refined, CW);
+                    pipe_fit_measure(r->fit, e, &cam, c->world, kmask, CW, c->refined, CW);
                 }
                 mask = c->refined;
             }
@@ -519,11 +589,20 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         fuse_image V = { c->V[e], GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
         fuse_image O = { c->out, GEN_VIRT_W, GEN_VIRT_H, 4 * GEN_VIRT_W };
         fuse_lighting L = workshop_lighting(&c->workshop, &cam);
+        if (cfg->kf_set) L.kf = cfg->kf;
+        if (cfg->tone > 0.0f) {   /* as pipe_desc.tone_match */
+            float tone[3];
+            if (fuse_tone_match(&P, mask, CW, &V, c->g.vp_x0, c->g.vp_y0, c->g.vp_width,
+                                c->g.vp_height, cfg->tone, tone) != FUSE_OK)
+                return -1;
+            for (int k = 0; k < 3; k++) L.tone[k] *= tone[k];
+        }
         if (fuse_light(&L, &K, &P, mask, CW, nrm, 3 * CW, &Q) != FUSE_OK ||
             fuse_composite(&Q, &V, c->g.vp_x0, c->g.vp_y0, c->g.vp_width, c->g.vp_height,
                            &O) != FUSE_OK)
             return -1;
         secs += cli_now() - t0;
+        cpu += thread_cpu() - c0;
         if (cfg->lod != 0 && posed && c->full_mask && cfg->div == 1 && !cfg->fine &&
             cfg->kind != M_SKIN) {
             /* the kinematic mask (c->mask_lo) against the full model's in
@@ -585,6 +664,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
     }
     r->have_prev = 1;
     r->secs += secs;
+    r->cpu_secs += cpu;
     r->n_frames++;
     if (r->fit && cfg->fit) {
         pipe_fit_thickness(r->fit, r->thick, NULL);
@@ -605,6 +685,20 @@ static method_cfg base_cfg(const eval_opts *o, method_kind k)
     c.band = o->band;
     c.fit = k == M_REFINE;
     c.global = o->global;
+    if (k == M_REFINE) {
+        /* docs/accuracy.md, issue 14 item 2: the last refined mask as the
+         * prior within 6 cm of hands slower than 0.5 m/s, moved with the
+         * hand's image motion; the hands' lag
+         * compensated from 0.2 to 0.8 m/s; the band from the projected
+         * uncertainty measured, off */
+        c.prior_radius = EVAL_PRIOR_RADIUS;
+        c.prior_speed = EVAL_PRIOR_SPEED;
+        c.prior_mc = 1;
+        c.lag_adapt_v0 = EVAL_LAG_V0;
+        c.lag_adapt_v1 = EVAL_LAG_V1;
+    }
+    c.band_sigma = 0.007f;
+    c.band_max = 64;
     c.track = gt_track_default();
     c.track.noise_mm = o->noise;
     c.track.latency_ms = o->latency;
@@ -626,7 +720,7 @@ static int add_cfg(method_cfg *list, int n, int cap, method_cfg c)
 }
 
 /* Phases of a report (each on its own ground truth and frame count). */
-enum { PH_METHODS, PH_KNOBS, PH_TRACK, PH_SEQ, PH_SPEED, PH_LOD };
+enum { PH_METHODS, PH_KNOBS, PH_TRACK, PH_SEQ, PH_SPEED, PH_LOD, PH_LIGHT, PH_KF };
 
 /* A configuration of a sweep: group, swept value and setting "name=" x
  * (x as %g) followed by unit. */
@@ -644,10 +738,16 @@ static method_cfg named_cfg(const eval_opts *o, method_kind k, const char *group
  * same (group "knobs") with every speed knob; PH_TRACK: the tracking sweeps (and the methods at the
  * given tracking, group "track"); PH_SEQ: the methods on sequence seq. */
 static int make_configs(const eval_opts *o, int phase, const char *seq, float speed,
-                        method_cfg *L, int cap)
+                        const eval_light *light, method_cfg *L, int cap)
 {
     int n = 0;
     method_cfg c;
+    if (phase == PH_LIGHT || phase == PH_KF) {   /* eval_light.c, eval_kf.c */
+        method_cfg base[4];
+        for (int k = 0; k < 4; k++) base[k] = base_cfg(o, (method_kind)k);
+        return phase == PH_KF ? eval__kf_configs(base, L, cap)
+                              : eval__light_configs(base, light, L, cap);
+    }
     if (phase == PH_SPEED)   /* the methods on the motion played at another speed */
         for (int k = 0; k < 4; k++) {
             if (k == M_SKIN || !(o->methods & (1u << k))) continue;
@@ -679,6 +779,21 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
         n = add_cfg(L, n, cap, c);
         c = named_cfg(o, M_REFINE, "global", 0.0f, "global", "");
         c.global = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        /* issue 14 item 2: refine without the prior, without the adaptive
+         * lag compensation, and with the band from the projected
+         * uncertainty (docs/accuracy.md) */
+        c = named_cfg(o, M_REFINE, "prior", 0.0f, "prior", "");
+        c.prior_radius = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        c = named_cfg(o, M_REFINE, "priormc", 0.0f, "priormc", "");
+        c.prior_mc = 0;
+        n = add_cfg(L, n, cap, c);
+        c = named_cfg(o, M_REFINE, "lagadapt", 0.0f, "lagadapt", "");
+        c.lag_adapt_v1 = 0.0f;
+        n = add_cfg(L, n, cap, c);
+        c = named_cfg(o, M_REFINE, "bandauto", 1.0f, "bandauto", "");
+        c.band_auto = 1;
         n = add_cfg(L, n, cap, c);
         for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
             c = named_cfg(o, (method_kind)k, "lagcomp", 1.0f, "lagcomp", "");
@@ -770,12 +885,13 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
  * seq (one ground truth). The context is left in *c for the caller to
  * free. */
 static int run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames, float speed,
-                     const method_cfg *cfgs, method_run *R, int n)
+                     const eval_light *light, const method_cfg *cfgs, method_run *R, int n)
 {
     method_cfg base = base_cfg(o, M_KIN_CAL);
     int irc = ctx_init(c, (uint64_t)o->seed, seq, &base.track);
     if (irc < 0)
         return irc == -2 ? EXIT_FAIL : cli_fail("cannot build the ground truth (out of memory)");
+    if (light) c->light = *light;
     int rc = EXIT_FAIL;
     int inited = 0;
     for (int i = 0; i < n; i++)
@@ -809,7 +925,9 @@ int eval_run(const eval_opts *o)
         return cli_fail("%s: cannot create the folder", o->dump);
     if (o->report && cli_mkdirs(o->report) != 0)
         return cli_fail("%s: cannot create the report folder", o->report);
-    enum { CAP = 160 };
+    if (o->light_dir && cli_mkdirs(o->light_dir) != 0)
+        return cli_fail("%s: cannot create the folder", o->light_dir);
+    enum { CAP = 300 };
     method_cfg *cfgs = calloc(CAP, sizeof *cfgs);
     method_run *R = calloc(CAP, sizeof *R);
     eval_ctx c;
@@ -817,10 +935,12 @@ int eval_run(const eval_opts *o)
     int n = 0, rc = EXIT_FAIL;
     if (!cfgs || !R) { cli_fail("out of memory"); goto done; }
     /* batches: (sequence, frames, phase) */
-    enum { NB = 14 };
+    enum { NB = 30 };
     const char *bseq[NB];
     int bframes[NB], bphase[NB], nb = 0;
     float bspeed[NB];
+    eval_light blight[NB];
+    memset(blight, 0, sizeof blight);
     for (int b = 0; b < NB; b++) bspeed[b] = o->speed;
     bseq[nb] = o->sequence; bframes[nb] = o->frames; bphase[nb++] = PH_METHODS;
     if (o->report) {
@@ -844,12 +964,32 @@ int eval_run(const eval_opts *o)
             bseq[nb] = name; bframes[nb] = o->seq_frames; bphase[nb++] = PH_SEQ;
         }
     }
+    if (o->report || o->light_sweep) {   /* the lighting mismatch (eval_light.c) */
+        eval_light lv[16];
+        const int nl = eval__light_levels(lv, 16);
+        for (int i = 0; i < nl && nb < NB; i++) {
+            bseq[nb] = o->sequence;
+            bframes[nb] = o->report ? o->sweep_frames : o->frames;
+            blight[nb] = lv[i];
+            bphase[nb++] = PH_LIGHT;
+        }
+    }
+    if ((o->report || o->kf_sweep) && nb < NB) {   /* the Fresnel fade (eval_kf.c) */
+        bseq[nb] = o->sequence;
+        bframes[nb] = o->report ? o->sweep_frames : o->frames;
+        blight[nb].opaque_ideal = 1;
+        bphase[nb++] = PH_KF;
+    }
     for (int b = 0; b < nb; b++) {
-        int m = make_configs(o, bphase[b], bseq[b], bspeed[b], cfgs + n, CAP - n);
+        int m = make_configs(o, bphase[b], bseq[b], bspeed[b], &blight[b], cfgs + n, CAP - n);
         if (n + m > CAP) { cli_fail("too many configurations"); goto done; }
         ctx_free(&c);
-        if (run_batch(o, &c, bseq[b], bframes[b], bspeed[b], cfgs + n, R + n, m)) goto done;
-        if (b == 0 || !o->quiet || bphase[b] == PH_LOD) {
+        if (run_batch(o, &c, bseq[b], bframes[b], bspeed[b],
+                      bphase[b] == PH_LIGHT || bphase[b] == PH_KF ? &blight[b] : NULL, cfgs + n,
+                      R + n, m))
+            goto done;
+        if (b == 0 || (!o->quiet && bphase[b] != PH_LIGHT && bphase[b] != PH_KF) ||
+            bphase[b] == PH_LOD) {
             printf("egofuse eval: sequence %s, %d frames, tracking noise %g mm, latency %g ms, "
                    "dropout %g, calibration error %g, speed %g; means per eye (640x400 masks)\n",
                    bseq[b], bframes[b], (double)o->noise, (double)o->latency,
@@ -870,6 +1010,8 @@ int eval_run(const eval_opts *o)
     }
     if (o->csv && eval__write_csv(o->csv, R, n)) goto done;
     if (o->report && eval__write_report(o->report, R, n, o, &c)) goto done;
+    if ((o->report || o->light_sweep) && eval__write_light(o->report ? o->report : o->light_dir, R, n)) goto done;
+    if ((o->report || o->kf_sweep) && eval__write_kf(o->report, R, n)) goto done;
     if (o->report) printf("egofuse eval: report in %s (summary.csv, table.md, *.png)\n", o->report);
     rc = EXIT_OK;
 done:
@@ -897,4 +1039,10 @@ unsigned eval_parse_methods(const char *list)
         if (*p == ',') p++;
     }
     return bits;
+}
+
+/* The workshop's lighting in cam's view space (eval_eye.c). */
+fuse_lighting eval__lighting(const gen_scene *ws, const kin_camera *cam)
+{
+    return workshop_lighting(ws, cam);
 }

@@ -48,6 +48,16 @@ typedef struct eval_opts {
     float lod_px;            /* the rule's target with PIPE_LOD_AUTO */
     int lod_sweep;           /* 1: also the levels batch (group "lod"; a
                                 report always runs it) */
+    int eyeview;             /* 1: `egofuse eval --eyeview` (eval_eye_run) */
+    int light_sweep;         /* 1: also the lighting-mismatch sweep (group
+                                "light", eval_light.c; a report always
+                                runs it, on sweep_frames) */
+    const char *light_dir;   /* with light_sweep and no report: the folder
+                                of its table, data and chart (NULL: the
+                                table on stdout only) */
+    int kf_sweep;            /* 1: also the Fresnel fade kf 0..1 against the
+                                opaque ideal composite (group "kf",
+                                eval_kf.c; a report always runs it) */
 } eval_opts;
 
 /* "kin,refine" -> bits of the methods (kin, kin-cal-pred, skin, refine:
@@ -57,5 +67,13 @@ unsigned eval_parse_methods(const char *list);
  * the report folder o->report when set. EXIT_OK, or EXIT_FAIL with the
  * message printed. */
 int eval_run(const eval_opts *o);
+
+/* The eye's viewpoint (src/eval/eval_eye.c, docs/accuracy.md): the hand
+ * held 15, 20, 30, 40 cm from the eyes, tracking noise 0-20 mm, per view
+ * method (crop, reproj) the hand's position and size error, the IoU and
+ * PSNR against ground truth from the true eye, the ms per stereo frame.
+ * Uses frames (per distance, at most 180), seed, csv, report, quiet,
+ * per_frame. EXIT_OK, or EXIT_FAIL with the message printed. */
+int eval_eye_run(const eval_opts *o);
 
 #endif

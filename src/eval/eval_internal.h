@@ -14,7 +14,7 @@
 enum { CW = 640, CH = 400 };
 
 typedef enum method_kind { M_KIN, M_KIN_CAL, M_SKIN, M_REFINE } method_kind;
-static const char *kind_name[] = { "kin", "kin-cal-pred", "skin", "refine" };
+static const char *kind_name[] __attribute__((unused)) = { "kin", "kin-cal-pred", "skin", "refine" };
 
 typedef struct method_cfg {
     method_kind kind;
@@ -34,7 +34,31 @@ typedef struct method_cfg {
     int lod;                 /* level of detail: 0 = full, a level, or
                                 PIPE_LOD_AUTO (eval_lod.c) */
     float lod_px;            /* the rule's target, px */
+    float tone;              /* > 0: gray-world tone matching of this
+                                strength (fuse_tone_match, as
+                                pipe_desc.tone_match) before lighting */
+    int kf_set;              /* 1: the Fresnel fade kf below instead of the
+                                workshop lighting's 0.5 (eval_kf.c) */
+    float kf;
+    int band_auto;           /* refine: band from the projected uncertainty
+                                (pipe_fit_band, band = its minimum); 0 off */
+    float band_sigma, band_tau;
+    int band_max;
+    float prior_radius;      /* refine: the last refined mask is the input
+                                within this many metres of slow hands (0 off) */
+    float prior_speed;       /* m/s: slower hands use it */
+    int prior_mc;            /* 1: moved with the hand (pipe_fit_hand_px) */
+    float lag_adapt_v0, lag_adapt_v1;   /* refine, kin-cal-pred: lag
+                                           compensation of the hands from
+                                           speed v0 (none) to v1 (full), m/s;
+                                           v1 0 = off */
 } method_cfg;
+
+/* refine's defaults (docs/accuracy.md, issue 14 item 2) */
+#define EVAL_PRIOR_RADIUS 0.06f
+#define EVAL_PRIOR_SPEED 0.5f
+#define EVAL_LAG_V0 0.2f
+#define EVAL_LAG_V1 0.8f
 
 /* Per-configuration state and sums. */
 typedef struct method_run {
@@ -50,6 +74,13 @@ typedef struct method_run {
     pipe_fit *fit;           /* refine: the elbow fit and colour models */
     float thick[2][2];       /* refine: limb thickness measured by the fit */
     int have_thick;
+    unsigned sides;          /* tracked hands of the frame (bit 0 left) */
+    float speed[2];          /* the filter's wrist speeds, m/s */
+    float hand_px[2][2][2];  /* [eye][side]: the hand in the image, last frame */
+    int have_hand_px[2][2];
+    double cpu_secs;         /* the method's thread CPU time (ms/frame is wall) */
+    double band_sum;         /* refine: the bands used, summed over eyes */
+    long n_band;
     /* sums over frames and eyes */
     double iou, bf1, bf3, fp, fn, mse, flicker, flicker_den, secs;
     long n_eye, n_flicker, n_frames;
@@ -58,6 +89,19 @@ typedef struct method_run {
     double iou_full, bf1_full, lod_sum, tris_sum, raster_secs;
     long n_full, n_raster;
 } method_run;
+
+/* A lighting mismatch between the cockpit (the camera images) and the
+ * virtual scene (eval_light.c): the cockpit's lights and ambient times
+ * gain, tinted to the colour temperature kelvin (6500: no tint, the
+ * luma kept), the lights' directions turned by roll_deg about the world's
+ * forward axis (0: from above as built; 90: from the side). on 0: none.
+ * opaque_ideal 1: the ideal composite without the Fresnel fade (kf 0: a
+ * real hand is opaque; the Fresnel sweep, eval_kf.c). */
+typedef struct eval_light {
+    int on;
+    float gain, kelvin, roll_deg;
+    int opaque_ideal;
+} eval_light;
 
 /* Shared per-frame buffers. */
 typedef struct eval_ctx {
@@ -84,6 +128,7 @@ typedef struct eval_ctx {
     kin_camera tcam[2];
     /* method scratch */
     uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
+    uint8_t *band_region, *mask_prior;   /* refine: the prior (fit_band.h) */
     uint32_t *aa_samples;    /* anti-aliased coverage, 640x400 */
     float *depth_lo, *nrm_lo, *mnrm;
     void *refine_scratch;
@@ -99,11 +144,24 @@ typedef struct eval_ctx {
     int lod_drawn;            /* the level the last draw_mask drew */
     uint8_t *full_mask;       /* the full model's mask, 640x400 */
     float *full_depth;
+    /* the lighting-mismatch sweep (eval_light.c): the ideal composite is
+     * made from the camera images under the cockpit's own light, the
+     * methods get the images under the mismatched light */
+    eval_light light;
 } eval_ctx;
 
 /* eval.c: the true operator's scales (arm, hand, shoulder width) against
  * the mask model's. */
 void eval__true_scales(const eval_ctx *c, float *arm, float *hand, float *shoulder);
+
+/* eval.c: the workshop's lighting (the composite's) in cam's view space. */
+fuse_lighting eval__lighting(const gen_scene *ws, const kin_camera *cam);
+
+/* eval_report.c: runs gnuplot on DIR/script, whose charts write
+ * "DIR/<chart>.png".sfx, and names each chart once it decodes whole
+ * (gnuplot missing or failing: a warning, EXIT_OK; a chart incomplete:
+ * removed, EXIT_FAIL). */
+int eval__gnuplot(const char *dir, const char *script, const char *const *charts, int n);
 
 /* eval_lod.c: levels of detail. The chain of c->mask and the full
  * model's scratch (0, or -1 with the message printed); the level a
@@ -115,6 +173,29 @@ int eval__lod_level(const eval_ctx *c, const method_cfg *cfg, const float *clip,
                     const kin_camera *cam);
 void eval__print_lod(FILE *f, const method_run *R, int n, int markdown);
 int eval__write_lod(const char *dir, const method_run *R, int n);
+
+/* eval_light.c: the lighting-mismatch sweep. The levels (the first the
+ * matched one; at most cap), written into L, their count returned; each
+ * level's x and its axis ("gain", "kelvin", "roll"): an axis's points
+ * are the matched level and the levels of that axis. */
+int eval__light_levels(eval_light *L, int cap);
+float eval__light_x(const eval_light *l, const char *axis);
+/* The camera image of eye e under c->light into c->P[e] (make_truth calls
+ * it after the ideal composite when c->light.on). 0, or -1. */
+int eval__light_render(eval_ctx *c, const kin_mat4 *world_from_head, int e, int frame);
+/* The methods of a level: kin-cal-pred, skin, refine, and refine with
+ * full tone matching ("refine+tone"), group "light" (base: the method's
+ * default configuration of o, in kind order). */
+int eval__light_configs(const method_cfg base[4], const eval_light *l, method_cfg *L, int cap);
+/* The table (stdout and DIR/light.md), DIR/light.dat and the chart
+ * DIR/light.png (gnuplot; missing: a warning). */
+int eval__write_light(const char *dir, const method_run *R, int n);
+
+/* eval_kf.c: the Fresnel fade against the opaque ideal composite: the
+ * configurations (kin-cal-pred and refine at kf 0 .. 1, group "kf"), and
+ * the table (stdout and DIR/kf.md when dir is set). */
+int eval__kf_configs(const method_cfg base[4], method_cfg *L, int cap);
+int eval__write_kf(const char *dir, const method_run *R, int n);
 
 /* eval_report.c: the tables, the CSV and the report folder. */
 void eval__print_calib(FILE *f, const eval_ctx *c);

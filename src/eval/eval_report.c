@@ -80,6 +80,13 @@ int eval__write_csv(const char *path, const method_run *R, int n)
  * from the images (pipe_fit_measure), against the truth's. */
 void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int n)
 {
+    /* the methods' own CPU time (the ms/frame column is the wall clock,
+     * which a shared machine inflates) */
+    if (n > 0) fprintf(f, "CPU ms per stereo frame (the method's thread):");
+    for (int i = 0; i < n; i++)
+        fprintf(f, " %s %s %.2f%s", kind_name[R[i].cfg.kind], R[i].cfg.setting,
+                1e3 * R[i].cpu_secs / (R[i].n_frames > 0 ? (double)R[i].n_frames : 1.0),
+                i + 1 < n ? "," : "\n");
     for (int i = 0; i < n; i++) {
         if (R[i].cfg.kind != M_REFINE || !R[i].have_thick) continue;
         fprintf(f, "refine's limb thickness from the images (pipe_fit, only thinner is "
@@ -87,6 +94,9 @@ void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int 
                    "(true %.2f)\n",
                 (double)R[i].thick[0][1], (double)R[i].thick[1][1], (double)c->op.fore_thick,
                 (double)R[i].thick[0][0], (double)R[i].thick[1][0], (double)c->op.upper_thick);
+        if (R[i].cfg.band_auto && R[i].n_band > 0)
+            fprintf(f, "refine's band from the projected uncertainty: mean %.1f px\n",
+                    R[i].band_sum / (double)R[i].n_band);
         return;
     }
 }
@@ -100,6 +110,10 @@ void eval__print_table(FILE *f, const method_run *R, int n, int markdown)
         fprintf(f, "%-13s %-9s %-16s %7s %6s %6s %8s %8s %6s %7s %8s\n", "method", "group",
                 "setting", "IoU", "BF1", "BF3", "FP px", "FN px", "PSNR", "flicker", "ms/frame");
     for (int i = 0; i < n; i++) {
+        /* the lighting and Fresnel sweeps have tables of their own
+         * (light.md, kf.md: eval_light.c, eval_kf.c) */
+        if (markdown && (!strcmp(R[i].cfg.group, "light") || !strcmp(R[i].cfg.group, "kf")))
+            continue;
         summary s = summarise(&R[i]);
         if (markdown)
             fprintf(f, "| %s | %s | %s | %.4f | %.3f | %.3f | %.0f | %.0f | %.2f | %.3f | %.2f |\n",
@@ -223,10 +237,14 @@ static int write_charts(const char *dir)
     static const char *const charts[] = {"speed_iou", "speed_bf", "noise",  "latency",
                                          "calib",     "dropout",  "handspeed", "band",
                                          "sequences", "lod"};
-    enum { NCHART = sizeof charts / sizeof charts[0] };
+    return eval__gnuplot(dir, "charts.gp", charts, (int)(sizeof charts / sizeof charts[0]));
+}
+
+int eval__gnuplot(const char *dir, const char *script, const char *const *charts, int NCHART)
+{
     char cmd[3 * IO_PATH_MAX], tmp[IO_PATH_MAX + 96], path[IO_PATH_MAX + 64];
     long pid = (long)getpid();
-    snprintf(cmd, sizeof cmd, "gnuplot -e \"sfx='.tmp.%ld'\" '%s/charts.gp'", pid, dir);
+    snprintf(cmd, sizeof cmd, "gnuplot -e \"sfx='.tmp.%ld'\" '%s/%s'", pid, dir, script);
     int rc = system(cmd);
     int bad = 0;
     for (int i = 0; i < NCHART; i++) {
@@ -255,7 +273,7 @@ static int write_charts(const char *dir)
     }
     if (rc != 0)
         fprintf(stderr, "egofuse eval: gnuplot failed (status %d): the data files and "
-                        "%s/charts.gp are written, the PNG charts are not\n", rc, dir);
+                        "%s/%s are written, the PNG charts are not\n", rc, dir, script);
     return bad ? EXIT_FAIL : EXIT_OK;
 }
 
@@ -443,7 +461,8 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
                "calibration error %g, speed %g, seed %d. Frames: %d for the methods (group "
                "methods), %d for the speed knobs (groups knobs, band, fit, global, lagcomp, "
                "res, aa, tris, dqs) and the tracking sweeps (groups track, noise, latency, calib), "
-               "%d per other sequence (group sequence).\n\n",
+               "%d per other sequence (group sequence). The lighting-mismatch and Fresnel sweeps "
+               "(groups light, kf; summary.csv) have their tables in light.md and kf.md.\n\n",
             o->sequence, (double)o->noise, (double)o->latency, (double)o->dropout,
             (double)o->calib_error, (double)o->speed, o->seed, o->frames, o->sweep_frames,
             o->seq_frames);

@@ -359,6 +359,14 @@ typedef struct fuse_eye {
      * alpha 255 everywhere in the viewport (an in-place composite reads
      * all of V to check it). */
     int v_opaque;
+    /* Soft edges where the camera image ends inside the display (issue 18;
+     * fuse_edge.h): edge_fade = k (0: off, the bytes of before; at most
+     * FUSE_EDGE_FADE_MAX), edge_sides = the FUSE_EDGE_* sides of Q to fade.
+     * Each row of Q, once lit and depth-tested, is faded over its last k
+     * pixels towards those sides (fuse_edge_fade_row), before the
+     * composite reads it. */
+    int edge_fade;
+    unsigned edge_sides;
 } fuse_eye;
 
 /* Every stage of count eyes (1..FUSE_MAX_THREADS) on ctx's threads: with

@@ -6,11 +6,11 @@
  * vector layer (src/cpu/simd_avx2.h, 8 lanes); AVX2's own part there is
  * the depth test's scene values (a window of the row and vpermps, or a
  * gather).
- * Composite through the row cache (fuse_internal.h): fuse__hrow_avx2 once
- * per layer row, fuse__vrow_avx2 per output row. The taps of 8 consecutive
- * output pixels lie in a window of 8 source pixels when the layer is
- * enlarged (640 -> 1194: at most 5), so one load and vpermd give them;
- * otherwise (reductions, narrow layers) vpgatherdd. */
+ * The row-cached composite (fuse__hrow_avx2 once per layer row,
+ * fuse__vrow_avx2 per output row; fuse_internal.h) is fuse_simd.inl's too
+ * (FUSE_ROWCACHE_ON_LAYER: the layer's "ROW-CACHE OPS"), as for AVX-512.
+ * AVX2's own: the YUYV conversion below (16-bit madd; AVX-512 runs it too,
+ * SSE2 and NEON the layer's int32 one). */
 #include "fuse_internal.h"
 
 #if defined(__AVX2__)
@@ -40,118 +40,14 @@ static inline __m256 scene_avx2(const fuse__depth_prep *p, const float *sc, __m2
 }
 #define FUSE_SCENE_LANES(p, sc, ox, has) scene_avx2(p, sc, ox, has)
 
+#define FUSE_ROWCACHE_ON_LAYER 1
 #include "fuse_simd.inl"
-/* ---- row-cached composite (fuse_internal.h, fuse__hrow_fn) ------------- */
-
-/* The fx of 4 pixels (int32) in each pixel's 4 u16 lanes. */
-static inline __m256i wx4_256(const int32_t *fx)
-{
-    const __m256i pat = _mm256_setr_epi8(0, -128, 0, -128, 0, -128, 0, -128, 4, -128, 4, -128, 4, -128, 4, -128,
-                                         8, -128, 8, -128, 8, -128, 8, -128, 12, -128, 12, -128, 12, -128, 12, -128);
-    const __m128i f = _mm_loadu_si128((const __m128i *)(const void *)fx);
-    return _mm256_shuffle_epi8(_mm256_broadcastsi128_si256(f), pat);
-}
-
-void fuse__hrow_avx2(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
-                     uint16_t *h)
-{
-    const __m256i one = _mm256_set1_epi32(1), last = _mm256_set1_epi32(sw - 1);
-    const __m256i w256 = _mm256_set1_epi16(256), bias = _mm256_set1_epi16((short)FUSE__H_BIAS);
-    const int32_t *ixs = cols->ix + c, *fxs = cols->fx + c;
-    int i = 0;
-    for (; i + 8 <= n; i += 8) {
-        const __m256i ix = _mm256_loadu_si256((const __m256i *)(const void *)(ixs + i));
-        const __m256i ix1 = _mm256_min_epi32(_mm256_add_epi32(ix, one), last);
-        __m256i a, b, w1;
-        int base = ixs[i];
-        const int hi = ixs[i + 7] + 1 < sw ? ixs[i + 7] + 1 : sw - 1;
-        if (base > sw - 8) base = sw - 8;
-        if (base >= 0 && hi - base < 8) {
-            const __m256i s0 = _mm256_loadu_si256((const __m256i *)(const void *)(q + 4 * base));
-            const __m256i bb = _mm256_set1_epi32(base);
-            if (_mm256_testz_si256(s0, s0)) {   /* every tap 0: h = 0 */
-                _mm256_storeu_si256((__m256i *)(void *)(h + 4 * i), bias);
-                _mm256_storeu_si256((__m256i *)(void *)(h + 4 * i + 16), bias);
-                continue;
-            }
-            a = _mm256_permutevar8x32_epi32(s0, _mm256_sub_epi32(ix, bb));
-            b = _mm256_permutevar8x32_epi32(s0, _mm256_sub_epi32(ix1, bb));
-        } else {
-            a = _mm256_i32gather_epi32((const int *)(const void *)q, ix, 4);
-            b = _mm256_i32gather_epi32((const int *)(const void *)q, ix1, 4);
-        }
-        w1 = wx4_256(fxs + i);
-        _mm256_storeu_si256((__m256i *)(void *)(h + 4 * i),
-                            _mm256_xor_si256(_mm256_add_epi16(
-                                _mm256_mullo_epi16(_mm256_cvtepu8_epi16(_mm256_castsi256_si128(a)),
-                                                   _mm256_sub_epi16(w256, w1)),
-                                _mm256_mullo_epi16(_mm256_cvtepu8_epi16(_mm256_castsi256_si128(b)), w1)), bias));
-        w1 = wx4_256(fxs + i + 4);
-        _mm256_storeu_si256((__m256i *)(void *)(h + 4 * i + 16),
-                            _mm256_xor_si256(_mm256_add_epi16(
-                                _mm256_mullo_epi16(_mm256_cvtepu8_epi16(_mm256_extracti128_si256(a, 1)),
-                                                   _mm256_sub_epi16(w256, w1)),
-                                _mm256_mullo_epi16(_mm256_cvtepu8_epi16(_mm256_extracti128_si256(b, 1)), w1)), bias));
-    }
-    for (; i < n; i++) fuse__hpx(q, ixs[i], (uint32_t)fxs[i], sw, h + 4 * i);
-}
-
-/* 4 pixels of the vertical blend and over (see vblend8_512 in
- * fuse_avx512.c). */
-static inline __m256i vblend4_256(__m256i a, __m256i b, __m256i vw, __m256i w)
-{
-    const __m256i lo8 = _mm256_set1_epi16(255), r128 = _mm256_set1_epi16(128);
-    const __m256i k = _mm256_set1_epi32(32768 * 257);
-    const __m256i sl = _mm256_srli_epi32(_mm256_add_epi32(_mm256_madd_epi16(_mm256_unpacklo_epi16(a, b), w), k), 16);
-    const __m256i sh = _mm256_srli_epi32(_mm256_add_epi32(_mm256_madd_epi16(_mm256_unpackhi_epi16(a, b), w), k), 16);
-    const __m256i q = _mm256_packus_epi32(sl, sh);
-    const __m256i qa = _mm256_shufflehi_epi16(_mm256_shufflelo_epi16(q, 0xFF), 0xFF);
-    __m256i t = _mm256_mullo_epi16(_mm256_sub_epi16(lo8, qa), vw);
-    /* div255: ((t + 128) + ((t + 128) >> 8)) >> 8 is ((t + 128) 257) >> 16 (the
-     * inner floor cannot move the outer one: an integer plus a fraction
-     * below 1 never crosses a multiple of 256), one vpmulhuw */
-    t = _mm256_mulhi_epu16(_mm256_add_epi16(t, r128), _mm256_set1_epi16(257));
-    return _mm256_add_epi16(q, t);
-}
-
-void fuse__vrow_avx2(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
-                     const uint8_t *v, uint8_t *out, int n)
-{
-    const __m256i w = _mm256_set1_epi32((int)((fy << 16) | (256u - fy)));
-    const __m256i opaque = _mm256_set1_epi32((int)0xFF000000u);
-    int i = 0;
-    for (; i + 8 <= n; i += 8) {
-        const __m256i vv = _mm256_loadu_si256((const __m256i *)(const void *)(v + 4 * i));
-        const __m256i r0 = vblend4_256(_mm256_loadu_si256((const __m256i *)(const void *)(h0 + 4 * i)),
-                                       _mm256_loadu_si256((const __m256i *)(const void *)(h1 + 4 * i)),
-                                       _mm256_cvtepu8_epi16(_mm256_castsi256_si128(vv)), w);
-        const __m256i r1 = vblend4_256(_mm256_loadu_si256((const __m256i *)(const void *)(h0 + 4 * i + 16)),
-                                       _mm256_loadu_si256((const __m256i *)(const void *)(h1 + 4 * i + 16)),
-                                       _mm256_cvtepu8_epi16(_mm256_extracti128_si256(vv, 1)), w);
-        /* packus interleaves the halves per 128-bit lane: qwords 0 2 1 3 */
-        const __m256i r = _mm256_permute4x64_epi64(_mm256_packus_epi16(r0, r1), 0xD8);
-        _mm256_storeu_si256((__m256i *)(void *)(out + 4 * i), _mm256_or_si256(r, opaque));
-    }
-    for (; i < n; i++) fuse__vpx(h0 + 4 * i, h1 + 4 * i, fy, v + 4 * i, out + 4 * i);
-}
 
 #else  /* not built for AVX2: never chosen by cpuid, falls back */
 
 #define FUSE_STUB(name) name##_avx2
+#define FUSE_ROWCACHE_ON_LAYER 1
 #include "fuse_stub.inl"
-
-void fuse__hrow_avx2(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
-                     uint16_t *h)
-{
-    int i;
-    for (i = 0; i < n; i++) fuse__hpx(q, cols->ix[c + i], (uint32_t)cols->fx[c + i], sw, h + 4 * i);
-}
-void fuse__vrow_avx2(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
-                     const uint8_t *v, uint8_t *out, int n)
-{
-    int i;
-    for (i = 0; i < n; i++) fuse__vpx(h0 + 4 * i, h1 + 4 * i, fy, v + 4 * i, out + 4 * i);
-}
 #endif
 
 #if defined(__AVX2__)

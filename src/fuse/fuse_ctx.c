@@ -8,6 +8,7 @@
 
 #include <stdlib.h>
 
+#include "fuse_edge.h"
 #include "fuse_pool.h"
 
 typedef struct kernels {
@@ -186,6 +187,27 @@ typedef struct comp_job {
     int in_place;
     int v_opaque;       /* fuse_eye.v_opaque: transparent spans are out = V */
 } comp_job;
+
+/* The jobs' inputs (fuse_light, fuse_composite, fuse_context_frame). */
+static void light_job_set(light_job *j, const kernels *k, const fuse_image *P,
+                          const uint8_t *mask, int mask_stride, const float *normal,
+                          int normal_stride, const fuse_image *out)
+{
+    j->k = k;
+    j->P = *P;
+    j->out = *out;
+    j->mask = mask;
+    j->normal = normal;
+    j->mask_stride = mask_stride;
+    j->normal_stride = normal_stride;
+}
+
+static void comp_job_set(comp_job *j, const kernels *k, const fuse_image *Q, const fuse_image *V,
+                         int vp_x0, int vp_y0, int vp_w, int vp_h, const fuse_image *out,
+                         int v_opaque)
+{
+    *j = (comp_job){k, *Q, *V, *out, vp_x0, vp_y0, vp_w, vp_h, fuse__same_image(out, V), v_opaque};
+}
 
 /* n pixels that the layer does not reach: out = V with alpha 255. With the
  * caller's promise that V is opaque that is V itself: nothing to do in
@@ -590,13 +612,7 @@ static fuse_result light_with(fuse_context *ctx, const kernels *k,
     fuse_result r = fuse__light_check(L, K, P, mask, mask_stride, normal,
                                       normal_stride, out, &j.prep);
     if (r != FUSE_OK) return r;
-    j.k = k;
-    j.P = *P;
-    j.out = *out;
-    j.mask = mask;
-    j.normal = normal;
-    j.mask_stride = mask_stride;
-    j.normal_stride = normal_stride;
+    light_job_set(&j, k, P, mask, mask_stride, normal, normal_stride, out);
     run(ctx, light_task, &j);
     return FUSE_OK;
 }
@@ -609,16 +625,7 @@ static fuse_result comp_with(fuse_context *ctx, const kernels *k,
     comp_job j;
     fuse_result r = fuse__composite_check(Q, V, vp_x0, vp_y0, vp_w, vp_h, out);
     if (r != FUSE_OK) return r;
-    j.k = k;
-    j.Q = *Q;
-    j.V = *V;
-    j.out = *out;
-    j.vx = vp_x0;
-    j.vy = vp_y0;
-    j.vw = vp_w;
-    j.vh = vp_h;
-    j.in_place = fuse__same_image(out, V);
-    j.v_opaque = 0;
+    comp_job_set(&j, k, Q, V, vp_x0, vp_y0, vp_w, vp_h, out, 0);
     run(ctx, comp_task, &j);
     return FUSE_OK;
 }
@@ -712,6 +719,8 @@ typedef struct eye_job {
     light_job light;
     comp_job comp;
     const fuse_depth *depth;
+    int edge_fade;            /* fuse_eye.edge_fade, edge_sides */
+    unsigned edge_sides;
 } eye_job;
 
 typedef struct frame_job {
@@ -725,7 +734,22 @@ typedef struct frame_job {
  * before lighting, so hidden pixels are never lit; the bytes are those of
  * lighting and then testing the layer (fuse_internal.h,
  * fuse__depth_mask_fn), which the reference does. */
+static void eye_light_depth_rows(const eye_job *e, int y0, int y1);
+
+/* ... and faded towards the sides that end inside the display (fuse_edge.h:
+ * one scalar pass over the border strips, once a row is final). */
 static void eye_light_depth(const eye_job *e, int y0, int y1)
+{
+    const int k = e->edge_fade, w = e->light.out.width, h = e->light.out.height;
+    int y;
+    eye_light_depth_rows(e, y0, y1);
+    if (k < 1 || e->edge_sides == 0) return;
+    for (y = y0; y < y1; y++)
+        if ((e->edge_sides & (FUSE_EDGE_LEFT | FUSE_EDGE_RIGHT)) || y < k || h - 1 - y < k)
+            fuse_edge_fade_row(row_of(&e->light.out, y), y, w, h, k, e->edge_sides);
+}
+
+static void eye_light_depth_rows(const eye_job *e, int y0, int y1)
 {
     const light_job *j = &e->light;
     const int w = j->P.width, sh = j->P.height;
@@ -898,25 +922,17 @@ fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int coun
             r = FUSE_ERR_SIZE;
         if (r == FUSE_OK && fuse__same_image(&s->P, &s->Q))
             r = FUSE_ERR_ARGS;   /* Q is a scratch layer of its own */
+        if (r == FUSE_OK && (s->edge_fade < 0 || s->edge_fade > FUSE_EDGE_FADE_MAX ||
+                             (s->edge_sides & ~FUSE_EDGE_ALL) != 0))
+            r = FUSE_ERR_ARGS;
         if (r != FUSE_OK) return r;
-        j->light.k = &ctx->k;
-        j->light.P = s->P;
-        j->light.out = s->Q;
-        j->light.mask = s->mask;
-        j->light.normal = s->normal;
-        j->light.mask_stride = s->mask_stride;
-        j->light.normal_stride = s->normal_stride;
-        j->comp.k = &ctx->k;
-        j->comp.Q = s->Q;
-        j->comp.V = s->V;
-        j->comp.out = s->out;
-        j->comp.vx = s->vp_x0;
-        j->comp.vy = s->vp_y0;
-        j->comp.vw = s->vp_w;
-        j->comp.vh = s->vp_h;
-        j->comp.in_place = fuse__same_image(&s->out, &s->V);
-        j->comp.v_opaque = s->v_opaque != 0;
+        light_job_set(&j->light, &ctx->k, &s->P, s->mask, s->mask_stride, s->normal,
+                      s->normal_stride, &s->Q);
+        comp_job_set(&j->comp, &ctx->k, &s->Q, &s->V, s->vp_x0, s->vp_y0, s->vp_w, s->vp_h,
+                     &s->out, s->v_opaque != 0);
         j->depth = s->depth;
+        j->edge_fade = s->edge_fade;
+        j->edge_sides = s->edge_sides;
     }
     /* one eye's writes must not land in another eye's inputs */
     for (e = 0; e < count; e++) {

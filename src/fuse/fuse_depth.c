@@ -77,31 +77,21 @@ static inline void depth_span(const fuse__depth_prep *p, uint8_t *q, int bpp,
     }
 }
 
-void fuse__depth_span_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                          const float *sc, int x0, int x1)
-{
-    depth_span(p, q, 4, hz, sc, x0, x1);
-}
-
-void fuse__depth_row_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                         const float *sc, int w)
-{
-    depth_span(p, q, 4, hz, sc, 0, w);
-}
-
-/* The same rule on mask bytes: m != 0 instead of a pixel that is not
- * (0,0,0,0). */
-void fuse__depth_mspan_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                           const float *sc, int x0, int x1)
-{
-    depth_span(p, m, 1, hz, sc, x0, x1);
-}
-
-void fuse__depth_mrow_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                          const float *sc, int w)
-{
-    depth_span(p, m, 1, hz, sc, 0, w);
-}
+/* The spans and rows of the layer (bpp 4) and of mask bytes (bpp 1: the
+ * same rule with m != 0 instead of a pixel that is not (0,0,0,0)). */
+#define DEPTH_REF(span, row, bpp)                                                      \
+    void span(const fuse__depth_prep *p, uint8_t *q, const float *hz, const float *sc, \
+              int x0, int x1)                                                          \
+    {                                                                                  \
+        depth_span(p, q, bpp, hz, sc, x0, x1);                                         \
+    }                                                                                  \
+    void row(const fuse__depth_prep *p, uint8_t *q, const float *hz, const float *sc,  \
+             int w)                                                                    \
+    {                                                                                  \
+        depth_span(p, q, bpp, hz, sc, 0, w);                                           \
+    }
+DEPTH_REF(fuse__depth_span_ref, fuse__depth_row_ref, 4)
+DEPTH_REF(fuse__depth_mspan_ref, fuse__depth_mrow_ref, 1)
 
 void fuse__depth_rows(const fuse_depth *d, const fuse_image *Q, int vp_x0,
                       int vp_y0, int vp_w, int vp_h, int y0, int y1, fuse__depth_fn fn)

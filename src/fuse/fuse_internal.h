@@ -344,8 +344,11 @@ void fuse__composite_cols_sse2(const uint8_t *q0, const uint8_t *q1, uint32_t fy
  * vertical sum is one signed 16x16 -> 32-bit multiply-add per pair
  * (pmaddwd): (h0 - 32768) w0 + (h1 - 32768) w1 + 32768 * 256 + 32768, with
  * w0 + w1 = 256; every term fits an int32. 4 values per output column in
- * the pixel's channel order (r, g, b, a), 4 * i + k for column i. A layer
- * row without taps there (h = 0) holds FUSE__H_BIAS. */
+ * the pixel's channel order (r, g, b, a); the columns of each step of
+ * SIMD_W (from a multiple of 16 of the tile: both kernels start every call
+ * there) in the vector layer's block order (fuse_simd.inl), the scalar tail
+ * at 4 * i + k for column i. Only the hrow and vrow of one ISA read and
+ * write it. A layer row without taps there (h = 0) holds FUSE__H_BIAS. */
 #define FUSE__H_BIAS 0x8000u
 
 /* h of columns c .. c + n - 1 of cols from layer row q (h points at column

@@ -599,3 +599,99 @@ void SIMD_FN(fuse__composite_cols)(const uint8_t *q0, const uint8_t *q1, uint32_
         fuse__composite_px(q0, q1, fy, ixs[i], (uint32_t)fxs[i], sw, v + 4 * i, out + 4 * i);
 }
 #endif
+
+#ifdef FUSE_ROWCACHE_ON_LAYER
+/* ---- row-cached composite (fuse_internal.h, fuse__hrow_fn / vrow_fn) ----
+ *
+ * fuse__hrow once per layer row, fuse__vrow per output row. The taps of
+ * SIMD_W consecutive output pixels lie in a window of SIMD_W source pixels
+ * when the layer is enlarged (640 -> 1194: at most 5 for 8), so one load
+ * and vi_permute give them; otherwise (reductions, narrow layers)
+ * vi_gather. h of a step of SIMD_W pixels is kept in the layer's block
+ * order (fuse_internal.h, "Stored"): the 16-bit lanes of vh_from_u8_lo
+ * (pixels 4B, 4B + 1 of each block B) then of vh_from_u8_hi (4B + 2,
+ * 4B + 3), so neither kernel reorders across blocks; vh_packus puts the
+ * pixels back in memory order. */
+void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
+                         uint16_t *h)
+{
+    const vint one = vi_set1(1), last = vi_set1(sw - 1);
+    const vint w256 = vh_set1(256), bias = vh_set1((int)FUSE__H_BIAS);
+    const int32_t *ixs = cols->ix + c, *fxs = cols->fx + c;
+    int i = 0;
+    for (; i + SIMD_W <= n; i += SIMD_W) {
+        const vint ix = vi_loadu(ixs + i);
+        const vint ix1 = vi_min(vi_add(ix, one), last);
+        vint a, b, fx, wl, wh;
+        int base = ixs[i];
+        const int hi = ixs[i + SIMD_W - 1] + 1 < sw ? ixs[i + SIMD_W - 1] + 1 : sw - 1;
+        if (base > sw - SIMD_W) base = sw - SIMD_W;
+        if (base >= 0 && hi - base < SIMD_W) {
+            const vint s0 = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)base));
+            const vint bb = vi_set1(base);
+            if (vm_all(vi_eq(s0, vi_zero()))) {   /* every tap 0: h = 0 */
+                vi_storeu((int32_t *)(void *)(h + 4 * i), bias);
+                vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W), bias);
+                continue;
+            }
+            a = vi_permute(s0, vi_sub(ix, bb));
+            b = vi_permute(s0, vi_sub(ix1, bb));
+        } else {
+            a = vi_gather((const int32_t *)(const void *)q, ix);
+            b = vi_gather((const int32_t *)(const void *)q, ix1);
+        }
+        /* fx of each pixel in its four 16-bit lanes, in the blocks' order */
+        fx = vi_loadu(fxs + i);
+        wl = vi_zip_lo(fx, fx);
+        wh = vi_zip_hi(fx, fx);
+        wl = vi_or(wl, vi_slli(wl, 16));
+        wh = vi_or(wh, vi_slli(wh, 16));
+        vi_storeu((int32_t *)(void *)(h + 4 * i),
+                  vi_xor(vh_add(vh_mullo(vh_from_u8_lo(a), vh_sub(w256, wl)),
+                                vh_mullo(vh_from_u8_lo(b), wl)), bias));
+        vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W),
+                  vi_xor(vh_add(vh_mullo(vh_from_u8_hi(a), vh_sub(w256, wh)),
+                                vh_mullo(vh_from_u8_hi(b), wh)), bias));
+    }
+    for (; i < n; i++) fuse__hpx(q, ixs[i], (uint32_t)fxs[i], sw, h + 4 * i);
+}
+
+/* Two pixels per block: q = ((h0 - 32768) w0 + (h1 - 32768) w1 + 32768 *
+ * 257) >> 16 per channel (fuse_internal.h: the stored values are h - 32768;
+ * w holds the pairs (w0, w1)), then over with V's two pixels in vw (16-bit
+ * lanes). vh_zip_lo/hi pair the channels of the block's first and second
+ * pixel; vh_packus32 puts them back in order. */
+SIMD_INL vint vblend_rc(vint a, vint b, vint vw, vint w)
+{
+    const vint lo8 = vh_set1(255), r128 = vh_set1(128);
+    const vint k = vi_set1(32768 * 257);
+    const vint sl = vi_srli(vi_add(vh_madd(vh_zip_lo(a, b), w), k), 16);
+    const vint sh = vi_srli(vi_add(vh_madd(vh_zip_hi(a, b), w), k), 16);
+    const vint qq = vh_packus32(sl, sh);
+    vint t = vh_mullo(vh_sub(lo8, vh_bcast3(qq)), vw);
+    /* div255: ((t + 128) + ((t + 128) >> 8)) >> 8 is ((t + 128) 257) >> 16 (the
+     * inner floor cannot move the outer one: an integer plus a fraction
+     * below 1 never crosses a multiple of 256), one pmulhuw */
+    t = vh_mulhi(vh_add(t, r128), vh_set1(257));
+    return vh_add(qq, t);
+}
+
+void SIMD_FN(fuse__vrow)(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
+                         const uint8_t *v, uint8_t *out, int n)
+{
+    const vint w = vi_set1((int32_t)((fy << 16) | (256u - fy)));
+    const vint opaque = vi_set1((int32_t)0xFF000000u);
+    int i = 0;
+    for (; i + SIMD_W <= n; i += SIMD_W) {
+        const vint vv = vi_loadu((const int32_t *)(const void *)(v + 4 * (size_t)i));
+        const vint r0 = vblend_rc(vi_loadu((const int32_t *)(const void *)(h0 + 4 * i)),
+                                  vi_loadu((const int32_t *)(const void *)(h1 + 4 * i)),
+                                  vh_from_u8_lo(vv), w);
+        const vint r1 = vblend_rc(vi_loadu((const int32_t *)(const void *)(h0 + 4 * i + 2 * SIMD_W)),
+                                  vi_loadu((const int32_t *)(const void *)(h1 + 4 * i + 2 * SIMD_W)),
+                                  vh_from_u8_hi(vv), w);
+        vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i), vi_or(vh_packus(r0, r1), opaque));
+    }
+    for (; i < n; i++) fuse__vpx(h0 + 4 * i, h1 + 4 * i, fy, v + 4 * i, out + 4 * i);
+}
+#endif

@@ -55,3 +55,19 @@ void FUSE_STUB(fuse__opaque)(const uint8_t *v, uint8_t *out, int n)
 {
     fuse__opaque_ref(v, out, n);
 }
+
+#ifdef FUSE_ROWCACHE_ON_LAYER
+void FUSE_STUB(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
+                           uint16_t *h)
+{
+    int i;
+    for (i = 0; i < n; i++) fuse__hpx(q, cols->ix[c + i], (uint32_t)cols->fx[c + i], sw, h + 4 * i);
+}
+
+void FUSE_STUB(fuse__vrow)(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
+                           const uint8_t *v, uint8_t *out, int n)
+{
+    int i;
+    for (i = 0; i < n; i++) fuse__vpx(h0 + 4 * i, h1 + 4 * i, fy, v + 4 * i, out + 4 * i);
+}
+#endif

@@ -1,5 +1,6 @@
 /* io_common.c - error helpers of the io module (see io.h, ERRORS). */
 #include "io.h"
+#include "io_dev.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -45,4 +46,12 @@ io_result io_check_file(const char *path, io_error *err)
     if (S_ISDIR(st.st_mode))
         return io_fail(err, IO_ERR_READ, "%s: is a directory", path);
     return IO_OK;
+}
+
+void io__status(char *dst, size_t n, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(dst, n, fmt, ap);
+    va_end(ap);
 }

@@ -467,6 +467,14 @@ void io_glove_set_calib(io_glove *g, const kin_glove_calib *c);
 void io_glove_to_sample(const io_glove *g, kin_track_sample *s);
 void io_glove_close(io_glove *g);
 
+/* Internal to src/io (io_common.c): snprintf into a status field of the
+ * devices (a truncated message is fine there); io_v4l2.c, io_glove.c. */
+void io__status(char *dst, size_t n, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
 #ifdef __cplusplus
 }
 #endif

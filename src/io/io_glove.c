@@ -46,16 +46,6 @@ void io_glove_build(const float raw[KIN_GLOVE_SENSORS], uint8_t rep[IO_GLOVE_REP
     }
 }
 
-static void set_status(char *dst, size_t n, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static void set_status(char *dst, size_t n, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(dst, n, fmt, ap);
-    va_end(ap);
-}
-
 void io_glove_set_calib(io_glove *g, const kin_glove_calib *c)
 {
     if (c) {
@@ -73,7 +63,7 @@ io_result io_glove_feed(io_glove *g, const uint8_t *rep, size_t n, io_error *err
     io_result r = io_glove_parse(g->name[0] ? g->name : "glove", rep, n, raw, &e);
     if (r != IO_OK) {
         g->bad_reports++;
-        set_status(g->status, sizeof g->status, "%s (report %llu dropped, keeping the last "
+        io__status(g->status, sizeof g->status, "%s (report %llu dropped, keeping the last "
                    "values)", e.msg, (unsigned long long)(g->reports + g->bad_reports));
         if (err) *err = e;
         return r;
@@ -225,7 +215,7 @@ io_result io_glove_poll(io_glove *g, int timeout_ms, int *fresh, io_error *err)
         g->done = 0;
         if (t->status == LIBUSB_TRANSFER_NO_DEVICE) {
             g->gone = 1;
-            set_status(g->status, sizeof g->status, "%s: unplugged", g->name);
+            io__status(g->status, sizeof g->status, "%s: unplugged", g->name);
             return io_fail(err, IO_ERR_DEVICE, "%s: unplugged", g->name);
         }
         if (t->status == LIBUSB_TRANSFER_COMPLETED && t->actual_length == 0) {
@@ -234,7 +224,7 @@ io_result io_glove_poll(io_glove *g, int timeout_ms, int *fresh, io_error *err)
             if (io_glove_feed(g, t->buffer, (size_t)t->actual_length, NULL) == IO_OK) (*fresh)++;
         } else if (t->status != LIBUSB_TRANSFER_TIMED_OUT && t->status != LIBUSB_TRANSFER_CANCELLED) {
             g->bad_reports++;
-            set_status(g->status, sizeof g->status, "%s: transfer failed (status %d)", g->name,
+            io__status(g->status, sizeof g->status, "%s: transfer failed (status %d)", g->name,
                        (int)t->status);
         }
         io_result s = submit(g, err);

@@ -48,6 +48,7 @@
 extern "C" {
 #include "io.h"
 }
+#include "io_cxx.hpp"
 
 namespace {
 
@@ -1372,13 +1373,7 @@ std::string dir_of(const char *path)
 }
 
 /* tinygltf messages end with a newline and may span lines: keep one line. */
-std::string one_line(std::string s)
-{
-    while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
-    for (char &c : s)
-        if (c == '\n' || c == '\r') c = ' ';
-    return s.empty() ? std::string("unknown error") : s;
-}
+std::string one_line(std::string s) { return io_cxx::one_line(s, "unknown error"); }
 
 /* Extensions egofuse implements (geometry), and those that change only
  * materials, textures or lights, which a coverage mask and normals do not
@@ -1779,16 +1774,8 @@ extern "C" io_result io_gltf_load_ex(const char *path, int scene,
     memset(out, 0, sizeof *out);
     if (!path || !*path)
         return io_fail(err, IO_ERR_ARGS, "io_gltf_load: no path");
-    io_result r;
-    try {
-        r = load(path, scene < 0 ? -1 : scene, out, info, err);
-    } catch (const std::bad_alloc &) {
-        r = io_fail(err, IO_ERR_NOMEM, "%s: out of memory", path);
-    } catch (const std::exception &e) {
-        r = io_fail(err, IO_ERR_FORMAT, "%s: %s", path, e.what());
-    } catch (...) {
-        r = io_fail(err, IO_ERR_FORMAT, "%s: unexpected exception", path);
-    }
+    io_result r = io_cxx::guard(path, err, IO_ERR_FORMAT, nullptr,
+                                [&] { return load(path, scene < 0 ? -1 : scene, out, info, err); });
     if (r != IO_OK) kin_model_free(out);  /* frees and zeroes */
     else if (err) io_fail(err, IO_OK, "%s", "ok");
     return r;

@@ -47,23 +47,17 @@ extern "C" {
 #include "io.h"
 #include "io_image_plugin.h"
 }
+#include "io_cxx.hpp"
 
 namespace {
+
+const char *const EXR_UNKNOWN = "unknown OpenEXR error";
 
 const char *const no_oiio =
     "this format needs OpenImageIO: this egofuse's image plugin was built with "
     "OpenEXR only (EXR files); install OpenImageIO (Debian: libopenimageio-dev, "
     "which make test installs) and run make again";
 
-/* One line of an OpenEXR message. */
-std::string one_line(const char *m)
-{
-    std::string s = m && *m ? m : "unknown OpenEXR error";
-    while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
-    for (char &c : s)
-        if (c == '\n' || c == '\r') c = ' ';
-    return s;
-}
 
 bool is_exr_name(const char *path)
 {
@@ -249,31 +243,16 @@ io_result save(const char *path, FILE *f, int fd, const io_image *img, io_error 
 
 io_result plugin_load(const char *path, io_type type, int channels, io_image *out, io_error *err)
 {
-    io_result r;
-    try {
-        r = load(path, type, channels, out, err);
-    } catch (const std::bad_alloc &) {
-        r = io_fail(err, IO_ERR_NOMEM, "%s: out of memory", path);
-    } catch (const std::exception &e) {
-        r = io_fail(err, IO_ERR_FORMAT, "%s: %s", path, one_line(e.what()).c_str());
-    } catch (...) {
-        r = io_fail(err, IO_ERR_FORMAT, "%s: unexpected exception", path);
-    }
+    io_result r = io_cxx::guard(path, err, IO_ERR_FORMAT, EXR_UNKNOWN,
+                                [&] { return load(path, type, channels, out, err); });
     if (r != IO_OK) io_image_free(out);
     return r;
 }
 
 io_result plugin_save(const char *path, FILE *f, int fd, const io_image *img, io_error *err)
 {
-    try {
-        return save(path, f, fd, img, err);
-    } catch (const std::bad_alloc &) {
-        return io_fail(err, IO_ERR_NOMEM, "%s: out of memory", path);
-    } catch (const std::exception &e) {
-        return io_fail(err, IO_ERR_WRITE, "%s: %s", path, one_line(e.what()).c_str());
-    } catch (...) {
-        return io_fail(err, IO_ERR_WRITE, "%s: unexpected exception", path);
-    }
+    return io_cxx::guard(path, err, IO_ERR_WRITE, EXR_UNKNOWN,
+                         [&] { return save(path, f, fd, img, err); });
 }
 
 const io_oiio_plugin the_plugin = {IO_OIIO_PLUGIN_ABI, plugin_load, plugin_save};

@@ -47,6 +47,7 @@ extern "C" {
 #include "io.h"
 #include "io_image_plugin.h"
 }
+#include "io_cxx.hpp"
 
 namespace {
 
@@ -58,13 +59,7 @@ OIIO::TypeDesc oiio_type(io_type t)
 }
 
 /* OpenImageIO messages may span lines: keep one. */
-std::string one_line(std::string s)
-{
-    while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
-    for (char &c : s)
-        if (c == '\n' || c == '\r') c = ' ';
-    return s.empty() ? std::string("unknown OpenImageIO error") : s;
-}
+std::string one_line(std::string s) { return io_cxx::one_line(s, "unknown OpenImageIO error"); }
 
 /* The pending global OpenImageIO error (cleared), or `fallback`. */
 std::string global_error(const char *fallback)
@@ -237,16 +232,8 @@ io_result save(const char *path, FILE *f, int fd, const io_image *img, io_error 
 io_result plugin_load(const char *path, io_type type, int channels, io_image *out,
                       io_error *err)
 {
-    io_result r;
-    try {
-        r = load(path, type, channels, out, err);
-    } catch (const std::bad_alloc &) {
-        r = io_fail(err, IO_ERR_NOMEM, "%s: out of memory", path);
-    } catch (const std::exception &e) {
-        r = io_fail(err, IO_ERR_FORMAT, "%s: %s", path, e.what());
-    } catch (...) {
-        r = io_fail(err, IO_ERR_FORMAT, "%s: unexpected exception", path);
-    }
+    io_result r = io_cxx::guard(path, err, IO_ERR_FORMAT, nullptr,
+                                [&] { return load(path, type, channels, out, err); });
     if (r != IO_OK) io_image_free(out);
     return r;
 }
@@ -254,15 +241,8 @@ io_result plugin_load(const char *path, io_type type, int channels, io_image *ou
 io_result plugin_save(const char *path, FILE *f, int fd, const io_image *img,
                       io_error *err)
 {
-    try {
-        return save(path, f, fd, img, err);
-    } catch (const std::bad_alloc &) {
-        return io_fail(err, IO_ERR_NOMEM, "%s: out of memory", path);
-    } catch (const std::exception &e) {
-        return io_fail(err, IO_ERR_WRITE, "%s: %s", path, e.what());
-    } catch (...) {
-        return io_fail(err, IO_ERR_WRITE, "%s: unexpected exception", path);
-    }
+    return io_cxx::guard(path, err, IO_ERR_WRITE, nullptr,
+                         [&] { return save(path, f, fd, img, err); });
 }
 
 const io_oiio_plugin the_plugin = {IO_OIIO_PLUGIN_ABI, plugin_load, plugin_save};

@@ -47,17 +47,6 @@ io_cam_config io_cam_config_default(const char *path)
     return c;
 }
 
-/* snprintf into a status field (a truncated message is fine there). */
-static void set_status(char *dst, size_t n, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static void set_status(char *dst, size_t n, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(dst, n, fmt, ap);
-    va_end(ap);
-}
-
 static uint64_t mono_ms(void)
 {
     struct timespec ts;
@@ -124,7 +113,7 @@ static void cam_failed(io_cam *cam, const io_error *e)
 {
     cam->state = IO_CAM_FAILED;
     cam->stats.errors++;
-    set_status(cam->status, sizeof cam->status, "%s", e->msg);
+    io__status(cam->status, sizeof cam->status, "%s", e->msg);
 }
 
 io_result io_cam_dequeue(io_cam *cam, io_frame *f, int *got, io_error *err)
@@ -169,7 +158,7 @@ io_result io_cam_dequeue(io_cam *cam, io_frame *f, int *got, io_error *err)
             bad = "short";
         }
         if (bad) {
-            set_status(cam->status, sizeof cam->status,
+            io__status(cam->status, sizeof cam->status,
                      "%s: frame %u %s (%zu of %zu bytes): dropped", cam->cfg.path,
                      (unsigned)fr.sequence, bad, fr.bytes, cam->image_bytes);
             io_result q = io_cam_release(cam, &fr, err);
@@ -306,7 +295,7 @@ io_result io_cam_reopen(io_cam *cam, const char *new_path, io_error *err)
         cam->be = be;
         cam->cfg = cfg;
         cam->state = IO_CAM_FAILED;
-        set_status(cam->status, sizeof cam->status, "%s", err ? err->msg : "reopen failed");
+        io__status(cam->status, sizeof cam->status, "%s", err ? err->msg : "reopen failed");
         return r;
     }
     if (stream && (r = io_cam_start(cam, err)) != IO_OK) {
@@ -386,7 +375,7 @@ io_result io_stereo_grab(io_stereo *s, int timeout_ms, io_frame out[2], int *got
                 if (!s->failed[e]) {
                     s->failed[e] = 1;
                     s->have[e] = 0; /* its buffers are gone with it */
-                    set_status(s->status, sizeof s->status, "%s camera %s failed: %s", eye_name[e],
+                    io__status(s->status, sizeof s->status, "%s camera %s failed: %s", eye_name[e],
                              c->cfg.path, c->status[0] ? c->status : "not streaming");
                 }
                 continue;
@@ -408,7 +397,7 @@ io_result io_stereo_grab(io_stereo *s, int timeout_ms, io_frame out[2], int *got
                 s->failed[e] = 1;
                 s->have[e] = 0;
                 alive--;
-                set_status(s->status, sizeof s->status, "%s camera failed: %s", eye_name[e], e2.msg);
+                io__status(s->status, sizeof s->status, "%s camera failed: %s", eye_name[e], e2.msg);
             }
         }
         if (!alive) {
@@ -898,20 +887,20 @@ io_result io_cam_list(const char *dev_dir, io_cam_info *out, int cap, int *count
         if (n < cap) {
             io_cam_info *c = &out[n];
             memset(c, 0, sizeof *c);
-            set_status(c->path, sizeof c->path, "%s/%s", dev_dir, e->d_name);
+            io__status(c->path, sizeof c->path, "%s/%s", dev_dir, e->d_name);
             int fd = open(c->path, O_RDWR | O_NONBLOCK | O_CLOEXEC);
             struct v4l2_capability cp;
             memset(&cp, 0, sizeof cp);
             if (fd < 0) {
-                set_status(c->card, sizeof c->card, "cannot open: %s", strerror(errno));
+                io__status(c->card, sizeof c->card, "cannot open: %s", strerror(errno));
             } else if (ioctl(fd, VIDIOC_QUERYCAP, &cp) < 0) {
-                set_status(c->card, sizeof c->card, "not a V4L2 device: %s", strerror(errno));
+                io__status(c->card, sizeof c->card, "not a V4L2 device: %s", strerror(errno));
             } else {
                 uint32_t caps = (cp.capabilities & V4L2_CAP_DEVICE_CAPS) ? cp.device_caps
                                                                            : cp.capabilities;
-                set_status(c->driver, sizeof c->driver, "%.31s", (const char *)cp.driver);
-                set_status(c->card, sizeof c->card, "%.63s", (const char *)cp.card);
-                set_status(c->bus_info, sizeof c->bus_info, "%.63s", (const char *)cp.bus_info);
+                io__status(c->driver, sizeof c->driver, "%.31s", (const char *)cp.driver);
+                io__status(c->card, sizeof c->card, "%.63s", (const char *)cp.card);
+                io__status(c->bus_info, sizeof c->bus_info, "%.63s", (const char *)cp.bus_info);
                 c->capture = (caps & V4L2_CAP_VIDEO_CAPTURE) && (caps & V4L2_CAP_STREAMING);
             }
             if (fd >= 0) close(fd);

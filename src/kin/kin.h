@@ -376,6 +376,17 @@ kin_camera kin_sthmd_camera(const kin_sthmd_desc *desc,
  * resolved ipd_m (NULL world_from_head: identity). */
 kin_mat4 kin_sthmd_eye(const kin_sthmd_desc *desc, const kin_mat4 *world_from_head,
                        kin_eye eye);
+/* The eye's own camera (for an eye reprojection, src/pipe/pipe_reproj.h):
+ * at kin_sthmd_eye (the resolved ipd_m), with the head's orientation, a
+ * pinhole of the display's FOVs (hmd_hfov_deg x hmd_vfov_deg) centred on
+ * a width x height image (0: the LCD's size), so that its pixel (i, j)
+ * is the display's pixel area (i + 0.5) lcd_w / width (the same for j):
+ *   fx = width / 2 / tan(hfov / 2), fy = height / 2 / tan(vfov / 2),
+ *   cx = width / 2, cy = height / 2, near and far the desc's.
+ * A virtual scene rendered for the eye (samples/gen: gen_render_virtual)
+ * uses the same intrinsics at the LCD's size. (src/kin/kin_hmd.c) */
+kin_camera kin_sthmd_eye_camera(const kin_sthmd_desc *desc, const kin_mat4 *world_from_head,
+                                kin_eye eye, int width, int height);
 /* Named HMDs (src/kin/kin_hmd.c, docs/kin.md "Named HMDs"): "paper" (the
  * defaults: 640x480 cameras, 1280x800 per eye), "consumer" (1280x1024
  * cameras, 2064x2208 per eye), "highend" (1920x1080 cameras, 2880x2720

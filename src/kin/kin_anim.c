@@ -9,6 +9,7 @@
  * with td = t1 - t0, a = in-tangent, b = out-tangent (glTF appendix C).
  * Rotations are renormalised. No allocation, no state. */
 #include "kin.h"
+#include "kin_internal.h"
 
 #include <string.h>
 
@@ -38,6 +39,59 @@ static const float *key_value(const kin_channel *ch, int k)
     return ch->values + (size_t)k * (size_t)ch->comps;
 }
 
+/* The channel's comps values at time t (kin_internal.h): the sampling
+ * of the file's opening comment, LINEAR rotations by slerp; also the
+ * morph weights of kin_morph.c. */
+void kin__channel_value(const kin_channel *ch, float t, float *out)
+{
+    const int n = ch->key_count, c = ch->comps;
+    const float *times = ch->times;
+
+    /* Clamp (NaN goes to the first key). */
+    if (n == 1 || !(t > times[0])) {
+        memcpy(out, key_value(ch, 0), sizeof(float) * (size_t)c);
+        return;
+    }
+    if (t >= times[n - 1]) {
+        memcpy(out, key_value(ch, n - 1), sizeof(float) * (size_t)c);
+        return;
+    }
+
+    int k = find_key(times, n, t);
+    float td = times[k + 1] - times[k];
+    float u = (t - times[k]) / td;
+    const float *v0 = key_value(ch, k), *v1 = key_value(ch, k + 1);
+
+    switch (ch->interp) {
+    case KIN_INTERP_STEP:
+        memcpy(out, v0, sizeof(float) * (size_t)c);
+        return;
+    case KIN_INTERP_CUBICSPLINE: {
+        const float *b0 = v0 + c;  /* out-tangent of key k */
+        const float *a1 = v1 - c;  /* in-tangent of key k+1 */
+        float u2 = u * u, u3 = u2 * u;
+        float h00 = 2.0f * u3 - 3.0f * u2 + 1.0f;
+        float h10 = (u3 - 2.0f * u2 + u) * td;
+        float h01 = -2.0f * u3 + 3.0f * u2;
+        float h11 = (u3 - u2) * td;
+        for (int i = 0; i < c; i++)
+            out[i] = h00 * v0[i] + h10 * b0[i] + h01 * v1[i] + h11 * a1[i];
+        return;
+    }
+    case KIN_INTERP_LINEAR:
+    default:
+        if (ch->path == KIN_PATH_ROTATION) {
+            kin_quat a = { v0[0], v0[1], v0[2], v0[3] };
+            kin_quat b = { v1[0], v1[1], v1[2], v1[3] };
+            kin_quat q = kin_quat_slerp(a, b, u);
+            out[0] = q.x; out[1] = q.y; out[2] = q.z; out[3] = q.w;
+        } else {
+            for (int i = 0; i < c; i++) out[i] = v0[i] + (v1[i] - v0[i]) * u;
+        }
+        return;
+    }
+}
+
 static void store(const kin_channel *ch, const float *v, kin_transform *dst)
 {
     switch (ch->path) {
@@ -54,49 +108,9 @@ static void store(const kin_channel *ch, const float *v, kin_transform *dst)
 
 static void sample_channel(const kin_channel *ch, float t, kin_transform *dst)
 {
-    const int n = ch->key_count, c = ch->comps;
-    const float *times = ch->times;
     float out[4];
-
-    /* Clamp (NaN goes to the first key). */
-    if (n == 1 || !(t > times[0])) { store(ch, key_value(ch, 0), dst); return; }
-    if (t >= times[n - 1]) { store(ch, key_value(ch, n - 1), dst); return; }
-
-    int k = find_key(times, n, t);
-    float td = times[k + 1] - times[k];
-    float u = (t - times[k]) / td;
-    const float *v0 = key_value(ch, k), *v1 = key_value(ch, k + 1);
-
-    switch (ch->interp) {
-    case KIN_INTERP_STEP:
-        store(ch, v0, dst);
-        return;
-    case KIN_INTERP_CUBICSPLINE: {
-        const float *b0 = v0 + c;  /* out-tangent of key k */
-        const float *a1 = v1 - c;  /* in-tangent of key k+1 */
-        float u2 = u * u, u3 = u2 * u;
-        float h00 = 2.0f * u3 - 3.0f * u2 + 1.0f;
-        float h10 = (u3 - 2.0f * u2 + u) * td;
-        float h01 = -2.0f * u3 + 3.0f * u2;
-        float h11 = (u3 - u2) * td;
-        for (int i = 0; i < c; i++)
-            out[i] = h00 * v0[i] + h10 * b0[i] + h01 * v1[i] + h11 * a1[i];
-        store(ch, out, dst);
-        return;
-    }
-    case KIN_INTERP_LINEAR:
-    default:
-        if (ch->path == KIN_PATH_ROTATION) {
-            kin_quat a = { v0[0], v0[1], v0[2], v0[3] };
-            kin_quat b = { v1[0], v1[1], v1[2], v1[3] };
-            kin_quat q = kin_quat_slerp(a, b, u);
-            out[0] = q.x; out[1] = q.y; out[2] = q.z; out[3] = q.w;
-        } else {
-            for (int i = 0; i < c; i++) out[i] = v0[i] + (v1[i] - v0[i]) * u;
-        }
-        store(ch, out, dst);
-        return;
-    }
+    kin__channel_value(ch, t, out);
+    store(ch, out, dst);
 }
 
 void kin_anim_sample(const kin_animation *anim, int node_count, float t,

@@ -267,11 +267,9 @@ int kin_user_calib_parse(const char *text, size_t len, kin_user_calib *out, int 
     int seen[K_COUNT] = { 0 };
     size_t pos = 0;
     int line_no = 0, have_header = 0;
-    while (pos < len) {
-        const char *ln = text + pos;
-        const char *nl = memchr(ln, '\n', len - pos);
-        size_t l = nl ? (size_t)(nl - ln) : len - pos;
-        pos += l + (nl ? 1 : 0);
+    const char *ln;
+    size_t l;
+    while ((ln = kin__next_line(text, len, &pos, &l))) {
         line_no++;
         *err_line = line_no;
         char buf[512];
@@ -280,16 +278,8 @@ int kin_user_calib_parse(const char *text, size_t len, kin_user_calib *out, int 
         buf[l] = '\0';
         if (memchr(buf, '\0', l)) return fail(why, why_size, "NUL byte in line");
         char *tok[16];
-        int nt = 0;
-        char *p = buf;
-        for (;;) {
-            while (*p == ' ' || *p == '\t' || *p == '\r') p++;
-            if (!*p || *p == '#') break;
-            if (nt == 16) return fail(why, why_size, "too many fields");
-            tok[nt++] = p;
-            while (*p && *p != ' ' && *p != '\t' && *p != '\r') p++;
-            if (*p) *p++ = '\0';
-        }
+        int nt = kin__tokens(buf, tok, 16);
+        if (nt < 0) return fail(why, why_size, "too many fields");
         if (!have_header) {
             if (nt != 2 || strcmp(tok[0], "egofuse-calib") != 0 || strcmp(tok[1], "1") != 0)
                 return fail(why, why_size, "first line must be 'egofuse-calib 1'");

@@ -115,23 +115,19 @@ static void dq_fit(float b[8])
 void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
                        float *pos_out, float *nrm_out, int v0, int v1)
 {
-    const int do_n = mesh->normals && nrm_out;
     const int skinned = mesh->joints && mesh->weights && dq;
-    const int extra = mesh->joints_extra && mesh->weights_extra && mesh->extra_sets > 0
-                      ? mesh->extra_sets : 0;
+    const int extra = kin__extra_sets(mesh);
     for (int v = v0; v < v1; v++) {
-        const float *p = mesh->positions + (size_t)v * 3;
-        float *po = pos_out + (size_t)v * 3;
-        const float *n = do_n ? mesh->normals + (size_t)v * 3 : NULL;
-        float *no = do_n ? nrm_out + (size_t)v * 3 : NULL;
+        const float *p, *n;
+        float *po, *no;
+        kin__vertex(mesh, pos_out, nrm_out, v, &p, &po, &n, &no);
         float b[8] = { 0 };
         float wsum = 0.0f;
         const kin_quat *r0 = NULL;
         for (int set = 0; skinned && set <= extra; set++) {
-            const uint16_t *j = set ? mesh->joints_extra + ((size_t)v * (size_t)extra + (size_t)(set - 1)) * 4
-                                    : mesh->joints + (size_t)v * 4;
-            const float *w = set ? mesh->weights_extra + ((size_t)v * (size_t)extra + (size_t)(set - 1)) * 4
-                                 : mesh->weights + (size_t)v * 4;
+            const uint16_t *j;
+            const float *w;
+            kin__influences(mesh, extra, v, set, &j, &w);
             for (int i = 0; i < 4; i++) {
                 if (w[i] == 0.0f) continue;
                 const kin_dualquat *q = &dq[j[i]];
@@ -149,8 +145,7 @@ void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
             sq = dq_sq(b);
         }
         if (wsum == 0.0f || !(sq > 0.0f)) {
-            po[0] = p[0]; po[1] = p[1]; po[2] = p[2];
-            if (do_n) { no[0] = n[0]; no[1] = n[1]; no[2] = n[2]; }
+            kin__bind_pose(p, po, n, no);
             continue;
         }
         const float k = 2.0f / sq, w = b[3], dw = b[7];
@@ -160,7 +155,7 @@ void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
         for (int c = 0; c < 3; c++) e[c] = e[c] + b[4 + c];
         cross3(u, e, g);
         for (int c = 0; c < 3; c++) po[c] = p[c] + k * ((w * e[c] + g[c]) - dw * u[c]);
-        if (do_n) {
+        if (n) {
             float f[3];
             cross3(u, n, f);
             cross3(u, f, g);
@@ -173,20 +168,8 @@ void kin_skin_dqs_isa(const kin_mesh *mesh, const kin_dualquat *dq,
                       float *pos_out, float *nrm_out, int isa)
 {
     if (!mesh || !pos_out) return;
-    int v = 0, n = mesh->vertex_count;
-    if (mesh->joints && mesh->weights && dq && mesh->extra_sets == 0) {
-        switch ((ef_isa)kin__skin_isa_of(isa)) {
-#if defined(__x86_64__)
-        case EF_ISA_AVX512: v = kin__skin_dqs_avx512(mesh, dq, pos_out, nrm_out, 0, n); break;
-        case EF_ISA_AVX2: v = kin__skin_dqs_avx2(mesh, dq, pos_out, nrm_out, 0, n); break;
-        case EF_ISA_SSE2: v = kin__skin_dqs_sse2(mesh, dq, pos_out, nrm_out, 0, n); break;
-#elif defined(__aarch64__) && defined(__ARM_NEON)
-        case EF_ISA_NEON: v = kin__skin_dqs_neon(mesh, dq, pos_out, nrm_out, 0, n); break;
-#endif
-        default: break;
-        }
-    }
-    kin__skin_dqs_ref(mesh, dq, pos_out, nrm_out, v, n);
+    int v = kin__skin_simd(mesh, dq, 1, pos_out, nrm_out, isa);
+    kin__skin_dqs_ref(mesh, dq, pos_out, nrm_out, v, mesh->vertex_count);
 }
 
 void kin_skin_dqs(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out, float *nrm_out)

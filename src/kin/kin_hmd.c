@@ -11,6 +11,7 @@
  * within a tenth of a degree (96 x 100 and 100 x 97 deg). */
 #include "kin.h"
 
+#include <math.h>
 #include <string.h>
 
 typedef struct hmd_preset {
@@ -53,4 +54,38 @@ const char *kin_sthmd_preset_name(int i)
 {
     if (i < 0 || (size_t)i >= sizeof presets / sizeof presets[0]) return NULL;
     return presets[i].name;
+}
+
+kin_camera kin_sthmd_eye_camera(const kin_sthmd_desc *desc, const kin_mat4 *world_from_head,
+                                kin_eye eye, int width, int height)
+{
+    kin_sthmd_desc r = kin_sthmd_desc_resolved(desc);
+    kin_camera c;
+    memset(&c, 0, sizeof c);
+    c.world_from_cam = kin_sthmd_eye(&r, world_from_head, eye);
+    if (!kin_mat4_inverse(&c.world_from_cam, &c.view)) {
+        /* a singular head matrix: the eye at its place with an identity head */
+        c.world_from_cam = kin_sthmd_eye(&r, NULL, eye);
+        kin_mat4_inverse(&c.world_from_cam, &c.view);
+    }
+    c.width = width > 0 ? width : r.lcd_width;
+    c.height = height > 0 ? height : r.lcd_height;
+    const double d2r = 0.017453292519943295;
+    double fx = 0.5 * c.width / tan(0.5 * r.hmd_hfov_deg * d2r);
+    double fy = 0.5 * c.height / tan(0.5 * r.hmd_vfov_deg * d2r);
+    c.fx = (float)fx;
+    c.fy = (float)fy;
+    c.cx = 0.5f * (float)c.width;
+    c.cy = 0.5f * (float)c.height;
+    c.proj = kin_proj_from_intrinsics(fx, fy, c.cx, c.cy, 0.0, c.width, c.height, r.znear, r.zfar);
+    c.view_proj = kin_mat4_mul(&c.proj, &c.view);
+    c.lens.model = KIN_LENS_PINHOLE;
+    c.lens.width = c.width;
+    c.lens.height = c.height;
+    c.lens.fx = fx;
+    c.lens.fy = fy;
+    c.lens.cx = c.cx - 0.5;
+    c.lens.cy = c.cy - 0.5;
+    kin_lens_check(&c.lens, NULL, 0);
+    return c;
 }

@@ -3,6 +3,7 @@
 #define EGOFUSE_KIN_INTERNAL_H
 
 #include <stddef.h>
+#include <string.h>
 
 #if defined(__GNUC__)
 #define KIN__PRINTF(f, a) __attribute__((format(printf, f, a)))
@@ -24,5 +25,31 @@ void kin__put(kin__sink *k, const char *fmt, ...) KIN__PRINTF(2, 3);
  * [+-].digits, optional exponent; no hex, inf or nan. Returns 0 and the
  * finite value, or -1. */
 int kin__parse_number(const char *tok, double *out);
+
+/* Splits a line in place into tokens separated by spaces, tabs and CRs,
+ * up to a '#' comment (each token NUL-terminated, tok[] pointing into
+ * buf); the number of tokens, or -1 when there are more than cap. The
+ * line formats of kin_calib.c and kin_track.c. */
+int kin__tokens(char *buf, char **tok, int cap);
+
+struct kin_channel;
+/* The value of an animation channel at time t (kin_anim.c): ch->comps
+ * floats into out; clamped to the first and last key, STEP, LINEAR
+ * (slerp for rotations, not renormalised), CUBICSPLINE (glTF appendix
+ * C). The caller has checked key_count >= 1, times and values. */
+void kin__channel_value(const struct kin_channel *ch, float t, float *out);
+
+/* The next line of text[0, len) at *pos: its start (NULL at the end), its
+ * length without the '\n' in *l; *pos moves past it. The line formats of
+ * kin_calib.c and kin_track.c. */
+static inline const char *kin__next_line(const char *text, size_t len, size_t *pos, size_t *l)
+{
+    if (*pos >= len) return NULL;
+    const char *ln = text + *pos;
+    const char *nl = memchr(ln, '\n', len - *pos);
+    *l = nl ? (size_t)(nl - ln) : len - *pos;
+    *pos += *l + (nl ? 1 : 0);
+    return ln;
+}
 
 #endif

@@ -1,69 +1,13 @@
 /* kin_morph.c - glTF morph targets: weights from an animation's `weights`
  * channel, and the weighted sum of the targets' deltas (before skinning).
  *
- * Sampling follows kin_anim.c (clamp to the first and last key; STEP,
- * LINEAR per component, CUBICSPLINE with the Hermite basis of glTF
- * appendix C) for any number of components. No allocation, no state. */
+ * Sampling is kin_anim.c's kin__channel_value (clamp to the first and
+ * last key; STEP, LINEAR per component, CUBICSPLINE with the Hermite
+ * basis of glTF appendix C) for any number of components. No allocation, no state. */
 #include "kin.h"
+#include "kin_internal.h"
 
 #include <string.h>
-
-/* Index k of the last key with times[k] <= t, for times[0] < t < times[n-1]. */
-static int find_key(const float *times, int n, float t)
-{
-    int lo = 0, hi = n - 1;
-    while (hi - lo > 1) {
-        int mid = lo + (hi - lo) / 2;
-        if (times[mid] <= t) lo = mid;
-        else hi = mid;
-    }
-    return lo;
-}
-
-static const float *key_value(const kin_channel *ch, int k)
-{
-    if (ch->interp == KIN_INTERP_CUBICSPLINE)
-        return ch->values + ((size_t)k * 3 + 1) * (size_t)ch->comps;
-    return ch->values + (size_t)k * (size_t)ch->comps;
-}
-
-static void sample_weights(const kin_channel *ch, float t, float *out)
-{
-    const int n = ch->key_count, c = ch->comps;
-    const float *times = ch->times;
-    if (n == 1 || !(t > times[0])) {
-        memcpy(out, key_value(ch, 0), sizeof(float) * (size_t)c);
-        return;
-    }
-    if (t >= times[n - 1]) {
-        memcpy(out, key_value(ch, n - 1), sizeof(float) * (size_t)c);
-        return;
-    }
-    int k = find_key(times, n, t);
-    float td = times[k + 1] - times[k];
-    float u = (t - times[k]) / td;
-    const float *v0 = key_value(ch, k), *v1 = key_value(ch, k + 1);
-    switch (ch->interp) {
-    case KIN_INTERP_STEP:
-        memcpy(out, v0, sizeof(float) * (size_t)c);
-        return;
-    case KIN_INTERP_CUBICSPLINE: {
-        const float *b0 = v0 + c, *a1 = v1 - c;
-        float u2 = u * u, u3 = u2 * u;
-        float h00 = 2.0f * u3 - 3.0f * u2 + 1.0f;
-        float h10 = (u3 - 2.0f * u2 + u) * td;
-        float h01 = -2.0f * u3 + 3.0f * u2;
-        float h11 = (u3 - u2) * td;
-        for (int i = 0; i < c; i++)
-            out[i] = h00 * v0[i] + h10 * b0[i] + h01 * v1[i] + h11 * a1[i];
-        return;
-    }
-    case KIN_INTERP_LINEAR:
-    default:
-        for (int i = 0; i < c; i++) out[i] = v0[i] + (v1[i] - v0[i]) * u;
-        return;
-    }
-}
 
 int kin_anim_sample_weights(const kin_animation *anim, int node, float t,
                             float *weights, int count)
@@ -77,7 +21,7 @@ int kin_anim_sample_weights(const kin_animation *anim, int node, float t,
         last = ch;
     }
     if (!last) return 0;
-    sample_weights(last, t, weights);
+    kin__channel_value(last, t, weights);
     return 1;
 }
 

@@ -64,24 +64,20 @@ static void xform_normal(const affine *b, const float *n, float *o)
 void kin__skin_lbs_ref(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
                        float *nrm_out, int v0, int v1)
 {
-    const int do_n = mesh->normals && nrm_out;
     const int skinned = mesh->joints && mesh->weights && jm;
-    const int extra = mesh->joints_extra && mesh->weights_extra && mesh->extra_sets > 0
-                      ? mesh->extra_sets : 0;
+    const int extra = kin__extra_sets(mesh);
     for (int v = v0; v < v1; v++) {
-        const float *p = mesh->positions + (size_t)v * 3;
-        float *po = pos_out + (size_t)v * 3;
-        const float *n = do_n ? mesh->normals + (size_t)v * 3 : NULL;
-        float *no = do_n ? nrm_out + (size_t)v * 3 : NULL;
+        const float *p, *n;
+        float *po, *no;
+        kin__vertex(mesh, pos_out, nrm_out, v, &p, &po, &n, &no);
 
         affine b = { { 0 } };
         float wsum = 0.0f;
         for (int set = 0; skinned && set <= extra; set++) {
             /* set 0: JOINTS_0/WEIGHTS_0; then the extra sets in order */
-            const uint16_t *j = set ? mesh->joints_extra + ((size_t)v * (size_t)extra + (size_t)(set - 1)) * 4
-                                    : mesh->joints + (size_t)v * 4;
-            const float *w = set ? mesh->weights_extra + ((size_t)v * (size_t)extra + (size_t)(set - 1)) * 4
-                                 : mesh->weights + (size_t)v * 4;
+            const uint16_t *j;
+            const float *w;
+            kin__influences(mesh, extra, v, set, &j, &w);
             for (int i = 0; i < 4; i++) {
                 if (w[i] == 0.0f) continue;
                 const float *m = jm[j[i]].m;
@@ -91,12 +87,11 @@ void kin__skin_lbs_ref(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
             }
         }
         if (wsum == 0.0f) {
-            po[0] = p[0]; po[1] = p[1]; po[2] = p[2];
-            if (do_n) { no[0] = n[0]; no[1] = n[1]; no[2] = n[2]; }
+            kin__bind_pose(p, po, n, no);
             continue;
         }
         xform_point(&b, p, po);
-        if (do_n) xform_normal(&b, n, no);
+        if (n) xform_normal(&b, n, no);
     }
 }
 
@@ -115,25 +110,41 @@ int kin__skin_isa_of(int isa)
     return (int)ef_cpu_cap((ef_isa)isa);
 }
 
+/* The SIMD kernel of the request's ISA over a mesh's vertices, LBS (xf:
+ * kin_mat4 joint matrices) or DQS (xf: kin_dualquat); the first vertex
+ * it did not do (0 where no kernel runs: extra influence sets, no joints
+ * or weights, the reference ISA). kin_skin_lbs_isa and kin_skin_dqs_isa
+ * finish from there with their reference. */
+int kin__skin_simd(const kin_mesh *mesh, const void *xf, int dqs, float *pos_out,
+                   float *nrm_out, int isa)
+{
+    /* extra influence sets: the reference alone */
+    if (!mesh->joints || !mesh->weights || !xf || mesh->extra_sets != 0) return 0;
+    const int n = mesh->vertex_count;
+    const kin_mat4 *jm = xf;
+    const kin_dualquat *dq = xf;
+    switch ((ef_isa)kin__skin_isa_of(isa)) {
+#if defined(__x86_64__)
+    case EF_ISA_AVX512: return dqs ? kin__skin_dqs_avx512(mesh, dq, pos_out, nrm_out, 0, n)
+                                   : kin__skin_lbs_avx512(mesh, jm, pos_out, nrm_out, 0, n);
+    case EF_ISA_AVX2: return dqs ? kin__skin_dqs_avx2(mesh, dq, pos_out, nrm_out, 0, n)
+                                 : kin__skin_lbs_avx2(mesh, jm, pos_out, nrm_out, 0, n);
+    case EF_ISA_SSE2: return dqs ? kin__skin_dqs_sse2(mesh, dq, pos_out, nrm_out, 0, n)
+                                 : kin__skin_lbs_sse2(mesh, jm, pos_out, nrm_out, 0, n);
+#elif defined(__aarch64__) && defined(__ARM_NEON)
+    case EF_ISA_NEON: return dqs ? kin__skin_dqs_neon(mesh, dq, pos_out, nrm_out, 0, n)
+                                 : kin__skin_lbs_neon(mesh, jm, pos_out, nrm_out, 0, n);
+#endif
+    default: return 0;
+    }
+}
+
 void kin_skin_lbs_isa(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
                       float *nrm_out, int isa)
 {
     if (!mesh || !pos_out) return;
-    int v = 0, n = mesh->vertex_count;
-    /* extra influence sets: the reference alone */
-    if (mesh->joints && mesh->weights && jm && mesh->extra_sets == 0) {
-        switch ((ef_isa)kin__skin_isa_of(isa)) {
-#if defined(__x86_64__)
-        case EF_ISA_AVX512: v = kin__skin_lbs_avx512(mesh, jm, pos_out, nrm_out, 0, n); break;
-        case EF_ISA_AVX2: v = kin__skin_lbs_avx2(mesh, jm, pos_out, nrm_out, 0, n); break;
-        case EF_ISA_SSE2: v = kin__skin_lbs_sse2(mesh, jm, pos_out, nrm_out, 0, n); break;
-#elif defined(__aarch64__) && defined(__ARM_NEON)
-        case EF_ISA_NEON: v = kin__skin_lbs_neon(mesh, jm, pos_out, nrm_out, 0, n); break;
-#endif
-        default: break;
-        }
-    }
-    kin__skin_lbs_ref(mesh, jm, pos_out, nrm_out, v, n);
+    int v = kin__skin_simd(mesh, jm, 0, pos_out, nrm_out, isa);
+    kin__skin_lbs_ref(mesh, jm, pos_out, nrm_out, v, mesh->vertex_count);
 }
 
 void kin_skin_lbs(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,

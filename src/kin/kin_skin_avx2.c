@@ -12,6 +12,7 @@
 #include <math.h>
 
 #include "../cpu/simd_avx2.h"
+#include "kin_skin_x86.inl"
 
 /* The blend with 8 lanes: each vertex's matrix as two ymm (columns 0-1,
  * 2-3), 8 vertices transposed by vf_tr4 per 128-bit half and 128-bit lane
@@ -64,27 +65,7 @@ static inline void dqs_block(skin_tab *tab, const kin_mesh *mesh, const kin_dual
     (void)tab;
     const uint16_t *j = mesh->joints + (size_t)v * 4;
     const float *w = mesh->weights + (size_t)v * 4;
-    for (int l = 0; l < 8; l++, j += 4, w += 4) {
-        __m256 acc = _mm256_setzero_ps();
-        float s = 0.0f;
-        const kin_quat *r0 = NULL;
-        for (unsigned bits = kin__nonzero4(w); bits; bits &= bits - 1) {
-            int i = __builtin_ctz(bits);
-            const kin_dualquat *q = &dq[j[i]];
-            float sw = w[i];
-            if (!r0) {
-                r0 = &q->r;
-            } else {
-                float dot = q->r.x * r0->x + q->r.y * r0->y + q->r.z * r0->z + q->r.w * r0->w;
-                if (dot < 0.0f) sw = -w[i];
-            }
-            acc = _mm256_add_ps(acc, _mm256_mul_ps(_mm256_set1_ps(sw),
-                                                   _mm256_loadu_ps(&q->r.x)));
-            s += w[i];
-        }
-        r[l] = acc;
-        ws[l] = s;
-    }
+    for (int l = 0; l < 8; l++, j += 4, w += 4) r[l] = dqs_vertex8(dq, j, w, &ws[l]);
     *wsum = _mm256_load_ps(ws);
     __m256 s[2][4];
     for (int I = 0; I < 2; I++) vf_tr4(r[4 * I], r[4 * I + 1], r[4 * I + 2], r[4 * I + 3], s[I]);

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "../cpu/simd_avx512.h"
+#include "kin_skin_x86.inl"
 
 #define KIN_SKIN_OWN_BLOCK
 static inline void lbs_rows(const kin_mesh *mesh, const kin_mat4 *jm, int v,
@@ -58,26 +59,9 @@ static inline void dqs_rows(const kin_mesh *mesh, const kin_dualquat *dq, int v,
     const uint16_t *j = mesh->joints + (size_t)v * 4;
     const float *w = mesh->weights + (size_t)v * 4;
     for (int l = 0; l < 16; l++, j += 4, w += 4) {
-        __m256 acc = _mm256_setzero_ps();
-        float s = 0.0f;
-        const kin_quat *r0 = NULL;
-        for (unsigned bits = kin__nonzero4(w); bits; bits &= bits - 1) {
-            int i = __builtin_ctz(bits);
-            const kin_dualquat *q = &dq[j[i]];
-            float sw = w[i];
-            if (!r0) {
-                r0 = &q->r;
-            } else {
-                float dot = q->r.x * r0->x + q->r.y * r0->y + q->r.z * r0->z + q->r.w * r0->w;
-                if (dot < 0.0f) sw = -w[i];
-            }
-            acc = _mm256_add_ps(acc, _mm256_mul_ps(_mm256_set1_ps(sw),
-                                                   _mm256_loadu_ps(&q->r.x)));
-            s += w[i];
-        }
+        __m256 acc = dqs_vertex8(dq, j, w, &ws[l]);
         int slot = (l & 8) + 2 * (l & 3) + ((l >> 2) & 1);
         _mm256_store_ps(blk + 8 * slot, acc);
-        ws[l] = s;
     }
     *wsum = _mm512_load_ps(ws);
     __m512 s[2][4];
@@ -176,99 +160,100 @@ static inline __m512 lookup(const float *row, __m512i j, int wide, __mmask16 hi)
     return _mm512_mask_blend_ps(hi, lo, up);
 }
 
-/* The slots of one block; WIDE: joints up to 63 (else up to 31). */
-#define LBS_SLOTS(WIDE)                                                        \
-    {                                                                          \
-        for (int i = 0; i < 4; i++) {                                          \
-            ws = _mm512_add_ps(ws, b.w[i]);                                    \
-            if (!b.k[i]) continue;                                             \
-            __mmask16 hi = _mm512_test_epi32_mask(b.j[i], _mm512_set1_epi32(32)); \
-            _Pragma("GCC unroll 12")                                           \
-            for (int e = 0; e < 12; e++)                                       \
-                acc[e] = _mm512_add_ps(acc[e], _mm512_maskz_mul_ps(            \
-                    b.k[i], b.w[i], lookup(T->t[e], b.j[i], WIDE, hi)));       \
-        }                                                                      \
-    }
-
-static inline void lbs_block(skin_tab *T, const kin_mesh *mesh, const kin_mat4 *jm, int v,
-                             __m512 a[12], __m512 *wsum)
+/* The four influence slots of one block: LBS (DQS 0: 12 matrix
+ * elements) or DQS (DQS 1: 8 dual-quaternion elements); WIDE: joints up
+ * to 63 (else up to 31). Per slot i the weight sum adds w_i in every
+ * lane; in lanes with w_i != 0 the slot's joint elements x are looked up
+ * and w_i * x added (masked product: +0 elsewhere). DQS first flips w_i
+ * to -w_i where r_i . r_first < 0, in lanes that had a first influence
+ * (the first one's own dot is >= 0: s = w, as the reference). Always
+ * called with constant WIDE and DQS, so each call is its own loop. */
+SIMD_INL void blend_slots(const skin_tab *T, const blk16 *b, const int WIDE, const int DQS,
+                          __m512 acc[12], __m512 *wsum)
 {
-    blk16 b;
-    blk16_load(T, mesh, v, &b);
-    if (b.maxj >= 64) {
-        lbs_rows(mesh, jm, v, a, wsum);
-        return;
-    }
-    if (b.maxj >= T->built) {
-        if (T->built == 0) memset(T->t, 0, sizeof T->t);
-        for (int jj = T->built; jj <= b.maxj; jj++)
-            for (int c = 0; c < 4; c++)
-                for (int r = 0; r < 3; r++) T->t[c * 3 + r][jj] = jm[jj].m[c * 4 + r];
-        T->built = b.maxj + 1;
-    }
-    __m512 ws = _mm512_setzero_ps();
-    __m512 acc[12];
+    const __m512 zero = _mm512_setzero_ps();
+    __m512 ws = zero, r0[4] = { zero, zero, zero, zero };
+    __mmask16 have = 0;   /* DQS: lanes whose first influence is known */
+    for (int i = 0; i < 4; i++) {
+        ws = _mm512_add_ps(ws, b->w[i]);
+        const __mmask16 k = b->k[i];
+        if (!k) continue;
+        __mmask16 hi = _mm512_test_epi32_mask(b->j[i], _mm512_set1_epi32(32));
+        if (!DQS) {   /* LBS: each element looked up and added at once */
 #pragma GCC unroll 12
-    for (int e = 0; e < 12; e++) acc[e] = ws;
-    if (b.maxj >= 32) LBS_SLOTS(1) else LBS_SLOTS(0)
-#pragma GCC unroll 12
-    for (int e = 0; e < 12; e++) a[e] = acc[e];
+            for (int e = 0; e < 12; e++)
+                acc[e] = _mm512_add_ps(acc[e], _mm512_maskz_mul_ps(
+                    k, b->w[i], lookup(T->t[e], b->j[i], WIDE, hi)));
+            continue;
+        }
+        __m512 x[8];
+#pragma GCC unroll 8
+        for (int e = 0; e < 8; e++) x[e] = lookup(T->t[e], b->j[i], WIDE, hi);
+        __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_add_ps(
+                         _mm512_mul_ps(x[0], r0[0]), _mm512_mul_ps(x[1], r0[1])),
+                         _mm512_mul_ps(x[2], r0[2])), _mm512_mul_ps(x[3], r0[3]));
+        __mmask16 neg = _mm512_mask_cmp_ps_mask(have, dot, zero, _CMP_LT_OQ);
+        __m512 sw = _mm512_mask_xor_ps(b->w[i], neg, b->w[i], _mm512_set1_ps(-0.0f));
+        __mmask16 first = (__mmask16)(k & ~have);
+#pragma GCC unroll 4
+        for (int e = 0; e < 4; e++) r0[e] = _mm512_mask_mov_ps(r0[e], first, x[e]);
+        have = (__mmask16)(have | k);
+#pragma GCC unroll 8
+        for (int e = 0; e < 8; e++) acc[e] = _mm512_add_ps(acc[e], _mm512_maskz_mul_ps(k, sw, x[e]));
+    }
     *wsum = ws;
 }
 
-/* s_i = -w_i where r_i . r_first < 0, in lanes that had a first
- * influence (the first one's own dot is >= 0: s = w, as the reference). */
-#define DQS_SLOTS(WIDE)                                                        \
-    {                                                                          \
-        for (int i = 0; i < 4; i++) {                                          \
-            ws = _mm512_add_ps(ws, b.w[i]);                                    \
-            __mmask16 k = b.k[i];                                              \
-            if (!k) continue;                                                  \
-            __mmask16 hi = _mm512_test_epi32_mask(b.j[i], _mm512_set1_epi32(32)); \
-            __m512 x[8];                                                       \
-            _Pragma("GCC unroll 8")                                            \
-            for (int e = 0; e < 8; e++) x[e] = lookup(T->t[e], b.j[i], WIDE, hi); \
-            __m512 dot = _mm512_add_ps(_mm512_add_ps(_mm512_add_ps(            \
-                             _mm512_mul_ps(x[0], r0[0]), _mm512_mul_ps(x[1], r0[1])), \
-                             _mm512_mul_ps(x[2], r0[2])), _mm512_mul_ps(x[3], r0[3])); \
-            __mmask16 neg = _mm512_mask_cmp_ps_mask(have, dot, zero, _CMP_LT_OQ); \
-            __m512 sw = _mm512_mask_xor_ps(b.w[i], neg, b.w[i], _mm512_set1_ps(-0.0f)); \
-            __mmask16 first = (__mmask16)(k & ~have);                          \
-            _Pragma("GCC unroll 4")                                            \
-            for (int e = 0; e < 4; e++) r0[e] = _mm512_mask_mov_ps(r0[e], first, x[e]); \
-            have = (__mmask16)(have | k);                                      \
-            _Pragma("GCC unroll 8")                                            \
-            for (int e = 0; e < 8; e++)                                        \
-                acc[e] = _mm512_add_ps(acc[e], _mm512_maskz_mul_ps(k, sw, x[e])); \
-        }                                                                      \
-    }
-
-static inline void dqs_block(skin_tab *T, const kin_mesh *mesh, const kin_dualquat *dq, int v,
-                             __m512 q[8], __m512 *wsum)
+/* A block of 16 vertices by the joint table: LBS (DQS 0: xf the joint
+ * matrices, o[12] as kin_skin_simd.inl's a[]) or DQS (DQS 1: xf the dual
+ * quaternions, o[8]); blocks reading joints >= 64 take the rows path. The
+ * table gets the joints up to the block's largest on demand, the
+ * elements the blend reads: columns 0-3, rows 0-2 of a matrix (element
+ * c * 3 + r), r.xyzw d.xyzw of a dual quaternion. */
+SIMD_INL void table_block(skin_tab *T, const kin_mesh *mesh, const void *xf, int v,
+                          const int DQS, __m512 *o, __m512 *wsum)
 {
     blk16 b;
     blk16_load(T, mesh, v, &b);
     if (b.maxj >= 64) {
-        dqs_rows(mesh, dq, v, q, wsum);
+        if (DQS) dqs_rows(mesh, xf, v, o, wsum);
+        else lbs_rows(mesh, xf, v, o, wsum);
         return;
     }
     if (b.maxj >= T->built) {
         if (T->built == 0) memset(T->t, 0, sizeof T->t);
         for (int jj = T->built; jj <= b.maxj; jj++) {
-            const float *src = &dq[jj].r.x;
-            for (int e = 0; e < 8; e++) T->t[e][jj] = src[e];
+            if (DQS) {
+                const float *src = &((const kin_dualquat *)xf)[jj].r.x;
+                for (int e = 0; e < 8; e++) T->t[e][jj] = src[e];
+            } else {
+                const float *m = ((const kin_mat4 *)xf)[jj].m;
+                for (int c = 0; c < 4; c++)
+                    for (int r = 0; r < 3; r++) T->t[c * 3 + r][jj] = m[c * 4 + r];
+            }
         }
         T->built = b.maxj + 1;
     }
-    const __m512 zero = _mm512_setzero_ps();
-    __m512 ws = zero, r0[4] = { zero, zero, zero, zero }, acc[8];
-    __mmask16 have = 0;   /* lanes whose first influence is known */
-#pragma GCC unroll 8
-    for (int e = 0; e < 8; e++) acc[e] = zero;
-    if (b.maxj >= 32) DQS_SLOTS(1) else DQS_SLOTS(0)
-#pragma GCC unroll 8
-    for (int e = 0; e < 8; e++) q[e] = acc[e];
-    *wsum = ws;
+    const int n = DQS ? 8 : 12;
+    __m512 acc[12];
+#pragma GCC unroll 12
+    for (int e = 0; e < n; e++) acc[e] = _mm512_setzero_ps();
+    if (b.maxj >= 32) blend_slots(T, &b, 1, DQS, acc, wsum);
+    else blend_slots(T, &b, 0, DQS, acc, wsum);
+#pragma GCC unroll 12
+    for (int e = 0; e < n; e++) o[e] = acc[e];
+}
+
+static inline void lbs_block(skin_tab *T, const kin_mesh *mesh, const kin_mat4 *jm, int v,
+                             __m512 a[12], __m512 *wsum)
+{
+    table_block(T, mesh, jm, v, 0, a, wsum);
+}
+
+static inline void dqs_block(skin_tab *T, const kin_mesh *mesh, const kin_dualquat *dq, int v,
+                             __m512 q[8], __m512 *wsum)
+{
+    table_block(T, mesh, dq, v, 1, q, wsum);
 }
 
 #include "kin_skin_simd.inl"

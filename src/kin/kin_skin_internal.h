@@ -34,6 +34,44 @@ static inline unsigned kin__nonzero4(const float *w)
 }
 #endif
 
+/* The references' per-vertex parts (kin_skin.c, kin_dqs.c). How many
+ * extra influence sets they read (0 unless the mesh has them all). */
+static inline int kin__extra_sets(const kin_mesh *mesh)
+{
+    return mesh->joints_extra && mesh->weights_extra && mesh->extra_sets > 0
+           ? mesh->extra_sets : 0;
+}
+
+/* Vertex v's bind position p and its output po; with normals (nrm_out
+ * and the mesh's), its normal n and output no, else both NULL. */
+static inline void kin__vertex(const kin_mesh *mesh, float *pos_out, float *nrm_out, int v,
+                               const float **p, float **po, const float **n, float **no)
+{
+    const int do_n = mesh->normals && nrm_out;
+    *p = mesh->positions + (size_t)v * 3;
+    *po = pos_out + (size_t)v * 3;
+    *n = do_n ? mesh->normals + (size_t)v * 3 : NULL;
+    *no = do_n ? nrm_out + (size_t)v * 3 : NULL;
+}
+
+/* Influence set `set` of vertex v: 0 is JOINTS_0/WEIGHTS_0, then the
+ * mesh's extra sets in order (extra: kin__extra_sets); its 4 joints and
+ * weights. */
+static inline void kin__influences(const kin_mesh *mesh, int extra, int v, int set,
+                                   const uint16_t **j, const float **w)
+{
+    const size_t e = ((size_t)v * (size_t)extra + (size_t)(set - 1)) * 4;
+    *j = set ? mesh->joints_extra + e : mesh->joints + (size_t)v * 4;
+    *w = set ? mesh->weights_extra + e : mesh->weights + (size_t)v * 4;
+}
+
+/* A vertex that keeps its bind pose: p to po, and n to no when n. */
+static inline void kin__bind_pose(const float *p, float *po, const float *n, float *no)
+{
+    po[0] = p[0]; po[1] = p[1]; po[2] = p[2];
+    if (n) { no[0] = n[0]; no[1] = n[1]; no[2] = n[2]; }
+}
+
 /* DQS range rule (kin_dqs.c dq_fit, kin_skin_simd.inl dqs_fit): when
  * |b.r|^2 is not in (KIN__DQS_SQ_MIN, KIN__DQS_SQ_MAX) (a tiny or huge
  * weight sum: k = 2 / |b.r|^2 would overflow, or |b.r|^2 under- or
@@ -50,6 +88,12 @@ static inline unsigned kin__nonzero4(const float *w)
  * 0 (or out of range) = kin_skin_isa(), else the request capped by what
  * the CPU has (never by EGOFUSE_ISA). */
 int kin__skin_isa_of(int isa);
+
+/* The SIMD kernel of a request over a mesh (kin_skin.c): LBS (dqs 0, xf
+ * kin_mat4 *) or DQS (dqs 1, xf kin_dualquat *); returns the first vertex
+ * not done (0: none), from where the caller runs the reference. */
+int kin__skin_simd(const kin_mesh *mesh, const void *xf, int dqs, float *pos_out,
+                   float *nrm_out, int isa);
 
 void kin__skin_lbs_ref(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
                        float *nrm_out, int v0, int v1);

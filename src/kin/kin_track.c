@@ -103,7 +103,6 @@ static void store(kin_track_sample *s, int tag, const float *v)
     }
 }
 
-static int is_space(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 
 int kin_track_parse_line(const char *line, size_t len, kin_track_sample *out,
                          char *why, size_t why_size)
@@ -117,16 +116,8 @@ int kin_track_parse_line(const char *line, size_t len, kin_track_sample *out,
 
     /* tokens */
     char *tok[64];
-    int nt = 0;
-    char *p = buf;
-    for (;;) {
-        while (is_space(*p)) p++;
-        if (!*p || *p == '#') break;
-        if (nt == 64) return fail(why, why_size, "too many fields");
-        tok[nt++] = p;
-        while (*p && !is_space(*p)) p++;
-        if (*p) *p++ = '\0';
-    }
+    int nt = kin__tokens(buf, tok, 64);
+    if (nt < 0) return fail(why, why_size, "too many fields");
     if (nt == 0) return 0;
 
     kin_track_sample s;
@@ -189,11 +180,9 @@ int kin_track_parse(const char *text, size_t text_len, kin_track_sample *out, in
     size_t pos = 0;
     int line_no = 0, n = 0, have_header = 0;
     double last_t = 0.0;
-    while (pos < text_len) {
-        const char *ln = text + pos;
-        const char *nl = memchr(ln, '\n', text_len - pos);
-        size_t len = nl ? (size_t)(nl - ln) : text_len - pos;
-        pos += len + (nl ? 1 : 0);
+    const char *ln;
+    size_t len;
+    while ((ln = kin__next_line(text, text_len, &pos, &len))) {
         line_no++;
         if (!have_header) {
             size_t l = len;

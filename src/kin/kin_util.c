@@ -53,3 +53,17 @@ int kin__parse_number(const char *tok, double *out)
     *out = v;
     return 0;
 }
+
+int kin__tokens(char *buf, char **tok, int cap)
+{
+    int nt = 0;
+    char *p = buf;
+    for (;;) {
+        while (*p == ' ' || *p == '\t' || *p == '\r') p++;
+        if (!*p || *p == '#') return nt;
+        if (nt == cap) return -1;
+        tok[nt++] = p;
+        while (*p && *p != ' ' && *p != '\t' && *p != '\r') p++;
+        if (*p) *p++ = '\0';
+    }
+}

@@ -5,6 +5,7 @@
 #include "pipe_parts.h"
 #include "pipe_internal.h"
 #include "pipe_lens.h"
+#include "pipe_reproj.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -40,6 +41,11 @@ typedef struct eye_state {
     char why[160];
     double ms_raster, ms_convert, ms_fuse, coverage;
     int lod_level;            /* the level drawn */
+    pipe__reproj rp;          /* eye_view REPROJECT: the eye's view */
+    int view_used;            /* this frame: PIPE_VIEW_* */
+    long fallbacks;           /* reprojecting frames that fell back */
+    int thread;               /* 0 the caller's thread, 1 the worker */
+    double t_start;           /* now_ms() at the eye's start */
 } eye_state;
 
 struct pipe_ctx {
@@ -55,6 +61,8 @@ struct pipe_ctx {
     pthread_cond_t cv;
     int job_seq, done_seq, quit;
     int job_kind;             /* JOB_SKIN or JOB_EYE */
+    int eye_next, eye_done;   /* JOB_EYE: the next eye to take (2: none
+                                 left), the eyes finished */
     int skin_split;           /* skin on both threads (large models) */
     kin_skin_plan *plans;     /* per mesh: the skin plan of a skinned mesh */
     void **plan_mem;          /* per mesh: its memory, or NULL */
@@ -76,10 +84,14 @@ enum { JOB_SKIN, JOB_EYE };
  * split over two. AVX-512 skins about 160k vertices per ms. */
 #define PIPE_SPLIT_SKIN_VERTICES 65536
 
+/* The clock of pipe_frame_stats: wall time, or with pipe_set_stats_clock
+ * the calling thread's CPU time. */
+static int stats_cpu_clock;
+
 static double now_ms(void)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(stats_cpu_clock ? CLOCK_THREAD_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
     return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
 }
 
@@ -118,15 +130,16 @@ static fuse_image raw_rows(const pipe_ctx *p, uint8_t *buf)
  * props) into tg through cam: straight for a pinhole, else through the
  * eye's lens map (pipe_lens.h), which writes every pixel of tg. Returns
  * the raster's result; *covered: the mask pixels set. */
-static rast_result eye_draw(pipe_ctx *p, eye_state *e, const kin_camera *cam,
-                            const rast_target *tg, int parts, long *covered)
+static rast_result eye_draw(pipe_ctx *p, eye_state *e, const pipe_lens_map *lens,
+                            const kin_camera *cam, const rast_target *tg, int parts,
+                            long *covered)
 {
     kin_camera pc;
     rast_target it = *tg;
-    if (e->lens) {
-        pc = pipe_lens_pinhole(e->lens, cam);
+    if (lens) {
+        pc = pipe_lens_pinhole(lens, cam);
         cam = &pc;
-        it = pipe_lens_target(e->lens);
+        it = pipe_lens_target(lens);
     }
     rast_context_clear(e->rast, &it); /* only what the last frame drew */
     rast_result rr = parts && pipe__cockpit_active(p->ck)
@@ -139,8 +152,53 @@ static rast_result eye_draw(pipe_ctx *p, eye_state *e, const kin_camera *cam,
                                           e->vnrm, NULL);
     if (rr != RAST_OK) return rr;
     /* Only the tiles the draws marked are read (the rest is clear). */
-    *covered = e->lens ? pipe_lens_warp(e->lens, tg) : rast_context_count(e->rast, &it);
+    *covered = lens ? pipe_lens_warp(lens, tg) : rast_context_count(e->rast, &it);
     return RAST_OK;
+}
+
+/* Reprojection (pipe_reproj.h): the model drawn from the eye, the camera
+ * image sampled through the eye's depths; fe then lights and composites
+ * the eye's view. 1 when fe was switched to it, 0 for the fallback to the
+ * crop (the eye inside the model), -1 on a raster error (e->why set). */
+static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *K)
+{
+    pipe__reproj *r = &e->rp;
+    const int w = r->width, h = r->height, cw = p->geo.crop_width;
+    r->cam = kin_sthmd_eye_camera(&p->hmd, &e->head, (kin_eye)e->eye, w, h);
+    rast_target tg = {w, h, r->depth, w, r->mask, w, r->nrm, 3 * w, 3};
+    long covered = 0;
+    int level = e->lod_level;
+    rast_result rr = eye_draw(p, e, NULL, &r->cam, &tg, 1, &covered);
+    e->lod_level = level;
+    if (rr != RAST_OK) {
+        e->result = PIPE_ERR_RASTER;
+        snprintf(e->why, sizeof e->why, "%s eye: rasterizer (eye view): %s",
+                 e->eye ? "right" : "left", rast_result_str(rr));
+        return -1;
+    }
+    if (pipe__reproj_sample(r, &e->cam, &fe->P, e->mask, cw, e->depth, cw, p->hmd.znear,
+                            p->hmd.zfar)) {
+        e->fallbacks++;
+        return 0;
+    }
+    fe->P = (fuse_image){r->P, w, h, 4 * w};
+    fe->mask = r->M;
+    fe->mask_stride = w;
+    *K = (fuse_intrinsics){r->cam.fx, r->cam.fy, r->cam.cx, r->cam.cy};
+    fe->intrinsics = K;
+    e->view_used = PIPE_VIEW_REPROJECT;
+    return 1;
+}
+
+int pipe__edge_fade_px(const pipe_desc *d)
+{
+    return d->edge_fade == 0 ? PIPE_EDGE_FADE_DEFAULT : d->edge_fade < 0 ? 0 : d->edge_fade;
+}
+
+unsigned pipe__edge_sides(int vx, int vy, int vw, int vh, int ow, int oh)
+{
+    return (vx > 0 ? FUSE_EDGE_LEFT : 0u) | (vx + vw < ow ? FUSE_EDGE_RIGHT : 0u) |
+           (vy > 0 ? FUSE_EDGE_TOP : 0u) | (vy + vh < oh ? FUSE_EDGE_BOTTOM : 0u);
 }
 
 static void run_eye(pipe_ctx *p, eye_state *e)
@@ -148,12 +206,13 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     const pipe_frame_in *in = e->in;
     const int cw = p->geo.crop_width, ch = p->geo.crop_height;
     double t0 = now_ms();
+    e->t_start = t0;
     e->result = PIPE_OK;
     e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
     rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
     long covered = 0;
     e->lod_level = 0;
-    rast_result rr = eye_draw(p, e, &e->cam, &tg, 1, &covered);
+    rast_result rr = eye_draw(p, e, e->lens, &e->cam, &tg, 1, &covered);
     if (rr == RAST_OK && e->aa.count) { /* no lens here: refused at pipe_create */
         pipe__aa_begin(&e->aa);
         rr = pipe__cockpit_active(p->ck)
@@ -249,27 +308,43 @@ static void run_eye(pipe_ctx *p, eye_state *e)
             pipe_fit_measure(p->fit, e->eye, &e->cam, p->pose.world, e->mask, cw, e->refined, cw);
         }
     }
+    /* the eye's view instead of the camera's crop (pipe_reproj.h) */
+    const fuse_image Pcam = fe.P;
+    fuse_intrinsics EK;
+    e->view_used = PIPE_VIEW_CROP;
+    if (p->desc.eye_view == PIPE_VIEW_REPROJECT && reproj_eye(p, e, &fe, &EK) < 0) return;
+    const int rp = e->view_used == PIPE_VIEW_REPROJECT;
     e->shown = fe.mask;
-    fe.normal = e->nrm;
+    fe.normal = rp ? e->rp.nrm : e->nrm;
     fe.normal_stride = 3 * cw;
     /* coverage beyond the model's pixel centres: its neighbours' normals */
     if (e->aa.count && p->desc.normal_smooth == 0)
         pipe__aa_fill_normals(&e->aa, fe.mask, e->mask, e->nrm);
     if (p->desc.normal_smooth > 0 &&
-        fuse_normal_smooth(fe.mask, fe.mask_stride, e->nrm, 3 * cw, e->snrm, 3 * cw, cw, ch,
+        fuse_normal_smooth(fe.mask, fe.mask_stride, fe.normal, 3 * cw, e->snrm, 3 * cw, cw, ch,
                            p->desc.normal_smooth) == FUSE_OK)
         fe.normal = e->snrm;
     fe.Q = (fuse_image){e->layer, cw, ch, 4 * cw};
     fe.V = in->virt[e->eye];
-    fe.vp_x0 = p->geo.vp_x0;
-    fe.vp_y0 = p->geo.vp_y0;
-    fe.vp_w = p->geo.vp_width;
-    fe.vp_h = p->geo.vp_height;
+    fe.vp_x0 = rp ? 0 : p->geo.vp_x0;
+    fe.vp_y0 = rp ? 0 : p->geo.vp_y0;
+    fe.vp_w = rp ? p->hmd.lcd_width : p->geo.vp_width;
+    fe.vp_h = rp ? p->hmd.lcd_height : p->geo.vp_height;
     fe.out = in->out[e->eye];
     fe.v_opaque = in->virt_opaque != 0;
+    /* soft edges on the viewport's sides inside the output (pipe_desc.edge_fade) */
+    fe.edge_fade = pipe__edge_fade_px(&p->desc);
+    fe.edge_sides = pipe__edge_sides(fe.vp_x0, fe.vp_y0, fe.vp_w, fe.vp_h, fe.out.width,
+                                     fe.out.height);
     fuse_depth dt;
     int filled[4] = {0, 0, 0, 0};
-    if (in->virt_depth[e->eye]) {
+    if (in->virt_depth[e->eye] && rp) {
+        /* the eye's own depths: the scene's distances are the eye's */
+        dt = (fuse_depth){e->rp.depth, cw, p->hmd.znear, p->hmd.zfar, 0.0f,
+                          in->virt_depth[e->eye], in->virt_depth_stride[e->eye],
+                          fe.V.width, fe.V.height};
+        fe.depth = &dt;
+    } else if (in->virt_depth[e->eye]) {
         dt = (fuse_depth){e->depth, cw, p->hmd.znear, p->hmd.zfar, p->hmd.cam_offset_m,
                           in->virt_depth[e->eye], in->virt_depth_stride[e->eye],
                           fe.V.width, fe.V.height};
@@ -289,7 +364,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     fuse_result fr = FUSE_OK;
     if (p->desc.tone_match > 0.0f) {
         float tone[3];
-        fr = fuse_tone_match(&fe.P, e->mask, cw, &fe.V, fe.vp_x0, fe.vp_y0, fe.vp_w,
+        fr = fuse_tone_match(&Pcam, e->mask, cw, &fe.V, fe.vp_x0, fe.vp_y0, fe.vp_w,
                              fe.vp_h, p->desc.tone_match, tone);
         for (int k = 0; k < 3; k++) L.tone[k] *= tone[k];
     }
@@ -307,6 +382,21 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     }
 }
 
+/* With p->mu held: runs the eyes of the current JOB_EYE that no thread
+ * has taken yet on this thread (0 the caller's, 1 the worker), each
+ * with the lock released; returns with it held. */
+static void take_eyes(pipe_ctx *p, int thread)
+{
+    while (p->eye_next < 2) {
+        eye_state *e = &p->eye[p->eye_next++];
+        pthread_mutex_unlock(&p->mu);
+        e->thread = thread;
+        run_eye(p, e);
+        pthread_mutex_lock(&p->mu);
+        p->eye_done++;
+    }
+}
+
 static void *worker_main(void *arg)
 {
     pipe_ctx *p = arg;
@@ -316,11 +406,15 @@ static void *worker_main(void *arg)
         while (p->job_seq == seen && !p->quit) pthread_cond_wait(&p->cv, &p->mu);
         if (p->quit) break;
         seen = p->job_seq;
-        int kind = p->job_kind;
-        pthread_mutex_unlock(&p->mu);
-        if (kind == JOB_SKIN) pipe__pose_skin_part(&p->pose, p->plans, 1, 2);
-        else run_eye(p, &p->eye[1]);
-        pthread_mutex_lock(&p->mu);
+        if (p->job_kind == JOB_EYE) {
+            /* the eyes not yet taken by the caller's thread (none when it
+             * was faster than this thread's wake-up) */
+            take_eyes(p, 1);
+        } else {
+            pthread_mutex_unlock(&p->mu);
+            pipe__pose_skin_part(&p->pose, p->plans, 1, 2);
+            pthread_mutex_lock(&p->mu);
+        }
         p->done_seq = seen;
         pthread_cond_broadcast(&p->cv);
     }
@@ -366,6 +460,7 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].refined);
         free(p->eye[e].refine_scratch);
         pipe__aa_free(&p->eye[e].aa);
+        pipe__reproj_free(&p->eye[e].rp);
         rast_context_destroy(p->eye[e].rast);
         fuse_context_destroy(p->eye[e].fuse);
         pipe_lens_map_free(p->eye[e].lens);
@@ -416,6 +511,11 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
     if (desc && desc->aa_samples != 0 && desc->aa_samples != 4 && desc->aa_samples != 8 &&
         desc->aa_samples != 16)
         return NULL;
+    if (desc && desc->eye_view != PIPE_VIEW_CROP &&
+        (desc->eye_view != PIPE_VIEW_REPROJECT || desc->aa_samples != 0 ||
+         pipe_view_check(&desc->hmd, NULL, 0) != 0))
+        return NULL;
+    if (desc && (desc->edge_fade < -1 || desc->edge_fade > FUSE_EDGE_FADE_MAX)) return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
     if (desc) p->desc = *desc;
@@ -477,6 +577,8 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         /* coverage samples are drawn through the pinhole: not with a
          * distorting lens (pipe.h ANTI-ALIASED EDGES) */
         if (ok && p->desc.aa_samples && s->lens) ok = 0;
+        if (ok && p->desc.eye_view == PIPE_VIEW_REPROJECT)
+            ok = pipe__reproj_init(&s->rp, p->geo.crop_width, p->geo.crop_height) == 0;
         if (ok && p->desc.aa_samples)
             ok = pipe__aa_init(&s->aa, p->desc.aa_samples, p->geo.crop_width,
                                p->geo.crop_height, p->desc.refine_band > 0) == 0;
@@ -568,7 +670,7 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
         if (pipe_fit_learned(p->fit, e)) continue;
         rast_target tg = {cw, ch, s->depth, cw, s->mask, cw, s->nrm, 3 * cw, 3};
         long covered;
-        rast_result rr = eye_draw(p, s, &cam[e], &tg, 0, &covered);
+        rast_result rr = eye_draw(p, s, s->lens, &cam[e], &tg, 0, &covered);
         const uint8_t *prev = s->have_refined && !p->fit_no_prev ? s->refined : NULL;
         fuse_result lr =
             rr == RAST_OK ? pipe_fit_learn(p->fit, e, &P[e], s->mask, cw, prev, cw) : FUSE_OK;
@@ -660,13 +762,28 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
         p->eye[e].head = head;
     }
     if (p->threaded) {
-        int job = post_job(p, JOB_EYE);
+        /* Eye 0 here, eye 1 on whichever thread is free first: the worker
+         * when it has woken, else this one (no wait for a late wake-up). */
+        pthread_mutex_lock(&p->mu);
+        p->eye_next = 1;
+        p->eye_done = 0;
+        p->job_kind = JOB_EYE;
+        ++p->job_seq;
+        pthread_cond_broadcast(&p->cv);
+        pthread_mutex_unlock(&p->mu);
+        p->eye[0].thread = 0;
         run_eye(p, &p->eye[0]);
-        wait_job(p, job);
+        pthread_mutex_lock(&p->mu);
+        p->eye_done++;
+        take_eyes(p, 0);
+        while (p->eye_done < 2) pthread_cond_wait(&p->cv, &p->mu);
+        pthread_mutex_unlock(&p->mu);
     } else {
+        p->eye[0].thread = p->eye[1].thread = 0;
         run_eye(p, &p->eye[0]);
         run_eye(p, &p->eye[1]);
     }
+    double t2 = now_ms();
     if (stats) {
         stats->ms_pose = t1 - t0;
         for (int e = 0; e < 2; e++) {
@@ -675,7 +792,16 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
             stats->ms_fuse[e] = p->eye[e].ms_fuse;
             stats->coverage[e] = p->eye[e].coverage;
             stats->lod_level[e] = p->eye[e].lod_level;
+            int rp = p->eye[e].view_used == PIPE_VIEW_REPROJECT;
+            stats->view[e] = p->eye[e].view_used;
+            stats->view_sampled[e] = rp ? p->eye[e].rp.sampled : 0;
+            stats->view_filled[e] = rp ? p->eye[e].rp.filled : 0;
+            stats->view_outside[e] = rp ? p->eye[e].rp.outside : 0;
+            stats->eye_thread[e] = p->eye[e].thread;
+            stats->ms_eye_start[e] = p->eye[e].t_start - t1;
         }
+        stats->view_fallbacks = p->eye[0].fallbacks + p->eye[1].fallbacks;
+        stats->ms_eyes = t2 - t1;
         stats->ms_total = now_ms() - t0;
     }
     for (int e = 0; e < 2; e++) {
@@ -712,6 +838,20 @@ const uint8_t *pipe_layer(const pipe_ctx *p, int eye, int *width, int *height)
 }
 
 kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].cam; }
+
+kin_camera pipe_view_camera(const pipe_ctx *p, int eye)
+{
+    const eye_state *e = &p->eye[eye ? 1 : 0];
+    return e->view_used == PIPE_VIEW_REPROJECT ? e->rp.cam : e->cam;
+}
+
+const uint8_t *pipe_view_mask(const pipe_ctx *p, int eye, int *width, int *height)
+{
+    const eye_state *e = &p->eye[eye ? 1 : 0];
+    if (width) *width = e->rp.width;
+    if (height) *height = e->rp.height;
+    return e->view_used == PIPE_VIEW_REPROJECT ? e->rp.M : NULL;
+}
 
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }
 
@@ -750,6 +890,8 @@ int pipe_image_opaque(const fuse_image *im, int x0, int y0, int w, int h)
     }
     return 1;
 }
+
+void pipe_set_stats_clock(int thread_cpu) { stats_cpu_clock = thread_cpu != 0; }
 
 int pipe_isa(const pipe_ctx *p) { return rast_context_isa(p->eye[0].rast); }
 

@@ -37,12 +37,14 @@
 
 #include "../fit/fit.h"
 #include "../fuse/fuse.h"
+#include "../fuse/fuse_edge.h"
 #include "../fuse/fuse_normals.h"
 #include "../fuse/fuse_refine.h"
 #include "../kin/kin.h"
 #include "../raster/raster.h"
 #include "pipe_lod.h"
 #include "pipe_pose.h"
+#include "pipe_reproj.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -100,7 +102,31 @@ typedef struct pipe_desc {
                                  the pinhole): pipe_create returns NULL.
                                  With a level of detail the samples still
                                  draw the full model. */
+    int eye_view;             /* PIPE_VIEW_CROP = 0 (default): the paper's
+                                 crop and scale (eq. 1-4), the bytes of
+                                 before; PIPE_VIEW_REPROJECT: each eye's
+                                 hands reprojected from its camera by the
+                                 model's depth, composited into the whole
+                                 display (pipe_reproj.h, docs/eyeview.md).
+                                 Another value, reprojection with
+                                 aa_samples, or hmd.ipd_m / cam_offset_m
+                                 out of range (pipe_view_check):
+                                 pipe_create returns NULL. */
+    int edge_fade;            /* soft viewport edges (issue 18, fuse_edge.h):
+                                 where the camera image ends inside the
+                                 display (the viewport's sides that do not
+                                 touch the output's border), the hands fade
+                                 over the last k camera pixels of the
+                                 layer. 0 = the default,
+                                 PIPE_EDGE_FADE_DEFAULT pixels; 1..
+                                 FUSE_EDGE_FADE_MAX: k; -1: off (the hard
+                                 cut, the bytes of before). Other values:
+                                 pipe_create returns NULL. */
 } pipe_desc;
+
+/* The default width of the soft viewport edges, in camera pixels (about
+ * 7.5 display pixels with the paper's viewport). */
+#define PIPE_EDGE_FADE_DEFAULT 4
 
 /* ANTI-ALIASED EDGES (pipe_desc.aa_samples = n). Each eye's model is drawn
  * a second time into n coverage samples per pixel (rast_draw_aa, the
@@ -194,6 +220,23 @@ typedef struct pipe_frame_stats {
     double coverage[2];       /* fraction of camera pixels in the mask */
     int lod_level[2];         /* per eye: the level of detail drawn
                                  (pipe_set_lod; 0 = the full model) */
+    int view[2];              /* per eye: the method used, PIPE_VIEW_*
+                                 (CROP when a reprojecting eye fell back:
+                                 the eye inside the model) */
+    long view_sampled[2];     /* reprojection, per eye: eye pixels sampled
+                                 from the camera, filled (seen by the eye,
+                                 not by the camera) and outside the
+                                 camera's image (pipe_reproj.h) */
+    long view_filled[2];
+    long view_outside[2];
+    long view_fallbacks;      /* reprojection: eye-frames that fell back
+                                 to the crop, since pipe_create */
+    /* Where the eyes ran (threads 2: each eye is taken by whichever
+     * thread is free first, so the caller's thread runs both when the
+     * worker has not woken by the time it finished its first) */
+    int eye_thread[2];        /* per eye: 0 the caller's thread, 1 the worker */
+    double ms_eye_start[2];   /* per eye: ms from the eyes' hand-off to its start */
+    double ms_eyes;           /* wall time from the hand-off to both eyes done */
 } pipe_frame_stats;
 
 typedef enum pipe_result {
@@ -228,8 +271,24 @@ const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
 const uint8_t *pipe_layer(const pipe_ctx *p, int eye, int *width, int *height);
 /* The camera of one eye in the last frame. */
 kin_camera pipe_camera(const pipe_ctx *p, int eye);
+/* With pipe_desc.eye_view = PIPE_VIEW_REPROJECT: the eye's own camera of
+ * the last frame (kin_sthmd_eye_camera at the layer's size, which
+ * pipe_layer then has), and the eye-view mask composited (0..255: the
+ * border fade, 0 outside the camera's view; width x height = the crop's
+ * size, covering the whole display). pipe_view_mask is NULL, and
+ * pipe_view_camera the camera's, for the crop method and for an eye that
+ * fell back to it in the last frame. */
+kin_camera pipe_view_camera(const pipe_ctx *p, int eye);
+const uint8_t *pipe_view_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The ISA that raster and fuse use (an ef_isa value). */
 int pipe_isa(const pipe_ctx *p);
+
+/* The clock of every pipe_frame_stats time, for all contexts: 0 (the
+ * default) wall time (CLOCK_MONOTONIC), 1 the CPU time of the thread that
+ * runs the stage (CLOCK_THREAD_CPUTIME_ID: for benchmarks on a shared
+ * machine, where wall time measures the neighbours; a thread's waits do
+ * not count). Set it before any pipe_frame runs. */
+void pipe_set_stats_clock(int thread_cpu);
 /* The derived HMD numbers in use (crop, viewport). */
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p);
 /* 1 when every pixel of the rectangle (x0, y0, w, h) of the RGBA8 image

@@ -20,4 +20,13 @@ void pipe__pose_locals_anim(pipe_pose *ps, const kin_animation *anim, float t);
 int pipe__fail(char *why, int why_size, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
+/* Soft viewport edges (pipe_desc.edge_fade, fuse_edge.h): the ramp width in
+ * camera pixels the desc asks for (0: off), and the sides of the viewport
+ * (vx, vy, vw, vh) that end inside an ow x oh output (FUSE_EDGE_*). A
+ * reprojection fades its camera samples with fuse_edge_weight(sx, sy,
+ * cam_w, cam_h, pipe__edge_fade_px(d), FUSE_EDGE_ALL). */
+struct pipe_desc;
+int pipe__edge_fade_px(const struct pipe_desc *d);
+unsigned pipe__edge_sides(int vx, int vy, int vw, int vh, int ow, int oh);
+
 #endif

@@ -507,6 +507,18 @@ static rast_result draw_mesh(rast_context *ctx, const kin_camera *cam, const ras
     return ctx ? rast_context_draw(ctx, tg, &d, NULL) : rast_draw(tg, &d, NULL);
 }
 
+/* The triangles of the operator's mesh i (me) the current visibility
+ * set draws: its index list in *ix, the triangle count returned. */
+static int mesh_tris(const pipe__cockpit *c, const kin_mesh *me, int i, const uint32_t **ix)
+{
+    if (c->set) {
+        *ix = c->lists[c->set][i];
+        return c->nvis[c->set][i];
+    }
+    *ix = me->indices;
+    return me->index_count / 3;
+}
+
 rast_result pipe__cockpit_draw(pipe__cockpit *c, const pipe_pose *ps, int eye,
                                rast_context *ctx, const kin_camera *cam,
                                const rast_target *target, rast_cull cull, float *clip,
@@ -515,12 +527,8 @@ rast_result pipe__cockpit_draw(pipe__cockpit *c, const pipe_pose *ps, int eye,
     const kin_model *m = ps->model;
     for (int i = 0; i < m->mesh_count; i++) {
         const kin_mesh *me = &ps->meshes[i];
-        const uint32_t *ix = me->indices;
-        int nt = me->index_count / 3;
-        if (c->set) {
-            ix = c->lists[c->set][i];
-            nt = c->nvis[c->set][i];
-        }
+        const uint32_t *ix;
+        int nt = mesh_tris(c, me, i, &ix);
         rast_result r = draw_mesh(ctx, cam, target, cull, ps->pos[i], ps->nrm[i],
                                   me->vertex_count, ix, nt, clip, vnrm);
         if (r != RAST_OK) return r;
@@ -546,12 +554,8 @@ rast_result pipe__cockpit_draw_aa(pipe__cockpit *c, const pipe_pose *ps, int eye
     const kin_model *m = ps->model;
     for (int i = 0; i < m->mesh_count; i++) {
         const kin_mesh *me = &ps->meshes[i];
-        const uint32_t *ix = me->indices;
-        int nt = me->index_count / 3;
-        if (c->set) {
-            ix = c->lists[c->set][i];
-            nt = c->nvis[c->set][i];
-        }
+        const uint32_t *ix;
+        int nt = mesh_tris(c, me, i, &ix);
         if (nt <= 0) continue;
         rast_transform_points(cam->view_proj.m, ps->pos[i], me->vertex_count, clip);
         rast_result r = pipe__aa_draw(aa, ctx, clip, me->vertex_count, ix, nt, cull);

@@ -146,8 +146,9 @@ static inline void tu_stages_free(tu_stages *s)
 /* One eye of a tu_quad_model frame by hand: the quad (posed by node 1's
  * rest transform) rastered by cam into s->mask (the crop's size, no
  * culling), the default lighting's first light turned into cam's view,
- * the crop P lit into s->layer and composited over V into R at the
- * viewport (vx, vy, vw, vh). */
+ * the crop P lit into s->layer, faded at the viewport's sides inside V as
+ * the pipeline does by default (fuse_edge_fade, PIPE_EDGE_FADE_DEFAULT)
+ * and composited over V into R at the viewport (vx, vy, vw, vh). */
 static inline void tu_quad_stages(const kin_model *m, const kin_camera *cam, tu_stages *s,
                                   const fuse_image *P, const fuse_image *V, int vx, int vy,
                                   int vw, int vh, fuse_image *R)
@@ -171,6 +172,11 @@ static inline void tu_quad_stages(const kin_model *m, const kin_camera *cam, tu_
     fuse_intrinsics K = {cam->fx, cam->fy, cam->cx, cam->cy};
     fuse_image Q = {s->layer, cw, ch, cw * 4};
     assert_int_equal(fuse_light(&L, &K, P, s->mask, cw, s->nrm, cw * 3, &Q), FUSE_OK);
+    /* the pipeline's default soft edges (pipe_desc.edge_fade 0): the sides
+     * of the viewport inside V */
+    const unsigned sides = (vx > 0 ? FUSE_EDGE_LEFT : 0u) | (vx + vw < V->width ? FUSE_EDGE_RIGHT : 0u) |
+                           (vy > 0 ? FUSE_EDGE_TOP : 0u) | (vy + vh < V->height ? FUSE_EDGE_BOTTOM : 0u);
+    assert_int_equal(fuse_edge_fade(&Q, PIPE_EDGE_FADE_DEFAULT, sides), FUSE_OK);
     assert_int_equal(fuse_composite(&Q, V, vx, vy, vw, vh, R), FUSE_OK);
 }
 

@@ -1,4 +1,5 @@
 #include "testutil.h"
+#include "fd_count.h"
 
 #include <dirent.h>
 #include <signal.h>
@@ -132,14 +133,16 @@ int tu_runl(char *out, size_t out_size, const char *prog, const char *a0, ...)
     return tu_run(argv, out, out_size);
 }
 
-int tu_count_fds(void)
+int tu_count_fds(void) { return tu_fd_count(); }
+
+int tu_file_is(const char *path, const char *text)
 {
-    DIR *d = opendir("/proc/self/fd");
-    int n = 0;
-    if (!d) return -1;
-    while (readdir(d)) n++;
-    closedir(d);
-    return n;
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    char buf[256] = {0};
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    return n == strlen(text) && memcmp(buf, text, n) == 0;
 }
 
 int tu_samples_dir(const char *name, int frames, char *dir, size_t n, char *why, size_t why_n)

@@ -53,6 +53,9 @@ int tu_runl(char *out, size_t out_size, const char *prog, const char *a0, ...);
 /* Open descriptors of this process (entries of /proc/self/fd, its own
  * listing's included), -1 when it cannot be read: compare before and after. */
 int tu_count_fds(void);
+/* 1 when the file holds exactly text (under 256 bytes), else 0 (also
+ * when it cannot be read). */
+int tu_file_is(const char *path, const char *text);
 /* The generated samples (gen_samples' output) for a test: the build's own
  * build/samples when it is at least as new as the generator next to
  * EGOFUSE_BIN (a stale folder from an older generator is not used), else

@@ -30,38 +30,13 @@
 
 #include "../../src/io/io_dev.h"
 #include "../../src/io/io_vsrc.h"
-
-static int failures;
-
-static void check(int ok, const char *name, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static void check(int ok, const char *name, const char *fmt, ...)
-{
-    char buf[1024];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
-    va_end(ap);
-    printf("VMTEST %s %s %s\n", name, ok ? "PASS" : "FAIL", buf);
-    fflush(stdout);
-    if (!ok) failures++;
-}
+#include "vm_check.h"
 
 static double now_s(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int count_fds(void)
-{
-    DIR *d = opendir("/proc/self/fd");
-    int n = 0;
-    if (!d) return -1;
-    while (readdir(d)) n++;
-    closedir(d);
-    return n;
 }
 
 /* ------------------------------------------------------------- capture */

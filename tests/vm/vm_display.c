@@ -31,8 +31,8 @@
 
 #include "../../src/io/io_display.h"
 #include "display_pattern.h"
+#include "vm_check.h"
 
-static int failures;
 static volatile sig_atomic_t sigint_seen;
 static void on_sigint(int sig)
 {
@@ -40,34 +40,11 @@ static void on_sigint(int sig)
     sigint_seen = 1;
 }
 
-static void check(int ok, const char *name, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-static void check(int ok, const char *name, const char *fmt, ...)
-{
-    char buf[2048];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(buf, sizeof buf, fmt, ap);
-    va_end(ap);
-    printf("VMTEST %s %s %s\n", name, ok ? "PASS" : "FAIL", buf);
-    fflush(stdout);
-    if (!ok) failures++;
-}
-
 static uint64_t now_ns(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
-}
-
-static int count_fds(void)
-{
-    DIR *d = opendir("/proc/self/fd");
-    int n = 0;
-    if (!d) return -1;
-    while (readdir(d)) n++;
-    closedir(d);
-    return n;
 }
 
 /* ------------------------------------------------------- CRTC snapshots */

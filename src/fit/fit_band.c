@@ -1,0 +1,213 @@
+/* fit_band.c - the refinement band from the projected uncertainty of the
+ * hands (fit_band.h). */
+#include "fit_band.h"
+
+#include <math.h>
+#include <string.h>
+
+pipe_fit_band_desc pipe_fit_band_desc_default(void)
+{
+    pipe_fit_band_desc d;
+    d.sigma = 0.02f;
+    d.tau = 0.0f;
+    d.reach = 32.0f;
+    d.band_min = 16;
+    d.band_max = 64;
+    d.hand_radius = 0.04f;
+    return d;
+}
+
+static int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }
+
+/* Image position and depth of joint n; 0 when behind the camera or
+ * farther than reach outside the image. */
+static int joint_px(const kin_camera *cam, const kin_mat4 *m, float reach, float *x, float *y,
+                    float *z)
+{
+    const float *V = cam->view.m;
+    const float px = m->m[12], py = m->m[13], pz = m->m[14];
+    /* view space (column-major, looks down -Z) */
+    float xv = V[0] * px + V[4] * py + V[8] * pz + V[12];
+    float yv = V[1] * px + V[5] * py + V[9] * pz + V[13];
+    float zv = V[2] * px + V[6] * py + V[10] * pz + V[14];
+    *z = -zv;
+    if (!(*z > 1e-3f)) return 0;
+    *x = cam->cx + cam->fx * xv / *z;
+    *y = cam->cy - cam->fy * yv / *z;
+    return *x >= -reach && *y >= -reach && *x <= (float)cam->width + reach &&
+           *y <= (float)cam->height + reach;
+}
+
+int pipe_fit_band(const pipe_fit_band_desc *dp, const kin_camera *cam, const kin_mat4 *world,
+                  const kin_arm_rig *rig, unsigned sides, const float speed[2])
+{
+    pipe_fit_band_desc d = dp ? *dp : pipe_fit_band_desc_default();
+    const int lo = clampi(d.band_min, 1, 64), hi = clampi(d.band_max, lo, 64);
+    if (!cam || !world || !rig || !(d.sigma >= 0.0f) || !(d.tau >= 0.0f) || !(d.reach >= 0.0f))
+        return lo;
+    const float f = 0.5f * (cam->fx + cam->fy);
+    float u = 0.0f;
+    for (int s = 0; s < 2; s++) {
+        if (!(sides & (1u << s))) continue;
+        float zmin = INFINITY;
+        for (int j = KIN_RIG_HAND; j < KIN_RIG_SIDE_JOINTS; j++) {
+            const int n = rig->joint[s][j];
+            if (n < 0) return lo;
+            float x, y, z;
+            if (!joint_px(cam, &world[n], d.reach, &x, &y, &z)) continue;
+            if (z < zmin) zmin = z;
+        }
+        if (!isfinite(zmin)) continue;
+        float v = speed && isfinite(speed[s]) && speed[s] > 0.0f ? speed[s] : 0.0f;
+        float us = f * (d.sigma + v * d.tau) / zmin;
+        if (us > u) u = us;
+    }
+    float b = ceilf(u);
+    return b >= (float)hi ? hi : b <= (float)lo ? lo : (int)b;
+}
+
+long pipe_fit_band_region(const pipe_fit_band_desc *dp, const kin_camera *cam,
+                          const kin_mat4 *world, const kin_arm_rig *rig, unsigned sides,
+                          int band, uint8_t *region, int stride)
+{
+    if (!region) return 0;
+    pipe_fit_band_desc d = dp ? *dp : pipe_fit_band_desc_default();
+    if (!cam || !world || !rig || cam->width < 1 || cam->height < 1 || stride < cam->width ||
+        !(d.reach >= 0.0f) || !(d.hand_radius >= 0.0f))
+        return 0;
+    const int W = cam->width, H = cam->height;
+    for (int y = 0; y < H; y++) memset(region + (size_t)y * (size_t)stride, 0, (size_t)W);
+    const float f = 0.5f * (cam->fx + cam->fy);
+    long n_set = 0;
+    for (int s = 0; s < 2; s++) {
+        if (!(sides & (1u << s))) continue;
+        for (int j = KIN_RIG_HAND; j < KIN_RIG_SIDE_JOINTS; j++) {
+            const int n = rig->joint[s][j];
+            if (n < 0) return n_set;
+            float x, y, z;
+            if (!joint_px(cam, &world[n], d.reach, &x, &y, &z)) continue;
+            float r = f * d.hand_radius / z + (float)band;
+            if (r > (float)(W + H)) r = (float)(W + H);
+            const int y0 = (int)floorf(y - r) < 0 ? 0 : (int)floorf(y - r);
+            const int y1 = (int)ceilf(y + r) >= H ? H - 1 : (int)ceilf(y + r);
+            for (int yy = y0; yy <= y1; yy++) {
+                const float dy = (float)yy + 0.5f - y, h2 = r * r - dy * dy;
+                if (h2 < 0.0f) continue;
+                const float hw = sqrtf(h2);
+                int x0 = (int)ceilf(x - hw - 0.5f), x1 = (int)floorf(x + hw - 0.5f);
+                if (x0 < 0) x0 = 0;
+                if (x1 >= W) x1 = W - 1;
+                uint8_t *row = region + (size_t)yy * (size_t)stride;
+                for (int xx = x0; xx <= x1; xx++) {
+                    n_set += row[xx] == 0;
+                    row[xx] = 255;
+                }
+            }
+        }
+    }
+    return n_set;
+}
+
+void pipe_fit_band_merge(const uint8_t *narrow, const uint8_t *wide, const uint8_t *region,
+                         uint8_t *out, int stride, int width, int height)
+{
+    if (!narrow || !wide || !region || !out || width < 1 || height < 1 || stride < width)
+        return;
+    for (int y = 0; y < height; y++) {
+        const size_t o = (size_t)y * (size_t)stride;
+        for (int x = 0; x < width; x++)
+            out[o + x] = region[o + x] ? wide[o + x] : narrow[o + x];
+    }
+}
+
+const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *d, const kin_camera *cam,
+                              const kin_mat4 *world, const kin_arm_rig *rig, unsigned sides,
+                              const float speed[2], float max_speed, const float shift[2][2],
+                              const uint8_t *kin, const uint8_t *prev, uint8_t *region,
+                              uint8_t *out, int stride)
+{
+    if (!kin || !prev || !region || !out || !cam || !world || !rig || !speed ||
+        stride < cam->width)
+        return kin;
+    const int W = cam->width, H = cam->height;
+    int any = 0;
+    for (int k = 0; k < 2; k++) {
+        if (!(sides & (1u << k)) || !(speed[k] < max_speed)) continue;
+        if (pipe_fit_band_region(d, cam, world, rig, 1u << k, 0, region, stride) <= 0) continue;
+        if (!any) {
+            for (int y = 0; y < H; y++)
+                memcpy(out + (size_t)y * (size_t)stride, kin + (size_t)y * (size_t)stride,
+                       (size_t)W);
+            any = 1;
+        }
+        int sx = 0, sy = 0;
+        if (shift && isfinite(shift[k][0]) && isfinite(shift[k][1]) &&
+            fabsf(shift[k][0]) < (float)W && fabsf(shift[k][1]) < (float)H) {
+            sx = (int)lrintf(shift[k][0]);
+            sy = (int)lrintf(shift[k][1]);
+        }
+        for (int y = 0; y < H; y++) {
+            const uint8_t *r = region + (size_t)y * (size_t)stride;
+            uint8_t *o = out + (size_t)y * (size_t)stride;
+            const int ys = y - sy;
+            for (int x = 0; x < W; x++) {
+                if (!r[x]) continue;
+                const int xs = x - sx;
+                if (ys < 0 || ys >= H || xs < 0 || xs >= W) continue;   /* kin stays */
+                o[x] = prev[(size_t)ys * (size_t)stride + (size_t)xs];
+            }
+        }
+    }
+    return any ? out : kin;
+}
+
+int pipe_fit_hand_px(const kin_camera *cam, const kin_mat4 *world, const kin_arm_rig *rig,
+                     int side, float xy[2])
+{
+    if (!cam || !world || !rig || !xy || side < 0 || side > 1) return 0;
+    double sx = 0.0, sy = 0.0;
+    int n = 0;
+    for (int j = KIN_RIG_HAND; j < KIN_RIG_SIDE_JOINTS; j++) {
+        const int node = rig->joint[side][j];
+        if (node < 0) return 0;
+        float x, y, z;
+        if (!joint_px(cam, &world[node], INFINITY, &x, &y, &z)) continue;
+        sx += x;
+        sy += y;
+        n++;
+    }
+    if (!n) return 0;
+    xy[0] = (float)(sx / n);
+    xy[1] = (float)(sy / n);
+    return 1;
+}
+
+void pipe_fit_filter_output(const kin_filter *f, double display_t, float v0, float v1,
+                            kin_track_sample *out, float speed[2])
+{
+    if (!f || !out) return;
+    kin_filter_output(f, display_t, out, NULL);
+    float sp[2];
+    for (int k = 0; k < 2; k++) {
+        /* the filter's parts: head, shoulder L/R, hand L/R, glove L/R */
+        const kin_vec3 v = f->part[3 + k].dx;
+        sp[k] = sqrtf(v.x * v.x + v.y * v.y + v.z * v.z);
+        if (!isfinite(sp[k])) sp[k] = 0.0f;
+        if (speed) speed[k] = sp[k];
+    }
+    if (!f->desc.no_lag_comp || !(v1 > v0)) return;
+    kin_filter g = *f;
+    g.desc.no_lag_comp = 0;
+    kin_track_sample c;
+    kin_filter_output(&g, display_t, &c, NULL);
+    for (int k = 0; k < 2; k++) {
+        const uint32_t bit = k ? KIN_TRACK_HAND_R : KIN_TRACK_HAND_L;
+        if (!(out->valid & bit) || !(c.valid & bit)) continue;
+        float a = (sp[k] - v0) / (v1 - v0);
+        if (!(a > 0.0f)) continue;
+        if (a > 1.0f) a = 1.0f;
+        const kin_vec3 p = out->hand_pos[k], q = c.hand_pos[k];
+        out->hand_pos[k] = kin_v3(p.x + a * (q.x - p.x), p.y + a * (q.y - p.y), p.z + a * (q.z - p.z));
+        out->hand_rot[k] = kin_quat_slerp(out->hand_rot[k], c.hand_rot[k], a);
+    }
+}

@@ -1,0 +1,135 @@
+/* pipe_reproj.h - the hands as the eye sees them: reprojection from the
+ * cameras to the eyes by the model's depth (issue 18 items 1, 3; docs/eyeview.md).
+ *
+ * WHAT IT DOES
+ *   The paper's correction of the camera offset D (eq. 2-4: crop, scale,
+ *   viewport) is exact only for a plane at F = 1 m. With
+ *   pipe_desc.eye_view = PIPE_VIEW_REPROJECT each eye instead
+ *     1. draws the posed model from the EYE (kin_sthmd_eye_camera: the
+ *        eye at +-ipd/2 with the head's orientation, a pinhole of the
+ *        display's FOVs) into an eye G-buffer of the crop's size
+ *        (640 x 400 for the paper), covering the whole display;
+ *     2. for every covered eye pixel, takes its 3D point from the eye
+ *        depth, projects it into the real camera (pipe_camera(), through
+ *        its lens: kin_lens_project, so no undistort pass) and samples
+ *        the cropped camera image there (bilinear, only the taps inside
+ *        the camera's own mask that show the same surface (the occlusion
+ *        test below), renormalised, so neither the room behind the hand
+ *        nor a part in front of the point bleeds into it);
+ *     3. hands that eye-view image, mask and normals to the unchanged fuse
+ *        stage (lighting in the eye's view, depth test against the virtual
+ *        scene with the EYE's depths, offset 0), composited into the
+ *        whole display (viewport 0, 0, lcd_width, lcd_height): the output
+ *        geometry is the eye's, as a virtual scene rendered for the eye.
+ *   The crop method (PIPE_VIEW_CROP, the default) is untouched: its bytes
+ *   are those of before.
+ *
+ * THE FILL (pixels the eye sees but the camera does not)
+ *   A covered eye pixel is
+ *     sampled  its point projects inside the camera image and the camera
+ *              sees it: the camera's G-buffer has the model at the nearest
+ *              camera pixel, no nearer than the point's own distance minus
+ *              PIPE_REPROJ_TOL_M + PIPE_REPROJ_TOL_REL * distance;
+ *     filled   it projects inside the camera image but the camera does not
+ *              see it (hidden behind another part: a finger behind the
+ *              palm, the disocclusion at a hand's edge): it takes the
+ *              colour of a sampled pixel of its own eye row on the same
+ *              surface: of the nearest sampled pixel to its left and the
+ *              nearest to its right, the one whose eye distance is nearer
+ *              to its own (the left one on a tie; the one there is when
+ *              only one side has any), so the background that a
+ *              disocclusion reveals is filled from the background, not
+ *              from the hand in front; a row without any takes the mean
+ *              colour of all sampled pixels of the eye; an eye without
+ *              any is not shown (mask 0);
+ *     outside  its point projects outside the camera image (or behind
+ *              the camera, or beyond the lens's valid region): mask 0.
+ *   Near the camera image's border the mask fades: M = 255 * min(1, b /
+ *   PIPE_REPROJ_FADE_PX) (rounded), b the distance in camera pixels of the
+ *   projected point to the nearest border, so the hands fade out where the
+ *   camera's view ends instead of a hard cut.
+ *
+ * FALLBACK (the eye inside the model)
+ *   When the eye's view is inside the model - more than half the covered
+ *   eye pixels see a back face (the normal turned away from the eye), or
+ *   the model comes nearer than PIPE_REPROJ_MIN_DIST_M to the eye - the
+ *   eye falls back to the crop method for that frame
+ *   (pipe_frame_stats.view[eye] = PIPE_VIEW_CROP, view_fallbacks counts
+ *   them). With RAST_CULL_BACK an eye inside a closed mesh sees none of
+ *   it: the frame shows what else is in front, never garbage.
+ *
+ * NUMBERS
+ *   Scalar C on the eye's thread (float, fixed operation order, the
+ *   lens in double), integer bilinear weights (8-bit fractions as
+ *   fuse_composite): the same bytes on every ISA and thread count.
+ *
+ * LIMITS
+ *   pipe_desc.aa_samples is refused with reprojection (pipe_create NULL).
+ *   refine_band still refines the camera's mask (the elbow fit learns
+ *   from it) but the eye's mask composited is the model's. The tone
+ *   match compares the camera's room with V over the whole display.
+ */
+#ifndef EGOFUSE_PIPE_REPROJ_H
+#define EGOFUSE_PIPE_REPROJ_H
+
+#include <stdint.h>
+
+#include "../fuse/fuse.h"
+#include "../kin/kin.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* pipe_desc.eye_view */
+enum { PIPE_VIEW_CROP = 0, PIPE_VIEW_REPROJECT = 1 };
+
+#define PIPE_REPROJ_FADE_PX 4.0f     /* fade width at the camera's border */
+#define PIPE_REPROJ_TOL_M 0.005f     /* occlusion test: absolute slack */
+#define PIPE_REPROJ_TOL_REL 0.02f    /* ... plus this fraction of the distance */
+#define PIPE_REPROJ_MIN_DIST_M 0.02f /* nearer to the eye: inside the model */
+/* The physical range of the reprojection's HMD numbers (pipe_view_check):
+ * IPD 40..90 mm (adults span about 50..78 mm), D 0..250 mm. */
+#define PIPE_IPD_MIN_M 0.04f
+#define PIPE_IPD_MAX_M 0.09f
+#define PIPE_CAM_OFFSET_MAX_M 0.25f
+
+/* "crop" or "reproject" -> PIPE_VIEW_*: 0, or -1 for another name. */
+int pipe_view_parse(const char *name, int *view);
+/* "crop", "reproject", or "?" */
+const char *pipe_view_name(int view);
+/* The resolved ipd_m and cam_offset_m of hmd within the ranges above: 0,
+ * or -1 with a sentence naming the field, its value and the range. Zero
+ * is the default (65 mm, 85 mm); a negative or NaN value, which
+ * kin_sthmd_desc_resolved would also take as the default, is refused
+ * here: for the reprojection it is a mistake, not a wish. */
+int pipe_view_check(const kin_sthmd_desc *hmd, char *why, int why_size);
+
+/* ---------------------------------------- internal to src/pipe (pipe.c) */
+
+typedef struct pipe__reproj {
+    int width, height;        /* the eye layer: the crop's size */
+    float *depth, *nrm;       /* the eye's G-buffer */
+    uint8_t *mask;
+    uint8_t *P;               /* RGBA8: camera colours seen from the eye */
+    uint8_t *M;               /* the mask composited (fade, fill) */
+    int32_t *row;             /* 2 * width: the fill's scan */
+    kin_camera cam;           /* this frame's eye camera */
+    long sampled, filled, outside; /* this frame's pixels of each kind */
+    int inside;               /* this frame: the eye is inside the model */
+} pipe__reproj;
+
+int pipe__reproj_init(pipe__reproj *r, int width, int height);
+void pipe__reproj_free(pipe__reproj *r);
+/* From the eye's G-buffer (drawn through r->cam), the camera (cam, its
+ * lens), its cropped image P and its G-buffer (cmask, cdepth; window
+ * depths of cam's projection, near n, far f): r->P and r->M, the counts and
+ * r->inside. Returns r->inside. */
+int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image *P,
+                        const uint8_t *cmask, int cmask_stride, const float *cdepth,
+                        int cdepth_stride, float n, float f);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,330 @@
+/* test_fit_band.c - the refinement's band and prior from the hands
+ * (src/fit/fit_band.h), on generated data: a "hand" of skin colour, a
+ * disc of radius 64 px over a dark-blue background with seeded noise,
+ * whose kinematic mask is a disc of radius 40 (24 px short: beyond the
+ * 16 px band).
+ *   - prior: refining the kinematic mask frame after frame stays at
+ *     40 + 16 px (IoU < 0.85); with pipe_fit_prior (the last refined
+ *     mask as the input around the slow hand) the edge reaches the true
+ *     one within 3 frames (IoU > 0.97); a fast hand keeps the kinematic
+ *     mask (pipe_fit_prior returns it); no prior without a last mask.
+ *   - band: f sigma / z of the nearest hand joint in view, clamped; 4x
+ *     nearer = 4x wider; a hand out of view or untracked: band_min; the
+ *     speed term.
+ *   - region: the pixels within f r / z + band of the joints, none for
+ *     untracked sides; merge picks wide inside, narrow outside; the prior
+ *     moved by a shift; the hand's image position.
+ *   - adaptive lag compensation: a hand moving at 2 m/s is predicted
+ *     closer to its true position than by the uncompensated filter (which
+ *     trails it), a hand at rest exactly as by kin_filter_output.
+ */
+#include "support/testutil.h"
+
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/fit/fit_band.h"
+#include "../src/fuse/fuse_refine.h"
+
+enum { W = 320, H = 240 };
+static const float F = 300.0f;
+
+/* A camera at the origin looking down -Z (view = identity). */
+static kin_camera cam_make(void)
+{
+    kin_camera c;
+    memset(&c, 0, sizeof c);
+    for (int i = 0; i < 4; i++) {
+        c.view.m[i * 5] = 1.0f;
+        c.world_from_cam.m[i * 5] = 1.0f;
+    }
+    c.width = W;
+    c.height = H;
+    c.fx = c.fy = F;
+    c.cx = W / 2.0f;
+    c.cy = H / 2.0f;
+    return c;
+}
+
+/* Every hand joint of side s at node s; world[s] at (x, y, z). */
+static void rig_make(kin_arm_rig *rig)
+{
+    memset(rig, 0, sizeof *rig);
+    for (int s = 0; s < 2; s++)
+        for (int j = 0; j < KIN_RIG_SIDE_JOINTS; j++) rig->joint[s][j] = s;
+}
+
+static kin_mat4 at(float x, float y, float z)
+{
+    kin_mat4 m;
+    memset(&m, 0, sizeof m);
+    m.m[0] = m.m[5] = m.m[10] = m.m[15] = 1.0f;
+    m.m[12] = x;
+    m.m[13] = y;
+    m.m[14] = z;
+    return m;
+}
+
+static void disc(uint8_t *m, float cx, float cy, float r)
+{
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            float dx = (float)x + 0.5f - cx, dy = (float)y + 0.5f - cy;
+            m[y * W + x] = dx * dx + dy * dy <= r * r ? 255 : 0;
+        }
+}
+
+static double iou(const uint8_t *a, const uint8_t *b)
+{
+    long i = 0, u = 0;
+    for (int k = 0; k < W * H; k++) {
+        int x = a[k] >= 128, y = b[k] >= 128;
+        i += x && y;
+        u += x || y;
+    }
+    return u ? (double)i / (double)u : 1.0;
+}
+
+typedef struct scene {
+    uint8_t *img, *truth, *kin, *prev, *out, *region, *prior;
+    float *llr;
+    void *scratch, *cscratch;
+    size_t scratch_size;
+    fuse_colour_model g;
+    fuse_refine_params rp;
+} scene;
+
+static void scene_make(scene *s)
+{
+    tu_rng rng = { 0x5eed0f17ull };
+    s->img = malloc((size_t)W * H * 4);
+    s->truth = malloc(W * H);
+    s->kin = malloc(W * H);
+    s->prev = malloc(W * H);
+    s->out = malloc(W * H);
+    s->region = malloc(W * H);
+    s->prior = malloc(W * H);
+    assert_non_null(s->img);
+    assert_non_null(s->truth && s->kin && s->prev && s->out && s->region && s->prior);
+    disc(s->truth, W / 2.0f, H / 2.0f, 64.0f);
+    disc(s->kin, W / 2.0f, H / 2.0f, 40.0f);
+    for (int k = 0; k < W * H; k++) {
+        const int skin = s->truth[k] != 0;
+        const float base[3] = { skin ? 200.0f : 30.0f, skin ? 150.0f : 40.0f, skin ? 120.0f : 90.0f };
+        for (int c = 0; c < 3; c++) {
+            float v = base[c] + tu_range(&rng, -10.0f, 10.0f);
+            s->img[4 * k + c] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
+        }
+        s->img[4 * k + 3] = 255;
+    }
+    s->rp = fuse_refine_params_default();
+    s->rp.band = 16;
+    s->rp.bits = 5;
+    s->scratch_size = fuse_refine_scratch_size(&s->rp, W, H);
+    s->scratch = aligned_alloc(16, (s->scratch_size + 15) & ~(size_t)15);
+    s->cscratch = malloc(fuse_colour_model_scratch_size(5));
+    s->llr = malloc(sizeof(float) << 15);
+    assert_non_null(s->scratch && s->cscratch && s->llr);
+    /* the image-wide colour model, learned from the true mask */
+    s->g.bits = 5;
+    s->g.llr = s->llr;
+    fuse_image P = { s->img, W, H, 4 * W };
+    assert_int_equal(fuse_colour_model_learn(&s->g, &P, s->truth, W, 4, 1, 3.0f, 64, s->cscratch,
+                                             fuse_colour_model_scratch_size(5)),
+                     FUSE_OK);
+}
+
+static void scene_free(scene *s)
+{
+    free(s->img); free(s->truth); free(s->kin); free(s->prev); free(s->out);
+    free(s->region); free(s->prior); free(s->llr); free(s->scratch); free(s->cscratch);
+}
+
+/* n frames of refinement; with_prior: the last refined mask is the input
+ * around the hand (speed: its wrist speed, m/s). */
+static double run_frames(scene *s, int n, int with_prior, float speed, int *used_prior)
+{
+    kin_camera cam = cam_make();
+    kin_arm_rig rig;
+    rig_make(&rig);
+    kin_mat4 world[2] = { at(0, 0, -0.4f), at(5.0f, 0, -0.4f) };   /* right hand out of view */
+    pipe_fit_band_desc d = pipe_fit_band_desc_default();
+    d.hand_radius = 0.1f;   /* 75 px at 0.4 m */
+    const float sp[2] = { speed, speed };
+    fuse_image P = { s->img, W, H, 4 * W };
+    int have_prev = 0;
+    *used_prior = 0;
+    for (int i = 0; i < n; i++) {
+        const uint8_t *in = s->kin;
+        if (with_prior)
+            in = pipe_fit_prior(&d, &cam, world, &rig, 3u, sp, 0.3f, NULL, s->kin,
+                                have_prev ? s->prev : NULL, s->region, s->prior, W);
+        if (in != s->kin) (*used_prior)++;
+        fuse_refine_stats st;
+        assert_int_equal(fuse_refine_mask_global(&s->rp, &s->g, 1.0f, &P, in, W, s->out, W,
+                                                 s->scratch, s->scratch_size, &st),
+                         FUSE_OK);
+        assert_true(st.used_colour);
+        memcpy(s->prev, s->out, W * H);
+        have_prev = 1;
+    }
+    return iou(s->out, s->truth);
+}
+
+static void prior_reaches_beyond_band(void **state)
+{
+    (void)state;
+    scene s;
+    scene_make(&s);
+    int used;
+    double without = run_frames(&s, 4, 0, 0.0f, &used);
+    assert_int_equal(used, 0);
+    double with = run_frames(&s, 4, 1, 0.0f, &used);
+    assert_int_equal(used, 3);   /* not on the first frame: no last mask */
+    print_message("IoU after 4 frames: kinematic input %.4f, with the prior %.4f\n", without, with);
+    assert_true(without < 0.85);
+    assert_true(with > 0.97);
+    /* a fast hand: the last mask is not where it is, kin stays the input */
+    double fast = run_frames(&s, 4, 1, 1.0f, &used);
+    assert_int_equal(used, 0);
+    assert_true(fabs(fast - without) < 1e-9);
+    scene_free(&s);
+}
+
+static void band_follows_depth_and_speed(void **state)
+{
+    (void)state;
+    kin_camera cam = cam_make();
+    kin_arm_rig rig;
+    rig_make(&rig);
+    pipe_fit_band_desc d = pipe_fit_band_desc_default();
+    d.sigma = 0.02f;
+    d.band_min = 4;
+    d.band_max = 64;
+    kin_mat4 world[2] = { at(0, 0, -0.4f), at(0.05f, 0, -0.1f) };
+    /* left only: 300 * 0.02 / 0.4 = 15 px */
+    assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 1u, NULL), 15);
+    /* right, 4x nearer: 60 px; both: the nearer */
+    assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 2u, NULL), 60);
+    assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 3u, NULL), 60);
+    /* clamped */
+    d.band_max = 32;
+    assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 3u, NULL), 32);
+    d.band_max = 64;
+    /* the speed term: (0.02 + 1 m/s * 0.02 s) * 300 / 0.4 = 30 */
+    d.tau = 0.02f;
+    const float sp[2] = { 1.0f, 0.0f };
+    assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 1u, sp), 30);
+    d.tau = 0.0f;
+    /* out of view (far beyond the reach) or behind: band_min */
+    world[0] = at(2.0f, 0, -0.4f);
+    assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 1u, NULL), 4);
+    world[0] = at(0, 0, 0.4f);
+    assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 1u, NULL), 4);
+    /* untracked, bad arguments */
+    assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 0u, NULL), 4);
+    assert_int_equal(pipe_fit_band(&d, NULL, world, &rig, 3u, NULL), 4);
+    assert_int_equal(pipe_fit_band(&d, &cam, NULL, &rig, 3u, NULL), 4);
+}
+
+static void region_and_merge(void **state)
+{
+    (void)state;
+    kin_camera cam = cam_make();
+    kin_arm_rig rig;
+    rig_make(&rig);
+    kin_mat4 world[2] = { at(0, 0, -0.4f), at(5.0f, 0, -0.4f) };
+    pipe_fit_band_desc d = pipe_fit_band_desc_default();
+    d.hand_radius = 0.04f;   /* 30 px at 0.4 m, + band 10 = 40 */
+    uint8_t *reg = malloc(W * H), *a = malloc(W * H), *b = malloc(W * H), *o = malloc(W * H);
+    assert_non_null(reg && a && b && o);
+    long n = pipe_fit_band_region(&d, &cam, world, &rig, 3u, 10, reg, W);
+    assert_true(n > 4800 && n < 5300);   /* pi 40^2 = 5027 */
+    assert_int_equal(reg[120 * W + 160], 255);
+    assert_int_equal(reg[120 * W + 160 + 38], 255);
+    assert_int_equal(reg[120 * W + 160 + 42], 0);
+    assert_int_equal(reg[0], 0);
+    assert_int_equal(pipe_fit_band_region(&d, &cam, world, &rig, 2u, 10, reg, W), 0);
+    assert_int_equal(reg[120 * W + 160], 0);
+    pipe_fit_band_region(&d, &cam, world, &rig, 1u, 10, reg, W);
+    memset(a, 1, W * H);
+    memset(b, 2, W * H);
+    pipe_fit_band_merge(a, b, reg, o, W, W, H);
+    assert_int_equal(o[120 * W + 160], 2);
+    assert_int_equal(o[0], 1);
+    /* no prior without a last mask, or with an untracked hand */
+    const float sp[2] = { 0, 0 };
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, NULL, a, NULL, reg, o, W), a);
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 0u, sp, 0.3f, NULL, a, b, reg, o, W), a);
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, NULL, a, b, reg, o, W), o);
+    /* moved with the hand: the last mask shifted by 10 px right, 4 down
+     * inside the region; the hand's image position */
+    float xy[2];
+    assert_int_equal(pipe_fit_hand_px(&cam, world, &rig, 0, xy), 1);
+    assert_true(fabsf(xy[0] - 160.0f) < 1e-3f && fabsf(xy[1] - 120.0f) < 1e-3f);
+    assert_int_equal(pipe_fit_hand_px(&cam, world, &rig, 2, xy), 0);
+    disc(a, 160.0f, 120.0f, 10.0f);
+    disc(b, 150.0f, 116.0f, 20.0f);
+    const float sh[2][2] = { { 10.0f, 4.0f }, { 0, 0 } };
+    assert_ptr_equal(pipe_fit_prior(&d, &cam, world, &rig, 1u, sp, 0.3f, sh, a, b, reg, o, W), o);
+    disc(a, 160.0f, 120.0f, 20.0f);
+    assert_memory_equal(o, a, W * H);
+    free(reg); free(a); free(b); free(o);
+}
+
+/* The filter fed with the left hand at x = v t (90 Hz, no noise) until
+ * t_end; returns the error of the prediction at t_end + 0.02 s. */
+static float lag_error(float v, float v0, float v1, kin_track_sample *out, float speed[2])
+{
+    kin_filter_desc fd = kin_filter_desc_resolved(NULL);
+    fd.no_lag_comp = 1;
+    kin_filter f;
+    kin_filter_init(&f, &fd);
+    double t = 0.0;
+    for (int i = 0; i < 90; i++) {
+        kin_track_sample s;
+        memset(&s, 0, sizeof s);
+        t = i / 90.0;
+        s.t = t;
+        s.valid = KIN_TRACK_HEAD | KIN_TRACK_HAND_L;
+        s.head_pos = kin_v3(0, 1.6f, 0);
+        s.head_rot = (kin_quat){ 0, 0, 0, 1 };
+        s.hand_pos[0] = kin_v3(v * (float)t, 1.2f, -0.4f);
+        s.hand_rot[0] = (kin_quat){ 0, 0, 0, 1 };
+        assert_true(kin_filter_push(&f, &s) & KIN_FILTER_ACCEPTED);
+    }
+    const double T = t + 0.02;
+    pipe_fit_filter_output(&f, T, v0, v1, out, speed);
+    return fabsf(out->hand_pos[0].x - v * (float)T);
+}
+
+static void lag_adapts_to_speed(void **state)
+{
+    (void)state;
+    kin_track_sample a, b;
+    float sp[2] = { -1, -1 };
+    float plain = lag_error(2.0f, 0.0f, 0.0f, &a, sp);
+    assert_true(sp[0] > 1.5f && sp[0] < 2.5f);
+    float adapt = lag_error(2.0f, 0.2f, 0.8f, &b, NULL);
+    print_message("2 m/s: error %.1f mm uncompensated, %.1f mm adaptive\n", 1e3 * plain, 1e3 * adapt);
+    assert_true(plain > 0.005f);
+    assert_true(adapt < 0.5f * plain);
+    /* at rest: the same as the filter's own output */
+    lag_error(0.0f, 0.0f, 0.0f, &a, NULL);
+    lag_error(0.0f, 0.2f, 0.8f, &b, NULL);
+    assert_memory_equal(&a.hand_pos[0], &b.hand_pos[0], sizeof a.hand_pos[0]);
+    assert_memory_equal(&a.hand_rot[0], &b.hand_rot[0], sizeof a.hand_rot[0]);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(prior_reaches_beyond_band),
+        cmocka_unit_test(band_follows_depth_and_speed),
+        cmocka_unit_test(region_and_merge),
+        cmocka_unit_test(lag_adapts_to_speed),
+    };
+    return cmocka_run_group_tests_name("fit_band", tests, NULL, NULL);
+}

@@ -1,0 +1,613 @@
+/* test_pipe_reproj.c - the hands reprojected to the eye
+ * (pipe_desc.eye_view = PIPE_VIEW_REPROJECT, src/pipe/pipe_reproj.h), on
+ * generated scenes whose geometry is known (the paper's HMD, the head at
+ * the origin looking down -Z, quads facing the eyes):
+ *   - the eye-view mask equals the model drawn directly from the eye
+ *     (kin_sthmd_eye_camera) pixel for pixel, 255 inside;
+ *   - a point at a known depth lands where the geometry says: the camera
+ *     image is a ramp of its own pixel position, so the colour each eye
+ *     pixel took names the camera position it was sampled at, checked
+ *     against the ray from the eye to the plane and on into the camera
+ *     (the paper's pinhole, and a distorting Brown lens: no undistort
+ *     pass, the lens applied where the image is sampled);
+ *   - disocclusion: a small quad in front of a large one; the ring of the
+ *     back quad the eye sees around the front one but the camera does not
+ *     is filled from the back quad (green), never the front one's red;
+ *   - the border of the camera's view fades over PIPE_REPROJ_FADE_PX;
+ *   - the same bytes with 1 and 2 threads and every ISA cap (a recorded
+ *     CRC); the crop method's bytes do not depend on the new code;
+ *   - bad input: IPD and D out of range, reprojection with AA, an unknown
+ *     view: pipe_create NULL and pipe_view_check names the field; the
+ *     eye inside the model: the crop for that frame, counted; NaN depths
+ *     of the virtual scene: no crash, the hand kept there. */
+#include "support/testutil.h"
+
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/pipe/pipe.h"
+#include "support/pipe_frames.h"
+
+enum { CAMW = 640, CAMH = 480, CW = 640, CH = 400, LCDW = 1280, LCDH = 800, CROP_Y0 = 40 };
+
+/* Lighting that passes the camera colour through: ambient 1, nothing
+ * else, so the lit layer is the sampled image times the mask. */
+static pipe_lighting pass_through(void)
+{
+    pipe_lighting l;
+    memset(&l, 0, sizeof l);
+    l.light.light_count = 0;
+    for (int k = 0; k < 3; k++) {
+        l.light.ambient[k] = 1.0f;
+        l.light.tone[k] = 1.0f;
+    }
+    l.light.shininess = 1.0f;
+    return l;
+}
+
+/* Quads facing +Z (towards the head), centred on the view axis: quad k
+ * is [-s_k, s_k]^2 at depth z_k. */
+static void quads_model(kin_model *m, int n, const float *s, const float *z)
+{
+    tu_mesh_parts t = tu_mesh_model(m, "head", "quads", 4 * n, 6 * n, 1);
+    for (int k = 0; k < n; k++) {
+        const float p[12] = {-s[k], -s[k], z[k], s[k], -s[k], z[k],
+                             s[k],  s[k],  z[k], -s[k], s[k], z[k]};
+        memcpy(t.pos + 12 * k, p, sizeof p);
+        for (int i = 0; i < 4; i++) t.nrm[12 * k + 3 * i + 2] = 1.0f;
+        const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
+        for (int i = 0; i < 6; i++) t.idx[6 * k + i] = ix[i] + 4u * (uint32_t)k;
+    }
+    char why[200];
+    assert_int_equal(kin_model_validate(m, why, sizeof why), 0);
+}
+
+/* A closed cube of half size s around the origin, normals outward. */
+static void cube_model(kin_model *m, float s)
+{
+    tu_mesh_parts t = tu_mesh_model(m, "head", "cube", 24, 36, 1);
+    for (int f = 0; f < 6; f++) {
+        int ax = f / 2;
+        float sg = (f & 1) ? 1.0f : -1.0f;
+        int u = (ax + 1) % 3, v = (ax + 2) % 3;
+        const float cu[4] = {-1, 1, 1, -1}, cv[4] = {-1, -1, 1, 1};
+        for (int i = 0; i < 4; i++) {
+            float *p = t.pos + 3 * (4 * f + i);
+            p[ax] = sg * s;
+            p[u] = cu[i] * s;
+            p[v] = cv[i] * s;
+            t.nrm[3 * (4 * f + i) + ax] = sg;
+        }
+        const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
+        for (int i = 0; i < 6; i++) t.idx[6 * f + i] = ix[i] + 4u * (uint32_t)f;
+    }
+    char why[200];
+    assert_int_equal(kin_model_validate(m, why, sizeof why), 0);
+}
+
+static pipe_ctx *make_pipe(const kin_model *m, int view, int threads, int isa)
+{
+    pipe_desc d;
+    memset(&d, 0, sizeof d);
+    d.eye_view = view;
+    d.threads = threads;
+    d.max_isa = isa;
+    pipe_ctx *p = pipe_create(&d, m);
+    assert_non_null(p);
+    return p;
+}
+
+/* The eye camera at the layer's size, as pipe_frame makes it. */
+static kin_camera eye_cam(int e)
+{
+    return kin_sthmd_eye_camera(NULL, NULL, (kin_eye)e, CW, CH);
+}
+
+/* The model drawn from the eye into mask (CW x CH). */
+static long draw_from_eye(const kin_model *m, int e, uint8_t *mask)
+{
+    const kin_mesh *me = &m->meshes[0];
+    float *depth = malloc(sizeof(float) * CW * CH);
+    float *clip = malloc(sizeof(float) * 4 * (size_t)me->vertex_count);
+    assert_non_null(depth);
+    assert_non_null(clip);
+    rast_target t = {CW, CH, depth, CW, mask, CW, NULL, 0, 0};
+    rast_target_clear(&t);
+    kin_camera c = eye_cam(e);
+    rast_transform_points(c.view_proj.m, me->positions, me->vertex_count, clip);
+    rast_mesh_desc md = {clip, me->vertex_count, NULL, 0, me->indices, me->index_count / 3,
+                         RAST_CULL_NONE};
+    assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
+    long n = 0;
+    for (int i = 0; i < CW * CH; i++) n += mask[i] != 0;
+    free(depth);
+    free(clip);
+    return n;
+}
+
+/* The eye-view mask of a quad in full view of the camera equals the quad
+ * drawn from the eye: every pixel, 255 inside (no border fade, nothing
+ * hidden); and it is not the crop method's mask. */
+static void result_mask_equals_eye_draw(void **state)
+{
+    (void)state;
+    kin_model m;
+    const float s[1] = {0.06f}, z[1] = {-0.35f};
+    quads_model(&m, 1, s, z);
+    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
+    tu_frame_bufs b;
+    pipe_frame_in in;
+    tu_frame_make(&b, &in, 11, CAMW, CAMH, LCDW, LCDH);
+    pipe_frame_stats st;
+    char why[200];
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    uint8_t *ref = malloc(CW * CH);
+    assert_non_null(ref);
+    for (int e = 0; e < 2; e++) {
+        assert_int_equal(st.view[e], PIPE_VIEW_REPROJECT);
+        int w, h;
+        const uint8_t *M = pipe_view_mask(p, e, &w, &h);
+        assert_non_null(M);
+        assert_int_equal(w, CW);
+        assert_int_equal(h, CH);
+        long n = draw_from_eye(&m, e, ref), diff = 0, full = 0;
+        for (int i = 0; i < CW * CH; i++) {
+            diff += (M[i] != 0) != (ref[i] != 0);
+            full += M[i] == 255;
+        }
+        print_message("NOTE eye %d: %ld eye pixels, %ld differ from the direct draw, %ld sampled, "
+                      "%ld filled, %ld outside\n", e, n, diff, st.view_sampled[e],
+                      st.view_filled[e], st.view_outside[e]);
+        assert_true(n > 5000);
+        assert_int_equal(diff, 0);
+        assert_int_equal(full, n);
+        assert_int_equal(st.view_outside[e], 0);
+        assert_int_equal(st.view_sampled[e] + st.view_filled[e], n);
+        /* the crop method's mask (the camera's, in the viewport) differs */
+        const uint8_t *cm = pipe_mask(p, e, NULL, NULL);
+        long cn = 0;
+        for (int i = 0; i < CW * CH; i++) cn += cm[i] != 0;
+        assert_true(cn > n + n / 4); /* the camera is D nearer: larger */
+        kin_camera vc = pipe_view_camera(p, e);
+        assert_int_equal(vc.width, CW);
+        NEAR(vc.world_from_cam.m[12], e ? 0.0325f : -0.0325f, 1e-6);
+        NEAR(vc.world_from_cam.m[14], 0.0f, 0);
+    }
+    assert_int_equal(st.view_fallbacks, 0);
+    free(ref);
+    tu_frame_free(&b);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
+/* A camera image whose colour names its pixel: R = x - xoff, G = y - yoff
+ * (sensor rows), B = 77, linear inside the quad's view. */
+static void ramp_image(uint8_t *img, int xoff, int yoff)
+{
+    for (int y = 0; y < CAMH; y++)
+        for (int x = 0; x < CAMW; x++) {
+            uint8_t *q = img + ((size_t)y * CAMW + (size_t)x) * 4;
+            int r = x - xoff, g = y - yoff;
+            q[0] = (uint8_t)(r < 0 ? 0 : r > 255 ? 255 : r);
+            q[1] = (uint8_t)(g < 0 ? 0 : g > 255 ? 255 : g);
+            q[2] = 77;
+            q[3] = 255;
+        }
+}
+
+/* Each eye pixel of the quad at depth 0.35 m took the camera colour at
+ * the point the geometry gives: eye ray -> plane -> camera (its lens:
+ * kin_lens_project of the camera's view-space point; for the paper's
+ * pinhole u = cx + fx X / -Z). k1 != 0: both cameras through a Brown
+ * lens, the camera images then in its distorted pixels. */
+static void point_lands(double k1)
+{
+    kin_model m;
+    const float s[1] = {0.05f}, z[1] = {-0.35f};
+    quads_model(&m, 1, s, z);
+    pipe_desc d;
+    memset(&d, 0, sizeof d);
+    d.eye_view = PIPE_VIEW_REPROJECT;
+    d.threads = 1;
+    if (k1 != 0.0) {
+        for (int e = 0; e < 2; e++) {
+            kin_lens *l = &d.hmd.lens[e];
+            l->model = KIN_LENS_BROWN;
+            l->width = CAMW;
+            l->height = CAMH;
+            l->fx = l->fy = 540.0;
+            l->cx = 319.5;
+            l->cy = 239.5;
+            l->k[0] = k1;
+            assert_int_equal(kin_lens_check(l, NULL, 0), 1);
+        }
+    }
+    pipe_ctx *p = pipe_create(&d, &m);
+    assert_non_null(p);
+    tu_frame_bufs b;
+    pipe_frame_in in;
+    tu_frame_make(&b, &in, 12, CAMW, CAMH, LCDW, LCDH);
+    in.lighting = pass_through();
+    const kin_sthmd_desc hd = pipe_hmd(p);
+    /* the ramps centred on where each camera sees the quad's centre */
+    int xoff[2];
+    for (int e = 0; e < 2; e++) {
+        kin_camera c = kin_sthmd_camera(&hd, NULL, (kin_eye)e);
+        double pc[3] = {-c.world_from_cam.m[12], 0.0, -0.35 - c.world_from_cam.m[14]}, u, v;
+        assert_int_equal(kin_lens_project(&c.lens, pc, &u, &v), 1);
+        xoff[e] = (int)lround(u) - 128;
+        ramp_image(b.cam[e], xoff[e], 112);
+    }
+    pipe_frame_stats st;
+    char why[200];
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) {
+        const uint8_t *Q = pipe_layer(p, e, NULL, NULL);
+        const uint8_t *M = pipe_view_mask(p, e, NULL, NULL);
+        kin_camera ec = eye_cam(e), cc = pipe_camera(p, e);
+        assert_int_equal(kin_lens_distorts(&cc.lens), k1 != 0.0);
+        const double ex = ec.world_from_cam.m[12];
+        const double cx = cc.world_from_cam.m[12], cz = cc.world_from_cam.m[14];
+        long checked = 0;
+        double worst = 0.0;
+        for (int y = 0; y < CH; y++)
+            for (int x = 0; x < CW; x++) {
+                size_t i = (size_t)y * CW + (size_t)x;
+                if (M[i] != 255) continue;
+                /* the eye ray to the plane z = -0.35 */
+                double rx = (x + 0.5 - ec.cx) / ec.fx, ry = -(y + 0.5 - ec.cy) / ec.fy;
+                double X = ex + 0.35 * rx, Y = 0.35 * ry;
+                if (fabs(X) > 0.048 || fabs(Y) > 0.048) continue; /* away from the edge */
+                /* into the camera (same orientation) and through its lens */
+                double pc[3] = {X - cx, Y, -0.35 - cz}, u, v;
+                assert_int_equal(kin_lens_project(&cc.lens, pc, &u, &v), 1);
+                if (k1 == 0.0) { /* the pinhole by hand */
+                    NEAR(u, cc.cx + cc.fx * (X - cx) / (0.35 + cz), 1e-3);
+                    NEAR(v, cc.cy - cc.fy * Y / (0.35 + cz), 1e-3);
+                }
+                double eu = u - 0.5 - xoff[e], ev = v - 0.5 + CROP_Y0 - 112.0;
+                if (eu < 1.0 || eu > 254.0 || ev < 1.0 || ev > 254.0) continue; /* the ramp */
+                double du = fabs(Q[4 * i] - eu), dv = fabs(Q[4 * i + 1] - ev);
+                if (du > worst) worst = du;
+                if (dv > worst) worst = dv;
+                assert_true(du <= 0.6);
+                assert_true(dv <= 0.6);
+                assert_int_equal(Q[4 * i + 2], 77);
+                checked++;
+            }
+        print_message("NOTE k1 %.2f, eye %d: %ld pixels checked, worst %.3f camera px off the "
+                      "geometry (D %.3f m, IPD %.3f m)\n", k1, e, checked, worst,
+                      (double)hd.cam_offset_m, (double)hd.ipd_m);
+        assert_true(checked > 5000);
+    }
+    tu_frame_free(&b);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
+static void result_point_lands_by_geometry(void **state)
+{
+    (void)state;
+    point_lands(0.0);
+}
+
+static void result_point_lands_through_lens(void **state)
+{
+    (void)state;
+    point_lands(-0.2);
+}
+
+/* Front quad (red in the camera) before a back quad (green): the ring of
+ * the back quad that only the eye sees is filled, and filled green. */
+static void result_disocclusion_fill(void **state)
+{
+    (void)state;
+    kin_model m;
+    const float s[2] = {0.15f, 0.03f}, z[2] = {-0.5f, -0.3f};
+    quads_model(&m, 2, s, z);
+    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
+    tu_frame_bufs b;
+    pipe_frame_in in;
+    tu_frame_make(&b, &in, 13, CAMW, CAMH, LCDW, LCDH);
+    in.lighting = pass_through();
+    for (int e = 0; e < 2; e++) {
+        /* red where the camera's ray meets the front quad, green elsewhere */
+        kin_camera c = kin_sthmd_camera(NULL, NULL, (kin_eye)e);
+        double cx = c.world_from_cam.m[12], d = 0.3 + (double)c.world_from_cam.m[14];
+        for (int y = 0; y < CAMH; y++)
+            for (int x = 0; x < CAMW; x++) {
+                double X = cx + d * (x + 0.5 - c.cx) / c.fx;
+                double Y = -d * (y - CROP_Y0 + 0.5 - c.cy) / c.fy;
+                int front = fabs(X) < 0.03 && fabs(Y) < 0.03;
+                uint8_t *q = b.cam[e] + ((size_t)y * CAMW + (size_t)x) * 4;
+                q[0] = front ? 255 : 0;
+                q[1] = front ? 0 : 255;
+                q[2] = 0;
+                q[3] = 255;
+            }
+    }
+    pipe_frame_stats st;
+    char why[200];
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) {
+        const uint8_t *Q = pipe_layer(p, e, NULL, NULL);
+        const uint8_t *M = pipe_view_mask(p, e, NULL, NULL);
+        kin_camera ec = eye_cam(e);
+        const double ex = ec.world_from_cam.m[12];
+        long back = 0, red = 0, front = 0, front_red = 0;
+        for (int y = 0; y < CH; y++)
+            for (int x = 0; x < CW; x++) {
+                size_t i = (size_t)y * CW + (size_t)x;
+                if (M[i] != 255) continue;
+                double rx = (x + 0.5 - ec.cx) / ec.fx, ry = -(y + 0.5 - ec.cy) / ec.fy;
+                double fX = ex + 0.3 * rx, fY = 0.3 * ry;
+                /* 2 eye px clear of the front quad's silhouette either way */
+                double margin = 2.0 * 0.3 / ec.fx;
+                if (fabs(fX) < 0.03 - margin && fabs(fY) < 0.03 - margin) {
+                    front++;
+                    front_red += Q[4 * i] > 200 && Q[4 * i + 1] < 55;
+                } else if (fabs(fX) > 0.03 + margin || fabs(fY) > 0.03 + margin) {
+                    back++;
+                    red += Q[4 * i] > 100; /* any of the front's red */
+                }
+            }
+        print_message("NOTE eye %d: back quad %ld px (%ld with red), front %ld (%ld red); "
+                      "%ld filled, %ld sampled\n", e, back, red, front, front_red,
+                      st.view_filled[e], st.view_sampled[e]);
+        /* the ring: about 8 eye px wide on each side of a 108 px square */
+        assert_true(st.view_filled[e] > 2000);
+        assert_int_equal(red, 0);
+        assert_true(front > 5000);
+        assert_int_equal(front_red, front);
+    }
+    tu_frame_free(&b);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
+/* A quad wider than the camera's view at 0.25 m: the eye's mask is 0
+ * where the camera does not see, 255 well inside, and ramps between. */
+static void result_border_fade(void **state)
+{
+    (void)state;
+    kin_model m;
+    const float s[1] = {0.4f}, z[1] = {-0.25f};
+    quads_model(&m, 1, s, z);
+    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
+    tu_frame_bufs b;
+    pipe_frame_in in;
+    tu_frame_make(&b, &in, 14, CAMW, CAMH, LCDW, LCDH);
+    pipe_frame_stats st;
+    char why[200];
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) {
+        const uint8_t *M = pipe_view_mask(p, e, NULL, NULL);
+        /* the middle row: 0 at both ends, 255 in the middle, and between
+         * them a ramp of at most 2 * FADE / (camera px per eye px) + 2
+         * pixels of each partial value run */
+        const uint8_t *row = M + (size_t)(CH / 2) * CW;
+        assert_int_equal(row[0], 0);
+        assert_int_equal(row[CW - 1], 0);
+        assert_int_equal(row[CW / 2], 255);
+        int partial = 0, rising = 1;
+        for (int x = 1; x < CW / 2; x++) {
+            if (row[x] > 0 && row[x] < 255) partial++;
+            if (row[x] < row[x - 1]) rising = 0;
+        }
+        print_message("NOTE eye %d: %d partial pixels on the left half of the middle row; "
+                      "%ld outside\n", e, partial, st.view_outside[e]);
+        assert_true(rising);
+        assert_true(partial >= 2 && partial <= 8);
+        assert_true(st.view_outside[e] > 1000);
+    }
+    tu_frame_free(&b);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
+/* The bytes of both outputs, the layers and the masks of a random frame
+ * of the two quads, with a virtual depth in front of part of them. */
+static uint32_t frame_crc(const kin_model *m, int view, int threads, int isa)
+{
+    pipe_ctx *p = make_pipe(m, view, threads, isa);
+    tu_frame_bufs b;
+    pipe_frame_in in;
+    tu_frame_make(&b, &in, 21, CAMW, CAMH, LCDW, LCDH);
+    float *vd = malloc(sizeof(float) * LCDW * LCDH);
+    assert_non_null(vd);
+    for (int y = 0; y < LCDH; y++)
+        for (int x = 0; x < LCDW; x++) vd[(size_t)y * LCDW + x] = x < LCDW / 2 ? 0.4f : 60.0f;
+    for (int e = 0; e < 2; e++) {
+        in.virt_depth[e] = vd;
+        in.virt_depth_stride[e] = LCDW;
+    }
+    pipe_frame_stats st;
+    char why[200];
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    uint32_t crc = 0;
+    for (int e = 0; e < 2; e++) {
+        crc = tu_crc32(crc, b.out[e], (size_t)LCDW * LCDH * 4);
+        crc = tu_crc32(crc, pipe_layer(p, e, NULL, NULL), (size_t)CW * CH * 4);
+        const uint8_t *M = pipe_view_mask(p, e, NULL, NULL);
+        if (M) crc = tu_crc32(crc, M, (size_t)CW * CH);
+    }
+    free(vd);
+    tu_frame_free(&b);
+    pipe_destroy(p);
+    return crc;
+}
+
+#define REPROJ_CRC 0x9b5bac78u
+
+static void determinism_isa_threads(void **state)
+{
+    (void)state;
+    kin_model m;
+    const float s[2] = {0.15f, 0.03f}, z[2] = {-0.5f, -0.3f};
+    quads_model(&m, 2, s, z);
+    const uint32_t ref = frame_crc(&m, PIPE_VIEW_REPROJECT, 1, EF_ISA_REF);
+    static const int isa[] = {EF_ISA_REF, EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512, 0};
+    for (int t = 1; t <= 2; t++)
+        for (size_t k = 0; k < sizeof isa / sizeof isa[0]; k++)
+            assert_int_equal(frame_crc(&m, PIPE_VIEW_REPROJECT, t, isa[k]), ref);
+    print_message("NOTE reprojection CRC %08x (every ISA cap, 1 and 2 threads)\n", ref);
+    assert_int_equal(ref, REPROJ_CRC);
+    /* the crop method is another image */
+    assert_int_not_equal(frame_crc(&m, PIPE_VIEW_CROP, 2, 0), ref);
+    kin_model_free(&m);
+}
+
+static void validity_bad_desc(void **state)
+{
+    (void)state;
+    kin_model m;
+    const float s[1] = {0.05f}, z[1] = {-0.35f};
+    quads_model(&m, 1, s, z);
+    pipe_desc d;
+    memset(&d, 0, sizeof d);
+    d.eye_view = PIPE_VIEW_REPROJECT;
+    char why[200];
+    assert_int_equal(pipe_view_check(&d.hmd, why, sizeof why), 0);
+    d.hmd.ipd_m = 0.2f;
+    assert_null(pipe_create(&d, &m));
+    assert_int_equal(pipe_view_check(&d.hmd, why, sizeof why), -1);
+    assert_non_null(strstr(why, "ipd_m"));
+    assert_non_null(strstr(why, "0.04..0.09"));
+    d.hmd.ipd_m = NAN;
+    assert_null(pipe_create(&d, &m));
+    d.hmd.ipd_m = 0.0f;
+    d.hmd.cam_offset_m = 0.4f;
+    assert_null(pipe_create(&d, &m));
+    assert_int_equal(pipe_view_check(&d.hmd, why, sizeof why), -1);
+    assert_non_null(strstr(why, "cam_offset_m"));
+    d.hmd.cam_offset_m = -0.01f;
+    assert_int_equal(pipe_view_check(&d.hmd, why, sizeof why), -1);
+    d.hmd.cam_offset_m = 0.0f;
+    d.aa_samples = 4;
+    assert_null(pipe_create(&d, &m));
+    d.aa_samples = 0;
+    d.eye_view = 7;
+    assert_null(pipe_create(&d, &m));
+    /* the crop method does not check them (its numbers as before) */
+    d.eye_view = PIPE_VIEW_CROP;
+    d.hmd.ipd_m = 0.2f;
+    pipe_ctx *p = pipe_create(&d, &m);
+    assert_non_null(p);
+    pipe_destroy(p);
+    int v = -1;
+    assert_int_equal(pipe_view_parse("reproject", &v), 0);
+    assert_int_equal(v, PIPE_VIEW_REPROJECT);
+    assert_int_equal(pipe_view_parse("crop", &v), 0);
+    assert_int_equal(v, PIPE_VIEW_CROP);
+    assert_int_equal(pipe_view_parse("eye", &v), -1);
+    assert_string_equal(pipe_view_name(PIPE_VIEW_REPROJECT), "reproject");
+    kin_model_free(&m);
+}
+
+/* The eye inside a closed cube around the head: the crop method for the
+ * frame (its very bytes), counted; the next frame outside reprojects. */
+static void validity_eye_inside_model(void **state)
+{
+    (void)state;
+    kin_model m;
+    cube_model(&m, 0.3f);
+    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
+    pipe_ctx *c = make_pipe(&m, PIPE_VIEW_CROP, 2, 0);
+    tu_frame_bufs b, bc;
+    pipe_frame_in in, ic;
+    tu_frame_make(&b, &in, 15, CAMW, CAMH, LCDW, LCDH);
+    tu_frame_make(&bc, &ic, 15, CAMW, CAMH, LCDW, LCDH);
+    pipe_frame_stats st;
+    char why[200];
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    assert_int_equal(pipe_frame(c, &ic, NULL, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) {
+        assert_int_equal(st.view[e], PIPE_VIEW_CROP);
+        assert_null(pipe_view_mask(p, e, NULL, NULL));
+        assert_memory_equal(b.out[e], bc.out[e], (size_t)LCDW * LCDH * 4);
+    }
+    assert_int_equal(st.view_fallbacks, 2);
+    /* the head 1 m back: the cube is in front, reprojected */
+    kin_mat4 head = kin_mat4_from_tr(kin_v3(0, 0, 1.0f), kin_quat_identity());
+    in.head_node = -1;
+    in.world_from_head = &head;
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) assert_int_equal(st.view[e], PIPE_VIEW_REPROJECT);
+    assert_int_equal(st.view_fallbacks, 2);
+    tu_frame_free(&b);
+    tu_frame_free(&bc);
+    pipe_destroy(p);
+    pipe_destroy(c);
+    kin_model_free(&m);
+}
+
+/* NaN depths of the virtual scene: nothing there, the hand is kept; an
+ * object in front (0.2 m) hides it; no crash, the same bytes twice. */
+static void validity_nan_virtual_depth(void **state)
+{
+    (void)state;
+    kin_model m;
+    const float s[1] = {0.05f}, z[1] = {-0.35f};
+    quads_model(&m, 1, s, z);
+    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
+    tu_frame_bufs b, b0;
+    pipe_frame_in in, i0;
+    tu_frame_make(&b, &in, 16, CAMW, CAMH, LCDW, LCDH);
+    tu_frame_make(&b0, &i0, 16, CAMW, CAMH, LCDW, LCDH);
+    float *vd = malloc(sizeof(float) * LCDW * LCDH);
+    assert_non_null(vd);
+    /* NaN on the left half, 0.2 m (in front of the hand) on the right */
+    for (int y = 0; y < LCDH; y++)
+        for (int x = 0; x < LCDW; x++) vd[(size_t)y * LCDW + x] = x < LCDW / 2 ? NAN : 0.2f;
+    for (int e = 0; e < 2; e++) {
+        in.virt_depth[e] = vd;
+        in.virt_depth_stride[e] = LCDW;
+    }
+    char why[200];
+    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_OK);
+    assert_int_equal(pipe_frame(p, &i0, NULL, why, sizeof why), PIPE_OK);
+    for (int e = 0; e < 2; e++) {
+        long same_left = 0, left = 0, virt_right = 0, right = 0;
+        for (int y = 0; y < LCDH; y++)
+            for (int x = 0; x < LCDW; x++) {
+                size_t i = ((size_t)y * LCDW + (size_t)x) * 4;
+                int hand = memcmp(b0.out[e] + i, b0.virt[e] + i, 3) != 0;
+                if (!hand) continue;
+                if (x < LCDW / 2 - 2) {
+                    left++;
+                    same_left += !memcmp(b.out[e] + i, b0.out[e] + i, 4);
+                } else if (x > LCDW / 2 + 2) {
+                    right++;
+                    virt_right += !memcmp(b.out[e] + i, b.virt[e] + i, 3);
+                }
+            }
+        print_message("NOTE eye %d: hand %ld px left (NaN: %ld kept), %ld right (hidden %ld)\n",
+                      e, left, same_left, right, virt_right);
+        assert_true(left > 1000 && right > 1000);
+        assert_int_equal(same_left, left);
+        assert_int_equal(virt_right, right);
+    }
+    free(vd);
+    tu_frame_free(&b);
+    tu_frame_free(&b0);
+    pipe_destroy(p);
+    kin_model_free(&m);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(result_mask_equals_eye_draw),
+        cmocka_unit_test(result_point_lands_by_geometry),
+        cmocka_unit_test(result_point_lands_through_lens),
+        cmocka_unit_test(result_disocclusion_fill),
+        cmocka_unit_test(result_border_fade),
+        cmocka_unit_test(determinism_isa_threads),
+        cmocka_unit_test(validity_bad_desc),
+        cmocka_unit_test(validity_eye_inside_model),
+        cmocka_unit_test(validity_nan_virtual_depth),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
