@@ -25,7 +25,7 @@
  *   bench_raster [--csv] [--runs N] [--tris N,N,...] [--size WxH]
  *                [--isa ref|sse2|avx2|avx512] [--threads 1|2]
  *                [--samples DIR|none] [--cold MB] [--no-pipe]
- *                [--sample-only] [--cull back|none]
+ *                [--sample-only] [--cull back|none] [--clear-normals]
  *
  * --sample-only skips the bench scene (its draw rows and pipe rows), --cull
  * runs one cull mode of the pipe rows: for counting instructions of the
@@ -78,6 +78,12 @@ typedef struct pipe_scene {
     const uint32_t *const *idx;
 } pipe_scene;
 
+/* --clear-normals: the pipe rows' clear also clears the normals
+ * (rast_context_clear; the pipe with a refined, anti-aliased, smoothed or
+ * reprojected mask, or a lens), else not (rast_context_clear_keep_attr,
+ * the pipe's default path, docs/raster.md section 13). */
+static int clear_normals = 0;
+
 typedef struct pipe_eye {
     rast_context *ctx;
     rast_target tg;
@@ -91,7 +97,10 @@ static void pipe_stage(pipe_eye *e, const pipe_scene *sc, const float vp[16],
                        const float view[16], rast_cull cull, double t[3], rast_stats *st)
 {
     double t0 = now_ms();
-    rast_context_clear(e->ctx, &e->tg);
+    if (clear_normals)
+        rast_context_clear(e->ctx, &e->tg);
+    else
+        rast_context_clear_keep_attr(e->ctx, &e->tg); /* the pipe's default path */
     t[0] += now_ms() - t0;
     for (int i = 0; i < sc->meshes; i++) {
         double a = now_ms();
@@ -369,6 +378,8 @@ int main(int argc, char **argv)
             csv = 1;
         else if (!strcmp(argv[i], "--no-pipe"))
             pipe = 0;
+        else if (!strcmp(argv[i], "--clear-normals"))
+            clear_normals = 1;
         else if (!strcmp(argv[i], "--sample-only"))
             ntl = 0;
         else if (!strcmp(argv[i], "--cull") && i + 1 < argc) {
@@ -399,7 +410,7 @@ int main(int argc, char **argv)
         } else {
             fprintf(stderr, "usage: %s [--csv] [--runs N] [--tris N,N,...] [--size WxH] "
                             "[--isa NAME] [--threads N] [--samples DIR|none] [--cold MB] "
-                            "[--no-pipe] [--sample-only] [--cull back|none]\n",
+                            "[--no-pipe] [--sample-only] [--cull back|none] [--clear-normals]\n",
                     argv[0]);
             return 2;
         }

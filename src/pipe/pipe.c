@@ -145,7 +145,15 @@ static rast_result eye_draw(pipe_ctx *p, eye_state *e, const pipe_lens_map *lens
         cam = &pc;
         it = pipe_lens_target(lens);
     }
-    rast_context_clear(e->rast, &it); /* only what the last frame drew */
+    /* only what the last frame drew; the normals not at all where every
+     * reader skips the pixels of mask 0 (docs/raster.md section 13): the
+     * lighting with the G-buffer's own mask, no lens warp, no refined or
+     * anti-aliased mask reaching past it, no smoothing, no reprojection */
+    if (!lens && p->desc.refine_band == 0 && p->desc.normal_smooth == 0 && e->aa.count == 0 &&
+        p->desc.eye_view != PIPE_VIEW_REPROJECT)
+        rast_context_clear_keep_attr(e->rast, &it);
+    else
+        rast_context_clear(e->rast, &it);
     rast_result rr = parts && pipe__cockpit_active(p->ck)
                          ? pipe__cockpit_draw(p->ck, &p->pose, e->eye, e->rast, cam, &it,
                                               p->desc.cull, e->clip, e->vnrm)

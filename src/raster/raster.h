@@ -209,6 +209,15 @@ rast_result rast_context_draw_jobs(rast_context *ctx, int n,
  * or rast_context_forget). ctx NULL: rast_target_clear. */
 #define RAST_CONTEXT_TARGETS 4
 void rast_context_clear(rast_context *ctx, const rast_target *t);
+/* rast_context_clear without the attribute plane: depth and mask as
+ * above; the attributes are cleared only where the target is unknown
+ * (cleared whole), elsewhere they keep what earlier draws wrote. After
+ * the next draws (all with the target's attributes), every pixel whose
+ * mask is nonzero holds this frame's attributes, the others may hold an
+ * earlier frame's: for callers whose every attribute reader skips the
+ * pixels of mask 0 (the pipe's lighting, docs/raster.md section 13). A
+ * later rast_context_clear of the same target clears it whole once. */
+void rast_context_clear_keep_attr(rast_context *ctx, const rast_target *t);
 /* Forgets every target: the next rast_context_clear clears whole. */
 void rast_context_forget(rast_context *ctx);
 /* The number of nonzero bytes of t's mask (the first width bytes of each

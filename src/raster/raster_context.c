@@ -193,6 +193,7 @@ typedef struct known_target {
     rast_target t;
     rast__tiles *dirty;
     int used;
+    int attr_stale; /* the attribute plane was left uncleared (keep_attr) */
 } known_target;
 
 struct rast_context {
@@ -470,8 +471,8 @@ static known_target *find_known(rast_context *c, const rast_target *t)
 }
 
 /* Clears columns x0..x1 of row y of every plane (as rast_target_clear
- * does for whole rows). */
-static void clear_span(const rast_target *t, int y, int x0, int x1)
+ * does for whole rows); the attribute plane only when attr. */
+static void clear_span(const rast_target *t, int y, int x0, int x1, int attr)
 {
     const size_t n = (size_t)(x1 - x0 + 1);
     if (t->depth) {
@@ -480,7 +481,7 @@ static void clear_span(const rast_target *t, int y, int x0, int x1)
             d[x] = 1.0f;
     }
     memset(t->mask + (size_t)y * (size_t)t->mask_stride + x0, 0, n);
-    if (t->attr && t->attr_count > 0)
+    if (attr && t->attr && t->attr_count > 0)
         memset(t->attr + (size_t)y * (size_t)t->attr_stride +
                    (size_t)x0 * (size_t)t->attr_count,
                0, n * (size_t)t->attr_count * sizeof(float));
@@ -490,7 +491,7 @@ static void clear_span(const rast_target *t, int y, int x0, int x1)
  * the clear of a cold target waits on each line's fetch before the store;
  * asking one row ahead overlaps them, 0.82-0.86 of the time for the
  * sample model's ~290 tiles per eye with the planes evicted). */
-static void prefetch_span(const rast_target *t, int y, int x0, int x1)
+static void prefetch_span(const rast_target *t, int y, int x0, int x1, int attr)
 {
     const size_t n = (size_t)(x1 - x0 + 1);
     if (t->depth) {
@@ -501,7 +502,7 @@ static void prefetch_span(const rast_target *t, int y, int x0, int x1)
     const char *m = (const char *)(t->mask + (size_t)y * (size_t)t->mask_stride + x0);
     for (size_t o = 0; o < n; o += 64)
         __builtin_prefetch(m + o, 1, 3);
-    if (t->attr && t->attr_count > 0) {
+    if (attr && t->attr && t->attr_count > 0) {
         const char *a = (const char *)(t->attr + (size_t)y * (size_t)t->attr_stride +
                                        (size_t)x0 * (size_t)t->attr_count);
         for (size_t o = 0; o < n * (size_t)t->attr_count * sizeof(float); o += 64)
@@ -539,7 +540,8 @@ static int tile_x1(const rast_target *t, int te)
     return x < t->width - 1 ? x : t->width - 1;
 }
 
-void rast_context_clear(rast_context *c, const rast_target *t)
+/* rast_context_clear (attr 1) and rast_context_clear_keep_attr (attr 0). */
+static void context_clear(rast_context *c, const rast_target *t, int attr)
 {
     if (!c || !t || !t->mask || t->width <= 0 || t->height <= 0 ||
         t->width > RAST_MAX_DIM || t->height > RAST_MAX_DIM) {
@@ -549,7 +551,11 @@ void rast_context_clear(rast_context *c, const rast_target *t)
     const int tw = (t->width + RAST__TILE - 1) / RAST__TILE;
     const int th = (t->height + RAST__TILE - 1) / RAST__TILE;
     known_target *k = find_known(c, t);
-    if (k) {
+    if (k && attr && k->attr_stale) {
+        /* the attributes outside the marked tiles are not known clear */
+        rast_target_clear(t);
+        k->attr_stale = 0;
+    } else if (k) {
         /* Runs of marked tiles of each tile row, row by row. */
         for (int ty = 0; ty < th; ty++) {
             const int ya = ty * RAST__TILE, yb = tile_y1(t, ty);
@@ -557,20 +563,33 @@ void rast_context_clear(rast_context *c, const rast_target *t)
                 const int x0 = tx * RAST__TILE, x1 = tile_x1(t, te);
                 for (int y = ya; y <= yb; y++) {
                     if (y < yb)
-                        prefetch_span(t, y + 1, x0, x1);
-                    clear_span(t, y, x0, x1);
+                        prefetch_span(t, y + 1, x0, x1, attr);
+                    clear_span(t, y, x0, x1, attr);
                 }
             }
         }
+        if (!attr && t->attr && t->attr_count > 0)
+            k->attr_stale = 1;
     } else {
         rast_target_clear(t);
         k = &c->known[c->known_next];
         c->known_next = (c->known_next + 1) % RAST_CONTEXT_TARGETS;
         k->t = *t;
         k->used = 1;
+        k->attr_stale = 0;
     }
     for (int ty = 0; ty < th; ty++)
         memset(k->dirty->bits[ty], 0, sizeof k->dirty->bits[ty]);
+}
+
+void rast_context_clear(rast_context *c, const rast_target *t)
+{
+    context_clear(c, t, 1);
+}
+
+void rast_context_clear_keep_attr(rast_context *c, const rast_target *t)
+{
+    context_clear(c, t, 0);
 }
 
 /* Nonzero bytes of m[0..n-1]. */
