@@ -19,39 +19,9 @@
 
 static char out[65536];
 
-static const char *bin(void)
-{
-    const char *b = getenv("EGOFUSE_BIN");
-    return b && *b ? b : "build/egofuse";
-}
-
-static int run(const char *a0, ...)
-{
-    char *argv[40];
-    int n = 0;
-    argv[n++] = (char *)bin();
-    va_list ap;
-    va_start(ap, a0);
-    for (const char *a = a0; a && n < 39; a = va_arg(ap, const char *)) argv[n++] = (char *)a;
-    va_end(ap);
-    argv[n] = NULL;
-    return tu_run(argv, out, sizeof out);
-}
-
-static void b64(const uint8_t *in, size_t n, char *o)
-{
-    static const char *t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t j = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) |
-                     (i + 2 < n ? in[i + 2] : 0);
-        o[j++] = t[v >> 18 & 63];
-        o[j++] = t[v >> 12 & 63];
-        o[j++] = i + 1 < n ? t[v >> 6 & 63] : '=';
-        o[j++] = i + 2 < n ? t[v & 63] : '=';
-    }
-    o[j] = '\0';
-}
+/* egofuse with the arguments (NULL-terminated), its output in out */
+#define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
+#define b64 tu_b64
 
 /* An unskinned quad [-s,s]^2 at depth z, facing +Z (normals given). */
 static void write_quad(const char *path, float s, float z)
