@@ -314,6 +314,7 @@ SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
 {
     const uint64x2_t g = vcgtq_f64(a, b);
     return (unsigned)(vgetq_lane_u64(g, 0) & 1u) | ((unsigned)(vgetq_lane_u64(g, 1) & 1u) << 1);
+}
 /* ---- row-cache ops (src/fuse's composite; simd.h "ROW-CACHE OPS") */
 /* TBL on bytes: lane l's four bytes from 4 (idx[l] & 3) + 0..3 */
 SIMD_INL vint vi_permute(vint i, vint idx)
