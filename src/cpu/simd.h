@@ -19,9 +19,8 @@
  * WHAT IT DOES NOT. No dispatch (src/cpu/cpu.h picks the ISA; each room
  * keeps one dispatch table), no FMA, no estimates (rcp/rsqrt), no fast-math,
  * no float gathers (vi_gather: int32, the row cache's fallback); of byte
- * and 16-bit lanes only what the fuse's composites need (vh_*, per 128-bit
- * block; the refinement's saturating
- * and unsigned-compare operations are not here, docs/portability.md);
+ * and 16-bit lanes only what the fuse's composites and the refinement
+ * need (vh_*, per 128-bit block; vb_*, REFINE OPS);
  * bytes widen to int32 lanes with vi_load_u8, RGBA8 pixels are int32
  * lanes through vi_loadu. What one
  * ISA does in a way the others cannot (AVX-512 joint tables, AVX2's
@@ -235,6 +234,25 @@
  *                            8 16-bit lanes (x86 packusdw)
  *   vh_mulhi(i, j)           16-bit lanes: (i j) >> 16, unsigned (x86
  *                            pmulhuw)
+ * REFINE OPS (added for src/fuse's band refinement, fuse_refine_simd.inl:
+ * the mask's bytes and the chamfer distances' 16-bit lanes in MEMORY
+ * order, no blocks; a separate block at the end of each implementation)
+ *   VB_W, VH_W               byte / 16-bit lanes of a vint: 4 SIMD_W and
+ *                            2 SIMD_W (16, 32, 64, 16 / 8, 16, 32, 8)
+ *   vb_loadu(p) vb_storeu(p, i)  VB_W bytes (uint8_t *p, any alignment)
+ *   vb_sign_bits(i)          uint64_t, bit l set where byte l has bit 7 set
+ *                            (x86 pmovmskb; NEON by a weighted add)
+ *   vb_sign_fill(i)          byte l = 0xFF where byte l has bit 7 set, else 0
+ *   vh_load_u8(p)            16-bit lane l = p[l], zero-extended; reads
+ *                            exactly VH_W bytes (uint8_t *p, any alignment)
+ *   vh_loadu(p) vh_storeu(p, i)  VH_W uint16 (uint16_t *p, any alignment)
+ *   vh_min_u(i, j)           16-bit lanes: the unsigned minimum
+ *   vh_adds_u(i, j)          16-bit lanes: i + j unsigned, saturated to 65535
+ *   vh_any_leu(i, j)         1 when some 16-bit lane has i <= j unsigned,
+ *                            else 0
+ *   vi_load_u16(p)           int32 lane l = p[l] (uint16_t *p, any
+ *                            alignment), zero-extended; reads exactly
+ *                            SIMD_W uint16
  *
  * NEW ISA. Copy simd_neon.h (the plainest), keep every name, meet every
  * line of this contract (the semantics above are x86's where the ISAs

@@ -286,6 +286,34 @@ SIMD_INL vint vh_madd(vint i, vint j) { return _mm256_madd_epi16(i, j); }
 SIMD_INL vint vh_packus32(vint i, vint j) { return _mm256_packus_epi32(i, j); }
 SIMD_INL vint vh_mulhi(vint i, vint j) { return _mm256_mulhi_epu16(i, j); }
 
+
+/* ---- refine ops (src/fuse's band refinement, fuse_refine_simd.inl;
+ * simd.h "REFINE OPS") */
+#define VB_W 32
+#define VH_W 16
+SIMD_INL vint vb_loadu(const uint8_t *p) { return _mm256_loadu_si256((const __m256i *)(const void *)p); }
+SIMD_INL void vb_storeu(uint8_t *p, vint i) { _mm256_storeu_si256((__m256i *)(void *)p, i); }
+SIMD_INL uint64_t vb_sign_bits(vint i) { return (uint64_t)(uint32_t)_mm256_movemask_epi8(i); }
+SIMD_INL vint vb_sign_fill(vint i) { return _mm256_cmpgt_epi8(_mm256_setzero_si256(), i); }
+SIMD_INL vint vh_load_u8(const uint8_t *p)
+{
+    return _mm256_cvtepu8_epi16(_mm_loadu_si128((const __m128i *)(const void *)p));
+}
+SIMD_INL vint vh_loadu(const uint16_t *p) { return _mm256_loadu_si256((const __m256i *)(const void *)p); }
+SIMD_INL void vh_storeu(uint16_t *p, vint i) { _mm256_storeu_si256((__m256i *)(void *)p, i); }
+SIMD_INL vint vh_min_u(vint i, vint j) { return _mm256_min_epu16(i, j); }
+SIMD_INL vint vh_adds_u(vint i, vint j) { return _mm256_adds_epu16(i, j); }
+/* i <= j unsigned  <=>  max(i, j) == j */
+SIMD_INL int vh_any_leu(vint i, vint j)
+{
+    const __m256i le = _mm256_cmpeq_epi16(_mm256_max_epu16(i, j), j);
+    return !_mm256_testz_si256(le, le);
+}
+SIMD_INL vint vi_load_u16(const uint16_t *p)
+{
+    return _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i *)(const void *)p));
+}
+
 #else
 #error "simd_avx2.h: another implementation of the vector layer is already included"
 #endif

@@ -272,6 +272,30 @@ SIMD_INL vint vh_madd(vint i, vint j) { return _mm512_madd_epi16(i, j); }
 SIMD_INL vint vh_packus32(vint i, vint j) { return _mm512_packus_epi32(i, j); }
 SIMD_INL vint vh_mulhi(vint i, vint j) { return _mm512_mulhi_epu16(i, j); }
 
+
+/* ---- refine ops (src/fuse's band refinement, fuse_refine_simd.inl;
+ * simd.h "REFINE OPS"; fuse_refine_avx512.c keeps its own masked-row
+ * algorithm) */
+#define VB_W 64
+#define VH_W 32
+SIMD_INL vint vb_loadu(const uint8_t *p) { return _mm512_loadu_si512((const void *)p); }
+SIMD_INL void vb_storeu(uint8_t *p, vint i) { _mm512_storeu_si512((void *)p, i); }
+SIMD_INL uint64_t vb_sign_bits(vint i) { return (uint64_t)_mm512_movepi8_mask(i); }
+SIMD_INL vint vb_sign_fill(vint i) { return _mm512_movm_epi8(_mm512_movepi8_mask(i)); }
+SIMD_INL vint vh_load_u8(const uint8_t *p)
+{
+    return _mm512_cvtepu8_epi16(_mm256_loadu_si256((const __m256i *)(const void *)p));
+}
+SIMD_INL vint vh_loadu(const uint16_t *p) { return _mm512_loadu_si512((const void *)p); }
+SIMD_INL void vh_storeu(uint16_t *p, vint i) { _mm512_storeu_si512((void *)p, i); }
+SIMD_INL vint vh_min_u(vint i, vint j) { return _mm512_min_epu16(i, j); }
+SIMD_INL vint vh_adds_u(vint i, vint j) { return _mm512_adds_epu16(i, j); }
+SIMD_INL int vh_any_leu(vint i, vint j) { return _mm512_cmple_epu16_mask(i, j) != 0; }
+SIMD_INL vint vi_load_u16(const uint16_t *p)
+{
+    return _mm512_cvtepu16_epi32(_mm256_loadu_si256((const __m256i *)(const void *)p));
+}
+
 #else
 #error "simd_avx512.h: another implementation of the vector layer is already included"
 #endif

@@ -361,6 +361,38 @@ SIMD_INL vint vh_mulhi(vint i, vint j)
                                               vshrn_n_u32(vmull_high_u16(a, b), 16)));
 }
 
+
+/* ---- refine ops (src/fuse's band refinement, fuse_refine_simd.inl;
+ * simd.h "REFINE OPS"): NEON's own u8 / u16 lanes; the byte sign bits
+ * (x86 pmovmskb) by a weighted add of each half */
+#define VB_W 16
+#define VH_W 8
+SIMD_INL vint vb_loadu(const uint8_t *p) { return vreinterpretq_s32_u8(vld1q_u8(p)); }
+SIMD_INL void vb_storeu(uint8_t *p, vint i) { vst1q_u8(p, vreinterpretq_u8_s32(i)); }
+SIMD_INL uint64_t vb_sign_bits(vint i)
+{
+    static const uint8_t w[16] = { 1, 2, 4, 8, 16, 32, 64, 128, 1, 2, 4, 8, 16, 32, 64, 128 };
+    const uint8x16_t b = vandq_u8(vcltzq_s8(vreinterpretq_s8_s32(i)), vld1q_u8(w));
+    return (uint64_t)vaddv_u8(vget_low_u8(b)) | (uint64_t)vaddv_u8(vget_high_u8(b)) << 8;
+}
+SIMD_INL vint vb_sign_fill(vint i) { return vreinterpretq_s32_u8(vcltzq_s8(vreinterpretq_s8_s32(i))); }
+SIMD_INL vint vh_load_u8(const uint8_t *p) { return vreinterpretq_s32_u16(vmovl_u8(vld1_u8(p))); }
+SIMD_INL vint vh_loadu(const uint16_t *p) { return vreinterpretq_s32_u16(vld1q_u16(p)); }
+SIMD_INL void vh_storeu(uint16_t *p, vint i) { vst1q_u16(p, vreinterpretq_u16_s32(i)); }
+SIMD_INL vint vh_min_u(vint i, vint j)
+{
+    return vreinterpretq_s32_u16(vminq_u16(vreinterpretq_u16_s32(i), vreinterpretq_u16_s32(j)));
+}
+SIMD_INL vint vh_adds_u(vint i, vint j)
+{
+    return vreinterpretq_s32_u16(vqaddq_u16(vreinterpretq_u16_s32(i), vreinterpretq_u16_s32(j)));
+}
+SIMD_INL int vh_any_leu(vint i, vint j)
+{
+    return vmaxvq_u16(vcleq_u16(vreinterpretq_u16_s32(i), vreinterpretq_u16_s32(j))) != 0;
+}
+SIMD_INL vint vi_load_u16(const uint16_t *p) { return vreinterpretq_s32_u32(vmovl_u16(vld1_u16(p))); }
+
 #else
 #error "simd_neon.h: another implementation of the vector layer is already included"
 #endif

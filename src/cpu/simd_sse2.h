@@ -295,6 +295,33 @@ SIMD_INL vint vh_packus32(vint i, vint j)
 }
 SIMD_INL vint vh_mulhi(vint i, vint j) { return _mm_mulhi_epu16(i, j); }
 
+
+/* ---- refine ops (src/fuse's band refinement, fuse_refine_simd.inl;
+ * simd.h "REFINE OPS"): SSE2 has no pminuw and no pmovzx; the unsigned
+ * 16-bit minimum is a - (a -sat b), widening unpacks with zero */
+#define VB_W 16
+#define VH_W 8
+SIMD_INL vint vb_loadu(const uint8_t *p) { return _mm_loadu_si128((const __m128i *)(const void *)p); }
+SIMD_INL void vb_storeu(uint8_t *p, vint i) { _mm_storeu_si128((__m128i *)(void *)p, i); }
+SIMD_INL uint64_t vb_sign_bits(vint i) { return (uint64_t)(unsigned)_mm_movemask_epi8(i); }
+SIMD_INL vint vb_sign_fill(vint i) { return _mm_cmpgt_epi8(_mm_setzero_si128(), i); }
+SIMD_INL vint vh_load_u8(const uint8_t *p)
+{
+    return _mm_unpacklo_epi8(_mm_loadl_epi64((const __m128i *)(const void *)p), _mm_setzero_si128());
+}
+SIMD_INL vint vh_loadu(const uint16_t *p) { return _mm_loadu_si128((const __m128i *)(const void *)p); }
+SIMD_INL void vh_storeu(uint16_t *p, vint i) { _mm_storeu_si128((__m128i *)(void *)p, i); }
+SIMD_INL vint vh_min_u(vint i, vint j) { return _mm_sub_epi16(i, _mm_subs_epu16(i, j)); }
+SIMD_INL vint vh_adds_u(vint i, vint j) { return _mm_adds_epu16(i, j); }
+SIMD_INL int vh_any_leu(vint i, vint j)
+{
+    return _mm_movemask_epi8(_mm_cmpeq_epi16(_mm_subs_epu16(i, j), _mm_setzero_si128())) != 0;
+}
+SIMD_INL vint vi_load_u16(const uint16_t *p)
+{
+    return _mm_unpacklo_epi16(_mm_loadl_epi64((const __m128i *)(const void *)p), _mm_setzero_si128());
+}
+
 #else
 #error "simd_sse2.h: another implementation of the vector layer is already included"
 #endif

@@ -1,0 +1,187 @@
+/* fuse_refine_simd.inl - the row kernels of the band-only refinement
+ * (fuse_refine_kern.h), written ONCE on the vector layer (src/cpu/simd.h,
+ * its REFINE OPS for the byte and 16-bit lanes) and included by
+ * fuse_refine_avx2.c and fuse_refine_neon.c after their simd_*.h. Same
+ * bytes as the reference (tests/test_fuse_refine.c). Whole vectors inside
+ * the row; the few pixels at a row's ends (and the histogram, the running
+ * minimum of the chamfer passes) go through the portable kernels, which
+ * give the same values:
+ *   edges      VB_W mask pixels per step: inside is the byte's bit 7, so
+ *              the edge is bit 7 of (m^l)|(m^r)|(m^u)|(m^d), its bits by
+ *              vb_sign_bits (pmovmskb);
+ *   dt_init    VH_W per step, the same rule on 16-bit lanes;
+ *   chamfer    the vertical minimum VH_W distances per step;
+ *   ring skip  VH_W distances per step;
+ *   decision   SIMD_W per step, the window sum in the reference's order;
+ *   binarise   VB_W per step.
+ * The includer defines, before the include, its score kernel
+ *   static void SIMD_FN(refine_score_row)(const fuse__refine_tabs *, ...)
+ * (AVX2 gathers its look-ups; NEON has no gather and calls the portable
+ * one); this file defines SIMD_FN(fuse__refine_kern)(), e.g.
+ * fuse__refine_kern_avx2(). fuse_refine_avx512.c keeps its own algorithm
+ * (masked row ends, a vector running minimum). */
+
+#define KC fuse__refine_kern_c
+
+/* bit 7 of each byte: the edge pixels of the VB_W at x (1 <= x,
+ * x + VB_W < w) */
+SIMD_INL vint SIMD_FN(refine_edge_bytes)(const uint8_t *up, const uint8_t *row,
+                                         const uint8_t *dn, int x)
+{
+    const vint m = vb_loadu(row + x);
+    const vint l = vi_xor(m, vb_loadu(row + x - 1)), r = vi_xor(m, vb_loadu(row + x + 1));
+    const vint u = vi_xor(m, vb_loadu(up + x)), d = vi_xor(m, vb_loadu(dn + x));
+    return vi_or(vi_or(l, r), vi_or(u, d));
+}
+
+static int SIMD_FN(refine_edge_span)(const uint8_t *up, const uint8_t *row, const uint8_t *dn,
+                                     int w, int *x0, int *x1)
+{
+    int a = -1, b = -1;
+    for (int x = 0; x < w;) {
+        if (x >= 1 && x + VB_W < w) {
+            const uint64_t e = vb_sign_bits(SIMD_FN(refine_edge_bytes)(up, row, dn, x));
+            if (e) { a = x + __builtin_ctzll(e); break; }
+            x += VB_W;
+        } else {
+            if (fuse__refine_edge_at(up, row, dn, w, x)) { a = x; break; }
+            x++;
+        }
+    }
+    if (a < 0) return 0;
+    for (int x = w - 1; x >= a;) {
+        if (x - (VB_W - 1) >= 1 && x + 1 < w) {
+            const uint64_t e = vb_sign_bits(SIMD_FN(refine_edge_bytes)(up, row, dn,
+                                                                       x - (VB_W - 1)));
+            /* the highest set bit h: pixel x - (VB_W - 1) + h */
+            if (e) { b = x - (VB_W - 1) + (63 - __builtin_clzll(e)); break; }
+            x -= VB_W;
+        } else {
+            if (fuse__refine_edge_at(up, row, dn, w, x)) { b = x; break; }
+            x--;
+        }
+    }
+    *x0 = a;
+    *x1 = b;
+    return 1;
+}
+
+static void SIMD_FN(refine_dt_init)(const uint8_t *up, const uint8_t *row, const uint8_t *dn,
+                                    int w, int a, int b, uint16_t cap, uint16_t *d)
+{
+    const vint vcap = vh_set1(cap), flip = vh_set1(cap ^ 3u), one = vh_set1(1);
+    int x = a;
+    if (x < 1) {   /* pixel 0: no left neighbour */
+        KC.dt_init(up, row, dn, w, 0, 0, cap, d);
+        x = 1;
+    }
+    for (; x + VH_W - 1 <= b && x + VH_W < w; x += VH_W) {
+        const vint m = vh_load_u8(row + x);
+        const vint e = vi_or(vi_or(vi_xor(m, vh_load_u8(row + x - 1)),
+                                   vi_xor(m, vh_load_u8(row + x + 1))),
+                             vi_or(vi_xor(m, vh_load_u8(up + x)),
+                                   vi_xor(m, vh_load_u8(dn + x))));
+        /* 0xFFFF on the edge lanes (bit 7 of the byte), else 0 */
+        const vint sel = vh_sub(vi_zero(), vi_and(vh_srli(e, 7), one));
+        vh_storeu(d + x, vi_xor(vcap, vi_and(sel, flip)));   /* edge ? 3 : cap */
+    }
+    if (x <= b) KC.dt_init(up, row, dn, w, x, b, cap, d);
+}
+
+/* the vertical part on [a, b]: min(r, v + 3, v[-1] + 4, v[+1] + 4), vectors
+ * inside, the portable rule at the ends; the saturating add gives the
+ * reference's minimum (v + k > 65535 never wins against r <= 65535) */
+static void SIMD_FN(refine_vert_row)(uint16_t *r, const uint16_t *v, int w, int a, int b)
+{
+    const vint three = vh_set1(3), four = vh_set1(4);
+    int x = a;
+    for (; x <= b && x < 1; x++) r[x] = fuse__refine_vert_px(r, v, w, x);
+    for (; x + VH_W - 1 <= b && x + VH_W < w; x += VH_W) {
+        vint m = vh_loadu(r + x);
+        m = vh_min_u(m, vh_adds_u(vh_loadu(v + x), three));
+        m = vh_min_u(m, vh_adds_u(vh_loadu(v + x - 1), four));
+        m = vh_min_u(m, vh_adds_u(vh_loadu(v + x + 1), four));
+        vh_storeu(r + x, m);
+    }
+    for (; x <= b; x++) r[x] = fuse__refine_vert_px(r, v, w, x);
+}
+
+static void SIMD_FN(refine_dt_fwd)(uint16_t *r, const uint16_t *u, int w, int a, int b)
+{
+    if (u) SIMD_FN(refine_vert_row)(r, u, w, a, b);
+    KC.dt_fwd(r, NULL, w, a, b);   /* the running minimum */
+}
+
+static void SIMD_FN(refine_dt_bwd)(uint16_t *r, const uint16_t *dn, int w, int a, int b)
+{
+    if (dn) SIMD_FN(refine_vert_row)(r, dn, w, a, b);
+    KC.dt_bwd(r, NULL, w, a, b);
+}
+
+static void SIMD_FN(refine_hist_row)(const uint8_t *px, const uint8_t *m, const uint16_t *d,
+                                     int a, int b, unsigned band3, unsigned outer3, int bits,
+                                     uint32_t *hf, uint32_t *hb, long *nf, long *nb)
+{
+    /* skip VH_W distances at a time that hold no ring pixel:
+     * band3 < d <= outer3  <=>  (uint16)(d - band3 - 1) <= outer3 - band3 - 1 */
+    const vint lo = vh_set1((int)(band3 + 1u)), span = vh_set1((int)(outer3 - band3 - 1u));
+    int x = a;
+    while (x <= b) {
+        if (x + VH_W - 1 <= b) {
+            if (vh_any_leu(vh_sub(vh_loadu(d + x), lo), span))
+                KC.hist_row(px, m, d, x, x + VH_W - 1, band3, outer3, bits, hf, hb, nf, nb);
+            x += VH_W;
+        } else {
+            KC.hist_row(px, m, d, x, b, band3, outer3, bits, hf, hb, nf, nb);
+            break;
+        }
+    }
+}
+
+static void SIMD_FN(refine_decide_row)(const float *s, ptrdiff_t ss, int rad, const uint8_t *m,
+                                       const uint16_t *d, unsigned band3, uint8_t *out, int a,
+                                       int b, long cnt[3])
+{
+    const vint vb3 = vi_set1((int)band3), v127 = vi_set1(127);
+    long nb = 0, fi = 0, fo = 0;
+    int x = a;
+    for (; x + SIMD_W - 1 <= b; x += SIMD_W) {
+        const unsigned band = SIMD_FULL & ~vm_bits(vi_gt(vi_load_u16(d + x), vb3));
+        const unsigned in = vm_bits(vi_gt(vi_load_u8(m + x), v127));
+        unsigned v = in;
+        if (band) {
+            vfloat sum = vf_zero();
+            for (int dy = -rad; dy <= rad; dy++) {
+                const float *r = s + dy * ss + x;
+                for (int dx = -rad; dx <= rad; dx++) sum = vf_add(sum, vf_loadu(r + dx));
+            }
+            const unsigned pos = vm_bits(vf_gt(sum, vf_zero()));
+            v = (in & ~band) | (pos & band);
+            nb += __builtin_popcount(band);
+            fi += __builtin_popcount(band & pos & ~in);
+            fo += __builtin_popcount(band & ~pos & in & SIMD_FULL);
+        }
+        for (int j = 0; j < SIMD_W; j++) out[x + j] = (v >> j) & 1u ? 255 : 0;
+    }
+    cnt[0] += nb;
+    cnt[1] += fi;
+    cnt[2] += fo;
+    if (x <= b) KC.decide_row(s, ss, rad, m, d, band3, out, x, b, cnt);
+}
+
+static void SIMD_FN(refine_binarise)(const uint8_t *m, uint8_t *out, int a, int b)
+{
+    int x = a;
+    for (; x + VB_W - 1 <= b; x += VB_W) vb_storeu(out + x, vb_sign_fill(vb_loadu(m + x)));
+    if (x <= b) KC.binarise(m, out, x, b);
+}
+
+static const fuse__refine_kern SIMD_FN(refine_kern) = {
+    SIMD_FN(refine_edge_span), SIMD_FN(refine_dt_init),   SIMD_FN(refine_dt_fwd),
+    SIMD_FN(refine_dt_bwd),    SIMD_FN(refine_hist_row),  SIMD_FN(refine_score_row),
+    SIMD_FN(refine_decide_row), SIMD_FN(refine_binarise),
+};
+
+const fuse__refine_kern *SIMD_FN(fuse__refine_kern)(void) { return &SIMD_FN(refine_kern); }
+
+#undef KC
