@@ -161,7 +161,7 @@ static void expect_usage(const char *what, const char *dir_out, const char *cons
 {
     char *argv[24];
     int k = 0;
-    argv[k++] = (char *)bin();
+    argv[k++] = (char *)tu_bin();
     for (int i = 0; i < n; i++) argv[k++] = (char *)args[i];
     argv[k] = NULL;
     int rc = tu_run(argv, out, sizeof out);
