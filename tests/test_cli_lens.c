@@ -16,13 +16,14 @@
 #include <string.h>
 
 #include "../src/io/io.h"
+#include "support/files.h"
 #include "../src/io/io_calib.h"
 
 static char out[65536];
 
 /* egofuse with the arguments (NULL-terminated), its output in out */
 #define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
-#define b64 tu_b64
+#define b64 tu_b64 /* support/files.h */
 
 /* An unskinned quad [x0,x1]x[y0,y1] at depth z. */
 static void write_quad(const char *path, float x0, float x1, float y0, float y1, float z)
