@@ -183,8 +183,9 @@ void tu_samples_remove(const char *name)
     tu_run(argv, log, sizeof log);
 }
 
-void tu_b64(const uint8_t *in, size_t n, char *o)
+void tu_b64(const void *inp, size_t n, char *o)
 {
+    const uint8_t *in = inp;
     static const char *t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     size_t j = 0;
     for (size_t i = 0; i < n; i += 3) {
