@@ -31,7 +31,6 @@ typedef struct eye_state {
     uint8_t *prior;           /* refine_prior: this frame's input mask */
     float hand_px[2][2];      /* refine_prior: each hand's image position */
     int have_hand_px[2];      /* last frame (pipe_fit_hand_px) */
-    int prior_used;           /* this frame's input was the prior */
     pipe__aa aa;              /* anti-aliased coverage (aa_samples) */
     const uint8_t *shown;     /* the mask composited last frame */
     int converted;            /* cam_rgba already holds this frame's crop */
@@ -312,15 +311,15 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         rp.band = p->desc.refine_band;
         /* the elbow fit's colour model as the global term only once it
          * has one: before that (or when the last learning found too few
-         * samples) its all-zero model would only halve the local term */
-        /* the refinement's input: the kinematic mask, or around the slow
-         * hands the last refined mask moved with the hand (pipe_fit_prior;
-         * e->refined still holds it until the refinement below) */
+         * samples) its all-zero model would only halve the local term.
+         * The refinement's input: the kinematic mask, or on tracked frames
+         * (the fit's) around the slow hands the last refined mask moved
+         * with the hand (pipe_fit_prior; e->refined still holds it until
+         * the refinement below) */
         const uint8_t *rin = e->mask;
-        e->prior_used = 0;
-        if (e->prior && in->locals) {   /* tracked frames (the fit's) */
+        if (e->prior) {
             const unsigned sides = 3u & ~in->fit_skip;
-            if (e->have_refined && !p->fit_no_prev) {
+            if (in->locals && e->have_refined && !p->fit_no_prev) {
                 pipe_fit_band_desc bd = pipe_fit_band_desc_default();
                 bd.hand_radius = PIPE_PRIOR_RADIUS;
                 const float zero[2] = {0.0f, 0.0f};
@@ -338,8 +337,8 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                 rin = pipe_fit_prior(&bd, &e->cam, p->pose.world, &p->fit_rig, sides,
                                      in->hand_speed ? in->hand_speed : zero, PIPE_PRIOR_SPEED,
                                      shift, e->mask, e->refined, e->prior, cw);
-                e->prior_used = rin == e->prior;
             }
+            /* where the hands are in this frame's refined mask */
             for (int k = 0; k < 2; k++)
                 e->have_hand_px[k] =
                     pipe_fit_hand_px(&e->cam, p->pose.world, &p->fit_rig, k, e->hand_px[k]);
