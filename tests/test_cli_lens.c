@@ -23,7 +23,7 @@ static char out[65536];
 
 /* egofuse with the arguments (NULL-terminated), its output in out */
 #define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
-#define b64 tu_b64 /* support/files.h */
+#define b64 tu_b64
 
 /* An unskinned quad [x0,x1]x[y0,y1] at depth z. */
 static void write_quad(const char *path, float x0, float x1, float y0, float y1, float z)

@@ -22,7 +22,7 @@ static char out[65536];
 
 /* egofuse with the arguments (NULL-terminated), its output in out */
 #define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
-#define b64 tu_b64 /* support/files.h */
+#define b64 tu_b64
 
 /* An unskinned quad [-s,s]^2 at depth z, facing +Z (normals given). */
 static void write_quad(const char *path, float s, float z)

@@ -74,7 +74,9 @@ static const char *render_usage =
     "  --refine BAND  refine the masks by colour in a band of BAND px (1..64,\n"
     "                 16 is `egofuse eval`'s default) around their edges; with\n"
     "                 --pose tracking the elbows are first fitted to the camera\n"
-    "                 images (pipe_fit): eval's method refine\n"
+    "                 images (pipe_fit), the last refined mask is the prior\n"
+    "                 around slow hands and the filter's lag compensation\n"
+    "                 grows with the hand's speed: eval's method refine\n"
     "  --hide PARTS   do not show these parts of the operator's arms: a comma\n"
     "                 list of left-hand, left-arm, right-hand, right-arm (or\n"
     "                 hands, arms, all); a hand is the wrist joint and below,\n"
@@ -155,6 +157,8 @@ typedef struct track_pose {
     kin_transform *locals;
     int rejected;              /* samples kin_arm_rig_pose could not use */
     unsigned fit_skip;         /* pipe_frame_in.fit_skip: untracked hands */
+    float speed[2];            /* pipe_frame_in.hand_speed: wrists, m/s */
+    pipe_desc pd;              /* the refine method's tracking (pipe_track_output) */
 } track_pose;
 
 static void track_pose_free(track_pose *tp)
@@ -188,7 +192,10 @@ static int track_pose_init(track_pose *tp, const render_opts *o, const io_scene 
         track_pose_free(tp);
         return cli_fail("%s: cannot pose it from tracking: %s", model_path, why);
     }
-    kin_filter_init(&tp->filter, NULL);
+    /* with --refine: the refine method's filter (pipe_track_filter_desc) */
+    tp->pd.refine_band = o->refine;
+    kin_filter_desc fd = pipe_track_filter_desc(&tp->pd);
+    kin_filter_init(&tp->filter, &fd);
     tp->locals = malloc(sizeof *tp->locals * (size_t)model->node_count);
     if (!tp->locals) {
         track_pose_free(tp);
@@ -210,7 +217,7 @@ static void track_pose_at(track_pose *tp, const render_opts *o, const kin_model 
     }
     if (tp->next > 0) {
         if (o->no_filter) cur = tp->samples[tp->next - 1];
-        else kin_filter_output(&tp->filter, t + 1e-3 * o->predict_ms, &cur, NULL);
+        else pipe_track_output(&tp->pd, &tp->filter, t + 1e-3 * o->predict_ms, &cur, tp->speed);
     }
     kin_pose_rest(model, tp->locals);
     tp->fit_skip = ((cur.valid & KIN_TRACK_HAND_L) ? 0u : 1u) | ((cur.valid & KIN_TRACK_HAND_R) ? 0u : 2u);
@@ -469,6 +476,7 @@ static int render(const render_opts *o)
             track_pose_at(&tp, o, &model, (double)f / (double)sc.fps);
             in.locals = tp.locals;
             in.fit_skip = tp.fit_skip;
+            in.hand_speed = tp.speed;
         }
         char why[256];
         pipe_result pr_ = pipe_frame(pp, &in, &st, why, sizeof why);

@@ -147,6 +147,8 @@ typedef struct run_state {
     kin_transform *locals;
     kin_user_calib ucal;
     kin_filter filter;
+    pipe_desc track_pd;       /* the refine method's tracking (pipe_track_output) */
+    float hand_speed[2];      /* pipe_frame_in.hand_speed: wrists, m/s */
     track_clock tclock;
     uint64_t track_samples;   /* samples taken into the filter */
     uint64_t t_track;         /* CLOCK_MONOTONIC time of the newest one */
@@ -709,7 +711,10 @@ static int run(const run_opts *o)
             cli_fail("out of memory");
             goto done;
         }
-        kin_filter_init(&r->filter, NULL);
+        /* with --refine: the refine method's filter (pipe_track_filter_desc) */
+        r->track_pd.refine_band = o->refine;
+        kin_filter_desc fd = pipe_track_filter_desc(&r->track_pd);
+        kin_filter_init(&r->filter, &fd);
     }
     if (o->track_port &&
         io_track_udp_listen(&r->udp, o->track_addr, o->track_port, &err) != IO_OK) {
@@ -1030,7 +1035,8 @@ static int run(const run_opts *o)
             track_service(r);
             if (r->track_samples) {
                 double t_pose = 1e-9 * (double)t_cam + 1e-3 * o->predict_ms - r->tclock.offset_s;
-                kin_filter_output(&r->filter, t_pose, &sample, NULL);
+                pipe_track_output(&r->track_pd, &r->filter, t_pose, &sample, r->hand_speed);
+                in.hand_speed = r->hand_speed;
                 for (int e = 0; e < 2; e++)
                     if (r->have_glove[e]) io_glove_to_sample(&r->glove[e], &sample);
                 kin_track_sample posed;

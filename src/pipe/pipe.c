@@ -6,6 +6,7 @@
 #include "pipe_internal.h"
 #include "pipe_lens.h"
 #include "pipe_reproj.h"
+#include "../fit/fit_band.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -27,6 +28,9 @@ typedef struct eye_state {
     void *refine_scratch;
     size_t refine_scratch_size;
     int have_refined;         /* refined holds the last frame's mask */
+    uint8_t *prior;           /* refine_prior: this frame's input mask */
+    float hand_px[2][2];      /* refine_prior: each hand's image position */
+    int have_hand_px[2];      /* last frame (pipe_fit_hand_px) */
     pipe__aa aa;              /* anti-aliased coverage (aa_samples) */
     const uint8_t *shown;     /* the mask composited last frame */
     int converted;            /* cam_rgba already holds this frame's crop */
@@ -307,14 +311,45 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         rp.band = p->desc.refine_band;
         /* the elbow fit's colour model as the global term only once it
          * has one: before that (or when the last learning found too few
-         * samples) its all-zero model would only halve the local term */
+         * samples) its all-zero model would only halve the local term.
+         * The refinement's input: the kinematic mask, or on tracked frames
+         * (the fit's) around the slow hands the last refined mask moved
+         * with the hand (pipe_fit_prior; e->refined still holds it until
+         * the refinement below) */
+        const uint8_t *rin = e->mask;
+        if (e->prior) {
+            const unsigned sides = 3u & ~in->fit_skip;
+            if (in->locals && e->have_refined && !p->fit_no_prev) {
+                pipe_fit_band_desc bd = pipe_fit_band_desc_default();
+                bd.hand_radius = PIPE_PRIOR_RADIUS;
+                const float zero[2] = {0.0f, 0.0f};
+                /* moved with the hand: its image motion since the last
+                 * frame (the drawn pose's) */
+                float shift[2][2] = {{0, 0}, {0, 0}};
+                for (int k = 0; k < 2; k++)
+                    if (e->have_hand_px[k] &&
+                        pipe_fit_hand_px(&e->cam, p->pose.world, &p->fit_rig, k, shift[k])) {
+                        shift[k][0] -= e->hand_px[k][0];
+                        shift[k][1] -= e->hand_px[k][1];
+                    } else {
+                        shift[k][0] = shift[k][1] = 0.0f;
+                    }
+                rin = pipe_fit_prior(&bd, &e->cam, p->pose.world, &p->fit_rig, sides,
+                                     in->hand_speed ? in->hand_speed : zero, PIPE_PRIOR_SPEED,
+                                     shift, e->mask, e->refined, e->prior, cw);
+            }
+            /* where the hands are in this frame's refined mask */
+            for (int k = 0; k < 2; k++)
+                e->have_hand_px[k] =
+                    pipe_fit_hand_px(&e->cam, p->pose.world, &p->fit_rig, k, e->hand_px[k]);
+        }
         fuse_refine_stats rs;
         fuse_result rr2 =
             p->fit && pipe_fit_learned(p->fit, e->eye)
                 ? fuse_refine_mask_global(&rp, pipe_fit_colour(p->fit, e->eye), 0.5f, &fe.P,
-                                          e->mask, cw, e->refined, cw, e->refine_scratch,
+                                          rin, cw, e->refined, cw, e->refine_scratch,
                                           e->refine_scratch_size, &rs)
-                : fuse_refine_mask(&rp, &fe.P, e->mask, cw, e->refined, cw, e->refine_scratch,
+                : fuse_refine_mask(&rp, &fe.P, rin, cw, e->refined, cw, e->refine_scratch,
                                    e->refine_scratch_size, &rs);
         if (rr2 != FUSE_OK) {
             e->result = PIPE_ERR_FUSE;
@@ -397,6 +432,8 @@ static void run_eye(pipe_ctx *p, eye_state *e)
             fuse_depth_fill(fe.mask, cw, e->depth, cw, cw, ch, b > 0 ? b + b / 8 + 3 : 2,
                             filled);
         }
+        /* (a prior's pixel beyond the fill's radius from the model gets
+         * the far plane from fuse_depth_fill: a virtual object hides it) */
     }
     fuse_result fr = FUSE_OK;
     if (p->desc.tone_match > 0.0f) {
@@ -495,6 +532,7 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].layer);
         free(p->eye[e].cam_rgba);
         free(p->eye[e].refined);
+        free(p->eye[e].prior);
         free(p->eye[e].refine_scratch);
         pipe__aa_free(&p->eye[e].aa);
         pipe__reproj_free(&p->eye[e].rp);
@@ -553,6 +591,9 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
          pipe_view_check(&desc->hmd, NULL, 0) != 0))
         return NULL;
     if (desc && (desc->edge_fade < -1 || desc->edge_fade > FUSE_EDGE_FADE_MAX)) return NULL;
+    if (desc && (desc->refine_prior < -1 || desc->refine_prior > 0 ||
+                 desc->refine_lag_adapt < -1 || desc->refine_lag_adapt > 0))
+        return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
     if (desc) p->desc = *desc;
@@ -613,6 +654,10 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
                                     ? aligned_alloc(16, (s->refine_scratch_size + 15) & ~(size_t)15)
                                     : NULL;
             ok = s->refined && s->refine_scratch;
+            if (ok && p->desc.refine_prior == 0 && p->desc.fit_rig) {
+                s->prior = malloc(px);
+                ok = s->prior != NULL;
+            }
         }
         /* coverage samples are drawn through the pinhole: not with a
          * distorting lens (pipe.h ANTI-ALIASED EDGES) */

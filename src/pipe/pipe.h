@@ -122,7 +122,47 @@ typedef struct pipe_desc {
                                  FUSE_EDGE_FADE_MAX: k; -1: off (the hard
                                  cut, the bytes of before). Other values:
                                  pipe_create returns NULL. */
+    int refine_prior;         /* with refine_band and fit_rig (the rig's
+                                 hand joints): 0 = the default, on: around
+                                 each tracked hand slower than
+                                 PIPE_PRIOR_SPEED (pipe_frame_in.hand_speed),
+                                 within PIPE_PRIOR_RADIUS of its joints, the
+                                 refinement starts from the eye's last
+                                 refined mask moved by the hand's image
+                                 motion since the last frame
+                                 (pipe_fit_prior, docs/accuracy.md), not
+                                 from the kinematic mask; the colour model
+                                 and the limb widths are still learned
+                                 against the kinematic mask. A refined
+                                 pixel the depth fill does not reach gets
+                                 the far plane's depth, so a virtual object
+                                 still hides it. -1: off (the bytes of
+                                 before). Other values: pipe_create
+                                 returns NULL. */
+    int refine_lag_adapt;     /* with refine_band: 0 = the default, on; -1
+                                 off. Not used by pipe_frame (the pipe
+                                 runs no filter): it tells the caller's
+                                 tracking how to pose the frames, see
+                                 pipe_track_output. Other values:
+                                 pipe_create returns NULL. */
 } pipe_desc;
+
+/* The defaults of the refine method (`egofuse eval`'s, docs/accuracy.md). */
+#define PIPE_PRIOR_RADIUS 0.03f   /* metres around each hand joint */
+#define PIPE_PRIOR_SPEED 0.3f     /* m/s: faster hands keep the kinematic mask */
+#define PIPE_LAG_V0 0.2f          /* m/s: the lag compensation starts ... */
+#define PIPE_LAG_V1 0.8f          /* ... and is whole here */
+
+/* The tracking of a pipe (egofuse render/run): with refine_band > 0 and
+ * refine_lag_adapt 0 the filter runs without its ramp-lag compensation
+ * (pipe_track_filter_desc sets no_lag_comp 1) and each hand's compensation
+ * grows with its speed from PIPE_LAG_V0 to PIPE_LAG_V1
+ * (pipe_fit_filter_output); otherwise the filter is kin's default and the
+ * output kin_filter_output's. speed (NULL or 2 floats) receives the
+ * filtered wrist speeds (m/s) for pipe_frame_in.hand_speed. */
+kin_filter_desc pipe_track_filter_desc(const pipe_desc *d);
+void pipe_track_output(const pipe_desc *d, const kin_filter *f, double display_t,
+                       kin_track_sample *out, float speed[2]);
 
 /* The default width of the soft viewport edges, in camera pixels (about
  * 7.5 display pixels with the paper's viewport). */
@@ -191,6 +231,9 @@ typedef struct pipe_frame_in {
     /* With an elbow fit (pipe_desc.fit_rig): bit 0 / bit 1 = do not turn
      * the left / right arm (its hand is not tracked this frame). */
     unsigned fit_skip;
+    /* With pipe_desc.refine_prior: the left and right wrists' speeds, m/s
+     * (pipe_track_output). NULL: 0 (every tracked hand takes the prior). */
+    const float *hand_speed;
     /* 1: the caller promises that both virtual images have alpha 255 at
      * every pixel of the viewport (pipe_geometry: vp_x0, vp_y0, vp_width,
      * vp_height), e.g. checked once with pipe_image_opaque. The composite

@@ -44,22 +44,6 @@ static inline unsigned char *tu_read_file(const char *path, size_t *n)
     return b;
 }
 
-/* The base64 (RFC 4648, padded) of the n bytes at in, into o (at least
- * 4 * ((n + 2) / 3) + 1 bytes), NUL-terminated: glTF data: URIs. */
-static inline void tu_b64(const void *in, size_t n, char *o)
-{
-    static const char *t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    const unsigned char *b = in;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)b[i] << 16;
-        if (i + 1 < n) v |= (uint32_t)b[i + 1] << 8;
-        if (i + 2 < n) v |= b[i + 2];
-        *o++ = t[(v >> 18) & 63];
-        *o++ = t[(v >> 12) & 63];
-        *o++ = i + 1 < n ? t[(v >> 6) & 63] : '=';
-        *o++ = i + 2 < n ? t[v & 63] : '=';
-    }
-    *o = 0;
-}
+/* tu_b64 (base64 of glTF data: URIs): testutil.h. */
 
 #endif

@@ -182,3 +182,19 @@ void tu_samples_remove(const char *name)
     char *argv[] = {"/bin/rm", "-rf", dir, NULL};
     tu_run(argv, log, sizeof log);
 }
+
+void tu_b64(const void *inp, size_t n, char *o)
+{
+    const uint8_t *in = inp;
+    static const char *t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    size_t j = 0;
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) |
+                     (i + 2 < n ? in[i + 2] : 0);
+        o[j++] = t[v >> 18 & 63];
+        o[j++] = t[v >> 12 & 63];
+        o[j++] = i + 1 < n ? t[v >> 6 & 63] : '=';
+        o[j++] = i + 2 < n ? t[v & 63] : '=';
+    }
+    o[j] = '\0';
+}

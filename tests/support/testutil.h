@@ -50,6 +50,8 @@ const char *tu_bin(void);
 /* tu_run of prog with the arguments a0, ... (NULL-terminated, at most
  * 46 are passed). */
 int tu_runl(char *out, size_t out_size, const char *prog, const char *a0, ...);
+/* Base64 (RFC 4648, padded) of in[0..n) into o (4 ceil(n / 3) + 1 bytes). */
+void tu_b64(const void *in, size_t n, char *o);
 /* Open descriptors of this process (entries of /proc/self/fd, its own
  * listing's included), -1 when it cannot be read: compare before and after. */
 int tu_count_fds(void);

@@ -1,0 +1,332 @@
+/* test_pipe_prior.c - the refine method's prior in the pipeline
+ * (pipe_desc.refine_prior, issue 14 item 2, docs/accuracy.md): the pipe-level
+ * twin of test_fit_band's disc-beyond-the-band case, through pipe_frame.
+ *
+ * Two skinned arms (tubes) whose hands are 20-35 cm in front of the
+ * cameras; each hand has a "fingers" node on the outer side of its tube
+ * (the rig's palm and finger joints). The camera images (seeded noise)
+ * show the model's arms plus a skin-coloured disc around each fingers
+ * node reaching 0.8 x PIPE_PRIOR_RADIUS beyond the tube: tens of pixels,
+ * more than the band (16) can take in from the kinematic mask.
+ *   - with the prior (the default) the refined mask grows into the disc
+ *     frame after frame; with refine_prior -1 it stays at the band;
+ *   - hands faster than PIPE_PRIOR_SPEED (pipe_frame_in.hand_speed): the
+ *     bytes of refine_prior -1;
+ *   - pipe_create refuses refine_prior / refine_lag_adapt outside -1..0.
+ */
+#include "support/testutil.h"
+
+#include <cmocka.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/fit/fit_band.h"
+#include "../src/pipe/pipe.h"
+#include "support/pipe_frames.h"
+#include "support/pipe_testrig.h"
+
+#define NODES 9
+#define W 640
+#define H 400
+
+typedef struct arms {
+    kin_model m;
+    kin_arm_rig rig;
+    int16_t parents[NODES];
+    kin_transform rest[NODES];
+    kin_mat4 ibm[NODES];
+    int joints[NODES];
+    kin_skin skin;
+    kin_mesh mesh;
+    float pos[6 * TU_TUBE_VERTS * 3];
+    uint16_t jnt[6 * TU_TUBE_VERTS * 4];
+    float wgt[6 * TU_TUBE_VERTS * 4];
+    uint32_t idx[6 * TU_TUBE_TRIS * 3];
+    int nv, nt;
+    kin_vec3 fingers[2];      /* world position of each fingers node */
+} arms;
+
+/* Nodes: 0 body; per side s: 1 + 4 s upper arm at the shoulder (-+0.2,
+ * -0.1, 0), + 1 forearm at the elbow, + 2 hand at the wrist (-+0.2,
+ * -0.05, -0.6), + 3 fingers 7.5 cm beyond the wrist on the tube's outer
+ * side (2.5 cm up), bound to no vertex. */
+static void arms_build(arms *A)
+{
+    memset(A, 0, sizeof *A);
+    A->parents[0] = KIN_NO_PARENT;
+    for (int j = 0; j < NODES; j++) A->rest[j] = kin_transform_identity();
+    for (int s = 0; s < 2; s++) {
+        float x = s ? 0.2f : -0.2f;
+        int u = 1 + 4 * s;
+        A->parents[u] = 0;
+        A->parents[u + 1] = (int16_t)u;
+        A->parents[u + 2] = (int16_t)(u + 1);
+        A->parents[u + 3] = (int16_t)(u + 2);
+        float in = s ? -0.12f : 0.12f;
+        A->rest[u].t = kin_v3(x, -0.1f, 0);
+        A->rest[u + 1].t = kin_v3(in, 0, -0.3f);
+        A->rest[u + 2].t = kin_v3(-in, 0.05f, -0.3f);
+        A->rest[u + 3].t = kin_v3(0, 0.025f, -0.075f);
+        kin_vec3 S = kin_v3(x, -0.1f, 0), E = kin_v3(x + in, -0.1f, -0.3f),
+                 Wr = kin_v3(x, -0.05f, -0.6f);
+        tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, S, E, 0.035f, u);
+        tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, E, Wr, 0.03f, u + 1);
+        tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, Wr, kin_v3(x, -0.05f, -0.75f),
+                0.025f, u + 2);
+        A->fingers[s] = kin_v3(x, -0.025f, -0.675f);
+        for (int j = 0; j < KIN_RIG_SIDE_JOINTS; j++) A->rig.joint[s][j] = u + 3;
+        A->rig.joint[s][KIN_RIG_SHOULDER] = 0;
+        A->rig.joint[s][KIN_RIG_UPPER_ARM] = u;
+        A->rig.joint[s][KIN_RIG_FOREARM] = u + 1;
+        A->rig.joint[s][KIN_RIG_HAND] = u + 2;
+    }
+    A->mesh = (kin_mesh){.vertex_count = A->nv, .positions = A->pos, .joints = A->jnt,
+                         .weights = A->wgt, .index_count = A->nt * 3, .indices = A->idx,
+                         .node = -1, .skin = 0};
+    tu_rig_bind(&A->m, &A->skin, &A->mesh, NODES, A->parents, A->rest, A->ibm, A->joints);
+}
+
+/* The camera images (640x480) of both eyes seen from head: the model's
+ * arms and a disc around each fingers node (radius 0.8 x the prior's,
+ * projected at the node's depth), skin-red over blue-grey, noise +-4;
+ * the silhouette (the crop, 640x400) in sil[e]. */
+static void paint(const arms *A, const kin_mat4 *head, kin_sthmd_geometry g, tu_frame_bufs *b,
+                  uint64_t seed, uint8_t *const sil[2], float disc_px[2][2])
+{
+    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
+    float *clip = malloc(sizeof(float) * 4 * (size_t)A->nv), *depth = malloc(sizeof(float) * W * H);
+    kin_mat4 *world = calloc(NODES, sizeof *world);
+    assert_true(clip && depth && world);
+    tu_rng r = {seed};
+    for (int e = 0; e < 2; e++) {
+        uint8_t *s = sil[e];
+        kin_camera cam = kin_sthmd_camera(&hd, head, (kin_eye)e);
+        rast_target t = {W, H, depth, W, s, W, NULL, 0, 0};
+        rast_target_clear(&t);
+        rast_transform_points(cam.view_proj.m, A->pos, A->nv, clip);
+        rast_mesh_desc md = {clip, A->nv, NULL, 0, A->idx, A->nt, RAST_CULL_NONE};
+        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
+        for (int k = 0; k < 2; k++) {
+            /* the fingers node's image position: pipe_fit_hand_px of a
+             * rig whose hand joints are all that node */
+            const int node = 4 + 4 * k;
+            world[node] = kin_mat4_from_tr(A->fingers[k], kin_quat_identity());
+            kin_arm_rig one = A->rig;
+            for (int j = KIN_RIG_HAND; j < KIN_RIG_SIDE_JOINTS; j++) one.joint[k][j] = node;
+            float xy[2];
+            assert_true(pipe_fit_hand_px(&cam, world, &one, k, xy));
+            const float z = head->m[14] - A->fingers[k].z;   /* the head looks down -z */
+            const float rr = 0.8f * 0.5f * (cam.fx + cam.fy) * PIPE_PRIOR_RADIUS / z;
+            if (e == 0) disc_px[k][0] = rr;
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < W; x++) {
+                    float dx = (float)x + 0.5f - xy[0], dy = (float)y + 0.5f - xy[1];
+                    if (dx * dx + dy * dy <= rr * rr) s[y * W + x] = 255;
+                }
+        }
+        for (int y = 0; y < 480; y++)
+            for (int x = 0; x < 640; x++) {
+                int yy = y - g.crop_y0;
+                int in_arm = yy >= 0 && yy < H && s[yy * W + x];
+                uint8_t *px = &b->cam[e][(y * 640 + x) * 4];
+                int n = (int)(tu_next(&r) % 9) - 4;
+                px[0] = (uint8_t)((in_arm ? 200 : 70) + n);
+                px[1] = (uint8_t)((in_arm ? 120 : 90) + n);
+                px[2] = (uint8_t)((in_arm ? 100 : 150) + n);
+                px[3] = 255;
+            }
+    }
+    free(clip);
+    free(depth);
+    free(world);
+}
+
+static double iou(const uint8_t *a, const uint8_t *b)
+{
+    long i_n = 0, u_n = 0;
+    for (int i = 0; i < W * H; i++) {
+        int x = a[i] >= 128, y = b[i] >= 128;
+        i_n += x && y;
+        u_n += x || y;
+    }
+    return u_n ? (double)i_n / (double)u_n : 1.0;
+}
+
+typedef struct scene {
+    arms A;
+    tu_frame_bufs b;
+    pipe_frame_in in;
+    kin_mat4 head;
+    uint8_t *sil[2];
+    float disc_px[2][2];
+} scene;
+
+static scene *scene_open(uint64_t seed)
+{
+    scene *S = calloc(1, sizeof *S);
+    assert_non_null(S);
+    arms_build(&S->A);
+    tu_frame_make(&S->b, &S->in, seed, 640, 480, 1280, 800);
+    /* the head 40 cm forward above the right arm: the right hand 20-35 cm
+     * in front of the cameras, the left one out of view */
+    S->head = kin_mat4_from_tr(kin_v3(0.2f, 0, -0.4f), kin_quat_identity());
+    S->in.head_node = -1;
+    S->in.world_from_head = &S->head;
+    S->in.locals = S->A.rest;   /* tracked frames (the fit's) */
+    for (int e = 0; e < 2; e++) {
+        S->sil[e] = malloc(W * H);
+        assert_non_null(S->sil[e]);
+    }
+    pipe_desc d = {0};
+    d.refine_band = 16;
+    d.fit_rig = &S->A.rig;
+    pipe_ctx *p = pipe_create(&d, &S->A.m);
+    assert_non_null(p);
+    kin_sthmd_geometry g = pipe_geometry(p);
+    assert_int_equal(g.crop_width, W);
+    assert_int_equal(g.crop_height, H);
+    paint(&S->A, &S->head, g, &S->b, seed + 1, S->sil, S->disc_px);
+    pipe_destroy(p);
+    return S;
+}
+
+static void scene_close(scene *S)
+{
+    tu_frame_free(&S->b);
+    for (int e = 0; e < 2; e++) free(S->sil[e]);
+    free(S);
+}
+
+static pipe_ctx *make_pipe_isa(scene *S, int prior, int threads, int isa)
+{
+    pipe_desc d = {0};
+    d.max_isa = isa;
+    d.refine_band = 16;
+    d.threads = threads;
+    d.fit_rig = &S->A.rig;
+    d.refine_prior = prior;
+    pipe_ctx *p = pipe_create(&d, &S->A.m);
+    assert_non_null(p);
+    return p;
+}
+
+static pipe_ctx *make_pipe(scene *S, int prior, int threads)
+{
+    return make_pipe_isa(S, prior, threads, 0);
+}
+
+/* The disc beyond the band: 6 frames with and without the prior. */
+static void prior_reaches_beyond_band(void **state)
+{
+    (void)state;
+    scene *S = scene_open(41);
+    print_message("disc radius %.1f px (the band: 16)\n", (double)S->disc_px[0][0]);
+    assert_true(S->disc_px[0][0] > 40.0f);
+    pipe_ctx *on = make_pipe(S, 0, 2), *off = make_pipe(S, -1, 2);
+    char why[200];
+    double i_on[2] = {0}, i_off[2] = {0};
+    for (int f = 0; f < 6; f++) {
+        assert_int_equal(pipe_frame(on, &S->in, NULL, why, sizeof why), PIPE_OK);
+        assert_int_equal(pipe_frame(off, &S->in, NULL, why, sizeof why), PIPE_OK);
+        for (int e = 0; e < 2; e++) {
+            i_on[e] = iou(pipe_mask(on, e, NULL, NULL), S->sil[e]);
+            i_off[e] = iou(pipe_mask(off, e, NULL, NULL), S->sil[e]);
+            if (f == 0) assert_true(i_on[e] == i_off[e]);   /* no last mask yet */
+        }
+    }
+    for (int e = 0; e < 2; e++) {
+        print_message("eye %d: IoU after 6 frames: prior %.4f, kinematic input %.4f\n", e,
+                      i_on[e], i_off[e]);
+        assert_true(i_on[e] > 0.97);
+        assert_true(i_on[e] > i_off[e] + 0.02);
+    }
+    pipe_destroy(on);
+    pipe_destroy(off);
+    scene_close(S);
+}
+
+/* Hands faster than PIPE_PRIOR_SPEED keep the kinematic input: the bytes
+ * of refine_prior -1 (masks and outputs); the prior's bytes do not depend
+ * on the thread count (one thread, the best ISA, against two, the scalar
+ * reference). */
+static void fast_hands_and_threads(void **state)
+{
+    (void)state;
+    scene *S = scene_open(43);
+    pipe_ctx *on = make_pipe(S, 0, 1), *on2 = make_pipe_isa(S, 0, 2, EF_ISA_REF),
+             *off = make_pipe(S, -1, 1);
+    const float fast[2] = {0.31f, 0.5f};
+    uint8_t *keep = malloc(1280 * 800 * 4), *m = malloc(W * H);
+    assert_true(keep && m);
+    char why[200];
+    for (int f = 0; f < 3; f++) {
+        S->in.hand_speed = fast;
+        assert_int_equal(pipe_frame(on, &S->in, NULL, why, sizeof why), PIPE_OK);
+        memcpy(keep, S->b.out[0], 1280 * 800 * 4);
+        memcpy(m, pipe_mask(on, 0, NULL, NULL), W * H);
+        S->in.hand_speed = NULL;
+        assert_int_equal(pipe_frame(off, &S->in, NULL, why, sizeof why), PIPE_OK);
+        assert_memory_equal(keep, S->b.out[0], 1280 * 800 * 4);
+        assert_memory_equal(m, pipe_mask(off, 0, NULL, NULL), W * H);
+    }
+    /* slow (NULL: 0 m/s) from here: one thread against two, ISAs */
+    pipe_ctx *on1 = make_pipe(S, 0, 1);
+    for (int f = 0; f < 3; f++) {
+        assert_int_equal(pipe_frame(on2, &S->in, NULL, why, sizeof why), PIPE_OK);
+        memcpy(keep, S->b.out[1], 1280 * 800 * 4);
+        memcpy(m, pipe_mask(on2, 1, NULL, NULL), W * H);
+        assert_int_equal(pipe_frame(on1, &S->in, NULL, why, sizeof why), PIPE_OK);
+        assert_memory_equal(keep, S->b.out[1], 1280 * 800 * 4);
+        assert_memory_equal(m, pipe_mask(on1, 1, NULL, NULL), W * H);
+    }
+    free(keep);
+    free(m);
+    pipe_destroy(on);
+    pipe_destroy(on1);
+    pipe_destroy(on2);
+    pipe_destroy(off);
+    scene_close(S);
+}
+
+static void bad_switches(void **state)
+{
+    (void)state;
+    arms *A = malloc(sizeof *A);
+    assert_non_null(A);
+    arms_build(A);
+    pipe_desc d = {0};
+    d.refine_band = 16;
+    d.fit_rig = &A->rig;
+    d.refine_prior = 1;
+    assert_null(pipe_create(&d, &A->m));
+    d.refine_prior = -2;
+    assert_null(pipe_create(&d, &A->m));
+    d.refine_prior = 0;
+    d.refine_lag_adapt = 2;
+    assert_null(pipe_create(&d, &A->m));
+    d.refine_lag_adapt = -1;
+    pipe_ctx *p = pipe_create(&d, &A->m);
+    assert_non_null(p);
+    pipe_destroy(p);
+    /* the tracking: refine_lag_adapt -1 or no refinement = kin's filter */
+    kin_filter_desc fd = pipe_track_filter_desc(&d);
+    assert_int_equal(fd.no_lag_comp, 0);
+    d.refine_lag_adapt = 0;
+    fd = pipe_track_filter_desc(&d);
+    assert_int_equal(fd.no_lag_comp, 1);
+    d.refine_band = 0;
+    fd = pipe_track_filter_desc(&d);
+    assert_int_equal(fd.no_lag_comp, 0);
+    free(A);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(prior_reaches_beyond_band),
+        cmocka_unit_test(fast_hands_and_threads),
+        cmocka_unit_test(bad_switches),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
