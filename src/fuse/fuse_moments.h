@@ -2,6 +2,21 @@
  * the position and size error of one mask against another (the eye-view
  * evaluation of `egofuse eval --eyeview`, docs/accuracy.md).
  *
+ * WHAT IT DOES
+ *   fuse_mask_moments sums a mask's area and first moments and finds its
+ *   bounding box; fuse_shape_compare gives the centroid distance (px) and
+ *   the size error (sqrt of the area ratio, and the box heights' ratio) of a
+ *   mask against a true one.
+ *
+ * WHAT IT DOES NOT
+ *   Overlap metrics (IoU, boundary F: fuse_metrics.h), or any drawing.
+ *
+ * USAGE
+ *   fuse_moments m, t; fuse_shape_error e;
+ *   fuse_mask_moments(out, stride, w, h, &m);
+ *   fuse_mask_moments(truth, stride, w, h, &t);
+ *   if (fuse_shape_compare(&m, &t, 50, &e)) ... e's fields (below)
+ *
  * CONVENTIONS
  *   A pixel is inside when its mask value is >= 128 (the masks of
  *   src/fuse). Pixel (x, y) has its centre at (x + 0.5, y + 0.5): the
