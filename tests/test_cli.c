@@ -17,8 +17,6 @@ static char out[65536];
 /* Runs egofuse with a NULL-terminated argument list; output in out. */
 #define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
 
-static double fin(float v) { return isfinite(v) ? v : 0.0; }
-
 /* A number option of render and run: both show `help` in --help;
  * render refuses bad0 and bad1, run refuses 'x', each with exit 2 and a
  * message that names the option and the value. */
@@ -42,33 +40,6 @@ static void number_option(const char *opt, const char *help, const char *bad0, c
 
 /* A glTF with a node "head" and an unskinned quad [x0,x1]x[y0,y1] at depth
  * z facing +Z, normals +Z. */
-static void write_quad_gltf(const char *path, float x0, float x1, float y0, float y1, float z)
-{
-    uint8_t buf[108];
-    float pos[12] = {x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z};
-    float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
-    uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(buf, pos, 48);
-    memcpy(buf + 48, nrm, 48);
-    memcpy(buf + 96, idx, 12);
-    char enc[200];
-    tu_b64(buf, sizeof buf, enc);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fprintf(f,
-            "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
-            "\"nodes\":[{\"name\":\"head\"},{\"name\":\"quad\",\"mesh\":0}],"
-            "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],"
-            "\"buffers\":[{\"byteLength\":108,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
-            "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
-            "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":96,\"byteLength\":12}],"
-            "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
-            "\"min\":[%g,%g,%g],\"max\":[%g,%g,%g]},"
-            "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
-            "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}\n",
-            enc, fin(x0), fin(y0), fin(z), fin(x1), fin(y1), fin(z));
-    fclose(f);
-}
 
 /* The scene of one frame around quad.gltf and the solid images. */
 #define QUAD_SCENE                       \
@@ -140,7 +111,7 @@ static void mask_bad_models(void **state)
     assert_false(tu_exists(png));
 
     tu_tmp_path("quad.gltf", model, sizeof model);
-    write_quad_gltf(model, -1, 1, -1, 1, 0);
+    tu_write_quad_gltf(model, -1, 1, -1, 1, 0);
     assert_int_equal(run("mask", model, "--width", "32", "--height", "32", "--fov-y", "60",
                          "--eye", "0,0,2", "--target", "0,0,0", "--anim", "0",
                          "--out", png, NULL), 1);
@@ -148,7 +119,7 @@ static void mask_bad_models(void **state)
     assert_false(tu_exists(png));
     /* A NaN in the model's data: rejected, named, nothing written. */
     tu_tmp_path("nan.gltf", model, sizeof model);
-    write_quad_gltf(model, -1, NAN, -1, 1, 0);
+    tu_write_quad_gltf(model, -1, NAN, -1, 1, 0);
     assert_int_equal(run("mask", model, "--width", "32", "--height", "32", "--fov-y", "60",
                          "--eye", "0,0,2", "--target", "0,0,0", "--out", png, NULL), 1);
     assert_non_null(strstr(out, "nan.gltf"));
@@ -174,7 +145,7 @@ static void mask_exact_quad(void **state)
     tu_tmp_path("quad2_mask.png", png, sizeof png);
     tu_tmp_path("quad2_n.png", nrm, sizeof nrm);
     tu_tmp_path("quad2_d.exr", dep, sizeof dep);
-    write_quad_gltf(model, -1, 1, -1, 1, 0);
+    tu_write_quad_gltf(model, -1, 1, -1, 1, 0);
     int rc = run("mask", model, "--width", "64", "--height", "64", "--fov-y", "90",
                  "--eye", "0,0,2", "--target", "0,0,0", "--up", "0,1,0", "--out", png,
                  "--normals", nrm, "--depth", dep, NULL);
@@ -246,7 +217,7 @@ static void write_scene(const char *dir, int cam_w, int cam_h)
     char p[600];
     snprintf(p, sizeof p, "%s/quad.gltf", dir);
     /* 0.2 m square, 0.6 m in front of the head: both cameras see it. */
-    write_quad_gltf(p, -0.1f, 0.1f, -0.1f, 0.1f, -0.6f);
+    tu_write_quad_gltf(p, -0.1f, 0.1f, -0.1f, 0.1f, -0.6f);
     snprintf(p, sizeof p, "%s/cam_l_0.png", dir);
     tu_write_solid(p, cam_w, cam_h, 200, 150, 120);
     snprintf(p, sizeof p, "%s/cam_r_0.png", dir);

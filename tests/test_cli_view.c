@@ -22,38 +22,7 @@ static char out[65536];
 
 /* egofuse with the arguments (NULL-terminated), its output in out */
 #define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
-#define b64 tu_b64
 
-/* An unskinned quad [-s,s]^2 at depth z, facing +Z (normals given). */
-static void write_quad(const char *path, float s, float z)
-{
-    uint8_t buf[108];
-    float pos[12] = {-s, -s, z, s, -s, z, s, s, z, -s, s, z};
-    float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
-    uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(buf, pos, 48);
-    memcpy(buf + 48, nrm, 48);
-    memcpy(buf + 96, idx, 12);
-    char enc[200];
-    b64(buf, sizeof buf, enc);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fprintf(f,
-            "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
-            "\"nodes\":[{\"name\":\"quad\",\"mesh\":0}],"
-            "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},"
-            "\"indices\":2}]}],"
-            "\"buffers\":[{\"byteLength\":108,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
-            "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
-            "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":48},"
-            "{\"buffer\":0,\"byteOffset\":96,\"byteLength\":12}],"
-            "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
-            "\"min\":[%g,%g,%g],\"max\":[%g,%g,%g]},"
-            "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
-            "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}\n",
-            enc, -s, -s, z, s, s, z);
-    fclose(f);
-}
 
 static void write_image(const char *path, int w, int h, int ramp)
 {
@@ -82,7 +51,7 @@ static int setup(void **state)
     snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s/cam' '%s/v'", dir, dir, dir);
     assert_int_equal(system(cmd), 0);
     snprintf(p, sizeof p, "%s/quad.gltf", dir);
-    write_quad(p, 0.05f, -0.35f);
+    tu_write_quad_gltf(p, -0.05f, 0.05f, -0.05f, 0.05f, -0.35f);
     const char *img[4][2] = {{"cam/l_0000.png", "c"}, {"cam/r_0000.png", "c"},
                              {"v/l_0000.png", "v"}, {"v/r_0000.png", "v"}};
     for (int i = 0; i < 4; i++) {

@@ -4,9 +4,13 @@
 #ifndef EGOFUSE_TU_FILES_H
 #define EGOFUSE_TU_FILES_H
 
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+
+#include "testutil.h" /* tu_b64 */
 
 /* path := text. */
 static inline void tu_write_text(const char *path, const char *text)
@@ -45,5 +49,39 @@ static inline unsigned char *tu_read_file(const char *path, size_t *n)
 }
 
 /* tu_b64 (base64 of glTF data: URIs): testutil.h. */
+
+/* A finite value as itself, NaN or infinity as 0 (for a glTF's min/max
+ * that must stay valid JSON while the vertex data carries the bad value). */
+static inline double tu_fin0(float v) { return isfinite(v) ? v : 0.0; }
+
+/* A glTF with an empty "head" node and one unskinned quad [x0,x1]x[y0,y1]
+ * at depth z facing +Z (normals given), its buffer as a data: URI. */
+static inline void tu_write_quad_gltf(const char *path, float x0, float x1, float y0, float y1, float z)
+{
+    uint8_t buf[108];
+    float pos[12] = {x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z};
+    float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    memcpy(buf, pos, 48);
+    memcpy(buf + 48, nrm, 48);
+    memcpy(buf + 96, idx, 12);
+    char enc[200];
+    tu_b64(buf, sizeof buf, enc);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f,
+            "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
+            "\"nodes\":[{\"name\":\"head\"},{\"name\":\"quad\",\"mesh\":0}],"
+            "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],"
+            "\"buffers\":[{\"byteLength\":108,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
+            "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
+            "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":96,\"byteLength\":12}],"
+            "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
+            "\"min\":[%g,%g,%g],\"max\":[%g,%g,%g]},"
+            "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
+            "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}\n",
+            enc, tu_fin0(x0), tu_fin0(y0), tu_fin0(z), tu_fin0(x1), tu_fin0(y1), tu_fin0(z));
+    fclose(f);
+}
 
 #endif
