@@ -129,7 +129,12 @@ int main(int argc, char **argv)
     int frames = 120, reps = 40, threads = 2, first = 0;
     float speed = 0.25f;
     const char *seq = "reach_grasp";
-    for (int i = 1; i + 1 < argc; i += 2) {
+    for (int i = 1; i < argc; i += 2) {
+        if (i + 1 == argc) {
+            fprintf(stderr, "bench_aa: %s wants a value; usage: bench_aa [--frames N] [--speed S] "
+                            "[--reps R] [--seq NAME] [--first F] [--threads T]\n", argv[i]);
+            return 2;
+        }
         if (!strcmp(argv[i], "--frames")) frames = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--speed")) speed = (float)atof(argv[i + 1]);
         else if (!strcmp(argv[i], "--reps")) reps = atoi(argv[i + 1]);

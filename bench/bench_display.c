@@ -43,7 +43,13 @@ static void run(int ew, int eh, int runs)
 
 int main(int argc, char **argv)
 {
-    int runs = argc > 1 ? atoi(argv[1]) : 51;
+    int runs = 51; /* bench_display [--runs N] (or the count alone, as before) */
+    if (argc == 3 && !strcmp(argv[1], "--runs")) runs = atoi(argv[2]);
+    else if (argc == 2) runs = atoi(argv[1]);
+    else if (argc != 1) {
+        fprintf(stderr, "bench_display: usage: bench_display [--runs N]\n");
+        return 2;
+    }
     if (runs < 1) runs = 1;
     run(1280, 800, runs);
     run(1440, 1600, runs);

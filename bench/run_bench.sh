@@ -74,6 +74,9 @@ for b in "$BUILD"/bench/bench_*; do
         bench_reproj) # the eye reprojection against the crop on the samples'
             # frames, side by side (docs/eyeview.md)
             "$b" --samples "$SAMPLES" --runs "$STAGE_RUNS" || echo "($name exited with status $?)" ;;
+        bench_aa) # anti-aliased edges against binary ones through pipe_frame
+            # (issue 14 item 3): PSNR, edge flicker and ms per stereo frame
+            "$b" --frames 24 --reps "$STAGE_RUNS" || echo "($name exited with status $?)" ;;
         bench_vsrc) # a V source's own speed needs a live source; here the
             # conversion of each frame format (median of 30 runs)
             "$b" --convert || echo "($name exited with status $?)" ;;
@@ -168,8 +171,8 @@ if [ -f "$OUT/bench.csv" ]; then
                      for (t = 1; t <= 2; t++) {
                          if (("t", t) in be) printf "- typical, %d thread%s: best egofuse %.3f ms (%s)%s\n", t, (t > 1 ? "s" : ""), be["t", t], bi["t", t], ((t == 2) ? sprintf(" - target <= 1.0 ms: %s", (be["t", t] <= 1.0 ? "met" : "missed")) : "")
                          if (("w", t) in be) printf "- worst case, %d thread%s: best egofuse %.3f ms (%s)%s\n", t, (t > 1 ? "s" : ""), be["w", t], bi["w", t], ((t == 2) ? sprintf(" - target <= 2.0 ms: %s", (be["w", t] <= 2.0 ? "met" : "missed")) : "")
-                         if ((t in lp) && (t in ea)) printf "- llvmpipe, %d thread%s: %.3f ms per frame; egofuse on the same frames, interleaved: %.3f ms; llvmpipe / egofuse = %.1fx (target >= 15x)\n", t, (t > 1 ? "s" : ""), lp[t], ea[t], lp[t] / ea[t]
-                         if ((t in mc) && (("t", t) in be)) printf "- memory floor (memcpy of both outputs), %d thread%s: %.3f ms; typical frame / floor = %.1fx\n", t, (t > 1 ? "s" : ""), mc[t], be["t", t] / mc[t]
+                         if ((t in lp) && (t in ea)) printf "- llvmpipe, %d thread%s: %.3f ms per frame; egofuse on the same frames, interleaved: %.3f ms; llvmpipe / egofuse = %.1fx (target >= 20x)\n", t, (t > 1 ? "s" : ""), lp[t], ea[t], lp[t] / ea[t]
+                         if ((t in mc) && (("t", t) in be)) printf "- memory floor (memcpy of both outputs), %d thread%s: %.3f ms; typical frame / floor = %.1fx (target <= 2.5x)\n", t, (t > 1 ? "s" : ""), mc[t], be["t", t] / mc[t]
                      }
                      if (px != "" && cb != "") printf "- composite stage: pixman %.3f ms, egofuse (%s, 1 thread) %.3f ms; pixman / egofuse = %.1fx\n", px, ci, cb, px / cb
                  }' "$OUT/bench.csv"
