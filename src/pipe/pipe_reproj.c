@@ -171,6 +171,20 @@ static pipe__reproj_row_fn row_kernel(int isa)
     }
 }
 
+static pipe__reproj_taps_fn taps_kernel(int isa)
+{
+    switch ((ef_isa)isa) {
+#if defined(__x86_64__)
+    case EF_ISA_AVX512: return pipe__reproj_taps_avx512;
+    case EF_ISA_AVX2: return pipe__reproj_taps_avx2;
+    case EF_ISA_SSE2: return pipe__reproj_taps_sse2;
+#elif defined(__aarch64__) && defined(__ARM_NEON)
+    case EF_ISA_NEON: return pipe__reproj_taps_neon;
+#endif
+    default: return NULL;
+    }
+}
+
 /* Does the camera's G-buffer show the point (window depth bound zmin) at
  * image pixel (x, y)? Outside the G-buffer (the sensor beyond the crop)
  * there is nothing to test against: yes. */
@@ -205,6 +219,13 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
     g.n = n, g.f = f, g.fpn = f + n, g.fmn = f - n, g.two_fn = 2.0f * f * n;
     const float efx = ec->fx, efy = ec->fy, ecx = ec->cx, ecy = ec->cy;
     const pipe__reproj_row_fn kernel = g.pinhole ? row_kernel(r->isa) : NULL;
+    /* the taps on the vector layer: the image's rows whole int32 pixels,
+     * the mask at least 4 bytes */
+    const long mlim = (long)(gh - 1) * cmask_stride + gw - 4;
+    const pipe__reproj_taps_fn taps =
+        P->stride % 4 == 0 && mlim >= 0 && gw > 0 && gh > 0 ? taps_kernel(r->isa) : NULL;
+    const pipe__reproj_tapd td = {cmask, cdepth, P->pixels, cmask_stride, cdepth_stride,
+                                  gw, gh, ox, oy, P->stride / 4, cw - 1, ch - 1, (int)mlim};
     const size_t lw = (size_t)w + 16;
     const pipe__reproj_lanes o = {r->lanes,          r->lanes + lw,     r->lanes + 2 * lw,
                                   r->lanes + 3 * lw, r->lanes + 4 * lw, r->lanes + 5 * lw,
@@ -229,7 +250,14 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         /* the geometry of the row's covered pixels (vector, then the tail) */
         int x1 = kernel ? kernel(&g, em, ed, en, ry, w, &o, &back, &mind) : 0;
         row_ref(&g, em, ed, en, ry, x1, w, &o, &back, &mind);
-        for (int x = 0; x < w; x++) {
+        /* the taps (vector, then the tail) */
+        int xt = 0;
+        if (taps) {
+            long cnt[4] = {0, 0, 0, 0};
+            xt = taps(&td, em, &o, w, M, Po, cnt, sum);
+            covered += cnt[0], outside += cnt[1], filled += cnt[2], sampled += cnt[3];
+        }
+        for (int x = xt; x < w; x++) {
             if (!em[x]) {
                 /* 8 empty mask bytes at a time */
                 uint64_t word;
