@@ -347,27 +347,33 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         const uint8_t *em = r->mask + (size_t)y * (size_t)w;
         uint8_t *M = r->M + (size_t)y * (size_t)w;
         uint8_t *Po = r->P + (size_t)y * (size_t)w * 4;
-        int32_t *left = r->row, *right = r->row + w;
+        int32_t *left = r->row;
+        /* the row's span of shown pixels (M != 0: covered, inside the
+         * camera image), 8 bytes at a time: nothing outside it counts */
+        int xa = 0, xb = w - 1;
+        uint64_t word;
+        while (xa + 8 <= w && (memcpy(&word, M + xa, 8), word == 0)) xa += 8;
+        while (xa < w && !M[xa]) xa++;
+        while (xb - 7 > xa && (memcpy(&word, M + xb - 7, 8), word == 0)) xb -= 8;
+        while (xb > xa && !M[xb]) xb--;
         int any = 0, last = -1;
-        for (int x = 0; x < w; x++) {
+        for (int x = xa; x <= xb; x++) {
             int st = em[x] && M[x] ? Po[4 * x + 3] : ST_NONE;
             if (st == ST_SAMPLED) last = x;
             else if (st == ST_FILL) any = 1;
             left[x] = last;
         }
         if (!any) continue;
+        /* right to left: the nearest sampled pixel to the right known */
         last = -1;
-        for (int x = w - 1; x >= 0; x--) {
+        for (int x = xb; x >= xa; x--) {
             int st = em[x] && M[x] ? Po[4 * x + 3] : ST_NONE;
             if (st == ST_SAMPLED) last = x;
-            right[x] = last;
-        }
-        for (int x = 0; x < w; x++) {
-            if (!em[x] || !M[x] || Po[4 * x + 3] != ST_FILL) continue;
+            if (st != ST_FILL) continue;
             done++;
             /* of the nearest sampled pixels left and right, the one on
              * the same surface: its eye distance nearer to this pixel's */
-            int l = left[x], rr = right[x], src = l >= 0 ? l : rr;
+            int l = left[x], rr = last, src = l >= 0 ? l : rr;
             if (l >= 0 && rr >= 0) {
                 const float *ed = r->depth + (size_t)y * (size_t)w;
                 float d0 = lin_depth(ed[x], n, f);
