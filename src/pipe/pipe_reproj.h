@@ -62,8 +62,10 @@
  *   On the eye's thread: the per-pixel geometry on the vector layer
  *   (pipe_reproj_simd.inl, 4/8/16 lanes; a distorting lens in scalar
  *   double), equal lane by lane to the scalar reference row_ref (float,
- *   fixed operation order); the taps scalar, integer bilinear weights
- *   (8-bit fractions as fuse_composite): the same bytes on every ISA and
+ *   fixed operation order); the taps too (pipe__reproj_taps_<isa>: the
+ *   G-buffer and image by gathers, integer bilinear weights with 8-bit
+ *   fractions as fuse_composite, the renormalisation exact), equal to the
+ *   scalar taps of pipe__reproj_sample: the same bytes on every ISA and
  *   thread count.
  *
  * THE WHOLE SENSOR
