@@ -254,6 +254,18 @@
  *                            alignment), zero-extended; reads exactly
  *                            SIMD_W uint16
  *
+ * REPROJ OPS (added for src/pipe's reprojection taps, pipe_reproj_simd.inl;
+ * a separate block at the end of each implementation)
+ *   vf_gather(p, idx)        float lane l = p[idx_l] (float *p), the bits
+ *                            as stored; reads exactly those SIMD_W floats
+ *                            (AVX2/AVX-512 vgatherdps, SSE2/NEON lane by lane)
+ *   vi_gather_u8x4(p, idx)   int32 lane l = the 4 bytes p[idx_l .. idx_l+3]
+ *                            as a little-endian int32 (uint8_t *p, any
+ *                            offset): all 4 bytes must be readable; the
+ *                            byte p[idx_l] is lane & 0xFF
+ *   vi_store_u8(p, i)        p[l] = the low 8 bits of lane l; writes
+ *                            exactly SIMD_W bytes (any alignment)
+ *
  * NEW ISA. Copy simd_neon.h (the plainest), keep every name, meet every
  * line of this contract (the semantics above are x86's where the ISAs
  * differ: min/max, conversion out of range), add the ISA to

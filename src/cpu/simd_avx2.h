@@ -314,6 +314,24 @@ SIMD_INL vint vi_load_u16(const uint16_t *p)
     return _mm256_cvtepu16_epi32(_mm_loadu_si128((const __m128i *)(const void *)p));
 }
 
+
+/* ---- reprojection ops (src/pipe's taps, pipe_reproj_simd.inl; simd.h
+ * "REPROJ OPS") */
+SIMD_INL vfloat vf_gather(const float *p, vint idx) { return _mm256_i32gather_ps(p, idx, 4); }
+SIMD_INL vint vi_gather_u8x4(const uint8_t *p, vint idx)
+{
+    return _mm256_i32gather_epi32((const int *)(const void *)p, idx, 1);
+}
+/* byte 0 of each dword to the low 4 bytes of each 128-bit half, joined */
+SIMD_INL void vi_store_u8(uint8_t *p, vint i)
+{
+    const __m256i t = _mm256_shuffle_epi8(
+        i, _mm256_setr_epi8(0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,
+                            0, 4, 8, 12, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1));
+    _mm_storel_epi64((__m128i *)(void *)p,
+                     _mm_unpacklo_epi32(_mm256_castsi256_si128(t), _mm256_extracti128_si256(t, 1)));
+}
+
 #else
 #error "simd_avx2.h: another implementation of the vector layer is already included"
 #endif

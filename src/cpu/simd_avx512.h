@@ -296,6 +296,19 @@ SIMD_INL vint vi_load_u16(const uint16_t *p)
     return _mm512_cvtepu16_epi32(_mm256_loadu_si256((const __m256i *)(const void *)p));
 }
 
+
+/* ---- reprojection ops (src/pipe's taps, pipe_reproj_simd.inl; simd.h
+ * "REPROJ OPS") */
+SIMD_INL vfloat vf_gather(const float *p, vint idx) { return _mm512_i32gather_ps(idx, (const void *)p, 4); }
+SIMD_INL vint vi_gather_u8x4(const uint8_t *p, vint idx)
+{
+    return _mm512_i32gather_epi32(idx, (const void *)p, 1);
+}
+SIMD_INL void vi_store_u8(uint8_t *p, vint i)
+{
+    _mm_storeu_si128((__m128i *)(void *)p, _mm512_cvtepi32_epi8(i));
+}
+
 #else
 #error "simd_avx512.h: another implementation of the vector layer is already included"
 #endif

@@ -393,6 +393,34 @@ SIMD_INL int vh_any_leu(vint i, vint j)
 }
 SIMD_INL vint vi_load_u16(const uint16_t *p) { return vreinterpretq_s32_u32(vmovl_u16(vld1_u16(p))); }
 
+
+/* ---- reprojection ops (src/pipe's taps, pipe_reproj_simd.inl; simd.h
+ * "REPROJ OPS"): no gather, lane by lane */
+SIMD_INL vfloat vf_gather(const float *p, vint idx)
+{
+    float32x4_t r = vdupq_n_f32(p[vgetq_lane_s32(idx, 0)]);
+    r = vsetq_lane_f32(p[vgetq_lane_s32(idx, 1)], r, 1);
+    r = vsetq_lane_f32(p[vgetq_lane_s32(idx, 2)], r, 2);
+    return vsetq_lane_f32(p[vgetq_lane_s32(idx, 3)], r, 3);
+}
+SIMD_INL vint vi_gather_u8x4(const uint8_t *p, vint idx)
+{
+    int32_t r[4];
+    for (int l = 0; l < 4; l++) {
+        const int32_t o = l == 0 ? vgetq_lane_s32(idx, 0) : l == 1 ? vgetq_lane_s32(idx, 1)
+                          : l == 2 ? vgetq_lane_s32(idx, 2) : vgetq_lane_s32(idx, 3);
+        __builtin_memcpy(&r[l], p + o, 4);
+    }
+    return vld1q_s32(r);
+}
+/* XTN twice: the low bytes */
+SIMD_INL void vi_store_u8(uint8_t *p, vint i)
+{
+    const uint16x4_t h = vmovn_u32(vreinterpretq_u32_s32(i));
+    const uint8x8_t b = vmovn_u16(vcombine_u16(h, h));
+    vst1_lane_u32((uint32_t *)(void *)p, vreinterpret_u32_u8(b), 0);
+}
+
 #else
 #error "simd_neon.h: another implementation of the vector layer is already included"
 #endif

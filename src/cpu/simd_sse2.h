@@ -322,6 +322,31 @@ SIMD_INL vint vi_load_u16(const uint16_t *p)
     return _mm_unpacklo_epi16(_mm_loadl_epi64((const __m128i *)(const void *)p), _mm_setzero_si128());
 }
 
+
+/* ---- reprojection ops (src/pipe's taps, pipe_reproj_simd.inl; simd.h
+ * "REPROJ OPS"): SSE2 has no gather, lane by lane */
+SIMD_INL vfloat vf_gather(const float *p, vint idx)
+{
+    _Alignas(16) int32_t x[4];
+    _mm_store_si128((__m128i *)(void *)x, idx);
+    return _mm_setr_ps(p[x[0]], p[x[1]], p[x[2]], p[x[3]]);
+}
+SIMD_INL vint vi_gather_u8x4(const uint8_t *p, vint idx)
+{
+    _Alignas(16) int32_t x[4], r[4];
+    _mm_store_si128((__m128i *)(void *)x, idx);
+    for (int l = 0; l < 4; l++) __builtin_memcpy(&r[l], p + x[l], 4);
+    return _mm_load_si128((const __m128i *)(const void *)r);
+}
+/* the low bytes: masked to 0..255, packs and packus are exact */
+SIMD_INL void vi_store_u8(uint8_t *p, vint i)
+{
+    const __m128i b = _mm_and_si128(i, _mm_set1_epi32(0xFF));
+    const __m128i h = _mm_packs_epi32(b, b);
+    const int v = _mm_cvtsi128_si32(_mm_packus_epi16(h, h));
+    __builtin_memcpy(p, &v, 4);
+}
+
 #else
 #error "simd_sse2.h: another implementation of the vector layer is already included"
 #endif

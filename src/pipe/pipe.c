@@ -152,9 +152,11 @@ static rast_result eye_draw(pipe_ctx *p, eye_state *e, const pipe_lens_map *lens
     /* only what the last frame drew; the normals not at all where every
      * reader skips the pixels of mask 0 (docs/raster.md section 13): the
      * lighting with the G-buffer's own mask, no lens warp, no refined or
-     * anti-aliased mask reaching past it, no smoothing, no reprojection */
-    if (!lens && p->desc.refine_band == 0 && p->desc.normal_smooth == 0 && e->aa.count == 0 &&
-        p->desc.eye_view != PIPE_VIEW_REPROJECT)
+     * anti-aliased mask reaching past it, no smoothing. The reprojection
+     * too: the eye's normals are read where its mask is (the back-face
+     * count; the lighting under M, which is 0 off the eye's mask), the
+     * camera's only by the crop fallback's lighting under its own mask */
+    if (!lens && p->desc.refine_band == 0 && p->desc.normal_smooth == 0 && e->aa.count == 0)
         rast_context_clear_keep_attr(e->rast, &it);
     else
         rast_context_clear(e->rast, &it);

@@ -171,6 +171,20 @@ static pipe__reproj_row_fn row_kernel(int isa)
     }
 }
 
+static pipe__reproj_taps_fn taps_kernel(int isa)
+{
+    switch ((ef_isa)isa) {
+#if defined(__x86_64__)
+    case EF_ISA_AVX512: return pipe__reproj_taps_avx512;
+    case EF_ISA_AVX2: return pipe__reproj_taps_avx2;
+    case EF_ISA_SSE2: return pipe__reproj_taps_sse2;
+#elif defined(__aarch64__) && defined(__ARM_NEON)
+    case EF_ISA_NEON: return pipe__reproj_taps_neon;
+#endif
+    default: return NULL;
+    }
+}
+
 /* Does the camera's G-buffer show the point (window depth bound zmin) at
  * image pixel (x, y)? Outside the G-buffer (the sensor beyond the crop)
  * there is nothing to test against: yes. */
@@ -205,6 +219,13 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
     g.n = n, g.f = f, g.fpn = f + n, g.fmn = f - n, g.two_fn = 2.0f * f * n;
     const float efx = ec->fx, efy = ec->fy, ecx = ec->cx, ecy = ec->cy;
     const pipe__reproj_row_fn kernel = g.pinhole ? row_kernel(r->isa) : NULL;
+    /* the taps on the vector layer: the image's rows whole int32 pixels,
+     * the mask at least 4 bytes */
+    const long mlim = (long)(gh - 1) * cmask_stride + gw - 4;
+    const pipe__reproj_taps_fn taps =
+        P->stride % 4 == 0 && mlim >= 0 && gw > 0 && gh > 0 ? taps_kernel(r->isa) : NULL;
+    const pipe__reproj_tapd td = {cmask, cdepth, P->pixels, cmask_stride, cdepth_stride,
+                                  gw, gh, ox, oy, P->stride / 4, cw - 1, ch - 1, (int)mlim};
     const size_t lw = (size_t)w + 16;
     const pipe__reproj_lanes o = {r->lanes,          r->lanes + lw,     r->lanes + 2 * lw,
                                   r->lanes + 3 * lw, r->lanes + 4 * lw, r->lanes + 5 * lw,
@@ -229,7 +250,14 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         /* the geometry of the row's covered pixels (vector, then the tail) */
         int x1 = kernel ? kernel(&g, em, ed, en, ry, w, &o, &back, &mind) : 0;
         row_ref(&g, em, ed, en, ry, x1, w, &o, &back, &mind);
-        for (int x = 0; x < w; x++) {
+        /* the taps (vector, then the tail) */
+        int xt = 0;
+        if (taps) {
+            long cnt[4] = {0, 0, 0, 0};
+            xt = taps(&td, em, &o, w, M, Po, cnt, sum);
+            covered += cnt[0], outside += cnt[1], filled += cnt[2], sampled += cnt[3];
+        }
+        for (int x = xt; x < w; x++) {
             if (!em[x]) {
                 /* 8 empty mask bytes at a time */
                 uint64_t word;
@@ -319,27 +347,33 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         const uint8_t *em = r->mask + (size_t)y * (size_t)w;
         uint8_t *M = r->M + (size_t)y * (size_t)w;
         uint8_t *Po = r->P + (size_t)y * (size_t)w * 4;
-        int32_t *left = r->row, *right = r->row + w;
+        int32_t *left = r->row;
+        /* the row's span of shown pixels (M != 0: covered, inside the
+         * camera image), 8 bytes at a time: nothing outside it counts */
+        int xa = 0, xb = w - 1;
+        uint64_t word;
+        while (xa + 8 <= w && (memcpy(&word, M + xa, 8), word == 0)) xa += 8;
+        while (xa < w && !M[xa]) xa++;
+        while (xb - 7 > xa && (memcpy(&word, M + xb - 7, 8), word == 0)) xb -= 8;
+        while (xb > xa && !M[xb]) xb--;
         int any = 0, last = -1;
-        for (int x = 0; x < w; x++) {
+        for (int x = xa; x <= xb; x++) {
             int st = em[x] && M[x] ? Po[4 * x + 3] : ST_NONE;
             if (st == ST_SAMPLED) last = x;
             else if (st == ST_FILL) any = 1;
             left[x] = last;
         }
         if (!any) continue;
+        /* right to left: the nearest sampled pixel to the right known */
         last = -1;
-        for (int x = w - 1; x >= 0; x--) {
+        for (int x = xb; x >= xa; x--) {
             int st = em[x] && M[x] ? Po[4 * x + 3] : ST_NONE;
             if (st == ST_SAMPLED) last = x;
-            right[x] = last;
-        }
-        for (int x = 0; x < w; x++) {
-            if (!em[x] || !M[x] || Po[4 * x + 3] != ST_FILL) continue;
+            if (st != ST_FILL) continue;
             done++;
             /* of the nearest sampled pixels left and right, the one on
              * the same surface: its eye distance nearer to this pixel's */
-            int l = left[x], rr = right[x], src = l >= 0 ? l : rr;
+            int l = left[x], rr = last, src = l >= 0 ? l : rr;
             if (l >= 0 && rr >= 0) {
                 const float *ed = r->depth + (size_t)y * (size_t)w;
                 float d0 = lin_depth(ed[x], n, f);

@@ -62,8 +62,10 @@
  *   On the eye's thread: the per-pixel geometry on the vector layer
  *   (pipe_reproj_simd.inl, 4/8/16 lanes; a distorting lens in scalar
  *   double), equal lane by lane to the scalar reference row_ref (float,
- *   fixed operation order); the taps scalar, integer bilinear weights
- *   (8-bit fractions as fuse_composite): the same bytes on every ISA and
+ *   fixed operation order); the taps too (pipe__reproj_taps_<isa>: the
+ *   G-buffer and image by gathers, integer bilinear weights with 8-bit
+ *   fractions as fuse_composite, the renormalisation exact), equal to the
+ *   scalar taps of pipe__reproj_sample: the same bytes on every ISA and
  *   thread count.
  *
  * THE WHOLE SENSOR
@@ -173,6 +175,38 @@ int pipe__reproj_row_avx512(const pipe__reproj_geo *g, const uint8_t *em, const 
 int pipe__reproj_row_neon(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
                           const float *en, float ry, int w, const pipe__reproj_lanes *o,
                           long *back, float *mind);
+
+/* What the taps pass needs (the camera's G-buffer of the crop, the image
+ * sampled as int32 RGBA pixels). mlim: the last mask offset with 4
+ * readable bytes ((gh - 1) * cms + gw - 4). */
+typedef struct pipe__reproj_tapd {
+    const uint8_t *cmask;
+    const float *cdepth;
+    const uint8_t *P;      /* the sampled image, RGBA8, stride ps4 pixels */
+    int cms, cds, gw, gh, ox, oy, ps4, icw1, ich1, mlim;
+} pipe__reproj_tapd;
+
+/* The taps pass per ISA (pipe_reproj_simd.inl): from one eye row's
+ * geometry (o, the covered pixels em), M (the mask composited: the fade
+ * or 0), Po (RGBA + the kind in alpha, written where the scalar
+ * reference writes), cnt[] += covered, outside, filled, sampled and
+ * sum[] += the sampled colours; the first column not done (the scalar
+ * taps finish). Equal to the scalar taps in pipe_reproj.c. */
+typedef int (*pipe__reproj_taps_fn)(const pipe__reproj_tapd *t, const uint8_t *em,
+                                    const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
+                                    long cnt[4], uint64_t sum[3]);
+int pipe__reproj_taps_sse2(const pipe__reproj_tapd *t, const uint8_t *em,
+                           const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
+                           long cnt[4], uint64_t sum[3]);
+int pipe__reproj_taps_avx2(const pipe__reproj_tapd *t, const uint8_t *em,
+                           const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
+                           long cnt[4], uint64_t sum[3]);
+int pipe__reproj_taps_avx512(const pipe__reproj_tapd *t, const uint8_t *em,
+                             const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
+                             long cnt[4], uint64_t sum[3]);
+int pipe__reproj_taps_neon(const pipe__reproj_tapd *t, const uint8_t *em,
+                           const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
+                           long cnt[4], uint64_t sum[3]);
 
 int pipe__reproj_init(pipe__reproj *r, int width, int height);
 void pipe__reproj_free(pipe__reproj *r);

@@ -4,7 +4,11 @@
  * SIMD_W eye pixels a step, written once on the vector layer
  * (src/cpu/simd.h). Included by pipe_reproj_{sse2,avx2,avx512,neon}.c
  * after their simd_*.h. Every lane is the scalar reference's arithmetic
- * (pipe_reproj.c, row_ref) in its order: the same bytes on every ISA. */
+ * (pipe_reproj.c, row_ref) in its order: the same bytes on every ISA.
+ * Then the taps (pipe__reproj_taps): the camera G-buffer's mask and depth
+ * and the image's pixels by gathers (vi_gather_u8x4, vf_gather, vi_gather:
+ * AVX2/AVX-512 gathers, SSE2/NEON lane by lane), the bilinear in int32
+ * lanes, the renormalising division in float (exact, see there). */
 
 /* Columns [0, w) of one eye row, SIMD_W at a time, skipping blocks with
  * no covered pixel; the first column not done (row_ref finishes). back:
@@ -82,3 +86,149 @@ int SIMD_FN(pipe__reproj_row)(const pipe__reproj_geo *g, const uint8_t *em, cons
     *back += bk;
     return x;
 }
+
+/* ------------------------------------------------------------ the taps */
+
+/* lanes with 0 <= gx < gw and 0 <= gy < gh */
+static inline vmask rp_inside(vint gx, vint gy, vint gw, vint gh)
+{
+    const vint m1 = vi_set1(-1);
+    return vm_and(vm_and(vi_gt(gx, m1), vi_gt(gw, gx)), vm_and(vi_gt(gy, m1), vi_gt(gh, gy)));
+}
+
+/* The scalar shows() (pipe_reproj.c) for the lanes of valid at G-buffer
+ * pixel (gx, gy): outside the G-buffer yes, else the camera's mask there
+ * and its depth not nearer than zmin. The other lanes: no. A mask byte
+ * with fewer than 4 readable bytes from it (the last pixels of the
+ * buffer) is read alone. */
+static inline vmask rp_shows(const pipe__reproj_tapd *t, vmask valid, vint gx, vint gy,
+                             vfloat zmin)
+{
+    const vint gw = vi_set1(t->gw), gh = vi_set1(t->gh), mlim = vi_set1(t->mlim);
+    const vmask in = vm_and(valid, rp_inside(gx, gy, gw, gh));
+    const vint mo = vi_sel(in, vi_add(vi_mullo(gy, vi_set1(t->cms)), gx), vi_zero());
+    const vint dof = vi_sel(in, vi_add(vi_mullo(gy, vi_set1(t->cds)), gx), vi_zero());
+    const vmask late = vm_and(in, vi_gt(mo, mlim));
+    vint mb = vi_and(vi_gather_u8x4(t->cmask, vi_sel(late, vi_zero(), mo)), vi_set1(0xFF));
+    if (vm_any(late)) {
+        _Alignas(64) int32_t off[SIMD_W], b[SIMD_W];
+        vi_storeu(off, mo);
+        vi_storeu(b, mb);
+        for (unsigned k = vm_bits(late); k; k &= k - 1) {
+            const int l = __builtin_ctz(k);
+            b[l] = t->cmask[off[l]];
+        }
+        mb = vi_loadu(b);
+    }
+    const vfloat d = vf_gather(t->cdepth, dof);
+    const vmask sh = vm_and(vm_not(vi_eq(mb, vi_zero())), vm_not(vf_lt(d, zmin)));
+    return vm_or(vm_andnot(in, valid), vm_and(in, sh));
+}
+
+#define RP_CH(p, k) vi_and(vi_srli(p, 8 * (k)), vi_set1(0xFF))
+
+/* Columns [0, w) of one eye row, SIMD_W at a time (the scalar taps of
+ * pipe_reproj.c lane by lane); the first column not done. */
+int SIMD_FN(pipe__reproj_taps)(const pipe__reproj_tapd *t, const uint8_t *em,
+                               const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
+                               long cnt[4], uint64_t sum[3])
+{
+    const vint zero = vi_zero(), one = vi_set1(1), k256 = vi_set1(256);
+    const vint ox = vi_set1(t->ox), oy = vi_set1(t->oy), ps4 = vi_set1(t->ps4);
+    const vint icw1 = vi_set1(t->icw1), ich1 = vi_set1(t->ich1);
+    const vint rgb = vi_set1(0x00FFFFFF), a_fill = vi_set1(2 << 24), a_samp = vi_set1(1 << 24);
+    const int32_t *P = (const int32_t *)(const void *)t->P;
+    vint s0 = zero, s1 = zero, s2 = zero;
+    long ncov = 0, nout = 0, nfill = 0, nsamp = 0;
+    int x = 0;
+    for (; w - x >= SIMD_W; x += SIMD_W) {
+        const vmask cov = vm_not(vi_eq(vi_load_u8(em + x), zero));
+        const unsigned cb = vm_bits(cov);
+        if (!cb) continue;
+        const vint mv = vi_loadu(o->mv + x);
+        const vmask valid = vm_and(cov, vi_gt(mv, zero));
+        vi_store_u8(M + x, vi_sel(cov, mv, zero));
+        const unsigned vb = vm_bits(valid);
+        ncov += __builtin_popcount(cb);
+        nout += __builtin_popcount(cb & ~vb);
+        if (!vb) continue;
+        /* the nearest camera pixel: does the camera see this point? */
+        const vfloat zmin = vf_loadu(o->zmin + x);
+        const vint iu = vi_loadu(o->iu + x), iv = vi_loadu(o->iv + x);
+        const vmask seen = rp_shows(t, valid, vi_sub(iu, ox), vi_sub(iv, oy), zmin);
+        const vmask fill = vm_andnot(seen, valid);
+        const unsigned sb = vm_bits(seen);
+        nfill += __builtin_popcount(vm_bits(fill));
+        nsamp += __builtin_popcount(sb);
+        int32_t *po = (int32_t *)(void *)(Po + 4 * (size_t)x);
+        const vint old = vi_loadu(po);
+        vint out = vi_sel(fill, vi_or(vi_and(old, rgb), a_fill), old);
+        if (sb) {
+            /* bilinear, the taps that show the point, renormalised */
+            const vint tx = vi_loadu(o->tx + x), ty = vi_loadu(o->ty + x);
+            const vint fx = vi_loadu(o->fx + x), fy = vi_loadu(o->fy + x);
+            const vint dx = vi_sel(vi_gt(icw1, tx), one, zero);
+            const vint y1 = vi_add(ty, vi_sel(vi_gt(ich1, ty), one, zero));
+            const vint gx = vi_sub(tx, ox), gx1 = vi_add(gx, dx);
+            const vint gy0 = vi_sub(ty, oy), gy1 = vi_sub(y1, oy);
+            const vmask t00 = rp_shows(t, seen, gx, gy0, zmin);
+            const vmask t01 = rp_shows(t, seen, gx1, gy0, zmin);
+            const vmask t10 = rp_shows(t, seen, gx, gy1, zmin);
+            const vmask t11 = rp_shows(t, seen, gx1, gy1, zmin);
+            const vint ifx = vi_sub(k256, fx), ify = vi_sub(k256, fy);
+            const vint w00 = vi_sel(t00, vi_mullo(ifx, ify), zero);
+            const vint w01 = vi_sel(t01, vi_mullo(fx, ify), zero);
+            const vint w10 = vi_sel(t10, vi_mullo(ifx, fy), zero);
+            const vint w11 = vi_sel(t11, vi_mullo(fx, fy), zero);
+            vint ws = vi_add(vi_add(vi_add(w00, w01), w10), w11);
+            const vint r0 = vi_sel(seen, vi_mullo(ty, ps4), zero);
+            const vint r1 = vi_sel(seen, vi_mullo(y1, ps4), zero);
+            const vint c0 = vi_sel(seen, tx, zero), c1 = vi_sel(seen, vi_add(tx, dx), zero);
+            const vint p00 = vi_gather(P, vi_add(r0, c0)), p01 = vi_gather(P, vi_add(r0, c1));
+            const vint p10 = vi_gather(P, vi_add(r1, c0)), p11 = vi_gather(P, vi_add(r1, c1));
+#define RP_ACC(k)                                                                          \
+    vi_add(vi_add(vi_add(vi_mullo(w00, RP_CH(p00, k)), vi_mullo(w01, RP_CH(p01, k))),       \
+                  vi_mullo(w10, RP_CH(p10, k))),                                            \
+           vi_mullo(w11, RP_CH(p11, k)))
+            vint a0 = RP_ACC(0), a1 = RP_ACC(1), a2 = RP_ACC(2);
+#undef RP_ACC
+            const vmask none = vm_and(seen, vi_eq(ws, zero));
+            if (vm_any(none)) { /* only the nearest pixel is the model's */
+                const vint pn = vi_gather(P, vi_sel(none, vi_add(vi_mullo(iv, ps4), iu), zero));
+                a0 = vi_sel(none, RP_CH(pn, 0), a0);
+                a1 = vi_sel(none, RP_CH(pn, 1), a1);
+                a2 = vi_sel(none, RP_CH(pn, 2), a2);
+                ws = vi_sel(none, one, ws);
+            }
+            /* (acc + ws / 2) / ws: below 2^24 over at most 2^16, so the
+             * float quotient truncates to the integer one */
+            ws = vi_sel(seen, ws, one);
+            const vint hw = vi_srli(ws, 1);
+            const vfloat fw = vf_from_vi(ws);
+            const vint q0 = vi_from_vf_trunc(vf_div(vf_from_vi(vi_add(a0, hw)), fw));
+            const vint q1 = vi_from_vf_trunc(vf_div(vf_from_vi(vi_add(a1, hw)), fw));
+            const vint q2 = vi_from_vf_trunc(vf_div(vf_from_vi(vi_add(a2, hw)), fw));
+            const vint px = vi_or(vi_or(q0, vi_slli(q1, 8)), vi_or(vi_slli(q2, 16), a_samp));
+            out = vi_sel(seen, px, out);
+            s0 = vi_add(s0, vi_sel(seen, q0, zero));
+            s1 = vi_add(s1, vi_sel(seen, q1, zero));
+            s2 = vi_add(s2, vi_sel(seen, q2, zero));
+        }
+        vi_storeu(po, out);
+    }
+    _Alignas(64) int32_t l0[SIMD_W], l1[SIMD_W], l2[SIMD_W];
+    vi_storeu(l0, s0);
+    vi_storeu(l1, s1);
+    vi_storeu(l2, s2);
+    for (int l = 0; l < SIMD_W; l++) {
+        sum[0] += (uint64_t)(uint32_t)l0[l];
+        sum[1] += (uint64_t)(uint32_t)l1[l];
+        sum[2] += (uint64_t)(uint32_t)l2[l];
+    }
+    cnt[0] += ncov;
+    cnt[1] += nout;
+    cnt[2] += nfill;
+    cnt[3] += nsamp;
+    return x;
+}
+#undef RP_CH
