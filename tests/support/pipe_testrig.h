@@ -1,6 +1,8 @@
-/* pipe_testrig.h - the synthetic skinned arms of tests/test_pipe.c and
- * tests/test_pipe_fit.c: a tube of rings around a bone, bound rigidly to
- * its joint, and the one-mesh, one-skin model around the tubes.
+/* pipe_testrig.h - the synthetic skinned arms of tests/test_pipe.c,
+ * tests/test_pipe_prior.c and tests/test_pipe_fit.c: a tube of rings
+ * around a bone, bound rigidly to its joint, the one-mesh, one-skin model
+ * around the tubes, and the two arms below the head (tu_arms_build) of
+ * test_pipe and test_pipe_prior.
  * Header-only (static inline); include after support/testutil.h,
  * <cmocka.h> and src/kin/kin.h (or src/pipe/pipe.h). The vertices and
  * triangles are in the order both tests built them before, so their
@@ -10,6 +12,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 /* Rings along a tube and vertices around each ring. */
 enum { TU_TUBE_RINGS = 12, TU_TUBE_AROUND = 10 };
@@ -83,6 +86,73 @@ static inline void tu_rig_bind(kin_model *m, kin_skin *skin, const kin_mesh *mes
     m->meshes = mesh;
     m->skin_count = 1;
     m->skins = skin;
+}
+
+/* Two arms below the head (world_from_head = identity, the cameras look
+ * down -Z), each of three tubes: upper arm from the shoulder (-+0.2,
+ * -0.1, 0) to the elbow 12 cm towards the middle and 30 cm in front of
+ * it, forearm to the wrist (-+0.2, -0.05, -0.6), hand 15 cm on; radii
+ * 3.5, 3 and 2.5 cm, each bound to its bone. Nodes: 0 body; per side s
+ * (per = 3, or 4 with fingers): 1 + per s upper arm at the shoulder,
+ * + 1 forearm at the elbow, + 2 hand at the wrist; with fingers, + 3 a
+ * fingers node 7.5 cm beyond the wrist on the tube's outer side (2.5 cm
+ * up), bound to no vertex, at fingers[s], and every other joint of the
+ * rig's side on it but the shoulder (node 0). */
+enum { TU_ARMS_MAX_NODES = 9 };
+typedef struct tu_arms {
+    kin_model m;
+    kin_arm_rig rig;
+    int nodes;
+    int16_t parents[TU_ARMS_MAX_NODES];
+    kin_transform rest[TU_ARMS_MAX_NODES];
+    kin_mat4 ibm[TU_ARMS_MAX_NODES];
+    int joints[TU_ARMS_MAX_NODES];
+    kin_skin skin;
+    kin_mesh mesh;
+    float pos[6 * TU_TUBE_VERTS * 3];
+    uint16_t jnt[6 * TU_TUBE_VERTS * 4];
+    float wgt[6 * TU_TUBE_VERTS * 4];
+    uint32_t idx[6 * TU_TUBE_TRIS * 3];
+    int nv, nt;
+    kin_vec3 fingers[2]; /* world position of each fingers node */
+} tu_arms;
+
+static inline void tu_arms_build(tu_arms *A, int fingers)
+{
+    memset(A, 0, sizeof *A);
+    const int per = fingers ? 4 : 3;
+    A->nodes = 1 + 2 * per;
+    A->parents[0] = KIN_NO_PARENT;
+    for (int j = 0; j < A->nodes; j++) A->rest[j] = kin_transform_identity();
+    for (int s = 0; s < 2; s++) {
+        float x = s ? 0.2f : -0.2f;
+        int u = 1 + per * s;
+        A->parents[u] = 0;
+        for (int k = 1; k < per; k++) A->parents[u + k] = (int16_t)(u + k - 1);
+        float in = s ? -0.12f : 0.12f; /* towards the middle */
+        A->rest[u].t = kin_v3(x, -0.1f, 0);
+        A->rest[u + 1].t = kin_v3(in, 0, -0.3f);
+        A->rest[u + 2].t = kin_v3(-in, 0.05f, -0.3f);
+        kin_vec3 S = kin_v3(x, -0.1f, 0), E = kin_v3(x + in, -0.1f, -0.3f),
+                 Wr = kin_v3(x, -0.05f, -0.6f);
+        tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, S, E, 0.035f, u);
+        tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, E, Wr, 0.03f, u + 1);
+        tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, Wr, kin_v3(x, -0.05f, -0.75f),
+                0.025f, u + 2);
+        if (fingers) {
+            A->rest[u + 3].t = kin_v3(0, 0.025f, -0.075f);
+            A->fingers[s] = kin_v3(x, -0.025f, -0.675f);
+            for (int j = 0; j < KIN_RIG_SIDE_JOINTS; j++) A->rig.joint[s][j] = u + 3;
+            A->rig.joint[s][KIN_RIG_SHOULDER] = 0;
+        }
+        A->rig.joint[s][KIN_RIG_UPPER_ARM] = u;
+        A->rig.joint[s][KIN_RIG_FOREARM] = u + 1;
+        A->rig.joint[s][KIN_RIG_HAND] = u + 2;
+    }
+    A->mesh = (kin_mesh){.vertex_count = A->nv, .positions = A->pos, .joints = A->jnt,
+                         .weights = A->wgt, .index_count = A->nt * 3, .indices = A->idx,
+                         .node = -1, .skin = 0};
+    tu_rig_bind(&A->m, &A->skin, &A->mesh, A->nodes, A->parents, A->rest, A->ibm, A->joints);
 }
 
 #endif
