@@ -70,6 +70,14 @@ static long file_size(const char *path)
     return (long)st.st_size;
 }
 
+/* args with no file size limit: exit 0 (else its output on stderr). */
+static void expect_ok(const char **args)
+{
+    int rc = run_limited(-1, XFSZ_IGNORE, args);
+    if (rc) fprintf(stderr, "%s\n", out);
+    assert_int_equal(rc, 0);
+}
+
 /* args under a file size limit of `limit` bytes: exit 1 with the EFBIG
  * message naming what. */
 static void expect_too_big(long limit, const char **args, const char *what)
@@ -155,9 +163,7 @@ static void mask_write_fails_cleanly(void **state)
     mask_args(a, model, mask, nrm, NULL);
 
     /* no limit: both written, whole */
-    int rc = run_limited(-1, XFSZ_IGNORE, a);
-    if (rc) fprintf(stderr, "%s\n", out);
-    assert_int_equal(rc, 0);
+    expect_ok(a);
     io_image img;
     io_error err;
     assert_int_equal(io_image_load(nrm, IO_U8, 0, &img, &err), IO_OK);
@@ -177,14 +183,13 @@ static void mask_write_fails_cleanly(void **state)
 
     /* an existing file is not touched by a failed overwrite */
     tu_write_text(nrm, "precious");
-    rc = run_limited(limit, XFSZ_IGNORE, a);
-    assert_int_equal(rc, 1);
+    assert_int_equal(run_limited(limit, XFSZ_IGNORE, a), 1);
     assert_true(tu_file_is(nrm, "precious"));
     assert_int_equal(temps_in(dir), 0);
 
     /* the same with named temporaries (file systems without O_TMPFILE) */
     setenv("EGOFUSE_NO_TMPFILE", "1", 1);
-    rc = run_limited(limit, XFSZ_IGNORE, a);
+    int rc = run_limited(limit, XFSZ_IGNORE, a);
     unsetenv("EGOFUSE_NO_TMPFILE");
     assert_int_equal(rc, 1);
     assert_non_null(strstr(out, strerror(EFBIG)));
@@ -203,9 +208,7 @@ static void plugin_write_fails_cleanly(void **state)
     snprintf(tif, sizeof tif, "%s/normals.tif", dir);
     const char *a[40];
     mask_args(a, model, mask, tif, depth);
-    int rc = run_limited(-1, XFSZ_IGNORE, a);
-    if (rc) fprintf(stderr, "%s\n", out);
-    assert_int_equal(rc, 0);
+    expect_ok(a);
     long limit = file_size(mask) + 64;
     assert_true(file_size(tif) > limit);
     assert_true(file_size(depth) > limit);
@@ -274,9 +277,7 @@ static void render_write_fails_cleanly(void **state)
     assert_int_equal(files_in(odir, ".png"), 0);
     assert_int_equal(temps_in(odir), 0);
     /* and without the limit it works */
-    int rc = run_limited(-1, XFSZ_IGNORE, a);
-    if (rc) fprintf(stderr, "%s\n", out);
-    assert_int_equal(rc, 0);
+    expect_ok(a);
     assert_int_equal(files_in(odir, ".png"), 2);
 }
 

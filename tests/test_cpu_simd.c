@@ -261,7 +261,7 @@ static int two_nans(int op, uint32_t ua, uint32_t ub)
 static void check_isa(void **state)
 {
     const ef_isa isa = tu_simd_test_isa(state, "", "");
-    tu_simd_check_fn *const fn = tu_simd_check_of(tu_simd_isa_index_of(state));
+    tu_simd_check_fn *const fn = tu_simd_check_isa[tu_simd_isa_index_of(state)];
     static uint32_t a[N], b[N], out[N], before[N];
     long lanes = 0, bad = 0;
     int W = 0;

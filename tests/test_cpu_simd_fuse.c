@@ -61,7 +61,7 @@ static const char *const names[FC_COUNT] = {
 static void check_isa(void **state)
 {
     const ef_isa isa = tu_simd_test_isa(state, " fuse", "the row-cache ops of ");
-    tu_simd_fcheck_fn *const fn = tu_simd_fcheck_of(tu_simd_isa_index_of(state));
+    tu_simd_fcheck_fn *const fn = tu_simd_fcheck_isa[tu_simd_isa_index_of(state)];
     static uint32_t a[N], b[N], out[N];
     static const uint32_t sp[] = { 0u, 0xFFFFFFFFu, 0x80000000u, 0x7FFFFFFFu, 0x8000u, 0x7FFFu,
                                    0xFFFFu, 0x10000u, 0x80008000u, 0xFFFF0000u, 1u, 0x00FF00FFu };

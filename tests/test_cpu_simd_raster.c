@@ -165,7 +165,7 @@ static void check_front_ops(ef_isa isa, tu_simd_rcheck_fn *fn, int W, uint64_t *
 static void check_isa(void **state)
 {
     const ef_isa isa = tu_simd_test_isa(state, " raster", "the raster ops of ");
-    tu_simd_rcheck_fn *const fn = tu_simd_rcheck_of(tu_simd_isa_index_of(state));
+    tu_simd_rcheck_fn *const fn = tu_simd_rcheck_isa[tu_simd_isa_index_of(state)];
     static _Alignas(64) uint32_t a[N], out[N], before[N];
     static uint8_t ob[N], bb[N];
     long checked = 0, bad = 0;

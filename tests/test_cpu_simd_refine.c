@@ -56,7 +56,7 @@ static uint32_t got(int op, const uint32_t *out, int k)
 static void check_isa(void **state)
 {
     const ef_isa isa = tu_simd_test_isa(state, " refine", "the refine ops of ");
-    tu_simd_qcheck_fn *const fn = tu_simd_qcheck_of(tu_simd_isa_index_of(state));
+    tu_simd_qcheck_fn *const fn = tu_simd_qcheck_isa[tu_simd_isa_index_of(state)];
     static uint16_t a[N], b[N];
     static uint32_t out[N];
     static const uint16_t sp[] = { 0, 1, 127, 128, 255, 0x7F80u, 0x80FFu, 0x7FFFu, 0x8000u,

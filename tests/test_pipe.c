@@ -616,30 +616,14 @@ static void fit_scene_close(fit_scene *S)
 static void paint_arms(const tu_arms *T, const kin_mat4 *head, kin_sthmd_geometry g,
                        frame_bufs *b, uint64_t seed, uint8_t *const sil[2])
 {
-    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
     uint8_t *own = malloc(640 * 400);
     float *clip = malloc(sizeof(float) * 4 * (size_t)T->nv), *depth = malloc(sizeof(float) * 640 * 400);
     assert_true(own && clip && depth);
     tu_rng r = {seed};
     for (int e = 0; e < 2; e++) {
         uint8_t *s = sil ? sil[e] : own;
-        kin_camera cam = kin_sthmd_camera(&hd, head, (kin_eye)e);
-        rast_target t = { 640, 400, depth, 640, s, 640, NULL, 0, 0 };
-        rast_target_clear(&t);
-        rast_transform_points(cam.view_proj.m, T->pos, T->nv, clip);
-        rast_mesh_desc md = { clip, T->nv, NULL, 0, T->idx, T->nt, RAST_CULL_NONE };
-        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
-        for (int y = 0; y < 480; y++)
-            for (int x = 0; x < 640; x++) {
-                int yy = y - g.crop_y0;
-                int in_arm = yy >= 0 && yy < 400 && s[yy * 640 + x];
-                uint8_t *px = &b->cam[e][(y * 640 + x) * 4];
-                int n = (int)(tu_next(&r) % 9) - 4;
-                px[0] = (uint8_t)((in_arm ? 200 : 70) + n);
-                px[1] = (uint8_t)((in_arm ? 120 : 90) + n);
-                px[2] = (uint8_t)((in_arm ? 100 : 150) + n);
-                px[3] = 255;
-            }
+        tu_arms_silhouette(T, head, e, s, depth, clip);
+        tu_paint_camera(b->cam[e], s, g.crop_y0, &r);
     }
     free(own);
     free(clip);

@@ -37,19 +37,13 @@
 static void paint(const tu_arms *A, const kin_mat4 *head, kin_sthmd_geometry g, tu_frame_bufs *b,
                   uint64_t seed, uint8_t *const sil[2], float disc_px[2][2])
 {
-    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
     float *clip = malloc(sizeof(float) * 4 * (size_t)A->nv), *depth = malloc(sizeof(float) * W * H);
     kin_mat4 *world = calloc(NODES, sizeof *world);
     assert_true(clip && depth && world);
     tu_rng r = {seed};
     for (int e = 0; e < 2; e++) {
         uint8_t *s = sil[e];
-        kin_camera cam = kin_sthmd_camera(&hd, head, (kin_eye)e);
-        rast_target t = {W, H, depth, W, s, W, NULL, 0, 0};
-        rast_target_clear(&t);
-        rast_transform_points(cam.view_proj.m, A->pos, A->nv, clip);
-        rast_mesh_desc md = {clip, A->nv, NULL, 0, A->idx, A->nt, RAST_CULL_NONE};
-        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
+        kin_camera cam = tu_arms_silhouette(A, head, e, s, depth, clip);
         for (int k = 0; k < 2; k++) {
             /* the fingers node's image position: pipe_fit_hand_px of a
              * rig whose hand joints are all that node */
@@ -68,17 +62,7 @@ static void paint(const tu_arms *A, const kin_mat4 *head, kin_sthmd_geometry g, 
                     if (dx * dx + dy * dy <= rr * rr) s[y * W + x] = 255;
                 }
         }
-        for (int y = 0; y < 480; y++)
-            for (int x = 0; x < 640; x++) {
-                int yy = y - g.crop_y0;
-                int in_arm = yy >= 0 && yy < H && s[yy * W + x];
-                uint8_t *px = &b->cam[e][(y * 640 + x) * 4];
-                int n = (int)(tu_next(&r) % 9) - 4;
-                px[0] = (uint8_t)((in_arm ? 200 : 70) + n);
-                px[1] = (uint8_t)((in_arm ? 120 : 90) + n);
-                px[2] = (uint8_t)((in_arm ? 100 : 150) + n);
-                px[3] = 255;
-            }
+        tu_paint_camera(b->cam[e], s, g.crop_y0, &r);
     }
     free(clip);
     free(depth);

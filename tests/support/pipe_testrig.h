@@ -1,12 +1,12 @@
 /* pipe_testrig.h - the synthetic skinned arms of tests/test_pipe.c,
  * tests/test_pipe_prior.c and tests/test_pipe_fit.c: a tube of rings
  * around a bone, bound rigidly to its joint, the one-mesh, one-skin model
- * around the tubes, and the two arms below the head (tu_arms_build) of
- * test_pipe and test_pipe_prior.
- * Header-only (static inline); include after support/testutil.h,
- * <cmocka.h> and src/kin/kin.h (or src/pipe/pipe.h). The vertices and
- * triangles are in the order both tests built them before, so their
- * images are unchanged. */
+ * around the tubes; the two arms below the head (tu_arms_build) of
+ * test_pipe and test_pipe_prior, their silhouette from an eye and the
+ * noisy camera image of it. Header-only (static inline); include after
+ * support/testutil.h, <cmocka.h> and src/pipe/pipe.h. The vertices,
+ * triangles and seeded draws are in the order the tests made them
+ * before, so their images are unchanged. */
 #ifndef EGOFUSE_PIPE_TESTRIG_H
 #define EGOFUSE_PIPE_TESTRIG_H
 
@@ -153,6 +153,41 @@ static inline void tu_arms_build(tu_arms *A, int fingers)
                          .weights = A->wgt, .index_count = A->nt * 3, .indices = A->idx,
                          .node = -1, .skin = 0};
     tu_rig_bind(&A->m, &A->skin, &A->mesh, A->nodes, A->parents, A->rest, A->ibm, A->joints);
+}
+
+/* The silhouette of A seen from eye e of the paper's HMD at head into sil
+ * (640x400, the crop), drawn with depth (640x400 floats) and clip (4
+ * floats a vertex of A) as scratch; returns the eye's camera. */
+static inline kin_camera tu_arms_silhouette(const tu_arms *A, const kin_mat4 *head, int e,
+                                            uint8_t *sil, float *depth, float *clip)
+{
+    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
+    kin_camera cam = kin_sthmd_camera(&hd, head, (kin_eye)e);
+    rast_target t = {640, 400, depth, 640, sil, 640, NULL, 0, 0};
+    rast_target_clear(&t);
+    rast_transform_points(cam.view_proj.m, A->pos, A->nv, clip);
+    rast_mesh_desc md = {clip, A->nv, NULL, 0, A->idx, A->nt, RAST_CULL_NONE};
+    assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
+    return cam;
+}
+
+/* The camera image cam (640x480 RGBA) of the silhouette sil (640x400,
+ * the crop from row crop_y0): skin-red (200, 120, 100) inside, blue-grey
+ * (70, 90, 150) outside, plus a noise of -4..4 a pixel (one draw of r a
+ * pixel, row by row). */
+static inline void tu_paint_camera(uint8_t *cam, const uint8_t *sil, int crop_y0, tu_rng *r)
+{
+    for (int y = 0; y < 480; y++)
+        for (int x = 0; x < 640; x++) {
+            int yy = y - crop_y0;
+            int in_arm = yy >= 0 && yy < 400 && sil[yy * 640 + x];
+            uint8_t *px = &cam[(y * 640 + x) * 4];
+            int n = (int)(tu_next(r) % 9) - 4;
+            px[0] = (uint8_t)((in_arm ? 200 : 70) + n);
+            px[1] = (uint8_t)((in_arm ? 120 : 90) + n);
+            px[2] = (uint8_t)((in_arm ? 100 : 150) + n);
+            px[3] = 255;
+        }
 }
 
 #endif

@@ -40,13 +40,4 @@ typedef int tu_simd_check_fn(int op, const uint32_t *a, const uint32_t *b, int k
 tu_simd_check_fn tu_simd_check_sse2, tu_simd_check_avx2, tu_simd_check_avx512,
     tu_simd_check_neon;
 
-/* The implementation of ISA i of tu_simd_isas (support/simd_isa_test.h):
- * sse2, avx2, avx512, neon. */
-static inline tu_simd_check_fn *tu_simd_check_of(int i)
-{
-    tu_simd_check_fn *const fn[4] = {tu_simd_check_sse2, tu_simd_check_avx2,
-                                     tu_simd_check_avx512, tu_simd_check_neon};
-    return fn[i];
-}
-
 #endif

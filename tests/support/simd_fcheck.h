@@ -28,13 +28,4 @@ typedef int tu_simd_fcheck_fn(int op, const uint32_t *a, const uint32_t *b, int 
 tu_simd_fcheck_fn tu_simd_fcheck_sse2, tu_simd_fcheck_avx2, tu_simd_fcheck_avx512,
     tu_simd_fcheck_neon;
 
-/* The implementation of ISA i of tu_simd_isas (support/simd_isa_test.h):
- * sse2, avx2, avx512, neon. */
-static inline tu_simd_fcheck_fn *tu_simd_fcheck_of(int i)
-{
-    tu_simd_fcheck_fn *const fn[4] = {tu_simd_fcheck_sse2, tu_simd_fcheck_avx2,
-                                      tu_simd_fcheck_avx512, tu_simd_fcheck_neon};
-    return fn[i];
-}
-
 #endif

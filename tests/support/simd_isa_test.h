@@ -1,14 +1,15 @@
-/* simd_isa_test.h - the frame the vector layer's tests
- * (tests/test_cpu_simd*.c) share: their seeded xorshift draw, the skip of
- * an ISA this machine does not run (reported as SKIP, never as a pass),
- * and the four per-ISA tests test_sse2, test_avx2, test_avx512, test_neon.
+/* simd_isa_test.h - the frame the per-ISA tests (tests/test_cpu_simd*.c,
+ * test_raster_small.c) share: the seeded xorshift draw of the vector
+ * layer's tests, the skip of an ISA this machine does not run (reported as
+ * SKIP, never as a pass), and the four per-ISA tests test_sse2, test_avx2,
+ * test_avx512, test_neon.
  * Header-only (static inline); include after support/testutil.h,
  * <cmocka.h> and src/cpu/cpu.h.
  *
  *   static void check_isa(void **state)
  *   {
  *       const ef_isa isa = tu_simd_test_isa(state, " fuse", "the row-cache ops of ");
- *       tu_simd_fcheck_fn *const fn = tu_simd_fcheck_of(tu_simd_isa_index_of(state));
+ *       tu_simd_fcheck_fn *const fn = tu_simd_fcheck_isa[tu_simd_isa_index_of(state)];
  *       ...
  *   }
  *   int main(void) { return tu_simd_run_isas(check_isa); }
@@ -17,6 +18,18 @@
 #define EGOFUSE_TU_SIMD_ISA_TEST_H
 
 #include <stdint.h>
+
+#include "simd_check.h"
+#include "simd_fcheck.h"
+#include "simd_qcheck.h"
+#include "simd_rcheck.h"
+
+/* The check functions of each layer by the index of tu_simd_isas: sse2,
+ * avx2, avx512, neon (support/simd_isa_fns.c). */
+extern tu_simd_check_fn *const tu_simd_check_isa[4];
+extern tu_simd_fcheck_fn *const tu_simd_fcheck_isa[4];
+extern tu_simd_qcheck_fn *const tu_simd_qcheck_isa[4];
+extern tu_simd_rcheck_fn *const tu_simd_rcheck_isa[4];
 
 /* xorshift64 (13, 7, 17) of *s; returns bits 16..47 of the new state. */
 static inline uint32_t tu_xorshift(uint64_t *s)

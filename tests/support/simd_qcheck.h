@@ -28,13 +28,4 @@ typedef int tu_simd_qcheck_fn(int op, const uint16_t *a, const uint16_t *b, int 
 tu_simd_qcheck_fn tu_simd_qcheck_sse2, tu_simd_qcheck_avx2, tu_simd_qcheck_avx512,
     tu_simd_qcheck_neon;
 
-/* The implementation of ISA i of tu_simd_isas (support/simd_isa_test.h):
- * sse2, avx2, avx512, neon. */
-static inline tu_simd_qcheck_fn *tu_simd_qcheck_of(int i)
-{
-    tu_simd_qcheck_fn *const fn[4] = {tu_simd_qcheck_sse2, tu_simd_qcheck_avx2,
-                                      tu_simd_qcheck_avx512, tu_simd_qcheck_neon};
-    return fn[i];
-}
-
 #endif

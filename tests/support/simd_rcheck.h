@@ -34,13 +34,4 @@ typedef int tu_simd_rcheck_fn(int op, const uint32_t *a, unsigned k, int n, void
 tu_simd_rcheck_fn tu_simd_rcheck_sse2, tu_simd_rcheck_avx2, tu_simd_rcheck_avx512,
     tu_simd_rcheck_neon;
 
-/* The implementation of ISA i of tu_simd_isas (support/simd_isa_test.h):
- * sse2, avx2, avx512, neon. */
-static inline tu_simd_rcheck_fn *tu_simd_rcheck_of(int i)
-{
-    tu_simd_rcheck_fn *const fn[4] = {tu_simd_rcheck_sse2, tu_simd_rcheck_avx2,
-                                      tu_simd_rcheck_avx512, tu_simd_rcheck_neon};
-    return fn[i];
-}
-
 #endif
