@@ -218,14 +218,7 @@ static void write_scene(const char *dir, int cam_w, int cam_h)
     snprintf(p, sizeof p, "%s/quad.gltf", dir);
     /* 0.2 m square, 0.6 m in front of the head: both cameras see it. */
     tu_write_quad_gltf(p, -0.1f, 0.1f, -0.1f, 0.1f, -0.6f);
-    snprintf(p, sizeof p, "%s/cam_l_0.png", dir);
-    tu_write_solid(p, cam_w, cam_h, 200, 150, 120);
-    snprintf(p, sizeof p, "%s/cam_r_0.png", dir);
-    tu_write_solid(p, cam_w, cam_h, 200, 150, 120);
-    snprintf(p, sizeof p, "%s/virt_l_0.png", dir);
-    tu_write_solid(p, 1280, 800, 10, 40, 90);
-    snprintf(p, sizeof p, "%s/virt_r_0.png", dir);
-    tu_write_solid(p, 1280, 800, 10, 40, 90);
+    tu_write_scene_images(dir, cam_w, cam_h, 1280, 800);
     snprintf(p, sizeof p, "%s/scene.txt", dir);
     tu_write_text(p, QUAD_SCENE);
 }

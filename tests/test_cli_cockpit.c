@@ -43,9 +43,7 @@ static void write_mesh_gltf(const char *path, const char *name, const float *pos
             mn[k] = fminf(mn[k], pos[3 * i + k]);
             mx[k] = fmaxf(mx[k], pos[3 * i + k]);
         }
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fprintf(f,
+    tu_write_fmt(path,
             "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
             "\"nodes\":[{\"name\":\"head\"},{\"name\":\"%s\",\"mesh\":0}],"
             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
@@ -56,7 +54,6 @@ static void write_mesh_gltf(const char *path, const char *name, const float *pos
             "\"min\":[%g,%g,%g],\"max\":[%g,%g,%g]},"
             "{\"bufferView\":1,\"componentType\":5123,\"count\":%d,\"type\":\"SCALAR\"}]}\n",
             name, pb + ib, enc, pb, pb, ib, nv, mn[0], mn[1], mn[2], mx[0], mx[1], mx[2], 3 * nt);
-    fclose(f);
     free(enc);
     free(buf);
 }
@@ -87,14 +84,7 @@ static int group_setup(void **state)
                                     2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
     snprintf(g_box, sizeof g_box, "%s/box.gltf", g_dir);
     write_mesh_gltf(g_box, "box", box, 8, bi, 12);
-    snprintf(p, sizeof p, "%s/cam_l_0.png", g_dir);
-    tu_write_solid(p, 640, 480, 200, 150, 120);
-    snprintf(p, sizeof p, "%s/cam_r_0.png", g_dir);
-    tu_write_solid(p, 640, 480, 200, 150, 120);
-    snprintf(p, sizeof p, "%s/virt_l_0.png", g_dir);
-    tu_write_solid(p, 1280, 800, 10, 40, 90);
-    snprintf(p, sizeof p, "%s/virt_r_0.png", g_dir);
-    tu_write_solid(p, 1280, 800, 10, 40, 90);
+    tu_write_scene_images(g_dir, 640, 480, 1280, 800);
     snprintf(g_scene, sizeof g_scene, "%s/scene.txt", g_dir);
     tu_write_text(g_scene, "egofuse-scene 1\n"
                         "model = hand.gltf\n"

@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "../src/io/io.h"
+#include "support/files.h"
 
 static char out[1 << 16];
 static char seq[512];       /* the generated sequence's folder */
@@ -32,14 +33,7 @@ static int setup(void **st)
     (void)st;
     snprintf(bin_path, sizeof bin_path, "%s", tu_bin());
     tu_gen_path(gen_path, sizeof gen_path);
-    tu_tmp_path("seq_consumer", seq, sizeof seq);
-    char *argv[] = {gen_path, "--out", seq, "--frames", "1", "--hmd", "consumer", NULL};
-    int rc = tu_run(argv, out, sizeof out);
-    if (rc != 0) {
-        fprintf(stderr, "gen_samples --hmd consumer: exit %d: %s\n", rc, out);
-        return -1;
-    }
-    return 0;
+    return tu_gen_seq("seq_consumer", 1, "consumer", seq, sizeof seq);
 }
 
 /* Runs egofuse with a NULL-terminated argument list; output in out. */
@@ -51,6 +45,17 @@ static io_image load(const char *path)
     io_error err;
     if (io_image_load(path, IO_U8, 4, &im, &err) != IO_OK) fail_msg("%s", err.msg);
     return im;
+}
+
+/* The largest difference of the R, G, B of pixel (x, y) of two RGBA
+ * images (load). */
+static int rgb_diff(const io_image *a, const io_image *b, int x, int y)
+{
+    const uint8_t *u = (const uint8_t *)a->data + (size_t)y * a->stride + 4 * (size_t)x;
+    const uint8_t *v = (const uint8_t *)b->data + (size_t)y * b->stride + 4 * (size_t)x;
+    int m = 0;
+    for (int k = 0; k < 3; k++) m = abs(u[k] - v[k]) > m ? abs(u[k] - v[k]) : m;
+    return m;
 }
 
 static void check_size(const char *path, int w, int h)
@@ -115,9 +120,7 @@ static void render(void **st)
         long outside_diff = 0, inside_diff = 0;
         for (int y = 0; y < R.height; y++)
             for (int x = 0; x < R.width; x++) {
-                const uint8_t *a = (uint8_t *)R.data + (size_t)y * R.stride + 4 * (size_t)x;
-                const uint8_t *b = (uint8_t *)V.data + (size_t)y * V.stride + 4 * (size_t)x;
-                int d = memcmp(a, b, 3) != 0;
+                int d = rgb_diff(&R, &V, x, y) != 0;
                 if (x >= vx && x < vx + vw && y >= vy && y < vy + vh) inside_diff += d;
                 else outside_diff += d;
             }
@@ -166,10 +169,7 @@ static void run(void **st)
         long differ = 0, big = 0;
         for (int r = 0; r < x.height; r++)
             for (int c = 0; c < x.width; c++) {
-                const uint8_t *u = (uint8_t *)x.data + (size_t)r * x.stride + 4 * (size_t)c;
-                const uint8_t *v = (uint8_t *)y.data + (size_t)r * y.stride + 4 * (size_t)c;
-                int m = 0;
-                for (int k = 0; k < 3; k++) m = abs(u[k] - v[k]) > m ? abs(u[k] - v[k]) : m;
+                const int m = rgb_diff(&x, &y, c, r);
                 differ += m > 0;
                 big += m > 1;
             }
@@ -198,12 +198,9 @@ static void run(void **st)
     /* a cockpit file */
     tu_tmp_path("hmd_cockpit.conf", conf, sizeof conf);
     tu_tmp_path("run_consumer_conf", o2, sizeof o2);
-    FILE *f = fopen(conf, "w");
-    assert_non_null(f);
-    fprintf(f, "scene = %s\n[cameras]\nleft = %s\nright = %s\nloop = yes\n[hmd]\n"
+    tu_write_fmt(conf, "scene = %s\n[cameras]\nleft = %s\nright = %s\nloop = yes\n[hmd]\n"
                "preset = consumer\n[output]\nout = %s\nframes = 1\nquiet = yes\n", scene, left,
             right, o2);
-    fclose(f);
     rc = ego("run", "--config", conf, NULL);
     if (rc != 0) fail_msg("run --config ([hmd] preset = consumer): exit %d: %s", rc, out);
     snprintf(p, sizeof p, "%s/right_0000.png", o2);

@@ -17,47 +17,13 @@
 
 #include "../src/io/io.h"
 #include "support/files.h"
+#include "support/io_images.h"
 #include "../src/io/io_calib.h"
 
 static char out[65536];
 
 /* egofuse with the arguments (NULL-terminated), its output in out */
 #define run(...) tu_runl(out, sizeof out, tu_bin(), __VA_ARGS__)
-#define b64 tu_b64
-
-/* An unskinned quad [x0,x1]x[y0,y1] at depth z. */
-static void write_quad(const char *path, float x0, float x1, float y0, float y1, float z)
-{
-    uint8_t buf[60];
-    float pos[12] = {x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z};
-    uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(buf, pos, 48);
-    memcpy(buf + 48, idx, 12);
-    char enc[120];
-    b64(buf, sizeof buf, enc);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fprintf(f,
-            "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
-            "\"nodes\":[{\"name\":\"quad\",\"mesh\":0}],"
-            "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":1}]}],"
-            "\"buffers\":[{\"byteLength\":60,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
-            "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
-            "{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12}],"
-            "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\","
-            "\"min\":[%g,%g,%g],\"max\":[%g,%g,%g]},"
-            "{\"bufferView\":1,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}\n",
-            enc, x0, y0, z, x1, y1, z);
-    fclose(f);
-}
-
-static void write_text(const char *path, const char *text)
-{
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fputs(text, f);
-    fclose(f);
-}
 
 /* The quad [-0.45,0.38]x[-0.3,0.33] at z = -1 seen from the origin along
  * -Z: its edges reach far into the barrel's periphery. */
@@ -74,7 +40,7 @@ static void result_mask_through_barrel(void **state)
     tu_tmp_path("lens_mask.png", png, sizeof png);
     tu_tmp_path("lens_mask0.png", png0, sizeof png0);
     tu_root_path("samples/calib/hmd_left.yml", cal, sizeof cal);
-    write_quad(quad, (float)QX0, (float)QX1, (float)QY0, (float)QY1, -1.0f);
+    tu_write_quad_gltf(quad, (float)QX0, (float)QX1, (float)QY0, (float)QY1, -1.0f);
     int rc = run("mask", quad, "--calibration", cal, "--eye", "0,0,0", "--target", "0,0,-1",
                  "--out", png, NULL);
     if (rc != 0) fail_msg("rc %d: %s", rc, out);
@@ -117,7 +83,7 @@ static void result_mask_through_barrel(void **state)
      * the quad covers more (the barrel pulls the periphery in) */
     char cal0[512];
     tu_tmp_path("lens_zero.yml", cal0, sizeof cal0);
-    write_text(cal0, "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n"
+    tu_write_text(cal0, "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n"
                      "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
                      "   data: [ 5.3182147638291553e+02, 0., 3.1820911370453001e+02, 0.,\n"
                      "       5.3244081209177625e+02, 2.4167300942111271e+02, 0., 0., 1. ]\n"
@@ -153,8 +119,8 @@ static void validity_mask_bad_calibration(void **state)
     tu_tmp_path("lens_quad2.gltf", quad, sizeof quad);
     tu_tmp_path("lens_bad.yml", cal, sizeof cal);
     tu_tmp_path("lens_none.png", png, sizeof png);
-    write_quad(quad, -0.5f, 0.5f, -0.5f, 0.5f, -1.0f);
-    write_text(cal, "%YAML:1.0\nimage_width: 640\nimage_height: 480\n"
+    tu_write_quad_gltf(quad, -0.5f, 0.5f, -0.5f, 0.5f, -1.0f);
+    tu_write_text(cal, "%YAML:1.0\nimage_width: 640\nimage_height: 480\n"
                     "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
                     "   data: [ 500., 0., 320., 0., .Nan, 240., 0., 0., 1. ]\n"
                     "distortion_coefficients: [ -0.2, 0.05, 0., 0., 0. ]\n");
@@ -167,7 +133,7 @@ static void validity_mask_bad_calibration(void **state)
     assert_non_null(strstr(out, "/nonexistent/c.yml: No such file"));
     assert_false(tu_exists(png));
     /* no size in the file and none given */
-    write_text(cal, "%YAML:1.0\nK: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n"
+    tu_write_text(cal, "%YAML:1.0\nK: [ 500., 0., 320., 0., 500., 240., 0., 0., 1. ]\n"
                     "D: [ -0.2, 0.05, 0., 0., 0. ]\n");
     assert_int_equal(run("mask", quad, "--calibration", cal, "--eye", "0,0,0", "--target",
                          "0,0,-1", "--out", png, NULL), 1);
@@ -194,7 +160,7 @@ static void validity_run_bad_calibration(void **state)
     snprintf(sub, sizeof sub, "mkdir -p '%s/calib'", dir);
     assert_int_equal(system(sub), 0);
     snprintf(cal, sizeof cal, "%s/calib/left.yml", dir);
-    write_text(cal, "%YAML:1.0\nimage_width: 1280\nimage_height: 720\n"
+    tu_write_text(cal, "%YAML:1.0\nimage_width: 1280\nimage_height: 720\n"
                     "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n"
                     "   data: [ 900., 0., 640., 0., 900., 360., 0., 0., 1. ]\n"
                     "distortion_coefficients: [ -0.2, 0.05, 0., 0., 0. ]\n");
@@ -204,22 +170,12 @@ static void validity_run_bad_calibration(void **state)
     assert_non_null(strstr(out, "left.yml: calibrated for 1280x720 images, the camera is 640x480"));
     /* the cockpit file: relative to its folder */
     snprintf(conf, sizeof conf, "%s/cockpit.conf", dir);
-    write_text(conf, "scene = nowhere.txt\n[hmd]\ncamera = 640x480\ncalibration = calib/missing.yml\n");
+    tu_write_text(conf, "scene = nowhere.txt\n[hmd]\ncamera = 640x480\ncalibration = calib/missing.yml\n");
     assert_int_equal(run("run", "--config", conf, NULL), 1);
     snprintf(sub, sizeof sub, "%s/calib/missing.yml: No such file", dir);
     if (!strstr(out, sub)) fail_msg("'%s' lacks '%s'", out, sub);
     snprintf(sub, sizeof sub, "rm -rf '%s'", dir);
     assert_int_equal(system(sub), 0);
-}
-
-static void write_solid(const char *path, int w, int h)
-{
-    io_image img;
-    io_error err;
-    assert_int_equal(io_image_alloc(&img, w, h, 3, IO_U8, &err), IO_OK);
-    memset(img.data, 90, (size_t)w * h * 3);
-    assert_int_equal(io_image_save(path, &img, &err), IO_OK);
-    io_image_free(&img);
 }
 
 /* render on a scene of a named HMD (hmd = consumer: 1280x1024 cameras):
@@ -233,18 +189,18 @@ static void validity_render_named_hmd(void **state)
     snprintf(cmd, sizeof cmd, "mkdir -p '%s/cam' '%s/v'", dir, dir);
     assert_int_equal(system(cmd), 0);
     snprintf(p, sizeof p, "%s/quad.gltf", dir);
-    write_quad(p, -0.2f, 0.2f, -0.2f, 0.2f, -0.6f);
+    tu_write_quad_gltf(p, -0.2f, 0.2f, -0.2f, 0.2f, -0.6f);
     snprintf(p, sizeof p, "%s/cam/l_0000.png", dir);
-    write_solid(p, 1280, 1024);
+    tu_write_solid(p, 1280, 1024, 90, 90, 90);
     snprintf(p, sizeof p, "%s/cam/r_0000.png", dir);
-    write_solid(p, 1280, 1024);
+    tu_write_solid(p, 1280, 1024, 90, 90, 90);
     snprintf(p, sizeof p, "%s/v/l_0000.png", dir);
-    write_solid(p, 2064, 2208);
+    tu_write_solid(p, 2064, 2208, 90, 90, 90);
     snprintf(p, sizeof p, "%s/v/r_0000.png", dir);
-    write_solid(p, 2064, 2208);
+    tu_write_solid(p, 2064, 2208, 90, 90, 90);
     char scene[700];
     snprintf(scene, sizeof scene, "%s/scene.txt", dir);
-    write_text(scene, "egofuse-scene 1\nmodel = quad.gltf\nframes = 1\nfps = 60\nhmd = consumer\n"
+    tu_write_text(scene, "egofuse-scene 1\nmodel = quad.gltf\nframes = 1\nfps = 60\nhmd = consumer\n"
                       "camera_left = cam/l_%04d.png\ncamera_right = cam/r_%04d.png\n"
                       "virtual_left = v/l_%04d.png\nvirtual_right = v/r_%04d.png\n");
     char cal[512];
@@ -259,7 +215,7 @@ static void validity_render_named_hmd(void **state)
     /* the same lens calibrated at 1280x1024 (a 5:4 sensor) */
     char cal2[700];
     snprintf(cal2, sizeof cal2, "%s/c.yml", dir);
-    write_text(cal2, "%YAML:1.0\nimage_width: 1280\nimage_height: 1024\n"
+    tu_write_text(cal2, "%YAML:1.0\nimage_width: 1280\nimage_height: 1024\n"
                      "camera_matrix: [ 540., 0., 639.5, 0., 540., 511.5, 0., 0., 1. ]\n"
                      "distortion_coefficients: [ -0.25, 0.07, 0., 0., -0.01 ]\n");
     int rc = run("render", "--scene", scene, "--out", out_dir, "--quiet", "--masks",

@@ -47,33 +47,44 @@ static void make_dir(const char *name, char *dir, size_t n)
     assert_int_equal(system(cmd), 0);
 }
 
-/* Names in dir containing ".tmp." (temporaries left behind). */
+/* Names in dir containing ".tmp." (temporaries left behind); 0 when
+ * there is no dir. */
 static int temps_in(const char *dir)
 {
-    DIR *d = opendir(dir);
-    if (!d) return 0;
-    int n = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL)
-        if (strstr(e->d_name, ".tmp.")) n++;
-    closedir(d);
-    return n;
+    const int n = tu_names_in(dir, ".tmp.", NULL);
+    return n < 0 ? 0 : n;
 }
 
-/* Files in dir ending in ext. */
+/* Files in dir ending in ext; 0 when there is no dir. */
 static int files_in(const char *dir, const char *ext)
 {
-    DIR *d = opendir(dir);
-    if (!d) return 0;
-    int n = 0;
-    struct dirent *e;
-    size_t el = strlen(ext);
-    while ((e = readdir(d)) != NULL) {
-        size_t l = strlen(e->d_name);
-        if (l > el && strcmp(e->d_name + l - el, ext) == 0) n++;
-    }
-    closedir(d);
-    return n;
+    const int n = tu_names_in(dir, NULL, ext);
+    return n < 0 ? 0 : n;
+}
+
+/* The size of the file at path, which exists. */
+static long file_size(const char *path)
+{
+    struct stat st;
+    assert_int_equal(stat(path, &st), 0);
+    return (long)st.st_size;
+}
+
+/* args with no file size limit: exit 0 (else its output on stderr). */
+static void expect_ok(const char **args)
+{
+    int rc = run_limited(-1, XFSZ_IGNORE, args);
+    if (rc) fprintf(stderr, "%s\n", out);
+    assert_int_equal(rc, 0);
+}
+
+/* args under a file size limit of `limit` bytes: exit 1 with the EFBIG
+ * message naming what. */
+static void expect_too_big(long limit, const char **args, const char *what)
+{
+    assert_int_equal(run_limited(limit, XFSZ_IGNORE, args), 1);
+    assert_non_null(strstr(out, what));
+    assert_non_null(strstr(out, strerror(EFBIG)));
 }
 
 /* A binary glTF (.glb) of one square [-1,1]^2 at z = 0 facing +Z, with a
@@ -112,10 +123,7 @@ static void write_glb(const char *path)
 {
     unsigned char glb[2048];
     size_t n = make_glb(glb, sizeof glb);
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(glb, 1, n, f), n);
-    assert_int_equal(fclose(f), 0);
+    tu_write_bytes(path, glb, n);
 }
 
 /* A fresh folder tmp/NAME (dir) holding the quad model (model: its
@@ -130,7 +138,10 @@ static void quad_files(const char *name, char dir[1024], char model[1100], char 
 
 /* ------------------------------------------------------------- mask */
 
-static void mask_args(const char **a, const char *model, const char *mask, const char *nrm)
+/* The mask command of the quad into mask, with --normals nrm and --depth
+ * depth unless NULL. */
+static void mask_args(const char **a, const char *model, const char *mask, const char *nrm,
+                      const char *depth)
 {
     int n = 0;
     a[n++] = "mask"; a[n++] = model;
@@ -138,6 +149,7 @@ static void mask_args(const char **a, const char *model, const char *mask, const
     a[n++] = "--fov-y"; a[n++] = "50"; a[n++] = "--eye"; a[n++] = "0.3,0.2,3";
     a[n++] = "--target"; a[n++] = "0,0,0"; a[n++] = "--out"; a[n++] = mask;
     if (nrm) { a[n++] = "--normals"; a[n++] = nrm; }
+    if (depth) { a[n++] = "--depth"; a[n++] = depth; }
     a[n] = NULL;
 }
 
@@ -148,45 +160,36 @@ static void mask_write_fails_cleanly(void **state)
     quad_files("out_mask", dir, model, mask);
     snprintf(nrm, sizeof nrm, "%s/normals.png", dir);
     const char *a[40];
-    mask_args(a, model, mask, nrm);
+    mask_args(a, model, mask, nrm, NULL);
 
     /* no limit: both written, whole */
-    int rc = run_limited(-1, XFSZ_IGNORE, a);
-    if (rc) fprintf(stderr, "%s\n", out);
-    assert_int_equal(rc, 0);
+    expect_ok(a);
     io_image img;
     io_error err;
     assert_int_equal(io_image_load(nrm, IO_U8, 0, &img, &err), IO_OK);
-    struct stat st;
-    assert_int_equal(stat(nrm, &st), 0);
-    long nrm_size = (long)st.st_size;
+    long nrm_size = file_size(nrm);
     io_image_free(&img);
     assert_int_equal(remove(nrm), 0);
 
     /* the mask fits under the limit, the normals image does not: the mask
      * is written, the normals are absent, the message says why */
-    assert_int_equal(stat(mask, &st), 0);
-    long limit = (long)st.st_size + 64;
+    long limit = file_size(mask) + 64;
     assert_true(limit < nrm_size);
     assert_int_equal(remove(mask), 0);
-    rc = run_limited(limit, XFSZ_IGNORE, a);
-    assert_int_equal(rc, 1);
-    assert_non_null(strstr(out, "normals.png"));
-    assert_non_null(strstr(out, strerror(EFBIG)));
+    expect_too_big(limit, a, "normals.png");
     assert_true(tu_exists(mask));
     assert_false(tu_exists(nrm));
     assert_int_equal(temps_in(dir), 0);
 
     /* an existing file is not touched by a failed overwrite */
     tu_write_text(nrm, "precious");
-    rc = run_limited(limit, XFSZ_IGNORE, a);
-    assert_int_equal(rc, 1);
+    assert_int_equal(run_limited(limit, XFSZ_IGNORE, a), 1);
     assert_true(tu_file_is(nrm, "precious"));
     assert_int_equal(temps_in(dir), 0);
 
     /* the same with named temporaries (file systems without O_TMPFILE) */
     setenv("EGOFUSE_NO_TMPFILE", "1", 1);
-    rc = run_limited(limit, XFSZ_IGNORE, a);
+    int rc = run_limited(limit, XFSZ_IGNORE, a);
     unsetenv("EGOFUSE_NO_TMPFILE");
     assert_int_equal(rc, 1);
     assert_non_null(strstr(out, strerror(EFBIG)));
@@ -204,41 +207,19 @@ static void plugin_write_fails_cleanly(void **state)
     snprintf(depth, sizeof depth, "%s/depth.exr", dir);
     snprintf(tif, sizeof tif, "%s/normals.tif", dir);
     const char *a[40];
-    mask_args(a, model, mask, tif);
-    int n = 0;
-    while (a[n]) n++;
-    a[n++] = "--depth";
-    a[n++] = depth;
-    a[n] = NULL;
-    int rc = run_limited(-1, XFSZ_IGNORE, a);
-    if (rc) fprintf(stderr, "%s\n", out);
-    assert_int_equal(rc, 0);
-    struct stat st;
-    assert_int_equal(stat(mask, &st), 0);
-    long limit = (long)st.st_size + 64;
-    assert_int_equal(stat(tif, &st), 0);
-    assert_true((long)st.st_size > limit);
-    assert_int_equal(stat(depth, &st), 0);
-    assert_true((long)st.st_size > limit);
+    mask_args(a, model, mask, tif, depth);
+    expect_ok(a);
+    long limit = file_size(mask) + 64;
+    assert_true(file_size(tif) > limit);
+    assert_true(file_size(depth) > limit);
     assert_int_equal(remove(tif), 0);
     assert_int_equal(remove(depth), 0);
-    rc = run_limited(limit, XFSZ_IGNORE, a);
-    assert_int_equal(rc, 1);
-    assert_non_null(strstr(out, "normals.tif"));
-    assert_non_null(strstr(out, strerror(EFBIG)));
+    expect_too_big(limit, a, "normals.tif");
     assert_false(tu_exists(tif));
     assert_false(tu_exists(depth));
     /* without the normals, the depth is the one that fails */
-    mask_args(a, model, mask, NULL);
-    n = 0;
-    while (a[n]) n++;
-    a[n++] = "--depth";
-    a[n++] = depth;
-    a[n] = NULL;
-    rc = run_limited(limit, XFSZ_IGNORE, a);
-    assert_int_equal(rc, 1);
-    assert_non_null(strstr(out, "depth.exr"));
-    assert_non_null(strstr(out, strerror(EFBIG)));
+    mask_args(a, model, mask, NULL, depth);
+    expect_too_big(limit, a, "depth.exr");
     assert_false(tu_exists(depth));
     assert_int_equal(temps_in(dir), 0);
 }
@@ -251,7 +232,7 @@ static void mask_killed_leaves_nothing(void **state)
     char dir[1024], model[1100], mask[1100];
     quad_files("out_kill", dir, model, mask);
     const char *a[40];
-    mask_args(a, model, mask, NULL);
+    mask_args(a, model, mask, NULL, NULL);
     int rc = run_limited(100, XFSZ_KILL, a);
     assert_int_equal(rc, -SIGXFSZ);
     assert_false(tu_exists(mask));
@@ -292,16 +273,11 @@ static void render_write_fails_cleanly(void **state)
                   "virtual_left = virt_%d.png\nvirtual_right = virt_%d.png\n");
     snprintf(odir, sizeof odir, "%s/out", dir);
     const char *a[] = {"render", "--scene", p, "--out", odir, "--quiet", NULL};
-    int rc = run_limited(4096, XFSZ_IGNORE, a);
-    assert_int_equal(rc, 1);
-    assert_non_null(strstr(out, "left_0000.png"));
-    assert_non_null(strstr(out, strerror(EFBIG)));
+    expect_too_big(4096, a, "left_0000.png");
     assert_int_equal(files_in(odir, ".png"), 0);
     assert_int_equal(temps_in(odir), 0);
     /* and without the limit it works */
-    rc = run_limited(-1, XFSZ_IGNORE, a);
-    if (rc) fprintf(stderr, "%s\n", out);
-    assert_int_equal(rc, 0);
+    expect_ok(a);
     assert_int_equal(files_in(odir, ".png"), 2);
 }
 
@@ -364,7 +340,7 @@ static void eye_overflow_names_eye(void **state)
     char dir[1024], model[1100], mask[1100];
     quad_files("msg_eye", dir, model, mask);
     const char *a[40];
-    mask_args(a, model, mask, NULL);
+    mask_args(a, model, mask, NULL, NULL);
     a[9] = "1e30,1,0";  /* --eye */
     assert_string_equal(a[8], "--eye");
     assert_int_equal(run_limited(-1, XFSZ_IGNORE, a), 2);
@@ -387,7 +363,7 @@ static void truncated_glb_says_where(void **state)
     assert_int_equal(fwrite(glb, 1, n - 30, f), n - 30);  /* inside the BIN chunk */
     fclose(f);
     const char *a[40];
-    mask_args(a, model, mask, NULL);
+    mask_args(a, model, mask, NULL, NULL);
     assert_int_equal(run_limited(-1, XFSZ_IGNORE, a), 1);
     assert_non_null(strstr(out, "cut.glb"));
     assert_non_null(strstr(out, "truncated"));
@@ -439,7 +415,7 @@ static void unwritable_folder_says_why(void **state)
     const char *a[40];
 
     snprintf(mask, sizeof mask, "%s/no_such_folder/mask.png", dir);
-    mask_args(a, model, mask, NULL);
+    mask_args(a, model, mask, NULL, NULL);
     assert_int_equal(run_limited(-1, XFSZ_IGNORE, a), 1);
     assert_non_null(strstr(out, "mask.png"));
     assert_non_null(strstr(out, "does not exist"));
@@ -447,7 +423,7 @@ static void unwritable_folder_says_why(void **state)
     snprintf(file, sizeof file, "%s/plain_file", dir);
     tu_write_text(file, "x");
     snprintf(mask, sizeof mask, "%s/mask.png", file);
-    mask_args(a, model, mask, NULL);
+    mask_args(a, model, mask, NULL, NULL);
     assert_int_equal(run_limited(-1, XFSZ_IGNORE, a), 1);
     assert_non_null(strstr(out, "is not a folder"));
 
@@ -458,7 +434,7 @@ static void unwritable_folder_says_why(void **state)
         snprintf(ro, sizeof ro, "%s/read_only", dir);
         assert_int_equal(mkdir(ro, 0555), 0);
         snprintf(mask, sizeof mask, "%s/mask.png", ro);
-        mask_args(a, model, mask, NULL);
+        mask_args(a, model, mask, NULL, NULL);
         assert_int_equal(run_limited(-1, XFSZ_IGNORE, a), 1);
         assert_non_null(strstr(out, strerror(EACCES)));
     }

@@ -19,25 +19,17 @@
 #include <unistd.h>
 
 #include "../src/io/io.h"
+#include "support/files.h"
 
 static char out[1 << 16];
 static char seq[512];       /* the generated sequence's folder */
 static char bin_path[600];  /* egofuse */
-static char gen_path[700];  /* gen_samples next to it */
 
 static int setup(void **st)
 {
     (void)st;
     snprintf(bin_path, sizeof bin_path, "%s", tu_bin());
-    tu_gen_path(gen_path, sizeof gen_path);
-    tu_tmp_path("seq", seq, sizeof seq);
-    char *argv[] = {gen_path, "--out", seq, "--frames", "3", NULL};
-    int rc = tu_run(argv, out, sizeof out);
-    if (rc != 0) {
-        fprintf(stderr, "gen_samples: exit %d: %s\n", rc, out);
-        return -1;
-    }
-    return 0;
+    return tu_gen_seq("seq", 3, NULL, seq, sizeof seq);
 }
 
 /* Runs egofuse with a NULL-terminated argument list; output in out. */
@@ -145,14 +137,11 @@ static void config_file(void **st)
     char conf[600], o[600];
     tu_tmp_path("cockpit.conf", conf, sizeof conf);
     tu_tmp_path("conf_out", o, sizeof o);
-    FILE *f = fopen(conf, "w");
-    assert_non_null(f);
     /* relative to the file's folder: seq/ is beside it */
-    fprintf(f, "# a dry-run cockpit\nscene = seq/scene.txt\nhide = left-arm\n[cameras]\n"
+    tu_write_fmt(conf, "# a dry-run cockpit\nscene = seq/scene.txt\nhide = left-arm\n[cameras]\n"
                "left = file:seq/cam/left_%%04d.png\nright = file:seq/cam/right_%%04d.png\n"
                "fps = 10\nloop = yes\n[hmd]\nipd = 0.062\n[output]\nout = conf_out\n"
                "frames = 5   ; the command line says 2\nquiet = yes\n");
-    fclose(f);
     int rc = ego("run", "--config", conf, "--frames", "2", NULL);
     if (rc != 0) fail_msg("run --config: exit %d: %s", rc, out);
     assert_non_null(strstr(out, "egofuse run: 2 stereo frames"));
@@ -163,10 +152,7 @@ static void config_file(void **st)
     assert_false(tu_exists(png));
 
     /* an unknown key names the file and the line */
-    f = fopen(conf, "w");
-    assert_non_null(f);
-    fprintf(f, "scene = seq/scene.txt\n[natnet]\nserver = 127.0.0.1\nbogus = 1\n");
-    fclose(f);
+    tu_write_fmt(conf, "scene = seq/scene.txt\n[natnet]\nserver = 127.0.0.1\nbogus = 1\n");
     rc = ego("run", "--config", conf, NULL);
     assert_int_equal(rc, 2);
     char want[700];

@@ -60,13 +60,9 @@ static int setup(void **state)
         else write_image(p, 1280, 800, 0);
     }
     snprintf(scene, sizeof scene, "%s/scene.txt", dir);
-    FILE *f = fopen(scene, "w");
-    assert_non_null(f);
-    fputs("egofuse-scene 1\nmodel = quad.gltf\nframes = 1\nfps = 60\n"
+    tu_write_text(scene, "egofuse-scene 1\nmodel = quad.gltf\nframes = 1\nfps = 60\n"
           "camera_left = cam/l_%04d.png\ncamera_right = cam/r_%04d.png\n"
-          "virtual_left = v/l_%04d.png\nvirtual_right = v/r_%04d.png\n",
-          f);
-    fclose(f);
+          "virtual_left = v/l_%04d.png\nvirtual_right = v/r_%04d.png\n");
     return 0;
 }
 
@@ -169,21 +165,12 @@ static void validity_bad_options(void **state)
     /* the cockpit file's key: [run] view = ... is --view */
     char conf[700];
     snprintf(conf, sizeof conf, "%s/cockpit.conf", dir);
-    FILE *f = fopen(conf, "w");
-    assert_non_null(f);
-    fputs("[run]\nview = sideways\n", f);
-    fclose(f);
+    tu_write_text(conf, "[run]\nview = sideways\n");
     const char *a8[] = {"run", "--config", conf};
     expect_usage("--view 'sideways'", o, a8, 3);
-    f = fopen(conf, "w");
-    assert_non_null(f);
-    fputs("[run]\nview = reproject\n[hmd]\nipd = 0.1\n", f);
-    fclose(f);
+    tu_write_text(conf, "[run]\nview = reproject\n[hmd]\nipd = 0.1\n");
     expect_usage("--hmd-ipd '0.1': 0.04..0.09 m", o, a8, 3);
-    f = fopen(conf, "w");
-    assert_non_null(f);
-    fputs("[run]\nview = reproject\n[hmd]\ncamera-offset = 0.3\n", f);
-    fclose(f);
+    tu_write_text(conf, "[run]\nview = reproject\n[hmd]\ncamera-offset = 0.3\n");
     expect_usage("(--hmd-camera-offset) 0.3 m is outside 0..0.25 m", o, a8, 3);
 }
 

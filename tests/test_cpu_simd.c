@@ -20,6 +20,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "support/simd_check.h"
+#include "support/simd_isa_test.h"
 
 #define N 960   /* 3 * 16 * 4 * 5 */
 
@@ -257,13 +258,10 @@ static int two_nans(int op, uint32_t ua, uint32_t ub)
            isnan_u(ub);
 }
 
-static void check_isa(ef_isa isa, tu_simd_check_fn *fn)
+static void check_isa(void **state)
 {
-    if (!ef_cpu_has(isa)) {
-        print_message("SKIP cpu simd %s: this CPU (or this build's architecture) does not run "
-                      "it; untested: src/cpu/simd_%s.h\n", ef_isa_name(isa), ef_isa_name(isa));
-        skip();
-    }
+    const ef_isa isa = tu_simd_test_isa(state, "", "");
+    tu_simd_check_fn *const fn = tu_simd_check_isa[tu_simd_isa_index_of(state)];
     static uint32_t a[N], b[N], out[N], before[N];
     long lanes = 0, bad = 0;
     int W = 0;
@@ -301,11 +299,6 @@ static void check_isa(ef_isa isa, tu_simd_check_fn *fn)
     assert_int_equal(bad, 0);
 }
 
-static void test_sse2(void **state) { (void)state; check_isa(EF_ISA_SSE2, tu_simd_check_sse2); }
-static void test_avx2(void **state) { (void)state; check_isa(EF_ISA_AVX2, tu_simd_check_avx2); }
-static void test_avx512(void **state) { (void)state; check_isa(EF_ISA_AVX512, tu_simd_check_avx512); }
-static void test_neon(void **state) { (void)state; check_isa(EF_ISA_NEON, tu_simd_check_neon); }
-
 /* Levels: one cap means the same on every architecture. */
 static void test_levels(void **state)
 {
@@ -342,10 +335,10 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_levels),
-        cmocka_unit_test(test_sse2),
-        cmocka_unit_test(test_avx2),
-        cmocka_unit_test(test_avx512),
-        cmocka_unit_test(test_neon),
+        tu_simd_isa_test(check_isa, 0),
+        tu_simd_isa_test(check_isa, 1),
+        tu_simd_isa_test(check_isa, 2),
+        tu_simd_isa_test(check_isa, 3),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

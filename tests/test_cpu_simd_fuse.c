@@ -13,16 +13,9 @@
 
 #include "../src/cpu/cpu.h"
 #include "support/simd_fcheck.h"
+#include "support/simd_isa_test.h"
 
 #define N 960
-
-static uint32_t rnd(uint64_t *s)
-{
-    *s ^= *s << 13;
-    *s ^= *s >> 7;
-    *s ^= *s << 17;
-    return (uint32_t)(*s >> 16);
-}
 
 static uint16_t lo16(uint32_t x) { return (uint16_t)(x & 0xFFFFu); }
 static uint16_t hi16(uint32_t x) { return (uint16_t)(x >> 16); }
@@ -65,14 +58,10 @@ static const char *const names[FC_COUNT] = {
     "vi_min", "vi_permute", "vi_gather", "vh_zip_lo", "vh_zip_hi", "vh_madd", "vh_packus32", "vh_mulhi",
 };
 
-static void check_isa(ef_isa isa, tu_simd_fcheck_fn *fn)
+static void check_isa(void **state)
 {
-    if (!ef_cpu_has(isa)) {
-        print_message("SKIP cpu simd fuse %s: this CPU (or this build's architecture) does "
-                      "not run it; untested: the row-cache ops of src/cpu/simd_%s.h\n",
-                      ef_isa_name(isa), ef_isa_name(isa));
-        skip();
-    }
+    const ef_isa isa = tu_simd_test_isa(state, " fuse", "the row-cache ops of ");
+    tu_simd_fcheck_fn *const fn = tu_simd_fcheck_isa[tu_simd_isa_index_of(state)];
     static uint32_t a[N], b[N], out[N];
     static const uint32_t sp[] = { 0u, 0xFFFFFFFFu, 0x80000000u, 0x7FFFFFFFu, 0x8000u, 0x7FFFu,
                                    0xFFFFu, 0x10000u, 0x80008000u, 0xFFFF0000u, 1u, 0x00FF00FFu };
@@ -82,10 +71,12 @@ static void check_isa(ef_isa isa, tu_simd_fcheck_fn *fn)
     for (int round = 0; round < 8; round++) {
         for (int op = 0; op < FC_COUNT; op++) {
             for (int i = 0; i < N; i++) {
-                a[i] = (rnd(&s) & 3) == 0 ? sp[rnd(&s) % (unsigned)ns] : rnd(&s) * 2654435761u;
-                b[i] = (rnd(&s) & 3) == 0 ? sp[rnd(&s) % (unsigned)ns] : rnd(&s) * 2246822519u;
+                a[i] = (tu_xorshift(&s) & 3) == 0 ? sp[tu_xorshift(&s) % (unsigned)ns]
+                       : tu_xorshift(&s) * 2654435761u;
+                b[i] = (tu_xorshift(&s) & 3) == 0 ? sp[tu_xorshift(&s) % (unsigned)ns]
+                       : tu_xorshift(&s) * 2246822519u;
                 if (op == FC_PERMUTE && round == 0) b[i] = (uint32_t)(i % 16); /* every lane */
-                if (op == FC_GATHER) b[i] = rnd(&s) % N;
+                if (op == FC_GATHER) b[i] = tu_xorshift(&s) % N;
                 out[i] = 0xA5A5A5A5u;
             }
             const int W = fn(op, a, b, N, out);
@@ -104,23 +95,4 @@ static void check_isa(ef_isa isa, tu_simd_fcheck_fn *fn)
     assert_int_equal(bad, 0);
 }
 
-/* one test per ISA, its index as the state */
-static const ef_isa isas[4] = { EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512, EF_ISA_NEON };
-static tu_simd_fcheck_fn *const fns[4] = { tu_simd_fcheck_sse2, tu_simd_fcheck_avx2,
-                                           tu_simd_fcheck_avx512, tu_simd_fcheck_neon };
-static int idx[4] = { 0, 1, 2, 3 };
-
-static void test_isa(void **state)
-{
-    const int i = *(const int *)*state;
-    check_isa(isas[i], fns[i]);
-}
-
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test_prestate(test_isa, &idx[0]), cmocka_unit_test_prestate(test_isa, &idx[1]),
-        cmocka_unit_test_prestate(test_isa, &idx[2]), cmocka_unit_test_prestate(test_isa, &idx[3]),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+int main(void) { return tu_simd_run_isas(check_isa); }

@@ -15,26 +15,19 @@
 #include <string.h>
 
 #include "../src/cpu/cpu.h"
+#include "support/simd_isa_test.h"
 #include "support/simd_rcheck.h"
 
 #define N 480   /* 3 * 16 * 10 */
-
-static uint32_t rnd(uint64_t *s)
-{
-    *s ^= *s << 13;
-    *s ^= *s >> 7;
-    *s ^= *s << 17;
-    return (uint32_t)(*s >> 16);
-}
 
 /* A seeded float: random bits (finite), or a special value. */
 static float rnd_float(uint64_t *s)
 {
     static const uint32_t sp[] = { 0x00000000u, 0x80000000u, 0x7F800000u, 0xFF800000u,
                                    0x00000001u, 0x807FFFFFu, 0x7F7FFFFFu, 0x3F800000u };
-    uint32_t b = rnd(s) * 2654435761u ^ rnd(s);
-    if ((rnd(s) & 7) == 0)
-        b = sp[rnd(s) % 8];
+    uint32_t b = tu_xorshift(s) * 2654435761u ^ tu_xorshift(s);
+    if ((tu_xorshift(s) & 7) == 0)
+        b = sp[tu_xorshift(s) % 8];
     else if ((b & 0x7F800000u) == 0x7F800000u)
         b &= 0xBFFFFFFFu;   /* no NaN: its payload is not part of the contract */
     float f;
@@ -46,17 +39,17 @@ static float rnd_float(uint64_t *s)
  * to float denormals), exact ties, signed zeros, infinities, NaN. */
 static double rnd_double(uint64_t *s)
 {
-    const uint32_t r = rnd(s) % 16;
+    const uint32_t r = tu_xorshift(s) % 16;
     if (r == 0) {
         static const double sp[] = { 0.0, -0.0, 1.0 / 0.0, -1.0 / 0.0, 0.0 / 0.0,
                                      3.4028235677973366e38, 1.401298464324817e-45,
                                      1.0 + 0x1p-24 };
-        return sp[rnd(s) % 8];
+        return sp[tu_xorshift(s) % 8];
     }
-    const double m = (double)(int32_t)(rnd(s) * 2654435761u ^ rnd(s)) * 0x1p-31 +
-                     (double)rnd(s) * 0x1p-55;
-    const int e = (int)(rnd(s) % 300) - 150;
-    return r == 1 ? (double)(rnd(s) % 5) - 2.0 : __builtin_ldexp(m, e);
+    const double m = (double)(int32_t)(tu_xorshift(s) * 2654435761u ^ tu_xorshift(s)) * 0x1p-31 +
+                     (double)tu_xorshift(s) * 0x1p-55;
+    const int e = (int)(tu_xorshift(s) % 300) - 150;
+    return r == 1 ? (double)(tu_xorshift(s) % 5) - 2.0 : __builtin_ldexp(m, e);
 }
 
 /* The raster front-end ops (vi_min, vi_max, vd_from_vf, vd_from_vi,
@@ -69,9 +62,9 @@ static void check_front_ops(ef_isa isa, tu_simd_rcheck_fn *fn, int W, uint64_t *
     for (int round = 0; round < 8; round++) {
         /* vi_min / vi_max */
         for (int i = 0; i < N; i++)
-            a[i] = (rnd(s) & 3) == 0 ? (uint32_t[]){ 0u, 0x80000000u, 0x7FFFFFFFu,
-                                                    0xFFFFFFFFu }[rnd(s) % 4]
-                                     : rnd(s) * 2654435761u;
+            a[i] = (tu_xorshift(s) & 3) == 0 ? (uint32_t[]){ 0u, 0x80000000u, 0x7FFFFFFFu,
+                                                    0xFFFFFFFFu }[tu_xorshift(s) % 4]
+                                     : tu_xorshift(s) * 2654435761u;
         if (round & 1)   /* equal pairs too */
             for (int i = 0; i < N; i += 2 * W) a[i + W] = a[i];
         assert_int_equal(fn(RC_VI_MINMAX, a, 0, N, out), W);
@@ -104,7 +97,7 @@ static void check_front_ops(ef_isa isa, tu_simd_rcheck_fn *fn, int W, uint64_t *
                               (double)f, got);
         }
         for (int i = 0; i < N / 2; i++)
-            a[i] = (rnd(s) & 7) == 0 ? 0x80000000u : rnd(s) * 2654435761u;
+            a[i] = (tu_xorshift(s) & 7) == 0 ? 0x80000000u : tu_xorshift(s) * 2654435761u;
         assert_int_equal(fn(RC_VD_FROM_VI, a, 0, N, out), W);
         for (int i = 0; i < N / 2; i++) {
             double got;
@@ -151,7 +144,7 @@ static void check_front_ops(ef_isa isa, tu_simd_rcheck_fn *fn, int W, uint64_t *
         /* vd_gt_bits: pairs, a third of them equal */
         for (int i = 0; i < N / 2; i++) {
             double d = rnd_double(s);
-            if (i % (2 * VD) >= VD && rnd(s) % 3 == 0)
+            if (i % (2 * VD) >= VD && tu_xorshift(s) % 3 == 0)
                 memcpy(&d, &a[2 * (i - VD)], 8);
             memcpy(&a[2 * i], &d, 8);
         }
@@ -169,14 +162,10 @@ static void check_front_ops(ef_isa isa, tu_simd_rcheck_fn *fn, int W, uint64_t *
     }
 }
 
-static void check_isa(ef_isa isa, tu_simd_rcheck_fn *fn)
+static void check_isa(void **state)
 {
-    if (!ef_cpu_has(isa)) {
-        print_message("SKIP cpu simd raster %s: this CPU (or this build's architecture) does "
-                      "not run it; untested: the raster ops of src/cpu/simd_%s.h\n",
-                      ef_isa_name(isa), ef_isa_name(isa));
-        skip();
-    }
+    const ef_isa isa = tu_simd_test_isa(state, " raster", "the raster ops of ");
+    tu_simd_rcheck_fn *const fn = tu_simd_rcheck_isa[tu_simd_isa_index_of(state)];
     static _Alignas(64) uint32_t a[N], out[N], before[N];
     static uint8_t ob[N], bb[N];
     long checked = 0, bad = 0;
@@ -188,7 +177,8 @@ static void check_isa(ef_isa isa, tu_simd_rcheck_fn *fn)
         /* vi_sign_bits: random ints, and 0, -1, INT32_MIN, INT32_MAX */
         static const uint32_t sp[] = { 0u, 0xFFFFFFFFu, 0x80000000u, 0x7FFFFFFFu, 1u };
         for (int i = 0; i < N; i++)
-            a[i] = (rnd(&s) & 7) == 0 ? sp[rnd(&s) % 5] : rnd(&s) * 2654435761u;
+            a[i] = (tu_xorshift(&s) & 7) == 0 ? sp[tu_xorshift(&s) % 5]
+                   : tu_xorshift(&s) * 2654435761u;
         assert_int_equal(fn(RC_SIGN_BITS, a, 0, N, out), W);
         for (int i = 0; i < N; i++) {
             checked++;
@@ -200,11 +190,11 @@ static void check_isa(ef_isa isa, tu_simd_rcheck_fn *fn)
         const int nk = W <= 8 ? (int)full + 1 : 64;
         for (int ki = 0; ki < nk; ki++) {
             const unsigned k = W <= 8 ? (unsigned)ki
-                               : ki == 0 ? 0u : ki == 1 ? full : rnd(&s) & full;
+                               : ki == 0 ? 0u : ki == 1 ? full : tu_xorshift(&s) & full;
             for (int i = 0; i < N; i++) {
-                bb[i] = ob[i] = (uint8_t)rnd(&s);
-                before[i] = out[i] = rnd(&s);
-                a[i] = rnd(&s);
+                bb[i] = ob[i] = (uint8_t)tu_xorshift(&s);
+                before[i] = out[i] = tu_xorshift(&s);
+                a[i] = tu_xorshift(&s);
             }
             assert_int_equal(fn(RC_VB_STORE_BITS, a, k, N, ob), W);
             for (int i = 0; i < N; i++) {
@@ -231,18 +221,4 @@ static void check_isa(ef_isa isa, tu_simd_rcheck_fn *fn)
     assert_int_equal(bad, 0);
 }
 
-static void test_sse2(void **state) { (void)state; check_isa(EF_ISA_SSE2, tu_simd_rcheck_sse2); }
-static void test_avx2(void **state) { (void)state; check_isa(EF_ISA_AVX2, tu_simd_rcheck_avx2); }
-static void test_avx512(void **state) { (void)state; check_isa(EF_ISA_AVX512, tu_simd_rcheck_avx512); }
-static void test_neon(void **state) { (void)state; check_isa(EF_ISA_NEON, tu_simd_rcheck_neon); }
-
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_sse2),
-        cmocka_unit_test(test_avx2),
-        cmocka_unit_test(test_avx512),
-        cmocka_unit_test(test_neon),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+int main(void) { return tu_simd_run_isas(check_isa); }

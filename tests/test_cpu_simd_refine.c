@@ -11,17 +11,10 @@
 #include <cmocka.h>
 
 #include "../src/cpu/cpu.h"
+#include "support/simd_isa_test.h"
 #include "support/simd_qcheck.h"
 
 #define N 1024
-
-static uint32_t rnd(uint64_t *s)
-{
-    *s ^= *s << 13;
-    *s ^= *s >> 7;
-    *s ^= *s << 17;
-    return (uint32_t)(*s >> 16);
-}
 
 static const char *const names[QC_COUNT] = {
     "vb_sign_bits", "vb_sign_fill", "vh_load_u8", "vh_min_u", "vh_adds_u", "vh_any_leu",
@@ -60,14 +53,10 @@ static uint32_t got(int op, const uint32_t *out, int k)
     }
 }
 
-static void check_isa(ef_isa isa, tu_simd_qcheck_fn *fn)
+static void check_isa(void **state)
 {
-    if (!ef_cpu_has(isa)) {
-        print_message("SKIP cpu simd refine %s: this CPU (or this build's architecture) does "
-                      "not run it; untested: the refine ops of src/cpu/simd_%s.h\n",
-                      ef_isa_name(isa), ef_isa_name(isa));
-        skip();
-    }
+    const ef_isa isa = tu_simd_test_isa(state, " refine", "the refine ops of ");
+    tu_simd_qcheck_fn *const fn = tu_simd_qcheck_isa[tu_simd_isa_index_of(state)];
     static uint16_t a[N], b[N];
     static uint32_t out[N];
     static const uint16_t sp[] = { 0, 1, 127, 128, 255, 0x7F80u, 0x80FFu, 0x7FFFu, 0x8000u,
@@ -78,14 +67,16 @@ static void check_isa(ef_isa isa, tu_simd_qcheck_fn *fn)
     for (int round = 0; round < 8; round++) {
         for (int op = 0; op < QC_COUNT; op++) {
             for (int i = 0; i < N; i++) {
-                a[i] = (rnd(&s) & 3) == 0 ? sp[rnd(&s) % (unsigned)ns] : (uint16_t)rnd(&s);
-                b[i] = (rnd(&s) & 3) == 0 ? sp[rnd(&s) % (unsigned)ns] : (uint16_t)rnd(&s);
+                a[i] = (tu_xorshift(&s) & 3) == 0 ? sp[tu_xorshift(&s) % (unsigned)ns]
+                       : (uint16_t)tu_xorshift(&s);
+                b[i] = (tu_xorshift(&s) & 3) == 0 ? sp[tu_xorshift(&s) % (unsigned)ns]
+                       : (uint16_t)tu_xorshift(&s);
                 /* odd rounds: b below a, so that a row's any-<= is often false
                  * (and true by a single lane where a is 0 or a planted one) */
                 if (op == QC_H_ANY_LEU && round % 2) {
                     a[i] = (uint16_t)(a[i] | 1u);
                     b[i] = (uint16_t)(a[i] - 1u);
-                    if (rnd(&s) % 97 == 0) b[i] = a[i];
+                    if (tu_xorshift(&s) % 97 == 0) b[i] = a[i];
                 }
                 out[i] = 0xA5A5A5A5u;
             }
@@ -108,23 +99,4 @@ static void check_isa(ef_isa isa, tu_simd_qcheck_fn *fn)
     assert_int_equal(bad, 0);
 }
 
-/* one test per ISA, its index as the state */
-static const ef_isa isas[4] = { EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512, EF_ISA_NEON };
-static tu_simd_qcheck_fn *const fns[4] = { tu_simd_qcheck_sse2, tu_simd_qcheck_avx2,
-                                           tu_simd_qcheck_avx512, tu_simd_qcheck_neon };
-static int idx[4] = { 0, 1, 2, 3 };
-
-static void test_isa(void **state)
-{
-    const int i = *(const int *)*state;
-    check_isa(isas[i], fns[i]);
-}
-
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test_prestate(test_isa, &idx[0]), cmocka_unit_test_prestate(test_isa, &idx[1]),
-        cmocka_unit_test_prestate(test_isa, &idx[2]), cmocka_unit_test_prestate(test_isa, &idx[3]),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+int main(void) { return tu_simd_run_isas(check_isa); }

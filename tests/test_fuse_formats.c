@@ -19,14 +19,7 @@ static uint8_t *px(const fuse_image *im, int x, int y)
 
 static fuse_frame frame(const uint8_t *d, size_t size, int w, int h, int stride, fuse_format f)
 {
-    fuse_frame s;
-    s.data = d;
-    s.size = size;
-    s.width = w;
-    s.height = h;
-    s.stride = stride;
-    s.format = f;
-    return s;
+    return (fuse_frame){d, size, w, h, stride, f};
 }
 
 static void expect_px(const fuse_image *o, int x, int y, int r, int g, int b)

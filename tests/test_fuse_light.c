@@ -319,46 +319,50 @@ static fuse_lighting one_light(float x, float y, float z, float c)
     return L;
 }
 
+/* No light, ambient 1: P' = P times the tone. */
+static fuse_lighting ambient_only(void)
+{
+    fuse_lighting L = one_light(0, 0, 1, 0);
+    L.light_count = 0;
+    L.ambient[0] = L.ambient[1] = L.ambient[2] = 1.0f;
+    return L;
+}
+
+/* light1 of p is FUSE_OK and writes (r, g, b, a). */
+static void expect_out(const fuse_lighting *L, px1 *p, int r, int g, int b, int a)
+{
+    assert_int_equal(light1(L, p), FUSE_OK);
+    assert_int_equal(p->out[0], r);
+    assert_int_equal(p->out[1], g);
+    assert_int_equal(p->out[2], b);
+    assert_int_equal(p->out[3], a);
+}
+
 static void test_facing_viewer(void **state)
 {
     /* N = V = L: N.L = N.H = 1, F = 0: C = a + c (kd + ks) = 0.2 + 0.5. */
     fuse_lighting L = one_light(0, 0, 1, 0.5f);
     px1 p = { { 100, 50, 200, 7 }, { 0 }, 255, { 0, 0, 1 }, { 0 }, { 0 } };
     (void)state;
-    assert_int_equal(light1(&L, &p), FUSE_OK);
-    assert_int_equal(p.out[0], 70);
-    assert_int_equal(p.out[1], 35);
-    assert_int_equal(p.out[2], 140);
-    assert_int_equal(p.out[3], 255);
+    expect_out(&L, &p, 70, 35, 140, 255);
     /* Half coverage: everything scales by 128/255, F = 0 still. */
     p.mask = 128;
     p.n[2] = 3.0f;                       /* length does not matter */
-    assert_int_equal(light1(&L, &p), FUSE_OK);
-    assert_int_equal(p.out[0], 35);      /* 70 * 128/255 = 35.14 */
-    assert_int_equal(p.out[1], 18);      /* 17.57 */
-    assert_int_equal(p.out[2], 70);      /* 70.27 */
-    assert_int_equal(p.out[3], 128);
+    expect_out(&L, &p, 35, 18, 70, 128); /* 70 * 128/255 = 35.14, 17.57, 70.27 */
 }
 
 static void test_grazing(void **state)
 {
     /* N perpendicular to V: F = 1, alpha = M (1 - kf). No light, ambient 1:
      * P' = P, rgb = M' P. */
-    fuse_lighting L = one_light(0, 0, 1, 0);
+    fuse_lighting L = ambient_only();
     px1 p = { { 100, 20, 255, 0 }, { 0 }, 255, { 1, 0, 0 }, { 0 }, { 0 } };
     (void)state;
-    L.light_count = 0;
-    L.ambient[0] = L.ambient[1] = L.ambient[2] = 1.0f;
     L.kf = 0.6f;
-    assert_int_equal(light1(&L, &p), FUSE_OK);
-    assert_int_equal(p.out[3], 102);     /* 255 * 0.4 */
-    assert_int_equal(p.out[0], 40);
-    assert_int_equal(p.out[1], 8);
-    assert_int_equal(p.out[2], 102);
+    expect_out(&L, &p, 40, 8, 102, 102); /* alpha 255 * 0.4 */
     /* kf = 1: a grazing pixel vanishes entirely. */
     L.kf = 1.0f;
-    assert_int_equal(light1(&L, &p), FUSE_OK);
-    assert_int_equal(p.out[0] | p.out[1] | p.out[2] | p.out[3], 0);
+    expect_out(&L, &p, 0, 0, 0, 0);
     /* A back-facing normal: 1 - N.V = 2 is clamped to 1, F = 1, as at a
      * grazing edge (the squared term without that clamp gave F = 4). */
     L.kf = 0.6f;
@@ -386,37 +390,24 @@ static void test_mask_zero(void **state)
     px1 p = { { 255, 255, 255, 255 }, { 9, 9, 9, 9 }, 0, { NAN, 0, 1 }, { 0 }, { 0 } };
     (void)state;
     L.ambient[0] = 5.0f;
-    assert_int_equal(light1(&L, &p), FUSE_OK);
-    assert_int_equal(p.out[0] | p.out[1] | p.out[2] | p.out[3], 0);
+    expect_out(&L, &p, 0, 0, 0, 0);
 }
 
 static void test_tone_and_clamp(void **state)
 {
     /* Only ambient 1: P' = P * tone. */
-    fuse_lighting L = one_light(0, 0, 1, 0);
+    fuse_lighting L = ambient_only();
     px1 p = { { 200, 200, 200, 0 }, { 0 }, 255, { 0, 0, 1 }, { 0 }, { 0 } };
     (void)state;
-    L.light_count = 0;
-    L.ambient[0] = L.ambient[1] = L.ambient[2] = 1.0f;
     L.tone[0] = 0.5f; L.tone[1] = 1.0f; L.tone[2] = 0.25f;
-    assert_int_equal(light1(&L, &p), FUSE_OK);
-    assert_int_equal(p.out[0], 100);
-    assert_int_equal(p.out[1], 200);
-    assert_int_equal(p.out[2], 50);
-    assert_int_equal(p.out[3], 255);
+    expect_out(&L, &p, 100, 200, 50, 255);
     /* Above 1 clamps: P' = 1, so rgb = alpha. */
     L.tone[0] = 2.0f; L.tone[1] = 1.3f; L.tone[2] = 100.0f;
     p.mask = 200;
-    assert_int_equal(light1(&L, &p), FUSE_OK);
-    assert_int_equal(p.out[0], 200);
-    assert_int_equal(p.out[1], 200);
-    assert_int_equal(p.out[2], 200);
-    assert_int_equal(p.out[3], 200);
+    expect_out(&L, &p, 200, 200, 200, 200);
     /* Negative light clamps at 0. */
     L.ambient[0] = L.ambient[1] = L.ambient[2] = -1.0f;
-    assert_int_equal(light1(&L, &p), FUSE_OK);
-    assert_int_equal(p.out[0] | p.out[1] | p.out[2], 0);
-    assert_int_equal(p.out[3], 200);
+    expect_out(&L, &p, 0, 0, 0, 200);
 }
 
 static void test_view_vector(void **state)

@@ -211,6 +211,15 @@ static int shared_ok(const char *rel, char *buf, size_t n)
     return 0;
 }
 
+/* The shared sample rel (its path in path) loaded with its default scene
+ * into m and info; the test skipped when the file is missing. */
+static void load_shared(const char *rel, char *path, size_t n, kin_model *m, io_gltf_info *info)
+{
+    if (!shared_ok(rel, path, n)) skip();
+    io_error err;
+    if (io_gltf_load_ex(path, -1, m, info, &err) != IO_OK) fail_msg("%s", err.msg);
+}
+
 /* ------------------------------------------- every model, every shot */
 
 static void every_model_matches_its_crcs(void **state)
@@ -338,12 +347,10 @@ static void primitive_modes_in_spec_order(void **state)
 {
     (void)state;
     char path[1024];
-    if (!shared_ok("gltf/MeshPrimitiveModes/glTF/MeshPrimitiveModes.gltf", path, sizeof path))
-        skip();
     kin_model m;
     io_gltf_info info;
-    io_error err;
-    assert_int_equal(io_gltf_load_ex(path, -1, &m, &info, &err), IO_OK);
+    load_shared("gltf/MeshPrimitiveModes/glTF/MeshPrimitiveModes.gltf", path, sizeof path, &m,
+                &info);
     assert_int_equal(info.skipped_points, 1);
     assert_int_equal(info.skipped_lines, 3);
     assert_int_equal(info.strips, 1);
@@ -375,11 +382,10 @@ static void scenes_pick_their_nodes(void **state)
 {
     (void)state;
     char path[1024];
-    if (!shared_ok("gltf/MultipleScenes/glTF/MultipleScenes.gltf", path, sizeof path)) skip();
     kin_model m;
     io_gltf_info info;
     io_error err;
-    assert_int_equal(io_gltf_load_ex(path, -1, &m, &info, &err), IO_OK);
+    load_shared("gltf/MultipleScenes/glTF/MultipleScenes.gltf", path, sizeof path, &m, &info);
     assert_int_equal(info.scene, 1);
     assert_int_equal(info.scene_count, 2);
     assert_int_equal(m.mesh_count, 1);
@@ -638,9 +644,7 @@ static void write_model(const char *path, const char *extra_json, const char *me
     char extra[512];
     snprintf(extra, sizeof extra, "%.*s%s", mv ? (int)(mv - extra_json) : (int)strlen(extra_json),
              extra_json, mv ? mv + 11 : "");
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fprintf(f,
+    tu_write_fmt(path,
             "{\"asset\":{\"version\":\"2.0\"},%s"
             "\"buffers\":[{\"byteLength\":112,\"uri\":\"data:application/octet-stream;base64,%s\"}%s],"
             "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},"
@@ -668,7 +672,6 @@ static void write_model(const char *path, const char *extra_json, const char *me
                  "\"byteStride\":12,\"count\":4,\"mode\":\"ATTRIBUTES\"}}}" : "",
             normal_normalized ? "true" : "false", meshes,
             scenes ? scenes : "\"scenes\":[{\"nodes\":[0]}],\"scene\":0");
-    assert_int_equal(fclose(f), 0);
 }
 
 static void expect_refused(const char *name, const char *extra, const char *meshes,
@@ -798,14 +801,11 @@ static void bad_input_named(void **state)
                    "POINTS and LINES are not drawn");
     /* counts that overflow: 2^27 elements */
     tu_tmp_path("huge.gltf", path, sizeof path);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fprintf(f, "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":4,\"uri\":"
+    tu_write_fmt(path, "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":4,\"uri\":"
                "\"data:application/octet-stream;base64,AAAAAA==\"}],\"bufferViews\":[{\"buffer\":0,"
                "\"byteLength\":4}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,"
                "\"count\":134217728,\"type\":\"VEC3\"}],\"meshes\":[{\"primitives\":[{\"attributes\":"
                "{\"POSITION\":0}}]}],\"nodes\":[{\"mesh\":0}]}\n");
-    fclose(f);
     assert_int_not_equal(io_gltf_load(path, &m, &err), IO_OK);
     if (!strstr(err.msg, "huge.gltf") || !strstr(err.msg, "POSITION of mesh 0 primitive 0"))
         fail_msg("%s", err.msg);
@@ -884,9 +884,7 @@ static void write_instanced(const char *path)
     for (int i = 0; i < 9; i++) put32(b, 120 + (size_t)i * 4, sc[i]);
     char data[260];
     tu_b64(b, sizeof b, data);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fprintf(f,
+    tu_write_fmt(path,
             "{\"asset\":{\"version\":\"2.0\"},"
             "\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\",\"KHR_mesh_quantization\"],"
             "\"extensionsRequired\":[\"EXT_mesh_gpu_instancing\",\"KHR_mesh_quantization\"],"
@@ -906,7 +904,6 @@ static void write_instanced(const char *path)
             "\"ROTATION\":3,\"SCALE\":4}}}},{\"mesh\":0,\"translation\":[2,-1,0]}],"
             "\"scenes\":[{\"nodes\":[0,1]}],\"scene\":0}\n",
             data);
-    assert_int_equal(fclose(f), 0);
 }
 
 /* A strip of 4 quads skinned with two influence sets (JOINTS_0/WEIGHTS_0
@@ -941,9 +938,7 @@ static void write_two_sets(const char *path)
     }
     char data[800];
     tu_b64(b, sizeof b, data);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fprintf(f,
+    tu_write_fmt(path,
             "{\"asset\":{\"version\":\"2.0\"},"
             "\"buffers\":[{\"byteLength\":568,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
             "\"bufferViews\":[{\"buffer\":0,\"byteLength\":120},{\"buffer\":0,\"byteOffset\":120,"
@@ -964,7 +959,6 @@ static void write_two_sets(const char *path)
             "{\"translation\":[0.2,0,0.1],\"rotation\":[0,-0.25881905,0,0.96592583]}],"
             "\"scenes\":[{\"nodes\":[0,1]}],\"scene\":0}\n",
             data);
-    assert_int_equal(fclose(f), 0);
 }
 
 /* Expected CRC-32 of the synthetic masks [model][view], recorded after

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "../src/io/io_calib.h"
+#include "support/files.h"
 
 static kin_lens parse_ok(const char *text, int camera)
 {
@@ -311,12 +312,8 @@ static void validity_files(void **state)
     assert_non_null(strstr(err.msg, "directory"));
     /* a file cut in the middle of a matrix: named with its line */
     tu_tmp_path("cut.yml", p, sizeof p);
-    FILE *f = fopen(p, "w");
-    assert_non_null(f);
-    fputs("%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
-          "   rows: 3\n   cols: 3\n   dt: d\n   data: [ 5.3e+02, 0., 3.2e+02, 0.,\n       5.3e+02, 2.4e+",
-          f);
-    fclose(f);
+    tu_write_text(p, "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\ncamera_matrix: !!opencv-matrix\n"
+          "   rows: 3\n   cols: 3\n   dt: d\n   data: [ 5.3e+02, 0., 3.2e+02, 0.,\n       5.3e+02, 2.4e+");
     int fds = tu_count_fds();
     assert_int_equal(io_calib_load(p, 0, &L, &err), IO_ERR_FORMAT);
     assert_non_null(strstr(err.msg, "cut.yml:9: camera_matrix"));

@@ -235,19 +235,6 @@ static void read_errors(void **state)
     assert_int_equal(io_image_load(NULL, IO_U8, 3, &img, &err), IO_ERR_ARGS);
 }
 
-/* Names in dir containing ".tmp." (left-over temp files). */
-static int temp_files_in(const char *dir)
-{
-    DIR *d = opendir(dir);
-    assert_non_null(d);
-    int n = 0;
-    struct dirent *e;
-    while ((e = readdir(d)) != NULL)
-        if (strstr(e->d_name, ".tmp.")) n++;
-    closedir(d);
-    return n;
-}
-
 static void save_errors_leave_files_untouched(void **state)
 {
     (void)state;
@@ -304,7 +291,7 @@ static void save_errors_leave_files_untouched(void **state)
     tu_write_text(sub, "x");
     assert_int_equal(io_image_save(path, &img, &err), IO_ERR_WRITE);
     assert_non_null(strstr(err.msg, "folder.png"));
-    assert_int_equal(temp_files_in(dir), 0);
+    assert_int_equal(tu_names_in(dir, ".tmp.", NULL), 0);
     remove(sub);
     remove(path);
 
@@ -312,7 +299,7 @@ static void save_errors_leave_files_untouched(void **state)
     snprintf(path, sizeof path, "%s/keep.png", dir);
     assert_int_equal(io_image_save(path, &img, &err), IO_OK);
     assert_false(tu_file_is(path, "precious"));
-    assert_int_equal(temp_files_in(dir), 0);
+    assert_int_equal(tu_names_in(dir, ".tmp.", NULL), 0);
     io_image_free(&img);
 }
 

@@ -24,6 +24,24 @@ static io_cam_config dummy_cfg(const char *name, const io_dummy_cam_opts *o)
     return c;
 }
 
+/* The options of a dummy camera at 60 FPS on the clock *clock. */
+static io_dummy_cam_opts clocked(uint64_t *clock)
+{
+    io_dummy_cam_opts o = {0};
+    o.period_ns = PERIOD;
+    o.clock_ns = clock;
+    return o;
+}
+
+/* io_cam_grab of cam: IO_OK and `want` frames (0 or 1), the frame in f. */
+static void grab_expect(io_cam *cam, io_frame *f, int want)
+{
+    io_error err;
+    int got;
+    assert_int_equal(io_cam_grab(cam, 0, f, &got, &err), IO_OK);
+    assert_int_equal(got, want);
+}
+
 static void open_start(io_cam *cam, const io_cam_config *c)
 {
     io_error err;
@@ -36,10 +54,8 @@ static void test_grab_newest_and_pixels(void **st)
 {
     (void)st;
     uint64_t clock = 0;
-    io_dummy_cam_opts o = {0};
-    o.period_ns = PERIOD;
+    io_dummy_cam_opts o = clocked(&clock);
     o.t0_ns = 1000 * MS;
-    o.clock_ns = &clock;
     io_cam_config c = dummy_cfg("dummy0", &o);
     io_cam cam;
     io_error err;
@@ -50,13 +66,11 @@ static void test_grab_newest_and_pixels(void **st)
     assert_int_equal(cam.stride, 128);
 
     /* nothing before the first frame time */
-    assert_int_equal(io_cam_grab(&cam, 0, &f, &got, &err), IO_OK);
-    assert_int_equal(got, 0);
+    grab_expect(&cam, &f, 0);
 
     /* 3 frames ready: the newest comes out, 2 are skipped */
     clock = o.t0_ns + 2 * PERIOD;
-    assert_int_equal(io_cam_grab(&cam, 0, &f, &got, &err), IO_OK);
-    assert_int_equal(got, 1);
+    grab_expect(&cam, &f, 1);
     assert_int_equal(f.sequence, 2);
     assert_true(f.t_ns == o.t0_ns + 2 * PERIOD);
     assert_int_equal(cam.stats.skipped, 2);
@@ -89,8 +103,7 @@ static void test_grab_newest_and_pixels(void **st)
     clock += 3 * PERIOD; /* 4 more frames pass with no buffer queued */
     for (int i = 0; i < n; i++) assert_int_equal(io_cam_release(&cam, &held[i], &err), IO_OK);
     clock += PERIOD;
-    assert_int_equal(io_cam_grab(&cam, 0, &f, &got, &err), IO_OK);
-    assert_int_equal(got, 1);
+    grab_expect(&cam, &f, 1);
     assert_true(cam.stats.dropped >= 3);
     io_cam_release(&cam, &f, &err);
     io_cam_close(&cam);
@@ -103,9 +116,7 @@ static void test_gaps_short_corrupt(void **st)
 {
     (void)st;
     uint64_t clock = 0;
-    io_dummy_cam_opts o = {0};
-    o.period_ns = PERIOD;
-    o.clock_ns = &clock;
+    io_dummy_cam_opts o = clocked(&clock);
     o.drop_every = 4;   /* frames 3, 7, 11 ... lost */
     o.short_at = 5;
     o.corrupt_at = 6;
@@ -145,9 +156,7 @@ static void test_unplug_and_reopen(void **st)
 {
     (void)st;
     uint64_t clock = 0;
-    io_dummy_cam_opts o = {0};
-    o.period_ns = PERIOD;
-    o.clock_ns = &clock;
+    io_dummy_cam_opts o = clocked(&clock);
     o.unplug_at = 3;
     io_cam_config c = dummy_cfg("dummy2", &o);
     io_cam cam;
@@ -156,8 +165,7 @@ static void test_unplug_and_reopen(void **st)
     int got;
     open_start(&cam, &c);
     clock = 2 * PERIOD;
-    assert_int_equal(io_cam_grab(&cam, 0, &f, &got, &err), IO_OK);
-    assert_int_equal(got, 1);
+    grab_expect(&cam, &f, 1);
     assert_int_equal(io_cam_release(&cam, &f, &err), IO_OK);
     clock = 3 * PERIOD;
     memset(&err, 0, sizeof err);
@@ -185,8 +193,7 @@ static void test_unplug_and_reopen(void **st)
     assert_int_equal(cam.stats.reopens, 1);
     assert_int_equal(cam.stats.errors, 1);
     clock = 11 * PERIOD;
-    assert_int_equal(io_cam_grab(&cam, 0, &f, &got, &err), IO_OK);
-    assert_int_equal(got, 1);
+    grab_expect(&cam, &f, 1);
     assert_int_equal(f.sequence, 11);
     io_cam_release(&cam, &f, &err);
     io_cam_close(&cam);
@@ -282,11 +289,9 @@ static void test_stereo_pairs(void **st)
     (void)st;
     tu_rng rng = {606};
     uint64_t clock = 0;
-    io_dummy_cam_opts ol = {0}, orr = {0};
-    ol.period_ns = orr.period_ns = PERIOD;
+    io_dummy_cam_opts ol = clocked(&clock), orr = clocked(&clock);
     ol.t0_ns = orr.t0_ns = 5000 * MS;
     orr.offset_ns = 3 * MS; /* right exposes 3 ms later */
-    ol.clock_ns = orr.clock_ns = &clock;
     orr.drop_every = 7;     /* right loses every 7th frame */
     io_cam_config cl = dummy_cfg("dummyL", &ol), cr = dummy_cfg("dummyR", &orr);
     io_cam L, R;

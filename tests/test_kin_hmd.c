@@ -142,6 +142,16 @@ static kin_sthmd_geometry preset_geo(const char *name, kin_sthmd_desc *d, const 
     return g;
 }
 
+/* The geometry of d with a display lw x lh and cameras cw x ch. */
+static kin_sthmd_geometry sized_geo(kin_sthmd_desc *d, int lw, int lh, int cw, int ch)
+{
+    d->lcd_width = lw;
+    d->lcd_height = lh;
+    d->cam_width = cw;
+    d->cam_height = ch;
+    return kin_sthmd_geometry_of(d);
+}
+
 /* The three HMDs: eq. 1-4 from the equations, and the figures quoted in
  * docs/kin.md. */
 static void three_hmds(void **state)
@@ -172,19 +182,11 @@ static void three_hmds(void **state)
 
     /* the same consumer display held landscape (2208x2064): the height is
      * cut instead, round(1280 * 2064 / 2208) = 1197 > 1024 still: width */
-    d.lcd_width = 2208;
-    d.lcd_height = 2064;
-    d.cam_width = 1280;
-    d.cam_height = 1024;
-    g = kin_sthmd_geometry_of(&d);
+    g = sized_geo(&d, 2208, 2064, 1280, 1024);
     assert_int_equal(g.crop_height, 1024);
     assert_int_equal(g.crop_width, 1095);
     /* a 4:3 camera on a 16:9 display: the height is cut */
-    d.lcd_width = 1920;
-    d.lcd_height = 1080;
-    d.cam_width = 1280;
-    d.cam_height = 960;
-    g = kin_sthmd_geometry_of(&d);
+    g = sized_geo(&d, 1920, 1080, 1280, 960);
     assert_int_equal(g.crop_width, 1280);
     assert_int_equal(g.crop_height, 720);
     assert_int_equal(g.crop_y0, 120);

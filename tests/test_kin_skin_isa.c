@@ -70,6 +70,35 @@ static void run(const tu_skin_case *k, int dqs, int isa, float *po, float *no)
     else kin_skin_lbs_isa(&k->mesh, k->jm, po, no, isa);
 }
 
+/* Case c with the reference's outputs (rp, rn) and another path's (sp,
+ * sn): 3 floats per vertex each. */
+typedef struct skin_run {
+    tu_skin_case k;
+    int n3;
+    float *rp, *rn, *sp, *sn;
+} skin_run;
+
+static void skin_run_make(skin_run *s, int c)
+{
+    make_case(c, &s->k);
+    s->n3 = s->k.mesh.vertex_count * 3;
+    const size_t n = (size_t)s->n3 * 4;
+    s->rp = malloc(n);
+    s->rn = malloc(n);
+    s->sp = malloc(n);
+    s->sn = malloc(n);
+    assert_true(s->rp && s->rn && s->sp && s->sn);
+}
+
+static void skin_run_free(skin_run *s)
+{
+    free(s->rp);
+    free(s->rn);
+    free(s->sp);
+    free(s->sn);
+    tu_skin_case_free(&s->k);
+}
+
 static void isa_equal(int isa)
 {
     if (!ef_cpu_has((ef_isa)isa)) {
@@ -80,25 +109,22 @@ static void isa_equal(int isa)
     uint32_t crc = 0;
     long verts = 0, kept = 0;
     for (int c = 0; c < NCASES; c++) {
-        tu_skin_case k;
-        make_case(c, &k);
-        int n3 = k.mesh.vertex_count * 3;
-        float *rp = malloc((size_t)n3 * 4), *rn = malloc((size_t)n3 * 4);
-        float *sp = malloc((size_t)n3 * 4), *sn = malloc((size_t)n3 * 4);
+        skin_run s;
+        skin_run_make(&s, c);
+        const int n3 = s.n3;
         for (int dqs = 0; dqs < 2; dqs++) {
-            run(&k, dqs, EF_ISA_REF, rp, rn);
-            crc = tu_crc32(crc, rp, (size_t)n3 * 4);
-            if (k.mesh.normals) crc = tu_crc32(crc, rn, (size_t)n3 * 4);
-            for (int i = 0; i < n3; i++) kept += rp[i] == k.pos[i];
-            run(&k, dqs, isa, sp, sn);
-            tu_skin_first_diff(rp, sp, n3, dqs ? "DQS position" : "LBS position", c,
-                       ef_isa_name((ef_isa)isa));
-            tu_skin_first_diff(rn, sn, n3, dqs ? "DQS normal" : "LBS normal", c,
-                       ef_isa_name((ef_isa)isa));
-            verts += k.mesh.vertex_count;
+            run(&s.k, dqs, EF_ISA_REF, s.rp, s.rn);
+            crc = tu_crc32(crc, s.rp, (size_t)n3 * 4);
+            if (s.k.mesh.normals) crc = tu_crc32(crc, s.rn, (size_t)n3 * 4);
+            for (int i = 0; i < n3; i++) kept += s.rp[i] == s.k.pos[i];
+            run(&s.k, dqs, isa, s.sp, s.sn);
+            tu_skin_first_diff(s.rp, s.sp, n3, dqs ? "DQS position" : "LBS position", c,
+                               ef_isa_name((ef_isa)isa));
+            tu_skin_first_diff(s.rn, s.sn, n3, dqs ? "DQS normal" : "LBS normal", c,
+                               ef_isa_name((ef_isa)isa));
+            verts += s.k.mesh.vertex_count;
         }
-        free(rp); free(rn); free(sp); free(sn);
-        tu_skin_case_free(&k);
+        skin_run_free(&s);
     }
     print_message("NOTE kin skin %s: %d cases, %ld vertex skins equal to the reference, "
                   "CRC32 0x%08X (recorded 0x%08X)\n", ef_isa_name((ef_isa)isa), NCASES,
@@ -122,22 +148,19 @@ static void test_dispatch_equal(void **state)
     assert_true(isa >= EF_ISA_REF && isa < EF_ISA_COUNT);
     assert_true(ef_cpu_has((ef_isa)isa));
     for (int c = 0; c < 20; c++) {
-        tu_skin_case k;
-        make_case(c, &k);
-        int n3 = k.mesh.vertex_count * 3;
-        float *rp = malloc((size_t)n3 * 4), *rn = malloc((size_t)n3 * 4);
-        float *sp = malloc((size_t)n3 * 4), *sn = malloc((size_t)n3 * 4);
+        skin_run s;
+        skin_run_make(&s, c);
+        const int n3 = s.n3;
         for (int dqs = 0; dqs < 2; dqs++) {
-            run(&k, dqs, EF_ISA_REF, rp, rn);
-            memset(sp, 0, (size_t)n3 * 4);
-            memset(sn, 0xA5, (size_t)n3 * 4);
-            if (dqs) kin_skin_dqs(&k.mesh, k.dq, sp, sn);
-            else kin_skin_lbs(&k.mesh, k.jm, sp, sn);
-            tu_skin_first_diff(rp, sp, n3, "position", c, "dispatch");
-            tu_skin_first_diff(rn, sn, n3, "normal", c, "dispatch");
+            run(&s.k, dqs, EF_ISA_REF, s.rp, s.rn);
+            memset(s.sp, 0, (size_t)n3 * 4);
+            memset(s.sn, 0xA5, (size_t)n3 * 4);
+            if (dqs) kin_skin_dqs(&s.k.mesh, s.k.dq, s.sp, s.sn);
+            else kin_skin_lbs(&s.k.mesh, s.k.jm, s.sp, s.sn);
+            tu_skin_first_diff(s.rp, s.sp, n3, "position", c, "dispatch");
+            tu_skin_first_diff(s.rn, s.sn, n3, "normal", c, "dispatch");
         }
-        free(rp); free(rn); free(sp); free(sn);
-        tu_skin_case_free(&k);
+        skin_run_free(&s);
     }
 }
 

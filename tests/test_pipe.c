@@ -531,64 +531,10 @@ static void refine_band_mask(void **state)
 
 /* ------------------------------------------- elbow fit in pipe_frame */
 
-enum { ARM_NODES = 7 };
-
-/* Two arms below the head (world_from_head = identity, the cameras look
- * down -Z): nodes 0 body; per side s: 1 + 3 s upper arm at the shoulder
- * (-+0.2, -0.1, 0), 2 + 3 s forearm at the elbow 12 cm towards the middle
- * and 30 cm in front of it, 3 + 3 s hand at the wrist (-+0.2, -0.05,
- * -0.6). Tubes of radius 3.5, 3 and 2.5 cm, each bound to its bone. The
- * shoulders are behind the cameras, elbows and hands in view. */
-typedef struct fit_arms {
-    kin_model m;
-    kin_arm_rig rig;
-    int16_t parents[ARM_NODES];
-    kin_transform rest[ARM_NODES];
-    kin_mat4 ibm[ARM_NODES];
-    int joints[ARM_NODES];
-    kin_skin skin;
-    kin_mesh mesh;
-    float pos[6 * TU_TUBE_VERTS * 3];
-    uint16_t jnt[6 * TU_TUBE_VERTS * 4];
-    float wgt[6 * TU_TUBE_VERTS * 4];
-    uint32_t idx[6 * TU_TUBE_TRIS * 3];
-    int nv, nt;
-} fit_arms;
-
-static void arm_tube(fit_arms *A, kin_vec3 a, kin_vec3 b, float r, int j)
-{
-    tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, a, b, r, j);
-}
-
-static void fit_arms_build(fit_arms *A)
-{
-    memset(A, 0, sizeof *A);
-    A->parents[0] = KIN_NO_PARENT;
-    for (int j = 0; j < ARM_NODES; j++) A->rest[j] = kin_transform_identity();
-    for (int s = 0; s < 2; s++) {
-        float x = s ? 0.2f : -0.2f;
-        int u = 1 + 3 * s;
-        A->parents[u] = 0;
-        A->parents[u + 1] = (int16_t)u;
-        A->parents[u + 2] = (int16_t)(u + 1);
-        float in = s ? -0.12f : 0.12f;     /* towards the middle */
-        A->rest[u].t = kin_v3(x, -0.1f, 0);
-        A->rest[u + 1].t = kin_v3(in, 0, -0.3f);
-        A->rest[u + 2].t = kin_v3(-in, 0.05f, -0.3f);
-        kin_vec3 S = kin_v3(x, -0.1f, 0), E = kin_v3(x + in, -0.1f, -0.3f), Wr = kin_v3(x, -0.05f, -0.6f);
-        arm_tube(A, S, E, 0.035f, u);
-        arm_tube(A, E, Wr, 0.03f, u + 1);
-        arm_tube(A, Wr, kin_v3(x, -0.05f, -0.75f), 0.025f, u + 2);
-        A->rig.joint[s][KIN_RIG_UPPER_ARM] = u;
-        A->rig.joint[s][KIN_RIG_FOREARM] = u + 1;
-        A->rig.joint[s][KIN_RIG_HAND] = u + 2;
-    }
-    A->mesh = (kin_mesh){ .vertex_count = A->nv, .positions = A->pos, .joints = A->jnt,
-                          .weights = A->wgt, .index_count = A->nt * 3, .indices = A->idx,
-                          .node = -1, .skin = 0 };
-    tu_rig_bind(&A->m, &A->skin, &A->mesh, ARM_NODES, A->parents, A->rest, A->ibm, A->joints);
-}
-
+/* The two arms of support/pipe_testrig.h (tu_arms_build with no
+ * fingers nodes): nodes 0 body; per side s: 1 + 3 s upper arm, 2 + 3 s forearm,
+ * 3 + 3 s hand. The shoulders are behind the cameras, elbows and hands in
+ * view. */
 /* IoU of two 640x400 masks (inside = >= 128). */
 static double mask_iou(const uint8_t *a, const uint8_t *b)
 {
@@ -604,7 +550,7 @@ static double mask_iou(const uint8_t *a, const uint8_t *b)
 /* Turns the tubes of T's upper arms and forearms about their
  * shoulder-wrist lines by +deg (left) and -deg (right) degrees: the truth
  * the camera images show. */
-static void turn_arms(fit_arms *T, float deg)
+static void turn_arms(tu_arms *T, float deg)
 {
     for (int v = 0; v < T->nv; v++) {
         int j = T->jnt[v * 4], s = j >= 4, k = j - 1 - 3 * s;
@@ -626,7 +572,7 @@ static void turn_arms(fit_arms *T, float deg)
  * without and pf with fit_rig = &A->rig. Keep the scene where it is
  * (in points into it). */
 typedef struct fit_scene {
-    fit_arms *A, *T;
+    tu_arms *A, *T;
     frame_bufs b;
     pipe_frame_in in;
     kin_mat4 head;
@@ -638,8 +584,8 @@ static void fit_scene_open(fit_scene *S, uint64_t seed)
     S->A = malloc(sizeof *S->A);
     S->T = malloc(sizeof *S->T);
     assert_true(S->A && S->T);
-    fit_arms_build(S->A);
-    fit_arms_build(S->T);
+    tu_arms_build(S->A, 0);
+    tu_arms_build(S->T, 0);
     make_frame(&S->b, &S->in, seed);
     S->head = kin_mat4_identity();
     S->in.head_node = -1;
@@ -667,33 +613,17 @@ static void fit_scene_close(fit_scene *S)
  * from head: skin-red arms over blue-grey, noise +-4 (seeded). With sil
  * not NULL, each eye's silhouette of T (640x400, the crop) is left in
  * sil[e]. */
-static void paint_arms(const fit_arms *T, const kin_mat4 *head, kin_sthmd_geometry g,
+static void paint_arms(const tu_arms *T, const kin_mat4 *head, kin_sthmd_geometry g,
                        frame_bufs *b, uint64_t seed, uint8_t *const sil[2])
 {
-    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
     uint8_t *own = malloc(640 * 400);
     float *clip = malloc(sizeof(float) * 4 * (size_t)T->nv), *depth = malloc(sizeof(float) * 640 * 400);
     assert_true(own && clip && depth);
     tu_rng r = {seed};
     for (int e = 0; e < 2; e++) {
         uint8_t *s = sil ? sil[e] : own;
-        kin_camera cam = kin_sthmd_camera(&hd, head, (kin_eye)e);
-        rast_target t = { 640, 400, depth, 640, s, 640, NULL, 0, 0 };
-        rast_target_clear(&t);
-        rast_transform_points(cam.view_proj.m, T->pos, T->nv, clip);
-        rast_mesh_desc md = { clip, T->nv, NULL, 0, T->idx, T->nt, RAST_CULL_NONE };
-        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
-        for (int y = 0; y < 480; y++)
-            for (int x = 0; x < 640; x++) {
-                int yy = y - g.crop_y0;
-                int in_arm = yy >= 0 && yy < 400 && s[yy * 640 + x];
-                uint8_t *px = &b->cam[e][(y * 640 + x) * 4];
-                int n = (int)(tu_next(&r) % 9) - 4;
-                px[0] = (uint8_t)((in_arm ? 200 : 70) + n);
-                px[1] = (uint8_t)((in_arm ? 120 : 90) + n);
-                px[2] = (uint8_t)((in_arm ? 100 : 150) + n);
-                px[3] = 255;
-            }
+        tu_arms_silhouette(T, head, e, s, depth, clip);
+        tu_paint_camera(b->cam[e], s, g.crop_y0, &r);
     }
     free(own);
     free(clip);
@@ -817,7 +747,7 @@ static void fit_state_across_frames(void **state)
     (void)state;
     fit_scene S;
     fit_scene_open(&S, 95);
-    fit_arms *T = S.T;
+    tu_arms *T = S.T;
     for (int s = 0; s < 2; s++) {       /* the truth's forearms thinner */
         float x = s ? 0.2f : -0.2f, in = s ? -0.12f : 0.12f;
         kin_vec3 E = kin_v3(x + in, -0.1f, -0.3f), Wr = kin_v3(x, -0.05f, -0.6f);

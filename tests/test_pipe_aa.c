@@ -34,6 +34,7 @@
 
 #include "../src/pipe/pipe.h"
 #include "../src/pipe/pipe_aa.h"
+#include "support/pipe_frames.h"
 
 enum { CW = 640, CH = 400, OW = 1280, OH = 800 };
 
@@ -41,70 +42,15 @@ enum { CW = 640, CH = 400, OW = 1280, OH = 800 };
  * (3 * nt vertices, view-facing normals +Z). */
 static void tri_model(kin_model *m, const float *p, int nt)
 {
-    memset(m, 0, sizeof *m);
     const int nv = 3 * nt;
-    int16_t *parents = kin_block_alloc(&m->block, 2 * sizeof(int16_t));
-    kin_transform *rest = kin_block_alloc(&m->block, 2 * sizeof(kin_transform));
-    char(*names)[KIN_NAME_MAX] = kin_block_alloc(&m->block, 2 * KIN_NAME_MAX);
-    float *pos = kin_block_alloc(&m->block, 3 * sizeof(float) * (size_t)nv);
-    float *nrm = kin_block_alloc(&m->block, 3 * sizeof(float) * (size_t)nv);
-    uint32_t *idx = kin_block_alloc(&m->block, sizeof(uint32_t) * (size_t)nv);
-    kin_mesh *mesh = kin_block_alloc(&m->block, sizeof(kin_mesh));
-    assert_non_null(mesh);
-    parents[0] = KIN_NO_PARENT;
-    parents[1] = 0;
-    rest[0] = rest[1] = kin_transform_identity();
-    strcpy(names[0], "head");
-    strcpy(names[1], "tri");
-    memcpy(pos, p, 3 * sizeof(float) * (size_t)nv);
+    tu_mesh_parts t = tu_mesh_model(m, "head", "tri", nv, nv, 1);
+    memcpy(t.pos, p, 3 * sizeof(float) * (size_t)nv);
     for (int i = 0; i < nv; i++) {
-        nrm[3 * i] = 0.0f;
-        nrm[3 * i + 1] = 0.0f;
-        nrm[3 * i + 2] = 1.0f;
-        idx[i] = (uint32_t)i;
+        t.nrm[3 * i + 2] = 1.0f;
+        t.idx[i] = (uint32_t)i;
     }
-    *mesh = (kin_mesh){.vertex_count = nv, .positions = pos, .normals = nrm,
-                       .index_count = nv, .indices = idx, .node = 1, .skin = -1};
-    m->node_count = 2;
-    m->parents = parents;
-    m->rest = rest;
-    m->names = (const char(*)[KIN_NAME_MAX])names;
-    m->mesh_count = 1;
-    m->meshes = mesh;
     char why[200];
     assert_int_equal(kin_model_validate(m, why, sizeof why), 0);
-}
-
-typedef struct bufs {
-    uint8_t *cam[2], *virt[2], *out[2];
-} bufs;
-
-static void bufs_make(bufs *b, pipe_frame_in *in, uint64_t seed)
-{
-    tu_rng r = {seed};
-    memset(in, 0, sizeof *in);
-    for (int e = 0; e < 2; e++) {
-        b->cam[e] = malloc(640 * 480 * 4);
-        b->virt[e] = malloc(OW * OH * 4);
-        b->out[e] = malloc(OW * OH * 4);
-        assert_non_null(b->out[e]);
-        for (size_t i = 0; i < 640 * 480 * 4; i++) b->cam[e][i] = (uint8_t)tu_next(&r);
-        for (size_t i = 0; i < (size_t)OW * OH * 4; i++) b->virt[e][i] = (uint8_t)tu_next(&r);
-        in->camera[e] = (fuse_image){b->cam[e], 640, 480, 640 * 4};
-        in->virt[e] = (fuse_image){b->virt[e], OW, OH, OW * 4};
-        in->out[e] = (fuse_image){b->out[e], OW, OH, OW * 4};
-    }
-    in->head_node = 0;
-    in->lighting = pipe_lighting_default();
-}
-
-static void bufs_free(bufs *b)
-{
-    for (int e = 0; e < 2; e++) {
-        free(b->cam[e]);
-        free(b->virt[e]);
-        free(b->out[e]);
-    }
 }
 
 /* ---- exact coverage ------------------------------------------------------ */
@@ -185,9 +131,9 @@ static area_err run_triangle(const float *tri, int aa)
     d.aa_samples = aa;
     pipe_ctx *p = pipe_create(&d, &m);
     assert_non_null(p);
-    bufs b;
+    tu_frame_bufs b;
     pipe_frame_in in;
-    bufs_make(&b, &in, 7);
+    tu_frame_make(&b, &in, 7, 640, 480, OW, OH);
     char why[200];
     assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_OK);
     int w, h;
@@ -217,7 +163,7 @@ static area_err run_triangle(const float *tri, int aa)
     r.mean_edge_err /= edge > 0 ? (double)edge : 1.0;
     for (int k = 0; k < 3; k++)
         r.perimeter += hypot(s[(k + 1) % 3].x - s[k].x, s[(k + 1) % 3].y - s[k].y);
-    bufs_free(&b);
+    tu_frame_free(&b);
     pipe_destroy(p);
     kin_model_free(&m);
     return r;
@@ -289,9 +235,9 @@ static void aa_interior(void **state)
         d.aa_samples = k ? 16 : 0;
         pipe_ctx *p = pipe_create(&d, &m);
         assert_non_null(p);
-        bufs b;
+        tu_frame_bufs b;
         pipe_frame_in in;
-        bufs_make(&b, &in, 11);
+        tu_frame_make(&b, &in, 11, 640, 480, OW, OH);
         char why[200];
         assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_OK);
         layer[k] = malloc((size_t)CW * CH * 4);
@@ -300,7 +246,7 @@ static void aa_interior(void **state)
         memcpy(layer[k], pipe_layer(p, 0, NULL, NULL), (size_t)CW * CH * 4);
         memcpy(mask[k], pipe_mask(p, 0, NULL, NULL), (size_t)CW * CH);
         memcpy(out[k], b.out[0], (size_t)OW * OH * 4);
-        bufs_free(&b);
+        tu_frame_free(&b);
         pipe_destroy(p);
     }
     long inner = 0, frac = 0, seam = 0;
@@ -383,9 +329,9 @@ static void aa_state_case(int refine, int smooth)
         d.normal_smooth = smooth;
         pipe_ctx *p = pipe_create(&d, &m);
         assert_non_null(p);
-        bufs b;
+        tu_frame_bufs b;
         pipe_frame_in in;
-        bufs_make(&b, &in, 5);
+        tu_frame_make(&b, &in, 5, 640, 480, OW, OH);
         in.head_node = -1;
         char why[200];
         for (int f = k ? 1 : 0; f < 2; f++) {
@@ -400,7 +346,7 @@ static void aa_state_case(int refine, int smooth)
         }
         if (k) crc_fresh = c;
         else crc_second = c;
-        bufs_free(&b);
+        tu_frame_free(&b);
         pipe_destroy(p);
     }
     assert_int_equal(crc_second, crc_fresh);

@@ -22,6 +22,7 @@
 #include "../src/pipe/pipe.h"
 #include "../src/pipe/pipe_lens.h"
 #include "../src/raster/raster.h"
+#include "support/pipe_frames.h"
 
 #define NV 12 /* polygon vertices */
 
@@ -367,34 +368,12 @@ static void validity_bad_maps(void **state)
 /* A head node and an unskinned quad [x0,x1]x[y0,y1] at depth z, facing +Z. */
 static void quad_model(kin_model *m, float x0, float x1, float y0, float y1, float z)
 {
-    memset(m, 0, sizeof *m);
-    int16_t *parents = kin_block_alloc(&m->block, 2 * sizeof(int16_t));
-    kin_transform *rest = kin_block_alloc(&m->block, 2 * sizeof(kin_transform));
-    char(*names)[KIN_NAME_MAX] = kin_block_alloc(&m->block, 2 * KIN_NAME_MAX);
-    float *pos = kin_block_alloc(&m->block, 12 * sizeof(float));
-    float *nrm = kin_block_alloc(&m->block, 12 * sizeof(float));
-    uint32_t *idx = kin_block_alloc(&m->block, 6 * sizeof(uint32_t));
-    kin_mesh *mesh = kin_block_alloc(&m->block, sizeof(kin_mesh));
-    assert_non_null(mesh);
-    parents[0] = KIN_NO_PARENT;
-    parents[1] = 0;
-    rest[0] = rest[1] = kin_transform_identity();
-    strcpy(names[0], "head");
-    strcpy(names[1], "quad");
+    tu_mesh_parts t = tu_mesh_model(m, "head", "quad", 4, 6, 1);
     const float p[12] = {x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z};
-    memcpy(pos, p, sizeof p);
-    memset(nrm, 0, 12 * sizeof(float));
-    for (int i = 0; i < 4; i++) nrm[3 * i + 2] = 1.0f;
+    memcpy(t.pos, p, sizeof p);
+    for (int i = 0; i < 4; i++) t.nrm[3 * i + 2] = 1.0f;
     const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
-    memcpy(idx, ix, sizeof ix);
-    *mesh = (kin_mesh){.vertex_count = 4, .positions = pos, .normals = nrm, .index_count = 6,
-                       .indices = idx, .node = 1, .skin = -1};
-    m->node_count = 2;
-    m->parents = parents;
-    m->rest = rest;
-    m->names = (const char(*)[KIN_NAME_MAX])names;
-    m->mesh_count = 1;
-    m->meshes = mesh;
+    memcpy(t.idx, ix, sizeof ix);
 }
 
 /* pipe_frame with a calibrated barrel lens on the paper's 640x480 camera:

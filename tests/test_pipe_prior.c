@@ -30,83 +30,20 @@
 #define W 640
 #define H 400
 
-typedef struct arms {
-    kin_model m;
-    kin_arm_rig rig;
-    int16_t parents[NODES];
-    kin_transform rest[NODES];
-    kin_mat4 ibm[NODES];
-    int joints[NODES];
-    kin_skin skin;
-    kin_mesh mesh;
-    float pos[6 * TU_TUBE_VERTS * 3];
-    uint16_t jnt[6 * TU_TUBE_VERTS * 4];
-    float wgt[6 * TU_TUBE_VERTS * 4];
-    uint32_t idx[6 * TU_TUBE_TRIS * 3];
-    int nv, nt;
-    kin_vec3 fingers[2];      /* world position of each fingers node */
-} arms;
-
-/* Nodes: 0 body; per side s: 1 + 4 s upper arm at the shoulder (-+0.2,
- * -0.1, 0), + 1 forearm at the elbow, + 2 hand at the wrist (-+0.2,
- * -0.05, -0.6), + 3 fingers 7.5 cm beyond the wrist on the tube's outer
- * side (2.5 cm up), bound to no vertex. */
-static void arms_build(arms *A)
-{
-    memset(A, 0, sizeof *A);
-    A->parents[0] = KIN_NO_PARENT;
-    for (int j = 0; j < NODES; j++) A->rest[j] = kin_transform_identity();
-    for (int s = 0; s < 2; s++) {
-        float x = s ? 0.2f : -0.2f;
-        int u = 1 + 4 * s;
-        A->parents[u] = 0;
-        A->parents[u + 1] = (int16_t)u;
-        A->parents[u + 2] = (int16_t)(u + 1);
-        A->parents[u + 3] = (int16_t)(u + 2);
-        float in = s ? -0.12f : 0.12f;
-        A->rest[u].t = kin_v3(x, -0.1f, 0);
-        A->rest[u + 1].t = kin_v3(in, 0, -0.3f);
-        A->rest[u + 2].t = kin_v3(-in, 0.05f, -0.3f);
-        A->rest[u + 3].t = kin_v3(0, 0.025f, -0.075f);
-        kin_vec3 S = kin_v3(x, -0.1f, 0), E = kin_v3(x + in, -0.1f, -0.3f),
-                 Wr = kin_v3(x, -0.05f, -0.6f);
-        tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, S, E, 0.035f, u);
-        tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, E, Wr, 0.03f, u + 1);
-        tu_tube(A->pos, A->jnt, A->wgt, A->idx, &A->nv, &A->nt, Wr, kin_v3(x, -0.05f, -0.75f),
-                0.025f, u + 2);
-        A->fingers[s] = kin_v3(x, -0.025f, -0.675f);
-        for (int j = 0; j < KIN_RIG_SIDE_JOINTS; j++) A->rig.joint[s][j] = u + 3;
-        A->rig.joint[s][KIN_RIG_SHOULDER] = 0;
-        A->rig.joint[s][KIN_RIG_UPPER_ARM] = u;
-        A->rig.joint[s][KIN_RIG_FOREARM] = u + 1;
-        A->rig.joint[s][KIN_RIG_HAND] = u + 2;
-    }
-    A->mesh = (kin_mesh){.vertex_count = A->nv, .positions = A->pos, .joints = A->jnt,
-                         .weights = A->wgt, .index_count = A->nt * 3, .indices = A->idx,
-                         .node = -1, .skin = 0};
-    tu_rig_bind(&A->m, &A->skin, &A->mesh, NODES, A->parents, A->rest, A->ibm, A->joints);
-}
-
 /* The camera images (640x480) of both eyes seen from head: the model's
  * arms and a disc around each fingers node (radius 0.8 x the prior's,
  * projected at the node's depth), skin-red over blue-grey, noise +-4;
  * the silhouette (the crop, 640x400) in sil[e]. */
-static void paint(const arms *A, const kin_mat4 *head, kin_sthmd_geometry g, tu_frame_bufs *b,
+static void paint(const tu_arms *A, const kin_mat4 *head, kin_sthmd_geometry g, tu_frame_bufs *b,
                   uint64_t seed, uint8_t *const sil[2], float disc_px[2][2])
 {
-    kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
     float *clip = malloc(sizeof(float) * 4 * (size_t)A->nv), *depth = malloc(sizeof(float) * W * H);
     kin_mat4 *world = calloc(NODES, sizeof *world);
     assert_true(clip && depth && world);
     tu_rng r = {seed};
     for (int e = 0; e < 2; e++) {
         uint8_t *s = sil[e];
-        kin_camera cam = kin_sthmd_camera(&hd, head, (kin_eye)e);
-        rast_target t = {W, H, depth, W, s, W, NULL, 0, 0};
-        rast_target_clear(&t);
-        rast_transform_points(cam.view_proj.m, A->pos, A->nv, clip);
-        rast_mesh_desc md = {clip, A->nv, NULL, 0, A->idx, A->nt, RAST_CULL_NONE};
-        assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
+        kin_camera cam = tu_arms_silhouette(A, head, e, s, depth, clip);
         for (int k = 0; k < 2; k++) {
             /* the fingers node's image position: pipe_fit_hand_px of a
              * rig whose hand joints are all that node */
@@ -125,17 +62,7 @@ static void paint(const arms *A, const kin_mat4 *head, kin_sthmd_geometry g, tu_
                     if (dx * dx + dy * dy <= rr * rr) s[y * W + x] = 255;
                 }
         }
-        for (int y = 0; y < 480; y++)
-            for (int x = 0; x < 640; x++) {
-                int yy = y - g.crop_y0;
-                int in_arm = yy >= 0 && yy < H && s[yy * W + x];
-                uint8_t *px = &b->cam[e][(y * 640 + x) * 4];
-                int n = (int)(tu_next(&r) % 9) - 4;
-                px[0] = (uint8_t)((in_arm ? 200 : 70) + n);
-                px[1] = (uint8_t)((in_arm ? 120 : 90) + n);
-                px[2] = (uint8_t)((in_arm ? 100 : 150) + n);
-                px[3] = 255;
-            }
+        tu_paint_camera(b->cam[e], s, g.crop_y0, &r);
     }
     free(clip);
     free(depth);
@@ -154,7 +81,7 @@ static double iou(const uint8_t *a, const uint8_t *b)
 }
 
 typedef struct scene {
-    arms A;
+    tu_arms A;
     tu_frame_bufs b;
     pipe_frame_in in;
     kin_mat4 head;
@@ -166,7 +93,7 @@ static scene *scene_open(uint64_t seed)
 {
     scene *S = calloc(1, sizeof *S);
     assert_non_null(S);
-    arms_build(&S->A);
+    tu_arms_build(&S->A, 1);
     tu_frame_make(&S->b, &S->in, seed, 640, 480, 1280, 800);
     /* the head 40 cm forward above the right arm: the right hand 20-35 cm
      * in front of the cameras, the left one out of view */
@@ -292,9 +219,9 @@ static void fast_hands_and_threads(void **state)
 static void bad_switches(void **state)
 {
     (void)state;
-    arms *A = malloc(sizeof *A);
+    tu_arms *A = malloc(sizeof *A);
     assert_non_null(A);
-    arms_build(A);
+    tu_arms_build(A, 1);
     pipe_desc d = {0};
     d.refine_band = 16;
     d.fit_rig = &A->rig;

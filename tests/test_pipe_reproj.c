@@ -88,16 +88,55 @@ static void cube_model(kin_model *m, float s)
     assert_int_equal(kin_model_validate(m, why, sizeof why), 0);
 }
 
-static pipe_ctx *make_pipe(const kin_model *m, int view, int threads, int isa)
+/* A pipe on a model with the frame buffers of one seeded frame at the
+ * HMD's sizes (pipe_hmd: the paper's 640x480 cameras and 1280x800 display
+ * unless the desc says else); rig_frame runs the frame into st. */
+typedef struct reproj_rig {
+    kin_model m;
+    pipe_ctx *p;
+    tu_frame_bufs b;
+    pipe_frame_in in;
+    pipe_frame_stats st;
+    char why[200];
+} reproj_rig;
+
+static pipe_desc reproj_desc(int view, int threads, int isa)
 {
     pipe_desc d;
     memset(&d, 0, sizeof d);
     d.eye_view = view;
     d.threads = threads;
     d.max_isa = isa;
-    pipe_ctx *p = pipe_create(&d, m);
-    assert_non_null(p);
-    return p;
+    return d;
+}
+
+/* r->m already built: its pipe of d and the frame of seed. */
+static void rig_start(reproj_rig *r, const pipe_desc *d, uint64_t seed)
+{
+    r->p = pipe_create(d, &r->m);
+    assert_non_null(r->p);
+    const kin_sthmd_desc hd = pipe_hmd(r->p);
+    tu_frame_make(&r->b, &r->in, seed, hd.cam_width, hd.cam_height, hd.lcd_width, hd.lcd_height);
+}
+
+/* One quad of half size s at depth z, reprojected with 2 threads. */
+static void rig_quad(reproj_rig *r, float s, float z, uint64_t seed)
+{
+    quads_model(&r->m, 1, &s, &z);
+    const pipe_desc d = reproj_desc(PIPE_VIEW_REPROJECT, 2, 0);
+    rig_start(r, &d, seed);
+}
+
+static void rig_frame(reproj_rig *r)
+{
+    assert_int_equal(pipe_frame(r->p, &r->in, &r->st, r->why, sizeof r->why), PIPE_OK);
+}
+
+static void rig_end(reproj_rig *r)
+{
+    tu_frame_free(&r->b);
+    pipe_destroy(r->p);
+    kin_model_free(&r->m);
 }
 
 /* The eye camera at the layer's size, as pipe_frame makes it. */
@@ -135,23 +174,15 @@ static long draw_from_eye(const kin_model *m, int e, uint8_t *mask)
 static void result_mask_other_hmd(void **state)
 {
     (void)state;
-    kin_model m;
+    reproj_rig r;
     const float s[1] = {0.05f}, z[1] = {-0.3f};
-    quads_model(&m, 1, s, z);
-    pipe_desc d;
-    memset(&d, 0, sizeof d);
+    quads_model(&r.m, 1, s, z);
+    pipe_desc d = reproj_desc(PIPE_VIEW_REPROJECT, 0, 0);
     assert_int_equal(kin_sthmd_preset("consumer", &d.hmd), 0);
-    d.eye_view = PIPE_VIEW_REPROJECT;
-    pipe_ctx *p = pipe_create(&d, &m);
-    assert_non_null(p);
-    const kin_sthmd_desc hd = pipe_hmd(p);
-    const kin_sthmd_geometry g = pipe_geometry(p);
-    tu_frame_bufs b;
-    pipe_frame_in in;
-    tu_frame_make(&b, &in, 17, hd.cam_width, hd.cam_height, hd.lcd_width, hd.lcd_height);
-    pipe_frame_stats st;
-    char why[200];
-    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    rig_start(&r, &d, 17);
+    const kin_sthmd_desc hd = pipe_hmd(r.p);
+    const kin_sthmd_geometry g = pipe_geometry(r.p);
+    rig_frame(&r);
     const int w = g.crop_width, h = g.crop_height;
     uint8_t *ref = malloc((size_t)w * h);
     float *depth = malloc(sizeof(float) * (size_t)w * h);
@@ -159,16 +190,16 @@ static void result_mask_other_hmd(void **state)
     assert_non_null(ref);
     assert_non_null(depth);
     for (int e = 0; e < 2; e++) {
-        assert_int_equal(st.view[e], PIPE_VIEW_REPROJECT);
+        assert_int_equal(r.st.view[e], PIPE_VIEW_REPROJECT);
         int mw, mh;
-        const uint8_t *M = pipe_view_mask(p, e, &mw, &mh);
+        const uint8_t *M = pipe_view_mask(r.p, e, &mw, &mh);
         assert_int_equal(mw, w);
         assert_int_equal(mh, h);
         kin_camera c = kin_sthmd_eye_camera(&hd, NULL, (kin_eye)e, w, h);
         rast_target t = {w, h, depth, w, ref, w, NULL, 0, 0};
         rast_target_clear(&t);
-        rast_transform_points(c.view_proj.m, m.meshes[0].positions, 4, clip);
-        rast_mesh_desc md = {clip, 4, NULL, 0, m.meshes[0].indices, 2, RAST_CULL_NONE};
+        rast_transform_points(c.view_proj.m, r.m.meshes[0].positions, 4, clip);
+        rast_mesh_desc md = {clip, 4, NULL, 0, r.m.meshes[0].indices, 2, RAST_CULL_NONE};
         assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
         long n = 0, diff = 0, full = 0;
         for (size_t i = 0; i < (size_t)w * h; i++) {
@@ -177,16 +208,14 @@ static void result_mask_other_hmd(void **state)
             full += M[i] == 255;
         }
         print_message("NOTE consumer HMD, eye %d: layer %dx%d, %ld eye pixels, %ld differ, "
-                      "%ld filled\n", e, w, h, n, diff, st.view_filled[e]);
+                      "%ld filled\n", e, w, h, n, diff, r.st.view_filled[e]);
         assert_true(n > 20000);
         assert_int_equal(diff, 0);
         assert_int_equal(full, n);
     }
     free(ref);
     free(depth);
-    tu_frame_free(&b);
-    pipe_destroy(p);
-    kin_model_free(&m);
+    rig_end(&r);
 }
 
 /* The eye-view mask of a quad in full view of the camera equals the quad
@@ -195,53 +224,44 @@ static void result_mask_other_hmd(void **state)
 static void result_mask_equals_eye_draw(void **state)
 {
     (void)state;
-    kin_model m;
-    const float s[1] = {0.06f}, z[1] = {-0.35f};
-    quads_model(&m, 1, s, z);
-    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
-    tu_frame_bufs b;
-    pipe_frame_in in;
-    tu_frame_make(&b, &in, 11, CAMW, CAMH, LCDW, LCDH);
-    pipe_frame_stats st;
-    char why[200];
-    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    reproj_rig r;
+    rig_quad(&r, 0.06f, -0.35f, 11);
+    rig_frame(&r);
     uint8_t *ref = malloc(CW * CH);
     assert_non_null(ref);
     for (int e = 0; e < 2; e++) {
-        assert_int_equal(st.view[e], PIPE_VIEW_REPROJECT);
+        assert_int_equal(r.st.view[e], PIPE_VIEW_REPROJECT);
         int w, h;
-        const uint8_t *M = pipe_view_mask(p, e, &w, &h);
+        const uint8_t *M = pipe_view_mask(r.p, e, &w, &h);
         assert_non_null(M);
         assert_int_equal(w, CW);
         assert_int_equal(h, CH);
-        long n = draw_from_eye(&m, e, ref), diff = 0, full = 0;
+        long n = draw_from_eye(&r.m, e, ref), diff = 0, full = 0;
         for (int i = 0; i < CW * CH; i++) {
             diff += (M[i] != 0) != (ref[i] != 0);
             full += M[i] == 255;
         }
         print_message("NOTE eye %d: %ld eye pixels, %ld differ from the direct draw, %ld sampled, "
-                      "%ld filled, %ld outside\n", e, n, diff, st.view_sampled[e],
-                      st.view_filled[e], st.view_outside[e]);
+                      "%ld filled, %ld outside\n", e, n, diff, r.st.view_sampled[e],
+                      r.st.view_filled[e], r.st.view_outside[e]);
         assert_true(n > 5000);
         assert_int_equal(diff, 0);
         assert_int_equal(full, n);
-        assert_int_equal(st.view_outside[e], 0);
-        assert_int_equal(st.view_sampled[e] + st.view_filled[e], n);
+        assert_int_equal(r.st.view_outside[e], 0);
+        assert_int_equal(r.st.view_sampled[e] + r.st.view_filled[e], n);
         /* the crop method's mask (the camera's, in the viewport) differs */
-        const uint8_t *cm = pipe_mask(p, e, NULL, NULL);
+        const uint8_t *cm = pipe_mask(r.p, e, NULL, NULL);
         long cn = 0;
         for (int i = 0; i < CW * CH; i++) cn += cm[i] != 0;
         assert_true(cn > n + n / 4); /* the camera is D nearer: larger */
-        kin_camera vc = pipe_view_camera(p, e);
+        kin_camera vc = pipe_view_camera(r.p, e);
         assert_int_equal(vc.width, CW);
         NEAR(vc.world_from_cam.m[12], e ? 0.0325f : -0.0325f, 1e-6);
         NEAR(vc.world_from_cam.m[14], 0.0f, 0);
     }
-    assert_int_equal(st.view_fallbacks, 0);
+    assert_int_equal(r.st.view_fallbacks, 0);
     free(ref);
-    tu_frame_free(&b);
-    pipe_destroy(p);
-    kin_model_free(&m);
+    rig_end(&r);
 }
 
 /* A camera image whose colour names its pixel: R = x - xoff, G = y - yoff
@@ -266,13 +286,10 @@ static void ramp_image(uint8_t *img, int xoff, int yoff)
  * lens, the camera images then in its distorted pixels. */
 static void point_lands(double k1)
 {
-    kin_model m;
+    reproj_rig r;
     const float s[1] = {0.05f}, z[1] = {-0.35f};
-    quads_model(&m, 1, s, z);
-    pipe_desc d;
-    memset(&d, 0, sizeof d);
-    d.eye_view = PIPE_VIEW_REPROJECT;
-    d.threads = 1;
+    quads_model(&r.m, 1, s, z);
+    pipe_desc d = reproj_desc(PIPE_VIEW_REPROJECT, 1, 0);
     if (k1 != 0.0) {
         for (int e = 0; e < 2; e++) {
             kin_lens *l = &d.hmd.lens[e];
@@ -286,13 +303,9 @@ static void point_lands(double k1)
             assert_int_equal(kin_lens_check(l, NULL, 0), 1);
         }
     }
-    pipe_ctx *p = pipe_create(&d, &m);
-    assert_non_null(p);
-    tu_frame_bufs b;
-    pipe_frame_in in;
-    tu_frame_make(&b, &in, 12, CAMW, CAMH, LCDW, LCDH);
-    in.lighting = pass_through();
-    const kin_sthmd_desc hd = pipe_hmd(p);
+    rig_start(&r, &d, 12);
+    r.in.lighting = pass_through();
+    const kin_sthmd_desc hd = pipe_hmd(r.p);
     /* the ramps centred on where each camera sees the quad's centre */
     int xoff[2];
     for (int e = 0; e < 2; e++) {
@@ -300,15 +313,13 @@ static void point_lands(double k1)
         double pc[3] = {-c.world_from_cam.m[12], 0.0, -0.35 - c.world_from_cam.m[14]}, u, v;
         assert_int_equal(kin_lens_project(&c.lens, pc, &u, &v), 1);
         xoff[e] = (int)lround(u) - 128;
-        ramp_image(b.cam[e], xoff[e], 112);
+        ramp_image(r.b.cam[e], xoff[e], 112);
     }
-    pipe_frame_stats st;
-    char why[200];
-    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    rig_frame(&r);
     for (int e = 0; e < 2; e++) {
-        const uint8_t *Q = pipe_layer(p, e, NULL, NULL);
-        const uint8_t *M = pipe_view_mask(p, e, NULL, NULL);
-        kin_camera ec = eye_cam(e), cc = pipe_camera(p, e);
+        const uint8_t *Q = pipe_layer(r.p, e, NULL, NULL);
+        const uint8_t *M = pipe_view_mask(r.p, e, NULL, NULL);
+        kin_camera ec = eye_cam(e), cc = pipe_camera(r.p, e);
         assert_int_equal(kin_lens_distorts(&cc.lens), k1 != 0.0);
         const double ex = ec.world_from_cam.m[12];
         const double cx = cc.world_from_cam.m[12], cz = cc.world_from_cam.m[14];
@@ -344,9 +355,7 @@ static void point_lands(double k1)
                       (double)hd.cam_offset_m, (double)hd.ipd_m);
         assert_true(checked > 5000);
     }
-    tu_frame_free(&b);
-    pipe_destroy(p);
-    kin_model_free(&m);
+    rig_end(&r);
 }
 
 static void result_point_lands_by_geometry(void **state)
@@ -366,14 +375,12 @@ static void result_point_lands_through_lens(void **state)
 static void result_disocclusion_fill(void **state)
 {
     (void)state;
-    kin_model m;
+    reproj_rig r;
     const float s[2] = {0.15f, 0.03f}, z[2] = {-0.5f, -0.3f};
-    quads_model(&m, 2, s, z);
-    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
-    tu_frame_bufs b;
-    pipe_frame_in in;
-    tu_frame_make(&b, &in, 13, CAMW, CAMH, LCDW, LCDH);
-    in.lighting = pass_through();
+    quads_model(&r.m, 2, s, z);
+    const pipe_desc d = reproj_desc(PIPE_VIEW_REPROJECT, 2, 0);
+    rig_start(&r, &d, 13);
+    r.in.lighting = pass_through();
     for (int e = 0; e < 2; e++) {
         /* red where the camera's ray meets the front quad, green elsewhere */
         kin_camera c = kin_sthmd_camera(NULL, NULL, (kin_eye)e);
@@ -383,19 +390,17 @@ static void result_disocclusion_fill(void **state)
                 double X = cx + d * (x + 0.5 - c.cx) / c.fx;
                 double Y = -d * (y - CROP_Y0 + 0.5 - c.cy) / c.fy;
                 int front = fabs(X) < 0.03 && fabs(Y) < 0.03;
-                uint8_t *q = b.cam[e] + ((size_t)y * CAMW + (size_t)x) * 4;
+                uint8_t *q = r.b.cam[e] + ((size_t)y * CAMW + (size_t)x) * 4;
                 q[0] = front ? 255 : 0;
                 q[1] = front ? 0 : 255;
                 q[2] = 0;
                 q[3] = 255;
             }
     }
-    pipe_frame_stats st;
-    char why[200];
-    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    rig_frame(&r);
     for (int e = 0; e < 2; e++) {
-        const uint8_t *Q = pipe_layer(p, e, NULL, NULL);
-        const uint8_t *M = pipe_view_mask(p, e, NULL, NULL);
+        const uint8_t *Q = pipe_layer(r.p, e, NULL, NULL);
+        const uint8_t *M = pipe_view_mask(r.p, e, NULL, NULL);
         kin_camera ec = eye_cam(e);
         const double ex = ec.world_from_cam.m[12];
         long back = 0, red = 0, front = 0, front_red = 0;
@@ -417,16 +422,14 @@ static void result_disocclusion_fill(void **state)
             }
         print_message("NOTE eye %d: back quad %ld px (%ld with red), front %ld (%ld red); "
                       "%ld filled, %ld sampled\n", e, back, red, front, front_red,
-                      st.view_filled[e], st.view_sampled[e]);
+                      r.st.view_filled[e], r.st.view_sampled[e]);
         /* the ring: about 8 eye px wide on each side of a 108 px square */
-        assert_true(st.view_filled[e] > 2000);
+        assert_true(r.st.view_filled[e] > 2000);
         assert_int_equal(red, 0);
         assert_true(front > 5000);
         assert_int_equal(front_red, front);
     }
-    tu_frame_free(&b);
-    pipe_destroy(p);
-    kin_model_free(&m);
+    rig_end(&r);
 }
 
 /* A band below the crop of eq. 1: at z = -0.3 m, y from -0.092 to -0.082
@@ -439,36 +442,32 @@ static void result_disocclusion_fill(void **state)
 static void result_full_sensor(void **state)
 {
     (void)state;
-    kin_model m;
-    tu_mesh_parts t = tu_mesh_model(&m, "head", "band", 4, 6, 1);
+    reproj_rig r;
+    tu_mesh_parts t = tu_mesh_model(&r.m, "head", "band", 4, 6, 1);
     const float x0 = -0.05f, x1 = 0.05f, y0 = -0.092f, y1 = -0.082f, z = -0.3f;
     const float pos[12] = {x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z};
     memcpy(t.pos, pos, sizeof pos);
     for (int i = 0; i < 4; i++) t.nrm[3 * i + 2] = 1.0f;
     const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
     memcpy(t.idx, ix, sizeof ix);
-    char why[200];
-    assert_int_equal(kin_model_validate(&m, why, sizeof why), 0);
-    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
-    tu_frame_bufs b;
-    pipe_frame_in in;
-    tu_frame_make(&b, &in, 15, CAMW, CAMH, LCDW, LCDH);
-    in.lighting = pass_through();
+    assert_int_equal(kin_model_validate(&r.m, r.why, sizeof r.why), 0);
+    const pipe_desc d = reproj_desc(PIPE_VIEW_REPROJECT, 2, 0);
+    rig_start(&r, &d, 15);
+    r.in.lighting = pass_through();
     for (int e = 0; e < 2; e++)
         for (int y = CROP_Y0 + CH; y < CAMH; y++)
             for (int x = 0; x < CAMW; x++) {
-                uint8_t *q = b.cam[e] + 4 * ((size_t)y * CAMW + (size_t)x);
+                uint8_t *q = r.b.cam[e] + 4 * ((size_t)y * CAMW + (size_t)x);
                 q[0] = 200, q[1] = 30, q[2] = 90, q[3] = 255;
             }
-    pipe_frame_stats st;
-    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    rig_frame(&r);
     uint8_t *ref = malloc(CW * CH);
     assert_non_null(ref);
     for (int e = 0; e < 2; e++) {
-        assert_int_equal(st.view[e], PIPE_VIEW_REPROJECT);
-        const long n = draw_from_eye(&m, e, ref);
-        const uint8_t *M = pipe_view_mask(p, e, NULL, NULL);
-        const uint8_t *Q = pipe_layer(p, e, NULL, NULL);
+        assert_int_equal(r.st.view[e], PIPE_VIEW_REPROJECT);
+        const long n = draw_from_eye(&r.m, e, ref);
+        const uint8_t *M = pipe_view_mask(r.p, e, NULL, NULL);
+        const uint8_t *Q = pipe_layer(r.p, e, NULL, NULL);
         long full = 0, colour = 0;
         for (size_t i = 0; i < (size_t)CW * CH; i++) {
             if (!M[i]) continue;
@@ -478,11 +477,11 @@ static void result_full_sensor(void **state)
         }
         print_message("NOTE full sensor, eye %d: %ld eye pixels of the band, %ld sampled, %ld "
                       "filled, %ld outside; %ld at 255, %ld of the sensor rows' colour\n", e, n,
-                      st.view_sampled[e], st.view_filled[e], st.view_outside[e], full, colour);
+                      r.st.view_sampled[e], r.st.view_filled[e], r.st.view_outside[e], full, colour);
         assert_true(n > 1000);
-        assert_int_equal(st.view_sampled[e], n);
-        assert_int_equal(st.view_filled[e], 0);
-        assert_int_equal(st.view_outside[e], 0);
+        assert_int_equal(r.st.view_sampled[e], n);
+        assert_int_equal(r.st.view_filled[e], 0);
+        assert_int_equal(r.st.view_outside[e], 0);
         assert_int_equal(full, n);
         assert_int_equal(colour, n);
     }
@@ -493,25 +492,23 @@ static void result_full_sensor(void **state)
     assert_non_null(layer0);
     assert_non_null(rgb);
     for (int e = 0; e < 2; e++) {
-        memcpy(layer0 + (size_t)e * CW * CH * 4, pipe_layer(p, e, NULL, NULL), (size_t)CW * CH * 4);
+        memcpy(layer0 + (size_t)e * CW * CH * 4, pipe_layer(r.p, e, NULL, NULL), (size_t)CW * CH * 4);
         uint8_t *r3 = rgb + (size_t)e * CAMW * CAMH * 3;
         for (size_t i = 0; i < (size_t)CAMW * CAMH; i++)
-            for (int k = 0; k < 3; k++) r3[3 * i + k] = b.cam[e][4 * i + k];
-        in.camera_raw[e] = (fuse_frame){r3, (size_t)CAMW * CAMH * 3, CAMW, CAMH, 3 * CAMW,
+            for (int k = 0; k < 3; k++) r3[3 * i + k] = r.b.cam[e][4 * i + k];
+        r.in.camera_raw[e] = (fuse_frame){r3, (size_t)CAMW * CAMH * 3, CAMW, CAMH, 3 * CAMW,
                                          FUSE_FMT_RGB24};
     }
-    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    rig_frame(&r);
     for (int e = 0; e < 2; e++) {
-        assert_int_equal(st.view_outside[e], 0);
-        assert_memory_equal(pipe_layer(p, e, NULL, NULL), layer0 + (size_t)e * CW * CH * 4,
+        assert_int_equal(r.st.view_outside[e], 0);
+        assert_memory_equal(pipe_layer(r.p, e, NULL, NULL), layer0 + (size_t)e * CW * CH * 4,
                             (size_t)CW * CH * 4);
     }
     free(layer0);
     free(rgb);
     free(ref);
-    tu_frame_free(&b);
-    pipe_destroy(p);
-    kin_model_free(&m);
+    rig_end(&r);
 }
 
 /* A quad wider than the camera's view at 0.25 m: the eye's mask is 0
@@ -519,18 +516,11 @@ static void result_full_sensor(void **state)
 static void result_border_fade(void **state)
 {
     (void)state;
-    kin_model m;
-    const float s[1] = {0.4f}, z[1] = {-0.25f};
-    quads_model(&m, 1, s, z);
-    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
-    tu_frame_bufs b;
-    pipe_frame_in in;
-    tu_frame_make(&b, &in, 14, CAMW, CAMH, LCDW, LCDH);
-    pipe_frame_stats st;
-    char why[200];
-    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    reproj_rig r;
+    rig_quad(&r, 0.4f, -0.25f, 14);
+    rig_frame(&r);
     for (int e = 0; e < 2; e++) {
-        const uint8_t *M = pipe_view_mask(p, e, NULL, NULL);
+        const uint8_t *M = pipe_view_mask(r.p, e, NULL, NULL);
         /* the middle row: 0 at both ends, 255 in the middle, and between
          * them a ramp of at most 2 * FADE / (camera px per eye px) + 2
          * pixels of each partial value run */
@@ -544,21 +534,21 @@ static void result_border_fade(void **state)
             if (row[x] < row[x - 1]) rising = 0;
         }
         print_message("NOTE eye %d: %d partial pixels on the left half of the middle row; "
-                      "%ld outside\n", e, partial, st.view_outside[e]);
+                      "%ld outside\n", e, partial, r.st.view_outside[e]);
         assert_true(rising);
         assert_true(partial >= 2 && partial <= 8);
-        assert_true(st.view_outside[e] > 1000);
+        assert_true(r.st.view_outside[e] > 1000);
     }
-    tu_frame_free(&b);
-    pipe_destroy(p);
-    kin_model_free(&m);
+    rig_end(&r);
 }
 
 /* The bytes of both outputs, the layers and the masks of a random frame
  * of the two quads, with a virtual depth in front of part of them. */
 static uint32_t frame_crc(const kin_model *m, int view, int threads, int isa)
 {
-    pipe_ctx *p = make_pipe(m, view, threads, isa);
+    const pipe_desc d = reproj_desc(view, threads, isa);
+    pipe_ctx *p = pipe_create(&d, m);
+    assert_non_null(p);
     tu_frame_bufs b;
     pipe_frame_in in;
     tu_frame_make(&b, &in, 21, CAMW, CAMH, LCDW, LCDH);
@@ -612,9 +602,7 @@ static void validity_bad_desc(void **state)
     kin_model m;
     const float s[1] = {0.05f}, z[1] = {-0.35f};
     quads_model(&m, 1, s, z);
-    pipe_desc d;
-    memset(&d, 0, sizeof d);
-    d.eye_view = PIPE_VIEW_REPROJECT;
+    pipe_desc d = reproj_desc(PIPE_VIEW_REPROJECT, 0, 0);
     char why[200];
     assert_int_equal(pipe_view_check(&d.hmd, why, sizeof why), 0);
     d.hmd.ipd_m = 0.2f;
@@ -660,8 +648,11 @@ static void validity_eye_inside_model(void **state)
     (void)state;
     kin_model m;
     cube_model(&m, 0.3f);
-    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
-    pipe_ctx *c = make_pipe(&m, PIPE_VIEW_CROP, 2, 0);
+    const pipe_desc dr = reproj_desc(PIPE_VIEW_REPROJECT, 2, 0);
+    const pipe_desc dc = reproj_desc(PIPE_VIEW_CROP, 2, 0);
+    pipe_ctx *p = pipe_create(&dr, &m), *c = pipe_create(&dc, &m);
+    assert_non_null(p);
+    assert_non_null(c);
     tu_frame_bufs b, bc;
     pipe_frame_in in, ic;
     tu_frame_make(&b, &in, 15, CAMW, CAMH, LCDW, LCDH);
@@ -695,13 +686,10 @@ static void validity_eye_inside_model(void **state)
 static void validity_nan_virtual_depth(void **state)
 {
     (void)state;
-    kin_model m;
-    const float s[1] = {0.05f}, z[1] = {-0.35f};
-    quads_model(&m, 1, s, z);
-    pipe_ctx *p = make_pipe(&m, PIPE_VIEW_REPROJECT, 2, 0);
-    tu_frame_bufs b, b0;
-    pipe_frame_in in, i0;
-    tu_frame_make(&b, &in, 16, CAMW, CAMH, LCDW, LCDH);
+    reproj_rig r;
+    rig_quad(&r, 0.05f, -0.35f, 16);
+    tu_frame_bufs b0;
+    pipe_frame_in i0;
     tu_frame_make(&b0, &i0, 16, CAMW, CAMH, LCDW, LCDH);
     float *vd = malloc(sizeof(float) * LCDW * LCDH);
     assert_non_null(vd);
@@ -709,12 +697,11 @@ static void validity_nan_virtual_depth(void **state)
     for (int y = 0; y < LCDH; y++)
         for (int x = 0; x < LCDW; x++) vd[(size_t)y * LCDW + x] = x < LCDW / 2 ? NAN : 0.2f;
     for (int e = 0; e < 2; e++) {
-        in.virt_depth[e] = vd;
-        in.virt_depth_stride[e] = LCDW;
+        r.in.virt_depth[e] = vd;
+        r.in.virt_depth_stride[e] = LCDW;
     }
-    char why[200];
-    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_OK);
-    assert_int_equal(pipe_frame(p, &i0, NULL, why, sizeof why), PIPE_OK);
+    assert_int_equal(pipe_frame(r.p, &r.in, NULL, r.why, sizeof r.why), PIPE_OK);
+    assert_int_equal(pipe_frame(r.p, &i0, NULL, r.why, sizeof r.why), PIPE_OK);
     for (int e = 0; e < 2; e++) {
         long same_left = 0, left = 0, virt_right = 0, right = 0;
         for (int y = 0; y < LCDH; y++)
@@ -724,10 +711,10 @@ static void validity_nan_virtual_depth(void **state)
                 if (!hand) continue;
                 if (x < LCDW / 2 - 2) {
                     left++;
-                    same_left += !memcmp(b.out[e] + i, b0.out[e] + i, 4);
+                    same_left += !memcmp(r.b.out[e] + i, b0.out[e] + i, 4);
                 } else if (x > LCDW / 2 + 2) {
                     right++;
-                    virt_right += !memcmp(b.out[e] + i, b.virt[e] + i, 3);
+                    virt_right += !memcmp(r.b.out[e] + i, r.b.virt[e] + i, 3);
                 }
             }
         print_message("NOTE eye %d: hand %ld px left (NaN: %ld kept), %ld right (hidden %ld)\n",
@@ -737,10 +724,8 @@ static void validity_nan_virtual_depth(void **state)
         assert_int_equal(virt_right, right);
     }
     free(vd);
-    tu_frame_free(&b);
     tu_frame_free(&b0);
-    pipe_destroy(p);
-    kin_model_free(&m);
+    rig_end(&r);
 }
 
 int main(void)

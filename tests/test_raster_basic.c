@@ -49,14 +49,7 @@ static const uint32_t k_idx[] = { 0, 1, 2, 0, 2, 3 };
 
 static rast_mesh_desc valid_mesh(void)
 {
-    rast_mesh_desc d;
-    memset(&d, 0, sizeof d);
-    d.clip = k_clip;
-    d.vertex_count = 4;
-    d.attr = k_attr;
-    d.attr_count = 2;
-    d.indices = k_idx;
-    d.tri_count = 2;
+    rast_mesh_desc d = { k_clip, 4, k_attr, 2, k_idx, 2, RAST_CULL_NONE };
     return d;
 }
 
@@ -391,14 +384,7 @@ static void draw_soup(rast_target *t, rast_stats *st)
     }
     for (int i = 0; i < NT * 3; i++)
         idx[i] = (uint32_t)tu_int(&r, NV);
-    rast_mesh_desc d;
-    memset(&d, 0, sizeof d);
-    d.clip = clip;
-    d.vertex_count = NV;
-    d.attr = attr;
-    d.attr_count = 3;
-    d.indices = idx;
-    d.tri_count = NT;
+    rast_mesh_desc d = { clip, NV, attr, 3, idx, NT, RAST_CULL_NONE };
     assert_int_equal(rast_draw(t, &d, st), RAST_OK);
 }
 

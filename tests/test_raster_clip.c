@@ -157,21 +157,28 @@ static long clip_sweep(cam *c, rast_target *t, uint64_t seed, double zlo, double
     return covered;
 }
 
+/* clip_sweep(seed, zlo, zhi, spread, n0) covers more than 20000 pixels
+ * and fewer than 1 in 1000 of them, each near an edge, differ. */
+static void sweep_checked(cam *c, rast_target *t, const char *what, uint64_t seed, double zlo,
+                          double zhi, double spread, int n0)
+{
+    long near_diff = 0;
+    double max_dist = 0;
+    long covered = clip_sweep(c, t, seed, zlo, zhi, spread, n0, &near_diff, &max_dist);
+    print_message("NOTE %s: %ld pixels covered, %ld within %.4f px of an edge differ "
+                  "(farthest %.5f px)\n", what, covered, near_diff, EDGE_TOL, max_dist);
+    assert_true(covered > 20000);
+    assert_true(near_diff * 1000 < covered);
+}
+
 static void test_near_plane_crossing(void **state)
 {
     (void)state;
     cam c;
     cam_init(&c);
     rast_target t = rt_make(W, H, 1, 0, 0);
-    long near_diff = 0;
-    double max_dist = 0;
     /* 1 or 2 vertices before the near plane */
-    long covered = clip_sweep(&c, &t, 31337, 0.01, 0.45, 0.6, 0, &near_diff, &max_dist);
-    print_message("NOTE near plane: %ld pixels covered, %ld within %.4f px of an "
-                  "edge differ (farthest %.5f px)\n", covered, near_diff, EDGE_TOL,
-                  max_dist);
-    assert_true(covered > 20000);
-    assert_true(near_diff * 1000 < covered);
+    sweep_checked(&c, &t, "near plane", 31337, 0.01, 0.45, 0.6, 0);
     rt_free(&t);
 }
 
@@ -181,14 +188,8 @@ static void test_vertex_behind_camera(void **state)
     cam c;
     cam_init(&c);
     rast_target t = rt_make(W, H, 1, 0, 0);
-    long near_diff = 0;
-    double max_dist = 0;
     /* w < 0 for 1 or 2 vertices */
-    long covered = clip_sweep(&c, &t, 4711, -6.0, -0.05, 0.8, 1000, &near_diff, &max_dist);
-    print_message("NOTE behind: %ld pixels covered, %ld near-edge differences "
-                  "(farthest %.5f px)\n", covered, near_diff, max_dist);
-    assert_true(covered > 20000);
-    assert_true(near_diff * 1000 < covered);
+    sweep_checked(&c, &t, "behind", 4711, -6.0, -0.05, 0.8, 1000);
 
     /* All three behind the eye: nothing, counted as clipped away. */
     const double e[3][3] = { { -1, -1, 2 }, { 1, -1, 2 }, { 0, 1, 3 } };

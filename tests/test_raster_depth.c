@@ -192,14 +192,7 @@ static void test_perspective_attributes(void **state)
     float clip[16];
     rast_transform_points(proj, pos, 4, clip);
     rast_target t = rt_make(W, H, 1, 2, 3);
-    rast_mesh_desc d;
-    memset(&d, 0, sizeof d);
-    d.clip = clip;
-    d.vertex_count = 4;
-    d.attr = uv;
-    d.attr_count = 2;
-    d.indices = idx;
-    d.tri_count = 2;
+    rast_mesh_desc d = { clip, 4, uv, 2, idx, 2, RAST_CULL_NONE };
     assert_int_equal(rast_draw(&t, &d, NULL), RAST_OK);
 
     /* Analytic: ray through the pixel centre meets the quad's plane at

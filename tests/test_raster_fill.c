@@ -119,13 +119,8 @@ static void test_full_screen_quad(void **state)
             assert_int_equal(count[i], 1);
         /* And with the depth test and both triangles in one draw. */
         rast_target td = rt_make(w, h, 1, 0, 0);
-        rast_mesh_desc d;
-        memset(&d, 0, sizeof d);
-        d.clip = clip;
-        d.vertex_count = 4;
-        d.indices = idx;
-        d.tri_count = 2;
-        d.cull = RAST_CULL_BACK;     /* the quad is counter-clockwise: front */
+        /* the quad is counter-clockwise: front */
+        rast_mesh_desc d = { clip, 4, NULL, 0, idx, 2, RAST_CULL_BACK };
         rast_stats st;
         memset(&st, 0, sizeof st);
         assert_int_equal(rast_draw(&td, &d, &st), RAST_OK);

@@ -26,6 +26,7 @@
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
 #include "support/raster_planes.h"
+#include "support/simd_isa_test.h"
 
 #define NCASES 6000
 /* Recorded: reference output of all cases. Since the ninth round of
@@ -92,8 +93,10 @@ static int make_case(int n, planes *ref, rast__tri *tri, int *ya, int *yb)
     return 1;
 }
 
-static void small_isa(int isa)
+/* One test per ISA (tu_simd_run_isas), its index as the state. */
+static void small_isa(void **state)
 {
+    const int isa = tu_simd_isas[tu_simd_isa_index_of(state)];
     if (!ef_cpu_has((ef_isa)isa)) {
         print_message("SKIP %s: not supported by this CPU; untested: small triangles through "
                       "src/raster/raster_%s.c\n", ef_isa_name((ef_isa)isa), ef_isa_name((ef_isa)isa));
@@ -138,18 +141,4 @@ static void small_isa(int isa)
     assert_int_equal(crc, SMALL_CRC);
 }
 
-static void test_small_sse2(void **state) { (void)state; small_isa(EF_ISA_SSE2); }
-static void test_small_avx2(void **state) { (void)state; small_isa(EF_ISA_AVX2); }
-static void test_small_avx512(void **state) { (void)state; small_isa(EF_ISA_AVX512); }
-static void test_small_neon(void **state) { (void)state; small_isa(EF_ISA_NEON); }
-
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_small_sse2),
-        cmocka_unit_test(test_small_avx2),
-        cmocka_unit_test(test_small_avx512),
-        cmocka_unit_test(test_small_neon),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+int main(void) { return tu_simd_run_isas(small_isa); }

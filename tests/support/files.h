@@ -4,7 +4,9 @@
 #ifndef EGOFUSE_TU_FILES_H
 #define EGOFUSE_TU_FILES_H
 
+#include <dirent.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,6 +20,20 @@ static inline void tu_write_text(const char *path, const char *text)
     FILE *f = fopen(path, "wb");
     if (!f) fail_msg("%s: cannot create", path);
     assert_true(fputs(text, f) >= 0);
+    assert_int_equal(fclose(f), 0);
+}
+
+/* path := printf(fmt, ...). */
+static inline void tu_write_fmt(const char *path, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+static inline void tu_write_fmt(const char *path, const char *fmt, ...)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) fail_msg("%s: cannot create", path);
+    va_list ap;
+    va_start(ap, fmt);
+    assert_true(vfprintf(f, fmt, ap) >= 0);
+    va_end(ap);
     assert_int_equal(fclose(f), 0);
 }
 
@@ -48,6 +64,25 @@ static inline unsigned char *tu_read_file(const char *path, size_t *n)
     return b;
 }
 
+/* The names in dir that contain part and end in ext (NULL: any); -1 when
+ * dir cannot be read. */
+static inline int tu_names_in(const char *dir, const char *part, const char *ext)
+{
+    DIR *d = opendir(dir);
+    if (!d) return -1;
+    int n = 0;
+    struct dirent *e;
+    size_t el = ext ? strlen(ext) : 0;
+    while ((e = readdir(d)) != NULL) {
+        size_t l = strlen(e->d_name);
+        if (part && !strstr(e->d_name, part)) continue;
+        if (ext && !(l > el && strcmp(e->d_name + l - el, ext) == 0)) continue;
+        n++;
+    }
+    closedir(d);
+    return n;
+}
+
 /* tu_b64 (base64 of glTF data: URIs): testutil.h. */
 
 /* A finite value as itself, NaN or infinity as 0 (for a glTF's min/max
@@ -67,9 +102,7 @@ static inline void tu_write_quad_gltf(const char *path, float x0, float x1, floa
     memcpy(buf + 96, idx, 12);
     char enc[200];
     tu_b64(buf, sizeof buf, enc);
-    FILE *f = fopen(path, "w");
-    assert_non_null(f);
-    fprintf(f,
+    tu_write_fmt(path,
             "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1]}],"
             "\"nodes\":[{\"name\":\"head\"},{\"name\":\"quad\",\"mesh\":0}],"
             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],"
@@ -81,7 +114,6 @@ static inline void tu_write_quad_gltf(const char *path, float x0, float x1, floa
             "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"},"
             "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}\n",
             enc, tu_fin0(x0), tu_fin0(y0), tu_fin0(z), tu_fin0(x1), tu_fin0(y1), tu_fin0(z));
-    fclose(f);
 }
 
 #endif

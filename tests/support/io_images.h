@@ -35,4 +35,19 @@ static inline void tu_write_solid(const char *path, int w, int h, uint8_t r, uin
     io_image_free(&img);
 }
 
+/* The images of a one-frame scene in dir: cam_l_0.png and cam_r_0.png,
+ * cw x ch of (200, 150, 120), virt_l_0.png and virt_r_0.png, lw x lh of
+ * (10, 40, 90). */
+static inline void tu_write_scene_images(const char *dir, int cw, int ch, int lw, int lh)
+{
+    static const char *const names[4] = {"cam_l_0.png", "cam_r_0.png", "virt_l_0.png",
+                                         "virt_r_0.png"};
+    for (int k = 0; k < 4; k++) {
+        char p[1200];
+        snprintf(p, sizeof p, "%s/%s", dir, names[k]);
+        if (k < 2) tu_write_solid(p, cw, ch, 200, 150, 120);
+        else tu_write_solid(p, lw, lh, 10, 40, 90);
+    }
+}
+
 #endif

@@ -120,6 +120,22 @@ void tu_gen_path(char *out, size_t n)
     snprintf(out, n, "%.*s/gen_samples", slash ? (int)(slash - bin) : 1, slash ? bin : ".");
 }
 
+int tu_gen_seq(const char *name, int frames, const char *hmd, char *dir, size_t n)
+{
+    char gen[1024], nf[16], log[8192];
+    tu_gen_path(gen, sizeof gen);
+    tu_tmp_path(name, dir, n);
+    snprintf(nf, sizeof nf, "%d", frames);
+    char *argv[] = {gen, "--out", dir, "--frames", nf, hmd ? "--hmd" : NULL, (char *)hmd, NULL};
+    int rc = tu_run(argv, log, sizeof log);
+    if (rc != 0) {
+        fprintf(stderr, "%s --out %s --frames %d%s%s: exit %d: %s\n", gen, dir, frames,
+                hmd ? " --hmd " : "", hmd ? hmd : "", rc, log);
+        return -1;
+    }
+    return 0;
+}
+
 int tu_runl(char *out, size_t out_size, const char *prog, const char *a0, ...)
 {
     char *argv[48];

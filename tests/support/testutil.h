@@ -26,6 +26,11 @@ static inline int tu_int(tu_rng *r, int n) { return (int)(tu_next(r) % (uint64_t
 
 /* The sample generator next to the egofuse under test (tu_bin()). */
 void tu_gen_path(char *out, size_t n);
+/* A sequence of FRAMES frames from that generator in the scratch folder
+ * NAME (tu_tmp_path; its path in dir), of the HMD preset hmd (--hmd)
+ * unless hmd is NULL. 0 when the generator ran; else -1, with its exit
+ * status and output on stderr. */
+int tu_gen_seq(const char *name, int frames, const char *hmd, char *dir, size_t n);
 
 /* Folder of the shared glTF models (EGOFUSE_SHARED/gltf); path of a file. */
 const char *tu_shared_path(const char *rel, char *buf, size_t n);
