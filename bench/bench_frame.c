@@ -305,8 +305,6 @@ typedef struct bench {
 
 static fuse_image img_of(uint8_t *px, int w, int h) { return (fuse_image){px, w, h, 4 * w}; }
 
-static kin_vec3 mat_pos(const kin_mat4 *m) { return kin_v3(m->m[12], m->m[13], m->m[14]); }
-
 static kin_quat mat_rot(const kin_mat4 *m)
 {
     kin_vec3 x = kin_v3_norm(kin_v3(m->m[0], m->m[1], m->m[2]));
@@ -331,11 +329,11 @@ static void make_samples(bench *b)
         memset(s, 0, sizeof *s);
         s->t = k / (double)b->fps;
         s->valid = KIN_TRACK_ALL;
-        s->head_pos = mat_pos(&ps.world[b->rig.head]);
+        s->head_pos = kin_mat4_translation(&ps.world[b->rig.head]);
         s->head_rot = mat_rot(&ps.world[b->rig.head]);
         for (int sd = 0; sd < 2; sd++) {
-            s->shoulder[sd] = mat_pos(&ps.world[b->rig.joint[sd][KIN_RIG_UPPER_ARM]]);
-            s->hand_pos[sd] = mat_pos(&ps.world[b->rig.joint[sd][KIN_RIG_HAND]]);
+            s->shoulder[sd] = kin_mat4_translation(&ps.world[b->rig.joint[sd][KIN_RIG_UPPER_ARM]]);
+            s->hand_pos[sd] = kin_mat4_translation(&ps.world[b->rig.joint[sd][KIN_RIG_HAND]]);
             s->hand_rot[sd] = mat_rot(&ps.world[b->rig.joint[sd][KIN_RIG_HAND]]);
             for (int f = 0; f < KIN_GLOVE_SENSORS; f++) {
                 int node = b->rig.joint[sd][KIN_RIG_FINGER0 + 3 * f + 1];
@@ -383,12 +381,7 @@ static int preload(bench *b, const char *samples_dir, int window)
         fprintf(stderr, "bench_frame: %s\n", err.msg);
         return 0;
     }
-    b->anim = NULL;
-    for (int i = 0; i < b->model.anim_count; i++)
-        if (!sc.animation[0] || !strcmp(b->model.anims[i].name, sc.animation)) {
-            b->anim = &b->model.anims[i];
-            break;
-        }
+    b->anim = kin_model_find_anim(&b->model, sc.animation);
     b->head = kin_model_find_node(&b->model, sc.head_node[0] ? sc.head_node : "head");
     char why[256];
     if (!b->anim || b->head < 0 || kin_arm_rig_init(&b->rig, &b->model, why, sizeof why) != 0) {
@@ -689,10 +682,10 @@ static void find_worst(bench *b, pipe_ctx *p)
     pipe_pose ps;
     if (pipe_pose_init(&ps, &b->model) != 0) exit(1);
     pipe_pose_anim(&ps, b->anim, (float)b->worst_frame / b->fps);
-    kin_vec3 l = mat_pos(&ps.world[b->rig.joint[0][KIN_RIG_PALM]]);
-    kin_vec3 r = mat_pos(&ps.world[b->rig.joint[1][KIN_RIG_PALM]]);
+    kin_vec3 l = kin_mat4_translation(&ps.world[b->rig.joint[0][KIN_RIG_PALM]]);
+    kin_vec3 r = kin_mat4_translation(&ps.world[b->rig.joint[1][KIN_RIG_PALM]]);
     const kin_vec3 targets[3] = {r, l, kin_v3_scale(kin_v3_add(l, r), 0.5f)};
-    b->head0 = mat_pos(&ps.world[b->head]);
+    b->head0 = kin_mat4_translation(&ps.world[b->head]);
     pipe_pose_free(&ps);
     posesrc src = {&b->samples[b->worst_frame], 1, NULL, 0};
     enum { STEPS = 14 };

@@ -143,12 +143,7 @@ int main(int argc, char **argv)
         return 0;
     }
     tb = bench_now_ms(CLOCK_MONOTONIC) - tb;
-    const kin_animation *anim = NULL;
-    for (int i = 0; i < model.anim_count; i++)
-        if (!sc.animation[0] || !strcmp(model.anims[i].name, sc.animation)) {
-            anim = &model.anims[i];
-            break;
-        }
+    const kin_animation *anim = kin_model_find_anim(&model, sc.animation);
     const int head = kin_model_find_node(&model, sc.head_node[0] ? sc.head_node : "head");
     pipe_pose ps;
     if (head < 0 || pipe_pose_init(&ps, &model) != 0) {

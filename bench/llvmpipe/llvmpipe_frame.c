@@ -190,9 +190,7 @@ static int load(inputs *in, const char *dir, int window)
         fprintf(stderr, "llvmpipe_frame: %s\n", err.msg);
         return 0;
     }
-    for (int i = 0; i < in->model.anim_count && !in->anim; i++)
-        if (!sc.animation[0] || !strcmp(in->model.anims[i].name, sc.animation))
-            in->anim = &in->model.anims[i];
+    in->anim = kin_model_find_anim(&in->model, sc.animation);
     in->head = kin_model_find_node(&in->model, sc.head_node[0] ? sc.head_node : "head");
     if (in->head < 0) {
         fprintf(stderr, "llvmpipe_frame: no head node\n");

@@ -103,6 +103,11 @@ const char *gen_joint_name(int side, int j, char *buf, size_t n);
 
 /* Fills the animation channels of arms->model (called by gen_arms_build). */
 int  gen_anim_build(gen_arms *arms);
+/* The nodes the animation turns, in channel order: the head, then per
+ * side (left first) the upper arm, forearm, hand and the 15 finger
+ * joints. Fills nodes and returns their count, GEN_ANIM_NODES. */
+#define GEN_ANIM_NODES (1 + 2 * (3 + GEN_SIDE_JOINTS - GEN_J_THUMB_1))
+int  gen_anim_nodes(const gen_arms *arms, int nodes[GEN_ANIM_NODES]);
 
 /* Writes the recorded tracking of the first `frames` frames (t = f /
  * GEN_FPS) of the animation to path ("egofuse-track 1", docs/tracking.md):

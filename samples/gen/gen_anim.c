@@ -215,20 +215,25 @@ static void pose_at(const gen_arms *a, const kin_vec3 shoulder[2], float t,
         if (!(ptr)) return -1;                                             \
     } while (0)
 
+int gen_anim_nodes(const gen_arms *a, int nodes[GEN_ANIM_NODES])
+{
+    int n = 0;
+    nodes[n++] = a->head;
+    for (int side = 0; side < 2; side++) {
+        nodes[n++] = a->joint[side][GEN_J_UPPER_ARM];
+        nodes[n++] = a->joint[side][GEN_J_FOREARM];
+        nodes[n++] = a->joint[side][GEN_J_HAND];
+        for (int j = GEN_J_THUMB_1; j < GEN_SIDE_JOINTS; j++)
+            nodes[n++] = a->joint[side][j];
+    }
+    return n;
+}
+
 int gen_anim_build(gen_arms *a)
 {
     kin_model *m = &a->model;
-    /* animated nodes: head, and per side upper arm, forearm, hand and the
-     * 15 finger joints */
-    int nodes[1 + 2 * 18], nch = 0;
-    nodes[nch++] = a->head;
-    for (int side = 0; side < 2; side++) {
-        nodes[nch++] = a->joint[side][GEN_J_UPPER_ARM];
-        nodes[nch++] = a->joint[side][GEN_J_FOREARM];
-        nodes[nch++] = a->joint[side][GEN_J_HAND];
-        for (int j = GEN_J_THUMB_1; j < GEN_SIDE_JOINTS; j++)
-            nodes[nch++] = a->joint[side][j];
-    }
+    int nodes[GEN_ANIM_NODES];
+    const int nch = gen_anim_nodes(a, nodes);
     float *times;
     kin_channel *ch;
     kin_animation *an;
@@ -238,7 +243,7 @@ int gen_anim_build(gen_arms *a)
     ALLOC(an, 1);
     ALLOC(q, m->node_count);
     for (int k = 0; k < GEN_ANIM_KEYS; k++) times[k] = (float)k / (float)GEN_FPS;
-    float *vals[1 + 2 * 18];
+    float *vals[GEN_ANIM_NODES];
     for (int c = 0; c < nch; c++) {
         ALLOC(vals[c], GEN_ANIM_KEYS * 4);
         ch[c].node = nodes[c];

@@ -28,8 +28,6 @@ static kin_quat rot_of(const kin_mat4 *m)
     return kin_quat_normalize(kin_quat_from_axes(x, y, z));
 }
 
-static kin_vec3 pos_of(const kin_mat4 *m) { return kin_v3(m->m[12], m->m[13], m->m[14]); }
-
 /* Rotation angle of a unit quaternion, degrees in [0, 180]. */
 static float angle_deg(kin_quat q)
 {
@@ -59,12 +57,12 @@ int gen_track_write(const char *path, const gen_arms *arms, int frames, char *wh
         kin_track_sample *o = &s[f];
         o->t = t;
         o->valid = KIN_TRACK_ALL;
-        o->head_pos = pos_of(&world[arms->head]);
+        o->head_pos = kin_mat4_translation(&world[arms->head]);
         o->head_rot = rot_of(&world[arms->head]);
         for (int side = 0; side < 2; side++) {
             const int *J = arms->joint[side];
-            o->shoulder[side] = pos_of(&world[J[GEN_J_UPPER_ARM]]);
-            o->hand_pos[side] = pos_of(&world[J[GEN_J_HAND]]);
+            o->shoulder[side] = kin_mat4_translation(&world[J[GEN_J_UPPER_ARM]]);
+            o->hand_pos[side] = kin_mat4_translation(&world[J[GEN_J_HAND]]);
             o->hand_rot[side] = rot_of(&world[J[GEN_J_HAND]]);
             for (int fi = 0; fi < KIN_GLOVE_SENSORS; fi++) {
                 float a = angle_deg(loc[J[GEN_J_THUMB_1 + 3 * fi + 1]].r);

@@ -41,20 +41,6 @@ gt_track_desc gt_track_default(void)
 
 /* ------------------------------------------------------------ the body */
 
-static kin_vec3 mat_t(const kin_mat4 *m)
-{
-    return kin_v3(m->m[12], m->m[13], m->m[14]);
-}
-
-static kin_quat mat_q(const kin_mat4 *m)
-{
-    kin_vec3 x = kin_v3_norm(kin_v3(m->m[0], m->m[1], m->m[2]));
-    kin_vec3 y = kin_v3_norm(kin_v3(m->m[4], m->m[5], m->m[6]));
-    kin_vec3 z = kin_v3_norm(kin_v3_cross(x, y));
-    y = kin_v3_cross(z, x);
-    return kin_quat_normalize(kin_quat_from_axes(x, y, z));
-}
-
 /* Area-weighted smooth normals. */
 static void normals_of(const float *pos, int nv, const uint32_t *idx, int nt,
                        float *nrm)
@@ -489,14 +475,14 @@ void gt_true_sample(const gen_arms *truth, float t, kin_transform *locals,
     memset(out, 0, sizeof *out);
     out->t = t;
     out->valid = KIN_TRACK_ALL;
-    out->head_pos = mat_t(&world[truth->head]);
-    out->head_rot = mat_q(&world[truth->head]);
+    out->head_pos = kin_mat4_translation(&world[truth->head]);
+    out->head_rot = kin_mat4_rotation(&world[truth->head]);
     kin_hand_params hp = kin_hand_params_default();
     for (int s = 0; s < 2; s++) {
         const int *J = truth->joint[s];
-        out->shoulder[s] = mat_t(&world[J[GEN_J_UPPER_ARM]]);
-        out->hand_pos[s] = mat_t(&world[J[GEN_J_HAND]]);
-        out->hand_rot[s] = mat_q(&world[J[GEN_J_HAND]]);
+        out->shoulder[s] = kin_mat4_translation(&world[J[GEN_J_UPPER_ARM]]);
+        out->hand_pos[s] = kin_mat4_translation(&world[J[GEN_J_HAND]]);
+        out->hand_rot[s] = kin_mat4_rotation(&world[J[GEN_J_HAND]]);
         for (int f = 0; f < 5; f++) {
             float a = finger_angle_deg(locals[J[GEN_J_THUMB_1 + 3 * f + 1]].r);
             float g = (a - hp.open_deg[f][1]) / (hp.fist_deg[f][1] - hp.open_deg[f][1]);
@@ -867,7 +853,7 @@ static int hold_desc(const gen_arms *mask, const char *name, seq_desc *sq)
                                    kin_quat_axis_angle(kin_v3(1, 0, 0), head0[1] * PI_F / 180.0f));
     kin_fk(m->parents, m->node_count, L, NULL, W);
     const kin_mat4 *H = &W[mask->head];
-    kin_vec3 E = mat_t(H);
+    kin_vec3 E = kin_mat4_translation(H);
     kin_vec3 xh = kin_v3_norm(kin_v3(H->m[0], H->m[1], H->m[2]));
     kin_vec3 yh = kin_v3_norm(kin_v3(H->m[4], H->m[5], H->m[6]));
     kin_vec3 zh = kin_v3_norm(kin_v3(H->m[8], H->m[9], H->m[10]));
@@ -925,15 +911,9 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
     const kin_model *m = &mask->model;
     kin_model *t = &truth->model;
     const int keys = (int)lroundf(sq->duration * GEN_FPS) + 1;
-    /* channels: head, per side upper arm, forearm, hand, 15 finger joints */
-    int nodes[1 + 2 * 18], nch = 0;
-    nodes[nch++] = mask->head;
-    for (int s = 0; s < 2; s++) {
-        nodes[nch++] = mask->joint[s][GEN_J_UPPER_ARM];
-        nodes[nch++] = mask->joint[s][GEN_J_FOREARM];
-        nodes[nch++] = mask->joint[s][GEN_J_HAND];
-        for (int j = GEN_J_THUMB_1; j < GEN_SIDE_JOINTS; j++) nodes[nch++] = mask->joint[s][j];
-    }
+    /* channels: the generator's (gen_anim_nodes) */
+    int nodes[GEN_ANIM_NODES];
+    const int nch = gen_anim_nodes(mask, nodes);
     float *times;
     kin_channel *ch;
     kin_animation *an;
@@ -962,7 +942,7 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
         /* the middle fingertip's surface beyond middle_3, along its bone
          * (the mesh is in the bind pose, which is the rest pose) */
         int m3 = mask->joint[s][GEN_J_MIDDLE_3];
-        kin_vec3 o = mat_t(&w[m3]);
+        kin_vec3 o = kin_mat4_translation(&w[m3]);
         kin_vec3 ax = kin_v3_norm(kin_v3(-w[m3].m[8], -w[m3].m[9], -w[m3].m[10]));
         for (int v = 0; v < bm->vertex_count; v++) {
             float wt = 0.0f;
@@ -978,9 +958,9 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
     float L1[2], L2[2];
     for (int s = 0; s < 2; s++) {
         const int *J = mask->joint[s];
-        S[s] = mat_t(&w[J[GEN_J_UPPER_ARM]]);
-        L1[s] = kin_v3_len(kin_v3_sub(mat_t(&w[J[GEN_J_FOREARM]]), S[s]));
-        L2[s] = kin_v3_len(kin_v3_sub(mat_t(&w[J[GEN_J_HAND]]), mat_t(&w[J[GEN_J_FOREARM]])));
+        S[s] = kin_mat4_translation(&w[J[GEN_J_UPPER_ARM]]);
+        L1[s] = kin_v3_len(kin_v3_sub(kin_mat4_translation(&w[J[GEN_J_FOREARM]]), S[s]));
+        L2[s] = kin_v3_len(kin_v3_sub(kin_mat4_translation(&w[J[GEN_J_HAND]]), kin_mat4_translation(&w[J[GEN_J_FOREARM]])));
     }
     const float D = PI_F / 180.0f;
     const kin_vec3 X = kin_v3(1, 0, 0);

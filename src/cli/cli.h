@@ -32,6 +32,11 @@ int cli_fail(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 int cli_usage_error(const char *cmd, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 
+/* getopt_long's answer c to a bad option (opterr 0): ':' "option --X
+ * needs a value", else "unknown option '--X'", as cli_usage_error (the
+ * option is argv[optind - 1]). */
+int cli_option_error(const char *cmd, int c, char *const *argv);
+
 /* Reads OpenCV calibration files (io_calib.h) into hmd->lens: both for
  * both cameras (a stereo file: its first camera left, its second right),
  * left / right for one each (they win over both); NULL = none. Checks the
@@ -59,6 +64,23 @@ int cli_hmd_len_parse(const char *cmd, const char *opt, const char *arg, float l
 int cli_parse_int(const char *s, int lo, int hi, int *out);
 int cli_parse_float(const char *s, float *out);
 int cli_parse_vec3(const char *s, float out[3]);
+
+/* A float option checked against a closed range, one row of a command's
+ * table of them (instead of a case each): getopt's value for it, its name
+ * ("--noise"), the range, what the message says after "NAME 'VALUE': "
+ * ("not in 0..200 mm"), and where the value goes. */
+typedef struct cli_float_opt {
+    int id;
+    const char *name;
+    float lo, hi;
+    const char *range;
+    float *dst;
+} cli_float_opt;
+/* The row of t[0..n) for getopt's value id, or NULL. */
+const cli_float_opt *cli_float_opt_find(const cli_float_opt *t, int n, int id);
+/* arg (cli_parse_float) into *e->dst when it is in [e->lo, e->hi]: 1;
+ * else 0, *e->dst unchanged. */
+int cli_float_opt_parse(const cli_float_opt *e, const char *arg);
 
 /* Creates a folder and its parents (like mkdir -p). 0 on success. */
 int cli_mkdirs(const char *path);

@@ -113,8 +113,7 @@ int cmd_calibrate(int argc, char **argv)
             if (!cli_parse_int(optarg, 0, 31, &invert))
                 return cli_usage_error("calibrate", "--glove-invert '%s': a mask 0..31", optarg);
             break;
-        case ':': return cli_usage_error("calibrate", "option %s needs a value", argv[optind - 1]);
-        default: return cli_usage_error("calibrate", "unknown option '%s'", argv[optind - 1]);
+        default: return cli_option_error("calibrate", c, argv);
         }
     }
     if (optind < argc) return cli_usage_error("calibrate", "unexpected argument '%s'", argv[optind]);

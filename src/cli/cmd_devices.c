@@ -36,7 +36,7 @@ int cmd_devices(int argc, char **argv)
         switch (c) {
         case 'h': fputs(devices_usage, stdout); return EXIT_OK;
         case 'a': all = 1; break;
-        default: return cli_usage_error("devices", "unknown option '%s'", argv[optind - 1]);
+        default: return cli_option_error("devices", c, argv);
         }
     }
     if (optind < argc) return cli_usage_error("devices", "unexpected argument '%s'", argv[optind]);

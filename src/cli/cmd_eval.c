@@ -131,41 +131,24 @@ int cmd_eval(int argc, char **argv)
     };
     eval_opts o = { 60, 0, 0, 5.0f, 20.0f, 0.02f, 0.0f, 1.0f, 1, NULL, NULL, NULL, 15u,
                     GEN_ANIM_NAME, 60, 90, 0.5f, 16, CLI_LOD_DEFAULT, CLI_LOD_PX_DEFAULT, 0, 0, 0, NULL, 0 };
+    const cli_float_opt fl[] = {
+        {O_NOISE, "--noise", 0.0f, 200.0f, "not in 0..200 mm", &o.noise},
+        {O_LATENCY, "--latency", 0.0f, 1000.0f, "not in 0..1000 ms", &o.latency},
+        {O_DROPOUT, "--dropout", 0.0f, 1.0f, "not in 0..1", &o.dropout},
+        {O_CALIB, "--calib-error", -0.3f, 0.3f, "not in -0.3..0.3", &o.calib_error},
+        {O_SPEED, "--speed", 0.1f, 10.0f, "not in 0.1..10", &o.speed},
+        {O_GLOBAL, "--global", 0.0f, 1.0f, "not in 0..1", &o.global},
+    };
+    enum { NFL = (int)(sizeof fl / sizeof fl[0]) };
     optind = 1;
     opterr = 0;
     int ch;
-    float v;
     while ((ch = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
         switch (ch) {
         case 'h': fputs(eval_usage, stdout); return EXIT_OK;
         case O_FRAMES:
             if (!cli_parse_int(optarg, 1, 100000, &o.frames))
                 return cli_usage_error("eval", "--frames '%s': not a positive count", optarg);
-            break;
-        case O_NOISE:
-            if (!cli_parse_float(optarg, &v) || v < 0.0f || v > 200.0f)
-                return cli_usage_error("eval", "--noise '%s': not in 0..200 mm", optarg);
-            o.noise = v;
-            break;
-        case O_LATENCY:
-            if (!cli_parse_float(optarg, &v) || v < 0.0f || v > 1000.0f)
-                return cli_usage_error("eval", "--latency '%s': not in 0..1000 ms", optarg);
-            o.latency = v;
-            break;
-        case O_DROPOUT:
-            if (!cli_parse_float(optarg, &v) || v < 0.0f || v > 1.0f)
-                return cli_usage_error("eval", "--dropout '%s': not in 0..1", optarg);
-            o.dropout = v;
-            break;
-        case O_CALIB:
-            if (!cli_parse_float(optarg, &v) || v < -0.3f || v > 0.3f)
-                return cli_usage_error("eval", "--calib-error '%s': not in -0.3..0.3", optarg);
-            o.calib_error = v;
-            break;
-        case O_SPEED:
-            if (!cli_parse_float(optarg, &v) || v < 0.1f || v > 10.0f)
-                return cli_usage_error("eval", "--speed '%s': not in 0.1..10", optarg);
-            o.speed = v;
             break;
         case O_SEED:
             if (!cli_parse_int(optarg, 0, 1 << 30, &o.seed))
@@ -212,11 +195,6 @@ int cmd_eval(int argc, char **argv)
             o.light_dir = optarg;
             break;
         case O_KF_SWEEP: o.kf_sweep = 1; break;
-        case O_GLOBAL:
-            if (!cli_parse_float(optarg, &v) || v < 0.0f || v > 1.0f)
-                return cli_usage_error("eval", "--global '%s': not in 0..1", optarg);
-            o.global = v;
-            break;
         case O_SEQ_FRAMES:
             if (!cli_parse_int(optarg, 1, 100000, &o.seq_frames))
                 return cli_usage_error("eval", "--seq-frames '%s': not a positive count", optarg);
@@ -225,8 +203,13 @@ int cmd_eval(int argc, char **argv)
             if (!cli_parse_int(optarg, 1, 64, &o.band))
                 return cli_usage_error("eval", "--band '%s': not in 1..64 px", optarg);
             break;
-        case ':': return cli_usage_error("eval", "option %s needs a value", argv[optind - 1]);
-        default: return cli_usage_error("eval", "unknown option '%s'", argv[optind - 1]);
+        default: {
+            const cli_float_opt *e = cli_float_opt_find(fl, NFL, ch);
+            if (!e) return cli_option_error("eval", ch, argv);
+            if (!cli_float_opt_parse(e, optarg))
+                return cli_usage_error("eval", "%s '%s': %s", e->name, optarg, e->range);
+            break;
+        }
         }
     }
     if (optind < argc) return cli_usage_error("eval", "unexpected argument '%s'", argv[optind]);

@@ -143,10 +143,7 @@ int cmd_mask(int argc, char **argv)
         case O_OUT: out = a; break;
         case O_NORMALS: out_n = a; break;
         case O_DEPTH: out_d = a; break;
-        case ':':
-            return cli_usage_error("mask", "option %s needs a value", argv[optind - 1]);
-        default:
-            return cli_usage_error("mask", "unknown option '%s'", argv[optind - 1]);
+        default: return cli_option_error("mask", c, argv);
         }
     }
     if (optind >= argc) return cli_usage_error("mask", "no model file given");

@@ -733,8 +733,7 @@ int cmd_render(int argc, char **argv)
             if (vr != EXIT_OK) return vr;
             break;
         }
-        case ':': return cli_usage_error("render", "option %s needs a value", argv[optind - 1]);
-        default: return cli_usage_error("render", "unknown option '%s'", argv[optind - 1]);
+        default: return cli_option_error("render", c, argv);
         }
     }
     if (optind < argc) return cli_usage_error("render", "unexpected argument '%s'", argv[optind]);
@@ -785,8 +784,7 @@ int cmd_demo(int argc, char **argv)
             if (!cli_parse_int(optarg, 1, 1 << 24, &o.frames))
                 return cli_usage_error("demo", "--frames '%s': not a positive count", optarg);
             break;
-        case ':': return cli_usage_error("demo", "option %s needs a value", argv[optind - 1]);
-        default: return cli_usage_error("demo", "unknown option '%s'", argv[optind - 1]);
+        default: return cli_option_error("demo", c, argv);
         }
     }
     if (optind < argc) return cli_usage_error("demo", "unexpected argument '%s'", argv[optind]);

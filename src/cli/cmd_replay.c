@@ -10,7 +10,6 @@
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
-#include <netdb.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
@@ -316,18 +315,12 @@ static int parse_hostport(const char *s, int need_port, int def_port, struct soc
     memset(sa, 0, sizeof *sa);
     sa->sin_family = AF_INET;
     sa->sin_port = htons((uint16_t)port);
-    if (inet_pton(AF_INET, host, &sa->sin_addr) == 1) return 0;
-    struct addrinfo hints, *res = NULL;
-    memset(&hints, 0, sizeof hints);
-    hints.ai_family = AF_INET;
-    int rc = getaddrinfo(host, NULL, &hints, &res);
-    if (rc != 0 || !res) {
+    const char *why;
+    if (io_ipv4_resolve(host, &sa->sin_addr.s_addr, &why) != 0) {
         cli_fail("%s '%s': '%s' is neither an IPv4 address nor a known host name (%s)", what, s,
-                 host, gai_strerror(rc));
+                 host, why);
         return -1;
     }
-    sa->sin_addr = ((struct sockaddr_in *)res->ai_addr)->sin_addr;
-    freeaddrinfo(res);
     return 0;
 }
 
@@ -560,8 +553,7 @@ int cmd_replay(int argc, char **argv)
             o.wait_s = f;
             break;
         case O_QUIET: o.quiet = 1; break;
-        case ':': return cli_usage_error("replay-track", "option %s needs a value", argv[optind - 1]);
-        default: return cli_usage_error("replay-track", "unknown option '%s'", argv[optind - 1]);
+        default: return cli_option_error("replay-track", c, argv);
         }
     }
     if (optind >= argc) return cli_usage_error("replay-track", "no tracking FILE given");

@@ -78,15 +78,15 @@ int cli_usage_error(const char *cmd, const char *fmt, ...)
     return EXIT_USAGE;
 }
 
+int cli_option_error(const char *cmd, int c, char *const *argv)
+{
+    if (c == ':') return cli_usage_error(cmd, "option %s needs a value", argv[optind - 1]);
+    return cli_usage_error(cmd, "unknown option '%s'", argv[optind - 1]);
+}
+
 int cli_parse_int(const char *s, int lo, int hi, int *out)
 {
-    if (!s || !*s) return 0;
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || *end || v < lo || v > hi) return 0;
-    *out = (int)v;
-    return 1;
+    return io_parse_int(s, lo, hi, out);
 }
 
 int cli_parse_float(const char *s, float *out)
@@ -97,6 +97,21 @@ int cli_parse_float(const char *s, float *out)
     double v = strtod(s, &end);
     if (errno || *end || !isfinite(v) || fabs(v) > 3.0e38) return 0;
     *out = (float)v;
+    return 1;
+}
+
+const cli_float_opt *cli_float_opt_find(const cli_float_opt *t, int n, int id)
+{
+    for (int i = 0; i < n; i++)
+        if (t[i].id == id) return &t[i];
+    return NULL;
+}
+
+int cli_float_opt_parse(const cli_float_opt *e, const char *arg)
+{
+    float v;
+    if (!cli_parse_float(arg, &v) || !(v >= e->lo && v <= e->hi)) return 0;
+    *e->dst = v;
     return 1;
 }
 

@@ -201,11 +201,6 @@ static int parse_size(const char *s, int *w, int *h)
     return cli_parse_int(a, 16, 16384, w) && cli_parse_int(x + 1, 16, 16384, h);
 }
 
-static int parse_range(const char *s, float lo, float hi, float *out)
-{
-    return cli_parse_float(s, out) && *out >= lo && *out <= hi;
-}
-
 /* [NAME=]MODEL[@X,Y,Z[,YAW,PITCH,ROLL]][#BODY] */
 static int parse_prop(const char *s, run_prop *p, char *why, size_t why_n)
 {
@@ -309,6 +304,17 @@ int run_parse(int argc, char **argv, run_opts *o)
     }
     for (int i = 1; i < argc; i++) av[conf.argc + i] = argv[i];
 
+    const cli_float_opt fl[] = {
+        {O_PREDICT, "--predict-ms", -200, 200, "-200..200 ms", &o->predict_ms},
+        {O_HMD_CAM_HFOV, "--hmd-camera-hfov", 1, 179, "1..179 degrees", &o->hmd.cam_hfov_deg},
+        {O_HMD_HFOV, "--hmd-hfov", 1, 179, "1..179 degrees", &o->hmd.hmd_hfov_deg},
+        {O_HMD_VFOV, "--hmd-vfov", 1, 179, "1..179 degrees", &o->hmd.hmd_vfov_deg},
+        {O_HMD_BASE, "--hmd-baseline", 0.001f, 1, "0.001..1 m", &o->hmd.baseline_m},
+        {O_HMD_OFFSET, "--hmd-camera-offset", 0, 1, "0..1 m", &o->hmd.cam_offset_m},
+        {O_HMD_FOCAL, "--hmd-focal", 0.05f, 100, "0.05..100 m", &o->hmd.focal_m},
+        {O_HMD_IPD, "--hmd-ipd", 0.04f, 0.09f, "0.04..0.09 m", &o->hmd.ipd_m},
+    };
+    enum { NFL = (int)(sizeof fl / sizeof fl[0]) };
 #define BAD(...) return run_bad(origin, optind, __VA_ARGS__)
     optind = 1;
     opterr = 0;
@@ -317,7 +323,6 @@ int run_parse(int argc, char **argv, run_opts *o)
     kin_sthmd_desc preset;
     int have_preset = 0;
     while ((c = getopt_long(ac, av, "h", run_long_opts, NULL)) != -1) {
-        float f;
         switch (c) {
         case 'h': fputs(run_usage, stdout); return EXIT_OK;
         case O_CONFIG: break; /* read above */
@@ -398,10 +403,6 @@ int run_parse(int argc, char **argv, run_opts *o)
         }
         case O_STATS: o->stats = optarg; break;
         case O_DUMP: o->dump = optarg; break;
-        case O_PREDICT:
-            if (!parse_range(optarg, -200, 200, &o->predict_ms))
-                BAD("--predict-ms '%s': -200..200 ms", optarg);
-            break;
         case O_HIDE: {
             char why[256];
             if (pipe_parts_parse(optarg, &o->hide, why, (int)sizeof why) != 0)
@@ -465,34 +466,6 @@ int run_parse(int argc, char **argv, run_opts *o)
             if (!parse_size(optarg, &o->hmd.lcd_width, &o->hmd.lcd_height))
                 BAD("--hmd-display '%s': WIDTHxHEIGHT per eye", optarg);
             break;
-        case O_HMD_CAM_HFOV:
-            if (!parse_range(optarg, 1, 179, &f)) BAD("--hmd-camera-hfov '%s': 1..179 degrees", optarg);
-            o->hmd.cam_hfov_deg = f;
-            break;
-        case O_HMD_HFOV:
-            if (!parse_range(optarg, 1, 179, &f)) BAD("--hmd-hfov '%s': 1..179 degrees", optarg);
-            o->hmd.hmd_hfov_deg = f;
-            break;
-        case O_HMD_VFOV:
-            if (!parse_range(optarg, 1, 179, &f)) BAD("--hmd-vfov '%s': 1..179 degrees", optarg);
-            o->hmd.hmd_vfov_deg = f;
-            break;
-        case O_HMD_BASE:
-            if (!parse_range(optarg, 0.001f, 1, &f)) BAD("--hmd-baseline '%s': 0.001..1 m", optarg);
-            o->hmd.baseline_m = f;
-            break;
-        case O_HMD_OFFSET:
-            if (!parse_range(optarg, 0, 1, &f)) BAD("--hmd-camera-offset '%s': 0..1 m", optarg);
-            o->hmd.cam_offset_m = f;
-            break;
-        case O_HMD_FOCAL:
-            if (!parse_range(optarg, 0.05f, 100, &f)) BAD("--hmd-focal '%s': 0.05..100 m", optarg);
-            o->hmd.focal_m = f;
-            break;
-        case O_HMD_IPD:
-            if (!parse_range(optarg, 0.04f, 0.09f, &f)) BAD("--hmd-ipd '%s': 0.04..0.09 m", optarg);
-            o->hmd.ipd_m = f;
-            break;
         case O_HMD_PRESET:
             if (kin_sthmd_preset(optarg, &preset) != 0)
                 BAD("--hmd-preset '%s': one of paper, consumer, highend", optarg);
@@ -507,7 +480,12 @@ int run_parse(int argc, char **argv, run_opts *o)
                     "(to the eye by depth)", optarg);
             break;
         case ':': BAD("option %s needs a value", av[optind - 1]);
-        default: BAD("unknown option '%s'", av[optind - 1]);
+        default: {
+            const cli_float_opt *e = cli_float_opt_find(fl, NFL, c);
+            if (!e) BAD("unknown option '%s'", av[optind - 1]);
+            if (!cli_float_opt_parse(e, optarg)) BAD("%s '%s': %s", e->name, optarg, e->range);
+            break;
+        }
         }
     }
     if (optind < ac) BAD("unexpected argument '%s'", av[optind]);

@@ -283,4 +283,29 @@
 #define SIMD_CAT_(a, b) a##_##b
 #define SIMD_CAT(a, b) SIMD_CAT_(a, b)
 
+/* Scalar lane loops the implementations share where the ISA has no
+ * masked byte or interleaved store (not part of the contract above;
+ * "bits" as above, full = SIMD_FULL of the caller, w = SIMD_W). */
+
+/* vb_store_bits: 0xFF to p[l] for each lane l of bits; one w-byte store
+ * when every lane is set. */
+SIMD_INL void simd__bytes_store_bits(uint8_t *p, unsigned bits, unsigned full, int w)
+{
+    if ((bits & full) == full) {
+        __builtin_memset(p, 0xFF, (unsigned)w);
+        return;
+    }
+    for (bits &= full; bits; bits &= bits - 1) p[__builtin_ctz(bits)] = 0xFF;
+}
+
+/* vf_store3_bits from the three vectors already stored to t[0] (x),
+ * t[1] (y), t[2] (z): p[3l + c] = t[c][l] for each lane l of bits. */
+SIMD_INL void simd__store3_lanes(float *p, unsigned bits, int w, const float t[3][w])
+{
+    for (; bits; bits &= bits - 1) {
+        const int l = __builtin_ctz(bits);
+        p[3 * l] = t[0][l]; p[3 * l + 1] = t[1][l]; p[3 * l + 2] = t[2][l];
+    }
+}
+
 #endif

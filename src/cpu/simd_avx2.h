@@ -218,12 +218,7 @@ SIMD_INL int vm_any(vmask m) { return _mm256_movemask_ps(m) != 0; }
 SIMD_INL unsigned vi_sign_bits(vint i) { return (unsigned)_mm256_movemask_ps(_mm256_castsi256_ps(i)); }
 SIMD_INL void vb_store_bits(uint8_t *p, unsigned bits)
 {
-    if ((bits & SIMD_FULL) == SIMD_FULL) {
-        const uint64_t ones = ~(uint64_t)0;
-        __builtin_memcpy(p, &ones, 8);
-        return;
-    }
-    for (bits &= SIMD_FULL; bits; bits &= bits - 1) p[__builtin_ctz(bits)] = 0xFF;
+    simd__bytes_store_bits(p, bits, SIMD_FULL, SIMD_W);
 }
 /* The three vectors to the stack, then three scalar stores per set bit
  * (raster measured six 128-bit vmaskmovps slower on AMD, and an
@@ -232,10 +227,7 @@ SIMD_INL void vf_store3_bits(float *p, unsigned bits, vfloat x, vfloat y, vfloat
 {
     _Alignas(32) float t[3][8];
     _mm256_store_ps(t[0], x); _mm256_store_ps(t[1], y); _mm256_store_ps(t[2], z);
-    for (bits &= SIMD_FULL; bits; bits &= bits - 1) {
-        const int l = __builtin_ctz(bits);
-        p[3 * l] = t[0][l]; p[3 * l + 1] = t[1][l]; p[3 * l + 2] = t[2][l];
-    }
+    simd__store3_lanes(p, bits & SIMD_FULL, SIMD_W, t);
 }
 
 

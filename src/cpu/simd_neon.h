@@ -268,12 +268,7 @@ SIMD_INL unsigned vi_sign_bits(vint i)
 }
 SIMD_INL void vb_store_bits(uint8_t *p, unsigned bits)
 {
-    if ((bits & SIMD_FULL) == SIMD_FULL) {
-        const uint32_t ones = ~(uint32_t)0;
-        __builtin_memcpy(p, &ones, 4);
-        return;
-    }
-    for (bits &= SIMD_FULL; bits; bits &= bits - 1) p[__builtin_ctz(bits)] = 0xFF;
+    simd__bytes_store_bits(p, bits, SIMD_FULL, SIMD_W);
 }
 SIMD_INL void vf_store3_bits(float *p, unsigned bits, vfloat x, vfloat y, vfloat z)
 {

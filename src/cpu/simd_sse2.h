@@ -218,21 +218,13 @@ SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
 SIMD_INL unsigned vi_sign_bits(vint i) { return (unsigned)_mm_movemask_ps(_mm_castsi128_ps(i)); }
 SIMD_INL void vb_store_bits(uint8_t *p, unsigned bits)
 {
-    if ((bits & SIMD_FULL) == SIMD_FULL) {
-        const uint32_t ones = ~(uint32_t)0;
-        __builtin_memcpy(p, &ones, 4);
-        return;
-    }
-    for (bits &= SIMD_FULL; bits; bits &= bits - 1) p[__builtin_ctz(bits)] = 0xFF;
+    simd__bytes_store_bits(p, bits, SIMD_FULL, SIMD_W);
 }
 SIMD_INL void vf_store3_bits(float *p, unsigned bits, vfloat x, vfloat y, vfloat z)
 {
     _Alignas(16) float t[3][4];
     _mm_store_ps(t[0], x); _mm_store_ps(t[1], y); _mm_store_ps(t[2], z);
-    for (bits &= SIMD_FULL; bits; bits &= bits - 1) {
-        const int l = __builtin_ctz(bits);
-        p[3 * l] = t[0][l]; p[3 * l + 1] = t[1][l]; p[3 * l + 2] = t[2][l];
-    }
+    simd__store3_lanes(p, bits & SIMD_FULL, SIMD_W, t);
 }
 
 

@@ -1,6 +1,7 @@
-/* eval_internal.h - internal to src/eval: the method configurations, their
- * runs (state and sums) and the shared per-frame context of the evaluation
- * (eval.c), which the report writer (eval_report.c) reads. */
+/* eval_internal.h - internal to src/eval: the method configurations
+ * (eval_plan.c makes them), their runs (state and sums) and the shared
+ * per-frame context of the evaluation (eval.c), which the report writer
+ * (eval_report.c) reads. */
 #ifndef EGOFUSE_EVAL_INTERNAL_H
 #define EGOFUSE_EVAL_INTERNAL_H
 
@@ -149,6 +150,18 @@ typedef struct eval_ctx {
      * methods get the images under the mismatched light */
     eval_light light;
 } eval_ctx;
+
+/* eval_plan.c: a method's default configuration under the options o
+ * (group "methods", setting "default"). */
+method_cfg eval__base_cfg(const eval_opts *o, method_kind k);
+
+/* eval.c: runs the configurations cfgs[0..n) into R on `frames` frames of
+ * sequence seq (one ground truth built into *c, left there for the caller
+ * to free with eval__ctx_free; light: the lighting mismatch, or NULL).
+ * EXIT_OK, or EXIT_FAIL with the message printed. */
+int eval__run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames, float speed,
+                    const eval_light *light, const method_cfg *cfgs, method_run *R, int n);
+void eval__ctx_free(eval_ctx *c);
 
 /* eval.c: the true operator's scales (arm, hand, shoulder width) against
  * the mask model's. */

@@ -115,7 +115,7 @@ static void fit_radii(pipe_fit *f)
                 !kin_mat4_inverse(&sk->inverse_bind[k0], &b0) ||
                 !kin_mat4_inverse(&sk->inverse_bind[k1], &b1))
                 continue;
-            kin_vec3 A = kin_v3(b0.m[12], b0.m[13], b0.m[14]), B = kin_v3(b1.m[12], b1.m[13], b1.m[14]);
+            kin_vec3 A = kin_mat4_translation(&b0), B = kin_mat4_translation(&b1);
             kin_vec3 d = kin_v3_sub(B, A);
             float dd = kin_v3_dot(d, d);
             if (!(dd > 0.0f)) continue;
@@ -353,17 +353,6 @@ fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint
     return FUSE_OK;
 }
 
-static kin_vec3 fit_node_pos(const kin_mat4 *m) { return kin_v3(m->m[12], m->m[13], m->m[14]); }
-
-static kin_quat fit_node_rot(const kin_mat4 *m)
-{
-    kin_vec3 x = kin_v3_norm(kin_v3(m->m[0], m->m[1], m->m[2]));
-    kin_vec3 y = kin_v3_norm(kin_v3(m->m[4], m->m[5], m->m[6]));
-    kin_vec3 z = kin_v3_norm(kin_v3_cross(x, y));
-    y = kin_v3_cross(z, x);
-    return kin_quat_normalize(kin_quat_from_axes(x, y, z));
-}
-
 /* Swivel phi of side s's arm: its points turned about the
  * shoulder-wrist line through S (unit u). */
 typedef struct fit_geo {
@@ -456,10 +445,10 @@ static void fit_apply(const pipe_fit *f, const kin_mat4 *world, int s, float phi
 {
     const kin_model *m = f->model;
     int ua = f->rig.joint[s][KIN_RIG_UPPER_ARM], hd = f->rig.joint[s][KIN_RIG_HAND];
-    kin_vec3 u = kin_v3_norm(kin_v3_sub(fit_node_pos(&world[hd]), fit_node_pos(&world[ua])));
+    kin_vec3 u = kin_v3_norm(kin_v3_sub(kin_mat4_translation(&world[hd]), kin_mat4_translation(&world[ua])));
     int par = m->parents[ua], hp = m->parents[hd];
-    kin_quat qp = par >= 0 ? fit_node_rot(&world[par]) : kin_quat_identity();
-    kin_quat qf = fit_node_rot(&world[hp]);
+    kin_quat qp = par >= 0 ? kin_mat4_rotation(&world[par]) : kin_quat_identity();
+    kin_quat qf = kin_mat4_rotation(&world[hp]);
     kin_vec3 ap = kin_quat_rotate(kin_quat_conjugate(qp), u);
     kin_vec3 af = kin_quat_rotate(kin_quat_conjugate(qf), u);
     locals[ua].r = kin_quat_normalize(kin_quat_mul(kin_quat_axis_angle(ap, phi), locals[ua].r));
@@ -508,8 +497,8 @@ void pipe_fit_elbows(pipe_fit *f, const kin_mat4 *world, const float *pos,
     float best[2];
     for (int s = 0; s < 2; s++) {
         int ua = f->rig.joint[s][KIN_RIG_UPPER_ARM], hd = f->rig.joint[s][KIN_RIG_HAND];
-        kin_vec3 S = fit_node_pos(&world[ua]);
-        kin_vec3 u = kin_v3_norm(kin_v3_sub(fit_node_pos(&world[hd]), S));
+        kin_vec3 S = kin_mat4_translation(&world[ua]);
+        kin_vec3 u = kin_v3_norm(kin_v3_sub(kin_mat4_translation(&world[hd]), S));
         const float range = f->d.range_deg * D, rate = f->d.rate_deg * D;
         float p0 = f->have_prev ? f->swivel[s] : 0.0f;
         float lo = f->have_prev ? p0 - rate : -range, hi = f->have_prev ? p0 + rate : range;
@@ -604,7 +593,7 @@ void pipe_fit_measure(pipe_fit *f, int eye, const kin_camera *cam, const kin_mat
             if (f->done[s][g]) continue;
             int j0 = f->rig.joint[s][g ? KIN_RIG_FOREARM : KIN_RIG_UPPER_ARM];
             int j1 = f->rig.joint[s][g ? KIN_RIG_HAND : KIN_RIG_FOREARM];
-            kin_vec3 A = fit_node_pos(&world[j0]), B = fit_node_pos(&world[j1]);
+            kin_vec3 A = kin_mat4_translation(&world[j0]), B = kin_mat4_translation(&world[j1]);
             float ax, ay, bx, by;
             if (!fit_project(cam, W, H, A, &ax, &ay) || !fit_project(cam, W, H, B, &bx, &by))
                 continue;
@@ -673,9 +662,9 @@ void pipe_fit_shape(const pipe_fit *f, const kin_mat4 *world, float *pos)
         float t0 = f->thick[s][0] - 1.0f, t1 = f->thick[s][1] - 1.0f;
         if (t0 == 0.0f && t1 == 0.0f) continue;
         kin_vec3 J[3];
-        J[0] = fit_node_pos(&world[f->rig.joint[s][KIN_RIG_UPPER_ARM]]);
-        J[1] = fit_node_pos(&world[f->rig.joint[s][KIN_RIG_FOREARM]]);
-        J[2] = fit_node_pos(&world[f->rig.joint[s][KIN_RIG_HAND]]);
+        J[0] = kin_mat4_translation(&world[f->rig.joint[s][KIN_RIG_UPPER_ARM]]);
+        J[1] = kin_mat4_translation(&world[f->rig.joint[s][KIN_RIG_FOREARM]]);
+        J[2] = kin_mat4_translation(&world[f->rig.joint[s][KIN_RIG_HAND]]);
         kin_vec3 d[2] = { kin_v3_sub(J[1], J[0]), kin_v3_sub(J[2], J[1]) };
         float dd[2] = { kin_v3_dot(d[0], d[0]), kin_v3_dot(d[1], d[1]) };
         const float tk[2] = { t0, t1 };

@@ -71,6 +71,11 @@ io_result io_fail(io_error *err, io_result code, const char *fmt, ...)
 #endif
     ;
 
+/* Strict decimal integer: the whole of s (leading blanks allowed, as
+ * strtol) a number in lo..hi: 1 and *out; else 0, *out unchanged. io's
+ * option values (io_natnet) and the command line's (cli_parse_int). */
+int io_parse_int(const char *s, int lo, int hi, int *out);
+
 /* IO_OK if path names an existing file that is not a folder, else
  * IO_ERR_NOT_FOUND or IO_ERR_READ with "path: reason". */
 io_result io_check_file(const char *path, io_error *err);
@@ -259,6 +264,12 @@ typedef struct io_track_udp {
                                     mismatch (...); keeping the pose of
                                     seq 15 (t = 1.250 s)" */
 } io_track_udp;
+
+/* An IPv4 address: host as a dotted quad, else a host name resolved to
+ * IPv4 (getaddrinfo). 0 and *addr (network order), or -1 and *why (may be
+ * NULL) the resolver's reason (gai_strerror; a static string). The UDP
+ * endpoints here, io_natnet and `egofuse replay` name their own input. */
+int io_ipv4_resolve(const char *host, uint32_t *addr, const char **why);
 
 /* Binds a receiver to addr (dotted IPv4 or a host name resolved to IPv4;
  * "0.0.0.0" = every interface, for a tracking PC on another machine;

@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
@@ -32,6 +33,17 @@ io_result io_fail(io_error *err, io_result code, const char *fmt, ...)
         }
     }
     return code;
+}
+
+int io_parse_int(const char *s, int lo, int hi, int *out)
+{
+    if (!s || !*s) return 0;
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || *end || v < lo || v > hi) return 0;
+    *out = (int)v;
+    return 1;
 }
 
 io_result io_check_file(const char *path, io_error *err)

@@ -7,6 +7,8 @@
  * OpenEXR) as one line of an io_error. guard: the one exception boundary
  * of a shim's entry point: nothing thrown crosses into C; every exception
  * becomes an io_result that names the file (io.h CONVENTIONS).
+ * channel_map: which of an image file's channels fills each channel the
+ * caller asked for (both image plugins).
  * WHAT IT DOES NOT. Free what the call made (the caller does, on a
  * non-OK result), or catch anything outside the callable it is given.
  * USAGE.
@@ -54,6 +56,24 @@ io_result guard(const char *path, io_error *err, io_result fail, const char *fal
     } catch (...) {
         return io_fail(err, fail, "%s: unexpected exception", path);
     }
+}
+
+/* The file channel of each of the `want` (1..4) channels asked for, from
+ * a file of fc channels whose alpha is channel `alpha` (-1: none): its
+ * colour channels (up to 3; one alone is repeated as grey, missing ones
+ * are 0; an alpha-only file is read as grey), then its alpha when want
+ * is 2 or 4. src[c]: a file channel, -1 = opaque (no alpha in the file),
+ * -2 = 0. */
+inline void channel_map(int fc, int alpha, int want, int src[4])
+{
+    int col[3], ncol = 0;
+    for (int c = 0; c < fc && ncol < 3; c++)
+        if (c != alpha) col[ncol++] = c;
+    if (ncol == 0) col[ncol++] = 0;
+    const bool out_alpha = want == 2 || want == 4;
+    const int out_col = out_alpha ? want - 1 : want;
+    for (int c = 0; c < out_col; c++) src[c] = ncol == 1 ? col[0] : (c < ncol ? col[c] : -2);
+    if (out_alpha) src[want - 1] = alpha;
 }
 
 }  // namespace io_cxx

@@ -157,14 +157,7 @@ io_result load(const char *path, io_type type, int want, io_image *out, io_error
     if (want == fc) {
         for (int c = 0; c < want; c++) src[c] = c;
     } else {
-        int col[3], ncol = 0;
-        for (int c = 0; c < fc && ncol < 3; c++)
-            if (c != alpha) col[ncol++] = c;
-        if (ncol == 0) col[ncol++] = 0; /* alpha-only file: read it as grey */
-        bool out_alpha = want == 2 || want == 4;
-        int out_col = out_alpha ? want - 1 : want;
-        for (int c = 0; c < out_col; c++) src[c] = ncol == 1 ? col[0] : (c < ncol ? col[c] : -2);
-        if (out_alpha) src[want - 1] = alpha;
+        io_cxx::channel_map(fc, alpha, want, src);
     }
     for (int y = 0; y < h; y++) {
         unsigned char *row = static_cast<unsigned char *>(out->data) + (size_t)y * out->stride;

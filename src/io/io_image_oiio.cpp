@@ -120,16 +120,8 @@ io_result load(const char *path, io_type type, int want, io_image *out,
     /* colour channels of the file (up to 3) and its alpha */
     int alpha = spec.alpha_channel;
     if (alpha < 0 || alpha >= fc) alpha = -1;
-    int col[3], ncol = 0;
-    for (int c = 0; c < fc && ncol < 3; c++)
-        if (c != alpha) col[ncol++] = c;
-    if (ncol == 0) col[ncol++] = 0;  /* alpha-only file: read it as grey */
-    bool out_alpha = want == 2 || want == 4;
-    int out_col = out_alpha ? want - 1 : want;
     int src[4];  /* file channel of each output channel, -1 = opaque, -2 = 0 */
-    for (int c = 0; c < out_col; c++)
-        src[c] = ncol == 1 ? col[0] : (c < ncol ? col[c] : -2);
-    if (out_alpha) src[want - 1] = alpha;
+    io_cxx::channel_map(fc, alpha, want, src);
 
     for (int y = 0; y < h; y++) {
         for (int x = 0; x < w; x++) {

@@ -16,7 +16,6 @@
 #include <arpa/inet.h>
 #include <errno.h>
 #include <math.h>
-#include <netdb.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <stdarg.h>
@@ -153,6 +152,20 @@ static size_t section_size(rd *r, int major, int minor, const char *what)
     return r->at + (size_t)sz;
 }
 
+/* The head of a section of the frame: its item count (each item at least
+ * min_bytes), then (NatNet 4.1+) its byte count, *end where that ends it
+ * (0: not given); the messages name "WHAT count" and "WHAT bytes". */
+static int32_t section_begin(rd *r, int major, int minor, size_t min_bytes, const char *what,
+                             size_t *end)
+{
+    char w[64];
+    snprintf(w, sizeof w, "%s count", what);
+    int32_t n = rd_count(r, min_bytes, w);
+    snprintf(w, sizeof w, "%s bytes", what);
+    *end = section_size(r, major, minor, w);
+    return n;
+}
+
 static void section_end(rd *r, size_t end, const char *what)
 {
     if (end && !r->bad && r->at != end)
@@ -194,8 +207,8 @@ static int parse_frame(rd *r, int major, int minor, frame_data *f, io_natnet_bod
     memset(f, 0, sizeof *f);
     f->frame = rd_i32(r, "frame number");
     /* marker sets: name, count, xyz each */
-    int32_t n = rd_count(r, 5, "marker set count");
-    size_t end = section_size(r, major, minor, "marker set bytes");
+    size_t end;
+    int32_t n = section_begin(r, major, minor, 5, "marker set", &end);
     for (int32_t i = 0; i < n && !r->bad; i++) {
         rd_str(r, NULL, 0, "marker set name");
         int32_t m = rd_count(r, 12, "marker set marker count");
@@ -203,13 +216,11 @@ static int parse_frame(rd *r, int major, int minor, frame_data *f, io_natnet_bod
     }
     section_end(r, end, "marker sets");
     /* legacy unlabeled ("other") markers */
-    n = rd_count(r, 12, "unlabeled marker count");
-    end = section_size(r, major, minor, "unlabeled marker bytes");
+    n = section_begin(r, major, minor, 12, "unlabeled marker", &end);
     rd_skip(r, (size_t)n * 12, "unlabeled markers");
     section_end(r, end, "unlabeled markers");
     /* rigid bodies */
-    n = rd_count(r, RB_BYTES, "rigid body count");
-    end = section_size(r, major, minor, "rigid body bytes");
+    n = section_begin(r, major, minor, RB_BYTES, "rigid body", &end);
     for (int32_t i = 0; i < n && !r->bad; i++) {
         io_natnet_body_pose b;
         int16_t params;
@@ -219,8 +230,7 @@ static int parse_frame(rd *r, int major, int minor, frame_data *f, io_natnet_bod
     f->count = n;
     section_end(r, end, "rigid bodies");
     /* skeletons: id, bone count, bones as rigid bodies */
-    n = rd_count(r, 8, "skeleton count");
-    end = section_size(r, major, minor, "skeleton bytes");
+    n = section_begin(r, major, minor, 8, "skeleton", &end);
     for (int32_t i = 0; i < n && !r->bad; i++) {
         rd_i32(r, "skeleton id");
         int32_t m = rd_count(r, RB_BYTES, "skeleton bone count");
@@ -229,8 +239,7 @@ static int parse_frame(rd *r, int major, int minor, frame_data *f, io_natnet_bod
     section_end(r, end, "skeletons");
     /* assets (NatNet 4.1+): id, rigid bodies, markers */
     if (ver_ge(major, minor, 4, 1)) {
-        n = rd_count(r, 12, "asset count");
-        end = section_size(r, major, minor, "asset bytes");
+        n = section_begin(r, major, minor, 12, "asset", &end);
         for (int32_t i = 0; i < n && !r->bad; i++) {
             rd_i32(r, "asset id");
             int32_t m = rd_count(r, RB_BYTES, "asset rigid body count");
@@ -241,18 +250,12 @@ static int parse_frame(rd *r, int major, int minor, frame_data *f, io_natnet_bod
         section_end(r, end, "assets");
     }
     /* labeled markers: id, xyz, size, params, residual */
-    n = rd_count(r, 26, "labeled marker count");
-    end = section_size(r, major, minor, "labeled marker bytes");
+    n = section_begin(r, major, minor, 26, "labeled marker", &end);
     rd_skip(r, (size_t)n * 26, "labeled markers");
     section_end(r, end, "labeled markers");
     /* force plates and devices: id, channels of (frame count, floats) */
     for (int k = 0; k < 2; k++) {
-        const char *what = k ? "device" : "force plate";
-        char w[64];
-        snprintf(w, sizeof w, "%s count", what);
-        n = rd_count(r, 8, w);
-        snprintf(w, sizeof w, "%s bytes", what);
-        end = section_size(r, major, minor, w);
+        n = section_begin(r, major, minor, 8, k ? "device" : "force plate", &end);
         for (int32_t i = 0; i < n && !r->bad; i++) {
             rd_i32(r, k ? "device id" : "force plate id");
             int32_t ch = rd_count(r, 4, k ? "device channel count" : "force plate channel count");
@@ -417,17 +420,6 @@ void io_natnet_config_default(io_natnet_config *c)
     }
 }
 
-static int parse_int(const char *s, int lo, int hi, int *out)
-{
-    if (!s || !*s) return 0;
-    char *e;
-    errno = 0;
-    long v = strtol(s, &e, 10);
-    if (errno || *e || v < lo || v > hi) return 0;
-    *out = (int)v;
-    return 1;
-}
-
 static int find_point(const char *s, size_t len)
 {
     for (int k = 0; k < IO_NATNET_POINTS; k++)
@@ -464,7 +456,7 @@ io_result io_natnet_config_set(io_natnet_config *c, const char *key, const char 
     }
     if (!strcmp(key, "command-port") || !strcmp(key, "data-port")) {
         int p;
-        if (!parse_int(value, key[0] == 'c' ? 1 : 0, 65535, &p)) BAD("not a port", key, value);
+        if (!io_parse_int(value, key[0] == 'c' ? 1 : 0, 65535, &p)) BAD("not a port", key, value);
         if (key[0] == 'c') c->command_port = p;
         else c->data_port = p;
         return IO_OK;
@@ -505,7 +497,7 @@ io_result io_natnet_config_set(io_natnet_config *c, const char *key, const char 
                 m->name[0] = 0;
             } else if (v[0] == '#') {
                 int id;
-                if (!parse_int(v + 1, 0, INT32_MAX, &id)) BAD("'#' needs a body id >= 0", key, value);
+                if (!io_parse_int(v + 1, 0, INT32_MAX, &id)) BAD("'#' needs a body id >= 0", key, value);
                 m->id = id;
                 m->name[0] = 0;
             } else {
@@ -547,21 +539,10 @@ io_result io_natnet_config_set(io_natnet_config *c, const char *key, const char 
 
 static io_result resolve4(const char *host, uint32_t *addr, const char *what, io_error *err)
 {
-    struct in_addr a;
-    if (inet_pton(AF_INET, host, &a) == 1) {
-        *addr = a.s_addr;
-        return IO_OK;
-    }
-    struct addrinfo hints, *res = NULL;
-    memset(&hints, 0, sizeof hints);
-    hints.ai_family = AF_INET;
-    hints.ai_socktype = SOCK_DGRAM;
-    int rc = getaddrinfo(host, NULL, &hints, &res);
-    if (rc != 0 || !res)
+    const char *why;
+    if (io_ipv4_resolve(host, addr, &why) != 0)
         return io_fail(err, IO_ERR_ARGS, "natnet %s '%s': not an IPv4 address or a known host "
-                       "name (%s)", what, host, gai_strerror(rc));
-    *addr = ((struct sockaddr_in *)res->ai_addr)->sin_addr.s_addr;
-    freeaddrinfo(res);
+                       "name (%s)", what, host, why);
     return IO_OK;
 }
 

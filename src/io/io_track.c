@@ -165,6 +165,28 @@ static void udp_reset(io_track_udp *u)
     u->fd = -1;
 }
 
+int io_ipv4_resolve(const char *host, uint32_t *addr, const char **why)
+{
+    struct in_addr a;
+    if (inet_pton(AF_INET, host, &a) == 1) {
+        *addr = a.s_addr;
+        return 0;
+    }
+    struct addrinfo hints, *res = NULL;
+    memset(&hints, 0, sizeof hints);
+    hints.ai_family = AF_INET;
+    hints.ai_socktype = SOCK_DGRAM;
+    int rc = getaddrinfo(host, NULL, &hints, &res);
+    if (rc != 0 || !res) {
+        if (why) *why = gai_strerror(rc);
+        if (res) freeaddrinfo(res);
+        return -1;
+    }
+    *addr = ((struct sockaddr_in *)res->ai_addr)->sin_addr.s_addr;
+    freeaddrinfo(res);
+    return 0;
+}
+
 static io_result addr_of(const char *addr, int port, struct sockaddr_in *sa, io_error *err)
 {
     if (port < 0 || port > 65535) return io_fail(err, IO_ERR_ARGS, "port %d out of range", port);
@@ -172,18 +194,12 @@ static io_result addr_of(const char *addr, int port, struct sockaddr_in *sa, io_
     sa->sin_family = AF_INET;
     sa->sin_port = htons((uint16_t)port);
     const char *a = addr && *addr ? addr : "127.0.0.1";
-    if (inet_pton(AF_INET, a, &sa->sin_addr) == 1) return IO_OK;
-    /* a host name (the tracking PC's, or this machine's own) */
-    struct addrinfo hints, *res = NULL;
-    memset(&hints, 0, sizeof hints);
-    hints.ai_family = AF_INET;
-    hints.ai_socktype = SOCK_DGRAM;
-    int rc = getaddrinfo(a, NULL, &hints, &res);
-    if (rc != 0 || !res)
+    /* a dotted address or a host name (the tracking PC's, or this
+     * machine's own) */
+    const char *why;
+    if (io_ipv4_resolve(a, &sa->sin_addr.s_addr, &why) != 0)
         return io_fail(err, IO_ERR_ARGS, "'%s' is neither a dotted IPv4 address nor a known host "
-                       "name (%s)", a, gai_strerror(rc));
-    sa->sin_addr = ((struct sockaddr_in *)res->ai_addr)->sin_addr;
-    freeaddrinfo(res);
+                       "name (%s)", a, why);
     return IO_OK;
 }
 

@@ -94,6 +94,11 @@ kin_mat4 kin_mat4_look_at(kin_vec3 eye, kin_vec3 target, kin_vec3 up);
 kin_mat4 kin_mat4_perspective(float fovy_rad, float aspect, float znear, float zfar);
 /* Transform from translation + rotation (scale 1). */
 kin_mat4 kin_mat4_from_tr(kin_vec3 t, kin_quat r);
+/* The other way, for a rigid (or nearly rigid) transform: its translation
+ * (column 3), and the rotation of its columns made orthonormal (x = column 0
+ * normalised, z = x cross column 1 normalised, y = z cross x), normalised. */
+kin_vec3 kin_mat4_translation(const kin_mat4 *m);
+kin_quat kin_mat4_rotation(const kin_mat4 *m);
 
 kin_transform kin_transform_identity(void);
 
@@ -207,6 +212,9 @@ void kin_model_free(kin_model *model);
 void *kin_block_alloc(void **block, size_t size);
 /* Index of the node with this name, or -1. */
 int  kin_model_find_node(const kin_model *model, const char *name);
+/* The first animation with this name; the first animation when name is
+ * NULL or ""; NULL when there is none. */
+const kin_animation *kin_model_find_anim(const kin_model *model, const char *name);
 /* Checks the invariants above (parent order, index ranges, finite values,
  * key times increasing, weights present when a skin is). Returns 0 if
  * valid, else a negative code and a reason in why[why_size]. */

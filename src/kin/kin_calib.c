@@ -129,7 +129,7 @@ int kin_user_calib_hand_tips(const kin_arm_rig *rig, const kin_model *model, kin
         kin_mat4 wh = rest_world(model, hand), w3 = rest_world(model, m3), inv;
         if (!kin_mat4_inverse(&wh, &inv))
             return fail(why, why_size, "%s hand: singular rest matrix", s ? "right" : "left");
-        kin_vec3 o = kin_v3(w3.m[12], w3.m[13], w3.m[14]);
+        kin_vec3 o = kin_mat4_translation(&w3);
         kin_vec3 axis = kin_v3_norm(kin_v3(-w3.m[8], -w3.m[9], -w3.m[10]));
         int jm3 = -1;
         for (int j = 0; j < sk->joint_count; j++)

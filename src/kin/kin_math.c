@@ -149,6 +149,20 @@ kin_mat4 kin_mat4_from_tr(kin_vec3 t, kin_quat r)
     return m;
 }
 
+kin_vec3 kin_mat4_translation(const kin_mat4 *m)
+{
+    return kin_v3(m->m[12], m->m[13], m->m[14]);
+}
+
+kin_quat kin_mat4_rotation(const kin_mat4 *m)
+{
+    kin_vec3 x = kin_v3_norm(kin_v3(m->m[0], m->m[1], m->m[2]));
+    kin_vec3 y = kin_v3_norm(kin_v3(m->m[4], m->m[5], m->m[6]));
+    kin_vec3 z = kin_v3_norm(kin_v3_cross(x, y));
+    y = kin_v3_cross(z, x);
+    return kin_quat_normalize(kin_quat_from_axes(x, y, z));
+}
+
 kin_mat4 kin_mat4_from_transform(const kin_transform *t)
 {
     kin_mat4 m = kin_mat4_from_tr(t->t, t->r);

@@ -44,6 +44,14 @@ int kin_model_find_node(const kin_model *model, const char *name)
     return -1;
 }
 
+const kin_animation *kin_model_find_anim(const kin_model *model, const char *name)
+{
+    if (!model) return NULL;
+    for (int i = 0; i < model->anim_count; i++)
+        if (!name || !name[0] || strcmp(model->anims[i].name, name) == 0) return &model->anims[i];
+    return NULL;
+}
+
 #define fail(why, n, ...) kin__fail(why, n, -1, __VA_ARGS__)
 
 static int finite_all(const float *v, size_t n)
