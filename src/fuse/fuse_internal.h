@@ -312,6 +312,24 @@ typedef void (*fuse__light_fn)(const fuse__light_prep *p, int y, int width,
                                const uint8_t *P, const uint8_t *mask,
                                const float *normal, uint8_t *out);
 
+/* The lighting of pixels x0 <= x < x1 of a row only (pointers at pixel 0),
+ * the bytes of fuse__light_span_ref. */
+typedef void (*fuse__light_span_fn)(const fuse__light_prep *p, int y, int x0, int x1,
+                                    const uint8_t *P, const uint8_t *mask,
+                                    const float *normal, uint8_t *out);
+void fuse__light_span_sse2(const fuse__light_prep *p, int y, int x0, int x1,
+                           const uint8_t *P, const uint8_t *mask, const float *normal,
+                           uint8_t *out);
+void fuse__light_span_avx2(const fuse__light_prep *p, int y, int x0, int x1,
+                           const uint8_t *P, const uint8_t *mask, const float *normal,
+                           uint8_t *out);
+void fuse__light_span_avx512(const fuse__light_prep *p, int y, int x0, int x1,
+                             const uint8_t *P, const uint8_t *mask, const float *normal,
+                             uint8_t *out);
+void fuse__light_span_neon(const fuse__light_prep *p, int y, int x0, int x1,
+                           const uint8_t *P, const uint8_t *mask, const float *normal,
+                           uint8_t *out);
+
 void fuse__composite_cols_ref(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
                               const fuse__cols *cols, int c, int n, int sw,
                               const uint8_t *v, uint8_t *out);
@@ -411,6 +429,15 @@ typedef void (*fuse__cover_fn)(const uint8_t *q, int w, uint64_t *bits);
  * out and v do not overlap. */
 typedef void (*fuse__opaque_fn)(const uint8_t *v, uint8_t *out, int n);
 
+/* The same when the caller knows that every pixel outside [x0, x1)
+ * (0 <= x0, x1 <= w) is 0: only the blocks that meet [x0, x1) are read
+ * (the lit rows' mask spans, fuse_ctx.c). Same bits. */
+typedef void (*fuse__cover_span_fn)(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
+void fuse__cover_span_ref(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
+void fuse__cover_span_sse2(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
+void fuse__cover_span_avx2(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
+void fuse__cover_span_avx512(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
+void fuse__cover_span_neon(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
 void fuse__cover_row_ref(const uint8_t *q, int w, uint64_t *bits);
 void fuse__cover_row_sse2(const uint8_t *q, int w, uint64_t *bits);
 void fuse__cover_row_avx2(const uint8_t *q, int w, uint64_t *bits);
@@ -482,6 +509,18 @@ void fuse__depth_mspan_ref(const fuse__depth_prep *p, uint8_t *m, const float *h
                            const float *sc, int x0, int x1);
 void fuse__depth_mrow_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
                           const float *sc, int w);
+/* Pixels x0 <= x < x1 of the mask row only (m, hz, sc at pixel 0): the
+ * bytes of fuse__depth_mspan_ref. */
+typedef void (*fuse__depth_mspan_fn)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                                     const float *sc, int x0, int x1);
+void fuse__depth_mspan_sse2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                            const float *sc, int x0, int x1);
+void fuse__depth_mspan_avx2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                            const float *sc, int x0, int x1);
+void fuse__depth_mspan_avx512(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                              const float *sc, int x0, int x1);
+void fuse__depth_mspan_neon(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                            const float *sc, int x0, int x1);
 void fuse__depth_mrow_sse2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
                            const float *sc, int w);
 void fuse__depth_mrow_avx2(const fuse__depth_prep *p, uint8_t *m, const float *hz,

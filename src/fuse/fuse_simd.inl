@@ -167,9 +167,14 @@ static inline __attribute__((always_inline)) void pow01_lanes(const VF *x, VF s,
     }
 }
 
+/* fuse__clamp01: v > 0 ? (v < 1 ? v : 1) : +0. As max(min(v, 1), +0) with
+ * the layer's vf_min / vf_max (a < b ? a : b, a > b ? a : b): the same value
+ * for every v but NaN (-0 gives +0 either way), one operation fewer; no NaN
+ * reaches it (validated parameters, normals without a usable length
+ * replaced: fuse_internal.h). */
 static inline VF clamp01_lanes(VF v)
 {
-    return FZERO_UNLESS(FGT(v, F1(0.0f)), FMIN1(v));
+    return FMAX0(FMIN1(v));
 }
 
 /* (int)(v * 255 + 0.5), v in [0, 1] */
@@ -256,13 +261,14 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
 }
 
 /* Two vectors a step where both have mask bytes, one where only one has,
- * a zero store where neither has (the reference's M == 0 pixels). */
-void LIGHT_ROW_NAME(const fuse__light_prep *p, int y, int width,
-                    const uint8_t *P, const uint8_t *mask,
-                    const float *normal, uint8_t *out)
+ * a zero store where neither has (the reference's M == 0 pixels). Pixels
+ * x0 <= x < x1 of the row (fuse__light_span_ref; the pointers at pixel 0). */
+void SIMD_FN(fuse__light_span)(const fuse__light_prep *p, int y, int x0, int width,
+                               const uint8_t *P, const uint8_t *mask,
+                               const float *normal, uint8_t *out)
 {
     const VF py = F1((((float)y + 0.5f) - p->cy) * p->ify);
-    int x = 0;
+    int x = x0;
     for (; x + 2 * LANES <= width; x += 2 * LANES) {
         const int z0 = MASK_ZERO(mask + x), z1 = MASK_ZERO(mask + x + LANES);
         if (!z0 && !z1) {
@@ -280,6 +286,13 @@ void LIGHT_ROW_NAME(const fuse__light_prep *p, int y, int width,
     }
     if (x < width)
         fuse__light_span_ref(p, y, x, width, P, mask, normal, out);
+}
+
+void LIGHT_ROW_NAME(const fuse__light_prep *p, int y, int width,
+                    const uint8_t *P, const uint8_t *mask,
+                    const float *normal, uint8_t *out)
+{
+    SIMD_FN(fuse__light_span)(p, y, 0, width, P, mask, normal, out);
 }
 
 /* pow01_lanes over an array (tests compare its float bits with
@@ -323,7 +336,7 @@ SIMD_INL vfloat fuse_scene_lanes(const fuse__depth_prep *p, const float *sc, vin
  * The column of each lane walks as fuse__depth_col's exact quotient and
  * remainder: stepped by SIMD_W pixels, 2 SIMD_W vw = sq den + sr. */
 SIMD_INL void depth_row(const fuse__depth_prep *p, uint8_t *q, const float *hz, const float *sc,
-                        int w, int bpp)
+                        int x0, int w, int bpp)
 {
     const vfloat zero = vf_zero(), one = vf_set1(1.0f), two = vf_set1(2.0f);
     const vfloat two_fn = vf_set1(p->two_fn), fpn = vf_set1(p->fpn);
@@ -334,15 +347,15 @@ SIMD_INL void depth_row(const fuse__depth_prep *p, uint8_t *q, const float *hz, 
     _Alignas(64) int32_t ox0[SIMD_W], rem0[SIMD_W];
     vint ox, rem;
     int x, k;
-    if (w < SIMD_W) {
-        if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, 0, w);
-        else fuse__depth_mspan_ref(p, q, hz, sc, 0, w);
+    if (w - x0 < SIMD_W) {
+        if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, x0, w);
+        else fuse__depth_mspan_ref(p, q, hz, sc, x0, w);
         return;
     }
-    for (k = 0; k < SIMD_W; k++) fuse__depth_col(p, k, &ox0[k], &rem0[k]);
+    for (k = 0; k < SIMD_W; k++) fuse__depth_col(p, x0 + k, &ox0[k], &rem0[k]);
     ox = vi_load(ox0);
     rem = vi_load(rem0);
-    for (x = 0; x + SIMD_W <= w; x += SIMD_W) {
+    for (x = x0; x + SIMD_W <= w; x += SIMD_W) {
         vint qq;
         int any;
         if (bpp == 4) {
@@ -386,26 +399,39 @@ SIMD_INL void depth_row(const fuse__depth_prep *p, uint8_t *q, const float *hz, 
 void SIMD_FN(fuse__depth_row)(const fuse__depth_prep *p, uint8_t *q, const float *hz,
                               const float *sc, int w)
 {
-    depth_row(p, q, hz, sc, w, 4);
+    depth_row(p, q, hz, sc, 0, w, 4);
 }
 
 void SIMD_FN(fuse__depth_mrow)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
                                const float *sc, int w)
 {
-    depth_row(p, m, hz, sc, w, 1);
+    depth_row(p, m, hz, sc, 0, w, 1);
+}
+
+/* pixels x0 <= x < x1 of the mask row only (m, hz, sc at pixel 0) */
+void SIMD_FN(fuse__depth_mspan)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                                const float *sc, int x0, int x1)
+{
+    depth_row(p, m, hz, sc, x0, x1, 1);
 }
 
 /* ---- coverage bits and opaque copies (fuse_internal.h) ----------------- */
 
-/* bit b set iff a byte of pixels [8b, 8b + 8) is not 0 */
-void SIMD_FN(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
+/* bit b set iff a byte of pixels [8b, 8b + 8) is not 0; only the pixels
+ * [x0, x1) are read (the caller knows the others are 0: their bits are
+ * 0), fuse__cover_span_fn */
+void SIMD_FN(fuse__cover_span)(const uint8_t *q, int w, int x0, int x1, uint64_t *bits)
 {
     const int nb = (w + 7) / 8;
-    int b = 0, x;
+    const int xa = x0 & ~(SIMD_W >= 8 ? SIMD_W - 1 : 7);   /* whole vectors (W >= 8) or blocks */
+    const int xe = ((x1 + 7) & ~7) < w ? ((x1 + 7) & ~7) : w;
+    const int ne = (xe + 7) / 8;
+    int b = xa / 8, x;
     memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
+    if (x0 >= x1) return;
 #if SIMD_W >= 8
     /* SIMD_W / 8 blocks per vector: the lanes' non-zero bits, 8 a block */
-    for (x = 0; x + SIMD_W <= w; x += SIMD_W, b += SIMD_W / 8) {
+    for (x = xa; x + SIMD_W <= xe; x += SIMD_W, b += SIMD_W / 8) {
         const vint t = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
         const unsigned nzb = vm_bits(vi_eq(t, vi_zero())) ^ SIMD_FULL;
         unsigned pat = 0;
@@ -416,7 +442,7 @@ void SIMD_FN(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
     }
 #else
     /* 8 / SIMD_W vectors per block, or-ed */
-    for (x = 0; x + 8 <= w; x += 8, b++) {
+    for (x = xa; x + 8 <= xe; x += 8, b++) {
         vint t = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
         int j;
         for (j = SIMD_W; j < 8; j += SIMD_W)
@@ -424,17 +450,22 @@ void SIMD_FN(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
         bits[b >> 6] |= (uint64_t)!vm_all(vi_eq(t, vi_zero())) << (b & 63);
     }
 #endif
-    if (b < nb) {   /* the last w % 8 (or w % SIMD_W) pixels */
-        for (; b < nb; b++) {
-            const int x1 = 8 * b + 8 < w ? 8 * b + 8 : w;
+    if (b < ne) {   /* the last blocks (xe % SIMD_W pixels) */
+        for (; b < ne; b++) {
+            const int xb = 8 * b + 8 < w ? 8 * b + 8 : w;
             uint32_t acc = 0, t;
-            for (x = 8 * b; x < x1; x++) {
+            for (x = 8 * b; x < xb; x++) {
                 memcpy(&t, q + 4 * (size_t)x, 4);
                 acc |= t;
             }
             if (acc) bits[b >> 6] |= (uint64_t)1 << (b & 63);
         }
     }
+}
+
+void SIMD_FN(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
+{
+    SIMD_FN(fuse__cover_span)(q, w, 0, w, bits);
 }
 
 /* out = v | alpha 255; in place (v == out) only the vectors with an alpha
