@@ -26,6 +26,7 @@ typedef struct kernels {
     fuse__opaque_fn opaque;    /* R = V, alpha 255 (transparent spans) */
     fuse__hrow_fn hrow;        /* NULL: no row cache, comp per output row */
     fuse__vrow_fn vrow;
+    fuse__hprep_fn hprep;      /* the row cache's per-tile tables (with hrow) */
     fuse__light_span_fn light_span;    /* the same kernels on a span of a row */
     fuse__depth_mspan_fn depth_mspan;
     fuse__cover_span_fn cover_span;
@@ -43,15 +44,16 @@ typedef struct kernels {
 static kernels kernels_for(ef_isa isa)
 {
     static const kernels ref = {EF_ISA_REF, 1, SIMD_KERNELS(ref), NULL, SIMD_COVER(ref), NULL, NULL,
-                                SIMD_SPANS(ref)};
+                                NULL, SIMD_SPANS(ref)};
     static const kernels sse2 = {EF_ISA_SSE2, 0, SIMD_KERNELS(sse2), fuse__composite_cols_sse2,
-                                 SIMD_COVER(sse2), NULL, NULL, SIMD_SPANS(sse2)};
+                                 SIMD_COVER(sse2), NULL, NULL, NULL, SIMD_SPANS(sse2)};
     static const kernels avx2 = {EF_ISA_AVX2, 0, SIMD_KERNELS(avx2), NULL, SIMD_COVER(avx2),
-                                 fuse__hrow_avx2, fuse__vrow_avx2, SIMD_SPANS(avx2)};
+                                 fuse__hrow_avx2, fuse__vrow_avx2, fuse__hprep_avx2, SIMD_SPANS(avx2)};
     static const kernels avx512 = {EF_ISA_AVX512, 0, SIMD_KERNELS(avx512), NULL, SIMD_COVER(avx512),
-                                   fuse__hrow_avx512, fuse__vrow_avx512, SIMD_SPANS(avx512)};
+                                   fuse__hrow_avx512, fuse__vrow_avx512, fuse__hprep_avx512,
+                                   SIMD_SPANS(avx512)};
     static const kernels neon = {EF_ISA_NEON, 0, SIMD_KERNELS(neon), fuse__composite_cols_neon,
-                                 SIMD_COVER(neon), NULL, NULL, SIMD_SPANS(neon)};
+                                 SIMD_COVER(neon), NULL, NULL, NULL, SIMD_SPANS(neon)};
     switch (isa) {
     case EF_ISA_AVX512: return avx512;
     case EF_ISA_AVX2: return avx2;
@@ -285,7 +287,7 @@ static void scratch_init(comp_scratch *s)
 /* Group g (output columns [g GROUP, g GROUP + GROUP) of the tile) reads the
  * source columns ix[first] .. min(ix[last] + 1, sw - 1), i.e. the blocks
  * blo(g) .. bhi(g); both grow with g. */
-static void scratch_tile(comp_scratch *s, int sw, int vw, int c0, int n)
+static void scratch_tile(comp_scratch *s, const kernels *k, int sw, int vw, int c0, int n)
 {
     const int ng = (n + GROUP - 1) / GROUP, nb = (sw + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
     int g, b;
@@ -296,6 +298,7 @@ static void scratch_tile(comp_scratch *s, int sw, int vw, int c0, int n)
         for (i = 0; i < 4 * FUSE__TILE; i++) s->h_zero[i] = (uint16_t)FUSE__H_BIAS;
     }
     fuse__cols_fill(&s->cols, sw, vw, c0, n);
+    if (k->hprep != NULL) k->hprep(&s->cols, n, sw);
     for (g = 0, b = 0; b < nb; b++) {    /* first g with bhi(g) >= b */
         while (g < ng) {
             const int last = g * GROUP + GROUP - 1 < n ? g * GROUP + GROUP - 1 : n - 1;
@@ -594,7 +597,7 @@ static void comp_vp_rows(const comp_job *j, comp_scratch *s, int y0, int y1)
     }
     for (c0 = 0; c0 < j->vw; c0 += FUSE__TILE) {
         const int n = j->vw - c0 < FUSE__TILE ? j->vw - c0 : FUSE__TILE;
-        scratch_tile(s, sw, j->vw, c0, n);
+        scratch_tile(s, j->k, sw, j->vw, c0, n);
         for (y = y0; y < y1; y++)
             comp_row_tiled(j, s, y, c0, n);
     }

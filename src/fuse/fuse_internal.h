@@ -262,6 +262,19 @@ void fuse__composite_row_ref(const uint8_t *q0, const uint8_t *q1,
 typedef struct fuse__cols {
     int32_t ix[FUSE__TILE];
     int32_t fx[FUSE__TILE];
+    /* What fuse__hprep_<isa> adds for that ISA's fuse__hrow (hprep_w its
+     * SIMD_W; 0: not prepared, then fuse__hrow goes pixel by pixel), per
+     * step of SIMD_W columns from column 0: hbase[k] the first layer pixel
+     * of the window of SIMD_W pixels that holds every tap of step k, -1
+     * when none does (a gather); hidx0/hidx1 the taps ix, min(ix + 1,
+     * sw - 1) of each column, relative to hbase (absolute for a gather);
+     * hw the column weights fx as two 16-bit copies per int32, in the
+     * layer's block order (2 SIMD_W int32 per step: the low then the high
+     * halves of the blocks, as vh_from_u8_lo / hi widen the pixels). */
+    int hprep_w;
+    int32_t hbase[FUSE__TILE / 4];
+    int32_t hidx0[FUSE__TILE], hidx1[FUSE__TILE];
+    int32_t hw[2 * FUSE__TILE];
 } fuse__cols;
 
 /* Fills cols for viewport columns [c0, c0 + n), n <= FUSE__TILE. */
@@ -281,6 +294,7 @@ static inline void fuse__cols_fill(fuse__cols *cols, int sw, int vw, int c0, int
         cols->ix[i] = p >> 16;
         cols->fx[i] = (int32_t)(((uint32_t)p >> 8) & 255u);
     }
+    cols->hprep_w = 0;
 }
 
 /* One output pixel of fuse__composite_row_ref from the table: the same
@@ -403,6 +417,11 @@ static inline void fuse__vpx(const uint16_t *h0, const uint16_t *h1, uint32_t fy
     out[3] = 255;
 }
 
+/* The ISA's per-step tables of cols (n columns of the tile, layer width
+ * sw), once per tile, before its fuse__hrow calls. */
+typedef void (*fuse__hprep_fn)(fuse__cols *cols, int n, int sw);
+void fuse__hprep_avx2(fuse__cols *cols, int n, int sw);
+void fuse__hprep_avx512(fuse__cols *cols, int n, int sw);
 void fuse__hrow_avx2(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
                      uint16_t *h);
 void fuse__hrow_avx512(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,

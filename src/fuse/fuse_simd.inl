@@ -643,47 +643,76 @@ void SIMD_FN(fuse__composite_cols)(const uint8_t *q0, const uint8_t *q1, uint32_
  * (pixels 4B, 4B + 1 of each block B) then of vh_from_u8_hi (4B + 2,
  * 4B + 3), so neither kernel reorders across blocks; vh_packus puts the
  * pixels back in memory order. */
+/* The per-step tables of fuse__cols for this ISA's hrow (fuse_internal.h):
+ * the window test, the taps' indices and the weights of each step, once
+ * per tile instead of once per layer row. */
+void SIMD_FN(fuse__hprep)(fuse__cols *cols, int n, int sw)
+{
+    const vint one = vi_set1(1), last = vi_set1(sw - 1);
+    int i;
+    for (i = 0; i + SIMD_W <= n; i += SIMD_W) {
+        const vint ix = vi_loadu(cols->ix + i);
+        const vint ix1 = vi_min(vi_add(ix, one), last);
+        const vint fx = vi_loadu(cols->fx + i);
+        vint wl = vi_zip_lo(fx, fx), wh = vi_zip_hi(fx, fx);
+        int base = cols->ix[i];
+        const int hi = cols->ix[i + SIMD_W - 1] + 1 < sw ? cols->ix[i + SIMD_W - 1] + 1 : sw - 1;
+        if (base > sw - SIMD_W) base = sw - SIMD_W;
+        /* fx of each pixel in its four 16-bit lanes, in the blocks' order */
+        wl = vi_or(wl, vi_slli(wl, 16));
+        wh = vi_or(wh, vi_slli(wh, 16));
+        vi_storeu(cols->hw + 2 * i, wl);
+        vi_storeu(cols->hw + 2 * i + SIMD_W, wh);
+        if (base >= 0 && hi - base < SIMD_W) {
+            const vint bb = vi_set1(base);
+            cols->hbase[i / SIMD_W] = base;
+            vi_storeu(cols->hidx0 + i, vi_sub(ix, bb));
+            vi_storeu(cols->hidx1 + i, vi_sub(ix1, bb));
+        } else {
+            cols->hbase[i / SIMD_W] = -1;
+            vi_storeu(cols->hidx0 + i, ix);
+            vi_storeu(cols->hidx1 + i, ix1);
+        }
+    }
+    cols->hprep_w = SIMD_W;
+}
+
 void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
                          uint16_t *h)
 {
-    const vint one = vi_set1(1), last = vi_set1(sw - 1);
     const vint w256 = vh_set1(256), bias = vh_set1((int)FUSE__H_BIAS);
     const int32_t *ixs = cols->ix + c, *fxs = cols->fx + c;
     int i = 0;
-    for (; i + SIMD_W <= n; i += SIMD_W) {
-        const vint ix = vi_loadu(ixs + i);
-        const vint ix1 = vi_min(vi_add(ix, one), last);
-        vint a, b, fx, wl, wh;
-        int base = ixs[i];
-        const int hi = ixs[i + SIMD_W - 1] + 1 < sw ? ixs[i + SIMD_W - 1] + 1 : sw - 1;
-        if (base > sw - SIMD_W) base = sw - SIMD_W;
-        if (base >= 0 && hi - base < SIMD_W) {
-            const vint s0 = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)base));
-            const vint bb = vi_set1(base);
-            if (vm_all(vi_eq(s0, vi_zero()))) {   /* every tap 0: h = 0 */
-                vi_storeu((int32_t *)(void *)(h + 4 * i), bias);
-                vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W), bias);
-                continue;
+    if (cols->hprep_w == SIMD_W && c % SIMD_W == 0) {
+        const int32_t *base = cols->hbase + c / SIMD_W;
+        const int32_t *i0s = cols->hidx0 + c, *i1s = cols->hidx1 + c, *ws = cols->hw + 2 * c;
+        for (; i + SIMD_W <= n; i += SIMD_W, base++) {
+            const vint i0 = vi_loadu(i0s + i), i1 = vi_loadu(i1s + i);
+            const vint wl = vi_loadu(ws + 2 * i), wh = vi_loadu(ws + 2 * i + SIMD_W);
+            vint a, b;
+            if (*base >= 0) {
+                const vint s0 = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)*base));
+                if (vm_all(vi_eq(s0, vi_zero()))) {   /* every tap 0: h = 0 */
+                    vi_storeu((int32_t *)(void *)(h + 4 * i), bias);
+                    vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W), bias);
+                    continue;
+                }
+                a = vi_permute(s0, i0);
+                b = vi_permute(s0, i1);
+            } else {
+                a = vi_gather((const int32_t *)(const void *)q, i0);
+                b = vi_gather((const int32_t *)(const void *)q, i1);
             }
-            a = vi_permute(s0, vi_sub(ix, bb));
-            b = vi_permute(s0, vi_sub(ix1, bb));
-        } else {
-            a = vi_gather((const int32_t *)(const void *)q, ix);
-            b = vi_gather((const int32_t *)(const void *)q, ix1);
+            vi_storeu((int32_t *)(void *)(h + 4 * i),
+                      vi_xor(vh_add(vh_mullo(vh_from_u8_lo(a), vh_sub(w256, wl)),
+                                    vh_mullo(vh_from_u8_lo(b), wl)), bias));
+            vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W),
+                      vi_xor(vh_add(vh_mullo(vh_from_u8_hi(a), vh_sub(w256, wh)),
+                                    vh_mullo(vh_from_u8_hi(b), wh)), bias));
         }
-        /* fx of each pixel in its four 16-bit lanes, in the blocks' order */
-        fx = vi_loadu(fxs + i);
-        wl = vi_zip_lo(fx, fx);
-        wh = vi_zip_hi(fx, fx);
-        wl = vi_or(wl, vi_slli(wl, 16));
-        wh = vi_or(wh, vi_slli(wh, 16));
-        vi_storeu((int32_t *)(void *)(h + 4 * i),
-                  vi_xor(vh_add(vh_mullo(vh_from_u8_lo(a), vh_sub(w256, wl)),
-                                vh_mullo(vh_from_u8_lo(b), wl)), bias));
-        vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W),
-                  vi_xor(vh_add(vh_mullo(vh_from_u8_hi(a), vh_sub(w256, wh)),
-                                vh_mullo(vh_from_u8_hi(b), wh)), bias));
     }
+    /* the last n % SIMD_W columns (all of them without the tables: the
+     * same bytes, pixel by pixel) */
     for (; i < n; i++) fuse__hpx(q, ixs[i], (uint32_t)fxs[i], sw, h + 4 * i);
 }
 
