@@ -5,11 +5,15 @@
  * which defines, with SIMD_FN's suffix (_sse2, _avx2, _avx512, _neon):
  *
  *   fuse__light_row     the lighting of one layer row (fuse__light_fn)
+ *   fuse__light_span    the same on a span of the row (fuse__light_span_fn)
  *   fuse__pow01_row     the lane power over an array (for the tests)
  *   fuse__depth_row     the depth test on a layer row (fuse__depth_fn)
  *   fuse__depth_mrow    the same on mask bytes (fuse__depth_mask_fn)
+ *   fuse__depth_mspan   the same on a span of the mask row (fuse__depth_mspan_fn)
  *   fuse__cover_row     coverage bits of a layer row (fuse__cover_fn)
+ *   fuse__cover_span    the same reading a span only (fuse__cover_span_fn)
  *   fuse__opaque        R = V | alpha 255 (fuse__opaque_fn)
+ *   fuse__hprep, fuse__hrow, fuse__vrow  the row cache (FUSE_ROWCACHE_ON_LAYER)
  *
  * Each repeats the reference (fuse_ref.c, fuse_depth.c) operation for
  * operation, in the same order, with the same constants, so every lane
