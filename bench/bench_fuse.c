@@ -5,6 +5,7 @@
  *
  *   bench_fuse [--csv] [--runs N] [--isa ref|sse2|avx2|avx512]
  *              [--threads 1|2] [--case typical|worst] [--no-pixman] [--cpu-time]
+ *              [--stage NAME]
  *
  * Per stereo frame (two eyes: 640x400 camera images lit, resampled into
  * the 1194x746 viewport at (43, 27) of 1280x800, composited over V):
@@ -68,6 +69,12 @@ enum { CW = 640, CH = 400, W = 1280, H = 800, VX = 43, VY = 27, VW = 1194, VHH =
  * (insensitive to being descheduled on a loaded machine; meaningful for
  * the 1-thread rows only, as the other threads' time is not counted). */
 static clockid_t clock_id = CLOCK_MONOTONIC;
+
+/* --stage NAME: run (and time) only that stage of each run (the others
+ * print 0), for profilers (perf record, cachegrind): light, comp, frame,
+ * ip, dp, op, dop, l2, cold, l2c, like; NULL: all of them. */
+static const char *only_stage;
+static int want(const char *name) { return only_stage == NULL || !strcmp(only_stage, name); }
 
 static double now_ms(void) { return bench_now_ms(clock_id); }
 
@@ -265,39 +272,39 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
     if (threads > 1) copier_start(&cp, &e[1]);
     for (k = -3; k < runs; k++) {   /* 3 warm-up runs */
         double m, t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11, t12, t13, t14;
-        m = time_memcpy(e, threads > 1 ? &cp : NULL);
+        m = only_stage == NULL || !strcmp(only_stage, "memcpy") ? time_memcpy(e, threads > 1 ? &cp : NULL) : 1.0;
         t0 = now_ms();
-        for (i = 0; i < 2; i++)
+        for (i = 0; i < 2 && want("light"); i++)
             if (fuse_context_light(ctx, &L, &K, &eyes[i].P, e[i].M, CW, e[i].N, 3 * CW,
                                    &eyes[i].Q) != FUSE_OK) exit(3);
         t1 = now_ms();
-        for (i = 0; i < 2; i++)
+        for (i = 0; i < 2 && want("comp"); i++)
             if (fuse_context_composite(ctx, &eyes[i].Q, &eyes[i].V, VX, VY, VW, VHH,
                                        &eyes[i].out) != FUSE_OK) exit(3);
         t2 = now_ms();
-        if (fuse_context_frame(ctx, eyes, 2) != FUSE_OK) exit(3);
+        if (want("frame") && fuse_context_frame(ctx, eyes, 2) != FUSE_OK) exit(3);
         t3 = now_ms();
-        if (fuse_context_frame(ctx, ip, 2) != FUSE_OK) exit(3);
+        if (want("ip") && fuse_context_frame(ctx, ip, 2) != FUSE_OK) exit(3);
         t4 = now_ms();
-        if (fuse_context_frame(ctx, dp, 2) != FUSE_OK) exit(3);
+        if (want("dp") && fuse_context_frame(ctx, dp, 2) != FUSE_OK) exit(3);
         t5 = now_ms();
-        if (fuse_context_frame(ctx, op, 2) != FUSE_OK) exit(3);
+        if (want("op") && fuse_context_frame(ctx, op, 2) != FUSE_OK) exit(3);
         t6 = now_ms();
-        if (fuse_context_frame(ctx, dop, 2) != FUSE_OK) exit(3);
+        if (want("dop") && fuse_context_frame(ctx, dop, 2) != FUSE_OK) exit(3);
         t7 = now_ms();
-        if (fuse_context_frame(ctx, dop2, 2) != FUSE_OK) exit(3);
+        if (want("l2") && fuse_context_frame(ctx, dop2, 2) != FUSE_OK) exit(3);
         t8 = now_ms();
-        evict_caches();
+        if (want("cold")) evict_caches();
         t9 = now_ms();
-        if (fuse_context_frame(ctx, dop, 2) != FUSE_OK) exit(3);
+        if (want("cold") && fuse_context_frame(ctx, dop, 2) != FUSE_OK) exit(3);
         t10 = now_ms();
-        evict_caches();
+        if (want("l2c")) evict_caches();
         t11 = now_ms();
-        if (fuse_context_frame(ctx, dop2, 2) != FUSE_OK) exit(3);
+        if (want("l2c") && fuse_context_frame(ctx, dop2, 2) != FUSE_OK) exit(3);
         t12 = now_ms();
-        evict_caches();
+        if (want("like")) evict_caches();
         t13 = now_ms();
-        if (fuse_context_frame(ctx, like, 2) != FUSE_OK) exit(3);
+        if (want("like") && fuse_context_frame(ctx, like, 2) != FUSE_OK) exit(3);
         t14 = now_ms();
         if (k < 0) continue;
         t[16][k] = t14 - t13;
@@ -411,7 +418,8 @@ static void bench_pixman(eye_buf e[2], int runs, pm_stats *s)
 static void usage(const char *argv0)
 {
     fprintf(stderr, "usage: %s [--csv] [--runs N] [--isa ref|sse2|avx2|avx512] "
-            "[--threads 1|2] [--case typical|worst] [--no-pixman] [--cpu-time]\n", argv0);
+            "[--threads 1|2] [--case typical|worst] [--no-pixman] [--cpu-time] [--stage NAME]\n"
+            "  --stage light|comp|frame|ip|dp|op|dop|l2|cold|l2c|like|memcpy: only that stage\n", argv0);
     exit(2);
 }
 
@@ -440,6 +448,10 @@ int main(int argc, char **argv)
             no_pixman = 1;
         else if (!strcmp(argv[a], "--cpu-time"))
             clock_id = CLOCK_THREAD_CPUTIME_ID;
+        else if (!strcmp(argv[a], "--stage") && a + 1 < argc) {
+            only_stage = argv[++a];
+            no_pixman = 1;
+        }
         else
             usage(argv[0]);
     }

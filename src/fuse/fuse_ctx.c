@@ -11,6 +11,10 @@
 #include "fuse_edge.h"
 #include "fuse_pool.h"
 
+/* Layer rows whose mask span the interleaved frame keeps (comp_scratch.span):
+ * more than the rows lit ahead of the composite (FUSE_CHUNK + 2). */
+#define SPAN_RING 64
+
 typedef struct kernels {
     ef_isa isa;
     int ref;                   /* the reference: axis walk, stages in order */
@@ -22,6 +26,10 @@ typedef struct kernels {
     fuse__opaque_fn opaque;    /* R = V, alpha 255 (transparent spans) */
     fuse__hrow_fn hrow;        /* NULL: no row cache, comp per output row */
     fuse__vrow_fn vrow;
+    fuse__hprep_fn hprep;      /* the row cache's per-tile tables (with hrow) */
+    fuse__light_span_fn light_span;    /* the same kernels on a span of a row */
+    fuse__depth_mspan_fn depth_mspan;
+    fuse__cover_span_fn cover_span;
 } kernels;
 
 /* The ISA's kernels, one row per ISA (the one dispatch table of the room):
@@ -31,18 +39,21 @@ typedef struct kernels {
  * AVX-512 through the row cache (hrow, vrow, per ISA). */
 #define SIMD_KERNELS(sfx) fuse__light_row_##sfx, fuse__depth_row_##sfx, fuse__depth_mrow_##sfx
 #define SIMD_COVER(sfx) fuse__cover_row_##sfx, fuse__opaque_##sfx
+#define SIMD_SPANS(sfx) fuse__light_span_##sfx, fuse__depth_mspan_##sfx, fuse__cover_span_##sfx
 
 static kernels kernels_for(ef_isa isa)
 {
-    static const kernels ref = {EF_ISA_REF, 1, SIMD_KERNELS(ref), NULL, SIMD_COVER(ref), NULL, NULL};
+    static const kernels ref = {EF_ISA_REF, 1, SIMD_KERNELS(ref), NULL, SIMD_COVER(ref), NULL, NULL,
+                                NULL, SIMD_SPANS(ref)};
     static const kernels sse2 = {EF_ISA_SSE2, 0, SIMD_KERNELS(sse2), fuse__composite_cols_sse2,
-                                 SIMD_COVER(sse2), NULL, NULL};
+                                 SIMD_COVER(sse2), NULL, NULL, NULL, SIMD_SPANS(sse2)};
     static const kernels avx2 = {EF_ISA_AVX2, 0, SIMD_KERNELS(avx2), NULL, SIMD_COVER(avx2),
-                                 fuse__hrow_avx2, fuse__vrow_avx2};
+                                 fuse__hrow_avx2, fuse__vrow_avx2, fuse__hprep_avx2, SIMD_SPANS(avx2)};
     static const kernels avx512 = {EF_ISA_AVX512, 0, SIMD_KERNELS(avx512), NULL, SIMD_COVER(avx512),
-                                   fuse__hrow_avx512, fuse__vrow_avx512};
+                                   fuse__hrow_avx512, fuse__vrow_avx512, fuse__hprep_avx512,
+                                   SIMD_SPANS(avx512)};
     static const kernels neon = {EF_ISA_NEON, 0, SIMD_KERNELS(neon), fuse__composite_cols_neon,
-                                 SIMD_COVER(neon), NULL, NULL};
+                                 SIMD_COVER(neon), NULL, NULL, NULL, SIMD_SPANS(neon)};
     switch (isa) {
     case EF_ISA_AVX512: return avx512;
     case EF_ISA_AVX2: return avx2;
@@ -161,7 +172,19 @@ static void light_prefetch(const light_job *j, int y, int x0, int x1)
     prefetch(row_of(&j->P, y) + 4 * (size_t)x0, 4u * (size_t)(x1 - x0), 0);
 }
 
-static void light_rows(const light_job *j, int y0, int y1)
+/* Layer row y: the pixels [x0, x1) lit (mask row m), the rest 0 (their
+ * mask bytes are 0: the reference writes 0 there). */
+static void light_span(const light_job *j, int y, int x0, int x1, const uint8_t *m, uint8_t *o)
+{
+    const int w = j->P.width;
+    if (x0 > 0) memset(o, 0, 4u * (size_t)x0);
+    if (x1 < w) memset(o + 4 * (size_t)x1, 0, 4u * (size_t)(w - x1));
+    j->k->light_span(&j->prep, y, x0, x1, row_of(&j->P, y), m,
+                     j->normal + (size_t)y * (size_t)j->normal_stride, o);
+}
+
+/* span: as eye_light_depth_rows (NULL: none) */
+static void light_rows(const light_job *j, int y0, int y1, int32_t (*span)[3])
 {
     const int w = j->P.width;
     int y;
@@ -170,13 +193,17 @@ static void light_rows(const light_job *j, int y0, int y1)
         uint8_t *o = row_of(&j->out, y);
         int x0, x1;
         mask_span(m, w, &x0, &x1);
+        if (span != NULL) {
+            span[y % SPAN_RING][0] = y;
+            span[y % SPAN_RING][1] = x0;
+            span[y % SPAN_RING][2] = x1;
+        }
         if (x0 >= x1) {     /* the rows above and below the hand */
             memset(o, 0, 4u * (size_t)w);
             continue;
         }
         light_prefetch(j, y + 1, x0, x1);
-        j->k->light(&j->prep, y, w, row_of(&j->P, y), m,
-                    j->normal + (size_t)y * (size_t)j->normal_stride, o);
+        light_span(j, y, x0, x1, m, o);
     }
 }
 
@@ -242,19 +269,25 @@ typedef struct comp_scratch {
     uint64_t grp[2][GWORDS];        /* groups with h computed */
     uint16_t h[2][4 * FUSE__TILE];  /* 4 channels per tile column */
     uint16_t h_zero[4 * FUSE__TILE];/* h = 0 (stored FUSE__H_BIAS), set with the tile */
+    /* The spans of the layer rows lit last (eye_whole): layer row r is 0
+     * outside [span[r % SPAN_RING][1], span[r % SPAN_RING][2]) when
+     * span[r % SPAN_RING][0] == r, so its coverage reads only that span. */
+    int32_t span[SPAN_RING][3];
 } comp_scratch;
 
 static void scratch_init(comp_scratch *s)
 {
+    int i;
     s->tile_c0 = 0;
     s->tile_n = 0;
     s->cov_row[0] = s->cov_row[1] = -1;
+    for (i = 0; i < SPAN_RING; i++) s->span[i][0] = -1;
 }
 
 /* Group g (output columns [g GROUP, g GROUP + GROUP) of the tile) reads the
  * source columns ix[first] .. min(ix[last] + 1, sw - 1), i.e. the blocks
  * blo(g) .. bhi(g); both grow with g. */
-static void scratch_tile(comp_scratch *s, int sw, int vw, int c0, int n)
+static void scratch_tile(comp_scratch *s, const kernels *k, int sw, int vw, int c0, int n)
 {
     const int ng = (n + GROUP - 1) / GROUP, nb = (sw + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
     int g, b;
@@ -265,6 +298,7 @@ static void scratch_tile(comp_scratch *s, int sw, int vw, int c0, int n)
         for (i = 0; i < 4 * FUSE__TILE; i++) s->h_zero[i] = (uint16_t)FUSE__H_BIAS;
     }
     fuse__cols_fill(&s->cols, sw, vw, c0, n);
+    if (k->hprep != NULL) k->hprep(&s->cols, n, sw);
     for (g = 0, b = 0; b < nb; b++) {    /* first g with bhi(g) >= b */
         while (g < ng) {
             const int last = g * GROUP + GROUP - 1 < n ? g * GROUP + GROUP - 1 : n - 1;
@@ -324,8 +358,12 @@ static const uint64_t *scratch_cover(comp_scratch *s, const comp_job *j, int r, 
     if (s->cov_row[0] == r) slot = 0;
     else if (s->cov_row[1] == r) slot = 1;
     else {
+        const int32_t *sp = s->span[r % SPAN_RING];
         slot = s->cov_row[0] == keep ? 1 : 0;
-        j->k->cover(row_of(&j->Q, r), j->Q.width, s->cov[slot]);
+        if (sp[0] == r)
+            j->k->cover_span(row_of(&j->Q, r), j->Q.width, sp[1], sp[2], s->cov[slot]);
+        else
+            j->k->cover(row_of(&j->Q, r), j->Q.width, s->cov[slot]);
         if (j->k->hrow != NULL) scratch_hrow(s, j, r, slot);
         s->cov_row[slot] = r;
     }
@@ -559,7 +597,7 @@ static void comp_vp_rows(const comp_job *j, comp_scratch *s, int y0, int y1)
     }
     for (c0 = 0; c0 < j->vw; c0 += FUSE__TILE) {
         const int n = j->vw - c0 < FUSE__TILE ? j->vw - c0 : FUSE__TILE;
-        scratch_tile(s, sw, j->vw, c0, n);
+        scratch_tile(s, j->k, sw, j->vw, c0, n);
         for (y = y0; y < y1; y++)
             comp_row_tiled(j, s, y, c0, n);
     }
@@ -589,7 +627,7 @@ static void light_task(void *arg, int t, int n)
     const light_job *j = arg;
     int y0, y1;
     band(j->P.height, t, n, &y0, &y1);
-    light_rows(j, y0, y1);
+    light_rows(j, y0, y1, NULL);
 }
 
 static void comp_task(void *arg, int t, int n)
@@ -734,22 +772,25 @@ typedef struct frame_job {
  * before lighting, so hidden pixels are never lit; the bytes are those of
  * lighting and then testing the layer (fuse_internal.h,
  * fuse__depth_mask_fn), which the reference does. */
-static void eye_light_depth_rows(const eye_job *e, int y0, int y1);
+static void eye_light_depth_rows(const eye_job *e, int y0, int y1, int32_t (*span)[3]);
 
 /* ... and faded towards the sides that end inside the display (fuse_edge.h:
  * one scalar pass over the border strips, once a row is final). */
-static void eye_light_depth(const eye_job *e, int y0, int y1)
+static void eye_light_depth(const eye_job *e, int y0, int y1, int32_t (*span)[3])
 {
     const int k = e->edge_fade, w = e->light.out.width, h = e->light.out.height;
     int y;
-    eye_light_depth_rows(e, y0, y1);
+    eye_light_depth_rows(e, y0, y1, span);
     if (k < 1 || e->edge_sides == 0) return;
     for (y = y0; y < y1; y++)
         if ((e->edge_sides & (FUSE_EDGE_LEFT | FUSE_EDGE_RIGHT)) || y < k || h - 1 - y < k)
             fuse_edge_fade_row(row_of(&e->light.out, y), y, w, h, k, e->edge_sides);
 }
 
-static void eye_light_depth_rows(const eye_job *e, int y0, int y1)
+/* span (NULL: none): a ring of SPAN_RING (row, x0, x1) where each lit row
+ * records the span outside which it is 0 (comp_scratch.span). The edge
+ * fade keeps a zero pixel zero. */
+static void eye_light_depth_rows(const eye_job *e, int y0, int y1, int32_t (*span)[3])
 {
     const light_job *j = &e->light;
     const int w = j->P.width, sh = j->P.height;
@@ -758,7 +799,7 @@ static void eye_light_depth_rows(const eye_job *e, int y0, int y1)
     uint8_t m[FUSE_MAX_DIM];
     int y;
     if (d == NULL || j->k->ref) {
-        light_rows(j, y0, y1);
+        light_rows(j, y0, y1, span);
         if (d != NULL)
             fuse__depth_rows(d, &j->out, e->comp.vx, e->comp.vy, e->comp.vw, e->comp.vh, y0, y1,
                              j->k->depth);
@@ -770,6 +811,11 @@ static void eye_light_depth_rows(const eye_job *e, int y0, int y1)
         uint8_t *o = row_of(&j->out, y);
         int x0, x1;
         mask_span(m0, w, &x0, &x1);
+        if (span != NULL) {
+            span[y % SPAN_RING][0] = y;
+            span[y % SPAN_RING][1] = x0;
+            span[y % SPAN_RING][2] = x1;
+        }
         if (x0 >= x1) {
             memset(o, 0, 4u * (size_t)w);
             continue;
@@ -783,11 +829,11 @@ static void eye_light_depth_rows(const eye_job *e, int y0, int y1)
             prefetch(fuse__depth_scene_row(d, y + 1, sh, e->comp.vx, e->comp.vy, e->comp.vh) + c0,
                      sizeof(float) * (size_t)(c1 - c0 + 1), 0);
         }
-        memcpy(m, m0, (size_t)w);
-        j->k->depth_mask(&dp, m, d->hand + (size_t)y * (size_t)d->hand_stride,
-                         fuse__depth_scene_row(d, y, sh, e->comp.vx, e->comp.vy, e->comp.vh), w);
-        j->k->light(&j->prep, y, w, row_of(&j->P, y), m,
-                    j->normal + (size_t)y * (size_t)j->normal_stride, o);
+        memcpy(m + x0, m0 + x0, (size_t)(x1 - x0));   /* the mask is 0 outside the span */
+        j->k->depth_mspan(&dp, m, d->hand + (size_t)y * (size_t)d->hand_stride,
+                          fuse__depth_scene_row(d, y, sh, e->comp.vx, e->comp.vy, e->comp.vh),
+                          x0, x1);
+        light_span(j, y, x0, x1, m, o);
     }
 }
 
@@ -811,7 +857,7 @@ static void eye_whole(const eye_job *e, int interleave)
     comp_scratch s;
     int lit = 0, y;
     if (!interleave || j->k->ref || j->vw > FUSE__TILE) {
-        eye_light_depth(e, 0, sh);
+        eye_light_depth(e, 0, sh, NULL);
         comp_rows(j, 0, j->V.height);
         return;
     }
@@ -822,12 +868,12 @@ static void eye_whole(const eye_job *e, int interleave)
         const int iy = pos >> 16, need = iy + 1 < sh ? iy + 1 : sh - 1;
         while (lit <= need) {
             const int n = sh - lit < FUSE_CHUNK ? sh - lit : FUSE_CHUNK;
-            eye_light_depth(e, lit, lit + n);
+            eye_light_depth(e, lit, lit + n, s.span);
             lit += n;
         }
         comp_vp_rows(j, &s, y, y + 1);
     }
-    if (lit < sh) eye_light_depth(e, lit, sh);
+    if (lit < sh) eye_light_depth(e, lit, sh, NULL);
 }
 
 /* count a multiple of n: thread t takes eyes t, t + n, ... whole */
@@ -845,7 +891,7 @@ static void frame_light_task(void *arg, int t, int n)
     int e, y0, y1;
     for (e = 0; e < f->count; e++) {
         band(f->eyes[e].light.P.height, t, n, &y0, &y1);
-        eye_light_depth(&f->eyes[e], y0, y1);
+        eye_light_depth(&f->eyes[e], y0, y1, NULL);
     }
 }
 

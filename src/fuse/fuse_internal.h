@@ -262,6 +262,19 @@ void fuse__composite_row_ref(const uint8_t *q0, const uint8_t *q1,
 typedef struct fuse__cols {
     int32_t ix[FUSE__TILE];
     int32_t fx[FUSE__TILE];
+    /* What fuse__hprep_<isa> adds for that ISA's fuse__hrow (hprep_w its
+     * SIMD_W; 0: not prepared, then fuse__hrow goes pixel by pixel), per
+     * step of SIMD_W columns from column 0: hbase[k] the first layer pixel
+     * of the window of SIMD_W pixels that holds every tap of step k, -1
+     * when none does (a gather); hidx0/hidx1 the taps ix, min(ix + 1,
+     * sw - 1) of each column, relative to hbase (absolute for a gather);
+     * hw the column weights fx as two 16-bit copies per int32, in the
+     * layer's block order (2 SIMD_W int32 per step: the low then the high
+     * halves of the blocks, as vh_from_u8_lo / hi widen the pixels). */
+    int hprep_w;
+    int32_t hbase[FUSE__TILE / 4];
+    int32_t hidx0[FUSE__TILE], hidx1[FUSE__TILE];
+    int32_t hw[2 * FUSE__TILE];
 } fuse__cols;
 
 /* Fills cols for viewport columns [c0, c0 + n), n <= FUSE__TILE. */
@@ -281,6 +294,7 @@ static inline void fuse__cols_fill(fuse__cols *cols, int sw, int vw, int c0, int
         cols->ix[i] = p >> 16;
         cols->fx[i] = (int32_t)(((uint32_t)p >> 8) & 255u);
     }
+    cols->hprep_w = 0;
 }
 
 /* One output pixel of fuse__composite_row_ref from the table: the same
@@ -311,6 +325,24 @@ typedef void (*fuse__composite_fn)(const uint8_t *q0, const uint8_t *q1,
 typedef void (*fuse__light_fn)(const fuse__light_prep *p, int y, int width,
                                const uint8_t *P, const uint8_t *mask,
                                const float *normal, uint8_t *out);
+
+/* The lighting of pixels x0 <= x < x1 of a row only (pointers at pixel 0),
+ * the bytes of fuse__light_span_ref. */
+typedef void (*fuse__light_span_fn)(const fuse__light_prep *p, int y, int x0, int x1,
+                                    const uint8_t *P, const uint8_t *mask,
+                                    const float *normal, uint8_t *out);
+void fuse__light_span_sse2(const fuse__light_prep *p, int y, int x0, int x1,
+                           const uint8_t *P, const uint8_t *mask, const float *normal,
+                           uint8_t *out);
+void fuse__light_span_avx2(const fuse__light_prep *p, int y, int x0, int x1,
+                           const uint8_t *P, const uint8_t *mask, const float *normal,
+                           uint8_t *out);
+void fuse__light_span_avx512(const fuse__light_prep *p, int y, int x0, int x1,
+                             const uint8_t *P, const uint8_t *mask, const float *normal,
+                             uint8_t *out);
+void fuse__light_span_neon(const fuse__light_prep *p, int y, int x0, int x1,
+                           const uint8_t *P, const uint8_t *mask, const float *normal,
+                           uint8_t *out);
 
 void fuse__composite_cols_ref(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
                               const fuse__cols *cols, int c, int n, int sw,
@@ -385,6 +417,11 @@ static inline void fuse__vpx(const uint16_t *h0, const uint16_t *h1, uint32_t fy
     out[3] = 255;
 }
 
+/* The ISA's per-step tables of cols (n columns of the tile, layer width
+ * sw), once per tile, before its fuse__hrow calls. */
+typedef void (*fuse__hprep_fn)(fuse__cols *cols, int n, int sw);
+void fuse__hprep_avx2(fuse__cols *cols, int n, int sw);
+void fuse__hprep_avx512(fuse__cols *cols, int n, int sw);
 void fuse__hrow_avx2(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
                      uint16_t *h);
 void fuse__hrow_avx512(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
@@ -411,6 +448,15 @@ typedef void (*fuse__cover_fn)(const uint8_t *q, int w, uint64_t *bits);
  * out and v do not overlap. */
 typedef void (*fuse__opaque_fn)(const uint8_t *v, uint8_t *out, int n);
 
+/* The same when the caller knows that every pixel outside [x0, x1)
+ * (0 <= x0, x1 <= w) is 0: only the blocks that meet [x0, x1) are read
+ * (the lit rows' mask spans, fuse_ctx.c). Same bits. */
+typedef void (*fuse__cover_span_fn)(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
+void fuse__cover_span_ref(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
+void fuse__cover_span_sse2(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
+void fuse__cover_span_avx2(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
+void fuse__cover_span_avx512(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
+void fuse__cover_span_neon(const uint8_t *q, int w, int x0, int x1, uint64_t *bits);
 void fuse__cover_row_ref(const uint8_t *q, int w, uint64_t *bits);
 void fuse__cover_row_sse2(const uint8_t *q, int w, uint64_t *bits);
 void fuse__cover_row_avx2(const uint8_t *q, int w, uint64_t *bits);
@@ -482,6 +528,18 @@ void fuse__depth_mspan_ref(const fuse__depth_prep *p, uint8_t *m, const float *h
                            const float *sc, int x0, int x1);
 void fuse__depth_mrow_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
                           const float *sc, int w);
+/* Pixels x0 <= x < x1 of the mask row only (m, hz, sc at pixel 0): the
+ * bytes of fuse__depth_mspan_ref. */
+typedef void (*fuse__depth_mspan_fn)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                                     const float *sc, int x0, int x1);
+void fuse__depth_mspan_sse2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                            const float *sc, int x0, int x1);
+void fuse__depth_mspan_avx2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                            const float *sc, int x0, int x1);
+void fuse__depth_mspan_avx512(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                              const float *sc, int x0, int x1);
+void fuse__depth_mspan_neon(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                            const float *sc, int x0, int x1);
 void fuse__depth_mrow_sse2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
                            const float *sc, int w);
 void fuse__depth_mrow_avx2(const fuse__depth_prep *p, uint8_t *m, const float *hz,

@@ -296,6 +296,25 @@ void fuse__cover_row_ref(const uint8_t *q, int w, uint64_t *bits)
     }
 }
 
+/* The same reading only the blocks that meet [x0, x1) (the others are 0). */
+void fuse__cover_span_ref(const uint8_t *q, int w, int x0, int x1, uint64_t *bits)
+{
+    const int nb = (w + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
+    int b;
+    memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
+    if (x0 >= x1) return;
+    for (b = x0 / FUSE__COV_BLOCK; b < nb && b * FUSE__COV_BLOCK < x1; b++) {
+        const int xb = 8 * b + 8 < w ? 8 * b + 8 : w;
+        uint32_t acc = 0, t;
+        int x;
+        for (x = 8 * b; x < xb; x++) {
+            memcpy(&t, q + 4 * (size_t)x, 4);
+            acc |= t;
+        }
+        if (acc != 0) bits[b >> 6] |= (uint64_t)1 << (b & 63);
+    }
+}
+
 void fuse__opaque_ref(const uint8_t *v, uint8_t *out, int n)
 {
     int i;

@@ -5,11 +5,15 @@
  * which defines, with SIMD_FN's suffix (_sse2, _avx2, _avx512, _neon):
  *
  *   fuse__light_row     the lighting of one layer row (fuse__light_fn)
+ *   fuse__light_span    the same on a span of the row (fuse__light_span_fn)
  *   fuse__pow01_row     the lane power over an array (for the tests)
  *   fuse__depth_row     the depth test on a layer row (fuse__depth_fn)
  *   fuse__depth_mrow    the same on mask bytes (fuse__depth_mask_fn)
+ *   fuse__depth_mspan   the same on a span of the mask row (fuse__depth_mspan_fn)
  *   fuse__cover_row     coverage bits of a layer row (fuse__cover_fn)
+ *   fuse__cover_span    the same reading a span only (fuse__cover_span_fn)
  *   fuse__opaque        R = V | alpha 255 (fuse__opaque_fn)
+ *   fuse__hprep, fuse__hrow, fuse__vrow  the row cache (FUSE_ROWCACHE_ON_LAYER)
  *
  * Each repeats the reference (fuse_ref.c, fuse_depth.c) operation for
  * operation, in the same order, with the same constants, so every lane
@@ -167,9 +171,14 @@ static inline __attribute__((always_inline)) void pow01_lanes(const VF *x, VF s,
     }
 }
 
+/* fuse__clamp01: v > 0 ? (v < 1 ? v : 1) : +0. As max(min(v, 1), +0) with
+ * the layer's vf_min / vf_max (a < b ? a : b, a > b ? a : b): the same value
+ * for every v but NaN (-0 gives +0 either way), one operation fewer; no NaN
+ * reaches it (validated parameters, normals without a usable length
+ * replaced: fuse_internal.h). */
 static inline VF clamp01_lanes(VF v)
 {
-    return FZERO_UNLESS(FGT(v, F1(0.0f)), FMIN1(v));
+    return FMAX0(FMIN1(v));
 }
 
 /* (int)(v * 255 + 0.5), v in [0, 1] */
@@ -256,13 +265,14 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
 }
 
 /* Two vectors a step where both have mask bytes, one where only one has,
- * a zero store where neither has (the reference's M == 0 pixels). */
-void LIGHT_ROW_NAME(const fuse__light_prep *p, int y, int width,
-                    const uint8_t *P, const uint8_t *mask,
-                    const float *normal, uint8_t *out)
+ * a zero store where neither has (the reference's M == 0 pixels). Pixels
+ * x0 <= x < x1 of the row (fuse__light_span_ref; the pointers at pixel 0). */
+void SIMD_FN(fuse__light_span)(const fuse__light_prep *p, int y, int x0, int width,
+                               const uint8_t *P, const uint8_t *mask,
+                               const float *normal, uint8_t *out)
 {
     const VF py = F1((((float)y + 0.5f) - p->cy) * p->ify);
-    int x = 0;
+    int x = x0;
     for (; x + 2 * LANES <= width; x += 2 * LANES) {
         const int z0 = MASK_ZERO(mask + x), z1 = MASK_ZERO(mask + x + LANES);
         if (!z0 && !z1) {
@@ -280,6 +290,13 @@ void LIGHT_ROW_NAME(const fuse__light_prep *p, int y, int width,
     }
     if (x < width)
         fuse__light_span_ref(p, y, x, width, P, mask, normal, out);
+}
+
+void LIGHT_ROW_NAME(const fuse__light_prep *p, int y, int width,
+                    const uint8_t *P, const uint8_t *mask,
+                    const float *normal, uint8_t *out)
+{
+    SIMD_FN(fuse__light_span)(p, y, 0, width, P, mask, normal, out);
 }
 
 /* pow01_lanes over an array (tests compare its float bits with
@@ -323,7 +340,7 @@ SIMD_INL vfloat fuse_scene_lanes(const fuse__depth_prep *p, const float *sc, vin
  * The column of each lane walks as fuse__depth_col's exact quotient and
  * remainder: stepped by SIMD_W pixels, 2 SIMD_W vw = sq den + sr. */
 SIMD_INL void depth_row(const fuse__depth_prep *p, uint8_t *q, const float *hz, const float *sc,
-                        int w, int bpp)
+                        int x0, int w, int bpp)
 {
     const vfloat zero = vf_zero(), one = vf_set1(1.0f), two = vf_set1(2.0f);
     const vfloat two_fn = vf_set1(p->two_fn), fpn = vf_set1(p->fpn);
@@ -334,15 +351,15 @@ SIMD_INL void depth_row(const fuse__depth_prep *p, uint8_t *q, const float *hz, 
     _Alignas(64) int32_t ox0[SIMD_W], rem0[SIMD_W];
     vint ox, rem;
     int x, k;
-    if (w < SIMD_W) {
-        if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, 0, w);
-        else fuse__depth_mspan_ref(p, q, hz, sc, 0, w);
+    if (w - x0 < SIMD_W) {
+        if (bpp == 4) fuse__depth_span_ref(p, q, hz, sc, x0, w);
+        else fuse__depth_mspan_ref(p, q, hz, sc, x0, w);
         return;
     }
-    for (k = 0; k < SIMD_W; k++) fuse__depth_col(p, k, &ox0[k], &rem0[k]);
+    for (k = 0; k < SIMD_W; k++) fuse__depth_col(p, x0 + k, &ox0[k], &rem0[k]);
     ox = vi_load(ox0);
     rem = vi_load(rem0);
-    for (x = 0; x + SIMD_W <= w; x += SIMD_W) {
+    for (x = x0; x + SIMD_W <= w; x += SIMD_W) {
         vint qq;
         int any;
         if (bpp == 4) {
@@ -386,26 +403,39 @@ SIMD_INL void depth_row(const fuse__depth_prep *p, uint8_t *q, const float *hz, 
 void SIMD_FN(fuse__depth_row)(const fuse__depth_prep *p, uint8_t *q, const float *hz,
                               const float *sc, int w)
 {
-    depth_row(p, q, hz, sc, w, 4);
+    depth_row(p, q, hz, sc, 0, w, 4);
 }
 
 void SIMD_FN(fuse__depth_mrow)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
                                const float *sc, int w)
 {
-    depth_row(p, m, hz, sc, w, 1);
+    depth_row(p, m, hz, sc, 0, w, 1);
+}
+
+/* pixels x0 <= x < x1 of the mask row only (m, hz, sc at pixel 0) */
+void SIMD_FN(fuse__depth_mspan)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                                const float *sc, int x0, int x1)
+{
+    depth_row(p, m, hz, sc, x0, x1, 1);
 }
 
 /* ---- coverage bits and opaque copies (fuse_internal.h) ----------------- */
 
-/* bit b set iff a byte of pixels [8b, 8b + 8) is not 0 */
-void SIMD_FN(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
+/* bit b set iff a byte of pixels [8b, 8b + 8) is not 0; only the pixels
+ * [x0, x1) are read (the caller knows the others are 0: their bits are
+ * 0), fuse__cover_span_fn */
+void SIMD_FN(fuse__cover_span)(const uint8_t *q, int w, int x0, int x1, uint64_t *bits)
 {
     const int nb = (w + 7) / 8;
-    int b = 0, x;
+    const int xa = x0 & ~(SIMD_W >= 8 ? SIMD_W - 1 : 7);   /* whole vectors (W >= 8) or blocks */
+    const int xe = ((x1 + 7) & ~7) < w ? ((x1 + 7) & ~7) : w;
+    const int ne = (xe + 7) / 8;
+    int b = xa / 8, x;
     memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
+    if (x0 >= x1) return;
 #if SIMD_W >= 8
     /* SIMD_W / 8 blocks per vector: the lanes' non-zero bits, 8 a block */
-    for (x = 0; x + SIMD_W <= w; x += SIMD_W, b += SIMD_W / 8) {
+    for (x = xa; x + SIMD_W <= xe; x += SIMD_W, b += SIMD_W / 8) {
         const vint t = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
         const unsigned nzb = vm_bits(vi_eq(t, vi_zero())) ^ SIMD_FULL;
         unsigned pat = 0;
@@ -416,7 +446,7 @@ void SIMD_FN(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
     }
 #else
     /* 8 / SIMD_W vectors per block, or-ed */
-    for (x = 0; x + 8 <= w; x += 8, b++) {
+    for (x = xa; x + 8 <= xe; x += 8, b++) {
         vint t = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
         int j;
         for (j = SIMD_W; j < 8; j += SIMD_W)
@@ -424,17 +454,22 @@ void SIMD_FN(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
         bits[b >> 6] |= (uint64_t)!vm_all(vi_eq(t, vi_zero())) << (b & 63);
     }
 #endif
-    if (b < nb) {   /* the last w % 8 (or w % SIMD_W) pixels */
-        for (; b < nb; b++) {
-            const int x1 = 8 * b + 8 < w ? 8 * b + 8 : w;
+    if (b < ne) {   /* the last blocks (xe % SIMD_W pixels) */
+        for (; b < ne; b++) {
+            const int xb = 8 * b + 8 < w ? 8 * b + 8 : w;
             uint32_t acc = 0, t;
-            for (x = 8 * b; x < x1; x++) {
+            for (x = 8 * b; x < xb; x++) {
                 memcpy(&t, q + 4 * (size_t)x, 4);
                 acc |= t;
             }
             if (acc) bits[b >> 6] |= (uint64_t)1 << (b & 63);
         }
     }
+}
+
+void SIMD_FN(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
+{
+    SIMD_FN(fuse__cover_span)(q, w, 0, w, bits);
 }
 
 /* out = v | alpha 255; in place (v == out) only the vectors with an alpha
@@ -612,47 +647,76 @@ void SIMD_FN(fuse__composite_cols)(const uint8_t *q0, const uint8_t *q1, uint32_
  * (pixels 4B, 4B + 1 of each block B) then of vh_from_u8_hi (4B + 2,
  * 4B + 3), so neither kernel reorders across blocks; vh_packus puts the
  * pixels back in memory order. */
+/* The per-step tables of fuse__cols for this ISA's hrow (fuse_internal.h):
+ * the window test, the taps' indices and the weights of each step, once
+ * per tile instead of once per layer row. */
+void SIMD_FN(fuse__hprep)(fuse__cols *cols, int n, int sw)
+{
+    const vint one = vi_set1(1), last = vi_set1(sw - 1);
+    int i;
+    for (i = 0; i + SIMD_W <= n; i += SIMD_W) {
+        const vint ix = vi_loadu(cols->ix + i);
+        const vint ix1 = vi_min(vi_add(ix, one), last);
+        const vint fx = vi_loadu(cols->fx + i);
+        vint wl = vi_zip_lo(fx, fx), wh = vi_zip_hi(fx, fx);
+        int base = cols->ix[i];
+        const int hi = cols->ix[i + SIMD_W - 1] + 1 < sw ? cols->ix[i + SIMD_W - 1] + 1 : sw - 1;
+        if (base > sw - SIMD_W) base = sw - SIMD_W;
+        /* fx of each pixel in its four 16-bit lanes, in the blocks' order */
+        wl = vi_or(wl, vi_slli(wl, 16));
+        wh = vi_or(wh, vi_slli(wh, 16));
+        vi_storeu(cols->hw + 2 * i, wl);
+        vi_storeu(cols->hw + 2 * i + SIMD_W, wh);
+        if (base >= 0 && hi - base < SIMD_W) {
+            const vint bb = vi_set1(base);
+            cols->hbase[i / SIMD_W] = base;
+            vi_storeu(cols->hidx0 + i, vi_sub(ix, bb));
+            vi_storeu(cols->hidx1 + i, vi_sub(ix1, bb));
+        } else {
+            cols->hbase[i / SIMD_W] = -1;
+            vi_storeu(cols->hidx0 + i, ix);
+            vi_storeu(cols->hidx1 + i, ix1);
+        }
+    }
+    cols->hprep_w = SIMD_W;
+}
+
 void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
                          uint16_t *h)
 {
-    const vint one = vi_set1(1), last = vi_set1(sw - 1);
     const vint w256 = vh_set1(256), bias = vh_set1((int)FUSE__H_BIAS);
     const int32_t *ixs = cols->ix + c, *fxs = cols->fx + c;
     int i = 0;
-    for (; i + SIMD_W <= n; i += SIMD_W) {
-        const vint ix = vi_loadu(ixs + i);
-        const vint ix1 = vi_min(vi_add(ix, one), last);
-        vint a, b, fx, wl, wh;
-        int base = ixs[i];
-        const int hi = ixs[i + SIMD_W - 1] + 1 < sw ? ixs[i + SIMD_W - 1] + 1 : sw - 1;
-        if (base > sw - SIMD_W) base = sw - SIMD_W;
-        if (base >= 0 && hi - base < SIMD_W) {
-            const vint s0 = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)base));
-            const vint bb = vi_set1(base);
-            if (vm_all(vi_eq(s0, vi_zero()))) {   /* every tap 0: h = 0 */
-                vi_storeu((int32_t *)(void *)(h + 4 * i), bias);
-                vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W), bias);
-                continue;
+    if (cols->hprep_w == SIMD_W && c % SIMD_W == 0) {
+        const int32_t *base = cols->hbase + c / SIMD_W;
+        const int32_t *i0s = cols->hidx0 + c, *i1s = cols->hidx1 + c, *ws = cols->hw + 2 * c;
+        for (; i + SIMD_W <= n; i += SIMD_W, base++) {
+            const vint i0 = vi_loadu(i0s + i), i1 = vi_loadu(i1s + i);
+            const vint wl = vi_loadu(ws + 2 * i), wh = vi_loadu(ws + 2 * i + SIMD_W);
+            vint a, b;
+            if (*base >= 0) {
+                const vint s0 = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)*base));
+                if (vm_all(vi_eq(s0, vi_zero()))) {   /* every tap 0: h = 0 */
+                    vi_storeu((int32_t *)(void *)(h + 4 * i), bias);
+                    vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W), bias);
+                    continue;
+                }
+                a = vi_permute(s0, i0);
+                b = vi_permute(s0, i1);
+            } else {
+                a = vi_gather((const int32_t *)(const void *)q, i0);
+                b = vi_gather((const int32_t *)(const void *)q, i1);
             }
-            a = vi_permute(s0, vi_sub(ix, bb));
-            b = vi_permute(s0, vi_sub(ix1, bb));
-        } else {
-            a = vi_gather((const int32_t *)(const void *)q, ix);
-            b = vi_gather((const int32_t *)(const void *)q, ix1);
+            vi_storeu((int32_t *)(void *)(h + 4 * i),
+                      vi_xor(vh_add(vh_mullo(vh_from_u8_lo(a), vh_sub(w256, wl)),
+                                    vh_mullo(vh_from_u8_lo(b), wl)), bias));
+            vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W),
+                      vi_xor(vh_add(vh_mullo(vh_from_u8_hi(a), vh_sub(w256, wh)),
+                                    vh_mullo(vh_from_u8_hi(b), wh)), bias));
         }
-        /* fx of each pixel in its four 16-bit lanes, in the blocks' order */
-        fx = vi_loadu(fxs + i);
-        wl = vi_zip_lo(fx, fx);
-        wh = vi_zip_hi(fx, fx);
-        wl = vi_or(wl, vi_slli(wl, 16));
-        wh = vi_or(wh, vi_slli(wh, 16));
-        vi_storeu((int32_t *)(void *)(h + 4 * i),
-                  vi_xor(vh_add(vh_mullo(vh_from_u8_lo(a), vh_sub(w256, wl)),
-                                vh_mullo(vh_from_u8_lo(b), wl)), bias));
-        vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W),
-                  vi_xor(vh_add(vh_mullo(vh_from_u8_hi(a), vh_sub(w256, wh)),
-                                vh_mullo(vh_from_u8_hi(b), wh)), bias));
     }
+    /* the last n % SIMD_W columns (all of them without the tables: the
+     * same bytes, pixel by pixel) */
     for (; i < n; i++) fuse__hpx(q, ixs[i], (uint32_t)fxs[i], sw, h + 4 * i);
 }
 

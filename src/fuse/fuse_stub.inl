@@ -11,6 +11,13 @@ void FUSE_STUB(fuse__light_row)(const fuse__light_prep *p, int y, int width,
     fuse__light_row_ref(p, y, width, P, mask, normal, out);
 }
 
+void FUSE_STUB(fuse__light_span)(const fuse__light_prep *p, int y, int x0, int x1,
+                                 const uint8_t *P, const uint8_t *mask,
+                                 const float *normal, uint8_t *out)
+{
+    fuse__light_span_ref(p, y, x0, x1, P, mask, normal, out);
+}
+
 void FUSE_STUB(fuse__pow01_row)(const float *x, int n, float s, float *out)
 {
     int i;
@@ -27,6 +34,17 @@ void FUSE_STUB(fuse__depth_mrow)(const fuse__depth_prep *p, uint8_t *m, const fl
                                  const float *sc, int w)
 {
     fuse__depth_mrow_ref(p, m, hz, sc, w);
+}
+
+void FUSE_STUB(fuse__depth_mspan)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
+                                  const float *sc, int x0, int x1)
+{
+    fuse__depth_mspan_ref(p, m, hz, sc, x0, x1);
+}
+
+void FUSE_STUB(fuse__cover_span)(const uint8_t *q, int w, int x0, int x1, uint64_t *bits)
+{
+    fuse__cover_span_ref(q, w, x0, x1, bits);
 }
 
 void FUSE_STUB(fuse__cover_row)(const uint8_t *q, int w, uint64_t *bits)
@@ -57,6 +75,11 @@ void FUSE_STUB(fuse__opaque)(const uint8_t *v, uint8_t *out, int n)
 }
 
 #ifdef FUSE_ROWCACHE_ON_LAYER
+void FUSE_STUB(fuse__hprep)(fuse__cols *cols, int n, int sw)
+{
+    (void)cols, (void)n, (void)sw;   /* the stub's hrow needs no tables */
+}
+
 void FUSE_STUB(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
                            uint16_t *h)
 {
