@@ -64,6 +64,7 @@ static void run_subset(const char *name, const char *methods)
     struct dirent *e;
     while ((e = readdir(d))) assert_null(strstr(e->d_name, ".tmp."));
     closedir(d);
+    assert_int_equal(system(cmd), 0);   /* rm -rf the report */
 }
 
 static void subset_kin_refine(void **state)
