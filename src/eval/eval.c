@@ -557,6 +557,10 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                     mask = pipe_fit_prior(&bd, &cam, c->world, &c->rig, r->sides, r->speed,
                                           cfg->prior_speed, shift, mask, r->prev[e],
                                           c->mask_prior, CW);
+                    /* its rim must look like the hand (last frame's
+                     * edge a pixel off: fit_band.h) */
+                    if (mask == c->mask_prior && cfg->fit && pipe_fit_learned(r->fit, e))
+                        pipe_fit_prior_colour(pipe_fit_colour(r->fit, e), &P, c->mask_prior, CW);
                 }
                 for (int k = 0; k < 2; k++)
                     r->have_hand_px[e][k] =
@@ -573,6 +577,10 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                         : fuse_refine_mask(&rp, &P, mask, CW, c->refined, CW, c->refine_scratch,
                                            c->refine_scratch_size, &rs);
                 if (fr != FUSE_OK) return -1;
+                /* and so must the pixels the vote let in beyond it */
+                if (mask == c->mask_prior && rs.used_colour && cfg->fit &&
+                    pipe_fit_learned(r->fit, e))
+                    pipe_fit_refined_colour(pipe_fit_colour(r->fit, e), &P, mask, c->refined, CW);
                 /* not from a fallback (out = M): its widths are the
                  * model's own (as pipe_frame) */
                 if (cfg->fit && posed && rs.used_colour) {

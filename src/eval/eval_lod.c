@@ -121,12 +121,16 @@ int eval__write_lod(const char *dir, const method_run *R, int n)
     static const method_kind kinds[2] = {M_KIN_CAL, M_REFINE};
     for (int k = 0; k < 2; k++) {
         fprintf(of.f, "# %s\n", kind_name[kinds[k]]);
+        int rows = 0;
         for (int i = 0; i < n; i++) {
             if (strcmp(R[i].cfg.group, "lod") || R[i].cfg.kind != kinds[k]) continue;
+            rows++;
             lod_sum s = lod_summary(&R[i]);
             fprintf(of.f, "%.0f %.4f %.5f %.5f %.5f %.5f \"%s\"\n", s.tris, s.ms_raster,
                     s.iou_full, s.iou, s.bf1_full, s.bf1, R[i].cfg.setting);
         }
+        /* an empty block is no gnuplot index (refine's would become 0) */
+        if (!rows) fprintf(of.f, "nan nan nan nan nan nan \"\"\n");
         fprintf(of.f, "\n\n");
     }
     if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);

@@ -187,8 +187,10 @@ static int write_group(const char *dir, const char *group, const method_run *R, 
 }
 
 /* DIR/sequences.dat: per sequence, IoU then BF(3 px) of the four methods. */
-static int write_sequences(const char *dir, const method_run *R, int n, const eval_opts *o)
+static int write_sequences(const char *dir, const method_run *R, int n, const eval_opts *o,
+                           int has[4])
 {
+    memset(has, 0, 4 * sizeof has[0]);
     char path[IO_PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/sequences.dat", dir);
     io_out of;
@@ -212,7 +214,7 @@ static int write_sequences(const char *dir, const method_run *R, int n, const ev
                 summary s = summarise(&R[i]);
                 iou[k] = s.iou;
                 bf3[k] = s.bf3;
-                any = 1;
+                any = has[k] = 1;
             }
         }
         if (!any) continue;
@@ -272,6 +274,16 @@ int eval__gnuplot(const char *dir, const char *script, const char *const *charts
         fprintf(stderr, "egofuse eval: gnuplot failed (status %d): the data files and "
                         "%s/%s are written, the PNG charts are not\n", rc, dir, script);
     return bad ? EXIT_FAIL : EXIT_OK;
+}
+
+/* A chart with no points (none of --methods runs it): gnuplot fails on a
+ * plot whose every point is undefined and then draws no chart at all, so
+ * the chart gets fixed ranges, a note and an empty plot. */
+static void empty_plot(FILE *f, const char *what)
+{
+    fprintf(f, "set xrange [0:1]\nset yrange [0:1]\nset key off\nset label 98 'no points: "
+               "%s' at graph 0.5, graph 0.5 center\nplot NaN notitle\nunset label 98\n"
+               "set key on\nset autoscale\n", what);
 }
 
 /* ---- the speed-accuracy charts: labels that do not overlap ----------
@@ -402,8 +414,19 @@ static void sp_chart(FILE *f, const char *dir, const char *name, const char *tit
     fprintf(f, "set xlabel 'ms per stereo frame (pose, skin, raster, refine, light, composite; "
                "1 thread)'\nset key bottom right box opaque\n");
     sp_labels(f, p, np, rg);
-    fprintf(f, "plot for [i=0:3] '%s/speed.dat' index i using 1:%d with points pt 7 ps 1.4 lc i+1 "
-               "title word(titles, i+1)\n", dir, ycol);
+    /* the kinds with points only: an empty block would be a legend entry
+     * with no point, and all empty a failed plot */
+    int first = 1;
+    for (int k = 0; k < 4; k++) {
+        int has = 0;
+        for (int i = 0; i < np && !has; i++) has = p[i].kind == k;
+        if (!has) continue;
+        fprintf(f, "%s'%s/speed.dat' index %d using 1:%d with points pt 7 ps 1.4 lc %d "
+                   "title word(titles, %d)", first ? "plot " : ", \\\n     ", dir, k, ycol,
+                k + 1, k + 1);
+        first = 0;
+    }
+    fprintf(f, "%s\n", first ? "plot NaN notitle" : "");
     fprintf(f, "unset label\nunset arrow\nunset logscale x\nset autoscale\n"
                "set lmargin\nset rmargin\nset bmargin\nset tmargin\n");
 }
@@ -433,15 +456,15 @@ static void sweep_chart(FILE *f, const char *dir, const char *group, const char 
     fprintf(f, "set arrow 90 from graph 0, first 0.9 to graph 1, first 0.9 nohead dt 2 "
                "lc rgb '#808080'\n");
     int first = 1;
-    fprintf(f, "plot ");
     for (int k = 0; k < 4; k++) {
         if (!si->has[k]) continue;
         fprintf(f, "%s'%s/%s.dat' index %d using 1:2 with linespoints lw 2 pt 7 lc %d title '%s'",
-                first ? "" : ", \\\n     ", dir, group, k, k + 1, tn[k]);
+                first ? "plot " : ", \\\n     ", dir, group, k, k + 1, tn[k]);
         first = 0;
     }
-    if (first) fprintf(f, "NaN notitle");
-    fprintf(f, "\nunset label\nunset arrow\n");
+    fprintf(f, "\n");
+    if (first) empty_plot(f, "no method of --methods runs this sweep");
+    fprintf(f, "unset label\nunset arrow\n");
 }
 
 int eval__write_report(const char *dir, const method_run *R, int n, const eval_opts *o,
@@ -483,6 +506,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
     }
     for (int k = 0; k < 4; k++) {
         fprintf(f, "# %s\n", kind_name[k]);
+        const int np0 = np;
         for (int i = 0; i < n; i++) {
             const method_cfg *cf = &R[i].cfg;
             if ((int)cf->kind != k) continue;
@@ -496,6 +520,9 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
             piou[np] = (sp_pt){s.ms, s.iou, k, cf->setting};
             pbf[np++] = (sp_pt){s.ms, s.bf3, k, cf->setting};
         }
+        /* an empty block is no gnuplot index: the next kind's would
+         * take its number */
+        if (np == np0) fprintf(f, "nan nan nan \"\"\n");
         fprintf(f, "\n\n");
     }
     if (out_commit(&of)) {
@@ -512,7 +539,8 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
             free(pbf);
             return EXIT_FAIL;
         }
-    if (write_sequences(dir, R, n, o) || eval__write_lod(dir, R, n)) {
+    int seq_has[4];
+    if (write_sequences(dir, R, n, o, seq_has) || eval__write_lod(dir, R, n)) {
         free(piou);
         free(pbf);
         return EXIT_FAIL;
@@ -547,34 +575,85 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
         "set terminal pngcairo noenhanced size 900,600 font ',11'\n"
         "set key bottom right box opaque\n"
         "set output '%s/band.png'.sfx\nset title 'Refinement band width'\n"
-        "set xlabel 'band half width, px'\nset ylabel 'IoU, BF(3 px)'\n"
-        "plot '%s/band.dat' index 3 using 1:2 with linespoints lw 2 title 'IoU', \\\n"
-        "     '%s/band.dat' index 3 using 1:3 with linespoints lw 2 title 'BF 3px'\n"
+        "set xlabel 'band half width, px'\nset ylabel 'IoU, BF(3 px)'\n", dir);
+    if (si[3].has[M_REFINE])
+        fprintf(f,
+            "plot '%s/band.dat' index 3 using 1:2 with linespoints lw 2 title 'IoU', \\\n"
+            "     '%s/band.dat' index 3 using 1:3 with linespoints lw 2 title 'BF 3px'\n",
+            dir, dir);
+    else
+        empty_plot(f, "refine did not run");
+    /* lod.dat: index 0 kin-cal-pred, 1 refine (eval_lod.c); only the
+     * methods of --methods run it */
+    int lod_has[2] = {0, 0};
+    for (int i = 0; i < n; i++)
+        if (!strcmp(R[i].cfg.group, "lod"))
+            lod_has[R[i].cfg.kind == M_REFINE] |= R[i].cfg.kind == M_KIN_CAL ||
+                                                  R[i].cfg.kind == M_REFINE;
+    const int lab = lod_has[0] ? 0 : 1;   /* the labels' block */
+    fprintf(f,
         "set key bottom right\n"
         "set terminal pngcairo noenhanced size 1400,600 font ',10'\n"
         "set output '%s/lod.png'.sfx\n"
         "set multiplot layout 1,2 title 'Levels of detail of the mask model (labels: level, "
         "or the rule at a target in px)'\n"
         "set title 'Mask accuracy against the triangles drawn'\n"
-        "set xlabel 'triangles drawn per eye (mean)'\nset ylabel 'IoU'\nset logscale x\n"
-        "plot '%s/lod.dat' index 0 using 1:3 with points pt 7 ps 1.3 title 'kin-cal-pred: kinematic mask vs the full model', \\\n"
-        "     '%s/lod.dat' index 0 using 1:4 with points pt 5 ps 1.3 title 'kin-cal-pred: vs the ground truth', \\\n"
-        "     '%s/lod.dat' index 1 using 1:4 with points pt 9 ps 1.3 title 'refine: vs the ground truth', \\\n"
-        "     '%s/lod.dat' index 0 using 1:3:7 with labels offset 0,0.8 font ',7' notitle\n"
-        "set title 'Raster time against the triangles drawn'\n"
-        "set ylabel 'raster ms per eye (transforms + draw, thread CPU time)'\n"
-        "plot '%s/lod.dat' index 0 using 1:2 with points pt 7 ps 1.3 title 'kin-cal-pred', \\\n"
-        "     '%s/lod.dat' index 1 using 1:2 with points pt 9 ps 1.3 title 'refine', \\\n"
-        "     '%s/lod.dat' index 0 using 1:2:7 with labels offset 0,0.8 font ',7' notitle\n"
+        "set xlabel 'triangles drawn per eye (mean)'\nset ylabel 'IoU'\n", dir);
+    if (!lod_has[0] && !lod_has[1]) {
+        empty_plot(f, "neither kin-cal-pred nor refine ran");
+    } else {
+        fprintf(f, "set logscale x\nplot ");
+        if (lod_has[0])
+            fprintf(f, "'%s/lod.dat' index 0 using 1:3 with points pt 7 ps 1.3 title 'kin-cal-pred: kinematic mask vs the full model', \\\n"
+                       "     '%s/lod.dat' index 0 using 1:4 with points pt 5 ps 1.3 title 'kin-cal-pred: vs the ground truth', \\\n     ",
+                    dir, dir);
+        else
+            fprintf(f, "'%s/lod.dat' index 1 using 1:3 with points pt 7 ps 1.3 title 'refine: kinematic mask vs the full model', \\\n     ",
+                    dir);
+        if (lod_has[1])
+            fprintf(f, "'%s/lod.dat' index 1 using 1:4 with points pt 9 ps 1.3 title 'refine: vs the ground truth', \\\n     ",
+                    dir);
+        fprintf(f, "'%s/lod.dat' index %d using 1:3:7 with labels offset 0,0.8 font ',7' notitle\n",
+                dir, lab);
+    }
+    fprintf(f, "set title 'Raster time against the triangles drawn'\n"
+               "set ylabel 'raster ms per eye (transforms + draw, thread CPU time)'\n");
+    if (!lod_has[0] && !lod_has[1]) {
+        empty_plot(f, "neither kin-cal-pred nor refine ran");
+    } else {
+        fprintf(f, "plot ");
+        if (lod_has[0])
+            fprintf(f, "'%s/lod.dat' index 0 using 1:2 with points pt 7 ps 1.3 title 'kin-cal-pred', \\\n     ",
+                    dir);
+        if (lod_has[1])
+            fprintf(f, "'%s/lod.dat' index 1 using 1:2 with points pt 9 ps 1.3 title 'refine', \\\n     ",
+                    dir);
+        fprintf(f, "'%s/lod.dat' index %d using 1:2:7 with labels offset 0,0.8 font ',7' notitle\n",
+                dir, lab);
+    }
+    fprintf(f,
         "unset multiplot\nunset logscale x\n"
         "set terminal pngcairo noenhanced size 900,600 font ',10'\n"
         "set output '%s/sequences.png'.sfx\nset title 'Mask IoU per sequence and method'\n"
-        "set style data histograms\nset style histogram clustered gap 1\n"
-        "set style fill solid 0.8 border -1\nset yrange [0:1.15]\nset key top center horizontal\n"
-        "set xlabel 'sequence'\nset ylabel 'mask IoU'\n"
-        "plot '%s/sequences.dat' using 2:xtic(1) title 'kin', '' using 3 title 'kin-cal-pred', "
-        "'' using 4 title 'skin', '' using 5 title 'refine'\n",
-        dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir, dir);
+        "set xlabel 'sequence'\nset ylabel 'mask IoU'\n", dir);
+    /* the columns of the methods that ran (sequences.dat: IoU of kin,
+     * kin-cal-pred, skin, refine in columns 2-5): a column of NaN fails
+     * the histogram */
+    int first = 1;
+    for (int k = 0; k < 4; k++) {
+        if (!seq_has[k]) continue;
+        if (first)
+            fprintf(f, "set style data histograms\nset style histogram clustered gap 1\n"
+                       "set style fill solid 0.8 border -1\nset yrange [0:1.15]\n"
+                       "set key top center horizontal\n"
+                       "plot '%s/sequences.dat' using %d:xtic(1) lc %d title '%s'", dir,
+                    k + 2, k + 1, kind_name[k]);
+        else
+            fprintf(f, ", '' using %d lc %d title '%s'", k + 2, k + 1, kind_name[k]);
+        first = 0;
+    }
+    if (first) empty_plot(f, "no sequence ran");
+    else fprintf(f, "\n");
     if (out_commit(&of)) return EXIT_FAIL;
     return write_charts(dir);
 }

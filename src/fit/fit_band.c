@@ -198,6 +198,75 @@ const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *dp, const kin_camera *ca
     return any ? out : kin;
 }
 
+long pipe_fit_prior_colour(const fuse_colour_model *g, const fuse_image *P, uint8_t *prior,
+                           int stride)
+{
+    if (!g || !g->llr || g->fg_samples <= 0 || g->bg_samples <= 0 || g->bits < 2 ||
+        g->bits > 6 || !P || !P->pixels || !prior || P->width < 1 || P->height < 1 ||
+        stride < P->width || P->stride < 4 * P->width)
+        return 0;
+    const int W = P->width, H = P->height;
+    long n = 0;
+    /* cleared pixels are 1 until the end: still inside for their
+     * neighbours' test (>= 1), outside for the refinement (< 128) */
+    for (int y = 0; y < H; y++) {
+        const uint8_t *s = P->pixels + (size_t)y * (size_t)P->stride;
+        uint8_t *o = prior + (size_t)y * (size_t)stride;
+        const uint8_t *up = y > 0 ? o - stride : NULL, *dn = y + 1 < H ? o + stride : NULL;
+        for (int x = 0; x < W; x++) {
+            if (o[x] < 128) continue;
+            const int rim = (x > 0 && !o[x - 1]) || (x + 1 < W && !o[x + 1]) ||
+                            (up && !up[x]) || (dn && !dn[x]);
+            if (rim && g->llr[fuse_colour_bin(s + 4 * x, g->bits)] <= 0.0f) {
+                o[x] = 1;
+                n++;
+            }
+        }
+    }
+    if (n)
+        for (int y = 0; y < H; y++) {
+            uint8_t *o = prior + (size_t)y * (size_t)stride;
+            for (int x = 0; x < W; x++)
+                if (o[x] == 1) o[x] = 0;
+        }
+    return n;
+}
+
+long pipe_fit_refined_colour(const fuse_colour_model *g, const fuse_image *P, const uint8_t *in,
+                             uint8_t *out, int stride)
+{
+    if (!g || !g->llr || g->fg_samples <= 0 || g->bg_samples <= 0 || g->bits < 2 ||
+        g->bits > 6 || !P || !P->pixels || !in || !out || P->width < 1 || P->height < 1 ||
+        stride < P->width || P->stride < 4 * P->width)
+        return 0;
+    const int W = P->width, H = P->height;
+    long n = 0;
+    /* cleared pixels are 1 until the end: still inside for their
+     * neighbours' count */
+    for (int y = 0; y < H; y++) {
+        const uint8_t *s = P->pixels + (size_t)y * (size_t)P->stride;
+        const uint8_t *i = in + (size_t)y * (size_t)stride;
+        uint8_t *o = out + (size_t)y * (size_t)stride;
+        const uint8_t *up = y > 0 ? o - stride : NULL, *dn = y + 1 < H ? o + stride : NULL;
+        for (int x = 0; x < W; x++) {
+            if (o[x] < 128 || i[x] >= 128) continue;
+            const int nb = (x > 0 && o[x - 1]) + (x + 1 < W && o[x + 1]) + (up && up[x]) +
+                           (dn && dn[x]);
+            if (nb <= 2 && g->llr[fuse_colour_bin(s + 4 * x, g->bits)] <= 0.0f) {
+                o[x] = 1;
+                n++;
+            }
+        }
+    }
+    if (n)
+        for (int y = 0; y < H; y++) {
+            uint8_t *o = out + (size_t)y * (size_t)stride;
+            for (int x = 0; x < W; x++)
+                if (o[x] == 1) o[x] = 0;
+        }
+    return n;
+}
+
 int pipe_fit_hand_px(const kin_camera *cam, const kin_mat4 *world, const kin_arm_rig *rig,
                      int side, float xy[2])
 {

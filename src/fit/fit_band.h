@@ -26,6 +26,7 @@
 
 #include <stdint.h>
 
+#include "../fuse/fuse_refine.h"
 #include "../kin/kin.h"
 
 #ifdef __cplusplus
@@ -96,6 +97,38 @@ const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *d, const kin_camera *cam
                               const float speed[2], float max_speed, const float shift[2][2],
                               const uint8_t *kin, const uint8_t *prev, uint8_t *out,
                               int stride);
+
+/* The colour check of a prior (pipe_fit_prior's out, docs/accuracy.md):
+ * the last refined mask moved with the hand keeps last frame's edge, and
+ * where the hand moved by a fraction of a pixel or changed its outline
+ * that edge is a pixel off. The band refinement then keeps such a 1-px
+ * rim (its 3x3 vote is carried by the confident hand beside it, and the
+ * model prior counts it as inside) and the prior keeps it frame after
+ * frame: a dotted line of background pixels along the hand's edge. So
+ * the prior's rim must also look like the hand: every pixel of prior
+ * (>= 128) with a 4-neighbour in the image outside it (< 128) is set to 0
+ * where g's log-likelihood ratio at P(x) is <= 0 (background at least as
+ * likely); the neighbours are those of prior as given (one pass, a rim
+ * 1 px deep). g: the fit's colour model (pipe_fit_colour, once
+ * pipe_fit_learned); NULL or a model without samples: nothing changes. P:
+ * RGBA8 of the mask's size. Returns the pixels cleared (0 for bad
+ * arguments). */
+long pipe_fit_prior_colour(const fuse_colour_model *g, const fuse_image *P, uint8_t *prior,
+                           int stride);
+
+/* The colour check of the refinement's output where its input was a
+ * prior (after fuse_refine_mask*, docs/accuracy.md): the band's 3x3 vote
+ * adds a pixel outside its input where the confident hand beside it
+ * outweighs its own colour, at the corners of the prior's stair-stepped
+ * edge: single background pixels along the hand's edge. out(x) = 0 where
+ * in(x) < 128, out(x) >= 128, at most 2 of its 4-neighbours in the image
+ * are set in out (a corner or a spur, not a straight edge: clearing those
+ * too made the edge flicker, docs/accuracy.md) and g's log-likelihood
+ * ratio at P(x) is <= 0; the neighbours are those of out as given. g, P:
+ * as pipe_fit_prior_colour; in, out: the same stride. Returns the pixels
+ * cleared (0 for bad arguments or g NULL / without samples). */
+long pipe_fit_refined_colour(const fuse_colour_model *g, const fuse_image *P, const uint8_t *in,
+                             uint8_t *out, int stride);
 
 /* The mean image position (pixels) of side's hand joints (hand, palm,
  * fingers) that are in front of cam; 0 when none is (or bad arguments). */

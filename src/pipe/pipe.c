@@ -339,6 +339,10 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                 rin = pipe_fit_prior(&bd, &e->cam, p->pose.world, &p->fit_rig, sides,
                                      in->hand_speed ? in->hand_speed : zero, PIPE_PRIOR_SPEED,
                                      shift, e->mask, e->refined, e->prior, cw);
+                /* its rim must look like the hand (last frame's edge a
+                 * pixel off: fit_band.h) */
+                if (rin == e->prior && p->fit && pipe_fit_learned(p->fit, e->eye))
+                    pipe_fit_prior_colour(pipe_fit_colour(p->fit, e->eye), &fe.P, e->prior, cw);
             }
             /* where the hands are in this frame's refined mask */
             for (int k = 0; k < 2; k++)
@@ -359,6 +363,10 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                      e->eye ? "right" : "left", fuse_result_str(rr2));
             return;
         }
+        /* the pixels the vote let in beyond a prior must look like the
+         * hand too (fit_band.h) */
+        if (rin == e->prior && rs.used_colour && p->fit && pipe_fit_learned(p->fit, e->eye))
+            pipe_fit_refined_colour(pipe_fit_colour(p->fit, e->eye), &fe.P, rin, e->refined, cw);
         pipe__cockpit_clamp(p->ck, &p->pose, e->eye, e->rast, &e->cam, e->mask, cw, e->refined,
                             cw, p->desc.refine_band, e->clip);
         e->have_refined = 1;

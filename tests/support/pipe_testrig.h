@@ -173,19 +173,21 @@ static inline kin_camera tu_arms_silhouette(const tu_arms *A, const kin_mat4 *he
 
 /* The camera image cam (640x480 RGBA) of the silhouette sil (640x400,
  * the crop from row crop_y0): skin-red (200, 120, 100) inside, blue-grey
- * (70, 90, 150) outside, plus a noise of -4..4 a pixel (one draw of r a
- * pixel, row by row). */
+ * (70, 90, 150) outside, a darker rim (66, 86, 146) where sil is 1 (an
+ * edge's shading: neither skin nor background), plus a noise of -4..4 a
+ * pixel (one draw of r a pixel, row by row). */
 static inline void tu_paint_camera(uint8_t *cam, const uint8_t *sil, int crop_y0, tu_rng *r)
 {
     for (int y = 0; y < 480; y++)
         for (int x = 0; x < 640; x++) {
             int yy = y - crop_y0;
-            int in_arm = yy >= 0 && yy < 400 && sil[yy * 640 + x];
+            const uint8_t v = yy >= 0 && yy < 400 ? sil[yy * 640 + x] : 0;
+            const int in_arm = v > 1, rim = v == 1;
             uint8_t *px = &cam[(y * 640 + x) * 4];
             int n = (int)(tu_next(r) % 9) - 4;
-            px[0] = (uint8_t)((in_arm ? 200 : 70) + n);
-            px[1] = (uint8_t)((in_arm ? 120 : 90) + n);
-            px[2] = (uint8_t)((in_arm ? 100 : 150) + n);
+            px[0] = (uint8_t)((in_arm ? 200 : rim ? 66 : 70) + n);
+            px[1] = (uint8_t)((in_arm ? 120 : rim ? 86 : 90) + n);
+            px[2] = (uint8_t)((in_arm ? 100 : rim ? 146 : 150) + n);
             px[3] = 255;
         }
 }

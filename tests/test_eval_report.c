@@ -1,0 +1,93 @@
+/* test_eval_report.c - the charts of `egofuse eval --report DIR` with a
+ * subset of the methods (issue 14, src/eval/eval_report.c).
+ *
+ *   subset_kin_refine  `--methods kin,refine`: every chart of the report
+ *                      (the speed charts, the tracking sweeps, the band,
+ *                      the levels of detail, the sequences, the lighting)
+ *                      is drawn. Before, gnuplot failed on the histogram
+ *                      of sequences.dat (a column of NaN for skin and
+ *                      kin-cal-pred) and on lod.dat (kin-cal-pred's empty
+ *                      block was no gnuplot index, so refine's index 1 did
+ *                      not exist), and a failed gnuplot run draws no chart
+ *                      at all; empty blocks of speed.dat were legend entries
+ *                      with no point.
+ *   subset_skin        `--methods skin`: no tracking sweep and no level of
+ *                      detail has a point; their charts are still drawn
+ *                      (empty, with a note), the others as usual.
+ * Both check that no ".tmp." file is left and that gnuplot did not fail.
+ * gnuplot missing: SKIP. Seeded (the generator's fixed seed), 1 frame per
+ * batch, no timings. */
+#include "support/testutil.h"
+
+#include <cmocka.h>
+#include <dirent.h>
+#include <stdlib.h>
+#include <string.h>
+
+static char out[1 << 16];
+
+static const char *const charts[] = {"speed_iou", "speed_bf", "noise",     "latency",
+                                     "calib",     "dropout",  "handspeed", "band",
+                                     "sequences", "lod",      "light"};
+
+static int have_gnuplot(void)
+{
+    return system("command -v gnuplot >/dev/null 2>&1") == 0;
+}
+
+static void run_subset(const char *name, const char *methods)
+{
+    if (!have_gnuplot()) {
+        printf("SKIP: gnuplot missing: the charts of eval --report are not drawn\n");
+        skip();
+        return;
+    }
+    char dir[1024], cmd[2200], p[1200];
+    tu_tmp_path(name, dir, sizeof dir);
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    assert_int_equal(system(cmd), 0);
+    int rc = tu_runl(out, sizeof out, tu_bin(), "eval", "--methods", methods, "--frames", "1",
+                     "--sweep-frames", "1", "--seq-frames", "1", "--quiet", "--report", dir,
+                     NULL);
+    if (rc != 0 || strstr(out, "gnuplot failed")) printf("%s\n", out);
+    assert_int_equal(rc, 0);
+    assert_null(strstr(out, "gnuplot failed"));
+    /* gnuplot's errors and warnings: "DIR/charts.gp" line N: ... */
+    assert_null(strstr(out, ".gp\" line"));
+    for (size_t i = 0; i < sizeof charts / sizeof charts[0]; i++) {
+        snprintf(p, sizeof p, "%s/%s.png", dir, charts[i]);
+        if (!tu_exists(p)) printf("missing: %s\n", p);
+        assert_true(tu_exists(p));
+    }
+    DIR *d = opendir(dir);
+    assert_non_null(d);
+    struct dirent *e;
+    while ((e = readdir(d))) assert_null(strstr(e->d_name, ".tmp."));
+    closedir(d);
+    assert_int_equal(system(cmd), 0);   /* rm -rf the report */
+}
+
+static void subset_kin_refine(void **state)
+{
+    (void)state;
+    run_subset("report_kin_refine", "kin,refine");
+}
+
+static void subset_skin(void **state)
+{
+    (void)state;
+    run_subset("report_skin", "skin");
+}
+
+int main(void)
+{
+    if (!tu_exists(tu_bin())) {
+        printf("SKIP: %s not built\n", tu_bin());
+        return 0;
+    }
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(subset_kin_refine),
+        cmocka_unit_test(subset_skin),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
