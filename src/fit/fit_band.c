@@ -198,61 +198,33 @@ const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *dp, const kin_camera *ca
     return any ? out : kin;
 }
 
-long pipe_fit_prior_colour(const fuse_colour_model *g, const fuse_image *P, uint8_t *prior,
-                           int stride)
+/* The colour check of both functions below: every pixel of out at >= 128
+ * that the rule keeps a candidate (prior: on the rim, a 4-neighbour 0;
+ * refined: added to in, at most 2 of its 4 neighbours set) and whose
+ * colour the model calls background (llr <= 0) is cleared. Cleared pixels
+ * are 1 until the end: still set for their neighbours' tests, below 128
+ * for the refinement. Returns the count cleared. */
+static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const uint8_t *in,
+                         uint8_t *out, int stride)
 {
     if (!g || !g->llr || g->fg_samples <= 0 || g->bg_samples <= 0 || g->bits < 2 ||
-        g->bits > 6 || !P || !P->pixels || !prior || P->width < 1 || P->height < 1 ||
+        g->bits > 6 || !P || !P->pixels || !out || P->width < 1 || P->height < 1 ||
         stride < P->width || P->stride < 4 * P->width)
         return 0;
     const int W = P->width, H = P->height;
     long n = 0;
-    /* cleared pixels are 1 until the end: still inside for their
-     * neighbours' test (>= 1), outside for the refinement (< 128) */
     for (int y = 0; y < H; y++) {
         const uint8_t *s = P->pixels + (size_t)y * (size_t)P->stride;
-        uint8_t *o = prior + (size_t)y * (size_t)stride;
-        const uint8_t *up = y > 0 ? o - stride : NULL, *dn = y + 1 < H ? o + stride : NULL;
-        for (int x = 0; x < W; x++) {
-            if (o[x] < 128) continue;
-            const int rim = (x > 0 && !o[x - 1]) || (x + 1 < W && !o[x + 1]) ||
-                            (up && !up[x]) || (dn && !dn[x]);
-            if (rim && g->llr[fuse_colour_bin(s + 4 * x, g->bits)] <= 0.0f) {
-                o[x] = 1;
-                n++;
-            }
-        }
-    }
-    if (n)
-        for (int y = 0; y < H; y++) {
-            uint8_t *o = prior + (size_t)y * (size_t)stride;
-            for (int x = 0; x < W; x++)
-                if (o[x] == 1) o[x] = 0;
-        }
-    return n;
-}
-
-long pipe_fit_refined_colour(const fuse_colour_model *g, const fuse_image *P, const uint8_t *in,
-                             uint8_t *out, int stride)
-{
-    if (!g || !g->llr || g->fg_samples <= 0 || g->bg_samples <= 0 || g->bits < 2 ||
-        g->bits > 6 || !P || !P->pixels || !in || !out || P->width < 1 || P->height < 1 ||
-        stride < P->width || P->stride < 4 * P->width)
-        return 0;
-    const int W = P->width, H = P->height;
-    long n = 0;
-    /* cleared pixels are 1 until the end: still inside for their
-     * neighbours' count */
-    for (int y = 0; y < H; y++) {
-        const uint8_t *s = P->pixels + (size_t)y * (size_t)P->stride;
-        const uint8_t *i = in + (size_t)y * (size_t)stride;
+        const uint8_t *i = in ? in + (size_t)y * (size_t)stride : NULL;
         uint8_t *o = out + (size_t)y * (size_t)stride;
         const uint8_t *up = y > 0 ? o - stride : NULL, *dn = y + 1 < H ? o + stride : NULL;
         for (int x = 0; x < W; x++) {
-            if (o[x] < 128 || i[x] >= 128) continue;
+            if (o[x] < 128 || (i && i[x] >= 128)) continue;
             const int nb = (x > 0 && o[x - 1]) + (x + 1 < W && o[x + 1]) + (up && up[x]) +
                            (dn && dn[x]);
-            if (nb <= 2 && g->llr[fuse_colour_bin(s + 4 * x, g->bits)] <= 0.0f) {
+            const int border = (x > 0) + (x + 1 < W) + (up != NULL) + (dn != NULL);
+            const int candidate = i ? nb <= 2 : nb < border;
+            if (candidate && g->llr[fuse_colour_bin(s + 4 * x, g->bits)] <= 0.0f) {
                 o[x] = 1;
                 n++;
             }
@@ -265,6 +237,18 @@ long pipe_fit_refined_colour(const fuse_colour_model *g, const fuse_image *P, co
                 if (o[x] == 1) o[x] = 0;
         }
     return n;
+}
+
+long pipe_fit_prior_colour(const fuse_colour_model *g, const fuse_image *P, uint8_t *prior,
+                           int stride)
+{
+    return colour_clear(g, P, NULL, prior, stride);
+}
+
+long pipe_fit_refined_colour(const fuse_colour_model *g, const fuse_image *P, const uint8_t *in,
+                             uint8_t *out, int stride)
+{
+    return in ? colour_clear(g, P, in, out, stride) : 0;
 }
 
 int pipe_fit_hand_px(const kin_camera *cam, const kin_mat4 *world, const kin_arm_rig *rig,
