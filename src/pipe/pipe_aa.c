@@ -1,6 +1,7 @@
 /* pipe_aa.c - the anti-aliased coverage mask of an eye (pipe_aa.h). */
 #include "pipe_aa.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -65,6 +66,7 @@ void pipe__aa_free(pipe__aa *a)
     free(a->tile);
     free(a->tsat);
     free(a->idx);
+    free(a->sxy);
     memset(a, 0, sizeof *a);
 }
 
@@ -196,24 +198,35 @@ static int band_filter(pipe__aa *a, const float *clip, int vertex_count, const u
         a->idx = n;
         a->idx_cap = tri_count;
     }
+    if (vertex_count > a->sxy_cap) {
+        float *n = realloc(a->sxy, sizeof *n * 2 * (size_t)vertex_count);
+        if (!n) return -1;
+        a->sxy = n;
+        a->sxy_cap = vertex_count;
+    }
     const float W = (float)a->width, H = (float)a->height;
+    float *sxy = a->sxy;
+    for (int i = 0; i < vertex_count; i++) {
+        const float *v = clip + 4 * (size_t)i;
+        float sx = NAN, sy = NAN;
+        if (v[3] > 1e-6f) {
+            sx = (v[0] / v[3] * 0.5f + 0.5f) * W;
+            sy = (0.5f - v[1] / v[3] * 0.5f) * H;
+        }
+        sxy[2 * i] = sx;
+        sxy[2 * i + 1] = sy;
+    }
     int kept = 0;
     for (int t = 0; t < tri_count; t++) {
         const uint32_t *ix = indices + 3 * (size_t)t;
         float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
         int keep = 0;
-        for (int k = 0; k < 3 && !keep; k++) {
+        for (int k = 0; k < 3; k++) {
             if (ix[k] >= (uint32_t)vertex_count) {
                 keep = 1;
                 break;
             }
-            const float *v = clip + 4 * (size_t)ix[k];
-            if (!(v[3] > 1e-6f)) {
-                keep = 1;
-                break;
-            }
-            const float sx = (v[0] / v[3] * 0.5f + 0.5f) * W;
-            const float sy = (0.5f - v[1] / v[3] * 0.5f) * H;
+            const float sx = sxy[2 * ix[k]], sy = sxy[2 * ix[k] + 1];
             if (!(sx == sx) || !(sy == sy)) {
                 keep = 1;
                 break;
@@ -351,7 +364,14 @@ void pipe__aa_resolve(pipe__aa *a)
                     o[x] = v ? lut[bits8[v & 255u] + bits8[v >> 8]] : 0;
                 }
             } else {
-                for (; x < xe; x++) o[x] = g[x] ? 255 : 0;
+                /* rast_draw's mask: 0 or 255 */
+                int xr = xe;
+                while (xr < b[2] && !trow[xr / PIPE__AA_TILE]) {
+                    xr += PIPE__AA_TILE;
+                    if (xr > b[2]) xr = b[2];
+                }
+                memcpy(o + x, g + x, (size_t)(xr - x));
+                x = xr;
             }
         }
     }
@@ -398,15 +418,35 @@ void pipe__aa_refined(pipe__aa *a, const uint8_t *mask, const uint8_t *refined, 
     }
 }
 
+/* 0x80 in each byte of the 8 at p that is not 0 */
+static uint64_t nz8(const uint8_t *p)
+{
+    uint64_t v;
+    memcpy(&v, p, 8);
+    const uint64_t lo7 = 0x7f7f7f7f7f7f7f7full;
+    return (((v & lo7) + lo7) | v) & ~lo7;
+}
+
+/* 1 when one of the 8 pixels at x has m > 0 and mask 0 */
+static int fill_cand8(const uint8_t *m, const uint8_t *k)
+{
+    return (nz8(m) & ~nz8(k)) != 0;
+}
+
 void pipe__aa_fill_normals(pipe__aa *a, const uint8_t *m, const uint8_t *mask, float *nrm)
 {
     const int W = a->width, H = a->height;
     const int *b = a->soft && m == a->soft ? a->soft_box : a->box;
     box_empty(a->nbox);
+    a->nsrc = m;
     for (int y = b[1]; y < b[3]; y++) {
         const uint8_t *mr = m + (size_t)y * (size_t)W;
         const uint8_t *kr = mask + (size_t)y * (size_t)W;
         for (int x = b[0]; x < b[2]; x++) {
+            if (x + 8 <= b[2] && !fill_cand8(mr + x, kr + x)) {
+                x += 7;
+                continue;
+            }
             if (mr[x] == 0 || kr[x] != 0) continue;
             float s[3] = {0.0f, 0.0f, 0.0f};
             for (int yy = y - 1; yy <= y + 1; yy++) {
@@ -433,11 +473,23 @@ void pipe__aa_unfill(pipe__aa *a, const uint8_t *mask, float *nrm)
 {
     const int W = a->width;
     const int *b = a->nbox;
-    for (int y = b[1]; y < b[3]; y++)
-        for (int x = b[0]; x < b[2]; x++)
-            if (mask[(size_t)y * (size_t)W + (size_t)x] == 0) {
+    const uint8_t *m = a->nsrc;
+    /* the pixels pipe__aa_fill_normals wrote: m > 0 and mask 0 (m is
+     * unchanged since) */
+    for (int y = b[1]; m && y < b[3]; y++) {
+        const uint8_t *mr = m + (size_t)y * (size_t)W;
+        const uint8_t *kr = mask + (size_t)y * (size_t)W;
+        for (int x = b[0]; x < b[2]; x++) {
+            if (x + 8 <= b[2] && !fill_cand8(mr + x, kr + x)) {
+                x += 7;
+                continue;
+            }
+            if (mr[x] != 0 && kr[x] == 0) {
                 float *o = nrm + 3 * ((size_t)y * (size_t)W + (size_t)x);
                 o[0] = o[1] = o[2] = 0.0f;
             }
+        }
+    }
     box_empty(a->nbox);
+    a->nsrc = NULL;
 }

@@ -29,6 +29,8 @@ typedef struct pipe__aa {
                                  cov are 0 outside (this frame's draws) */
     int soft_box[4];          /* soft is 0 outside */
     int nbox[4];              /* normals written by pipe__aa_fill_normals */
+    const uint8_t *nsrc;      /* the m of that call (its pixels m > 0,
+                                 mask 0), or NULL */
     /* the boundary band (pipe__aa_band): tiles of PIPE__AA_TILE px */
     int tw, th;               /* tiles across, down */
     uint8_t *tile;            /* tw x th: 1 = a pixel of the tile has a 3x3
@@ -39,6 +41,9 @@ typedef struct pipe__aa {
                                  (no band: every triangle, every pixel) */
     uint32_t *idx;            /* the triangles kept, 3 indices each */
     int idx_cap;              /* triangles idx holds */
+    float *sxy;               /* the vertices' pixel x, y (NaN: behind the
+                                 eye, or not finite) */
+    int sxy_cap;              /* vertices sxy holds */
 } pipe__aa;
 
 #define PIPE__AA_TILE 4
