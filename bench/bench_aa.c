@@ -37,8 +37,11 @@
  *   ms                pipe_frame's wall time per stereo frame: the median
  *                     of R repetitions of the last frame (--reps, 40), and
  *                     the minimum.
+ *   cpu med           the median of the process CPU time of those runs.
+ * --cull-back: both draws skip back faces (as `egofuse render --cull-back`;
+ * the arm meshes are closed).
  * Usage: build/bench/bench_aa [--frames N] [--speed S] [--reps R]
- *                             [--seq NAME] [--threads T] */
+ *                             [--seq NAME] [--threads T] [--cull-back] */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -126,13 +129,19 @@ static fuse_lighting view_lighting(const pipe_lighting *pl, const kin_camera *ca
 
 int main(int argc, char **argv)
 {
-    int frames = 120, reps = 40, threads = 2, first = 0;
+    int frames = 120, reps = 40, threads = 2, first = 0, cull_back = 0;
     float speed = 0.25f;
     const char *seq = "reach_grasp";
     for (int i = 1; i < argc; i += 2) {
+        if (!strcmp(argv[i], "--cull-back")) {
+            cull_back = 1;
+            i--;
+            continue;
+        }
         if (i + 1 == argc) {
             fprintf(stderr, "bench_aa: %s wants a value; usage: bench_aa [--frames N] [--speed S] "
-                            "[--reps R] [--seq NAME] [--first F] [--threads T]\n", argv[i]);
+                            "[--reps R] [--seq NAME] [--first F] [--threads T] [--cull-back]\n",
+                    argv[i]);
             return 2;
         }
         if (!strcmp(argv[i], "--frames")) frames = atoi(argv[i + 1]);
@@ -207,6 +216,7 @@ int main(int argc, char **argv)
         pipe_desc d = {0};
         d.threads = threads;
         d.aa_samples = r->aa;
+        if (cull_back) d.cull = RAST_CULL_BACK; /* closed arm meshes: the same masks */
         if (r->method == M_REFINE || r->method == M_REFINE_TRACK) d.refine_band = 16;
         if (r->method == M_REFINE_TRACK) d.fit_rig = &rig;
         r->p = pipe_create(&d, &mask.model);

@@ -21,6 +21,11 @@
  *                 agrees in the 3x3 window, the box filter of the refined
  *                 mask elsewhere;
  *   aa_resolve    the pipe's resolve gives rast_aa_resolve's bytes;
+ *   aa_band       the boundary band (pipe__aa_band) on seeded meshes of
+ *                 small triangles: every pixel whose 3x3 window of the
+ *                 binary mask is not uniform lies in a band tile, every
+ *                 band tile has the coverage of the full sample draw byte
+ *                 for byte, every other pixel the binary mask's 0 / 255;
  *   aa_args       aa_samples other than 0, 4, 8, 16: pipe_create NULL.
  * The depth test with AA on (occlusion never broken, every method) is in
  * test_occlusion.c. */
@@ -422,6 +427,85 @@ static void aa_resolve(void **state)
     }
 }
 
+/* seeded small triangles (clip w = 1, some off the target, one through
+ * the eye plane), the binary mask by rast_draw and the coverage with and
+ * without the band */
+static void aa_band(void **state)
+{
+    (void)state;
+    enum { W = 160, H = 120, NT = 300 };
+    const int counts[2] = {4, 16};
+    for (int seed = 1; seed <= 6; seed++) {
+        tu_rng r = {(uint64_t)seed * 7919u};
+        float clip[4 * 3 * NT];
+        uint32_t idx[3 * NT];
+        for (int t = 0; t < NT; t++) {
+            /* clusters: blobs with holes and slivers between them */
+            const float cx = tu_range(&r, -1.1f, 1.1f), cy = tu_range(&r, -1.1f, 1.1f);
+            const float sz = t % 17 == 0 ? 0.4f : 0.08f;
+            for (int k = 0; k < 3; k++) {
+                float *v = clip + 4 * (3 * t + k);
+                v[0] = cx + tu_range(&r, -sz, sz);
+                v[1] = cy + tu_range(&r, -sz, sz);
+                v[2] = 0.5f;
+                v[3] = 1.0f;
+                idx[3 * t + k] = (uint32_t)(3 * t + k);
+            }
+        }
+        clip[4 * 5 + 3] = -0.5f; /* triangle 1: a vertex behind the eye */
+        clip[4 * 5 + 2] = -0.7f;
+        uint8_t mask[W * H];
+        rast_target tg = {W, H, NULL, 0, mask, W, NULL, 0, 0};
+        rast_target_clear(&tg);
+        rast_mesh_desc d = {clip, 3 * NT, NULL, 0, idx, NT, RAST_CULL_NONE};
+        assert_int_equal(rast_draw(&tg, &d, NULL), RAST_OK);
+        for (int c = 0; c < 2; c++) {
+            pipe__aa a;
+            assert_int_equal(pipe__aa_init(&a, counts[c], W, H, 0), 0);
+            pipe__aa_begin(&a);
+            assert_int_equal(pipe__aa_draw(&a, NULL, clip, 3 * NT, idx, NT, RAST_CULL_NONE),
+                             RAST_OK);
+            pipe__aa_resolve(&a);
+            uint8_t full[W * H];
+            memcpy(full, a.cov, sizeof full);
+            pipe__aa_begin(&a);
+            pipe__aa_band(&a, mask);
+            assert_int_equal(pipe__aa_draw(&a, NULL, clip, 3 * NT, idx, NT, RAST_CULL_NONE),
+                             RAST_OK);
+            pipe__aa_resolve(&a);
+            int band_tiles = 0, band_px = 0, differ = 0;
+            for (int i = 0; i < a.tw * a.th; i++) band_tiles += a.tile[i];
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < W; x++) {
+                    const int in =
+                        a.tile[(y / PIPE__AA_TILE) * a.tw + x / PIPE__AA_TILE] != 0;
+                    int uniform = 1;
+                    for (int yy = y - 1; yy <= y + 1; yy++)
+                        for (int xx = x - 1; xx <= x + 1; xx++)
+                            if (yy >= 0 && yy < H && xx >= 0 && xx < W &&
+                                (mask[yy * W + xx] != 0) != (mask[y * W + x] != 0))
+                                uniform = 0;
+                    if (!uniform) assert_true(in);
+                    band_px += in;
+                    const int want = in ? full[y * W + x] : mask[y * W + x] ? 255 : 0;
+                    if (a.cov[y * W + x] != want)
+                        fail_msg("seed %d aa %d: (%d, %d) %d, want %d (band %d)", seed,
+                                 counts[c], x, y, a.cov[y * W + x], want, in);
+                    differ += a.cov[y * W + x] != full[y * W + x];
+                }
+            /* the band is a part of the target, and most of the model's
+             * edge pixels agree with the full draw */
+            assert_true(band_tiles > 0 && band_tiles < a.tw * a.th);
+            if (seed == 1)
+                printf("seed %d aa %2d: %d band tiles of %d (%d px), %d px differ from the full "
+                       "draw\n",
+                       seed, counts[c], band_tiles, a.tw * a.th, band_px, differ);
+            assert_true(differ * 20 < band_px);
+            pipe__aa_free(&a);
+        }
+    }
+}
+
 static void aa_args(void **state)
 {
     (void)state;
@@ -450,6 +534,7 @@ int main(void)
         cmocka_unit_test(aa_area),     cmocka_unit_test(aa_interior),
         cmocka_unit_test(aa_state),    cmocka_unit_test(aa_refined),
         cmocka_unit_test(aa_resolve),  cmocka_unit_test(aa_args),
+        cmocka_unit_test(aa_band),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -258,6 +258,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     rast_result rr = eye_draw(p, e, e->lens, &e->cam, &tg, 1, &covered);
     if (rr == RAST_OK && e->aa.count) { /* no lens here: refused at pipe_create */
         pipe__aa_begin(&e->aa);
+        pipe__aa_band(&e->aa, e->mask);
         rr = pipe__cockpit_active(p->ck)
                  ? pipe__cockpit_draw_aa(p->ck, &p->pose, e->eye, e->rast, &e->cam, &e->aa,
                                          p->desc.cull, e->clip)

@@ -1,6 +1,7 @@
 /* pipe_aa.c - the anti-aliased coverage mask of an eye (pipe_aa.h). */
 #include "pipe_aa.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -45,7 +46,13 @@ int pipe__aa_init(pipe__aa *a, int count, int width, int height, int with_soft)
     a->colsum = calloc((size_t)width + 2, sizeof *a->colsum);
     a->colflip = calloc((size_t)width + 2, 1);
     if (with_soft) a->soft = calloc(px, 1);
-    if (!a->samples || !a->cov || !a->colsum || !a->colflip || (with_soft && !a->soft)) return -1;
+    a->tw = (width + PIPE__AA_TILE - 1) / PIPE__AA_TILE;
+    a->th = (height + PIPE__AA_TILE - 1) / PIPE__AA_TILE;
+    a->tile = calloc((size_t)a->tw * (size_t)a->th, 1);
+    a->tsat = calloc((size_t)(a->tw + 1) * (size_t)(a->th + 1), sizeof *a->tsat);
+    if (!a->samples || !a->cov || !a->colsum || !a->colflip || (with_soft && !a->soft) ||
+        !a->tile || !a->tsat)
+        return -1;
     return 0;
 }
 
@@ -56,6 +63,10 @@ void pipe__aa_free(pipe__aa *a)
     free(a->soft);
     free(a->colsum);
     free(a->colflip);
+    free(a->tile);
+    free(a->tsat);
+    free(a->idx);
+    free(a->sxy);
     memset(a, 0, sizeof *a);
 }
 
@@ -72,6 +83,177 @@ void pipe__aa_begin(pipe__aa *a)
     for (int y = b[1]; a->soft && y < b[3]; y++)
         memset(a->soft + (size_t)y * (size_t)a->width + b[0], 0, (size_t)(b[2] - b[0]));
     box_empty(a->soft_box);
+    a->gmask = NULL;
+}
+
+/* tiles of the pixel rectangle x0..x1, y0..y1 (inclusive, clamped) set */
+static void tiles_mark(pipe__aa *a, int x0, int y0, int x1, int y1)
+{
+    if (x0 < 0) x0 = 0;
+    if (y0 < 0) y0 = 0;
+    if (x1 > a->width - 1) x1 = a->width - 1;
+    if (y1 > a->height - 1) y1 = a->height - 1;
+    for (int ty = y0 / PIPE__AA_TILE; ty <= y1 / PIPE__AA_TILE; ty++)
+        for (int tx = x0 / PIPE__AA_TILE; tx <= x1 / PIPE__AA_TILE; tx++)
+            a->tile[(size_t)ty * (size_t)a->tw + (size_t)tx] = 1;
+}
+
+/* first and last non-zero byte of r[0..n-1]: *lo > *hi when none */
+static void row_span(const uint8_t *r, int n, int *lo, int *hi)
+{
+    int i = 0, j = n - 1;
+    while (i + 8 <= n) {
+        uint64_t w;
+        memcpy(&w, r + i, 8);
+        if (w) break;
+        i += 8;
+    }
+    while (i < n && r[i] == 0) i++;
+    if (i >= n) {
+        *lo = 1, *hi = 0;
+        return;
+    }
+    while (j - 7 > i) {
+        uint64_t w;
+        memcpy(&w, r + j - 7, 8);
+        if (w) break;
+        j -= 8;
+    }
+    while (r[j] == 0) j--;
+    *lo = i, *hi = j;
+}
+
+void pipe__aa_band(pipe__aa *a, const uint8_t *mask)
+{
+    const int W = a->width, H = a->height, tw = a->tw, th = a->th;
+    memset(a->tile, 0, (size_t)tw * (size_t)th);
+    /* A 3x3 window is not uniform iff two 4-neighbours in it differ: for
+     * each differing pair, the tiles of every pixel whose window holds
+     * both (a superset: the pair's box grown by 1). Rows of zeros have no
+     * pair inside; a vertical pair needs a non-zero pixel in one row. */
+    int lo, hi;
+    row_span(mask, W, &lo, &hi);
+    for (int y = 0; y < H; y++) {
+        const uint8_t *r = mask + (size_t)y * (size_t)W;
+        int nlo = 1, nhi = 0;
+        if (y + 1 < H) row_span(r + W, W, &nlo, &nhi);
+        if (lo <= hi) {
+            /* horizontal pairs (x, x + 1) */
+            const int x0 = lo > 0 ? lo - 1 : 0;
+            for (int x = x0; x <= hi && x + 1 < W; x++)
+                if ((r[x] != 0) != (r[x + 1] != 0)) tiles_mark(a, x - 1, y - 1, x + 2, y + 1);
+        }
+        if (y + 1 < H && (lo <= hi || nlo <= nhi)) {
+            /* vertical pairs (y, y + 1) where either row is non-zero */
+            int x0 = lo <= hi ? lo : nlo, x1 = lo <= hi ? hi : nhi;
+            if (nlo <= nhi && nlo < x0) x0 = nlo;
+            if (nlo <= nhi && nhi > x1) x1 = nhi;
+            for (int x = x0; x <= x1; x++)
+                if ((r[x] != 0) != (r[x + W] != 0)) tiles_mark(a, x - 1, y - 1, x + 1, y + 2);
+        }
+        lo = nlo, hi = nhi;
+    }
+    /* summed-area table: tsat[(ty) * (tw + 1) + tx] = tiles above-left */
+    int *S = a->tsat;
+    const size_t sw = (size_t)tw + 1;
+    memset(S, 0, sizeof *S * sw);
+    for (int ty = 0; ty < th; ty++) {
+        int run = 0;
+        S[(size_t)(ty + 1) * sw] = 0;
+        for (int tx = 0; tx < tw; tx++) {
+            run += a->tile[(size_t)ty * (size_t)tw + (size_t)tx];
+            S[(size_t)(ty + 1) * sw + (size_t)tx + 1] = S[(size_t)ty * sw + (size_t)tx + 1] + run;
+        }
+    }
+    a->gmask = mask;
+}
+
+/* 1 when a band tile meets the pixel rectangle x0..x1, y0..y1 (inclusive;
+ * clamped, an empty rectangle meets none) */
+static int band_meets(const pipe__aa *a, int x0, int y0, int x1, int y1)
+{
+    if (x0 < 0) x0 = 0;
+    if (y0 < 0) y0 = 0;
+    if (x1 > a->width - 1) x1 = a->width - 1;
+    if (y1 > a->height - 1) y1 = a->height - 1;
+    if (x0 > x1 || y0 > y1) return 0;
+    const int tx0 = x0 / PIPE__AA_TILE, ty0 = y0 / PIPE__AA_TILE;
+    const int tx1 = x1 / PIPE__AA_TILE + 1, ty1 = y1 / PIPE__AA_TILE + 1;
+    const size_t sw = (size_t)a->tw + 1;
+    const int *S = a->tsat;
+    return S[(size_t)ty1 * sw + (size_t)tx1] - S[(size_t)ty0 * sw + (size_t)tx1] -
+               S[(size_t)ty1 * sw + (size_t)tx0] + S[(size_t)ty0 * sw + (size_t)tx0] >
+           0;
+}
+
+/* The triangles of indices that may cover a sample of a band tile, into
+ * a->idx: a triangle with a vertex at or behind the eye plane, a NaN or
+ * a bad index is kept (rast_draw_aa clips it, or refuses the mesh). */
+static int band_filter(pipe__aa *a, const float *clip, int vertex_count, const uint32_t *indices,
+                       int tri_count)
+{
+    if (tri_count > a->idx_cap) {
+        uint32_t *n = realloc(a->idx, sizeof *n * 3 * (size_t)tri_count);
+        if (!n) return -1;
+        a->idx = n;
+        a->idx_cap = tri_count;
+    }
+    if (vertex_count > a->sxy_cap) {
+        float *n = realloc(a->sxy, sizeof *n * 2 * (size_t)vertex_count);
+        if (!n) return -1;
+        a->sxy = n;
+        a->sxy_cap = vertex_count;
+    }
+    const float W = (float)a->width, H = (float)a->height;
+    float *sxy = a->sxy;
+    for (int i = 0; i < vertex_count; i++) {
+        const float *v = clip + 4 * (size_t)i;
+        float sx = NAN, sy = NAN;
+        if (v[3] > 1e-6f) {
+            sx = (v[0] / v[3] * 0.5f + 0.5f) * W;
+            sy = (0.5f - v[1] / v[3] * 0.5f) * H;
+        }
+        sxy[2 * i] = sx;
+        sxy[2 * i + 1] = sy;
+    }
+    int kept = 0;
+    for (int t = 0; t < tri_count; t++) {
+        const uint32_t *ix = indices + 3 * (size_t)t;
+        float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
+        int keep = 0;
+        for (int k = 0; k < 3; k++) {
+            if (ix[k] >= (uint32_t)vertex_count) {
+                keep = 1;
+                break;
+            }
+            const float sx = sxy[2 * ix[k]], sy = sxy[2 * ix[k] + 1];
+            if (!(sx == sx) || !(sy == sy)) {
+                keep = 1;
+                break;
+            }
+            if (sx < x0) x0 = sx;
+            if (sx > x1) x1 = sx;
+            if (sy < y0) y0 = sy;
+            if (sy > y1) y1 = sy;
+        }
+        if (!keep) {
+            /* off the target entirely: nothing to draw; else the pixels
+             * whose samples the triangle may reach (a sample is at most
+             * half a pixel from its centre; 1 px covers that and the
+             * snapping) */
+            if (x1 < -4.0f || y1 < -4.0f || x0 > W + 4.0f || y0 > H + 4.0f) continue;
+            x0 = x0 < -4.0f ? -4.0f : x0;
+            y0 = y0 < -4.0f ? -4.0f : y0;
+            x1 = x1 > W + 4.0f ? W + 4.0f : x1;
+            y1 = y1 > H + 4.0f ? H + 4.0f : y1;
+            keep = band_meets(a, (int)x0 - 1, (int)y0 - 1, (int)x1 + 1, (int)y1 + 1);
+        }
+        if (keep) {
+            uint32_t *o = a->idx + 3 * (size_t)kept++;
+            o[0] = ix[0], o[1] = ix[1], o[2] = ix[2];
+        }
+    }
+    return kept;
 }
 
 rast_result pipe__aa_draw(pipe__aa *a, rast_context *ctx, const float *clip, int vertex_count,
@@ -111,6 +293,13 @@ rast_result pipe__aa_draw(pipe__aa *a, rast_context *ctx, const float *clip, int
         y1 = y1 < -4.0f ? -4.0f : y1 > H + 4.0f ? H + 4.0f : y1;
         box_add(a->box, (int)x0 - 2, (int)y0 - 2, (int)x1 + 3, (int)y1 + 3, a->width,
                 a->height);
+    }
+    if (a->gmask) {
+        const int kept = band_filter(a, clip, vertex_count, indices, tri_count);
+        if (kept < 0) return RAST_ERR_ARGS; /* out of memory */
+        if (kept == 0) return RAST_OK;
+        indices = a->idx;
+        tri_count = kept;
     }
     rast_aa_target t = {a->width, a->height, a->samples, a->width, a->count};
     rast_mesh_desc d = {
@@ -156,9 +345,34 @@ void pipe__aa_resolve(pipe__aa *a)
     for (int y = b[1]; y < b[3]; y++) {
         const uint32_t *s = a->samples + (size_t)y * (size_t)a->width;
         uint8_t *o = a->cov + (size_t)y * (size_t)a->width;
-        for (int x = b[0]; x < b[2]; x++) {
-            const uint32_t v = s[x] & mask;
-            o[x] = v ? lut[bits8[v & 255u] + bits8[v >> 8]] : 0;
+        if (!a->gmask) {
+            for (int x = b[0]; x < b[2]; x++) {
+                const uint32_t v = s[x] & mask;
+                o[x] = v ? lut[bits8[v & 255u] + bits8[v >> 8]] : 0;
+            }
+            continue;
+        }
+        const uint8_t *g = a->gmask + (size_t)y * (size_t)a->width;
+        const uint8_t *trow = a->tile + (size_t)(y / PIPE__AA_TILE) * (size_t)a->tw;
+        for (int x = b[0]; x < b[2];) {
+            const int t = x / PIPE__AA_TILE;
+            int xe = (t + 1) * PIPE__AA_TILE;
+            if (xe > b[2]) xe = b[2];
+            if (trow[t]) {
+                for (; x < xe; x++) {
+                    const uint32_t v = s[x] & mask;
+                    o[x] = v ? lut[bits8[v & 255u] + bits8[v >> 8]] : 0;
+                }
+            } else {
+                /* rast_draw's mask: 0 or 255 */
+                int xr = xe;
+                while (xr < b[2] && !trow[xr / PIPE__AA_TILE]) {
+                    xr += PIPE__AA_TILE;
+                    if (xr > b[2]) xr = b[2];
+                }
+                memcpy(o + x, g + x, (size_t)(xr - x));
+                x = xr;
+            }
         }
     }
 }
@@ -204,15 +418,35 @@ void pipe__aa_refined(pipe__aa *a, const uint8_t *mask, const uint8_t *refined, 
     }
 }
 
+/* 0x80 in each byte of the 8 at p that is not 0 */
+static uint64_t nz8(const uint8_t *p)
+{
+    uint64_t v;
+    memcpy(&v, p, 8);
+    const uint64_t lo7 = 0x7f7f7f7f7f7f7f7full;
+    return (((v & lo7) + lo7) | v) & ~lo7;
+}
+
+/* 1 when one of the 8 pixels at x has m > 0 and mask 0 */
+static int fill_cand8(const uint8_t *m, const uint8_t *k)
+{
+    return (nz8(m) & ~nz8(k)) != 0;
+}
+
 void pipe__aa_fill_normals(pipe__aa *a, const uint8_t *m, const uint8_t *mask, float *nrm)
 {
     const int W = a->width, H = a->height;
     const int *b = a->soft && m == a->soft ? a->soft_box : a->box;
     box_empty(a->nbox);
+    a->nsrc = m;
     for (int y = b[1]; y < b[3]; y++) {
         const uint8_t *mr = m + (size_t)y * (size_t)W;
         const uint8_t *kr = mask + (size_t)y * (size_t)W;
         for (int x = b[0]; x < b[2]; x++) {
+            if (x + 8 <= b[2] && !fill_cand8(mr + x, kr + x)) {
+                x += 7;
+                continue;
+            }
             if (mr[x] == 0 || kr[x] != 0) continue;
             float s[3] = {0.0f, 0.0f, 0.0f};
             for (int yy = y - 1; yy <= y + 1; yy++) {
@@ -239,11 +473,23 @@ void pipe__aa_unfill(pipe__aa *a, const uint8_t *mask, float *nrm)
 {
     const int W = a->width;
     const int *b = a->nbox;
-    for (int y = b[1]; y < b[3]; y++)
-        for (int x = b[0]; x < b[2]; x++)
-            if (mask[(size_t)y * (size_t)W + (size_t)x] == 0) {
+    const uint8_t *m = a->nsrc;
+    /* the pixels pipe__aa_fill_normals wrote: m > 0 and mask 0 (m is
+     * unchanged since) */
+    for (int y = b[1]; m && y < b[3]; y++) {
+        const uint8_t *mr = m + (size_t)y * (size_t)W;
+        const uint8_t *kr = mask + (size_t)y * (size_t)W;
+        for (int x = b[0]; x < b[2]; x++) {
+            if (x + 8 <= b[2] && !fill_cand8(mr + x, kr + x)) {
+                x += 7;
+                continue;
+            }
+            if (mr[x] != 0 && kr[x] == 0) {
                 float *o = nrm + 3 * ((size_t)y * (size_t)W + (size_t)x);
                 o[0] = o[1] = o[2] = 0.0f;
             }
+        }
+    }
     box_empty(a->nbox);
+    a->nsrc = NULL;
 }

@@ -29,7 +29,24 @@ typedef struct pipe__aa {
                                  cov are 0 outside (this frame's draws) */
     int soft_box[4];          /* soft is 0 outside */
     int nbox[4];              /* normals written by pipe__aa_fill_normals */
+    const uint8_t *nsrc;      /* the m of that call (its pixels m > 0,
+                                 mask 0), or NULL */
+    /* the boundary band (pipe__aa_band): tiles of PIPE__AA_TILE px */
+    int tw, th;               /* tiles across, down */
+    uint8_t *tile;            /* tw x th: 1 = a pixel of the tile has a 3x3
+                                 window of the kinematic mask that is not
+                                 uniform (or is next to one) */
+    int *tsat;                /* (tw + 1) x (th + 1) summed-area table of tile */
+    const uint8_t *gmask;     /* the kinematic mask of this frame, or NULL
+                                 (no band: every triangle, every pixel) */
+    uint32_t *idx;            /* the triangles kept, 3 indices each */
+    int idx_cap;              /* triangles idx holds */
+    float *sxy;               /* the vertices' pixel x, y (NaN: behind the
+                                 eye, or not finite) */
+    int sxy_cap;              /* vertices sxy holds */
 } pipe__aa;
+
+#define PIPE__AA_TILE 4
 
 /* Allocates the planes for count samples (4, 8, 16) at width x height;
  * with_soft: the refined coverage too. 0, or -1 (out of memory or a bad
@@ -38,6 +55,16 @@ int pipe__aa_init(pipe__aa *a, int count, int width, int height, int with_soft);
 void pipe__aa_free(pipe__aa *a);
 /* Clears what the last frame wrote (samples, cov, soft in their boxes). */
 void pipe__aa_begin(pipe__aa *a);
+/* The boundary band of this frame (call after pipe__aa_begin, before the
+ * draws): tiles of PIPE__AA_TILE px that hold a pixel whose 3x3 window of
+ * the kinematic mask (0/255, G-buffer) is not uniform. Then pipe__aa_draw
+ * draws only the triangles whose pixel box meets such a tile (every
+ * sample of a band tile gets the bits of the full draw), and
+ * pipe__aa_resolve takes the kinematic mask (0 or 255) in every other
+ * tile: there the pixel and its 8 neighbours' centres agree, and the
+ * coverage of a closed surface is whole or none but for slivers thinner
+ * than a pixel. mask must stay unchanged until pipe__aa_resolve. */
+void pipe__aa_band(pipe__aa *a, const uint8_t *mask);
 /* ORs in the samples of one mesh (clip coordinates, as rast_draw) and
  * grows the box by the vertices' pixel box (the whole target when a
  * vertex is at or behind the eye plane, w <= 1e-6). */
