@@ -175,7 +175,37 @@ typedef struct simd_vec1 {
     uint8_t *mrow;
     float *drow, *arow;           /* NULL without depth / attributes */
     long written;
+    int inrow;                    /* the SIMD_W pixels from x0 lie in the row */
 } simd_vec1;
+
+/* p[l] = 0xFF for the lanes l in bits (the scan's mask store) as one
+ * read-modify-write of the SIMD_W bytes p[0 .. SIMD_W) (all of them inside
+ * the target's row: the caller checked), the others written back with the
+ * values read: no per-pixel loop and no data-dependent branch. Rows
+ * belong to one thread (bands are rows), so the bytes written back are
+ * never another thread's. Byte k of (b * 0x0101..01) & 0x8040..0201 is
+ * nonzero iff bit k of b is set; + 0x7F per byte carries into bit 7 of the
+ * byte exactly then (no carry leaves a byte: at most 0x80 + 0x7F). */
+static inline void simd_mask_or(uint8_t *p, unsigned bits)
+{
+#if SIMD_W == 16
+    vb_store_bits(p, bits);
+#elif SIMD_W == 8
+    uint64_t m = ((uint64_t)(bits & 0xFFu) * 0x0101010101010101ull) & 0x8040201008040201ull;
+    m = (((m + 0x7F7F7F7F7F7F7F7Full) & 0x8080808080808080ull) >> 7) * 0xFFu;
+    uint64_t v;
+    memcpy(&v, p, 8);
+    v |= m;
+    memcpy(p, &v, 8);
+#else
+    uint32_t m = ((uint32_t)(bits & 0xFu) * 0x01010101u) & 0x08040201u;
+    m = (((m + 0x7F7F7F7Fu) & 0x80808080u) >> 7) * 0xFFu;
+    uint32_t v;
+    memcpy(&v, p, 4);
+    v |= m;
+    memcpy(p, &v, 4);
+#endif
+}
 
 /* Coverage, depth and mask of row y (the reference's z per lane), the
  * edges stepped to the next row; returns the lanes written. */
@@ -193,14 +223,27 @@ static inline unsigned simd_vec1_row(simd_vec1 *s, const rast__tri *tri, int y,
     z = vf_max(vf_set1(0.0f), z);
     z = vf_min(vf_set1(1.0f), z);
     unsigned pass = cov;
-    if (s->drow) {
-        const vfloat d = vf_load_bits(s->drow, cov);
-        pass = cov & simd_lt_bits(z, d);
-        if (!pass)
-            return 0;
-        vf_store_bits(s->drow, pass, z);
+    if (s->inrow) {
+        /* Whole-vector accesses inside the row: the lanes not written
+         * get back the bits read (vf_sel copies them). */
+        if (s->drow) {
+            const vfloat d = vf_loadu(s->drow);
+            pass = cov & simd_lt_bits(z, d);
+            if (!pass)
+                return 0;
+            vf_storeu(s->drow, vf_sel(vm_from_bits(pass), z, d));
+        }
+        simd_mask_or(s->mrow, pass);
+    } else {
+        if (s->drow) {
+            const vfloat d = vf_load_bits(s->drow, cov);
+            pass = cov & simd_lt_bits(z, d);
+            if (!pass)
+                return 0;
+            vf_store_bits(s->drow, pass, z);
+        }
+        vb_store_bits(s->mrow, pass);
     }
-    vb_store_bits(s->mrow, pass);
     s->written += simd_popcount(pass);
     return pass;
 }
@@ -233,6 +276,7 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
     s.e1 = vi_add(vi_set1(c1), simd_lane_mul(lanev, sx1));
     s.e2 = vi_add(vi_set1(c2), simd_lane_mul(lanev, sx2));
     s.written = 0;
+    s.inrow = tri->x0 + SIMD_W <= t->width;
     s.mrow = t->mask + (size_t)ys * (size_t)t->mask_stride + tri->x0;
     s.drow = t->depth ? t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0 : NULL;
     s.arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride + (size_t)tri->x0 * (size_t)na
