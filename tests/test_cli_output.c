@@ -327,6 +327,7 @@ static void eval_report_write_fails_cleanly(void **state)
         skip();
         return;
     }
+    if (rc != 1 || !strstr(out, ".png")) printf("eval --report said (exit %d):\n%s\n", rc, out);
     assert_int_equal(rc, 1);
     assert_non_null(strstr(out, ".png"));
     assert_int_equal(files_in(dir, ".png"), 0);

@@ -272,7 +272,8 @@ int eval__gnuplot(const char *dir, const char *script, const char *const *charts
     }
     if (rc != 0)
         fprintf(stderr, "egofuse eval: gnuplot failed (status %d): the data files and "
-                        "%s/%s are written, the PNG charts are not\n", rc, dir, script);
+                        "%s/%s are written, the charts (%s/%s.png and %d more) are not\n", rc,
+                dir, script, dir, charts[0], NCHART - 1);
     return bad ? EXIT_FAIL : EXIT_OK;
 }
 
