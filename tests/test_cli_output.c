@@ -298,7 +298,7 @@ static int lines_of(const char *path)
 }
 
 /* The data files fit under the limit, the charts do not: the data is
- * written whole, every chart absent, exit 1. */
+ * written whole, every chart absent, exit 1 with the file named. */
 static void eval_report_write_fails_cleanly(void **state)
 {
     (void)state;
@@ -327,9 +327,15 @@ static void eval_report_write_fails_cleanly(void **state)
         skip();
         return;
     }
-    if (rc != 1 || !strstr(out, ".png")) printf("eval --report said (exit %d):\n%s\n", rc, out);
+    /* the chart step fails on its first PNG, or already on charts.gp: its
+     * size moves with the labels' leader lines, which follow the timings
+     * (a slow sanitizer build's went past the limit); either way the
+     * message names the file, and no chart is left */
+    const int named = strstr(out, ".png") != NULL ||
+                      (strstr(out, "charts.gp") != NULL && strstr(out, strerror(EFBIG)) != NULL);
+    if (rc != 1 || !named) printf("eval --report said (exit %d):\n%s\n", rc, out);
     assert_int_equal(rc, 1);
-    assert_non_null(strstr(out, ".png"));
+    assert_true(named);
     assert_int_equal(files_in(dir, ".png"), 0);
 }
 
