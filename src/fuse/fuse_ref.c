@@ -278,25 +278,8 @@ void fuse__composite_cols_ref(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
                            sw, v + 4 * i, out + 4 * i);
 }
 
-/* Coverage bits of a layer row (fuse_internal.h). */
-void fuse__cover_row_ref(const uint8_t *q, int w, uint64_t *bits)
-{
-    const int nb = (w + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
-    int b;
-    memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
-    for (b = 0; b < nb; b++) {
-        const int x1 = 8 * b + 8 < w ? 8 * b + 8 : w;
-        uint32_t acc = 0, t;
-        int x;
-        for (x = 8 * b; x < x1; x++) {
-            memcpy(&t, q + 4 * (size_t)x, 4);
-            acc |= t;
-        }
-        if (acc != 0) bits[b >> 6] |= (uint64_t)1 << (b & 63);
-    }
-}
-
-/* The same reading only the blocks that meet [x0, x1) (the others are 0). */
+/* Coverage bits of a layer row (fuse_internal.h), reading only the blocks
+ * that meet [x0, x1) (the others are 0). */
 void fuse__cover_span_ref(const uint8_t *q, int w, int x0, int x1, uint64_t *bits)
 {
     const int nb = (w + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
@@ -313,6 +296,12 @@ void fuse__cover_span_ref(const uint8_t *q, int w, int x0, int x1, uint64_t *bit
         }
         if (acc != 0) bits[b >> 6] |= (uint64_t)1 << (b & 63);
     }
+}
+
+/* The whole row: the span [0, w). */
+void fuse__cover_row_ref(const uint8_t *q, int w, uint64_t *bits)
+{
+    fuse__cover_span_ref(q, w, 0, w, bits);
 }
 
 void fuse__opaque_ref(const uint8_t *v, uint8_t *out, int n)

@@ -186,18 +186,11 @@ static int band_meets(const pipe__aa *a, int x0, int y0, int x1, int y1)
            0;
 }
 
-/* The triangles of indices that may cover a sample of a band tile, into
- * a->idx: a triangle with a vertex at or behind the eye plane, a NaN or
- * a bad index is kept (rast_draw_aa clips it, or refuses the mesh). */
-static int band_filter(pipe__aa *a, const float *clip, int vertex_count, const uint32_t *indices,
-                       int tri_count)
+/* a->sxy: the pixel x, y of each vertex of clip (NaN at or behind the eye
+ * plane, w <= 1e-6, or from a NaN), once per mesh for both the mesh's box
+ * and the band filter. 0, or -1 (out of memory). */
+static int project_vertices(pipe__aa *a, const float *clip, int vertex_count)
 {
-    if (tri_count > a->idx_cap) {
-        uint32_t *n = realloc(a->idx, sizeof *n * 3 * (size_t)tri_count);
-        if (!n) return -1;
-        a->idx = n;
-        a->idx_cap = tri_count;
-    }
     if (vertex_count > a->sxy_cap) {
         float *n = realloc(a->sxy, sizeof *n * 2 * (size_t)vertex_count);
         if (!n) return -1;
@@ -205,7 +198,6 @@ static int band_filter(pipe__aa *a, const float *clip, int vertex_count, const u
         a->sxy_cap = vertex_count;
     }
     const float W = (float)a->width, H = (float)a->height;
-    float *sxy = a->sxy;
     for (int i = 0; i < vertex_count; i++) {
         const float *v = clip + 4 * (size_t)i;
         float sx = NAN, sy = NAN;
@@ -213,9 +205,26 @@ static int band_filter(pipe__aa *a, const float *clip, int vertex_count, const u
             sx = (v[0] / v[3] * 0.5f + 0.5f) * W;
             sy = (0.5f - v[1] / v[3] * 0.5f) * H;
         }
-        sxy[2 * i] = sx;
-        sxy[2 * i + 1] = sy;
+        a->sxy[2 * i] = sx;
+        a->sxy[2 * i + 1] = sy;
     }
+    return 0;
+}
+
+/* The triangles of indices that may cover a sample of a band tile, into
+ * a->idx (the vertices' pixel positions in a->sxy: project_vertices): a
+ * triangle with a vertex at or behind the eye plane, a NaN or
+ * a bad index is kept (rast_draw_aa clips it, or refuses the mesh). */
+static int band_filter(pipe__aa *a, int vertex_count, const uint32_t *indices, int tri_count)
+{
+    if (tri_count > a->idx_cap) {
+        uint32_t *n = realloc(a->idx, sizeof *n * 3 * (size_t)tri_count);
+        if (!n) return -1;
+        a->idx = n;
+        a->idx_cap = tri_count;
+    }
+    const float W = (float)a->width, H = (float)a->height;
+    const float *sxy = a->sxy;
     int kept = 0;
     for (int t = 0; t < tri_count; t++) {
         const uint32_t *ix = indices + 3 * (size_t)t;
@@ -263,16 +272,11 @@ rast_result pipe__aa_draw(pipe__aa *a, rast_context *ctx, const float *clip, int
     /* the vertices' pixel box: every covered sample lies in the convex
      * hull of the projected vertices when all are in front of the eye
      * (clipping only cuts the triangles); 2 px for the snapping */
+    if (project_vertices(a, clip, vertex_count)) return RAST_ERR_ARGS; /* out of memory */
     float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
     int all = 0;
-    for (int i = 0; i < vertex_count && !all; i++) {
-        const float *v = clip + 4 * (size_t)i;
-        if (!(v[3] > 1e-6f)) {
-            all = 1;
-            break;
-        }
-        const float sx = (v[0] / v[3] * 0.5f + 0.5f) * (float)a->width;
-        const float sy = (0.5f - v[1] / v[3] * 0.5f) * (float)a->height;
+    for (int i = 0; i < vertex_count; i++) {
+        const float sx = a->sxy[2 * i], sy = a->sxy[2 * i + 1];
         if (!(sx == sx) || !(sy == sy)) {
             all = 1;
             break;
@@ -295,7 +299,7 @@ rast_result pipe__aa_draw(pipe__aa *a, rast_context *ctx, const float *clip, int
                 a->height);
     }
     if (a->gmask) {
-        const int kept = band_filter(a, clip, vertex_count, indices, tri_count);
+        const int kept = band_filter(a, vertex_count, indices, tri_count);
         if (kept < 0) return RAST_ERR_ARGS; /* out of memory */
         if (kept == 0) return RAST_OK;
         indices = a->idx;
