@@ -43,13 +43,6 @@ static void on_signal(int s)
     stop_flag = 1;
 }
 
-static uint64_t mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
-}
-
 /* Resolves a camera selector to a /dev/videoN path. */
 static int resolve(const char *sel, char *path, size_t n, io_error *err)
 {
@@ -224,7 +217,7 @@ static void track_service(run_state *r)
     io_error err;
     kin_track_sample s;
     int fresh = 0;
-    double t_arr = 1e-9 * (double)mono_ns();
+    double t_arr = 1e-9 * (double)io_now_ns();
     if (r->udp.fd >= 0) {
         if (io_track_udp_poll(&r->udp, 0, &s, &fresh, &err) != IO_OK) return;
     } else if (r->have_natnet) {
@@ -296,7 +289,7 @@ static int wait_until(const run_opts *o, run_state *r, uint64_t deadline_ns, int
                     ncam++;
                 }
         }
-        uint64_t now = mono_ns();
+        uint64_t now = io_now_ns();
         int ms = now >= deadline_ns ? 0 : (int)((deadline_ns - now + 999999) / 1000000);
         if (ms > 100) ms = 100;
         int k = poll(pf, (nfds_t)n, ms);
@@ -314,7 +307,7 @@ static int wait_until(const run_opts *o, run_state *r, uint64_t deadline_ns, int
         if (want_cams)
             for (int i = 0; i < ncam; i++)
                 if (pf[cam0 + i].revents) return 1;
-        if (mono_ns() >= deadline_ns) return 0;
+        if (io_now_ns() >= deadline_ns) return 0;
     }
 }
 
@@ -902,7 +895,7 @@ static int run(const run_opts *o)
     memset(&sample, 0, sizeof sample);
     int have_img[2] = {0, 0}, cam_lost[2] = {0, 0};
     char reopen_msg[2][sizeof err.msg] = {"", ""};
-    uint64_t t_start = mono_ns(), t_status = t_start, t_retry[2] = {0, 0};
+    uint64_t t_start = io_now_ns(), t_status = t_start, t_retry[2] = {0, 0};
     io_lat lat_cam, lat_pipe, lat_deq;
     io_lat_reset(&lat_cam);
     io_lat_reset(&lat_pipe);
@@ -911,7 +904,7 @@ static int run(const run_opts *o)
     uint64_t v_used = 0;
     while (!stop_flag && (o->frames == 0 || frames < o->frames)) {
         if (r->disp && io_display_quit_requested(r->disp)) break;
-        uint64_t now = mono_ns();
+        uint64_t now = io_now_ns();
         /* ---- the repaint window: start so as to finish just before the
          * vblank that shows the frame (free-running without a display) */
         io_sched_plan plan = {now, 0, 0};
@@ -924,7 +917,7 @@ static int run(const run_opts *o)
         io_frame fr[2];
         int got = 0;
         io_result gr = io_stereo_grab(&st, 0, fr, &got, &err);
-        now = mono_ns();
+        now = io_now_ns();
         /* a failed camera: said once, then reopened once a second, found
          * again by its selector */
         for (int e = 0; e < 2; e++) {
@@ -1053,9 +1046,9 @@ static int run(const run_opts *o)
 
         char why[256];
         pipe_frame_stats ps;
-        lg.t_start = mono_ns();
+        lg.t_start = io_now_ns();
         pipe_result pr = pipe_frame(r->pipe, &in, &ps, why, (int)sizeof why);
-        lg.t_done = mono_ns();
+        lg.t_done = io_now_ns();
         if (pr != PIPE_OK) {
             cli_fail("frame %d: %s", frames, why);
             goto done;
@@ -1071,7 +1064,7 @@ static int run(const run_opts *o)
             dump_frame(o, r, &in, &sample, tracked && r->track_samples, W, H) != EXIT_OK)
             goto done;
         /* ---- output */
-        lg.t_present = mono_ns();
+        lg.t_present = io_now_ns();
         if (r->disp) {
             const uint8_t *eyes[2] = {r->outimg[0].data, r->outimg[1].data};
             size_t stride[2] = {r->outimg[0].stride, r->outimg[1].stride};
@@ -1079,7 +1072,7 @@ static int run(const run_opts *o)
                 cli_fail("display: %s", err.msg);
                 goto done;
             }
-            io_sched_presented(&r->sched, &plan, lg.t_dequeue, mono_ns());
+            io_sched_presented(&r->sched, &plan, lg.t_dequeue, io_now_ns());
             if (r->npending == (int)(sizeof r->pending / sizeof r->pending[0])) {
                 io_stats_row(&r->stats, &r->pending[0]); /* never shown */
                 r->pending[0] = r->pending[--r->npending];
@@ -1088,14 +1081,14 @@ static int run(const run_opts *o)
             drain_flips(o, r, &lat_cam, &lat_deq); /* SDL's come with the present */
         } else {
             if (write_outputs(o, r, frames, W, H) != EXIT_OK) goto done;
-            lg.t_shown = mono_ns();
+            lg.t_shown = io_now_ns();
             io_stats_row(&r->stats, &lg);
             io_lat_push(&lat_cam, 1e-6 * ((double)lg.t_shown - (double)t_cam));
             io_lat_push(&lat_deq, 1e-6 * ((double)lg.t_shown - (double)lg.t_dequeue));
         }
         frames++;
         frames_status++;
-        now = mono_ns();
+        now = io_now_ns();
         if (!o->quiet && (now - t_status >= 1000000000ull || frames == o->frames)) {
             char vw[256], tw[256];
             fprintf(stderr,
@@ -1119,14 +1112,14 @@ static int run(const run_opts *o)
     }
     /* the last flips, then (--hold) the last frame stays on until Ctrl-C */
     if (r->disp) {
-        uint64_t until = mono_ns() + 1000000000ull;
-        while (r->npending && !stop_flag && mono_ns() < until)
+        uint64_t until = io_now_ns() + 1000000000ull;
+        while (r->npending && !stop_flag && io_now_ns() < until)
             wait_until(o, r, until, 0, &lat_cam, &lat_deq);
         if (o->hold && !stop_flag) {
             fprintf(stderr, "\negofuse run: holding frame %d on %s (Ctrl-C ends)\n", frames - 1,
                     io_display_describe(r->disp));
             while (!stop_flag && !io_display_quit_requested(r->disp))
-                wait_until(o, r, mono_ns() + 100000000ull, 0, &lat_cam, &lat_deq);
+                wait_until(o, r, io_now_ns() + 100000000ull, 0, &lat_cam, &lat_deq);
         }
     }
     for (int i = 0; i < r->npending; i++) io_stats_row(&r->stats, &r->pending[i]);
@@ -1138,7 +1131,7 @@ static int run(const run_opts *o)
     }
     {
         char vw[256], tw[256];
-        uint64_t now = mono_ns();
+        uint64_t now = io_now_ns();
         /* stdout carries the frames with --raw */
         fprintf(o->raw ? stderr : stdout,
                 "egofuse run: %d stereo frames%s, %llu pairs, dropped %llu/%llu, unpaired "
