@@ -109,6 +109,18 @@ int  gen_anim_build(gen_arms *arms);
 #define GEN_ANIM_NODES (1 + 2 * (3 + GEN_SIDE_JOINTS - GEN_J_THUMB_1))
 int  gen_anim_nodes(const gen_arms *arms, int nodes[GEN_ANIM_NODES]);
 
+/* An animation `name` of m (memory from m's block, not attached: the
+ * caller sets m->anims when the keys are in) with one LINEAR rotation
+ * channel per node of nodes[nch], `keys` keys at GEN_FPS from time 0;
+ * the values are set by gen_rot_anim_key. NULL when out of memory. The
+ * generator's animation and the ground truth's sequences (gt.c). */
+kin_animation *gen_rot_anim(kin_model *m, const char *name, const int *nodes, int nch,
+                            int keys);
+/* Key k of every channel of an from q (the rotations of all nodes), each
+ * negated where needed to stay in the hemisphere of key k-1 (so LINEAR
+ * blends the short way). */
+void gen_rot_anim_key(kin_animation *an, int k, const kin_quat *q);
+
 /* Writes the recorded tracking of the first `frames` frames (t = f /
  * GEN_FPS) of the animation to path ("egofuse-track 1", docs/tracking.md):
  * head, shoulders, hands and glove values of the true motion

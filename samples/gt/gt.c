@@ -914,22 +914,13 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
     /* channels: the generator's (gen_anim_nodes) */
     int nodes[GEN_ANIM_NODES];
     const int nch = gen_anim_nodes(mask, nodes);
-    float *times;
-    kin_channel *ch;
-    kin_animation *an;
+    kin_animation *an = gen_rot_anim(t, name, nodes, nch, keys);
+    const float *times = an ? an->channels[0].times : NULL;
     kin_quat *q;
     kin_mat4 *w;
-    ALLOC(times, keys);
-    ALLOC(ch, nch);
-    ALLOC(an, 1);
+    if (!an) goto oom;
     ALLOC(q, m->node_count);
     ALLOC(w, m->node_count);
-    for (int k = 0; k < keys; k++) times[k] = (float)k / (float)GEN_FPS;
-    for (int c = 0; c < nch; c++) {
-        float *v;
-        ALLOC(v, keys * 4);
-        ch[c] = (kin_channel){ nodes[c], KIN_PATH_ROTATION, KIN_INTERP_LINEAR, keys, 4, times, v };
-    }
     /* the mask model's shoulders and bone lengths (the angles are then
      * given to the true operator, as the generator does), or for a
      * true_bones sequence the true operator's own */
@@ -996,19 +987,8 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
             q[J[GEN_J_THUMB_2]] = kin_quat_axis_angle(X, -(10.0f + 22.0f * g) * D);
             q[J[GEN_J_THUMB_3]] = kin_quat_axis_angle(X, -(12.0f + 30.0f * g) * D);
         }
-        for (int c = 0; c < nch; c++) {
-            kin_quat r = q[nodes[c]];
-            float *v = (float *)ch[c].values;
-            if (k > 0 && v[(k - 1) * 4] * r.x + v[(k - 1) * 4 + 1] * r.y +
-                                 v[(k - 1) * 4 + 2] * r.z + v[(k - 1) * 4 + 3] * r.w < 0.0f)
-                r = (kin_quat){ -r.x, -r.y, -r.z, -r.w };
-            memcpy(&v[k * 4], &r, sizeof r);
-        }
+        gen_rot_anim_key(an, k, q);
     }
-    snprintf(an->name, KIN_NAME_MAX, "%s", name);
-    an->channel_count = nch;
-    an->channels = ch;
-    an->duration = times[keys - 1];
     t->anim_count = 1;
     t->anims = an;
     return 0;
