@@ -98,6 +98,16 @@ typedef struct gen_arms {
  * (the partial model is freed). */
 int  gen_arms_build(gen_arms *arms);
 void gen_arms_free(gen_arms *arms);
+
+/* The one skin of a generated model m (memory from m's block): joint j
+ * is node joints[j] (NULL: node j), its inverse bind matrix the inverse
+ * of bind[that node]; -1 when out of memory or a bind matrix is
+ * singular. The generator's model and the ground truth's (gt.c). */
+int  gen_model_skin(kin_model *m, int joint_count, const int *joints, const kin_mat4 *bind);
+/* The one mesh of m, skin 0, on node `node`, over arrays the caller
+ * allocated from m's block (nt triangles); -1 when out of memory. */
+int  gen_model_mesh(kin_model *m, int nv, float *pos, float *nrm, uint16_t *jnt, float *w,
+                    int nt, uint32_t *idx, int node);
 /* Name of joint j of side (0 = "L_", 1 = "R_") into buf. */
 const char *gen_joint_name(int side, int j, char *buf, size_t n);
 

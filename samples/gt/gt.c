@@ -305,34 +305,9 @@ int gt_truth_build(const gen_arms *mask, const gt_operator_desc *d,
     t->rest = rest;
     t->names = (const char (*)[KIN_NAME_MAX])names;
     t->node_src = src;
-    kin_skin *skin;
-    int *joints;
-    kin_mat4 *ibm;
-    ALLOC(skin, 1);
-    ALLOC(joints, sk->joint_count);
-    ALLOC(ibm, sk->joint_count);
-    for (int j = 0; j < sk->joint_count; j++) {
-        joints[j] = sk->joints[j];
-        if (!kin_mat4_inverse(&bnew[joints[j]], &ibm[j])) goto oom;
-    }
-    skin->joint_count = sk->joint_count;
-    skin->joints = joints;
-    skin->inverse_bind = ibm;
-    t->skin_count = 1;
-    t->skins = skin;
-    kin_mesh *mesh;
-    ALLOC(mesh, 1);
-    mesh->vertex_count = fin.nv;
-    mesh->positions = fin.pos;
-    mesh->normals = fin.nrm;
-    mesh->joints = fin.jnt;
-    mesh->weights = fin.w;
-    mesh->index_count = fin.nt * 3;
-    mesh->indices = fin.idx;
-    mesh->node = me->node;
-    mesh->skin = 0;
-    t->mesh_count = 1;
-    t->meshes = mesh;
+    if (gen_model_skin(t, sk->joint_count, sk->joints, bnew) < 0 ||
+        gen_model_mesh(t, fin.nv, fin.pos, fin.nrm, fin.jnt, fin.w, fin.nt, fin.idx, me->node) < 0)
+        goto oom;
     t->anim_count = m->anim_count;
     t->anims = m->anims;
     truth->albedo = fin.albedo;
