@@ -174,8 +174,7 @@ static void validity_run_bad_calibration(void **state)
     assert_int_equal(run("run", "--config", conf, NULL), 1);
     snprintf(sub, sizeof sub, "%s/calib/missing.yml: No such file", dir);
     if (!strstr(out, sub)) fail_msg("'%s' lacks '%s'", out, sub);
-    snprintf(sub, sizeof sub, "rm -rf '%s'", dir);
-    assert_int_equal(system(sub), 0);
+    assert_int_equal(tu_rm_rf(dir), 0);
 }
 
 /* render on a scene of a named HMD (hmd = consumer: 1280x1024 cameras):
@@ -231,8 +230,7 @@ static void validity_render_named_hmd(void **state)
     assert_non_null(strstr(out, "--aa 4: anti-aliased edges are drawn through the pinhole"));
     snprintf(p2, sizeof p2, "%s/left_0000.png", out2);
     assert_false(tu_exists(p2));
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    assert_int_equal(system(cmd), 0);
+    assert_int_equal(tu_rm_rf(dir), 0);
 }
 
 int main(void)

@@ -25,6 +25,7 @@
 
 #include "../src/io/io_natnet.h"
 #include "support/sample_model.h"
+#include "support/tu_kin.h"
 
 static char out[65536];
 
@@ -324,17 +325,9 @@ static int calib_recording(kin_track_sample *s, const kin_arm_rig *rig, const ki
         s[n].head_pos = kin_v3(0, 1.3f, -0.08f);
         s[n].shoulder[0] = kin_v3(-0.5f * width, 1.0f, 0);
         s[n].shoulder[1] = kin_v3(0.5f * width, 1.0f, 0);
-        float yaw = 0.44f * sinf(0.05f * (float)i), tilt = 0.26f * cosf(0.03f * (float)i);
-        kin_quat pair = kin_quat_mul(kin_quat_axis_angle(kin_v3(0, 1, 0), yaw),
-                                     kin_quat_axis_angle(kin_v3(0, 0, 1), tilt));
-        /* the fingers (-Z) of the left hand to +X, of the right hand to -X */
-        s[n].hand_rot[0] = kin_quat_mul(pair, kin_quat_axis_angle(kin_v3(0, 1, 0), -1.5707963f));
-        s[n].hand_rot[1] = kin_quat_mul(pair, kin_quat_axis_angle(kin_v3(0, 1, 0), 1.5707963f));
-        kin_vec3 C = kin_v3(0.01f, 1.02f, -0.38f);
-        kin_vec3 tl = kin_quat_rotate(s[n].hand_rot[0], kin_v3_scale(tip[0], TRUE_HAND));
-        kin_vec3 tr = kin_quat_rotate(s[n].hand_rot[1], kin_v3_scale(tip[1], TRUE_HAND));
-        s[n].hand_pos[0] = kin_v3_sub(C, tl);
-        s[n].hand_pos[1] = kin_v3_sub(C, tr);
+        /* the fingertip gesture, touching */
+        tu_fingertip_gesture(&s[n], i, kin_v3_scale(tip[0], TRUE_HAND),
+                             kin_v3_scale(tip[1], TRUE_HAND), 0.0f);
         for (int k = 0; k < 2; k++) {
             float nx = 0.001f * tu_range(&g, -1, 1);
             float ny = 0.001f * tu_range(&g, -1, 1);

@@ -42,10 +42,9 @@ static void run_subset(const char *name, const char *methods)
         skip();
         return;
     }
-    char dir[1024], cmd[2200], p[1200];
+    char dir[1024], p[1200];
     tu_tmp_path(name, dir, sizeof dir);
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-    assert_int_equal(system(cmd), 0);
+    assert_int_equal(tu_rm_rf(dir), 0);
     int rc = tu_runl(out, sizeof out, tu_bin(), "eval", "--methods", methods, "--frames", "1",
                      "--sweep-frames", "1", "--seq-frames", "1", "--quiet", "--report", dir,
                      NULL);
@@ -64,7 +63,7 @@ static void run_subset(const char *name, const char *methods)
     struct dirent *e;
     while ((e = readdir(d))) assert_null(strstr(e->d_name, ".tmp."));
     closedir(d);
-    assert_int_equal(system(cmd), 0);   /* rm -rf the report */
+    assert_int_equal(tu_rm_rf(dir), 0);   /* the report */
 }
 
 static void subset_kin_refine(void **state)

@@ -71,9 +71,7 @@ static int setup(void **st)
 {
     (void)st;
     tu_tmp_path("fake_sysfs", root, sizeof root);
-    char cmd[600];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", root);
-    if (system(cmd) != 0) return -1;
+    if (tu_rm_rf(root) != 0) return -1;
     /* two UVC cameras (each with a metadata node of index 1), a glove, a hub */
     device("1-2.3", "046d", "0825", "CAMR42", "Webcam R", "0e");
     device("1-2.1", "046d", "0825", "CAML17", "Webcam L", "0e");
@@ -90,9 +88,7 @@ static int setup(void **st)
 static int teardown(void **st)
 {
     (void)st;
-    char cmd[600];
-    snprintf(cmd, sizeof cmd, "rm -rf '%s'", root);
-    return system(cmd) == 0 ? 0 : -1;
+    return tu_rm_rf(root);
 }
 
 static void test_port_path(void **st)

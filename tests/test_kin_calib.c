@@ -77,18 +77,7 @@ static int gesture(kin_track_sample *s, int n, float scale, float gap, float noi
         s[i].head_pos = kin_v3(0, 1.3f, -0.08f);
         s[i].shoulder[0] = kin_v3(-0.21f, 1.0f, 0.0f);
         s[i].shoulder[1] = kin_v3(0.21f, 1.0f, 0.0f);
-        float yaw = 0.44f * sinf(0.05f * (float)i), tilt = 0.26f * cosf(0.03f * (float)i);
-        kin_quat pair = kin_quat_mul(kin_quat_axis_angle(kin_v3(0, 1, 0), yaw),
-                                     kin_quat_axis_angle(kin_v3(0, 0, 1), tilt));
-        /* -Z (the fingers) to +X for the left hand, to -X for the right */
-        s[i].hand_rot[0] = kin_quat_mul(pair, kin_quat_axis_angle(kin_v3(0, 1, 0), -1.5707963f));
-        s[i].hand_rot[1] = kin_quat_mul(pair, kin_quat_axis_angle(kin_v3(0, 1, 0), 1.5707963f));
-        kin_vec3 C = kin_v3(0.01f, 1.02f, -0.38f);
-        kin_vec3 x = kin_quat_rotate(pair, kin_v3(1, 0, 0));
-        kin_vec3 tl = kin_quat_rotate(s[i].hand_rot[0], kin_v3_scale(TIP_L, scale));
-        kin_vec3 tr = kin_quat_rotate(s[i].hand_rot[1], kin_v3_scale(TIP_R, scale));
-        s[i].hand_pos[0] = kin_v3_sub(kin_v3_sub(C, tl), kin_v3_scale(x, 0.5f * gap));
-        s[i].hand_pos[1] = kin_v3_add(kin_v3_sub(C, tr), kin_v3_scale(x, 0.5f * gap));
+        tu_fingertip_gesture(&s[i], i, kin_v3_scale(TIP_L, scale), kin_v3_scale(TIP_R, scale), gap);
         for (int k = 0; k < 2; k++)
             s[i].hand_pos[k] = kin_v3_add(s[i].hand_pos[k],
                                           kin_v3_scale(tu_v3(g, -1, 1), noise));

@@ -54,20 +54,31 @@ static inline double eh_p99_sorted(const double *v, int n)
     return v[k < 0 ? 0 : k];
 }
 
+/* Exits with status 3, the GL log printed after `what`, unless the
+ * object's status (GL_COMPILE_STATUS of a shader, GL_LINK_STATUS of a
+ * program) is set: one check for the shader and the program, whose
+ * query and log functions have the same signatures. */
+static inline void eh_check(GLuint obj, GLenum status, const char *what,
+                            void (*getiv)(GLuint, GLenum, GLint *),
+                            void (*getlog)(GLuint, GLsizei, GLsizei *, GLchar *))
+{
+    GLint ok = 0;
+    getiv(obj, status, &ok);
+    if (!ok) {
+        char log[2048];
+        getlog(obj, sizeof log, NULL, log);
+        fprintf(stderr, "%s: %s\n", what, log);
+        exit(3);
+    }
+}
+
 /* Compiles a shader; on error prints the log and exits with status 3. */
 static inline GLuint eh_compile(GLenum type, const char *src)
 {
     GLuint s = glCreateShader(type);
     glShaderSource(s, 1, &src, NULL);
     glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[2048];
-        glGetShaderInfoLog(s, sizeof log, NULL, log);
-        fprintf(stderr, "shader: %s\n", log);
-        exit(3);
-    }
+    eh_check(s, GL_COMPILE_STATUS, "shader", glGetShaderiv, glGetShaderInfoLog);
     return s;
 }
 
@@ -78,14 +89,7 @@ static inline GLuint eh_program(const char *vs, const char *fs)
     glAttachShader(p, eh_compile(GL_VERTEX_SHADER, vs));
     glAttachShader(p, eh_compile(GL_FRAGMENT_SHADER, fs));
     glLinkProgram(p);
-    GLint ok = 0;
-    glGetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[2048];
-        glGetProgramInfoLog(p, sizeof log, NULL, log);
-        fprintf(stderr, "program: %s\n", log);
-        exit(3);
-    }
+    eh_check(p, GL_LINK_STATUS, "program", glGetProgramiv, glGetProgramInfoLog);
     return p;
 }
 

@@ -98,6 +98,16 @@ typedef struct gen_arms {
  * (the partial model is freed). */
 int  gen_arms_build(gen_arms *arms);
 void gen_arms_free(gen_arms *arms);
+
+/* The one skin of a generated model m (memory from m's block): joint j
+ * is node joints[j] (NULL: node j), its inverse bind matrix the inverse
+ * of bind[that node]; -1 when out of memory or a bind matrix is
+ * singular. The generator's model and the ground truth's (gt.c). */
+int  gen_model_skin(kin_model *m, int joint_count, const int *joints, const kin_mat4 *bind);
+/* The one mesh of m, skin 0, on node `node`, over arrays the caller
+ * allocated from m's block (nt triangles); -1 when out of memory. */
+int  gen_model_mesh(kin_model *m, int nv, float *pos, float *nrm, uint16_t *jnt, float *w,
+                    int nt, uint32_t *idx, int node);
 /* Name of joint j of side (0 = "L_", 1 = "R_") into buf. */
 const char *gen_joint_name(int side, int j, char *buf, size_t n);
 
@@ -108,6 +118,18 @@ int  gen_anim_build(gen_arms *arms);
  * joints. Fills nodes and returns their count, GEN_ANIM_NODES. */
 #define GEN_ANIM_NODES (1 + 2 * (3 + GEN_SIDE_JOINTS - GEN_J_THUMB_1))
 int  gen_anim_nodes(const gen_arms *arms, int nodes[GEN_ANIM_NODES]);
+
+/* An animation `name` of m (memory from m's block, not attached: the
+ * caller sets m->anims when the keys are in) with one LINEAR rotation
+ * channel per node of nodes[nch], `keys` keys at GEN_FPS from time 0;
+ * the values are set by gen_rot_anim_key. NULL when out of memory. The
+ * generator's animation and the ground truth's sequences (gt.c). */
+kin_animation *gen_rot_anim(kin_model *m, const char *name, const int *nodes, int nch,
+                            int keys);
+/* Key k of every channel of an from q (the rotations of all nodes), each
+ * negated where needed to stay in the hemisphere of key k-1 (so LINEAR
+ * blends the short way). */
+void gen_rot_anim_key(kin_animation *an, int k, const kin_quat *q);
 
 /* Writes the recorded tracking of the first `frames` frames (t = f /
  * GEN_FPS) of the animation to path ("egofuse-track 1", docs/tracking.md):

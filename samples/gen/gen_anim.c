@@ -229,31 +229,53 @@ int gen_anim_nodes(const gen_arms *a, int nodes[GEN_ANIM_NODES])
     return n;
 }
 
+kin_animation *gen_rot_anim(kin_model *m, const char *name, const int *nodes, int nch,
+                            int keys)
+{
+    float *times = kin_block_alloc(&m->block, sizeof(float) * (size_t)keys);
+    kin_channel *ch = kin_block_alloc(&m->block, sizeof(kin_channel) * (size_t)nch);
+    kin_animation *an = kin_block_alloc(&m->block, sizeof(kin_animation));
+    if (!times || !ch || !an) return NULL;
+    for (int k = 0; k < keys; k++) times[k] = (float)k / (float)GEN_FPS;
+    for (int c = 0; c < nch; c++) {
+        float *v = kin_block_alloc(&m->block, sizeof(float) * 4 * (size_t)keys);
+        if (!v) return NULL;
+        ch[c] = (kin_channel){ nodes[c], KIN_PATH_ROTATION, KIN_INTERP_LINEAR, keys, 4, times, v };
+    }
+    snprintf(an->name, KIN_NAME_MAX, "%s", name);
+    an->channel_count = nch;
+    an->channels = ch;
+    an->duration = times[keys - 1];
+    return an;
+}
+
+void gen_rot_anim_key(kin_animation *an, int k, const kin_quat *q)
+{
+    for (int c = 0; c < an->channel_count; c++) {
+        kin_quat r = q[an->channels[c].node];
+        float *v = (float *)an->channels[c].values;
+        if (k > 0) {
+            const float *p = v + (k - 1) * 4;
+            if (p[0] * r.x + p[1] * r.y + p[2] * r.z + p[3] * r.w < 0.0f) {
+                r.x = -r.x; r.y = -r.y; r.z = -r.z; r.w = -r.w;
+            }
+        }
+        v[k * 4 + 0] = r.x;
+        v[k * 4 + 1] = r.y;
+        v[k * 4 + 2] = r.z;
+        v[k * 4 + 3] = r.w;
+    }
+}
+
 int gen_anim_build(gen_arms *a)
 {
     kin_model *m = &a->model;
     int nodes[GEN_ANIM_NODES];
     const int nch = gen_anim_nodes(a, nodes);
-    float *times;
-    kin_channel *ch;
-    kin_animation *an;
+    kin_animation *an = gen_rot_anim(m, GEN_ANIM_NAME, nodes, nch, GEN_ANIM_KEYS);
     kin_quat *q;
-    ALLOC(times, GEN_ANIM_KEYS);
-    ALLOC(ch, nch);
-    ALLOC(an, 1);
+    if (!an) return -1;
     ALLOC(q, m->node_count);
-    for (int k = 0; k < GEN_ANIM_KEYS; k++) times[k] = (float)k / (float)GEN_FPS;
-    float *vals[GEN_ANIM_NODES];
-    for (int c = 0; c < nch; c++) {
-        ALLOC(vals[c], GEN_ANIM_KEYS * 4);
-        ch[c].node = nodes[c];
-        ch[c].path = KIN_PATH_ROTATION;
-        ch[c].interp = KIN_INTERP_LINEAR;
-        ch[c].key_count = GEN_ANIM_KEYS;
-        ch[c].comps = 4;
-        ch[c].times = times;
-        ch[c].values = vals[c];
-    }
     /* shoulder joints (upper_arm origins) in the rest pose */
     kin_vec3 shoulder[2];
     for (int side = 0; side < 2; side++) {
@@ -264,25 +286,9 @@ int gen_anim_build(gen_arms *a)
         shoulder[side] = p;
     }
     for (int k = 0; k < GEN_ANIM_KEYS; k++) {
-        pose_at(a, shoulder, times[k], q);
-        for (int c = 0; c < nch; c++) {
-            kin_quat r = q[nodes[c]];
-            if (k > 0) {
-                const float *p = vals[c] + (k - 1) * 4;
-                if (p[0] * r.x + p[1] * r.y + p[2] * r.z + p[3] * r.w < 0.0f) {
-                    r.x = -r.x; r.y = -r.y; r.z = -r.z; r.w = -r.w;
-                }
-            }
-            vals[c][k * 4 + 0] = r.x;
-            vals[c][k * 4 + 1] = r.y;
-            vals[c][k * 4 + 2] = r.z;
-            vals[c][k * 4 + 3] = r.w;
-        }
+        pose_at(a, shoulder, an->channels[0].times[k], q);
+        gen_rot_anim_key(an, k, q);
     }
-    snprintf(an->name, KIN_NAME_MAX, "%s", GEN_ANIM_NAME);
-    an->channel_count = nch;
-    an->channels = ch;
-    an->duration = times[GEN_ANIM_KEYS - 1];
     m->anim_count = 1;
     m->anims = an;
 

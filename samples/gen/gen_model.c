@@ -487,6 +487,49 @@ void gen_arms_free(gen_arms *a)
         if (!(ptr)) goto oom;                                              \
     } while (0)
 
+int gen_model_skin(kin_model *m, int joint_count, const int *joints, const kin_mat4 *bind)
+{
+    kin_skin *skin;
+    int *jn;
+    kin_mat4 *ibm;
+    ALLOC(skin, 1);
+    ALLOC(jn, joint_count);
+    ALLOC(ibm, joint_count);
+    for (int j = 0; j < joint_count; j++) {
+        jn[j] = joints ? joints[j] : j;
+        if (!kin_mat4_inverse(&bind[jn[j]], &ibm[j])) return -1;
+    }
+    skin->joint_count = joint_count;
+    skin->joints = jn;
+    skin->inverse_bind = ibm;
+    m->skin_count = 1;
+    m->skins = skin;
+    return 0;
+oom:
+    return -1;
+}
+
+int gen_model_mesh(kin_model *m, int nv, float *pos, float *nrm, uint16_t *jnt, float *w,
+                   int nt, uint32_t *idx, int node)
+{
+    kin_mesh *mesh;
+    ALLOC(mesh, 1);
+    mesh->vertex_count = nv;
+    mesh->positions = pos;
+    mesh->normals = nrm;
+    mesh->joints = jnt;
+    mesh->weights = w;
+    mesh->index_count = nt * 3;
+    mesh->indices = idx;
+    mesh->node = node;
+    mesh->skin = 0;
+    m->mesh_count = 1;
+    m->meshes = mesh;
+    return 0;
+oom:
+    return -1;
+}
+
 int gen_arms_build(gen_arms *a)
 {
     memset(a, 0, sizeof *a);
@@ -527,38 +570,13 @@ int gen_arms_build(gen_arms *a)
     m->node_src = src;
 
     /* skin: every node except the mesh node (which comes last) */
-    kin_skin *skin;
-    int *joints;
-    kin_mat4 *ibm;
-    int jc = b->node_count - 1;
-    ALLOC(skin, 1);
-    ALLOC(joints, jc);
-    ALLOC(ibm, jc);
-    for (int j = 0; j < jc; j++) {
-        joints[j] = j;
-        if (!kin_mat4_inverse(&b->bind[j], &ibm[j])) goto oom;
-    }
-    skin->joint_count = jc;
-    skin->joints = joints;
-    skin->inverse_bind = ibm;
-    m->skin_count = 1;
-    m->skins = skin;
+    if (gen_model_skin(m, b->node_count - 1, NULL, b->bind) < 0) goto oom;
 
     /* mesh: trimmed copies are not needed, the builder arrays are owned by
      * the block already */
-    kin_mesh *mesh;
-    ALLOC(mesh, 1);
-    mesh->vertex_count = b->vcount;
-    mesh->positions = b->pos;
-    mesh->normals = b->nrm;
-    mesh->joints = b->jnt;
-    mesh->weights = b->w;
-    mesh->index_count = b->tcount * 3;
-    mesh->indices = b->idx;
-    mesh->node = a->mesh_node;
-    mesh->skin = 0;
-    m->mesh_count = 1;
-    m->meshes = mesh;
+    if (gen_model_mesh(m, b->vcount, b->pos, b->nrm, b->jnt, b->w, b->tcount, b->idx,
+                       a->mesh_node) < 0)
+        goto oom;
     a->albedo = b->albedo;
     a->uv = b->uv;
     free(b);

@@ -305,34 +305,9 @@ int gt_truth_build(const gen_arms *mask, const gt_operator_desc *d,
     t->rest = rest;
     t->names = (const char (*)[KIN_NAME_MAX])names;
     t->node_src = src;
-    kin_skin *skin;
-    int *joints;
-    kin_mat4 *ibm;
-    ALLOC(skin, 1);
-    ALLOC(joints, sk->joint_count);
-    ALLOC(ibm, sk->joint_count);
-    for (int j = 0; j < sk->joint_count; j++) {
-        joints[j] = sk->joints[j];
-        if (!kin_mat4_inverse(&bnew[joints[j]], &ibm[j])) goto oom;
-    }
-    skin->joint_count = sk->joint_count;
-    skin->joints = joints;
-    skin->inverse_bind = ibm;
-    t->skin_count = 1;
-    t->skins = skin;
-    kin_mesh *mesh;
-    ALLOC(mesh, 1);
-    mesh->vertex_count = fin.nv;
-    mesh->positions = fin.pos;
-    mesh->normals = fin.nrm;
-    mesh->joints = fin.jnt;
-    mesh->weights = fin.w;
-    mesh->index_count = fin.nt * 3;
-    mesh->indices = fin.idx;
-    mesh->node = me->node;
-    mesh->skin = 0;
-    t->mesh_count = 1;
-    t->meshes = mesh;
+    if (gen_model_skin(t, sk->joint_count, sk->joints, bnew) < 0 ||
+        gen_model_mesh(t, fin.nv, fin.pos, fin.nrm, fin.jnt, fin.w, fin.nt, fin.idx, me->node) < 0)
+        goto oom;
     t->anim_count = m->anim_count;
     t->anims = m->anims;
     truth->albedo = fin.albedo;
@@ -914,22 +889,13 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
     /* channels: the generator's (gen_anim_nodes) */
     int nodes[GEN_ANIM_NODES];
     const int nch = gen_anim_nodes(mask, nodes);
-    float *times;
-    kin_channel *ch;
-    kin_animation *an;
+    kin_animation *an = gen_rot_anim(t, name, nodes, nch, keys);
+    const float *times = an ? an->channels[0].times : NULL;
     kin_quat *q;
     kin_mat4 *w;
-    ALLOC(times, keys);
-    ALLOC(ch, nch);
-    ALLOC(an, 1);
+    if (!an) goto oom;
     ALLOC(q, m->node_count);
     ALLOC(w, m->node_count);
-    for (int k = 0; k < keys; k++) times[k] = (float)k / (float)GEN_FPS;
-    for (int c = 0; c < nch; c++) {
-        float *v;
-        ALLOC(v, keys * 4);
-        ch[c] = (kin_channel){ nodes[c], KIN_PATH_ROTATION, KIN_INTERP_LINEAR, keys, 4, times, v };
-    }
     /* the mask model's shoulders and bone lengths (the angles are then
      * given to the true operator, as the generator does), or for a
      * true_bones sequence the true operator's own */
@@ -996,19 +962,8 @@ int gt_sequence_build(const gen_arms *mask, const char *name, gen_arms *truth)
             q[J[GEN_J_THUMB_2]] = kin_quat_axis_angle(X, -(10.0f + 22.0f * g) * D);
             q[J[GEN_J_THUMB_3]] = kin_quat_axis_angle(X, -(12.0f + 30.0f * g) * D);
         }
-        for (int c = 0; c < nch; c++) {
-            kin_quat r = q[nodes[c]];
-            float *v = (float *)ch[c].values;
-            if (k > 0 && v[(k - 1) * 4] * r.x + v[(k - 1) * 4 + 1] * r.y +
-                                 v[(k - 1) * 4 + 2] * r.z + v[(k - 1) * 4 + 3] * r.w < 0.0f)
-                r = (kin_quat){ -r.x, -r.y, -r.z, -r.w };
-            memcpy(&v[k * 4], &r, sizeof r);
-        }
+        gen_rot_anim_key(an, k, q);
     }
-    snprintf(an->name, KIN_NAME_MAX, "%s", name);
-    an->channel_count = nch;
-    an->channels = ch;
-    an->duration = times[keys - 1];
     t->anim_count = 1;
     t->anims = an;
     return 0;

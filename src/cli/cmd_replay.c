@@ -324,13 +324,6 @@ static int parse_hostport(const char *s, int need_port, int def_port, struct soc
     return 0;
 }
 
-static uint64_t mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
-}
-
 /* ------------------------------------------------------------ the replay */
 
 static int replay(const replay_opts *o)
@@ -415,20 +408,20 @@ static int replay(const replay_opts *o)
         if (!srv.multicast) {
             if (!o->quiet)
                 fprintf(stderr, "egofuse replay-track: %s waiting for a client\n", dest);
-            uint64_t t_end = o->wait_s > 0 ? mono_ns() + (uint64_t)(o->wait_s * 1e9) : 0;
+            uint64_t t_end = o->wait_s > 0 ? io_now_ns() + (uint64_t)(o->wait_s * 1e9) : 0;
             uint64_t t_client = 0;
             /* start when the first client connected and asked for the
              * model definitions (its frames then carry names), or 1 s
              * after it connected */
             while (!stop_flag && (!srv.clients || (!srv.model_requests &&
-                                                   mono_ns() - t_client < 1000000000ull))) {
+                                                   io_now_ns() - t_client < 1000000000ull))) {
                 struct pollfd pf = { srv.cmd_fd, POLLIN, 0 };
                 poll(&pf, 1, srv.clients ? 10 : 100);
                 int had = srv.clients;
                 serve(&srv, o);
-                if (!had && srv.clients) t_client = mono_ns();
+                if (!had && srv.clients) t_client = io_now_ns();
                 if (srv.clients) continue;
-                if (t_end && mono_ns() > t_end) {
+                if (t_end && io_now_ns() > t_end) {
                     cli_fail("%s: no NatNet client connected within %g s", dest, o->wait_s);
                     goto done;
                 }
@@ -440,7 +433,7 @@ static int replay(const replay_opts *o)
     if (!o->quiet)
         fprintf(stderr, "egofuse replay-track: %s, %d samples over %.3f s, to %s at %gx%s\n",
                 o->file, count, span, dest, o->speed, o->loop ? ", looping" : "");
-    uint64_t t0 = mono_ns();
+    uint64_t t0 = io_now_ns();
     long sent = 0, send_errors = 0;
     int loops = 0;
     for (int loop = 0; !stop_flag; loop++) {
@@ -448,7 +441,7 @@ static int replay(const replay_opts *o)
             double rel = (smp[i].t - smp[0].t) + loop * period;
             uint64_t due = t0 + (uint64_t)llround(rel / o->speed * 1e9);
             for (;;) {   /* wait, answering requests meanwhile */
-                uint64_t now = mono_ns();
+                uint64_t now = io_now_ns();
                 if (now >= due || stop_flag) break;
                 int ms = (int)((due - now) / 1000000ull);
                 if (o->natnet) {
@@ -467,7 +460,7 @@ static int replay(const replay_opts *o)
             if (o->natnet) {
                 serve(&srv, o);
                 buf b;
-                frame(&srv, &b, (int32_t)(1 + i + (long)loop * count), s.t, &s, mono_ns());
+                frame(&srv, &b, (int32_t)(1 + i + (long)loop * count), s.t, &s, io_now_ns());
                 if (b.n > sizeof b.d) {
                     cli_fail("frame too large");
                     goto done;
@@ -487,7 +480,7 @@ static int replay(const replay_opts *o)
         if (!o->loop) break;
     }
     printf("egofuse replay-track: sent %ld samples (%d pass%s) to %s in %.3f s", sent, loops,
-           loops == 1 ? "" : "es", dest, 1e-9 * (double)(mono_ns() - t0));
+           loops == 1 ? "" : "es", dest, 1e-9 * (double)(io_now_ns() - t0));
     if (send_errors) printf(", %ld refused (no receiver)", send_errors);
     printf("\n");
     rc = EXIT_OK;

@@ -12,10 +12,10 @@
  *
  * Why one file of this length: one job, the live loop of `egofuse run`
  * (run(), about 550 lines: open, then per frame wait, grab, track, pipe,
- * show, account). Its options are parsed in run_opts.c (run.h); what is
- * left here are that loop and the helpers that read and write its
- * run_state (tracking service, flips, outputs, the status words), which
- * nothing else uses. */
+ * show, account). Its options are parsed in run_opts.c and --dump's files
+ * written in run_dump.c (run.h); what is left here are that loop and the
+ * helpers that read and write its run_state (tracking service, flips,
+ * outputs, the status words), which nothing else uses. */
 #include "run.h"
 #include "cli_lod.h"
 
@@ -41,13 +41,6 @@ static void on_signal(int s)
 {
     (void)s;
     stop_flag = 1;
-}
-
-static uint64_t mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
 }
 
 /* Resolves a camera selector to a /dev/videoN path. */
@@ -224,7 +217,7 @@ static void track_service(run_state *r)
     io_error err;
     kin_track_sample s;
     int fresh = 0;
-    double t_arr = 1e-9 * (double)mono_ns();
+    double t_arr = 1e-9 * (double)io_now_ns();
     if (r->udp.fd >= 0) {
         if (io_track_udp_poll(&r->udp, 0, &s, &fresh, &err) != IO_OK) return;
     } else if (r->have_natnet) {
@@ -296,7 +289,7 @@ static int wait_until(const run_opts *o, run_state *r, uint64_t deadline_ns, int
                     ncam++;
                 }
         }
-        uint64_t now = mono_ns();
+        uint64_t now = io_now_ns();
         int ms = now >= deadline_ns ? 0 : (int)((deadline_ns - now + 999999) / 1000000);
         if (ms > 100) ms = 100;
         int k = poll(pf, (nfds_t)n, ms);
@@ -314,7 +307,7 @@ static int wait_until(const run_opts *o, run_state *r, uint64_t deadline_ns, int
         if (want_cams)
             for (int i = 0; i < ncam; i++)
                 if (pf[cam0 + i].revents) return 1;
-        if (mono_ns() >= deadline_ns) return 0;
+        if (io_now_ns() >= deadline_ns) return 0;
     }
 }
 
@@ -368,181 +361,6 @@ static int write_outputs(const run_opts *o, run_state *r, int frame, int W, int 
         size_t n = (size_t)W * (size_t)H * 6;
         if (fwrite(r->rawbuf, 1, n, stdout) != n || fflush(stdout) != 0)
             return cli_fail("stdout: write error: %s (reader gone?)", strerror(errno));
-    }
-    return EXIT_OK;
-}
-
-/* Copies a file byte for byte (to a temporary, renamed when complete). */
-static int copy_file(const char *from, const char *to)
-{
-    char tmp[IO_PATH_MAX + 96];
-    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", to, (long)getpid());
-    FILE *in = fopen(from, "rb");
-    if (!in) return -1;
-    FILE *o = fopen(tmp, "wb");
-    if (!o) {
-        fclose(in);
-        return -1;
-    }
-    char buf[65536];
-    size_t n;
-    int bad = 0;
-    while (!bad && (n = fread(buf, 1, sizeof buf, in)) > 0) bad = fwrite(buf, 1, n, o) != n;
-    bad |= ferror(in);
-    fclose(in);
-    bad |= fclose(o) != 0;
-    if (bad || rename(tmp, to) != 0) {
-        int e = errno;
-        unlink(tmp);
-        errno = e ? e : EIO;
-        return -1;
-    }
-    return 0;
-}
-
-/* --dump DIR: the inputs of the last frame as a one-frame scene that
- * `egofuse render` composites to the same bytes (camera images as
- * converted, the virtual images used, the pose sample used; the scene's
- * lighting lines copied verbatim). With --refine the elbow fit's learned
- * state is not part of it, so render differs there. */
-static int dump_frame(const run_opts *o, run_state *r, const pipe_frame_in *in,
-                      const kin_track_sample *sample, int tracked, int W, int H)
-{
-    io_error err;
-    if (cli_mkdirs(o->dump) != 0)
-        return cli_fail("%s: cannot create the dump folder: %s", o->dump, strerror(errno));
-    static const char *const eye[2] = {"left", "right"};
-    for (int e = 0; e < 2; e++) {
-        char p[IO_PATH_MAX + 64];
-        snprintf(p, sizeof p, "%s/cam_%s_0000.png", o->dump, eye[e]);
-        if (io_image_save(p, &r->camimg[e], &err) != IO_OK) return cli_fail("%s", err.msg);
-        io_image v = {in->virt[e].pixels, W, H, 4, IO_U8, (size_t)in->virt[e].stride};
-        snprintf(p, sizeof p, "%s/virt_%s_0000.png", o->dump, eye[e]);
-        if (io_image_save(p, &v, &err) != IO_OK) return cli_fail("%s", err.msg);
-        if (in->virt_depth[e] && in->virt_depth[e] != r->vdepth[e].data) {
-            /* a live source's depth, as float EXR */
-            io_image d = {(void *)in->virt_depth[e], W, H, 1, IO_F32,
-                          (size_t)in->virt_depth_stride[e] * sizeof(float)};
-            snprintf(p, sizeof p, "%s/virt_depth_%s_0000.exr", o->dump, eye[e]);
-            if (io_image_save(p, &d, &err) != IO_OK) return cli_fail("%s", err.msg);
-        }
-    }
-    char path[IO_PATH_MAX + 64], tmp[IO_PATH_MAX + 96];
-    if (tracked) {
-        kin_track_sample s = *sample;
-        s.t = 0;
-        snprintf(path, sizeof path, "%s/track.txt", o->dump);
-        if (io_track_save(path, &s, 1, &err) != IO_OK) return cli_fail("%s", err.msg);
-    }
-    char model_abs[IO_PATH_MAX + 64];
-    if (!realpath(r->model_path, model_abs)) snprintf(model_abs, sizeof model_abs, "%s", r->model_path);
-    snprintf(path, sizeof path, "%s/scene.txt", o->dump);
-    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
-    FILE *f = fopen(tmp, "w");
-    if (!f) return cli_fail("%s: %s", path, strerror(errno));
-    int bad = fprintf(f,
-                      "egofuse-scene 1\n# the last frame of egofuse run (--dump)\nmodel = %s\n"
-                      "frames = 1\nfps = 60\ncamera_left = cam_left_%%04d.png\n"
-                      "camera_right = cam_right_%%04d.png\nvirtual_left = virt_left_%%04d.png\n"
-                      "virtual_right = virt_right_%%04d.png\n%s",
-                      model_abs, tracked ? "tracking = track.txt\n" : "") < 0;
-    for (int e = 0; e < 2; e++) {
-        char dabs[IO_PATH_MAX + 64];
-        if (in->virt_depth[e] && in->virt_depth[e] != r->vdepth[e].data) {
-            bad |= fprintf(f, "virtual_depth_%s = virt_depth_%s_%%04d.exr\n", eye[e], eye[e]) < 0;
-            continue;
-        }
-        if (!r->vdepth[e].data || !in->virt_depth[e]) continue;
-        /* the still image's depth file, copied as it is (a frame pattern) */
-        snprintf(dabs, sizeof dabs, "%s/virt_depth_%s_0000%s", o->dump, eye[e],
-                 strrchr(r->vdepth_path[e], '.') ? strrchr(r->vdepth_path[e], '.') : "");
-        if (copy_file(r->vdepth_path[e], dabs) != 0) {
-            fclose(f);
-            unlink(tmp);
-            return cli_fail("%s: cannot copy %s: %s", dabs, r->vdepth_path[e], strerror(errno));
-        }
-        bad |= fprintf(f, "virtual_depth_%s = virt_depth_%s_%%04d%s\n", eye[e], eye[e],
-                       strrchr(dabs, '.') ? strrchr(dabs, '.') : "") < 0;
-    }
-    if (r->have_scene && r->sc.head_node[0]) bad |= fprintf(f, "head_node = %s\n", r->sc.head_node) < 0;
-    {
-        /* a named HMD other than the paper's (render follows the key; an
-         * HMD of other numbers has no scene key yet) */
-        const kin_sthmd_desc hd = kin_sthmd_desc_resolved(&o->hmd);
-        kin_sthmd_desc nd;
-        for (int k = 1; kin_sthmd_preset_name(k); k++)
-            if (kin_sthmd_preset(kin_sthmd_preset_name(k), &nd) == 0 && !memcmp(&hd, &nd, sizeof hd))
-                bad |= fprintf(f, "hmd = %s\n", kin_sthmd_preset_name(k)) < 0;
-    }
-    if (r->have_scene && r->sc.animation[0]) bad |= fprintf(f, "animation = %s\n", r->sc.animation) < 0;
-    /* posed by the animation at the run's clock: that time (%.9g gives the
-     * float back exactly; render poses frame 0 at it) */
-    if (!tracked && in->anim) bad |= fprintf(f, "animation_start = %.9g\n", (double)in->time) < 0;
-    if (r->have_scene && r->sc.has_lighting) {
-        /* the lighting lines as written, so render parses the same floats */
-        FILE *in = fopen(o->scene, "r");
-        char line[4096];
-        static const char *const keys[] = {"ambient", "light", "kd", "ks", "shininess", "kf", "tone", NULL};
-        while (in && fgets(line, sizeof line, in)) {
-            const char *t = line + strspn(line, " \t");
-            for (int k = 0; keys[k]; k++) {
-                size_t n = strlen(keys[k]);
-                if (!strncmp(t, keys[k], n) && strchr(" \t=", t[n])) {
-                    bad |= fputs(line, f) == EOF;
-                    break;
-                }
-            }
-        }
-        if (in) fclose(in);
-        else bad = 1;
-    }
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, path) != 0) {
-        int e = errno;
-        unlink(tmp);
-        return cli_fail("%s: %s", path, strerror(e ? e : EIO));
-    }
-    snprintf(path, sizeof path, "%s/command.txt", o->dump);
-    snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
-    f = fopen(tmp, "w");
-    if (!f) return cli_fail("%s: %s", path, strerror(errno));
-    bad = fprintf(f, "egofuse render --scene %s/scene.txt --out OUT%s%s%s", o->dump,
-                  tracked ? " --pose tracking --no-filter" : "", o->calib ? " --calib " : "",
-                  o->calib ? o->calib : "") < 0;
-    /* the lenses: render draws the masks through the same ones */
-    static const char *const calib_opt[3] = {"", "-left", "-right"};
-    for (int k = 0; k < 3; k++)
-        if (o->hmd_calib[k]) bad |= fprintf(f, " --hmd-calibration%s %s", calib_opt[k], o->hmd_calib[k]) < 0;
-    if (o->hide) {
-        static const char *const part[4] = {"left-hand", "left-arm", "right-hand", "right-arm"};
-        int first = 1;
-        bad |= fputs(" --hide ", f) == EOF;
-        for (int k = 0; k < 4; k++)
-            if (o->hide & (1u << k)) {
-                bad |= fprintf(f, "%s%s", first ? "" : ",", part[k]) < 0;
-                first = 0;
-            }
-    }
-    for (int k = 0; k < o->prop_count; k++) {
-        const run_prop *p = &o->prop[k];
-        if (p->body[0] || p->rot_deg[1] != 0 || p->rot_deg[2] != 0)
-            bad |= fprintf(f, " # prop %s is tracked or tilted: render cannot place it", p->name) < 0;
-        else
-            bad |= fprintf(f, " --prop %s@%.9g,%.9g,%.9g,%.9g", p->model, (double)p->at[0],
-                           (double)p->at[1], (double)p->at[2], (double)p->rot_deg[0]) < 0;
-    }
-    if (o->lod == PIPE_LOD_AUTO)
-        bad |= fprintf(f, " --lod auto --lod-px %.9g", (double)o->lod_px) < 0;
-    else if (o->lod) bad |= fprintf(f, " --lod %d", o->lod) < 0;
-    if (o->aa) bad |= fprintf(f, " --aa %d", o->aa) < 0;
-    if (o->edge_fade) bad |= fprintf(f, " --edge-fade %d", o->edge_fade < 0 ? 0 : o->edge_fade) < 0;
-    if (o->refine) bad |= fprintf(f, " --refine %d # the elbow fit's learned state differs", o->refine) < 0;
-    bad |= fputc('\n', f) == EOF;
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, path) != 0) {
-        int e = errno;
-        unlink(tmp);
-        return cli_fail("%s: %s", path, strerror(e ? e : EIO));
     }
     return EXIT_OK;
 }
@@ -902,7 +720,7 @@ static int run(const run_opts *o)
     memset(&sample, 0, sizeof sample);
     int have_img[2] = {0, 0}, cam_lost[2] = {0, 0};
     char reopen_msg[2][sizeof err.msg] = {"", ""};
-    uint64_t t_start = mono_ns(), t_status = t_start, t_retry[2] = {0, 0};
+    uint64_t t_start = io_now_ns(), t_status = t_start, t_retry[2] = {0, 0};
     io_lat lat_cam, lat_pipe, lat_deq;
     io_lat_reset(&lat_cam);
     io_lat_reset(&lat_pipe);
@@ -911,7 +729,7 @@ static int run(const run_opts *o)
     uint64_t v_used = 0;
     while (!stop_flag && (o->frames == 0 || frames < o->frames)) {
         if (r->disp && io_display_quit_requested(r->disp)) break;
-        uint64_t now = mono_ns();
+        uint64_t now = io_now_ns();
         /* ---- the repaint window: start so as to finish just before the
          * vblank that shows the frame (free-running without a display) */
         io_sched_plan plan = {now, 0, 0};
@@ -924,7 +742,7 @@ static int run(const run_opts *o)
         io_frame fr[2];
         int got = 0;
         io_result gr = io_stereo_grab(&st, 0, fr, &got, &err);
-        now = mono_ns();
+        now = io_now_ns();
         /* a failed camera: said once, then reopened once a second, found
          * again by its selector */
         for (int e = 0; e < 2; e++) {
@@ -1053,9 +871,9 @@ static int run(const run_opts *o)
 
         char why[256];
         pipe_frame_stats ps;
-        lg.t_start = mono_ns();
+        lg.t_start = io_now_ns();
         pipe_result pr = pipe_frame(r->pipe, &in, &ps, why, (int)sizeof why);
-        lg.t_done = mono_ns();
+        lg.t_done = io_now_ns();
         if (pr != PIPE_OK) {
             cli_fail("frame %d: %s", frames, why);
             goto done;
@@ -1067,11 +885,14 @@ static int run(const run_opts *o)
         }
         lg.ms_total = ps.ms_total;
         io_lat_push(&lat_pipe, ps.ms_total);
-        if (o->dump && frames + 1 == o->frames &&
-            dump_frame(o, r, &in, &sample, tracked && r->track_samples, W, H) != EXIT_OK)
-            goto done;
+        if (o->dump && frames + 1 == o->frames) {
+            const run_dump_src src = {r->camimg, r->vdepth, r->vdepth_path, r->model_path,
+                                      r->have_scene ? &r->sc : NULL};
+            if (run_dump_frame(o, &src, &in, &sample, tracked && r->track_samples, W, H) != EXIT_OK)
+                goto done;
+        }
         /* ---- output */
-        lg.t_present = mono_ns();
+        lg.t_present = io_now_ns();
         if (r->disp) {
             const uint8_t *eyes[2] = {r->outimg[0].data, r->outimg[1].data};
             size_t stride[2] = {r->outimg[0].stride, r->outimg[1].stride};
@@ -1079,7 +900,7 @@ static int run(const run_opts *o)
                 cli_fail("display: %s", err.msg);
                 goto done;
             }
-            io_sched_presented(&r->sched, &plan, lg.t_dequeue, mono_ns());
+            io_sched_presented(&r->sched, &plan, lg.t_dequeue, io_now_ns());
             if (r->npending == (int)(sizeof r->pending / sizeof r->pending[0])) {
                 io_stats_row(&r->stats, &r->pending[0]); /* never shown */
                 r->pending[0] = r->pending[--r->npending];
@@ -1088,14 +909,14 @@ static int run(const run_opts *o)
             drain_flips(o, r, &lat_cam, &lat_deq); /* SDL's come with the present */
         } else {
             if (write_outputs(o, r, frames, W, H) != EXIT_OK) goto done;
-            lg.t_shown = mono_ns();
+            lg.t_shown = io_now_ns();
             io_stats_row(&r->stats, &lg);
             io_lat_push(&lat_cam, 1e-6 * ((double)lg.t_shown - (double)t_cam));
             io_lat_push(&lat_deq, 1e-6 * ((double)lg.t_shown - (double)lg.t_dequeue));
         }
         frames++;
         frames_status++;
-        now = mono_ns();
+        now = io_now_ns();
         if (!o->quiet && (now - t_status >= 1000000000ull || frames == o->frames)) {
             char vw[256], tw[256];
             fprintf(stderr,
@@ -1119,14 +940,14 @@ static int run(const run_opts *o)
     }
     /* the last flips, then (--hold) the last frame stays on until Ctrl-C */
     if (r->disp) {
-        uint64_t until = mono_ns() + 1000000000ull;
-        while (r->npending && !stop_flag && mono_ns() < until)
+        uint64_t until = io_now_ns() + 1000000000ull;
+        while (r->npending && !stop_flag && io_now_ns() < until)
             wait_until(o, r, until, 0, &lat_cam, &lat_deq);
         if (o->hold && !stop_flag) {
             fprintf(stderr, "\negofuse run: holding frame %d on %s (Ctrl-C ends)\n", frames - 1,
                     io_display_describe(r->disp));
             while (!stop_flag && !io_display_quit_requested(r->disp))
-                wait_until(o, r, mono_ns() + 100000000ull, 0, &lat_cam, &lat_deq);
+                wait_until(o, r, io_now_ns() + 100000000ull, 0, &lat_cam, &lat_deq);
         }
     }
     for (int i = 0; i < r->npending; i++) io_stats_row(&r->stats, &r->pending[i]);
@@ -1138,7 +959,7 @@ static int run(const run_opts *o)
     }
     {
         char vw[256], tw[256];
-        uint64_t now = mono_ns();
+        uint64_t now = io_now_ns();
         /* stdout carries the frames with --raw */
         fprintf(o->raw ? stderr : stdout,
                 "egofuse run: %d stereo frames%s, %llu pairs, dropped %llu/%llu, unpaired "

@@ -1,6 +1,6 @@
 /* run.h - `egofuse run`, the live cockpit: its options (run_opts.c: the
  * command line merged with the cockpit configuration file) and the loop
- * (cmd_run.c). docs/cockpit.md. */
+ * (cmd_run.c) and its --dump files (run_dump.c). docs/cockpit.md. */
 #ifndef EGOFUSE_RUN_H
 #define EGOFUSE_RUN_H
 
@@ -56,5 +56,24 @@ int run_parse(int argc, char **argv, run_opts *o);
 void run_opts_free(run_opts *o);
 
 extern const char *run_usage;
+
+/* What --dump reads of the run besides its options (cmd_run.c's state). */
+typedef struct run_dump_src {
+    const io_image *camimg;       /* [2] the camera images as converted */
+    const io_image *vdepth;       /* [2] the still virtual images' depth (data NULL: none) */
+    const char (*vdepth_path)[IO_PATH_MAX + 64]; /* [2] their files */
+    const char *model_path;
+    const io_scene *sc;           /* the scene file's, NULL without one */
+} run_dump_src;
+
+/* --dump DIR (run_dump.c): the inputs of the last frame as a one-frame
+ * scene that `egofuse render` composites to the same bytes (camera images
+ * as converted, the virtual images used, the pose sample used; the
+ * scene's lighting lines copied verbatim), and the render command in
+ * command.txt. With --refine the elbow fit's learned state is not part of
+ * it, so render differs there. EXIT_OK, or EXIT_FAIL with the message
+ * printed. */
+int run_dump_frame(const run_opts *o, const run_dump_src *src, const pipe_frame_in *in,
+                   const kin_track_sample *sample, int tracked, int W, int H);
 
 #endif

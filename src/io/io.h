@@ -76,6 +76,10 @@ io_result io_fail(io_error *err, io_result code, const char *fmt, ...)
  * option values (io_natnet) and the command line's (cli_parse_int). */
 int io_parse_int(const char *s, int lo, int hi, int *out);
 
+/* CLOCK_MONOTONIC now, in ns: the clock of the devices' time stamps
+ * (io_dev.h, io_display.h, io_vsrc.h) and of `egofuse run`'s loop. */
+uint64_t io_now_ns(void);
+
 /* IO_OK if path names an existing file that is not a folder, else
  * IO_ERR_NOT_FOUND or IO_ERR_READ with "path: reason". */
 io_result io_check_file(const char *path, io_error *err);

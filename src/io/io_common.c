@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 
 const char *io_result_str(io_result r)
 {
@@ -33,6 +34,13 @@ io_result io_fail(io_error *err, io_result code, const char *fmt, ...)
         }
     }
     return code;
+}
+
+uint64_t io_now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
 }
 
 int io_parse_int(const char *s, int lo, int hi, int *out)

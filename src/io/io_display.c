@@ -14,9 +14,7 @@
 
 uint64_t io_display_now_ns(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
+    return io_now_ns();
 }
 
 void io_display_push_flip(io_display *d, uint64_t frame_id, uint64_t t_ns, uint32_t seq)

@@ -57,19 +57,10 @@ int io_cam_file_ended(const io_cam *cam)
     return p && p->ended;
 }
 
-static uint64_t mono(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
-}
-
 static uint64_t now_of(const fcam *p)
 {
     if (p->o.clock_ns) return *p->o.clock_ns;
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
+    return io_now_ns();
 }
 
 /* One %d or %0Nd (N 1..2 digits), "%%" literal: 1 if a valid pattern, 0
@@ -199,7 +190,7 @@ static io_result open_seq(io_cam *cam, fcam *p, io_error *err)
 /* Waits up to ms for the next video frame (blocking use at open). */
 static int video_next(io_cam *cam, fcam *p, int wait_ms, io_error *err)
 {
-    uint64_t end = mono() + (uint64_t)wait_ms * 1000000ull;
+    uint64_t end = io_now_ns() + (uint64_t)wait_ms * 1000000ull;
     for (;;) {
         vs_frame f;
         int st = vs_parse(&p->r, &f);
@@ -249,7 +240,7 @@ static int video_next(io_cam *cam, fcam *p, int wait_ms, io_error *err)
             io_fail(err, IO_ERR_READ, "%s", p->r.msg);
             return -1;
         }
-        uint64_t t = mono();
+        uint64_t t = io_now_ns();
         if (t >= end || wait_ms <= 0) return 2; /* not yet */
         struct pollfd pf = {p->vfd, POLLIN, 0};
         poll(&pf, 1, (int)((end - t) / 1000000ull) + 1);

@@ -465,31 +465,27 @@ typedef struct v4l2_ops {
     int (*close_fn)(int);
 } v4l2_ops;
 
-static int plain_ioctl(int fd, unsigned long req, ...)
-{
-    va_list ap;
-    va_start(ap, req);
-    void *arg = va_arg(ap, void *);
-    va_end(ap);
-    int r;
-    do r = ioctl(fd, req, arg);
-    while (r < 0 && errno == EINTR);
-    return r;
-}
+/* An ioctl through `call` (the kernel's, or libv4l2's), again while
+ * interrupted (EINTR): one definition for both. */
+#define V4L2_RETRY_IOCTL(name, call)                                  \
+    static int name(int fd, unsigned long req, ...)                    \
+    {                                                                  \
+        va_list ap;                                                    \
+        va_start(ap, req);                                             \
+        void *arg = va_arg(ap, void *);                                \
+        va_end(ap);                                                    \
+        int r;                                                         \
+        do r = call(fd, req, arg);                                     \
+        while (r < 0 && errno == EINTR);                               \
+        return r;                                                      \
+    }
+V4L2_RETRY_IOCTL(plain_ioctl, ioctl)
+V4L2_RETRY_IOCTL(lib_ioctl, v4l2_ioctl)
+#undef V4L2_RETRY_IOCTL
+
 static void *plain_mmap(void *a, size_t n, int prot, int flags, int fd, int64_t off)
 {
     return mmap(a, n, prot, flags, fd, (off_t)off);
-}
-static int lib_ioctl(int fd, unsigned long req, ...)
-{
-    va_list ap;
-    va_start(ap, req);
-    void *arg = va_arg(ap, void *);
-    va_end(ap);
-    int r;
-    do r = v4l2_ioctl(fd, req, arg);
-    while (r < 0 && errno == EINTR);
-    return r;
 }
 
 static const v4l2_ops plain_ops = {plain_ioctl, plain_mmap, munmap, close};

@@ -65,16 +65,9 @@ struct io_vsrc {
     uint64_t since_rewind;        /* frames parsed since the (re)start */
 };
 
-static uint64_t mono_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
-}
-
 static uint64_t clock_of(const io_vsrc *v)
 {
-    return v->cfg.clock_ns ? *v->cfg.clock_ns : mono_ns();
+    return v->cfg.clock_ns ? *v->cfg.clock_ns : io_now_ns();
 }
 
 static void set_msg(io_vsrc *v, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -670,7 +663,7 @@ io_result io_vsrc_poll(io_vsrc *v, int timeout_ms, int *fresh, io_error *err)
     int fr = 0;
     if (fresh) *fresh = 0;
     if (!v) return io_fail(err, IO_ERR_ARGS, "V source: io_vsrc_poll of nothing");
-    uint64_t start = mono_ns();
+    uint64_t start = io_now_ns();
     uint64_t deadline = start + (uint64_t)(timeout_ms > 0 ? timeout_ms : 0) * 1000000ull;
     for (;;) {
         uint64_t now = clock_of(v);
@@ -681,7 +674,7 @@ io_result io_vsrc_poll(io_vsrc *v, int timeout_ms, int *fresh, io_error *err)
             if (v->fd >= 0) stream_take(v, now, &fr);
         }
         if (fr) break;
-        uint64_t t = mono_ns();
+        uint64_t t = io_now_ns();
         if (t >= deadline) break;
         struct pollfd pf[2];
         int n = io_vsrc_pollfds(v, pf, 2);
@@ -696,7 +689,7 @@ io_result io_vsrc_poll(io_vsrc *v, int timeout_ms, int *fresh, io_error *err)
         }
         int pr;
         do pr = poll(pf, (nfds_t)n, ms);
-        while (pr < 0 && errno == EINTR && mono_ns() < deadline);
+        while (pr < 0 && errno == EINTR && io_now_ns() < deadline);
         if (pr <= 0) {
             /* timeout: one last look (a FIFO's writer may have gone) */
             now = clock_of(v);

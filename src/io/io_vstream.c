@@ -273,16 +273,27 @@ static int line_at(vs_reader *r, size_t *n)
     return avail >= VS_LINE_MAX ? -1 : 0;
 }
 
+/* line_at for a Y4M line (`what`, `cut`: its names in the messages): 1
+ * with its length in *n; else 0 and in *ret what the parser returns:
+ * VS_MORE (its end not read yet), or VS_FATAL when it is longer than
+ * VS_LINE_MAX or the stream ends inside it. */
+static int y4m_line(vs_reader *r, const char *what, const char *cut, size_t *n, int *ret)
+{
+    int lr = line_at(r, n);
+    if (lr > 0) return 1;
+    if (lr < 0) *ret = bad(r, VS_FATAL, "%s longer than %d bytes", what, VS_LINE_MAX);
+    else {
+        r->need = 0;
+        *ret = r->eof ? bad(r, VS_FATAL, "truncated %s at the end of the stream", cut) : VS_MORE;
+    }
+    return 0;
+}
+
 static int parse_y4m_header(vs_reader *r)
 {
     size_t n;
-    int lr = line_at(r, &n);
-    if (lr < 0) return bad(r, VS_FATAL, "YUV4MPEG2 header line longer than %d bytes", VS_LINE_MAX);
-    if (lr == 0) {
-        r->need = 0;
-        if (r->eof) return bad(r, VS_FATAL, "truncated YUV4MPEG2 header at the end of the stream");
-        return VS_MORE;
-    }
+    int ret;
+    if (!y4m_line(r, "YUV4MPEG2 header line", "YUV4MPEG2 header", &n, &ret)) return ret;
     char line[VS_LINE_MAX + 1];
     memcpy(line, r->buf + r->pos, n);
     line[n] = '\0';
@@ -364,13 +375,8 @@ static int parse_y4m(vs_reader *r, vs_frame *f)
                    "%02x %02x (stream out of step)", (unsigned long long)r->parsed,
                    (unsigned long long)(r->offset + r->pos), p[0], p[1], p[2], p[3], p[4]);
     size_t n;
-    int lr = line_at(r, &n);
-    if (lr < 0) return bad(r, VS_FATAL, "FRAME line longer than %d bytes", VS_LINE_MAX);
-    if (lr == 0) {
-        r->need = 0;
-        if (r->eof) return bad(r, VS_FATAL, "truncated FRAME line at the end of the stream");
-        return VS_MORE;
-    }
+    int ret;
+    if (!y4m_line(r, "FRAME line", "FRAME line", &n, &ret)) return ret;
     size_t pb = tight_bytes(r->y4m_fmt, r->y4m_w, r->y4m_h);
     size_t total = n + 1 + pb;
     if (avail < total) {

@@ -274,12 +274,10 @@ int kin_user_calib_parse(const char *text, size_t len, kin_user_calib *out, int 
         *err_line = line_no;
         char buf[512];
         if (l >= sizeof buf) return fail(why, why_size, "line too long");
-        memcpy(buf, ln, l);
-        buf[l] = '\0';
-        if (memchr(buf, '\0', l)) return fail(why, why_size, "NUL byte in line");
         char *tok[16];
-        int nt = kin__tokens(buf, tok, 16);
-        if (nt < 0) return fail(why, why_size, "too many fields");
+        const char *reason;
+        int nt = kin__line_tokens(ln, l, buf, tok, 16, &reason);
+        if (nt < 0) return fail(why, why_size, "%s", reason);
         if (!have_header) {
             if (nt != 2 || strcmp(tok[0], "egofuse-calib") != 0 || strcmp(tok[1], "1") != 0)
                 return fail(why, why_size, "first line must be 'egofuse-calib 1'");

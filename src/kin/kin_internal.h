@@ -32,6 +32,13 @@ int kin__parse_number(const char *tok, double *out);
  * line formats of kin_calib.c and kin_track.c. */
 int kin__tokens(char *buf, char **tok, int cap);
 
+/* One line of those formats split into tokens: copies line[0, len) into
+ * buf (the caller has checked that len < the size of buf), terminates it
+ * and splits it with kin__tokens. The number of tokens, or -1 with
+ * *reason set ("NUL byte in line", "too many fields"). */
+int kin__line_tokens(const char *line, size_t len, char *buf, char **tok, int cap,
+                     const char **reason);
+
 struct kin_channel;
 /* The value of an animation channel at time t (kin_anim.c): ch->comps
  * floats into out; clamped to the first and last key, STEP, LINEAR

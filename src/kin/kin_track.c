@@ -110,14 +110,10 @@ int kin_track_parse_line(const char *line, size_t len, kin_track_sample *out,
     if (!line || !out) return fail(why, why_size, "no input");
     if (len >= LINE_CAP) return fail(why, why_size, "line longer than %d bytes", LINE_CAP - 1);
     char buf[LINE_CAP];
-    memcpy(buf, line, len);
-    buf[len] = '\0';
-    if (memchr(buf, '\0', len)) return fail(why, why_size, "NUL byte in line");
-
-    /* tokens */
     char *tok[64];
-    int nt = kin__tokens(buf, tok, 64);
-    if (nt < 0) return fail(why, why_size, "too many fields");
+    const char *reason;
+    int nt = kin__line_tokens(line, len, buf, tok, 64, &reason);
+    if (nt < 0) return fail(why, why_size, "%s", reason);
     if (nt == 0) return 0;
 
     kin_track_sample s;

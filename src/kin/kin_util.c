@@ -67,3 +67,17 @@ int kin__tokens(char *buf, char **tok, int cap)
         if (*p) *p++ = '\0';
     }
 }
+
+int kin__line_tokens(const char *line, size_t len, char *buf, char **tok, int cap,
+                     const char **reason)
+{
+    memcpy(buf, line, len);
+    buf[len] = '\0';
+    if (memchr(buf, '\0', len)) {
+        *reason = "NUL byte in line";
+        return -1;
+    }
+    int nt = kin__tokens(buf, tok, cap);
+    if (nt < 0) *reason = "too many fields";
+    return nt;
+}

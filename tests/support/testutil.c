@@ -41,6 +41,13 @@ int tu_exists(const char *path)
     return stat(path, &st) == 0;
 }
 
+int tu_rm_rf(const char *path)
+{
+    char cmd[4200];
+    if ((size_t)snprintf(cmd, sizeof cmd, "rm -rf '%s'", path) >= sizeof cmd) return -1;
+    return system(cmd) == 0 ? 0 : -1;
+}
+
 uint32_t tu_crc32(uint32_t crc, const void *data, size_t n)
 {
     const uint8_t *p = data;

@@ -40,6 +40,9 @@ const char *tu_tmp_path(const char *name, char *buf, size_t n);
 const char *tu_root_path(const char *rel, char *buf, size_t n);
 /* 1 if the file exists. */
 int tu_exists(const char *path);
+/* Removes the file or folder tree at path (rm -rf; nothing there is
+ * fine): 0, or -1 when rm failed. */
+int tu_rm_rf(const char *path);
 /* CRC-32 (IEEE), chainable: start with crc = 0. */
 uint32_t tu_crc32(uint32_t crc, const void *data, size_t n);
 /* Runs argv (argv[0] = program path) with stdout+stderr captured into

@@ -52,6 +52,17 @@ typedef struct stream_result {
     uint64_t dropped[2];
 } stream_result;
 
+/* The VMTEST line of a stream check: its figures, whether ok or not. */
+static void check_stream(int ok, const char *name, const stream_result *r)
+{
+    check(ok, name, "frames %llu/%llu, pairs %llu, camera %.2f/%.2f FPS, "
+          "delivered %.1f/%.1f FPS, dropped %llu/%llu, skew mean %.3f ms max %.3f ms",
+          (unsigned long long)r->frames[0], (unsigned long long)r->frames[1],
+          (unsigned long long)r->pairs, r->cam_fps[0], r->cam_fps[1], r->got_fps[0],
+          r->got_fps[1], (unsigned long long)r->dropped[0], (unsigned long long)r->dropped[1],
+          r->mean_skew_ms, 1e-6 * (double)r->max_skew_ns);
+}
+
 static int stream(io_cam cam[2], double seconds, stream_result *r, uint8_t *rgba)
 {
     io_stereo s;
@@ -161,14 +172,9 @@ static int cmd_capture(void)
     c.input = 0;
     if (open_pair(cam, dev, &c) == 0) {
         int ok = stream(cam, 3.0, &r, rgba) == 0;
-        check(ok && r.monotonic && r.formats_ok && r.pairs >= 20 && r.cam_fps[0] > 20 &&
-                  r.cam_fps[0] < 30,
-              "capture_webcam", "frames %llu/%llu, pairs %llu, camera %.2f/%.2f FPS, "
-              "delivered %.1f/%.1f FPS, dropped %llu/%llu, skew mean %.3f ms max %.3f ms",
-              (unsigned long long)r.frames[0], (unsigned long long)r.frames[1],
-              (unsigned long long)r.pairs, r.cam_fps[0], r.cam_fps[1], r.got_fps[0],
-              r.got_fps[1], (unsigned long long)r.dropped[0], (unsigned long long)r.dropped[1],
-              r.mean_skew_ms, 1e-6 * (double)r.max_skew_ns);
+        check_stream(ok && r.monotonic && r.formats_ok && r.pairs >= 20 && r.cam_fps[0] > 20 &&
+                         r.cam_fps[0] < 30,
+                     "capture_webcam", &r);
         /* the second user of a streaming camera is refused, with the reason */
         io_cam other;
         io_cam_config c2 = c;
@@ -214,14 +220,9 @@ static int cmd_capture(void)
     c.dv_timings = 1;
     if (open_pair(cam, dev, &c) == 0) {
         int ok = stream(cam, 4.0, &r, NULL) == 0;
-        check(ok && r.monotonic && r.formats_ok && r.pairs >= 40 && r.cam_fps[0] > 55 &&
-                  r.cam_fps[0] < 65 && r.cam_fps[1] > 55 && r.cam_fps[1] < 65,
-              "capture_hdmi60", "frames %llu/%llu, pairs %llu, camera %.2f/%.2f FPS, "
-              "delivered %.1f/%.1f FPS, dropped %llu/%llu, skew mean %.3f ms max %.3f ms",
-              (unsigned long long)r.frames[0], (unsigned long long)r.frames[1],
-              (unsigned long long)r.pairs, r.cam_fps[0], r.cam_fps[1], r.got_fps[0],
-              r.got_fps[1], (unsigned long long)r.dropped[0], (unsigned long long)r.dropped[1],
-              r.mean_skew_ms, 1e-6 * (double)r.max_skew_ns);
+        check_stream(ok && r.monotonic && r.formats_ok && r.pairs >= 40 && r.cam_fps[0] > 55 &&
+                         r.cam_fps[0] < 65 && r.cam_fps[1] > 55 && r.cam_fps[1] < 65,
+                     "capture_hdmi60", &r);
         printf("VMMEASURE hdmi_camera_fps %.2f %.2f\n", r.cam_fps[0], r.cam_fps[1]);
         printf("VMMEASURE hdmi_delivered_fps %.2f %.2f\n", r.got_fps[0], r.got_fps[1]);
         io_cam_close(&cam[0]);

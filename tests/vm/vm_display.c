@@ -40,13 +40,6 @@ static void on_sigint(int sig)
     sigint_seen = 1;
 }
 
-static uint64_t now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
-}
-
 /* ------------------------------------------------------- CRTC snapshots */
 
 #define MAX_CRTC 8
@@ -213,7 +206,7 @@ static int cmd_two(const char *outdir)
     int ok = 1;
     char why[512] = "";
     for (int f = 1; f <= 4 && ok; f++) {
-        uint64_t t0 = now_ns();
+        uint64_t t0 = io_now_ns();
         io_display_flip ev;
         int got = 0;
         if (present(d, f, 300 + (uint64_t)f, &err) != IO_OK || wait_flip(d, &ev, &err) != 0) {
@@ -343,7 +336,7 @@ int main(int argc, char **argv)
         uint64_t last_t = 0;
         double sum_ms = 0;
         for (int f = 1; f <= 6 && ok; f++) {
-            uint64_t t0 = now_ns();
+            uint64_t t0 = io_now_ns();
             if (present(d, f, 100 + (uint64_t)f, &err) != IO_OK) {
                 ok = 0;
                 snprintf(why, sizeof why, "present %d: %s", f, err.msg);
@@ -360,7 +353,7 @@ int main(int argc, char **argv)
                 snprintf(why, sizeof why, "frame %d: %s", f, err.msg);
                 break;
             }
-            uint64_t t1 = now_ns();
+            uint64_t t1 = io_now_ns();
             if (ev.frame_id != 100 + (uint64_t)f || ev.t_ns < t0 || ev.t_ns > t1 || ev.t_ns <= last_t ||
                 io_display_busy(d)) {
                 ok = 0;
