@@ -195,6 +195,12 @@ static inline double simd_absd(double a)
 static inline int simd_box_hidden(const rast_target *t, const rast__tri *tri, int ys, int ye,
                                   int nx)
 {
+    /* Most visible triangles: a depth above the box corner's z (the
+     * cleared 1.0 or a farther surface) at the box's first pixel ends the
+     * test before its set-up (returning 0 only costs the scan). */
+    const float *d = t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0;
+    if (*d > tri->z.c + tri->z.dy * (float)(ys - tri->y0))
+        return 0;
     const double c = tri->z.c, fi1 = nx - 1;
     const double ay = (double)tri->z.dy * (double)(ys - tri->y0);
     const double by = (double)tri->z.dy * (double)(ye - tri->y0);
@@ -205,7 +211,6 @@ static inline int simd_box_hidden(const rast_target *t, const rast__tri *tri, in
     if (!(zb > 0.0 && zb < 1e30))
         return 0;
     const vfloat zv = vf_set1(zb < 1.0 ? (float)zb : 1.0f);
-    const float *d = t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0;
     if (nx <= SIMD_W) {
         const unsigned valid = nx >= SIMD_W ? SIMD_FULL : (1u << nx) - 1u;
         if (tri->x0 + SIMD_W <= t->width) {
