@@ -14,6 +14,7 @@
  *   - disocclusion: a small quad in front of a large one; the ring of the
  *     back quad the eye sees around the front one but the camera does not
  *     is filled from the back quad (green), never the front one's red;
+ *     the fill of a row against its rule written plainly (seeded rows);
  *   - the border of the camera's view fades over PIPE_REPROJ_FADE_PX;
  *   - the same bytes with 1 and 2 threads and every ISA cap (a recorded
  *     CRC); the crop method's bytes do not depend on the new code;
@@ -683,6 +684,67 @@ static void validity_eye_inside_model(void **state)
     kin_model_free(&m);
 }
 
+/* The fill of one row (pipe__reproj_fill_row, the word skipping) against
+ * the rule written plainly: seeded rows of runs of sampled, filled and
+ * empty pixels, of widths around the 8-pixel words, random colours and
+ * depths; a row with filled pixels but no sampled one is left alone (0). */
+static float ref_lin(float z, float n, float f)
+{
+    float zn = 2.0f * z - 1.0f;
+    return 2.0f * f * n / ((f + n) - zn * (f - n));
+}
+
+static void result_fill_row_rule(void **state)
+{
+    (void)state;
+    tu_rng g = {0x5eed18u};
+    const float n = 0.05f, f = 100.0f;
+    const int widths[9] = {1, 7, 8, 9, 16, 17, 63, 64, 301};
+    uint8_t K[320], P[4 * 320], E[4 * 320];
+    float ed[320];
+    long filled = 0, empty_rows = 0;
+    for (int it = 0; it < 3000; it++) {
+        const int w = widths[it % 9];
+        /* runs: long ones of each kind, or (every 3rd) single pixels */
+        const int maxrun = it % 3 == 0 ? 1 : 1 + tu_int(&g, 20);
+        const int pk[3] = {tu_int(&g, 4), tu_int(&g, 4), tu_int(&g, 4)};
+        for (int x = 0; x < w;) {
+            int k = tu_int(&g, pk[0] + pk[1] + pk[2] + 1), run = 1 + tu_int(&g, maxrun);
+            k = k < pk[0] ? 0 : k < pk[0] + pk[1] ? 1 : 2;
+            for (; run > 0 && x < w; run--, x++) K[x] = (uint8_t)k;
+        }
+        for (int x = 0; x < w; x++) {
+            ed[x] = tu_range(&g, 0.9f, 0.9999f);
+            for (int j = 0; j < 4; j++) P[4 * x + j] = (uint8_t)tu_int(&g, 256);
+        }
+        memcpy(E, P, (size_t)(4 * w));
+        int any = 0;
+        for (int x = 0; x < w; x++) any |= K[x] == 1;
+        for (int x = 0; x < w && any; x++) {
+            if (K[x] != 2) continue;
+            int l = -1, r = -1;
+            for (int i = x - 1; i >= 0 && l < 0; i--)
+                if (K[i] == 1) l = i;
+            for (int i = x + 1; i < w && r < 0; i++)
+                if (K[i] == 1) r = i;
+            int src = l >= 0 ? l : r;
+            if (l >= 0 && r >= 0) {
+                float d0 = ref_lin(ed[x], n, f);
+                if (fabsf(ref_lin(ed[r], n, f) - d0) < fabsf(ref_lin(ed[l], n, f) - d0)) src = r;
+            }
+            for (int j = 0; j < 3; j++) E[4 * x + j] = P[4 * src + j];
+            filled++;
+        }
+        int fills = 0;
+        for (int x = 0; x < w; x++) fills |= K[x] == 2;
+        empty_rows += !any && fills;
+        assert_int_equal(pipe__reproj_fill_row(K, w, P, ed, n, f), any || !fills);
+        assert_memory_equal(P, E, (size_t)(4 * w));
+    }
+    assert_true(filled > 10000);
+    assert_true(empty_rows > 50);
+}
+
 /* A closed cube of half size s around the origin (normals outward) and a
  * quad of half size q facing +Z at depth z, one mesh: from inside the
  * cube an eye falls back while its camera, D in front and outside the
@@ -826,6 +888,7 @@ int main(void)
         cmocka_unit_test(result_point_lands_by_geometry),
         cmocka_unit_test(result_point_lands_through_lens),
         cmocka_unit_test(result_disocclusion_fill),
+        cmocka_unit_test(result_fill_row_rule),
         cmocka_unit_test(result_border_fade),
         cmocka_unit_test(result_full_sensor),
         cmocka_unit_test(determinism_isa_threads),
