@@ -14,12 +14,15 @@
  *   - disocclusion: a small quad in front of a large one; the ring of the
  *     back quad the eye sees around the front one but the camera does not
  *     is filled from the back quad (green), never the front one's red;
+ *     the fill of a row against its rule written plainly (seeded rows);
  *   - the border of the camera's view fades over PIPE_REPROJ_FADE_PX;
  *   - the same bytes with 1 and 2 threads and every ISA cap (a recorded
  *     CRC); the crop method's bytes do not depend on the new code;
  *   - bad input: IPD and D out of range, reprojection with AA, an unknown
  *     view: pipe_create NULL and pipe_view_check names the field; the
- *     eye inside the model: the crop for that frame, counted; NaN depths
+ *     eye inside the model: the crop for that frame, counted, also
+ *     alternating with reprojected frames (each frame a fresh pipe's
+ *     bytes); NaN depths
  *     of the virtual scene: no crash, the hand kept there. */
 #include "support/testutil.h"
 
@@ -681,6 +684,155 @@ static void validity_eye_inside_model(void **state)
     kin_model_free(&m);
 }
 
+/* The fill of one row (pipe__reproj_fill_row, the word skipping) against
+ * the rule written plainly: seeded rows of runs of sampled, filled and
+ * empty pixels, of widths around the 8-pixel words, random colours and
+ * depths; a row with filled pixels but no sampled one is left alone (0). */
+static float ref_lin(float z, float n, float f)
+{
+    float zn = 2.0f * z - 1.0f;
+    return 2.0f * f * n / ((f + n) - zn * (f - n));
+}
+
+static void result_fill_row_rule(void **state)
+{
+    (void)state;
+    tu_rng g = {0x5eed18u};
+    const float n = 0.05f, f = 100.0f;
+    const int widths[9] = {1, 7, 8, 9, 16, 17, 63, 64, 301};
+    uint8_t K[320], P[4 * 320], E[4 * 320];
+    float ed[320];
+    long filled = 0, empty_rows = 0;
+    for (int it = 0; it < 3000; it++) {
+        const int w = widths[it % 9];
+        /* runs: long ones of each kind, or (every 3rd) single pixels */
+        const int maxrun = it % 3 == 0 ? 1 : 1 + tu_int(&g, 20);
+        const int pk[3] = {tu_int(&g, 4), tu_int(&g, 4), tu_int(&g, 4)};
+        for (int x = 0; x < w;) {
+            int k = tu_int(&g, pk[0] + pk[1] + pk[2] + 1), run = 1 + tu_int(&g, maxrun);
+            k = k < pk[0] ? 0 : k < pk[0] + pk[1] ? 1 : 2;
+            for (; run > 0 && x < w; run--, x++) K[x] = (uint8_t)k;
+        }
+        for (int x = 0; x < w; x++) {
+            ed[x] = tu_range(&g, 0.9f, 0.9999f);
+            for (int j = 0; j < 4; j++) P[4 * x + j] = (uint8_t)tu_int(&g, 256);
+        }
+        memcpy(E, P, (size_t)(4 * w));
+        int any = 0;
+        for (int x = 0; x < w; x++) any |= K[x] == 1;
+        for (int x = 0; x < w && any; x++) {
+            if (K[x] != 2) continue;
+            int l = -1, r = -1;
+            for (int i = x - 1; i >= 0 && l < 0; i--)
+                if (K[i] == 1) l = i;
+            for (int i = x + 1; i < w && r < 0; i++)
+                if (K[i] == 1) r = i;
+            int src = l >= 0 ? l : r;
+            if (l >= 0 && r >= 0) {
+                float d0 = ref_lin(ed[x], n, f);
+                if (fabsf(ref_lin(ed[r], n, f) - d0) < fabsf(ref_lin(ed[l], n, f) - d0)) src = r;
+            }
+            for (int j = 0; j < 3; j++) E[4 * x + j] = P[4 * src + j];
+            filled++;
+        }
+        int fills = 0;
+        for (int x = 0; x < w; x++) fills |= K[x] == 2;
+        empty_rows += !any && fills;
+        assert_int_equal(pipe__reproj_fill_row(K, w, P, ed, n, f), any || !fills);
+        assert_memory_equal(P, E, (size_t)(4 * w));
+    }
+    assert_true(filled > 10000);
+    assert_true(empty_rows > 50);
+}
+
+/* A closed cube of half size s around the origin (normals outward) and a
+ * quad of half size q facing +Z at depth z, one mesh: from inside the
+ * cube an eye falls back while its camera, D in front and outside the
+ * cube, sees the quad. */
+static void cube_quad_model(kin_model *m, float s, float q, float z)
+{
+    tu_mesh_parts t = tu_mesh_model(m, "head", "cubequad", 28, 42, 1);
+    for (int f = 0; f < 6; f++) {
+        int ax = f / 2;
+        float sg = (f & 1) ? 1.0f : -1.0f;
+        int u = (ax + 1) % 3, v = (ax + 2) % 3;
+        const float cu[4] = {-1, 1, 1, -1}, cv[4] = {-1, -1, 1, 1};
+        for (int i = 0; i < 4; i++) {
+            float *p = t.pos + 3 * (4 * f + i);
+            p[ax] = sg * s;
+            p[u] = cu[i] * s;
+            p[v] = cv[i] * s;
+            t.nrm[3 * (4 * f + i) + ax] = sg;
+        }
+        const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
+        for (int i = 0; i < 6; i++) t.idx[6 * f + i] = ix[i] + 4u * (uint32_t)f;
+    }
+    const float p[12] = {-q, -q, z, q, -q, z, q, q, z, -q, q, z};
+    memcpy(t.pos + 72, p, sizeof p);
+    for (int i = 0; i < 4; i++) t.nrm[72 + 3 * i + 2] = 1.0f;
+    const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
+    for (int i = 0; i < 6; i++) t.idx[36 + i] = ix[i] + 24u;
+    char why[200];
+    assert_int_equal(kin_model_validate(m, why, sizeof why), 0);
+}
+
+/* Frames alternating outside and inside the cube (the head moved between
+ * the inside ones, so the camera's view of the quad moves), with culling
+ * and without: every frame's bytes equal a fresh pipe's. Reprojecting,
+ * the camera is drawn without normals and a fallback draws it again with
+ * them into the same depth and mask planes: what the raster context
+ * keeps as clear must hold across the switch. */
+static void validity_fallback_alternating(void **state)
+{
+    (void)state;
+    kin_model m;
+    cube_quad_model(&m, 0.05f, 0.06f, -0.3f);
+    const float hx[7] = {0.0f, 0.0f, 0.0f, 0.012f, -0.01f, 0.0f, 0.0f};
+    const float hz[7] = {1.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.8f, 0.0f};
+    for (int cull = 0; cull < 2; cull++) {
+        pipe_desc dr = reproj_desc(PIPE_VIEW_REPROJECT, 2, 0);
+        dr.cull = cull ? RAST_CULL_BACK : RAST_CULL_NONE;
+        pipe_ctx *p = pipe_create(&dr, &m);
+        assert_non_null(p);
+        tu_frame_bufs b, bf;
+        pipe_frame_in in, inf;
+        tu_frame_make(&b, &in, 21, CAMW, CAMH, LCDW, LCDH);
+        tu_frame_make(&bf, &inf, 21, CAMW, CAMH, LCDW, LCDH);
+        pipe_frame_stats st;
+        char why[200];
+        long fallbacks = 0;
+        for (int k = 0; k < 7; k++) {
+            const int inside = hz[k] == 0.0f;
+            kin_mat4 head = kin_mat4_from_tr(kin_v3(hx[k], 0, hz[k]), kin_quat_identity());
+            in.head_node = inf.head_node = -1;
+            in.world_from_head = inf.world_from_head = &head;
+            pipe_ctx *f = pipe_create(&dr, &m);
+            assert_non_null(f);
+            assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+            assert_int_equal(pipe_frame(f, &inf, NULL, why, sizeof why), PIPE_OK);
+            for (int e = 0; e < 2; e++) {
+                /* not culled: inside falls back (culled, the cube's
+                 * faces wound inwards may still be drawn) */
+                if (!cull) {
+                    assert_int_equal(st.view[e], inside ? PIPE_VIEW_CROP : PIPE_VIEW_REPROJECT);
+                    fallbacks += inside;
+                } else {
+                    fallbacks += st.view[e] == PIPE_VIEW_CROP;
+                }
+                assert_memory_equal(b.out[e], bf.out[e], (size_t)LCDW * LCDH * 4);
+                assert_memory_equal(pipe_layer(p, e, NULL, NULL), pipe_layer(f, e, NULL, NULL),
+                                    (size_t)CW * CH * 4);
+            }
+            assert_int_equal(st.view_fallbacks, fallbacks);
+            pipe_destroy(f);
+        }
+        tu_frame_free(&b);
+        tu_frame_free(&bf);
+        pipe_destroy(p);
+    }
+    kin_model_free(&m);
+}
+
 /* NaN depths of the virtual scene: nothing there, the hand is kept; an
  * object in front (0.2 m) hides it; no crash, the same bytes twice. */
 static void validity_nan_virtual_depth(void **state)
@@ -736,11 +888,13 @@ int main(void)
         cmocka_unit_test(result_point_lands_by_geometry),
         cmocka_unit_test(result_point_lands_through_lens),
         cmocka_unit_test(result_disocclusion_fill),
+        cmocka_unit_test(result_fill_row_rule),
         cmocka_unit_test(result_border_fade),
         cmocka_unit_test(result_full_sensor),
         cmocka_unit_test(determinism_isa_threads),
         cmocka_unit_test(validity_bad_desc),
         cmocka_unit_test(validity_eye_inside_model),
+        cmocka_unit_test(validity_fallback_alternating),
         cmocka_unit_test(validity_nan_virtual_depth),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -137,7 +137,8 @@ static fuse_image raw_rows(const pipe_ctx *p, uint8_t *buf)
 /* Draws the posed model (parts: with the cockpit's hidden parts and
  * props) into tg through cam: straight for a pinhole, else through the
  * eye's lens map (pipe_lens.h), which writes every pixel of tg. Returns
- * the raster's result; *covered: the mask pixels set. */
+ * the raster's result; *covered: the mask pixels set (covered NULL: not
+ * counted). */
 static rast_result eye_draw(pipe_ctx *p, eye_state *e, const pipe_lens_map *lens,
                             const kin_camera *cam, const rast_target *tg, int parts,
                             long *covered)
@@ -169,9 +170,28 @@ static rast_result eye_draw(pipe_ctx *p, eye_state *e, const pipe_lens_map *lens
                          : pipe_pose_draw(&p->pose, e->rast, cam, &it, p->desc.cull, e->clip,
                                           e->vnrm, NULL);
     if (rr != RAST_OK) return rr;
-    /* Only the tiles the draws marked are read (the rest is clear). */
-    *covered = lens ? pipe_lens_warp(lens, tg) : rast_context_count(e->rast, &it);
+    /* Only the tiles the draws marked are read (the rest is clear);
+     * covered NULL (the eye's view): not counted */
+    if (lens) {
+        long c = pipe_lens_warp(lens, tg);
+        if (covered) *covered = c;
+    } else if (covered) {
+        *covered = rast_context_count(e->rast, &it);
+    }
     return RAST_OK;
+}
+
+/* The camera's G-buffer as a target. Reprojecting (without a lens map),
+ * nothing reads the camera's normals unless the eye falls back to the
+ * crop: the lighting reads the eye's, the occlusion test the camera's
+ * depth and mask. So its draws (run_eye's, the elbow fit's) write depth
+ * and mask only; reproj_eye draws the normals for a fallback. */
+static rast_target cam_target(const pipe_ctx *p, const eye_state *e)
+{
+    const int cw = p->geo.crop_width, ch = p->geo.crop_height;
+    if (p->desc.eye_view == PIPE_VIEW_REPROJECT && !e->lens)
+        return (rast_target){cw, ch, e->depth, cw, e->mask, cw, NULL, 0, 0};
+    return (rast_target){cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
 }
 
 /* Reprojection (pipe_reproj.h): the model drawn from the eye, the camera
@@ -184,9 +204,8 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
     const int w = r->width, h = r->height, cw = p->geo.crop_width, ch = p->geo.crop_height;
     r->cam = kin_sthmd_eye_camera(&p->hmd, &e->head, (kin_eye)e->eye, w, h);
     rast_target tg = {w, h, r->depth, w, r->mask, w, r->nrm, 3 * w, 3};
-    long covered = 0;
     int level = e->lod_level;
-    rast_result rr = eye_draw(p, e, NULL, &r->cam, &tg, 1, &covered);
+    rast_result rr = eye_draw(p, e, NULL, &r->cam, &tg, 1, NULL);
     e->lod_level = level;
     if (rr != RAST_OK) {
         e->result = PIPE_ERR_RASTER;
@@ -222,6 +241,25 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
     if (pipe__reproj_sample(r, &e->cam, &S, ox, oy, e->mask, cw, e->depth, cw, cw, ch,
                             p->hmd.znear, p->hmd.zfar)) {
         e->fallbacks++;
+        if (!cam_target(p, e).attr) {
+            /* the crop's lighting reads the camera's normals: the camera
+             * drawn again with them (the same depth and mask). This
+             * target shares the depth and mask planes with the camera's
+             * depth-only one, so the context's record of what is clear
+             * would not hold for it across the other's draws: the
+             * context forgets its targets first, and this one is cleared
+             * whole (the others next frame) */
+            rast_target ct = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
+            rast_context_forget(e->rast);
+            rr = eye_draw(p, e, NULL, &e->cam, &ct, 1, NULL);
+            e->lod_level = level;
+            if (rr != RAST_OK) {
+                e->result = PIPE_ERR_RASTER;
+                snprintf(e->why, sizeof e->why, "%s eye: rasterizer (fallback normals): %s",
+                         e->eye ? "right" : "left", rast_result_str(rr));
+                return -1;
+            }
+        }
         return 0;
     }
     fe->P = (fuse_image){r->P, w, h, 4 * w};
@@ -252,7 +290,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     e->t_start = t0;
     e->result = PIPE_OK;
     e->cam = kin_sthmd_camera(&p->hmd, &e->head, (kin_eye)e->eye);
-    rast_target tg = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
+    rast_target tg = cam_target(p, e);
     long covered = 0;
     e->lod_level = 0;
     rast_result rr = eye_draw(p, e, e->lens, &e->cam, &tg, 1, &covered);
@@ -764,7 +802,7 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
         /* the colour model of the last frame's masks (run_eye) when there
          * is one; else this frame's kinematic mask is drawn for it */
         if (pipe_fit_learned(p->fit, e)) continue;
-        rast_target tg = {cw, ch, s->depth, cw, s->mask, cw, s->nrm, 3 * cw, 3};
+        rast_target tg = cam_target(p, s);
         long covered;
         rast_result rr = eye_draw(p, s, s->lens, &cam[e], &tg, 0, &covered);
         const uint8_t *prev = s->have_refined && !p->fit_no_prev ? s->refined : NULL;

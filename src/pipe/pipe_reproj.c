@@ -59,7 +59,8 @@ int pipe__reproj_init(pipe__reproj *r, int width, int height)
     r->M = calloc(px, 1);
     r->row = malloc(sizeof(int32_t) * 3 * (size_t)width + (size_t)height);
     r->lanes = malloc(sizeof(int32_t) * 8 * ((size_t)width + 16));
-    if (!r->depth || !r->nrm || !r->mask || !r->P || !r->M || !r->row || !r->lanes) {
+    r->kind = calloc((size_t)width + 64, 1);
+    if (!r->depth || !r->nrm || !r->mask || !r->P || !r->M || !r->row || !r->lanes || !r->kind) {
         pipe__reproj_free(r);
         return -1;
     }
@@ -75,6 +76,7 @@ void pipe__reproj_free(pipe__reproj *r)
     free(r->M);
     free(r->row);
     free(r->lanes);
+    free(r->kind);
     memset(r, 0, sizeof *r);
 }
 
@@ -196,6 +198,77 @@ static inline int shows(const uint8_t *cmask, int cms, const float *cdepth, int 
            !(cdepth[(size_t)gy * (size_t)cds + (size_t)gx] < zmin);
 }
 
+/* 8 kind bytes (K) from p. */
+static inline uint64_t kind8(const uint8_t *p)
+{
+    uint64_t v;
+    memcpy(&v, p, 8);
+    return v;
+}
+
+#define KIND_ONES 0x0101010101010101ull /* the ST_SAMPLED bit of each byte */
+#define KIND_TWOS 0x0202020202020202ull /* the ST_FILL bit */
+
+/* The first column >= x of row K (w columns) that is sampled, or -1. */
+static int next_sampled(const uint8_t *K, int x, int w)
+{
+    for (; x + 8 <= w && !(kind8(K + x) & KIND_ONES); x += 8) {
+    }
+    for (; x < w; x++)
+        if (K[x] == ST_SAMPLED) return x;
+    return -1;
+}
+
+/* (pipe_reproj.h) Blocks of 8 pixels without a filled one are passed by
+ * a word test, keeping the last sampled one; the next sampled one is
+ * searched once per run of filled pixels. */
+int pipe__reproj_fill_row(const uint8_t *K, int w, uint8_t *Po, const float *ed, float n, float f)
+{
+    int last = -1, nxt = -2; /* last sampled before x; the next from x on (-2: unknown) */
+    int x = 0;
+    while (x < w) {
+        if (x + 8 <= w) {
+            const uint64_t k = kind8(K + x);
+            if (!(k & KIND_TWOS)) {
+                const uint64_t sm = k & KIND_ONES;
+                if (sm) {
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+                    last = x + (63 - __builtin_clzll(sm)) / 8;
+#else
+                    for (int i = 7; i >= 0; i--)
+                        if (K[x + i] == ST_SAMPLED) {
+                            last = x + i;
+                            break;
+                        }
+#endif
+                }
+                x += 8;
+                continue;
+            }
+        }
+        const int end = x + 8 < w ? x + 8 : w;
+        for (; x < end; x++) {
+            if (K[x] == ST_SAMPLED) {
+                last = x;
+                continue;
+            }
+            if (K[x] != ST_FILL) continue;
+            if (nxt != -1 && nxt < x) nxt = next_sampled(K, x + 1, w);
+            const int l = last, rr = nxt;
+            int src = l >= 0 ? l : rr;
+            if (src < 0) return 0; /* no sampled pixel in the row */
+            if (l >= 0 && rr >= 0) {
+                const float d0 = lin_depth(ed[x], n, f);
+                const float dl = fabsf(lin_depth(ed[l], n, f) - d0);
+                const float dr = fabsf(lin_depth(ed[rr], n, f) - d0);
+                if (dr < dl) src = rr;
+            }
+            for (int j = 0; j < 3; j++) Po[4 * x + j] = Po[4 * src + j];
+        }
+    }
+    return 1;
+}
+
 int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image *P, int ox,
                         int oy, const uint8_t *cmask, int cmask_stride, const float *cdepth,
                         int cdepth_stride, int gw, int gh, float n, float f)
@@ -233,9 +306,11 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
     long covered = 0, back = 0, sampled = 0, filled = 0, outside = 0;
     float mind = INFINITY;
     uint64_t sum[3] = {0, 0, 0};
-    /* the eye rays' x per column, and per row: a fill pixel in it */
+    /* the eye rays' x per column, and per row: filled pixels left for
+     * the mean (no sampled pixel in the row) */
     float *rxs = (float *)(r->row + 2 * w);
     uint8_t *row_fill = (uint8_t *)(r->row + 3 * w);
+    uint8_t *K = r->kind;
     for (int x = 0; x < w; x++) rxs[x] = ((float)x + 0.5f - ecx) / efx;
     g.rxs = rxs;
     for (int y = 0; y < h; y++) {
@@ -247,6 +322,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         const float ry = -((float)y + 0.5f - ecy) / efy;
         const long filled0 = filled;
         memset(M, 0, (size_t)w);
+        memset(K, 0, (size_t)w);
         /* the geometry of the row's covered pixels (vector, then the tail) */
         int x1 = kernel ? kernel(&g, em, ed, en, ry, w, &o, &back, &mind) : 0;
         row_ref(&g, em, ed, en, ry, x1, w, &o, &back, &mind);
@@ -254,7 +330,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         int xt = 0;
         if (taps) {
             long cnt[4] = {0, 0, 0, 0};
-            xt = taps(&td, em, &o, w, M, Po, cnt, sum);
+            xt = taps(&td, em, &o, w, M, Po, K, cnt, sum);
             covered += cnt[0], outside += cnt[1], filled += cnt[2], sampled += cnt[3];
         }
         for (int x = xt; x < w; x++) {
@@ -277,6 +353,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
                              zmin);
             if (!seen) {
                 Po[4 * x + 3] = ST_FILL;
+                K[x] = ST_FILL;
                 filled++;
                 continue;
             }
@@ -325,9 +402,11 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
                 sum[j] += c;
             }
             Po[4 * x + 3] = ST_SAMPLED;
+            K[x] = ST_SAMPLED;
             sampled++;
         }
-        row_fill[y] = filled != filled0;
+        /* the fill from the row's own sampled pixels, while it is warm */
+        row_fill[y] = filled != filled0 && !pipe__reproj_fill_row(K, w, Po, ed, n, f);
     }
     r->sampled = sampled;
     r->outside = outside;
@@ -336,54 +415,20 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         r->filled = 0;
         return 1;
     }
-    /* the fill: the nearest sampled pixel of the row, else the mean */
+    /* the rows without a sampled pixel: the mean of the eye's sampled
+     * pixels, or (none at all) not shown */
     uint8_t mean[3] = {0, 0, 0};
     if (sampled)
         for (int j = 0; j < 3; j++)
             mean[j] = (uint8_t)((sum[j] + (uint64_t)sampled / 2) / (uint64_t)sampled);
-    long done = 0;
-    for (int y = 0; y < h && done < filled; y++) {
+    for (int y = 0; y < h; y++) {
         if (!row_fill[y]) continue;
         const uint8_t *em = r->mask + (size_t)y * (size_t)w;
         uint8_t *M = r->M + (size_t)y * (size_t)w;
         uint8_t *Po = r->P + (size_t)y * (size_t)w * 4;
-        int32_t *left = r->row;
-        /* the row's span of shown pixels (M != 0: covered, inside the
-         * camera image), 8 bytes at a time: nothing outside it counts */
-        int xa = 0, xb = w - 1;
-        uint64_t word;
-        while (xa + 8 <= w && (memcpy(&word, M + xa, 8), word == 0)) xa += 8;
-        while (xa < w && !M[xa]) xa++;
-        while (xb - 7 > xa && (memcpy(&word, M + xb - 7, 8), word == 0)) xb -= 8;
-        while (xb > xa && !M[xb]) xb--;
-        int any = 0, last = -1;
-        for (int x = xa; x <= xb; x++) {
-            int st = em[x] && M[x] ? Po[4 * x + 3] : ST_NONE;
-            if (st == ST_SAMPLED) last = x;
-            else if (st == ST_FILL) any = 1;
-            left[x] = last;
-        }
-        if (!any) continue;
-        /* right to left: the nearest sampled pixel to the right known */
-        last = -1;
-        for (int x = xb; x >= xa; x--) {
-            int st = em[x] && M[x] ? Po[4 * x + 3] : ST_NONE;
-            if (st == ST_SAMPLED) last = x;
-            if (st != ST_FILL) continue;
-            done++;
-            /* of the nearest sampled pixels left and right, the one on
-             * the same surface: its eye distance nearer to this pixel's */
-            int l = left[x], rr = last, src = l >= 0 ? l : rr;
-            if (l >= 0 && rr >= 0) {
-                const float *ed = r->depth + (size_t)y * (size_t)w;
-                float d0 = lin_depth(ed[x], n, f);
-                float dl = fabsf(lin_depth(ed[l], n, f) - d0);
-                float dr = fabsf(lin_depth(ed[rr], n, f) - d0);
-                if (dr < dl) src = rr;
-            }
-            if (src >= 0) {
-                for (int j = 0; j < 3; j++) Po[4 * x + j] = Po[4 * src + j];
-            } else if (sampled) {
+        for (int x = 0; x < w; x++) {
+            if (!em[x] || !M[x] || Po[4 * x + 3] != ST_FILL) continue;
+            if (sampled) {
                 for (int j = 0; j < 3; j++) Po[4 * x + j] = mean[j];
             } else {
                 M[x] = 0; /* nothing seen at all: not shown */

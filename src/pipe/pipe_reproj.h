@@ -125,7 +125,8 @@ typedef struct pipe__reproj {
     uint8_t *mask;
     uint8_t *P;               /* RGBA8: camera colours seen from the eye */
     uint8_t *M;               /* the mask composited (fade, fill) */
-    int32_t *row;             /* 2 * width: the fill's scan */
+    int32_t *row;             /* the eye rays' x, the rows to fill with the mean */
+    uint8_t *kind;            /* width + 64: one row's kinds (1 sampled, 2 filled) */
     int32_t *lanes;           /* 8 * width: one row's geometry (pipe__reproj_lanes) */
     int isa;                  /* the geometry pass's ISA (ef_isa; pipe.c sets it) */
     kin_camera cam;           /* this frame's eye camera */
@@ -189,24 +190,37 @@ typedef struct pipe__reproj_tapd {
 /* The taps pass per ISA (pipe_reproj_simd.inl): from one eye row's
  * geometry (o, the covered pixels em), M (the mask composited: the fade
  * or 0), Po (RGBA + the kind in alpha, written where the scalar
- * reference writes), cnt[] += covered, outside, filled, sampled and
- * sum[] += the sampled colours; the first column not done (the scalar
- * taps finish). Equal to the scalar taps in pipe_reproj.c. */
+ * reference writes), K (the kind: 1 sampled, 2 filled, written where it
+ * is one of them; the caller zeroes the row first), cnt[] += covered,
+ * outside, filled, sampled and sum[] += the sampled colours; the first
+ * column not done (the scalar taps finish). Equal to the scalar taps in
+ * pipe_reproj.c. */
 typedef int (*pipe__reproj_taps_fn)(const pipe__reproj_tapd *t, const uint8_t *em,
                                     const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                                    long cnt[4], uint64_t sum[3]);
+                                    uint8_t *K, long cnt[4], uint64_t sum[3]);
 int pipe__reproj_taps_sse2(const pipe__reproj_tapd *t, const uint8_t *em,
                            const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                           long cnt[4], uint64_t sum[3]);
+                           uint8_t *K, long cnt[4], uint64_t sum[3]);
 int pipe__reproj_taps_avx2(const pipe__reproj_tapd *t, const uint8_t *em,
                            const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                           long cnt[4], uint64_t sum[3]);
+                           uint8_t *K, long cnt[4], uint64_t sum[3]);
 int pipe__reproj_taps_avx512(const pipe__reproj_tapd *t, const uint8_t *em,
                              const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                             long cnt[4], uint64_t sum[3]);
+                             uint8_t *K, long cnt[4], uint64_t sum[3]);
 int pipe__reproj_taps_neon(const pipe__reproj_tapd *t, const uint8_t *em,
                            const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                           long cnt[4], uint64_t sum[3]);
+                           uint8_t *K, long cnt[4], uint64_t sum[3]);
+
+/* The fill of one eye row (THE FILL above) from its kinds K (w bytes:
+ * 1 sampled, 2 filled, else 0; 8 bytes readable past w not needed): each
+ * filled pixel of Po (RGBA) takes the RGB of the nearest sampled pixel to
+ * its left or to its right, the one whose eye distance (ed: window
+ * depths, near n, far f) is nearer to its own (the left one on a tie; the
+ * one there is when only one side has any). 0 when the row has filled
+ * pixels but no sampled one: nothing written (the caller fills with the
+ * mean). */
+int pipe__reproj_fill_row(const uint8_t *K, int w, uint8_t *Po, const float *ed, float n,
+                          float f);
 
 int pipe__reproj_init(pipe__reproj *r, int width, int height);
 void pipe__reproj_free(pipe__reproj *r);
