@@ -91,7 +91,10 @@ static const char *render_usage =
     "                 the pixel centres); default 0\n"
     "  --smooth-normals R  sum the model's normals over a (2R+1)^2 window\n"
     "                 before lighting (1..4; default 0: off): for models of\n"
-    "                 crossing parts whose shading shows seams\n"
+    "                 crossing parts whose shading shows seams. With --refine\n"
+    "                 the normals are always smoothed (default R 3) and\n"
+    "                 continued beyond the model's rim to the refined edge;\n"
+    "                 -1: the model's own normals (the view vector beyond it)\n"
     "  --edge-fade K  soft viewport edges: where the camera image ends inside\n"
     "                 the display, the hands fade over its last K pixels\n"
     "                 (1..64; 0: off, a hard cut); default 4\n"
@@ -669,8 +672,8 @@ int cmd_render(int argc, char **argv)
                 return cli_usage_error("render", "--refine '%s': a band of 1..64 px", optarg);
             break;
         case O_SMOOTH:
-            if (!cli_parse_int(optarg, 1, FUSE_NORMAL_SMOOTH_MAX, &o.smooth_normals))
-                return cli_usage_error("render", "--smooth-normals '%s': a radius of 1..%d px",
+            if (!cli_parse_int(optarg, -1, FUSE_NORMAL_SMOOTH_MAX, &o.smooth_normals))
+                return cli_usage_error("render", "--smooth-normals '%s': a radius of -1..%d px",
                                        optarg, FUSE_NORMAL_SMOOTH_MAX);
             break;
         case O_EDGE_FADE:

@@ -90,8 +90,18 @@ typedef struct pipe_desc {
                                  the (2r + 1)^2 window before lighting
                                  (fuse_normal_smooth): for models of
                                  crossing parts with their own normals,
-                                 whose shading seams become ramps. Out of
-                                 range: pipe_create returns NULL. */
+                                 whose shading seams become ramps. With
+                                 refine_band (and no aa_samples, the crop
+                                 view) the refined mask is always lit
+                                 with the model's normals summed over the
+                                 window (radius PIPE_NFILL_RADIUS 3 for 0)
+                                 and continued beyond the model's rim
+                                 (src/pipe/pipe_nfill.h: no halo, no
+                                 second edge where the model lags the
+                                 hand); -1 there: the model's own normals,
+                                 the view vector beyond them (the bytes
+                                 before issue 14's fill). Out of range:
+                                 pipe_create returns NULL. */
     int aa_samples;           /* 0 = off (default): the binary mask of the
                                  pixel centres, the bytes of before; 4, 8
                                  or 16: anti-aliased edges, the mask is
