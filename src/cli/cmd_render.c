@@ -15,7 +15,7 @@ static const char *render_usage =
     "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
     "                      [--tone-match S] [--pose animation|tracking]\n"
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
-    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--edge-fade K] [--hide PARTS]\n"
+    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--soft-edges] [--edge-fade K] [--hide PARTS]\n"
     "                      [--prop MODEL@X,Y,Z[,YAW]]... [--allow-outside]\n"
     "                      [--lod MODE] [--lod-px PX] [--view crop|reproject]\n"
     "                      [--hmd-ipd M] [--hmd-camera-offset M]\n"
@@ -95,6 +95,10 @@ static const char *render_usage =
     "                 the normals are always smoothed (default R 3) and\n"
     "                 continued beyond the model's rim to the refined edge;\n"
     "                 -1: the model's own normals (the view vector beyond it)\n"
+    "  --soft-edges   soft silhouettes at the cost of one pass over the mask:\n"
+    "                 its edge pixels fade by the share of their 3x3 window\n"
+    "                 inside it, a one-pixel ramp instead of stair-steps\n"
+    "                 (not with --aa or --view reproject)\n"
     "  --edge-fade K  soft viewport edges: where the camera image ends inside\n"
     "                 the display, the hands fade over its last K pixels\n"
     "                 (1..64; 0: off, a hard cut); default 4\n"
@@ -131,6 +135,7 @@ typedef struct render_opts {
     float predict_ms;      /* display time past the frame time */
     int no_filter;         /* raw samples instead of the One Euro filter */
     int cull_back;         /* cull back faces (closed models) */
+    int soft_edge;         /* pipe_desc.soft_edge */
     int refine;            /* refinement band, px; 0 = off */
     unsigned hide;         /* PIPE_PART_* bits not shown */
     int nprops;            /* --prop: models fixed in the world frame */
@@ -368,6 +373,7 @@ static int render(const render_opts *o)
     pd.refine_band = o->refine;
     pd.normal_smooth = o->smooth_normals;
     pd.aa_samples = o->aa;
+    pd.soft_edge = o->soft_edge;
     pd.edge_fade = o->edge_fade;
     pd.fit_rig = o->refine && o->pose_tracking ? &tp.rig : NULL;
     /* the scene's HMD (its `hmd` key, checked on load), or the paper's */
@@ -554,7 +560,7 @@ done:
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
        O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
        O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
-       O_HMD_CALIB_R, O_AA, O_VIEW, O_HMD_IPD, O_HMD_OFFSET, O_EDGE_FADE };
+       O_HMD_CALIB_R, O_AA, O_VIEW, O_HMD_IPD, O_HMD_OFFSET, O_EDGE_FADE, O_SOFT };
 
 /* --aa N: 0 (off), 4, 8 or 16 samples per pixel. 1, or 0 for another. */
 static int parse_aa(const char *s, int *aa)
@@ -611,6 +617,7 @@ int cmd_render(int argc, char **argv)
         {"smooth-normals", required_argument, 0, O_SMOOTH},
         {"aa", required_argument, 0, O_AA},
         {"edge-fade", required_argument, 0, O_EDGE_FADE},
+        {"soft-edges", no_argument, 0, O_SOFT},
         {"tone-match", required_argument, 0, O_TONE},
         {"pose", required_argument, 0, O_POSE},
         {"calib", required_argument, 0, O_CALIB},
@@ -657,6 +664,7 @@ int cmd_render(int argc, char **argv)
             break;
         case O_NO_DEPTH: o.no_depth = 1; break;
         case O_CULL: o.cull_back = 1; break;
+        case O_SOFT: o.soft_edge = 1; break;
         case O_LOD:
             if (!cli_lod_parse(optarg, &o.lod))
                 return cli_usage_error("render", "--lod '%s': off, auto or a level 0..%d",
@@ -742,6 +750,9 @@ int cmd_render(int argc, char **argv)
     if (optind < argc) return cli_usage_error("render", "unexpected argument '%s'", argv[optind]);
     if (!o.scene) return cli_usage_error("render", "--scene is required");
     if (!o.out) return cli_usage_error("render", "--out is required");
+    if (o.soft_edge && (o.aa || o.view != PIPE_VIEW_CROP))
+        return cli_usage_error("render", "--soft-edges: not with --aa or --view reproject (it "
+                               "softens the binary mask of the camera's crop)");
     if (tracking_only && !o.pose_tracking)
         return cli_usage_error("render", "%s needs --pose tracking",
                                tracking_only == O_CALIB ? "--calib"

@@ -155,6 +155,15 @@ typedef struct pipe_desc {
                                  tracking how to pose the frames, see
                                  pipe_track_output. Other values:
                                  pipe_create returns NULL. */
+    int soft_edge;            /* 0 = off (default): the binary mask; 1:
+                                 soft silhouettes, the binary (G-buffer's
+                                 or refined) mask's edge pixels faded by
+                                 the share of their 3x3 window inside it,
+                                 a one-pixel ramp instead of stair-steps
+                                 (src/pipe/pipe_soft.h, docs/antialias.md),
+                                 one pass over the mask. With aa_samples,
+                                 eye_view REPROJECT or another value:
+                                 pipe_create returns NULL. */
 } pipe_desc;
 
 /* The defaults of the refine method (`egofuse eval`'s, docs/accuracy.md). */
