@@ -111,9 +111,10 @@ static const char *render_usage =
 static const char *demo_usage =
     "usage: egofuse demo [--samples DIR] [--out DIR] [--frames N]\n"
     "\n"
-    "Runs `egofuse render --cull-back` on the bundled samples (closed arm\n"
-    "meshes: culling back faces gives the same masks), which `make demo` generates\n"
-    "into build/samples (build/gen_samples --out DIR makes them by hand).\n"
+    "Runs `egofuse render --cull-back --soft-edges` on the bundled samples (closed\n"
+    "arm meshes: culling back faces gives the same masks; soft silhouettes instead\n"
+    "of stair-steps, docs/antialias.md), which `make demo` generates into\n"
+    "build/samples (build/gen_samples --out DIR makes them by hand).\n"
     "\n"
     "  --samples DIR  folder holding scene.txt (default build/samples)\n"
     "  --out DIR      output folder (default out/demo)\n"
@@ -786,6 +787,7 @@ int cmd_demo(int argc, char **argv)
     o.lod_px = CLI_LOD_PX_DEFAULT;
     o.out = "out/demo";
     o.cull_back = 1; /* the sample arms are closed: same masks, half the setups */
+    o.soft_edge = 1; /* no stair-steps (issue 14 item 3; docs/antialias.md) */
     optind = 1;
     opterr = 0;
     int c;
