@@ -327,7 +327,8 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
                        pipe_frame_stats *stats, char *why, int why_size);
 /* The last frame's mask of one eye (valid until the next frame): the
  * refined one with pipe_desc.refine_band, else the G-buffer's; with
- * pipe_desc.aa_samples the coverage mask composited (0..255). */
+ * pipe_desc.aa_samples the coverage mask composited (0..255), with
+ * pipe_desc.soft_edge that mask softened at its edge (0..255). */
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The last frame's lit layer of one eye (premultiplied RGBA8, the
  * mask's size, 4 * width bytes per row; valid until the next frame):
