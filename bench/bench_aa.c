@@ -7,7 +7,8 @@
  * true arms, their camera images, the workshop as the virtual scene) on
  * reach_grasp, slowed down (--speed, default 0.25: a slow sequence, where
  * a stair-stepped edge crawls pixel by pixel), frames 0..N-1, both eyes.
- * Methods, each with aa 0 (binary), 4, 8, 16, through pipe_frame:
+ * Methods, each with aa 0 (binary), -1 (soft_edge), 4, 8, 16, through
+ * pipe_frame:
  *   kin          the mask model posed by the animation;
  *   refine       the same, mask refined by colour (band 16);
  *   kin-track    posed from the tracking (eval's tracker: 5 mm noise,
@@ -55,8 +56,11 @@
 enum { CW = 640, CH = 400, OW = GEN_VIRT_W, OH = GEN_VIRT_H };
 enum { M_KIN, M_REFINE, M_KIN_TRACK, M_REFINE_TRACK, M_COUNT };
 static const char *mname[M_COUNT] = {"kin", "refine", "kin-track", "refine-track"};
-static const int aa_of[4] = {0, 4, 8, 16};
-#define NCFG (M_COUNT * 4)
+/* samples per pixel; -1: pipe_desc.soft_edge (the binary mask's edge
+ * faded by its 3x3 window, pipe_soft.h), printed as aa -1 */
+static const int aa_of[5] = {0, -1, 4, 8, 16};
+#define NAA 5
+#define NCFG (M_COUNT * NAA)
 
 typedef struct cfg_run {
     int method, aa;
@@ -211,11 +215,12 @@ int main(int argc, char **argv)
     memset(R, 0, sizeof R);
     for (int i = 0; i < NCFG; i++) {
         cfg_run *r = &R[i];
-        r->method = i / 4;
-        r->aa = aa_of[i % 4];
+        r->method = i / NAA;
+        r->aa = aa_of[i % NAA];
         pipe_desc d = {0};
         d.threads = threads;
-        d.aa_samples = r->aa;
+        d.aa_samples = r->aa > 0 ? r->aa : 0;
+        d.soft_edge = r->aa < 0;
         if (cull_back) d.cull = RAST_CULL_BACK; /* closed arm meshes: the same masks */
         if (r->method == M_REFINE || r->method == M_REFINE_TRACK) d.refine_band = 16;
         if (r->method == M_REFINE_TRACK) d.fit_rig = &rig;

@@ -27,7 +27,8 @@
  *     vacuous);
  *   - every ISA gives the reference's bytes (outputs and layers).
  * The pipe methods run again with anti-aliased silhouettes
- * (pipe_desc.aa_samples 4, 8 or 16: occl_*_aa), the same checks.
+ * (pipe_desc.aa_samples 4, 8 or 16: occl_*_aa) and with soft silhouettes
+ * (pipe_desc.soft_edge: occl_*_soft), the same checks.
  * Before fuse_depth_fill (the refined pixels outside the model had no
  * depth and were kept) refine and refine-anim drew hundreds of hand
  * pixels inside the band per frame (with the fill disabled: refine 25,913,
@@ -74,6 +75,8 @@ typedef struct world {
 static world W;
 /* pipe_desc.aa_samples of the pipe methods (0: binary masks) */
 static int g_aa;
+/* pipe_desc.soft_edge of the pipe methods */
+static int g_soft;
 
 /* The band of BAND_W output columns holding the most silhouette pixels. */
 static int best_band(const uint8_t *sil, const kin_sthmd_geometry *g)
@@ -238,6 +241,7 @@ static long run_pipe(int m, ef_isa isa, int with_depth, uint64_t crc[NF], long *
     d.threads = 2;
     d.max_isa = (int)isa;
     d.aa_samples = g_aa;
+    d.soft_edge = g_soft;
     if (m == M_REFINE || m == M_REFINE_ANIM) d.refine_band = 16;
     if (m == M_REFINE) d.fit_rig = &W.rig;
     pipe_ctx *p = pipe_create(&d, &W.mask.model);
@@ -405,6 +409,16 @@ static void occl_kin_aa(void **state) { (void)state; aa_case(M_KIN, 16); }
 static void occl_kin_pred_aa(void **state) { (void)state; aa_case(M_KIN_PRED, 4); }
 static void occl_refine_aa(void **state) { (void)state; aa_case(M_REFINE, 8); }
 static void occl_refine_anim_aa(void **state) { (void)state; aa_case(M_REFINE_ANIM, 16); }
+/* The same with soft silhouettes (pipe_desc.soft_edge: the binary mask's
+ * edge faded inside it, pipe_soft.h). */
+static void soft_case(int m)
+{
+    g_soft = 1;
+    method_case(m);
+    g_soft = 0;
+}
+static void occl_kin_pred_soft(void **state) { (void)state; soft_case(M_KIN_PRED); }
+static void occl_refine_soft(void **state) { (void)state; soft_case(M_REFINE); }
 
 /* fuse_depth_fill's rule on small cases: nearest known depth, ties to
  * the upper row then the left column, sources only the depths before the
@@ -483,6 +497,8 @@ int main(void)
         cmocka_unit_test(occl_kin_pred_aa),
         cmocka_unit_test(occl_refine_aa),
         cmocka_unit_test(occl_refine_anim_aa),
+        cmocka_unit_test(occl_kin_pred_soft),
+        cmocka_unit_test(occl_refine_soft),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

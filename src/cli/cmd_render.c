@@ -15,7 +15,7 @@ static const char *render_usage =
     "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
     "                      [--tone-match S] [--pose animation|tracking]\n"
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
-    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--edge-fade K] [--hide PARTS]\n"
+    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--soft-edges] [--edge-fade K] [--hide PARTS]\n"
     "                      [--prop MODEL@X,Y,Z[,YAW]]... [--allow-outside]\n"
     "                      [--lod MODE] [--lod-px PX] [--view crop|reproject]\n"
     "                      [--hmd-ipd M] [--hmd-camera-offset M]\n"
@@ -91,7 +91,14 @@ static const char *render_usage =
     "                 the pixel centres); default 0\n"
     "  --smooth-normals R  sum the model's normals over a (2R+1)^2 window\n"
     "                 before lighting (1..4; default 0: off): for models of\n"
-    "                 crossing parts whose shading shows seams\n"
+    "                 crossing parts whose shading shows seams. With --refine\n"
+    "                 the normals are always smoothed (default R 3) and\n"
+    "                 continued beyond the model's rim to the refined edge;\n"
+    "                 -1: the model's own normals (the view vector beyond it)\n"
+    "  --soft-edges   soft silhouettes at the cost of one pass over the mask:\n"
+    "                 its edge pixels fade by the share of their 3x3 window\n"
+    "                 inside it, a one-pixel ramp instead of stair-steps\n"
+    "                 (not with --aa or --view reproject)\n"
     "  --edge-fade K  soft viewport edges: where the camera image ends inside\n"
     "                 the display, the hands fade over its last K pixels\n"
     "                 (1..64; 0: off, a hard cut); default 4\n"
@@ -104,9 +111,10 @@ static const char *render_usage =
 static const char *demo_usage =
     "usage: egofuse demo [--samples DIR] [--out DIR] [--frames N]\n"
     "\n"
-    "Runs `egofuse render --cull-back` on the bundled samples (closed arm\n"
-    "meshes: culling back faces gives the same masks), which `make demo` generates\n"
-    "into build/samples (build/gen_samples --out DIR makes them by hand).\n"
+    "Runs `egofuse render --cull-back --soft-edges` on the bundled samples (closed\n"
+    "arm meshes: culling back faces gives the same masks; soft silhouettes instead\n"
+    "of stair-steps, docs/antialias.md), which `make demo` generates into\n"
+    "build/samples (build/gen_samples --out DIR makes them by hand).\n"
     "\n"
     "  --samples DIR  folder holding scene.txt (default build/samples)\n"
     "  --out DIR      output folder (default out/demo)\n"
@@ -128,6 +136,7 @@ typedef struct render_opts {
     float predict_ms;      /* display time past the frame time */
     int no_filter;         /* raw samples instead of the One Euro filter */
     int cull_back;         /* cull back faces (closed models) */
+    int soft_edge;         /* pipe_desc.soft_edge */
     int refine;            /* refinement band, px; 0 = off */
     unsigned hide;         /* PIPE_PART_* bits not shown */
     int nprops;            /* --prop: models fixed in the world frame */
@@ -365,6 +374,7 @@ static int render(const render_opts *o)
     pd.refine_band = o->refine;
     pd.normal_smooth = o->smooth_normals;
     pd.aa_samples = o->aa;
+    pd.soft_edge = o->soft_edge;
     pd.edge_fade = o->edge_fade;
     pd.fit_rig = o->refine && o->pose_tracking ? &tp.rig : NULL;
     /* the scene's HMD (its `hmd` key, checked on load), or the paper's */
@@ -551,7 +561,7 @@ done:
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
        O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
        O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
-       O_HMD_CALIB_R, O_AA, O_VIEW, O_HMD_IPD, O_HMD_OFFSET, O_EDGE_FADE };
+       O_HMD_CALIB_R, O_AA, O_VIEW, O_HMD_IPD, O_HMD_OFFSET, O_EDGE_FADE, O_SOFT };
 
 /* --aa N: 0 (off), 4, 8 or 16 samples per pixel. 1, or 0 for another. */
 static int parse_aa(const char *s, int *aa)
@@ -608,6 +618,7 @@ int cmd_render(int argc, char **argv)
         {"smooth-normals", required_argument, 0, O_SMOOTH},
         {"aa", required_argument, 0, O_AA},
         {"edge-fade", required_argument, 0, O_EDGE_FADE},
+        {"soft-edges", no_argument, 0, O_SOFT},
         {"tone-match", required_argument, 0, O_TONE},
         {"pose", required_argument, 0, O_POSE},
         {"calib", required_argument, 0, O_CALIB},
@@ -654,6 +665,7 @@ int cmd_render(int argc, char **argv)
             break;
         case O_NO_DEPTH: o.no_depth = 1; break;
         case O_CULL: o.cull_back = 1; break;
+        case O_SOFT: o.soft_edge = 1; break;
         case O_LOD:
             if (!cli_lod_parse(optarg, &o.lod))
                 return cli_usage_error("render", "--lod '%s': off, auto or a level 0..%d",
@@ -669,8 +681,8 @@ int cmd_render(int argc, char **argv)
                 return cli_usage_error("render", "--refine '%s': a band of 1..64 px", optarg);
             break;
         case O_SMOOTH:
-            if (!cli_parse_int(optarg, 1, FUSE_NORMAL_SMOOTH_MAX, &o.smooth_normals))
-                return cli_usage_error("render", "--smooth-normals '%s': a radius of 1..%d px",
+            if (!cli_parse_int(optarg, -1, FUSE_NORMAL_SMOOTH_MAX, &o.smooth_normals))
+                return cli_usage_error("render", "--smooth-normals '%s': a radius of -1..%d px",
                                        optarg, FUSE_NORMAL_SMOOTH_MAX);
             break;
         case O_EDGE_FADE:
@@ -739,6 +751,9 @@ int cmd_render(int argc, char **argv)
     if (optind < argc) return cli_usage_error("render", "unexpected argument '%s'", argv[optind]);
     if (!o.scene) return cli_usage_error("render", "--scene is required");
     if (!o.out) return cli_usage_error("render", "--out is required");
+    if (o.soft_edge && (o.aa || o.view != PIPE_VIEW_CROP))
+        return cli_usage_error("render", "--soft-edges: not with --aa or --view reproject (it "
+                               "softens the binary mask of the camera's crop)");
     if (tracking_only && !o.pose_tracking)
         return cli_usage_error("render", "%s needs --pose tracking",
                                tracking_only == O_CALIB ? "--calib"
@@ -772,6 +787,7 @@ int cmd_demo(int argc, char **argv)
     o.lod_px = CLI_LOD_PX_DEFAULT;
     o.out = "out/demo";
     o.cull_back = 1; /* the sample arms are closed: same masks, half the setups */
+    o.soft_edge = 1; /* no stair-steps (issue 14 item 3; docs/antialias.md) */
     optind = 1;
     opterr = 0;
     int c;

@@ -316,43 +316,81 @@ int eval__write_light(const char *dir, const method_run *R, int n)
     static const char *const xlab[3] = {"cockpit light intensity, x the matched",
                                         "cockpit light colour temperature, K (matched: 6500)",
                                         "cockpit light direction, degrees to the side"};
+    /* one legend for the six panels, below them (a box inside a panel hid
+     * skin's points); the crossings under each panel's axis label, not
+     * over its curves; the IoU panels without refine+tone, whose masks are
+     * refine's (its line hid refine's) */
     fprintf(f, "if (!exists('sfx')) sfx = ''\nset grid\n"
-               "set terminal pngcairo noenhanced size 1500,900 font ',11'\n"
+               "set terminal pngcairo noenhanced size 1500,980 font ',12'\n"
                "set output '%s/light.png'.sfx\n"
-               "set multiplot layout 2,3 title 'Lighting mismatch between the cockpit (camera "
-               "images) and the virtual scene: circles where IoU falls below 0.9 (top) or PSNR "
-               "%.0f dB below the matched light (bottom)'\n",
+               "set multiplot title 'Lighting mismatch between the cockpit (camera images) and the "
+               "virtual scene: circles where IoU falls below 0.9 (top) or PSNR %.0f dB below the "
+               "matched light (bottom)'\n",
             dir, LIGHT_PSNR_DROP);
     for (int row = 0; row < 2; row++)
         for (int a = 0; a < 3; a++) {
-            fprintf(f, "unset label\nunset arrow\nset xlabel '%s'\nset ylabel '%s'\n%s\n"
-                       "set key bottom left box opaque font ',9'\n",
-                    xlab[a], row ? "composite PSNR, dB" : "mask IoU",
+            /* "below 0.9 at: refine 0.969, kin-cal-pred 0.948; skin throughout" */
+            char cr[320];
+            size_t u = (size_t)snprintf(cr, sizeof cr, "%s", row ? "1 dB down at:" : "below 0.9 at:");
+            int listed = 0, line = 0;
+            for (int q = 0; q < NCURVE; q++) {
+                if (row == 0 && q == 3) continue;
+                const double b = row ? below_psnr[a][q] : below_iou[a][q];
+                if (isnan(b) || u >= sizeof cr - 48) continue;
+                if (listed == 2 && !line) {
+                    u += (size_t)snprintf(cr + u, sizeof cr - u, ",\\n");
+                    line = 1;
+                } else if (listed) {
+                    u += (size_t)snprintf(cr + u, sizeof cr - u, ",");
+                }
+                if (isinf(b))
+                    u += (size_t)snprintf(cr + u, sizeof cr - u, " %s from the start", curve_name[q]);
+                else
+                    u += (size_t)snprintf(cr + u, sizeof cr - u, fabs(b) >= 1000.0 ? " %s %.0f"
+                                                                               : " %s %.3g",
+                                          curve_name[q], b);
+                listed++;
+            }
+            if (!listed) snprintf(cr + u, sizeof cr - u, " none");
+            fprintf(f, "unset label\nunset arrow\nunset object\nset xlabel \"%s\\n%s\"\n"
+                       "set ylabel '%s'\n%s\n",
+                    xlab[a], cr, row ? "composite PSNR, dB" : "mask IoU",
                     a == 0 ? "set logscale x 2\nset xtics (0.5, 0.7, 1, 1.4, 2)" : "unset logscale x\nset xtics autofreq");
+            /* panels placed by hand: the legend's strip below them */
+            fprintf(f, "unset key\nset origin %.4f, %.4f\nset size 0.3333, 0.445\n",
+                    a / 3.0, row ? 0.065 : 0.51);
             if (row == 0)
                 fprintf(f, "set arrow 90 from graph 0, first 0.9 to graph 1, first 0.9 nohead dt 2 "
                            "lc rgb '#808080'\n");
-            int lab = 1;
+            int obj = 1;
             for (int q = 0; q < NCURVE; q++) {
+                if (row == 0 && q == 3) continue;
                 const double b = row ? below_psnr[a][q] : below_iou[a][q];
-                double yv = row ? S[q][0].psnr - LIGHT_PSNR_DROP : 0.9;
-                if (isnan(b)) continue;
-                if (isinf(b))
-                    fprintf(f, "set label %d '%s: below throughout' at graph 0.98, graph %.2f right "
-                               "tc lt %d font ',9'\n", lab++, curve_name[q], 0.55 + 0.07 * q, q + 1);
-                else
-                    fprintf(f, "set label %d '%s: %.4g' at %.6g,%.6g point pt 6 ps 2.5 lc %d "
-                               "offset 0.8,%d tc lt %d font ',9'\n", lab++, curve_name[q], b, b,
-                            yv, q + 1, q % 2 ? -1 : 1, q + 1);
+                const double yv = row ? S[q][0].psnr - LIGHT_PSNR_DROP : 0.9;
+                if (isnan(b) || isinf(b)) continue;
+                fprintf(f, "set object %d circle at first %.6g, first %.6g size screen 0.01 "
+                           "front fs empty border lc lt %d lw 2\n", obj++, b, yv, q + 1);
             }
             fprintf(f, "plot ");
-            for (int q = 0; q < NCURVE; q++)
+            for (int q = 0; q < NCURVE; q++) {
+                if (row == 0 && q == 3) continue;
                 fprintf(f, "%s'%s/light_%s.dat' index %d using 1:%d with linespoints lw 2 pt 7 "
                            "lc %d title '%s'",
-                        q ? ", \\\n     " : "", dir, axes[a], q, row ? 4 : 2, q + 1, curve_name[q]);
+                        q ? ", \\\n     " : "", dir, axes[a], q, row ? 4 : 2, q + 1,
+                        q == 2 ? "refine (refine+tone: the same masks)" : curve_name[q]);
+            }
             fprintf(f, "\n");
         }
-    fprintf(f, "unset multiplot\n");
+    /* the legend: lines with no point in range, in a strip of its own */
+    fprintf(f, "set origin 0, 0\nset size 1, 0.06\nunset border\nunset tics\nunset xlabel\n"
+               "unset ylabel\nunset grid\nunset arrow\nunset object\nunset logscale x\n"
+               "set xrange [0:1]\nset yrange [0:1]\n"
+               "set key center center horizontal maxrows 1 box\nplot ");
+    for (int q = 0; q < NCURVE; q++)
+        fprintf(f, "%s2 with linespoints lw 2 pt 7 lc %d title '%s'", q ? ", " : "", q + 1,
+                q == 2 ? "refine (refine+tone: the same masks)" : curve_name[q]);
+    fprintf(f, "\nunset multiplot\nset border\nset tics\nset grid\nset autoscale\n"
+               "set origin 0, 0\nset size 1, 1\n");
     if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
     /* gnuplot, then the chart named only once it decodes whole */
     char cmd[3 * IO_PATH_MAX], tmp[IO_PATH_MAX + 96];

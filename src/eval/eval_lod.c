@@ -126,8 +126,24 @@ int eval__write_lod(const char *dir, const method_run *R, int n)
             if (strcmp(R[i].cfg.group, "lod") || R[i].cfg.kind != kinds[k]) continue;
             rows++;
             lod_sum s = lod_summary(&R[i]);
+            /* settings that draw the same level share one point: one label
+             * "L2, auto@4px, auto@8px" on the first, none on the others
+             * (they were printed over each other) */
+            char lab[160];
+            size_t u = 0;
+            int dup = 0;
+            lab[0] = '\0';
+            for (int j = 0; j < n && !dup; j++) {
+                if (strcmp(R[j].cfg.group, "lod") || R[j].cfg.kind != kinds[k]) continue;
+                lod_sum t = lod_summary(&R[j]);
+                if ((long)(t.tris + 0.5) != (long)(s.tris + 0.5)) continue;
+                if (j < i) dup = 1;
+                else if (u + strlen(R[j].cfg.setting) + 3 < sizeof lab)
+                    u += (size_t)snprintf(lab + u, sizeof lab - u, "%s%s", u ? ", " : "",
+                                          R[j].cfg.setting);
+            }
             fprintf(of.f, "%.0f %.4f %.5f %.5f %.5f %.5f \"%s\"\n", s.tris, s.ms_raster,
-                    s.iou_full, s.iou, s.bf1_full, s.bf1, R[i].cfg.setting);
+                    s.iou_full, s.iou, s.bf1_full, s.bf1, dup ? "" : lab);
         }
         /* an empty block is no gnuplot index (refine's would become 0) */
         if (!rows) fprintf(of.f, "nan nan nan nan nan nan \"\"\n");

@@ -127,12 +127,16 @@ void eval__print_table(FILE *f, const method_run *R, int n, int markdown)
  * sorted by x; the method at the given tracking (group "track") is the
  * point at the given value of a tracking curve, the default refine (group
  * "knobs") the default band's point. */
-/* Per method of a sweep chart: whether it has points, and the swept value
- * where its IoU first falls below 0.9 (linear between the points; NAN
- * when it never does, -INFINITY when already at the first point). */
+/* Per method of a sweep chart: whether it has points, the swept range,
+ * and every value where its IoU crosses 0.9 (linear between the points),
+ * with the side it starts on: the ranges at or above 0.9 follow. */
+enum { SW_MAXX = 16 };
 typedef struct sweep_info {
     int has[4];
-    double below[4];
+    double x0[4], x1[4];          /* the first and last swept value */
+    int start_ok[4];              /* IoU >= 0.9 at x0 */
+    int ncross[4];
+    double cross[4][SW_MAXX];     /* ascending */
 } sweep_info;
 
 static int write_group(const char *dir, const char *group, const method_run *R, int n,
@@ -169,14 +173,18 @@ static int write_group(const char *dir, const char *group, const method_run *R, 
             idx[j] = i;
         }
         si->has[k] = m > 0;
-        si->below[k] = NAN;
         double px = 0.0, piou = 0.0;
         for (int j = 0; j < m; j++) {
             summary s = summarise(&R[idx[j]]);
             fprintf(f, "%g %.5f %.5f %.3f %.3f\n", (double)xs[j], s.iou, s.bf3, s.ms, s.psnr);
-            if (isnan(si->below[k]) && s.iou < 0.9)
-                si->below[k] = j == 0 ? -INFINITY
-                                      : px + (0.9 - piou) * ((double)xs[j] - px) / (s.iou - piou);
+            if (j == 0) {
+                si->x0[k] = (double)xs[j];
+                si->start_ok[k] = s.iou >= 0.9;
+            } else if ((s.iou >= 0.9) != (piou >= 0.9) && si->ncross[k] < SW_MAXX) {
+                si->cross[k][si->ncross[k]++] =
+                    px + (0.9 - piou) * ((double)xs[j] - px) / (s.iou - piou);
+            }
+            si->x1[k] = (double)xs[j];
             px = (double)xs[j];
             piou = s.iou;
         }
@@ -412,8 +420,19 @@ static void sp_chart(FILE *f, const char *dir, const char *name, const char *tit
             rg[2], rg[3]);
     fprintf(f, "set output '%s/%s.png'.sfx\nset title '%s'\nset ylabel '%s'\n", dir, name, title,
             ylabel);
-    fprintf(f, "set xlabel 'ms per stereo frame (pose, skin, raster, refine, light, composite; "
-               "1 thread)'\nset key bottom right box opaque\n");
+    fprintf(f, "set xlabel 'CPU ms per stereo frame (pose, skin, raster, refine, light, "
+               "composite; 1 thread)'\nset key bottom right box opaque\n");
+    /* a log axis has tics at the decades only: 1, 2, 5 x 10^k in range */
+    char tics[512];
+    size_t tu = 0;
+    for (double d = 0.1; d < 1e5; d *= 10.0)
+        for (int m = 0; m < 3; m++) {
+            const double v = d * (m == 0 ? 1.0 : m == 1 ? 2.0 : 5.0);
+            if (v < rg[0] || v > rg[1] || tu >= sizeof tics - 40) continue;
+            tu += (size_t)snprintf(tics + tu, sizeof tics - tu, "%s'%g' %g", tu ? ", " : "", v,
+                                   v);
+        }
+    if (tu) fprintf(f, "set xtics (%s)\n", tics);
     sp_labels(f, p, np, rg);
     /* the kinds with points only: an empty block would be a legend entry
      * with no point, and all empty a failed plot */
@@ -428,44 +447,86 @@ static void sp_chart(FILE *f, const char *dir, const char *name, const char *tit
         first = 0;
     }
     fprintf(f, "%s\n", first ? "plot NaN notitle" : "");
-    fprintf(f, "unset label\nunset arrow\nunset logscale x\nset autoscale\n"
+    fprintf(f, "unset label\nunset arrow\nunset logscale x\nset autoscale\nset xtics autofreq\n"
                "set lmargin\nset rmargin\nset bmargin\nset tmargin\n");
 }
 
-/* A sweep chart of the methods that have points, with the IoU 0.9 line
- * and, per method, the swept value where it falls below (a circle and
- * the value; "< first" when below from the start). */
+/* "%.3g" with a sign when the axis is signed (calibration error) */
+static void sw_num(char *b, size_t n, double v, int sign)
+{
+    snprintf(b, n, sign && v > 0.0 ? "+%.3g" : "%.3g", v);
+}
+
+/* The legend text of method k of a sweep: where its IoU is at or above
+ * 0.9, e.g. "kin-cal-pred: IoU >= 0.9 up to 12.4 mm", "refine: IoU >= 0.9
+ * throughout", "kin: IoU < 0.9 throughout", "... >= 0.9 from +1.6 to +7.3 %". */
+static void sw_title(char *t, size_t n, const char *name, const sweep_info *si, int k,
+                     const char *unit, int sign)
+{
+    const int nc = si->ncross[k];
+    if (nc == 0) {
+        snprintf(t, n, "%s: IoU %s 0.9 throughout", name, si->start_ok[k] ? ">=" : "<");
+        return;
+    }
+    size_t u = (size_t)snprintf(t, n, "%s: IoU >= 0.9", name);
+    /* the ranges at or above: [x0 or a crossing, the next crossing or x1] */
+    int ok = si->start_ok[k], first = 1;
+    double from = si->x0[k];
+    for (int c = 0; c <= nc && u < n; c++) {
+        const double at = c < nc ? si->cross[k][c] : si->x1[k];
+        if (ok) {
+            char a[32], b[32];
+            sw_num(a, sizeof a, from, sign);
+            sw_num(b, sizeof b, at, sign);
+            if (from == si->x0[k] && c < nc)
+                u += (size_t)snprintf(t + u, n - u, "%s up to %s", first ? "" : ",", b);
+            else if (c == nc)
+                u += (size_t)snprintf(t + u, n - u, "%s from %s", first ? "" : ",", a);
+            else
+                u += (size_t)snprintf(t + u, n - u, "%s from %s to %s", first ? "" : ",", a, b);
+            first = 0;
+        }
+        from = at;
+        ok = !ok;
+    }
+    if (u < n) snprintf(t + u, n - u, " %s", unit);
+}
+
+/* A sweep chart of the methods that have points, with the IoU 0.9 line,
+ * a circle where each method's IoU crosses it, and the ranges at or above
+ * 0.9 in the legend, which sits below the plot and its axis label (it
+ * never hides a point; gnuplot's own "key below" overlaps the label). */
 static void sweep_chart(FILE *f, const char *dir, const char *group, const char *title,
-                        const char *xlabel, const sweep_info *si)
+                        const char *xlabel, const char *unit, const sweep_info *si)
 {
     static const char *const tn[4] = {"kin", "kin-cal-pred", "skin", "refine"};
-    fprintf(f, "set terminal pngcairo noenhanced size 900,600 font ',11'\n");
+    const int sign = !strcmp(group, "calib");
+    fprintf(f, "set terminal pngcairo noenhanced size 900,600 font ',12'\n");
     fprintf(f, "set output '%s/%s.png'.sfx\nset title '%s'\nset xlabel '%s'\n"
-               "set ylabel 'mask IoU'\nset key bottom left box opaque\n",
+               "set ylabel 'mask IoU'\nset bmargin 8\n"
+               "set key at screen 0.5, screen 0.012 center bottom vertical Left reverse box\n",
             dir, group, title, xlabel);
-    int lab = 1;
+    int obj = 1;
     for (int k = 0; k < 4; k++) {
-        if (!si->has[k] || isnan(si->below[k])) continue;
-        if (isinf(si->below[k]))
-            fprintf(f, "set label %d '%s: below 0.9 throughout' at graph 0.98, graph %.2f right "
-                       "tc lt %d font ',9'\n", lab++, tn[k], 0.30 + 0.06 * k, k + 1);
-        else
-            fprintf(f, "set label %d '%s < 0.9 from %.3g' at %.6g,0.9 point pt 6 ps 2.5 lc %d "
-                       "offset 0.8,%d tc lt %d font ',9'\n", lab++, tn[k], si->below[k],
-                    si->below[k], k + 1, k % 2 ? -1 : 1, k + 1);
+        if (!si->has[k]) continue;
+        for (int c = 0; c < si->ncross[k]; c++)
+            fprintf(f, "set object %d circle at first %.6g, first 0.9 size screen 0.012 front "
+                       "fs empty border lc lt %d lw 2\n", obj++, si->cross[k][c], k + 1);
     }
     fprintf(f, "set arrow 90 from graph 0, first 0.9 to graph 1, first 0.9 nohead dt 2 "
                "lc rgb '#808080'\n");
     int first = 1;
     for (int k = 0; k < 4; k++) {
         if (!si->has[k]) continue;
+        char t[200];
+        sw_title(t, sizeof t, tn[k], si, k, unit, sign);
         fprintf(f, "%s'%s/%s.dat' index %d using 1:2 with linespoints lw 2 pt 7 lc %d title '%s'",
-                first ? "plot " : ", \\\n     ", dir, group, k, k + 1, tn[k]);
+                first ? "plot " : ", \\\n     ", dir, group, k, k + 1, t);
         first = 0;
     }
     fprintf(f, "\n");
     if (first) empty_plot(f, "no method of --methods runs this sweep");
-    fprintf(f, "unset label\nunset arrow\n");
+    fprintf(f, "unset label\nunset arrow\nunset object\nset key default\nset bmargin\n");
 }
 
 int eval__write_report(const char *dir, const method_run *R, int n, const eval_opts *o,
@@ -517,9 +578,14 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
                 strcmp(cf->group, "global") && strcmp(cf->group, "lagcomp"))
                 continue;
             summary s = summarise(&R[i]);
-            fprintf(f, "%.3f %.5f %.5f \"%s\"\n", s.ms, s.iou, s.bf3, cf->setting);
-            piou[np] = (sp_pt){s.ms, s.iou, k, cf->setting};
-            pbf[np++] = (sp_pt){s.ms, s.bf3, k, cf->setting};
+            /* the method's own thread's CPU time: the wall clock of a
+             * batch of knobs run side by side on a shared machine is
+             * 2-3x the CPU time and moves with the load */
+            const double cpu_ms =
+                1e3 * R[i].cpu_secs / (R[i].n_frames > 0 ? (double)R[i].n_frames : 1.0);
+            fprintf(f, "%.3f %.5f %.5f \"%s\"\n", cpu_ms, s.iou, s.bf3, cf->setting);
+            piou[np] = (sp_pt){cpu_ms, s.iou, k, cf->setting};
+            pbf[np++] = (sp_pt){cpu_ms, s.bf3, k, cf->setting};
         }
         /* an empty block is no gnuplot index: the next kind's would
          * take its number */
@@ -563,15 +629,15 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
     free(pbf);
     char t[160];
     snprintf(t, sizeof t, "Accuracy against tracking noise (latency %g ms)", (double)o->latency);
-    sweep_chart(f, dir, "noise", t, "RMS position noise, mm", &si[0]);
+    sweep_chart(f, dir, "noise", t, "RMS position noise, mm", "mm", &si[0]);
     snprintf(t, sizeof t, "Accuracy against tracking latency (noise %g mm)", (double)o->noise);
-    sweep_chart(f, dir, "latency", t, "latency, ms", &si[1]);
+    sweep_chart(f, dir, "latency", t, "latency, ms", "ms", &si[1]);
     sweep_chart(f, dir, "calib", "Accuracy against calibration error (on top of the estimate)",
-                "error of the arm, hand and shoulder scales, %", &si[2]);
+                "error of the arm, hand and shoulder scales, %", "%", &si[2]);
     sweep_chart(f, dir, "dropout", "Accuracy against tracking dropouts (hands lost)",
-                "samples that lose the hands, %", &si[4]);
+                "samples that lose the hands, %", "%", &si[4]);
     sweep_chart(f, dir, "handspeed", "Accuracy against hand speed (the motion played faster)",
-                "speed, x the recorded motion", &si[5]);
+                "speed, x the recorded motion", "x", &si[5]);
     fprintf(f,
         "set terminal pngcairo noenhanced size 900,600 font ',11'\n"
         "set key bottom right box opaque\n"
@@ -594,7 +660,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
     const int lab = lod_has[0] ? 0 : 1;   /* the labels' block */
     fprintf(f,
         "set key bottom right\n"
-        "set terminal pngcairo noenhanced size 1400,600 font ',10'\n"
+        "set terminal pngcairo noenhanced size 1400,600 font ',12'\n"
         "set output '%s/lod.png'.sfx\n"
         "set multiplot layout 1,2 title 'Levels of detail of the mask model (labels: level, "
         "or the rule at a target in px)'\n"
@@ -614,7 +680,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
         if (lod_has[1])
             fprintf(f, "'%s/lod.dat' index 1 using 1:4 with points pt 9 ps 1.3 title 'refine: vs the ground truth', \\\n     ",
                     dir);
-        fprintf(f, "'%s/lod.dat' index %d using 1:3:7 with labels offset 0,0.8 font ',7' notitle\n",
+        fprintf(f, "'%s/lod.dat' index %d using 1:3:7 with labels offset 0,0.9 font ',10' notitle\n",
                 dir, lab);
     }
     fprintf(f, "set title 'Raster time against the triangles drawn'\n"
@@ -629,12 +695,12 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
         if (lod_has[1])
             fprintf(f, "'%s/lod.dat' index 1 using 1:2 with points pt 9 ps 1.3 title 'refine', \\\n     ",
                     dir);
-        fprintf(f, "'%s/lod.dat' index %d using 1:2:7 with labels offset 0,0.8 font ',7' notitle\n",
+        fprintf(f, "'%s/lod.dat' index %d using 1:2:7 with labels offset 0,0.9 font ',10' notitle\n",
                 dir, lab);
     }
     fprintf(f,
         "unset multiplot\nunset logscale x\n"
-        "set terminal pngcairo noenhanced size 900,600 font ',10'\n"
+        "set terminal pngcairo noenhanced size 900,600 font ',12'\n"
         "set output '%s/sequences.png'.sfx\nset title 'Mask IoU per sequence and method'\n"
         "set xlabel 'sequence'\nset ylabel 'mask IoU'\n", dir);
     /* the columns of the methods that ran (sequences.dat: IoU of kin,

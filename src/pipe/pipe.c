@@ -5,6 +5,8 @@
 #include "pipe_parts.h"
 #include "pipe_internal.h"
 #include "pipe_lens.h"
+#include "pipe_nfill.h"
+#include "pipe_soft.h"
 #include "pipe_reproj.h"
 #include "../fit/fit_band.h"
 
@@ -23,7 +25,10 @@ typedef struct eye_state {
     float *depth, *nrm, *clip, *vnrm;
     uint8_t *mask, *layer;
     uint8_t *cam_rgba;        /* the cropped camera image, when given raw */
-    float *snrm;              /* smoothed normals (normal_smooth) */
+    float *snrm;              /* smoothed normals (normal_smooth), or
+                                 the refined mask's (pipe_nfill.h) */
+    void *nfill_scratch;      /* refine_band, normal_smooth >= 0 */
+    uint8_t *soft;            /* soft_edge: the softened mask */
     uint8_t *refined;         /* the refined mask (refine_band) */
     void *refine_scratch;
     size_t refine_scratch_size;
@@ -429,6 +434,14 @@ static void run_eye(pipe_ctx *p, eye_state *e)
             pipe_fit_measure(p->fit, e->eye, &e->cam, p->pose.world, e->mask, cw, e->refined, cw);
         }
     }
+    /* the binary mask lit (the G-buffer's or the refined one) */
+    const int refined_in = fe.mask == e->refined;
+    /* soft silhouettes: a one-pixel ramp inside the binary mask's edge
+     * (pipe_soft.h; not with aa_samples or the eye view: pipe_create) */
+    if (e->soft) {
+        pipe__soft_edge(fe.mask, e->soft, cw, ch, NULL);
+        fe.mask = e->soft;
+    }
     /* the eye's view instead of the camera's crop (pipe_reproj.h) */
     const fuse_image Pcam = fe.P;
     fuse_intrinsics EK;
@@ -441,7 +454,14 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     /* coverage beyond the model's pixel centres: its neighbours' normals */
     if (e->aa.count && p->desc.normal_smooth == 0)
         pipe__aa_fill_normals(&e->aa, fe.mask, e->mask, e->nrm);
-    if (p->desc.normal_smooth > 0 &&
+    if (!rp && refined_in && e->nfill_scratch) {
+        /* the refined mask's normals: the model's, smoothed over the lag
+         * and continued beyond its rim (pipe_nfill.h) */
+        pipe__nfill_refined(e->refined, e->mask, e->nrm, e->snrm, cw, ch,
+                            p->desc.normal_smooth > 0 ? p->desc.normal_smooth : PIPE_NFILL_RADIUS,
+                            e->nfill_scratch);
+        fe.normal = e->snrm;
+    } else if (p->desc.normal_smooth > 0 &&
         fuse_normal_smooth(fe.mask, fe.mask_stride, fe.normal, 3 * cw, e->snrm, 3 * cw, cw, ch,
                            p->desc.normal_smooth) == FUSE_OK)
         fe.normal = e->snrm;
@@ -473,7 +493,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         /* refined pixels outside the model have no depth: they take the
          * model's beside them, so the depth test hides them too; the same
          * for the anti-aliased coverage beyond the pixel centres */
-        if (fe.mask == e->refined) {
+        if (refined_in) {
             const int b = p->desc.refine_band;
             fuse_depth_fill(e->refined, cw, e->depth, cw, cw, ch, b + b / 8 + 2, filled);
         } else if (e->aa.count) {
@@ -575,6 +595,8 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].depth);
         free(p->eye[e].nrm);
         free(p->eye[e].snrm);
+        free(p->eye[e].nfill_scratch);
+        free(p->eye[e].soft);
         free(p->eye[e].clip);
         free(p->eye[e].vnrm);
         free(p->eye[e].mask);
@@ -630,7 +652,10 @@ static int skin_plans_build(pipe_ctx *p)
 pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
 {
     if (!model) return NULL;
-    if (desc && (desc->normal_smooth < 0 || desc->normal_smooth > FUSE_NORMAL_SMOOTH_MAX))
+    if (desc && (desc->soft_edge < 0 || desc->soft_edge > 1 ||
+                 (desc->soft_edge && (desc->aa_samples || desc->eye_view != PIPE_VIEW_CROP))))
+        return NULL;
+    if (desc && (desc->normal_smooth < -1 || desc->normal_smooth > FUSE_NORMAL_SMOOTH_MAX))
         return NULL;
     if (desc && desc->aa_samples != 0 && desc->aa_samples != 4 && desc->aa_samples != 8 &&
         desc->aa_samples != 16)
@@ -689,9 +714,19 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
                 }
             }
         }
-        if (ok && p->desc.normal_smooth > 0) {
+        if (ok && (p->desc.normal_smooth > 0 ||
+                   (p->desc.refine_band > 0 && p->desc.normal_smooth == 0))) {
             s->snrm = malloc(sizeof(float) * 3 * px);
             ok = s->snrm != NULL;
+        }
+        if (ok && p->desc.soft_edge == 1) {
+            s->soft = malloc(px);
+            ok = s->soft != NULL;
+        }
+        if (ok && p->desc.refine_band > 0 && p->desc.normal_smooth >= 0) {
+            const size_t ns = pipe__nfill_scratch_size(p->geo.crop_width, p->geo.crop_height);
+            s->nfill_scratch = aligned_alloc(16, (ns + 15) & ~(size_t)15);
+            ok = s->nfill_scratch != NULL;
         }
         if (ok && p->desc.refine_band > 0) {
             fuse_refine_params rp = fuse_refine_params_default();

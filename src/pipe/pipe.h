@@ -90,8 +90,18 @@ typedef struct pipe_desc {
                                  the (2r + 1)^2 window before lighting
                                  (fuse_normal_smooth): for models of
                                  crossing parts with their own normals,
-                                 whose shading seams become ramps. Out of
-                                 range: pipe_create returns NULL. */
+                                 whose shading seams become ramps. With
+                                 refine_band (and no aa_samples, the crop
+                                 view) the refined mask is always lit
+                                 with the model's normals summed over the
+                                 window (radius PIPE_NFILL_RADIUS 3 for 0)
+                                 and continued beyond the model's rim
+                                 (src/pipe/pipe_nfill.h: no halo, no
+                                 second edge where the model lags the
+                                 hand); -1 there: the model's own normals,
+                                 the view vector beyond them (the bytes
+                                 before issue 14's fill). Out of range:
+                                 pipe_create returns NULL. */
     int aa_samples;           /* 0 = off (default): the binary mask of the
                                  pixel centres, the bytes of before; 4, 8
                                  or 16: anti-aliased edges, the mask is
@@ -144,6 +154,15 @@ typedef struct pipe_desc {
                                  runs no filter): it tells the caller's
                                  tracking how to pose the frames, see
                                  pipe_track_output. Other values:
+                                 pipe_create returns NULL. */
+    int soft_edge;            /* 0 = off (default): the binary mask; 1:
+                                 soft silhouettes, the binary (G-buffer's
+                                 or refined) mask's edge pixels faded by
+                                 the share of their 3x3 window inside it,
+                                 a one-pixel ramp instead of stair-steps
+                                 (src/pipe/pipe_soft.h, docs/antialias.md),
+                                 one pass over the mask. With aa_samples,
+                                 eye_view REPROJECT or another value:
                                  pipe_create returns NULL. */
 } pipe_desc;
 
@@ -308,7 +327,8 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
                        pipe_frame_stats *stats, char *why, int why_size);
 /* The last frame's mask of one eye (valid until the next frame): the
  * refined one with pipe_desc.refine_band, else the G-buffer's; with
- * pipe_desc.aa_samples the coverage mask composited (0..255). */
+ * pipe_desc.aa_samples the coverage mask composited (0..255), with
+ * pipe_desc.soft_edge that mask softened at its edge (0..255). */
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The last frame's lit layer of one eye (premultiplied RGBA8, the
  * mask's size, 4 * width bytes per row; valid until the next frame):
