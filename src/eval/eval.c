@@ -78,6 +78,7 @@ void eval__ctx_free(eval_ctx *c)
     free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->mask_prior); free(c->layer); free(c->out);
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
+    free(c->stereo_scratch);
     free(c->gt_depth); free(c->gt_mask);
     memset(c, 0, sizeof *c);
 }
@@ -172,9 +173,11 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     rp.margin = 64;
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
+    c->stereo_scratch_size = pipe_fit_stereo_scratch_size(CW, CH);
+    c->stereo_scratch = aligned_alloc(16, (c->stereo_scratch_size + 15) & ~(size_t)15);
     ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && 
          c->mask_prior && c->layer && c->out && c->depth_lo &&
-         c->nrm_lo && c->mnrm && c->refine_scratch;
+         c->nrm_lo && c->mnrm && c->refine_scratch && c->stereo_scratch;
     c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
     c->gt_mask = malloc((size_t)GEN_CAM_W * GEN_CAM_H);
     ok = ok && c->gt_depth && c->gt_mask;
@@ -445,6 +448,23 @@ static pipe_fit_band_desc band_desc(const method_cfg *cfg)
     return bd;
 }
 
+/* the stereo step's parameters (EGOFUSE_STEREO_* while measuring) */
+static pipe_fit_stereo_desc stereo_desc(void)
+{
+    pipe_fit_stereo_desc d = pipe_fit_stereo_desc_default();
+    const char *v;
+    if ((v = getenv("EGOFUSE_STEREO_R"))) d.radius = atoi(v);
+    if ((v = getenv("EGOFUSE_STEREO_STEP"))) d.step = atoi(v);
+    if ((v = getenv("EGOFUSE_STEREO_DZ"))) d.hand_dz = (float)atof(v);
+    if ((v = getenv("EGOFUSE_STEREO_GAP"))) d.gap = (float)atof(v);
+    if ((v = getenv("EGOFUSE_STEREO_TEX"))) d.min_texture = (float)atof(v);
+    if ((v = getenv("EGOFUSE_STEREO_MARGIN"))) d.margin = (float)atof(v);
+    if ((v = getenv("EGOFUSE_STEREO_MATCH"))) d.match = (float)atof(v);
+    if ((v = getenv("EGOFUSE_STEREO_ACCEPT"))) d.accept = atoi(v);
+    if ((v = getenv("EGOFUSE_STEREO_FILL"))) d.fill_radius = atoi(v);
+    return d;
+}
+
 static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const char *dump)
 {
     const method_cfg *cfg = &r->cfg;
@@ -581,6 +601,20 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 if (mask == c->mask_prior && rs.used_colour && cfg->fit &&
                     pipe_fit_learned(r->fit, e))
                     pipe_fit_refined_colour(pipe_fit_colour(r->fit, e), &P, mask, c->refined, CW);
+                /* the stereo pair's depth test (fit_stereo.h): refined
+                 * pixels found behind the hand in the other camera */
+                if (cfg->stereo && posed && rs.used_colour && cfg->div == 1) {
+                    pipe_fit_stereo_desc sd = stereo_desc();
+                    kin_camera oc = eye_camera(c, 1 - e);
+                    fuse_image Qo = { c->P[1 - e], CW, CH, 4 * CW };
+                    pipe_fit_stereo_stats ss;
+                    if (pipe_fit_stereo(&sd, &cam, &P, &oc, &Qo, c->depth_lo, CW, c->refined, CW,
+                                        c->stereo_scratch, c->stereo_scratch_size, &ss) < 0)
+                        return -1;
+                    r->stereo_tested += ss.tested;
+                    r->stereo_cleared += ss.cleared;
+                    r->stereo_added += ss.added;
+                }
                 /* not from a fallback (out = M): its widths are the
                  * model's own (as pipe_frame) */
                 if (cfg->fit && posed && rs.used_colour) {
@@ -717,6 +751,11 @@ int eval__run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames
         progress_step(&pr, f + 1, what);
     }
     progress_end(&pr);
+    for (int i = 0; i < n; i++)
+        if (R[i].cfg.stereo && getenv("EGOFUSE_STEREO_STATS"))
+            fprintf(stderr, "stereo %s: tested %ld cleared %ld added %ld per eye-frame\n",
+                    R[i].cfg.setting, R[i].stereo_tested / (2L * frames),
+                    R[i].stereo_cleared / (2L * frames), R[i].stereo_added / (2L * frames));
     rc = EXIT_OK;
 done:
     for (int i = 0; i < inited; i++) run_free(&R[i]);
