@@ -10,6 +10,9 @@
  *   - a plain (textureless) background strip is left alone: ambiguous;
  *   - with accept, a strip of the hand cut from the mask (fingers beyond
  *     the model) is put back; background beyond the mask is not taken in;
+ *   - background seen through a hole in the hand (inside the mask, not
+ *     connected to its outside) is kept; without `connected` the part the
+ *     other camera sees through the hole goes;
  *   - the grid (step 4) decides like every pixel within a few percent;
  *   - bad arguments: -1 and the mask untouched.
  */
@@ -56,6 +59,12 @@ static float vnoise(float x, float y, float cell, uint32_t s)
     return (a + (b - a) * fu) * (1 - fv) + (c + (d - c) * fu) * fv;
 }
 
+/* a hole through the hand (render's hole): x in [HOX0, HOX1], |y| <= HOY */
+#define HOX0 (-0.025f)
+#define HOX1 (-0.005f)
+#define HOY 0.02f
+static int hole;
+
 /* Renders camera e: the hand over the background (plain: the background
  * without texture). */
 static void render(int e, int plain, uint8_t *rgba, uint32_t seed)
@@ -68,7 +77,8 @@ static void render(int e, int plain, uint8_t *rgba, uint32_t seed)
             const float a = ((float)x + 0.5f - c->cx) / c->fx;
             const float b = -((float)y + 0.5f - c->cy) / c->fy;
             float t = Z_CAM - Z_HAND, X = ox + a * t, Y = b * t, m;
-            const int hand = X >= HX0 && X <= HX1 && Y >= -HY && Y <= HY;
+            const int hand = X >= HX0 && X <= HX1 && Y >= -HY && Y <= HY &&
+                             !(hole && X >= HOX0 && X <= HOX1 && Y >= -HOY && Y <= HOY);
             if (hand) {
                 m = 0.75f + 0.5f * vnoise(X, Y, 0.0015f, 7u);
             } else {
@@ -261,6 +271,47 @@ static void accepts_the_hand_beyond_the_mask(void **state)
     scene_free(&s);
 }
 
+/* The left camera's pixels of the hole (x, y ranges). */
+static void hole_px(int *x0, int *x1, int *y0, int *y1)
+{
+    const kin_camera *c = &cams[0];
+    const float ox = c->world_from_cam.m[12], t = Z_CAM - Z_HAND;
+    *x0 = (int)ceilf(c->cx + c->fx * (HOX0 - ox) / t - 0.5f);
+    *x1 = (int)floorf(c->cx + c->fx * (HOX1 - ox) / t - 0.5f);
+    *y0 = (int)ceilf(c->cy - c->fy * HOY / t - 0.5f);
+    *y1 = (int)floorf(c->cy + c->fy * HOY / t - 0.5f);
+}
+
+/* Background seen through a hole in the hand, which the model covers: a
+ * depth edge inside the mask, not connected to its outside, is kept
+ * (connected 1); without the rule it is cleared. */
+static void enclosed_background_is_kept(void **state)
+{
+    (void)state;
+    hole = 1;
+    scene s;
+    scene_make(&s, 0);
+    hole = 0;
+    int x0, x1, y0, y1;
+    hole_px(&x0, &x1, &y0, &y1);
+    const long area = (long)(x1 - x0 - 5) * (y1 - y0 - 5);
+    long kept[2];
+    for (int conn = 1; conn >= 0; conn--) {
+        mask_cols(&s, s.hx0, s.hx1);
+        pipe_fit_stereo_desc d = pipe_fit_stereo_desc_default();
+        d.connected = conn;
+        assert_int_equal(run(&s, &d, NULL), 0);
+        long k = 0;
+        for (int y = y0 + 3; y < y1 - 2; y++)
+            for (int x = x0 + 3; x < x1 - 2; x++) k += s.mask[(size_t)y * W + x] >= 128;
+        kept[conn] = k;
+    }
+    print_message("hole: %ld px, kept %ld connected, %ld not\n", area, kept[1], kept[0]);
+    assert_true(kept[1] * 100 >= area * 98);
+    assert_true(kept[0] * 100 <= area * 75);   /* the half the other camera sees */
+    scene_free(&s);
+}
+
 static void grid_decides_like_every_pixel(void **state)
 {
     (void)state;
@@ -268,6 +319,7 @@ static void grid_decides_like_every_pixel(void **state)
     scene_make(&s, 0);
     mask_cols(&s, s.hx0, s.hx1 + 24);
     pipe_fit_stereo_desc d = pipe_fit_stereo_desc_default();
+    d.step = 1;
     pipe_fit_stereo_stats st1, st4;
     assert_int_equal(run(&s, &d, &st1), 0);
     uint8_t *m1 = malloc((size_t)W * H);
@@ -327,6 +379,7 @@ int main(void)
         cmocka_unit_test(rejects_background_behind_the_hand),
         cmocka_unit_test(plain_background_is_ambiguous),
         cmocka_unit_test(accepts_the_hand_beyond_the_mask),
+        cmocka_unit_test(enclosed_background_is_kept),
         cmocka_unit_test(grid_decides_like_every_pixel),
         cmocka_unit_test(bad_arguments),
     };

@@ -448,23 +448,6 @@ static pipe_fit_band_desc band_desc(const method_cfg *cfg)
     return bd;
 }
 
-/* the stereo step's parameters (EGOFUSE_STEREO_* while measuring) */
-static pipe_fit_stereo_desc stereo_desc(void)
-{
-    pipe_fit_stereo_desc d = pipe_fit_stereo_desc_default();
-    const char *v;
-    if ((v = getenv("EGOFUSE_STEREO_R"))) d.radius = atoi(v);
-    if ((v = getenv("EGOFUSE_STEREO_STEP"))) d.step = atoi(v);
-    if ((v = getenv("EGOFUSE_STEREO_DZ"))) d.hand_dz = (float)atof(v);
-    if ((v = getenv("EGOFUSE_STEREO_GAP"))) d.gap = (float)atof(v);
-    if ((v = getenv("EGOFUSE_STEREO_TEX"))) d.min_texture = (float)atof(v);
-    if ((v = getenv("EGOFUSE_STEREO_MARGIN"))) d.margin = (float)atof(v);
-    if ((v = getenv("EGOFUSE_STEREO_MATCH"))) d.match = (float)atof(v);
-    if ((v = getenv("EGOFUSE_STEREO_ACCEPT"))) d.accept = atoi(v);
-    if ((v = getenv("EGOFUSE_STEREO_FILL"))) d.fill_radius = atoi(v);
-    return d;
-}
-
 static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const char *dump)
 {
     const method_cfg *cfg = &r->cfg;
@@ -604,7 +587,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 /* the stereo pair's depth test (fit_stereo.h): refined
                  * pixels found behind the hand in the other camera */
                 if (cfg->stereo && posed && rs.used_colour && cfg->div == 1) {
-                    pipe_fit_stereo_desc sd = stereo_desc();
+                    const pipe_fit_stereo_desc sd = pipe_fit_stereo_desc_default();
                     kin_camera oc = eye_camera(c, 1 - e);
                     fuse_image Qo = { c->P[1 - e], CW, CH, 4 * CW };
                     pipe_fit_stereo_stats ss;
@@ -751,11 +734,6 @@ int eval__run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames
         progress_step(&pr, f + 1, what);
     }
     progress_end(&pr);
-    for (int i = 0; i < n; i++)
-        if (R[i].cfg.stereo && getenv("EGOFUSE_STEREO_STATS"))
-            fprintf(stderr, "stereo %s: tested %ld cleared %ld added %ld per eye-frame\n",
-                    R[i].cfg.setting, R[i].stereo_tested / (2L * frames),
-                    R[i].stereo_cleared / (2L * frames), R[i].stereo_added / (2L * frames));
     rc = EXIT_OK;
 done:
     for (int i = 0; i < inited; i++) run_free(&R[i]);

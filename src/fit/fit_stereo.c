@@ -11,15 +11,17 @@ pipe_fit_stereo_desc pipe_fit_stereo_desc_default(void)
 {
     pipe_fit_stereo_desc d;
     d.radius = 2;
-    d.step = 1;
+    d.step = 2;
     d.hand_dz = 0.04f;
     d.gap = 0.06f;
     d.far_m = 3.0f;
     d.min_texture = 4.0f;
     d.margin = 2.0f;
     d.match = 1.0f;
+    d.ratio = 1.0f;
     d.fill_radius = 32;
     d.accept = 0;
+    d.connected = 1;
     return d;
 }
 
@@ -29,8 +31,9 @@ size_t pipe_fit_stereo_scratch_size(int width, int height)
 {
     if (width < 1 || height < 1 || width > FUSE_MAX_DIM || height > FUSE_MAX_DIM) return 0;
     const size_t n = (size_t)width * (size_t)height;
-    /* grey P, grey Q, the filled depth, the test mask, the classes */
-    return align16(n) * 2 + align16(n * sizeof(float)) + align16(n) * 2;
+    /* grey P, grey Q, the filled depth, the test mask, the classes, out
+     * as given, the decisions; the depths' plane is then the stack */
+    return align16(n) * 2 + align16(n * sizeof(float)) + align16(n) * 4;
 }
 
 static void to_grey(const fuse_image *I, uint8_t *g)
@@ -47,6 +50,7 @@ typedef struct st_ctx {
     pipe_fit_stereo_desc d;
     int w, h;
     const uint8_t *gp, *gq;      /* grey images */
+    const uint8_t *in;           /* out as given (0/255), w per row */
     const float *dep;            /* filled window depths, w per row */
     float p10, p14;              /* cam's projection: window depth -> distance */
     float fx, fy, cx, cy;        /* cam */
@@ -76,7 +80,8 @@ static int other_px(const st_ctx *c, int x, int y, float z, float *ox, float *oy
 /* The smallest mean absolute difference of the patch ref (n x n) along
  * the segment of the other image from the points at distances z0 and z1;
  * -1 when no candidate lies inside the image. */
-static float best_cost(const st_ctx *c, const uint8_t *ref, int x, int y, float z0, float z1)
+static float best_cost(const st_ctx *c, const uint8_t *ref, const uint8_t *sup, int cnt, int x,
+                       int y, float z0, float z1)
 {
     float x0, y0, x1, y1;
     if (!(z0 > 0.0f) || !(z1 > z0)) return -1.0f;
@@ -98,11 +103,12 @@ static float best_cost(const st_ctx *c, const uint8_t *ref, int x, int y, float 
         for (int j = 0; j < n; j++) {
             const uint8_t *o = c->gq + (size_t)(qy - r + j) * (size_t)c->w + (qx - r);
             const uint8_t *p = ref + j * n;
-            for (int i = 0; i < n; i++) s += o[i] > p[i] ? o[i] - p[i] : p[i] - o[i];
+            const uint8_t *m = sup + j * n;
+            for (int i = 0; i < n; i++) s += (o[i] > p[i] ? o[i] - p[i] : p[i] - o[i]) & m[i];
         }
         if (best < 0 || s < best) best = s;
     }
-    return best < 0 ? -1.0f : (float)best / (float)(n * n);
+    return best < 0 ? -1.0f : (float)best / (float)cnt;
 }
 
 static int classify(st_ctx *c, int x, int y)
@@ -115,30 +121,42 @@ static int classify(st_ctx *c, int x, int y)
     if (den == 0.0f) return C_AMBIG;
     const float z = -(c->p14 / den);
     if (!(z > 0.0f)) return C_AMBIG;
-    uint8_t ref[81];
-    int sum = 0;
+    /* the patch's support: its pixels on the same side of out as the
+     * pixel (an edge pixel's patch straddles the hand and what is behind
+     * it, which match at different disparities) */
+    uint8_t ref[81], sup[81];
+    const uint8_t side = c->in[(size_t)y * (size_t)c->w + x];
+    int sum = 0, cnt = 0;
     for (int j = 0; j < n; j++) {
         const uint8_t *p = c->gp + (size_t)(y - r + j) * (size_t)c->w + (x - r);
+        const uint8_t *m = c->in + (size_t)(y - r + j) * (size_t)c->w + (x - r);
         for (int i = 0; i < n; i++) {
             ref[j * n + i] = p[i];
-            sum += p[i];
+            sup[j * n + i] = m[i] == side ? 0xff : 0;
+            if (m[i] == side) {
+                sum += p[i];
+                cnt++;
+            }
         }
     }
-    const float mean = (float)sum / (float)(n * n);
+    if (cnt * 2 < n * n) return C_AMBIG;
+    const float mean = (float)sum / (float)cnt;
     float tex = 0.0f;
-    for (int i = 0; i < n * n; i++) tex += fabsf((float)ref[i] - mean);
-    tex /= (float)(n * n);
+    for (int i = 0; i < n * n; i++)
+        if (sup[i]) tex += fabsf((float)ref[i] - mean);
+    tex /= (float)cnt;
     c->tested++;
     if (tex < c->d.min_texture) {
         c->textureless++;
         return C_AMBIG;
     }
     const float zn = fmaxf(z - c->d.hand_dz, 0.02f);
-    const float ch = best_cost(c, ref, x, y, zn, z + c->d.hand_dz);
-    const float cb = best_cost(c, ref, x, y, z + c->d.gap, fmaxf(c->d.far_m, z + c->d.gap + 0.01f));
+    const float ch = best_cost(c, ref, sup, cnt, x, y, zn, z + c->d.hand_dz);
+    const float cb = best_cost(c, ref, sup, cnt, x, y, z + c->d.gap,
+                               fmaxf(c->d.far_m, z + c->d.gap + 0.01f));
     if (ch < 0.0f || cb < 0.0f) return C_AMBIG;
-    if (cb + c->d.margin < ch && cb <= c->d.match * tex) return C_BACK;
-    if (ch + c->d.margin < cb && ch <= c->d.match * tex) return C_HAND;
+    if (cb + c->d.margin < ch && cb <= c->d.match * tex && cb <= c->d.ratio * ch) return C_BACK;
+    if (ch + c->d.margin < cb && ch <= c->d.match * tex && ch <= c->d.ratio * cb) return C_HAND;
     return C_AMBIG;
 }
 
@@ -158,7 +176,7 @@ int pipe_fit_stereo(const pipe_fit_stereo_desc *dp, const kin_camera *cam, const
         return -1;
     if (d.radius < 1 || d.radius > 4 || d.step < 1 || d.step > 8 || !(d.hand_dz > 0.0f) ||
         !(d.gap >= d.hand_dz) || !(d.far_m > 0.0f) || !(d.min_texture >= 0.0f) ||
-        !(d.margin >= 0.0f) || !(d.match > 0.0f) || d.fill_radius < 1 ||
+        !(d.margin >= 0.0f) || !(d.match > 0.0f) || !(d.ratio > 0.0f) || d.fill_radius < 1 ||
         d.fill_radius > FUSE_DEPTH_FILL_MAX_RADIUS || d.accept < 0 || d.accept > 64 ||
         !(cam->fx > 0.0f) || !(cam->fy > 0.0f) || !(other->fx > 0.0f) || !(other->fy > 0.0f))
         return -1;
@@ -168,11 +186,14 @@ int pipe_fit_stereo(const pipe_fit_stereo_desc *dp, const kin_camera *cam, const
     float *dep = (float *)(gq + align16(n));
     uint8_t *test = (uint8_t *)dep + align16(n * sizeof(float));
     uint8_t *cls = test + align16(n);
+    uint8_t *in = cls + align16(n);
+    uint8_t *dec = in + align16(n);
 
     /* the pixels to test: out, and within accept of it */
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++)
-            test[(size_t)y * w + x] = out[(size_t)y * stride + x] >= 128 ? 255 : 0;
+            in[(size_t)y * w + x] = test[(size_t)y * w + x] =
+                out[(size_t)y * stride + x] >= 128 ? 255 : 0;
     if (d.accept > 0) {
         /* chamfer 1/1 distance to out, capped at accept + 1, in cls */
         const int cap = d.accept + 1;
@@ -205,6 +226,7 @@ int pipe_fit_stereo(const pipe_fit_stereo_desc *dp, const kin_camera *cam, const
     c.h = h;
     c.gp = gp;
     c.gq = gq;
+    c.in = in;
     c.dep = dep;
     c.p10 = cam->proj.m[10];
     c.p14 = cam->proj.m[14];
@@ -214,44 +236,71 @@ int pipe_fit_stereo(const pipe_fit_stereo_desc *dp, const kin_camera *cam, const
     memcpy(c.M, M.m, sizeof c.M);
 
     memset(cls, C_NONE, n);
+    memset(dec, C_NONE, n);
     const int s = d.step;
     for (int y = 0; y < h; y += s)
         for (int x = 0; x < w; x += s)
             if (test[(size_t)y * w + x]) cls[(size_t)y * w + x] = (uint8_t)classify(&c, x, y);
-    long cleared = 0, added = 0;
-    if (s == 1) {
+    /* every pixel's decision: its cell's sample's; the cells beside a cell
+     * of another decision are tested at every pixel */
+    for (int y0 = 0; y0 < h; y0 += s)
+        for (int x0 = 0; x0 < w; x0 += s) {
+            const uint8_t k = cls[(size_t)y0 * w + x0];
+            if (k != C_BACK && k != C_HAND) continue;
+            int border = 0;
+            for (int dy = -s; dy <= s && !border && s > 1; dy += s)
+                for (int dx = -s; dx <= s; dx += s) {
+                    const int xx = x0 + dx, yy = y0 + dy;
+                    if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+                    if (cls[(size_t)yy * w + xx] != k) { border = 1; break; }
+                }
+            const int x1 = x0 + s < w ? x0 + s : w, y1 = y0 + s < h ? y0 + s : h;
+            for (int y = y0; y < y1; y++)
+                for (int x = x0; x < x1; x++)
+                    if (test[(size_t)y * w + x])
+                        dec[(size_t)y * w + x] =
+                            (uint8_t)(border && (x != x0 || y != y0) ? classify(&c, x, y) : k);
+        }
+    /* background only where it reaches the outside of out through
+     * background (a depth edge inside the hand, a finger over the palm,
+     * is not the desk) */
+    const uint8_t BACK_OUT = C_BACK | 0x80;
+    if (d.connected) {
+        int32_t *stack = (int32_t *)dep;   /* the depths are no longer used */
+        size_t top = 0;
         for (int y = 0; y < h; y++)
             for (int x = 0; x < w; x++) {
-                const uint8_t k = cls[(size_t)y * w + x];
-                uint8_t *o = &out[(size_t)y * stride + x];
-                if (k == C_BACK && *o >= 128) { *o = 0; cleared++; }
-                else if (k == C_HAND && *o < 128 && d.accept > 0) { *o = 255; added++; }
+                const size_t i = (size_t)y * w + x;
+                if (dec[i] != C_BACK) continue;
+                if (x == 0 || y == 0 || x == w - 1 || y == h - 1 || !in[i - 1] || !in[i + 1] ||
+                    !in[i - (size_t)w] || !in[i + (size_t)w]) {
+                    dec[i] = BACK_OUT;
+                    stack[top++] = (int32_t)i;
+                }
             }
+        while (top > 0) {
+            const size_t i = (size_t)stack[--top];
+            const int x = (int)(i % (size_t)w), y = (int)(i / (size_t)w);
+            const size_t nb[4] = { i - 1, i + 1, i - (size_t)w, i + (size_t)w };
+            const int ok[4] = { x > 0, x < w - 1, y > 0, y < h - 1 };
+            for (int k = 0; k < 4; k++)
+                if (ok[k] && dec[nb[k]] == C_BACK) {
+                    dec[nb[k]] = BACK_OUT;
+                    stack[top++] = (int32_t)nb[k];
+                }
+        }
     } else {
-        /* a sample's decision for its cell; cells beside a cell of another
-         * decision are tested at every pixel */
-        for (int y0 = 0; y0 < h; y0 += s)
-            for (int x0 = 0; x0 < w; x0 += s) {
-                const uint8_t k = cls[(size_t)y0 * w + x0];
-                if (k != C_BACK && k != C_HAND) continue;
-                int border = 0;
-                for (int dy = -s; dy <= s && !border; dy += s)
-                    for (int dx = -s; dx <= s; dx += s) {
-                        const int xx = x0 + dx, yy = y0 + dy;
-                        if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-                        if (cls[(size_t)yy * w + xx] != k) { border = 1; break; }
-                    }
-                const int x1 = x0 + s < w ? x0 + s : w, y1 = y0 + s < h ? y0 + s : h;
-                for (int y = y0; y < y1; y++)
-                    for (int x = x0; x < x1; x++) {
-                        if (!test[(size_t)y * w + x]) continue;
-                        const int kk = border && (x != x0 || y != y0) ? classify(&c, x, y) : k;
-                        uint8_t *o = &out[(size_t)y * stride + x];
-                        if (kk == C_BACK && *o >= 128) { *o = 0; cleared++; }
-                        else if (kk == C_HAND && *o < 128 && d.accept > 0) { *o = 255; added++; }
-                    }
-            }
+        for (size_t i = 0; i < n; i++)
+            if (dec[i] == C_BACK) dec[i] = BACK_OUT;
     }
+    long cleared = 0, added = 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const uint8_t k = dec[(size_t)y * w + x];
+            uint8_t *o = &out[(size_t)y * stride + x];
+            if (k == BACK_OUT && *o >= 128) { *o = 0; cleared++; }
+            else if (k == C_HAND && *o < 128 && d.accept > 0) { *o = 255; added++; }
+        }
     if (stats) {
         stats->tested = c.tested;
         stats->textureless = c.textureless;

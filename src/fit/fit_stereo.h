@@ -60,7 +60,7 @@ extern "C" {
 
 typedef struct pipe_fit_stereo_desc {
     int radius;          /* patch half width, 1..4 (2: 5x5) */
-    int step;            /* grid step, 1..8 */
+    int step;            /* grid step, 1..8 (2) */
     float hand_dz;       /* metres either side of the model's depth (0.04) */
     float gap;           /* metres behind the model where the background
                             starts (0.06) */
@@ -68,8 +68,11 @@ typedef struct pipe_fit_stereo_desc {
     float min_texture;   /* grey levels (4) */
     float margin;        /* grey levels per pixel (2) */
     float match;         /* the winning cost must be <= match * texture (1) */
+    float ratio;         /* and <= ratio * the losing cost (1: off) */
     int fill_radius;     /* pixels, 1..128 (32) */
     int accept;          /* pixels beyond out tested for the hand (0: none) */
+    int connected;       /* 1: background only where connected to the
+                            outside of out through background (1) */
 } pipe_fit_stereo_desc;
 
 pipe_fit_stereo_desc pipe_fit_stereo_desc_default(void);
