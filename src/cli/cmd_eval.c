@@ -14,7 +14,7 @@ static const char *eval_usage =
     "                    [--dropout P] [--calib-error E] [--speed S] [--seed S]\n"
     "                    [--methods LIST] [--band PX] [--global W] [--per-frame]\n"
     "                    [--csv FILE] [--report DIR] [--sweep-frames N]\n"
-    "                    [--seq-frames N] [--dump DIR] [--quiet]\n"
+    "                    [--seq-frames N] [--dump DIR] [--quiet] [--stereo]\n"
     "                    [--lod MODE] [--lod-px PX] [--lod-sweep] [--light-sweep[=DIR]]\n"
     "                    [--kf-sweep]\n"
     "       egofuse eval --eyeview [--frames N] [--seed S] [--csv FILE] [--report DIR]\n"
@@ -48,6 +48,9 @@ static const char *eval_usage =
     "  --band PX        refinement band half width, 1..64 (default 16)\n"
     "  --global W       refine: weight of the image-wide colour model against\n"
     "                   the band's local one, 0..1 (default 0.5)\n"
+    "  --stereo         refine: also the stereo pair's depth test (refined pixels\n"
+    "                   that the other camera finds behind the hand are\n"
+    "                   cleared; off by default: measured, it did not pay)\n"
     "  --per-frame      print every frame's figures per method\n"
     "  --csv FILE       write the summary table as CSV\n"
     "  --report DIR     also run the speed knobs (band width, elbow fit, global\n"
@@ -97,7 +100,7 @@ static const char *eval_usage =
 enum { O_FRAMES = 256, O_NOISE, O_LATENCY, O_DROPOUT, O_CALIB, O_SPEED, O_SEED, O_PERFRAME,
        O_CSV, O_REPORT, O_QUIET, O_DUMP, O_METHODS, O_BAND, O_SEQUENCE, O_SWEEP_FRAMES,
        O_SEQ_FRAMES, O_GLOBAL, O_LOD, O_LOD_PX, O_LOD_SWEEP, O_EYEVIEW,
-       O_LIGHT_SWEEP, O_KF_SWEEP };
+       O_LIGHT_SWEEP, O_KF_SWEEP, O_STEREO };
 
 int cmd_eval(int argc, char **argv)
 {
@@ -126,11 +129,12 @@ int cmd_eval(int argc, char **argv)
         {"eyeview", no_argument, 0, O_EYEVIEW},
         {"light-sweep", optional_argument, 0, O_LIGHT_SWEEP},
         {"kf-sweep", no_argument, 0, O_KF_SWEEP},
+        {"stereo", no_argument, 0, O_STEREO},
         {"help", no_argument, 0, 'h'},
         {0, 0, 0, 0},
     };
     eval_opts o = { 60, 0, 0, 5.0f, 20.0f, 0.02f, 0.0f, 1.0f, 1, NULL, NULL, NULL, 15u,
-                    GEN_ANIM_NAME, 60, 90, 0.5f, 16, CLI_LOD_DEFAULT, CLI_LOD_PX_DEFAULT, 0, 0, 0, NULL, 0 };
+                    GEN_ANIM_NAME, 60, 90, 0.5f, 16, CLI_LOD_DEFAULT, CLI_LOD_PX_DEFAULT, 0, 0, 0, NULL, 0, 0 };
     const cli_float_opt fl[] = {
         {O_NOISE, "--noise", 0.0f, 200.0f, "not in 0..200 mm", &o.noise},
         {O_LATENCY, "--latency", 0.0f, 1000.0f, "not in 0..1000 ms", &o.latency},
@@ -195,6 +199,7 @@ int cmd_eval(int argc, char **argv)
             o.light_dir = optarg;
             break;
         case O_KF_SWEEP: o.kf_sweep = 1; break;
+        case O_STEREO: o.stereo = 1; break;
         case O_SEQ_FRAMES:
             if (!cli_parse_int(optarg, 1, 100000, &o.seq_frames))
                 return cli_usage_error("eval", "--seq-frames '%s': not a positive count", optarg);

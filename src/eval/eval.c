@@ -78,6 +78,7 @@ void eval__ctx_free(eval_ctx *c)
     free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->mask_prior); free(c->layer); free(c->out);
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
+    free(c->stereo_scratch);
     free(c->gt_depth); free(c->gt_mask);
     memset(c, 0, sizeof *c);
 }
@@ -172,9 +173,11 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     rp.margin = 64;
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
+    c->stereo_scratch_size = pipe_fit_stereo_scratch_size(CW, CH);
+    c->stereo_scratch = aligned_alloc(16, (c->stereo_scratch_size + 15) & ~(size_t)15);
     ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && 
          c->mask_prior && c->layer && c->out && c->depth_lo &&
-         c->nrm_lo && c->mnrm && c->refine_scratch;
+         c->nrm_lo && c->mnrm && c->refine_scratch && c->stereo_scratch;
     c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
     c->gt_mask = malloc((size_t)GEN_CAM_W * GEN_CAM_H);
     ok = ok && c->gt_depth && c->gt_mask;
@@ -581,6 +584,20 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 if (mask == c->mask_prior && rs.used_colour && cfg->fit &&
                     pipe_fit_learned(r->fit, e))
                     pipe_fit_refined_colour(pipe_fit_colour(r->fit, e), &P, mask, c->refined, CW);
+                /* the stereo pair's depth test (fit_stereo.h): refined
+                 * pixels found behind the hand in the other camera */
+                if (cfg->stereo && posed && rs.used_colour && cfg->div == 1) {
+                    const pipe_fit_stereo_desc sd = pipe_fit_stereo_desc_default();
+                    kin_camera oc = eye_camera(c, 1 - e);
+                    fuse_image Qo = { c->P[1 - e], CW, CH, 4 * CW };
+                    pipe_fit_stereo_stats ss;
+                    if (pipe_fit_stereo(&sd, &cam, &P, &oc, &Qo, c->depth_lo, CW, c->refined, CW,
+                                        c->stereo_scratch, c->stereo_scratch_size, &ss) < 0)
+                        return -1;
+                    r->stereo_tested += ss.tested;
+                    r->stereo_cleared += ss.cleared;
+                    r->stereo_added += ss.added;
+                }
                 /* not from a fallback (out = M): its widths are the
                  * model's own (as pipe_frame) */
                 if (cfg->fit && posed && rs.used_colour) {

@@ -58,6 +58,9 @@ typedef struct eval_opts {
     int kf_sweep;            /* 1: also the Fresnel fade kf 0..1 against the
                                 opaque ideal composite (group "kf",
                                 eval_kf.c; a report always runs it) */
+    int stereo;              /* 1: refine with the stereo pair's depth test
+                                (src/fit/fit_stereo.h; measured, off by
+                                default: docs/accuracy.md) */
 } eval_opts;
 
 /* "kin,refine" -> bits of the methods (kin, kin-cal-pred, skin, refine:

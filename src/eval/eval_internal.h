@@ -11,6 +11,7 @@
 #include "../fuse/fuse_metrics.h"
 #include "../fuse/fuse_refine.h"
 #include "../pipe/pipe.h"
+#include "../fit/fit_stereo.h"
 
 enum { CW = 640, CH = 400 };
 
@@ -49,6 +50,8 @@ typedef struct method_cfg {
                                 within this many metres of slow hands (0 off) */
     float prior_speed;       /* m/s: slower hands use it */
     int prior_mc;            /* 1: moved with the hand (pipe_fit_hand_px) */
+    int stereo;              /* refine: 1 = the stereo pair's depth test of
+                                the refined mask (fit_stereo.h) */
     float lag_adapt_v0, lag_adapt_v1;   /* refine, kin-cal-pred: lag
                                            compensation of the hands from
                                            speed v0 (none) to v1 (full), m/s;
@@ -80,6 +83,7 @@ typedef struct method_run {
     float hand_px[2][2][2];  /* [eye][side]: the hand in the image, last frame */
     int have_hand_px[2][2];
     double cpu_secs;         /* the method's thread CPU time (ms/frame is wall) */
+    long stereo_tested, stereo_cleared, stereo_added;   /* refine: fit_stereo.h */
     double band_sum;         /* refine: the bands used, summed over eyes */
     long n_band;
     /* sums over frames and eyes */
@@ -134,6 +138,8 @@ typedef struct eval_ctx {
     float *depth_lo, *nrm_lo, *mnrm;
     void *refine_scratch;
     size_t refine_scratch_size;
+    void *stereo_scratch;    /* refine: fit_stereo.h */
+    size_t stereo_scratch_size;
     kin_sthmd_geometry g;
     float *gt_depth;          /* gt_render_eye scratch, 640x480 */
     uint8_t *gt_mask;

@@ -35,6 +35,7 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k)
         c.prior_mc = 1;
         c.lag_adapt_v0 = EVAL_LAG_V0;
         c.lag_adapt_v1 = EVAL_LAG_V1;
+        c.stereo = o->stereo;   /* measured, off by default */
     }
     c.band_sigma = 0.007f;
     c.band_max = 64;

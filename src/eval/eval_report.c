@@ -90,6 +90,12 @@ void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int 
         if (R[i].cfg.band_auto && R[i].n_band > 0)
             fprintf(f, "refine's band from the projected uncertainty: mean %.1f px\n",
                     R[i].band_sum / (double)R[i].n_band);
+        if (R[i].cfg.stereo && R[i].n_band > 0)
+            fprintf(f, "refine's stereo depth test (fit_stereo.h): per eye and frame %.0f "
+                       "patches compared, %.0f px cleared, %.0f px added\n",
+                    (double)R[i].stereo_tested / (double)R[i].n_band,
+                    (double)R[i].stereo_cleared / (double)R[i].n_band,
+                    (double)R[i].stereo_added / (double)R[i].n_band);
         return;
     }
 }
