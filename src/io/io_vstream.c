@@ -280,14 +280,8 @@ static int line_at(vs_reader *r, size_t *n)
 static int give_frame(vs_reader *r, vs_frame *f, size_t off, size_t bytes, int w, int h,
                       uint32_t fourcc, int full, size_t advance)
 {
-    memset(f, 0, sizeof *f);
-    f->off = off;
-    f->bytes = bytes;
-    f->width = w;
-    f->height = h;
-    f->fourcc = fourcc;
-    f->full_range = full;
-    f->sequence = r->parsed++;
+    *f = (vs_frame){ .off = off, .bytes = bytes, .width = w, .height = h, .fourcc = fourcc,
+                     .full_range = full, .sequence = r->parsed++ };
     r->pos += advance;
     r->need = 0;
     return VS_FRAME;
