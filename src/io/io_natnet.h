@@ -104,6 +104,11 @@ typedef struct io_natnet_config {
 /* Defaults above; the points map by name to "Head", "ShoulderL",
  * "ShoulderR", "HandL", "HandR" (the names `egofuse replay-track` serves). */
 void io_natnet_config_default(io_natnet_config *c);
+
+/* The name of tracking point k (0 .. IO_NATNET_POINTS-1) in the keys
+ * body= and offset= and in messages: "head", "shoulder-left",
+ * "shoulder-right", "hand-left", "hand-right"; "?" out of range. */
+const char *io_natnet_point_name(int k);
 /* Sets one key (docs/tracking.md): server, local, multicast (GROUP or
  * "off"), command-port, data-port, version (3.1, 4.1, ...), units (m|mm),
  * up (y|z), body (POINT=NAME, POINT=#ID or POINT=none), offset

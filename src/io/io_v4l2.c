@@ -586,6 +586,18 @@ static io_result pick_format(io_cam *cam, uint32_t *out, io_error *err)
                    n ? list : "nothing");
 }
 
+/* The mmap capture buffer `index`, as VIDIOC_QUERYBUF and VIDIOC_QBUF
+ * take it (VIDIOC_DQBUF fills in the index). */
+static struct v4l2_buffer mmap_buffer(int index)
+{
+    struct v4l2_buffer b;
+    memset(&b, 0, sizeof b);
+    b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+    b.memory = V4L2_MEMORY_MMAP;
+    b.index = (uint32_t)index;
+    return b;
+}
+
 static io_result v4l2_open_cb(io_cam *cam, io_error *err)
 {
     v4l2_priv *p = (v4l2_priv *)cam->priv_store;
@@ -704,11 +716,7 @@ static io_result v4l2_open_cb(io_cam *cam, io_error *err)
                        rb.count);
     int n = rb.count > IO_CAM_MAX_BUFFERS ? IO_CAM_MAX_BUFFERS : (int)rb.count;
     for (int i = 0; i < n; i++) {
-        struct v4l2_buffer b;
-        memset(&b, 0, sizeof b);
-        b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-        b.memory = V4L2_MEMORY_MMAP;
-        b.index = (uint32_t)i;
+        struct v4l2_buffer b = mmap_buffer(i);
         if (xioctl(cam, VIDIOC_QUERYBUF, &b) < 0) return errno_fail(cam, err, "VIDIOC_QUERYBUF", errno);
         void *m = ops_of(cam)->mmap_fn(NULL, b.length, PROT_READ | PROT_WRITE, MAP_SHARED, fd,
                                        (int64_t)b.m.offset);
@@ -722,11 +730,7 @@ static io_result v4l2_open_cb(io_cam *cam, io_error *err)
 
 static io_result v4l2_queue_cb(io_cam *cam, int index, io_error *err)
 {
-    struct v4l2_buffer b;
-    memset(&b, 0, sizeof b);
-    b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    b.memory = V4L2_MEMORY_MMAP;
-    b.index = (uint32_t)index;
+    struct v4l2_buffer b = mmap_buffer(index);
     if (xioctl(cam, VIDIOC_QBUF, &b) < 0) return errno_fail(cam, err, "VIDIOC_QBUF", errno);
     return IO_OK;
 }
@@ -747,10 +751,7 @@ static io_result v4l2_start_cb(io_cam *cam, io_error *err)
 static io_result v4l2_dequeue_cb(io_cam *cam, io_frame *f, int *got, uint32_t *flags,
                                  io_error *err)
 {
-    struct v4l2_buffer b;
-    memset(&b, 0, sizeof b);
-    b.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    b.memory = V4L2_MEMORY_MMAP;
+    struct v4l2_buffer b = mmap_buffer(0); /* the driver fills in the index */
     *got = 0;
     if (xioctl(cam, VIDIOC_DQBUF, &b) < 0) {
         if (errno == EAGAIN) return IO_OK;

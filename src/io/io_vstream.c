@@ -273,6 +273,20 @@ static int line_at(vs_reader *r, size_t *n)
     return avail >= VS_LINE_MAX ? -1 : 0;
 }
 
+/* A Y4M or raw frame in hand: f is the colour payload at r->buf + off
+ * (bytes long, w x h fourcc, full range or not, nothing else said), the
+ * next frame's number; the read position moves `advance` bytes on.
+ * VS_FRAME. */
+static int give_frame(vs_reader *r, vs_frame *f, size_t off, size_t bytes, int w, int h,
+                      uint32_t fourcc, int full, size_t advance)
+{
+    *f = (vs_frame){ .off = off, .bytes = bytes, .width = w, .height = h, .fourcc = fourcc,
+                     .full_range = full, .sequence = r->parsed++ };
+    r->pos += advance;
+    r->need = 0;
+    return VS_FRAME;
+}
+
 /* line_at for a Y4M line (`what`, `cut`: its names in the messages): 1
  * with its length in *n; else 0 and in *ret what the parser returns:
  * VS_MORE (its end not read yet), or VS_FATAL when it is longer than
@@ -386,17 +400,8 @@ static int parse_y4m(vs_reader *r, vs_frame *f)
                        "bytes)", (unsigned long long)r->parsed, avail, total);
         return VS_MORE;
     }
-    memset(f, 0, sizeof *f);
-    f->off = r->pos + n + 1;
-    f->bytes = pb;
-    f->width = r->y4m_w;
-    f->height = r->y4m_h;
-    f->fourcc = r->y4m_fmt;
-    f->full_range = r->y4m_full;
-    f->sequence = r->parsed++;
-    r->pos += total;
-    r->need = 0;
-    return VS_FRAME;
+    return give_frame(r, f, r->pos + n + 1, pb, r->y4m_w, r->y4m_h, r->y4m_fmt, r->y4m_full,
+                      total);
 }
 
 /* ---------------------------------------------------------------- raw */
@@ -412,16 +417,7 @@ static int parse_raw(vs_reader *r, vs_frame *f)
                        "bytes)", (unsigned long long)r->parsed, avail, pb);
         return VS_MORE;
     }
-    memset(f, 0, sizeof *f);
-    f->off = r->pos;
-    f->bytes = pb;
-    f->width = r->raw_w;
-    f->height = r->raw_h;
-    f->fourcc = r->raw_fmt;
-    f->sequence = r->parsed++;
-    r->pos += pb;
-    r->need = 0;
-    return VS_FRAME;
+    return give_frame(r, f, r->pos, pb, r->raw_w, r->raw_h, r->raw_fmt, 0, pb);
 }
 
 int vs_parse(vs_reader *r, vs_frame *f)
