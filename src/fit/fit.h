@@ -55,7 +55,9 @@ extern "C" {
  * within +-step_deg/2 of the best. The colour model of each eye is learned
  * from the camera image where a kinematic mask and a refined mask agree
  * (learning margin 4 px, every 2nd pixel, clamp 3 nats, >= 64 samples
- * per class). pipe_frame and `egofuse eval` learn it after each frame's
+ * per class), kept over frames (pipe_fit_desc.learn_memory: each frame's
+ * histograms weigh 0.95 per frame since). pipe_frame and `egofuse eval`
+ * learn it after each frame's
  * refinement, from that frame's masks (not when the refinement fell
  * back to the kinematic mask), and fit the next frame with it (no raster
  * for the fit); only while there is no model (pipe_fit_learned 0) do
