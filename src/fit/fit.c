@@ -33,6 +33,9 @@ struct pipe_fit {
     uint8_t *learn[2];        /* width x height per eye (the eyes may
                                  learn on two threads) */
     void *scratch[2];
+    float *acc[2];            /* per eye (learn_memory > 0): the arm and
+                                 the background histograms over frames */
+    double accn[2][2];        /* per eye: their sums (arm, background) */
     size_t scratch_size;
     /* limb thickness (self-calibration from the masks) */
     int *sv[2];               /* per side: vertices weighted to its arm */
@@ -158,6 +161,9 @@ static int fit_settings(pipe_fit_desc *d)
         return 0;
     if (d->points == 0) d->points = 400;
     if (d->shape_samples == 0) d->shape_samples = 48;
+    if (d->learn_memory == 0.0f) d->learn_memory = PIPE_FIT_LEARN_MEMORY;
+    if (!(d->learn_memory < 0.0f || (d->learn_memory > 0.0f && d->learn_memory < 1.0f)))
+        return 0;   /* NaN, >= 1 */
     return d->points >= 1 && d->points <= PIPE_FIT_MAX_POINTS &&
            d->shape_samples <= PIPE_FIT_MAX_SHAPE_SAMPLES;
 }
@@ -240,8 +246,9 @@ pipe_fit *pipe_fit_create(const pipe_fit_desc *desc, const kin_model *model,
         f->sv[e] = malloc(sizeof(int) * nv);
         f->sw[e] = malloc(sizeof(float) * 2 * nv);
         f->scratch[e] = malloc(f->scratch_size);
+        f->acc[e] = calloc((size_t)2 << (3 * PIPE_FIT_BITS), sizeof(float));
         f->learn[e] = malloc((size_t)width * (size_t)height);
-        ok = ok && f->llr[e] && f->v[e] && f->use[e] && f->sv[e] && f->sw[e] && f->scratch[e] && f->learn[e];
+        ok = ok && f->acc[e] && f->llr[e] && f->v[e] && f->use[e] && f->sv[e] && f->sw[e] && f->scratch[e] && f->learn[e];
         for (int s = 0; s < 2; s++)
             for (int g = 0; g < 2; g++) {
                 f->samples[e][s][g] = malloc(sizeof(float) * (size_t)f->cap);
@@ -268,6 +275,7 @@ void pipe_fit_destroy(pipe_fit *f)
         free(f->sv[e]);
         free(f->sw[e]);
         free(f->scratch[e]);
+        free(f->acc[e]);
         free(f->learn[e]);
         for (int s = 0; s < 2; s++)
             for (int g = 0; g < 2; g++) free(f->samples[e][s][g]);
@@ -304,6 +312,8 @@ void pipe_fit_forget(pipe_fit *f)
         f->learned[e] = 0;
         f->cm[e].fg_samples = f->cm[e].bg_samples = 0;
         memset(f->llr[e], 0, sizeof(float) << (3 * PIPE_FIT_BITS));
+        memset(f->acc[e], 0, sizeof(float) << (3 * PIPE_FIT_BITS + 1));
+        f->accn[e][0] = f->accn[e][1] = 0.0;
     }
 }
 
@@ -315,6 +325,58 @@ const fuse_colour_model *pipe_fit_colour(const pipe_fit *f, int eye)
 int pipe_fit_learned(const pipe_fit *f, int eye)
 {
     return f ? f->learned[eye ? 1 : 0] : 0;
+}
+
+/* The colour model of eye from histograms kept over frames (learn_memory
+ * m > 0): each bin of both classes is multiplied by m, then this frame's
+ * pixels of f->learn[eye] (255 arm, 0 background, else not learned) are
+ * added, with fuse_colour_model_learn's margin (4 px), step (2), pseudo
+ * counts and clamp (3 nats); the model is the log ratio of the kept
+ * histograms, and needs >= 64 kept samples per class (fg_samples and
+ * bg_samples: the kept sums, rounded down). A pixel learned wrongly in one
+ * frame (the desk pad under a kinematic arm that is off) weighs against
+ * every frame that saw it right, instead of making the whole model. */
+static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
+{
+    const int w = f->width, h = f->height, bits = PIPE_FIT_BITS, bins = 1 << (3 * bits);
+    const int margin = 4;
+    const float m = f->d.learn_memory;
+    float *af = f->acc[eye], *ab = af + bins;
+    const uint8_t *mask = f->learn[eye];
+    for (int b = 0; b < 2 * bins; b++) af[b] *= m;
+    long nf = 0, nb = 0;
+    for (int y = 0; y < h; y += 2) {
+        const uint8_t *row = mask + (size_t)y * (size_t)w;
+        const uint8_t *src = P->pixels + (size_t)y * (size_t)P->stride;
+        for (int x = 0; x < w; x += 2) {
+            const uint8_t v = row[x];
+            if (v != 0 && v != 255) continue;
+            int xl = x - margin < 0 ? 0 : x - margin, xr = x + margin >= w ? w - 1 : x + margin;
+            int yu = y - margin < 0 ? 0 : y - margin, yd = y + margin >= h ? h - 1 : y + margin;
+            if (row[xl] != v || row[xr] != v || mask[(size_t)yu * (size_t)w + (size_t)x] != v ||
+                mask[(size_t)yd * (size_t)w + (size_t)x] != v)
+                continue;
+            unsigned b = fuse_colour_bin(src + 4 * x, bits);
+            if (v == 255) { af[b] += 1.0f; nf++; }
+            else { ab[b] += 1.0f; nb++; }
+        }
+    }
+    f->accn[eye][0] = f->accn[eye][0] * m + (double)nf;
+    f->accn[eye][1] = f->accn[eye][1] * m + (double)nb;
+    fuse_colour_model *cm = &f->cm[eye];
+    cm->fg_samples = (long)f->accn[eye][0];
+    cm->bg_samples = (long)f->accn[eye][1];
+    f->learned[eye] = cm->fg_samples >= 64 && cm->bg_samples >= 64;
+    if (!f->learned[eye]) {
+        memset(cm->llr, 0, (size_t)bins * sizeof(float));
+        return;
+    }
+    const float a = 4.0f / (float)bins;
+    const float off = logf((float)f->accn[eye][1] + 4.0f) - logf((float)f->accn[eye][0] + 4.0f);
+    for (int b = 0; b < bins; b++) {
+        float v = logf((af[b] + a) / (ab[b] + a)) + off;
+        cm->llr[b] = v > 3.0f ? 3.0f : v < -3.0f ? -3.0f : v;
+    }
 }
 
 fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint8_t *mask,
@@ -345,6 +407,10 @@ fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint
                 L[x] = (uint8_t)(128u + 127u * (ia & ib) - 128u * ((ia | ib) ^ 1u));
             }
         }
+    }
+    if (f->d.learn_memory > 0.0f) {
+        fit_learn_memory(f, eye, P);
+        return FUSE_OK;
     }
     fuse_result r = fuse_colour_model_learn(&f->cm[eye], P, learn, stride, 4, 2, 3.0f, 64,
                                             f->scratch[eye], f->scratch_size);
