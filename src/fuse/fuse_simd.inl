@@ -187,38 +187,86 @@ static inline VI round_lanes(VF v)
     return F2I_TRUNC(FADD(v, F1(0.5f)));
 }
 
-/* fuse__spec01 in lanes, for nu vectors x2[u] (the squared cosines); n =
- * fuse__pow_int(s) (uniform). */
-static inline __attribute__((always_inline)) void spec01_lanes(const VF *x2, float s, int n, int nu,
-                                                               VF *r)
+/* fuse__spec01 in lanes, for nl lights (1 or 2, a constant at each call)
+ * of nu vectors x2[j][u] (the squared cosines); n = fuse__pow_int(s)
+ * (uniform). The squarings of the lights and vectors interleave. */
+static inline __attribute__((always_inline)) void spec01_lanes(int nl, VF (*x2)[U_MAX], float s,
+                                                               int n, int nu, VF (*r)[U_MAX])
 {
-    VF p[U_MAX];
-    int u;
+    VF p[2][U_MAX];
+    int j, u;
     if (n == 0) {
-        pow01_lanes(x2, F1(s * 0.5f), fuse__pow_int(s * 0.5f), nu, r);
+        _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
+            pow01_lanes(x2[j], F1(s * 0.5f), fuse__pow_int(s * 0.5f), nu, r[j]);
         return;
     }
+    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = F1(1.0f);
     if (n >= 2) {
-        VF b[U_MAX];
+        VF b[2][U_MAX];
         int k = n >> 1;
-        EACH {
-            b[u] = x2[u];
-            p[u] = F1(1.0f);
-        }
+        _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH b[j][u] = x2[j][u];
         for (;;) {
-            if (k & 1) EACH p[u] = FMUL(p[u], b[u]);
+            if (k & 1) _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = FMUL(p[j][u], b[j][u]);
             k >>= 1;
             if (k == 0) break;
-            EACH b[u] = FMUL(b[u], b[u]);
+            _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH b[j][u] = FMUL(b[j][u], b[j][u]);
         }
-    } else {
-        EACH p[u] = F1(1.0f);
     }
-    if (n & 1) EACH p[u] = FMUL(p[u], FSQRT(x2[u]));
-    EACH {   /* the early returns of fuse__spec01 */
-        const VF q = FSEL(FGE(x2[u], F1(1.0f)), F1(1.0f), p[u]);
-        r[u] = FZERO_UNLESS(FGT(x2[u], F1(FUSE__POW_MIN)), q);
+    if (n & 1) _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = FMUL(p[j][u], FSQRT(x2[j][u]));
+    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH {   /* the early returns of fuse__spec01 */
+        const VF q = FSEL(FGE(x2[j][u], F1(1.0f)), F1(1.0f), p[j][u]);
+        r[j][u] = FZERO_UNLESS(FGT(x2[j][u], F1(FUSE__POW_MIN)), q);
     }
+}
+
+/* Lights i .. i + nl - 1 (nl = 1 or 2, a constant at each call) added to
+ * C0..C2: the diffuse weights, the specular terms with one division for
+ * both 1 / hh of a pair (fuse__light_span_ref). */
+static inline __attribute__((always_inline)) void light_pair_lanes(
+    const fuse__light_prep *p, int i, int nl, int nu, const VF *nx, const VF *ny, const VF *nz,
+    const VF *inv, const VF *vx, const VF *vy, const VF *vz, const VF *ndv, VF *C0, VF *C1, VF *C2)
+{
+    const VF one = F1(1.0f);
+    VF w[2][U_MAX], nd[2][U_MAX], hh[2][U_MAX];
+    int j, u;
+    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) {
+        const VF lx = F1(p->dir[i + j][0]), ly = F1(p->dir[i + j][1]), lz = F1(p->dir[i + j][2]);
+        EACH {
+            const VF hx = FADD(lx, vx[u]), hy = FADD(ly, vy[u]), hz = FADD(lz, vz[u]);
+            nd[j][u] = FMUL(FADD(FADD(FMUL(nx[u], lx), FMUL(ny[u], ly)), FMUL(nz[u], lz)), inv[u]);
+            w[j][u] = FMUL(F1(p->kd), FMAX0(nd[j][u]));
+            hh[j][u] = FADD(FADD(FMUL(hx, hx), FMUL(hy, hy)), FMUL(hz, hz));
+        }
+    }
+    if (p->ks != 0.0f) {
+        VF x2[2][U_MAX], sp[2][U_MAX];
+        VM g[2][U_MAX];
+        _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
+            EACH {
+                const VF n0 = FMAX0(FADD(nd[j][u], ndv[u]));
+                g[j][u] = FGT(hh[j][u], F1(1.0e-12f));
+                x2[j][u] = FMUL(n0, n0);
+            }
+        if (nl == 2) {
+            EACH {
+                const VF a0 = FSEL(g[0][u], hh[0][u], one), a1 = FSEL(g[1][u], hh[1][u], one);
+                const VF d = FDIV(one, FMUL(a0, a1));
+                x2[0][u] = FMUL(x2[0][u], FMUL(a1, d));
+                x2[1][u] = FMUL(x2[1][u], FMUL(a0, d));
+            }
+        } else {
+            EACH x2[0][u] = FDIV(x2[0][u], hh[0][u]);
+        }
+        spec01_lanes(nl, x2, p->shininess, p->ipow, nu, sp);
+        _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
+            EACH w[j][u] = FSEL(g[j][u], FADD(w[j][u], FMUL(F1(p->ks), sp[j][u])), w[j][u]);
+    }
+    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
+        EACH {
+            C0[u] = FADD(C0[u], FMUL(F1(p->color_t[i + j][0]), w[j][u]));
+            C1[u] = FADD(C1[u], FMUL(F1(p->color_t[i + j][1]), w[j][u]));
+            C2[u] = FADD(C2[u], FMUL(F1(p->color_t[i + j][2]), w[j][u]));
+        }
 }
 
 /* The pixels x .. x + nu LANES - 1 of the row (fuse__light_span_ref lane
@@ -269,50 +317,10 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
         C1[u] = F1(p->ambient_t[1]);
         C2[u] = F1(p->ambient_t[2]);
     }
-    for (i = 0; i < p->light_count; i += 2) {
-        const int two = i + 1 < p->light_count, nl = two ? 2 : 1;
-        VF w[2][U_MAX], nd[2][U_MAX], hh[2][U_MAX];
-        int j;
-        for (j = 0; j < nl; j++) {
-            const VF lx = F1(p->dir[i + j][0]), ly = F1(p->dir[i + j][1]), lz = F1(p->dir[i + j][2]);
-            EACH {
-                const VF hx = FADD(lx, vx[u]), hy = FADD(ly, vy[u]), hz = FADD(lz, vz[u]);
-                nd[j][u] = FMUL(FADD(FADD(FMUL(nx[u], lx), FMUL(ny[u], ly)), FMUL(nz[u], lz)), inv[u]);
-                w[j][u] = FMUL(F1(p->kd), FMAX0(nd[j][u]));
-                hh[j][u] = FADD(FADD(FMUL(hx, hx), FMUL(hy, hy)), FMUL(hz, hz));
-            }
-        }
-        if (p->ks != 0.0f) {
-            VF x2[2][U_MAX], sp[2][U_MAX];
-            VM g[2][U_MAX];
-            for (j = 0; j < nl; j++)
-                EACH {
-                    const VF n0 = FMAX0(FADD(nd[j][u], ndv[u]));
-                    g[j][u] = FGT(hh[j][u], F1(1.0e-12f));
-                    x2[j][u] = FMUL(n0, n0);
-                }
-            if (two) {
-                EACH {
-                    const VF a0 = FSEL(g[0][u], hh[0][u], one), a1 = FSEL(g[1][u], hh[1][u], one);
-                    const VF d = FDIV(one, FMUL(a0, a1));
-                    x2[0][u] = FMUL(x2[0][u], FMUL(a1, d));
-                    x2[1][u] = FMUL(x2[1][u], FMUL(a0, d));
-                }
-            } else {
-                EACH x2[0][u] = FDIV(x2[0][u], hh[0][u]);
-            }
-            for (j = 0; j < nl; j++) {
-                spec01_lanes(x2[j], p->shininess, p->ipow, nu, sp[j]);
-                EACH w[j][u] = FSEL(g[j][u], FADD(w[j][u], FMUL(F1(p->ks), sp[j][u])), w[j][u]);
-            }
-        }
-        for (j = 0; j < nl; j++)
-            EACH {
-                C0[u] = FADD(C0[u], FMUL(F1(p->color_t[i + j][0]), w[j][u]));
-                C1[u] = FADD(C1[u], FMUL(F1(p->color_t[i + j][1]), w[j][u]));
-                C2[u] = FADD(C2[u], FMUL(F1(p->color_t[i + j][2]), w[j][u]));
-            }
-    }
+    for (i = 0; i + 2 <= p->light_count; i += 2)
+        light_pair_lanes(p, i, 2, nu, nx, ny, nz, inv, vx, vy, vz, ndv, C0, C1, C2);
+    if (i < p->light_count)
+        light_pair_lanes(p, i, 1, nu, nx, ny, nz, inv, vx, vy, vz, ndv, C0, C1, C2);
     EACH {
         const VF t = clamp01_lanes(FSUB(one, ndv[u]));
         const VF t2 = FMUL(t, t);
