@@ -107,6 +107,12 @@ static inline float fuse__clamp01(float v) { return v > 0.0f ? (v < 1.0f ? v : 1
  * multiplication, not a division (255 * FUSE__INV255 rounds to 1.0f). */
 #define FUSE__INV255 (1.0f / 255.0f)
 
+/* t in [0, 255] rounded to the nearest integer, ties to even, as the low 8
+ * bits of the float t + 2^23 (whose unit in the last place is 1): one
+ * addition, no conversion; the bits are 0x4B000000 | round(t). */
+#define FUSE__MAGIC 8388608.0f   /* 2^23 */
+static inline uint8_t fuse__round8(float t) { return (uint8_t)fuse__f2u(t + FUSE__MAGIC); }
+
 /* float in [0, 1] to u8: (int)(v * 255 + 0.5), truncation. */
 static inline uint8_t fuse__unorm8(float v) { return (uint8_t)(int)(v * 255.0f + 0.5f); }
 
@@ -249,6 +255,7 @@ typedef struct fuse__light_prep {
     float kt[3];              /* tone[c] * FUSE__INV255 */
     float ifx, ify, cx, cy;   /* 1.0f / fx, 1.0f / fy (one IEEE division) */
     float nifx;               /* -ifx (exact): the view ray's x is -px */
+    float mo;                 /* (0.5f - cx) * nifx: -px = (float)x * nifx + mo */
 } fuse__light_prep;
 
 /* Validates L and K (docs/fuse.md) and fills *p. FUSE_OK or

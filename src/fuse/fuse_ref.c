@@ -131,6 +131,7 @@ fuse_result fuse__light_prepare(const fuse_lighting *L,
     p->kf = L->kf;
     p->ifx = 1.0f / K->fx;
     p->nifx = -p->ifx;
+    p->mo = (0.5f - K->cx) * p->nifx;
     p->ify = 1.0f / K->fy;
     p->cx = K->cx;
     p->cy = K->cy;
@@ -176,7 +177,7 @@ void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
             continue;
         }
         /* The view ray v = (-px, py, 1), V = v / |v|; mpx = -px. */
-        mpx = (((float)x + 0.5f) - p->cx) * p->nifx;
+        mpx = (float)x * p->nifx + p->mo;
         vv = mpx * mpx + pyy;
         sv = sqrtf(vv);
         /* n as given, or v when it has no usable length (N = V). */
@@ -240,9 +241,9 @@ void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
         m = (float)M * fade;                /* 255 m' */
         for (c = 0; c < 3; c++) {
             const float v = fuse__clamp01((float)P[c] * C[c]);
-            out[c] = (uint8_t)(int)(m * v + 0.5f);
+            out[c] = fuse__round8(m * v);
         }
-        out[3] = (uint8_t)(int)(m + 0.5f);
+        out[3] = fuse__round8(m);
     }
 }
 

@@ -93,7 +93,6 @@ SIMD_INL int mask_zero(const uint8_t *p)
 #endif
 #define STORE_RGBA(p, v) vi_storeu((int32_t *)(void *)(p), v)
 #define STORE_ZERO(p) vi_storeu((int32_t *)(void *)(p), vi_zero())
-#define IZERO_IF_EQ0(m, v) vi_sel(vi_eq(m, vi_zero()), vi_zero(), v)
 #define LIGHT_ROW_NAME SIMD_FN(fuse__light_row)
 #define POW_ROW_NAME SIMD_FN(fuse__pow01_row)
 #define LOADF(p) vf_loadu(p)
@@ -181,10 +180,11 @@ static inline VF clamp01_lanes(VF v)
     return FMAX0(FMIN1(v));
 }
 
-/* (int)(v + 0.5), v in [0, 255] */
+/* fuse__round8 before its last step: the bits of v + 2^23 (v in [0, 255]),
+ * 0x4B000000 | round(v); the byte is the low 8 bits. */
 static inline VI round_lanes(VF v)
 {
-    return F2I_TRUNC(FADD(v, F1(0.5f)));
+    return FBITS(FADD(v, F1(FUSE__MAGIC)));
 }
 
 /* fuse__spec01 in lanes, for nl lights (1 or 2, a constant at each call)
@@ -286,8 +286,7 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
     int u, i;
     EACH {
         Mi[u] = LOAD_MASK(mask + x + u * LANES);
-        mpx[u] = FMUL(FSUB(FADD(I2F(IADD(I1(x + u * LANES), LANE_INDEX)), F1(0.5f)), F1(p->cx)),
-                      F1(p->nifx));
+        mpx[u] = FADD(FMUL(I2F(IADD(I1(x + u * LANES), LANE_INDEX)), F1(p->nifx)), F1(p->mo));
         vv[u] = FADD(FMUL(mpx[u], mpx[u]), pyy);
     }
     EACH {
@@ -332,9 +331,15 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
         v0 = clamp01_lanes(FMUL(I2F(IAND(pix, I1(255))), C0[u]));
         v1 = clamp01_lanes(FMUL(I2F(IAND(ISRL(pix, 8), I1(255))), C1[u]));
         v2 = clamp01_lanes(FMUL(I2F(IAND(ISRL(pix, 16), I1(255))), C2[u]));
-        rgba = IOR(IOR(round_lanes(FMUL(m, v0)), ISLL(round_lanes(FMUL(m, v1)), 8)),
+        /* the shifts left by 8, 16, 24 drop the 0x4B of the upper bytes */
+        rgba = IOR(IOR(IAND(round_lanes(FMUL(m, v0)), I1(255)), ISLL(round_lanes(FMUL(m, v1)), 8)),
                    IOR(ISLL(round_lanes(FMUL(m, v2)), 16), ISLL(round_lanes(m), 24)));
-        STORE_RGBA(out + 4 * (size_t)(x + u * LANES), IZERO_IF_EQ0(Mi[u], rgba));
+        /* A lane with M == 0 is (0, 0, 0, 0) without a select: every value
+         * above is finite there (a normal without a usable length is
+         * replaced by v, P is a byte, the parameters are bounded), fade and
+         * v lie in [0, 1], so m = 0 * fade = +0 and every channel rounds
+         * +0 to 0, as the reference writes. */
+        STORE_RGBA(out + 4 * (size_t)(x + u * LANES), rgba);
     }
 }
 
