@@ -288,6 +288,102 @@ static void test_pow01(void **state)
     assert_true(ints > 50000);
 }
 
+/* fuse__spec01 (the specular power from the squared cosine, issue 17)
+ * against pow(): x2 = x * x rounded, result x^s. Integer s by squaring x2
+ * (and one square root for odd s): relative error below about
+ * (s / 2 + 1) 2^-24 for the squarings plus s / 2 times that of x2 (2^-24);
+ * other s through fuse__pow01(x2, s / 2). */
+static void test_spec01(void **state)
+{
+    static const float shin[] = { 1.0f, 1.5f, 2.0f, 3.0f, 3.7f, 5.0f, 16.0f, 20.0f, 63.0f,
+                                  64.0f, 65.0f, 128.0f, 1000.0f };
+    enum { NS = sizeof shin / sizeof shin[0] };
+    tu_rng r = { 0x5EED0006u };
+    double worst_int = 0, worst = 0;
+    int i, k;
+    (void)state;
+    assert_true(fuse__spec01(1.0f, 16.0f, 16) == 1.0f);
+    assert_true(fuse__spec01(2.0f, 3.0f, 3) == 1.0f);
+    assert_true(fuse__spec01(0.0f, 1.0f, 1) == 0.0f);
+    assert_true(fuse__spec01(0x1p-100f, 2.5f, 0) == 0.0f);
+    assert_true(fuse__spec01(0.25f, 1.0f, 1) == 0.5f);          /* sqrt, exact */
+    assert_true(fuse__spec01(0.25f, 2.0f, 2) == 0.25f);
+    assert_true(fuse__spec01(0.25f, 3.0f, 3) == 0.125f);        /* x2 * sqrt(x2) */
+    assert_true(fuse__spec01(0.25f, 20.0f, 20) == 0x1p-20f);    /* (x2^2)^2 * x2^8 */
+    for (k = 0; k < NS; k++) {
+        const int n = fuse__pow_int(shin[k]);
+        for (i = 0; i < 20000; i++) {
+            const float x = i < 10000 ? tu_unit(&r) : 1.0f - tu_unit(&r) * 0.01f;
+            const double ref = pow(x, shin[k]);
+            const double got = fuse__spec01(x * x, shin[k], n);
+            if (ref > 1e-25) {
+                const double e = fabs(got - ref) / ref;
+                if (n) {
+                    const double b = (shin[k] / 2.0 + 1.0) * 0x1p-24 + shin[k] * 0x1p-25;
+                    if (e / b > worst_int) worst_int = e / b;
+                } else {
+                    /* pow01's bound, plus s/2 times the rounding of x2 */
+                    const double y = fabs(shin[k] * log2((double)x));
+                    const double b = 1.3e-7 * (1.0 + y) + shin[k] * 0x1p-25;
+                    if (e / b > worst) worst = e / b;
+                }
+            } else {
+                assert_true(got < 1e-20);
+            }
+        }
+    }
+    printf("NOTE spec01: max relative error / ((s/2 + 1) 2^-24 + s 2^-25) %.3g (integer s), "
+           "/ (1.3e-7 (1 + |s log2 x|) + s 2^-25) %.3g (other s)\n", worst_int, worst);
+    assert_true(worst_int <= 1.0);
+    assert_true(worst <= 1.0);
+}
+
+/* The lighting against double where the specular term carries the output:
+ * lights from every side (behind the surface, near -V, grazing), ks up to
+ * 1, odd and large exponents. */
+static void test_light_vs_double_spec(void **state)
+{
+    static const float shin[] = { 1.0f, 3.0f, 5.0f, 20.0f, 63.0f, 64.0f, 65.0f, 130.5f, 2.5f };
+    tu_rng r = { 0x5EED0007u };
+    fuse_intrinsics K = intrinsics_for(160, 100);
+    double max_err = 0;
+    long ones = 0, channels = 0;
+    int k, i, c;
+    scene s;
+    (void)state;
+    scene_alloc(&s, 160, 100);
+    for (k = 0; k < 18; k++) {
+        fuse_lighting L = fuse_lighting_default();
+        L.light_count = 1 + k % 4;
+        for (i = 0; i < L.light_count; i++) {
+            for (c = 0; c < 3; c++) {
+                L.lights[i].dir[c] = tu_range(&r, -1, 1);
+                L.lights[i].color[c] = tu_range(&r, 0.5f, 1.0f);
+            }
+            if (k % 3 == 0 && i == 0) {   /* about -V of the image centre */
+                L.lights[i].dir[0] = tu_range(&r, -0.05f, 0.05f);
+                L.lights[i].dir[1] = tu_range(&r, -0.05f, 0.05f);
+                L.lights[i].dir[2] = -1.0f;
+            }
+        }
+        for (c = 0; c < 3; c++) {
+            L.ambient[c] = tu_range(&r, 0, 0.2f);
+            L.tone[c] = 1.0f;
+        }
+        L.kd = tu_range(&r, 0, 0.3f);
+        L.ks = tu_range(&r, 0.5f, 1.0f);
+        L.shininess = shin[k % 9];
+        L.kf = tu_range(&r, 0, 1);
+        scene_random(&s, &r);
+        ones += check_scene(&L, &K, &s, &max_err);
+        channels += 4L * s.w * s.h;
+    }
+    scene_free(&s);
+    printf("NOTE lighting vs double, specular cases: max error %.4f LSB, %ld of %ld channels off by 1\n",
+           max_err, ones, channels);
+    assert_true(max_err < 1.0);
+}
+
 /* ---- hand-worked single pixels --------------------------------------- */
 
 typedef struct px1 {
@@ -609,6 +705,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_light_vs_double),
         cmocka_unit_test(test_pow01),
+        cmocka_unit_test(test_spec01),
+        cmocka_unit_test(test_light_vs_double_spec),
         cmocka_unit_test(test_facing_viewer),
         cmocka_unit_test(test_grazing),
         cmocka_unit_test(test_mask_zero),

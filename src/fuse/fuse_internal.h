@@ -107,6 +107,12 @@ static inline float fuse__clamp01(float v) { return v > 0.0f ? (v < 1.0f ? v : 1
  * multiplication, not a division (255 * FUSE__INV255 rounds to 1.0f). */
 #define FUSE__INV255 (1.0f / 255.0f)
 
+/* t in [0, 255] rounded to the nearest integer, ties to even, as the low 8
+ * bits of the float t + 2^23 (whose unit in the last place is 1): one
+ * addition, no conversion; the bits are 0x4B000000 | round(t). */
+#define FUSE__MAGIC 8388608.0f   /* 2^23 */
+static inline uint8_t fuse__round8(float t) { return (uint8_t)fuse__f2u(t + FUSE__MAGIC); }
+
 /* float in [0, 1] to u8: (int)(v * 255 + 0.5), truncation. */
 static inline uint8_t fuse__unorm8(float v) { return (uint8_t)(int)(v * 255.0f + 0.5f); }
 
@@ -207,19 +213,49 @@ static inline float fuse__pow01(float x, float s)
     return p * fuse__u2f((uint32_t)((int)k + 127) << 23);
 }
 
+/* The specular power from the square of the cosine (issue 17): x2 =
+ * (N.H)^2 = (N.(L + V))^2 / |L + V|^2 needs no square root and no
+ * division of its own, and x^s = (x^2)^(s/2):
+ *   x2 <= 2^-100           -> 0
+ *   x2 >= 1                -> 1
+ *   integer s = n in [1, FUSE__POW_INT_MAX]:
+ *       r = n >= 2 ? fuse__powi01(x2, n >> 1) : 1.0f
+ *       odd n: r = r * sqrtf(x2)          (1.0f * sqrtf(x2) when n == 1)
+ *   any other s: fuse__pow01(x2, s * 0.5f)  (its own rules, exponent s / 2,
+ *       which is exact: a halving)
+ * n is fuse__pow_int(s). Relative error about (n / 2) 2^-24 plus that of
+ * x2 times s / 2 (tested against pow()). */
+static inline float fuse__spec01(float x2, float s, int n)
+{
+    float r;
+    if (!(x2 > FUSE__POW_MIN)) return 0.0f;
+    if (x2 >= 1.0f) return 1.0f;
+    if (n == 0) return fuse__pow01(x2, s * 0.5f);
+    r = n >= 2 ? fuse__powi01(x2, n >> 1) : 1.0f;
+    if (n & 1) r = r * sqrtf(x2);
+    return r;
+}
+
 /* ---- prepared lighting ---------------------------------------------- */
 
 /* Lighting parameters after validation: light directions normalised once
- * per call (dir / sqrtf(dot(dir, dir))), everything else copied. */
+ * per call (dir / sqrtf(dot(dir, dir))), the tone and 1/255 folded into
+ * the colours (kt_c = tone_c * FUSE__INV255; ambient_t = ambient * kt,
+ * color_t = color * kt), everything else copied. */
 typedef struct fuse__light_prep {
     int light_count;
     float dir[FUSE_MAX_LIGHTS][3];
     float color[FUSE_MAX_LIGHTS][3];
+    float color_t[FUSE_MAX_LIGHTS][3];   /* color[i][c] * kt[c] */
     float ambient[3];
+    float ambient_t[3];                  /* ambient[c] * kt[c] */
     float kd, ks, shininess, kf;
     int ipow;                 /* fuse__pow_int(shininess) */
     float tone[3];
+    float kt[3];              /* tone[c] * FUSE__INV255 */
     float ifx, ify, cx, cy;   /* 1.0f / fx, 1.0f / fy (one IEEE division) */
+    float nifx;               /* -ifx (exact): the view ray's x is -px */
+    float mo;                 /* (0.5f - cx) * nifx: -px = (float)x * nifx + mo */
 } fuse__light_prep;
 
 /* Validates L and K (docs/fuse.md) and fills *p. FUSE_OK or

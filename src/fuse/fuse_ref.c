@@ -119,6 +119,10 @@ fuse_result fuse__light_prepare(const fuse_lighting *L,
     for (c = 0; c < 3; c++) {
         p->ambient[c] = L->ambient[c];
         p->tone[c] = L->tone[c];
+        p->kt[c] = L->tone[c] * FUSE__INV255;
+        p->ambient_t[c] = L->ambient[c] * p->kt[c];
+        for (i = 0; i < L->light_count; i++)
+            p->color_t[i][c] = p->color[i][c] * p->kt[c];
     }
     p->kd = L->kd;
     p->ks = L->ks;
@@ -126,6 +130,8 @@ fuse_result fuse__light_prepare(const fuse_lighting *L,
     p->ipow = fuse__pow_int(L->shininess);
     p->kf = L->kf;
     p->ifx = 1.0f / K->fx;
+    p->nifx = -p->ifx;
+    p->mo = (0.5f - K->cx) * p->nifx;
     p->ify = 1.0f / K->fy;
     p->cx = K->cx;
     p->cy = K->cy;
@@ -139,73 +145,105 @@ void fuse__light_row_ref(const fuse__light_prep *p, int y, int width,
     fuse__light_span_ref(p, y, 0, width, P, mask, normal, out);
 }
 
+/* One light's diffuse weight, and what its specular term needs: nl =
+ * N.L_i, hh = |L_i + V|^2 (docs/fuse.md, "Lighting"). */
+static void light_terms(const fuse__light_prep *p, int i, float nx, float ny, float nz,
+                        float inv, float vx, float vy, float vz, float *w, float *nl, float *hh)
+{
+    const float lx = p->dir[i][0], ly = p->dir[i][1], lz = p->dir[i][2];
+    const float hx = lx + vx, hy = ly + vy, hz = lz + vz;
+    *nl = ((nx * lx + ny * ly) + nz * lz) * inv;
+    *w = p->kd * fuse__max0(*nl);
+    *hh = (hx * hx + hy * hy) + hz * hz;
+}
+
 void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
                           const uint8_t *P, const uint8_t *mask,
                           const float *normal, uint8_t *out)
 {
     /* View ray of the row; the image's y axis points down, view y up. */
     const float py = (((float)y + 0.5f) - p->cy) * p->ify;
+    const float pyy = py * py + 1.0f;
     int x, i, c;
     P += 4 * (size_t)x0;
     normal += 3 * (size_t)x0;
     out += 4 * (size_t)x0;
     for (x = x0; x < x1; x++, P += 4, normal += 3, out += 4) {
         const unsigned M = mask[x];
-        float px, il, vx, vy, vz, nx, ny, nz, nn, ndv, t, t2, fade, mp;
+        float mpx, vv, sv, sn, r, il, inv, vx, vy, vz, nx, ny, nz, nn, ndv, t, t2, fade, m;
         float C[3];
         if (M == 0) {
             out[0] = out[1] = out[2] = out[3] = 0;
             continue;
         }
-        /* V = -normalize(px, -py, -1) = (-px, py, 1) / |(px, py, 1)| */
-        px = (((float)x + 0.5f) - p->cx) * p->ifx;
-        il = 1.0f / sqrtf((px * px + py * py) + 1.0f);
-        vx = -(px * il);
-        vy = py * il;
-        vz = il;
-        /* N: normalised, or V when it has no usable length. */
+        /* The view ray v = (-px, py, 1), V = v / |v|; mpx = -px. */
+        mpx = (float)x * p->nifx + p->mo;
+        vv = mpx * mpx + pyy;
+        sv = sqrtf(vv);
+        /* n as given, or v when it has no usable length (N = V). */
         nx = normal[0];
         ny = normal[1];
         nz = normal[2];
         nn = (nx * nx + ny * ny) + nz * nz;
         if (nn > 1.0e-30f && nn < 1.0e30f) {
-            float inv = 1.0f / sqrtf(nn);
-            nx = nx * inv;
-            ny = ny * inv;
-            nz = nz * inv;
+            sn = sqrtf(nn);
         } else {
-            nx = vx;
-            ny = vy;
-            nz = vz;
+            nx = mpx;
+            ny = py;
+            nz = 1.0f;
+            sn = sv;
         }
-        ndv = (nx * vx + ny * vy) + nz * vz;
-        C[0] = p->ambient[0];
-        C[1] = p->ambient[1];
-        C[2] = p->ambient[2];
-        for (i = 0; i < p->light_count; i++) {
-            const float lx = p->dir[i][0], ly = p->dir[i][1], lz = p->dir[i][2];
-            float w = p->kd * fuse__max0((nx * lx + ny * ly) + nz * lz);
+        /* One division for both lengths: 1/|n| and 1/|v|. */
+        r = 1.0f / (sn * sv);
+        il = sn * r;
+        inv = sv * r;
+        vx = mpx * il;
+        vy = py * il;
+        vz = il;
+        ndv = ((nx * mpx + ny * py) + nz) * r;
+        C[0] = p->ambient_t[0];
+        C[1] = p->ambient_t[1];
+        C[2] = p->ambient_t[2];
+        /* Lights in pairs: one division gives both 1 / hh. */
+        for (i = 0; i < p->light_count; i += 2) {
+            const int two = i + 1 < p->light_count;
+            float w0, w1 = 0.0f, nl0, nl1 = 0.0f, hh0, hh1 = 1.0f;
+            light_terms(p, i, nx, ny, nz, inv, vx, vy, vz, &w0, &nl0, &hh0);
+            if (two) light_terms(p, i + 1, nx, ny, nz, inv, vx, vy, vz, &w1, &nl1, &hh1);
             if (p->ks != 0.0f) {           /* ks == 0: the term is +0 */
-                const float hx = lx + vx, hy = ly + vy, hz = lz + vz;
-                const float hh = (hx * hx + hy * hy) + hz * hz;
-                if (hh > 1.0e-12f) {        /* L == -V: no half vector */
-                    float ndh = ((nx * hx + ny * hy) + nz * hz) / sqrtf(hh);
-                    w = w + p->ks * fuse__pow01(ndh, p->shininess);
+                /* hh <= 1e-12 (L == -V): no half vector, no specular */
+                const int g0 = hh0 > 1.0e-12f, g1 = hh1 > 1.0e-12f;
+                const float n0 = fuse__max0(nl0 + ndv), n1 = fuse__max0(nl1 + ndv);
+                float x0s, x1s;
+                if (two) {
+                    const float a0 = g0 ? hh0 : 1.0f, a1 = g1 ? hh1 : 1.0f;
+                    const float d = 1.0f / (a0 * a1);
+                    x0s = (n0 * n0) * (a1 * d);
+                    x1s = (n1 * n1) * (a0 * d);
+                    if (g1) w1 = w1 + p->ks * fuse__spec01(x1s, p->shininess, p->ipow);
+                } else {
+                    x0s = g0 ? (n0 * n0) / hh0 : 0.0f;
                 }
+                if (g0) w0 = w0 + p->ks * fuse__spec01(x0s, p->shininess, p->ipow);
             }
-            C[0] = C[0] + p->color[i][0] * w;
-            C[1] = C[1] + p->color[i][1] * w;
-            C[2] = C[2] + p->color[i][2] * w;
+            C[0] = C[0] + p->color_t[i][0] * w0;
+            C[1] = C[1] + p->color_t[i][1] * w0;
+            C[2] = C[2] + p->color_t[i][2] * w0;
+            if (two) {
+                C[0] = C[0] + p->color_t[i + 1][0] * w1;
+                C[1] = C[1] + p->color_t[i + 1][1] * w1;
+                C[2] = C[2] + p->color_t[i + 1][2] * w1;
+            }
         }
         t = fuse__clamp01(1.0f - ndv);      /* Schlick's (1 - cos)^5 */
         t2 = t * t;
         fade = fuse__clamp01(1.0f - p->kf * ((t2 * t2) * t));
-        mp = ((float)M * FUSE__INV255) * fade;
+        m = (float)M * fade;                /* 255 m' */
         for (c = 0; c < 3; c++) {
-            float v = fuse__clamp01((((float)P[c] * FUSE__INV255) * C[c]) * p->tone[c]);
-            out[c] = fuse__unorm8(mp * v);
+            const float v = fuse__clamp01((float)P[c] * C[c]);
+            out[c] = fuse__round8(m * v);
         }
-        out[3] = fuse__unorm8(mp);
+        out[3] = fuse__round8(m);
     }
 }
 

@@ -93,7 +93,6 @@ SIMD_INL int mask_zero(const uint8_t *p)
 #endif
 #define STORE_RGBA(p, v) vi_storeu((int32_t *)(void *)(p), v)
 #define STORE_ZERO(p) vi_storeu((int32_t *)(void *)(p), vi_zero())
-#define IZERO_IF_EQ0(m, v) vi_sel(vi_eq(m, vi_zero()), vi_zero(), v)
 #define LIGHT_ROW_NAME SIMD_FN(fuse__light_row)
 #define POW_ROW_NAME SIMD_FN(fuse__pow01_row)
 #define LOADF(p) vf_loadu(p)
@@ -181,86 +180,166 @@ static inline VF clamp01_lanes(VF v)
     return FMAX0(FMIN1(v));
 }
 
-/* (int)(v * 255 + 0.5), v in [0, 1] */
-static inline VI unorm8_lanes(VF v)
+/* fuse__round8 before its last step: the bits of v + 2^23 (v in [0, 255]),
+ * 0x4B000000 | round(v); the byte is the low 8 bits. */
+static inline VI round_lanes(VF v)
 {
-    return F2I_TRUNC(FADD(FMUL(v, F1(255.0f)), F1(0.5f)));
+    return FBITS(FADD(v, F1(FUSE__MAGIC)));
+}
+
+/* fuse__spec01 in lanes, for nl lights (1 or 2, a constant at each call)
+ * of nu vectors x2[j][u] (the squared cosines); n = fuse__pow_int(s)
+ * (uniform). The squarings of the lights and vectors interleave. */
+static inline __attribute__((always_inline)) void spec01_lanes(int nl, VF (*x2)[U_MAX], float s,
+                                                               int n, int nu, VF (*r)[U_MAX])
+{
+    VF p[2][U_MAX];
+    int j, u;
+    if (n == 0) {
+        _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
+            pow01_lanes(x2[j], F1(s * 0.5f), fuse__pow_int(s * 0.5f), nu, r[j]);
+        return;
+    }
+    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = F1(1.0f);
+    if (n >= 2) {
+        VF b[2][U_MAX];
+        int k = n >> 1;
+        _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH b[j][u] = x2[j][u];
+        for (;;) {
+            if (k & 1) _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = FMUL(p[j][u], b[j][u]);
+            k >>= 1;
+            if (k == 0) break;
+            _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH b[j][u] = FMUL(b[j][u], b[j][u]);
+        }
+    }
+    if (n & 1) _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = FMUL(p[j][u], FSQRT(x2[j][u]));
+    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH {   /* the early returns of fuse__spec01 */
+        const VF q = FSEL(FGE(x2[j][u], F1(1.0f)), F1(1.0f), p[j][u]);
+        r[j][u] = FZERO_UNLESS(FGT(x2[j][u], F1(FUSE__POW_MIN)), q);
+    }
+}
+
+/* Lights i .. i + nl - 1 (nl = 1 or 2, a constant at each call) added to
+ * C0..C2: the diffuse weights, the specular terms with one division for
+ * both 1 / hh of a pair (fuse__light_span_ref). */
+static inline __attribute__((always_inline)) void light_pair_lanes(
+    const fuse__light_prep *p, int i, int nl, int nu, const VF *nx, const VF *ny, const VF *nz,
+    const VF *inv, const VF *vx, const VF *vy, const VF *vz, const VF *ndv, VF *C0, VF *C1, VF *C2)
+{
+    const VF one = F1(1.0f);
+    VF w[2][U_MAX], nd[2][U_MAX], hh[2][U_MAX];
+    int j, u;
+    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) {
+        const VF lx = F1(p->dir[i + j][0]), ly = F1(p->dir[i + j][1]), lz = F1(p->dir[i + j][2]);
+        EACH {
+            const VF hx = FADD(lx, vx[u]), hy = FADD(ly, vy[u]), hz = FADD(lz, vz[u]);
+            nd[j][u] = FMUL(FADD(FADD(FMUL(nx[u], lx), FMUL(ny[u], ly)), FMUL(nz[u], lz)), inv[u]);
+            w[j][u] = FMUL(F1(p->kd), FMAX0(nd[j][u]));
+            hh[j][u] = FADD(FADD(FMUL(hx, hx), FMUL(hy, hy)), FMUL(hz, hz));
+        }
+    }
+    if (p->ks != 0.0f) {
+        VF x2[2][U_MAX], sp[2][U_MAX];
+        VM g[2][U_MAX];
+        _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
+            EACH {
+                const VF n0 = FMAX0(FADD(nd[j][u], ndv[u]));
+                g[j][u] = FGT(hh[j][u], F1(1.0e-12f));
+                x2[j][u] = FMUL(n0, n0);
+            }
+        if (nl == 2) {
+            EACH {
+                const VF a0 = FSEL(g[0][u], hh[0][u], one), a1 = FSEL(g[1][u], hh[1][u], one);
+                const VF d = FDIV(one, FMUL(a0, a1));
+                x2[0][u] = FMUL(x2[0][u], FMUL(a1, d));
+                x2[1][u] = FMUL(x2[1][u], FMUL(a0, d));
+            }
+        } else {
+            EACH x2[0][u] = FDIV(x2[0][u], hh[0][u]);
+        }
+        spec01_lanes(nl, x2, p->shininess, p->ipow, nu, sp);
+        _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
+            EACH w[j][u] = FSEL(g[j][u], FADD(w[j][u], FMUL(F1(p->ks), sp[j][u])), w[j][u]);
+    }
+    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
+        EACH {
+            C0[u] = FADD(C0[u], FMUL(F1(p->color_t[i + j][0]), w[j][u]));
+            C1[u] = FADD(C1[u], FMUL(F1(p->color_t[i + j][1]), w[j][u]));
+            C2[u] = FADD(C2[u], FMUL(F1(p->color_t[i + j][2]), w[j][u]));
+        }
 }
 
 /* The pixels x .. x + nu LANES - 1 of the row (fuse__light_span_ref lane
- * by lane), stored to out. */
+ * by lane), stored to out. pyy = py * py + 1 of the row. */
 static inline __attribute__((always_inline)) void light_lanes(const fuse__light_prep *p, VF py,
-                                                              int x, int nu, const uint8_t *P,
+                                                              VF pyy, int x, int nu,
+                                                              const uint8_t *P,
                                                               const uint8_t *mask,
                                                               const float *normal, uint8_t *out)
 {
-    const VF one = F1(1.0f), inv255 = F1(FUSE__INV255);
+    const VF one = F1(1.0f);
     VI Mi[U_MAX], pix;
-    VF px[U_MAX], il[U_MAX], vx[U_MAX], vy[U_MAX], vz[U_MAX], nx[U_MAX], ny[U_MAX], nz[U_MAX];
-    VF nn[U_MAX], inv[U_MAX], ndv[U_MAX], C0[U_MAX], C1[U_MAX], C2[U_MAX];
+    VF mpx[U_MAX], vv[U_MAX], sv[U_MAX], sn[U_MAX], r[U_MAX], il[U_MAX], inv[U_MAX];
+    VF vx[U_MAX], vy[U_MAX], vz[U_MAX], nx[U_MAX], ny[U_MAX], nz[U_MAX];
+    VF nn[U_MAX], ndv[U_MAX], C0[U_MAX], C1[U_MAX], C2[U_MAX];
     VM ok[U_MAX];
     int u, i;
     EACH {
         Mi[u] = LOAD_MASK(mask + x + u * LANES);
-        px[u] = FMUL(FSUB(FADD(I2F(IADD(I1(x + u * LANES), LANE_INDEX)), F1(0.5f)), F1(p->cx)),
-                     F1(p->ifx));
-    }
-    EACH il[u] = FDIV(one, FSQRT(FADD(FADD(FMUL(px[u], px[u]), FMUL(py, py)), one)));
-    EACH {
-        vx[u] = FNEG(FMUL(px[u], il[u]));
-        vy[u] = FMUL(py, il[u]);
-        vz[u] = il[u];
+        mpx[u] = FADD(FMUL(I2F(IADD(I1(x + u * LANES), LANE_INDEX)), F1(p->nifx)), F1(p->mo));
+        vv[u] = FADD(FMUL(mpx[u], mpx[u]), pyy);
     }
     EACH {
         LOAD_NORMALS(normal + 3 * (size_t)(x + u * LANES), nx[u], ny[u], nz[u]);
         nn[u] = FADD(FADD(FMUL(nx[u], nx[u]), FMUL(ny[u], ny[u])), FMUL(nz[u], nz[u]));
         ok[u] = MAND(FGT(nn[u], F1(1.0e-30f)), FLT(nn[u], F1(1.0e30f)));
     }
-    EACH inv[u] = FDIV(one, FSQRT(nn[u]));
     EACH {
-        nx[u] = FSEL(ok[u], FMUL(nx[u], inv[u]), vx[u]);
-        ny[u] = FSEL(ok[u], FMUL(ny[u], inv[u]), vy[u]);
-        nz[u] = FSEL(ok[u], FMUL(nz[u], inv[u]), vz[u]);
-        ndv[u] = FADD(FADD(FMUL(nx[u], vx[u]), FMUL(ny[u], vy[u])), FMUL(nz[u], vz[u]));
-        C0[u] = F1(p->ambient[0]);
-        C1[u] = F1(p->ambient[1]);
-        C2[u] = F1(p->ambient[2]);
+        sv[u] = FSQRT(vv[u]);
+        sn[u] = FSQRT(nn[u]);
     }
-    for (i = 0; i < p->light_count; i++) {
-        const VF lx = F1(p->dir[i][0]), ly = F1(p->dir[i][1]), lz = F1(p->dir[i][2]);
-        VF w[U_MAX];
-        EACH w[u] = FMUL(F1(p->kd), FMAX0(FADD(FADD(FMUL(nx[u], lx), FMUL(ny[u], ly)), FMUL(nz[u], lz))));
-        if (p->ks != 0.0f) {
-            VF hh[U_MAX], ndh[U_MAX], sp[U_MAX];
-            EACH {
-                const VF hx = FADD(lx, vx[u]), hy = FADD(ly, vy[u]), hz = FADD(lz, vz[u]);
-                hh[u] = FADD(FADD(FMUL(hx, hx), FMUL(hy, hy)), FMUL(hz, hz));
-                ndh[u] = FADD(FADD(FMUL(nx[u], hx), FMUL(ny[u], hy)), FMUL(nz[u], hz));
-            }
-            EACH ndh[u] = FDIV(ndh[u], FSQRT(hh[u]));
-            pow01_lanes(ndh, F1(p->shininess), p->ipow, nu, sp);
-            EACH w[u] = FSEL(FGT(hh[u], F1(1.0e-12f)), FADD(w[u], FMUL(F1(p->ks), sp[u])), w[u]);
-        }
-        EACH {
-            C0[u] = FADD(C0[u], FMUL(F1(p->color[i][0]), w[u]));
-            C1[u] = FADD(C1[u], FMUL(F1(p->color[i][1]), w[u]));
-            C2[u] = FADD(C2[u], FMUL(F1(p->color[i][2]), w[u]));
-        }
+    EACH {
+        nx[u] = FSEL(ok[u], nx[u], mpx[u]);
+        ny[u] = FSEL(ok[u], ny[u], py);
+        nz[u] = FSEL(ok[u], nz[u], one);
+        sn[u] = FSEL(ok[u], sn[u], sv[u]);
     }
+    EACH r[u] = FDIV(one, FMUL(sn[u], sv[u]));
+    EACH {
+        il[u] = FMUL(sn[u], r[u]);
+        inv[u] = FMUL(sv[u], r[u]);
+        vx[u] = FMUL(mpx[u], il[u]);
+        vy[u] = FMUL(py, il[u]);
+        vz[u] = il[u];
+        ndv[u] = FMUL(FADD(FADD(FMUL(nx[u], mpx[u]), FMUL(ny[u], py)), nz[u]), r[u]);
+        C0[u] = F1(p->ambient_t[0]);
+        C1[u] = F1(p->ambient_t[1]);
+        C2[u] = F1(p->ambient_t[2]);
+    }
+    for (i = 0; i + 2 <= p->light_count; i += 2)
+        light_pair_lanes(p, i, 2, nu, nx, ny, nz, inv, vx, vy, vz, ndv, C0, C1, C2);
+    if (i < p->light_count)
+        light_pair_lanes(p, i, 1, nu, nx, ny, nz, inv, vx, vy, vz, ndv, C0, C1, C2);
     EACH {
         const VF t = clamp01_lanes(FSUB(one, ndv[u]));
         const VF t2 = FMUL(t, t);
         const VF fade = clamp01_lanes(FSUB(one, FMUL(F1(p->kf), FMUL(FMUL(t2, t2), t))));
-        const VF mp = FMUL(FMUL(I2F(Mi[u]), inv255), fade);
+        const VF m = FMUL(I2F(Mi[u]), fade);
         VF v0, v1, v2;
         VI rgba;
         pix = LOAD_RGBA(P + 4 * (size_t)(x + u * LANES));
-        v0 = clamp01_lanes(FMUL(FMUL(FMUL(I2F(IAND(pix, I1(255))), inv255), C0[u]), F1(p->tone[0])));
-        v1 = clamp01_lanes(FMUL(FMUL(FMUL(I2F(IAND(ISRL(pix, 8), I1(255))), inv255), C1[u]), F1(p->tone[1])));
-        v2 = clamp01_lanes(FMUL(FMUL(FMUL(I2F(IAND(ISRL(pix, 16), I1(255))), inv255), C2[u]), F1(p->tone[2])));
-        rgba = IOR(IOR(unorm8_lanes(FMUL(mp, v0)), ISLL(unorm8_lanes(FMUL(mp, v1)), 8)),
-                   IOR(ISLL(unorm8_lanes(FMUL(mp, v2)), 16), ISLL(unorm8_lanes(mp), 24)));
-        STORE_RGBA(out + 4 * (size_t)(x + u * LANES), IZERO_IF_EQ0(Mi[u], rgba));
+        v0 = clamp01_lanes(FMUL(I2F(IAND(pix, I1(255))), C0[u]));
+        v1 = clamp01_lanes(FMUL(I2F(IAND(ISRL(pix, 8), I1(255))), C1[u]));
+        v2 = clamp01_lanes(FMUL(I2F(IAND(ISRL(pix, 16), I1(255))), C2[u]));
+        /* the shifts left by 8, 16, 24 drop the 0x4B of the upper bytes */
+        rgba = IOR(IOR(IAND(round_lanes(FMUL(m, v0)), I1(255)), ISLL(round_lanes(FMUL(m, v1)), 8)),
+                   IOR(ISLL(round_lanes(FMUL(m, v2)), 16), ISLL(round_lanes(m), 24)));
+        /* A lane with M == 0 is (0, 0, 0, 0) without a select: every value
+         * above is finite there (a normal without a usable length is
+         * replaced by v, P is a byte, the parameters are bounded), fade and
+         * v lie in [0, 1], so m = 0 * fade = +0 and every channel rounds
+         * +0 to 0, as the reference writes. */
+        STORE_RGBA(out + 4 * (size_t)(x + u * LANES), rgba);
     }
 }
 
@@ -271,22 +350,23 @@ void SIMD_FN(fuse__light_span)(const fuse__light_prep *p, int y, int x0, int wid
                                const uint8_t *P, const uint8_t *mask,
                                const float *normal, uint8_t *out)
 {
-    const VF py = F1((((float)y + 0.5f) - p->cy) * p->ify);
+    const float pys = (((float)y + 0.5f) - p->cy) * p->ify;
+    const VF py = F1(pys), pyy = F1(pys * pys + 1.0f);
     int x = x0;
     for (; x + 2 * LANES <= width; x += 2 * LANES) {
         const int z0 = MASK_ZERO(mask + x), z1 = MASK_ZERO(mask + x + LANES);
         if (!z0 && !z1) {
-            light_lanes(p, py, x, 2, P, mask, normal, out);
+            light_lanes(p, py, pyy, x, 2, P, mask, normal, out);
             continue;
         }
         if (z0) STORE_ZERO(out + 4 * (size_t)x);
-        else light_lanes(p, py, x, 1, P, mask, normal, out);
+        else light_lanes(p, py, pyy, x, 1, P, mask, normal, out);
         if (z1) STORE_ZERO(out + 4 * (size_t)(x + LANES));
-        else light_lanes(p, py, x + LANES, 1, P, mask, normal, out);
+        else light_lanes(p, py, pyy, x + LANES, 1, P, mask, normal, out);
     }
     for (; x + LANES <= width; x += LANES) {
         if (MASK_ZERO(mask + x)) STORE_ZERO(out + 4 * (size_t)x);
-        else light_lanes(p, py, x, 1, P, mask, normal, out);
+        else light_lanes(p, py, pyy, x, 1, P, mask, normal, out);
     }
     if (x < width)
         fuse__light_span_ref(p, y, x, width, P, mask, normal, out);
