@@ -6,7 +6,9 @@
  * display's size; bad options (an unknown view, an IPD or a camera offset
  * out of range, reprojection with --aa), on the command line or in the
  * cockpit file ([run] view, [hmd] ipd / camera-offset), exit 2 with the
- * option and the range named and write nothing. */
+ * option and the range named and write nothing. Soft silhouettes are
+ * render's default in the crop view, --hard-edges the binary mask, and
+ * --soft-edges with --aa or the reprojected view a usage error. */
 #include "support/testutil.h"
 #include <cmocka.h>
 
@@ -121,6 +123,45 @@ static void result_render_both_views(void **state)
     assert_true(tu_exists(p));
 }
 
+/* Bytes of two outputs that differ (both 1280x800 RGB). */
+static long differing(const char *a, const char *b)
+{
+    io_image x, y;
+    io_error err;
+    assert_int_equal(io_image_load(a, IO_U8, 3, &x, &err), IO_OK);
+    assert_int_equal(io_image_load(b, IO_U8, 3, &y, &err), IO_OK);
+    long n = 0;
+    for (int r = 0; r < x.height; r++)
+        for (int i = 0; i < 3 * x.width; i++)
+            n += ((const uint8_t *)x.data)[(size_t)r * x.stride + (size_t)i] !=
+                 ((const uint8_t *)y.data)[(size_t)r * y.stride + (size_t)i];
+    io_image_free(&x);
+    io_image_free(&y);
+    return n;
+}
+
+/* Soft silhouettes are render's default in the crop view (--soft-edges
+ * gives the same bytes), --hard-edges the binary mask: the two differ only
+ * along the quad's outline, a band of a few thousand bytes, not its inside. */
+static void result_soft_edges_default(void **state)
+{
+    (void)state;
+    char o[3][800], p[3][900];
+    const char *flag[3] = {NULL, "--soft-edges", "--hard-edges"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(o[k], sizeof o[k], "%s/edges%d", dir, k);
+        int rc = run("render", "--scene", scene, "--out", o[k], "--quiet", flag[k] ? flag[k] : NULL,
+                     NULL);
+        if (rc != 0) fail_msg("rc %d: %s", rc, out);
+        snprintf(p[k], sizeof p[k], "%s/edges%d/left_0000.png", dir, k);
+    }
+    assert_int_equal(differing(p[0], p[1]), 0);
+    long d = differing(p[0], p[2]);
+    print_message("NOTE soft against hard edges: %ld bytes differ\n", d);
+    assert_true(d > 500);
+    assert_true(d < 3 * 40000);
+}
+
 static void expect_usage(const char *what, const char *dir_out, const char *const *args, int n)
 {
     char *argv[24];
@@ -158,6 +199,10 @@ static void validity_bad_options(void **state)
     const char *a6[] = {"run", "--view", "reproject", "--hmd-camera-offset", "0.5"};
     expect_usage("the camera offset D (--hmd-camera-offset) 0.5 m is outside 0..0.25 m", o, a6,
                  5);
+    const char *a9[] = {"render", "--scene", scene, "--out", o, "--soft-edges", "--aa", "4"};
+    expect_usage("--soft-edges: not with --aa", o, a9, 8);
+    const char *a10[] = {"run", "--view", "reproject", "--soft-edges"};
+    expect_usage("--soft-edges: not with --view reproject", o, a10, 4);
     const char *a7[] = {"run", "--view", "sideways"};
     expect_usage("--view 'sideways'", o, a7, 3);
     /* the cockpit file's key: [run] view = ... is --view */
@@ -176,6 +221,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(result_render_both_views),
+        cmocka_unit_test(result_soft_edges_default),
         cmocka_unit_test(validity_bad_options),
     };
     return cmocka_run_group_tests_name("cli_view", tests, setup, teardown);

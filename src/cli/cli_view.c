@@ -32,6 +32,17 @@ int cli_view_check(const char *cmd, int view, int aa, const kin_sthmd_desc *hmd)
     return EXIT_OK;
 }
 
+int cli_soft_edges(const char *cmd, int *soft, int aa, int view)
+{
+    int can = !aa && view == PIPE_VIEW_CROP;
+    if (*soft == 1 && !can)
+        return cli_usage_error(cmd, "--soft-edges: not with %s (it softens the binary mask "
+                                    "of the camera's crop)",
+                               aa ? "--aa" : "--view reproject");
+    if (*soft < 0) *soft = can;
+    return EXIT_OK;
+}
+
 int cli_hmd_len_parse(const char *cmd, const char *opt, const char *arg, float lo, float hi,
                       float *out)
 {

@@ -15,7 +15,7 @@ static const char *render_usage =
     "                      [--masks] [--quiet] [--threads 1|2] [--no-depth]\n"
     "                      [--tone-match S] [--pose animation|tracking]\n"
     "                      [--calib FILE] [--predict MS] [--no-filter]\n"
-    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--soft-edges] [--edge-fade K] [--hide PARTS]\n"
+    "                      [--refine BAND] [--smooth-normals R] [--aa N] [--soft-edges|--hard-edges] [--edge-fade K] [--hide PARTS]\n"
     "                      [--prop MODEL@X,Y,Z[,YAW]]... [--allow-outside]\n"
     "                      [--lod MODE] [--lod-px PX] [--view crop|reproject]\n"
     "                      [--hmd-ipd M] [--hmd-camera-offset M]\n"
@@ -98,7 +98,8 @@ static const char *render_usage =
     "  --soft-edges   soft silhouettes at the cost of one pass over the mask:\n"
     "                 its edge pixels fade by the share of their 3x3 window\n"
     "                 inside it, a one-pixel ramp instead of stair-steps\n"
-    "                 (not with --aa or --view reproject)\n"
+    "                 (the default, except with --aa or --view reproject)\n"
+    "  --hard-edges   the binary mask's stair-stepped silhouettes\n"
     "  --edge-fade K  soft viewport edges: where the camera image ends inside\n"
     "                 the display, the hands fade over its last K pixels\n"
     "                 (1..64; 0: off, a hard cut); default 4\n"
@@ -561,7 +562,7 @@ done:
 enum { O_SCENE = 256, O_OUT, O_FIRST, O_FRAMES, O_MASKS, O_QUIET, O_SAMPLES, O_THREADS,
        O_NO_DEPTH, O_TONE, O_CULL, O_POSE, O_CALIB, O_PREDICT, O_NO_FILTER, O_REFINE, O_HIDE,
        O_PROP, O_SMOOTH, O_ALLOW_OUTSIDE, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
-       O_HMD_CALIB_R, O_AA, O_VIEW, O_HMD_IPD, O_HMD_OFFSET, O_EDGE_FADE, O_SOFT };
+       O_HMD_CALIB_R, O_AA, O_VIEW, O_HMD_IPD, O_HMD_OFFSET, O_EDGE_FADE, O_SOFT, O_HARD };
 
 /* --aa N: 0 (off), 4, 8 or 16 samples per pixel. 1, or 0 for another. */
 static int parse_aa(const char *s, int *aa)
@@ -619,6 +620,7 @@ int cmd_render(int argc, char **argv)
         {"aa", required_argument, 0, O_AA},
         {"edge-fade", required_argument, 0, O_EDGE_FADE},
         {"soft-edges", no_argument, 0, O_SOFT},
+        {"hard-edges", no_argument, 0, O_HARD},
         {"tone-match", required_argument, 0, O_TONE},
         {"pose", required_argument, 0, O_POSE},
         {"calib", required_argument, 0, O_CALIB},
@@ -639,6 +641,7 @@ int cmd_render(int argc, char **argv)
     render_opts o = {0};
     o.lod = CLI_LOD_DEFAULT;
     o.lod_px = CLI_LOD_PX_DEFAULT;
+    o.soft_edge = -1; /* the default: cli_soft_edges */
     char why[200];
     int tracking_only = 0;   /* an option that needs --pose tracking */
     optind = 1;
@@ -666,6 +669,7 @@ int cmd_render(int argc, char **argv)
         case O_NO_DEPTH: o.no_depth = 1; break;
         case O_CULL: o.cull_back = 1; break;
         case O_SOFT: o.soft_edge = 1; break;
+        case O_HARD: o.soft_edge = 0; break;
         case O_LOD:
             if (!cli_lod_parse(optarg, &o.lod))
                 return cli_usage_error("render", "--lod '%s': off, auto or a level 0..%d",
@@ -751,9 +755,10 @@ int cmd_render(int argc, char **argv)
     if (optind < argc) return cli_usage_error("render", "unexpected argument '%s'", argv[optind]);
     if (!o.scene) return cli_usage_error("render", "--scene is required");
     if (!o.out) return cli_usage_error("render", "--out is required");
-    if (o.soft_edge && (o.aa || o.view != PIPE_VIEW_CROP))
-        return cli_usage_error("render", "--soft-edges: not with --aa or --view reproject (it "
-                               "softens the binary mask of the camera's crop)");
+    {
+        int sr = cli_soft_edges("render", &o.soft_edge, o.aa, o.view);
+        if (sr != EXIT_OK) return sr;
+    }
     if (tracking_only && !o.pose_tracking)
         return cli_usage_error("render", "%s needs --pose tracking",
                                tracking_only == O_CALIB ? "--calib"

@@ -623,6 +623,7 @@ static int run(const run_opts *o)
     pd.aa_samples = o->aa;
     pd.eye_view = o->view;
     pd.edge_fade = o->edge_fade;
+    pd.soft_edge = o->soft_edge;
     pd.fit_rig = o->refine && tracked ? &r->rig : NULL;
     if (!(r->pipe = pipe_create(&pd, model))) {
         if (o->aa && (kin_lens_distorts(&pd.hmd.lens[0]) || kin_lens_distorts(&pd.hmd.lens[1])))

@@ -39,6 +39,7 @@ typedef struct run_opts {
     int aa;                   /* coverage samples per pixel (--aa); 0 = off */
     int view;                 /* --view: PIPE_VIEW_CROP (default), _REPROJECT */
     int edge_fade;            /* pipe_desc.edge_fade (--edge-fade): 0 default, -1 off */
+    int soft_edge;            /* pipe_desc.soft_edge (--soft-edges, --hard-edges) */
     float predict_ms;         /* pose time = camera time + this */
     unsigned hide;            /* PIPE_PART_* bits hidden */
     kin_sthmd_desc hmd;       /* zero fields = the paper's */

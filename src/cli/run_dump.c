@@ -169,6 +169,7 @@ int run_dump_frame(const run_opts *o, const run_dump_src *r, const pipe_frame_in
     else if (o->lod) bad |= fprintf(f, " --lod %d", o->lod) < 0;
     if (o->aa) bad |= fprintf(f, " --aa %d", o->aa) < 0;
     if (o->edge_fade) bad |= fprintf(f, " --edge-fade %d", o->edge_fade < 0 ? 0 : o->edge_fade) < 0;
+    bad |= fprintf(f, o->soft_edge ? " --soft-edges" : " --hard-edges") < 0;
     if (o->refine) bad |= fprintf(f, " --refine %d # the elbow fit's learned state differs", o->refine) < 0;
     bad |= fputc('\n', f) == EOF;
     bad |= fclose(f) != 0;

@@ -104,6 +104,10 @@ const char *run_usage =
     "  --lod-px PX      the error auto allows, pixels (default 2)\n"
     "  --aa N           anti-aliased silhouettes: N coverage samples per pixel\n"
     "                   (4, 8 or 16; 0: off, the binary mask); default 0\n"
+    "  --soft-edges     soft silhouettes: the mask's edge pixels fade by the\n"
+    "                   share of their 3x3 window inside it (the default,\n"
+    "                   except with --aa or --view reproject; docs/antialias.md)\n"
+    "  --hard-edges     the binary mask's stair-stepped silhouettes\n"
     "  --edge-fade K    soft viewport edges: the hands fade over the last K\n"
     "                   camera pixels (1..64; 0: off, a hard cut); default 4\n"
     "  --quiet          no status line\n"
@@ -120,7 +124,7 @@ enum {
     O_NN_OFFSET, O_NN_CMDPORT, O_NN_DATAPORT, O_LOOP, O_HOLD, O_ALLOW_OUTSIDE, O_AA,
     O_HMD_CAM, O_HMD_CAM_HFOV, O_HMD_BASE, O_HMD_OFFSET, O_HMD_DISP, O_HMD_HFOV, O_HMD_VFOV,
     O_HMD_FOCAL, O_HMD_IPD, O_HMD_PRESET, O_DUMP, O_LOD, O_LOD_PX, O_HMD_CALIB, O_HMD_CALIB_L,
-    O_HMD_CALIB_R, O_VIEW, O_EDGE_FADE
+    O_HMD_CALIB_R, O_VIEW, O_EDGE_FADE, O_SOFT, O_HARD
 };
 
 static const struct option run_long_opts[] = {
@@ -149,6 +153,8 @@ static const struct option run_long_opts[] = {
     {"lod-px", required_argument, 0, O_LOD_PX},
     {"aa", required_argument, 0, O_AA},
     {"edge-fade", required_argument, 0, O_EDGE_FADE},
+    {"soft-edges", no_argument, 0, O_SOFT},
+    {"hard-edges", no_argument, 0, O_HARD},
     {"config", required_argument, 0, O_CONFIG},
     {"stats", required_argument, 0, O_STATS},
     {"predict-ms", required_argument, 0, O_PREDICT},
@@ -275,6 +281,7 @@ int run_parse(int argc, char **argv, run_opts *o)
     o->virt_stale_ms = 200;
     o->lod = CLI_LOD_DEFAULT;
     o->lod_px = CLI_LOD_PX_DEFAULT;
+    o->soft_edge = -1; /* the default: cli_soft_edges */
 
     /* ---- --config first: its options go before the command line's */
     const char *config = NULL;
@@ -401,6 +408,8 @@ int run_parse(int argc, char **argv, run_opts *o)
             o->edge_fade = v == 0 ? -1 : v;
             break;
         }
+        case O_SOFT: o->soft_edge = 1; break;
+        case O_HARD: o->soft_edge = 0; break;
         case O_STATS: o->stats = optarg; break;
         case O_DUMP: o->dump = optarg; break;
         case O_HIDE: {
@@ -513,6 +522,8 @@ int run_parse(int argc, char **argv, run_opts *o)
     }
     {
         int vr = cli_view_check("run", o->view, o->aa, &o->hmd);
+        if (vr != EXIT_OK) return vr;
+        vr = cli_soft_edges("run", &o->soft_edge, o->aa, o->view);
         if (vr != EXIT_OK) return vr;
     }
     if (!o->sel[0] != !o->sel[1]) return cli_usage_error("run", "give both --left and --right");
