@@ -68,10 +68,10 @@ static void quads_model(kin_model *m, int n, const float *s, const float *z)
     assert_int_equal(kin_model_validate(m, why, sizeof why), 0);
 }
 
-/* A closed cube of half size s around the origin, normals outward. */
-static void cube_model(kin_model *m, float s)
+/* The six faces of a closed cube of half size s around the origin,
+ * normals outward: vertices 0..23 and indices 0..35 of t. */
+static void cube_faces(tu_mesh_parts t, float s)
 {
-    tu_mesh_parts t = tu_mesh_model(m, "head", "cube", 24, 36, 1);
     for (int f = 0; f < 6; f++) {
         int ax = f / 2;
         float sg = (f & 1) ? 1.0f : -1.0f;
@@ -87,6 +87,13 @@ static void cube_model(kin_model *m, float s)
         const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
         for (int i = 0; i < 6; i++) t.idx[6 * f + i] = ix[i] + 4u * (uint32_t)f;
     }
+}
+
+/* A closed cube of half size s around the origin, normals outward. */
+static void cube_model(kin_model *m, float s)
+{
+    tu_mesh_parts t = tu_mesh_model(m, "head", "cube", 24, 36, 1);
+    cube_faces(t, s);
     char why[200];
     assert_int_equal(kin_model_validate(m, why, sizeof why), 0);
 }
@@ -752,21 +759,7 @@ static void result_fill_row_rule(void **state)
 static void cube_quad_model(kin_model *m, float s, float q, float z)
 {
     tu_mesh_parts t = tu_mesh_model(m, "head", "cubequad", 28, 42, 1);
-    for (int f = 0; f < 6; f++) {
-        int ax = f / 2;
-        float sg = (f & 1) ? 1.0f : -1.0f;
-        int u = (ax + 1) % 3, v = (ax + 2) % 3;
-        const float cu[4] = {-1, 1, 1, -1}, cv[4] = {-1, -1, 1, 1};
-        for (int i = 0; i < 4; i++) {
-            float *p = t.pos + 3 * (4 * f + i);
-            p[ax] = sg * s;
-            p[u] = cu[i] * s;
-            p[v] = cv[i] * s;
-            t.nrm[3 * (4 * f + i) + ax] = sg;
-        }
-        const uint32_t ix[6] = {0, 1, 2, 0, 2, 3};
-        for (int i = 0; i < 6; i++) t.idx[6 * f + i] = ix[i] + 4u * (uint32_t)f;
-    }
+    cube_faces(t, s);
     const float p[12] = {-q, -q, z, q, -q, z, q, q, z, -q, q, z};
     memcpy(t.pos + 72, p, sizeof p);
     for (int i = 0; i < 4; i++) t.nrm[72 + 3 * i + 2] = 1.0f;

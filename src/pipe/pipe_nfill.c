@@ -45,6 +45,28 @@ static int relax(uint16_t *dist, float *out, int w, const int b[4], int x,
     return 1;
 }
 
+/* Row y of the horizontal window sums (hs: 3 floats, hc: counts) added to
+ * (sign 1) or taken from (sign -1) the vertical sums acc / accc over the
+ * box's columns. */
+static void window_row(float *acc, int *accc, const float *hs, const uint8_t *hc, int w, int y,
+                       const int b[4], int sign)
+{
+    const float *s = hs + 3 * (size_t)y * (size_t)w;
+    const uint8_t *c = hc + (size_t)y * (size_t)w;
+    for (int x = b[0]; x < b[2]; x++) {
+        if (sign > 0) {
+            acc[3 * x] = acc[3 * x] + s[3 * x];
+            acc[3 * x + 1] = acc[3 * x + 1] + s[3 * x + 1];
+            acc[3 * x + 2] = acc[3 * x + 2] + s[3 * x + 2];
+        } else {
+            acc[3 * x] = acc[3 * x] - s[3 * x];
+            acc[3 * x + 1] = acc[3 * x + 1] - s[3 * x + 1];
+            acc[3 * x + 2] = acc[3 * x + 2] - s[3 * x + 2];
+        }
+        accc[x] += sign * (int)c[x];
+    }
+}
+
 void pipe__nfill_refined(const uint8_t *mask, const uint8_t *kmask, const float *nrm,
                          float *out, int w, int h, int r, void *scratch)
 {
@@ -101,38 +123,13 @@ void pipe__nfill_refined(const uint8_t *mask, const uint8_t *kmask, const float 
     memset(acc, 0, sizeof(float) * 3 * (size_t)w);
     memset(accc, 0, sizeof(int) * (size_t)w);
     for (int y = ya; y <= b[1] + r && y < h; y++) {
-        const float *s = hs + 3 * (size_t)y * (size_t)w;
-        const uint8_t *c = hc + (size_t)y * (size_t)w;
-        for (int x = b[0]; x < b[2]; x++) {
-            acc[3 * x] = acc[3 * x] + s[3 * x];
-            acc[3 * x + 1] = acc[3 * x + 1] + s[3 * x + 1];
-            acc[3 * x + 2] = acc[3 * x + 2] + s[3 * x + 2];
-            accc[x] += c[x];
-        }
+        window_row(acc, accc, hs, hc, w, y, b, 1);
     }
     for (int y = b[1]; y < b[3]; y++) {
         if (y > b[1]) {
             const int yi = y + r, yo = y - r - 1;
-            if (yi < h) {
-                const float *s = hs + 3 * (size_t)yi * (size_t)w;
-                const uint8_t *c = hc + (size_t)yi * (size_t)w;
-                for (int x = b[0]; x < b[2]; x++) {
-                    acc[3 * x] = acc[3 * x] + s[3 * x];
-                    acc[3 * x + 1] = acc[3 * x + 1] + s[3 * x + 1];
-                    acc[3 * x + 2] = acc[3 * x + 2] + s[3 * x + 2];
-                    accc[x] += c[x];
-                }
-            }
-            if (yo >= 0) {
-                const float *s = hs + 3 * (size_t)yo * (size_t)w;
-                const uint8_t *c = hc + (size_t)yo * (size_t)w;
-                for (int x = b[0]; x < b[2]; x++) {
-                    acc[3 * x] = acc[3 * x] - s[3 * x];
-                    acc[3 * x + 1] = acc[3 * x + 1] - s[3 * x + 1];
-                    acc[3 * x + 2] = acc[3 * x + 2] - s[3 * x + 2];
-                    accc[x] -= c[x];
-                }
-            }
+            if (yi < h) window_row(acc, accc, hs, hc, w, yi, b, 1);
+            if (yo >= 0) window_row(acc, accc, hs, hc, w, yo, b, -1);
         }
         float *o = out + 3 * (size_t)y * (size_t)w;
         uint16_t *d = dist + (size_t)y * (size_t)w;
