@@ -228,6 +228,18 @@ SIMD_INL unsigned fv_hidden(const rast_target *t, const vfloat *P, vint bx0, vin
 {
     if (!t || !lanes)
         return 0;
+    /* simd_zbox_hidden's first step for every lane at once: a depth above
+     * z.c at the box's first pixel (most visible triangles) ends the
+     * lane's test; one gather (unused lanes read pixel 0) instead of a
+     * data-dependent branch per lane. Offsets in int32: the plane's
+     * size checked. */
+    if ((size_t)t->depth_stride * (size_t)t->height <= (size_t)INT32_MAX) {
+        const vint at = vi_add(vi_mullo(by0, vi_set1(t->depth_stride)), bx0);
+        const vfloat d0 = vf_gather(t->depth, vi_sel(vm_from_bits(lanes), at, vi_zero()));
+        lanes &= ~vm_bits(vf_gt(d0, P[0]));
+        if (!lanes)
+            return 0;
+    }
     _Alignas(64) float zc[SIMD_W], zx[SIMD_W], zy[SIMD_W];
     _Alignas(64) int32_t b[4][SIMD_W];
     vf_store(zc, P[0]);
