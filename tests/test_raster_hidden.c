@@ -10,6 +10,15 @@
  * Seeded; every plane, padding included, and the
  * counters must equal the reference's.
  *
+ * The same test in the vector front ends (raster_frontv.inl, fv_hidden:
+ * records found hidden before they are written, RAST__HIDDEN): the draw
+ * through rast__draw_valid_vb (AVX2, AVX-512 front ends with their scans)
+ * against the reference, planes, counters and dirty tiles; and record by
+ * record, every record a front end marks hidden, set up without the test
+ * and scanned by the reference at that point of the draw, writes nothing
+ * (and the others are the records written without the test, byte for
+ * byte), with at least one hidden record over the cases.
+ *
  * An ISA the CPU lacks is reported ("SKIP ...") and skipped. */
 #include "support/testutil.h"
 #include <cmocka.h>
@@ -242,6 +251,162 @@ static void hidden_isa(int isa)
     assert_true(written > 0);
 }
 
+static rast_mesh_desc mesh_of(const hcase *k)
+{
+    rast_mesh_desc m;
+    memset(&m, 0, sizeof m);
+    m.clip = k->clip;
+    m.vertex_count = k->nv;
+    m.attr = k->attr;
+    m.attr_count = NA;
+    m.indices = k->idx;
+    m.tri_count = k->nt;
+    m.cull = RAST_CULL_NONE;
+    return m;
+}
+
+static int front_skip(int isa)
+{
+    if (!ef_cpu_has((ef_isa)isa)) {
+        print_message("SKIP raster hidden front %s: this CPU does not run it\n",
+                      ef_isa_name((ef_isa)isa));
+        return 1;
+    }
+    return 0;
+}
+
+/* The whole draw through the vector front end against the reference;
+ * dirty tiles against the scalar set-up's with the same scan. */
+static void front_draw_isa(int isa, const rast__setup_isa *si)
+{
+    if (front_skip(isa))
+        skip();
+    const rast__scan_rows_fn scan = rast__scan_for_isa(isa);
+    rast__vbuf *vb = rast__vbuf_alloc(12000);
+    rast__tiles *tr = calloc(1, sizeof *tr), *tg = calloc(1, sizeof *tg);
+    assert_non_null(vb);
+    assert_non_null(tr);
+    assert_non_null(tg);
+    for (int n = 0; n < NCASES; n++) {
+        hcase k;
+        make_case(n, &k);
+        const rast_mesh_desc m = mesh_of(&k);
+        rast_target ref = target_make(&k), got = target_make(&k), sc = target_make(&k);
+        rast_stats sr, sg = { 0 }, ss = { 0 };
+        draw(&k, &ref, rast__scan_rows_ref, &sr);
+        target_reset(&k, &got);
+        target_reset(&k, &sc);
+        memset(tr, 0, sizeof *tr);
+        memset(tg, 0, sizeof *tg);
+        rast__draw_valid_vb(&got, &m, &sg, scan, si, tg, vb);
+        rast__draw_valid(&sc, &m, &ss, scan, si, tr);
+        if (!planes_equal(&ref, &got) || memcmp(&sr, &sg, sizeof sr) ||
+            memcmp(tr, tg, sizeof *tr)) {
+            print_error("case %d (%dx%d, %d triangles, poison %d): the %s front end differs "
+                        "from the reference (pixels %ld / %ld)\n", n, k.w, k.h, k.nt,
+                        k.poison, ef_isa_name((ef_isa)isa), sr.pixels_written,
+                        sg.pixels_written);
+            fail();
+        }
+        rast_target *ts[3] = { &ref, &got, &sc };
+        for (int i = 0; i < 3; i++) {
+            free(ts[i]->mask);
+            free(ts[i]->depth);
+            free(ts[i]->attr);
+        }
+        free_case(&k);
+    }
+    free(tr);
+    free(tg);
+    rast__vbuf_free(vb);
+}
+
+/* Record by record: chunks set up with and without the test against the
+ * depth of the chunks before (scanned by the reference). */
+static void front_records_isa(int isa, const rast__setup_isa *si)
+{
+    if (front_skip(isa))
+        skip();
+    const size_t nout = (size_t)RAST__VX_CHUNK * RAST__MAX_FAN;
+    rast__vbuf *vb = rast__vbuf_alloc(12000);
+    rast__tri *with = malloc(nout * sizeof *with), *without = malloc(nout * sizeof *without);
+    assert_non_null(vb);
+    assert_non_null(with);
+    assert_non_null(without);
+    long hidden = 0, records = 0;
+    for (int n = 0; n < NCASES; n++) {
+        hcase k;
+        make_case(n, &k);
+        const rast_mesh_desc m = mesh_of(&k);
+        rast_target t = target_make(&k);
+        target_reset(&k, &t);
+        rast__view vw, vn;
+        rast__view_init(&vn, t.width, t.height, NA);
+        rast__view_init(&vw, t.width, t.height, NA);
+        vw.hz = &t;
+        si->vpass(&vn, m.clip, m.vertex_count, vb);
+        rast_stats s1 = { 0 }, s2 = { 0 };
+        int last[4] = { 1, 0, 1, 0 };
+        for (int ti = 0; ti < m.tri_count; ti += RAST__VX_CHUNK) {
+            const int te = m.tri_count - ti > RAST__VX_CHUNK ? ti + RAST__VX_CHUNK : m.tri_count;
+            memset(with, 0x33, nout * sizeof *with);
+            memset(without, 0x33, nout * sizeof *without);
+            const int n1 = si->frontv(&vw, &m, vb, ti, te, with, &s1, 1);
+            const int n2 = si->frontv(&vn, &m, vb, ti, te, without, &s2, 1);
+            assert_int_equal(n1, n2);
+            for (int i = 0; i < n1; i++) {
+                records++;
+                if (with[i].micro != RAST__HIDDEN) {
+                    assert_memory_equal(&with[i], &without[i], sizeof with[i]);
+                    continue;
+                }
+                hidden++;
+                assert_int_equal(without[i].micro, 0);
+                assert_memory_equal(&with[i], &without[i], 16);   /* the box */
+                if (rast__scan_rows_ref(&t, &without[i], without[i].y0, without[i].y1) != 0) {
+                    print_error("case %d: record %d of chunk %d marked hidden by the %s "
+                                "front end writes pixels\n", n, i, ti / RAST__VX_CHUNK,
+                                ef_isa_name((ef_isa)isa));
+                    fail();
+                }
+            }
+            rast__scan_list(&t, without, n2, rast__scan_rows_ref, NULL, last, 1);
+        }
+        assert_memory_equal(&s1, &s2, sizeof s1);
+        free(t.mask);
+        free(t.depth);
+        free(t.attr);
+        free_case(&k);
+    }
+    print_message("%s front end: %ld of %ld records hidden\n", ef_isa_name((ef_isa)isa), hidden,
+                  records);
+    assert_true(hidden > 0);
+    free(with);
+    free(without);
+    rast__vbuf_free(vb);
+}
+
+static void test_front_draw_avx2(void **state)
+{
+    (void)state;
+    front_draw_isa(EF_ISA_AVX2, &rast__setup_isa_avx2);
+}
+static void test_front_draw_avx512(void **state)
+{
+    (void)state;
+    front_draw_isa(EF_ISA_AVX512, &rast__setup_isa_avx512);
+}
+static void test_front_records_avx2(void **state)
+{
+    (void)state;
+    front_records_isa(EF_ISA_AVX2, &rast__setup_isa_avx2);
+}
+static void test_front_records_avx512(void **state)
+{
+    (void)state;
+    front_records_isa(EF_ISA_AVX512, &rast__setup_isa_avx512);
+}
+
 static void test_hidden_sse2(void **state) { (void)state; hidden_isa(EF_ISA_SSE2); }
 static void test_hidden_avx2(void **state) { (void)state; hidden_isa(EF_ISA_AVX2); }
 static void test_hidden_avx512(void **state) { (void)state; hidden_isa(EF_ISA_AVX512); }
@@ -252,6 +417,10 @@ int main(void)
         cmocka_unit_test(test_hidden_sse2),
         cmocka_unit_test(test_hidden_avx2),
         cmocka_unit_test(test_hidden_avx512),
+        cmocka_unit_test(test_front_draw_avx2),
+        cmocka_unit_test(test_front_draw_avx512),
+        cmocka_unit_test(test_front_records_avx2),
+        cmocka_unit_test(test_front_records_avx512),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

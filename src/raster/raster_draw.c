@@ -83,11 +83,13 @@ long rast__scan_list(const rast_target *t, const rast__tri *tri, int n,
     for (int i = 0; i < n; i++) {
         const rast__tri *r = &tri[i];
         if (micro && r->micro) {
-            /* Defensive: the empty test drops boxes up to 2x2 with no
-             * covered centre before they get a record. */
-            if (!(r->micro & 15))
-                continue;
-            px += micro_apply(t, r);
+            if (r->micro != RAST__HIDDEN) {
+                /* Defensive: the empty test drops boxes up to 2x2 with
+                 * no covered centre before they get a record. */
+                if (!(r->micro & 15))
+                    continue;
+                px += micro_apply(t, r);
+            }
         } else {
             px += scan(t, r, r->y0, r->y1);
         }
@@ -143,6 +145,8 @@ void rast__draw_valid_vb(const rast_target *t, const rast_mesh_desc *m,
     }
     rast__view view;
     rast__view_init(&view, t->width, t->height, rast__draw_na(t, m));
+    if (t->depth)
+        view.hz = t;   /* hidden records (docs/raster.md section 14) */
     rast_stats st = { 0 };
     st.tris_in = m->tri_count;
     isa->vpass(&view, m->clip, m->vertex_count, vb);

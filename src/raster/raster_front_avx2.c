@@ -333,6 +333,8 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
     _Alignas(32) int32_t cov[8] = { 0 };
     _Alignas(32) float mq[3 * 32];
     const unsigned mic = micro ? micro_lanes(qf, Lb, (const __m256i (*)[2])E, P, cov, mq) : 0u;
+    const unsigned hid =
+        fv_hidden(micro ? v->hz : NULL, P, bx0, by0, qf[Q_BX1], qf[Q_BY1], Lb & ~mic);
     /* box; the planes z.c .. q.c, q.dx .. b1.dx, b1.dy .. b2.dy */
     _Alignas(32) int32_t bq[32];
     _Alignas(32) float pq[3 * 32];
@@ -340,7 +342,7 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
           _mm256_castsi256_ps(qf[Q_BY1]), (float *)(void *)bq);
     /* the edge pairs (e_c[0], e_c[1]) .. (e_dy[0], e_dy[1]) and e_dy[2] */
     _Alignas(32) int64_t eq[4][16], e8[8];
-    if (mic != Lb) {
+    if ((mic | hid) != Lb) {
 #pragma GCC unroll 3
         for (int i = 0; i < 3; i++)
             quads(P[4 * i], P[4 * i + 1], P[4 * i + 2], P[4 * i + 3], pq + 32 * i);
@@ -357,6 +359,10 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
                                           _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
     for (int l = 0; l < k; l++) {
         rast__tri *t = out + qs[Q_SLOT][l];
+        if ((hid >> l) & 1u) {
+            front_hidden_record(t, l, bq);
+            continue;
+        }
         if (!front_write_record(t, l, (int)((mic >> l) & 1u), (unsigned)cov[l], ac, bq, mq, pq,
                                 (const int64_t (*)[2 * FRONT_V])eq, e8))
             continue;

@@ -265,6 +265,8 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
     _Alignas(64) float mq[3 * 64];
     const unsigned mic = micro ? micro_lanes(qf, L, (const __m512i (*)[2])E, P, cov, mq)
                                : 0u;
+    const unsigned hid =
+        fv_hidden(micro ? v->hz : NULL, P, bx0, by0, qf[Q_BX1], qf[Q_BY1], L & ~mic);
     /* box; the planes z.c .. q.c, q.dx .. b1.dx, b1.dy .. b2.dy */
     _Alignas(64) int32_t bq[64];
     _Alignas(64) float pq[3 * 64];
@@ -273,7 +275,7 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
     /* the edge pairs (e_c[0], e_c[1]) .. (e_dy[0], e_dy[1]) at 16 .. 79 and
      * e_dy[2] at 80 */
     _Alignas(64) int64_t eq[4][32], e8[16];
-    if (mic != L) {
+    if ((mic | hid) != L) {
 #pragma GCC unroll 3
         for (int i = 0; i < 3; i++)
             quads(P[4 * i], P[4 * i + 1], P[4 * i + 2], P[4 * i + 3], pq + 64 * i);
@@ -289,6 +291,10 @@ static void flush(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf
     const __mmask8 AM = (__mmask8)((1u << ac) - 1u);
     for (int l = 0; l < k; l++) {
         rast__tri *t = out + qs[Q_SLOT][l];
+        if ((hid >> l) & 1u) {
+            front_hidden_record(t, l, bq);
+            continue;
+        }
         if (!front_write_record(t, l, (int)((mic >> l) & 1u), (unsigned)cov[l], ac, bq, mq, pq,
                                 (const int64_t (*)[2 * FRONT_V])eq, e8))
             continue;

@@ -58,3 +58,12 @@ static inline __attribute__((always_inline)) int front_write_record(
     memcpy(&t->attr_count, &acm, 8);
     return 1;
 }
+
+/* Lane l's hidden record t (fv_hidden): the box and micro = RAST__HIDDEN,
+ * nothing else (rast__scan_list reads no other field of it). */
+static inline __attribute__((always_inline)) void front_hidden_record(rast__tri *t, int l,
+                                                                      const int32_t *bq)
+{
+    copy16(t, bq + QUAD_AT(l));
+    t->micro = RAST__HIDDEN;
+}

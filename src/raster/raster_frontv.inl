@@ -210,3 +210,52 @@ SIMD_INL void fv_micro_values(const vfloat *P, vfloat Z[4], vfloat B1[4], vfloat
         }
     }
 }
+
+/* ---- hidden records ----------------------------------------------------- */
+
+#include "raster_hidden.inl"
+
+/* The lanes (of lanes) whose record the scan would find hidden: the box
+ * depth test of the scan (simd_zbox_hidden) on the lane's float z plane
+ * (P[0 .. 2] as fv_planes: the record's z.c, z.dx, z.dy) and clamped box,
+ * over all its rows, against t's depth plane as it is now (before the
+ * scans of this chunk's earlier records: depth only decreases during a
+ * draw, so an older state is conservative). Boxes wider than four vectors
+ * are not tested (as in the scan). Only on the single-thread driver
+ * (rast__draw_valid_vb: no other thread writes t). t NULL: none. */
+SIMD_INL unsigned fv_hidden(const rast_target *t, const vfloat *P, vint bx0, vint by0, vint bx1,
+                            vint by1, unsigned lanes)
+{
+    if (!t || !lanes)
+        return 0;
+    /* simd_zbox_hidden's first step for every lane at once: a depth above
+     * z.c at the box's first pixel (most visible triangles) ends the
+     * lane's test; one gather (unused lanes read pixel 0) instead of a
+     * data-dependent branch per lane. Offsets in int32: the plane's
+     * size checked. */
+    if ((size_t)t->depth_stride * (size_t)t->height <= (size_t)INT32_MAX) {
+        const vint at = vi_add(vi_mullo(by0, vi_set1(t->depth_stride)), bx0);
+        const vfloat d0 = vf_gather(t->depth, vi_sel(vm_from_bits(lanes), at, vi_zero()));
+        lanes &= ~vm_bits(vf_gt(d0, P[0]));
+        if (!lanes)
+            return 0;
+    }
+    _Alignas(64) float zc[SIMD_W], zx[SIMD_W], zy[SIMD_W];
+    _Alignas(64) int32_t b[4][SIMD_W];
+    vf_store(zc, P[0]);
+    vf_store(zx, P[1]);
+    vf_store(zy, P[2]);
+    vi_store(b[0], bx0);
+    vi_store(b[1], by0);
+    vi_store(b[2], bx1);
+    vi_store(b[3], by1);
+    unsigned hid = 0;
+    for (unsigned bits = lanes; bits; bits &= bits - 1) {
+        const int l = __builtin_ctz(bits);
+        const int nx = b[2][l] - b[0][l] + 1;
+        if (nx <= 4 * SIMD_W &&
+            simd_zbox_hidden(t, zc[l], zx[l], zy[l], b[0][l], b[1][l], b[1][l], b[3][l], nx))
+            hid |= 1u << l;
+    }
+    return hid;
+}

@@ -78,6 +78,11 @@ typedef struct rast__view {
     int32_t min_x, max_x;    /* snapped x clamp: -G*256 .. (W+G)*256 */
     int32_t min_y, max_y;
     int attr_count;          /* attributes carried through clipping */
+    /* The target whose depth the vector front end tests boxes against
+     * before writing a record (docs/raster.md section 14): NULL (set by
+     * rast__view_init) for no test; rast__draw_valid_vb sets it when the
+     * target has depth. */
+    const rast_target *hz;
 } rast__view;
 
 /* A float plane: value at the centre of the bounding box's first pixel
@@ -115,6 +120,11 @@ typedef struct rast__tri {
     float mz[4], mb1[4], mb2[4];
 } rast__tri;
 #define RAST__MICRO 0x10
+/* micro == RAST__HIDDEN: a record the vector front end found hidden (its
+ * box holds no depth a pixel of it could pass, docs/raster.md section 14):
+ * only the box and micro are written; rast__scan_list marks its tiles as
+ * after a scan and scans nothing. */
+#define RAST__HIDDEN 0x20
 
 /* Result of rast__setup_tri. */
 enum {

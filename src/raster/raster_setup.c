@@ -36,6 +36,7 @@ void rast__view_init(rast__view *v, int width, int height, int attr_count)
     v->min_y = -RAST_GUARD_PX * RAST__FIX_ONE;
     v->max_y = (height + RAST_GUARD_PX) * RAST__FIX_ONE;
     v->attr_count = attr_count;
+    v->hz = NULL;
 }
 
 /* ---- clipping ---------------------------------------------------------- */
