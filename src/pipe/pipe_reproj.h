@@ -195,21 +195,12 @@ typedef struct pipe__reproj_tapd {
  * outside, filled, sampled and sum[] += the sampled colours; the first
  * column not done (the scalar taps finish). Equal to the scalar taps in
  * pipe_reproj.c. */
-typedef int (*pipe__reproj_taps_fn)(const pipe__reproj_tapd *t, const uint8_t *em,
-                                    const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                                    uint8_t *K, long cnt[4], uint64_t sum[3]);
-int pipe__reproj_taps_sse2(const pipe__reproj_tapd *t, const uint8_t *em,
-                           const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                           uint8_t *K, long cnt[4], uint64_t sum[3]);
-int pipe__reproj_taps_avx2(const pipe__reproj_tapd *t, const uint8_t *em,
-                           const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                           uint8_t *K, long cnt[4], uint64_t sum[3]);
-int pipe__reproj_taps_avx512(const pipe__reproj_tapd *t, const uint8_t *em,
-                             const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                             uint8_t *K, long cnt[4], uint64_t sum[3]);
-int pipe__reproj_taps_neon(const pipe__reproj_tapd *t, const uint8_t *em,
-                           const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                           uint8_t *K, long cnt[4], uint64_t sum[3]);
+typedef int pipe__reproj_taps_t(const pipe__reproj_tapd *t, const uint8_t *em,
+                                const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
+                                uint8_t *K, long cnt[4], uint64_t sum[3]);
+typedef pipe__reproj_taps_t *pipe__reproj_taps_fn;
+pipe__reproj_taps_t pipe__reproj_taps_sse2, pipe__reproj_taps_avx2, pipe__reproj_taps_avx512,
+    pipe__reproj_taps_neon;
 
 /* The fill of one eye row (THE FILL above) from its kinds K (w bytes:
  * 1 sampled, 2 filled, else 0; 8 bytes readable past w not needed): each
