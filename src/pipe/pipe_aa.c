@@ -186,17 +186,24 @@ static int band_meets(const pipe__aa *a, int x0, int y0, int x1, int y1)
            0;
 }
 
+/* buf grown to n items of size bytes when it holds fewer (*cap): the
+ * buffer, or NULL (out of memory; buf is kept and still held). */
+static void *grow(void *buf, int *cap, int n, size_t size)
+{
+    if (n <= *cap) return buf;
+    void *b = realloc(buf, size * (size_t)n);
+    if (b) *cap = n;
+    return b;
+}
+
 /* a->sxy: the pixel x, y of each vertex of clip (NaN at or behind the eye
  * plane, w <= 1e-6, or from a NaN), once per mesh for both the mesh's box
  * and the band filter. 0, or -1 (out of memory). */
 static int project_vertices(pipe__aa *a, const float *clip, int vertex_count)
 {
-    if (vertex_count > a->sxy_cap) {
-        float *n = realloc(a->sxy, sizeof *n * 2 * (size_t)vertex_count);
-        if (!n) return -1;
-        a->sxy = n;
-        a->sxy_cap = vertex_count;
-    }
+    float *n = grow(a->sxy, &a->sxy_cap, vertex_count, 2 * sizeof *n);
+    if (!n) return -1;
+    a->sxy = n;
     const float W = (float)a->width, H = (float)a->height;
     for (int i = 0; i < vertex_count; i++) {
         const float *v = clip + 4 * (size_t)i;
@@ -246,12 +253,9 @@ static void box_clamp(float b[4], float W, float H)
  * a bad index is kept (rast_draw_aa clips it, or refuses the mesh). */
 static int band_filter(pipe__aa *a, int vertex_count, const uint32_t *indices, int tri_count)
 {
-    if (tri_count > a->idx_cap) {
-        uint32_t *n = realloc(a->idx, sizeof *n * 3 * (size_t)tri_count);
-        if (!n) return -1;
-        a->idx = n;
-        a->idx_cap = tri_count;
-    }
+    uint32_t *n = grow(a->idx, &a->idx_cap, tri_count, 3 * sizeof *n);
+    if (!n) return -1;
+    a->idx = n;
     const float W = (float)a->width, H = (float)a->height;
     const float *sxy = a->sxy;
     int kept = 0;

@@ -161,21 +161,12 @@ typedef struct pipe__reproj_geo {
 
 /* The vector geometry pass per ISA (pipe_reproj_simd.inl): the first
  * column it did not do. The pinhole camera only. */
-typedef int (*pipe__reproj_row_fn)(const pipe__reproj_geo *g, const uint8_t *em,
-                                   const float *ed, const float *en, float ry, int w,
-                                   const pipe__reproj_lanes *o, long *back, float *mind);
-int pipe__reproj_row_sse2(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                          const float *en, float ry, int w, const pipe__reproj_lanes *o,
-                          long *back, float *mind);
-int pipe__reproj_row_avx2(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                          const float *en, float ry, int w, const pipe__reproj_lanes *o,
-                          long *back, float *mind);
-int pipe__reproj_row_avx512(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                            const float *en, float ry, int w, const pipe__reproj_lanes *o,
-                            long *back, float *mind);
-int pipe__reproj_row_neon(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                          const float *en, float ry, int w, const pipe__reproj_lanes *o,
-                          long *back, float *mind);
+typedef int pipe__reproj_row_t(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
+                               const float *en, float ry, int w, const pipe__reproj_lanes *o,
+                               long *back, float *mind);
+typedef pipe__reproj_row_t *pipe__reproj_row_fn;
+pipe__reproj_row_t pipe__reproj_row_sse2, pipe__reproj_row_avx2, pipe__reproj_row_avx512,
+    pipe__reproj_row_neon;
 
 /* What the taps pass needs (the camera's G-buffer of the crop, the image
  * sampled as int32 RGBA pixels). mlim: the last mask offset with 4
