@@ -55,24 +55,8 @@
  * the caller's thread only). */
 static clockid_t bench_clock = CLOCK_MONOTONIC;
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(bench_clock, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+static double now_ms(void) { return bench_now_ms(bench_clock); }
+static double median(double *v, int n) { return bench_median(v, n); }
 
 
 /* ---- the pipeline's configuration ------------------------------------- */
