@@ -436,6 +436,20 @@ static int fill_cand8(const uint8_t *m, const uint8_t *k)
     return (nz8(m) & ~nz8(k)) != 0;
 }
 
+/* The first x of x..x1-1 that m covers and mask does not (mr[x] != 0,
+ * kr[x] == 0: a pixel the normals' fill writes), else x1. */
+static int next_fill(const uint8_t *mr, const uint8_t *kr, int x, int x1)
+{
+    for (; x < x1; x++) {
+        if (x + 8 <= x1 && !fill_cand8(mr + x, kr + x)) {
+            x += 7;
+            continue;
+        }
+        if (mr[x] != 0 && kr[x] == 0) return x;
+    }
+    return x1;
+}
+
 void pipe__aa_fill_normals(pipe__aa *a, const uint8_t *m, const uint8_t *mask, float *nrm)
 {
     const int W = a->width, H = a->height;
@@ -445,12 +459,7 @@ void pipe__aa_fill_normals(pipe__aa *a, const uint8_t *m, const uint8_t *mask, f
     for (int y = b[1]; y < b[3]; y++) {
         const uint8_t *mr = m + (size_t)y * (size_t)W;
         const uint8_t *kr = mask + (size_t)y * (size_t)W;
-        for (int x = b[0]; x < b[2]; x++) {
-            if (x + 8 <= b[2] && !fill_cand8(mr + x, kr + x)) {
-                x += 7;
-                continue;
-            }
-            if (mr[x] == 0 || kr[x] != 0) continue;
+        for (int x = next_fill(mr, kr, b[0], b[2]); x < b[2]; x = next_fill(mr, kr, x + 1, b[2])) {
             float s[3] = {0.0f, 0.0f, 0.0f};
             for (int yy = y - 1; yy <= y + 1; yy++) {
                 if (yy < 0 || yy >= H) continue;
@@ -482,15 +491,9 @@ void pipe__aa_unfill(pipe__aa *a, const uint8_t *mask, float *nrm)
     for (int y = b[1]; m && y < b[3]; y++) {
         const uint8_t *mr = m + (size_t)y * (size_t)W;
         const uint8_t *kr = mask + (size_t)y * (size_t)W;
-        for (int x = b[0]; x < b[2]; x++) {
-            if (x + 8 <= b[2] && !fill_cand8(mr + x, kr + x)) {
-                x += 7;
-                continue;
-            }
-            if (mr[x] != 0 && kr[x] == 0) {
-                float *o = nrm + 3 * ((size_t)y * (size_t)W + (size_t)x);
-                o[0] = o[1] = o[2] = 0.0f;
-            }
+        for (int x = next_fill(mr, kr, b[0], b[2]); x < b[2]; x = next_fill(mr, kr, x + 1, b[2])) {
+            float *o = nrm + 3 * ((size_t)y * (size_t)W + (size_t)x);
+            o[0] = o[1] = o[2] = 0.0f;
         }
     }
     box_empty(a->nbox);
