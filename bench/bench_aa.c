@@ -52,6 +52,7 @@
 #include "../samples/gt/gt.h"
 #include "../src/fuse/fuse_metrics.h"
 #include "../src/pipe/pipe.h"
+#include "bench_util.h"
 
 enum { CW = 640, CH = 400, OW = GEN_VIRT_W, OH = GEN_VIRT_H };
 enum { M_KIN, M_REFINE, M_KIN_TRACK, M_REFINE_TRACK, M_COUNT };
@@ -74,27 +75,11 @@ typedef struct cfg_run {
     long ms_n;
 } cfg_run;
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
-}
+static double now_ms(void) { return bench_now_ms(CLOCK_MONOTONIC); }
 
 /* CPU time of the process (all threads): on a shared machine the wall
  * time also counts the time the threads wait for a core. */
-static double cpu_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
-}
-
-static int cmp_d(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
+static double cpu_ms(void) { return bench_now_ms(CLOCK_PROCESS_CPUTIME_ID); }
 
 static pipe_lighting workshop_world(const gen_scene *ws)
 {
@@ -415,8 +400,8 @@ int main(int argc, char **argv)
         cfg_run *r = &R[i];
         double *v = ms + (size_t)i * reps;
         double *cv = cpu + (size_t)i * reps;
-        qsort(v, (size_t)reps, sizeof *v, cmp_d);
-        qsort(cv, (size_t)reps, sizeof *cv, cmp_d);
+        qsort(v, (size_t)reps, sizeof *v, bench_cmp_double);
+        qsort(cv, (size_t)reps, sizeof *cv, bench_cmp_double);
         printf("%-13s %3d %9.3f %9.3f %8.4f %9.4f %9.3f %8.3f %8.3f %8.3f\n", mname[r->method], r->aa,
                fuse_psnr_of_mse(r->mse_bin / (double)r->n_eye),
                fuse_psnr_of_mse(r->mse_soft / (double)r->n_eye),

@@ -81,27 +81,11 @@
 
 /* ------------------------------------------------------------- helpers */
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
+static double now_ms(void) { return bench_now_ms(CLOCK_MONOTONIC); }
 
 /* CPU time of the whole process (every thread), ms: on a shared machine
  * the work of a frame, without the time its threads waited for a core. */
-static double cpu_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
+static double cpu_ms(void) { return bench_now_ms(CLOCK_PROCESS_CPUTIME_ID); }
 
 /* Summary of n samples (sorts v). */
 typedef struct summary { double median, p99, max, mean; } summary;
@@ -110,7 +94,7 @@ static summary summarize(double *v, int n)
 {
     summary s = {0, 0, 0, 0};
     if (n < 1) return s;
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    qsort(v, (size_t)n, sizeof *v, bench_cmp_double);
     double sum = 0;
     for (int i = 0; i < n; i++) sum += v[i];
     s.median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
@@ -486,9 +470,7 @@ static int frame_cpu_clock = 0;
 
 static double frame_ms(void)
 {
-    struct timespec ts;
-    clock_gettime(frame_cpu_clock ? CLOCK_THREAD_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
-    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
+    return bench_now_ms(frame_cpu_clock ? CLOCK_THREAD_CPUTIME_ID : CLOCK_MONOTONIC);
 }
 
 /* One whole stereo frame i: convert, track, pipe_frame. Fills slot k of

@@ -30,6 +30,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/kin/kin.h"
+#include "bench_util.h"
 
 #define PI_F 3.14159265358979f
 
@@ -51,11 +52,6 @@ static float gauss(rng *r)
 static kin_vec3 noise3(rng *r, float sigma)
 {
     return kin_v3(sigma * gauss(r), sigma * gauss(r), sigma * gauss(r));
-}
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
 }
 static double now_s(void)
 {
@@ -514,7 +510,7 @@ static void timing(void)
                     }
                     batch[bi] = (now_s() - t0) * 1e3 / frames;
                 }
-                qsort(batch, BATCHES, sizeof batch[0], cmp_double);
+                qsort(batch, BATCHES, sizeof batch[0], bench_cmp_double);
                 char cell[40];
                 snprintf(cell, sizeof cell, "%.4f (%.4f)", batch[BATCHES / 2], batch[0]);
                 printf(" %-17s", cell);

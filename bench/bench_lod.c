@@ -30,6 +30,7 @@
 #include "../src/pipe/pipe.h"
 #include "../src/pipe/pipe_lod.h"
 #include "../src/raster/raster.h"
+#include "bench_sample.h"
 #include "bench_util.h"
 
 #include <math.h>
@@ -123,16 +124,7 @@ int main(int argc, char **argv)
     io_scene sc;
     io_error err;
     kin_model model;
-    snprintf(path, sizeof path, "%s/scene.txt", dir);
-    if (io_scene_load(path, &sc, &err) != IO_OK) {
-        printf("%ssample model: skipped (%s; build/gen_samples --out %s)\n", pfx, err.msg, dir);
-        return 0;
-    }
-    io_scene_frame_path(&sc, sc.model, 0, path, sizeof path);
-    if (io_gltf_load(path, &model, &err) != IO_OK) {
-        printf("%ssample model: skipped (%s)\n", pfx, err.msg);
-        return 0;
-    }
+    if (!bench_sample_model(dir, pfx, &sc, &model, path, sizeof path)) return 0;
     pipe_lod lod;
     io_lod_desc ld = {0};
     ld.whole = whole;

@@ -7,6 +7,8 @@
 #ifndef EGOFUSE_BENCH_MESH_H
 #define EGOFUSE_BENCH_MESH_H
 
+#include "../src/raster/raster.h"
+
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -131,6 +133,41 @@ static void bm_eye_mvp(int eye, int width, int height, float mvp[16])
     mvp[11] = -1.0f;
     mvp[14] = (float)(2.0 * f * n / (n - f));
     mvp[12] = (float)(-tx * ex);    /* P * T(-ex): x' = tx*(x - ex) */
+}
+
+/* The two eyes' targets: W x H depth, coverage and 3 normal floats a
+ * pixel, each plane one allocation (eye 1 after eye 0). */
+typedef struct bm_eyes {
+    float *depth;
+    uint8_t *mask;
+    float *nrm;
+    rast_target tg[2];
+} bm_eyes;
+
+static inline void bm_eyes_free(bm_eyes *b)
+{
+    free(b->depth);
+    free(b->mask);
+    free(b->nrm);
+    memset(b, 0, sizeof *b);
+}
+
+/* 1, or 0 (nothing held) when out of memory. */
+static inline int bm_eyes_init(bm_eyes *b, int W, int H)
+{
+    b->depth = malloc((size_t)W * H * 2 * sizeof(float));
+    b->mask = malloc((size_t)W * H * 2);
+    b->nrm = malloc((size_t)W * H * 2 * 3 * sizeof(float));
+    if (!b->depth || !b->mask || !b->nrm) {
+        bm_eyes_free(b);
+        return 0;
+    }
+    for (int e = 0; e < 2; e++) {
+        rast_target t = { W, H, b->depth + (size_t)e * W * H, W, b->mask + (size_t)e * W * H, W,
+                          b->nrm + (size_t)e * W * H * 3, 3 * W, 3 };
+        b->tg[e] = t;
+    }
+    return 1;
 }
 
 #endif

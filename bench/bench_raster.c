@@ -40,6 +40,7 @@
 #include "../src/pipe/pipe.h"
 #include "../src/raster/raster.h"
 #include "bench_mesh.h"
+#include "bench_sample.h"
 #include "bench_util.h"
 
 #include <stdio.h>
@@ -54,24 +55,8 @@
  * the caller's thread only). */
 static clockid_t bench_clock = CLOCK_MONOTONIC;
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(bench_clock, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+static double now_ms(void) { return bench_now_ms(bench_clock); }
+static double median(double *v, int n) { return bench_median(v, n); }
 
 
 /* ---- the pipeline's configuration ------------------------------------- */
@@ -247,25 +232,9 @@ static int pipe_samples(int csv, const char *dir, int np, int runs, int only_isa
 {
     char path[IO_PATH_MAX + 64];
     io_scene sc;
-    io_error err;
     kin_model model;
-    snprintf(path, sizeof path, "%s/scene.txt", dir);
-    if (io_scene_load(path, &sc, &err) != IO_OK) {
-        printf("%ssample model: skipped (%s; build/gen_samples --out %s)\n", csv ? "# " : "",
-               err.msg, dir);
-        return 0;
-    }
-    io_scene_frame_path(&sc, sc.model, 0, path, sizeof path);
-    if (io_gltf_load(path, &model, &err) != IO_OK) {
-        printf("%ssample model: skipped (%s)\n", csv ? "# " : "", err.msg);
-        return 0;
-    }
-    const kin_animation *anim = NULL;
-    for (int i = 0; i < model.anim_count; i++)
-        if (!sc.animation[0] || !strcmp(model.anims[i].name, sc.animation)) {
-            anim = &model.anims[i];
-            break;
-        }
+    if (!bench_sample_model(dir, csv ? "# " : "", &sc, &model, path, sizeof path)) return 0;
+    const kin_animation *anim = kin_model_find_anim(&model, sc.animation);
     const int head = kin_model_find_node(&model, sc.head_node[0] ? sc.head_node : "head");
     pipe_pose ps;
     if (head < 0 || pipe_pose_init(&ps, &model) != 0) {
@@ -453,21 +422,14 @@ int main(int argc, char **argv)
                "mode", "ms/eye", "ms/2eyes", "Mtri/s", "px/eye", "clr full", "clr ctx",
                "xform");
 
-    float *depth = malloc((size_t)W * H * 2 * sizeof(float));
-    uint8_t *mask = malloc((size_t)W * H * 2);
-    float *nrm = malloc((size_t)W * H * 2 * 3 * sizeof(float));
+    bm_eyes eyes;
     double *t_draw = malloc((size_t)runs * sizeof(double));
     double *t_clear = malloc((size_t)runs * sizeof(double));
     double *t_xf = malloc((size_t)runs * sizeof(double));
     double *t_cclear = malloc((size_t)runs * sizeof(double));
-    if (!depth || !mask || !nrm || !t_draw || !t_clear || !t_xf || !t_cclear)
+    if (!bm_eyes_init(&eyes, W, H) || !t_draw || !t_clear || !t_xf || !t_cclear)
         return 1;
-    rast_target tg[2];
-    for (int e = 0; e < 2; e++) {
-        rast_target t = { W, H, depth + (size_t)e * W * H, W, mask + (size_t)e * W * H, W,
-                          nrm + (size_t)e * W * H * 3, 3 * W, 3 };
-        tg[e] = t;
-    }
+    rast_target *tg = eyes.tg;
 
     for (int ti = 0; ti < ntl; ti++) {
         bm_mesh mesh;
@@ -557,9 +519,7 @@ int main(int argc, char **argv)
         free(vn);
         bm_free(&mesh);
     }
-    free(depth);
-    free(mask);
-    free(nrm);
+    bm_eyes_free(&eyes);
     free(t_draw);
     free(t_clear);
     free(t_xf);

@@ -28,6 +28,7 @@
 
 #include "../src/io/io_vsrc.h"
 #include "../src/io/io_vstream.h"
+#include "bench_util.h"
 
 static uint64_t mono_ns(void)
 {
@@ -36,18 +37,7 @@ static uint64_t mono_ns(void)
     return (uint64_t)ts.tv_sec * 1000000000ull + (uint64_t)ts.tv_nsec;
 }
 
-static int cmp_d(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double cpu_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
-}
+static double cpu_ms(void) { return bench_now_ms(CLOCK_THREAD_CPUTIME_ID); }
 
 static int bench_convert(int w, int h)
 {
@@ -73,7 +63,7 @@ static int bench_convert(int w, int h)
             io_frame_to_rgba(&f, dst, 4 * (size_t)w, &err);
             t[r] = cpu_ms() - a;
         }
-        qsort(t, 30, sizeof t[0], cmp_d);
+        qsort(t, 30, sizeof t[0], bench_cmp_double);
         char fs[5];
         printf("convert    %s %dx%d -> RGBA: %.2f ms (median CPU time)\n", io_fourcc_str(fmts[k], fs),
                w, h, t[15]);
@@ -88,7 +78,7 @@ static int bench_convert(int w, int h)
         vs_scale_rgba(dst, sw, sh, 4 * (size_t)w, eye, 1280, 800, 4 * 1280, xt, yt, rows);
         t[r] = cpu_ms() - a;
     }
-    qsort(t, 30, sizeof t[0], cmp_d);
+    qsort(t, 30, sizeof t[0], bench_cmp_double);
     printf("scale      %dx%d -> 1280x800 bilinear, one eye: %.2f ms (median CPU time)\n", sw, sh,
            t[15]);
     free(xt);
@@ -146,7 +136,7 @@ static int bench_cams(int argc, char **argv)
             io_stereo_release(&st, f, &err);
         }
     }
-    qsort(delay, n, sizeof *delay, cmp_d);
+    qsort(delay, n, sizeof *delay, bench_cmp_double);
     printf("cams       %s + %s, %dx%d at %d FPS: %llu pairs in %.1f s (%.1f/s), max |skew| %.3f ms, "
            "dropped %llu/%llu, unpaired %llu/%llu\n", argv[2], argv[3], w, h, fps,
            (unsigned long long)st.pairs, seconds, (double)st.pairs / seconds,
@@ -243,8 +233,8 @@ int main(int argc, char **argv)
             if (poll_ms[i] > mp) mp = poll_ms[i];
             if (age_ms[i] > ma) ma = age_ms[i];
         }
-        qsort(poll_ms, n, sizeof *poll_ms, cmp_d);
-        qsort(age_ms, n, sizeof *age_ms, cmp_d);
+        qsort(poll_ms, n, sizeof *poll_ms, bench_cmp_double);
+        qsort(age_ms, n, sizeof *age_ms, bench_cmp_double);
         printf("poll       %.3f ms median, %.3f ms max per fresh frame (read + convert + scale)\n",
                poll_ms[n / 2], mp);
         printf("age        %.3f ms median, %.3f ms max when ready (time stamp -> eyes ready)\n",

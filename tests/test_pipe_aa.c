@@ -125,22 +125,30 @@ typedef struct area_err {
     int values_binary;
 } area_err;
 
+/* A pipe of m (threads, aa_samples aa) after one frame of the camera
+ * images of seed, held in b (tu_frame_free and pipe_destroy them). */
+static pipe_ctx *aa_frame(const kin_model *m, int threads, int aa, uint64_t seed, tu_frame_bufs *b)
+{
+    pipe_desc d = {0};
+    d.threads = threads;
+    d.aa_samples = aa;
+    pipe_ctx *p = pipe_create(&d, m);
+    assert_non_null(p);
+    pipe_frame_in in;
+    tu_frame_make(b, &in, seed, 640, 480, OW, OH);
+    char why[200];
+    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_OK);
+    return p;
+}
+
 /* One triangle (world = head frame: head at the origin) through a pipe
  * with aa samples: the mask of the left eye against the exact coverage. */
 static area_err run_triangle(const float *tri, int aa)
 {
     kin_model m;
     tri_model(&m, tri, 1);
-    pipe_desc d = {0};
-    d.threads = 1;
-    d.aa_samples = aa;
-    pipe_ctx *p = pipe_create(&d, &m);
-    assert_non_null(p);
     tu_frame_bufs b;
-    pipe_frame_in in;
-    tu_frame_make(&b, &in, 7, 640, 480, OW, OH);
-    char why[200];
-    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_OK);
+    pipe_ctx *p = aa_frame(&m, 1, aa, 7, &b);
     int w, h;
     const uint8_t *mask = pipe_mask(p, 0, &w, &h);
     assert_int_equal(w, CW);
@@ -235,16 +243,8 @@ static void aa_interior(void **state)
     tri_model(&m, quad_tris, 2);
     uint8_t *layer[2], *out[2], *mask[2];
     for (int k = 0; k < 2; k++) {
-        pipe_desc d = {0};
-        d.threads = 2;
-        d.aa_samples = k ? 16 : 0;
-        pipe_ctx *p = pipe_create(&d, &m);
-        assert_non_null(p);
         tu_frame_bufs b;
-        pipe_frame_in in;
-        tu_frame_make(&b, &in, 11, 640, 480, OW, OH);
-        char why[200];
-        assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_OK);
+        pipe_ctx *p = aa_frame(&m, 2, k ? 16 : 0, 11, &b);
         layer[k] = malloc((size_t)CW * CH * 4);
         mask[k] = malloc((size_t)CW * CH);
         out[k] = malloc((size_t)OW * OH * 4);

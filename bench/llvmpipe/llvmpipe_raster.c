@@ -153,19 +153,14 @@ int main(int argc, char **argv)
 
     int bad_total = 0;
     uint8_t *rgba = malloc((size_t)W * H * 4);
-    float *depth = malloc((size_t)W * H * 2 * sizeof(float));
-    uint8_t *mask = malloc((size_t)W * H * 2);
-    float *nrmp = malloc((size_t)W * H * 2 * 3 * sizeof(float));
+    bm_eyes eyes;
     double *tg = malloc((size_t)runs * sizeof(double)), *te = malloc((size_t)runs * sizeof(double));
     double *tc = malloc((size_t)runs * sizeof(double)), *td = malloc((size_t)runs * sizeof(double));
-    if (!rgba || !depth || !mask || !nrmp || !tg || !te || !tc || !td)
+    if (!rgba || !bm_eyes_init(&eyes, W, H) || !tg || !te || !tc || !td)
         return 1;
-    rast_target tgt[2];
-    for (int e = 0; e < 2; e++) {
-        rast_target t = { W, H, depth + (size_t)e * W * H, W, mask + (size_t)e * W * H, W,
-                          nrmp + (size_t)e * W * H * 3, 3 * W, 3 };
-        tgt[e] = t;
-    }
+    rast_target *tgt = eyes.tg;
+    const float *depth = eyes.depth, *nrmp = eyes.nrm;
+    const uint8_t *mask = eyes.mask;
     for (int ti = 0; ti < ntl; ti++) {
         bm_mesh m;
         if (!bm_arms(&m, tris_list[ti]))
@@ -410,9 +405,7 @@ int main(int argc, char **argv)
     }
     eh_close(&gl);
     free(rgba);
-    free(depth);
-    free(mask);
-    free(nrmp);
+    bm_eyes_free(&eyes);
     free(tg);
     free(te);
     free(tc);

@@ -68,9 +68,8 @@ void eval__ctx_free(eval_ctx *c)
     gen_arms_free(&c->mask);
     gen_scene_free(&c->cockpit);
     gen_scene_free(&c->workshop);
-    free(c->world); free(c->jm); free(c->tlocals); free(c->tworld); free(c->dq);
-    free(c->pos); free(c->nrm); free(c->clip); free(c->vnrm);
-    free(c->cam_rgb); free(c->vdepth); free(c->vrgb);
+    eval__pose_free(&c->ps);
+    free(c->dq); free(c->vdepth); free(c->vrgb);
     for (int e = 0; e < 2; e++) {
         free(c->P[e]); free(c->sil[e]); free(c->sil_prev[e]); free(c->tnrm[e]); free(c->V[e]); free(c->ideal[e]);
     }
@@ -79,7 +78,6 @@ void eval__ctx_free(eval_ctx *c)
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
     free(c->stereo_scratch);
-    free(c->gt_depth); free(c->gt_mask);
     memset(c, 0, sizeof *c);
 }
 
@@ -101,7 +99,7 @@ static int estimate_calib(eval_ctx *c, const gt_track_desc *track)
     kin_vec3 tips[2];
     if (S && scratch) {
         for (int k = 0; k < n; k++)
-            gt_track_sample(&cal, track, k, c->tlocals, c->tworld, &S[k]);
+            gt_track_sample(&cal, track, k, c->ps.tlocals, c->ps.tworld, &S[k]);
         int have_tips = kin_user_calib_hand_tips(&c->rig, &c->mask.model, tips, c->calib_why,
                                                  sizeof c->calib_why) == 0;
         rc = kin_user_calib_estimate_tips(S, n, &c->rig, have_tips ? tips : NULL, scratch,
@@ -131,24 +129,13 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
         return -1;
     }
     const kin_model *m = &c->mask.model;
-    size_t N = (size_t)m->node_count;
-    size_t V = (size_t)c->mask_fine.model.meshes[0].vertex_count;
     size_t J = (size_t)m->skins[0].joint_count;
     const size_t cp = (size_t)CW * CH, vp = (size_t)GEN_VIRT_W * GEN_VIRT_H;
-    c->world = malloc(sizeof *c->world * N);
-    c->tworld = malloc(sizeof *c->tworld * N);
-    c->tlocals = malloc(sizeof *c->tlocals * N);
-    c->jm = malloc(sizeof *c->jm * J);
+    int ok = eval__pose_init(&c->ps, m, c->mask_fine.model.meshes[0].vertex_count) == 0;
     c->dq = malloc(sizeof *c->dq * J);
-    c->pos = malloc(sizeof(float) * 3 * V);
-    c->nrm = malloc(sizeof(float) * 3 * V);
-    c->clip = malloc(sizeof(float) * 4 * V);
-    c->vnrm = malloc(sizeof(float) * 3 * V);
-    c->cam_rgb = malloc((size_t)GEN_CAM_W * GEN_CAM_H * 3);
     c->vdepth = malloc(sizeof(float) * vp);
     c->vrgb = malloc(vp * 3);
-    int ok = c->world && c->tworld && c->tlocals && c->jm && c->dq && c->pos && c->nrm &&
-             c->clip && c->vnrm && c->cam_rgb && c->vdepth && c->vrgb;
+    ok = ok && c->dq && c->vdepth && c->vrgb;
     for (int e = 0; e < 2 && ok; e++) {
         c->P[e] = malloc(cp * 4);
         c->sil[e] = malloc(cp);
@@ -178,9 +165,6 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && 
          c->mask_prior && c->layer && c->out && c->depth_lo &&
          c->nrm_lo && c->mnrm && c->refine_scratch && c->stereo_scratch;
-    c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
-    c->gt_mask = malloc((size_t)GEN_CAM_W * GEN_CAM_H);
-    ok = ok && c->gt_depth && c->gt_mask;
     if (!ok) return -1;
     if (estimate_calib(c, track) < 0) {
         cli_fail("user calibration from the calibration motion: %s", c->calib_why);
@@ -206,9 +190,9 @@ static int make_truth(eval_ctx *c, int frame, float speed, int first)
     for (int e = 0; e < 2; e++) {
         kin_camera cam = kin_sthmd_camera(NULL, &wfh, (kin_eye)e);
         c->tcam[e] = cam;
-        gt_render_eye(&c->gctx, &wfh, (kin_eye)e, frame, c->cam_rgb, c->sil[e], c->tnrm[e],
-                      c->gt_depth, c->gt_mask);
-        const uint8_t *src = c->cam_rgb + (size_t)c->g.crop_y0 * GEN_CAM_W * 3;
+        gt_render_eye(&c->gctx, &wfh, (kin_eye)e, frame, c->ps.cam_rgb, c->sil[e], c->tnrm[e],
+                      c->ps.gt_depth, c->ps.gt_mask);
+        const uint8_t *src = c->ps.cam_rgb + (size_t)c->g.crop_y0 * GEN_CAM_W * 3;
         if (fuse_rgb24_to_rgba(src, GEN_CAM_W * 3, CW, CH,
                                &(fuse_image){ c->P[e], CW, CH, 4 * CW }) != FUSE_OK)
             return -1;
@@ -343,18 +327,18 @@ static int dump_masks(const char *dir, const method_cfg *cfg, int frame, int eye
     return EXIT_OK;
 }
 
-/* FK and skinning of locals into c->world, c->pos, c->nrm. */
+/* FK and skinning of locals into c->ps.world, c->ps.pos, c->ps.nrm. */
 static void pose_skin(eval_ctx *c, const method_cfg *cfg, const kin_model *m,
                       const kin_transform *locals)
 {
     const kin_mesh *me = &m->meshes[0];
-    kin_fk(m->parents, m->node_count, locals, NULL, c->world);
-    kin_skin_joint_matrices(&m->skins[0], c->world, c->jm);
+    kin_fk(m->parents, m->node_count, locals, NULL, c->ps.world);
+    kin_skin_joint_matrices(&m->skins[0], c->ps.world, c->ps.jm);
     if (cfg->dqs) {
-        kin_skin_dq_from_matrices(c->jm, m->skins[0].joint_count, c->dq);
-        kin_skin_dqs(me, c->dq, c->pos, c->nrm);
+        kin_skin_dq_from_matrices(c->ps.jm, m->skins[0].joint_count, c->dq);
+        kin_skin_dqs(me, c->dq, c->ps.pos, c->ps.nrm);
     } else {
-        kin_skin_lbs(me, c->jm, c->pos, c->nrm);
+        kin_skin_lbs(me, c->ps.jm, c->ps.pos, c->ps.nrm);
     }
 }
 
@@ -367,13 +351,13 @@ static int draw_mask(eval_ctx *c, const method_cfg *cfg, const kin_mesh *me, int
     rast_target tg = { w, h, c->depth_lo, w, c->mask_lo, w, c->nrm_lo, 3 * w, 3 };
     rast_target_clear(&tg);
     if (posed) {
-        rast_transform_points(cam->view_proj.m, c->pos, me->vertex_count, c->clip);
-        rast_transform_dirs(cam->view.m, c->nrm, me->vertex_count, c->vnrm);
+        rast_transform_points(cam->view_proj.m, c->ps.pos, me->vertex_count, c->ps.clip);
+        rast_transform_dirs(cam->view.m, c->ps.nrm, me->vertex_count, c->ps.vnrm);
         /* the method's level of detail (eval_lod.c): its index list
          * over the same vertices */
-        c->lod_drawn = eval__lod_level(c, cfg, c->clip, me->vertex_count, cam);
+        c->lod_drawn = eval__lod_level(c, cfg, c->ps.clip, me->vertex_count, cam);
         const kin_mesh *lm = c->lod_drawn ? &c->lod.level[c->lod_drawn].meshes[0] : me;
-        rast_mesh_desc d = { c->clip, me->vertex_count, c->vnrm, 3, lm->indices,
+        rast_mesh_desc d = { c->ps.clip, me->vertex_count, c->ps.vnrm, 3, lm->indices,
                              lm->index_count / 3, RAST_CULL_NONE };
         if (rast_draw(&tg, &d, NULL) != RAST_OK) return -1;
         if (cfg->aa > 1) {
@@ -400,7 +384,7 @@ static int draw_mask(eval_ctx *c, const method_cfg *cfg, const kin_mesh *me, int
 static kin_camera eye_camera(const eval_ctx *c, int e)
 {
     kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
-    return kin_sthmd_camera(&hd, &c->world[c->rig.head], (kin_eye)e);
+    return kin_sthmd_camera(&hd, &c->ps.world[c->rig.head], (kin_eye)e);
 }
 
 /* The elbow fit of the refine method (pipe_fit): learns the colour
@@ -425,7 +409,7 @@ static int fit_elbows(eval_ctx *c, method_run *r, const kin_model *m, uint32_t v
             return -1;
     }
     unsigned sides = ((valid & KIN_TRACK_HAND_L) ? 1u : 0u) | ((valid & KIN_TRACK_HAND_R) ? 2u : 0u);
-    pipe_fit_elbows(r->fit, c->world, c->pos, cam, P, sides, r->locals, r->swivel);
+    pipe_fit_elbows(r->fit, c->ps.world, c->ps.pos, cam, P, sides, r->locals, r->swivel);
     return 0;
 }
 
@@ -459,7 +443,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         double tc = (double)r->next_k / cfg->track.rate_hz;
         if (tc + lat > T + 1e-9) break;
         kin_track_sample s;
-        gt_track_sample(&c->truth, &cfg->track, r->next_k, c->tlocals, c->tworld, &s);
+        gt_track_sample(&c->truth, &cfg->track, r->next_k, c->ps.tlocals, c->ps.tworld, &s);
         r->next_k++;
         if (cfg->kind == M_KIN) {
             if (!r->have_last) { r->last = s; r->have_last = 1; }
@@ -495,10 +479,10 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         }
         if (posed) pose_skin(c, cfg, m, r->locals);
         if (posed && cfg->kind == M_REFINE && cfg->fit) {
-            pipe_fit_shape(r->fit, c->world, c->pos);
+            pipe_fit_shape(r->fit, c->ps.world, c->ps.pos);
             if (fit_elbows(c, r, m, s.valid) < 0) return -1;
             pose_skin(c, cfg, m, r->locals);
-            pipe_fit_shape(r->fit, c->world, c->pos);
+            pipe_fit_shape(r->fit, c->ps.world, c->ps.pos);
         }
     }
     double secs = cli_now() - t0, cpu = thread_cpu() - c0;
@@ -535,7 +519,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                     /* the band from the projected uncertainty (fit_band.h),
                      * at least --band */
                     pipe_fit_band_desc bd = band_desc(cfg);
-                    rp.band = pipe_fit_band(&bd, &cam, c->world, &c->rig, r->sides, r->speed);
+                    rp.band = pipe_fit_band(&bd, &cam, c->ps.world, &c->rig, r->sides, r->speed);
                 }
                 r->band_sum += rp.band;
                 r->n_band++;
@@ -551,13 +535,13 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                     float shift[2][2] = { { 0, 0 }, { 0, 0 } };
                     for (int k = 0; k < 2; k++)
                         if (cfg->prior_mc && r->have_hand_px[e][k] &&
-                            pipe_fit_hand_px(&cam, c->world, &c->rig, k, shift[k])) {
+                            pipe_fit_hand_px(&cam, c->ps.world, &c->rig, k, shift[k])) {
                             shift[k][0] -= r->hand_px[e][k][0];
                             shift[k][1] -= r->hand_px[e][k][1];
                         } else {
                             shift[k][0] = shift[k][1] = 0.0f;
                         }
-                    mask = pipe_fit_prior(&bd, &cam, c->world, &c->rig, r->sides, r->speed,
+                    mask = pipe_fit_prior(&bd, &cam, c->ps.world, &c->rig, r->sides, r->speed,
                                           cfg->prior_speed, shift, mask, r->prev[e],
                                           c->mask_prior, CW);
                     /* its rim must look like the hand (last frame's
@@ -567,7 +551,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 }
                 for (int k = 0; k < 2; k++)
                     r->have_hand_px[e][k] =
-                        posed && pipe_fit_hand_px(&cam, c->world, &c->rig, k, r->hand_px[e][k]);
+                        posed && pipe_fit_hand_px(&cam, c->ps.world, &c->rig, k, r->hand_px[e][k]);
                 /* the global term only once the fit has a colour model
                  * (as pipe_frame): an all-zero one would halve the local
                  * term */
@@ -606,7 +590,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                      * raster), and the limb widths (self-calibration) */
                     if (pipe_fit_learn(r->fit, e, &P, kmask, CW, c->refined, CW) != FUSE_OK)
                         return -1;
-                    pipe_fit_measure(r->fit, e, &cam, c->world, kmask, CW, c->refined, CW);
+                    pipe_fit_measure(r->fit, e, &cam, c->ps.world, kmask, CW, c->refined, CW);
                 }
                 mask = c->refined;
             }
@@ -636,8 +620,8 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
              * the same pose (not timed) */
             rast_target ft = { CW, CH, c->full_depth, CW, c->full_mask, CW, NULL, 0, 0 };
             rast_target_clear(&ft);
-            rast_transform_points(cam.view_proj.m, c->pos, me->vertex_count, c->clip);
-            rast_mesh_desc d = { c->clip, me->vertex_count, NULL, 0, me->indices,
+            rast_transform_points(cam.view_proj.m, c->ps.pos, me->vertex_count, c->ps.clip);
+            rast_mesh_desc d = { c->ps.clip, me->vertex_count, NULL, 0, me->indices,
                                  me->index_count / 3, RAST_CULL_NONE };
             if (rast_draw(&ft, &d, NULL) != RAST_OK) return -1;
             fuse_confusion fc;

@@ -76,11 +76,7 @@ typedef struct eye_ctx {
     kin_sthmd_geometry geo;
     uint32_t *hand_m, *hand_t;   /* hand triangles of the mask model, the truth */
     int ntri_m, ntri_t;
-    kin_mat4 *world, *jm, *tworld;
-    kin_transform *tlocals;
-    float *pos, *nrm, *clip, *vnrm;
-    uint8_t *cam_rgb, *gt_mask;
-    float *gt_depth;
+    eval_pose ps;
     uint8_t *P[2], *V[2], *ideal[2], *sil[2], *hand[2], *seen[2];
     double hand_depth[2];
     float *vdepth, *enrm, *scratch;
@@ -103,9 +99,7 @@ static void ctx_free(eye_ctx *c)
     gen_scene_free(&c->cockpit);
     gen_scene_free(&c->workshop);
     free(c->hand_m); free(c->hand_t);
-    free(c->world); free(c->jm); free(c->tworld); free(c->tlocals);
-    free(c->pos); free(c->nrm); free(c->clip); free(c->vnrm);
-    free(c->cam_rgb); free(c->gt_mask); free(c->gt_depth);
+    eval__pose_free(&c->ps);
     for (int e = 0; e < 2; e++) {
         free(c->P[e]); free(c->V[e]); free(c->ideal[e]); free(c->sil[e]); free(c->hand[e]);
         free(c->cam_full[e]); free(c->out[e]); free(c->seen[e]);
@@ -135,22 +129,8 @@ static int ctx_init(eye_ctx *c, uint64_t seed, const char *seq)
     c->hand_m = gt_part_triangles(&c->mask, 2u, GEN_J_MIDDLE_3, GEN_J_MIDDLE_3, &c->ntri_m);
     c->hand_t = gt_part_triangles(&c->truth, 2u, GEN_J_MIDDLE_3, GEN_J_MIDDLE_3, &c->ntri_t);
     const kin_model *m = &c->mask.model;
-    size_t N = (size_t)m->node_count, V = (size_t)m->meshes[0].vertex_count;
-    size_t J = (size_t)m->skins[0].joint_count;
     const size_t cp = (size_t)CW * CH, dp = (size_t)DW * DH;
-    c->world = malloc(sizeof *c->world * N);
-    c->tworld = malloc(sizeof *c->tworld * N);
-    c->tlocals = malloc(sizeof *c->tlocals * N);
-    c->jm = malloc(sizeof *c->jm * J);
-    c->pos = malloc(sizeof(float) * 3 * V);
-    c->nrm = malloc(sizeof(float) * 3 * V);
-    c->clip = malloc(sizeof(float) * 4 * V);
-    c->vnrm = malloc(sizeof(float) * 3 * V);
-    c->cam_rgb = malloc((size_t)GEN_CAM_W * GEN_CAM_H * 3);
-    c->gt_mask = malloc((size_t)GEN_CAM_W * GEN_CAM_H);
-    c->gt_depth = malloc(sizeof(float) * GEN_CAM_W * GEN_CAM_H);
-    int ok = c->hand_m && c->hand_t && c->world && c->tworld && c->tlocals && c->jm && c->pos &&
-             c->nrm && c->clip && c->vnrm && c->cam_rgb && c->gt_mask && c->gt_depth;
+    int ok = eval__pose_init(&c->ps, m, m->meshes[0].vertex_count) == 0 && c->hand_m && c->hand_t;
     for (int e = 0; e < 2 && ok; e++) {
         c->P[e] = malloc(cp * 4);
         c->V[e] = malloc(dp * 4);
@@ -212,12 +192,12 @@ static int make_truth(eye_ctx *c, int fi)
     gen_pose(&c->g, t, &wfh);
     for (int e = 0; e < 2; e++) {
         /* the camera image (sil, normals: the camera's, unused here) */
-        gt_render_eye(&c->g, &wfh, (kin_eye)e, fi, c->cam_rgb, c->mask_c, NULL, c->gt_depth,
-                      c->gt_mask);
-        const uint8_t *src = c->cam_rgb + (size_t)c->geo.crop_y0 * GEN_CAM_W * 3;
+        gt_render_eye(&c->g, &wfh, (kin_eye)e, fi, c->ps.cam_rgb, c->mask_c, NULL, c->ps.gt_depth,
+                      c->ps.gt_mask);
+        const uint8_t *src = c->ps.cam_rgb + (size_t)c->geo.crop_y0 * GEN_CAM_W * 3;
         if (fuse_rgb24_to_rgba(src, GEN_CAM_W * 3, CW, CH,
                                &(fuse_image){ c->P[e], CW, CH, 4 * CW }) != FUSE_OK ||
-            fuse_rgb24_to_rgba(c->cam_rgb, GEN_CAM_W * 3, GEN_CAM_W, GEN_CAM_H,
+            fuse_rgb24_to_rgba(c->ps.cam_rgb, GEN_CAM_W * 3, GEN_CAM_W, GEN_CAM_H,
                                &(fuse_image){ c->cam_full[e], GEN_CAM_W, GEN_CAM_H,
                                               4 * GEN_CAM_W }) != FUSE_OK)
             return -1;
@@ -309,7 +289,7 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
         double tc = (double)r->next_k / r->track.rate_hz;
         if (tc + r->track.latency_ms * 1e-3 > T + 1e-9) break;
         kin_track_sample s;
-        gt_track_sample(&c->truth, &r->track, r->next_k, c->tlocals, c->tworld, &s);
+        gt_track_sample(&c->truth, &r->track, r->next_k, c->ps.tlocals, c->ps.tworld, &s);
         r->next_k++;
         kin_filter_push(&r->filter, &s);
         r->have = 1;
@@ -350,9 +330,9 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
     if (pipe_frame(p, &in, &st, why, sizeof why) != PIPE_OK) return cli_fail("%s", why);
     double secs = thread_secs() - t0;
     /* the posed model, for its fingertip (not timed) */
-    kin_fk(m->parents, m->node_count, r->locals, NULL, c->world);
-    kin_skin_joint_matrices(&m->skins[0], c->world, c->jm);
-    kin_skin_lbs(me, c->jm, c->pos, c->nrm);
+    kin_fk(m->parents, m->node_count, r->locals, NULL, c->ps.world);
+    kin_skin_joint_matrices(&m->skins[0], c->ps.world, c->ps.jm);
+    kin_skin_lbs(me, c->ps.jm, c->ps.pos, c->ps.nrm);
     (void)posed;
     for (int e = 0; e < 2; e++) {
         /* the view layer's mask and camera, and where it goes */
@@ -384,8 +364,8 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
          * through the layer's camera, where the layer shows the hand */
         rast_target th = { CW, CH, c->depth_c, CW, c->hmask_c, CW, NULL, 0, 0 };
         rast_target_clear(&th);
-        rast_transform_points(cam.view_proj.m, c->pos, me->vertex_count, c->clip);
-        rast_mesh_desc dh = { c->clip, me->vertex_count, NULL, 0, c->hand_m, c->ntri_m,
+        rast_transform_points(cam.view_proj.m, c->ps.pos, me->vertex_count, c->ps.clip);
+        rast_mesh_desc dh = { c->ps.clip, me->vertex_count, NULL, 0, c->hand_m, c->ntri_m,
                               RAST_CULL_NONE };
         if (rast_draw(&th, &dh, NULL) != RAST_OK) return -1;
         for (size_t i = 0; i < (size_t)CW * CH; i++)

@@ -108,6 +108,22 @@ typedef struct eval_light {
     int opaque_ideal;
 } eval_light;
 
+/* The posed mask model's buffers both evaluations (eval.c, eval_eye.c)
+ * need, and the ground truth renderer's scratch (eval_pose.c). */
+typedef struct eval_pose {
+    kin_mat4 *world, *jm, *tworld;      /* node_count, joint_count, node_count */
+    kin_transform *tlocals;             /* node_count: the truth's locals */
+    float *pos, *nrm, *clip, *vnrm;     /* vertex_count x 3, 3, 4, 3 */
+    uint8_t *cam_rgb, *gt_mask;         /* 640x480x3, 640x480 */
+    float *gt_depth;                    /* 640x480 */
+} eval_pose;
+
+/* p's buffers for model m (its first skin) and meshes of vertex_count
+ * vertices: 0, or -1 when out of memory (what was allocated is held:
+ * eval__pose_free frees it). */
+int eval__pose_init(eval_pose *p, const kin_model *m, int vertex_count);
+void eval__pose_free(eval_pose *p);
+
 /* Shared per-frame buffers. */
 typedef struct eval_ctx {
     gen_arms mask, mask_fine, truth;
@@ -115,13 +131,9 @@ typedef struct eval_ctx {
     gen_frame_ctx gctx;
     kin_arm_rig rig;
     gt_operator_desc op;
-    kin_mat4 *world, *jm;
-    kin_transform *tlocals;
-    kin_mat4 *tworld;
+    eval_pose ps;
     kin_dualquat *dq;
-    float *pos, *nrm, *clip, *vnrm;
     /* per eye */
-    uint8_t *cam_rgb;                       /* 640x480x3 */
     uint8_t *P[2];                          /* 640x400 RGBA */
     uint8_t *sil[2], *sil_prev[2];          /* true silhouettes, 640x400 */
     int have_sil_prev;
@@ -141,8 +153,6 @@ typedef struct eval_ctx {
     void *stereo_scratch;    /* refine: fit_stereo.h */
     size_t stereo_scratch_size;
     kin_sthmd_geometry g;
-    float *gt_depth;          /* gt_render_eye scratch, 640x480 */
-    uint8_t *gt_mask;
     kin_user_calib calib;     /* estimated from the calibration motion */
     char calib_why[256];
     int calib_hand_fallback;  /* 1: no fingertip gesture, hand = arm scale */

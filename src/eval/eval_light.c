@@ -106,12 +106,12 @@ int eval__light_render(eval_ctx *c, const kin_mat4 *world_from_head, int e, int 
     for (int k = 0; k < 3; k++) s->ambient[k] = amb[k] * c->light.gain * m[k];
     /* the same silhouette and normals as the matched image (the geometry
      * and the camera noise's seed do not change) */
-    gt_render_eye(&c->gctx, world_from_head, (kin_eye)e, frame, c->cam_rgb, c->sil[e],
-                  c->tnrm[e], c->gt_depth, c->gt_mask);
+    gt_render_eye(&c->gctx, world_from_head, (kin_eye)e, frame, c->ps.cam_rgb, c->sil[e],
+                  c->tnrm[e], c->ps.gt_depth, c->ps.gt_mask);
     memcpy(s->light_dir, dir, sizeof dir);
     memcpy(s->light_color, col, sizeof col);
     memcpy(s->ambient, amb, sizeof amb);
-    const uint8_t *src = c->cam_rgb + (size_t)c->g.crop_y0 * GEN_CAM_W * 3;
+    const uint8_t *src = c->ps.cam_rgb + (size_t)c->g.crop_y0 * GEN_CAM_W * 3;
     fuse_image P = {c->P[e], CW, CH, 4 * CW};
     return fuse_rgb24_to_rgba(src, GEN_CAM_W * 3, CW, CH, &P) == FUSE_OK ? 0 : -1;
 }

@@ -186,17 +186,24 @@ static int band_meets(const pipe__aa *a, int x0, int y0, int x1, int y1)
            0;
 }
 
+/* buf grown to n items of size bytes when it holds fewer (*cap): the
+ * buffer, or NULL (out of memory; buf is kept and still held). */
+static void *grow(void *buf, int *cap, int n, size_t size)
+{
+    if (n <= *cap) return buf;
+    void *b = realloc(buf, size * (size_t)n);
+    if (b) *cap = n;
+    return b;
+}
+
 /* a->sxy: the pixel x, y of each vertex of clip (NaN at or behind the eye
  * plane, w <= 1e-6, or from a NaN), once per mesh for both the mesh's box
  * and the band filter. 0, or -1 (out of memory). */
 static int project_vertices(pipe__aa *a, const float *clip, int vertex_count)
 {
-    if (vertex_count > a->sxy_cap) {
-        float *n = realloc(a->sxy, sizeof *n * 2 * (size_t)vertex_count);
-        if (!n) return -1;
-        a->sxy = n;
-        a->sxy_cap = vertex_count;
-    }
+    float *n = grow(a->sxy, &a->sxy_cap, vertex_count, 2 * sizeof *n);
+    if (!n) return -1;
+    a->sxy = n;
     const float W = (float)a->width, H = (float)a->height;
     for (int i = 0; i < vertex_count; i++) {
         const float *v = clip + 4 * (size_t)i;
@@ -211,51 +218,59 @@ static int project_vertices(pipe__aa *a, const float *clip, int vertex_count)
     return 0;
 }
 
+/* The box x0, y0, x1, y1 (b; x0 > x1 when n is 0) of the n projected
+ * points sxy[ix[k]] (ix NULL: sxy[k]); 1 (b unfinished) when an index is
+ * not below vertex_count or a point is a NaN (at or behind the eye). */
+static int sxy_box(const float *sxy, const uint32_t *ix, int n, int vertex_count, float b[4])
+{
+    b[0] = b[1] = 1e30f;
+    b[2] = b[3] = -1e30f;
+    for (int k = 0; k < n; k++) {
+        const uint32_t i = ix ? ix[k] : (uint32_t)k;
+        if (i >= (uint32_t)vertex_count) return 1;
+        const float sx = sxy[2 * (size_t)i], sy = sxy[2 * (size_t)i + 1];
+        if (!(sx == sx) || !(sy == sy)) return 1;
+        if (sx < b[0]) b[0] = sx;
+        if (sx > b[2]) b[2] = sx;
+        if (sy < b[1]) b[1] = sy;
+        if (sy > b[3]) b[3] = sy;
+    }
+    return 0;
+}
+
+/* b clamped to 4 px around the W x H target */
+static void box_clamp(float b[4], float W, float H)
+{
+    for (int k = 0; k < 4; k++) {
+        const float hi = (k & 1 ? H : W) + 4.0f;
+        b[k] = b[k] < -4.0f ? -4.0f : b[k] > hi ? hi : b[k];
+    }
+}
+
 /* The triangles of indices that may cover a sample of a band tile, into
  * a->idx (the vertices' pixel positions in a->sxy: project_vertices): a
  * triangle with a vertex at or behind the eye plane, a NaN or
  * a bad index is kept (rast_draw_aa clips it, or refuses the mesh). */
 static int band_filter(pipe__aa *a, int vertex_count, const uint32_t *indices, int tri_count)
 {
-    if (tri_count > a->idx_cap) {
-        uint32_t *n = realloc(a->idx, sizeof *n * 3 * (size_t)tri_count);
-        if (!n) return -1;
-        a->idx = n;
-        a->idx_cap = tri_count;
-    }
+    uint32_t *n = grow(a->idx, &a->idx_cap, tri_count, 3 * sizeof *n);
+    if (!n) return -1;
+    a->idx = n;
     const float W = (float)a->width, H = (float)a->height;
     const float *sxy = a->sxy;
     int kept = 0;
     for (int t = 0; t < tri_count; t++) {
         const uint32_t *ix = indices + 3 * (size_t)t;
-        float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
-        int keep = 0;
-        for (int k = 0; k < 3; k++) {
-            if (ix[k] >= (uint32_t)vertex_count) {
-                keep = 1;
-                break;
-            }
-            const float sx = sxy[2 * ix[k]], sy = sxy[2 * ix[k] + 1];
-            if (!(sx == sx) || !(sy == sy)) {
-                keep = 1;
-                break;
-            }
-            if (sx < x0) x0 = sx;
-            if (sx > x1) x1 = sx;
-            if (sy < y0) y0 = sy;
-            if (sy > y1) y1 = sy;
-        }
+        float b[4];
+        int keep = sxy_box(sxy, ix, 3, vertex_count, b);
         if (!keep) {
             /* off the target entirely: nothing to draw; else the pixels
              * whose samples the triangle may reach (a sample is at most
              * half a pixel from its centre; 1 px covers that and the
              * snapping) */
-            if (x1 < -4.0f || y1 < -4.0f || x0 > W + 4.0f || y0 > H + 4.0f) continue;
-            x0 = x0 < -4.0f ? -4.0f : x0;
-            y0 = y0 < -4.0f ? -4.0f : y0;
-            x1 = x1 > W + 4.0f ? W + 4.0f : x1;
-            y1 = y1 > H + 4.0f ? H + 4.0f : y1;
-            keep = band_meets(a, (int)x0 - 1, (int)y0 - 1, (int)x1 + 1, (int)y1 + 1);
+            if (b[2] < -4.0f || b[3] < -4.0f || b[0] > W + 4.0f || b[1] > H + 4.0f) continue;
+            box_clamp(b, W, H);
+            keep = band_meets(a, (int)b[0] - 1, (int)b[1] - 1, (int)b[2] + 1, (int)b[3] + 1);
         }
         if (keep) {
             uint32_t *o = a->idx + 3 * (size_t)kept++;
@@ -273,29 +288,13 @@ rast_result pipe__aa_draw(pipe__aa *a, rast_context *ctx, const float *clip, int
      * hull of the projected vertices when all are in front of the eye
      * (clipping only cuts the triangles); 2 px for the snapping */
     if (project_vertices(a, clip, vertex_count)) return RAST_ERR_ARGS; /* out of memory */
-    float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
-    int all = 0;
-    for (int i = 0; i < vertex_count; i++) {
-        const float sx = a->sxy[2 * i], sy = a->sxy[2 * i + 1];
-        if (!(sx == sx) || !(sy == sy)) {
-            all = 1;
-            break;
-        }
-        if (sx < x0) x0 = sx;
-        if (sx > x1) x1 = sx;
-        if (sy < y0) y0 = sy;
-        if (sy > y1) y1 = sy;
-    }
-    if (all)
+    float b[4];
+    if (sxy_box(a->sxy, NULL, vertex_count, vertex_count, b))
         box_add(a->box, 0, 0, a->width, a->height, a->width, a->height);
-    else if (x0 <= x1) {
-        const float W = (float)a->width, H = (float)a->height;
+    else if (b[0] <= b[2]) {
         /* clamped in float first: huge values do not overflow an int */
-        x0 = x0 < -4.0f ? -4.0f : x0 > W + 4.0f ? W + 4.0f : x0;
-        x1 = x1 < -4.0f ? -4.0f : x1 > W + 4.0f ? W + 4.0f : x1;
-        y0 = y0 < -4.0f ? -4.0f : y0 > H + 4.0f ? H + 4.0f : y0;
-        y1 = y1 < -4.0f ? -4.0f : y1 > H + 4.0f ? H + 4.0f : y1;
-        box_add(a->box, (int)x0 - 2, (int)y0 - 2, (int)x1 + 3, (int)y1 + 3, a->width,
+        box_clamp(b, (float)a->width, (float)a->height);
+        box_add(a->box, (int)b[0] - 2, (int)b[1] - 2, (int)b[2] + 3, (int)b[3] + 3, a->width,
                 a->height);
     }
     if (a->gmask) {
@@ -437,6 +436,20 @@ static int fill_cand8(const uint8_t *m, const uint8_t *k)
     return (nz8(m) & ~nz8(k)) != 0;
 }
 
+/* The first x of x..x1-1 that m covers and mask does not (mr[x] != 0,
+ * kr[x] == 0: a pixel the normals' fill writes), else x1. */
+static int next_fill(const uint8_t *mr, const uint8_t *kr, int x, int x1)
+{
+    for (; x < x1; x++) {
+        if (x + 8 <= x1 && !fill_cand8(mr + x, kr + x)) {
+            x += 7;
+            continue;
+        }
+        if (mr[x] != 0 && kr[x] == 0) return x;
+    }
+    return x1;
+}
+
 void pipe__aa_fill_normals(pipe__aa *a, const uint8_t *m, const uint8_t *mask, float *nrm)
 {
     const int W = a->width, H = a->height;
@@ -446,12 +459,7 @@ void pipe__aa_fill_normals(pipe__aa *a, const uint8_t *m, const uint8_t *mask, f
     for (int y = b[1]; y < b[3]; y++) {
         const uint8_t *mr = m + (size_t)y * (size_t)W;
         const uint8_t *kr = mask + (size_t)y * (size_t)W;
-        for (int x = b[0]; x < b[2]; x++) {
-            if (x + 8 <= b[2] && !fill_cand8(mr + x, kr + x)) {
-                x += 7;
-                continue;
-            }
-            if (mr[x] == 0 || kr[x] != 0) continue;
+        for (int x = next_fill(mr, kr, b[0], b[2]); x < b[2]; x = next_fill(mr, kr, x + 1, b[2])) {
             float s[3] = {0.0f, 0.0f, 0.0f};
             for (int yy = y - 1; yy <= y + 1; yy++) {
                 if (yy < 0 || yy >= H) continue;
@@ -483,15 +491,9 @@ void pipe__aa_unfill(pipe__aa *a, const uint8_t *mask, float *nrm)
     for (int y = b[1]; m && y < b[3]; y++) {
         const uint8_t *mr = m + (size_t)y * (size_t)W;
         const uint8_t *kr = mask + (size_t)y * (size_t)W;
-        for (int x = b[0]; x < b[2]; x++) {
-            if (x + 8 <= b[2] && !fill_cand8(mr + x, kr + x)) {
-                x += 7;
-                continue;
-            }
-            if (mr[x] != 0 && kr[x] == 0) {
-                float *o = nrm + 3 * ((size_t)y * (size_t)W + (size_t)x);
-                o[0] = o[1] = o[2] = 0.0f;
-            }
+        for (int x = next_fill(mr, kr, b[0], b[2]); x < b[2]; x = next_fill(mr, kr, x + 1, b[2])) {
+            float *o = nrm + 3 * ((size_t)y * (size_t)W + (size_t)x);
+            o[0] = o[1] = o[2] = 0.0f;
         }
     }
     box_empty(a->nbox);

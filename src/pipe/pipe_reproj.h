@@ -161,21 +161,12 @@ typedef struct pipe__reproj_geo {
 
 /* The vector geometry pass per ISA (pipe_reproj_simd.inl): the first
  * column it did not do. The pinhole camera only. */
-typedef int (*pipe__reproj_row_fn)(const pipe__reproj_geo *g, const uint8_t *em,
-                                   const float *ed, const float *en, float ry, int w,
-                                   const pipe__reproj_lanes *o, long *back, float *mind);
-int pipe__reproj_row_sse2(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                          const float *en, float ry, int w, const pipe__reproj_lanes *o,
-                          long *back, float *mind);
-int pipe__reproj_row_avx2(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                          const float *en, float ry, int w, const pipe__reproj_lanes *o,
-                          long *back, float *mind);
-int pipe__reproj_row_avx512(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                            const float *en, float ry, int w, const pipe__reproj_lanes *o,
-                            long *back, float *mind);
-int pipe__reproj_row_neon(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                          const float *en, float ry, int w, const pipe__reproj_lanes *o,
-                          long *back, float *mind);
+typedef int pipe__reproj_row_t(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
+                               const float *en, float ry, int w, const pipe__reproj_lanes *o,
+                               long *back, float *mind);
+typedef pipe__reproj_row_t *pipe__reproj_row_fn;
+pipe__reproj_row_t pipe__reproj_row_sse2, pipe__reproj_row_avx2, pipe__reproj_row_avx512,
+    pipe__reproj_row_neon;
 
 /* What the taps pass needs (the camera's G-buffer of the crop, the image
  * sampled as int32 RGBA pixels). mlim: the last mask offset with 4
@@ -195,21 +186,12 @@ typedef struct pipe__reproj_tapd {
  * outside, filled, sampled and sum[] += the sampled colours; the first
  * column not done (the scalar taps finish). Equal to the scalar taps in
  * pipe_reproj.c. */
-typedef int (*pipe__reproj_taps_fn)(const pipe__reproj_tapd *t, const uint8_t *em,
-                                    const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                                    uint8_t *K, long cnt[4], uint64_t sum[3]);
-int pipe__reproj_taps_sse2(const pipe__reproj_tapd *t, const uint8_t *em,
-                           const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                           uint8_t *K, long cnt[4], uint64_t sum[3]);
-int pipe__reproj_taps_avx2(const pipe__reproj_tapd *t, const uint8_t *em,
-                           const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                           uint8_t *K, long cnt[4], uint64_t sum[3]);
-int pipe__reproj_taps_avx512(const pipe__reproj_tapd *t, const uint8_t *em,
-                             const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                             uint8_t *K, long cnt[4], uint64_t sum[3]);
-int pipe__reproj_taps_neon(const pipe__reproj_tapd *t, const uint8_t *em,
-                           const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                           uint8_t *K, long cnt[4], uint64_t sum[3]);
+typedef int pipe__reproj_taps_t(const pipe__reproj_tapd *t, const uint8_t *em,
+                                const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
+                                uint8_t *K, long cnt[4], uint64_t sum[3]);
+typedef pipe__reproj_taps_t *pipe__reproj_taps_fn;
+pipe__reproj_taps_t pipe__reproj_taps_sse2, pipe__reproj_taps_avx2, pipe__reproj_taps_avx512,
+    pipe__reproj_taps_neon;
 
 /* The fill of one eye row (THE FILL above) from its kinds K (w bytes:
  * 1 sampled, 2 filled, else 0; 8 bytes readable past w not needed): each
