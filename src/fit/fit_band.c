@@ -214,6 +214,9 @@ static uint64_t ld8(const uint8_t *p)
 #define B01 0x0101010101010101ull
 #define B80 0x8080808080808080ull
 
+/* 1 when one of the 8 bytes of v is 0 */
+static int has_zero(uint64_t v) { return ((v - B01) & ~v & B80) != 0; }
+
 static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const uint8_t *in,
                          uint8_t *out, int stride)
 {
@@ -235,6 +238,12 @@ static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const 
             if (x0 + 8 <= W) {
                 const uint64_t t = i ? ld8(o + x0) & ~ld8(i + x0) : ld8(o + x0);
                 if (!(t & B80)) continue;
+                /* prior: inside the mask, with every 4-neighbour set (no
+                 * zero byte in the block, the row above and below, nor
+                 * beside it), no pixel is on the rim */
+                if (!i && x0 > 0 && x0 + 8 < W && up && dn && o[x0 - 1] && o[x0 + 8] &&
+                    !has_zero(ld8(o + x0)) && !has_zero(ld8(up + x0)) && !has_zero(ld8(dn + x0)))
+                    continue;
             }
             const int x1 = x0 + 8 < W ? x0 + 8 : W;
             for (int x = x0; x < x1; x++) {
@@ -260,8 +269,7 @@ static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const 
             int x = 0;
             for (; x + 8 <= W; x += 8) {
                 /* no byte equal to 1: none of (v ^ 0x01..) is zero */
-                const uint64_t v = ld8(o + x) ^ B01;
-                if (!((v - B01) & ~v & B80)) continue;
+                if (!has_zero(ld8(o + x) ^ B01)) continue;
                 for (int k = x; k < x + 8; k++)
                     if (o[k] == 1) o[k] = 0;
             }
