@@ -336,6 +336,15 @@ int pipe_fit_learned(const pipe_fit *f, int eye)
  * bg_samples: the kept sums, rounded down). A pixel learned wrongly in one
  * frame (the desk pad under a kinematic arm that is off) weighs against
  * every frame that saw it right, instead of making the whole model. */
+/* The bin of an RGBA pixel (fuse_colour_bin, inlined: it runs per
+ * sampled pixel). */
+static inline unsigned fit_bin(const uint8_t *px, int bits)
+{
+    const int s = 8 - bits;
+    return ((unsigned)(px[0] >> s) << (2 * bits)) | ((unsigned)(px[1] >> s) << bits) |
+           (unsigned)(px[2] >> s);
+}
+
 static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
 {
     const int w = f->width, h = f->height, bits = PIPE_FIT_BITS, bins = 1 << (3 * bits);
@@ -347,16 +356,15 @@ static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
     long nf = 0, nb = 0;
     for (int y = 0; y < h; y += 2) {
         const uint8_t *row = mask + (size_t)y * (size_t)w;
+        const int yu = y - margin < 0 ? 0 : y - margin, yd = y + margin >= h ? h - 1 : y + margin;
+        const uint8_t *up = mask + (size_t)yu * (size_t)w, *dn = mask + (size_t)yd * (size_t)w;
         const uint8_t *src = P->pixels + (size_t)y * (size_t)P->stride;
         for (int x = 0; x < w; x += 2) {
             const uint8_t v = row[x];
             if (v != 0 && v != 255) continue;
             int xl = x - margin < 0 ? 0 : x - margin, xr = x + margin >= w ? w - 1 : x + margin;
-            int yu = y - margin < 0 ? 0 : y - margin, yd = y + margin >= h ? h - 1 : y + margin;
-            if (row[xl] != v || row[xr] != v || mask[(size_t)yu * (size_t)w + (size_t)x] != v ||
-                mask[(size_t)yd * (size_t)w + (size_t)x] != v)
-                continue;
-            unsigned b = fuse_colour_bin(src + 4 * x, bits);
+            if (row[xl] != v || row[xr] != v || up[x] != v || dn[x] != v) continue;
+            unsigned b = fit_bin(src + 4 * x, bits);
             if (v == 255) { af[b] += 1.0f; nf++; }
             else { ab[b] += 1.0f; nb++; }
         }
@@ -373,11 +381,29 @@ static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
     }
     const float a = 4.0f / (float)bins;
     const float off = logf((float)f->accn[eye][1] + 4.0f) - logf((float)f->accn[eye][0] + 4.0f);
+    /* a bin never seen by either class (both 0) has the ratio a / a = 1
+     * exactly, logf 0: its entry is the offset, clamped */
+    const float off_c = off > 3.0f ? 3.0f : off < -3.0f ? -3.0f : off;
     for (int b = 0; b < bins; b++) {
+        if (af[b] == 0.0f && ab[b] == 0.0f) {
+            cm->llr[b] = off_c;
+            continue;
+        }
         float v = logf((af[b] + a) / (ab[b] + a)) + off;
         cm->llr[b] = v > 3.0f ? 3.0f : v < -3.0f ? -3.0f : v;
     }
 }
+
+/* The learning mask's rows, 8 pixels a step as bytes of a 64-bit word
+ * (the same bytes as the per-pixel expressions in pipe_fit_learn). */
+static uint64_t fit_ld8(const uint8_t *p)
+{
+    uint64_t v;
+    memcpy(&v, p, 8);
+    return v;
+}
+
+#define FIT_B01 0x0101010101010101ull
 
 fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint8_t *mask,
                            int mask_stride, const uint8_t *prev, int prev_stride)
@@ -393,7 +419,12 @@ fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint
         for (int y = 0; y < f->height; y++) {
             const uint8_t *a = mask + (size_t)y * (size_t)mask_stride;
             uint8_t *L = f->learn[eye] + (size_t)y * (size_t)f->width;
-            for (int x = 0; x < f->width; x++) L[x] = (uint8_t)(0u - (unsigned)(a[x] >> 7));
+            int x = 0;
+            for (; x + 8 <= f->width; x += 8) {
+                const uint64_t r = ((fit_ld8(a + x) >> 7) & FIT_B01) * 0xFFu;
+                memcpy(L + x, &r, 8);
+            }
+            for (; x < f->width; x++) L[x] = (uint8_t)(0u - (unsigned)(a[x] >> 7));
         }
     } else {
         /* 255 where both hold the pixel, 0 where neither does, else 128
@@ -402,7 +433,15 @@ fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint
             const uint8_t *a = mask + (size_t)y * (size_t)mask_stride;
             const uint8_t *b = prev + (size_t)y * (size_t)prev_stride;
             uint8_t *L = f->learn[eye] + (size_t)y * (size_t)f->width;
-            for (int x = 0; x < f->width; x++) {
+            int x = 0;
+            for (; x + 8 <= f->width; x += 8) {
+                /* per byte: 0x80, + 0x7f where both, 0 where neither */
+                const uint64_t ia = (fit_ld8(a + x) >> 7) & FIT_B01, ib = (fit_ld8(b + x) >> 7) & FIT_B01;
+                const uint64_t r = ((0x80u * FIT_B01) | ((ia & ib) * 0x7Fu)) &
+                                   ~(((ia | ib) ^ FIT_B01) * 0xFFu);
+                memcpy(L + x, &r, 8);
+            }
+            for (; x < f->width; x++) {
                 unsigned ia = a[x] >> 7, ib = b[x] >> 7;
                 L[x] = (uint8_t)(128u + 127u * (ia & ib) - 128u * ((ia | ib) ^ 1u));
             }

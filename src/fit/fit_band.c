@@ -204,6 +204,19 @@ const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *dp, const kin_camera *ca
  * colour the model calls background (llr <= 0) is cleared. Cleared pixels
  * are 1 until the end: still set for their neighbours' tests, below 128
  * for the refinement. Returns the count cleared. */
+static uint64_t ld8(const uint8_t *p)
+{
+    uint64_t v;
+    memcpy(&v, p, 8);
+    return v;
+}
+
+#define B01 0x0101010101010101ull
+#define B80 0x8080808080808080ull
+
+/* 1 when one of the 8 bytes of v is 0 */
+static int has_zero(uint64_t v) { return ((v - B01) & ~v & B80) != 0; }
+
 static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const uint8_t *in,
                          uint8_t *out, int stride)
 {
@@ -211,29 +224,56 @@ static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const 
         g->bits > 6 || !P || !P->pixels || !out || P->width < 1 || P->height < 1 ||
         stride < P->width || P->stride < 4 * P->width)
         return 0;
-    const int W = P->width, H = P->height;
+    const int W = P->width, H = P->height, bits = g->bits, sh = 8 - bits;
     long n = 0;
     for (int y = 0; y < H; y++) {
         const uint8_t *s = P->pixels + (size_t)y * (size_t)P->stride;
         const uint8_t *i = in ? in + (size_t)y * (size_t)stride : NULL;
         uint8_t *o = out + (size_t)y * (size_t)stride;
         const uint8_t *up = y > 0 ? o - stride : NULL, *dn = y + 1 < H ? o + stride : NULL;
-        for (int x = 0; x < W; x++) {
-            if (o[x] < 128 || (i && i[x] >= 128)) continue;
-            const int nb = (x > 0 && o[x - 1]) + (x + 1 < W && o[x + 1]) + (up && up[x]) +
-                           (dn && dn[x]);
-            const int border = (x > 0) + (x + 1 < W) + (up != NULL) + (dn != NULL);
-            const int candidate = i ? nb <= 2 : nb < border;
-            if (candidate && g->llr[fuse_colour_bin(s + 4 * x, g->bits)] <= 0.0f) {
-                o[x] = 1;
-                n++;
+        for (int x0 = 0; x0 < W; x0 += 8) {
+            /* 8 pixels at a time past those that cannot be tested (out
+             * below 128, or in at >= 128); the bytes from x0 on are not
+             * written yet */
+            if (x0 + 8 <= W) {
+                const uint64_t t = i ? ld8(o + x0) & ~ld8(i + x0) : ld8(o + x0);
+                if (!(t & B80)) continue;
+                /* prior: inside the mask, with every 4-neighbour set (no
+                 * zero byte in the block, the row above and below, nor
+                 * beside it), no pixel is on the rim */
+                if (!i && x0 > 0 && x0 + 8 < W && up && dn && o[x0 - 1] && o[x0 + 8] &&
+                    !has_zero(ld8(o + x0)) && !has_zero(ld8(up + x0)) && !has_zero(ld8(dn + x0)))
+                    continue;
+            }
+            const int x1 = x0 + 8 < W ? x0 + 8 : W;
+            for (int x = x0; x < x1; x++) {
+                if (o[x] < 128 || (i && i[x] >= 128)) continue;
+                const int nb = (x > 0 && o[x - 1]) + (x + 1 < W && o[x + 1]) + (up && up[x]) +
+                               (dn && dn[x]);
+                const int border = (x > 0) + (x + 1 < W) + (up != NULL) + (dn != NULL);
+                const int candidate = i ? nb <= 2 : nb < border;
+                if (!candidate) continue;
+                const uint8_t *px = s + 4 * x;
+                const unsigned bin = ((unsigned)(px[0] >> sh) << (2 * bits)) |
+                                     ((unsigned)(px[1] >> sh) << bits) | (unsigned)(px[2] >> sh);
+                if (g->llr[bin] <= 0.0f) {
+                    o[x] = 1;
+                    n++;
+                }
             }
         }
     }
     if (n)
         for (int y = 0; y < H; y++) {
             uint8_t *o = out + (size_t)y * (size_t)stride;
-            for (int x = 0; x < W; x++)
+            int x = 0;
+            for (; x + 8 <= W; x += 8) {
+                /* no byte equal to 1: none of (v ^ 0x01..) is zero */
+                if (!has_zero(ld8(o + x) ^ B01)) continue;
+                for (int k = x; k < x + 8; k++)
+                    if (o[k] == 1) o[k] = 0;
+            }
+            for (; x < W; x++)
                 if (o[x] == 1) o[x] = 0;
         }
     return n;
