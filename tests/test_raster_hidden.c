@@ -200,7 +200,7 @@ static int planes_equal(const rast_target *a, const rast_target *b)
            !memcmp(a->attr, b->attr, (size_t)a->attr_stride * (size_t)a->height * 4);
 }
 
-static void draw(const hcase *k, const rast_target *t, rast__scan_rows_fn scan, rast_stats *st)
+static rast_mesh_desc mesh_of(const hcase *k)
 {
     rast_mesh_desc m;
     memset(&m, 0, sizeof m);
@@ -211,6 +211,12 @@ static void draw(const hcase *k, const rast_target *t, rast__scan_rows_fn scan, 
     m.indices = k->idx;
     m.tri_count = k->nt;
     m.cull = RAST_CULL_NONE;
+    return m;
+}
+
+static void draw(const hcase *k, const rast_target *t, rast__scan_rows_fn scan, rast_stats *st)
+{
+    const rast_mesh_desc m = mesh_of(k);
     target_reset(k, t);
     memset(st, 0, sizeof *st);
     assert_int_equal(rast__draw_with(t, &m, st, scan), RAST_OK);
@@ -249,20 +255,6 @@ static void hidden_isa(int isa)
         free_case(&k);
     }
     assert_true(written > 0);
-}
-
-static rast_mesh_desc mesh_of(const hcase *k)
-{
-    rast_mesh_desc m;
-    memset(&m, 0, sizeof m);
-    m.clip = k->clip;
-    m.vertex_count = k->nv;
-    m.attr = k->attr;
-    m.attr_count = NA;
-    m.indices = k->idx;
-    m.tri_count = k->nt;
-    m.cull = RAST_CULL_NONE;
-    return m;
 }
 
 static int front_skip(int isa)
