@@ -4,6 +4,7 @@
 #include "pipe_morph.h"
 #include "pipe_parts.h"
 #include "pipe_internal.h"
+#include "pipe_ctx.h"
 #include "pipe_lens.h"
 #include "pipe_nfill.h"
 #include "pipe_soft.h"
@@ -20,73 +21,6 @@
 
 /* ------------------------------------------------------------- frames */
 
-typedef struct eye_state {
-    int eye;
-    float *depth, *nrm, *clip, *vnrm;
-    uint8_t *mask, *layer;
-    uint8_t *cam_rgba;        /* the cropped camera image, when given raw */
-    float *snrm;              /* smoothed normals (normal_smooth), or
-                                 the refined mask's (pipe_nfill.h) */
-    void *nfill_scratch;      /* refine_band, normal_smooth >= 0 */
-    uint8_t *soft;            /* soft_edge: the softened mask */
-    uint8_t *refined;         /* the refined mask (refine_band) */
-    void *refine_scratch;
-    size_t refine_scratch_size;
-    int have_refined;         /* refined holds the last frame's mask */
-    uint8_t *prior;           /* refine_prior: this frame's input mask */
-    float hand_px[2][2];      /* refine_prior: each hand's image position */
-    int have_hand_px[2];      /* last frame (pipe_fit_hand_px) */
-    pipe__aa aa;              /* anti-aliased coverage (aa_samples) */
-    const uint8_t *shown;     /* the mask composited last frame */
-    int converted;            /* cam_rgba already holds this frame's crop */
-    rast_context *rast;
-    fuse_context *fuse;
-    pipe_lens_map *lens;      /* a distorting lens: the mask through it */
-    kin_camera cam;
-    /* per-frame job */
-    const pipe_frame_in *in;
-    kin_mat4 head;
-    pipe_result result;
-    char why[160];
-    double ms_raster, ms_convert, ms_fuse, coverage;
-    int lod_level;            /* the level drawn */
-    pipe__reproj rp;          /* eye_view REPROJECT: the eye's view */
-    int view_used;            /* this frame: PIPE_VIEW_* */
-    long fallbacks;           /* reprojecting frames that fell back */
-    int thread;               /* 0 the caller's thread, 1 the worker */
-    double t_start;           /* now_ms() at the eye's start */
-} eye_state;
-
-struct pipe_ctx {
-    pipe_desc desc;
-    kin_sthmd_desc hmd;
-    kin_sthmd_geometry geo;
-    pipe_pose pose;
-    eye_state eye[2];
-    /* the worker thread runs eye 1 when threads == 2 */
-    int threaded;
-    pthread_t worker;
-    pthread_mutex_t mu;
-    pthread_cond_t cv;
-    int job_seq, done_seq, quit;
-    int job_kind;             /* JOB_SKIN or JOB_EYE */
-    int eye_next, eye_done;   /* JOB_EYE: the next eye to take (2: none
-                                 left), the eyes finished */
-    int skin_split;           /* skin on both threads (large models) */
-    kin_skin_plan *plans;     /* per mesh: the skin plan of a skinned mesh */
-    void **plan_mem;          /* per mesh: its memory, or NULL */
-    pipe_fit *fit;            /* elbow fit (refine_band and fit_rig) */
-    kin_arm_rig fit_rig;
-    int fit_no_prev;          /* pipe_reset_fit: the refined masks are of
-                                 before it, not to be learned from */
-    pipe__cockpit *ck;        /* hidden parts and props (pipe_parts.c) */
-    const kin_model *model;
-    const pipe_lod *lod;      /* pipe_set_lod, or NULL */
-    int lod_level;            /* a level, or PIPE_LOD_AUTO */
-    float lod_px;             /* the rule's target, pixels */
-};
-
-enum { JOB_SKIN, JOB_EYE };
 /* Below this many vertices, splitting the skinning costs more in the
  * hand-over than it saves: measured with the 7.8k-vertex sample arms
  * (make bench), FK + skinning took 0.089 ms on one thread and 0.155 ms
@@ -583,12 +517,6 @@ static void wait_job(pipe_ctx *p, int job)
     pthread_mutex_unlock(&p->mu);
 }
 
-pipe_lighting pipe_lighting_default(void)
-{
-    pipe_lighting l = {fuse_lighting_default()};
-    return l;
-}
-
 static void free_eyes(pipe_ctx *p)
 {
     for (int e = 0; e < 2; e++) {
@@ -983,94 +911,4 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
     return PIPE_OK;
 }
 
-void pipe_reset_fit(pipe_ctx *p)
-{
-    if (!p || !p->fit) return;
-    pipe_fit_forget(p->fit);
-    p->fit_no_prev = 1;
-}
-
-const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
-{
-    if (width) *width = p->geo.crop_width;
-    if (height) *height = p->geo.crop_height;
-    const eye_state *e = &p->eye[eye ? 1 : 0];
-    if (e->aa.count && e->shown) return e->shown;
-    return e->have_refined ? e->refined : e->mask;
-}
-
-const uint8_t *pipe_layer(const pipe_ctx *p, int eye, int *width, int *height)
-{
-    if (width) *width = p->geo.crop_width;
-    if (height) *height = p->geo.crop_height;
-    return p->eye[eye ? 1 : 0].layer;
-}
-
-kin_camera pipe_camera(const pipe_ctx *p, int eye) { return p->eye[eye ? 1 : 0].cam; }
-
-kin_camera pipe_view_camera(const pipe_ctx *p, int eye)
-{
-    const eye_state *e = &p->eye[eye ? 1 : 0];
-    return e->view_used == PIPE_VIEW_REPROJECT ? e->rp.cam : e->cam;
-}
-
-const uint8_t *pipe_view_mask(const pipe_ctx *p, int eye, int *width, int *height)
-{
-    const eye_state *e = &p->eye[eye ? 1 : 0];
-    if (width) *width = e->rp.width;
-    if (height) *height = e->rp.height;
-    return e->view_used == PIPE_VIEW_REPROJECT ? e->rp.M : NULL;
-}
-
-kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }
-
-kin_sthmd_desc pipe_hmd(const pipe_ctx *p) { return p->hmd; }
-
-int pipe_set_lod(pipe_ctx *p, const pipe_lod *lod, int level, float target_px)
-{
-    if (!p || level < PIPE_LOD_AUTO) return -1;
-    if (lod && !pipe_lod_check(lod, p->model, NULL, 0)) return -1;
-    if (level == PIPE_LOD_AUTO && (!(target_px > 0.0f) || !isfinite(target_px))) return -1;
-    p->lod = level == 0 ? NULL : lod;
-    p->lod_level = level;
-    p->lod_px = target_px;
-    return 0;
-}
-
-unsigned pipe_parts_present(const pipe_ctx *p) { return p ? pipe__cockpit_present(p->ck) : 0; }
-
-int pipe_add_prop(pipe_ctx *p, const kin_model *m)
-{
-    return p ? pipe__cockpit_add_prop(p->ck, m) : -1;
-}
-
-int pipe_prop_count(const pipe_ctx *p) { return p ? pipe__cockpit_prop_count(p->ck) : 0; }
-
-int pipe_image_opaque(const fuse_image *im, int x0, int y0, int w, int h)
-{
-    if (!im || !im->pixels || w < 1 || h < 1 || x0 < 0 || y0 < 0 || x0 > im->width - w ||
-        y0 > im->height - h || im->stride < 4 * im->width)
-        return 0;
-    for (int y = y0; y < y0 + h; y++) {
-        const uint8_t *a = im->pixels + (size_t)y * (size_t)im->stride + (size_t)x0 * 4 + 3;
-        unsigned all = 255;
-        for (int x = 0; x < w; x++) all &= a[(size_t)x * 4];
-        if (all != 255) return 0;
-    }
-    return 1;
-}
-
 void pipe_set_stats_clock(int thread_cpu) { stats_cpu_clock = thread_cpu != 0; }
-
-int pipe_isa(const pipe_ctx *p) { return rast_context_isa(p->eye[0].rast); }
-
-const char *pipe_result_str(pipe_result r)
-{
-    switch (r) {
-    case PIPE_OK: return "ok";
-    case PIPE_ERR_ARGS: return "invalid arguments";
-    case PIPE_ERR_RASTER: return "rasterizer error";
-    case PIPE_ERR_FUSE: return "lighting/composite error";
-    }
-    return "unknown error";
-}

@@ -1,0 +1,86 @@
+/* pipe_ctx.h - internal to src/pipe: the state of a pipe (struct pipe_ctx)
+ * and of each of its eyes, shared by the frame (pipe.c: creation, the
+ * eyes' work, the worker thread) and the queries of the last frame
+ * (pipe_query.c). Nothing here is public: pipe.h's callers see an opaque
+ * pipe_ctx. */
+#ifndef EGOFUSE_PIPE_CTX_H
+#define EGOFUSE_PIPE_CTX_H
+
+#include "pipe.h"
+#include "pipe_aa.h"
+#include "pipe_internal.h"
+#include "pipe_lens.h"
+#include "pipe_parts.h"
+#include "pipe_reproj.h"
+
+#include <pthread.h>
+
+typedef struct eye_state {
+    int eye;
+    float *depth, *nrm, *clip, *vnrm;
+    uint8_t *mask, *layer;
+    uint8_t *cam_rgba;        /* the cropped camera image, when given raw */
+    float *snrm;              /* smoothed normals (normal_smooth), or
+                                 the refined mask's (pipe_nfill.h) */
+    void *nfill_scratch;      /* refine_band, normal_smooth >= 0 */
+    uint8_t *soft;            /* soft_edge: the softened mask */
+    uint8_t *refined;         /* the refined mask (refine_band) */
+    void *refine_scratch;
+    size_t refine_scratch_size;
+    int have_refined;         /* refined holds the last frame's mask */
+    uint8_t *prior;           /* refine_prior: this frame's input mask */
+    float hand_px[2][2];      /* refine_prior: each hand's image position */
+    int have_hand_px[2];      /* last frame (pipe_fit_hand_px) */
+    pipe__aa aa;              /* anti-aliased coverage (aa_samples) */
+    const uint8_t *shown;     /* the mask composited last frame */
+    int converted;            /* cam_rgba already holds this frame's crop */
+    rast_context *rast;
+    fuse_context *fuse;
+    pipe_lens_map *lens;      /* a distorting lens: the mask through it */
+    kin_camera cam;
+    /* per-frame job */
+    const pipe_frame_in *in;
+    kin_mat4 head;
+    pipe_result result;
+    char why[160];
+    double ms_raster, ms_convert, ms_fuse, coverage;
+    int lod_level;            /* the level drawn */
+    pipe__reproj rp;          /* eye_view REPROJECT: the eye's view */
+    int view_used;            /* this frame: PIPE_VIEW_* */
+    long fallbacks;           /* reprojecting frames that fell back */
+    int thread;               /* 0 the caller's thread, 1 the worker */
+    double t_start;           /* now_ms() at the eye's start */
+} eye_state;
+
+struct pipe_ctx {
+    pipe_desc desc;
+    kin_sthmd_desc hmd;
+    kin_sthmd_geometry geo;
+    pipe_pose pose;
+    eye_state eye[2];
+    /* the worker thread runs eye 1 when threads == 2 */
+    int threaded;
+    pthread_t worker;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    int job_seq, done_seq, quit;
+    int job_kind;             /* JOB_SKIN or JOB_EYE */
+    int eye_next, eye_done;   /* JOB_EYE: the next eye to take (2: none
+                                 left), the eyes finished */
+    int skin_split;           /* skin on both threads (large models) */
+    kin_skin_plan *plans;     /* per mesh: the skin plan of a skinned mesh */
+    void **plan_mem;          /* per mesh: its memory, or NULL */
+    pipe_fit *fit;            /* elbow fit (refine_band and fit_rig) */
+    kin_arm_rig fit_rig;
+    int fit_no_prev;          /* pipe_reset_fit: the refined masks are of
+                                 before it, not to be learned from */
+    pipe__cockpit *ck;        /* hidden parts and props (pipe_parts.c) */
+    const kin_model *model;
+    const pipe_lod *lod;      /* pipe_set_lod, or NULL */
+    int lod_level;            /* a level, or PIPE_LOD_AUTO */
+    float lod_px;             /* the rule's target, pixels */
+};
+
+enum { JOB_SKIN, JOB_EYE };
+
+#endif
