@@ -95,8 +95,11 @@ static void make_case(tu_rng *g)
                 if (fx * fx + fy * fy < (rad + grow) * (rad + grow)) rm[y * W + x] = 255;
             }
     }
-    for (int k = tu_int(g, 20); k > 0; k--) rm[tu_int(g, H) * W + tu_int(g, W)] = 255;
-    for (int k = tu_int(g, 20); k > 0; k--) rm[tu_int(g, H) * W + tu_int(g, W)] = 0;
+    for (int v = 255; v >= 0; v -= 255)   /* specks set, then holes */
+        for (int k = tu_int(g, 20); k > 0; k--) {
+            const int y = tu_int(g, H);
+            rm[y * W + tu_int(g, W)] = (uint8_t)v;
+        }
     for (int i = 0; i < W * H; i++)
         if (km[i])
             for (int k = 0; k < 3; k++) nrm[3 * i + k] = tu_range(g, -1, 1);

@@ -714,7 +714,8 @@ static void result_fill_row_rule(void **state)
         const int w = widths[it % 9];
         /* runs: long ones of each kind, or (every 3rd) single pixels */
         const int maxrun = it % 3 == 0 ? 1 : 1 + tu_int(&g, 20);
-        const int pk[3] = {tu_int(&g, 4), tu_int(&g, 4), tu_int(&g, 4)};
+        int pk[3];
+        for (int i = 0; i < 3; i++) pk[i] = tu_int(&g, 4);
         for (int x = 0; x < w;) {
             int k = tu_int(&g, pk[0] + pk[1] + pk[2] + 1), run = 1 + tu_int(&g, maxrun);
             k = k < pk[0] ? 0 : k < pk[0] + pk[1] ? 1 : 2;

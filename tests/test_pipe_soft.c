@@ -49,11 +49,15 @@ static void against_reference(void **state)
                     for (int x = 0; x < W; x++)
                         if ((x - cx) * (x - cx) + (y - cy) * (y - cy) < r * r) m[y * W + x] = 255;
             }
-            for (int k = tu_int(&g, 12); k > 0; k--)
-                m[tu_int(&g, H) * W + tu_int(&g, W)] = (uint8_t)tu_int(&g, 256);
+            for (int k = tu_int(&g, 12); k > 0; k--) {
+                const int y = tu_int(&g, H), x = tu_int(&g, W);
+                m[y * W + x] = (uint8_t)tu_int(&g, 256);
+            }
         }
         memset(o, 0xA5, sizeof o);
-        int box[4] = {tu_int(&g, W), tu_int(&g, H), 0, 0};
+        int box[4] = {0, 0, 0, 0};
+        box[0] = tu_int(&g, W);
+        box[1] = tu_int(&g, H);
         box[2] = box[0] + 1 + tu_int(&g, W - box[0]);
         box[3] = box[1] + 1 + tu_int(&g, H - box[1]);
         pipe__soft_edge(m, o, W, H, c % 3 ? box : NULL);

@@ -120,32 +120,41 @@ static void make_case(int n, hcase *k)
     const int nl = 3 + tu_int(&r, 4);
     for (int l = 0; l < nl; l++) {
         switch (tu_int(&r, 5)) {
-        case 0:   /* the same plane, the other diagonal, other cells */
-            add_layer(k, &r, cap_v, cap_t, x0, y0, x1, y1, 1 + tu_int(&r, gx + 2),
-                      1 + tu_int(&r, gy + 2), a, b, c, !diag, 0);
+        /* each layer's draws one statement at a time (a defined order) */
+        case 0: { /* the same plane, the other diagonal, other cells */
+            const int cx = 1 + tu_int(&r, gx + 2), cy = 1 + tu_int(&r, gy + 2);
+            add_layer(k, &r, cap_v, cap_t, x0, y0, x1, y1, cx, cy, a, b, c, !diag, 0);
             break;
-        case 1:   /* the same grid, z moved by a few ulps */
-            add_layer(k, &r, cap_v, cap_t, x0, y0, x1, y1, gx, gy, a, b, c, tu_int(&r, 2),
-                      1 + tu_int(&r, 4));
+        }
+        case 1: { /* the same grid, z moved by a few ulps */
+            const int dg = tu_int(&r, 2), ulps = 1 + tu_int(&r, 4);
+            add_layer(k, &r, cap_v, cap_t, x0, y0, x1, y1, gx, gy, a, b, c, dg, ulps);
             break;
+        }
         case 2: { /* behind: hidden where the first layer covers */
             const float dz = tu_range(&r, 1e-6f, 0.1f);
-            add_layer(k, &r, cap_v, cap_t, x0 + tu_range(&r, -0.2f, 0.2f), y0, x1,
-                      y1 + tu_range(&r, -0.2f, 0.2f), 1 + tu_int(&r, 2 * gx + 1),
-                      1 + tu_int(&r, 2 * gy + 1), a + dz, b, c, tu_int(&r, 2), 0);
+            const float sx = tu_range(&r, -0.2f, 0.2f);
+            const float sy = tu_range(&r, -0.2f, 0.2f);
+            const int cx = 1 + tu_int(&r, 2 * gx + 1);
+            const int cy = 1 + tu_int(&r, 2 * gy + 1);
+            const int dg = tu_int(&r, 2);
+            add_layer(k, &r, cap_v, cap_t, x0 + sx, y0, x1, y1 + sy, cx, cy, a + dz, b, c, dg, 0);
             break;
         }
         case 3: { /* in front, a smaller patch */
             const float dz = tu_range(&r, 1e-6f, 0.05f);
-            add_layer(k, &r, cap_v, cap_t, x0 * 0.5f, y0 * 0.5f, x1 * 0.5f, y1 * 0.5f,
-                      1 + tu_int(&r, gx), 1 + tu_int(&r, gy), a - dz, b, c, tu_int(&r, 2), 0);
+            const int cx = 1 + tu_int(&r, gx), cy = 1 + tu_int(&r, gy), dg = tu_int(&r, 2);
+            add_layer(k, &r, cap_v, cap_t, x0 * 0.5f, y0 * 0.5f, x1 * 0.5f, y1 * 0.5f, cx, cy,
+                      a - dz, b, c, dg, 0);
             break;
         }
-        default:  /* a tilted plane through the first one */
-            add_layer(k, &r, cap_v, cap_t, x0, y0, x1, y1, 1 + tu_int(&r, gx + 1),
-                      1 + tu_int(&r, gy + 1), a, -b, c + tu_range(&r, -0.2f, 0.2f),
-                      tu_int(&r, 2), 0);
+        default: { /* a tilted plane through the first one */
+            const int cx = 1 + tu_int(&r, gx + 1), cy = 1 + tu_int(&r, gy + 1);
+            const float dc = tu_range(&r, -0.2f, 0.2f);
+            const int dg = tu_int(&r, 2);
+            add_layer(k, &r, cap_v, cap_t, x0, y0, x1, y1, cx, cy, a, -b, c + dc, dg, 0);
             break;
+        }
         }
     }
 }
