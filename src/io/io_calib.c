@@ -419,6 +419,9 @@ static io_result x_close_tag(xcur *c, const char *name, int line, io_error *err)
         return io_fail(err, IO_ERR_FORMAT, "%s:%d: <%s> (opened on line %d) is not closed by </%s>",
                        c->name, c->line, name, line, name);
     const char *e = memchr(c->p, '>', (size_t)(c->end - c->p));
+    if (!e)   /* "</name" and white space to the end of the file */
+        return io_fail(err, IO_ERR_FORMAT, "%s:%d: </%s> has no closing '>'", c->name, c->line,
+                       name);
     x_adv(c, (size_t)(e + 1 - c->p));
     return IO_OK;
 }
