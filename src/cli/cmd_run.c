@@ -12,10 +12,11 @@
  *
  * Why one file of this length: one job, the live loop of `egofuse run`
  * (run(), about 550 lines: open, then per frame wait, grab, track, pipe,
- * show, account). Its options are parsed in run_opts.c and --dump's files
- * written in run_dump.c (run.h); what is left here are that loop and the
- * helpers that read and write its run_state (tracking service, flips,
- * outputs, the status words), which nothing else uses. */
+ * show, account). Its options are parsed in run_opts.c, the cameras found
+ * in run_cams.c and --dump's files written in run_dump.c (run.h); what is
+ * left here are that loop and the helpers that read and write its
+ * run_state (tracking service, flips, outputs, the status words), which
+ * nothing else uses. */
 #include "run.h"
 #include "cli_lod.h"
 
@@ -41,47 +42,6 @@ static void on_signal(int s)
 {
     (void)s;
     stop_flag = 1;
-}
-
-/* Resolves a camera selector to a /dev/videoN path. */
-static int resolve(const char *sel, char *path, size_t n, io_error *err)
-{
-    if (!strncmp(sel, "/dev/", 5)) {
-        snprintf(path, n, "%s", sel);
-        return 0;
-    }
-    if (io_usb_selector_check(sel, err) != IO_OK) return -1;
-    io_usb_dev d[64];
-    int nd = 0;
-    if (io_usb_list(d, 64, &nd, err) != IO_OK) return -1;
-    if (nd > 64) nd = 64;
-    for (int i = 0; i < nd; i++)
-        if (io_usb_match(&d[i], sel)) {
-            if (!d[i].video[0]) {
-                io_fail(err, IO_ERR_NOT_FOUND, "%s: USB device %s (%04x:%04x) has no video node",
-                        sel, d[i].port_path, d[i].vid, d[i].pid);
-                return -1;
-            }
-            snprintf(path, n, "%s", d[i].video);
-            return 0;
-        }
-    io_fail(err, IO_ERR_NOT_FOUND, "%s: no USB device matches ('egofuse devices' lists them)", sel);
-    return -1;
-}
-
-static int no_cameras(const char *why)
-{
-    fprintf(stderr,
-            "egofuse run: no cameras found%s%s.\n"
-            "  Plug in the HMD's two cameras ('egofuse devices' lists what is seen), or\n"
-            "  make a dry run from recorded camera frames or a video:\n"
-            "    egofuse run --scene FILE --left file:cam_left_%%04d.png --right "
-            "file:cam_right_%%04d.png\n"
-            "  or composite recorded input offline:\n"
-            "    egofuse render --scene FILE --out DIR   (docs/scene.md)\n"
-            "    egofuse demo                            (the bundled samples)\n",
-            why ? ": " : "", why ? why : "");
-    return EXIT_FAIL;
 }
 
 static int load_virt(const char *path, int w, int h, io_image *img)
@@ -405,30 +365,9 @@ static int run(const run_opts *o)
     int rc = EXIT_FAIL;
     /* ---- cameras first: without them nothing else matters */
     char path[2][IO_CAM_NAME_MAX];
-    int file_cams = o->sel[0] && io_cam_file_selector(o->sel[0]);
-    if (o->sel[0]) {
-        if (io_cam_file_selector(o->sel[0]) != io_cam_file_selector(o->sel[1]))
-            return cli_usage_error("run", "--left and --right: both cameras or both recorded");
-        for (int e = 0; e < 2; e++) {
-            if (file_cams) {
-                snprintf(path[e], sizeof path[e], "%s", o->sel[e]);
-                continue;
-            }
-            if (resolve(o->sel[e], path[e], sizeof path[e], &err) != 0) return no_cameras(err.msg);
-        }
-    } else {
-        io_cam_info ci[64];
-        int n = 0, k = 0;
-        io_cam_list(NULL, ci, 64, &n, &err);
-        for (int i = 0; i < n && i < 64 && k < 2; i++)
-            if (ci[i].capture) snprintf(path[k++], sizeof path[0], "%.63s", ci[i].path);
-        if (k < 2) {
-            char why[128];
-            snprintf(why, sizeof why, "%d video capture node%s in /dev, 2 needed", k,
-                     k == 1 ? "" : "s");
-            return no_cameras(why);
-        }
-    }
+    int file_cams = 0;
+    int crc = run_find_cameras(o, path, &file_cams);
+    if (crc != EXIT_OK) return crc;
 
     if (!o->scene && !o->model)
         return cli_usage_error("run", "--scene or --model is required (the arm model to mask)");
@@ -761,7 +700,7 @@ static int run(const run_opts *o)
             char np[IO_CAM_NAME_MAX];
             io_error e2;
             const char *where = NULL;
-            if (o->sel[e] && !file_cams && resolve(o->sel[e], np, sizeof np, &e2) == 0) where = np;
+            if (o->sel[e] && !file_cams && run_resolve_camera(o->sel[e], np, sizeof np, &e2) == 0) where = np;
             if (io_cam_reopen(&r->cam[e], where, &e2) == IO_OK) {
                 cam_lost[e] = 0;
                 reopen_msg[e][0] = '\0';

@@ -5,6 +5,7 @@
 #define EGOFUSE_RUN_H
 
 #include "cli.h"
+#include "../io/io_dev.h"
 
 #define RUN_MAX_PROPS 8
 #define RUN_MAX_NATNET 32
@@ -57,6 +58,15 @@ int run_parse(int argc, char **argv, run_opts *o);
 void run_opts_free(run_opts *o);
 
 extern const char *run_usage;
+
+/* The cameras of a run (run_cams.c): --left / --right resolved (a USB
+ * selector to its /dev/videoN), or recorded frames (*file_cams 1), or
+ * without selectors the first two capture nodes in /dev. EXIT_OK with
+ * path[0] left and path[1] right, else the exit status with the message
+ * printed (how to make a dry run when no camera is found). */
+int run_find_cameras(const run_opts *o, char path[2][IO_CAM_NAME_MAX], int *file_cams);
+/* A camera selector to a /dev/videoN path: 0, or -1 with err set. */
+int run_resolve_camera(const char *sel, char *path, size_t n, io_error *err);
 
 /* What --dump reads of the run besides its options (cmd_run.c's state). */
 typedef struct run_dump_src {
