@@ -201,12 +201,37 @@ static long check_scene(const fuse_lighting *L, const fuse_intrinsics *K,
     return ones;
 }
 
+/* What the lighting-vs-double tests count: the largest error (LSB), and
+ * how many of the channels checked are off by one. */
+typedef struct err_tally {
+    double max_err;
+    long ones, channels;
+} err_tally;
+
+/* A random scene s (drawn from r) lit by L, checked against double and
+ * counted into t. */
+static void check_random_scene(const fuse_lighting *L, const fuse_intrinsics *K, scene *s,
+                               tu_rng *r, err_tally *t)
+{
+    scene_random(s, r);
+    t->ones += check_scene(L, K, s, &t->max_err);
+    t->channels += 4L * s->w * s->h;
+}
+
+/* Prints the tally (`what` names the cases) and fails unless every channel
+ * is within one LSB. */
+static void tally_end(const char *what, const err_tally *t)
+{
+    printf("NOTE lighting vs double%s: max error %.4f LSB, %ld of %ld channels off by 1\n", what,
+           t->max_err, t->ones, t->channels);
+    assert_true(t->max_err < 1.0);
+}
+
 static void test_light_vs_double(void **state)
 {
     static const int sizes[][2] = { { 160, 100 }, { 37, 23 }, { 640, 400 } };
     tu_rng r = { 0x5EED0001u };
-    double max_err = 0;
-    long ones = 0, channels = 0;
+    err_tally t = { 0, 0, 0 };
     int si, k;
     (void)state;
     for (si = 0; si < 3; si++) {
@@ -217,15 +242,11 @@ static void test_light_vs_double(void **state)
             static const int counts[] = { 1, 0, 3, 8, 2, 5 };
             fuse_lighting L = k == 0 ? fuse_lighting_default()
                                      : random_lighting(&r, counts[k]);
-            scene_random(&s, &r);
-            ones += check_scene(&L, &K, &s, &max_err);
-            channels += 4L * s.w * s.h;
+            check_random_scene(&L, &K, &s, &r, &t);
         }
         scene_free(&s);
     }
-    printf("NOTE lighting vs double: max error %.4f LSB, %ld of %ld channels off by 1\n",
-           max_err, ones, channels);
-    assert_true(max_err < 1.0);
+    tally_end("", &t);
 }
 
 /* x^s of fuse__pow01 against pow(): the reproducible power is accurate.
@@ -346,8 +367,7 @@ static void test_light_vs_double_spec(void **state)
     static const float shin[] = { 1.0f, 3.0f, 5.0f, 20.0f, 63.0f, 64.0f, 65.0f, 130.5f, 2.5f };
     tu_rng r = { 0x5EED0007u };
     fuse_intrinsics K = intrinsics_for(160, 100);
-    double max_err = 0;
-    long ones = 0, channels = 0;
+    err_tally t = { 0, 0, 0 };
     int k, i, c;
     scene s;
     (void)state;
@@ -374,14 +394,10 @@ static void test_light_vs_double_spec(void **state)
         L.ks = tu_range(&r, 0.5f, 1.0f);
         L.shininess = shin[k % 9];
         L.kf = tu_range(&r, 0, 1);
-        scene_random(&s, &r);
-        ones += check_scene(&L, &K, &s, &max_err);
-        channels += 4L * s.w * s.h;
+        check_random_scene(&L, &K, &s, &r, &t);
     }
     scene_free(&s);
-    printf("NOTE lighting vs double, specular cases: max error %.4f LSB, %ld of %ld channels off by 1\n",
-           max_err, ones, channels);
-    assert_true(max_err < 1.0);
+    tally_end(", specular cases", &t);
 }
 
 /* ---- hand-worked single pixels --------------------------------------- */

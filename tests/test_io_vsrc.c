@@ -801,6 +801,21 @@ static void write_pngs(const char *pattern, int count, int w, int h, int salt)
     }
 }
 
+/* Opens the file camera of selector sel as the tests record it (64x48 at
+ * 30 Hz, the format the file offers) with the backend options o; a
+ * failure fails the test with the camera's message. */
+static void file_cam_open(io_cam *cam, const char *sel, io_file_cam_opts *o)
+{
+    io_error err;
+    io_cam_config c = io_cam_config_default(sel);
+    c.width = 64;
+    c.height = 48;
+    c.fourcc = 0;
+    c.fps = 30;
+    c.backend_opts = o;
+    if (io_cam_open(cam, &io_cam_file, &c, &err) != IO_OK) fail_msg("%s", err.msg);
+}
+
 static void test_file_cam_sequence(void **st)
 {
     (void)st;
@@ -823,13 +838,7 @@ static void test_file_cam_sequence(void **st)
         for (int e = 0; e < 2; e++) {
             snprintf(sel[e], sizeof sel[e], "file:%s", pat[e]);
             assert_true(io_cam_file_selector(sel[e]));
-            io_cam_config c = io_cam_config_default(sel[e]);
-            c.width = 64;
-            c.height = 48;
-            c.fourcc = 0;
-            c.fps = 30;
-            c.backend_opts = &o;
-            if (io_cam_open(&cam[e], &io_cam_file, &c, &err) != IO_OK) fail_msg("%s", err.msg);
+            file_cam_open(&cam[e], sel[e], &o);
             assert_int_equal(cam[e].fourcc, IO_FMT_RGB3);
             assert_int_equal(io_cam_start(&cam[e], &err), IO_OK);
         }
@@ -918,13 +927,7 @@ static void test_file_cam_video(void **st)
         o.t0_ns = clock;
         io_cam cam;
         io_error err;
-        io_cam_config c = io_cam_config_default(sel);
-        c.width = 64;
-        c.height = 48;
-        c.fourcc = 0;
-        c.fps = 30;
-        c.backend_opts = &o;
-        if (io_cam_open(&cam, &io_cam_file, &c, &err) != IO_OK) fail_msg("%s", err.msg);
+        file_cam_open(&cam, sel, &o);
         assert_int_equal(io_cam_start(&cam, &err), IO_OK);
         io_frame f;
         int got = 0;
