@@ -41,14 +41,22 @@ static void parse_bad(const char *text, const char *name, const char *const *fra
     assert_memory_equal(&L, &before, sizeof L); /* untouched */
 }
 
-static void result_samples(void **state)
+/* The calibration file `rel` of the repository, camera `camera`, loaded
+ * (a refusal fails the test with its message). */
+static kin_lens load_sample(const char *rel, int camera)
 {
-    (void)state;
     char p[512];
     kin_lens L;
     io_error err;
-    tu_root_path("samples/calib/hmd_left.yml", p, sizeof p);
-    if (io_calib_load(p, 0, &L, &err) != IO_OK) fail_msg("%s", err.msg);
+    tu_root_path(rel, p, sizeof p);
+    if (io_calib_load(p, camera, &L, &err) != IO_OK) fail_msg("%s", err.msg);
+    return L;
+}
+
+static void result_samples(void **state)
+{
+    (void)state;
+    kin_lens L = load_sample("samples/calib/hmd_left.yml", 0);
     assert_int_equal(L.model, KIN_LENS_BROWN);
     assert_int_equal(L.width, 640);
     assert_int_equal(L.height, 480);
@@ -64,15 +72,13 @@ static void result_samples(void **state)
     NEAR(L.k[4], -1.7311900478122741e-02, 0);
     NEAR(L.k[5], 0, 0);
     assert_true(kin_lens_distorts(&L));
-    tu_root_path("samples/calib/hmd_right.xml", p, sizeof p);
-    if (io_calib_load(p, 1, &L, &err) != IO_OK) fail_msg("%s", err.msg);
+    L = load_sample("samples/calib/hmd_right.xml", 1);
     assert_int_equal(L.model, KIN_LENS_BROWN);
     assert_int_equal(L.width, 640);
     NEAR(L.fx, 5.3310933859204113e+02, 0);
     NEAR(L.cy, 2.3891482099620541e+02, 0);
     NEAR(L.k[4], -1.4258839501221170e-02, 0);
-    tu_root_path("samples/calib/fisheye_KD.yml", p, sizeof p);
-    if (io_calib_load(p, 0, &L, &err) != IO_OK) fail_msg("%s", err.msg);
+    L = load_sample("samples/calib/fisheye_KD.yml", 0);
     assert_int_equal(L.model, KIN_LENS_FISHEYE);
     assert_int_equal(L.width, 848);
     assert_int_equal(L.height, 800);
