@@ -262,8 +262,8 @@ typedef struct comp_scratch {
      * padding): the transparent pixels are not copied one span at a time;
      * out = V over [pend, start of a blended run) in one call before the
      * run (defer_flush), so everything between two runs, across rows and
-     * the viewport's border, is one copy: the bytes above the hand are one
-     * large copy, which libc does without reading out first. */
+     * the viewport's border, is one copy: the rows above the hand are one
+     * libc call (its large-copy path), not one call per row. */
     int defer;
     size_t pend;          /* out's bytes before pend are final */
 } comp_scratch;
