@@ -3,34 +3,19 @@
  * per-frame entry fuse_context_frame. The row kernels are in fuse_ref.c
  * (the reference), fuse_simd.inl (written once on the vector layer) and
  * fuse_{sse2,avx2,avx512,neon}.c; every row is independent,
- * so the bytes do not depend on the ISA, the thread count or the banding. */
+ * so the bytes do not depend on the ISA, the thread count or the banding.
+ * The kernel table and the context are declared in fuse_ctx.h; the depth
+ * test's job is fuse_depth_job.c. */
 #include "fuse_internal.h"
 
 #include <stdlib.h>
 
+#include "fuse_ctx.h"
 #include "fuse_edge.h"
-#include "fuse_pool.h"
 
 /* Layer rows whose mask span the interleaved frame keeps (comp_scratch.span):
  * more than the rows lit ahead of the composite (FUSE_CHUNK + 2). */
 #define SPAN_RING 64
-
-typedef struct kernels {
-    ef_isa isa;
-    int ref;                   /* the reference: axis walk, stages in order */
-    fuse__light_fn light;
-    fuse__depth_fn depth;
-    fuse__depth_mask_fn depth_mask;   /* the depth test on mask bytes */
-    fuse__composite_fn comp;   /* SSE2: table-driven, per output row */
-    fuse__cover_fn cover;      /* coverage bits of a layer row */
-    fuse__opaque_fn opaque;    /* R = V, alpha 255 (transparent spans) */
-    fuse__hrow_fn hrow;        /* NULL: no row cache, comp per output row */
-    fuse__vrow_fn vrow;
-    fuse__hprep_fn hprep;      /* the row cache's per-tile tables (with hrow) */
-    fuse__light_span_fn light_span;    /* the same kernels on a span of a row */
-    fuse__depth_mspan_fn depth_mspan;
-    fuse__cover_span_fn cover_span;
-} kernels;
 
 /* The ISA's kernels, one row per ISA (the one dispatch table of the room):
  * the ones of fuse_simd.inl (written once on the vector layer: light,
@@ -41,7 +26,7 @@ typedef struct kernels {
 #define SIMD_COVER(sfx) fuse__cover_row_##sfx, fuse__opaque_##sfx
 #define SIMD_SPANS(sfx) fuse__light_span_##sfx, fuse__depth_mspan_##sfx, fuse__cover_span_##sfx
 
-static kernels kernels_for(ef_isa isa)
+kernels fuse__kernels_for(ef_isa isa)
 {
     static const kernels ref = {EF_ISA_REF, 1, SIMD_KERNELS(ref), NULL, SIMD_COVER(ref), NULL, NULL,
                                 NULL, SIMD_SPANS(ref)};
@@ -63,13 +48,8 @@ static kernels kernels_for(ef_isa isa)
     }
 }
 
-struct fuse_context {
-    kernels k;
-    fuse__pool pool;
-};
-
 /* fn(arg, t, n) for t = 0 .. n-1, t = 0 on the calling thread. */
-static void run(fuse_context *ctx, fuse__task_fn fn, void *arg)
+void fuse__ctx_run(fuse_context *ctx, fuse__task_fn fn, void *arg)
 {
     fuse__pool_run(ctx != NULL ? &ctx->pool : NULL, fn, arg);
 }
@@ -82,7 +62,7 @@ fuse_context *fuse_context_create(const fuse_context_desc *desc)
     if ((unsigned)d.max_isa >= EF_ISA_COUNT) d.max_isa = EF_ISA_DEFAULT;
     ctx = calloc(1, sizeof *ctx);
     if (ctx == NULL) return NULL;
-    ctx->k = kernels_for(ef_isa_choose(d.max_isa));
+    ctx->k = fuse__kernels_for(ef_isa_choose(d.max_isa));
     if (!fuse__pool_init(&ctx->pool, d.threads)) {
         free(ctx);
         return NULL;
@@ -236,13 +216,18 @@ static void comp_job_set(comp_job *j, const kernels *k, const fuse_image *Q, con
     *j = (comp_job){k, *Q, *V, *out, vp_x0, vp_y0, vp_w, vp_h, fuse__same_image(out, V), v_opaque};
 }
 
+/* memcpy called through a pointer: gcc expands a memcpy of 4 n bytes
+ * inline as rep movsq, which costs more than libc's on the spans of a row
+ * (a few hundred bytes to a few KB, unaligned) and on a whole image. */
+static void *(*volatile copy_fn)(void *, const void *, size_t) = memcpy;
+
 /* n pixels that the layer does not reach: out = V with alpha 255. With the
  * caller's promise that V is opaque that is V itself: nothing to do in
  * place, a copy otherwise. */
 static void transparent(const comp_job *j, const uint8_t *v, uint8_t *o, int n)
 {
     if (!j->v_opaque) j->k->opaque(v, o, n);
-    else if (!j->in_place) memcpy(o, v, 4u * (size_t)n);
+    else if (!j->in_place) copy_fn(o, v, 4u * (size_t)n);
 }
 
 /* Output pixels per transparency group: a group whose taps all lie in
@@ -273,6 +258,14 @@ typedef struct comp_scratch {
      * outside [span[r % SPAN_RING][1], span[r % SPAN_RING][2]) when
      * span[r % SPAN_RING][0] == r, so its coverage reads only that span. */
     int32_t span[SPAN_RING][3];
+    /* defer (eye_whole: out of place, V opaque, both images without row
+     * padding): the transparent pixels are not copied one span at a time;
+     * out = V over [pend, start of a blended run) in one call before the
+     * run (defer_flush), so everything between two runs, across rows and
+     * the viewport's border, is one copy: the rows above the hand are one
+     * libc call (its large-copy path), not one call per row. */
+    int defer;
+    size_t pend;          /* out's bytes before pend are final */
 } comp_scratch;
 
 static void scratch_init(comp_scratch *s)
@@ -282,6 +275,17 @@ static void scratch_init(comp_scratch *s)
     s->tile_n = 0;
     s->cov_row[0] = s->cov_row[1] = -1;
     for (i = 0; i < SPAN_RING; i++) s->span[i][0] = -1;
+    s->defer = 0;
+    s->pend = 0;
+}
+
+/* comp_scratch.defer: out = V over [pend, o), then pend = o_end (the end
+ * of the run blended at o). */
+static void defer_flush(const comp_job *j, comp_scratch *s, const uint8_t *o, const uint8_t *o_end)
+{
+    const size_t at = (size_t)(o - j->out.pixels);
+    if (at > s->pend) copy_fn(j->out.pixels + s->pend, j->V.pixels + s->pend, at - s->pend);
+    s->pend = (size_t)(o_end - j->out.pixels);
 }
 
 /* Group g (output columns [g GROUP, g GROUP + GROUP) of the tile) reads the
@@ -410,15 +414,17 @@ static void comp_border_rows(const comp_job *j, int y0, int y1)
 
 /* n pixels from tile column c of row y: blended, or (transparent) V with
  * alpha 255. */
-static void comp_span(const comp_job *j, const comp_scratch *s, const uint8_t *q0,
+static void comp_span(const comp_job *j, comp_scratch *s, const uint8_t *q0,
                       const uint8_t *q1, uint32_t fy, const uint8_t *v, uint8_t *o, int c,
                       int n, int covered)
 {
     if (n <= 0) return;
-    if (covered)
+    if (covered) {
+        if (s->defer) defer_flush(j, s, o + 4 * (size_t)c, o + 4 * (size_t)(c + n));
         j->k->comp(q0, q1, fy, &s->cols, c, n, j->Q.width, v + 4 * (size_t)c, o + 4 * (size_t)c);
-    else
+    } else if (!s->defer) {
         transparent(j, v + 4 * (size_t)c, o + 4 * (size_t)c, n);
+    }
 }
 
 /* Bits of the groups whose class (1: h only in the upper row, 2: only in
@@ -449,7 +455,7 @@ static int class_end(const uint64_t *g0, const uint64_t *g1, int ng, int g, int 
  * next: prefetch the next output row's pixels over the blended runs (in
  * place with an opaque V, where nothing else reads the row: otherwise the
  * rows are read from end to end and the hardware prefetcher streams them). */
-static void comp_row_cached(const comp_job *j, const comp_scratch *s, int r0, int r1,
+static void comp_row_cached(const comp_job *j, comp_scratch *s, int r0, int r1,
                             uint32_t fy, const uint8_t *v, uint8_t *o, int n, int next)
 {
     const int ng = (n + GROUP - 1) / GROUP;
@@ -464,7 +470,8 @@ static void comp_row_cached(const comp_job *j, const comp_scratch *s, int r0, in
         ge = class_end(g0, g1, ng, gs, cls);
         c = gs * GROUP;
         e = ge * GROUP < n ? ge * GROUP : n;
-        if (c > done) transparent(j, v + 4 * (size_t)done, o + 4 * (size_t)done, c - done);
+        if (s->defer) defer_flush(j, s, o + 4 * (size_t)c, o + 4 * (size_t)e);
+        else if (c > done) transparent(j, v + 4 * (size_t)done, o + 4 * (size_t)done, c - done);
         if (next)   /* the same span of the next output row (prefetch above) */
             prefetch(v + (size_t)j->V.stride + 4 * (size_t)c, 4u * (size_t)(e - c), 1);
         j->k->vrow((cls & 1) ? h0 + 4 * (size_t)c : s->h_zero, (cls & 2) ? h1 + 4 * (size_t)c : s->h_zero,
@@ -472,7 +479,7 @@ static void comp_row_cached(const comp_job *j, const comp_scratch *s, int r0, in
         done = e;
         g = ge;
     }
-    if (n > done) transparent(j, v + 4 * (size_t)done, o + 4 * (size_t)done, n - done);
+    if (n > done && !s->defer) transparent(j, v + 4 * (size_t)done, o + 4 * (size_t)done, n - done);
 }
 
 /* One output row y of the viewport, columns [c0, c0 + n) of the tile in s.
@@ -615,18 +622,11 @@ static void comp_rows(const comp_job *j, int y0, int y1)
     comp_vp_rows(j, &s, y0, y1);
 }
 
-/* Band t of n over h rows: [h t / n, h (t + 1) / n). */
-static void band(int h, int t, int n, int *y0, int *y1)
-{
-    *y0 = (int)((int64_t)h * t / n);
-    *y1 = (int)((int64_t)h * (t + 1) / n);
-}
-
 static void light_task(void *arg, int t, int n)
 {
     const light_job *j = arg;
     int y0, y1;
-    band(j->P.height, t, n, &y0, &y1);
+    fuse__band(j->P.height, t, n, &y0, &y1);
     light_rows(j, y0, y1, NULL);
 }
 
@@ -634,7 +634,7 @@ static void comp_task(void *arg, int t, int n)
 {
     const comp_job *j = arg;
     int y0, y1;
-    band(j->V.height, t, n, &y0, &y1);
+    fuse__band(j->V.height, t, n, &y0, &y1);
     comp_rows(j, y0, y1);
 }
 
@@ -651,7 +651,7 @@ static fuse_result light_with(fuse_context *ctx, const kernels *k,
                                       normal_stride, out, &j.prep);
     if (r != FUSE_OK) return r;
     light_job_set(&j, k, P, mask, mask_stride, normal, normal_stride, out);
-    run(ctx, light_task, &j);
+    fuse__ctx_run(ctx, light_task, &j);
     return FUSE_OK;
 }
 
@@ -664,7 +664,7 @@ static fuse_result comp_with(fuse_context *ctx, const kernels *k,
     fuse_result r = fuse__composite_check(Q, V, vp_x0, vp_y0, vp_w, vp_h, out);
     if (r != FUSE_OK) return r;
     comp_job_set(&j, k, Q, V, vp_x0, vp_y0, vp_w, vp_h, out, 0);
-    run(ctx, comp_task, &j);
+    fuse__ctx_run(ctx, comp_task, &j);
     return FUSE_OK;
 }
 
@@ -673,7 +673,7 @@ fuse_result fuse_light(const fuse_lighting *L, const fuse_intrinsics *K,
                        int mask_stride, const float *normal,
                        int normal_stride, fuse_image *out)
 {
-    const kernels k = kernels_for(ef_isa_choose(EF_ISA_DEFAULT));
+    const kernels k = fuse__kernels_for(ef_isa_choose(EF_ISA_DEFAULT));
     return light_with(NULL, &k, L, K, P, mask, mask_stride, normal,
                       normal_stride, out);
 }
@@ -682,7 +682,7 @@ fuse_result fuse_composite(const fuse_image *Q, const fuse_image *V,
                            int vp_x0, int vp_y0, int vp_w, int vp_h,
                            fuse_image *out)
 {
-    const kernels k = kernels_for(ef_isa_choose(EF_ISA_DEFAULT));
+    const kernels k = fuse__kernels_for(ef_isa_choose(EF_ISA_DEFAULT));
     return comp_with(NULL, &k, Q, V, vp_x0, vp_y0, vp_w, vp_h, out);
 }
 
@@ -703,52 +703,6 @@ fuse_result fuse_context_composite(fuse_context *ctx, const fuse_image *Q,
 {
     if (ctx == NULL) return FUSE_ERR_ARGS;
     return comp_with(ctx, &ctx->k, Q, V, vp_x0, vp_y0, vp_w, vp_h, out);
-}
-
-typedef struct depth_job {
-    const kernels *k;
-    const fuse_depth *d;
-    fuse_image Q;
-    int vx, vy, vw, vh;
-} depth_job;
-
-static void depth_task(void *arg, int t, int n)
-{
-    const depth_job *j = arg;
-    int y0, y1;
-    band(j->Q.height, t, n, &y0, &y1);
-    fuse__depth_rows(j->d, &j->Q, j->vx, j->vy, j->vw, j->vh, y0, y1, j->k->depth);
-}
-
-static fuse_result depth_with(fuse_context *ctx, const kernels *k, const fuse_depth *d,
-                              fuse_image *Q, int vp_x0, int vp_y0, int vp_w, int vp_h)
-{
-    depth_job j;
-    fuse_result r = fuse__depth_check(d, Q, vp_x0, vp_y0, vp_w, vp_h);
-    if (r != FUSE_OK) return r;
-    j.k = k;
-    j.d = d;
-    j.Q = *Q;
-    j.vx = vp_x0;
-    j.vy = vp_y0;
-    j.vw = vp_w;
-    j.vh = vp_h;
-    run(ctx, depth_task, &j);
-    return FUSE_OK;
-}
-
-fuse_result fuse_depth_test(const fuse_depth *d, fuse_image *Q, int vp_x0,
-                            int vp_y0, int vp_w, int vp_h)
-{
-    const kernels k = kernels_for(ef_isa_choose(EF_ISA_DEFAULT));
-    return depth_with(NULL, &k, d, Q, vp_x0, vp_y0, vp_w, vp_h);
-}
-
-fuse_result fuse_context_depth_test(fuse_context *ctx, const fuse_depth *d, fuse_image *Q,
-                                    int vp_x0, int vp_y0, int vp_w, int vp_h)
-{
-    if (ctx == NULL) return FUSE_ERR_ARGS;
-    return depth_with(ctx, &ctx->k, d, Q, vp_x0, vp_y0, vp_w, vp_h);
 }
 
 /* ---- a whole frame ------------------------------------------------------- */
@@ -862,7 +816,9 @@ static void eye_whole(const eye_job *e, int interleave)
         return;
     }
     scratch_init(&s);
-    comp_border_rows(j, 0, j->V.height);
+    s.defer = !j->in_place && j->v_opaque && j->out.stride == 4 * j->out.width &&
+              j->V.stride == j->out.stride;
+    if (!s.defer) comp_border_rows(j, 0, j->V.height);
     for (y = j->vy; y < j->vy + j->vh; y++) {
         const int32_t pos = fuse__src_pos(y - j->vy, sh, j->vh);
         const int iy = pos >> 16, need = iy + 1 < sh ? iy + 1 : sh - 1;
@@ -872,6 +828,10 @@ static void eye_whole(const eye_job *e, int interleave)
             lit += n;
         }
         comp_vp_rows(j, &s, y, y + 1);
+    }
+    if (s.defer) {   /* the rest of out: after the last blended run */
+        uint8_t *end = j->out.pixels + (size_t)j->out.height * (size_t)j->out.stride;
+        defer_flush(j, &s, end, end);
     }
     if (lit < sh) eye_light_depth(e, lit, sh, NULL);
 }
@@ -890,7 +850,7 @@ static void frame_light_task(void *arg, int t, int n)
     const frame_job *f = arg;
     int e, y0, y1;
     for (e = 0; e < f->count; e++) {
-        band(f->eyes[e].light.P.height, t, n, &y0, &y1);
+        fuse__band(f->eyes[e].light.P.height, t, n, &y0, &y1);
         eye_light_depth(&f->eyes[e], y0, y1, NULL);
     }
 }
@@ -900,7 +860,7 @@ static void frame_comp_task(void *arg, int t, int n)
     const frame_job *f = arg;
     int e, y0, y1;
     for (e = 0; e < f->count; e++) {
-        band(f->eyes[e].comp.V.height, t, n, &y0, &y1);
+        fuse__band(f->eyes[e].comp.V.height, t, n, &y0, &y1);
         comp_rows(&f->eyes[e].comp, y0, y1);
     }
 }
@@ -994,10 +954,10 @@ fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int coun
     for (e = 0; e < count; e++)
         f.interleave[e] = may_interleave(&eyes[e]);
     if (count % ctx->pool.threads == 0) {
-        run(ctx, frame_whole_task, &f);
+        fuse__ctx_run(ctx, frame_whole_task, &f);
     } else {
-        run(ctx, frame_light_task, &f);
-        run(ctx, frame_comp_task, &f);
+        fuse__ctx_run(ctx, frame_light_task, &f);
+        fuse__ctx_run(ctx, frame_comp_task, &f);
     }
     return FUSE_OK;
 }
