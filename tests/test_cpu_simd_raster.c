@@ -5,7 +5,8 @@
  * scalar model of the contract: the bits, and that no byte or float
  * outside the lanes in bits is written; and the raster front-end ops
  * (vi_min, vi_max, vd_from_vf, vd_from_vi, vf_from_vd, vd_gt_bits, vd_sqrt) against
- * their scalar definitions. Seeded inputs; every lane subset
+ * their scalar definitions, and the raster edge ops (vl_*,
+ * vi_compress_lanes; AVX2 and AVX-512 only). Seeded inputs; every lane subset
  * for 4 and 8 lanes, seeded subsets (and the empty and full ones) for 16.
  * An ISA the machine does not run is reported as SKIP, never as a pass.
  * (A test of its own so that test_cpu_simd.c stays the fuse port's.) */
@@ -162,6 +163,84 @@ static void check_front_ops(ef_isa isa, tu_simd_rcheck_fn *fn, int W, uint64_t *
     }
 }
 
+/* The raster edge ops (vl_*, vi_compress_lanes: AVX2 and AVX-512 only)
+ * against their scalar definitions; *has 0 on an ISA without them. */
+static void check_edge_ops(ef_isa isa, tu_simd_rcheck_fn *fn, int W, uint64_t *s,
+                           long *checked, long *bad, int *has)
+{
+    static _Alignas(64) uint32_t a[N], out[N];
+    const int VD = W / 2;
+    *has = fn(RC_COMPRESS, a, 0, N, out) != 0;
+    if (!*has)
+        return;
+    for (int round = 0; round < 8; round++) {
+        static const uint32_t sp[] = { 0u, 0xFFFFFFFFu, 0x80000000u, 0x7FFFFFFFu, 1u };
+        for (int i = 0; i < N; i++)
+            a[i] = (tu_xorshift(s) & 7) == 0 ? sp[tu_xorshift(s) % 5]
+                                             : tu_xorshift(s) * 2654435761u;
+        /* vl_from_vi, vl_mul32, vl_slli, vl_sub, vl_add, vl_or, vl_zero,
+         * vl_dec_unless, vl_store, vl_sign_bits */
+        assert_int_equal(fn(RC_VL_ARITH, a, 0, N, out), W);
+        for (int b = 0; 3 * W * (b + 1) <= N; b++)
+            for (int l = 0; l < W; l++) {
+                const int64_t i = (int32_t)a[3 * W * b + l], j = (int32_t)a[3 * W * b + W + l];
+                const int f = (int32_t)a[3 * W * b + 2 * W + l] < 0;
+                const int64_t want = i * j - i * 256 + j - (f ? 0 : 1);
+                int64_t got;
+                memcpy(&got, &out[2 * (W * b + l)], 8);
+                const uint32_t sb = out[2 * N / 3 + W * b + l];
+                *checked += 2;
+                if ((got != want || sb != (uint32_t)(want < 0)) && (*bad)++ < 8)
+                    print_message("FAIL %s vl ops lane %d: %lld %lld %d -> %lld sign %u\n",
+                                  ef_isa_name(isa), l, (long long)i, (long long)j, f,
+                                  (long long)got, sb);
+            }
+        /* vl_zip_lo, vl_zip_hi: per 128-bit block of int64 lanes */
+        assert_int_equal(fn(RC_VL_ZIP, a, 0, N, out), W);
+        for (int b = 0; 4 * W * (b + 1) <= N; b++)
+            for (int h = 0; h < 2; h++)
+                for (int q = 0; q < VD; q++) {
+                    /* zip_lo lane q: block q/2, a (even q) or b (odd q) of
+                     * int64 lane 2 (q/2); zip_hi: lane 2 (q/2) + 1 */
+                    for (int z = 0; z < 2; z++) {
+                        const int src = (q & 1) ? W : 0, lane = 2 * (q / 2) + z;
+                        const int64_t want = (int32_t)a[2 * W * b + src + VD * h + lane];
+                        int64_t got;
+                        memcpy(&got, &out[2 * (2 * W * b + 2 * VD * h + VD * z + q)], 8);
+                        (*checked)++;
+                        if (got != want && (*bad)++ < 8)
+                            print_message("FAIL %s vl_zip_%s half %d lane %d: %lld, want %lld\n",
+                                          ef_isa_name(isa), z ? "hi" : "lo", h, q,
+                                          (long long)got, (long long)want);
+                    }
+                }
+    }
+    /* vi_compress_lanes: every subset (W <= 8), seeded ones for 16 */
+    const unsigned full = (1u << W) - 1u;
+    const int nk = W <= 8 ? (int)full + 1 : 512;
+    for (int ki = 0; ki < nk; ki++) {
+        const unsigned k = W <= 8 ? (unsigned)ki
+                           : ki == 0 ? 0u : ki == 1 ? full : tu_xorshift(s) & full;
+        assert_int_equal(fn(RC_COMPRESS, a, k, N, out), W);
+        int j = 0;
+        for (int l = 0; l < W; l++) {
+            (*checked)++;
+            if ((k >> l) & 1u) {
+                if (out[j] != (uint32_t)l && (*bad)++ < 8)
+                    print_message("FAIL %s vi_compress_lanes 0x%X lane %d: %u, want %d\n",
+                                  ef_isa_name(isa), k, j, out[j], l);
+                j++;
+            }
+        }
+        for (; j < W; j++) {
+            (*checked)++;
+            if (out[j] >= (uint32_t)W && (*bad)++ < 8)
+                print_message("FAIL %s vi_compress_lanes 0x%X lane %d: %u out of range\n",
+                              ef_isa_name(isa), k, j, out[j]);
+        }
+    }
+}
+
 static void check_isa(void **state)
 {
     const ef_isa isa = tu_simd_test_isa(state, " raster", "the raster ops of ");
@@ -216,8 +295,11 @@ static void check_isa(void **state)
         }
     }
     check_front_ops(isa, fn, W, &s, &checked, &bad);
-    print_message("NOTE cpu simd raster %s: %d lanes, %ld results equal to the scalar model\n",
-                  ef_isa_name(isa), W, checked - bad);
+    int has_vl;
+    check_edge_ops(isa, fn, W, &s, &checked, &bad, &has_vl);
+    print_message("NOTE cpu simd raster %s: %d lanes, %ld results equal to the scalar model%s\n",
+                  ef_isa_name(isa), W, checked - bad,
+                  has_vl ? "" : " (no RASTER EDGE OPS on this ISA)");
     assert_int_equal(bad, 0);
 }
 

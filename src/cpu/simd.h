@@ -213,6 +213,28 @@
  *                            ordered (false when either is NaN)
  *   vd_sqrt(a)               square root, correctly rounded (the vertex
  *                            transforms' normal length, raster_xform.inl)
+ * RASTER EDGE OPS (src/raster's vector front end, raster_frontq.inl: the
+ * int64 edge values of the survivors and the survivor queue's compression;
+ * x86 only: simd_avx2.h and simd_avx512.h define SIMD_HAS_VL 1 and these,
+ * SSE2 and NEON do not, and their raster kernels do not compile the
+ * vector front end; h as above)
+ *   vlong                    VD_W int64 lanes (a vector of vint's size)
+ *   vl_zero()                every lane 0
+ *   vl_from_vi(i, h)         the int32 lanes of half h of i, sign-extended
+ *   vl_add vl_sub vl_or(a, b)  int64, wrapping
+ *   vl_mul32(a, b)           the low 32 bits of each lane of a and b read
+ *                            as int32, their exact int64 product (vpmuldq)
+ *   vl_slli(a, k)            shift left by a CONSTANT 0 <= k <= 63
+ *   vl_sign_bits(a)          bits (VD_W of them) of the lanes with the sign
+ *                            bit set
+ *   vl_dec_unless(a, m, h)   a - 1 in lane l of a where lane h*VD_W + l of
+ *                            the vmask m is clear; a where it is set
+ *   vl_zip_lo(a, b)          in each 128-bit block (2 int64 lanes): a0 b0
+ *   vl_zip_hi(a, b)          a1 b1 (x86 punpcklqdq / punpckhqdq)
+ *   vl_store(p, a)           int64_t *p aligned to SIMD_ALIGN
+ *   vi_compress_lanes(bits)  lane j = the lane number of the j-th set bit
+ *                            of bits (j < popcount(bits)); the other lanes
+ *                            are in 0 .. SIMD_W-1, otherwise unspecified
  * ROW-CACHE OPS (added for src/fuse's row-cached composite, fuse_simd.inl
  * fuse__hrow / fuse__vrow; a separate block at the end of each
  * implementation; tests/test_cpu_simd_fuse.c)

@@ -266,6 +266,39 @@ SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
 {
     return (unsigned)_mm256_movemask_pd(_mm256_cmp_pd(a, b, _CMP_GT_OQ));
 }
+/* ---- raster edge ops (x86 only; simd.h "RASTER EDGE OPS") */
+#define SIMD_HAS_VL 1
+typedef __m256i vlong;   /* VD_W = 4 int64 lanes */
+SIMD_INL vlong vl_zero(void) { return _mm256_setzero_si256(); }
+SIMD_INL vlong vl_from_vi(vint i, int h)
+{
+    return _mm256_cvtepi32_epi64(h ? _mm256_extracti128_si256(i, 1) : _mm256_castsi256_si128(i));
+}
+SIMD_INL vlong vl_add(vlong a, vlong b) { return _mm256_add_epi64(a, b); }
+SIMD_INL vlong vl_sub(vlong a, vlong b) { return _mm256_sub_epi64(a, b); }
+SIMD_INL vlong vl_or(vlong a, vlong b) { return _mm256_or_si256(a, b); }
+SIMD_INL vlong vl_mul32(vlong a, vlong b) { return _mm256_mul_epi32(a, b); }
+#define vl_slli(a, k) _mm256_slli_epi64(a, k)
+SIMD_INL unsigned vl_sign_bits(vlong a) { return (unsigned)_mm256_movemask_pd(_mm256_castsi256_pd(a)); }
+/* the int32 flags of half h widened: -1 (all ones) -> subtract 0, else 1 */
+SIMD_INL vlong vl_dec_unless(vlong a, vmask m, int h)
+{
+    const __m256i one = _mm256_andnot_si256(_mm256_castps_si256(m), _mm256_set1_epi32(1));
+    return _mm256_sub_epi64(a, vl_from_vi(one, h));
+}
+SIMD_INL vlong vl_zip_lo(vlong a, vlong b) { return _mm256_unpacklo_epi64(a, b); }
+SIMD_INL vlong vl_zip_hi(vlong a, vlong b) { return _mm256_unpackhi_epi64(a, b); }
+SIMD_INL void vl_store(int64_t *p, vlong a) { _mm256_store_si256((__m256i *)(void *)p, a); }
+/* 8 3-bit lane numbers packed in one int, spread by a variable shift */
+SIMD_INL vint vi_compress_lanes(unsigned bits)
+{
+    uint32_t p = 0;
+    int k = 0;
+    for (unsigned x = bits & SIMD_FULL; x; x &= x - 1, k++)
+        p |= (uint32_t)__builtin_ctz(x) << (3 * k);
+    const __m256i sh = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
+    return _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32((int)p), sh), _mm256_set1_epi32(7));
+}
 /* ---- row-cache ops (src/fuse's composite; simd.h "ROW-CACHE OPS") */
 SIMD_INL vint vi_permute(vint i, vint idx) { return _mm256_permutevar8x32_epi32(i, idx); }
 SIMD_INL vint vi_gather(const int32_t *p, vint idx)

@@ -260,6 +260,32 @@ SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
 {
     return (unsigned)_mm512_cmp_pd_mask(a, b, _CMP_GT_OQ);
 }
+/* ---- raster edge ops (x86 only; simd.h "RASTER EDGE OPS") */
+#define SIMD_HAS_VL 1
+typedef __m512i vlong;   /* VD_W = 8 int64 lanes */
+SIMD_INL vlong vl_zero(void) { return _mm512_setzero_si512(); }
+SIMD_INL vlong vl_from_vi(vint i, int h)
+{
+    return _mm512_cvtepi32_epi64(h ? _mm512_extracti32x8_epi32(i, 1) : _mm512_castsi512_si256(i));
+}
+SIMD_INL vlong vl_add(vlong a, vlong b) { return _mm512_add_epi64(a, b); }
+SIMD_INL vlong vl_sub(vlong a, vlong b) { return _mm512_sub_epi64(a, b); }
+SIMD_INL vlong vl_or(vlong a, vlong b) { return _mm512_or_si512(a, b); }
+SIMD_INL vlong vl_mul32(vlong a, vlong b) { return _mm512_mul_epi32(a, b); }
+#define vl_slli(a, k) _mm512_slli_epi64(a, k)
+SIMD_INL unsigned vl_sign_bits(vlong a) { return (unsigned)_mm512_movepi64_mask(a); }
+/* one masked subtract: the lanes of half h whose flag is clear */
+SIMD_INL vlong vl_dec_unless(vlong a, vmask m, int h)
+{
+    return _mm512_mask_sub_epi64(a, (__mmask8)~(m >> (8 * h)), a, _mm512_set1_epi64(1));
+}
+SIMD_INL vlong vl_zip_lo(vlong a, vlong b) { return _mm512_unpacklo_epi64(a, b); }
+SIMD_INL vlong vl_zip_hi(vlong a, vlong b) { return _mm512_unpackhi_epi64(a, b); }
+SIMD_INL void vl_store(int64_t *p, vlong a) { _mm512_store_si512((void *)p, a); }
+SIMD_INL vint vi_compress_lanes(unsigned bits)
+{
+    return _mm512_maskz_compress_epi32((__mmask16)bits, vi_lanes());
+}
 /* ---- row-cache ops (src/fuse's composite; simd.h "ROW-CACHE OPS") */
 SIMD_INL vint vi_permute(vint i, vint idx) { return _mm512_permutexvar_epi32(idx, i); }
 SIMD_INL vint vi_gather(const int32_t *p, vint idx)

@@ -19,6 +19,25 @@
  * holds the bit of the pixel that float 16*o + f belongs to,
  * 1 << ((16*o + f) / 3). */
 
+/* The attributes of a one-vector row computed in the interleaved layout:
+ * lane f of output vector o is attribute (16*o + f) % 3 of pixel
+ * (16*o + f) / 3. Its barycentrics are lanes of the pixels' b1, b2
+ * (permutes copy bits) and its constants a0, d1, d2 of that attribute, so
+ * each float gets the reference's (a0 + b1 * d1) + b2 * d2, and no
+ * transposition is needed: two permutes, four operations and a masked
+ * store per output vector (a row of up to 5 pixels needs one;
+ * attr3_prep, attr3_out below). pix3[o][f] = (16*o + f) / 3, att3[o][f] =
+ * (16*o + f) % 3; attr3_store_m takes attribute 2's lanes by pix3 too. */
+static const int32_t pix3[3][16] __attribute__((aligned(64))) = {
+    { 0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4, 5 },
+    { 5, 5, 6, 6, 6, 7, 7, 7, 8, 8, 8, 9, 9, 9, 10, 10 },
+    { 10, 11, 11, 11, 12, 12, 12, 13, 13, 13, 14, 14, 14, 15, 15, 15 },
+};
+static const int32_t att3[3][16] __attribute__((aligned(64))) = {
+    { 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0 },
+    { 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1 },
+    { 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2 },
+};
 /* The pixels in bits only (masked stores: other floats are not touched),
  * bits within the first `lanes` lanes. Only the output vectors those lanes
  * reach are built (a box 5 pixels wide needs one of the three: the count
@@ -33,40 +52,19 @@ static inline void attr3_store_m(float *p, unsigned bits, int lanes, __m512 a, _
         { 21, 0, 6, 22, 0, 7, 23, 0, 8, 24, 0, 9, 25, 0, 10, 26 },
         { 0, 11, 27, 0, 12, 28, 0, 13, 29, 0, 14, 30, 0, 15, 31, 0 },
     };
-    static const int32_t idx_c[3][16] __attribute__((aligned(64))) = {
-        { 0, 0, 0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0, 4, 0 },
-        { 0, 5, 0, 0, 6, 0, 0, 7, 0, 0, 8, 0, 0, 9, 0, 0 },
-        { 10, 0, 0, 11, 0, 0, 12, 0, 0, 13, 0, 0, 14, 0, 0, 15 },
-    };
     static const __mmask16 mc[3] = { 0x4924, 0x2492, 0x9249 };
     const __m512i pb = _mm512_set1_epi32((int)bits);
     const int nout = lanes >= 16 ? 3 : (3 * lanes + 15) >> 4;
     for (int o = 0; o < nout; o++) {
         const __mmask16 k = _mm512_test_epi32_mask(pb, _mm512_load_si512(simd__sel3[o]));
         __m512 v = _mm512_permutex2var_ps(a, _mm512_load_si512(idx_ab[o]), b);
-        v = _mm512_mask_permutexvar_ps(v, mc[o], _mm512_load_si512(idx_c[o]), c);
+        /* the lanes of attribute 2 (mc): pixel pix3 of c */
+        v = _mm512_mask_permutexvar_ps(v, mc[o], _mm512_load_si512(pix3[o]), c);
         _mm512_mask_storeu_ps(p + 16 * o, k, v);
     }
 }
 #define ATTR3_STORE_M(p, bits, lanes, a, b, c) attr3_store_m(p, bits, lanes, a, b, c)
 
-/* The attributes of a one-vector row computed in the interleaved layout:
- * lane f of output vector o is attribute (16*o + f) % 3 of pixel
- * (16*o + f) / 3. Its barycentrics are lanes of the pixels' b1, b2
- * (permutes copy bits) and its constants a0, d1, d2 of that attribute, so
- * each float gets the reference's (a0 + b1 * d1) + b2 * d2, and no
- * transposition is needed: two permutes, four operations and a masked
- * store per output vector (a row of up to 5 pixels needs one). */
-static const int32_t pix3[3][16] __attribute__((aligned(64))) = {
-    { 0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 4, 4, 4, 5 },
-    { 5, 5, 6, 6, 6, 7, 7, 7, 8, 8, 8, 9, 9, 9, 10, 10 },
-    { 10, 11, 11, 11, 12, 12, 12, 13, 13, 13, 14, 14, 14, 15, 15, 15 },
-};
-static const int32_t att3[3][16] __attribute__((aligned(64))) = {
-    { 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0 },
-    { 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1 },
-    { 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2 },
-};
 typedef struct attr3_state {
     __m512 a0[3], d1[3], d2[3];   /* per output vector, its lanes' constants */
     int nout;                     /* output vectors a row needs (1..3) */

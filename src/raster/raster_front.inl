@@ -1,6 +1,7 @@
 /* raster_front.inl - the steps of the vector front end that are the same at
  * every lane width, written once on the vector layer (src/cpu/simd.h) and
- * shared by raster_front_avx2.c (8 lanes), raster_front_avx512.c and the
+ * shared by the front end (raster_frontv.inl, raster_frontq.inl) of
+ * raster_front_avx2.c (8 lanes) and raster_front_avx512.c, and by the
  * 16-triangle rejection of raster_avx512.c (16 lanes). Every step runs,
  * per lane, the operations of the scalar path (raster_setup.c) in its
  * order, so the bytes do not depend on the lane width (docs/raster.md

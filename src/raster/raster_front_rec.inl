@@ -1,14 +1,44 @@
-/* raster_front_rec.inl - a record of the vector front ends written from
- * their lane-transposed stack layouts by 16-byte copies, shared by
- * raster_front_avx2.c (8 lanes) and raster_front_avx512.c (16 lanes).
- * Included after the includer's FRONT_V, QUAD_AT(l), PAIR_AT(l) (where
- * its shuffles put lane l's 16 bytes) and copy16(d, s) (16 bytes, source
- * aligned). Layouts, 4 * FRONT_V floats or int32 per quad array:
+/* raster_front_rec.inl - a record of the vector front end written from
+ * lane-transposed stack layouts by 16-byte copies, on the vector layer
+ * (quads: vf_tr4; pairs: the int64 lanes of "RASTER EDGE OPS"); included
+ * by raster_frontq.inl after raster_front.inl (FRONT_V = SIMD_W).
+ * Layouts, 4 * FRONT_V floats or int32 per quad array:
  *   bq        box x0, y0, x1, y1 (quads);
  *   mq        micro values mz, mb1, mb2 (three quad arrays);
  *   pq        planes z.c .. q.c, q.dx .. b1.dx, b1.dy .. b2.dy (three);
  *   eq, e8    edge pairs (e_c[0], e_c[1]) .. (e_dy[0], e_dy[1]) (four pair
- *             arrays of 2 * FRONT_V int64) and e_dy[2] per lane. */
+ *             arrays of 2 * FRONT_V int64) and e_dy[2] per lane.
+ *
+ *   quads  4 float or int32 vectors a, b, c, d: lane l's (a, b, c, d) as 16
+ *          bytes at s + QUAD_AT(l) (vf_tr4, 4 vector stores);
+ *   pairs  2 int64 vectors a, b of the lanes of one half: lane l's (a, b)
+ *          as 16 bytes at s + PAIR_AT(l) (2 vector stores per half, the
+ *          second half at s + 2 * VD_W). */
+#define QUAD_AT(l) (SIMD_W * ((l) & 3) + 4 * ((l) >> 2))
+#define PAIR_AT(l) \
+    (2 * VD_W * ((l) / VD_W) + VD_W * ((l) & 1) + 2 * (((l) >> 1) & (VD_W / 2 - 1)))
+
+SIMD_INL void quads(vfloat a, vfloat b, vfloat c, vfloat d, float *s)
+{
+    vfloat o[4];
+    vf_tr4(a, b, c, d, o);   /* o[k] block J: lane 4J + k's a, b, c, d */
+    vf_store(s, o[0]);
+    vf_store(s + SIMD_W, o[1]);
+    vf_store(s + 2 * SIMD_W, o[2]);
+    vf_store(s + 3 * SIMD_W, o[3]);
+}
+
+SIMD_INL void pairs(vlong a, vlong b, int64_t *s)
+{
+    vl_store(s, vl_zip_lo(a, b));          /* even lanes */
+    vl_store(s + VD_W, vl_zip_hi(a, b));   /* odd lanes */
+}
+
+/* 16 bytes from s to d. */
+SIMD_INL void copy16(void *d, const void *s)
+{
+    __builtin_memcpy(d, s, 16);
+}
 
 /* The record layout the copies assume. */
 _Static_assert(offsetof(rast__tri, x0) == 0 && offsetof(rast__tri, y0) == 4 &&

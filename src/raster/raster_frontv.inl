@@ -15,10 +15,11 @@
  *
  * Every lane runs the scalar path's operations in its order (no
  * contraction: -ffp-contract=off), so the bytes equal rast__prepare_range
- * with the scalar set-up at every lane width. What stays in the ISA files
- * is what the layer does not have: the de-interleaving loads of vertices,
- * indices and (X, Y) pairs, the survivor queue's compressing permutes, the
- * int64 edges and the record layouts (AVX-512: mask registers).
+ * with the scalar set-up at every lane width. The group loop, the survivor
+ * queue, the int64 edges and the records are written once too
+ * (raster_frontq.inl, on the layer's x86 RASTER EDGE OPS); what stays in
+ * the ISA files is the de-interleaving loads of vertices, indices and
+ * (X, Y) pairs, the double gathers and the attribute copies.
  *
  * Included after one layer implementation, raster_front.inl and the
  * includer's two helpers:

@@ -24,11 +24,14 @@
  *                   the vector front end (below: rast__vbuf): vertex pass,
  *                   rejection and set-up in lanes, for whole-job draws
  *                   through a context; same records as the scalar set-up.
- *                   The steps common to both widths (classification, box,
- *                   empty test, queue, planes, records) are in
- *                   raster_front.inl; raster_front_avx512.inl holds its
- *                   AVX-512 lane macros and 16-lane rejection helpers, also
- *                   used by rast__front_avx512 (raster_avx512.c).
+ *                   Written once on the vector layer: raster_front.inl
+ *                   (rejection), raster_frontv.inl (vertex pass, planes,
+ *                   micro values), raster_frontq.inl (group loop, queue,
+ *                   edges, records); the two .c files hold only their
+ *                   ISA's loads and attribute copies. raster_front_avx512.inl
+ *                   holds the 16-lane index de-interleave and rejection
+ *                   helpers, also used by rast__front_avx512
+ *                   (raster_avx512.c).
  *   raster_ref.c    rast__scan_ref(): the per-pixel loop over one set-up
  *                   triangle. This is the only thing a SIMD path replaces,
  *                   and it must give the same bytes (op order below).

@@ -25,6 +25,19 @@ enum {
                        * bit l of vd_gt_bits(x, y), out[block + VD_W + l] = 0
                        * (0xBAD in out[block] when a bit above VD_W is set) */
     RC_VD_SQRT,       /* a: n/2 doubles; out: n/2 doubles, vd_sqrt */
+    /* the raster edge ops (simd.h "RASTER EDGE OPS"; the op returns 0 on an
+     * ISA without them) */
+    RC_VL_ARITH,      /* a: blocks b of 3*SIMD_W int32 (i, j, f); out: int64
+                       * out64[b*SIMD_W + l] = vl_dec_unless(i*j - (i << 8) + j,
+                       * f < 0, h) by vl_mul32, vl_slli, vl_sub, vl_add, vl_or
+                       * (with vl_zero), lane l of half h; then, at out + 2n/3,
+                       * uint32 per lane: bit of vl_sign_bits of that value
+                       * (0xBAD when a bit above VD_W is set) */
+    RC_VL_ZIP,        /* a: blocks b of 2*SIMD_W int32 (i, j), n/(4*SIMD_W) of them
+                       * (the output is twice the input); out: int64, per half
+                       * h: vl_zip_lo then vl_zip_hi of the widened halves
+                       * (2*VD_W int64 per half) */
+    RC_COMPRESS,      /* out[l] = lane l of vi_compress_lanes(k), l < SIMD_W */
     RC_COUNT
 };
 

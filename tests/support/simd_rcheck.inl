@@ -74,6 +74,55 @@ int SIMD_FN(tu_simd_rcheck)(int op, const uint32_t *a, unsigned k, int n, void *
         for (int v = 0; v + VD_W <= n / 2; v += VD_W) vd_storeu(o + v, vd_sqrt(vd_loadu(d + v)));
         return W;
     }
+#ifdef SIMD_HAS_VL
+    case RC_VL_ARITH: {
+        int64_t *o = out;
+        uint32_t *sb = (uint32_t *)out + 2 * n / 3;
+        const int32_t *p = (const int32_t *)(const void *)a;
+        _Alignas(SIMD_ALIGN) int64_t t[VD_W];
+        for (int b = 0; 3 * W * (b + 1) <= n; b++) {
+            const vint i = vi_loadu(p + 3 * W * b), j = vi_loadu(p + 3 * W * b + W);
+            const vmask m = vi_gt(vi_zero(), vi_loadu(p + 3 * W * b + 2 * W));
+            for (int h = 0; h < 2; h++) {
+                const vlong I = vl_from_vi(i, h), J = vl_from_vi(j, h);
+                const vlong r = vl_add(vl_sub(vl_mul32(I, J), vl_slli(I, 8)), vl_or(J, vl_zero()));
+                const vlong d = h ? vl_dec_unless(r, m, 1) : vl_dec_unless(r, m, 0);
+                vl_store(t, d);
+                const unsigned bits = vl_sign_bits(d);
+                for (int l = 0; l < VD_W; l++) {
+                    o[W * b + VD_W * h + l] = t[l];
+                    sb[W * b + VD_W * h + l] = (bits >> l) & 1u;
+                }
+                if (bits >> VD_W) sb[W * b + VD_W * h] = 0xBAD;
+            }
+        }
+        return W;
+    }
+    case RC_VL_ZIP: {
+        int64_t *o = out;
+        const int32_t *p = (const int32_t *)(const void *)a;
+        _Alignas(SIMD_ALIGN) int64_t t[2][VD_W];
+        for (int b = 0; 4 * W * (b + 1) <= n; b++) {
+            const vint i = vi_loadu(p + 2 * W * b), j = vi_loadu(p + 2 * W * b + W);
+            for (int h = 0; h < 2; h++) {
+                const vlong I = h ? vl_from_vi(i, 1) : vl_from_vi(i, 0);
+                const vlong J = h ? vl_from_vi(j, 1) : vl_from_vi(j, 0);
+                vl_store(t[0], vl_zip_lo(I, J));
+                vl_store(t[1], vl_zip_hi(I, J));
+                __builtin_memcpy(o + 2 * W * b + 2 * VD_W * h, t, sizeof t);
+            }
+        }
+        return W;
+    }
+    case RC_COMPRESS: {
+        vi_storeu((int32_t *)out, vi_compress_lanes(k));
+        return W;
+    }
+#else
+    case RC_VL_ARITH:
+    case RC_VL_ZIP:
+    case RC_COMPRESS: return 0;
+#endif
     default: return -1;
     }
 }
