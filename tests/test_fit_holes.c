@@ -4,6 +4,7 @@
  * - every hole (clear component touching no border) of at most max_hole
  *   pixels is set to 255, every island (set component touching no border)
  *   of at most max_island pixels cleared, nothing else changes;
+ * - with a kinematic mask `inside`, only holes it covers wholly are filled;
  * - the count returned is the pixels changed; a scratch too small leaves
  *   the mask as it was and returns -1; max 0 turns a half off. */
 #include "support/testutil.h"
@@ -16,11 +17,11 @@
 
 enum { W = 67, H = 41, S = 70 };
 
-static uint8_t m[S * H], ref[S * H], orig[S * H];
+static uint8_t m[S * H], ref[S * H], orig[S * H], ins[S * H];
 static int comp[W * H], stack_[W * H];
 
 /* ref = the rule applied by flood fill over orig */
-static long reference(int max_hole, int max_island)
+static long reference(int max_hole, int max_island, const uint8_t *inside)
 {
     memcpy(ref, orig, sizeof ref);
     for (int i = 0; i < W * H; i++) comp[i] = -1;
@@ -48,7 +49,10 @@ static long reference(int max_hole, int max_island)
             }
         }
         const int lim = v ? max_island : max_hole;
-        if (!border && n <= lim)
+        int out = 0;   /* a hole's pixels outside `inside` */
+        for (int k = 0; k < n && inside && !v; k++)
+            out += inside[(members[k] / W) * S + members[k] % W] < 128;
+        if (!border && n <= lim && !out)
             for (int k = 0; k < n; k++) {
                 ref[(members[k] / W) * S + members[k] % W] = v ? 0 : 255;
                 changed++;
@@ -96,9 +100,24 @@ static void against_reference(void **state)
         make_case(&g);
         const int mh = tu_int(&g, 60);
         const int mi = tu_int(&g, 60);
-        const long want = reference(mh, mi);
+        /* every other case: holes only where `inside` (random discs) is set */
+        const uint8_t *in = NULL;
+        if (c & 1) {
+            memset(ins, 0, sizeof ins);
+            const int nd = 1 + tu_int(&g, 6);
+            for (int d = 0; d < nd; d++) {
+                const int cx = tu_int(&g, W);
+                const int cy = tu_int(&g, H);
+                const int r = 3 + tu_int(&g, 20);
+                for (int y = 0; y < H; y++)
+                    for (int x = 0; x < W; x++)
+                        if ((x - cx) * (x - cx) + (y - cy) * (y - cy) <= r * r) ins[y * S + x] = 255;
+            }
+            in = ins;
+        }
+        const long want = reference(mh, mi, in);
         memcpy(m, orig, sizeof m);
-        const long got = pipe_fit_fill_small(m, S, W, H, mh, mi, scratch, sz);
+        const long got = pipe_fit_fill_small(m, S, W, H, mh, mi, in, S, scratch, sz);
         if (got != want || memcmp(m, ref, sizeof m) != 0)
             fail_msg("case %d (holes %d, islands %d): %ld changed, want %ld", c, mh, mi, got, want);
         total += got;
@@ -130,22 +149,30 @@ static void sizes_and_off(void **state)
     assert_non_null(scratch);
     disc_case();
     memcpy(m, orig, sizeof m);
-    assert_int_equal(pipe_fit_fill_small(m, S, W, H, 12, 0, scratch, sz), 12);
+    assert_int_equal(pipe_fit_fill_small(m, S, W, H, 12, 0, NULL, 0, scratch, sz), 12);
     assert_int_equal(m[16 * S + 26], 255);
     assert_int_equal(m[22 * S + 32], 0);
     assert_int_equal(m[10 * S + 57], 200);
     memcpy(m, orig, sizeof m);
-    assert_int_equal(pipe_fit_fill_small(m, S, W, H, 30, 5, scratch, sz), 47);
+    assert_int_equal(pipe_fit_fill_small(m, S, W, H, 30, 5, NULL, 0, scratch, sz), 47);
     assert_int_equal(m[22 * S + 32], 255);
     assert_int_equal(m[10 * S + 57], 0);
     assert_int_equal(m[40 * S + 2], 255);
+    /* with the kinematic mask: only the hole it covers is filled */
+    memset(ins, 0, sizeof ins);
+    for (int y = 14; y < 19; y++)
+        for (int x = 24; x < 30; x++) ins[y * S + x] = 255;
+    memcpy(m, orig, sizeof m);
+    assert_int_equal(pipe_fit_fill_small(m, S, W, H, 30, 0, ins, S, scratch, sz), 12);
+    assert_int_equal(m[16 * S + 26], 255);
+    assert_int_equal(m[22 * S + 32], 0);
     /* off, bad arguments, scratch too small: the mask as it was */
     memcpy(m, orig, sizeof m);
-    assert_int_equal(pipe_fit_fill_small(m, S, W, H, 0, 0, scratch, sz), 0);
-    assert_int_equal(pipe_fit_fill_small(m, S, W, H, -1, 5, scratch, sz), -1);
-    assert_int_equal(pipe_fit_fill_small(m, W - 1, W, H, 30, 5, scratch, sz), -1);
-    assert_int_equal(pipe_fit_fill_small(m, S, W, H, 30, 5, scratch, 200), -1);
-    assert_int_equal(pipe_fit_fill_small(NULL, S, W, H, 30, 5, scratch, sz), -1);
+    assert_int_equal(pipe_fit_fill_small(m, S, W, H, 0, 0, NULL, 0, scratch, sz), 0);
+    assert_int_equal(pipe_fit_fill_small(m, S, W, H, -1, 5, NULL, 0, scratch, sz), -1);
+    assert_int_equal(pipe_fit_fill_small(m, W - 1, W, H, 30, 5, NULL, 0, scratch, sz), -1);
+    assert_int_equal(pipe_fit_fill_small(m, S, W, H, 30, 5, NULL, 0, scratch, 200), -1);
+    assert_int_equal(pipe_fit_fill_small(NULL, S, W, H, 30, 5, NULL, 0, scratch, sz), -1);
     assert_memory_equal(m, orig, sizeof m);
     assert_int_equal(pipe_fit_fill_scratch_size(0, H), 0);
     free(scratch);

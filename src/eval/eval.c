@@ -610,7 +610,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 /* small holes and islands of the refined mask
                  * (fit_holes.h) */
                 if (rs.used_colour && cfg->fill_hole + cfg->fill_island > 0)
-                    pipe_fit_fill_small(c->refined, CW, CW, CH, cfg->fill_hole, cfg->fill_island,
+                    pipe_fit_fill_small(c->refined, CW, CW, CH, cfg->fill_hole, cfg->fill_island, kmask, CW,
                                         c->refine_scratch, c->refine_scratch_size);
                 /* not from a fallback (out = M): its widths are the
                  * model's own (as pipe_frame) */

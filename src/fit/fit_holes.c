@@ -9,6 +9,7 @@
 typedef struct {
     int32_t parent; /* union-find; the root's area below */
     int32_t area;
+    int32_t out;      /* the root's: its pixels outside `inside` */
     uint16_t x0, x1; /* [x0, x1) */
     uint8_t val, border;
 } run;
@@ -42,10 +43,11 @@ static void join(run *r, int32_t a, int32_t b)
 #define B80 0x8080808080808080ull
 
 long pipe_fit_fill_small(uint8_t *mask, int stride, int width, int height, int max_hole,
-                         int max_island, void *scratch, size_t scratch_size)
+                         int max_island, const uint8_t *inside, int inside_stride, void *scratch,
+                         size_t scratch_size)
 {
     if (!mask || !scratch || width < 1 || height < 1 || width > 65535 || stride < width ||
-        max_hole < 0 || max_island < 0)
+        max_hole < 0 || max_island < 0 || (inside && inside_stride < width))
         return -1;
     if (!max_hole && !max_island) return 0;
     const int W = width, H = height;
@@ -76,6 +78,7 @@ long pipe_fit_fill_small(uint8_t *mask, int stride, int width, int height, int m
             run *q = &r[n];
             q->parent = (int32_t)n;
             q->area = e - x;
+            q->out = 0;
             q->x0 = (uint16_t)x;
             q->x1 = (uint16_t)e;
             q->val = v;
@@ -94,6 +97,18 @@ long pipe_fit_fill_small(uint8_t *mask, int stride, int width, int height, int m
         }
     }
     row0[H] = (int32_t)n;
+    if (inside && max_hole)
+        /* the candidate holes' pixels outside `inside` (only small
+         * components are visited pixel by pixel) */
+        for (int y = 0; y < H; y++) {
+            const uint8_t *in = inside + (size_t)y * (size_t)inside_stride;
+            for (int32_t i = row0[y]; i < row0[y + 1]; i++) {
+                if (r[i].val) continue;
+                run *root = &r[find(r, i)];
+                if (root->border || root->area > max_hole) continue;
+                for (int x = r[i].x0; x < r[i].x1; x++) root->out += in[x] < 128;
+            }
+        }
     long changed = 0;
     for (int y = 0; y < H; y++) {
         uint8_t *m = mask + (size_t)y * (size_t)stride;
@@ -101,7 +116,7 @@ long pipe_fit_fill_small(uint8_t *mask, int stride, int width, int height, int m
             const run *root = &r[find(r, i)];
             if (root->border) continue;
             const int lim = r[i].val ? max_island : max_hole;
-            if (root->area > lim) continue;
+            if (root->area > lim || (!r[i].val && root->out)) continue;
             memset(m + r[i].x0, r[i].val ? 0 : 255, (size_t)(r[i].x1 - r[i].x0));
             changed += r[i].x1 - r[i].x0;
         }

@@ -349,7 +349,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         /* its small holes filled and islands cleared (fit_holes.h); the
          * refinement's scratch is free again */
         if (rs.used_colour && p->fit && p->desc.refine_fill == 0)
-            pipe_fit_fill_small(e->refined, cw, cw, ch, PIPE_FILL_HOLE, PIPE_FILL_ISLAND,
+            pipe_fit_fill_small(e->refined, cw, cw, ch, PIPE_FILL_HOLE, PIPE_FILL_ISLAND, e->mask, cw,
                                 e->refine_scratch, e->refine_scratch_size);
         pipe__cockpit_clamp(p->ck, &p->pose, e->eye, e->rast, &e->cam, e->mask, cw, e->refined,
                             cw, p->desc.refine_band, e->clip);
