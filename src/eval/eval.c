@@ -607,11 +607,11 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                     r->stereo_cleared += ss.cleared;
                     r->stereo_added += ss.added;
                 }
-                /* small holes and islands of the refined mask
-                 * (fit_holes.h) */
+                /* small islands (and holes) of the refined mask
+                 * (fit_holes.h, as pipe_frame) */
                 if (rs.used_colour && cfg->fill_hole + cfg->fill_island > 0)
-                    pipe_fit_fill_small(c->refined, CW, CW, CH, cfg->fill_hole, cfg->fill_island, kmask, CW,
-                                        c->refine_scratch, c->refine_scratch_size);
+                    pipe_fit_fill_small(c->refined, CW, CW, CH, cfg->fill_hole, cfg->fill_island,
+                                        kmask, CW, c->refine_scratch, c->refine_scratch_size);
                 /* not from a fallback (out = M): its widths are the
                  * model's own (as pipe_frame) */
                 if (cfg->fit && posed && rs.used_colour) {

@@ -346,8 +346,8 @@ static void run_eye(pipe_ctx *p, eye_state *e)
          * hand too (fit_band.h) */
         if (rin == e->prior && rs.used_colour && p->fit && pipe_fit_learned(p->fit, e->eye))
             pipe_fit_refined_colour(pipe_fit_colour(p->fit, e->eye), &fe.P, rin, e->refined, cw);
-        /* its small holes filled and islands cleared (fit_holes.h); the
-         * refinement's scratch is free again */
+        /* its small islands cleared (and holes filled, PIPE_FILL_HOLE:
+         * fit_holes.h); the refinement's scratch is free again */
         if (rs.used_colour && p->fit && p->desc.refine_fill == 0)
             pipe_fit_fill_small(e->refined, cw, cw, ch, PIPE_FILL_HOLE, PIPE_FILL_ISLAND, e->mask, cw,
                                 e->refine_scratch, e->refine_scratch_size);
