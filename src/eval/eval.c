@@ -14,6 +14,7 @@
 #include "../cli/cli.h"
 #include "../io/io_lod.h"
 #include "../fit/fit_band.h"
+#include "../fit/fit_holes.h"
 
 /* The ground truth comes from samples/gt/ and the sample generator
  * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
@@ -247,11 +248,35 @@ static int run_init(method_run *r, const method_cfg *cfg, const eval_ctx *c)
     return 0;
 }
 
+static int cmp_float(const void *a, const void *b)
+{
+    const float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+/* The error area's mean, 95th percentile (nearest rank) and max over
+ * every eye and frame (eval__print_error_area). */
+static void error_area_stats(method_run *r)
+{
+    if (r->n_err < 1) return;
+    qsort(r->err, (size_t)r->n_err, sizeof *r->err, cmp_float);
+    double sum = 0.0;
+    for (long k = 0; k < r->n_err; k++) sum += (double)r->err[k];
+    long r95 = (long)ceil(0.95 * (double)r->n_err) - 1;
+    if (r95 < 0) r95 = 0;
+    r->err_mean = sum / (double)r->n_err;
+    r->err_p95 = (double)r->err[r95];
+    r->err_max = (double)r->err[r->n_err - 1];
+}
+
 static void run_free(method_run *r)
 {
+    error_area_stats(r);
     free(r->locals);
     free(r->prev[0]);
     free(r->prev[1]);
+    free(r->err);
+    r->err = NULL;
     pipe_fit_destroy(r->fit);
 }
 
@@ -582,6 +607,11 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                     r->stereo_cleared += ss.cleared;
                     r->stereo_added += ss.added;
                 }
+                /* small islands (and holes) of the refined mask
+                 * (fit_holes.h, as pipe_frame) */
+                if (rs.used_colour && cfg->fill_hole + cfg->fill_island > 0)
+                    pipe_fit_fill_small(c->refined, CW, CW, CH, cfg->fill_hole, cfg->fill_island,
+                                        kmask, CW, c->refine_scratch, c->refine_scratch_size);
                 /* not from a fallback (out = M): its widths are the
                  * model's own (as pipe_frame) */
                 if (cfg->fit && posed && rs.used_colour) {
@@ -646,6 +676,16 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
         r->bf3 += bf3;
         r->fp += (double)cf.fp;
         r->fn += (double)cf.fn;
+        if (r->n_err == r->err_cap) {
+            const long cap = r->err_cap ? 2 * r->err_cap : 256;
+            float *ne = realloc(r->err, sizeof *ne * (size_t)cap);
+            if (!ne) return -1;
+            r->err = ne;
+            r->err_cap = cap;
+        }
+        r->err[r->n_err++] = (float)(cf.fp + cf.fn);
+        r->tp_sum += (double)cf.tp;
+        r->union_sum += (double)(cf.tp + cf.fp + cf.fn);
         r->mse += mse;
         r->n_eye++;
         if (per_frame) {

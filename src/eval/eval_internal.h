@@ -50,6 +50,9 @@ typedef struct method_cfg {
                                 within this many metres of slow hands (0 off) */
     float prior_speed;       /* m/s: slower hands use it */
     int prior_mc;            /* 1: moved with the hand (pipe_fit_hand_px) */
+    int fill_hole, fill_island; /* refine: holes / islands of the refined
+                                   mask up to this many pixels filled /
+                                   cleared (fit_holes.h); 0 off */
     int stereo;              /* refine: 1 = the stereo pair's depth test of
                                 the refined mask (fit_stereo.h) */
     float lag_adapt_v0, lag_adapt_v1;   /* refine, kin-cal-pred: lag
@@ -63,6 +66,11 @@ typedef struct method_cfg {
 #define EVAL_PRIOR_SPEED 0.3f
 #define EVAL_LAG_V0 0.2f
 #define EVAL_LAG_V1 0.8f
+/* refine: the refined mask's holes up to this many pixels filled and its
+ * islands up to this many cleared (fit_holes.h; as PIPE_FILL_HOLE,
+ * PIPE_FILL_ISLAND) */
+#define EVAL_FILL_HOLE PIPE_FILL_HOLE
+#define EVAL_FILL_ISLAND PIPE_FILL_ISLAND
 
 /* Per-configuration state and sums. */
 typedef struct method_run {
@@ -88,6 +96,11 @@ typedef struct method_run {
     long n_band;
     /* sums over frames and eyes */
     double iou, bf1, bf3, fp, fn, mse, flicker, flicker_den, secs;
+    float *err;              /* FP + FN px of every eye and frame (the error
+                                area, eval__print_error_area) */
+    long n_err, err_cap;
+    double err_mean, err_p95, err_max; /* of err, set when the run ends */
+    double tp_sum, union_sum;  /* pooled IoU: sums over every eye and frame */
     long n_eye, n_flicker, n_frames;
     /* levels of detail (cfg.lod != 0): the kinematic mask against the
      * full model's in the same pose, the level drawn, the raster's time */
@@ -230,6 +243,11 @@ int eval__write_kf(const char *dir, const method_run *R, int n);
 void eval__print_calib(FILE *f, const eval_ctx *c);
 void eval__print_table(FILE *f, const method_run *R, int n, int markdown);
 void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int n);
+/* Per method: the error area per eye and frame (FP + FN pixels: mean,
+ * 95th percentile, max) and the pooled IoU (the sum of intersections
+ * over the sum of unions, every eye and frame): the fair figures where
+ * the true mask gets small (a hand leaving the view, docs/accuracy.md). */
+void eval__print_error_area(FILE *f, const method_run *R, int n);
 int eval__write_csv(const char *path, const method_run *R, int n);
 int eval__write_report(const char *dir, const method_run *R, int n, const eval_opts *o,
                        const eval_ctx *c);

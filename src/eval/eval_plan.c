@@ -36,6 +36,8 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k)
         c.lag_adapt_v0 = EVAL_LAG_V0;
         c.lag_adapt_v1 = EVAL_LAG_V1;
         c.stereo = o->stereo;   /* measured, off by default */
+        c.fill_hole = EVAL_FILL_HOLE;
+        c.fill_island = EVAL_FILL_ISLAND;
     }
     c.band_sigma = 0.007f;
     c.band_max = 64;
@@ -300,6 +302,7 @@ int eval_run(const eval_opts *o)
             if (b == 0) eval__print_calib(stdout, &c);
             eval__print_table(stdout, R + n, m, 0);
             eval__print_thickness(stdout, &c, R + n, m);
+            eval__print_error_area(stdout, R + n, m);
             if (bphase[b] == PH_LOD) {
                 printf("levels of detail of the mask model (meshoptimizer %d):", io_lod_version());
                 for (int l = 0; l < c.lod.level_count; l++)

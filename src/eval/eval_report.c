@@ -76,6 +76,18 @@ int eval__write_csv(const char *path, const method_run *R, int n)
     return out_commit(&of);
 }
 
+void eval__print_error_area(FILE *f, const method_run *R, int n)
+{
+    for (int i = 0; i < n; i++) {
+        if (R[i].n_err < 1) continue;
+        fprintf(f, "%-13s %-9s %-16s error area per eye and frame (FP + FN px): mean %.0f, p95 "
+                   "%.0f, max %.0f; pooled IoU %.4f\n",
+                kind_name[R[i].cfg.kind], R[i].cfg.group, R[i].cfg.setting, R[i].err_mean,
+                R[i].err_p95, R[i].err_max,
+                R[i].union_sum > 0.0 ? R[i].tp_sum / R[i].union_sum : 1.0);
+    }
+}
+
 /* The limb thickness the first refine run with the elbow fit measured
  * from the images (pipe_fit_measure), against the truth's. */
 void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int n)

@@ -10,6 +10,7 @@
 #include "pipe_soft.h"
 #include "pipe_reproj.h"
 #include "../fit/fit_band.h"
+#include "../fit/fit_holes.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -345,6 +346,11 @@ static void run_eye(pipe_ctx *p, eye_state *e)
          * hand too (fit_band.h) */
         if (rin == e->prior && rs.used_colour && p->fit && pipe_fit_learned(p->fit, e->eye))
             pipe_fit_refined_colour(pipe_fit_colour(p->fit, e->eye), &fe.P, rin, e->refined, cw);
+        /* its small islands cleared (and holes filled, PIPE_FILL_HOLE:
+         * fit_holes.h); the refinement's scratch is free again */
+        if (rs.used_colour && p->fit && p->desc.refine_fill == 0)
+            pipe_fit_fill_small(e->refined, cw, cw, ch, PIPE_FILL_HOLE, PIPE_FILL_ISLAND, e->mask, cw,
+                                e->refine_scratch, e->refine_scratch_size);
         pipe__cockpit_clamp(p->ck, &p->pose, e->eye, e->rast, &e->cam, e->mask, cw, e->refined,
                             cw, p->desc.refine_band, e->clip);
         e->have_refined = 1;
@@ -594,7 +600,8 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         return NULL;
     if (desc && (desc->edge_fade < -1 || desc->edge_fade > FUSE_EDGE_FADE_MAX)) return NULL;
     if (desc && (desc->refine_prior < -1 || desc->refine_prior > 0 ||
-                 desc->refine_lag_adapt < -1 || desc->refine_lag_adapt > 0))
+                 desc->refine_lag_adapt < -1 || desc->refine_lag_adapt > 0 ||
+                 desc->refine_fill < -1 || desc->refine_fill > 0))
         return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;

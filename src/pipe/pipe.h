@@ -164,10 +164,25 @@ typedef struct pipe_desc {
                                  one pass over the mask. With aa_samples,
                                  eye_view REPROJECT or another value:
                                  pipe_create returns NULL. */
+    int refine_fill;          /* with refine_band and a fit (fit_rig): 0 =
+                                 the default, on: the refined mask's
+                                 islands (set components touching no image
+                                 border) of at most PIPE_FILL_ISLAND pixels
+                                 are cleared, and its holes of at most
+                                 PIPE_FILL_HOLE pixels that the kinematic
+                                 mask covers filled (0: none, the default:
+                                 measured, filling them lost on edge)
+                                 (pipe_fit_fill_small, src/fit/fit_holes.h,
+                                 docs/accuracy.md), before the colour model
+                                 learns from it. -1: off (the bytes of
+                                 before). Other values: pipe_create
+                                 returns NULL. */
 } pipe_desc;
 
 /* The defaults of the refine method (`egofuse eval`'s, docs/accuracy.md). */
 #define PIPE_PRIOR_RADIUS 0.03f   /* metres around each hand joint */
+#define PIPE_FILL_HOLE 0          /* px: refine_fill's largest hole filled (0 off) */
+#define PIPE_FILL_ISLAND 64       /* px: and largest island cleared */
 #define PIPE_PRIOR_SPEED 0.3f     /* m/s: faster hands keep the kinematic mask */
 #define PIPE_LAG_V0 0.2f          /* m/s: the lag compensation starts ... */
 #define PIPE_LAG_V1 0.8f          /* ... and is whole here */
