@@ -160,6 +160,8 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     rp.band = 64;
     rp.margin = 64;
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
+    if (pipe_fit_fill_scratch_size(CW, CH) > c->refine_scratch_size)   /* shared (as pipe_frame) */
+        c->refine_scratch_size = pipe_fit_fill_scratch_size(CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
     c->stereo_scratch_size = pipe_fit_stereo_scratch_size(CW, CH);
     c->stereo_scratch = aligned_alloc(16, (c->stereo_scratch_size + 15) & ~(size_t)15);

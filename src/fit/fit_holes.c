@@ -17,7 +17,7 @@ typedef struct {
 size_t pipe_fit_fill_scratch_size(int width, int height)
 {
     if (width < 1 || height < 1 || width > 65535 || height > (1 << 20)) return 0;
-    return (size_t)height * (size_t)(width + 1) * sizeof(run) + (size_t)(height + 1) * sizeof(int32_t);
+    return (size_t)height * (size_t)(width + 1) * sizeof(run) + (size_t)(height + 1) * sizeof(int32_t) + 15;
 }
 
 static int32_t find(run *r, int32_t i)
@@ -51,12 +51,10 @@ long pipe_fit_fill_small(uint8_t *mask, int stride, int width, int height, int m
         return -1;
     if (!max_hole && !max_island) return 0;
     const int W = width, H = height;
-    const size_t head = (size_t)(H + 1) * sizeof(int32_t);
-    if (scratch_size < head + sizeof(run)) return -1;
-    int32_t *row0 = scratch; /* first run of each row; row0[H] = the count */
-    run *r = (run *)((uint8_t *)scratch + ((head + 15) & ~(size_t)15));
-    const size_t used = (head + 15) & ~(size_t)15;
+    const size_t used = ((size_t)(H + 1) * sizeof(int32_t) + 15) & ~(size_t)15;
     if (scratch_size < used + sizeof(run)) return -1;
+    int32_t *row0 = scratch; /* first run of each row; row0[H] = the count */
+    run *r = (run *)((uint8_t *)scratch + used);
     const size_t cap = (scratch_size - used) / sizeof(run);
     size_t n = 0;
     for (int y = 0; y < H; y++) {

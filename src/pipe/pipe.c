@@ -666,8 +666,11 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         if (ok && p->desc.refine_band > 0) {
             fuse_refine_params rp = fuse_refine_params_default();
             rp.band = p->desc.refine_band;
-            s->refine_scratch_size =
-                fuse_refine_scratch_size(&rp, p->geo.crop_width, p->geo.crop_height);
+            /* shared with pipe_fit_fill_small, sized for its worst case:
+             * it leaves a mask with more runs than fit unchanged */
+            const size_t rs = fuse_refine_scratch_size(&rp, p->geo.crop_width, p->geo.crop_height),
+                         fs = pipe_fit_fill_scratch_size(p->geo.crop_width, p->geo.crop_height);
+            s->refine_scratch_size = rs && fs > rs ? fs : rs;
             s->refined = malloc(px);
             s->refine_scratch = s->refine_scratch_size
                                     ? aligned_alloc(16, (s->refine_scratch_size + 15) & ~(size_t)15)
