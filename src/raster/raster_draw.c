@@ -9,7 +9,6 @@
 
 #include <stddef.h>
 #include <stdlib.h>
-#include <string.h>
 
 void rast__stats_add(rast_stats *dst, const rast_stats *s)
 {
@@ -51,7 +50,7 @@ void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1)
 /* The pixels of a micro record (r->micro != 0): the depth test and the
  * stores of the scan (rast__scan_rows_ref) for its covered pixels, from
  * the values the front end computed with the scan's operations. */
-static long micro_apply(const rast_target *t, const rast__tri *r, const rast__idt *idt)
+static long micro_apply(const rast_target *t, const rast__tri *r)
 {
     long n = 0;
     const int na = t->attr ? r->attr_count : 0;
@@ -67,8 +66,6 @@ static long micro_apply(const rast_target *t, const rast__tri *r, const rast__id
         }
         t->mask[(size_t)y * (size_t)t->mask_stride + x] = 255;
         n++;
-        if (idt)   /* attributes written here: the resolve leaves them */
-            idt->ids[(size_t)y * (size_t)idt->stride + x] = 0;
         if (na) {
             const float b1 = r->mb1[p], b2 = r->mb2[p];
             float *a = t->attr + (size_t)y * (size_t)t->attr_stride + (size_t)x * (size_t)na;
@@ -91,7 +88,7 @@ long rast__scan_list(const rast_target *t, const rast__tri *tri, int n,
                  * no covered centre before they get a record. */
                 if (!(r->micro & 15))
                     continue;
-                px += micro_apply(t, r, NULL);
+                px += micro_apply(t, r);
             }
         } else {
             px += scan(t, r, r->y0, r->y1);
@@ -138,153 +135,6 @@ void rast__draw_valid(const rast_target *t, const rast_mesh_desc *m,
         rast__stats_add(stats, &st);
 }
 
-/* The deferred attributes of a draw (rast__draw_valid_vb with an id scan
- * and a resolve, docs/raster.md section 14). */
-typedef struct defer {
-    rast__vbuf *vb;
-    const rast__setup_isa *isa;
-    int na, rs;                  /* attributes, resolve record floats */
-    int32_t n;                   /* resolve records (ids id_base .. + n - 1) */
-    int bx0, bx1, by0, by1;      /* box of the pixels written with an id */
-} defer;
-
-/* Sets up the id plane for a w x h target and a draw of up to maxrec
- * records: 0 when memory fails (then the scan writes the attributes). */
-static int defer_begin(defer *d, rast__vbuf *vb, const rast__setup_isa *isa, int w, int h,
-                       int na, long maxrec)
-{
-    enum { PAD = 16 };   /* whole-vector id accesses past a row's end */
-    int stride = ((w + PAD + 15) & ~15);
-    if (stride < vb->ids_stride)
-        stride = vb->ids_stride;
-    const size_t need = (size_t)stride * (size_t)(h + 1);
-    if (need > vb->ids_cap || stride != vb->ids_stride) {
-        free(vb->ids);
-        vb->ids = calloc(need, sizeof(int32_t));
-        vb->ids_cap = vb->ids ? need : 0;
-        vb->ids_stride = vb->ids ? stride : 0;
-        vb->id_base = 1;
-        if (!vb->ids)
-            return 0;
-    }
-    /* Ids stay in 0 .. 2^31 - 1 (0: written by a micro record); those of
-     * earlier draws are below id_base. */
-    if (maxrec >= INT32_MAX - (long)vb->id_base) {
-        memset(vb->ids, 0, vb->ids_cap * sizeof(int32_t));
-        vb->id_base = 1;
-        if (maxrec >= INT32_MAX - 1L)
-            return 0;
-    }
-    d->vb = vb;
-    d->isa = isa;
-    d->na = na;
-    d->rs = RAST__RES_STRIDE(na);
-    d->n = 0;
-    d->bx0 = d->by0 = INT32_MAX;
-    d->bx1 = d->by1 = -1;
-    return 1;
-}
-
-/* The attributes of the pixels written since defer_begin (or the last
- * defer_flush), then the next ids. */
-static void defer_flush(const rast_target *t, defer *d)
-{
-    if (d->n > 0 && d->bx1 >= 0)
-        d->isa->resolve(t, d->na, d->vb->ids, d->vb->ids_stride, d->vb->id_base, d->n,
-                        d->vb->res, d->bx0, d->bx1, d->by0, d->by1);
-    d->vb->id_base += d->n;
-    d->n = 0;
-    d->bx0 = d->by0 = INT32_MAX;
-    d->bx1 = d->by1 = -1;
-}
-
-/* rast__scan_list (micro set) with the id scan: each record scanned gets
- * the next id and a resolve record (kept only when it wrote a pixel);
- * micro records write their attributes and id 0. When the resolve
- * records cannot grow, the pixels so far are resolved and *d switched off
- * (d->vb = NULL: the scan writes the attributes from then on). */
-static long scan_list_id(const rast_target *t, const rast__tri *tri, int n,
-                         rast__scan_rows_fn scan, rast__tiles *tiles, int last[4], defer *d)
-{
-    long px = 0;
-    for (int i = 0; i < n; i++) {
-        const rast__tri *r = &tri[i];
-        if (!d->vb) {
-            px += rast__scan_list(t, r, 1, scan, tiles, last, 1);
-            continue;
-        }
-        rast__vbuf *vb = d->vb;
-        const rast__idt idt = { vb->ids, vb->ids_stride, 0 };
-        long w = 0;
-        if (r->micro) {
-            if (r->micro != RAST__HIDDEN && (r->micro & 15))
-                w = micro_apply(t, r, &idt);
-        } else {
-            const size_t need = (size_t)(d->n + 1) * (size_t)d->rs;
-            if (need > vb->res_cap) {
-                size_t cap = vb->res_cap ? vb->res_cap * 2 : (size_t)4096 * (size_t)d->rs;
-                while (cap < need)
-                    cap *= 2;
-                float *p = realloc(vb->res, cap * sizeof(float));
-                if (!p) {
-                    defer_flush(t, d);
-                    d->vb = NULL;
-                    i--;
-                    continue;
-                }
-                vb->res = p;
-                vb->res_cap = cap;
-            }
-            float *o = vb->res + (size_t)d->n * (size_t)d->rs;
-            memcpy(&o[0], &r->x0, sizeof(int32_t));
-            memcpy(&o[1], &r->y0, sizeof(int32_t));
-            o[2] = r->q.c;  o[3] = r->q.dx;  o[4] = r->q.dy;
-            o[5] = r->b1.c; o[6] = r->b1.dx; o[7] = r->b1.dy;
-            o[8] = r->b2.c; o[9] = r->b2.dx; o[10] = r->b2.dy;
-            float *a = o + RAST__RES_HEAD;
-            for (int k = 0; k < d->na; k++) {
-                a[k] = r->a0[k];
-                a[d->na + k] = r->d1[k];
-                a[2 * d->na + k] = r->d2[k];
-            }
-            const rast__idt id = { vb->ids, vb->ids_stride, vb->id_base + d->n };
-            w = d->isa->scan_id(t, r, r->y0, r->y1, &id);
-            if (w) {
-                d->n++;
-                if (r->x0 < d->bx0) d->bx0 = r->x0;
-                if (r->x1 > d->bx1) d->bx1 = r->x1;
-                if (r->y0 < d->by0) d->by0 = r->y0;
-                if (r->y1 > d->by1) d->by1 = r->y1;
-            }
-        }
-        px += w;
-        if (!tiles)
-            continue;
-        const int tx0 = r->x0 / RAST__TILE, tx1 = r->x1 / RAST__TILE;
-        const int ty0 = r->y0 / RAST__TILE, ty1 = r->y1 / RAST__TILE;
-        if (tx0 >= last[0] && tx1 <= last[1] && ty0 >= last[2] && ty1 <= last[3])
-            continue;
-        rast__tiles_add(tiles, r->y0, r->y1, r->x0, r->x1);
-        last[0] = tx0;
-        last[1] = tx1;
-        last[2] = ty0;
-        last[3] = ty1;
-    }
-    return px;
-}
-
-/* EGOFUSE_RASTER_DEFER=0 in the environment switches the deferred
- * attributes off (bench_raster's old/new comparison in one binary). */
-static int defer_enabled(void)
-{
-    static int v = -1;
-    if (v < 0) {
-        const char *e = getenv("EGOFUSE_RASTER_DEFER");
-        v = !(e && e[0] == '0');
-    }
-    return v;
-}
-
 void rast__draw_valid_vb(const rast_target *t, const rast_mesh_desc *m,
                          rast_stats *stats, rast__scan_rows_fn scan,
                          const rast__setup_isa *isa, rast__tiles *tiles, rast__vbuf *vb)
@@ -301,23 +151,11 @@ void rast__draw_valid_vb(const rast_target *t, const rast_mesh_desc *m,
     st.tris_in = m->tri_count;
     isa->vpass(&view, m->clip, m->vertex_count, vb);
     int last[4] = { 1, 0, 1, 0 };
-    /* Attributes resolved after the draw when the ISA has the kernels. */
-    defer d;
-    d.vb = NULL;
-    if (view.attr_count > 0 && isa->scan_id && isa->resolve && defer_enabled() &&
-        !defer_begin(&d, vb, isa, t->width, t->height, view.attr_count,
-                     (long)m->tri_count * RAST__MAX_FAN))
-        d.vb = NULL;
     for (int ti = 0; ti < m->tri_count; ti += RAST__VX_CHUNK) {
         const int te = m->tri_count - ti > RAST__VX_CHUNK ? ti + RAST__VX_CHUNK : m->tri_count;
         const int n = isa->frontv(&view, m, vb, ti, te, vb->out, &st, 1);
-        if (d.vb)
-            st.pixels_written += scan_list_id(t, vb->out, n, scan, tiles, last, &d);
-        else
-            st.pixels_written += rast__scan_list(t, vb->out, n, scan, tiles, last, 1);
+        st.pixels_written += rast__scan_list(t, vb->out, n, scan, tiles, last, 1);
     }
-    if (d.vb)
-        defer_flush(t, &d);
     if (stats)
         rast__stats_add(stats, &st);
 }
@@ -327,8 +165,7 @@ rast__vbuf *rast__vbuf_alloc(int cap)
     if (cap < 0 || cap > (1 << 24))
         return NULL;
     const size_t c = ((size_t)cap + 15u) & ~(size_t)15u;
-    const size_t head = (sizeof(rast__vbuf) + 63u) & ~(size_t)63u;
-    const size_t nout = (size_t)RAST__VX_CHUNK * RAST__MAX_FAN;
+    const size_t head = 64, nout = (size_t)RAST__VX_CHUNK * RAST__MAX_FAN;
     const size_t size = head + c * (2 * sizeof(int32_t) + 2 * sizeof(double)) +
                         ((nout * sizeof(rast__tri) + 63u) & ~(size_t)63u);
     char *p = aligned_alloc(64, (size + 63u) & ~(size_t)63u);
@@ -340,20 +177,10 @@ rast__vbuf *rast__vbuf_alloc(int cap)
     vb->zw = (double *)(void *)(p + head + c * 2 * sizeof(int32_t));
     vb->iw = vb->zw + c;
     vb->out = (rast__tri *)(void *)(vb->iw + c);
-    vb->ids = NULL;
-    vb->ids_cap = 0;
-    vb->ids_stride = 0;
-    vb->id_base = 1;
-    vb->res = NULL;
-    vb->res_cap = 0;
     return vb;
 }
 
 void rast__vbuf_free(rast__vbuf *vb)
 {
-    if (vb) {
-        free(vb->ids);
-        free(vb->res);
-    }
     free(vb);
 }

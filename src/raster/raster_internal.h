@@ -48,7 +48,6 @@
 #ifndef EGOFUSE_RASTER_INTERNAL_H
 #define EGOFUSE_RASTER_INTERNAL_H
 
-#include <stddef.h>
 #include <stdint.h>
 
 #include "raster.h"
@@ -362,16 +361,6 @@ typedef struct rast__vbuf {
     int32_t *xy;              /* 2 per vertex: X, Y */
     double *zw, *iw;          /* 1 per vertex */
     rast__tri *out;           /* RAST__VX_CHUNK * RAST__MAX_FAN records */
-    /* Resolved attributes (above): the id plane (ids_cap int32, rows of
-     * ids_stride; ids below id_base belong to earlier draws), the
-     * resolve records (res_cap floats). Allocated at the first draw that
-     * uses them; freed by rast__vbuf_free. */
-    int32_t *ids;
-    size_t ids_cap;
-    int ids_stride;
-    int32_t id_base;
-    float *res;
-    size_t res_cap;
 } rast__vbuf;
 /* A buffer for cap vertices (rounded up to 16) in one 64-byte aligned
  * block, or NULL; rast__vbuf_free(NULL) is fine. */
@@ -396,47 +385,12 @@ void rast__vpass_avx512(const rast__view *v, const float *clip, int count, rast_
 int rast__frontv_avx512(const rast__view *v, const rast_mesh_desc *m, const rast__vbuf *vb,
                         int ti0, int ti1, rast__tri *out, rast_stats *st, int micro);
 
-/* ---- attributes resolved after the draw (docs/raster.md section 14) ----
- *
- * With the vector front end and a target with attributes, the scan writes
- * depth, mask and the record's id (int32, an id plane of the vbuf) instead
- * of the attributes; after the draw, rast__resolve_fn computes the
- * attributes of the pixels whose id is one of this draw's, from a copy of
- * their record's q, b1, b2 planes, box origin and attribute values, with
- * the scan's float operations (raster_internal.h's per-pixel rule): the
- * bytes of the in-scan attributes, since each pixel's last writer is the
- * record whose values the scan would have left there.
- *
- * A resolve record (RAST__RES_STRIDE(na) floats): x0, y0 (int32 bits),
- * q.c q.dx q.dy, b1.c b1.dx b1.dy, b2.c b2.dx b2.dy, a0[na], d1[na], d2[na]. */
-#define RAST__RES_HEAD 11
-#define RAST__RES_STRIDE(na) (RAST__RES_HEAD + 3 * (na))
-/* The id plane of a scan: ids[y * stride + x] = id for every pixel written
- * (depth and mask as the scan writes them; no attributes). */
-typedef struct rast__idt {
-    int32_t *ids;
-    int stride;
-    int32_t id;
-} rast__idt;
-typedef long (*rast__scan_id_fn)(const rast_target *t, const rast__tri *tri, int ya, int yb,
-                                 const rast__idt *idt);
-/* The attributes of t (na of them per pixel, t->attr) for the pixels of
- * the rows y0..y1, columns x0..x1, whose id lies in base .. base + n - 1:
- * from resolve record id - base of res. ids: the id plane (stride floats
- * a row; at least x1 + SIMD_W columns readable). */
-typedef void (*rast__resolve_fn)(const rast_target *t, int na, const int32_t *ids,
-                                 int stride, int32_t base, int32_t n, const float *res,
-                                 int x0, int x1, int y0, int y1);
-
 typedef struct rast__setup_isa {
     rast__planes_fn planes;
     rast__vfill_fn vfill;
     rast__front_fn front;     /* NULL: every triangle through the scalar path */
     rast__vpass_fn vpass;     /* NULL (with frontv): no vector front end */
     rast__frontv_fn frontv;
-    /* NULL (both): attributes written by the scan only. */
-    rast__scan_id_fn scan_id;
-    rast__resolve_fn resolve;
 } rast__setup_isa;
 extern const rast__setup_isa rast__setup_isa_ref, rast__setup_isa_sse2, rast__setup_isa_avx2,
     rast__setup_isa_avx512, rast__setup_isa_neon;

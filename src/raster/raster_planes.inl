@@ -193,15 +193,5 @@ void SIMD_FN(rast__vfill)(const rast__view *v, const float *clip, uint32_t base,
 #ifndef SETUP_PLANES
 #define SETUP_PLANES SIMD_FN(rast__planes)
 #endif
-/* The id scan and the resolve (raster_simd.inl) go with the vector front
- * end: the only driver that uses them (rast__draw_valid_vb). */
-#if defined(SIMD_HAS_VL) && SIMD_HAS_VL
-#define SCAN_ID_FN SIMD_FN(rast__scan_rows_id)
-#define RESOLVE_FN SIMD_FN(rast__resolve)
-#else
-#define SCAN_ID_FN NULL
-#define RESOLVE_FN NULL
-#endif
 const rast__setup_isa SIMD_FN(rast__setup_isa) = { SETUP_PLANES, SIMD_FN(rast__vfill), FRONT_FN,
-                                                   VPASS_FN, FRONTV_FN, SCAN_ID_FN,
-                                                   RESOLVE_FN };
+                                                   VPASS_FN, FRONTV_FN };

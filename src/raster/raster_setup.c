@@ -409,7 +409,7 @@ static int setup_oriented(const rast__view *v, const int32_t X[3], const int32_t
 }
 
 const rast__setup_isa rast__setup_isa_ref = { rast__planes_ref, rast__vfill_ref, NULL, NULL,
-                                               NULL, NULL, NULL };
+                                               NULL };
 
 void rast__planes_ref(rast__pbatch *b)
 {

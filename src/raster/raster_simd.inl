@@ -139,8 +139,7 @@ static inline void simd_attr_store(float *dst, int na, unsigned pass, int lanes,
  * pixels (1x1, 2x1, 1x2), whose vector set-up costs more than their
  * pixels. (Drawn through a context with the vector front end, such boxes
  * come as micro records instead and are not scanned.) */
-static inline long simd_scan_pixel(const rast_target *t, const rast__tri *tri, int x, int y,
-                                   const rast__idt *idt)
+static inline long simd_scan_pixel(const rast_target *t, const rast__tri *tri, int x, int y)
 {
     const int64_t i = x - tri->x0, j = y - tri->y0;
     if (((tri->e_c[0] + j * tri->e_dy[0] + i * tri->e_dx[0]) |
@@ -158,10 +157,6 @@ static inline long simd_scan_pixel(const rast_target *t, const rast__tri *tri, i
         *d = z;
     }
     t->mask[(size_t)y * (size_t)t->mask_stride + x] = 255;
-    if (idt) {
-        idt->ids[(size_t)y * (size_t)idt->stride + x] = idt->id;
-        return 1;
-    }
     const int na = t->attr ? tri->attr_count : 0;
     if (na) {
         const float r = 1.0f / ((tri->q.c + tri->q.dy * fj) + tri->q.dx * fi);
@@ -190,9 +185,6 @@ typedef struct simd_vec1 {
     vint e0, e1, e2;                /* reduced edges of the current row */
     uint8_t *mrow;
     float *drow, *arow;           /* NULL without depth / attributes */
-    float *irow;                  /* the id plane's row (NULL: none), its stride */
-    int istride;
-    vfloat idf;                   /* the record's id (bits) in every lane */
     long written;
     int inrow;                    /* the SIMD_W pixels from x0 lie in the row */
 } simd_vec1;
@@ -263,8 +255,6 @@ static inline unsigned simd_vec1_row(simd_vec1 *s, const rast__tri *tri, int y,
         }
         vb_store_bits(s->mrow, pass);
     }
-    if (s->irow)   /* the id plane is the thread's own, padded: whole vectors */
-        vf_storeu(s->irow, vf_sel(vm_from_bits(pass), s->idf, vf_loadu(s->irow)));
     s->written += simd_popcount(pass);
     return pass;
 }
@@ -276,8 +266,6 @@ static inline void simd_vec1_next(simd_vec1 *s, const rast_target *t)
         s->drow += t->depth_stride;
     if (s->arow)
         s->arow += t->attr_stride;
-    if (s->irow)
-        s->irow += s->istride;
 }
 
 /* Triangles one vector wide (nx <= SIMD_W; most of a fine mesh), int32
@@ -287,10 +275,10 @@ static inline void simd_vec1_next(simd_vec1 *s, const rast_target *t)
  * the attributes before the first row that writes a pixel (many scanned
  * triangles are hidden). Every row-invariant product (dx * fi) is computed
  * once: the same IEEE product in every row. */
-SIMD_INL long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, int ye,
-                             int nx, int na, int32_t c0, int32_t c1, int32_t c2,
-                             int32_t sx0, int32_t sx1, int32_t sx2, int32_t sy0,
-                             int32_t sy1, int32_t sy2, const rast__idt *idt)
+static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, int ye,
+                           int nx, int na, int32_t c0, int32_t c1, int32_t c2,
+                           int32_t sx0, int32_t sx1, int32_t sx2, int32_t sy0,
+                           int32_t sy1, int32_t sy2)
 {
     const unsigned valid = nx >= SIMD_W ? SIMD_FULL : (1u << nx) - 1u;
     const vint lanev = vi_lanes();
@@ -304,14 +292,6 @@ SIMD_INL long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys,
     s.drow = t->depth ? t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0 : NULL;
     s.arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride + (size_t)tri->x0 * (size_t)na
                 : NULL;
-    s.irow = NULL;
-    s.istride = 0;
-    s.idf = vf_set1(0.0f);
-    if (idt) {
-        s.irow = (float *)(void *)(idt->ids + (size_t)ys * (size_t)idt->stride + tri->x0);
-        s.istride = idt->stride;
-        s.idf = vi_as_vf(vi_set1(idt->id));
-    }
     const vint dy0 = vi_set1(sy0), dy1 = vi_set1(sy1), dy2 = vi_set1(sy2);
     const vfloat fi = vf_from_vi(lanev);
     const vfloat zfi = vf_mul(vf_set1(tri->z.dx), fi);
@@ -384,9 +364,9 @@ SIMD_INL long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys,
  * that writes (hidden rows and triangles never pay for them); a run
  * vector of at most half the lanes divides on half a vector where the
  * lane macros allow it (VF_DIV_LANES). */
-SIMD_INL long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, int ye,
-                             int nx, int nvec, int na, const int64_t *c, const int32_t *sx,
-                             const int32_t *sy, const rast__idt *idt)
+static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, int ye,
+                           int nx, int nvec, int na, const int64_t *c, const int32_t *sx,
+                           const int32_t *sy)
 {
     const vint lanev = vi_lanes();
     const unsigned lastvalid = SIMD_FULL >> (nvec * SIMD_W - nx);
@@ -405,9 +385,6 @@ SIMD_INL long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys,
     float *arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride +
                            (size_t)tri->x0 * (size_t)na
                      : NULL;
-    float *irow = idt ? (float *)(void *)(idt->ids + (size_t)ys * (size_t)idt->stride + tri->x0)
-                      : NULL;
-    const vfloat idf = vi_as_vf(vi_set1(idt ? idt->id : 0));
     /* Attribute state, set up at the first pixel written (aset). */
     int aset = 0;
     vfloat qdx = vf_set1(0.0f), b1dx = qdx, b2dx = qdx;
@@ -420,8 +397,7 @@ SIMD_INL long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys,
 #endif
     for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
              drow = drow ? drow + t->depth_stride : NULL,
-             arow = arow ? arow + t->attr_stride : NULL,
-             irow = irow ? irow + idt->stride : NULL) {
+             arow = arow ? arow + t->attr_stride : NULL) {
         vint e0 = r0, e1 = r1, e2 = r2;
         r0 = vi_add(r0, sy0);
         r1 = vi_add(r1, sy1);
@@ -478,8 +454,6 @@ SIMD_INL long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys,
             }
             vb_store_bits(mrow + i0, pass);
             written += simd_popcount(pass);
-            if (irow)
-                vf_store_bits(irow + i0, pass, idf);
             if (!na)
                 continue;
             if (!aset) {
@@ -532,10 +506,7 @@ SIMD_INL long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys,
     return written;
 }
 
-/* The row scan; with idt (not NULL) the id scan: the record's id to the
- * id plane for every pixel written instead of the attributes. */
-SIMD_INL long simd_scan_rows(const rast_target *t, const rast__tri *tri, int ya, int yb,
-                             const rast__idt *idt)
+long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya, int yb)
 {
     const int ys = ya > tri->y0 ? ya : tri->y0;
     const int ye = yb < tri->y1 ? yb : tri->y1;
@@ -543,15 +514,13 @@ SIMD_INL long simd_scan_rows(const rast_target *t, const rast__tri *tri, int ya,
         return 0;
     if (tri->x0 == tri->x1) {
         if (ys == ye)
-            return simd_scan_pixel(t, tri, tri->x0, ys, idt);
+            return simd_scan_pixel(t, tri, tri->x0, ys);
         if (ys + 1 == ye)
-            return simd_scan_pixel(t, tri, tri->x0, ys, idt) +
-                   simd_scan_pixel(t, tri, tri->x0, ye, idt);
+            return simd_scan_pixel(t, tri, tri->x0, ys) + simd_scan_pixel(t, tri, tri->x0, ye);
     } else if (tri->x0 + 1 == tri->x1 && ys == ye) {
-        return simd_scan_pixel(t, tri, tri->x0, ys, idt) +
-               simd_scan_pixel(t, tri, tri->x1, ys, idt);
+        return simd_scan_pixel(t, tri, tri->x0, ys) + simd_scan_pixel(t, tri, tri->x1, ys);
     }
-    const int na = t->attr && !idt ? tri->attr_count : 0;
+    const int na = t->attr ? tri->attr_count : 0;
     const int nx = tri->x1 - tri->x0 + 1;
     if (nx <= SIMD_W) {
         if (t->depth && simd_box_hidden(t, tri, ys, ye, nx))
@@ -571,7 +540,7 @@ SIMD_INL long simd_scan_rows(const rast_target *t, const rast__tri *tri, int ya,
             simd_abs64(c1) + rows * simd_abs64(sy1) + cols * simd_abs64(sx1) <= SIMD_LIM30 &&
             simd_abs64(c2) + rows * simd_abs64(sy2) + cols * simd_abs64(sx2) <= SIMD_LIM30)
             return simd_scan_vec1(t, tri, ys, ye, nx, na, (int32_t)c0, (int32_t)c1,
-                                  (int32_t)c2, sx0, sx1, sx2, sy0, sy1, sy2, idt);
+                                  (int32_t)c2, sx0, sx1, sx2, sy0, sy1, sy2);
     }
     const int nvec = (nx + SIMD_W - 1) / SIMD_W;
     if (t->depth && nx > SIMD_W && nvec <= 4 && simd_box_hidden(t, tri, ys, ye, nx))
@@ -595,7 +564,7 @@ SIMD_INL long simd_scan_rows(const rast_target *t, const rast__tri *tri, int ya,
                 SIMD_LIM30;
     }
     if (fits)
-        return simd_scan_wide(t, tri, ys, ye, nx, nvec, na, c, sx, sy, idt);
+        return simd_scan_wide(t, tri, ys, ye, nx, nvec, na, c, sx, sy);
     const vint lanev = vi_lanes();
     const vint off0 = simd_lane_mul(lanev, sx[0]), off1 = simd_lane_mul(lanev, sx[1]),
              off2 = simd_lane_mul(lanev, sx[2]);
@@ -618,17 +587,13 @@ SIMD_INL long simd_scan_rows(const rast_target *t, const rast__tri *tri, int ya,
                      : NULL;
     const vfloat qdx = vf_set1(tri->q.dx);
     const vfloat b1dx = vf_set1(tri->b1.dx), b2dx = vf_set1(tri->b2.dx);
-    float *irow = idt ? (float *)(void *)(idt->ids + (size_t)ys * (size_t)idt->stride + tri->x0)
-                      : NULL;
-    const vfloat idf = vi_as_vf(vi_set1(idt ? idt->id : 0));
 
     /* Int64 coverage (clamped starts, see COVERAGE): vectors aligned at
      * x0, every vector of every row tested. */
     int64_t rb[3] = { c[0], c[1], c[2] };
     for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
              drow = drow ? drow + t->depth_stride : NULL,
-             arow = arow ? arow + t->attr_stride : NULL,
-             irow = irow ? irow + idt->stride : NULL) {
+             arow = arow ? arow + t->attr_stride : NULL) {
         /* Row bases: the reference's scalar expressions. */
         const float fj = (float)(y - tri->y0);
         const float zr = tri->z.c + tri->z.dy * fj;
@@ -665,8 +630,6 @@ SIMD_INL long simd_scan_rows(const rast_target *t, const rast__tri *tri, int ya,
             }
             vb_store_bits(mrow + i0, pass);
             written += simd_popcount(pass);
-            if (irow)
-                vf_store_bits(irow + i0, pass, idf);
             if (!na)
                 continue;
             const vfloat r = vf_div(one, vf_add(vf_set1(qr), vf_mul(qdx, fi)));
@@ -689,86 +652,4 @@ SIMD_INL long simd_scan_rows(const rast_target *t, const rast__tri *tri, int ya,
         rb[2] += sy[2];
     }
     return written;
-}
-
-long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya, int yb)
-{
-    return simd_scan_rows(t, tri, ya, yb, NULL);
-}
-
-long SIMD_FN(rast__scan_rows_id)(const rast_target *t, const rast__tri *tri, int ya, int yb,
-                                 const rast__idt *idt);
-long SIMD_FN(rast__scan_rows_id)(const rast_target *t, const rast__tri *tri, int ya, int yb,
-                                 const rast__idt *idt)
-{
-    return simd_scan_rows(t, tri, ya, yb, idt);
-}
-
-/* RESOLVE (docs/raster.md section 14): the attributes of the pixels whose
- * id is one of this draw's, SIMD_W pixels of a row at a time, each lane's
- * record fields gathered by its id; per lane the reference's operations
- * (raster_internal.h): fi = (float)(x - x0), fj = (float)(y - y0),
- * r = 1 / ((q.c + q.dy*fj) + q.dx*fi), b = ((b.c + b.dy*fj) + b.dx*fi) * r,
- * a_k = (a0 + b1*d1) + b2*d2: the bytes the scan's last writer of the pixel
- * would have stored. Lanes not resolved read record 0 (n > 0) and store
- * nothing. */
-void SIMD_FN(rast__resolve)(const rast_target *t, int na, const int32_t *ids, int stride,
-                            int32_t base, int32_t n, const float *res, int x0, int x1,
-                            int y0, int y1);
-void SIMD_FN(rast__resolve)(const rast_target *t, int na, const int32_t *ids, int stride,
-                            int32_t base, int32_t n, const float *res, int x0, int x1,
-                            int y0, int y1)
-{
-    if (n <= 0 || na <= 0)
-        return;
-    const vint lanev = vi_lanes();
-    const vint basev = vi_set1(base), nv = vi_set1(n), m1 = vi_set1(-1);
-    const vint rsv = vi_set1(RAST__RES_STRIDE(na));
-    const vint zero = vi_set1(0);
-    const vfloat one = vf_set1(1.0f);
-    const int32_t *resi = (const int32_t *)(const void *)res;
-    for (int y = y0; y <= y1; y++) {
-        const int32_t *irow = ids + (size_t)y * (size_t)stride;
-        float *arow = t->attr + (size_t)y * (size_t)t->attr_stride;
-        const vint yv = vi_set1(y);
-        for (int x = x0; x <= x1; x += SIMD_W) {
-            const int rem = x1 - x + 1;
-            const int lanes = rem < SIMD_W ? rem : SIMD_W;
-            const unsigned valid = rem >= SIMD_W ? SIMD_FULL : (1u << rem) - 1u;
-            const vint rel = vi_sub(vi_loadu(irow + x), basev);
-            const vmask in = vm_and(vi_gt(rel, m1), vi_gt(nv, rel));
-            const unsigned bits = vm_bits(in) & valid;
-            if (!bits)
-                continue;
-            const vint idx = vi_mullo(vi_sel(in, rel, zero), rsv);
-            const vint rx0 = vi_gather(resi, idx);
-            const vint ry0 = vi_gather(resi + 1, idx);
-            const vfloat fi = vf_from_vi(vi_sub(vi_add(vi_set1(x), lanev), rx0));
-            const vfloat fj = vf_from_vi(vi_sub(yv, ry0));
-            const vfloat qr = vf_add(vf_gather(res + 2, idx), vf_mul(vf_gather(res + 4, idx), fj));
-            const vfloat b1r = vf_add(vf_gather(res + 5, idx), vf_mul(vf_gather(res + 7, idx), fj));
-            const vfloat b2r = vf_add(vf_gather(res + 8, idx), vf_mul(vf_gather(res + 10, idx), fj));
-            const vfloat r = vf_div(one, vf_add(qr, vf_mul(vf_gather(res + 3, idx), fi)));
-            const vfloat b1 = vf_mul(vf_add(b1r, vf_mul(vf_gather(res + 6, idx), fi)), r);
-            const vfloat b2 = vf_mul(vf_add(b2r, vf_mul(vf_gather(res + 9, idx), fi)), r);
-            vfloat av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
-            const float *a = res + RAST__RES_HEAD;
-            for (int k = 0; k < na; k++) {
-                av0[k] = vf_gather(a + k, idx);
-                av1[k] = vf_gather(a + na + k, idx);
-                av2[k] = vf_gather(a + 2 * na + k, idx);
-            }
-            float *dst = arow + (size_t)x * (size_t)na;
-#ifdef ATTR3_STORE_FULL
-            if (na == 3 && bits == SIMD_FULL) {
-                ATTR3_STORE_FULL(dst,
-                    vf_add(vf_add(av0[0], vf_mul(b1, av1[0])), vf_mul(b2, av2[0])),
-                    vf_add(vf_add(av0[1], vf_mul(b1, av1[1])), vf_mul(b2, av2[1])),
-                    vf_add(vf_add(av0[2], vf_mul(b1, av1[2])), vf_mul(b2, av2[2])));
-                continue;
-            }
-#endif
-            simd_attr_store(dst, na, bits, lanes, b1, b2, av0, av1, av2);
-        }
-    }
 }
