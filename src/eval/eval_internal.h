@@ -50,6 +50,9 @@ typedef struct method_cfg {
                                 within this many metres of slow hands (0 off) */
     float prior_speed;       /* m/s: slower hands use it */
     int prior_mc;            /* 1: moved with the hand (pipe_fit_hand_px) */
+    int shift;               /* refine: the hands of the input moved to the
+                                colour (fit_shift.h): 0 off, 1 the hands
+                                without the prior, 2 every tracked hand */
     int fill_hole, fill_island; /* refine: holes / islands of the refined
                                    mask up to this many pixels filled /
                                    cleared (fit_holes.h); 0 off */
@@ -60,6 +63,12 @@ typedef struct method_cfg {
                                            speed v0 (none) to v1 (full), m/s;
                                            v1 0 = off */
 } method_cfg;
+
+/* refine's variants in --methods (eval_plan.c): refine-nomc (the prior
+ * not moved with the hand), refine-shift, refine-shiftall (fit_shift.h,
+ * the hands without the prior / every hand) */
+#define EVAL_VARIANTS 3
+method_cfg eval__variant_cfg(const eval_opts *o, int v);
 
 /* refine's defaults (docs/accuracy.md, issue 14 item 2) */
 #define EVAL_PRIOR_RADIUS 0.03f
@@ -159,6 +168,7 @@ typedef struct eval_ctx {
     /* method scratch */
     uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
     uint8_t *mask_prior;     /* refine: the prior (fit_band.h) */
+    uint8_t *mask_shift;     /* refine: the hands moved (fit_shift.h) */
     uint32_t *aa_samples;    /* anti-aliased coverage, 640x400 */
     float *depth_lo, *nrm_lo, *mnrm;
     void *refine_scratch;
