@@ -578,13 +578,14 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                     if (mask == c->mask_prior && cfg->fit && pipe_fit_learned(r->fit, e))
                         pipe_fit_prior_colour(pipe_fit_colour(r->fit, e), &P, c->mask_prior, CW);
                 }
+                const int from_prior = mask == c->mask_prior;
                 /* the hands of the input moved to where the colour
                  * says they are (fit_shift.h): the hands without the
                  * prior, or every tracked hand */
                 if (cfg->shift && posed && cfg->fit && pipe_fit_learned(r->fit, e) &&
                     c->refine_scratch_size >= pipe_fit_shift_scratch_size(CW, CH)) {
                     unsigned ss = r->sides;
-                    if (cfg->shift == 1 && mask == c->mask_prior)
+                    if (cfg->shift == 1 && from_prior)
                         for (int k = 0; k < 2; k++)
                             if (r->speed[k] < cfg->prior_speed) ss &= ~(1u << k);
                     const pipe_fit_shift_desc sd = pipe_fit_shift_desc_default();
@@ -608,7 +609,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                                            c->refine_scratch_size, &rs);
                 if (fr != FUSE_OK) return -1;
                 /* and so must the pixels the vote let in beyond it */
-                if (mask == c->mask_prior && rs.used_colour && cfg->fit &&
+                if (from_prior && rs.used_colour && cfg->fit &&
                     pipe_fit_learned(r->fit, e))
                     pipe_fit_refined_colour(pipe_fit_colour(r->fit, e), &P, mask, c->refined, CW);
                 /* the stereo pair's depth test (fit_stereo.h): refined

@@ -66,8 +66,8 @@ typedef struct method_cfg {
 
 /* refine's variants in --methods (eval_plan.c): refine-nomc (the prior
  * not moved with the hand), refine-shift, refine-shiftall (fit_shift.h,
- * the hands without the prior / every hand) */
-#define EVAL_VARIANTS 3
+ * the hands without the prior / every hand), refine-nomc-shift (both) */
+#define EVAL_VARIANTS 4
 method_cfg eval__variant_cfg(const eval_opts *o, int v);
 
 /* refine's defaults (docs/accuracy.md, issue 14 item 2) */

@@ -58,7 +58,7 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k)
 /* refine's variants, selectable in --methods (bits 4.. of
  * eval_opts.methods): refine with one knob changed (docs/accuracy.md) */
 static const char *variant_name[EVAL_VARIANTS] = { "refine-nomc", "refine-shift",
-                                                   "refine-shiftall" };
+                                                   "refine-shiftall", "refine-nomc-shift" };
 
 method_cfg eval__variant_cfg(const eval_opts *o, int v)
 {
@@ -66,7 +66,12 @@ method_cfg eval__variant_cfg(const eval_opts *o, int v)
     switch (v) {
     case 0: c.prior_mc = 0; snprintf(c.setting, sizeof c.setting, "priormc=0"); break;
     case 1: c.shift = 1; snprintf(c.setting, sizeof c.setting, "shift=1"); break;
-    default: c.shift = 2; snprintf(c.setting, sizeof c.setting, "shift=2"); break;
+    case 2: c.shift = 2; snprintf(c.setting, sizeof c.setting, "shift=2"); break;
+    default:
+        c.prior_mc = 0;
+        c.shift = 1;
+        snprintf(c.setting, sizeof c.setting, "priormc=0,shift=1");
+        break;
     }
     return c;
 }

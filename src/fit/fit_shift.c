@@ -9,7 +9,7 @@ pipe_fit_shift_desc pipe_fit_shift_desc_default(void)
 {
     pipe_fit_shift_desc d;
     d.range = 24;
-    d.max_points = 1000;
+    d.max_points = 1500;
     d.min_gain = 0.1f;
     d.cost = 0.004f;
     d.hand_radius = 0.04f;
@@ -99,7 +99,8 @@ const uint8_t *pipe_fit_shift(const pipe_fit_shift_desc *dp, const fuse_colour_m
             if (!row_span(r, W, &a, &b)) continue;
             if (y < y0) y0 = y;
             y1 = y;
-            for (int x = a; x <= b; x++) n1 += m[x] >= 128;
+            if (y & 1) continue;   /* counted on every other row and column */
+            for (int x = a + (a & 1); x <= b; x += 2) n1 += 4 * (m[x] >= 128);
         }
         if (n1 < 16) continue;
         int q = (int)ceil(sqrt((double)n1 / (double)d.max_points));

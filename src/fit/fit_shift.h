@@ -38,13 +38,13 @@ extern "C" {
 
 typedef struct pipe_fit_shift_desc {
     int range;        /* pixels searched each way, 2..64 (24) */
-    int max_points;   /* points per side at most, >= 16 (1000) */
+    int max_points;   /* points per side at most, >= 16 (1500) */
     float min_gain;   /* nats per point the best shift must gain (0.1) */
     float cost;       /* nats per point and pixel of shift (0.004) */
     float hand_radius;/* metres around each hand joint: the region (0.04) */
 } pipe_fit_shift_desc;
 
-/* range 24, max_points 1000, min_gain 0.1, cost 0.004, hand_radius 0.04. */
+/* range 24, max_points 1500, min_gain 0.1, cost 0.004, hand_radius 0.04. */
 pipe_fit_shift_desc pipe_fit_shift_desc_default(void);
 
 /* Bytes of scratch for an image of width x height (stride >= width). */
