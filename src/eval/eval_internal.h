@@ -65,9 +65,10 @@ typedef struct method_cfg {
 } method_cfg;
 
 /* refine's variants in --methods (eval_plan.c): refine-nomc (the prior
- * not moved with the hand), refine-shift, refine-shiftall (fit_shift.h,
- * the hands without the prior / every hand), refine-nomc-shift (both) */
-#define EVAL_VARIANTS 4
+ * not moved with the hand), refine-noshift (the hands of the input not
+ * moved to the colour, fit_shift.h), refine-shiftall (every tracked hand
+ * moved, those of the prior too) */
+#define EVAL_VARIANTS 3
 method_cfg eval__variant_cfg(const eval_opts *o, int v);
 
 /* refine's defaults (docs/accuracy.md, issue 14 item 2) */
@@ -75,6 +76,9 @@ method_cfg eval__variant_cfg(const eval_opts *o, int v);
 #define EVAL_PRIOR_SPEED 0.3f
 #define EVAL_LAG_V0 0.2f
 #define EVAL_LAG_V1 0.8f
+/* refine: the hands without the prior moved to the colour before the
+ * band (fit_shift.h; 0 off, 2 every hand) */
+#define EVAL_SHIFT 1
 /* refine: the refined mask's holes up to this many pixels filled and its
  * islands up to this many cleared (fit_holes.h; as PIPE_FILL_HOLE,
  * PIPE_FILL_ISLAND) */

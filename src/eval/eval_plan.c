@@ -38,6 +38,7 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k)
         c.stereo = o->stereo;   /* measured, off by default */
         c.fill_hole = EVAL_FILL_HOLE;
         c.fill_island = EVAL_FILL_ISLAND;
+        c.shift = EVAL_SHIFT;   /* the fast hands moved to the colour (fit_shift.h) */
     }
     c.band_sigma = 0.007f;
     c.band_max = 64;
@@ -57,21 +58,16 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k)
 
 /* refine's variants, selectable in --methods (bits 4.. of
  * eval_opts.methods): refine with one knob changed (docs/accuracy.md) */
-static const char *variant_name[EVAL_VARIANTS] = { "refine-nomc", "refine-shift",
-                                                   "refine-shiftall", "refine-nomc-shift" };
+static const char *variant_name[EVAL_VARIANTS] = { "refine-nomc", "refine-noshift",
+                                                   "refine-shiftall" };
 
 method_cfg eval__variant_cfg(const eval_opts *o, int v)
 {
     method_cfg c = eval__base_cfg(o, M_REFINE);
     switch (v) {
     case 0: c.prior_mc = 0; snprintf(c.setting, sizeof c.setting, "priormc=0"); break;
-    case 1: c.shift = 1; snprintf(c.setting, sizeof c.setting, "shift=1"); break;
-    case 2: c.shift = 2; snprintf(c.setting, sizeof c.setting, "shift=2"); break;
-    default:
-        c.prior_mc = 0;
-        c.shift = 1;
-        snprintf(c.setting, sizeof c.setting, "priormc=0,shift=1");
-        break;
+    case 1: c.shift = 0; snprintf(c.setting, sizeof c.setting, "shift=0"); break;
+    default: c.shift = 2; snprintf(c.setting, sizeof c.setting, "shift=2"); break;
     }
     return c;
 }

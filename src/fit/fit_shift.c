@@ -21,11 +21,54 @@ static size_t point_cap(int stride, int height)
     return (size_t)(stride / 2 + 1) * (size_t)(height / 2 + 1);
 }
 
+/* the ratio table of the box around the points: (stride + 2 * 64) x
+ * (height + 2 * 64) bytes at most */
+static size_t box_cap(int stride, int height)
+{
+    return (size_t)(stride + 128) * (size_t)(height + 128);
+}
+
+static size_t align16(size_t n) { return (n + 15u) & ~(size_t)15u; }
+
 size_t pipe_fit_shift_scratch_size(int stride, int height)
 {
     if (stride < 1 || height < 1) return 0;
-    const size_t region = ((size_t)stride * (size_t)height + 15u) & ~(size_t)15u;
-    return region + 4u * point_cap(stride, height);
+    return align16((size_t)stride * (size_t)height) + align16(4u * point_cap(stride, height)) +
+           box_cap(stride, height);
+}
+
+/* The clamped log-likelihood ratio of every other pixel of every other
+ * row of the box x0..x0+2bw-1, y0..y0+2bh-1 (the points and the shifts
+ * are all even: x0 + 2i, y0 + 2j; the box may reach beyond the image: 0
+ * there, unknown) as int8, LLR_Q per nat, bw x bh. */
+enum { LLR_Q = 40 };
+
+static void llr_box(const fuse_colour_model *g, const fuse_image *P, int x0, int y0, int bw,
+                    int bh, int8_t *box)
+{
+    const int bits = g->bits, sh = 8 - bits;
+    for (int y = 0; y < bh; y++) {
+        int8_t *b = box + (size_t)y * (size_t)bw;
+        const int iy = y0 + 2 * y;
+        if (iy < 0 || iy >= P->height) {
+            memset(b, 0, (size_t)bw);
+            continue;
+        }
+        const uint8_t *row = P->pixels + (size_t)iy * (size_t)P->stride;
+        for (int x = 0; x < bw; x++) {
+            const int ix = x0 + 2 * x;
+            if (ix < 0 || ix >= P->width) {
+                b[x] = 0;
+                continue;
+            }
+            const uint8_t *px = row + 4 * ix;
+            const unsigned bin = ((unsigned)(px[0] >> sh) << (2 * bits)) |
+                                 ((unsigned)(px[1] >> sh) << bits) | (unsigned)(px[2] >> sh);
+            float v = g->llr[bin];
+            v = v > 3.0f ? 3.0f : v < -3.0f ? -3.0f : v;
+            b[x] = (int8_t)lrintf(v * (float)LLR_Q);
+        }
+    }
 }
 
 /* the first and last set column of a region row (one span); 0 if none */
@@ -40,25 +83,14 @@ static int row_span(const uint8_t *r, int W, int *a, int *b)
     return 1;
 }
 
-/* the clamped log-likelihood ratio of the pixel at (x, y); 0 outside */
-static float llr_at(const fuse_colour_model *g, const fuse_image *P, int x, int y)
+/* pt: offsets into the box of the points at shift 0 */
+static double score_at(const int8_t *box, int bw, const uint32_t *pt, long n, int dx, int dy,
+                       float cost)
 {
-    if (x < 0 || y < 0 || x >= P->width || y >= P->height) return 0.0f;
-    const int bits = g->bits, sh = 8 - bits;
-    const uint8_t *px = P->pixels + (size_t)y * (size_t)P->stride + 4u * (size_t)x;
-    const unsigned bin = ((unsigned)(px[0] >> sh) << (2 * bits)) |
-                         ((unsigned)(px[1] >> sh) << bits) | (unsigned)(px[2] >> sh);
-    const float v = g->llr[bin];
-    return v > 3.0f ? 3.0f : v < -3.0f ? -3.0f : v;
-}
-
-static double score_at(const fuse_colour_model *g, const fuse_image *P, const uint32_t *pt,
-                       long n, int dx, int dy, float cost)
-{
-    double s = 0.0;
-    for (long i = 0; i < n; i++)
-        s += llr_at(g, P, (int)(pt[i] & 0xffffu) + dx, (int)(pt[i] >> 16) + dy);
-    return s - (double)cost * sqrt((double)(dx * dx + dy * dy)) * (double)n;
+    const long off = (long)(dy / 2) * bw + dx / 2;   /* dx, dy even */
+    long s = 0;
+    for (long i = 0; i < n; i++) s += box[(long)pt[i] + off];
+    return (double)s / LLR_Q - (double)cost * sqrt((double)(dx * dx + dy * dy)) * (double)n;
 }
 
 const uint8_t *pipe_fit_shift(const pipe_fit_shift_desc *dp, const fuse_colour_model *g,
@@ -72,15 +104,16 @@ const uint8_t *pipe_fit_shift(const pipe_fit_shift_desc *dp, const fuse_colour_m
     if (!g || !g->llr || g->fg_samples <= 0 || g->bg_samples <= 0 || g->bits < 2 ||
         g->bits > 6 || !P || !P->pixels || !cam || !world || !rig || !in || !out ||
         !scratch || cam->width != P->width || cam->height != P->height ||
-        stride < P->width || P->stride < 4 * P->width || d.range < 2 || d.range > 64 ||
+        stride < P->width || P->stride < 4 * P->width || d.range < 2 || d.range > 64 || (d.range & 1) ||
         d.max_points < 16 || !(d.min_gain >= 0.0f) || !(d.cost >= 0.0f) ||
         !(d.hand_radius > 0.0f) ||
         scratch_size < pipe_fit_shift_scratch_size(stride, P->height))
         return in;
     const int W = P->width, H = P->height;
     uint8_t *region = scratch;
-    uint32_t *pt = (uint32_t *)(void *)((uint8_t *)scratch +
-                                        (((size_t)stride * (size_t)H + 15u) & ~(size_t)15u));
+    uint32_t *pt = (uint32_t *)(void *)((uint8_t *)scratch + align16((size_t)stride * (size_t)H));
+    int8_t *box = (int8_t *)((uint8_t *)scratch + align16((size_t)stride * (size_t)H) +
+                             align16(4u * point_cap(stride, H)));
     const long cap = (long)point_cap(stride, H);
     pipe_fit_band_desc bd = pipe_fit_band_desc_default();
     bd.hand_radius = d.hand_radius;
@@ -104,6 +137,7 @@ const uint8_t *pipe_fit_shift(const pipe_fit_shift_desc *dp, const fuse_colour_m
         }
         if (n1 < 16) continue;
         int q = (int)ceil(sqrt((double)n1 / (double)d.max_points));
+        q += q & 1;   /* even: the points on even columns and rows */
         if (q < 2) q = 2;
         long n = 0;
         for (int y = y0; y <= y1 && n < cap && n < d.max_points; y += q) {
@@ -115,12 +149,27 @@ const uint8_t *pipe_fit_shift(const pipe_fit_shift_desc *dp, const fuse_colour_m
                 if (x >= a && m[x] >= 128) pt[n++] = (uint32_t)x | ((uint32_t)y << 16);
         }
         if (n < 4) continue;
-        const double s0 = score_at(g, P, pt, n, 0, 0, d.cost);
+        /* the ratios of the box the points reach at every shift */
+        int px0 = W, px1 = -1, py0 = H, py1 = -1;
+        for (long i = 0; i < n; i++) {
+            const int x = (int)(pt[i] & 0xffffu), y = (int)(pt[i] >> 16);
+            if (x < px0) px0 = x;
+            if (x > px1) px1 = x;
+            if (y < py0) py0 = y;
+            if (y > py1) py1 = y;
+        }
+        const int bx0 = px0 - d.range, by0 = py0 - d.range;
+        const int bw = (px1 - px0 + 2 * d.range) / 2 + 1, bh = (py1 - py0 + 2 * d.range) / 2 + 1;
+        llr_box(g, P, bx0, by0, bw, bh, box);
+        for (long i = 0; i < n; i++)
+            pt[i] = (uint32_t)(((int)(pt[i] >> 16) - by0) / 2 * bw +
+                               ((int)(pt[i] & 0xffffu) - bx0) / 2);
+        const double s0 = score_at(box, bw, pt, n, 0, 0, d.cost);
         int bx = 0, by = 0;
         double best = s0;
         for (int dy = -d.range; dy <= d.range; dy += 8)
             for (int dx = -d.range; dx <= d.range; dx += 8) {
-                const double v = score_at(g, P, pt, n, dx, dy, d.cost);
+                const double v = score_at(box, bw, pt, n, dx, dy, d.cost);
                 if (v > best) { best = v; bx = dx; by = dy; }
             }
         for (int st = 4; st >= 2; st /= 2) {
@@ -130,7 +179,7 @@ const uint8_t *pipe_fit_shift(const pipe_fit_shift_desc *dp, const fuse_colour_m
                     if (dx < -d.range || dx > d.range || dy < -d.range || dy > d.range ||
                         (dx == cx && dy == cy))
                         continue;
-                    const double v = score_at(g, P, pt, n, dx, dy, d.cost);
+                    const double v = score_at(box, bw, pt, n, dx, dy, d.cost);
                     if (v > best) { best = v; bx = dx; by = dy; }
                 }
         }

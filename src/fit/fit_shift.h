@@ -9,8 +9,8 @@
  *   one whose mask points fall on the most hand-coloured pixels:
  *     points  = the pixels of in (>= 128) inside the side's region
  *               (pipe_fit_band_region of that side alone, band = range),
- *               on a grid of step q (q >= 2, chosen so that there are at
- *               most d->max_points of them);
+ *               on a grid of even step q (q >= 2, chosen so that there
+ *               are at most about d->max_points of them);
  *     score(s)= sum over points p of clamp(llr(P(p + s)), -3, 3) (0 where
  *               p + s is outside the image: unknown)
  *               - d->cost * |s| * npoints;
@@ -37,7 +37,7 @@ extern "C" {
 #endif
 
 typedef struct pipe_fit_shift_desc {
-    int range;        /* pixels searched each way, 2..64 (24) */
+    int range;        /* pixels searched each way, even, 2..64 (24) */
     int max_points;   /* points per side at most, >= 16 (1500) */
     float min_gain;   /* nats per point the best shift must gain (0.1) */
     float cost;       /* nats per point and pixel of shift (0.004) */
