@@ -64,9 +64,9 @@ static void llr_box(const fuse_colour_model *g, const fuse_image *P, int x0, int
             const uint8_t *px = row + 4 * ix;
             const unsigned bin = ((unsigned)(px[0] >> sh) << (2 * bits)) |
                                  ((unsigned)(px[1] >> sh) << bits) | (unsigned)(px[2] >> sh);
-            float v = g->llr[bin];
-            v = v > 3.0f ? 3.0f : v < -3.0f ? -3.0f : v;
-            b[x] = (int8_t)lrintf(v * (float)LLR_Q);
+            float v = g->llr[bin] * (float)LLR_Q;
+            v = v > 3.0f * LLR_Q ? 3.0f * LLR_Q : v < -3.0f * LLR_Q ? -3.0f * LLR_Q : v;
+            b[x] = (int8_t)(int)(v + (v >= 0.0f ? 0.5f : -0.5f));   /* to nearest */
         }
     }
 }
