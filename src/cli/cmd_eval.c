@@ -44,7 +44,11 @@ static const char *eval_usage =
     "  --speed S        playback speed of the motion (default 1)\n"
     "  --seed S         seed of the camera and tracking noise (default 1)\n"
     "  --methods LIST   comma-separated subset of kin,kin-cal-pred,skin,refine\n"
-    "                   (default: all four)\n"
+    "                   (default: all four) and refine's variants:\n"
+    "                   refine-nomc (the prior not moved with the hand),\n"
+    "                   refine-noshift (the fast hands not moved to the\n"
+    "                   colour before the band), refine-shiftall (every\n"
+    "                   hand moved)\n"
     "  --band PX        refinement band half width, 1..64 (default 16)\n"
     "  --global W       refine: weight of the image-wide colour model against\n"
     "                   the band's local one, 0..1 (default 0.5)\n"
@@ -167,7 +171,8 @@ int cmd_eval(int argc, char **argv)
             o.methods = eval_parse_methods(optarg);
             if (!o.methods)
                 return cli_usage_error("eval", "--methods '%s': not a list of kin, "
-                                       "kin-cal-pred, skin, refine", optarg);
+                                       "kin-cal-pred, skin, refine, refine-nomc, "
+                                       "refine-noshift, refine-shiftall", optarg);
             break;
         case O_SEQUENCE: {
             int known = 0;

@@ -15,6 +15,7 @@
 #include "../io/io_lod.h"
 #include "../fit/fit_band.h"
 #include "../fit/fit_holes.h"
+#include "../fit/fit_shift.h"
 
 /* The ground truth comes from samples/gt/ and the sample generator
  * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
@@ -75,7 +76,7 @@ void eval__ctx_free(eval_ctx *c)
         free(c->P[e]); free(c->sil[e]); free(c->sil_prev[e]); free(c->tnrm[e]); free(c->V[e]); free(c->ideal[e]);
     }
     free(c->aa_samples);
-    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->mask_prior); free(c->layer); free(c->out);
+    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->mask_prior); free(c->mask_shift); free(c->layer); free(c->out);
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
     free(c->stereo_scratch);
@@ -151,6 +152,7 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->mask_up = malloc(cp);
     c->refined = malloc(cp);
     c->mask_prior = malloc(cp);
+    c->mask_shift = malloc(cp);
     c->layer = malloc(cp * 4);
     c->out = malloc(vp * 4);
     c->depth_lo = malloc(sizeof(float) * cp);
@@ -166,7 +168,7 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->stereo_scratch_size = pipe_fit_stereo_scratch_size(CW, CH);
     c->stereo_scratch = aligned_alloc(16, (c->stereo_scratch_size + 15) & ~(size_t)15);
     ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && 
-         c->mask_prior && c->layer && c->out && c->depth_lo &&
+         c->mask_prior && c->mask_shift && c->layer && c->out && c->depth_lo &&
          c->nrm_lo && c->mnrm && c->refine_scratch && c->stereo_scratch;
     if (!ok) return -1;
     if (estimate_calib(c, track) < 0) {
@@ -576,6 +578,21 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                     if (mask == c->mask_prior && cfg->fit && pipe_fit_learned(r->fit, e))
                         pipe_fit_prior_colour(pipe_fit_colour(r->fit, e), &P, c->mask_prior, CW);
                 }
+                const int from_prior = mask == c->mask_prior;
+                /* the hands of the input moved to where the colour
+                 * says they are (fit_shift.h): the hands without the
+                 * prior, or every tracked hand */
+                if (cfg->shift && posed && cfg->fit && pipe_fit_learned(r->fit, e) &&
+                    c->refine_scratch_size >= pipe_fit_shift_scratch_size(CW, CH)) {
+                    unsigned ss = r->sides;
+                    if (cfg->shift == 1 && from_prior)
+                        for (int k = 0; k < 2; k++)
+                            if (r->speed[k] < cfg->prior_speed) ss &= ~(1u << k);
+                    const pipe_fit_shift_desc sd = pipe_fit_shift_desc_default();
+                    mask = pipe_fit_shift(&sd, pipe_fit_colour(r->fit, e), &P, &cam, c->ps.world,
+                                          &c->rig, ss, mask, c->mask_shift, CW,
+                                          c->refine_scratch, c->refine_scratch_size, NULL);
+                }
                 for (int k = 0; k < 2; k++)
                     r->have_hand_px[e][k] =
                         posed && pipe_fit_hand_px(&cam, c->ps.world, &c->rig, k, r->hand_px[e][k]);
@@ -592,7 +609,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                                            c->refine_scratch_size, &rs);
                 if (fr != FUSE_OK) return -1;
                 /* and so must the pixels the vote let in beyond it */
-                if (mask == c->mask_prior && rs.used_colour && cfg->fit &&
+                if (from_prior && rs.used_colour && cfg->fit &&
                     pipe_fit_learned(r->fit, e))
                     pipe_fit_refined_colour(pipe_fit_colour(r->fit, e), &P, mask, c->refined, CW);
                 /* the stereo pair's depth test (fit_stereo.h): refined

@@ -64,7 +64,8 @@ typedef struct eval_opts {
 } eval_opts;
 
 /* "kin,refine" -> bits of the methods (kin, kin-cal-pred, skin, refine:
- * bits 0..3); 0 when a name is unknown. */
+ * bits 0..3; refine's variants refine-nomc, refine-noshift,
+ * refine-shiftall: bits 4..6); 0 when a name is unknown. */
 unsigned eval_parse_methods(const char *list);
 /* Runs the evaluation o describes, prints its tables, writes o->csv and
  * the report folder o->report when set. EXIT_OK, or EXIT_FAIL with the

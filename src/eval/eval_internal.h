@@ -50,6 +50,9 @@ typedef struct method_cfg {
                                 within this many metres of slow hands (0 off) */
     float prior_speed;       /* m/s: slower hands use it */
     int prior_mc;            /* 1: moved with the hand (pipe_fit_hand_px) */
+    int shift;               /* refine: the hands of the input moved to the
+                                colour (fit_shift.h): 0 off, 1 the hands
+                                without the prior, 2 every tracked hand */
     int fill_hole, fill_island; /* refine: holes / islands of the refined
                                    mask up to this many pixels filled /
                                    cleared (fit_holes.h); 0 off */
@@ -61,11 +64,21 @@ typedef struct method_cfg {
                                            v1 0 = off */
 } method_cfg;
 
+/* refine's variants in --methods (eval_plan.c): refine-nomc (the prior
+ * not moved with the hand), refine-noshift (the hands of the input not
+ * moved to the colour, fit_shift.h), refine-shiftall (every tracked hand
+ * moved, those of the prior too) */
+#define EVAL_VARIANTS 3
+method_cfg eval__variant_cfg(const eval_opts *o, int v);
+
 /* refine's defaults (docs/accuracy.md, issue 14 item 2) */
 #define EVAL_PRIOR_RADIUS 0.03f
 #define EVAL_PRIOR_SPEED 0.3f
 #define EVAL_LAG_V0 0.2f
 #define EVAL_LAG_V1 0.8f
+/* refine: the hands without the prior moved to the colour before the
+ * band (fit_shift.h; 0 off, 2 every hand) */
+#define EVAL_SHIFT 1
 /* refine: the refined mask's holes up to this many pixels filled and its
  * islands up to this many cleared (fit_holes.h; as PIPE_FILL_HOLE,
  * PIPE_FILL_ISLAND) */
@@ -159,6 +172,7 @@ typedef struct eval_ctx {
     /* method scratch */
     uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
     uint8_t *mask_prior;     /* refine: the prior (fit_band.h) */
+    uint8_t *mask_shift;     /* refine: the hands moved (fit_shift.h) */
     uint32_t *aa_samples;    /* anti-aliased coverage, 640x400 */
     float *depth_lo, *nrm_lo, *mnrm;
     void *refine_scratch;

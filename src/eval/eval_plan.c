@@ -38,6 +38,7 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k)
         c.stereo = o->stereo;   /* measured, off by default */
         c.fill_hole = EVAL_FILL_HOLE;
         c.fill_island = EVAL_FILL_ISLAND;
+        c.shift = EVAL_SHIFT;   /* the fast hands moved to the colour (fit_shift.h) */
     }
     c.band_sigma = 0.007f;
     c.band_max = 64;
@@ -52,6 +53,22 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k)
     c.lod_px = o->lod_px;
     snprintf(c.group, sizeof c.group, "methods");
     snprintf(c.setting, sizeof c.setting, "default");
+    return c;
+}
+
+/* refine's variants, selectable in --methods (bits 4.. of
+ * eval_opts.methods): refine with one knob changed (docs/accuracy.md) */
+static const char *variant_name[EVAL_VARIANTS] = { "refine-nomc", "refine-noshift",
+                                                   "refine-shiftall" };
+
+method_cfg eval__variant_cfg(const eval_opts *o, int v)
+{
+    method_cfg c = eval__base_cfg(o, M_REFINE);
+    switch (v) {
+    case 0: c.prior_mc = 0; snprintf(c.setting, sizeof c.setting, "priormc=0"); break;
+    case 1: c.shift = 0; snprintf(c.setting, sizeof c.setting, "shift=0"); break;
+    default: c.shift = 2; snprintf(c.setting, sizeof c.setting, "shift=2"); break;
+    }
     return c;
 }
 
@@ -107,6 +124,13 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
             } else if (phase == PH_KNOBS) {
                 snprintf(c.group, sizeof c.group, "knobs");
             }
+            n = add_cfg(L, n, cap, c);
+        }
+    if (phase == PH_METHODS || phase == PH_SEQ)   /* refine's variants (eval_parse_methods) */
+        for (int v = 0; v < EVAL_VARIANTS; v++) {
+            if (!(o->methods & (1u << (4 + v)))) continue;
+            c = eval__variant_cfg(o, v);
+            if (phase == PH_SEQ) snprintf(c.group, sizeof c.group, "sequence");
             n = add_cfg(L, n, cap, c);
         }
     if (phase == PH_KNOBS) {
@@ -338,6 +362,11 @@ unsigned eval_parse_methods(const char *list)
         for (int k = 0; k < 4; k++)
             if (strlen(kind_name[k]) == n && !strncmp(p, kind_name[k], n)) {
                 bits |= 1u << k;
+                found = 1;
+            }
+        for (int v = 0; v < EVAL_VARIANTS; v++)
+            if (strlen(variant_name[v]) == n && !strncmp(p, variant_name[v], n)) {
+                bits |= 1u << (4 + v);
                 found = 1;
             }
         if (!found) return 0;
