@@ -83,7 +83,34 @@ static void window_hrow(const float *restrict n, const uint8_t *restrict k, floa
             s2 = s2 + n[3 * x + 2];
             cnt++;
         }
+    /* b[0], then the columns whose window enters and leaves the row
+     * (xa .. xb - 1: no bound checks), then the rest */
+    int xa = r + 1 > b[0] + 1 ? r + 1 : b[0] + 1, xb = w - r < b[2] ? w - r : b[2];
+    if (xb < xa) xb = xa;
     for (int x = b[0]; x < b[2]; x++) {
+        if (x == xa) {
+            for (; x < xb; x++) {
+                const int xi = x + r, xo = x - r - 1;
+                if (k[xi]) {
+                    s0 = s0 + n[3 * xi];
+                    s1 = s1 + n[3 * xi + 1];
+                    s2 = s2 + n[3 * xi + 2];
+                    cnt++;
+                }
+                if (k[xo]) {
+                    s0 = s0 - n[3 * xo];
+                    s1 = s1 - n[3 * xo + 1];
+                    s2 = s2 - n[3 * xo + 2];
+                    cnt--;
+                }
+                if (cnt == 0) s0 = s1 = s2 = 0.0f;
+                o[3 * x] = s0;
+                o[3 * x + 1] = s1;
+                o[3 * x + 2] = s2;
+                c[x] = (uint8_t)cnt;
+            }
+            if (x >= b[2]) break;
+        }
         if (x > b[0]) {
             const int xi = x + r, xo = x - r - 1;
             if (xi < w && k[xi]) {
