@@ -20,8 +20,9 @@ static float far_depth(void)
     return f;
 }
 
-/* 8 mask bytes at once: the passes skip the zero runs of a row (a
- * refined mask covers a fifth of the image; same visits otherwise) */
+/* 8 mask bytes at once: from a zero mask byte the passes skip the zero
+ * run that follows (a refined mask covers a fifth of the image; the same
+ * visits otherwise) */
 static uint64_t ld8(const uint8_t *p)
 {
     uint64_t v;
@@ -54,9 +55,11 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
         for (x = 0; x < width; x++) {
             int r, best = -1;
             long bd2 = 0;
-            while (x + 8 <= width && ld8(m + x) == 0) x += 8;
-            if (x >= width) break;
-            if (m[x] == 0 || known(z[x])) continue;
+            if (m[x] == 0) {
+                while (x + 9 <= width && ld8(m + x + 1) == 0) x += 8;
+                continue;
+            }
+            if (known(z[x])) continue;
             /* rings of growing Chebyshev radius; a pixel of ring r is at
              * least r away, so stop once the best is nearer than r + 1 */
             for (r = 1; r <= R; r++) {
@@ -96,9 +99,11 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
         float *z = depth + (size_t)y * (size_t)depth_stride;
         for (x = x0; x < x1; x++) {
             int code, dx, dy;
-            while (x + 8 <= x1 && ld8(m + x) == 0) x += 8;
-            if (x >= x1) break;
-            if (m[x] == 0 || known(z[x])) continue;
+            if (m[x] == 0) {
+                while (x + 9 <= x1 && ld8(m + x + 1) == 0) x += 8;
+                continue;
+            }
+            if (known(z[x])) continue;
             code = (int)(z[x] - 2.0f);
             if (code >= side * side) {
                 z[x] = far_depth();
