@@ -35,8 +35,11 @@
  *   scalar code: the same bytes on every ISA and thread count. The
  *   window's model pixels are counted in integers, so an empty window is
  *   known exactly (not from a sum that rounds to a tiny non-zero).
- *   Cost: 4 additions per component and pixel of the box (running sums),
- *   and 2-3 pairs of the fill's passes over the box (no allocation).
+ *   Cost: 4 additions per component and pixel of the box (running sums;
+ *   the horizontal ones in a ring of 2 r + 2 rows, the vertical ones 4
+ *   floats at a time, the same additions in the same order), and 2-3
+ *   pairs of the fill's passes over each row's span of candidates (no
+ *   allocation). docs/accuracy.md, "Refine's cost inside the pipeline".
  */
 #ifndef EGOFUSE_PIPE_NFILL_H
 #define EGOFUSE_PIPE_NFILL_H
