@@ -164,6 +164,8 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
     if (pipe_fit_fill_scratch_size(CW, CH) > c->refine_scratch_size)   /* shared (as pipe_frame) */
         c->refine_scratch_size = pipe_fit_fill_scratch_size(CW, CH);
+    if (pipe_fit_shift_scratch_size(CW, CH) > c->refine_scratch_size)
+        c->refine_scratch_size = pipe_fit_shift_scratch_size(CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
     c->stereo_scratch_size = pipe_fit_stereo_scratch_size(CW, CH);
     c->stereo_scratch = aligned_alloc(16, (c->stereo_scratch_size + 15) & ~(size_t)15);
@@ -582,8 +584,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 /* the hands of the input moved to where the colour
                  * says they are (fit_shift.h): the hands without the
                  * prior, or every tracked hand */
-                if (cfg->shift && posed && cfg->fit && pipe_fit_learned(r->fit, e) &&
-                    c->refine_scratch_size >= pipe_fit_shift_scratch_size(CW, CH)) {
+                if (cfg->shift && posed && cfg->fit && pipe_fit_learned(r->fit, e)) {
                     unsigned ss = r->sides;
                     if (cfg->shift == 1 && from_prior)
                         for (int k = 0; k < 2; k++)

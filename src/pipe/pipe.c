@@ -11,6 +11,7 @@
 #include "pipe_reproj.h"
 #include "../fit/fit_band.h"
 #include "../fit/fit_holes.h"
+#include "../fit/fit_shift.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -298,8 +299,8 @@ static void run_eye(pipe_ctx *p, eye_state *e)
          * with the hand (pipe_fit_prior; e->refined still holds it until
          * the refinement below) */
         const uint8_t *rin = e->mask;
+        const unsigned sides = 3u & ~in->fit_skip;
         if (e->prior) {
-            const unsigned sides = 3u & ~in->fit_skip;
             if (in->locals && e->have_refined && !p->fit_no_prev) {
                 pipe_fit_band_desc bd = pipe_fit_band_desc_default();
                 bd.hand_radius = PIPE_PRIOR_RADIUS;
@@ -323,6 +324,24 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                 if (rin == e->prior && p->fit && pipe_fit_learned(p->fit, e->eye))
                     pipe_fit_prior_colour(pipe_fit_colour(p->fit, e->eye), &fe.P, e->prior, cw);
             }
+        }
+        const int from_prior = rin == e->prior;
+        /* the hands that did not take the prior moved to where the colour
+         * says they are (fit_shift.h: the tracking's error beyond the
+         * band, docs/accuracy.md); eval's refine does the same */
+        if (e->shifted && in->locals && p->fit && pipe_fit_learned(p->fit, e->eye)) {
+            unsigned ss = sides;
+            if (from_prior)
+                for (int k = 0; k < 2; k++)
+                    if (!in->hand_speed || in->hand_speed[k] < PIPE_PRIOR_SPEED) ss &= ~(1u << k);
+            if (ss) {
+                const pipe_fit_shift_desc sd = pipe_fit_shift_desc_default();
+                rin = pipe_fit_shift(&sd, pipe_fit_colour(p->fit, e->eye), &fe.P, &e->cam,
+                                     p->pose.world, &p->fit_rig, ss, rin, e->shifted, cw,
+                                     e->refine_scratch, e->refine_scratch_size, NULL);
+            }
+        }
+        if (e->prior) {
             /* where the hands are in this frame's refined mask */
             for (int k = 0; k < 2; k++)
                 e->have_hand_px[k] =
@@ -344,7 +363,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         }
         /* the pixels the vote let in beyond a prior must look like the
          * hand too (fit_band.h) */
-        if (rin == e->prior && rs.used_colour && p->fit && pipe_fit_learned(p->fit, e->eye))
+        if (from_prior && rs.used_colour && p->fit && pipe_fit_learned(p->fit, e->eye))
             pipe_fit_refined_colour(pipe_fit_colour(p->fit, e->eye), &fe.P, rin, e->refined, cw);
         /* its small islands cleared (and holes filled, PIPE_FILL_HOLE:
          * fit_holes.h); the refinement's scratch is free again */
@@ -538,6 +557,7 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].cam_rgba);
         free(p->eye[e].refined);
         free(p->eye[e].prior);
+        free(p->eye[e].shifted);
         free(p->eye[e].refine_scratch);
         pipe__aa_free(&p->eye[e].aa);
         pipe__reproj_free(&p->eye[e].rp);
@@ -601,7 +621,8 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
     if (desc && (desc->edge_fade < -1 || desc->edge_fade > FUSE_EDGE_FADE_MAX)) return NULL;
     if (desc && (desc->refine_prior < -1 || desc->refine_prior > 0 ||
                  desc->refine_lag_adapt < -1 || desc->refine_lag_adapt > 0 ||
-                 desc->refine_fill < -1 || desc->refine_fill > 0))
+                 desc->refine_fill < -1 || desc->refine_fill > 0 ||
+                 desc->refine_shift < -1 || desc->refine_shift > 0))
         return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
@@ -666,11 +687,15 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         if (ok && p->desc.refine_band > 0) {
             fuse_refine_params rp = fuse_refine_params_default();
             rp.band = p->desc.refine_band;
-            /* shared with pipe_fit_fill_small, sized for its worst case:
-             * it leaves a mask with more runs than fit unchanged */
-            const size_t rs = fuse_refine_scratch_size(&rp, p->geo.crop_width, p->geo.crop_height),
-                         fs = pipe_fit_fill_scratch_size(p->geo.crop_width, p->geo.crop_height);
+            /* shared with pipe_fit_fill_small and pipe_fit_shift, sized
+             * for the largest: each leaves its input unchanged when its
+             * scratch is short */
+            const int cw = p->geo.crop_width, ch = p->geo.crop_height;
+            const size_t rs = fuse_refine_scratch_size(&rp, cw, ch),
+                         fs = pipe_fit_fill_scratch_size(cw, ch),
+                         ss = pipe_fit_shift_scratch_size(cw, ch);
             s->refine_scratch_size = rs && fs > rs ? fs : rs;
+            if (rs && ss > s->refine_scratch_size) s->refine_scratch_size = ss;
             s->refined = malloc(px);
             s->refine_scratch = s->refine_scratch_size
                                     ? aligned_alloc(16, (s->refine_scratch_size + 15) & ~(size_t)15)
@@ -679,6 +704,10 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
             if (ok && p->desc.refine_prior == 0 && p->desc.fit_rig) {
                 s->prior = malloc(px);
                 ok = s->prior != NULL;
+            }
+            if (ok && p->desc.refine_shift == 0 && p->desc.fit_rig) {
+                s->shifted = malloc(px);
+                ok = s->shifted != NULL;
             }
         }
         /* coverage samples are drawn through the pinhole: not with a

@@ -177,6 +177,24 @@ typedef struct pipe_desc {
                                  learns from it. -1: off (the bytes of
                                  before). Other values: pipe_create
                                  returns NULL. */
+    int refine_shift;         /* with refine_band and a fit (fit_rig): 0 =
+                                 the default, on: on tracked frames
+                                 (pipe_frame_in.locals), once the fit has
+                                 learned the hand's colour, each hand of
+                                 the refinement's input that did not take
+                                 the prior (refine_prior; a hand at least
+                                 PIPE_PRIOR_SPEED fast, or every hand on
+                                 frames without the prior) is moved by
+                                 the whole-pixel 2D shift, at most 24 px,
+                                 that puts its mask on the most
+                                 hand-coloured pixels (pipe_fit_shift,
+                                 src/fit/fit_shift.h, docs/accuracy.md):
+                                 the tracking's error beyond the band. A
+                                 moved pixel the depth fill does not reach
+                                 gets the far plane's depth, so a virtual
+                                 object still hides it. -1: off (the
+                                 bytes of before). Other values:
+                                 pipe_create returns NULL. */
 } pipe_desc;
 
 /* The defaults of the refine method (`egofuse eval`'s, docs/accuracy.md). */

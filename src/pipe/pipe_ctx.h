@@ -29,6 +29,7 @@ typedef struct eye_state {
     size_t refine_scratch_size;
     int have_refined;         /* refined holds the last frame's mask */
     uint8_t *prior;           /* refine_prior: this frame's input mask */
+    uint8_t *shifted;         /* refine_shift: the input's hands moved */
     float hand_px[2][2];      /* refine_prior: each hand's image position */
     int have_hand_px[2];      /* last frame (pipe_fit_hand_px) */
     pipe__aa aa;              /* anti-aliased coverage (aa_samples) */
