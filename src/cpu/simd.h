@@ -281,6 +281,12 @@
  *   vf_gather(p, idx)        float lane l = p[idx_l] (float *p), the bits
  *                            as stored; reads exactly those SIMD_W floats
  *                            (AVX2/AVX-512 vgatherdps, SSE2/NEON lane by lane)
+ *   vf_gather_m(p, idx, m)   float lane l = p[idx_l] where lane l of the
+ *                            vmask m is set, +0.0f elsewhere; reads only
+ *                            the lanes in m (the others' idx_l may point
+ *                            anywhere; AVX2/AVX-512 masked vgatherdps,
+ *                            SSE2/NEON lane by lane; the refinement's
+ *                            score look-ups, fuse_refine_simd.inl)
  *   vi_gather_u8x4(p, idx)   int32 lane l = the 4 bytes p[idx_l .. idx_l+3]
  *                            as a little-endian int32 (uint8_t *p, any
  *                            offset): all 4 bytes must be readable; the

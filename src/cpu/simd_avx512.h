@@ -326,6 +326,10 @@ SIMD_INL vint vi_load_u16(const uint16_t *p)
 /* ---- reprojection ops (src/pipe's taps, pipe_reproj_simd.inl; simd.h
  * "REPROJ OPS") */
 SIMD_INL vfloat vf_gather(const float *p, vint idx) { return _mm512_i32gather_ps(idx, (const void *)p, 4); }
+SIMD_INL vfloat vf_gather_m(const float *p, vint idx, vmask m)
+{
+    return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, idx, (const void *)p, 4);
+}
 SIMD_INL vint vi_gather_u8x4(const uint8_t *p, vint idx)
 {
     return _mm512_i32gather_epi32(idx, (const void *)p, 1);

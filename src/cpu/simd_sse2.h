@@ -323,6 +323,16 @@ SIMD_INL vfloat vf_gather(const float *p, vint idx)
     _mm_store_si128((__m128i *)(void *)x, idx);
     return _mm_setr_ps(p[x[0]], p[x[1]], p[x[2]], p[x[3]]);
 }
+/* lane by lane, only the lanes in m read */
+SIMD_INL vfloat vf_gather_m(const float *p, vint idx, vmask m)
+{
+    _Alignas(16) int32_t x[4];
+    _Alignas(16) float r[4];
+    const unsigned bits = (unsigned)_mm_movemask_ps(m);
+    _mm_store_si128((__m128i *)(void *)x, idx);
+    for (int l = 0; l < 4; l++) r[l] = (bits >> l) & 1u ? p[x[l]] : 0.0f;
+    return _mm_load_ps(r);
+}
 SIMD_INL vint vi_gather_u8x4(const uint8_t *p, vint idx)
 {
     _Alignas(16) int32_t x[4], r[4];
