@@ -181,6 +181,12 @@
  *                          (lanes 4J .. 4J+3): lane 4J+i of o[k] is lane
  *                          4J+k of the i-th input (o is vfloat[4]). On
  *                          SSE2 and NEON the whole transpose.
+ *   vf_tr_blocks(in, out)  the transpose of SIMD_W / 4 vectors as a matrix
+ *                          of 128-bit blocks: block J of out[k] is block k
+ *                          of in[J] (in, out: vfloat[SIMD_W / 4]; SSE2 and
+ *                          NEON a copy, AVX2 vperm2f128, AVX-512
+ *                          vshuff32x4); with vf_tr4, SIMD_W vertices of 4
+ *                          floats each to 4 vectors (kin_skin_rows.inl)
  *
  * RASTER OPS (added for src/raster's scan; a separate block at the end of
  * each implementation)

@@ -111,6 +111,18 @@ SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
     o[2] = _mm512_castpd_ps(_mm512_unpacklo_pd(t2, t3));
     o[3] = _mm512_castpd_ps(_mm512_unpackhi_pd(t2, t3));
 }
+/* 4 x 4 blocks: two rounds of vshuff32x4 */
+SIMD_INL void vf_tr_blocks(const vfloat in[4], vfloat out[4])
+{
+    const __m512 abl = _mm512_shuffle_f32x4(in[0], in[1], 0x44);
+    const __m512 cdl = _mm512_shuffle_f32x4(in[2], in[3], 0x44);
+    const __m512 abh = _mm512_shuffle_f32x4(in[0], in[1], 0xEE);
+    const __m512 cdh = _mm512_shuffle_f32x4(in[2], in[3], 0xEE);
+    out[0] = _mm512_shuffle_f32x4(abl, cdl, 0x88);
+    out[1] = _mm512_shuffle_f32x4(abl, cdl, 0xDD);
+    out[2] = _mm512_shuffle_f32x4(abh, cdh, 0x88);
+    out[3] = _mm512_shuffle_f32x4(abh, cdh, 0xDD);
+}
 
 /* an in-block transpose gives each lane's x y z (and a spare) in one
  * 128-bit block, stored with a 3-float mask */

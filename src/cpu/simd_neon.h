@@ -258,6 +258,8 @@ SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
     o[2] = vreinterpretq_f32_f64(vtrn2q_f64(vreinterpretq_f64_f32(ab0), vreinterpretq_f64_f32(cd0)));
     o[3] = vreinterpretq_f32_f64(vtrn2q_f64(vreinterpretq_f64_f32(ab1), vreinterpretq_f64_f32(cd1)));
 }
+/* one block: a copy */
+SIMD_INL void vf_tr_blocks(const vfloat in[1], vfloat out[1]) { out[0] = in[0]; }
 
 
 /* ---- raster ops (src/raster's scan; simd.h "RASTER OPS") */

@@ -212,6 +212,8 @@ SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
     _MM_TRANSPOSE4_PS(a, b, c, d);
     o[0] = a; o[1] = b; o[2] = c; o[3] = d;
 }
+/* one block: a copy */
+SIMD_INL void vf_tr_blocks(const vfloat in[1], vfloat out[1]) { out[0] = in[0]; }
 
 
 /* ---- raster ops (src/raster's scan; simd.h "RASTER OPS") */
