@@ -17,15 +17,18 @@
  * reference's order, gives the reference's bytes on every ISA.
  *
  * WHAT IT DOES NOT. No dispatch (src/cpu/cpu.h picks the ISA; each room
- * keeps one dispatch table), no FMA, no estimates (rcp/rsqrt), no fast-math,
- * no float gathers (vi_gather: int32, the row cache's fallback); of byte
+ * keeps one dispatch table), no FMA, no estimates (rcp/rsqrt), no fast-math;
+ * gathers (vi_gather, vf_gather, vf_gather_m) are one instruction on AVX2
+ * and AVX-512 only, lane by lane on SSE2 and NEON; of byte
  * and 16-bit lanes only what the fuse's composites and the refinement
  * need (vh_*, per 128-bit block; vb_*, REFINE OPS);
  * bytes widen to int32 lanes with vi_load_u8, RGBA8 pixels are int32
  * lanes through vi_loadu. What one
- * ISA does in a way the others cannot (AVX-512 joint tables, AVX2's
- * 128-bit lane permutes) stays in that ISA's kernel file, on the layer's
- * types.
+ * ISA does in a way the others cannot (AVX-512's joint tables and masked
+ * row ends in the skinning and refinement kernels) stays in that ISA's
+ * kernel file, on the layer's types; what two ISAs would write alike is
+ * an operation here (vf_tr_blocks: AVX2's and AVX-512's block transposes;
+ * vf_gather_m: their masked look-ups).
  *
  * USAGE (a kernel file, e.g. src/kin/kin_skin_avx2.c):
  *
