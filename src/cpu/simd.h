@@ -27,8 +27,8 @@
  * ISA does in a way the others cannot (AVX-512's joint tables and masked
  * row ends in the skinning and refinement kernels) stays in that ISA's
  * kernel file, on the layer's types; what two ISAs would write alike is
- * an operation here (vf_tr_blocks: AVX2's and AVX-512's block transposes;
- * vf_gather_m: their masked look-ups).
+ * an operation here (vf_gather_m: their masked look-ups; vf_tr_blocks:
+ * their 128-bit block transposes).
  *
  * USAGE (a kernel file, e.g. src/kin/kin_skin_avx2.c):
  *
@@ -189,7 +189,7 @@
  *                          of in[J] (in, out: vfloat[SIMD_W / 4]; SSE2 and
  *                          NEON a copy, AVX2 vperm2f128, AVX-512
  *                          vshuff32x4); with vf_tr4, SIMD_W vertices of 4
- *                          floats each to 4 vectors (kin_skin_rows.inl)
+ *                          floats each to 4 vectors
  *
  * RASTER OPS (added for src/raster's scan; a separate block at the end of
  * each implementation)

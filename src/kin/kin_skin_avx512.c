@@ -1,11 +1,9 @@
 /* kin_skin_avx512.c - skinning kernels, AVX-512 (16 vertices per vector):
  * the vector layer's AVX-512 implementation, the blend below (AVX-512's
- * own: masks, vpermt2ps joint tables) and the one body, kin_skin_simd.inl.
- * Blocks reading joints past the table take the per-vertex rows: LBS the
- * layer's (kin_skin_rows.inl, a joint matrix one zmm), DQS a dual
- * quaternion in one ymm (kin_skin_x86.inl) in AVX-512's slot order.
- * Bytes equal the reference (kin_skin.c, kin_dqs.c). Built with
- * -mavx512f/bw/dq/vl. */
+ * own: masks, vpermt2ps joint tables) and the one body, kin_skin_simd.inl. A vertex's joint matrix is one zmm (LBS), its
+ * dual quaternion one ymm (DQS); 16 blended vertices are transposed with
+ * in-lane 4x4 transposes and 128-bit block shuffles. Bytes equal the
+ * reference (kin_skin.c, kin_dqs.c). Built with -mavx512f/bw/dq/vl. */
 #include "kin_skin_internal.h"
 
 #if defined(__x86_64__)
@@ -14,9 +12,43 @@
 
 #include "../cpu/simd_avx512.h"
 #include "kin_skin_x86.inl"
-#include "kin_skin_rows.inl"
 
 #define KIN_SKIN_OWN_BLOCK
+static inline void lbs_rows(const kin_mesh *mesh, const kin_mat4 *jm, int v,
+                             __m512 a[12], __m512 *wsum)
+{
+    _Alignas(64) float ws[16];
+    __m512 r[16];
+    const uint16_t *j = mesh->joints + (size_t)v * 4;
+    const float *w = mesh->weights + (size_t)v * 4;
+    for (int l = 0; l < 16; l++, j += 4, w += 4) {
+        __m512 acc = _mm512_setzero_ps();
+        float s = 0.0f;
+        for (unsigned bits = kin__nonzero4(w); bits; bits &= bits - 1) {
+            int i = __builtin_ctz(bits);
+            acc = _mm512_add_ps(acc, _mm512_mul_ps(_mm512_set1_ps(w[i]),
+                                                   _mm512_loadu_ps(jm[j[i]].m)));
+            s += w[i];
+        }
+        r[l] = acc;
+        ws[l] = s;
+    }
+    *wsum = _mm512_load_ps(ws);
+    /* s[I][rho], block J: column J, row rho of vertices 4I..4I+3 */
+    __m512 s[4][4];
+    for (int I = 0; I < 4; I++) vf_tr4(r[4 * I], r[4 * I + 1], r[4 * I + 2], r[4 * I + 3], s[I]);
+    for (int rho = 0; rho < 3; rho++) {
+        __m512 abl = _mm512_shuffle_f32x4(s[0][rho], s[1][rho], 0x44);
+        __m512 cdl = _mm512_shuffle_f32x4(s[2][rho], s[3][rho], 0x44);
+        __m512 abh = _mm512_shuffle_f32x4(s[0][rho], s[1][rho], 0xEE);
+        __m512 cdh = _mm512_shuffle_f32x4(s[2][rho], s[3][rho], 0xEE);
+        a[0 * 3 + rho] = _mm512_shuffle_f32x4(abl, cdl, 0x88);
+        a[1 * 3 + rho] = _mm512_shuffle_f32x4(abl, cdl, 0xDD);
+        a[2 * 3 + rho] = _mm512_shuffle_f32x4(abh, cdh, 0x88);
+        a[3 * 3 + rho] = _mm512_shuffle_f32x4(abh, cdh, 0xDD);
+    }
+}
+
 static inline void dqs_rows(const kin_mesh *mesh, const kin_dualquat *dq, int v,
                              __m512 b[8], __m512 *wsum)
 {

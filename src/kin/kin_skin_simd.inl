@@ -36,17 +36,40 @@
 typedef struct skin_tab { int unused; } skin_tab;
 SIMD_INL void tab_init(skin_tab *t) { t->unused = 0; }
 
-#include "kin_skin_rows.inl"
-
 /* Bit i set when weight i is not 0 (NaN counts as not 0: the reference's
  * "w == 0: skip"). */
-SIMD_INL unsigned nonzero4(const float *w) { return kin_rows_nonzero4(w); }
+SIMD_INL unsigned nonzero4(const float *w)
+{
+    return vm_bits(vf_ne(vf_loadu(w), vf_zero()));
+}
 
 static inline void lbs_block(skin_tab *tab, const kin_mesh *mesh, const kin_mat4 *jm, int v,
                              vfloat a[12], vfloat *wsum)
 {
+    _Alignas(16) float ws[4];
+    vfloat r[4][4];   /* [vertex][column] */
     (void)tab;
-    lbs_rows(mesh, jm, v, a, wsum);
+    const uint16_t *j = mesh->joints + (size_t)v * 4;
+    const float *w = mesh->weights + (size_t)v * 4;
+    for (int l = 0; l < 4; l++, j += 4, w += 4) {
+        vfloat c[4] = { vf_zero(), vf_zero(), vf_zero(), vf_zero() };
+        float s = 0.0f;
+        for (unsigned bits = nonzero4(w); bits; bits &= bits - 1) {
+            int i = __builtin_ctz(bits);
+            const vfloat wv = vf_set1(w[i]);
+            const float *m = jm[j[i]].m;
+            for (int k = 0; k < 4; k++) c[k] = vf_add(c[k], vf_mul(wv, vf_loadu(m + 4 * k)));
+            s += w[i];
+        }
+        for (int k = 0; k < 4; k++) r[l][k] = c[k];
+        ws[l] = s;
+    }
+    *wsum = vf_load(ws);
+    for (int k = 0; k < 4; k++) {
+        vfloat t[4];
+        vf_tr4(r[0][k], r[1][k], r[2][k], r[3][k], t);
+        a[k * 3] = t[0]; a[k * 3 + 1] = t[1]; a[k * 3 + 2] = t[2];
+    }
 }
 
 static inline void dqs_block(skin_tab *tab, const kin_mesh *mesh, const kin_dualquat *dq, int v,
