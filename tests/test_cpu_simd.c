@@ -234,6 +234,10 @@ static uint32_t model(int op, const uint32_t *A, const uint32_t *B, int i, int W
         const int J = lane / 4, q = lane % 4;
         return A[g + q * W + 4 * J + kk];
     }
+    case SC_TRB: {   /* group of (W/4) W: block J of o[kk] = block kk of input J */
+        const int g = i - i % (W / 4 * W), j = i - g, kk = j / W, lane = j % W;
+        return A[g + (lane / 4) * W + 4 * kk + lane % 4];
+    }
     default: return 0xDEADBEEFu;
     }
 }
@@ -248,7 +252,7 @@ static const char *const op_names[SC_COUNT] = {
     "from_bits", "lanes", "load", "load_bits", "store_bits",
     "load3", "store3", "scatter3", "tr4", "load_u8", "store2",
     "h_add", "h_sub", "h_mullo", "h_srli5", "h_set1", "h_from_u8_lo", "h_from_u8_hi", "h_packus",
-    "h_bcast3", "zip_lo", "zip_hi",
+    "h_bcast3", "zip_lo", "zip_hi", "tr_blocks",
 };
 
 /* Both NaN inputs: any NaN. */

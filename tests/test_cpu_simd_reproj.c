@@ -1,5 +1,6 @@
 /* test_cpu_simd_reproj.c - the reprojection ops of the vector layer
- * (src/cpu/simd.h, "REPROJ OPS": vf_gather, vi_gather_u8x4, vi_store_u8)
+ * (src/cpu/simd.h, "REPROJ OPS": vf_gather, vf_gather_m, vi_gather_u8x4,
+ * vi_store_u8)
  * of every implementation this machine runs (sse2, avx2, avx512 on x86-64;
  * neon on aarch64) against a scalar model of the contract, lane by lane.
  * Seeded inputs with special floats (NaN payloads, -0, infinities,
@@ -24,7 +25,8 @@ static uint32_t rnd(uint64_t *s)
     return (uint32_t)(*s >> 16);
 }
 
-static const char *const names[PC_COUNT] = {"vf_gather", "vi_gather_u8x4", "vi_store_u8"};
+static const char *const names[PC_COUNT] = {"vf_gather", "vi_gather_u8x4", "vi_store_u8",
+                                             "vf_gather_m"};
 
 static void check_isa(ef_isa isa, tu_simd_pcheck_fn *fn)
 {
@@ -50,6 +52,12 @@ static void check_isa(ef_isa isa, tu_simd_pcheck_fn *fn)
                 idx[i] = op == PC_FGATHER ? (int32_t)(rnd(&s) % N)
                                           : (int32_t)(rnd(&s) % (4 * N - 3));
                 if (op == PC_U8X4 && round == 0 && i < 16) idx[i] = 4 * N - 4 - i; /* the end */
+                /* vf_gather_m: about a third of the lanes off, their index
+                 * far outside a (reading one would fault) */
+                if (op == PC_FGATHER_M) {
+                    idx[i] = (int32_t)(rnd(&s) % N);
+                    if (rnd(&s) % 3 == 0) idx[i] = -0x10000000 - (int32_t)(rnd(&s) & 0xFFFF);
+                }
                 out[i] = 0xA5A5A5A5u;
             }
             const int W = fn(op, a, idx, N, out);
@@ -59,6 +67,8 @@ static void check_isa(ef_isa isa, tu_simd_pcheck_fn *fn)
                 uint32_t want, got;
                 if (op == PC_FGATHER) {
                     want = a[idx[i]], got = out[i];
+                } else if (op == PC_FGATHER_M) {
+                    want = idx[i] >= 0 ? a[idx[i]] : 0u, got = out[i];
                 } else if (op == PC_U8X4) {
                     want = (uint32_t)ab[idx[i]] | (uint32_t)ab[idx[i] + 1] << 8 |
                            (uint32_t)ab[idx[i] + 2] << 16 | (uint32_t)ab[idx[i] + 3] << 24;

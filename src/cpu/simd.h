@@ -17,15 +17,18 @@
  * reference's order, gives the reference's bytes on every ISA.
  *
  * WHAT IT DOES NOT. No dispatch (src/cpu/cpu.h picks the ISA; each room
- * keeps one dispatch table), no FMA, no estimates (rcp/rsqrt), no fast-math,
- * no float gathers (vi_gather: int32, the row cache's fallback); of byte
+ * keeps one dispatch table), no FMA, no estimates (rcp/rsqrt), no fast-math;
+ * gathers (vi_gather, vf_gather, vf_gather_m) are one instruction on AVX2
+ * and AVX-512 only, lane by lane on SSE2 and NEON; of byte
  * and 16-bit lanes only what the fuse's composites and the refinement
  * need (vh_*, per 128-bit block; vb_*, REFINE OPS);
  * bytes widen to int32 lanes with vi_load_u8, RGBA8 pixels are int32
  * lanes through vi_loadu. What one
- * ISA does in a way the others cannot (AVX-512 joint tables, AVX2's
- * 128-bit lane permutes) stays in that ISA's kernel file, on the layer's
- * types.
+ * ISA does in a way the others cannot (AVX-512's joint tables and masked
+ * row ends in the skinning and refinement kernels) stays in that ISA's
+ * kernel file, on the layer's types; what two ISAs would write alike is
+ * an operation here (vf_gather_m: their masked look-ups; vf_tr_blocks:
+ * their 128-bit block transposes).
  *
  * USAGE (a kernel file, e.g. src/kin/kin_skin_avx2.c):
  *
@@ -181,6 +184,12 @@
  *                          (lanes 4J .. 4J+3): lane 4J+i of o[k] is lane
  *                          4J+k of the i-th input (o is vfloat[4]). On
  *                          SSE2 and NEON the whole transpose.
+ *   vf_tr_blocks(in, out)  the transpose of SIMD_W / 4 vectors as a matrix
+ *                          of 128-bit blocks: block J of out[k] is block k
+ *                          of in[J] (in, out: vfloat[SIMD_W / 4]; SSE2 and
+ *                          NEON a copy, AVX2 vperm2f128, AVX-512
+ *                          vshuff32x4); with vf_tr4, SIMD_W vertices of 4
+ *                          floats each to 4 vectors
  *
  * RASTER OPS (added for src/raster's scan; a separate block at the end of
  * each implementation)
@@ -281,6 +290,12 @@
  *   vf_gather(p, idx)        float lane l = p[idx_l] (float *p), the bits
  *                            as stored; reads exactly those SIMD_W floats
  *                            (AVX2/AVX-512 vgatherdps, SSE2/NEON lane by lane)
+ *   vf_gather_m(p, idx, m)   float lane l = p[idx_l] where lane l of the
+ *                            vmask m is set, +0.0f elsewhere; reads only
+ *                            the lanes in m (the others' idx_l may point
+ *                            anywhere; AVX2/AVX-512 masked vgatherdps,
+ *                            SSE2/NEON lane by lane; the refinement's
+ *                            score look-ups, fuse_refine_simd.inl)
  *   vi_gather_u8x4(p, idx)   int32 lane l = the 4 bytes p[idx_l .. idx_l+3]
  *                            as a little-endian int32 (uint8_t *p, any
  *                            offset): all 4 bytes must be readable; the

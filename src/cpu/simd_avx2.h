@@ -127,6 +127,13 @@ SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
     o[2] = _mm256_castpd_ps(_mm256_unpacklo_pd(t2, t3));
     o[3] = _mm256_castpd_ps(_mm256_unpackhi_pd(t2, t3));
 }
+/* 2 x 2 blocks: vperm2f128 */
+SIMD_INL void vf_tr_blocks(const vfloat in[2], vfloat out[2])
+{
+    const __m256 a = in[0], b = in[1];
+    out[0] = _mm256_permute2f128_ps(a, b, 0x20);
+    out[1] = _mm256_permute2f128_ps(a, b, 0x31);
+}
 
 /* one lane's x y z (lanes 0-2 of a) to q: 8 bytes and 4 bytes */
 SIMD_INL void simd__store3_one(float *q, __m128 a)
@@ -343,6 +350,10 @@ SIMD_INL vint vi_load_u16(const uint16_t *p)
 /* ---- reprojection ops (src/pipe's taps, pipe_reproj_simd.inl; simd.h
  * "REPROJ OPS") */
 SIMD_INL vfloat vf_gather(const float *p, vint idx) { return _mm256_i32gather_ps(p, idx, 4); }
+SIMD_INL vfloat vf_gather_m(const float *p, vint idx, vmask m)
+{
+    return _mm256_mask_i32gather_ps(_mm256_setzero_ps(), p, idx, m, 4);
+}
 SIMD_INL vint vi_gather_u8x4(const uint8_t *p, vint idx)
 {
     return _mm256_i32gather_epi32((const int *)(const void *)p, idx, 1);

@@ -111,6 +111,18 @@ SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
     o[2] = _mm512_castpd_ps(_mm512_unpacklo_pd(t2, t3));
     o[3] = _mm512_castpd_ps(_mm512_unpackhi_pd(t2, t3));
 }
+/* 4 x 4 blocks: two rounds of vshuff32x4 */
+SIMD_INL void vf_tr_blocks(const vfloat in[4], vfloat out[4])
+{
+    const __m512 abl = _mm512_shuffle_f32x4(in[0], in[1], 0x44);
+    const __m512 cdl = _mm512_shuffle_f32x4(in[2], in[3], 0x44);
+    const __m512 abh = _mm512_shuffle_f32x4(in[0], in[1], 0xEE);
+    const __m512 cdh = _mm512_shuffle_f32x4(in[2], in[3], 0xEE);
+    out[0] = _mm512_shuffle_f32x4(abl, cdl, 0x88);
+    out[1] = _mm512_shuffle_f32x4(abl, cdl, 0xDD);
+    out[2] = _mm512_shuffle_f32x4(abh, cdh, 0x88);
+    out[3] = _mm512_shuffle_f32x4(abh, cdh, 0xDD);
+}
 
 /* an in-block transpose gives each lane's x y z (and a spare) in one
  * 128-bit block, stored with a 3-float mask */
@@ -326,6 +338,10 @@ SIMD_INL vint vi_load_u16(const uint16_t *p)
 /* ---- reprojection ops (src/pipe's taps, pipe_reproj_simd.inl; simd.h
  * "REPROJ OPS") */
 SIMD_INL vfloat vf_gather(const float *p, vint idx) { return _mm512_i32gather_ps(idx, (const void *)p, 4); }
+SIMD_INL vfloat vf_gather_m(const float *p, vint idx, vmask m)
+{
+    return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, idx, (const void *)p, 4);
+}
 SIMD_INL vint vi_gather_u8x4(const uint8_t *p, vint idx)
 {
     return _mm512_i32gather_epi32(idx, (const void *)p, 1);

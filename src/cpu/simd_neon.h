@@ -258,6 +258,8 @@ SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
     o[2] = vreinterpretq_f32_f64(vtrn2q_f64(vreinterpretq_f64_f32(ab0), vreinterpretq_f64_f32(cd0)));
     o[3] = vreinterpretq_f32_f64(vtrn2q_f64(vreinterpretq_f64_f32(ab1), vreinterpretq_f64_f32(cd1)));
 }
+/* one block: a copy */
+SIMD_INL void vf_tr_blocks(const vfloat in[1], vfloat out[1]) { out[0] = in[0]; }
 
 
 /* ---- raster ops (src/raster's scan; simd.h "RASTER OPS") */
@@ -397,6 +399,17 @@ SIMD_INL vfloat vf_gather(const float *p, vint idx)
     r = vsetq_lane_f32(p[vgetq_lane_s32(idx, 1)], r, 1);
     r = vsetq_lane_f32(p[vgetq_lane_s32(idx, 2)], r, 2);
     return vsetq_lane_f32(p[vgetq_lane_s32(idx, 3)], r, 3);
+}
+/* lane by lane, only the lanes in m read */
+SIMD_INL vfloat vf_gather_m(const float *p, vint idx, vmask m)
+{
+    float r[4];
+    for (int l = 0; l < 4; l++) r[l] = 0.0f;
+    if (vgetq_lane_u32(m, 0)) r[0] = p[vgetq_lane_s32(idx, 0)];
+    if (vgetq_lane_u32(m, 1)) r[1] = p[vgetq_lane_s32(idx, 1)];
+    if (vgetq_lane_u32(m, 2)) r[2] = p[vgetq_lane_s32(idx, 2)];
+    if (vgetq_lane_u32(m, 3)) r[3] = p[vgetq_lane_s32(idx, 3)];
+    return vld1q_f32(r);
 }
 SIMD_INL vint vi_gather_u8x4(const uint8_t *p, vint idx)
 {

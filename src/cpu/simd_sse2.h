@@ -212,6 +212,8 @@ SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
     _MM_TRANSPOSE4_PS(a, b, c, d);
     o[0] = a; o[1] = b; o[2] = c; o[3] = d;
 }
+/* one block: a copy */
+SIMD_INL void vf_tr_blocks(const vfloat in[1], vfloat out[1]) { out[0] = in[0]; }
 
 
 /* ---- raster ops (src/raster's scan; simd.h "RASTER OPS") */
@@ -322,6 +324,16 @@ SIMD_INL vfloat vf_gather(const float *p, vint idx)
     _Alignas(16) int32_t x[4];
     _mm_store_si128((__m128i *)(void *)x, idx);
     return _mm_setr_ps(p[x[0]], p[x[1]], p[x[2]], p[x[3]]);
+}
+/* lane by lane, only the lanes in m read */
+SIMD_INL vfloat vf_gather_m(const float *p, vint idx, vmask m)
+{
+    _Alignas(16) int32_t x[4];
+    _Alignas(16) float r[4];
+    const unsigned bits = (unsigned)_mm_movemask_ps(m);
+    _mm_store_si128((__m128i *)(void *)x, idx);
+    for (int l = 0; l < 4; l++) r[l] = (bits >> l) & 1u ? p[x[l]] : 0.0f;
+    return _mm_load_ps(r);
 }
 SIMD_INL vint vi_gather_u8x4(const uint8_t *p, vint idx)
 {

@@ -1,16 +1,19 @@
 /* fuse_refine_avx512.c - AVX-512 (F, BW, DQ, VL) row kernels of the
  * band-only refinement (fuse_refine_kern.h), built with the flags of
  * *_avx512.c and chosen only when cpuid reports them. Same bytes as the
- * reference (tests/test_fuse_refine.c):
+ * reference (tests/test_fuse_refine.c). The scores and the colour bins
+ * are fuse_refine_simd.inl on the vector layer (src/cpu/simd_avx512.h);
+ * the other kernels are AVX-512's own (REFINE_OWN_ROWS), as the layer's
+ * other ISAs cannot do them: every row end is one masked step (k
+ * registers), and
  *   edges      64 mask pixels per step as bit masks (vpmovb2m), the four
  *              neighbours as shifted loads;
  *   chamfer    32 distances per step: the vertical minimum in lanes, the
  *              horizontal running minimum as a log-step scan (vpermw) on
  *              d - 3 lane (forward) or d + 3 lane (backward), exact in
  *              16-bit integers;
- *   histogram  ring pixels found 32 at a time, bins computed 16 at a time,
- *              counted in scalar;
- *   scores     16 per step: bins in lanes, table look-ups by vgatherdps;
+ *   histogram  ring pixels found 32 at a time as mask bits, bins computed
+ *              16 at a time (refine_bins), counted in scalar;
  *   decision   16 per step: the window sum in the reference's order
  *              (rows top down, columns left to right), one float add per
  *              term per lane, as the reference adds them. */
@@ -18,7 +21,10 @@
 
 #if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512DQ__) && \
     defined(__AVX512VL__)
-#include <immintrin.h>
+#include "../cpu/simd_avx512.h"
+
+#define REFINE_OWN_ROWS
+#include "fuse_refine_simd.inl"
 
 /* lanes [0, n) of a 64 / 32 / 16-lane mask (n may be <= 0 or >= lanes) */
 static inline __mmask64 lanes64(int n)
@@ -55,7 +61,7 @@ static inline uint64_t edge_bits(const uint8_t *up, const uint8_t *row, const ui
     return ((m ^ l) | (m ^ r) | (m ^ u) | (m ^ d)) & (uint64_t)valid;
 }
 
-static int edge_span_avx512(const uint8_t *up, const uint8_t *row, const uint8_t *dn, int w,
+static int SIMD_FN(refine_edge_span)(const uint8_t *up, const uint8_t *row, const uint8_t *dn, int w,
                             int *x0, int *x1)
 {
     int a = -1;
@@ -79,7 +85,7 @@ static int edge_span_avx512(const uint8_t *up, const uint8_t *row, const uint8_t
     return 1;
 }
 
-static void dt_init_avx512(const uint8_t *up, const uint8_t *row, const uint8_t *dn, int w,
+static void SIMD_FN(refine_dt_init)(const uint8_t *up, const uint8_t *row, const uint8_t *dn, int w,
                            int a, int b, uint16_t cap, uint16_t *d)
 {
     const __m512i vcap = _mm512_set1_epi16((short)cap), v3 = _mm512_set1_epi16(3);
@@ -162,7 +168,7 @@ static inline __m512i pass_in(const uint16_t *r, const uint16_t *v, int w, int x
     return _mm512_mask_blend_epi16(ld, big, c);
 }
 
-static void dt_fwd_avx512(uint16_t *r, const uint16_t *u, int w, int a, int b)
+static void SIMD_FN(refine_dt_fwd)(uint16_t *r, const uint16_t *u, int w, int a, int b)
 {
     const __m512i l3 = lane3(), big = _mm512_set1_epi16(BIG);
     const __m512i s[5] = {shift_idx(1), shift_idx(2), shift_idx(4), shift_idx(8),
@@ -179,7 +185,7 @@ static void dt_fwd_avx512(uint16_t *r, const uint16_t *u, int w, int a, int b)
     }
 }
 
-static void dt_bwd_avx512(uint16_t *r, const uint16_t *dn, int w, int a, int b)
+static void SIMD_FN(refine_dt_bwd)(uint16_t *r, const uint16_t *dn, int w, int a, int b)
 {
     const __m512i l3 = lane3(), big = _mm512_set1_epi16(BIG);
     const __m512i s[5] = {shift_idx(-1), shift_idx(-2), shift_idx(-4), shift_idx(-8),
@@ -199,22 +205,7 @@ static void dt_bwd_avx512(uint16_t *r, const uint16_t *dn, int w, int a, int b)
     }
 }
 
-/* bins of 16 RGBA pixels */
-static inline __m512i bins16(const uint8_t *px, __mmask16 ld, int bits)
-{
-    const __m512i v = _mm512_maskz_loadu_epi32(ld, px);
-    const __m128i s = _mm_cvtsi32_si128(8 - bits);
-    const __m512i ff = _mm512_set1_epi32(0xFF);
-    const __m512i r = _mm512_srl_epi32(_mm512_and_si512(v, ff), s);
-    const __m512i g = _mm512_srl_epi32(_mm512_and_si512(_mm512_srli_epi32(v, 8), ff), s);
-    const __m512i bl = _mm512_srl_epi32(_mm512_and_si512(_mm512_srli_epi32(v, 16), ff), s);
-    return _mm512_or_si512(
-        _mm512_or_si512(_mm512_sll_epi32(r, _mm_cvtsi32_si128(2 * bits)),
-                        _mm512_sll_epi32(g, _mm_cvtsi32_si128(bits))),
-        bl);
-}
-
-static void hist_row_avx512(const uint8_t *px, const uint8_t *m, const uint16_t *d, int a,
+static void SIMD_FN(refine_hist_row)(const uint8_t *px, const uint8_t *m, const uint16_t *d, int a,
                             int b, unsigned band3, unsigned outer3, int bits, uint32_t *hf,
                             uint32_t *hb, long *nf, long *nb)
 {
@@ -230,9 +221,12 @@ static void hist_row_avx512(const uint8_t *px, const uint8_t *m, const uint16_t 
         if (!ring) continue;
         const uint32_t in = (uint32_t)_mm256_movepi8_mask(
             _mm256_maskz_loadu_epi8(ld, m + x));
-        _mm512_storeu_si512(bn, bins16(px + 4 * (size_t)x, (__mmask16)ring, bits));
-        _mm512_storeu_si512(bn + 16,
-                            bins16(px + 4 * (size_t)x + 64, (__mmask16)(ring >> 16), bits));
+        const int32_t *p = (const int32_t *)(const void *)(px + 4 * (size_t)x);
+        _mm512_storeu_si512(bn, SIMD_FN(refine_bins)(
+                                    _mm512_maskz_loadu_epi32((__mmask16)ring, p), bits));
+        _mm512_storeu_si512(bn + 16, SIMD_FN(refine_bins)(_mm512_maskz_loadu_epi32(
+                                                              (__mmask16)(ring >> 16), p + 16),
+                                                          bits));
         uint32_t rf = ring & in, rb = ring & ~in;
         f += __builtin_popcount(rf);
         g += __builtin_popcount(rb);
@@ -249,39 +243,7 @@ static void hist_row_avx512(const uint8_t *px, const uint8_t *m, const uint16_t 
     *nb += g;
 }
 
-static void score_row_avx512(const fuse__refine_tabs *t, const uint8_t *px, const uint8_t *m,
-                             const uint16_t *d, float *s, int a, int b)
-{
-    const __m512i vb3 = _mm512_set1_epi32((int)t->band3);
-    const __m512 p4 = _mm512_set1_ps(4.0f), n4 = _mm512_set1_ps(-4.0f);
-    const __m512 w0 = _mm512_set1_ps(t->w0), gw = _mm512_set1_ps(t->gw);
-    const int out_off = (int)(t->pr_out - t->pr_in);
-    for (int x = a; x <= b; x += 16) {
-        const __mmask16 ld = lanes16(b + 1 - x);
-        const __m512i dv = _mm512_cvtepu16_epi32(_mm256_maskz_loadu_epi16(ld, d + x));
-        const __mmask16 in = _mm_movepi8_mask(_mm_maskz_loadu_epi8(ld, m + x));
-        const __mmask16 band = _mm512_mask_cmple_epu32_mask(ld, dv, vb3);
-        __m512 o = _mm512_mask_blend_ps(in, n4, p4);
-        if (band) {
-            const __m512i bin = bins16(px + 4 * (size_t)x, band, t->bits);
-            __m512 c = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), band, bin, t->llr, 4);
-            if (t->gllr) {
-                const __m512i gbin = bins16(px + 4 * (size_t)x, band, t->gbits);
-                const __m512 gc =
-                    _mm512_mask_i32gather_ps(_mm512_setzero_ps(), band, gbin, t->gllr, 4);
-                c = _mm512_add_ps(_mm512_mul_ps(w0, c), _mm512_mul_ps(gw, gc));
-            }
-            const __m512i pidx = _mm512_mask_add_epi32(dv, (__mmask16)~in, dv,
-                                                       _mm512_set1_epi32(out_off));
-            const __m512 pr = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), band, pidx,
-                                                       t->pr_in, 4);
-            o = _mm512_mask_add_ps(o, band, c, pr);
-        }
-        _mm512_mask_storeu_ps(s + x, ld, o);
-    }
-}
-
-static void decide_row_avx512(const float *s, ptrdiff_t ss, int rad, const uint8_t *m,
+static void SIMD_FN(refine_decide_row)(const float *s, ptrdiff_t ss, int rad, const uint8_t *m,
                               const uint16_t *d, unsigned band3, uint8_t *out, int a, int b,
                               long cnt[3])
 {
@@ -314,7 +276,7 @@ static void decide_row_avx512(const float *s, ptrdiff_t ss, int rad, const uint8
     cnt[2] += fo;
 }
 
-static void binarise_avx512(const uint8_t *m, uint8_t *out, int a, int b)
+static void SIMD_FN(refine_binarise)(const uint8_t *m, uint8_t *out, int a, int b)
 {
     const __m512i ff = _mm512_set1_epi8((char)0xFF);
     for (int x = a; x <= b; x += 64) {
@@ -323,13 +285,6 @@ static void binarise_avx512(const uint8_t *m, uint8_t *out, int a, int b)
         _mm512_mask_storeu_epi8(out + x, ld, _mm512_maskz_mov_epi8(in, ff));
     }
 }
-
-static const fuse__refine_kern kern = {
-    edge_span_avx512, dt_init_avx512, dt_fwd_avx512, dt_bwd_avx512, hist_row_avx512,
-    score_row_avx512, decide_row_avx512, binarise_avx512,
-};
-
-const fuse__refine_kern *fuse__refine_kern_avx512(void) { return &kern; }
 
 #else
 const fuse__refine_kern *fuse__refine_kern_avx512(void) { return NULL; }

@@ -13,6 +13,7 @@
 #include "../cpu/simd_neon.h"
 
 /* the scores: the portable kernel (NEON has no gather for the look-ups) */
+#define REFINE_OWN_SCORE
 static void SIMD_FN(refine_score_row)(const fuse__refine_tabs *t, const uint8_t *px,
                                       const uint8_t *m, const uint16_t *d, float *s, int a,
                                       int b)

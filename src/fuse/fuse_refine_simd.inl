@@ -1,27 +1,67 @@
 /* fuse_refine_simd.inl - the row kernels of the band-only refinement
  * (fuse_refine_kern.h), written ONCE on the vector layer (src/cpu/simd.h,
- * its REFINE OPS for the byte and 16-bit lanes) and included by
- * fuse_refine_avx2.c and fuse_refine_neon.c after their simd_*.h. Same
- * bytes as the reference (tests/test_fuse_refine.c). Whole vectors inside
- * the row; the few pixels at a row's ends (and the histogram, the running
- * minimum of the chamfer passes) go through the portable kernels, which
- * give the same values:
+ * its REFINE OPS for the byte and 16-bit lanes, vf_gather_m for the score
+ * look-ups) and included by fuse_refine_avx2.c, fuse_refine_avx512.c and
+ * fuse_refine_neon.c after their simd_*.h. Same bytes as the reference
+ * (tests/test_fuse_refine.c). Whole vectors inside the row; the few pixels
+ * at a row's ends (and the histogram, the running minimum of the chamfer
+ * passes) go through the portable kernels, which give the same values:
  *   edges      VB_W mask pixels per step: inside is the byte's bit 7, so
  *              the edge is bit 7 of (m^l)|(m^r)|(m^u)|(m^d), its bits by
  *              vb_sign_bits (pmovmskb);
  *   dt_init    VH_W per step, the same rule on 16-bit lanes;
  *   chamfer    the vertical minimum VH_W distances per step;
  *   ring skip  VH_W distances per step;
+ *   scores     SIMD_W per step: colour bins in lanes (refine_bins), the
+ *              table look-ups by vf_gather_m (the band's lanes), the
+ *              last vector ending at the row's end (it overlaps the one
+ *              before and writes the same values again);
  *   decision   SIMD_W per step, the window sum in the reference's order;
  *   binarise   VB_W per step.
- * The includer defines, before the include, its score kernel
- *   static void SIMD_FN(refine_score_row)(const fuse__refine_tabs *, ...)
- * (AVX2 gathers its look-ups; NEON has no gather and calls the portable
- * one); this file defines SIMD_FN(fuse__refine_kern)(), e.g.
- * fuse__refine_kern_avx2(). fuse_refine_avx512.c keeps its own algorithm
- * (masked row ends, a vector running minimum). */
+ * This file defines SIMD_FN(fuse__refine_kern)(), e.g.
+ * fuse__refine_kern_avx2(), whose table names the eight kernels
+ * SIMD_FN(refine_edge_span) ... SIMD_FN(refine_binarise) (prototypes
+ * below). What an ISA does its own way, the includer defines before or
+ * after the include, with a switch:
+ *   REFINE_OWN_ROWS   every kernel but the scores (fuse_refine_avx512.c:
+ *                     masked row ends, a vpermw running minimum, the ring
+ *                     pixels' mask bits; it calls SIMD_FN(refine_bins));
+ *   REFINE_OWN_SCORE  the scores (fuse_refine_neon.c: the portable kernel;
+ *                     NEON has no gather, vf_gather_m would go lane by lane). */
 
 #define KC fuse__refine_kern_c
+
+static int SIMD_FN(refine_edge_span)(const uint8_t *up, const uint8_t *row, const uint8_t *dn,
+                                     int w, int *x0, int *x1);
+static void SIMD_FN(refine_dt_init)(const uint8_t *up, const uint8_t *row, const uint8_t *dn,
+                                    int w, int a, int b, uint16_t cap, uint16_t *d);
+static void SIMD_FN(refine_dt_fwd)(uint16_t *r, const uint16_t *u, int w, int a, int b);
+static void SIMD_FN(refine_dt_bwd)(uint16_t *r, const uint16_t *dn, int w, int a, int b);
+static void SIMD_FN(refine_hist_row)(const uint8_t *px, const uint8_t *m, const uint16_t *d,
+                                     int a, int b, unsigned band3, unsigned outer3, int bits,
+                                     uint32_t *hf, uint32_t *hb, long *nf, long *nb);
+static void SIMD_FN(refine_score_row)(const fuse__refine_tabs *t, const uint8_t *px,
+                                      const uint8_t *m, const uint16_t *d, float *s, int a,
+                                      int b);
+static void SIMD_FN(refine_decide_row)(const float *s, ptrdiff_t ss, int rad, const uint8_t *m,
+                                       const uint16_t *d, unsigned band3, uint8_t *out, int a,
+                                       int b, long cnt[3]);
+static void SIMD_FN(refine_binarise)(const uint8_t *m, uint8_t *out, int a, int b);
+
+/* the colour bins of SIMD_W RGBA8 pixels (int32 lanes, R in the low
+ * byte), as the portable bin_of: (R >> s) << 2 bits | (G >> s) << bits |
+ * B >> s, s = 8 - bits */
+SIMD_INL vint SIMD_FN(refine_bins)(vint v, int bits)
+{
+    const vint ff = vi_set1(0xFF);
+    const int s = 8 - bits;
+    const vint r = vi_srl(vi_and(v, ff), s);
+    const vint g = vi_srl(vi_and(vi_srli(v, 8), ff), s);
+    const vint bl = vi_srl(vi_and(vi_srli(v, 16), ff), s);
+    return vi_or(vi_or(vi_sll(r, 2 * bits), vi_sll(g, bits)), bl);
+}
+
+#ifndef REFINE_OWN_ROWS
 
 /* bit 7 of each byte: the edge pixels of the VB_W at x (1 <= x,
  * x + VB_W < w) */
@@ -138,6 +178,49 @@ static void SIMD_FN(refine_hist_row)(const uint8_t *px, const uint8_t *m, const 
     }
 }
 
+#endif /* REFINE_OWN_ROWS: the score kernel, then the decision and binarise */
+
+#ifndef REFINE_OWN_SCORE
+/* SIMD_W scores per step (rows shorter than a vector: the portable
+ * kernel); the look-ups only in the band's lanes (vf_gather_m) */
+static void SIMD_FN(refine_score_row)(const fuse__refine_tabs *t, const uint8_t *px,
+                                      const uint8_t *m, const uint16_t *d, float *s, int a,
+                                      int b)
+{
+    if (b - a + 1 < SIMD_W) {
+        KC.score_row(t, px, m, d, s, a, b);
+        return;
+    }
+    const vint vb3 = vi_set1((int)t->band3), v127 = vi_set1(127);
+    const vint off = vi_set1((int)(t->pr_out - t->pr_in));
+    const vfloat p4 = vf_set1(4.0f), n4 = vf_set1(-4.0f);
+    const vfloat w0 = vf_set1(t->w0), gw = vf_set1(t->gw);
+    /* the table fields in locals: the stores to s could alias *t */
+    const float *const llr = t->llr, *const gllr = t->gllr, *const pr_in = t->pr_in;
+    const int bits = t->bits, gbits = t->gbits;
+    for (int x = a;; x += SIMD_W) {
+        if (x > b - (SIMD_W - 1)) x = b - (SIMD_W - 1);   /* the last vector ends at b */
+        const vint dv = vi_load_u16(d + x);
+        const vmask in = vi_gt(vi_load_u8(m + x), v127);
+        const vmask band = vm_not(vi_gt(dv, vb3));
+        vfloat o = vf_sel(in, p4, n4);
+        if (vm_any(band)) {
+            const vint v = vi_loadu((const int32_t *)(const void *)(px + 4 * (size_t)x));
+            vfloat c = vf_gather_m(llr, SIMD_FN(refine_bins)(v, bits), band);
+            if (gllr) {
+                const vfloat gc = vf_gather_m(gllr, SIMD_FN(refine_bins)(v, gbits), band);
+                c = vf_add(vf_mul(w0, c), vf_mul(gw, gc));
+            }
+            const vint pidx = vi_sel(in, dv, vi_add(dv, off));
+            o = vf_sel(band, vf_add(c, vf_gather_m(pr_in, pidx, band)), o);
+        }
+        vf_storeu(s + x, o);
+        if (x == b - (SIMD_W - 1)) break;
+    }
+}
+#endif
+
+#ifndef REFINE_OWN_ROWS
 static void SIMD_FN(refine_decide_row)(const float *s, ptrdiff_t ss, int rad, const uint8_t *m,
                                        const uint16_t *d, unsigned band3, uint8_t *out, int a,
                                        int b, long cnt[3])
@@ -175,6 +258,7 @@ static void SIMD_FN(refine_binarise)(const uint8_t *m, uint8_t *out, int a, int 
     for (; x + VB_W - 1 <= b; x += VB_W) vb_storeu(out + x, vb_sign_fill(vb_loadu(m + x)));
     if (x <= b) KC.binarise(m, out, x, b);
 }
+#endif /* REFINE_OWN_ROWS */
 
 static const fuse__refine_kern SIMD_FN(refine_kern) = {
     SIMD_FN(refine_edge_span), SIMD_FN(refine_dt_init),   SIMD_FN(refine_dt_fwd),

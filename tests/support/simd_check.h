@@ -30,6 +30,7 @@ enum {
     SC_HADD, SC_HSUB, SC_HMUL, SC_HSRLI5, SC_HSET1,          /* 16-bit lanes; HSET1: k */
     SC_HLO8, SC_HHI8, SC_HPACKUS, SC_HBCAST3,
     SC_ZIPLO, SC_ZIPHI,                                      /* int a, b, per block */
+    SC_TRB,                                                  /* vf_tr_blocks, groups of W*W/4 */
     SC_COUNT
 };
 

@@ -37,6 +37,16 @@ int SIMD_FN(tu_simd_check)(int op, const uint32_t *a, const uint32_t *b, int k, 
             vi_store2((int32_t *)(void *)(out + g), ldi(a + g), ldi(a + g + W));
         return W;
     }
+    if (op == SC_TRB) {
+        enum { NB = SIMD_W / 4 };
+        for (int g = 0; g + NB * W <= n; g += NB * W) {
+            vfloat in[NB], o[NB];
+            for (int q = 0; q < NB; q++) in[q] = ld(a + g + q * W);
+            vf_tr_blocks(in, o);
+            for (int q = 0; q < NB; q++) st(out + g + q * W, o[q]);
+        }
+        return W;
+    }
     if (op == SC_TR4) {
         for (int g = 0; g + 4 * W <= n; g += 4 * W) {
             vfloat t[4];

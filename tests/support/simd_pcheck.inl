@@ -19,6 +19,11 @@ int PC_NAME(int op, const uint32_t *a, const int32_t *idx, int n, uint32_t *out)
             vi_storeu((int32_t *)(void *)(out + v),
                       vf_as_vi(vf_gather((const float *)(const void *)a, j)));
             break;
+        case PC_FGATHER_M:
+            vi_storeu((int32_t *)(void *)(out + v),
+                      vf_as_vi(vf_gather_m((const float *)(const void *)a, j,
+                                           vi_gt(j, vi_set1(-1)))));
+            break;
         case PC_U8X4:
             vi_storeu((int32_t *)(void *)(out + v),
                       vi_gather_u8x4((const uint8_t *)(const void *)a, j));
