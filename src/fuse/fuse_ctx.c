@@ -142,6 +142,21 @@ static void mask_span(const uint8_t *m, int w, int *x0, int *x1)
     *x1 = b;
 }
 
+/* The lit span [*x0, *x1) of a mask row (w bytes) widened to a whole number
+ * of SPAN_VEC pixels where the row has room (to the right, else to the
+ * left; unchanged when the row is narrower): the kernels of every ISA then
+ * run whole vectors only, without the scalar tail of the reference on the
+ * last x1 - x0 mod SIMD_W pixels (mask_span's x1 is w - 8 k, so at an odd
+ * width every row had one). The added pixels have mask byte 0: lit, depth-
+ * tested and written as 0, the bytes of the narrower span. */
+#define SPAN_VEC 16
+static void span_widen(int w, int *x0, int *x1)
+{
+    const int n = (*x1 - *x0 + SPAN_VEC - 1) / SPAN_VEC * SPAN_VEC;
+    if (*x0 + n <= w) *x1 = *x0 + n;
+    else if (*x1 - n >= 0) *x0 = *x1 - n;
+}
+
 /* Prefetches the inputs of layer row y over [x0, x1) (the span of the row
  * before it: the hand moves little from row to row). */
 static void light_prefetch(const light_job *j, int y, int x0, int x1)
@@ -183,6 +198,7 @@ static void light_rows(const light_job *j, int y0, int y1, int32_t (*span)[3])
             continue;
         }
         light_prefetch(j, y + 1, x0, x1);
+        span_widen(w, &x0, &x1);
         light_span(j, y, x0, x1, m, o);
     }
 }
@@ -783,6 +799,7 @@ static void eye_light_depth_rows(const eye_job *e, int y0, int y1, int32_t (*spa
             prefetch(fuse__depth_scene_row(d, y + 1, sh, e->comp.vx, e->comp.vy, e->comp.vh) + c0,
                      sizeof(float) * (size_t)(c1 - c0 + 1), 0);
         }
+        span_widen(w, &x0, &x1);
         memcpy(m + x0, m0 + x0, (size_t)(x1 - x0));   /* the mask is 0 outside the span */
         j->k->depth_mspan(&dp, m, d->hand + (size_t)y * (size_t)d->hand_stride,
                           fuse__depth_scene_row(d, y, sh, e->comp.vx, e->comp.vy, e->comp.vh),
