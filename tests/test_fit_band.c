@@ -19,6 +19,7 @@
  *     trails it), a hand at rest exactly as by kin_filter_output.
  */
 #include "support/testutil.h"
+#include "support/fit_scene.h"
 
 #include <cmocka.h>
 #include <math.h>
@@ -30,42 +31,6 @@
 
 enum { W = 320, H = 240 };
 static const float F = 300.0f;
-
-/* A camera at the origin looking down -Z (view = identity). */
-static kin_camera cam_make(void)
-{
-    kin_camera c;
-    memset(&c, 0, sizeof c);
-    for (int i = 0; i < 4; i++) {
-        c.view.m[i * 5] = 1.0f;
-        c.world_from_cam.m[i * 5] = 1.0f;
-    }
-    c.width = W;
-    c.height = H;
-    c.fx = c.fy = F;
-    c.cx = W / 2.0f;
-    c.cy = H / 2.0f;
-    return c;
-}
-
-/* Every hand joint of side s at node s; world[s] at (x, y, z). */
-static void rig_make(kin_arm_rig *rig)
-{
-    memset(rig, 0, sizeof *rig);
-    for (int s = 0; s < 2; s++)
-        for (int j = 0; j < KIN_RIG_SIDE_JOINTS; j++) rig->joint[s][j] = s;
-}
-
-static kin_mat4 at(float x, float y, float z)
-{
-    kin_mat4 m;
-    memset(&m, 0, sizeof m);
-    m.m[0] = m.m[5] = m.m[10] = m.m[15] = 1.0f;
-    m.m[12] = x;
-    m.m[13] = y;
-    m.m[14] = z;
-    return m;
-}
 
 static void disc(uint8_t *m, float cx, float cy, float r)
 {
@@ -146,10 +111,10 @@ static void scene_free(scene *s)
  * around the hand (speed: its wrist speed, m/s). */
 static double run_frames(scene *s, int n, int with_prior, float speed, int *used_prior)
 {
-    kin_camera cam = cam_make();
+    kin_camera cam = fit_scene_camera(W, H, F);
     kin_arm_rig rig;
-    rig_make(&rig);
-    kin_mat4 world[2] = { at(0, 0, -0.4f), at(5.0f, 0, -0.4f) };   /* right hand out of view */
+    fit_scene_rig(&rig);
+    kin_mat4 world[2] = { fit_scene_at(0, 0, -0.4f), fit_scene_at(5.0f, 0, -0.4f) };   /* right hand out of view */
     pipe_fit_band_desc d = pipe_fit_band_desc_default();
     d.hand_radius = 0.1f;   /* 75 px at 0.4 m */
     const float sp[2] = { speed, speed };
@@ -196,14 +161,14 @@ static void prior_reaches_beyond_band(void **state)
 static void band_follows_depth_and_speed(void **state)
 {
     (void)state;
-    kin_camera cam = cam_make();
+    kin_camera cam = fit_scene_camera(W, H, F);
     kin_arm_rig rig;
-    rig_make(&rig);
+    fit_scene_rig(&rig);
     pipe_fit_band_desc d = pipe_fit_band_desc_default();
     d.sigma = 0.02f;
     d.band_min = 4;
     d.band_max = 64;
-    kin_mat4 world[2] = { at(0, 0, -0.4f), at(0.05f, 0, -0.1f) };
+    kin_mat4 world[2] = { fit_scene_at(0, 0, -0.4f), fit_scene_at(0.05f, 0, -0.1f) };
     /* left only: 300 * 0.02 / 0.4 = 15 px */
     assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 1u, NULL), 15);
     /* right, 4x nearer: 60 px; both: the nearer */
@@ -219,9 +184,9 @@ static void band_follows_depth_and_speed(void **state)
     assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 1u, sp), 30);
     d.tau = 0.0f;
     /* out of view (far beyond the reach) or behind: band_min */
-    world[0] = at(2.0f, 0, -0.4f);
+    world[0] = fit_scene_at(2.0f, 0, -0.4f);
     assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 1u, NULL), 4);
-    world[0] = at(0, 0, 0.4f);
+    world[0] = fit_scene_at(0, 0, 0.4f);
     assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 1u, NULL), 4);
     /* untracked, bad arguments */
     assert_int_equal(pipe_fit_band(&d, &cam, world, &rig, 0u, NULL), 4);
@@ -232,10 +197,10 @@ static void band_follows_depth_and_speed(void **state)
 static void region_and_merge(void **state)
 {
     (void)state;
-    kin_camera cam = cam_make();
+    kin_camera cam = fit_scene_camera(W, H, F);
     kin_arm_rig rig;
-    rig_make(&rig);
-    kin_mat4 world[2] = { at(0, 0, -0.4f), at(5.0f, 0, -0.4f) };
+    fit_scene_rig(&rig);
+    kin_mat4 world[2] = { fit_scene_at(0, 0, -0.4f), fit_scene_at(5.0f, 0, -0.4f) };
     pipe_fit_band_desc d = pipe_fit_band_desc_default();
     d.hand_radius = 0.04f;   /* 30 px at 0.4 m, + band 10 = 40 */
     uint8_t *reg = malloc(W * H), *a = malloc(W * H), *b = malloc(W * H), *o = malloc(W * H);

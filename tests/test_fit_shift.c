@@ -15,6 +15,7 @@
  *     returned, shift 0.
  */
 #include "support/testutil.h"
+#include "support/fit_scene.h"
 
 #include <cmocka.h>
 #include <math.h>
@@ -27,40 +28,6 @@
 enum { W = 320, H = 240 };
 static const float F = 300.0f;
 enum { DX = 20, DY = -12 };   /* the true hand's offset from the model's */
-
-static kin_camera cam_make(void)
-{
-    kin_camera c;
-    memset(&c, 0, sizeof c);
-    for (int i = 0; i < 4; i++) {
-        c.view.m[i * 5] = 1.0f;
-        c.world_from_cam.m[i * 5] = 1.0f;
-    }
-    c.width = W;
-    c.height = H;
-    c.fx = c.fy = F;
-    c.cx = W / 2.0f;
-    c.cy = H / 2.0f;
-    return c;
-}
-
-static void rig_make(kin_arm_rig *rig)
-{
-    memset(rig, 0, sizeof *rig);
-    for (int s = 0; s < 2; s++)
-        for (int j = 0; j < KIN_RIG_SIDE_JOINTS; j++) rig->joint[s][j] = s;
-}
-
-static kin_mat4 at(float x, float y, float z)
-{
-    kin_mat4 m;
-    memset(&m, 0, sizeof m);
-    m.m[0] = m.m[5] = m.m[10] = m.m[15] = 1.0f;
-    m.m[12] = x;
-    m.m[13] = y;
-    m.m[14] = z;
-    return m;
-}
 
 /* a disc added to m (255 inside; clear = 1 clears m first) */
 static void disc(uint8_t *m, float cx, float cy, float r, int clear)
@@ -134,10 +101,10 @@ static void scene_make(scene *s)
     assert_int_equal(fuse_colour_model_learn(&s->g, &P, s->truth, W, 4, 1, 3.0f, 64, s->cscratch,
                                              fuse_colour_model_scratch_size(5)),
                      FUSE_OK);
-    s->cam = cam_make();
-    rig_make(&s->rig);
-    s->world[0] = at(0, 0, -0.4f);      /* the left hand: the image centre */
-    s->world[1] = at(5.0f, 0, -0.4f);   /* the right hand out of view */
+    s->cam = fit_scene_camera(W, H, F);
+    fit_scene_rig(&s->rig);
+    s->world[0] = fit_scene_at(0, 0, -0.4f);      /* the left hand: the image centre */
+    s->world[1] = fit_scene_at(5.0f, 0, -0.4f);   /* the right hand out of view */
     s->d = pipe_fit_shift_desc_default();
     s->d.hand_radius = 0.05f;           /* 37.5 px at 0.4 m, + range 24 */
 }

@@ -1,0 +1,49 @@
+/* fit_scene.h - the small synthetic scene of the fit tests (test_fit_band,
+ * test_fit_shift): a pinhole camera at the origin looking down -Z (view =
+ * identity), a rig whose every hand joint of side s is node s, and world
+ * matrices that only translate. Header-only (static inline). */
+#ifndef EGOFUSE_TEST_FIT_SCENE_H
+#define EGOFUSE_TEST_FIT_SCENE_H
+
+#include <string.h>
+
+#include "../../src/kin/kin.h"
+
+/* A w x h camera of focal length f (pixels), principal point the centre. */
+static inline kin_camera fit_scene_camera(int w, int h, float f)
+{
+    kin_camera c;
+    memset(&c, 0, sizeof c);
+    for (int i = 0; i < 4; i++) {
+        c.view.m[i * 5] = 1.0f;
+        c.world_from_cam.m[i * 5] = 1.0f;
+    }
+    c.width = w;
+    c.height = h;
+    c.fx = c.fy = f;
+    c.cx = (float)w / 2.0f;
+    c.cy = (float)h / 2.0f;
+    return c;
+}
+
+/* Every hand joint of side s at node s. */
+static inline void fit_scene_rig(kin_arm_rig *rig)
+{
+    memset(rig, 0, sizeof *rig);
+    for (int s = 0; s < 2; s++)
+        for (int j = 0; j < KIN_RIG_SIDE_JOINTS; j++) rig->joint[s][j] = s;
+}
+
+/* The translation to (x, y, z). */
+static inline kin_mat4 fit_scene_at(float x, float y, float z)
+{
+    kin_mat4 m;
+    memset(&m, 0, sizeof m);
+    m.m[0] = m.m[5] = m.m[10] = m.m[15] = 1.0f;
+    m.m[12] = x;
+    m.m[13] = y;
+    m.m[14] = z;
+    return m;
+}
+
+#endif
