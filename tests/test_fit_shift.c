@@ -40,16 +40,7 @@ static void disc(uint8_t *m, float cx, float cy, float r, int clear)
         }
 }
 
-static double iou(const uint8_t *a, const uint8_t *b)
-{
-    long i = 0, u = 0;
-    for (int k = 0; k < W * H; k++) {
-        int x = a[k] >= 128, y = b[k] >= 128;
-        i += x && y;
-        u += x || y;
-    }
-    return u ? (double)i / (double)u : 1.0;
-}
+static double iou(const uint8_t *a, const uint8_t *b) { return fit_scene_iou(a, b, (long)W * H); }
 
 typedef struct scene {
     uint8_t *img, *truth, *kin, *out, *ref;

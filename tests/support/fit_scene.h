@@ -1,10 +1,11 @@
 /* fit_scene.h - the small synthetic scene of the fit tests (test_fit_band,
  * test_fit_shift): a pinhole camera at the origin looking down -Z (view =
- * identity), a rig whose every hand joint of side s is node s, and world
- * matrices that only translate. Header-only (static inline). */
+ * identity), a rig whose every hand joint of side s is node s, world
+ * matrices that only translate, and the IoU of two masks. Header-only (static inline). */
 #ifndef EGOFUSE_TEST_FIT_SCENE_H
 #define EGOFUSE_TEST_FIT_SCENE_H
 
+#include <stdint.h>
 #include <string.h>
 
 #include "../../src/kin/kin.h"
@@ -44,6 +45,18 @@ static inline kin_mat4 fit_scene_at(float x, float y, float z)
     m.m[13] = y;
     m.m[14] = z;
     return m;
+}
+
+/* The IoU of two masks of n bytes (set: >= 128); 1 when both are empty. */
+static inline double fit_scene_iou(const uint8_t *a, const uint8_t *b, long n)
+{
+    long i = 0, u = 0;
+    for (long k = 0; k < n; k++) {
+        int x = a[k] >= 128, y = b[k] >= 128;
+        i += x && y;
+        u += x || y;
+    }
+    return u ? (double)i / (double)u : 1.0;
 }
 
 #endif
