@@ -1,6 +1,7 @@
 /* fit_band.c - the refinement band from the projected uncertainty of the
  * hands (fit_band.h). */
 #include "fit_band.h"
+#include "../cpu/mask_rows.h"
 
 #include <math.h>
 #include <string.h>
@@ -204,12 +205,6 @@ const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *dp, const kin_camera *ca
  * colour the model calls background (llr <= 0) is cleared. Cleared pixels
  * are 1 until the end: still set for their neighbours' tests, below 128
  * for the refinement. Returns the count cleared. */
-static uint64_t ld8(const uint8_t *p)
-{
-    uint64_t v;
-    memcpy(&v, p, 8);
-    return v;
-}
 
 #define B01 0x0101010101010101ull
 #define B80 0x8080808080808080ull
@@ -236,13 +231,13 @@ static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const 
              * below 128, or in at >= 128); the bytes from x0 on are not
              * written yet */
             if (x0 + 8 <= W) {
-                const uint64_t t = i ? ld8(o + x0) & ~ld8(i + x0) : ld8(o + x0);
+                const uint64_t t = i ? ef_ld8(o + x0) & ~ef_ld8(i + x0) : ef_ld8(o + x0);
                 if (!(t & B80)) continue;
                 /* prior: inside the mask, with every 4-neighbour set (no
                  * zero byte in the block, the row above and below, nor
                  * beside it), no pixel is on the rim */
                 if (!i && x0 > 0 && x0 + 8 < W && up && dn && o[x0 - 1] && o[x0 + 8] &&
-                    !has_zero(ld8(o + x0)) && !has_zero(ld8(up + x0)) && !has_zero(ld8(dn + x0)))
+                    !has_zero(ef_ld8(o + x0)) && !has_zero(ef_ld8(up + x0)) && !has_zero(ef_ld8(dn + x0)))
                     continue;
             }
             const int x1 = x0 + 8 < W ? x0 + 8 : W;
@@ -269,7 +264,7 @@ static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const 
             int x = 0;
             for (; x + 8 <= W; x += 8) {
                 /* no byte equal to 1: none of (v ^ 0x01..) is zero */
-                if (!has_zero(ld8(o + x) ^ B01)) continue;
+                if (!has_zero(ef_ld8(o + x) ^ B01)) continue;
                 for (int k = x; k < x + 8; k++)
                     if (o[k] == 1) o[k] = 0;
             }

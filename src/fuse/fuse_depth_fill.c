@@ -5,6 +5,7 @@
  * pixels"). One scalar implementation: every ISA path of the depth test
  * then sees the same hand depths. */
 #include "fuse_refine.h"
+#include "../cpu/mask_rows.h"
 
 #include <string.h>
 
@@ -18,16 +19,6 @@ static float far_depth(void)
     float f;
     memcpy(&f, &bits, sizeof f);
     return f;
-}
-
-/* 8 mask bytes at once: from a zero mask byte the passes skip the zero
- * run that follows (a refined mask covers a fifth of the image; the same
- * visits otherwise) */
-static uint64_t ld8(const uint8_t *p)
-{
-    uint64_t v;
-    memcpy(&v, p, 8);
-    return v;
 }
 
 /* Pass 1 writes into each unknown mask pixel a code >= 2 (still unknown,
@@ -55,8 +46,8 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
         for (x = 0; x < width; x++) {
             int r, best = -1;
             long bd2 = 0;
-            if (m[x] == 0) {
-                while (x + 9 <= width && ld8(m + x + 1) == 0) x += 8;
+            if (m[x] == 0) {   /* on to the next set byte (8 at a time) */
+                x = ef_row_first_set(m, x + 1, width) - 1;
                 continue;
             }
             if (known(z[x])) continue;
@@ -100,7 +91,7 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
         for (x = x0; x < x1; x++) {
             int code, dx, dy;
             if (m[x] == 0) {
-                while (x + 9 <= x1 && ld8(m + x + 1) == 0) x += 8;
+                x = ef_row_first_set(m, x + 1, x1) - 1;
                 continue;
             }
             if (known(z[x])) continue;

@@ -1,5 +1,6 @@
 /* pipe_aa.c - the anti-aliased coverage mask of an eye (pipe_aa.h). */
 #include "pipe_aa.h"
+#include "../cpu/mask_rows.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -101,26 +102,12 @@ static void tiles_mark(pipe__aa *a, int x0, int y0, int x1, int y1)
 /* first and last non-zero byte of r[0..n-1]: *lo > *hi when none */
 static void row_span(const uint8_t *r, int n, int *lo, int *hi)
 {
-    int i = 0, j = n - 1;
-    while (i + 8 <= n) {
-        uint64_t w;
-        memcpy(&w, r + i, 8);
-        if (w) break;
-        i += 8;
-    }
-    while (i < n && r[i] == 0) i++;
+    const int i = ef_row_first_set(r, 0, n);
     if (i >= n) {
         *lo = 1, *hi = 0;
         return;
     }
-    while (j - 7 > i) {
-        uint64_t w;
-        memcpy(&w, r + j - 7, 8);
-        if (w) break;
-        j -= 8;
-    }
-    while (r[j] == 0) j--;
-    *lo = i, *hi = j;
+    *lo = i, *hi = ef_row_last_set(r, i, n) - 1;
 }
 
 void pipe__aa_band(pipe__aa *a, const uint8_t *mask)

@@ -1,5 +1,6 @@
 /* pipe_nfill.c - the normals a refined mask is lit with (pipe_nfill.h). */
 #include "pipe_nfill.h"
+#include "../cpu/mask_rows.h"
 
 #include <string.h>
 
@@ -16,36 +17,13 @@ size_t pipe__nfill_scratch_size(int w, int h)
            sizeof(uint16_t) * px + px + sizeof(int) * 2 * (size_t)h;
 }
 
-static uint64_t ld8(const uint8_t *p)
-{
-    uint64_t v;
-    memcpy(&v, p, 8);
-    return v;
-}
-
-/* the first non-zero byte of r[x0 .. x1 - 1], x1 if none (8 at a time) */
-static int first_set(const uint8_t *r, int x0, int x1)
-{
-    while (x0 + 8 <= x1 && ld8(r + x0) == 0) x0 += 8;
-    while (x0 < x1 && r[x0] == 0) x0++;
-    return x0;
-}
-
-/* one past the last non-zero byte of r[x0 .. x1 - 1], x0 if none */
-static int last_set(const uint8_t *r, int x0, int x1)
-{
-    while (x1 - 8 >= x0 && ld8(r + x1 - 8) == 0) x1 -= 8;
-    while (x1 > x0 && r[x1 - 1] == 0) x1--;
-    return x1;
-}
-
 static void bbox(const uint8_t *m, int w, int h, int b[4])
 {
     for (int y = 0; y < h; y++) {
         const uint8_t *r = m + (size_t)y * (size_t)w;
-        const int x0 = first_set(r, 0, w);
+        const int x0 = ef_row_first_set(r, 0, w);
         if (x0 == w) continue;
-        const int x1 = last_set(r, x0, w) - 1;
+        const int x1 = ef_row_last_set(r, x0, w) - 1;
         if (b[0] > x0) b[0] = x0;
         if (b[2] < x1 + 1) b[2] = x1 + 1;
         if (b[1] > y) b[1] = y;

@@ -1,0 +1,47 @@
+/* mask_rows.h - finding the set bytes of a mask row 8 bytes at a time.
+ *
+ * WHAT IT DOES
+ *   Scalar helpers shared by the rooms that skip the empty parts of a mask
+ *   row (the depth fill, the refined mask's normal fill, the anti-aliased
+ *   coverage, the fit's colour checks): an unaligned 8-byte load, the
+ *   first and one past the last non-zero byte of a range. Plain C, the
+ *   same answer on every ISA and compiler.
+ *
+ * WHAT IT DOES NOT
+ *   No SIMD (the kernels' vector layer is simd.h), no state.
+ *
+ * USAGE
+ *   int x0 = ef_row_first_set(r, 0, w);      // w if the row is empty
+ *   int x1 = ef_row_last_set(r, x0, w);      // one past the last set
+ */
+#ifndef EGOFUSE_MASK_ROWS_H
+#define EGOFUSE_MASK_ROWS_H
+
+#include <stdint.h>
+#include <string.h>
+
+/* The 8 bytes at p (any alignment), in memory order. */
+static inline uint64_t ef_ld8(const uint8_t *p)
+{
+    uint64_t v;
+    memcpy(&v, p, 8);
+    return v;
+}
+
+/* The first non-zero byte of r[x0 .. x1 - 1]; x1 if none. */
+static inline int ef_row_first_set(const uint8_t *r, int x0, int x1)
+{
+    while (x0 + 8 <= x1 && ef_ld8(r + x0) == 0) x0 += 8;
+    while (x0 < x1 && r[x0] == 0) x0++;
+    return x0;
+}
+
+/* One past the last non-zero byte of r[x0 .. x1 - 1]; x0 if none. */
+static inline int ef_row_last_set(const uint8_t *r, int x0, int x1)
+{
+    while (x1 - 8 >= x0 && ef_ld8(r + x1 - 8) == 0) x1 -= 8;
+    while (x1 > x0 && r[x1 - 1] == 0) x1--;
+    return x1;
+}
+
+#endif
