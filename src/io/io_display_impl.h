@@ -1,5 +1,7 @@
-/* io_display_impl.h - what io_display.c shares with its backends
- * (io_display_kms.c, io_display_sdl.c). Not a public header. */
+/* io_display_impl.h - what the dispatcher (io_display.c) and its backends
+ * (io_display_kms.c, io_display_sdl.c) share: the display's state, the
+ * backend table, and the helpers of io_display_common.c. Not a public
+ * header. */
 #ifndef EGOFUSE_IO_DISPLAY_IMPL_H
 #define EGOFUSE_IO_DISPLAY_IMPL_H
 

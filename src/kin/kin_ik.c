@@ -14,43 +14,6 @@
 
 #define fail(why, n, ...) kin__fail(why, n, 0, __VA_ARGS__)
 
-/* ------------------------------------------------------------ quaternions */
-
-kin_quat kin_quat_from_axes(kin_vec3 x, kin_vec3 y, kin_vec3 z)
-{
-    float tr = x.x + y.y + z.z;
-    kin_quat q;
-    if (tr > 0.0f) {
-        float r = sqrtf(1.0f + tr) * 2.0f;
-        q.w = 0.25f * r;
-        q.x = (y.z - z.y) / r;
-        q.y = (z.x - x.z) / r;
-        q.z = (x.y - y.x) / r;
-    } else if (x.x > y.y && x.x > z.z) {
-        float r = sqrtf(1.0f + x.x - y.y - z.z) * 2.0f;
-        q.w = (y.z - z.y) / r;
-        q.x = 0.25f * r;
-        q.y = (y.x + x.y) / r;
-        q.z = (z.x + x.z) / r;
-    } else if (y.y > z.z) {
-        float r = sqrtf(1.0f + y.y - x.x - z.z) * 2.0f;
-        q.w = (z.x - x.z) / r;
-        q.x = (y.x + x.y) / r;
-        q.y = 0.25f * r;
-        q.z = (z.y + y.z) / r;
-    } else {
-        float r = sqrtf(1.0f + z.z - x.x - y.y) * 2.0f;
-        q.w = (x.y - y.x) / r;
-        q.x = (z.x + x.z) / r;
-        q.y = (z.y + y.z) / r;
-        q.z = 0.25f * r;
-    }
-    if (q.w < 0.0f) { q.x = -q.x; q.y = -q.y; q.z = -q.z; q.w = -q.w; }
-    return kin_quat_normalize(q);
-}
-
-kin_quat kin_quat_conjugate(kin_quat q) { return (kin_quat){ -q.x, -q.y, -q.z, q.w }; }
-
 /* ----------------------------------------------------------------- IK job */
 
 static int finite3(kin_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }

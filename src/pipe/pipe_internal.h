@@ -16,7 +16,7 @@ void pipe__pose_locals_anim(pipe_pose *ps, const kin_animation *anim, float t);
 
 /* Writes the printf-style message into why[why_size] (when why is not
  * NULL) and returns -1: the error path of the room's checked calls
- * (pipe_mask.c, pipe_lens.c). */
+ * (pipe_mask.c, pipe_lens.c); defined in pipe_fail.c. */
 int pipe__fail(char *why, int why_size, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 

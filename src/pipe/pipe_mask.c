@@ -3,7 +3,6 @@
 #include "pipe_mask.h"
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,17 +10,6 @@
 #include "pipe.h"
 #include "pipe_lens.h"
 #include "pipe_internal.h"
-
-int pipe__fail(char *why, int why_size, const char *fmt, ...)
-{
-    if (why && why_size > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(why, (size_t)why_size, fmt, ap);
-        va_end(ap);
-    }
-    return -1;
-}
 
 static int finite3(const float v[3])
 {

@@ -91,6 +91,6 @@ cc -std=c11 -O2 -g -Wall -Wextra -D_GNU_SOURCE -ffp-contract=off $PKGC -o "$VM/v
 DRMC=$(pkg-config --cflags libdrm sdl2)
 DRML=$(pkg-config --libs libdrm)
 cc -std=c11 -O2 -g -Wall -Wextra -D_GNU_SOURCE -ffp-contract=off $DRMC -o "$VM/vm_display" \
-    "$ROOT/tests/vm/vm_display.c" "$ROOT"/src/io/io_display.c "$ROOT"/src/io/io_display_kms.c \
+    "$ROOT/tests/vm/vm_display.c" "$ROOT"/src/io/io_display.c "$ROOT"/src/io/io_display_common.c "$ROOT"/src/io/io_display_kms.c \
     "$ROOT"/src/io/io_display_sdl.c "$ROOT"/src/io/io_common.c $DRML
 echo "prepared: kernel $KV, initramfs $(du -k "$VM/initramfs.cpio.gz" | cut -f1) KiB"

@@ -1,0 +1,18 @@
+/* pipe_fail.c - the error path of the room's checked calls (pipe__fail,
+ * pipe_internal.h), at the bottom of the room: pipe_mask.c and pipe_lens.c
+ * both call it, and it calls neither. */
+#include <stdarg.h>
+#include <stdio.h>
+
+#include "pipe_internal.h"
+
+int pipe__fail(char *why, int why_size, const char *fmt, ...)
+{
+    if (why && why_size > 0) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(why, (size_t)why_size, fmt, ap);
+        va_end(ap);
+    }
+    return -1;
+}
