@@ -1,14 +1,9 @@
-/* egofuse.c - the egofuse program: subcommand dispatch and shared helpers. */
+/* egofuse.c - the egofuse program: subcommand dispatch (the helpers the
+ * subcommands share are in cli_util.c). */
 #include "cli.h"
 
-#include <errno.h>
-#include <math.h>
-#include <stdarg.h>
-#include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <time.h>
-#include <unistd.h>
 
 static const char *main_usage =
     "usage: egofuse COMMAND [OPTIONS]\n"
@@ -54,131 +49,4 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "calibrate")) return cmd_calibrate(argc - 1, argv + 1);
     fprintf(stderr, "egofuse: unknown command '%s'\n\n%s", cmd, main_usage);
     return EXIT_USAGE;
-}
-
-int cli_fail(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fputs("egofuse: ", stderr);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
-    va_end(ap);
-    return EXIT_FAIL;
-}
-
-int cli_usage_error(const char *cmd, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fprintf(stderr, "egofuse %s: ", cmd);
-    vfprintf(stderr, fmt, ap);
-    fprintf(stderr, "\n(run 'egofuse %s --help' for the options)\n", cmd);
-    va_end(ap);
-    return EXIT_USAGE;
-}
-
-int cli_option_error(const char *cmd, int c, char *const *argv)
-{
-    if (c == ':') return cli_usage_error(cmd, "option %s needs a value", argv[optind - 1]);
-    return cli_usage_error(cmd, "unknown option '%s'", argv[optind - 1]);
-}
-
-int cli_parse_int(const char *s, int lo, int hi, int *out)
-{
-    return io_parse_int(s, lo, hi, out);
-}
-
-int cli_parse_float(const char *s, float *out)
-{
-    if (!s || !*s) return 0;
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (errno || *end || !isfinite(v) || fabs(v) > 3.0e38) return 0;
-    *out = (float)v;
-    return 1;
-}
-
-const cli_float_opt *cli_float_opt_find(const cli_float_opt *t, int n, int id)
-{
-    for (int i = 0; i < n; i++)
-        if (t[i].id == id) return &t[i];
-    return NULL;
-}
-
-int cli_float_opt_parse(const cli_float_opt *e, const char *arg)
-{
-    float v;
-    if (!cli_parse_float(arg, &v) || !(v >= e->lo && v <= e->hi)) return 0;
-    *e->dst = v;
-    return 1;
-}
-
-int cli_parse_vec3(const char *s, float out[3])
-{
-    if (!s) return 0;
-    char buf[256];
-    if (strlen(s) >= sizeof buf) return 0;
-    strcpy(buf, s);
-    char *parts[3];
-    char *p = buf;
-    for (int i = 0; i < 3; i++) {
-        parts[i] = p;
-        char *c = strchr(p, ',');
-        if (i < 2) {
-            if (!c) return 0;
-            *c = 0;
-            p = c + 1;
-        } else if (c) {
-            return 0;
-        }
-    }
-    for (int i = 0; i < 3; i++)
-        if (!cli_parse_float(parts[i], &out[i])) return 0;
-    return 1;
-}
-
-int cli_mkdirs(const char *path)
-{
-    char buf[IO_PATH_MAX];
-    if (strlen(path) >= sizeof buf) return -1;
-    strcpy(buf, path);
-    for (char *p = buf + 1; *p; p++) {
-        if (*p != '/') continue;
-        *p = 0;
-        if (mkdir(buf, 0777) != 0 && errno != EEXIST) return -1;
-        *p = '/';
-    }
-    if (mkdir(buf, 0777) != 0 && errno != EEXIST) return -1;
-    struct stat st;
-    return (stat(buf, &st) == 0 && S_ISDIR(st.st_mode)) ? 0 : -1;
-}
-
-double cli_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-void progress_start(progress *p, int total)
-{
-    p->enabled = isatty(2);
-    p->total = total;
-    p->t0 = cli_now();
-}
-
-void progress_step(progress *p, int done, const char *what)
-{
-    if (!p->enabled) return;
-    double dt = cli_now() - p->t0;
-    fprintf(stderr, "\r%s %d/%d  %.1f ms/frame ", what, done, p->total,
-            done > 0 ? 1000.0 * dt / done : 0.0);
-    fflush(stderr);
-}
-
-void progress_end(progress *p)
-{
-    if (p->enabled) fputc('\n', stderr);
 }
