@@ -6,16 +6,13 @@
 
 #include "../fuse/fuse.h"
 #include "../io/io.h"
+#include "../io/io_term.h"
 #include "../kin/kin.h"
 #include "../pipe/pipe.h"
 #include "../raster/raster.h"
 
-/* Exit codes of every subcommand. */
-enum {
-    EXIT_OK = 0,
-    EXIT_FAIL = 1,     /* a bad input or a failed step: message on stderr */
-    EXIT_USAGE = 2     /* bad command line */
-};
+/* Exit codes of every subcommand (io_term.h). */
+enum { EXIT_OK = IO_EXIT_OK, EXIT_FAIL = IO_EXIT_FAIL, EXIT_USAGE = IO_EXIT_USAGE };
 
 int cmd_mask(int argc, char **argv);
 int cmd_render(int argc, char **argv);
@@ -26,8 +23,8 @@ int cmd_devices(int argc, char **argv);/* cmd_devices.c, docs/devices.md */
 int cmd_replay(int argc, char **argv); /* cmd_replay.c, docs/tracking.md */
 int cmd_calibrate(int argc, char **argv); /* cmd_calibrate.c, docs/tracking.md */
 
-/* Prints "egofuse: " + message to stderr; returns EXIT_FAIL. */
-int cli_fail(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+/* Messages with the program's name (io_term_fail), progress, folders and
+ * the clock: src/io/io_term.h, shared with the evaluation (src/eval). */
 /* Prints "egofuse CMD: " + message + a hint to run --help; EXIT_USAGE. */
 int cli_usage_error(const char *cmd, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
@@ -88,19 +85,5 @@ const cli_float_opt *cli_float_opt_find(const cli_float_opt *t, int n, int id);
 /* arg (cli_parse_float) into *e->dst when it is in [e->lo, e->hi]: 1;
  * else 0, *e->dst unchanged. */
 int cli_float_opt_parse(const cli_float_opt *e, const char *arg);
-
-/* Creates a folder and its parents (like mkdir -p). 0 on success. */
-int cli_mkdirs(const char *path);
-
-/* Progress on a terminal (stderr), nothing otherwise. */
-typedef struct progress {
-    int enabled;
-    int total;
-    double t0;
-} progress;
-void progress_start(progress *p, int total);
-void progress_step(progress *p, int done, const char *what);
-void progress_end(progress *p);
-double cli_now(void);
 
 #endif

@@ -27,10 +27,10 @@ int cli_lod_setup(const char *name, const kin_model *model, int level, float px,
     memset(lod, 0, sizeof *lod);
     if (level == 0) return EXIT_OK;
     io_error err;
-    if (io_lod_build(name, model, NULL, lod, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_lod_build(name, model, NULL, lod, &err) != IO_OK) return io_term_fail("%s", err.msg);
     if (p && pipe_set_lod(p, lod, level, px) != 0) {
         io_lod_free(lod);
-        return cli_fail("%s: the levels of detail do not fit the pipe's model", name);
+        return io_term_fail("%s: the levels of detail do not fit the pipe's model", name);
     }
     return EXIT_OK;
 }

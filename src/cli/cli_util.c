@@ -12,17 +12,6 @@
 #include <time.h>
 #include <unistd.h>
 
-int cli_fail(const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    fputs("egofuse: ", stderr);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
-    va_end(ap);
-    return EXIT_FAIL;
-}
-
 int cli_usage_error(const char *cmd, const char *fmt, ...)
 {
     va_list ap;
@@ -93,48 +82,4 @@ int cli_parse_vec3(const char *s, float out[3])
     for (int i = 0; i < 3; i++)
         if (!cli_parse_float(parts[i], &out[i])) return 0;
     return 1;
-}
-
-int cli_mkdirs(const char *path)
-{
-    char buf[IO_PATH_MAX];
-    if (strlen(path) >= sizeof buf) return -1;
-    strcpy(buf, path);
-    for (char *p = buf + 1; *p; p++) {
-        if (*p != '/') continue;
-        *p = 0;
-        if (mkdir(buf, 0777) != 0 && errno != EEXIST) return -1;
-        *p = '/';
-    }
-    if (mkdir(buf, 0777) != 0 && errno != EEXIST) return -1;
-    struct stat st;
-    return (stat(buf, &st) == 0 && S_ISDIR(st.st_mode)) ? 0 : -1;
-}
-
-double cli_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-void progress_start(progress *p, int total)
-{
-    p->enabled = isatty(2);
-    p->total = total;
-    p->t0 = cli_now();
-}
-
-void progress_step(progress *p, int done, const char *what)
-{
-    if (!p->enabled) return;
-    double dt = cli_now() - p->t0;
-    fprintf(stderr, "\r%s %d/%d  %.1f ms/frame ", what, done, p->total,
-            done > 0 ? 1000.0 * dt / done : 0.0);
-    fflush(stderr);
-}
-
-void progress_end(progress *p)
-{
-    if (p->enabled) fputc('\n', stderr);
 }

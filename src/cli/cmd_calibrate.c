@@ -40,7 +40,7 @@ static const char *calib_usage =
 static int read_glove(const char *path, float **out, int *count)
 {
     FILE *f = fopen(path, "r");
-    if (!f) return cli_fail("%s: %s", path, strerror(errno));
+    if (!f) return io_term_fail("%s: %s", path, strerror(errno));
     int cap = 256, n = 0, line = 0;
     float *v = malloc(sizeof(float) * 5 * (size_t)cap);
     char buf[1024];
@@ -64,7 +64,7 @@ static int read_glove(const char *path, float **out, int *count)
             if (e == p || errno || !isfinite(d)) {
                 fclose(f);
                 free(v);
-                return cli_fail("%s:%d: reading %d: needs 5 numbers (thumb .. little)", path,
+                return io_term_fail("%s:%d: reading %d: needs 5 numbers (thumb .. little)", path,
                                 line, k + 1);
             }
             v[5 * n + k] = (float)d;
@@ -74,12 +74,12 @@ static int read_glove(const char *path, float **out, int *count)
         if (*p) {
             fclose(f);
             free(v);
-            return cli_fail("%s:%d: more than 5 numbers", path, line);
+            return io_term_fail("%s:%d: more than 5 numbers", path, line);
         }
         n++;
     }
     fclose(f);
-    if (!v) return cli_fail("%s: out of memory", path);
+    if (!v) return io_term_fail("%s: out of memory", path);
     *out = v;
     *count = n;
     return EXIT_OK;
@@ -125,13 +125,13 @@ int cmd_calibrate(int argc, char **argv)
     char model_path[IO_PATH_MAX + 64];
     if (scene) {
         io_scene sc;
-        if (io_scene_load(scene, &sc, &err) != IO_OK) return cli_fail("%s", err.msg);
+        if (io_scene_load(scene, &sc, &err) != IO_OK) return io_term_fail("%s", err.msg);
         io_scene_frame_path(&sc, sc.model, 0, model_path, sizeof model_path);
     } else {
         snprintf(model_path, sizeof model_path, "%s", model_arg);
     }
     kin_model model;
-    if (io_gltf_load(model_path, &model, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_gltf_load(model_path, &model, &err) != IO_OK) return io_term_fail("%s", err.msg);
     int rc = EXIT_FAIL;
     kin_track_sample *smp = NULL;
     float *scratch = NULL, *raw = NULL;
@@ -139,25 +139,25 @@ int cmd_calibrate(int argc, char **argv)
     char why[512];
     kin_arm_rig rig;
     if (kin_arm_rig_init(&rig, &model, why, sizeof why) != 0) {
-        cli_fail("%s: cannot calibrate this model: %s", model_path, why);
+        io_term_fail("%s: cannot calibrate this model: %s", model_path, why);
         goto done;
     }
     kin_vec3 tip[2];
     char tip_why[256] = "";
     int have_tips = kin_user_calib_hand_tips(&rig, &model, tip, tip_why, sizeof tip_why) == 0;
     if (io_track_load(rec, &smp, &count, &err) != IO_OK) {
-        cli_fail("%s", err.msg);
+        io_term_fail("%s", err.msg);
         goto done;
     }
     if (!(scratch = malloc(sizeof(float) * (size_t)(count > 0 ? count : 1)))) {
-        cli_fail("out of memory");
+        io_term_fail("out of memory");
         goto done;
     }
     kin_user_calib cal;
     int er = kin_user_calib_estimate_tips(smp, count, &rig, have_tips ? tip : NULL, scratch, &cal,
                                           why, sizeof why);
     if (er < 0) {
-        cli_fail("%s: %s", rec, why);
+        io_term_fail("%s: %s", rec, why);
         goto done;
     }
     for (int s = 0; s < 2; s++) {
@@ -168,7 +168,7 @@ int cmd_calibrate(int argc, char **argv)
         if (read_glove(glove[s], &raw, &n) != EXIT_OK) goto done;
         float *sc2 = malloc(sizeof(float) * (size_t)(n > 0 ? n : 1));
         if (!sc2) {
-            cli_fail("out of memory");
+            io_term_fail("out of memory");
             goto done;
         }
         char gw[256];
@@ -176,13 +176,13 @@ int cmd_calibrate(int argc, char **argv)
                                      gw, sizeof gw);
         free(sc2);
         if (gr != 0) {
-            cli_fail("%s: %s glove: %s", glove[s], s ? "right" : "left", gw);
+            io_term_fail("%s: %s glove: %s", glove[s], s ? "right" : "left", gw);
             goto done;
         }
         cal.has_glove[s] = 1;
     }
     if (io_user_calib_save(out, &cal, &err) != IO_OK) {
-        cli_fail("%s", err.msg);
+        io_term_fail("%s", err.msg);
         goto done;
     }
     printf("egofuse calibrate: %s: arm scale %.3f %.3f (arms %.3f %.3f m), shoulder scale %.3f "

@@ -181,18 +181,18 @@ int cmd_mask(int argc, char **argv)
     io_error err;
     kin_lens lens;
     if (calib) {
-        if (io_calib_load(calib, 0, &lens, &err) != IO_OK) return cli_fail("%s", err.msg);
+        if (io_calib_load(calib, 0, &lens, &err) != IO_OK) return io_term_fail("%s", err.msg);
         if (!width && !lens.width)
-            return cli_fail("%s: no image size in the file (image_width, image_height): give "
+            return io_term_fail("%s: no image size in the file (image_width, image_height): give "
                             "--width and --height", calib);
         if (!width) width = lens.width, height = lens.height;
         if (lens.width > RAST_MAX_DIM || lens.height > RAST_MAX_DIM)
-            return cli_fail("%s: image size %dx%d above %d", calib, lens.width, lens.height,
+            return io_term_fail("%s: image size %dx%d above %d", calib, lens.width, lens.height,
                             RAST_MAX_DIM);
     }
     kin_model model;
     io_gltf_info info;
-    if (io_gltf_load_ex(model_path, scene, &model, &info, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_gltf_load_ex(model_path, scene, &model, &info, &err) != IO_OK) return io_term_fail("%s", err.msg);
     if (info.skipped_points || info.skipped_lines)
         fprintf(stderr, "egofuse: note: %s: %d POINTS and %d LINES/LINE_LOOP/LINE_STRIP "
                 "primitive%s not drawn (a mask holds triangles only)\n", model_path,
@@ -203,16 +203,16 @@ int cmd_mask(int argc, char **argv)
         if (anim >= model.anim_count) {
             int n = model.anim_count;
             kin_model_free(&model);
-            return cli_fail("%s: --anim %d: the model has %d animation%s", model_path, anim, n, n == 1 ? "" : "s");
+            return io_term_fail("%s: --anim %d: the model has %d animation%s", model_path, anim, n, n == 1 ? "" : "s");
         }
         an = &model.anims[anim];
     }
 
     int rc = EXIT_FAIL;
     io_image mask = {0}, nimg = {0}, dimg = {0};
-    if (io_image_alloc(&mask, width, height, 1, IO_U8, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
-    if (out_n && io_image_alloc(&nimg, width, height, 3, IO_U8, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
-    if (out_d && io_image_alloc(&dimg, width, height, 1, IO_F32, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
+    if (io_image_alloc(&mask, width, height, 1, IO_U8, &err) != IO_OK) { io_term_fail("%s", err.msg); goto done; }
+    if (out_n && io_image_alloc(&nimg, width, height, 3, IO_U8, &err) != IO_OK) { io_term_fail("%s", err.msg); goto done; }
+    if (out_d && io_image_alloc(&dimg, width, height, 1, IO_F32, &err) != IO_OK) { io_term_fail("%s", err.msg); goto done; }
     /* The rendering itself is the library call pipe_mask_render (pipe_mask.h). */
     pipe_mask_desc md = {0};
     md.width = width;
@@ -229,13 +229,13 @@ int cmd_mask(int argc, char **argv)
     char why[256];
     if (pipe_mask_render(&model, &md, mask.data, out_n ? nimg.data : NULL, out_d ? dimg.data : NULL,
                          why, sizeof why) != 0) {
-        cli_fail("%s: cannot draw the model: %s", model_path, why);
+        io_term_fail("%s: cannot draw the model: %s", model_path, why);
         goto done;
     }
     /* Write every output only after everything has been computed. */
-    if (io_image_save(out, &mask, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
-    if (out_n && io_image_save(out_n, &nimg, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
-    if (out_d && io_image_save(out_d, &dimg, &err) != IO_OK) { cli_fail("%s", err.msg); goto done; }
+    if (io_image_save(out, &mask, &err) != IO_OK) { io_term_fail("%s", err.msg); goto done; }
+    if (out_n && io_image_save(out_n, &nimg, &err) != IO_OK) { io_term_fail("%s", err.msg); goto done; }
+    if (out_d && io_image_save(out_d, &dimg, &err) != IO_OK) { io_term_fail("%s", err.msg); goto done; }
     rc = EXIT_OK;
 done:
     io_image_free(&mask);

@@ -186,22 +186,22 @@ static int track_pose_init(track_pose *tp, const render_opts *o, const io_scene 
     char path[IO_PATH_MAX + 64], why[512];
     memset(tp, 0, sizeof *tp);
     if (!sc->tracking[0])
-        return cli_fail("%s: --pose tracking, but the scene has no 'tracking' file "
+        return io_term_fail("%s: --pose tracking, but the scene has no 'tracking' file "
                         "(docs/scene.md)", o->scene);
     io_scene_frame_path(sc, sc->tracking, 0, path, sizeof path);
-    if (io_track_load(path, &tp->samples, &tp->count, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_track_load(path, &tp->samples, &tp->count, &err) != IO_OK) return io_term_fail("%s", err.msg);
     if (tp->count < 1) {
         track_pose_free(tp);
-        return cli_fail("%s: no tracking samples", path);
+        return io_term_fail("%s: no tracking samples", path);
     }
     tp->calib = kin_user_calib_identity();
     if (o->calib && io_user_calib_load(o->calib, &tp->calib, &err) != IO_OK) {
         track_pose_free(tp);
-        return cli_fail("%s", err.msg);
+        return io_term_fail("%s", err.msg);
     }
     if (kin_arm_rig_init(&tp->rig, model, why, sizeof why) != 0) {
         track_pose_free(tp);
-        return cli_fail("%s: cannot pose it from tracking: %s", model_path, why);
+        return io_term_fail("%s: cannot pose it from tracking: %s", model_path, why);
     }
     /* with --refine: the refine method's filter (pipe_track_filter_desc) */
     tp->pd.refine_band = o->refine;
@@ -210,7 +210,7 @@ static int track_pose_init(track_pose *tp, const render_opts *o, const io_scene 
     tp->locals = malloc(sizeof *tp->locals * (size_t)model->node_count);
     if (!tp->locals) {
         track_pose_free(tp);
-        return cli_fail("out of memory");
+        return io_term_fail("out of memory");
     }
     return EXIT_OK;
 }
@@ -251,9 +251,9 @@ static int load_rgba(const char *path, int w, int h, const char *what,
     io_error err;
     io_image_free(img);
     if (io_image_load(path, IO_U8, 4, img, &err) != IO_OK)
-        return cli_fail("%s", err.msg);
+        return io_term_fail("%s", err.msg);
     if (img->width != w || img->height != h) {
-        cli_fail("%s: %s image is %dx%d, expected %dx%d", path, what,
+        io_term_fail("%s: %s image is %dx%d, expected %dx%d", path, what,
                  img->width, img->height, w, h);
         io_image_free(img);
         return EXIT_FAIL;
@@ -270,7 +270,7 @@ static int save_rgb(const char *path, const io_image *rgba, io_image *rgb)
         for (int x = 0; x < rgba->width; x++)
             for (int k = 0; k < 3; k++)
                 d[(size_t)y * rgb->stride + 3 * x + k] = s[(size_t)y * rgba->stride + 4 * x + k];
-    if (io_image_save(path, rgb, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_image_save(path, rgb, &err) != IO_OK) return io_term_fail("%s", err.msg);
     return EXIT_OK;
 }
 
@@ -278,7 +278,7 @@ static int save_mask(const char *path, const uint8_t *mask, int w, int h)
 {
     io_image img = {(void *)mask, w, h, 1, IO_U8, (size_t)w};
     io_error err;
-    if (io_image_save(path, &img, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_image_save(path, &img, &err) != IO_OK) return io_term_fail("%s", err.msg);
     return EXIT_OK;
 }
 
@@ -297,10 +297,10 @@ static int render_props(const render_opts *o, pipe_ctx *pp, kin_model *props, in
     io_error err;
     for (int k = 0; k < o->nprops; k++) {
         if (io_gltf_load(o->props[k].path, &props[k], &err) != IO_OK)
-            return cli_fail("--prop %s: %s", o->props[k].path, err.msg);
+            return io_term_fail("--prop %s: %s", o->props[k].path, err.msg);
         (*loaded)++;
         if (pipe_add_prop(pp, &props[k]) != k)
-            return cli_fail("--prop %s: the model has no triangles (or out of memory)",
+            return io_term_fail("--prop %s: the model has no triangles (or out of memory)",
                             o->props[k].path);
         kin_vec3 t = kin_v3(o->props[k].at[0], o->props[k].at[1], o->props[k].at[2]);
         kin_quat r = kin_quat_axis_angle(kin_v3(0, 1, 0),
@@ -315,12 +315,12 @@ static int render(const render_opts *o)
 {
     io_error err;
     io_scene sc;
-    if (io_scene_load(o->scene, &sc, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_scene_load(o->scene, &sc, &err) != IO_OK) return io_term_fail("%s", err.msg);
     int first = o->first, count = o->frames > 0 ? o->frames : sc.frames - first;
     if (first >= sc.frames)
-        return cli_fail("%s: --first %d, but the scene has %d frames", o->scene, first, sc.frames);
+        return io_term_fail("%s: --first %d, but the scene has %d frames", o->scene, first, sc.frames);
     if (first + count > sc.frames)
-        return cli_fail("%s: frames %d..%d asked, but the scene has %d frames", o->scene, first,
+        return io_term_fail("%s: frames %d..%d asked, but the scene has %d frames", o->scene, first,
                         first + count - 1, sc.frames);
 
     /* Every input must be there before anything is written. */
@@ -332,21 +332,21 @@ static int render(const render_opts *o)
                 if (!pat[k][0]) continue; /* no depth for this scene */
                 io_scene_frame_path(&sc, pat[k], f, path, sizeof path);
                 if (!file_exists(path))
-                    return cli_fail("%s: frame %d: %s is missing", o->scene, f, path);
+                    return io_term_fail("%s: frame %d: %s is missing", o->scene, f, path);
             }
         }
 
     kin_model model;
     char model_path[IO_PATH_MAX + 64];
     io_scene_frame_path(&sc, sc.model, 0, model_path, sizeof model_path);
-    if (io_gltf_load(model_path, &model, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_gltf_load(model_path, &model, &err) != IO_OK) return io_term_fail("%s", err.msg);
 
     const kin_animation *anim = NULL;
     if (sc.animation[0]) {
         for (int i = 0; i < model.anim_count; i++)
             if (!strcmp(model.anims[i].name, sc.animation)) anim = &model.anims[i];
         if (!anim) {
-            cli_fail("%s: the scene's animation '%s' is not in %s", o->scene, sc.animation, model_path);
+            io_term_fail("%s: the scene's animation '%s' is not in %s", o->scene, sc.animation, model_path);
             kin_model_free(&model);
             return EXIT_FAIL;
         }
@@ -355,7 +355,7 @@ static int render(const render_opts *o)
     }
     int head = -1;
     if (sc.head_node[0] && (head = kin_model_find_node(&model, sc.head_node)) < 0) {
-        cli_fail("%s: the scene's head node '%s' is not in %s", o->scene, sc.head_node, model_path);
+        io_term_fail("%s: the scene's head node '%s' is not in %s", o->scene, sc.head_node, model_path);
         kin_model_free(&model);
         return EXIT_FAIL;
     }
@@ -398,19 +398,19 @@ static int render(const render_opts *o)
     int props_loaded = 0;
     if (!pp) {
         if (o->aa && (kin_lens_distorts(&pd.hmd.lens[0]) || kin_lens_distorts(&pd.hmd.lens[1])))
-            cli_fail("--aa %d: anti-aliased edges are drawn through the pinhole and cannot be used "
+            io_term_fail("--aa %d: anti-aliased edges are drawn through the pinhole and cannot be used "
                      "with a distorting lens (--hmd-calibration)", o->aa);
         else if (pd.fit_rig)
-            cli_fail("cannot start the pipeline: out of memory, no thread, or the elbow fit "
+            io_term_fail("cannot start the pipeline: out of memory, no thread, or the elbow fit "
                      "cannot use %s (mesh 0's skin, the arms' node chains)", model_path);
         else
-            cli_fail("cannot start the pipeline: out of memory or no thread");
+            io_term_fail("cannot start the pipeline: out of memory or no thread");
         goto done;
     }
     {
         char lw[300];
         if (!cli_lens_fits(&pd.hmd, lw, sizeof lw)) {
-            cli_fail("%s: %s", o->scene, lw);
+            io_term_fail("%s: %s", o->scene, lw);
             goto done;
         }
     }
@@ -424,11 +424,11 @@ static int render(const render_opts *o)
                 pipe_parts_present(pp) & PIPE_PART_HAND_R ? "right-hand " : "",
                 pipe_parts_present(pp) & PIPE_PART_ARM_R ? "right-arm" : "");
     if (io_image_alloc(&rgb, hd.lcd_width, hd.lcd_height, 3, IO_U8, &err) != IO_OK) {
-        cli_fail("out of memory");
+        io_term_fail("out of memory");
         goto done;
     }
-    if (cli_mkdirs(o->out) != 0) {
-        cli_fail("%s: cannot create the output folder", o->out);
+    if (io_mkdirs(o->out) != 0) {
+        io_term_fail("%s: cannot create the output folder", o->out);
         goto done;
     }
 
@@ -448,8 +448,8 @@ static int render(const render_opts *o)
     static const char *eye_name[2] = {"left", "right"};
     pipe_frame_stats st, sum = {0};
     long lod_sum = 0;
-    progress pr;
-    progress_start(&pr, count);
+    io_progress pr;
+    io_progress_start(&pr, count);
     if (o->quiet) pr.enabled = 0;
     for (int f = first; f < first + count; f++) {
         for (int e = 0; e < 2; e++) {
@@ -461,11 +461,11 @@ static int render(const render_opts *o)
                 io_scene_frame_path(&sc, sc.virt_depth[e], f, path, sizeof path);
                 io_image_free(&vdepth[e]);
                 if (io_image_load(path, IO_F32, 1, &vdepth[e], &err) != IO_OK) {
-                    cli_fail("%s", err.msg);
+                    io_term_fail("%s", err.msg);
                     goto done;
                 }
                 if (vdepth[e].width != hd.lcd_width || vdepth[e].height != hd.lcd_height) {
-                    cli_fail("%s: virtual depth image is %dx%d, expected %dx%d", path,
+                    io_term_fail("%s: virtual depth image is %dx%d, expected %dx%d", path,
                              vdepth[e].width, vdepth[e].height, hd.lcd_width, hd.lcd_height);
                     goto done;
                 }
@@ -493,7 +493,7 @@ static int render(const render_opts *o)
         char why[256];
         pipe_result pr_ = pipe_frame(pp, &in, &st, why, sizeof why);
         if (pr_ != PIPE_OK) {
-            cli_fail("%s: frame %d: %s", o->scene, f, why);
+            io_term_fail("%s: frame %d: %s", o->scene, f, why);
             goto done;
         }
         sum.ms_pose += st.ms_pose;
@@ -513,11 +513,11 @@ static int render(const render_opts *o)
                 if (save_mask(path, m, mw, mh)) goto done;
             }
         }
-        progress_step(&pr, f - first + 1, "frame");
+        io_progress_step(&pr, f - first + 1, "frame");
     }
-    progress_end(&pr);
+    io_progress_end(&pr);
     if (!o->quiet) {
-        double wall = cli_now() - pr.t0;
+        double wall = io_now_s() - pr.t0;
         printf("egofuse: wrote %d stereo frames (%dx%d per eye) to %s\n", count, hd.lcd_width,
                hd.lcd_height, o->out);
         printf("egofuse: per stereo frame, %s, %d thread%s: %.3f ms (pose+skin %.3f ms; "
@@ -813,7 +813,7 @@ int cmd_demo(int argc, char **argv)
     char scene[IO_PATH_MAX + 32];
     snprintf(scene, sizeof scene, "%s/scene.txt", samples);
     if (!file_exists(scene))
-        return cli_fail("%s is missing: run 'make demo' (it generates the samples), or "
+        return io_term_fail("%s is missing: run 'make demo' (it generates the samples), or "
                         "'build/gen_samples --out %s'", scene, samples);
     o.scene = scene;
     return render(&o);

@@ -317,7 +317,7 @@ static int parse_hostport(const char *s, int need_port, int def_port, struct soc
     sa->sin_port = htons((uint16_t)port);
     const char *why;
     if (io_ipv4_resolve(host, &sa->sin_addr.s_addr, &why) != 0) {
-        cli_fail("%s '%s': '%s' is neither an IPv4 address nor a known host name (%s)", what, s,
+        io_term_fail("%s '%s': '%s' is neither an IPv4 address nor a known host name (%s)", what, s,
                  host, why);
         return -1;
     }
@@ -331,10 +331,10 @@ static int replay(const replay_opts *o)
     io_error err;
     kin_track_sample *smp = NULL;
     int count = 0;
-    if (io_track_load(o->file, &smp, &count, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_track_load(o->file, &smp, &count, &err) != IO_OK) return io_term_fail("%s", err.msg);
     if (count < 1) {
         io_track_free(smp);
-        return cli_fail("%s: no samples to replay", o->file);
+        return io_term_fail("%s: no samples to replay", o->file);
     }
     double span = smp[count - 1].t - smp[0].t;
     double period = span + (count > 1 ? span / (count - 1) : 1.0 / 60.0);
@@ -352,7 +352,7 @@ static int replay(const replay_opts *o)
         char ip[INET_ADDRSTRLEN];
         inet_ntop(AF_INET, &sa.sin_addr, ip, sizeof ip);
         if (io_track_udp_connect(&udp, ip, ntohs(sa.sin_port), &err) != IO_OK) {
-            cli_fail("--to %s: %s", o->to, err.msg);
+            io_term_fail("--to %s: %s", o->to, err.msg);
             goto done;
         }
         snprintf(dest, sizeof dest, "udp %s:%d", ip, ntohs(sa.sin_port));
@@ -367,20 +367,20 @@ static int replay(const replay_opts *o)
         srv.data_fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
         int one = 1;
         if (srv.cmd_fd < 0 || srv.data_fd < 0) {
-            cli_fail("socket: %s", strerror(errno));
+            io_term_fail("socket: %s", strerror(errno));
             goto done;
         }
         setsockopt(srv.cmd_fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
         char ip[INET_ADDRSTRLEN];
         inet_ntop(AF_INET, &sa.sin_addr, ip, sizeof ip);
         if (bind(srv.cmd_fd, (struct sockaddr *)&sa, sizeof sa) != 0) {
-            cli_fail("--to %s: bind %s:%d: %s", o->to, ip, ntohs(sa.sin_port), strerror(errno));
+            io_term_fail("--to %s: bind %s:%d: %s", o->to, ip, ntohs(sa.sin_port), strerror(errno));
             goto done;
         }
         struct sockaddr_in da = sa;
         da.sin_port = 0;
         if (bind(srv.data_fd, (struct sockaddr *)&da, sizeof da) != 0) {
-            cli_fail("--to %s: bind %s:0: %s", o->to, ip, strerror(errno));
+            io_term_fail("--to %s: bind %s:0: %s", o->to, ip, strerror(errno));
             goto done;
         }
         if (o->multicast) {
@@ -422,7 +422,7 @@ static int replay(const replay_opts *o)
                 if (!had && srv.clients) t_client = io_now_ns();
                 if (srv.clients) continue;
                 if (t_end && io_now_ns() > t_end) {
-                    cli_fail("%s: no NatNet client connected within %g s", dest, o->wait_s);
+                    io_term_fail("%s: no NatNet client connected within %g s", dest, o->wait_s);
                     goto done;
                 }
             }
@@ -462,7 +462,7 @@ static int replay(const replay_opts *o)
                 buf b;
                 frame(&srv, &b, (int32_t)(1 + i + (long)loop * count), s.t, &s, io_now_ns());
                 if (b.n > sizeof b.d) {
-                    cli_fail("frame too large");
+                    io_term_fail("frame too large");
                     goto done;
                 }
                 if (srv.multicast) send_to(srv.data_fd, &b, &srv.group);

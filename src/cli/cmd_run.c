@@ -47,10 +47,10 @@ static void on_signal(int s)
 static int load_virt(const char *path, int w, int h, io_image *img)
 {
     io_error err;
-    if (io_image_load(path, IO_U8, 4, img, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_image_load(path, IO_U8, 4, img, &err) != IO_OK) return io_term_fail("%s", err.msg);
     if (img->width != w || img->height != h) {
         /* the sizes before the image is freed (which zeroes them) */
-        cli_fail("%s: virtual image is %dx%d, expected %dx%d", path, img->width, img->height, w,
+        io_term_fail("%s: virtual image is %dx%d, expected %dx%d", path, img->width, img->height, w,
                  h);
         io_image_free(img);
         return EXIT_FAIL;
@@ -304,7 +304,7 @@ static int write_outputs(const run_opts *o, run_state *r, int frame, int W, int 
         for (int e = 0; e < 2; e++) {
             char p[IO_PATH_MAX + 64];
             snprintf(p, sizeof p, "%s/%s_%04d.png", o->out, eye[e], frame);
-            if (io_image_save(p, &r->outimg[e], &err) != IO_OK) return cli_fail("%s", err.msg);
+            if (io_image_save(p, &r->outimg[e], &err) != IO_OK) return io_term_fail("%s", err.msg);
         }
     }
     if (o->raw) {
@@ -320,7 +320,7 @@ static int write_outputs(const run_opts *o, run_state *r, int frame, int W, int 
             }
         size_t n = (size_t)W * (size_t)H * 6;
         if (fwrite(r->rawbuf, 1, n, stdout) != n || fflush(stdout) != 0)
-            return cli_fail("stdout: write error: %s (reader gone?)", strerror(errno));
+            return io_term_fail("stdout: write error: %s (reader gone?)", strerror(errno));
     }
     return EXIT_OK;
 }
@@ -373,7 +373,7 @@ static int run(const run_opts *o)
         return cli_usage_error("run", "--scene or --model is required (the arm model to mask)");
 
     run_state *r = calloc(1, sizeof *r);
-    if (!r) return cli_fail("out of memory");
+    if (!r) return io_term_fail("out of memory");
     r->cam[0].fd = r->cam[1].fd = -1;
     r->udp.fd = -1;
     r->ucal = kin_user_calib_identity();
@@ -383,7 +383,7 @@ static int run(const run_opts *o)
     char model_path[IO_PATH_MAX + 64];
     if (o->scene) {
         if (io_scene_load(o->scene, &r->sc, &err) != IO_OK) {
-            cli_fail("%s", err.msg);
+            io_term_fail("%s", err.msg);
             goto done;
         }
         r->have_scene = 1;
@@ -391,7 +391,7 @@ static int run(const run_opts *o)
     }
     if (o->model) snprintf(model_path, sizeof model_path, "%s", o->model);
     if (io_gltf_load(model_path, &r->model, &err) != IO_OK) {
-        cli_fail("%s", err.msg);
+        io_term_fail("%s", err.msg);
         goto done;
     }
     r->have_model = 1;
@@ -424,11 +424,11 @@ static int run(const run_opts *o)
                 io_scene_frame_path(&r->sc, r->sc.virt_depth[e], 0, r->vdepth_path[e],
                                     sizeof r->vdepth_path[e]);
                 if (io_image_load(r->vdepth_path[e], IO_F32, 1, &r->vdepth[e], &err) != IO_OK) {
-                    cli_fail("%s", err.msg);
+                    io_term_fail("%s", err.msg);
                     goto done;
                 }
                 if (r->vdepth[e].width != W || r->vdepth[e].height != H) {
-                    cli_fail("%s: virtual depth image is %dx%d, expected %dx%d", r->vdepth_path[e],
+                    io_term_fail("%s: virtual depth image is %dx%d, expected %dx%d", r->vdepth_path[e],
                              r->vdepth[e].width, r->vdepth[e].height, W, H);
                     goto done;
                 }
@@ -443,17 +443,17 @@ static int run(const run_opts *o)
                 }
             }
         } else {
-            cli_fail("%s", err.msg);
+            io_term_fail("%s", err.msg);
             goto done;
         }
         if (io_image_alloc(&r->outimg[e], W, H, 4, IO_U8, &err) != IO_OK ||
             io_image_alloc(&r->camimg[e], hd.cam_width, hd.cam_height, 4, IO_U8, &err) != IO_OK) {
-            cli_fail("%s", err.msg);
+            io_term_fail("%s", err.msg);
             goto done;
         }
     }
     if (o->raw && !(r->rawbuf = malloc((size_t)W * (size_t)H * 6))) {
-        cli_fail("out of memory");
+        io_term_fail("out of memory");
         goto done;
     }
     /* ---- the pose */
@@ -461,11 +461,11 @@ static int run(const run_opts *o)
     if (tracked) {
         char why[256];
         if (kin_arm_rig_init(&r->rig, model, why, sizeof why) != 0) {
-            cli_fail("%s: cannot follow the tracker: %s", model_path, why);
+            io_term_fail("%s: cannot follow the tracker: %s", model_path, why);
             goto done;
         }
         if (!(r->locals = malloc(sizeof(kin_transform) * (size_t)model->node_count))) {
-            cli_fail("out of memory");
+            io_term_fail("out of memory");
             goto done;
         }
         /* with --refine: the refine method's filter (pipe_track_filter_desc) */
@@ -475,7 +475,7 @@ static int run(const run_opts *o)
     }
     if (o->track_port &&
         io_track_udp_listen(&r->udp, o->track_addr, o->track_port, &err) != IO_OK) {
-        cli_fail("tracking stream: %s", err.msg);
+        io_term_fail("tracking stream: %s", err.msg);
         goto done;
     }
     if (o->natnet) {
@@ -483,11 +483,11 @@ static int run(const run_opts *o)
         io_natnet_config_default(&nc);
         for (int i = 0; i < o->natnet_kv_count; i++)
             if (io_natnet_config_set(&nc, o->natnet_kv[i][0], o->natnet_kv[i][1], &err) != IO_OK) {
-                cli_fail("%s", err.msg);
+                io_term_fail("%s", err.msg);
                 goto done;
             }
         if (io_natnet_open(&r->natnet, &nc, &err) != IO_OK) {
-            cli_fail("%s", err.msg);
+            io_term_fail("%s", err.msg);
             goto done;
         }
         r->have_natnet = 1;
@@ -500,14 +500,14 @@ static int run(const run_opts *o)
                             "it does)\n", err.msg);
     }
     if (o->calib && io_user_calib_load(o->calib, &r->ucal, &err) != IO_OK) {
-        cli_fail("%s", err.msg);
+        io_term_fail("%s", err.msg);
         goto done;
     }
     for (int e = 0; e < 2; e++) {
         if (!o->glove_sel[e]) continue;
         const char *gs = strcmp(o->glove_sel[e], "any") ? o->glove_sel[e] : NULL;
         if (io_glove_open(&r->glove[e], gs, &err) != IO_OK) {
-            cli_fail("%s glove: %s", e ? "right" : "left", err.msg);
+            io_term_fail("%s glove: %s", e ? "right" : "left", err.msg);
             goto done;
         }
         r->have_glove[e] = 1;
@@ -525,7 +525,7 @@ static int run(const run_opts *o)
         vc.stale_ms = o->virt_stale_ms;
         vc.loop = o->loop;
         if (io_vsrc_open(&r->vsrc, &vc, &err) != IO_OK) {
-            cli_fail("virtual scene: %s", err.msg);
+            io_term_fail("virtual scene: %s", err.msg);
             goto done;
         }
     }
@@ -549,13 +549,13 @@ static int run(const run_opts *o)
         c.buffers = o->buffers;
         if (file_cams) c.backend_opts = &fco;
         if (io_cam_open(&r->cam[e], file_cams ? &io_cam_file : &io_cam_v4l2, &c, &err) != IO_OK) {
-            cli_fail("%s camera: %s", e ? "right" : "left", err.msg);
+            io_term_fail("%s camera: %s", e ? "right" : "left", err.msg);
             goto done;
         }
     }
     for (int e = 0; e < 2; e++) /* both opened: start together */
         if (io_cam_start(&r->cam[e], &err) != IO_OK) {
-            cli_fail("%s camera: %s", e ? "right" : "left", err.msg);
+            io_term_fail("%s camera: %s", e ? "right" : "left", err.msg);
             goto done;
         }
     pd.refine_band = o->refine;
@@ -566,9 +566,9 @@ static int run(const run_opts *o)
     pd.fit_rig = o->refine && tracked ? &r->rig : NULL;
     if (!(r->pipe = pipe_create(&pd, model))) {
         if (o->aa && (kin_lens_distorts(&pd.hmd.lens[0]) || kin_lens_distorts(&pd.hmd.lens[1])))
-            cli_fail("--aa %d: anti-aliased edges are drawn through the pinhole and cannot be used "
+            io_term_fail("--aa %d: anti-aliased edges are drawn through the pinhole and cannot be used "
                      "with a distorting lens (the calibration of the cockpit's HMD)", o->aa);
-        else cli_fail(pd.fit_rig ? "cannot start the pipeline (out of memory, no thread, or the elbow "
+        else io_term_fail(pd.fit_rig ? "cannot start the pipeline (out of memory, no thread, or the elbow "
                               "fit cannot use the model: mesh 0's skin, the arms' node chains)"
                             : "cannot start the pipeline (out of memory or no thread)");
         goto done;
@@ -583,31 +583,31 @@ static int run(const run_opts *o)
                 parts & PIPE_PART_ARM_R ? "right-arm" : "");
     for (int k = 0; k < o->prop_count; k++) {
         if (io_gltf_load(o->prop[k].model, &r->props[k], &err) != IO_OK) {
-            cli_fail("--prop %s: %s", o->prop[k].name, err.msg);
+            io_term_fail("--prop %s: %s", o->prop[k].name, err.msg);
             goto done;
         }
         r->props_loaded++;
         if (pipe_add_prop(r->pipe, &r->props[k]) != k) {
-            cli_fail("--prop %s: %s has no triangles (or out of memory)", o->prop[k].name,
+            io_term_fail("--prop %s: %s has no triangles (or out of memory)", o->prop[k].name,
                      o->prop[k].model);
             goto done;
         }
     }
-    if (o->out && cli_mkdirs(o->out) != 0) {
-        cli_fail("%s: cannot create the output folder: %s", o->out, strerror(errno));
+    if (o->out && io_mkdirs(o->out) != 0) {
+        io_term_fail("%s: cannot create the output folder: %s", o->out, strerror(errno));
         goto done;
     }
     /* ---- the display last: the screen changes only once all else is up */
     if (o->display) {
         io_display_config dc = {o->display, W, H, 0};
         if (io_display_open(&r->disp, &dc, &err) != IO_OK) {
-            cli_fail("display: %s", err.msg);
+            io_term_fail("display: %s", err.msg);
             goto done;
         }
         io_sched_init(&r->sched, io_display_refresh_ns(r->disp));
     }
     if (o->stats && io_stats_open(&r->stats, o->stats, &err) != IO_OK) {
-        cli_fail("%s", err.msg);
+        io_term_fail("%s", err.msg);
         goto done;
     }
     if (!o->quiet) {
@@ -815,7 +815,7 @@ static int run(const run_opts *o)
         pipe_result pr = pipe_frame(r->pipe, &in, &ps, why, (int)sizeof why);
         lg.t_done = io_now_ns();
         if (pr != PIPE_OK) {
-            cli_fail("frame %d: %s", frames, why);
+            io_term_fail("frame %d: %s", frames, why);
             goto done;
         }
         lg.ms_pose = ps.ms_pose;
@@ -837,7 +837,7 @@ static int run(const run_opts *o)
             const uint8_t *eyes[2] = {r->outimg[0].data, r->outimg[1].data};
             size_t stride[2] = {r->outimg[0].stride, r->outimg[1].stride};
             if (io_display_present(r->disp, eyes, stride, lg.frame, &err) != IO_OK) {
-                cli_fail("display: %s", err.msg);
+                io_term_fail("display: %s", err.msg);
                 goto done;
             }
             io_sched_presented(&r->sched, &plan, lg.t_dequeue, io_now_ns());
@@ -894,7 +894,7 @@ static int run(const run_opts *o)
     r->npending = 0;
     if (!o->quiet) fputc('\n', stderr);
     if (io_stats_close(&r->stats, &err) != IO_OK) {
-        cli_fail("%s", err.msg);
+        io_term_fail("%s", err.msg);
         goto done;
     }
     {

@@ -42,22 +42,22 @@ int run_dump_frame(const run_opts *o, const run_dump_src *r, const pipe_frame_in
                    const kin_track_sample *sample, int tracked, int W, int H)
 {
     io_error err;
-    if (cli_mkdirs(o->dump) != 0)
-        return cli_fail("%s: cannot create the dump folder: %s", o->dump, strerror(errno));
+    if (io_mkdirs(o->dump) != 0)
+        return io_term_fail("%s: cannot create the dump folder: %s", o->dump, strerror(errno));
     static const char *const eye[2] = {"left", "right"};
     for (int e = 0; e < 2; e++) {
         char p[IO_PATH_MAX + 64];
         snprintf(p, sizeof p, "%s/cam_%s_0000.png", o->dump, eye[e]);
-        if (io_image_save(p, &r->camimg[e], &err) != IO_OK) return cli_fail("%s", err.msg);
+        if (io_image_save(p, &r->camimg[e], &err) != IO_OK) return io_term_fail("%s", err.msg);
         io_image v = {in->virt[e].pixels, W, H, 4, IO_U8, (size_t)in->virt[e].stride};
         snprintf(p, sizeof p, "%s/virt_%s_0000.png", o->dump, eye[e]);
-        if (io_image_save(p, &v, &err) != IO_OK) return cli_fail("%s", err.msg);
+        if (io_image_save(p, &v, &err) != IO_OK) return io_term_fail("%s", err.msg);
         if (in->virt_depth[e] && in->virt_depth[e] != r->vdepth[e].data) {
             /* a live source's depth, as float EXR */
             io_image d = {(void *)in->virt_depth[e], W, H, 1, IO_F32,
                           (size_t)in->virt_depth_stride[e] * sizeof(float)};
             snprintf(p, sizeof p, "%s/virt_depth_%s_0000.exr", o->dump, eye[e]);
-            if (io_image_save(p, &d, &err) != IO_OK) return cli_fail("%s", err.msg);
+            if (io_image_save(p, &d, &err) != IO_OK) return io_term_fail("%s", err.msg);
         }
     }
     char path[IO_PATH_MAX + 64], tmp[IO_PATH_MAX + 96];
@@ -65,14 +65,14 @@ int run_dump_frame(const run_opts *o, const run_dump_src *r, const pipe_frame_in
         kin_track_sample s = *sample;
         s.t = 0;
         snprintf(path, sizeof path, "%s/track.txt", o->dump);
-        if (io_track_save(path, &s, 1, &err) != IO_OK) return cli_fail("%s", err.msg);
+        if (io_track_save(path, &s, 1, &err) != IO_OK) return io_term_fail("%s", err.msg);
     }
     char model_abs[IO_PATH_MAX + 64];
     if (!realpath(r->model_path, model_abs)) snprintf(model_abs, sizeof model_abs, "%s", r->model_path);
     snprintf(path, sizeof path, "%s/scene.txt", o->dump);
     snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
     FILE *f = fopen(tmp, "w");
-    if (!f) return cli_fail("%s: %s", path, strerror(errno));
+    if (!f) return io_term_fail("%s: %s", path, strerror(errno));
     int bad = fprintf(f,
                       "egofuse-scene 1\n# the last frame of egofuse run (--dump)\nmodel = %s\n"
                       "frames = 1\nfps = 60\ncamera_left = cam_left_%%04d.png\n"
@@ -92,7 +92,7 @@ int run_dump_frame(const run_opts *o, const run_dump_src *r, const pipe_frame_in
         if (copy_file(r->vdepth_path[e], dabs) != 0) {
             fclose(f);
             unlink(tmp);
-            return cli_fail("%s: cannot copy %s: %s", dabs, r->vdepth_path[e], strerror(errno));
+            return io_term_fail("%s: cannot copy %s: %s", dabs, r->vdepth_path[e], strerror(errno));
         }
         bad |= fprintf(f, "virtual_depth_%s = virt_depth_%s_%%04d%s\n", eye[e], eye[e],
                        strrchr(dabs, '.') ? strrchr(dabs, '.') : "") < 0;
@@ -133,12 +133,12 @@ int run_dump_frame(const run_opts *o, const run_dump_src *r, const pipe_frame_in
     if (bad || rename(tmp, path) != 0) {
         int e = errno;
         unlink(tmp);
-        return cli_fail("%s: %s", path, strerror(e ? e : EIO));
+        return io_term_fail("%s: %s", path, strerror(e ? e : EIO));
     }
     snprintf(path, sizeof path, "%s/command.txt", o->dump);
     snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
     f = fopen(tmp, "w");
-    if (!f) return cli_fail("%s: %s", path, strerror(errno));
+    if (!f) return io_term_fail("%s: %s", path, strerror(errno));
     bad = fprintf(f, "egofuse render --scene %s/scene.txt --out OUT%s%s%s", o->dump,
                   tracked ? " --pose tracking --no-filter" : "", o->calib ? " --calib " : "",
                   o->calib ? o->calib : "") < 0;
@@ -176,7 +176,7 @@ int run_dump_frame(const run_opts *o, const run_dump_src *r, const pipe_frame_in
     if (bad || rename(tmp, path) != 0) {
         int e = errno;
         unlink(tmp);
-        return cli_fail("%s: %s", path, strerror(e ? e : EIO));
+        return io_term_fail("%s: %s", path, strerror(e ? e : EIO));
     }
     return EXIT_OK;
 }

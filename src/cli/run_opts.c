@@ -294,7 +294,7 @@ int run_parse(int argc, char **argv, run_opts *o)
     io_conf_free(&conf);
     if (config) {
         io_error err;
-        if (io_conf_load(config, &conf, &err) != IO_OK) return cli_fail("%s", err.msg);
+        if (io_conf_load(config, &conf, &err) != IO_OK) return io_term_fail("%s", err.msg);
     }
     static char **av;
     static const char **origin;
@@ -303,7 +303,7 @@ int run_parse(int argc, char **argv, run_opts *o)
     int ac = argc + conf.argc;
     av = calloc((size_t)ac + 1, sizeof *av);
     origin = calloc((size_t)ac + 1, sizeof *origin);
-    if (!av || !origin) return cli_fail("out of memory");
+    if (!av || !origin) return io_term_fail("out of memory");
     av[0] = argv[0];
     for (int i = 0; i < conf.argc; i++) {
         av[1 + i] = conf.argv[i];

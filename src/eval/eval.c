@@ -11,7 +11,8 @@
  * are timed and measured. A report runs several such batches (methods,
  * knobs, tracking sweeps, other sequences), each on its own ground truth. */
 #include "eval_internal.h"
-#include "../cli/cli.h"
+#include "../io/io.h"
+#include "../io/io_term.h"
 #include "../io/io_lod.h"
 #include "../fit/fit_band.h"
 #include "../fit/fit_holes.h"
@@ -127,7 +128,7 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
         return -1;
     char why[256];
     if (kin_arm_rig_init(&c->rig, &c->mask.model, why, sizeof why) < 0) {
-        cli_fail("mask model: %s", why);
+        io_term_fail("mask model: %s", why);
         return -1;
     }
     const kin_model *m = &c->mask.model;
@@ -174,7 +175,7 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
          c->nrm_lo && c->mnrm && c->refine_scratch && c->stereo_scratch;
     if (!ok) return -1;
     if (estimate_calib(c, track) < 0) {
-        cli_fail("user calibration from the calibration motion: %s", c->calib_why);
+        io_term_fail("user calibration from the calibration motion: %s", c->calib_why);
         return -2;
     }
     if (gt_sequence_build(&c->mask, sequence, &c->truth) < 0) return -1;
@@ -354,8 +355,8 @@ static int dump_masks(const char *dir, const method_cfg *cfg, int frame, int eye
              eye ? "right" : "left", frame);
     io_image img = { rgb, CW, CH, 3, IO_U8, (size_t)CW * 3 };
     io_error err;
-    if (io_image_save(path, &img, &err) != IO_OK) return cli_fail("%s", err.msg);
-    return EXIT_OK;
+    if (io_image_save(path, &img, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    return IO_EXIT_OK;
 }
 
 /* FK and skinning of locals into c->ps.world, c->ps.pos, c->ps.nrm. */
@@ -467,7 +468,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
 {
     const method_cfg *cfg = &r->cfg;
     double T = (double)frame / GEN_FPS;
-    double t0 = cli_now();
+    double t0 = io_now_s();
     /* tracking: every sample delivered by now */
     const double lat = cfg->track.latency_ms * 1e-3;
     for (;;) {
@@ -484,7 +485,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             r->have_last = 1;
         }
     }
-    t0 = cli_now();   /* the tracker's simulation is not the method's time */
+    t0 = io_now_s();   /* the tracker's simulation is not the method's time */
     double c0 = thread_cpu();   /* and the same as this thread's CPU time */
     const kin_model *m = cfg->fine ? &c->mask_fine.model : &c->mask.model;
     const kin_mesh *me = &m->meshes[0];
@@ -516,9 +517,9 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             pipe_fit_shape(r->fit, c->ps.world, c->ps.pos);
         }
     }
-    double secs = cli_now() - t0, cpu = thread_cpu() - c0;
+    double secs = io_now_s() - t0, cpu = thread_cpu() - c0;
     for (int e = 0; e < 2; e++) {
-        t0 = cli_now();
+        t0 = io_now_s();
         c0 = thread_cpu();
         kin_camera cam = posed ? eye_camera(c, e) : c->tcam[e];
         const uint8_t *mask = c->mask_up;
@@ -662,7 +663,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             fuse_composite(&Q, &V, c->g.vp_x0, c->g.vp_y0, c->g.vp_width, c->g.vp_height,
                            &O) != FUSE_OK)
             return -1;
-        secs += cli_now() - t0;
+        secs += io_now_s() - t0;
         cpu += thread_cpu() - c0;
         if (cfg->lod != 0 && posed && c->full_mask && cfg->div == 1 && !cfg->fine &&
             cfg->kind != M_SKIN) {
@@ -755,30 +756,30 @@ int eval__run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames
     method_cfg base = eval__base_cfg(o, M_KIN_CAL);
     int irc = ctx_init(c, (uint64_t)o->seed, seq, &base.track);
     if (irc < 0)
-        return irc == -2 ? EXIT_FAIL : cli_fail("cannot build the ground truth (out of memory)");
+        return irc == -2 ? IO_EXIT_FAIL : io_term_fail("cannot build the ground truth (out of memory)");
     if (light) c->light = *light;
-    int rc = EXIT_FAIL;
+    int rc = IO_EXIT_FAIL;
     int inited = 0;
     for (int i = 0; i < n; i++)
-        if (cfgs[i].lod != 0 && eval__lod_init(c) < 0) return EXIT_FAIL;
+        if (cfgs[i].lod != 0 && eval__lod_init(c) < 0) return IO_EXIT_FAIL;
     for (; inited < n; inited++)
-        if (run_init(&R[inited], &cfgs[inited], c) < 0) { cli_fail("out of memory"); goto done; }
-    progress pr;
-    progress_start(&pr, frames);
+        if (run_init(&R[inited], &cfgs[inited], c) < 0) { io_term_fail("out of memory"); goto done; }
+    io_progress pr;
+    io_progress_start(&pr, frames);
     if (o->quiet) pr.enabled = 0;
     for (int f = 0; f < frames; f++) {
-        if (make_truth(c, f, speed, f == 0) < 0) { cli_fail("frame %d: ground truth", f); goto done; }
+        if (make_truth(c, f, speed, f == 0) < 0) { io_term_fail("frame %d: ground truth", f); goto done; }
         for (int i = 0; i < n; i++)
             if (run_frame(c, &R[i], f, o->per_frame, o->dump) < 0) {
-                cli_fail("frame %d: %s %s failed", f, kind_name[R[i].cfg.kind], R[i].cfg.setting);
+                io_term_fail("frame %d: %s %s failed", f, kind_name[R[i].cfg.kind], R[i].cfg.setting);
                 goto done;
             }
         char what[64];
         snprintf(what, sizeof what, "eval %s frame", seq);
-        progress_step(&pr, f + 1, what);
+        io_progress_step(&pr, f + 1, what);
     }
-    progress_end(&pr);
-    rc = EXIT_OK;
+    io_progress_end(&pr);
+    rc = IO_EXIT_OK;
 done:
     for (int i = 0; i < inited; i++) run_free(&R[i]);
     return rc;

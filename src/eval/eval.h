@@ -20,12 +20,12 @@
  *   is not part of the core library: it needs the sample generator and the
  *   ground truth (samples/gen, samples/gt, build/libegofuse_samples.a) and
  *   is linked into the egofuse program only. Messages and the progress
- *   line go through the program's helpers (src/cli/cli.h).
+ *   line go through src/io/io_term.h (shared with the commands).
  *
  * USAGE
  *   eval_opts o = ...;              // see cmd_eval.c for the defaults
  *   o.methods = eval_parse_methods("kin,refine");
- *   return eval_run(&o);            // EXIT_OK or EXIT_FAIL (message printed)
+ *   return eval_run(&o);            // IO_EXIT_OK or IO_EXIT_FAIL (message printed)
  */
 #ifndef EGOFUSE_EVAL_H
 #define EGOFUSE_EVAL_H
@@ -68,7 +68,7 @@ typedef struct eval_opts {
  * refine-shiftall: bits 4..6); 0 when a name is unknown. */
 unsigned eval_parse_methods(const char *list);
 /* Runs the evaluation o describes, prints its tables, writes o->csv and
- * the report folder o->report when set. EXIT_OK, or EXIT_FAIL with the
+ * the report folder o->report when set. IO_EXIT_OK, or IO_EXIT_FAIL with the
  * message printed. */
 int eval_run(const eval_opts *o);
 
@@ -77,7 +77,7 @@ int eval_run(const eval_opts *o);
  * method (crop, reproj) the hand's position and size error, the IoU and
  * PSNR against ground truth from the true eye, the ms per stereo frame.
  * Uses frames (per distance, at most 180), seed, csv, report, quiet,
- * per_frame. EXIT_OK, or EXIT_FAIL with the message printed. */
+ * per_frame. IO_EXIT_OK, or IO_EXIT_FAIL with the message printed. */
 int eval_eye_run(const eval_opts *o);
 
 #endif

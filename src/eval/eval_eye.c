@@ -37,7 +37,8 @@
 #include <time.h>
 
 #include "../../samples/gt/gt_eye.h"
-#include "../cli/cli.h"
+#include "../io/io.h"
+#include "../io/io_term.h"
 #include "../fuse/fuse_moments.h"
 
 enum { DW = GEN_VIRT_W, DH = GEN_VIRT_H };
@@ -120,12 +121,12 @@ static int ctx_init(eye_ctx *c, uint64_t seed, const char *seq)
     if (gen_arms_build(&c->mask) < 0 || gt_truth_build(&c->mask, &same, &c->truth) < 0 ||
         gt_cockpit_build(&c->cockpit) < 0 || gen_scene_workshop(&c->workshop, &c->mask) < 0 ||
         gen_frame_ctx_init(&c->g, &c->truth, &c->cockpit, &c->workshop, seed) < 0)
-        return cli_fail("cannot build the ground truth (out of memory)");
+        return io_term_fail("cannot build the ground truth (out of memory)");
     if (gt_sequence_build(&c->mask, seq, &c->truth) < 0)
-        return cli_fail("sequence %s: cannot build it", seq);
+        return io_term_fail("sequence %s: cannot build it", seq);
     char why[256];
     if (kin_arm_rig_init(&c->rig, &c->mask.model, why, sizeof why) < 0)
-        return cli_fail("mask model: %s", why);
+        return io_term_fail("mask model: %s", why);
     c->hand_m = gt_part_triangles(&c->mask, 2u, GEN_J_MIDDLE_3, GEN_J_MIDDLE_3, &c->ntri_m);
     c->hand_t = gt_part_triangles(&c->truth, 2u, GEN_J_MIDDLE_3, GEN_J_MIDDLE_3, &c->ntri_t);
     const kin_model *m = &c->mask.model;
@@ -161,14 +162,14 @@ static int ctx_init(eye_ctx *c, uint64_t seed, const char *seq)
     ok = ok && c->vdepth && c->enrm && c->scratch && c->vrgb && c->eye_rgba && c->mask_c &&
          c->hmask_c && c->layer && c->disp && c->disp_sil && c->disp_hand && c->black && c->white &&
          c->depth_c && c->nrm_c;
-    if (!ok) return cli_fail("out of memory");
+    if (!ok) return io_term_fail("out of memory");
     for (int k = 0; k < EM_COUNT; k++) {
         pipe_desc pd;
         memset(&pd, 0, sizeof pd);
         pd.threads = 1;
         pd.eye_view = k == EM_CROP ? PIPE_VIEW_CROP : PIPE_VIEW_REPROJECT;
         c->pipe[k] = pipe_create(&pd, m);
-        if (!c->pipe[k]) return cli_fail("the %s pipeline: cannot create it", em_name[k]);
+        if (!c->pipe[k]) return io_term_fail("the %s pipeline: cannot create it", em_name[k]);
     }
     /* the workshop's lights in world space (pipe_frame turns them into
      * each view's space) */
@@ -277,8 +278,8 @@ static int dump_view(const char *dir, const eye_run *r, int fi, int e, const uin
              em_name[r->method], (double)r->noise, e ? "right" : "left", fi);
     io_image img = { rgb, DW, DH, 3, IO_U8, (size_t)DW * 3 };
     io_error err;
-    if (io_image_save(path, &img, &err) != IO_OK) return cli_fail("%s", err.msg);
-    return EXIT_OK;
+    if (io_image_save(path, &img, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    return IO_EXIT_OK;
 }
 
 /* One display frame fi of one configuration, both eyes, measured. */
@@ -327,7 +328,7 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
     pipe_frame_stats st;
     char why[256];
     double t0 = thread_secs();
-    if (pipe_frame(p, &in, &st, why, sizeof why) != PIPE_OK) return cli_fail("%s", why);
+    if (pipe_frame(p, &in, &st, why, sizeof why) != PIPE_OK) return io_term_fail("%s", why);
     double secs = thread_secs() - t0;
     /* the posed model, for its fingertip (not timed) */
     kin_fk(m->parents, m->node_count, r->locals, NULL, c->ps.world);
@@ -352,7 +353,7 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
             vw = c->geo.vp_width;
             vh = c->geo.vp_height;
         }
-        if (!M || w != CW || h != CH) return cli_fail("the %s pipeline: no mask", em_name[r->method]);
+        if (!M || w != CW || h != CH) return io_term_fail("the %s pipeline: no mask", em_name[r->method]);
         uint8_t *sil = c->disp_sil;
         if (layer_to_display(c, M, w, h, x0, y0, vw, vh, sil) < 0) return -1;
         fuse_confusion cf;
@@ -479,7 +480,7 @@ static int write_csv(const char *path, const eye_ctx *c, const eye_run *R, int n
 {
     io_out of;
     io_error err;
-    if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
     fprintf(of.f, "distance_cm,hand_depth_cm,method,noise_mm,pos_px,size_pct,size_abs_pct,"
                   "height_pct,crop_geometry_pct,iou,iou_camera_view,psnr_db,ms_per_stereo_frame,"
                   "frames,eyes_with_hand,fallbacks\n");
@@ -490,8 +491,8 @@ static int write_csv(const char *path, const eye_ctx *c, const eye_run *R, int n
                 s.size_abs, s.height, crop_predicted(c, s.depth_cm / 100.0), s.iou, s.iou_seen,
                 s.psnr, s.ms, R[i].n_frames, R[i].n_shape, R[i].fallbacks);
     }
-    if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
-    return EXIT_OK;
+    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    return IO_EXIT_OK;
 }
 
 /* DIR/eyeview.csv, eyeview.md, eyeview.dat (gnuplot blocks: per method
@@ -503,11 +504,11 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
 {
     char path[IO_PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/eyeview.csv", dir);
-    if (write_csv(path, c, R, n)) return EXIT_FAIL;
+    if (write_csv(path, c, R, n)) return IO_EXIT_FAIL;
     io_out of;
     io_error err;
     snprintf(path, sizeof path, "%s/eyeview.md", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
     int fr = o->frames < 180 ? o->frames : 180;
     fprintf(of.f, "Eye viewpoint: sequences hold15/20/30/40, %d frames each (one display frame "
                   "in %d of the 3 s), seed %d; tracking noise 0 (the true pose), 5, 10, 20 mm (One "
@@ -520,9 +521,9 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
                   "fingertip depth; ms: pipe_frame, one thread, thread CPU time.\n\n",
             fr, 180 / fr, o->seed);
     print_table(of.f, c, R, n, 1);
-    if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
     snprintf(path, sizeof path, "%s/eyeview.dat", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
     int blocks = 0;
     char titles[EM_COUNT * NNOISE][48];
     for (int mth = 0; mth < EM_COUNT; mth++)
@@ -542,9 +543,9 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
                      (double)noise_mm[k]);
             fprintf(of.f, "\n\n");
         }
-    if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
     snprintf(path, sizeof path, "%s/eyeview.gp", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
     FILE *f = of.f;
     static const char *const charts[] = { "eyeview_pos", "eyeview_size", "eyeview_iou",
                                           "eyeview_psnr" };
@@ -580,7 +581,7 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
         if (!blocks) fprintf(f, "NaN notitle");
         fprintf(f, "\n");
     }
-    if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
     return eval__gnuplot(dir, "eyeview.gp", charts, NCH);
 }
 
@@ -588,10 +589,10 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
 
 int eval_eye_run(const eval_opts *o)
 {
-    if (o->report && cli_mkdirs(o->report) != 0)
-        return cli_fail("%s: cannot create the report folder", o->report);
-    if (o->dump && cli_mkdirs(o->dump) != 0)
-        return cli_fail("%s: cannot create the folder", o->dump);
+    if (o->report && io_mkdirs(o->report) != 0)
+        return io_term_fail("%s: cannot create the report folder", o->report);
+    if (o->dump && io_mkdirs(o->dump) != 0)
+        return io_term_fail("%s: cannot create the folder", o->dump);
     int methods[EM_COUNT] = { 1, 1 };
     int nm = 0;
     for (int k = 0; k < EM_COUNT; k++) nm += methods[k];
@@ -599,12 +600,12 @@ int eval_eye_run(const eval_opts *o)
     eye_run *R = calloc((size_t)n, sizeof *R);
     eye_ctx c;
     memset(&c, 0, sizeof c);
-    int rc = EXIT_FAIL, i = 0;
-    if (!R) return cli_fail("out of memory");
+    int rc = IO_EXIT_FAIL, i = 0;
+    if (!R) return io_term_fail("out of memory");
     const int frames = o->frames < 180 ? o->frames : 180;
     const int stride = 180 / frames;
-    progress pr;
-    progress_start(&pr, NDIST * frames);
+    io_progress pr;
+    io_progress_start(&pr, NDIST * frames);
     if (o->quiet) pr.enabled = 0;
     for (int d = 0; d < NDIST; d++) {
         char seq[16];
@@ -629,21 +630,21 @@ int eval_eye_run(const eval_opts *o)
                     r->track.head_rot_noise_deg = 0.0f;
                     r->track.glove_noise = 0.0f;
                 }
-                if (run_init(r, &c) < 0) { cli_fail("out of memory"); goto done; }
+                if (run_init(r, &c) < 0) { io_term_fail("out of memory"); goto done; }
             }
         }
         for (int f = 0; f < frames; f++) {
             int fi = f * stride;
-            if (make_truth(&c, fi) < 0) { cli_fail("%s frame %d: ground truth", seq, fi); goto done; }
+            if (make_truth(&c, fi) < 0) { io_term_fail("%s frame %d: ground truth", seq, fi); goto done; }
             for (int j = first; j < i; j++)
                 if (run_frame(&c, &R[j], fi, o->per_frame, o->dump) < 0) {
-                    cli_fail("%s frame %d: %s failed", seq, fi, em_name[R[j].method]);
+                    io_term_fail("%s frame %d: %s failed", seq, fi, em_name[R[j].method]);
                     goto done;
                 }
-            progress_step(&pr, d * frames + f + 1, "eval eye view frame");
+            io_progress_step(&pr, d * frames + f + 1, "eval eye view frame");
         }
     }
-    progress_end(&pr);
+    io_progress_end(&pr);
     printf("egofuse eval --eyeview: the right hand held 15-40 cm from the eyes (sequences "
            "holdNN), %d frames each, tracking noise 0-20 mm (no latency, no dropouts); "
            "errors of the hand in the 1280x800 display against the true eye's view\n",
@@ -652,7 +653,7 @@ int eval_eye_run(const eval_opts *o)
     if (o->csv && write_csv(o->csv, &c, R, n)) goto done;
     if (o->report && write_report(o->report, &c, R, n, o)) goto done;
     if (o->report) printf("egofuse eval --eyeview: report in %s (eyeview.csv, eyeview.md, eyeview_pos/size/iou/psnr.png)\n", o->report);
-    rc = EXIT_OK;
+    rc = IO_EXIT_OK;
 done:
     for (int j = 0; j < n; j++) free(R[j].locals);
     free(R);

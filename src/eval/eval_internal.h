@@ -201,7 +201,7 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k);
 /* eval.c: runs the configurations cfgs[0..n) into R on `frames` frames of
  * sequence seq (one ground truth built into *c, left there for the caller
  * to free with eval__ctx_free; light: the lighting mismatch, or NULL).
- * EXIT_OK, or EXIT_FAIL with the message printed. */
+ * IO_EXIT_OK, or IO_EXIT_FAIL with the message printed. */
 int eval__run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames, float speed,
                     const eval_light *light, const method_cfg *cfgs, method_run *R, int n);
 void eval__ctx_free(eval_ctx *c);
@@ -215,8 +215,8 @@ fuse_lighting eval__lighting(const gen_scene *ws, const kin_camera *cam);
 
 /* eval_report.c: runs gnuplot on DIR/script, whose charts write
  * "DIR/<chart>.png".sfx, and names each chart once it decodes whole
- * (gnuplot missing or failing: a warning, EXIT_OK; a chart incomplete:
- * removed, EXIT_FAIL). */
+ * (gnuplot missing or failing: a warning, IO_EXIT_OK; a chart incomplete:
+ * removed, IO_EXIT_FAIL). */
 int eval__gnuplot(const char *dir, const char *script, const char *const *charts, int n);
 
 /* eval_lod.c: levels of detail. The chain of c->mask and the full

@@ -11,7 +11,8 @@
  * kf = 0, 0.25, 0.5, 0.75, 1 with kin-cal-pred and refine: the kf with the
  * highest PSNR is the one to use. */
 #include "eval_internal.h"
-#include "../cli/cli.h"
+#include "../io/io.h"
+#include "../io/io_term.h"
 #include "../io/io.h"
 
 #include <string.h>
@@ -47,7 +48,7 @@ int eval__write_kf(const char *dir, const method_run *R, int n)
             char path[IO_PATH_MAX + 64];
             if (!dir) break;
             snprintf(path, sizeof path, "%s/kf.md", dir);
-            if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
+            if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
             f = of.f;
         }
         fprintf(f, "%sThe Fresnel fade kf against the opaque ideal composite (the true "
@@ -86,6 +87,6 @@ int eval__write_kf(const char *dir, const method_run *R, int n)
             fprintf(f, "%s%s%g%s\n", row, pass ? " " : "  ", bkf, pass ? " |" : "");
         }
     }
-    if (dir && io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
-    return EXIT_OK;
+    if (dir && io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    return IO_EXIT_OK;
 }

@@ -24,7 +24,8 @@
  * at the matched light (IoU does not depend on the light for the
  * geometric methods; PSNR does for all). */
 #include "eval_internal.h"
-#include "../cli/cli.h"
+#include "../io/io.h"
+#include "../io/io_term.h"
 #include "../io/io.h"
 
 #include <errno.h>
@@ -225,7 +226,7 @@ int eval__write_light(const char *dir, const method_run *R, int n)
         if (pass == 1) {
             if (!dir) break;
             snprintf(path, sizeof path, "%s/light.md", dir);
-            if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
+            if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
             f = of.f;
         }
         fprintf(f, "%sLighting mismatch between the cockpit and the virtual scene (the ideal "
@@ -257,7 +258,7 @@ int eval__write_light(const char *dir, const method_run *R, int n)
             fprintf(f, "\n");
         }
     }
-    if (!dir) return EXIT_OK;
+    if (!dir) return IO_EXIT_OK;
     /* where each curve falls below IoU 0.9 / its matched PSNR - drop */
     double below_iou[3][NCURVE], below_psnr[3][NCURVE];
     for (int a = 0; a < 3; a++)
@@ -285,7 +286,7 @@ int eval__write_light(const char *dir, const method_run *R, int n)
     /* light_<axis>.dat: per curve a block of x iou bf3 psnr */
     for (int a = 0; a < 3; a++) {
         snprintf(path, sizeof path, "%s/light_%s.dat", dir, axes[a]);
-        if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
+        if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
         for (int q = 0; q < NCURVE; q++) {
             fprintf(of.f, "# %s: %s iou bf3 psnr\n", curve_name[q], axes[a]);
             int any = 0;
@@ -307,11 +308,11 @@ int eval__write_light(const char *dir, const method_run *R, int n)
             if (!any) fprintf(of.f, "nan nan nan nan\n");
             fprintf(of.f, "\n\n");
         }
-        if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
+        if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
     }
     /* the chart: IoU (top) and PSNR (bottom) per axis */
     snprintf(path, sizeof path, "%s/light.gp", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
     f = of.f;
     static const char *const xlab[3] = {"cockpit light intensity, x the matched",
                                         "cockpit light colour temperature, K (matched: 6500)",
@@ -391,7 +392,7 @@ int eval__write_light(const char *dir, const method_run *R, int n)
                 q == 2 ? "refine (refine+tone: the same masks)" : curve_name[q]);
     fprintf(f, "\nunset multiplot\nset border\nset tics\nset grid\nset autoscale\n"
                "set origin 0, 0\nset size 1, 1\n");
-    if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
     /* gnuplot, then the chart named only once it decodes whole */
     char cmd[3 * IO_PATH_MAX], tmp[IO_PATH_MAX + 96];
     const long pid = (long)getpid();
@@ -403,19 +404,19 @@ int eval__write_light(const char *dir, const method_run *R, int n)
         remove(tmp);
         fprintf(stderr, "egofuse eval: gnuplot failed (status %d): %s/light_*.dat and light.gp "
                         "are written, light.png is not\n", rc, dir);
-        return EXIT_OK;
+        return IO_EXIT_OK;
     }
     io_image img;
     if (io_image_load(tmp, IO_U8, 0, &img, &err) != IO_OK) {
         remove(tmp);
-        return cli_fail("%s: gnuplot wrote it incomplete or not at all (%s); removed", path,
+        return io_term_fail("%s: gnuplot wrote it incomplete or not at all (%s); removed", path,
                         err.msg);
     }
     io_image_free(&img);
     if (rename(tmp, path) != 0) {
         const int e = errno;
         remove(tmp);
-        return cli_fail("%s: cannot name it (rename from %s): %s", path, tmp, strerror(e));
+        return io_term_fail("%s: cannot name it (rename from %s): %s", path, tmp, strerror(e));
     }
-    return EXIT_OK;
+    return IO_EXIT_OK;
 }

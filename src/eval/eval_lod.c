@@ -13,7 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../cli/cli.h"
+#include "../io/io.h"
+#include "../io/io_term.h"
 #include "../io/io_lod.h"
 
 int eval__lod_init(eval_ctx *c)
@@ -21,14 +22,14 @@ int eval__lod_init(eval_ctx *c)
     if (c->lod.level_count > 0) return 0;
     io_error err;
     if (io_lod_build("the mask model", &c->mask.model, NULL, &c->lod, &err) != IO_OK) {
-        cli_fail("%s", err.msg);
+        io_term_fail("%s", err.msg);
         return -1;
     }
     c->full_mask = malloc((size_t)CW * CH);
     c->full_depth = malloc(sizeof(float) * (size_t)CW * CH);
     if (!c->full_mask || !c->full_depth) {
         eval__lod_free(c);
-        cli_fail("out of memory");
+        io_term_fail("out of memory");
         return -1;
     }
     return 0;
@@ -102,7 +103,7 @@ int eval__write_lod(const char *dir, const method_run *R, int n)
     io_error err;
     io_out of;
     snprintf(path, sizeof path, "%s/lod.csv", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
     fprintf(of.f, "method,setting,level_mean,tris_mean,ms_raster_per_eye,iou_vs_full,"
                   "bf1_vs_full,iou,bf1,bf3\n");
     for (int i = 0; i < n; i++) {
@@ -112,12 +113,12 @@ int eval__write_lod(const char *dir, const method_run *R, int n)
                 kind_name[R[i].cfg.kind], R[i].cfg.setting, s.level, s.tris, s.ms_raster,
                 s.iou_full, s.bf1_full, s.iou, s.bf1, s.bf3);
     }
-    if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
     /* DIR/lod.dat: per method a block (gnuplot index 0 kin-cal-pred, 1
      * refine) of: triangles, raster ms, IoU vs full, IoU, BF1 vs full,
      * BF1, "setting" */
     snprintf(path, sizeof path, "%s/lod.dat", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return cli_fail("%s", err.msg);
+    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
     static const method_kind kinds[2] = {M_KIN_CAL, M_REFINE};
     for (int k = 0; k < 2; k++) {
         fprintf(of.f, "# %s\n", kind_name[kinds[k]]);
@@ -149,6 +150,6 @@ int eval__write_lod(const char *dir, const method_run *R, int n)
         if (!rows) fprintf(of.f, "nan nan nan nan nan nan \"\"\n");
         fprintf(of.f, "\n\n");
     }
-    if (io_out_commit(&of, &err) != IO_OK) return cli_fail("%s", err.msg);
-    return EXIT_OK;
+    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    return IO_EXIT_OK;
 }

@@ -5,7 +5,8 @@
  * (eval__run_batch, eval.c) and hands the sums to the tables and the
  * report (eval_report.c). The frames themselves: eval.c. */
 #include "eval_internal.h"
-#include "../cli/cli.h"
+#include "../io/io.h"
+#include "../io/io_term.h"
 #include "../io/io_lod.h"
 
 #include <stdio.h>
@@ -250,19 +251,19 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
 
 int eval_run(const eval_opts *o)
 {
-    if (o->dump && cli_mkdirs(o->dump) != 0)
-        return cli_fail("%s: cannot create the folder", o->dump);
-    if (o->report && cli_mkdirs(o->report) != 0)
-        return cli_fail("%s: cannot create the report folder", o->report);
-    if (o->light_dir && cli_mkdirs(o->light_dir) != 0)
-        return cli_fail("%s: cannot create the folder", o->light_dir);
+    if (o->dump && io_mkdirs(o->dump) != 0)
+        return io_term_fail("%s: cannot create the folder", o->dump);
+    if (o->report && io_mkdirs(o->report) != 0)
+        return io_term_fail("%s: cannot create the report folder", o->report);
+    if (o->light_dir && io_mkdirs(o->light_dir) != 0)
+        return io_term_fail("%s: cannot create the folder", o->light_dir);
     enum { CAP = 300 };
     method_cfg *cfgs = calloc(CAP, sizeof *cfgs);
     method_run *R = calloc(CAP, sizeof *R);
     eval_ctx c;
     memset(&c, 0, sizeof c);
-    int n = 0, rc = EXIT_FAIL;
-    if (!cfgs || !R) { cli_fail("out of memory"); goto done; }
+    int n = 0, rc = IO_EXIT_FAIL;
+    if (!cfgs || !R) { io_term_fail("out of memory"); goto done; }
     /* batches: (sequence, frames, phase) */
     enum { NB = 30 };
     const char *bseq[NB];
@@ -311,7 +312,7 @@ int eval_run(const eval_opts *o)
     }
     for (int b = 0; b < nb; b++) {
         int m = make_configs(o, bphase[b], bseq[b], bspeed[b], &blight[b], cfgs + n, CAP - n);
-        if (n + m > CAP) { cli_fail("too many configurations"); goto done; }
+        if (n + m > CAP) { io_term_fail("too many configurations"); goto done; }
         eval__ctx_free(&c);
         if (eval__run_batch(o, &c, bseq[b], bframes[b], bspeed[b],
                             bphase[b] == PH_LIGHT || bphase[b] == PH_KF ? &blight[b] : NULL,
@@ -343,7 +344,7 @@ int eval_run(const eval_opts *o)
     if ((o->report || o->light_sweep) && eval__write_light(o->report ? o->report : o->light_dir, R, n)) goto done;
     if ((o->report || o->kf_sweep) && eval__write_kf(o->report, R, n)) goto done;
     if (o->report) printf("egofuse eval: report in %s (summary.csv, table.md, *.png)\n", o->report);
-    rc = EXIT_OK;
+    rc = IO_EXIT_OK;
 done:
     eval__ctx_free(&c);
     free(R);

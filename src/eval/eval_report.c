@@ -2,7 +2,8 @@
  * the per-group and per-sequence data files and the gnuplot charts of the
  * report folder (see eval.h, docs/accuracy.md). */
 #include "eval_internal.h"
-#include "../cli/cli.h"
+#include "../io/io.h"
+#include "../io/io_term.h"
 
 #include <errno.h>
 #include <math.h>
@@ -48,7 +49,7 @@ static FILE *out_open(io_out *o, const char *path)
 {
     io_error err;
     if (io_out_open(o, path, &err) != IO_OK) {
-        cli_fail("%s", err.msg);
+        io_term_fail("%s", err.msg);
         return NULL;
     }
     return o->f;
@@ -57,15 +58,15 @@ static FILE *out_open(io_out *o, const char *path)
 static int out_commit(io_out *o)
 {
     io_error err;
-    if (io_out_commit(o, &err) != IO_OK) return cli_fail("%s", err.msg);
-    return EXIT_OK;
+    if (io_out_commit(o, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    return IO_EXIT_OK;
 }
 
 int eval__write_csv(const char *path, const method_run *R, int n)
 {
     io_out of;
     FILE *f = out_open(&of, path);
-    if (!f) return EXIT_FAIL;
+    if (!f) return IO_EXIT_FAIL;
     fprintf(f, "method,setting,iou,bf1,bf3,fp_area,fn_area,psnr,ms_per_frame,flicker,group\n");
     for (int i = 0; i < n; i++) {
         summary s = summarise(&R[i]);
@@ -165,7 +166,7 @@ static int write_group(const char *dir, const char *group, const method_run *R, 
     snprintf(path, sizeof path, "%s/%s.dat", dir, group);
     io_out of;
     FILE *f = out_open(&of, path);
-    if (!f) return EXIT_FAIL;
+    if (!f) return IO_EXIT_FAIL;
     for (int k = 0; k < 4; k++) {
         fprintf(f, "# %s\n", kind_name[k]);
         float xs[64];
@@ -221,7 +222,7 @@ static int write_sequences(const char *dir, const method_run *R, int n, const ev
     snprintf(path, sizeof path, "%s/sequences.dat", dir);
     io_out of;
     FILE *f = out_open(&of, path);
-    if (!f) return EXIT_FAIL;
+    if (!f) return IO_EXIT_FAIL;
     fprintf(f, "# sequence iou(kin kin-cal-pred skin refine) bf3(same)\n");
     for (int q = 0; gt_sequence_name(q); q++) {
         const char *name = gt_sequence_name(q);
@@ -300,7 +301,7 @@ int eval__gnuplot(const char *dir, const char *script, const char *const *charts
         fprintf(stderr, "egofuse eval: gnuplot failed (status %d): the data files and "
                         "%s/%s are written, the charts (%s/%s.png and %d more) are not\n", rc,
                 dir, script, dir, charts[0], NCHART - 1);
-    return bad ? EXIT_FAIL : EXIT_OK;
+    return bad ? IO_EXIT_FAIL : IO_EXIT_OK;
 }
 
 /* A chart with no points (none of --methods runs it): gnuplot fails on a
@@ -552,11 +553,11 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
 {
     char path[IO_PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/summary.csv", dir);
-    if (eval__write_csv(path, R, n)) return EXIT_FAIL;
+    if (eval__write_csv(path, R, n)) return IO_EXIT_FAIL;
     snprintf(path, sizeof path, "%s/table.md", dir);
     io_out of;
     FILE *f = out_open(&of, path);
-    if (!f) return EXIT_FAIL;
+    if (!f) return IO_EXIT_FAIL;
     fprintf(f, "Ground truth: sequence %s, tracking noise %g mm, latency %g ms, dropout %g, "
                "calibration error %g, speed %g, seed %d. Frames: %d for the methods (group "
                "methods), %d for the speed knobs (groups knobs, band, fit, global, lagcomp, "
@@ -570,11 +571,11 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
     eval__print_thickness(f, c, R, n);
     fprintf(f, "\n");
     eval__print_table(f, R, n, 1);
-    if (out_commit(&of)) return EXIT_FAIL;
+    if (out_commit(&of)) return IO_EXIT_FAIL;
     /* speed-accuracy points: label, ms, iou, bf3 */
     snprintf(path, sizeof path, "%s/speed.dat", dir);
     f = out_open(&of, path);
-    if (!f) return EXIT_FAIL;
+    if (!f) return IO_EXIT_FAIL;
     sp_pt *piou = malloc(sizeof *piou * (size_t)(n > 0 ? n : 1));
     sp_pt *pbf = malloc(sizeof *pbf * (size_t)(n > 0 ? n : 1));
     int np = 0;
@@ -582,7 +583,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
         free(piou);
         free(pbf);
         io_out_abort(&of);
-        return cli_fail("out of memory");
+        return io_term_fail("out of memory");
     }
     for (int k = 0; k < 4; k++) {
         fprintf(f, "# %s\n", kind_name[k]);
@@ -613,7 +614,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
     if (out_commit(&of)) {
         free(piou);
         free(pbf);
-        return EXIT_FAIL;
+        return IO_EXIT_FAIL;
     }
     static const char *groups[] = { "noise", "latency", "calib", "band", "dropout", "handspeed" };
     enum { NG = sizeof groups / sizeof groups[0] };
@@ -622,20 +623,20 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
         if (write_group(dir, groups[g], R, n, o, &si[g])) {
             free(piou);
             free(pbf);
-            return EXIT_FAIL;
+            return IO_EXIT_FAIL;
         }
     int seq_has[4];
     if (write_sequences(dir, R, n, o, seq_has) || eval__write_lod(dir, R, n)) {
         free(piou);
         free(pbf);
-        return EXIT_FAIL;
+        return IO_EXIT_FAIL;
     }
     snprintf(path, sizeof path, "%s/charts.gp", dir);
     f = out_open(&of, path);
     if (!f) {
         free(piou);
         free(pbf);
-        return EXIT_FAIL;
+        return IO_EXIT_FAIL;
     }
     fprintf(f, "if (!exists('sfx')) sfx = ''\nset grid\n"
                "titles = 'kin kin-cal-pred skin refine'\n");
@@ -739,7 +740,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
     }
     if (first) empty_plot(f, "no sequence ran");
     else fprintf(f, "\n");
-    if (out_commit(&of)) return EXIT_FAIL;
+    if (out_commit(&of)) return IO_EXIT_FAIL;
     return write_charts(dir);
 }
 
