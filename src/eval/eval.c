@@ -748,13 +748,13 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
 /* ---------------------------------------------------------------- run */
 
 /* Runs configurations cfgs[0..n) into R on `frames` frames of sequence
- * seq (one ground truth). The context is left in *c for the caller to
- * free. */
-int eval__run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames, float speed,
-                    const eval_light *light, const method_cfg *cfgs, method_run *R, int n)
+ * seq (one ground truth, its tracking `track`). The context is left in *c
+ * for the caller to free. */
+int eval__run_batch(const eval_opts *o, const gt_track_desc *track, eval_ctx *c, const char *seq,
+                    int frames, float speed, const eval_light *light, const method_cfg *cfgs,
+                    method_run *R, int n)
 {
-    method_cfg base = eval__base_cfg(o, M_KIN_CAL);
-    int irc = ctx_init(c, (uint64_t)o->seed, seq, &base.track);
+    int irc = ctx_init(c, (uint64_t)o->seed, seq, track);
     if (irc < 0)
         return irc == -2 ? IO_EXIT_FAIL : io_term_fail("cannot build the ground truth (out of memory)");
     if (light) c->light = *light;

@@ -199,11 +199,13 @@ typedef struct eval_ctx {
 method_cfg eval__base_cfg(const eval_opts *o, method_kind k);
 
 /* eval.c: runs the configurations cfgs[0..n) into R on `frames` frames of
- * sequence seq (one ground truth built into *c, left there for the caller
- * to free with eval__ctx_free; light: the lighting mismatch, or NULL).
- * IO_EXIT_OK, or IO_EXIT_FAIL with the message printed. */
-int eval__run_batch(const eval_opts *o, eval_ctx *c, const char *seq, int frames, float speed,
-                    const eval_light *light, const method_cfg *cfgs, method_run *R, int n);
+ * sequence seq (one ground truth built into *c with the tracking `track`,
+ * eval__base_cfg's; left there for the caller to free with eval__ctx_free;
+ * light: the lighting mismatch, or NULL). IO_EXIT_OK, or IO_EXIT_FAIL with
+ * the message printed. */
+int eval__run_batch(const eval_opts *o, const gt_track_desc *track, eval_ctx *c, const char *seq,
+                    int frames, float speed, const eval_light *light, const method_cfg *cfgs,
+                    method_run *R, int n);
 void eval__ctx_free(eval_ctx *c);
 
 /* eval.c: the true operator's scales (arm, hand, shoulder width) against

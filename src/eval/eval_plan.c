@@ -314,7 +314,8 @@ int eval_run(const eval_opts *o)
         int m = make_configs(o, bphase[b], bseq[b], bspeed[b], &blight[b], cfgs + n, CAP - n);
         if (n + m > CAP) { io_term_fail("too many configurations"); goto done; }
         eval__ctx_free(&c);
-        if (eval__run_batch(o, &c, bseq[b], bframes[b], bspeed[b],
+        const method_cfg base = eval__base_cfg(o, M_KIN_CAL);
+        if (eval__run_batch(o, &base.track, &c, bseq[b], bframes[b], bspeed[b],
                             bphase[b] == PH_LIGHT || bphase[b] == PH_KF ? &blight[b] : NULL,
                             cfgs + n, R + n, m))
             goto done;
