@@ -135,17 +135,6 @@ static rast_target cam_target(const pipe_ctx *p, const eye_state *e)
     return (rast_target){cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
 }
 
-/* Reprojecting with nothing else reading the camera's G-buffer (no lens
- * map, no refinement or elbow fit, no tone match): the camera is not
- * drawn, the occlusion test splats the eye's points into a camera depth
- * buffer instead (pipe_reproj.h, THE CAMERA'S VIEW FROM THE EYE'S
- * POINTS); a fallback to the crop draws it. */
-static int cam_splat(const pipe_ctx *p, const eye_state *e)
-{
-    return p->desc.eye_view == PIPE_VIEW_REPROJECT && !e->lens && p->desc.refine_band == 0 &&
-           !p->fit && !(p->desc.tone_match > 0.0f) && e->aa.count == 0;
-}
-
 /* Reprojection (pipe_reproj.h): the model drawn from the eye, the camera
  * image sampled through the eye's depths; fe then lights and composites
  * the eye's view. 1 when fe was switched to it, 0 for the fallback to the
@@ -156,10 +145,9 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
     const int w = r->width, h = r->height, cw = p->geo.crop_width, ch = p->geo.crop_height;
     r->cam = kin_sthmd_eye_camera(&p->hmd, &e->head, (kin_eye)e->eye, w, h);
     rast_target tg = {w, h, r->depth, w, r->mask, w, r->nrm, 3 * w, 3};
-    const int splat = cam_splat(p, e);
     int level = e->lod_level;
     rast_result rr = eye_draw(p, e, NULL, &r->cam, &tg, 1, NULL);
-    if (!splat) e->lod_level = level; /* (splat: the eye's level) */
+    e->lod_level = level;
     if (rr != RAST_OK) {
         e->result = PIPE_ERR_RASTER;
         snprintf(e->why, sizeof e->why, "%s eye: rasterizer (eye view): %s",
@@ -191,10 +179,10 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
         S = in->camera[e->eye];
         ox = p->geo.crop_x0, oy = y0;
     }
-    if (pipe__reproj_sample(r, &e->cam, &S, ox, oy, splat ? NULL : e->mask, cw, e->depth, cw,
-                            cw, ch, p->hmd.znear, p->hmd.zfar)) {
+    if (pipe__reproj_sample(r, &e->cam, &S, ox, oy, e->mask, cw, e->depth, cw, cw, ch,
+                            p->hmd.znear, p->hmd.zfar)) {
         e->fallbacks++;
-        if (splat || !cam_target(p, e).attr) {
+        if (!cam_target(p, e).attr) {
             /* the crop's lighting reads the camera's normals: the camera
              * drawn again with them (the same depth and mask). This
              * target shares the depth and mask planes with the camera's
@@ -204,10 +192,8 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
              * whole (the others next frame) */
             rast_target ct = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
             rast_context_forget(e->rast);
-            long covered = 0;
-            rr = eye_draw(p, e, NULL, &e->cam, &ct, 1, splat ? &covered : NULL);
+            rr = eye_draw(p, e, NULL, &e->cam, &ct, 1, NULL);
             e->lod_level = level;
-            if (splat) e->coverage = (double)covered / (double)(cw * ch);
             if (rr != RAST_OK) {
                 e->result = PIPE_ERR_RASTER;
                 snprintf(e->why, sizeof e->why, "%s eye: rasterizer (fallback normals): %s",
@@ -217,7 +203,6 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
         }
         return 0;
     }
-    if (splat) e->coverage = (double)r->splat_px / (double)(cw * ch);
     fe->P = (fuse_image){r->P, w, h, 4 * w};
     fe->mask = r->M;
     fe->mask_stride = w;
@@ -249,8 +234,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     rast_target tg = cam_target(p, e);
     long covered = 0;
     e->lod_level = 0;
-    rast_result rr = cam_splat(p, e) ? RAST_OK /* reproj_eye: the splat */
-                                     : eye_draw(p, e, e->lens, &e->cam, &tg, 1, &covered);
+    rast_result rr = eye_draw(p, e, e->lens, &e->cam, &tg, 1, &covered);
     if (rr == RAST_OK && e->aa.count) { /* no lens here: refused at pipe_create */
         pipe__aa_begin(&e->aa);
         pipe__aa_band(&e->aa, e->mask);

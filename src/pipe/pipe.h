@@ -361,10 +361,7 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
 /* The last frame's mask of one eye (valid until the next frame): the
  * refined one with pipe_desc.refine_band, else the G-buffer's; with
  * pipe_desc.aa_samples the coverage mask composited (0..255), with
- * pipe_desc.soft_edge that mask softened at its edge (0..255). With
- * PIPE_VIEW_REPROJECT and the camera not drawn (pipe_reproj.h, THE
- * CAMERA'S VIEW FROM THE EYE'S POINTS) the camera pixels of the eye's
- * points' splat (0 or 255). */
+ * pipe_desc.soft_edge that mask softened at its edge (0..255). */
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The last frame's lit layer of one eye (premultiplied RGBA8, the
  * mask's size, 4 * width bytes per row; valid until the next frame):

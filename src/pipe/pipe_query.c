@@ -27,8 +27,6 @@ const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height)
     if (height) *height = p->geo.crop_height;
     const eye_state *e = &p->eye[eye ? 1 : 0];
     if (e->aa.count && e->shown) return e->shown;
-    /* reprojected without drawing the camera: the splat's (pipe_reproj.h) */
-    if (e->view_used == PIPE_VIEW_REPROJECT && e->rp.splat_used) return e->rp.smask;
     return e->have_refined ? e->refined : e->mask;
 }
 

@@ -58,17 +58,9 @@ int pipe__reproj_init(pipe__reproj *r, int width, int height)
     r->P = calloc(px, 4);
     r->M = calloc(px, 1);
     r->row = malloc(sizeof(int32_t) * 3 * (size_t)width + (size_t)height);
-    r->lanes = malloc(sizeof(int32_t) * 10 * ((size_t)width + 16));
+    r->lanes = malloc(sizeof(int32_t) * 8 * ((size_t)width + 16));
     r->kind = calloc((size_t)width + 64, 1);
-    /* the splat's camera G-buffer: nothing touched yet, so cleared whole
-     * once (then only the rows the last frame touched) */
-    r->smask = calloc(px, 1);
-    r->sdepth = malloc(sizeof(float) * px);
-    if (r->sdepth) memset(r->sdepth, 0x7F, sizeof(float) * px); /* 3.4e38: beyond any depth */
-    r->scap = px;
-    r->sgw = width;
-    if (!r->depth || !r->nrm || !r->mask || !r->P || !r->M || !r->row || !r->lanes || !r->kind ||
-        !r->smask || !r->sdepth) {
+    if (!r->depth || !r->nrm || !r->mask || !r->P || !r->M || !r->row || !r->lanes || !r->kind) {
         pipe__reproj_free(r);
         return -1;
     }
@@ -85,8 +77,6 @@ void pipe__reproj_free(pipe__reproj *r)
     free(r->row);
     free(r->lanes);
     free(r->kind);
-    free(r->smask);
-    free(r->sdepth);
     memset(r, 0, sizeof *r);
 }
 
@@ -153,11 +143,6 @@ static void row_ref(const pipe__reproj_geo *g, const uint8_t *em, const float *e
          * depth of the camera's projection, zmin */
         const float dp = -pz, dmin = dp - (PIPE_REPROJ_TOL_M + PIPE_REPROJ_TOL_REL * dp);
         o->zmin[x] = dmin > n ? 0.5f * (g->fpn - g->two_fn / dmin) / g->fmn + 0.5f : 0.0f;
-        /* the splat's: the point's own camera depth, its footprint */
-        const float iz = 1.0f / -pz;
-        o->zc[x] = 0.5f * (g->fpn - g->two_fn * iz) / g->fmn + 0.5f;
-        const float hs = g->ks * dist * iz;
-        o->hw[x] = hs < 0.5f ? 0.5f : hs;
         int iu = (int)fu, iv = (int)fv;
         o->iu[x] = iu > g->icw1 ? g->icw1 : iu;
         o->iv[x] = iv > g->ich1 ? g->ich1 : iv;
@@ -284,96 +269,6 @@ int pipe__reproj_fill_row(const uint8_t *K, int w, uint8_t *Po, const float *ed,
     return 1;
 }
 
-/* The splat of eye row y's covered points inside the camera image
- * (pipe_reproj.h, THE CAMERA'S VIEW FROM THE EYE'S POINTS) into r's
- * gw x gh camera buffers: the least window depth, the mask set; r->sy0,
- * r->sy1 widened to the rows touched. Returns the covered pixels. */
-static long splat_row(pipe__reproj *r, int y, const pipe__reproj_lanes *o, int ox, int oy,
-                      int gw, int gh, const pipe__reproj_geo *g)
-{
-    const int w = r->width, h = r->height;
-    const uint8_t *const em = r->mask + (size_t)y * (size_t)w;
-    const float *const ed = r->depth + (size_t)y * (size_t)w;
-    uint8_t *const sm = r->smask;
-    float *const sd = r->sdepth;
-    const uint16_t m2 = 0xFFFF;
-    const int up = y > 0 ? -w : 0, down = y + 1 < h ? w : 0;
-    const float A = g->f / (g->f - g->n), ia = (g->f - g->n) / g->f;
-    const float c1 = A * PIPE_REPROJ_TOL_M / g->n, c2 = A * PIPE_REPROJ_TOL_REL;
-    int y0 = r->sy0, y1 = r->sy1;
-    long covered = 0;
-    for (int x = 0; x < w; x++) {
-        if (!em[x]) {
-            uint64_t word;
-            while (x + 9 <= w && (memcpy(&word, em + x + 1, 8), word == 0)) x += 8;
-            continue;
-        }
-        covered++;
-        if (!o->mv[x]) continue;
-        const float z = o->zc[x], sp = o->hw[x];
-        /* an occluding edge: a 4-neighbour of another surface behind */
-        const float e0 = ed[x];
-        const int l = x > 0 ? -1 : 0, rt = x + 1 < w ? 1 : 0;
-        float far = e0;
-        if (em[x + l] && ed[x + l] > far) far = ed[x + l];
-        if (em[x + rt] && ed[x + rt] > far) far = ed[x + rt];
-        if (em[x + up] && ed[x + up] > far) far = ed[x + up];
-        if (em[x + down] && ed[x + down] > far) far = ed[x + down];
-        /* farther by the occlusion test's slack TOL + REL d, to first
-         * order in window depth: z = A (1 - n / d), A = f / (f - n), so
-         * dz = A q^2 / n * dd with q = 1 - z / A = n / d */
-        const float q = 1.0f - e0 * ia;
-        const int edge = far > e0 + q * (c1 * q + c2);
-        /* the radius: an edge's pixels within the spacing, the others'
-         * within half of it */
-        const float rad = edge ? sp : 0.5f * sp;
-        const int gx = o->tx[x] - ox, gy = o->ty[x] - oy;
-        if (rad <= 1.0f && (unsigned)gx < (unsigned)(gw - 1) && (unsigned)gy < (unsigned)(gh - 1)) {
-            /* the point's four taps (the camera pixels whose centres are
-             * within 1 of it), all inside */
-            const size_t i = (size_t)gy * (size_t)gw + (size_t)gx;
-            float *d = sd + i;
-            float d0 = d[0], d1 = d[1], d2 = d[gw], d3 = d[gw + 1];
-            d[0] = z < d0 ? z : d0;
-            d[1] = z < d1 ? z : d1;
-            d[gw] = z < d2 ? z : d2;
-            d[gw + 1] = z < d3 ? z : d3;
-            memcpy(sm + i, &m2, 2);
-            memcpy(sm + i + gw, &m2, 2);
-            if (gy < y0) y0 = gy;
-            if (gy + 2 > y1) y1 = gy + 2;
-            continue;
-        }
-        int u0 = gx, u1 = gx + 1, v0 = gy, v1 = gy + 1;
-        if (rad > 1.0f) {
-            /* the pixels whose centres are within rad of (u, v), the
-             * camera position (to 1/256 pixel: the taps' corner and
-             * fractions, u - 0.5 = tx + fx / 256) */
-            const float u = (float)o->tx[x] + (float)o->fx[x] * (1.0f / 256.0f);
-            const float v = (float)o->ty[x] + (float)o->fy[x] * (1.0f / 256.0f);
-            u0 = (int)ceilf(u - rad) - ox, u1 = (int)floorf(u + rad) - ox;
-            v0 = (int)ceilf(v - rad) - oy, v1 = (int)floorf(v + rad) - oy;
-        }
-        if (u0 < 0) u0 = 0;
-        if (v0 < 0) v0 = 0;
-        if (u1 > gw - 1) u1 = gw - 1;
-        if (v1 > gh - 1) v1 = gh - 1;
-        if (u0 > u1 || v0 > v1) continue;
-        for (int v = v0; v <= v1; v++) {
-            float *d = sd + (size_t)v * (size_t)gw;
-            uint8_t *m = sm + (size_t)v * (size_t)gw;
-            for (int u = u0; u <= u1; u++) {
-                d[u] = z < d[u] ? z : d[u];
-                m[u] = 255;
-            }
-        }
-        if (v0 < y0) y0 = v0;
-        if (v1 + 1 > y1) y1 = v1 + 1;
-    }
-    r->sy0 = y0, r->sy1 = y1;
-    return covered;
-}
-
 int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image *P, int ox,
                         int oy, const uint8_t *cmask, int cmask_stride, const float *cdepth,
                         int cdepth_stride, int gw, int gh, float n, float f)
@@ -396,20 +291,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
     g.icw1 = cw - 1, g.ich1 = ch - 1;
     g.n = n, g.f = f, g.fpn = f + n, g.fmn = f - n, g.two_fn = 2.0f * f * n;
     const float efx = ec->fx, efy = ec->fy, ecx = ec->cx, ecy = ec->cy;
-    g.ks = PIPE_REPROJ_SPLAT_MARGIN * fmaxf(cam->fx / efx, cam->fy / efy);
     const pipe__reproj_row_fn kernel = g.pinhole ? row_kernel(r->isa) : NULL;
-    /* no camera G-buffer: the eye's points splatted into r's (the eye
-     * layer's size) */
-    const int splat = cmask == NULL;
-    r->splat_used = splat;
-    if (splat) {
-        if (gw != r->sgw || (size_t)gw * (size_t)gh > r->scap) {
-            r->inside = 0, r->sampled = r->filled = r->outside = 0;
-            memset(r->M, 0, (size_t)w * (size_t)h);
-            return 0; /* (pipe.c passes the eye layer's size) */
-        }
-        cmask = r->smask, cdepth = r->sdepth, cmask_stride = cdepth_stride = gw;
-    }
     /* the taps on the vector layer: the image's rows whole int32 pixels,
      * the mask at least 4 bytes */
     const long mlim = (long)(gh - 1) * cmask_stride + gw - 4;
@@ -420,8 +302,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
     const size_t lw = (size_t)w + 16;
     const pipe__reproj_lanes o = {r->lanes,          r->lanes + lw,     r->lanes + 2 * lw,
                                   r->lanes + 3 * lw, r->lanes + 4 * lw, r->lanes + 5 * lw,
-                                  r->lanes + 6 * lw, (float *)(r->lanes + 7 * lw),
-                                  (float *)(r->lanes + 8 * lw), (float *)(r->lanes + 9 * lw)};
+                                  r->lanes + 6 * lw, (float *)(r->lanes + 7 * lw)};
     long covered = 0, back = 0, sampled = 0, filled = 0, outside = 0;
     float mind = INFINITY;
     uint64_t sum[3] = {0, 0, 0};
@@ -432,51 +313,6 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
     uint8_t *K = r->kind;
     for (int x = 0; x < w; x++) rxs[x] = ((float)x + 0.5f - ecx) / efx;
     g.rxs = rxs;
-    /* the back faces and the least distance: counted by the first pass
-     * over the eye (the splat's, or the only one) */
-    long back2 = 0;
-    float mind2 = INFINITY;
-    long *const pback = splat ? &back2 : &back;
-    float *const pmind = splat ? &mind2 : &mind;
-    if (splat) {
-        /* the rows the last frame touched cleared, then every covered
-         * point splatted */
-        if (r->sy1 > r->sy0) {
-            const size_t a = (size_t)r->sy0 * (size_t)gw, n_px = (size_t)(r->sy1 - r->sy0) * gw;
-            memset(r->smask + a, 0, n_px);
-            memset(r->sdepth + a, 0x7F, sizeof(float) * n_px);
-        }
-        r->sy0 = gh, r->sy1 = 0;
-        long cov1 = 0;
-        for (int y = 0; y < h; y++) {
-            const uint8_t *em = r->mask + (size_t)y * (size_t)w;
-            const float *ed = r->depth + (size_t)y * (size_t)w;
-            const float *en = r->nrm + (size_t)y * (size_t)w * 3;
-            const float ry = -((float)y + 0.5f - ecy) / efy;
-            int x1 = kernel ? kernel(&g, em, ed, en, ry, w, &o, &back, &mind) : 0;
-            row_ref(&g, em, ed, en, ry, x1, w, &o, &back, &mind);
-            cov1 += splat_row(r, y, &o, ox, oy, gw, gh, &g);
-        }
-        /* the camera pixels set (bytes 0 or 255) */
-        long np = 0;
-        if (r->sy1 > r->sy0) {
-            const uint8_t *m = r->smask + (size_t)r->sy0 * (size_t)gw;
-            const size_t n_px = (size_t)(r->sy1 - r->sy0) * gw;
-            size_t i = 0;
-            for (; i + 8 <= n_px; i += 8) {
-                uint64_t v;
-                memcpy(&v, m + i, 8);
-                np += (long)(((v & 0x0101010101010101ull) * 0x0101010101010101ull) >> 56);
-            }
-            for (; i < n_px; i++) np += m[i] != 0;
-        }
-        r->splat_px = np;
-        if (cov1 > 0 && (2 * back > cov1 || mind < PIPE_REPROJ_MIN_DIST_M)) {
-            /* the eye inside the model: no second pass */
-            r->inside = 1, r->sampled = r->filled = r->outside = 0;
-            return 1;
-        }
-    }
     for (int y = 0; y < h; y++) {
         const uint8_t *em = r->mask + (size_t)y * (size_t)w;
         uint8_t *M = r->M + (size_t)y * (size_t)w;
@@ -488,8 +324,8 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         memset(M, 0, (size_t)w);
         memset(K, 0, (size_t)w);
         /* the geometry of the row's covered pixels (vector, then the tail) */
-        int x1 = kernel ? kernel(&g, em, ed, en, ry, w, &o, pback, pmind) : 0;
-        row_ref(&g, em, ed, en, ry, x1, w, &o, pback, pmind);
+        int x1 = kernel ? kernel(&g, em, ed, en, ry, w, &o, &back, &mind) : 0;
+        row_ref(&g, em, ed, en, ry, x1, w, &o, &back, &mind);
         /* the taps (vector, then the tail) */
         int xt = 0;
         if (taps) {

@@ -58,34 +58,6 @@
  *   them). With RAST_CULL_BACK an eye inside a closed mesh sees none of
  *   it: the frame shows what else is in front, never garbage.
  *
- * THE CAMERA'S VIEW FROM THE EYE'S POINTS (issue 18 item 6)
- *   The occlusion test needs to know what the camera sees: its depth and
- *   mask at the taps. Unless something else reads the camera's G-buffer
- *   (the refinement and the elbow fit, the tone match, a lens map: then
- *   the camera is drawn, as the crop does) it is not drawn: the eye's
- *   covered points inside the camera image are splatted forward into a
- *   camera depth buffer of the crop's size (the least window depth per
- *   camera pixel, the mask set), and the taps test against that. A
- *   point's footprint is the camera pixels whose centres lie within a
- *   radius of its camera position (u, v), and at least its own four
- *   bilinear taps (those within 1): with s = PIPE_REPROJ_SPLAT_MARGIN *
- *   (camera focal / eye focal) * (eye distance / camera distance), the
- *   spacing of neighbouring eye points in the camera with a margin, the
- *   radius is s/2 (so the footprints of a surface leave no hole between
- *   them), and s at an occluding edge (a 4-neighbour in the eye of
- *   another surface behind: farther by more than the occlusion test's
- *   slack), because the eye's last pixel centre inside a part may lie up
- *   to a spacing from its true edge, and the camera pixels between must
- *   hide what is behind. Up to s <= 2 (the hands beyond about 17 cm)
- *   that is the four taps alone for all but the edge points. What the eye
- *   does not see cannot occlude (the eye and the camera share the axis:
- *   what is nearer to the camera is nearer to the eye, and seen by it
- *   unless hidden by something nearer still); the edges' footprint widens a
- *   part in front by up to s camera pixels, so slightly more of what is
- *   behind it is filled. pipe_frame_stats.coverage is then the splat's
- *   pixels (r->splat_px) over the crop's; a fallback (the eye inside the
- *   model) draws the camera for the crop as before.
- *
  * NUMBERS
  *   On the eye's thread: the per-pixel geometry on the vector layer
  *   (pipe_reproj_simd.inl, 4/8/16 lanes; a distorting lens in scalar
@@ -128,10 +100,6 @@ enum { PIPE_VIEW_CROP = 0, PIPE_VIEW_REPROJECT = 1 };
 #define PIPE_REPROJ_TOL_M 0.005f     /* occlusion test: absolute slack */
 #define PIPE_REPROJ_TOL_REL 0.02f    /* ... plus this fraction of the distance */
 #define PIPE_REPROJ_MIN_DIST_M 0.02f /* nearer to the eye: inside the model */
-/* The splat's footprint (cmask NULL): the eye points' spacing in the
- * camera times this (a slanted surface spreads its points further than the distance
- * ratio alone says) */
-#define PIPE_REPROJ_SPLAT_MARGIN 1.25f
 /* The physical range of the reprojection's HMD numbers (pipe_view_check):
  * IPD 40..90 mm (adults span about 50..78 mm), D 0..250 mm. */
 #define PIPE_IPD_MIN_M 0.04f
@@ -161,12 +129,6 @@ typedef struct pipe__reproj {
     uint8_t *kind;            /* width + 64: one row's kinds (1 sampled, 2 filled) */
     int32_t *lanes;           /* 8 * width: one row's geometry (pipe__reproj_lanes) */
     int isa;                  /* the geometry pass's ISA (ef_isa; pipe.c sets it) */
-    uint8_t *smask;           /* the splat's camera G-buffer (cmask NULL): mask, */
-    float *sdepth;            /* ... window depths (min), gw x gh, stride gw */
-    size_t scap;              /* its pixels allocated */
-    int sgw, sy0, sy1;        /* its width; the rows [sy0, sy1) touched last */
-    long splat_px;            /* this frame: the splat's camera pixels set */
-    int splat_used;           /* this frame: the occlusion test against the splat */
     kin_camera cam;           /* this frame's eye camera */
     long sampled, filled, outside; /* this frame's pixels of each kind */
     int inside;               /* this frame: the eye is inside the model */
@@ -176,14 +138,10 @@ typedef struct pipe__reproj {
  * are not written): mv the mask (0: outside the camera image, else the
  * faded 1..255), zmin the occlusion bound as a window depth of the
  * camera, iu/iv the nearest camera pixel, tx/ty the bilinear's top-left
- * tap, fx/fy its 8-bit fractions, zc the point's camera window depth
- * (0.5 (f + n - 2 f n / dp) / (f - n) + 0.5), hw = max(0.5, ks * dist /
- * dp), the splat's spacing s (ks: pipe__reproj_geo). */
+ * tap, fx/fy its 8-bit fractions. */
 typedef struct pipe__reproj_lanes {
     int32_t *mv, *iu, *iv, *tx, *ty, *fx, *fy;
     float *zmin;
-    float *zc, *hw; /* the point's own camera window depth; the splat's
-                     * spacing s in camera pixels (>= 0.5) */
 } pipe__reproj_lanes;
 
 /* What the geometry pass needs of the frame (the eye view -> camera view
@@ -196,8 +154,6 @@ typedef struct pipe__reproj_geo {
     float ox, oy;           /* the crop's (the G-buffer's) origin in the image */
     int icw1, ich1;
     float n, f, fpn, fmn, two_fn; /* near, far, f + n, f - n, 2 f n */
-    float ks;               /* the splat: PIPE_REPROJ_SPLAT_MARGIN * the larger of
-                             * the camera's and the eye's focal ratios */
     int pinhole;
     const kin_lens *lens;   /* !pinhole: kin_lens_project */
     const float *rxs;       /* the eye rays' x per column */
@@ -257,10 +213,7 @@ void pipe__reproj_free(pipe__reproj *r);
  * window depths of cam's projection, near n, far f): r->P and r->M, the
  * counts and r->inside. Returns r->inside. Where P reaches beyond the
  * G-buffer (the sensor rows above and below the crop of eq. 1) the
- * camera is taken to see the point: every tap there counts.
- * cmask NULL: no camera G-buffer (THE CAMERA'S VIEW FROM THE EYE'S POINTS
- * above): the eye's covered points are splatted into r's own gw x gh
- * buffers first (r->smask, r->sdepth, r->splat_px), and those tested. */
+ * camera is taken to see the point: every tap there counts. */
 int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image *P, int ox,
                         int oy, const uint8_t *cmask, int cmask_stride, const float *cdepth,
                         int cdepth_stride, int gw, int gh, float n, float f);

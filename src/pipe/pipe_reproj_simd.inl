@@ -30,8 +30,7 @@ int SIMD_FN(pipe__reproj_row)(const pipe__reproj_geo *g, const uint8_t *em, cons
                  cw1 = vf_set1(g->cw1), ch1 = vf_set1(g->ch1);
     const vfloat behind = vf_set1(-1e-6f), fade = vf_set1(PIPE_REPROJ_FADE_PX),
                  k255 = vf_set1(255.0f), half = vf_set1(0.5f), k256 = vf_set1(256.0f),
-                 tol = vf_set1(PIPE_REPROJ_TOL_M), rel = vf_set1(PIPE_REPROJ_TOL_REL),
-                 ks = vf_set1(g->ks);
+                 tol = vf_set1(PIPE_REPROJ_TOL_M), rel = vf_set1(PIPE_REPROJ_TOL_REL);
     const vint icw1 = vi_set1(g->icw1), ich1 = vi_set1(g->ich1), i255 = vi_set1(255);
     vfloat vmind = vf_set1(*mind);
     long bk = 0;
@@ -67,11 +66,6 @@ int SIMD_FN(pipe__reproj_row)(const pipe__reproj_geo *g, const uint8_t *em, cons
         const vfloat dp = vf_neg(pz), dmin = vf_sub(dp, vf_add(tol, vf_mul(rel, dp)));
         const vfloat zm = vf_add(vf_div(vf_mul(half, vf_sub(fpn, vf_div(two_fn, dmin))), fmn), half);
         vf_storeu(o->zmin + x, vf_selz(vf_gt(dmin, nn), zm));
-        /* the splat's: the point's own camera depth, its footprint */
-        vf_storeu(o->zc + x,
-                  vf_add(vf_div(vf_mul(half, vf_sub(fpn, vf_mul(two_fn, iz))), fmn), half));
-        const vfloat hs = vf_mul(vf_mul(ks, dist), iz);
-        vf_storeu(o->hw + x, vf_sel(vf_lt(hs, half), half, hs));
         vi_storeu(o->iu + x, vi_min(vi_from_vf_trunc(fu), icw1));
         vi_storeu(o->iv + x, vi_min(vi_from_vf_trunc(fv), ich1));
         vfloat sx = vf_sub(fu, half), sy = vf_sub(fv, half);
