@@ -18,8 +18,13 @@
  * --only crop|reproject|none runs one method (none: only the loading), for
  * instruction counts (valgrind --tool=cachegrind --cache-sim=no): the
  * differences of three runs are the methods' instructions.
+ * --lod auto|N draws both at a level of detail (io_lod_build's chain of
+ * the model, pipe_set_lod: auto the level of pipe_lod.h's rule for 2 px,
+ * N that level; the default none): the eye's and the camera's draws
+ * alike (issue 18 item 6, option 3).
  * Usage: build/bench/bench_reproj [--samples DIR] [--runs N] [--frames K]
- *                                 [--threads T] [--csv FILE] [--only M] */
+ *                                 [--threads T] [--csv FILE] [--only M]
+ *                                 [--lod auto|N] */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,6 +32,8 @@
 #include <time.h>
 
 #include "../src/io/io.h"
+#include "../src/io/io_lod.h"
+#include "../src/pipe/pipe_lod.h"
 #include "../src/pipe/pipe.h"
 #include "bench_util.h"
 
@@ -48,6 +55,7 @@ int main(int argc, char **argv)
 {
     const char *samples = "build/samples", *csv = NULL;
     int runs = 15, nframes = 8, threads = 2, only = -1; /* --only: 0 crop, 1 reproject, 2 none */
+    int lod_level = 0;                                   /* --lod: 0 none, PIPE_LOD_AUTO, a level */
     for (int i = 1; i < argc; i++) {
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(argv[i], "--samples") && v) samples = v, i++;
@@ -58,9 +66,11 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--only") && v && (!strcmp(v, "crop") || !strcmp(v, "reproject") ||
                                                      !strcmp(v, "none")))
             only = !strcmp(v, "crop") ? 0 : !strcmp(v, "reproject") ? 1 : 2, i++;
+        else if (!strcmp(argv[i], "--lod") && v && (!strcmp(v, "auto") || atoi(v) > 0))
+            lod_level = !strcmp(v, "auto") ? PIPE_LOD_AUTO : atoi(v), i++;
         else {
             fprintf(stderr, "usage: %s [--samples DIR] [--runs N] [--frames K] [--threads T] "
-                            "[--csv FILE] [--only crop|reproject|none]\n", argv[0]);
+                            "[--csv FILE] [--only crop|reproject|none] [--lod auto|N]\n", argv[0]);
             return 2;
         }
     }
@@ -106,6 +116,15 @@ int main(int argc, char **argv)
                 return 2;
         }
     }
+    pipe_lod lod;
+    memset(&lod, 0, sizeof lod);
+    if (lod_level) {
+        io_scene_frame_path(&sc, sc.model, 0, path, sizeof path);
+        if (io_lod_build(path, &model, NULL, &lod, &err) != IO_OK) {
+            fprintf(stderr, "bench_reproj: %s\n", err.msg);
+            return 1;
+        }
+    }
     pipe_ctx *p[2];
     for (int m = 0; m < 2; m++) {
         pipe_desc d;
@@ -119,7 +138,12 @@ int main(int argc, char **argv)
             fprintf(stderr, "bench_reproj: cannot create the pipe\n");
             return 1;
         }
+        if (lod_level && pipe_set_lod(p[m], &lod, lod_level, 2.0f) != 0) {
+            fprintf(stderr, "bench_reproj: the levels of detail do not fit the pipe's model\n");
+            return 1;
+        }
     }
+    long lod_sum[2] = {0, 0}, lod_n[2] = {0, 0};
     const int n = runs * nframes;
     double *wall[2], *cpu[2];
     for (int m = 0; m < 2; m++) {
@@ -159,6 +183,7 @@ int main(int argc, char **argv)
                 }
                 double c1 = bench_now_ms(CLOCK_PROCESS_CPUTIME_ID), w1 = bench_now_ms(CLOCK_MONOTONIC);
                 if (r < 0) continue;
+                for (int e = 0; e < 2; e++) lod_sum[m] += st.lod_level[e], lod_n[m]++;
                 wall[m][i + 0] = w1 - w0;
                 cpu[m][i + 0] = c1 - c0;
                 if (m == 1 && r == runs - 1)
@@ -170,6 +195,11 @@ int main(int argc, char **argv)
             }
             if (r >= 0) i++;
         }
+    if (lod_level)
+        printf("bench_reproj: levels of detail %s: %d levels, mean level drawn: crop %.2f, "
+               "reproject %.2f\n", lod_level == PIPE_LOD_AUTO ? "auto@2px" : "fixed",
+               lod.level_count, lod_n[0] ? (double)lod_sum[0] / (double)lod_n[0] : 0.0,
+               lod_n[1] ? (double)lod_sum[1] / (double)lod_n[1] : 0.0);
     if (only >= 0) {
         printf("bench_reproj: --only %s: %d stereo frames (+%d warm-up)\n",
                only == 0 ? "crop" : only == 1 ? "reproject" : "none", only < 2 ? n : 0,
@@ -216,6 +246,7 @@ int main(int argc, char **argv)
         free(wall[m]);
         free(cpu[m]);
     }
+    io_lod_free(&lod);
     for (int k = 0; k < nframes; k++)
         for (int e = 0; e < 2; e++) {
             io_image_free(&fs[k].cam[e]);
