@@ -334,6 +334,10 @@ typedef struct pipe_frame_stats {
     int eye_thread[2];        /* per eye: 0 the caller's thread, 1 the worker */
     double ms_eye_start[2];   /* per eye: ms from the eyes' hand-off to its start */
     double ms_eyes;           /* wall time from the hand-off to both eyes done */
+    /* Per thread (0 the caller's, 1 the worker): time in the eyes' work
+     * (each eye's raster and refinement, then bands of either eye's fuse:
+     * a thread that finished its own eye takes the other's bands) */
+    double ms_busy[2];
 } pipe_frame_stats;
 
 typedef enum pipe_result {
