@@ -1007,11 +1007,31 @@ struct fuse__banded {
     eye_job e;
     fuse_depth depth;   /* a copy of the caller's (it may be gone) */
     int interleave, rows, bands;
+    /* per layer row r, as comp_scratch.span: (r, x0, x1) once a band lit
+     * it with its span known, else r's entry -1 (each band writes its own
+     * rows; the finish reads them, so its composite reads only the spans) */
+    int32_t span[FUSE_MAX_DIM][3];
 };
 
 static struct fuse__banded *banded_new(void)
 {
-    return calloc(1, sizeof(struct fuse__banded));
+    return malloc(sizeof(struct fuse__banded));
+}
+
+/* The spans of layer rows [y0, y1) into B->span: from the ring (NULL:
+ * unknown). */
+static void band_spans(struct fuse__banded *B, int y0, int y1, int32_t (*ring)[3])
+{
+    int r;
+    for (r = y0; r < y1; r++) {
+        if (ring != NULL && ring[r % SPAN_RING][0] == r) {
+            B->span[r][0] = r;
+            B->span[r][1] = ring[r % SPAN_RING][1];
+            B->span[r][2] = ring[r % SPAN_RING][2];
+        } else {
+            B->span[r][0] = -1;
+        }
+    }
 }
 
 /* The first layer row output row y reads (0 above the viewport, sh below). */
@@ -1068,7 +1088,7 @@ fuse_result fuse_context_frame_prepare(fuse_context *ctx, const fuse_eye *eye, i
 
 void fuse_context_frame_band(const fuse_context *ctx, int band)
 {
-    const struct fuse__banded *B = ctx->banded;
+    struct fuse__banded *B = ctx->banded;
     const eye_job *e = &B->e;
     const comp_job *j = &e->comp;
     const int sh = e->light.P.height;
@@ -1078,6 +1098,7 @@ void fuse_context_frame_band(const fuse_context *ctx, int band)
     band_bounds(B, band, &o0, &o1, &l0, &l1, &st);
     if (!B->interleave || j->k->ref || j->vw > FUSE__TILE) {   /* as eye_whole */
         eye_light_depth(e, l0, l1, NULL);
+        band_spans(B, l0, l1, NULL);
         if (o0 < st) comp_rows(j, o0, st);
         return;
     }
@@ -1095,6 +1116,7 @@ void fuse_context_frame_band(const fuse_context *ctx, int band)
         while (lit <= need) {
             const int n = l1 - lit < FUSE_CHUNK ? l1 - lit : FUSE_CHUNK;
             eye_light_depth(e, lit, lit + n, s.span);
+            band_spans(B, lit, lit + n, s.span);
             lit += n;
         }
         comp_vp_rows(j, &s, y, y + 1);
@@ -1103,15 +1125,37 @@ void fuse_context_frame_band(const fuse_context *ctx, int band)
         uint8_t *end = j->out.pixels + (size_t)st * (size_t)j->out.stride;
         defer_flush(j, &s, end, end);
     }
-    if (lit < l1) eye_light_depth(e, lit, l1, NULL);
+    if (lit < l1) {
+        eye_light_depth(e, lit, l1, NULL);
+        band_spans(B, lit, l1, NULL);
+    }
 }
 
 void fuse_context_frame_finish(fuse_context *ctx)
 {
     const struct fuse__banded *B = ctx->banded;
-    int b, o0, o1, l0, l1, st;
+    const comp_job *j = &B->e.comp;
+    const int sh = B->e.light.P.height;
+    comp_scratch s;
+    int b, o0, o1, l0, l1, st, y;
+    /* the rows at the band borders: one scratch for all (the tile's
+     * tables once), the layer rows' spans from the bands */
+    scratch_init(&s);
     for (b = 0; b < B->bands; b++) {
         band_bounds(B, b, &o0, &o1, &l0, &l1, &st);
-        if (st < o1) comp_rows(&B->e.comp, st, o1);
+        if (st >= o1) continue;
+        comp_border_rows(j, st, o1);
+        for (y = st > j->vy ? st : j->vy; y < o1 && y < j->vy + j->vh; y++) {
+            const int iy = fuse__src_pos(y - j->vy, sh, j->vh) >> 16;
+            const int need = iy + 1 < sh ? iy + 1 : sh - 1;
+            int r;
+            for (r = iy; r <= need; r++)
+                if (s.cov_row[0] != r && s.cov_row[1] != r) {
+                    s.span[r % SPAN_RING][0] = B->span[r][0];
+                    s.span[r % SPAN_RING][1] = B->span[r][1];
+                    s.span[r % SPAN_RING][2] = B->span[r][2];
+                }
+            comp_vp_rows(j, &s, y, y + 1);
+        }
     }
 }

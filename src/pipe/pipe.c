@@ -29,11 +29,14 @@
  * split over two. AVX-512 skins about 160k vertices per ms. */
 #define PIPE_SPLIT_SKIN_VERTICES 65536
 
-/* Output rows per band of an eye's fuse on two threads (eye_work): about
- * 0.1 ms of work at the sample's 1080-row outputs, so the thread that
- * finishes first waits little for the other's last band; each band border
- * leaves a row or two to the eye's tail (fuse_context_frame_finish). */
-#define PIPE_BAND_ROWS 48
+/* Output rows per band of an eye's fuse on two threads (eye_work): 13
+ * bands per eye at the sample's 800-row outputs (0.1-0.3 ms each), so the
+ * thread that finishes first waits little for the other's last band. Each
+ * band costs a setup (the composite's column tables) and leaves 2-4 rows
+ * at its border to the eye's tail (fuse_context_frame_finish): callgrind,
+ * render of the sample, per eye-frame: +11% of the fuse's instructions
+ * at 48 rows, +8% at 64, +6% at 96 (docs/bench.md). */
+#define PIPE_BAND_ROWS 64
 
 /* The clock of pipe_frame_stats: wall time, or with pipe_set_stats_clock
  * the calling thread's CPU time. */
