@@ -66,7 +66,7 @@ struct pipe_ctx {
     kin_sthmd_geometry geo;
     pipe_pose pose;
     eye_state eye[2];
-    /* the worker thread runs eye 1 when threads == 2 */
+    /* threads == 2: the worker shares the eyes' work (pipe.c eye_work) */
     int threaded;
     pthread_t worker;
     pthread_mutex_t mu;
