@@ -375,6 +375,36 @@ typedef struct fuse_eye {
  * before any is written; on an error nothing is written. */
 fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int count);
 
+/* One eye of fuse_context_frame in bands of output rows, for threads of
+ * the caller's own (issue 17: two threads share an eye's work):
+ *
+ *   int n;
+ *   if (fuse_context_frame_prepare(ctx, &eye, 64, &n) == FUSE_OK) {
+ *       for (int b = 0; b < n; b++)            // on any threads, each b once
+ *           fuse_context_frame_band(ctx, b);
+ *       fuse_context_frame_finish(ctx);        // once every band returned
+ *   }
+ *
+ * prepare checks eye as fuse_context_frame(ctx, eye, 1) does (same errors;
+ * nothing written) and keeps it in ctx: *bands = ceil(out.height /
+ * band_rows) (band_rows >= out.height: one band). The images, mask and
+ * normals of eye must stay as they are until finish returns; eye itself,
+ * its lighting, intrinsics and depth description are copied. Band b lights
+ * (and depth-tests, fades) the layer rows that only its output rows
+ * [b band_rows, (b + 1) band_rows) read first, then composites those rows,
+ * interleaved as fuse_context_frame's own order, except the few last rows
+ * that also read the next band's first layer row: finish composites them.
+ * Different bands write different bytes, so they may run at once on
+ * different threads (never the same band twice; prepare and finish on one
+ * thread, ordered before and after every band by the caller, e.g. with a
+ * mutex). The bytes are fuse_context_frame's on every ISA and band size.
+ * The bands run on the calling thread (ctx's pool is not used); a context
+ * holds one prepared eye at a time. */
+fuse_result fuse_context_frame_prepare(fuse_context *ctx, const fuse_eye *eye, int band_rows,
+                                       int *bands);
+void fuse_context_frame_band(const fuse_context *ctx, int band);
+void fuse_context_frame_finish(fuse_context *ctx);
+
 /* A static English message for r (never NULL). */
 const char *fuse_result_str(fuse_result r);
 

@@ -54,6 +54,9 @@ void fuse__ctx_run(fuse_context *ctx, fuse__task_fn fn, void *arg)
     fuse__pool_run(ctx != NULL ? &ctx->pool : NULL, fn, arg);
 }
 
+/* The state of fuse_context_frame_prepare (below). */
+static struct fuse__banded *banded_new(void);
+
 fuse_context *fuse_context_create(const fuse_context_desc *desc)
 {
     fuse_context_desc d = {EF_ISA_DEFAULT, 1};
@@ -63,7 +66,9 @@ fuse_context *fuse_context_create(const fuse_context_desc *desc)
     ctx = calloc(1, sizeof *ctx);
     if (ctx == NULL) return NULL;
     ctx->k = fuse__kernels_for(ef_isa_choose(d.max_isa));
-    if (!fuse__pool_init(&ctx->pool, d.threads)) {
+    ctx->banded = banded_new();
+    if (ctx->banded == NULL || !fuse__pool_init(&ctx->pool, d.threads)) {
+        free(ctx->banded);
         free(ctx);
         return NULL;
     }
@@ -74,6 +79,7 @@ void fuse_context_destroy(fuse_context *ctx)
 {
     if (ctx == NULL) return;
     fuse__pool_destroy(&ctx->pool);
+    free(ctx->banded);
     free(ctx);
 }
 
@@ -922,6 +928,36 @@ static int may_interleave(const fuse_eye *s)
     return 1;
 }
 
+/* Checks one eye's inputs (fuse_context_frame) and fills *j. */
+static fuse_result eye_prepare(fuse_context *ctx, const fuse_eye *s, eye_job *j)
+{
+    fuse_result r = fuse__light_check(s->lighting, s->intrinsics, &s->P, s->mask,
+                                      s->mask_stride, s->normal, s->normal_stride,
+                                      &s->Q, &j->light.prep);
+    if (r == FUSE_OK && s->depth != NULL)
+        r = fuse__depth_check(s->depth, &s->Q, s->vp_x0, s->vp_y0, s->vp_w, s->vp_h);
+    if (r == FUSE_OK)
+        r = fuse__composite_check(&s->Q, &s->V, s->vp_x0, s->vp_y0, s->vp_w,
+                                  s->vp_h, &s->out);
+    if (r == FUSE_OK && s->depth != NULL &&
+        (s->depth->scene_width != s->V.width || s->depth->scene_height != s->V.height))
+        r = FUSE_ERR_SIZE;
+    if (r == FUSE_OK && fuse__same_image(&s->P, &s->Q))
+        r = FUSE_ERR_ARGS;   /* Q is a scratch layer of its own */
+    if (r == FUSE_OK && (s->edge_fade < 0 || s->edge_fade > FUSE_EDGE_FADE_MAX ||
+                         (s->edge_sides & ~FUSE_EDGE_ALL) != 0))
+        r = FUSE_ERR_ARGS;
+    if (r != FUSE_OK) return r;
+    light_job_set(&j->light, &ctx->k, &s->P, s->mask, s->mask_stride, s->normal,
+                  s->normal_stride, &s->Q);
+    comp_job_set(&j->comp, &ctx->k, &s->Q, &s->V, s->vp_x0, s->vp_y0, s->vp_w, s->vp_h,
+                 &s->out, s->v_opaque != 0);
+    j->depth = s->depth;
+    j->edge_fade = s->edge_fade;
+    j->edge_sides = s->edge_sides;
+    return FUSE_OK;
+}
+
 fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int count)
 {
     frame_job f;
@@ -930,32 +966,8 @@ fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int coun
         return FUSE_ERR_ARGS;
     f.count = count;
     for (e = 0; e < count; e++) {
-        const fuse_eye *s = &eyes[e];
-        eye_job *j = &f.eyes[e];
-        fuse_result r = fuse__light_check(s->lighting, s->intrinsics, &s->P, s->mask,
-                                          s->mask_stride, s->normal, s->normal_stride,
-                                          &s->Q, &j->light.prep);
-        if (r == FUSE_OK && s->depth != NULL)
-            r = fuse__depth_check(s->depth, &s->Q, s->vp_x0, s->vp_y0, s->vp_w, s->vp_h);
-        if (r == FUSE_OK)
-            r = fuse__composite_check(&s->Q, &s->V, s->vp_x0, s->vp_y0, s->vp_w,
-                                      s->vp_h, &s->out);
-        if (r == FUSE_OK && s->depth != NULL &&
-            (s->depth->scene_width != s->V.width || s->depth->scene_height != s->V.height))
-            r = FUSE_ERR_SIZE;
-        if (r == FUSE_OK && fuse__same_image(&s->P, &s->Q))
-            r = FUSE_ERR_ARGS;   /* Q is a scratch layer of its own */
-        if (r == FUSE_OK && (s->edge_fade < 0 || s->edge_fade > FUSE_EDGE_FADE_MAX ||
-                             (s->edge_sides & ~FUSE_EDGE_ALL) != 0))
-            r = FUSE_ERR_ARGS;
+        fuse_result r = eye_prepare(ctx, &eyes[e], &f.eyes[e]);
         if (r != FUSE_OK) return r;
-        light_job_set(&j->light, &ctx->k, &s->P, s->mask, s->mask_stride, s->normal,
-                      s->normal_stride, &s->Q);
-        comp_job_set(&j->comp, &ctx->k, &s->Q, &s->V, s->vp_x0, s->vp_y0, s->vp_w, s->vp_h,
-                     &s->out, s->v_opaque != 0);
-        j->depth = s->depth;
-        j->edge_fade = s->edge_fade;
-        j->edge_sides = s->edge_sides;
     }
     /* one eye's writes must not land in another eye's inputs */
     for (e = 0; e < count; e++) {
@@ -977,4 +989,173 @@ fuse_result fuse_context_frame(fuse_context *ctx, const fuse_eye *eyes, int coun
         fuse__ctx_run(ctx, frame_comp_task, &f);
     }
     return FUSE_OK;
+}
+
+/* ---- one eye in row bands ------------------------------------------------
+ *
+ * fuse_context_frame_prepare / _band / _finish (fuse.h). Band b holds the
+ * output rows [o0, o1) = [b R, (b + 1) R) and lights the layer rows
+ * [l0, l1): l0 the first layer row its first viewport row reads (0 for
+ * band 0), l1 the next band's l0 (sh for the last band). So every layer
+ * row is lit by exactly one band. An output row reads layer rows iy and
+ * iy + 1 (fuse__src_pos): the last rows of a band may read l1, which the
+ * next band lights; those rows ([st, o1), at most a few per border) wait
+ * for the finish, which composites them once every band is done. No two
+ * bands write the same byte: each writes its own layer rows and its own
+ * output rows [o0, st). */
+struct fuse__banded {
+    eye_job e;
+    fuse_depth depth;   /* a copy of the caller's (it may be gone) */
+    int interleave, rows, bands;
+    /* per layer row r, as comp_scratch.span: (r, x0, x1) once a band lit
+     * it with its span known, else r's entry -1 (each band writes its own
+     * rows; the finish reads them, so its composite reads only the spans) */
+    int32_t span[FUSE_MAX_DIM][3];
+};
+
+static struct fuse__banded *banded_new(void)
+{
+    return malloc(sizeof(struct fuse__banded));
+}
+
+/* The spans of layer rows [y0, y1) into B->span: from the ring (NULL:
+ * unknown). */
+static void band_spans(struct fuse__banded *B, int y0, int y1, int32_t (*ring)[3])
+{
+    int r;
+    for (r = y0; r < y1; r++) {
+        if (ring != NULL && ring[r % SPAN_RING][0] == r) {
+            B->span[r][0] = r;
+            B->span[r][1] = ring[r % SPAN_RING][1];
+            B->span[r][2] = ring[r % SPAN_RING][2];
+        } else {
+            B->span[r][0] = -1;
+        }
+    }
+}
+
+/* The first layer row output row y reads (0 above the viewport, sh below). */
+static int band_layer(const comp_job *j, int sh, int y)
+{
+    if (y <= j->vy) return 0;
+    if (y >= j->vy + j->vh) return sh;
+    return fuse__src_pos(y - j->vy, sh, j->vh) >> 16;
+}
+
+/* Band b's output rows [*o0, *o1), layer rows [*l0, *l1) and the first of
+ * its rows left to the finish, *st (*o1: none). */
+static void band_bounds(const struct fuse__banded *B, int b, int *o0, int *o1, int *l0, int *l1,
+                        int *st)
+{
+    const comp_job *j = &B->e.comp;
+    const int sh = B->e.light.P.height, H = j->out.height;
+    int y;
+    *o0 = (int)((int64_t)b * B->rows < H ? (int64_t)b * B->rows : H);
+    *o1 = (int)((int64_t)(b + 1) * B->rows < H ? (int64_t)(b + 1) * B->rows : H);
+    if (b == B->bands - 1) *o1 = H;
+    *l0 = b == 0 ? 0 : band_layer(j, sh, *o0);
+    *l1 = b == B->bands - 1 ? sh : band_layer(j, sh, *o1);
+    *st = *o1;
+    for (y = *o1 - 1; y >= *o0 && y >= j->vy && y < j->vy + j->vh; y--) {
+        const int iy = fuse__src_pos(y - j->vy, sh, j->vh) >> 16;
+        const int need = iy + 1 < sh ? iy + 1 : sh - 1;
+        if (need < *l1) break;
+        *st = y;
+    }
+}
+
+fuse_result fuse_context_frame_prepare(fuse_context *ctx, const fuse_eye *eye, int band_rows,
+                                       int *bands)
+{
+    struct fuse__banded *B;
+    fuse_result r;
+    int H;
+    if (ctx == NULL || eye == NULL || bands == NULL || band_rows < 1) return FUSE_ERR_ARGS;
+    B = ctx->banded;
+    r = eye_prepare(ctx, eye, &B->e);
+    if (r != FUSE_OK) return r;
+    if (eye->depth != NULL) {
+        B->depth = *eye->depth;
+        B->e.depth = &B->depth;
+    }
+    B->interleave = may_interleave(eye);
+    H = eye->out.height;
+    B->rows = band_rows < H ? band_rows : H;
+    B->bands = (H + B->rows - 1) / B->rows;
+    *bands = B->bands;
+    return FUSE_OK;
+}
+
+void fuse_context_frame_band(const fuse_context *ctx, int band)
+{
+    struct fuse__banded *B = ctx->banded;
+    const eye_job *e = &B->e;
+    const comp_job *j = &e->comp;
+    const int sh = e->light.P.height;
+    comp_scratch s;
+    int o0, o1, l0, l1, st, lit, y, ya, yb;
+    if (band < 0 || band >= B->bands) return;
+    band_bounds(B, band, &o0, &o1, &l0, &l1, &st);
+    if (!B->interleave || j->k->ref || j->vw > FUSE__TILE) {   /* as eye_whole */
+        eye_light_depth(e, l0, l1, NULL);
+        band_spans(B, l0, l1, NULL);
+        if (o0 < st) comp_rows(j, o0, st);
+        return;
+    }
+    scratch_init(&s);
+    s.defer = !j->in_place && j->v_opaque && j->out.stride == 4 * j->out.width &&
+              j->V.stride == j->out.stride;
+    s.pend = (size_t)o0 * (size_t)j->out.stride;
+    if (!s.defer) comp_border_rows(j, o0, st);
+    ya = o0 > j->vy ? o0 : j->vy;
+    yb = st < j->vy + j->vh ? st : j->vy + j->vh;
+    lit = l0;
+    for (y = ya; y < yb; y++) {
+        const int32_t pos = fuse__src_pos(y - j->vy, sh, j->vh);
+        const int iy = pos >> 16, need = iy + 1 < sh ? iy + 1 : sh - 1;
+        while (lit <= need) {
+            const int n = l1 - lit < FUSE_CHUNK ? l1 - lit : FUSE_CHUNK;
+            eye_light_depth(e, lit, lit + n, s.span);
+            band_spans(B, lit, lit + n, s.span);
+            lit += n;
+        }
+        comp_vp_rows(j, &s, y, y + 1);
+    }
+    if (s.defer) {   /* the rest of the band's rows: after its last blended run */
+        uint8_t *end = j->out.pixels + (size_t)st * (size_t)j->out.stride;
+        defer_flush(j, &s, end, end);
+    }
+    if (lit < l1) {
+        eye_light_depth(e, lit, l1, NULL);
+        band_spans(B, lit, l1, NULL);
+    }
+}
+
+void fuse_context_frame_finish(fuse_context *ctx)
+{
+    const struct fuse__banded *B = ctx->banded;
+    const comp_job *j = &B->e.comp;
+    const int sh = B->e.light.P.height;
+    comp_scratch s;
+    int b, o0, o1, l0, l1, st, y;
+    /* the rows at the band borders: one scratch for all (the tile's
+     * tables once), the layer rows' spans from the bands */
+    scratch_init(&s);
+    for (b = 0; b < B->bands; b++) {
+        band_bounds(B, b, &o0, &o1, &l0, &l1, &st);
+        if (st >= o1) continue;
+        comp_border_rows(j, st, o1);
+        for (y = st > j->vy ? st : j->vy; y < o1 && y < j->vy + j->vh; y++) {
+            const int iy = fuse__src_pos(y - j->vy, sh, j->vh) >> 16;
+            const int need = iy + 1 < sh ? iy + 1 : sh - 1;
+            int r;
+            for (r = iy; r <= need; r++)
+                if (s.cov_row[0] != r && s.cov_row[1] != r) {
+                    s.span[r % SPAN_RING][0] = B->span[r][0];
+                    s.span[r % SPAN_RING][1] = B->span[r][1];
+                    s.span[r % SPAN_RING][2] = B->span[r][2];
+                }
+            comp_vp_rows(j, &s, y, y + 1);
+        }
+    }
 }

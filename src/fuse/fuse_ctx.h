@@ -31,6 +31,7 @@ typedef struct kernels {
 struct fuse_context {
     kernels k;
     fuse__pool pool;
+    struct fuse__banded *banded;   /* fuse_context_frame_prepare's eye (fuse_ctx.c) */
 };
 
 /* The kernels of isa (ref for an ISA this build has no kernels for). */

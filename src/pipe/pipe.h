@@ -328,12 +328,17 @@ typedef struct pipe_frame_stats {
     long view_outside[2];
     long view_fallbacks;      /* reprojection: eye-frames that fell back
                                  to the crop, since pipe_create */
-    /* Where the eyes ran (threads 2: each eye is taken by whichever
-     * thread is free first, so the caller's thread runs both when the
-     * worker has not woken by the time it finished its first) */
-    int eye_thread[2];        /* per eye: 0 the caller's thread, 1 the worker */
+    /* Where the eyes ran (threads 2: each eye's raster and refinement is
+     * taken by whichever thread is free first, so the caller's thread runs
+     * both when the worker has not woken by the time it finished its
+     * first; the bands of its fuse then run on both threads, ms_busy) */
+    int eye_thread[2];        /* per eye: the thread of its raster (0 the caller's, 1 the worker) */
     double ms_eye_start[2];   /* per eye: ms from the eyes' hand-off to its start */
     double ms_eyes;           /* wall time from the hand-off to both eyes done */
+    /* Per thread (0 the caller's, 1 the worker): time in the eyes' work
+     * (each eye's raster and refinement, then bands of either eye's fuse:
+     * a thread that finished its own eye takes the other's bands) */
+    double ms_busy[2];
 } pipe_frame_stats;
 
 typedef enum pipe_result {

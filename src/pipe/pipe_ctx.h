@@ -51,6 +51,13 @@ typedef struct eye_state {
     long fallbacks;           /* reprojecting frames that fell back */
     int thread;               /* 0 the caller's thread, 1 the worker */
     double t_start;           /* now_ms() at the eye's start */
+    /* the fuse in row bands shared by the threads (pipe.c eye_work) */
+    int fusing;               /* run_eye reached the fuse: eye_finish's part runs */
+    fuse_result fr;           /* the fuse's prepare (tone match) result */
+    int filled[4];            /* fuse_depth_fill's box, restored after the fuse */
+    int ready;                /* run_eye done: bands open to both threads */
+    int bands, band_next, bands_done;
+    double ms_bands;          /* the bands' time, summed over threads */
 } eye_state;
 
 struct pipe_ctx {
@@ -59,7 +66,7 @@ struct pipe_ctx {
     kin_sthmd_geometry geo;
     pipe_pose pose;
     eye_state eye[2];
-    /* the worker thread runs eye 1 when threads == 2 */
+    /* threads == 2: the worker shares the eyes' work (pipe.c eye_work) */
     int threaded;
     pthread_t worker;
     pthread_mutex_t mu;
@@ -68,6 +75,7 @@ struct pipe_ctx {
     int job_kind;             /* JOB_SKIN or JOB_EYE */
     int eye_next, eye_done;   /* JOB_EYE: the next eye to take (2: none
                                  left), the eyes finished */
+    double ms_busy[2];        /* JOB_EYE: per thread, time in the eyes' work */
     int skin_split;           /* skin on both threads (large models) */
     kin_skin_plan *plans;     /* per mesh: the skin plan of a skinned mesh */
     void **plan_mem;          /* per mesh: its memory, or NULL */
