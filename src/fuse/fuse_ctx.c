@@ -5,7 +5,15 @@
  * fuse_{sse2,avx2,avx512,neon}.c; every row is independent,
  * so the bytes do not depend on the ISA, the thread count or the banding.
  * The kernel table and the context are declared in fuse_ctx.h; the depth
- * test's job is fuse_depth_job.c. */
+ * test's job is fuse_depth_job.c.
+ *
+ * WHY ONE FILE OF ABOUT 1150 LINES: one job, driving the row kernels over an
+ * eye's rows. The single-stage entries, the interleaved whole frame and the
+ * row bands that pipe_frame hands to either thread (fuse_context_frame_prepare
+ * / _band / _finish) all run the same static row machinery (the lit spans,
+ * the composite's scratch, tiles and row cache, the border rows), which the
+ * compiler inlines into each; a split would turn about twenty of these into
+ * cross-file internals of fuse_ctx.h. */
 #include "fuse_internal.h"
 
 #include <stdlib.h>
