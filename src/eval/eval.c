@@ -16,6 +16,7 @@
 #include "../fit/fit_band.h"
 #include "../fit/fit_holes.h"
 #include "../fit/fit_shift.h"
+#include "../fit/fit_smooth.h"
 
 /* The ground truth comes from samples/gt/ and the sample generator
  * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
@@ -164,6 +165,8 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
     if (pipe_fit_fill_scratch_size(CW, CH) > c->refine_scratch_size)   /* shared (as pipe_frame) */
         c->refine_scratch_size = pipe_fit_fill_scratch_size(CW, CH);
+    if (pipe_fit_smooth_scratch_size(CW, CH) > c->refine_scratch_size)
+        c->refine_scratch_size = pipe_fit_smooth_scratch_size(CW, CH);
     if (pipe_fit_shift_scratch_size(CW, CH) > c->refine_scratch_size)
         c->refine_scratch_size = pipe_fit_shift_scratch_size(CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
@@ -632,6 +635,10 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 if (rs.used_colour && cfg->fill_hole + cfg->fill_island > 0)
                     pipe_fit_fill_small(c->refined, CW, CW, CH, cfg->fill_hole, cfg->fill_island,
                                         kmask, CW, c->refine_scratch, c->refine_scratch_size);
+                /* its ragged edge smoothed (fit_smooth.h, as pipe_frame) */
+                if (rs.used_colour && cfg->smooth)
+                    pipe_fit_smooth(c->refined, CW, CW, CH, c->refine_scratch,
+                                    c->refine_scratch_size);
                 /* not from a fallback (out = M): its widths are the
                  * model's own (as pipe_frame) */
                 if (cfg->fit && posed && rs.used_colour) {

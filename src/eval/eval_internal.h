@@ -56,6 +56,8 @@ typedef struct method_cfg {
     int fill_hole, fill_island; /* refine: holes / islands of the refined
                                    mask up to this many pixels filled /
                                    cleared (fit_holes.h); 0 off */
+    int smooth;              /* refine: 1 = the refined mask's 3x3 closing
+                                and opening (fit_smooth.h) */
     int stereo;              /* refine: 1 = the stereo pair's depth test of
                                 the refined mask (fit_stereo.h) */
     float lag_adapt_v0, lag_adapt_v1;   /* refine, kin-cal-pred: lag
@@ -67,8 +69,9 @@ typedef struct method_cfg {
 /* refine's variants in --methods (eval_plan.c): refine-nomc (the prior
  * not moved with the hand), refine-noshift (the hands of the input not
  * moved to the colour, fit_shift.h), refine-shiftall (every tracked hand
- * moved, those of the prior too) */
-#define EVAL_VARIANTS 3
+ * moved, those of the prior too), refine-nosmooth (the refined mask
+ * not smoothed, fit_smooth.h) */
+#define EVAL_VARIANTS 4
 method_cfg eval__variant_cfg(const eval_opts *o, int v);
 
 /* refine's defaults (docs/accuracy.md, issue 14 item 2) */
@@ -79,6 +82,8 @@ method_cfg eval__variant_cfg(const eval_opts *o, int v);
 /* refine: the hands without the prior moved to the colour before the
  * band (fit_shift.h; 0 off, 2 every hand) */
 #define EVAL_SHIFT 1
+/* refine: the refined mask's ragged edge smoothed (fit_smooth.h; 0 off) */
+#define EVAL_SMOOTH 1
 /* refine: the refined mask's holes up to this many pixels filled and its
  * islands up to this many cleared (fit_holes.h; as PIPE_FILL_HOLE,
  * PIPE_FILL_ISLAND) */

@@ -12,6 +12,7 @@
 #include "../fit/fit_band.h"
 #include "../fit/fit_holes.h"
 #include "../fit/fit_shift.h"
+#include "../fit/fit_smooth.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -370,6 +371,10 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         if (rs.used_colour && p->fit && p->desc.refine_fill == 0)
             pipe_fit_fill_small(e->refined, cw, cw, ch, PIPE_FILL_HOLE, PIPE_FILL_ISLAND, e->mask, cw,
                                 e->refine_scratch, e->refine_scratch_size);
+        /* and its ragged edge smoothed (fit_smooth.h; the scratch is
+         * free, larger than it needs: the fill's) */
+        if (rs.used_colour && p->fit && p->desc.refine_smooth == 0)
+            pipe_fit_smooth(e->refined, cw, cw, ch, e->refine_scratch, e->refine_scratch_size);
         pipe__cockpit_clamp(p->ck, &p->pose, e->eye, e->rast, &e->cam, e->mask, cw, e->refined,
                             cw, p->desc.refine_band, e->clip);
         e->have_refined = 1;
@@ -622,7 +627,8 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
     if (desc && (desc->refine_prior < -1 || desc->refine_prior > 0 ||
                  desc->refine_lag_adapt < -1 || desc->refine_lag_adapt > 0 ||
                  desc->refine_fill < -1 || desc->refine_fill > 0 ||
-                 desc->refine_shift < -1 || desc->refine_shift > 0))
+                 desc->refine_shift < -1 || desc->refine_shift > 0 ||
+                 desc->refine_smooth < -1 || desc->refine_smooth > 0))
         return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;

@@ -195,6 +195,14 @@ typedef struct pipe_desc {
                                  object still hides it. -1: off (the
                                  bytes of before). Other values:
                                  pipe_create returns NULL. */
+    int refine_smooth;        /* with refine_band and a fit (fit_rig): 0 =
+                                 the default, on: after refine_fill, the
+                                 refined mask's 3x3 closing then opening
+                                 (pipe_fit_smooth, src/fit/fit_smooth.h,
+                                 docs/accuracy.md): its 1-2 px notches
+                                 filled and spurs cut. -1: off (the bytes
+                                 of before). Other values: pipe_create
+                                 returns NULL. */
 } pipe_desc;
 
 /* The defaults of the refine method (`egofuse eval`'s, docs/accuracy.md). */

@@ -1,0 +1,46 @@
+/* fit_smooth.h - the refined mask's ragged edge smoothed (issue 14 item 2,
+ * docs/accuracy.md, "The refined edge smoothed").
+ *
+ * WHAT IT DOES
+ *   The colour vote decides each band pixel on its own: shadowed skin on
+ *   the hand's underside and the finger sides falls out as notches and
+ *   cracks 1-2 px wide, background specks stick out as 1-px spurs. Each
+ *   is an edge of the mask a few pixels from the true edge (a miss of
+ *   boundary F at 3 px). pipe_fit_smooth applies a 3x3 closing, then a
+ *   3x3 opening (square structuring element, grey-level: max / min of
+ *   the 3x3 neighbourhood, so 0/255 masks stay 0/255):
+ *     close(m) = erode(dilate(m)),  open(m) = dilate(erode(m)),
+ *     out      = open(close(m)),   in place;
+ *   outside the image a dilation sees 0 and an erosion sees 255 (a mask
+ *   touching the border is not cut back from it). Rows farther than 2
+ *   from any set pixel are untouched (they stay 0).
+ *
+ * WHAT IT DOES NOT
+ *   No allocation (the caller passes scratch), no colour, no state.
+ *   Gaps wider than 2 px (between fingers) and islands wider than 2 px
+ *   stay; notches 1-2 px wide are filled and spurs 1-2 px wide cut.
+ */
+#ifndef EGOFUSE_FIT_SMOOTH_H
+#define EGOFUSE_FIT_SMOOTH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Bytes of scratch for a width x height mask (0 for bad sizes). */
+size_t pipe_fit_smooth_scratch_size(int width, int height);
+
+/* See above. mask: width x height bytes at stride >= width, rewritten in
+ * place. Returns 0, or -1 (mask unchanged) for bad arguments or a
+ * scratch smaller than pipe_fit_smooth_scratch_size. */
+int pipe_fit_smooth(uint8_t *mask, int stride, int width, int height, void *scratch,
+                    size_t scratch_size);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
