@@ -1,9 +1,12 @@
 /* test_fit_smooth.c - the refined mask's 3x3 closing then opening
  * (src/fit/fit_smooth.h, issue 14 item 2), on seeded masks against a
- * direct reference (each output pixel the min / max over its 3x3 window,
- * pixels outside the image 0 for a dilation and 255 for an erosion):
+ * direct reference (the mask made 0/255 at 128, then each output pixel
+ * the min / max over its 3x3 window, pixels outside the image 0 for a
+ * dilation and 255 for an erosion):
  * - 300 seeded masks (discs, notches, specks, grey values, masks touching
  *   the border, empty rows above and below) equal to the reference;
+ * - every other one with a mask `inside` (the closing adds pixels only
+ *   where it is set);
  * - a disc with a 1-px crack and a 1-px spur: both gone; a gap of 4 px
  *   between two blocks and a 4x4 island: kept;
  * - bad arguments and a scratch too small: -1, the mask as it was. */
@@ -17,7 +20,7 @@
 
 enum { W = 53, H = 37, S = 58 };
 
-static uint8_t m[S * H], orig[S * H];
+static uint8_t m[S * H], orig[S * H], ins[S * H];
 
 static uint64_t rng = 0x9E3779B97F4A7C15ull;
 static uint32_t next(void)
@@ -46,12 +49,17 @@ static void ref_step(const uint8_t *a, uint8_t *b, int dil)
         }
 }
 
-static void reference(const uint8_t *in, uint8_t *out)
+static void reference(const uint8_t *in, const uint8_t *inside, uint8_t *out)
 {
     uint8_t a[W * H], b[W * H];
-    for (int y = 0; y < H; y++) memcpy(a + y * W, in + y * S, W);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) a[y * W + x] = in[y * S + x] >= 128 ? 255 : 0;
     ref_step(a, b, 1);
     ref_step(b, a, 0);
+    if (inside)   /* the closing's new pixels only inside */
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++)
+                if (in[y * S + x] < 128 && inside[y * S + x] < 128) a[y * W + x] = 0;
     ref_step(a, b, 0);
     ref_step(b, out, 1);
 }
@@ -83,9 +91,17 @@ static void against_reference(void **state)
         }
         /* the padding between rows must not be read or written */
         for (int y = 0; y < H; y++) memset(orig + y * S + W, 0xA5, S - W);
+        /* every other mask: the closing only inside a disc */
+        const int use_in = it % 2;
+        if (use_in) {
+            const int cx = (int)(next() % W), cy = (int)(next() % H), r = 5 + (int)(next() % 20);
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < S; x++)
+                    ins[y * S + x] = (x - cx) * (x - cx) + (y - cy) * (y - cy) <= r * r ? 200 : 7;
+        }
         memcpy(m, orig, sizeof m);
-        assert_int_equal(pipe_fit_smooth(m, S, W, H, scratch, sz), 0);
-        reference(orig, want);
+        assert_int_equal(pipe_fit_smooth(m, S, W, H, use_in ? ins : NULL, S, scratch, sz), 0);
+        reference(orig, use_in ? ins : NULL, want);
         for (int y = 0; y < H; y++) {
             assert_memory_equal(m + y * S, want + y * W, W);
             assert_memory_equal(m + y * S + W, orig + y * S + W, S - W);
@@ -114,7 +130,7 @@ static void cracks_and_gaps(void **state)
     for (int y = 25; y < 29; y++)
         for (int x = 40; x < 44; x++) orig[y * S + x] = 255;
     memcpy(m, orig, sizeof m);
-    assert_int_equal(pipe_fit_smooth(m, S, W, H, scratch, sz), 0);
+    assert_int_equal(pipe_fit_smooth(m, S, W, H, NULL, 0, scratch, sz), 0);
     for (int x = 15; x < 24; x++) assert_int_equal(m[18 * S + x], 255);
     for (int y = 4; y < 7; y++) assert_int_equal(m[y * S + 15], 0);
     for (int y = 3; y < 11; y++)
@@ -123,17 +139,18 @@ static void cracks_and_gaps(void **state)
         for (int x = 40; x < 44; x++) assert_int_equal(m[y * S + x], 255);
     /* an empty mask stays empty; a full one full */
     memset(m, 0, sizeof m);
-    assert_int_equal(pipe_fit_smooth(m, S, W, H, scratch, sz), 0);
+    assert_int_equal(pipe_fit_smooth(m, S, W, H, NULL, 0, scratch, sz), 0);
     for (int i = 0; i < S * H; i++) assert_int_equal(m[i], 0);
     memset(m, 255, sizeof m);
-    assert_int_equal(pipe_fit_smooth(m, S, W, H, scratch, sz), 0);
+    assert_int_equal(pipe_fit_smooth(m, S, W, H, NULL, 0, scratch, sz), 0);
     for (int i = 0; i < S * H; i++) assert_int_equal(m[i], 255);
     /* bad arguments, scratch too small: the mask as it was */
     memcpy(m, orig, sizeof m);
-    assert_int_equal(pipe_fit_smooth(m, S, W, H, scratch, sz - 1), -1);
-    assert_int_equal(pipe_fit_smooth(m, W - 1, W, H, scratch, sz), -1);
-    assert_int_equal(pipe_fit_smooth(NULL, S, W, H, scratch, sz), -1);
-    assert_int_equal(pipe_fit_smooth(m, S, W, H, NULL, sz), -1);
+    assert_int_equal(pipe_fit_smooth(m, S, W, H, NULL, 0, scratch, sz - 1), -1);
+    assert_int_equal(pipe_fit_smooth(m, W - 1, W, H, NULL, 0, scratch, sz), -1);
+    assert_int_equal(pipe_fit_smooth(NULL, S, W, H, NULL, 0, scratch, sz), -1);
+    assert_int_equal(pipe_fit_smooth(m, S, W, H, NULL, 0, NULL, sz), -1);
+    assert_int_equal(pipe_fit_smooth(m, S, W, H, orig, W - 1, scratch, sz), -1);
     assert_memory_equal(m, orig, sizeof m);
     assert_int_equal(pipe_fit_smooth_scratch_size(0, H), 0);
     free(scratch);

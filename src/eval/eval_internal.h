@@ -71,7 +71,7 @@ typedef struct method_cfg {
  * moved to the colour, fit_shift.h), refine-shiftall (every tracked hand
  * moved, those of the prior too), refine-nosmooth (the refined mask
  * not smoothed, fit_smooth.h) */
-#define EVAL_VARIANTS 4
+#define EVAL_VARIANTS 8
 method_cfg eval__variant_cfg(const eval_opts *o, int v);
 
 /* refine's defaults (docs/accuracy.md, issue 14 item 2) */
@@ -178,6 +178,7 @@ typedef struct eval_ctx {
     uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
     uint8_t *mask_prior;     /* refine: the prior (fit_band.h) */
     uint8_t *mask_shift;     /* refine: the hands moved (fit_shift.h) */
+    uint8_t *mask_smooth;    /* refine: the output smoothed (fit_smooth.h) */
     uint32_t *aa_samples;    /* anti-aliased coverage, 640x400 */
     float *depth_lo, *nrm_lo, *mnrm;
     void *refine_scratch;

@@ -60,7 +60,9 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k)
 /* refine's variants, selectable in --methods (bits 4.. of
  * eval_opts.methods): refine with one knob changed (docs/accuracy.md) */
 static const char *variant_name[EVAL_VARIANTS] = { "refine-nomc", "refine-noshift",
-                                                   "refine-shiftall", "refine-nosmooth" };
+                                                   "refine-shiftall", "refine-nosmooth",
+                                                   "refine-smoothlate", "refine-smoothout",
+                                                   "refine-smoothin", "refine-smoothoutin" };
 
 method_cfg eval__variant_cfg(const eval_opts *o, int v)
 {
@@ -69,7 +71,11 @@ method_cfg eval__variant_cfg(const eval_opts *o, int v)
     case 0: c.prior_mc = 0; snprintf(c.setting, sizeof c.setting, "priormc=0"); break;
     case 1: c.shift = 0; snprintf(c.setting, sizeof c.setting, "shift=0"); break;
     case 2: c.shift = 2; snprintf(c.setting, sizeof c.setting, "shift=2"); break;
-    default: c.smooth = 0; snprintf(c.setting, sizeof c.setting, "smooth=0"); break;
+    case 3: c.smooth = 0; snprintf(c.setting, sizeof c.setting, "smooth=0"); break;
+    case 4: c.smooth = 2; snprintf(c.setting, sizeof c.setting, "smooth=2"); break;
+    case 5: c.smooth = 3; snprintf(c.setting, sizeof c.setting, "smooth=3"); break;
+    case 6: c.smooth = 4; snprintf(c.setting, sizeof c.setting, "smooth=4"); break;
+    default: c.smooth = 5; snprintf(c.setting, sizeof c.setting, "smooth=5"); break;
     }
     return c;
 }

@@ -1,116 +1,152 @@
 /* The refined mask's 3x3 closing then opening (fit_smooth.h). Each
- * dilation / erosion is separable: a 3-tap max / min along the row into
- * a buffer, then along the column. Only the rows that can change (the
- * set rows and 2 around them; an all-zero row far from set pixels stays
- * zero under all four steps) are processed. */
+ * dilation / erosion is separable: a 3-tap OR / AND along the row, then
+ * along the column, on 0/255 bytes 8 at a time (a uint64_t: the row's
+ * neighbours by shifting in the next word's byte). The rows are copied
+ * into scratch rows of a stride rounded up to 8, whose tail bytes hold
+ * the pad the next row pass needs (0 before a dilation, 255 before an
+ * erosion). Only the rows that can change (the set rows and 2 around
+ * them; a zero row 2+ from set rows stays zero under all four steps)
+ * are processed. */
 #include "fit_smooth.h"
 
 #include <string.h>
 
+static int stride8(int width) { return (width + 7) / 8 * 8; }
+
 size_t pipe_fit_smooth_scratch_size(int width, int height)
 {
     if (width < 1 || height < 1 || width > (1 << 16) || height > (1 << 16)) return 0;
-    return 2 * (size_t)width * (size_t)height;
+    return 2 * (size_t)stride8(width) * (size_t)height;
 }
 
-static inline uint8_t mx(uint8_t a, uint8_t b) { return a > b ? a : b; }
-static inline uint8_t mn(uint8_t a, uint8_t b) { return a < b ? a : b; }
-
-/* rows [y0, y1) of src (stride ss) -> dst (stride ds): 3-tap along x,
- * outside = pad */
-static void pass_x(const uint8_t *src, int ss, uint8_t *dst, int ds, int w, int y0, int y1, int dil)
+static inline uint64_t ld(const uint8_t *p)
 {
-    const uint8_t pad = dil ? 0 : 255;
+    uint64_t v;
+    memcpy(&v, p, 8);
+    return v;
+}
+
+static inline void st(uint8_t *p, uint64_t v) { memcpy(p, &v, 8); }
+
+/* rows [y0, y1) of a -> b (stride s8, n8 words a row): 3-tap along x
+ * (byte j of a word is the pixel at the lowest address + j: little and
+ * big endian handled by the shifts' direction) */
+static void pass_x(const uint8_t *a, uint8_t *b, int s8, int y0, int y1, int dil)
+{
+    const uint64_t pad = dil ? 0 : ~(uint64_t)0;
+    const int n8 = s8 / 8;
     for (int y = y0; y < y1; y++) {
-        const uint8_t *s = src + (size_t)y * ss;
-        uint8_t *d = dst + (size_t)y * ds;
-        if (w == 1) { d[0] = s[0]; continue; }
-        if (dil) {
-            d[0] = mx(mx(pad, s[0]), s[1]);
-            for (int x = 1; x < w - 1; x++) d[x] = mx(mx(s[x - 1], s[x]), s[x + 1]);
-            d[w - 1] = mx(mx(s[w - 2], s[w - 1]), pad);
-        } else {
-            d[0] = mn(mn(pad, s[0]), s[1]);
-            for (int x = 1; x < w - 1; x++) d[x] = mn(mn(s[x - 1], s[x]), s[x + 1]);
-            d[w - 1] = mn(mn(s[w - 2], s[w - 1]), pad);
+        const uint8_t *r = a + (size_t)y * s8;
+        uint8_t *d = b + (size_t)y * s8;
+        uint64_t prev = pad, cur = ld(r);
+        for (int i = 0; i < n8; i++) {
+            const uint64_t next = i + 1 < n8 ? ld(r + 8 * (i + 1)) : pad;
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
+            const uint64_t lft = (cur >> 8) | (prev << 56), rgt = (cur << 8) | (next >> 56);
+#else
+            const uint64_t lft = (cur << 8) | (prev >> 56), rgt = (cur >> 8) | (next << 56);
+#endif
+            st(d + 8 * i, dil ? (cur | lft | rgt) : (cur & lft & rgt));
+            prev = cur;
+            cur = next;
         }
     }
 }
 
-/* rows [y0, y1): 3-tap along y of src (rows y-1..y+1 read within [0, h),
- * outside = pad) */
-static void pass_y(const uint8_t *src, int ss, uint8_t *dst, int ds, int w, int h, int y0, int y1,
-                   int dil)
+/* rows [y0, y1) of a -> b: 3-tap along y, rows outside [0, h) = pad */
+static void pass_y(const uint8_t *a, uint8_t *b, int s8, int h, int y0, int y1, int dil)
 {
-    const uint8_t pad = dil ? 0 : 255;
+    const uint64_t pad = dil ? 0 : ~(uint64_t)0;
+    const int n8 = s8 / 8;
     for (int y = y0; y < y1; y++) {
-        const uint8_t *a = y > 0 ? src + (size_t)(y - 1) * ss : NULL;
-        const uint8_t *b = src + (size_t)y * ss;
-        const uint8_t *c = y + 1 < h ? src + (size_t)(y + 1) * ss : NULL;
-        uint8_t *d = dst + (size_t)y * ds;
-        if (dil) {
-            if (a && c)
-                for (int x = 0; x < w; x++) d[x] = mx(mx(a[x], b[x]), c[x]);
-            else
-                for (int x = 0; x < w; x++)
-                    d[x] = mx(mx(a ? a[x] : pad, b[x]), c ? c[x] : pad);
-        } else {
-            if (a && c)
-                for (int x = 0; x < w; x++) d[x] = mn(mn(a[x], b[x]), c[x]);
-            else
-                for (int x = 0; x < w; x++)
-                    d[x] = mn(mn(a ? a[x] : pad, b[x]), c ? c[x] : pad);
+        const uint8_t *u = y > 0 ? a + (size_t)(y - 1) * s8 : NULL;
+        const uint8_t *c = a + (size_t)y * s8;
+        const uint8_t *l = y + 1 < h ? a + (size_t)(y + 1) * s8 : NULL;
+        uint8_t *d = b + (size_t)y * s8;
+        for (int i = 0; i < n8; i++) {
+            const uint64_t vu = u ? ld(u + 8 * i) : pad, vc = ld(c + 8 * i),
+                           vl = l ? ld(l + 8 * i) : pad;
+            st(d + 8 * i, dil ? (vu | vc | vl) : (vu & vc & vl));
         }
     }
 }
 
-static int row_set(const uint8_t *r, int w)
+/* the tail bytes [w, s8) of rows [y0, y1) of a set to v */
+static void tail(uint8_t *a, int w, int s8, int y0, int y1, uint8_t v)
 {
-    for (int x = 0; x < w; x++)
-        if (r[x]) return 1;
-    return 0;
+    if (w == s8) return;
+    for (int y = y0; y < y1; y++) memset(a + (size_t)y * s8 + w, v, (size_t)(s8 - w));
 }
 
-int pipe_fit_smooth(uint8_t *mask, int stride, int width, int height, void *scratch,
-                    size_t scratch_size)
+int pipe_fit_smooth(uint8_t *mask, int stride, int width, int height, const uint8_t *inside,
+                    int inside_stride, void *scratch, size_t scratch_size)
 {
+    if (inside && inside_stride < width) return -1;
     if (!mask || !scratch || stride < width) return -1;
     const size_t need = pipe_fit_smooth_scratch_size(width, height);
     if (!need || scratch_size < need) return -1;
+    const int w = width, h = height, s8 = stride8(width);
+    uint8_t *a = scratch, *b = a + (size_t)s8 * h;
+    /* the mask made 0/255 into a; its set rows */
     int first = -1, last = -1;
-    for (int y = 0; y < height; y++)
-        if (row_set(mask + (size_t)y * stride, width)) {
+    for (int y = 0; y < h; y++) {
+        const uint8_t *r = mask + (size_t)y * stride;
+        uint8_t *d = a + (size_t)y * s8;
+        uint64_t any = 0;
+        int x = 0;
+        for (; x + 8 <= w; x += 8) {
+            /* the top bit of each byte spread over the byte: 0 or 0xFF */
+            const uint64_t t = (ld(r + x) >> 7) & 0x0101010101010101ull;
+            const uint64_t v = t * 0xFF;
+            st(d + x, v);
+            any |= v;
+        }
+        for (; x < w; x++) {
+            d[x] = r[x] >= 128 ? 255 : 0;
+            any |= d[x];
+        }
+        if (any) {
             if (first < 0) first = y;
             last = y;
         }
+    }
     if (first < 0) return 0;
-    /* the rows that can change: a set pixel reaches 2 rows under the
-     * closing's dilation; the erosions and the opening stay inside */
     const int y0 = first - 2 < 0 ? 0 : first - 2;
-    const int y1 = last + 3 > height ? height : last + 3;
-    /* the passes read one row beyond [y0, y1): those rows are zero in
-     * the mask (or outside the image) and stay zero in every
-     * intermediate (a zero row 3+ from set pixels), so a and b hold them
-     * as zero */
-    const int r0 = y0 - 1 < 0 ? 0 : y0 - 1, r1 = y1 + 1 > height ? height : y1 + 1;
-    uint8_t *a = scratch, *b = a + (size_t)width * height;
-    const int w = width;
-    for (int y = r0; y < r1; y++)
-        if (y < y0 || y >= y1) {
-            memset(a + (size_t)y * w, 0, (size_t)w);
-            memset(b + (size_t)y * w, 0, (size_t)w);
+    const int y1 = last + 3 > h ? h : last + 3;
+    /* the column passes read one row beyond [y0, y1): those rows are
+     * zero in the mask and in every intermediate (2+ rows from set
+     * pixels), zero in a and b */
+    const int r0 = y0 - 1 < 0 ? 0 : y0 - 1, r1 = y1 + 1 > h ? h : y1 + 1;
+    if (r0 < y0) {
+        memset(a + (size_t)r0 * s8, 0, (size_t)s8);
+        memset(b + (size_t)r0 * s8, 0, (size_t)s8);
+    }
+    if (r1 > y1) {
+        memset(a + (size_t)y1 * s8, 0, (size_t)s8);
+        memset(b + (size_t)y1 * s8, 0, (size_t)s8);
+    }
+    /* close: dilate (a -> b -> a), erode (a -> b -> a) */
+    tail(a, w, s8, y0, y1, 0);
+    pass_x(a, b, s8, y0, y1, 1);
+    pass_y(b, a, s8, h, y0, y1, 1);
+    tail(a, w, s8, y0, y1, 255);
+    pass_x(a, b, s8, y0, y1, 0);
+    pass_y(b, a, s8, h, y0, y1, 0);
+    /* the closing's new pixels only where inside is set */
+    if (inside)
+        for (int y = y0; y < y1; y++) {
+            const uint8_t *r = mask + (size_t)y * stride, *in = inside + (size_t)y * inside_stride;
+            uint8_t *d = a + (size_t)y * s8;
+            for (int x = 0; x < w; x++)
+                if (r[x] < 128 && in[x] < 128) d[x] = 0;
         }
-    /* close: dilate (mask -> a -> b), erode (b -> a -> b) */
-    pass_x(mask, stride, a, w, w, y0, y1, 1);
-    pass_y(a, w, b, w, w, height, y0, y1, 1);
-    pass_x(b, w, a, w, w, y0, y1, 0);
-    /* the erosion along y must see 255 beyond the image but the zero
-     * rows beyond [y0, y1) as zero: they are in a (zeroed above) */
-    pass_y(a, w, b, w, w, height, y0, y1, 0);
-    /* open: erode (b -> a -> b), dilate (b -> a -> mask) */
-    pass_x(b, w, a, w, w, y0, y1, 0);
-    pass_y(a, w, b, w, w, height, y0, y1, 0);
-    pass_x(b, w, a, w, w, y0, y1, 1);
-    pass_y(a, w, mask, stride, w, height, y0, y1, 1);
+    /* open: erode (a -> b -> a), dilate (a -> b -> a) */
+    tail(a, w, s8, y0, y1, 255);
+    pass_x(a, b, s8, y0, y1, 0);
+    pass_y(b, a, s8, h, y0, y1, 0);
+    tail(a, w, s8, y0, y1, 0);
+    pass_x(a, b, s8, y0, y1, 1);
+    pass_y(b, a, s8, h, y0, y1, 1);
+    for (int y = y0; y < y1; y++) memcpy(mask + (size_t)y * stride, a + (size_t)y * s8, (size_t)w);
     return 0;
 }

@@ -6,11 +6,14 @@
  *   the hand's underside and the finger sides falls out as notches and
  *   cracks 1-2 px wide, background specks stick out as 1-px spurs. Each
  *   is an edge of the mask a few pixels from the true edge (a miss of
- *   boundary F at 3 px). pipe_fit_smooth applies a 3x3 closing, then a
- *   3x3 opening (square structuring element, grey-level: max / min of
- *   the 3x3 neighbourhood, so 0/255 masks stay 0/255):
+ *   boundary F at 3 px). pipe_fit_smooth makes the mask binary (set:
+ *   >= 128, written 255; clear 0) and applies a 3x3 closing, then a
+ *   3x3 opening (square structuring element: OR / AND over the 3x3
+ *   neighbourhood):
  *     close(m) = erode(dilate(m)),  open(m) = dilate(erode(m)),
- *     out      = open(close(m)),   in place;
+ *     c        = close(m), or with a mask `inside`: m | (close(m) & inside)
+ *                (the closing adds only pixels inside sets),
+ *     out      = open(c),   in place;
  *   outside the image a dilation sees 0 and an erosion sees 255 (a mask
  *   touching the border is not cut back from it). Rows farther than 2
  *   from any set pixel are untouched (they stay 0).
@@ -34,10 +37,11 @@ extern "C" {
 size_t pipe_fit_smooth_scratch_size(int width, int height);
 
 /* See above. mask: width x height bytes at stride >= width, rewritten in
- * place. Returns 0, or -1 (mask unchanged) for bad arguments or a
- * scratch smaller than pipe_fit_smooth_scratch_size. */
-int pipe_fit_smooth(uint8_t *mask, int stride, int width, int height, void *scratch,
-                    size_t scratch_size);
+ * place; inside: NULL or a mask of the same size (>= 128 set) at
+ * inside_stride >= width. Returns 0, or -1 (mask unchanged) for bad
+ * arguments or a scratch smaller than pipe_fit_smooth_scratch_size. */
+int pipe_fit_smooth(uint8_t *mask, int stride, int width, int height, const uint8_t *inside,
+                    int inside_stride, void *scratch, size_t scratch_size);
 
 #ifdef __cplusplus
 }

@@ -374,7 +374,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         /* and its ragged edge smoothed (fit_smooth.h; the scratch is
          * free, larger than it needs: the fill's) */
         if (rs.used_colour && p->fit && p->desc.refine_smooth == 0)
-            pipe_fit_smooth(e->refined, cw, cw, ch, e->refine_scratch, e->refine_scratch_size);
+            pipe_fit_smooth(e->refined, cw, cw, ch, NULL, 0, e->refine_scratch, e->refine_scratch_size);
         pipe__cockpit_clamp(p->ck, &p->pose, e->eye, e->rast, &e->cam, e->mask, cw, e->refined,
                             cw, p->desc.refine_band, e->clip);
         e->have_refined = 1;
