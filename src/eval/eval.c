@@ -637,7 +637,8 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 if (rs.used_colour && cfg->fill_hole + cfg->fill_island > 0)
                     pipe_fit_fill_small(c->refined, CW, CW, CH, cfg->fill_hole, cfg->fill_island,
                                         kmask, CW, c->refine_scratch, c->refine_scratch_size);
-                /* its ragged edge smoothed (fit_smooth.h, as pipe_frame) */
+                /* its ragged edge smoothed (fit_smooth.h; the default,
+                 * 3, as pipe_frame: the shown mask only, below) */
                 /* 1, 4 (the closing only inside the refinement's input):
                  * in place, before the learning */
                 if (rs.used_colour && (cfg->smooth == 1 || cfg->smooth == 4))
@@ -659,10 +660,11 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 if (rs.used_colour && cfg->smooth == 2)
                     pipe_fit_smooth(c->refined, CW, CW, CH, NULL, 0, c->refine_scratch,
                                     c->refine_scratch_size);
-                if (rs.used_colour && (cfg->smooth == 3 || cfg->smooth == 5)) {
+                if (rs.used_colour && (cfg->smooth == 3 || cfg->smooth >= 5)) {
                     memcpy(c->mask_smooth, c->refined, (size_t)CW * CH);
-                    pipe_fit_smooth(c->mask_smooth, CW, CW, CH, cfg->smooth == 5 ? rin : NULL, CW,
-                                    c->refine_scratch, c->refine_scratch_size);
+                    pipe_fit_smooth_ops(c->mask_smooth, CW, CW, CH, cfg->smooth == 5 ? rin : NULL,
+                                        CW, c->refine_scratch, c->refine_scratch_size,
+                                        cfg->smooth == 6 ? 1u : cfg->smooth == 7 ? 2u : 3u);
                     mask = c->mask_smooth;
                 }
             }
@@ -753,7 +755,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             r->flicker_den += den;
             r->n_flicker++;
         }
-        memcpy(r->prev[e], cfg->kind == M_REFINE && (cfg->smooth == 3 || cfg->smooth == 5) ? c->refined
+        memcpy(r->prev[e], cfg->kind == M_REFINE && (cfg->smooth == 3 || cfg->smooth >= 5) ? c->refined
                                                                            : mask,
                (size_t)CW * CH);
     }

@@ -62,7 +62,8 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k)
 static const char *variant_name[EVAL_VARIANTS] = { "refine-nomc", "refine-noshift",
                                                    "refine-shiftall", "refine-nosmooth",
                                                    "refine-smoothlate", "refine-smoothout",
-                                                   "refine-smoothin", "refine-smoothoutin" };
+                                                   "refine-smoothin", "refine-smoothoutin",
+                                                   "refine-closeout", "refine-openout" };
 
 method_cfg eval__variant_cfg(const eval_opts *o, int v)
 {
@@ -75,7 +76,9 @@ method_cfg eval__variant_cfg(const eval_opts *o, int v)
     case 4: c.smooth = 2; snprintf(c.setting, sizeof c.setting, "smooth=2"); break;
     case 5: c.smooth = 3; snprintf(c.setting, sizeof c.setting, "smooth=3"); break;
     case 6: c.smooth = 4; snprintf(c.setting, sizeof c.setting, "smooth=4"); break;
-    default: c.smooth = 5; snprintf(c.setting, sizeof c.setting, "smooth=5"); break;
+    case 7: c.smooth = 5; snprintf(c.setting, sizeof c.setting, "smooth=5"); break;
+    case 8: c.smooth = 6; snprintf(c.setting, sizeof c.setting, "smooth=6"); break;
+    default: c.smooth = 7; snprintf(c.setting, sizeof c.setting, "smooth=7"); break;
     }
     return c;
 }

@@ -81,6 +81,13 @@ static void tail(uint8_t *a, int w, int s8, int y0, int y1, uint8_t v)
 int pipe_fit_smooth(uint8_t *mask, int stride, int width, int height, const uint8_t *inside,
                     int inside_stride, void *scratch, size_t scratch_size)
 {
+    return pipe_fit_smooth_ops(mask, stride, width, height, inside, inside_stride, scratch,
+                               scratch_size, 3u);
+}
+
+int pipe_fit_smooth_ops(uint8_t *mask, int stride, int width, int height, const uint8_t *inside,
+                        int inside_stride, void *scratch, size_t scratch_size, unsigned ops)
+{
     if (inside && inside_stride < width) return -1;
     if (!mask || !scratch || stride < width) return -1;
     const size_t need = pipe_fit_smooth_scratch_size(width, height);
@@ -126,6 +133,7 @@ int pipe_fit_smooth(uint8_t *mask, int stride, int width, int height, const uint
         memset(b + (size_t)y1 * s8, 0, (size_t)s8);
     }
     /* close: dilate (a -> b -> a), erode (a -> b -> a) */
+    if (ops & 1u) {
     tail(a, w, s8, y0, y1, 0);
     pass_x(a, b, s8, y0, y1, 1);
     pass_y(b, a, s8, h, y0, y1, 1);
@@ -140,13 +148,16 @@ int pipe_fit_smooth(uint8_t *mask, int stride, int width, int height, const uint
             for (int x = 0; x < w; x++)
                 if (r[x] < 128 && in[x] < 128) d[x] = 0;
         }
+    }
     /* open: erode (a -> b -> a), dilate (a -> b -> a) */
+    if (ops & 2u) {
     tail(a, w, s8, y0, y1, 255);
     pass_x(a, b, s8, y0, y1, 0);
     pass_y(b, a, s8, h, y0, y1, 0);
     tail(a, w, s8, y0, y1, 0);
     pass_x(a, b, s8, y0, y1, 1);
     pass_y(b, a, s8, h, y0, y1, 1);
+    }
     for (int y = y0; y < y1; y++) memcpy(mask + (size_t)y * stride, a + (size_t)y * s8, (size_t)w);
     return 0;
 }

@@ -43,6 +43,11 @@ size_t pipe_fit_smooth_scratch_size(int width, int height);
 int pipe_fit_smooth(uint8_t *mask, int stride, int width, int height, const uint8_t *inside,
                     int inside_stride, void *scratch, size_t scratch_size);
 
+/* The same with the steps chosen: ops bit 0 the closing, bit 1 the
+ * opening (3: pipe_fit_smooth). */
+int pipe_fit_smooth_ops(uint8_t *mask, int stride, int width, int height, const uint8_t *inside,
+                        int inside_stride, void *scratch, size_t scratch_size, unsigned ops);
+
 #ifdef __cplusplus
 }
 #endif

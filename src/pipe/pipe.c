@@ -319,7 +319,9 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                     }
                 rin = pipe_fit_prior(&bd, &e->cam, p->pose.world, &p->fit_rig, sides,
                                      in->hand_speed ? in->hand_speed : zero, PIPE_PRIOR_SPEED,
-                                     shift, e->mask, e->refined, e->prior, cw);
+                                     shift, e->mask,
+                                     e->have_unsmoothed ? e->unsmoothed : e->refined, e->prior,
+                                     cw);
                 /* its rim must look like the hand (last frame's edge a
                  * pixel off: fit_band.h) */
                 if (rin == e->prior && p->fit && pipe_fit_learned(p->fit, e->eye))
@@ -371,12 +373,27 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         if (rs.used_colour && p->fit && p->desc.refine_fill == 0)
             pipe_fit_fill_small(e->refined, cw, cw, ch, PIPE_FILL_HOLE, PIPE_FILL_ISLAND, e->mask, cw,
                                 e->refine_scratch, e->refine_scratch_size);
-        /* and its ragged edge smoothed (fit_smooth.h; the scratch is
-         * free, larger than it needs: the fill's) */
-        if (rs.used_colour && p->fit && p->desc.refine_smooth == 0)
-            pipe_fit_smooth(e->refined, cw, cw, ch, NULL, 0, e->refine_scratch, e->refine_scratch_size);
         pipe__cockpit_clamp(p->ck, &p->pose, e->eye, e->rast, &e->cam, e->mask, cw, e->refined,
                             cw, p->desc.refine_band, e->clip);
+        /* the mask shown smoothed (fit_smooth.h: 1-2 px notches filled,
+         * spurs cut); the fit learns from the mask before it and the next
+         * frame's prior is that one (as eval's refine: smoothing what is
+         * fed back lost on edge). The scratch is free and larger than it
+         * needs (the fill's); the cockpit clamp again after it, so the
+         * closing brings nothing back behind the cockpit. Tracked frames
+         * only (as the fit): an animation-posed frame gives the bytes of
+         * a pipe without fit */
+        e->have_unsmoothed = 0;
+        if (e->unsmoothed && rs.used_colour && p->fit && in->locals) {
+            memcpy(e->unsmoothed, e->refined, (size_t)cw * (size_t)ch);
+            if (pipe_fit_smooth(e->refined, cw, cw, ch, NULL, 0, e->refine_scratch,
+                                e->refine_scratch_size) == 0) {
+                e->have_unsmoothed = 1;
+                pipe__cockpit_clamp(p->ck, &p->pose, e->eye, e->rast, &e->cam, e->mask, cw,
+                                    e->refined, cw, p->desc.refine_band, e->clip);
+            }
+        }
+        const uint8_t *learned = e->have_unsmoothed ? e->unsmoothed : e->refined;
         e->have_refined = 1;
         fe.mask = e->refined;
         if (e->aa.count) {
@@ -389,13 +406,13 @@ static void run_eye(pipe_ctx *p, eye_state *e)
              * the refinement fell back to the kinematic mask (out = M):
              * its widths would be the model's own, samples equal to the
              * factor in use */
-            if (pipe_fit_learn(p->fit, e->eye, &fe.P, e->mask, cw, e->refined, cw) != FUSE_OK) {
+            if (pipe_fit_learn(p->fit, e->eye, &fe.P, e->mask, cw, learned, cw) != FUSE_OK) {
                 e->result = PIPE_ERR_FUSE;
                 snprintf(e->why, sizeof e->why, "%s eye: elbow fit: colour model",
                          e->eye ? "right" : "left");
                 return;
             }
-            pipe_fit_measure(p->fit, e->eye, &e->cam, p->pose.world, e->mask, cw, e->refined, cw);
+            pipe_fit_measure(p->fit, e->eye, &e->cam, p->pose.world, e->mask, cw, learned, cw);
         }
     }
     /* the binary mask lit (the G-buffer's or the refined one) */
@@ -563,6 +580,7 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].refined);
         free(p->eye[e].prior);
         free(p->eye[e].shifted);
+        free(p->eye[e].unsmoothed);
         free(p->eye[e].refine_scratch);
         pipe__aa_free(&p->eye[e].aa);
         pipe__reproj_free(&p->eye[e].rp);
@@ -715,6 +733,10 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
                 s->shifted = malloc(px);
                 ok = s->shifted != NULL;
             }
+            if (ok && p->desc.refine_smooth == 0 && p->desc.fit_rig) {
+                s->unsmoothed = malloc(px);
+                ok = s->unsmoothed != NULL;
+            }
         }
         /* coverage samples are drawn through the pinhole: not with a
          * distorting lens (pipe.h ANTI-ALIASED EDGES) */
@@ -813,7 +835,9 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
         rast_target tg = cam_target(p, s);
         long covered;
         rast_result rr = eye_draw(p, s, s->lens, &cam[e], &tg, 0, &covered);
-        const uint8_t *prev = s->have_refined && !p->fit_no_prev ? s->refined : NULL;
+        const uint8_t *prev = s->have_refined && !p->fit_no_prev
+                                  ? (s->have_unsmoothed ? s->unsmoothed : s->refined)
+                                  : NULL;
         fuse_result lr =
             rr == RAST_OK ? pipe_fit_learn(p->fit, e, &P[e], s->mask, cw, prev, cw) : FUSE_OK;
         if (rr != RAST_OK || lr != FUSE_OK) {
