@@ -15,8 +15,10 @@
  *                (the closing adds only pixels inside sets),
  *     out      = open(c),   in place;
  *   outside the image a dilation sees 0 and an erosion sees 255 (a mask
- *   touching the border is not cut back from it). Rows farther than 2
- *   from any set pixel are untouched (they stay 0).
+ *   touching the border is not cut back from it). Only the rows and
+ *   8-pixel column blocks within 2 rows / 1 block of a set pixel are
+ *   rewritten: a clear pixel (< 128) farther out keeps its value (0 in a
+ *   0/255 mask).
  *
  * WHAT IT DOES NOT
  *   No allocation (the caller passes scratch), no colour, no state.
