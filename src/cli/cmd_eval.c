@@ -48,7 +48,10 @@ static const char *eval_usage =
     "                   refine-nomc (the prior not moved with the hand),\n"
     "                   refine-noshift (the fast hands not moved to the\n"
     "                   colour before the band), refine-shiftall (every\n"
-    "                   hand moved)\n"
+    "                   hand moved), refine-nosmooth (the refined mask's\n"
+    "                   edge not smoothed; refine-smoothlate, -smoothout,\n"
+    "                   -smoothin, -smoothoutin, -closeout, -openout: the\n"
+    "                   smoothing's other placements, docs/accuracy.md)\n"
     "  --band PX        refinement band half width, 1..64 (default 16)\n"
     "  --global W       refine: weight of the image-wide colour model against\n"
     "                   the band's local one, 0..1 (default 0.5)\n"
@@ -172,7 +175,9 @@ int cmd_eval(int argc, char **argv)
             if (!o.methods)
                 return cli_usage_error("eval", "--methods '%s': not a list of kin, "
                                        "kin-cal-pred, skin, refine, refine-nomc, "
-                                       "refine-noshift, refine-shiftall", optarg);
+                                       "refine-noshift, refine-shiftall, refine-nosmooth, "
+                                       "refine-smoothlate, refine-smoothout, refine-smoothin, "
+                                       "refine-smoothoutin, refine-closeout, refine-openout", optarg);
             break;
         case O_SEQUENCE: {
             int known = 0;

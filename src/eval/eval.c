@@ -17,6 +17,7 @@
 #include "../fit/fit_band.h"
 #include "../fit/fit_holes.h"
 #include "../fit/fit_shift.h"
+#include "../fit/fit_smooth.h"
 
 /* The ground truth comes from samples/gt/ and the sample generator
  * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
@@ -77,7 +78,7 @@ void eval__ctx_free(eval_ctx *c)
         free(c->P[e]); free(c->sil[e]); free(c->sil_prev[e]); free(c->tnrm[e]); free(c->V[e]); free(c->ideal[e]);
     }
     free(c->aa_samples);
-    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->mask_prior); free(c->mask_shift); free(c->layer); free(c->out);
+    free(c->mask_lo); free(c->mask_up); free(c->refined); free(c->mask_prior); free(c->mask_shift); free(c->mask_smooth); free(c->layer); free(c->out);
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
     free(c->stereo_scratch);
@@ -154,6 +155,7 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->refined = malloc(cp);
     c->mask_prior = malloc(cp);
     c->mask_shift = malloc(cp);
+    c->mask_smooth = malloc(cp);
     c->layer = malloc(cp * 4);
     c->out = malloc(vp * 4);
     c->depth_lo = malloc(sizeof(float) * cp);
@@ -165,13 +167,15 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->refine_scratch_size = fuse_refine_scratch_size(&rp, CW, CH);
     if (pipe_fit_fill_scratch_size(CW, CH) > c->refine_scratch_size)   /* shared (as pipe_frame) */
         c->refine_scratch_size = pipe_fit_fill_scratch_size(CW, CH);
+    if (pipe_fit_smooth_scratch_size(CW, CH) > c->refine_scratch_size)
+        c->refine_scratch_size = pipe_fit_smooth_scratch_size(CW, CH);
     if (pipe_fit_shift_scratch_size(CW, CH) > c->refine_scratch_size)
         c->refine_scratch_size = pipe_fit_shift_scratch_size(CW, CH);
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
     c->stereo_scratch_size = pipe_fit_stereo_scratch_size(CW, CH);
     c->stereo_scratch = aligned_alloc(16, (c->stereo_scratch_size + 15) & ~(size_t)15);
     ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && 
-         c->mask_prior && c->mask_shift && c->layer && c->out && c->depth_lo &&
+         c->mask_prior && c->mask_shift && c->mask_smooth && c->layer && c->out && c->depth_lo &&
          c->nrm_lo && c->mnrm && c->refine_scratch && c->stereo_scratch;
     if (!ok) return -1;
     if (estimate_calib(c, track) < 0) {
@@ -601,6 +605,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 /* the global term only once the fit has a colour model
                  * (as pipe_frame): an all-zero one would halve the local
                  * term */
+                const uint8_t *rin = mask;   /* the refinement's input */
                 fuse_refine_stats rs;
                 fuse_result fr =
                     cfg->fit && cfg->global > 0.0f && pipe_fit_learned(r->fit, e)
@@ -633,6 +638,13 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 if (rs.used_colour && cfg->fill_hole + cfg->fill_island > 0)
                     pipe_fit_fill_small(c->refined, CW, CW, CH, cfg->fill_hole, cfg->fill_island,
                                         kmask, CW, c->refine_scratch, c->refine_scratch_size);
+                /* its ragged edge smoothed (fit_smooth.h; the default,
+                 * 3, as pipe_frame: the shown mask only, below) */
+                /* 1, 4 (the closing only inside the refinement's input):
+                 * in place, before the learning */
+                if (rs.used_colour && (cfg->smooth == 1 || cfg->smooth == 4))
+                    pipe_fit_smooth(c->refined, CW, CW, CH, cfg->smooth == 4 ? mask : NULL, CW,
+                                    c->refine_scratch, c->refine_scratch_size);
                 /* not from a fallback (out = M): its widths are the
                  * model's own (as pipe_frame) */
                 if (cfg->fit && posed && rs.used_colour) {
@@ -644,6 +656,18 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                     pipe_fit_measure(r->fit, e, &cam, c->ps.world, kmask, CW, c->refined, CW);
                 }
                 mask = c->refined;
+                /* smoothed after the learning: 2 the prior smoothed too,
+                 * 3 the output only */
+                if (rs.used_colour && cfg->smooth == 2)
+                    pipe_fit_smooth(c->refined, CW, CW, CH, NULL, 0, c->refine_scratch,
+                                    c->refine_scratch_size);
+                if (rs.used_colour && (cfg->smooth == 3 || cfg->smooth >= 5)) {
+                    memcpy(c->mask_smooth, c->refined, (size_t)CW * CH);
+                    pipe_fit_smooth_ops(c->mask_smooth, CW, CW, CH, cfg->smooth == 5 ? rin : NULL,
+                                        CW, c->refine_scratch, c->refine_scratch_size,
+                                        cfg->smooth == 6 ? 1u : cfg->smooth == 7 ? 2u : 3u);
+                    mask = c->mask_smooth;
+                }
             }
         }
         fuse_intrinsics K = { cam.fx, cam.fy, cam.cx, cam.cy };
@@ -732,7 +756,9 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             r->flicker_den += den;
             r->n_flicker++;
         }
-        memcpy(r->prev[e], mask, (size_t)CW * CH);
+        memcpy(r->prev[e], cfg->kind == M_REFINE && (cfg->smooth == 3 || cfg->smooth >= 5) ? c->refined
+                                                                           : mask,
+               (size_t)CW * CH);
     }
     r->have_prev = 1;
     r->secs += secs;

@@ -56,6 +56,8 @@ typedef struct method_cfg {
     int fill_hole, fill_island; /* refine: holes / islands of the refined
                                    mask up to this many pixels filled /
                                    cleared (fit_holes.h); 0 off */
+    int smooth;              /* refine: the refined mask's 3x3 closing and
+                                opening (fit_smooth.h): EVAL_SMOOTH */
     int stereo;              /* refine: 1 = the stereo pair's depth test of
                                 the refined mask (fit_stereo.h) */
     float lag_adapt_v0, lag_adapt_v1;   /* refine, kin-cal-pred: lag
@@ -67,8 +69,11 @@ typedef struct method_cfg {
 /* refine's variants in --methods (eval_plan.c): refine-nomc (the prior
  * not moved with the hand), refine-noshift (the hands of the input not
  * moved to the colour, fit_shift.h), refine-shiftall (every tracked hand
- * moved, those of the prior too) */
-#define EVAL_VARIANTS 3
+ * moved, those of the prior too), refine-nosmooth (the refined mask
+ * not smoothed, fit_smooth.h) and the smoothing's other placements
+ * (refine-smoothlate 2, -smoothout 3, -smoothin 4, -smoothoutin 5,
+ * -closeout 6, -openout 7: EVAL_SMOOTH) */
+#define EVAL_VARIANTS 10
 method_cfg eval__variant_cfg(const eval_opts *o, int v);
 
 /* refine's defaults (docs/accuracy.md, issue 14 item 2) */
@@ -79,6 +84,13 @@ method_cfg eval__variant_cfg(const eval_opts *o, int v);
 /* refine: the hands without the prior moved to the colour before the
  * band (fit_shift.h; 0 off, 2 every hand) */
 #define EVAL_SHIFT 1
+/* refine: the refined mask's ragged edge smoothed (fit_smooth.h; 0 off;
+ * 1 in place before the learning, 2 after it (the next prior smoothed),
+ * 3 the shown mask only: the learning and the next prior unsmoothed (as
+ * pipe_frame), 4 as 1 and 5 as 3 with the closing only inside the
+ * refinement's input, 6 the closing only, 7 the opening only, both as
+ * 3; docs/accuracy.md) */
+#define EVAL_SMOOTH 3
 /* refine: the refined mask's holes up to this many pixels filled and its
  * islands up to this many cleared (fit_holes.h; as PIPE_FILL_HOLE,
  * PIPE_FILL_ISLAND) */
@@ -173,6 +185,7 @@ typedef struct eval_ctx {
     uint8_t *mask_lo, *mask_up, *refined, *layer, *out;
     uint8_t *mask_prior;     /* refine: the prior (fit_band.h) */
     uint8_t *mask_shift;     /* refine: the hands moved (fit_shift.h) */
+    uint8_t *mask_smooth;    /* refine: the output smoothed (fit_smooth.h) */
     uint32_t *aa_samples;    /* anti-aliased coverage, 640x400 */
     float *depth_lo, *nrm_lo, *mnrm;
     void *refine_scratch;

@@ -40,6 +40,7 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k)
         c.fill_hole = EVAL_FILL_HOLE;
         c.fill_island = EVAL_FILL_ISLAND;
         c.shift = EVAL_SHIFT;   /* the fast hands moved to the colour (fit_shift.h) */
+        c.smooth = EVAL_SMOOTH; /* the refined edge smoothed (fit_smooth.h) */
     }
     c.band_sigma = 0.007f;
     c.band_max = 64;
@@ -60,7 +61,10 @@ method_cfg eval__base_cfg(const eval_opts *o, method_kind k)
 /* refine's variants, selectable in --methods (bits 4.. of
  * eval_opts.methods): refine with one knob changed (docs/accuracy.md) */
 static const char *variant_name[EVAL_VARIANTS] = { "refine-nomc", "refine-noshift",
-                                                   "refine-shiftall" };
+                                                   "refine-shiftall", "refine-nosmooth",
+                                                   "refine-smoothlate", "refine-smoothout",
+                                                   "refine-smoothin", "refine-smoothoutin",
+                                                   "refine-closeout", "refine-openout" };
 
 method_cfg eval__variant_cfg(const eval_opts *o, int v)
 {
@@ -68,7 +72,14 @@ method_cfg eval__variant_cfg(const eval_opts *o, int v)
     switch (v) {
     case 0: c.prior_mc = 0; snprintf(c.setting, sizeof c.setting, "priormc=0"); break;
     case 1: c.shift = 0; snprintf(c.setting, sizeof c.setting, "shift=0"); break;
-    default: c.shift = 2; snprintf(c.setting, sizeof c.setting, "shift=2"); break;
+    case 2: c.shift = 2; snprintf(c.setting, sizeof c.setting, "shift=2"); break;
+    case 3: c.smooth = 0; snprintf(c.setting, sizeof c.setting, "smooth=0"); break;
+    case 4: c.smooth = 2; snprintf(c.setting, sizeof c.setting, "smooth=2"); break;
+    case 5: c.smooth = 3; snprintf(c.setting, sizeof c.setting, "smooth=3"); break;
+    case 6: c.smooth = 4; snprintf(c.setting, sizeof c.setting, "smooth=4"); break;
+    case 7: c.smooth = 5; snprintf(c.setting, sizeof c.setting, "smooth=5"); break;
+    case 8: c.smooth = 6; snprintf(c.setting, sizeof c.setting, "smooth=6"); break;
+    default: c.smooth = 7; snprintf(c.setting, sizeof c.setting, "smooth=7"); break;
     }
     return c;
 }

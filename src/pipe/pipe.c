@@ -12,6 +12,7 @@
 #include "../fit/fit_band.h"
 #include "../fit/fit_holes.h"
 #include "../fit/fit_shift.h"
+#include "../fit/fit_smooth.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -327,7 +328,9 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                     }
                 rin = pipe_fit_prior(&bd, &e->cam, p->pose.world, &p->fit_rig, sides,
                                      in->hand_speed ? in->hand_speed : zero, PIPE_PRIOR_SPEED,
-                                     shift, e->mask, e->refined, e->prior, cw);
+                                     shift, e->mask,
+                                     e->have_unsmoothed ? e->unsmoothed : e->refined, e->prior,
+                                     cw);
                 /* its rim must look like the hand (last frame's edge a
                  * pixel off: fit_band.h) */
                 if (rin == e->prior && p->fit && pipe_fit_learned(p->fit, e->eye))
@@ -381,6 +384,25 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                                 e->refine_scratch, e->refine_scratch_size);
         pipe__cockpit_clamp(p->ck, &p->pose, e->eye, e->rast, &e->cam, e->mask, cw, e->refined,
                             cw, p->desc.refine_band, e->clip);
+        /* the mask shown smoothed (fit_smooth.h: 1-2 px notches filled,
+         * spurs cut); the fit learns from the mask before it and the next
+         * frame's prior is that one (as eval's refine: smoothing what is
+         * fed back lost on edge). The scratch is free and larger than it
+         * needs (the fill's); the cockpit clamp again after it, so the
+         * closing brings nothing back behind the cockpit. Tracked frames
+         * only (as the fit): an animation-posed frame gives the bytes of
+         * a pipe without fit */
+        e->have_unsmoothed = 0;
+        if (e->unsmoothed && rs.used_colour && p->fit && in->locals) {
+            memcpy(e->unsmoothed, e->refined, (size_t)cw * (size_t)ch);
+            if (pipe_fit_smooth(e->refined, cw, cw, ch, NULL, 0, e->refine_scratch,
+                                e->refine_scratch_size) == 0) {
+                e->have_unsmoothed = 1;
+                pipe__cockpit_clamp(p->ck, &p->pose, e->eye, e->rast, &e->cam, e->mask, cw,
+                                    e->refined, cw, p->desc.refine_band, e->clip);
+            }
+        }
+        const uint8_t *learned = e->have_unsmoothed ? e->unsmoothed : e->refined;
         e->have_refined = 1;
         fe.mask = e->refined;
         if (e->aa.count) {
@@ -393,13 +415,13 @@ static void run_eye(pipe_ctx *p, eye_state *e)
              * the refinement fell back to the kinematic mask (out = M):
              * its widths would be the model's own, samples equal to the
              * factor in use */
-            if (pipe_fit_learn(p->fit, e->eye, &fe.P, e->mask, cw, e->refined, cw) != FUSE_OK) {
+            if (pipe_fit_learn(p->fit, e->eye, &fe.P, e->mask, cw, learned, cw) != FUSE_OK) {
                 e->result = PIPE_ERR_FUSE;
                 snprintf(e->why, sizeof e->why, "%s eye: elbow fit: colour model",
                          e->eye ? "right" : "left");
                 return;
             }
-            pipe_fit_measure(p->fit, e->eye, &e->cam, p->pose.world, e->mask, cw, e->refined, cw);
+            pipe_fit_measure(p->fit, e->eye, &e->cam, p->pose.world, e->mask, cw, learned, cw);
         }
     }
     /* the binary mask lit (the G-buffer's or the refined one) */
@@ -628,6 +650,7 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].refined);
         free(p->eye[e].prior);
         free(p->eye[e].shifted);
+        free(p->eye[e].unsmoothed);
         free(p->eye[e].refine_scratch);
         pipe__aa_free(&p->eye[e].aa);
         pipe__reproj_free(&p->eye[e].rp);
@@ -692,7 +715,8 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
     if (desc && (desc->refine_prior < -1 || desc->refine_prior > 0 ||
                  desc->refine_lag_adapt < -1 || desc->refine_lag_adapt > 0 ||
                  desc->refine_fill < -1 || desc->refine_fill > 0 ||
-                 desc->refine_shift < -1 || desc->refine_shift > 0))
+                 desc->refine_shift < -1 || desc->refine_shift > 0 ||
+                 desc->refine_smooth < -1 || desc->refine_smooth > 0))
         return NULL;
     pipe_ctx *p = calloc(1, sizeof *p);
     if (!p) return NULL;
@@ -778,6 +802,10 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
             if (ok && p->desc.refine_shift == 0 && p->desc.fit_rig) {
                 s->shifted = malloc(px);
                 ok = s->shifted != NULL;
+            }
+            if (ok && p->desc.refine_smooth == 0 && p->desc.fit_rig) {
+                s->unsmoothed = malloc(px);
+                ok = s->unsmoothed != NULL;
             }
         }
         /* coverage samples are drawn through the pinhole: not with a
@@ -877,7 +905,9 @@ static pipe_result fit_elbows(pipe_ctx *p, const pipe_frame_in *in, const kin_ma
         rast_target tg = cam_target(p, s);
         long covered;
         rast_result rr = eye_draw(p, s, s->lens, &cam[e], &tg, 0, &covered);
-        const uint8_t *prev = s->have_refined && !p->fit_no_prev ? s->refined : NULL;
+        const uint8_t *prev = s->have_refined && !p->fit_no_prev
+                                  ? (s->have_unsmoothed ? s->unsmoothed : s->refined)
+                                  : NULL;
         fuse_result lr =
             rr == RAST_OK ? pipe_fit_learn(p->fit, e, &P[e], s->mask, cw, prev, cw) : FUSE_OK;
         if (rr != RAST_OK || lr != FUSE_OK) {

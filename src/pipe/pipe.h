@@ -195,6 +195,19 @@ typedef struct pipe_desc {
                                  object still hides it. -1: off (the
                                  bytes of before). Other values:
                                  pipe_create returns NULL. */
+    int refine_smooth;        /* with refine_band and a fit (fit_rig): 0 =
+                                 the default, on: on tracked frames
+                                 (pipe_frame_in.locals), after refine_fill
+                                 and the cockpit clamp, the refined mask
+                                 shown gets a 3x3 closing then opening
+                                 (pipe_fit_smooth, src/fit/fit_smooth.h,
+                                 docs/accuracy.md): its 1-2 px notches
+                                 filled and spurs cut; the fit learns from
+                                 the mask before it and the next frame's
+                                 prior is that one; the cockpit clamp runs
+                                 again after it. -1: off (the bytes of
+                                 before). Other values: pipe_create
+                                 returns NULL. */
 } pipe_desc;
 
 /* The defaults of the refine method (`egofuse eval`'s, docs/accuracy.md). */

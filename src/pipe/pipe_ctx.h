@@ -30,6 +30,10 @@ typedef struct eye_state {
     int have_refined;         /* refined holds the last frame's mask */
     uint8_t *prior;           /* refine_prior: this frame's input mask */
     uint8_t *shifted;         /* refine_shift: the input's hands moved */
+    uint8_t *unsmoothed;      /* refine_smooth: the refined mask before
+                                 pipe_fit_smooth (the fit learns from it
+                                 and the next prior is it) */
+    int have_unsmoothed;      /* unsmoothed holds this frame's */
     float hand_px[2][2];      /* refine_prior: each hand's image position */
     int have_hand_px[2];      /* last frame (pipe_fit_hand_px) */
     pipe__aa aa;              /* anti-aliased coverage (aa_samples) */
