@@ -70,6 +70,18 @@ static void tail(uint64_t *a, int w, int n, int y0, int y1, int v)
     }
 }
 
+/* One 3x3 step on rows [y0, y1), words [i0, i1) of a (b its scratch):
+ * dilate (dil 1) or erode (dil 0), the tail bits beyond the width first
+ * set so they neither grow nor eat the row's last pixels (tl: the last
+ * word is processed). */
+static void step(uint64_t *a, uint64_t *b, int w, int n, int h, int y0, int y1, int i0, int i1,
+                 int tl, int dil)
+{
+    if (tl) tail(a, w, n, y0, y1, !dil);
+    pass_x(a, b, n, y0, y1, i0, i1, dil);
+    pass_y(b, a, n, h, y0, y1, i0, i1, dil);
+}
+
 int pipe_fit_smooth(uint8_t *mask, int stride, int width, int height, const uint8_t *inside,
                     int inside_stride, void *scratch, size_t scratch_size)
 {
@@ -138,12 +150,8 @@ int pipe_fit_smooth_ops(uint8_t *mask, int stride, int width, int height, const 
     const int tl = i1 == n;   /* the last word is processed: its tail bits */
     /* close: dilate (a -> b -> a), erode (a -> b -> a) */
     if (ops & 1u) {
-        if (tl) tail(a, w, n, y0, y1, 0);
-        pass_x(a, b, n, y0, y1, i0, i1, 1);
-        pass_y(b, a, n, h, y0, y1, i0, i1, 1);
-        if (tl) tail(a, w, n, y0, y1, 1);
-        pass_x(a, b, n, y0, y1, i0, i1, 0);
-        pass_y(b, a, n, h, y0, y1, i0, i1, 0);
+        step(a, b, w, n, h, y0, y1, i0, i1, tl, 1);
+        step(a, b, w, n, h, y0, y1, i0, i1, tl, 0);
         /* the closing's new pixels only where inside is set */
         if (inside)
             for (int y = y0; y < y1; y++) {
@@ -156,12 +164,8 @@ int pipe_fit_smooth_ops(uint8_t *mask, int stride, int width, int height, const 
     }
     /* open: erode (a -> b -> a), dilate (a -> b -> a) */
     if (ops & 2u) {
-        if (tl) tail(a, w, n, y0, y1, 1);
-        pass_x(a, b, n, y0, y1, i0, i1, 0);
-        pass_y(b, a, n, h, y0, y1, i0, i1, 0);
-        if (tl) tail(a, w, n, y0, y1, 0);
-        pass_x(a, b, n, y0, y1, i0, i1, 1);
-        pass_y(b, a, n, h, y0, y1, i0, i1, 1);
+        step(a, b, w, n, h, y0, y1, i0, i1, tl, 0);
+        step(a, b, w, n, h, y0, y1, i0, i1, tl, 1);
     }
     /* unpacked: 8 pixels a byte of the word through the table (byte k of
      * an entry 0xFF where bit k of its index is set) */
