@@ -96,4 +96,9 @@ struct pipe_ctx {
 
 enum { JOB_SKIN, JOB_EYE };
 
+/* pipe_refine.c: eye e's colour refinement (run_eye, when
+ * desc.refine_band > 0); fe->mask set to the mask to light. 0, or -1 with
+ * e->result and e->why set. */
+int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe);
+
 #endif
