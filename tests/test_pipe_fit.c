@@ -592,6 +592,121 @@ static void learn_memory_keeps_background(void **state)
     arms_free(&A);
 }
 
+/* pipe_fit_learn's colour model (learn_memory, the default) against a
+ * scalar reference of its definition (the learning mask, the histograms
+ * decayed by the memory, the samples of every 2nd row and column whose
+ * 4 neighbours at 4 px agree, the clamped log ratio): the same llr bytes
+ * and sample counts over 8 seeded frames (masks with noisy rims and stray
+ * bytes, with and without the previous mask, two image widths: the word
+ * steps' tails). */
+static void ref_learn(float *af, float *ab, double accn[2], float *llr, long ns[2],
+                      const uint8_t *rgba, int w, int h, const uint8_t *mask, const uint8_t *prev,
+                      uint8_t *L)
+{
+    const int bits = PIPE_FIT_BITS, bins = 1 << (3 * bits), sh = 8 - bits, mg = 4;
+    const float m = PIPE_FIT_LEARN_MEMORY;
+    for (int i = 0; i < w * h; i++) {
+        const int ia = mask[i] >= 128, ib = prev ? prev[i] >= 128 : ia;
+        L[i] = (uint8_t)(prev ? (ia && ib ? 255 : !ia && !ib ? 0 : 128) : ia ? 255 : 0);
+    }
+    for (int b = 0; b < bins; b++) af[b] *= m;
+    for (int b = 0; b < bins; b++) ab[b] *= m;
+    long nf = 0, nb = 0;
+    for (int y = 0; y < h; y += 2)
+        for (int x = 0; x < w; x += 2) {
+            const uint8_t v = L[y * w + x];
+            if (v != 0 && v != 255) continue;
+            const int xl = x - mg < 0 ? 0 : x - mg, xr = x + mg >= w ? w - 1 : x + mg;
+            const int yu = y - mg < 0 ? 0 : y - mg, yd = y + mg >= h ? h - 1 : y + mg;
+            if (L[y * w + xl] != v || L[y * w + xr] != v || L[yu * w + x] != v || L[yd * w + x] != v)
+                continue;
+            const uint8_t *px = rgba + 4 * (y * w + x);
+            const unsigned b = ((unsigned)(px[0] >> sh) << (2 * bits)) |
+                               ((unsigned)(px[1] >> sh) << bits) | (unsigned)(px[2] >> sh);
+            if (v == 255) { af[b] += 1.0f; nf++; }
+            else { ab[b] += 1.0f; nb++; }
+        }
+    accn[0] = accn[0] * m + (double)nf;
+    accn[1] = accn[1] * m + (double)nb;
+    ns[0] = (long)accn[0];
+    ns[1] = (long)accn[1];
+    if (!(ns[0] >= 64 && ns[1] >= 64)) {
+        memset(llr, 0, sizeof(float) * (size_t)bins);
+        return;
+    }
+    const float a = 4.0f / (float)bins;
+    const float off = logf((float)accn[1] + 4.0f) - logf((float)accn[0] + 4.0f);
+    const float off_c = off > 3.0f ? 3.0f : off < -3.0f ? -3.0f : off;
+    for (int b = 0; b < bins; b++) {
+        if (af[b] == 0.0f && ab[b] == 0.0f) {
+            llr[b] = off_c;
+            continue;
+        }
+        const float v = logf((af[b] + a) / (ab[b] + a)) + off;
+        llr[b] = v > 3.0f ? 3.0f : v < -3.0f ? -3.0f : v;
+    }
+}
+
+static void learn_matches_reference(void **state)
+{
+    (void)state;
+    arms A;
+    arms_build(&A);
+    const int bins = 1 << (3 * PIPE_FIT_BITS);
+    float *af = malloc(sizeof(float) * 2 * (size_t)bins), *llr = malloc(sizeof(float) * (size_t)bins);
+    uint8_t *rgba = malloc(4 * W * H), *m = malloc(W * H), *pv = malloc(W * H), *L = malloc(W * H);
+    assert_true(af && llr && rgba && m && pv && L);
+    tu_rng g = { 0x6c6561726eu };
+    long checked = 0;
+    for (int sz = 0; sz < 2; sz++) {
+        const int w = sz ? W - 5 : W, h = sz ? H - 3 : H;
+        pipe_fit *f = pipe_fit_create(NULL, &A.m, &A.rig, w, h);
+        assert_non_null(f);
+        memset(af, 0, sizeof(float) * 2 * (size_t)bins);
+        double accn[2] = { 0.0, 0.0 };
+        for (int t = 0; t < 8; t++) {
+            const float cx = (float)(w / 3 + (int)(tu_next(&g) % (unsigned)(w / 3)));
+            const float cy = (float)(h / 3 + (int)(tu_next(&g) % (unsigned)(h / 3)));
+            const float r = (float)(h / 6 + (int)(tu_next(&g) % (unsigned)(h / 6)));
+            const float dx = (float)((int)(tu_next(&g) % 9) - 4), dy = (float)((int)(tu_next(&g) % 9) - 4);
+            for (int y = 0; y < h; y++)
+                for (int x = 0; x < w; x++) {
+                    const int i = y * w + x;
+                    const float ex = (float)x - cx, ey = (float)y - cy, fx = ex - dx, fy = ey - dy;
+                    const int in = ex * ex + ey * ey < r * r, inp = fx * fx + fy * fy < r * r;
+                    const uint32_t n = tu_next(&g);
+                    m[i] = n % 40 == 0 ? (uint8_t)(n >> 8) : in ? 255 : 0;
+                    pv[i] = n % 53 == 1 ? (uint8_t)(n >> 12) : inp ? 255 : 0;
+                    const uint32_t c = tu_next(&g);
+                    rgba[4 * i] = (uint8_t)(in ? 200 + (c & 31) : 40 + (c & 127));
+                    rgba[4 * i + 1] = (uint8_t)(in ? 110 + ((c >> 5) & 31) : 60 + ((c >> 7) & 127));
+                    rgba[4 * i + 2] = (uint8_t)(in ? 90 + ((c >> 10) & 31) : 100 + ((c >> 14) & 127));
+                    rgba[4 * i + 3] = 255;
+                }
+            const fuse_image P = { rgba, w, h, 4 * w };
+            const int noprev = t == 3;
+            assert_int_equal(pipe_fit_learn(f, 1, &P, m, w, noprev ? NULL : pv, w), FUSE_OK);
+            long ns[2];
+            ref_learn(af, af + bins, accn, llr, ns, rgba, w, h, m, noprev ? NULL : pv, L);
+            const fuse_colour_model *cm = pipe_fit_colour(f, 1);
+            assert_int_equal(cm->fg_samples, ns[0]);
+            assert_int_equal(cm->bg_samples, ns[1]);
+            assert_memory_equal(cm->llr, llr, sizeof(float) * (size_t)bins);
+            checked += ns[0] + ns[1];
+        }
+        pipe_fit_destroy(f);
+    }
+    printf("learn: the reference's llr bytes, %ld kept samples\n", checked);
+    assert_true(checked > 10000);
+    free(af);
+    free(llr);
+    free(rgba);
+    free(m);
+    free(pv);
+    free(L);
+    arms_free(&A);
+}
+
 static void bad_arguments(void **state)
 {
     (void)state;
@@ -862,6 +977,7 @@ int main(void)
         cmocka_unit_test(thickness_from_masks),
         cmocka_unit_test(learned_flag),
         cmocka_unit_test(learn_memory_keeps_background),
+        cmocka_unit_test(learn_matches_reference),
         cmocka_unit_test(bad_arguments),
         cmocka_unit_test(fit_through_wrist_node),
         cmocka_unit_test(fit_uses_mesh_skin),
