@@ -16,6 +16,7 @@
 #include "../io/io_lod.h"
 #include "../fit/fit_band.h"
 #include "../fit/fit_holes.h"
+#include "../fit/fit_narrow.h"
 #include "../fit/fit_shift.h"
 #include "../fit/fit_smooth.h"
 
@@ -607,13 +608,14 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                  * term */
                 const uint8_t *rin = mask;   /* the refinement's input */
                 fuse_refine_stats rs;
-                fuse_result fr =
+                /* the band halved (down to 4 px) where the hand is too
+                 * thin for its learning ring (fit_narrow.h, as pipe_frame) */
+                fuse_result fr = pipe_fit_refine_narrow(
+                    &rp,
                     cfg->fit && cfg->global > 0.0f && pipe_fit_learned(r->fit, e)
-                        ? fuse_refine_mask_global(&rp, pipe_fit_colour(r->fit, e), cfg->global, &P, mask, CW, c->refined,
-                                                  CW, c->refine_scratch, c->refine_scratch_size,
-                                                  &rs)
-                        : fuse_refine_mask(&rp, &P, mask, CW, c->refined, CW, c->refine_scratch,
-                                           c->refine_scratch_size, &rs);
+                        ? pipe_fit_colour(r->fit, e) : NULL,
+                    cfg->global, PIPE_NARROW_MIN_BAND, &P, mask, CW, c->refined, CW,
+                    c->refine_scratch, c->refine_scratch_size, &rs, NULL);
                 if (fr != FUSE_OK) return -1;
                 /* and so must the pixels the vote let in beyond it */
                 if (from_prior && rs.used_colour && cfg->fit &&

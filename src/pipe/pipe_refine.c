@@ -9,6 +9,7 @@
 #include "pipe_aa.h"
 #include "../fit/fit_band.h"
 #include "../fit/fit_holes.h"
+#include "../fit/fit_narrow.h"
 #include "../fit/fit_shift.h"
 #include "../fit/fit_smooth.h"
 #include "../fuse/fuse_refine.h"
@@ -87,13 +88,12 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
                 pipe_fit_hand_px(&e->cam, p->pose.world, &p->fit_rig, k, e->hand_px[k]);
     }
     fuse_refine_stats rs;
-    fuse_result rr2 =
-        p->fit && pipe_fit_learned(p->fit, e->eye)
-            ? fuse_refine_mask_global(&rp, pipe_fit_colour(p->fit, e->eye), 0.5f, &fe->P,
-                                      rin, cw, e->refined, cw, e->refine_scratch,
-                                      e->refine_scratch_size, &rs)
-            : fuse_refine_mask(&rp, &fe->P, rin, cw, e->refined, cw, e->refine_scratch,
-                               e->refine_scratch_size, &rs);
+    /* the band halved where the hand is too thin for its learning ring
+     * (fit_narrow.h; eval's refine does the same) */
+    fuse_result rr2 = pipe_fit_refine_narrow(
+        &rp, p->fit && pipe_fit_learned(p->fit, e->eye) ? pipe_fit_colour(p->fit, e->eye) : NULL,
+        0.5f, PIPE_NARROW_MIN_BAND, &fe->P, rin, cw, e->refined, cw, e->refine_scratch,
+        e->refine_scratch_size, &rs, NULL);
     if (rr2 != FUSE_OK) {
         e->result = PIPE_ERR_FUSE;
         snprintf(e->why, sizeof e->why, "%s eye: mask refinement: %s",

@@ -1,0 +1,37 @@
+/* fit_narrow.c - the band refinement, narrower where the hand is thin
+ * (fit_narrow.h). */
+#include "fit_narrow.h"
+
+static fuse_result run(const fuse_refine_params *p, const fuse_colour_model *g, float weight,
+                       const fuse_image *P, const uint8_t *mask, int mask_stride, uint8_t *out,
+                       int out_stride, void *scratch, size_t scratch_size,
+                       fuse_refine_stats *stats)
+{
+    return g ? fuse_refine_mask_global(p, g, weight, P, mask, mask_stride, out, out_stride,
+                                       scratch, scratch_size, stats)
+             : fuse_refine_mask(p, P, mask, mask_stride, out, out_stride, scratch, scratch_size,
+                                stats);
+}
+
+fuse_result pipe_fit_refine_narrow(const fuse_refine_params *p, const fuse_colour_model *g,
+                                   float weight, int min_band, const fuse_image *P,
+                                   const uint8_t *mask, int mask_stride, uint8_t *out,
+                                   int out_stride, void *scratch, size_t scratch_size,
+                                   fuse_refine_stats *stats, int *band_used)
+{
+    if (!p || !P || !stats) return FUSE_ERR_ARGS;
+    fuse_refine_params q = *p;
+    fuse_result r = run(&q, g, weight, P, mask, mask_stride, out, out_stride, scratch,
+                        scratch_size, stats);
+    while (r == FUSE_OK && !stats->used_colour && min_band > 0 && q.band / 2 >= min_band) {
+        fuse_refine_params n = q;
+        n.band = q.band / 2;
+        const size_t need = fuse_refine_scratch_size(&n, P->width, P->height);
+        if (!need || need > scratch_size) break;
+        q = n;
+        r = run(&q, g, weight, P, mask, mask_stride, out, out_stride, scratch, scratch_size,
+                stats);
+    }
+    if (band_used) *band_used = q.band;
+    return r;
+}
