@@ -437,7 +437,6 @@ static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
     }
 }
 
-
 #define FIT_B01 0x0101010101010101ull
 typedef uint64_t fit_v2 __attribute__((vector_size(16)));
 

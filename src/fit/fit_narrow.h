@@ -1,12 +1,25 @@
 #ifndef EGOFUSE_FIT_NARROW_H
 #define EGOFUSE_FIT_NARROW_H
-/* The band refinement with a narrower band where the hand is thin (issue
- * 14 item 2, docs/accuracy.md "Where `edge` loses the hand"): the local
- * histograms learn the hand from the ring band..band+margin px inside the
- * mask; a hand at the image border thinner than twice that has no hand
- * samples (fg_samples < min_samples), the refinement returns its input
- * unchanged, and a prior (the last refined mask moved) is then carried
- * for many frames without any colour decision. */
+/* fit_narrow.h - the band refinement with a narrower band where the hand
+ * is thin (issue 14 item 2, docs/accuracy.md "Where `edge` loses the hand").
+ *
+ * WHAT IT DOES
+ *   The local histograms of the band refinement (fuse_refine.h) learn the
+ *   hand from the ring band..band+margin px inside the mask; a hand at the
+ *   image border thinner than twice that has no hand samples (fg_samples <
+ *   min_samples), the refinement returns its input unchanged, and a prior
+ *   (the last refined mask moved) is then carried for many frames without
+ *   any colour decision. pipe_fit_refine_narrow runs the refinement again
+ *   with the band halved while it falls back.
+ *
+ * WHAT IT DOES NOT
+ *   No allocation (the caller's scratch), no threads; never widens the band.
+ *
+ * USAGE
+ *   eval's refine and pipe_refine.c call it where they called
+ *   fuse_refine_mask(_global); the result is that call's whenever it did
+ *   not fall back.
+ */
 #include "../fuse/fuse_refine.h"
 
 /* The narrowest band tried (px; edge: 4 measured, docs/accuracy.md). */
@@ -15,8 +28,8 @@
 /* fuse_refine_mask_global (g not NULL) or fuse_refine_mask with p; when
  * that falls back (stats->used_colour 0), again with the band halved while
  * the band stays >= min_band and the scratch suffices for it. *band_used
- * (not NULL) receives the band of the result. Returns what the last
- * refinement returned. */
+ * (not NULL) receives the band of the result. stats must not be NULL
+ * (FUSE_ERR_ARGS). Returns what the last refinement returned. */
 fuse_result pipe_fit_refine_narrow(const fuse_refine_params *p, const fuse_colour_model *g,
                                    float weight, int min_band, const fuse_image *P,
                                    const uint8_t *mask, int mask_stride, uint8_t *out,
