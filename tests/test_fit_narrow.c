@@ -6,7 +6,13 @@
  *   samples (out = input); the narrow refinement halves the band to 8,
  *   uses the colour and brings the mask closer to the stripe;
  * - min_band 16 (no halving): the plain refinement's bytes and stats;
- * - a wide stripe: no fallback, the plain refinement's bytes exactly. */
+ * - a wide stripe: no fallback, the plain refinement's bytes exactly;
+ * - the regrow (pipe_fit_refine_regrow): a mask 18 px short of the stripe
+ *   on each side (the band reaches 16): the first refinement lets in more
+ *   than PIPE_REGROW_PER_MILLE of the image, the second from its result
+ *   (the same bytes as a plain refinement of it) brings the last 2 px in;
+ *   below the limit, or after a fallback, the refined mask is left as it
+ *   is. */
 #include "support/testutil.h"
 
 #include <cmocka.h>
@@ -15,15 +21,15 @@
 
 #include "../src/fit/fit_narrow.h"
 
-enum { W = 120, H = 80 };
+enum { W = 160, H = 80 };
 
-static uint8_t img[4 * W * H], mask[W * H], out[W * H], out2[W * H];
+static uint8_t img[4 * W * H], mask[W * H], out[W * H], out2[W * H], tmp[W * H];
 
 static unsigned rng = 12345u;
 static unsigned rnd(void) { rng = rng * 1664525u + 1013904223u; return rng >> 24; }
 
-/* stripe x0..x1-1 of skin, the mask widened by 3 px */
-static void scene(int x0, int x1)
+/* stripe x0..x1-1 of skin, the mask widened by grow px (< 0: narrower) */
+static void scene_grow(int x0, int x1, int grow)
 {
     rng = 12345u;
     for (int y = 0; y < H; y++)
@@ -35,9 +41,11 @@ static void scene(int x0, int x1)
             p[1] = (uint8_t)(skin ? 140 + n : 50 + n);
             p[2] = (uint8_t)(skin ? 110 + n : 160 + n);
             p[3] = 255;
-            mask[y * W + x] = (x >= x0 - 3 && x < x1 + 3) ? 255 : 0;
+            mask[y * W + x] = (x >= x0 - grow && x < x1 + grow) ? 255 : 0;
         }
 }
+
+static void scene(int x0, int x1) { scene_grow(x0, x1, 3); }
 
 static long errors(const uint8_t *m, int x0, int x1)
 {
@@ -105,6 +113,46 @@ static void test_wide_unchanged(void **st)
     assert_true(errors(out, 30, 90) * 4 < errors(mask, 30, 90));
 }
 
+static void test_regrow(void **st)
+{
+    (void)st;
+    scene_grow(30, 130, -18);   /* the hand 18 px beyond the band's 16 */
+    fuse_refine_params p = fuse_refine_params_default();
+    fuse_image P = { img, W, H, 4 * W };
+    fuse_refine_stats rs, rs2;
+    assert_int_equal(fuse_refine_mask(&p, &P, mask, W, out, W, scratch, scratch_size, &rs),
+                     FUSE_OK);
+    assert_int_equal(rs.used_colour, 1);
+    assert_true((double)rs.flipped_in > PIPE_REGROW_PER_MILLE / 1000.0 * W * H);
+    const long e1 = errors(out, 30, 130);
+    assert_true(e1 >= 3 * H);   /* the band left the last 2 px on each side out */
+    /* the plain second refinement, from the first's result */
+    assert_int_equal(fuse_refine_mask(&p, &P, out, W, out2, W, scratch, scratch_size, &rs2),
+                     FUSE_OK);
+    assert_int_equal(pipe_fit_refine_regrow(&p, NULL, 0.0f, &P, out, W, tmp, scratch,
+                                            scratch_size, &rs),
+                     1);
+    assert_memory_equal(out, out2, sizeof out);
+    assert_true(errors(out, 30, 130) * 4 < e1);
+    /* below the limit: left as it is */
+    memcpy(out2, out, sizeof out);
+    rs.flipped_in = (long)(PIPE_REGROW_PER_MILLE / 1000.0 * W * H);
+    assert_int_equal(pipe_fit_refine_regrow(&p, NULL, 0.0f, &P, out, W, tmp, scratch,
+                                            scratch_size, &rs),
+                     0);
+    assert_memory_equal(out, out2, sizeof out);
+    /* after a fallback: left as it is */
+    rs.flipped_in = W * H;
+    rs.used_colour = 0;
+    assert_int_equal(pipe_fit_refine_regrow(&p, NULL, 0.0f, &P, out, W, tmp, scratch,
+                                            scratch_size, &rs),
+                     0);
+    assert_memory_equal(out, out2, sizeof out);
+    assert_int_equal(pipe_fit_refine_regrow(&p, NULL, 0.0f, &P, out, W, NULL, scratch,
+                                            scratch_size, &rs),
+                     -1);
+}
+
 int main(void)
 {
     fuse_refine_params p = fuse_refine_params_default();
@@ -113,6 +161,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_thin_halves),
         cmocka_unit_test(test_wide_unchanged),
+        cmocka_unit_test(test_regrow),
     };
     const int r = cmocka_run_group_tests(tests, NULL, NULL);
     free(scratch);

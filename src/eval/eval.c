@@ -617,6 +617,15 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                     cfg->global, PIPE_NARROW_MIN_BAND, &P, mask, CW, c->refined, CW,
                     c->refine_scratch, c->refine_scratch_size, &rs, NULL);
                 if (fr != FUSE_OK) return -1;
+                /* once more from its own edge where it let in much: the
+                 * hand beyond the band (fit_narrow.h, as pipe_frame) */
+                if (pipe_fit_refine_regrow(&rp,
+                                           cfg->fit && cfg->global > 0.0f &&
+                                                   pipe_fit_learned(r->fit, e)
+                                               ? pipe_fit_colour(r->fit, e) : NULL,
+                                           cfg->global, &P, c->refined, CW, c->mask_smooth,
+                                           c->refine_scratch, c->refine_scratch_size, &rs) < 0)
+                    return -1;
                 /* and so must the pixels the vote let in beyond it */
                 if (from_prior && rs.used_colour && cfg->fit &&
                     pipe_fit_learned(r->fit, e))

@@ -2,6 +2,8 @@
  * (fit_narrow.h). */
 #include "fit_narrow.h"
 
+#include <string.h>
+
 static fuse_result run(const fuse_refine_params *p, const fuse_colour_model *g, float weight,
                        const fuse_image *P, const uint8_t *mask, int mask_stride, uint8_t *out,
                        int out_stride, void *scratch, size_t scratch_size,
@@ -34,4 +36,21 @@ fuse_result pipe_fit_refine_narrow(const fuse_refine_params *p, const fuse_colou
     }
     if (band_used) *band_used = q.band;
     return r;
+}
+
+int pipe_fit_refine_regrow(const fuse_refine_params *p, const fuse_colour_model *g,
+                           float weight, const fuse_image *P, uint8_t *refined, int stride,
+                           uint8_t *tmp, void *scratch, size_t scratch_size,
+                           const fuse_refine_stats *first)
+{
+    if (!p || !P || !refined || !tmp || !first || stride < P->width) return -1;
+    const double limit = PIPE_REGROW_PER_MILLE / 1000.0 * (double)P->width * (double)P->height;
+    if (!first->used_colour || (double)first->flipped_in <= limit) return 0;
+    for (int y = 0; y < P->height; y++)
+        memcpy(tmp + (size_t)y * (size_t)P->width, refined + (size_t)y * (size_t)stride,
+               (size_t)P->width);
+    fuse_refine_stats st;
+    fuse_result r = pipe_fit_refine_narrow(p, g, weight, PIPE_NARROW_MIN_BAND, P, tmp, P->width,
+                                           refined, stride, scratch, scratch_size, &st, NULL);
+    return r == FUSE_OK ? 1 : -1;
 }

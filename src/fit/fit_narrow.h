@@ -1,7 +1,9 @@
 #ifndef EGOFUSE_FIT_NARROW_H
 #define EGOFUSE_FIT_NARROW_H
 /* fit_narrow.h - the band refinement with a narrower band where the hand
- * is thin (issue 14 item 2, docs/accuracy.md "Where `edge` loses the hand").
+ * is thin, and once more where the hand lies beyond the band (issue 14
+ * item 2, docs/accuracy.md "Where `edge` loses the hand", "The band once
+ * more from the refined edge").
  *
  * WHAT IT DOES
  *   The local histograms of the band refinement (fuse_refine.h) learn the
@@ -11,9 +13,16 @@
  *   (the last refined mask moved) is then carried for many frames without
  *   any colour decision. pipe_fit_refine_narrow runs the refinement again
  *   with the band halved while it falls back.
+ *   Where the tracking is off by more than the band (hands crossing, hands
+ *   at 15 cm), the colour takes in pixels up to the band's outer edge and
+ *   the rest of the hand stays out. pipe_fit_refine_regrow runs the
+ *   refinement once more from its own result (the band re-centred on the
+ *   refined edge reaches band px further) when the first let in more than
+ *   PIPE_REGROW_PER_MILLE / 1000 of the image's pixels.
  *
  * WHAT IT DOES NOT
- *   No allocation (the caller's scratch), no threads; never widens the band.
+ *   No allocation (the caller's scratch and buffer), no threads; never
+ *   widens the band.
  *
  * USAGE
  *   eval's refine and pipe_refine.c call it where they called
@@ -35,4 +44,20 @@ fuse_result pipe_fit_refine_narrow(const fuse_refine_params *p, const fuse_colou
                                    const uint8_t *mask, int mask_stride, uint8_t *out,
                                    int out_stride, void *scratch, size_t scratch_size,
                                    fuse_refine_stats *stats, int *band_used);
+/* More pixels let in than this many per mille of the image (flipped_in;
+ * 4480 at 640x400): the refinement runs once more (measured on the eval
+ * sequences: docs/accuracy.md). */
+#define PIPE_REGROW_PER_MILLE 17.5
+
+/* When first (the stats of the refinement that wrote refined, P's size,
+ * stride bytes per row) used the colour and let in more than
+ * PIPE_REGROW_PER_MILLE / 1000 of P's pixels: refined copied into tmp (P's
+ * width x height bytes, its own stride P->width) and refined again from it
+ * with pipe_fit_refine_narrow (p, g, weight, PIPE_NARROW_MIN_BAND) into
+ * refined. Returns 1 when it ran, 0 when not (refined unchanged), -1 when
+ * the refinement failed (FUSE_ERR_ARGS). */
+int pipe_fit_refine_regrow(const fuse_refine_params *p, const fuse_colour_model *g,
+                           float weight, const fuse_image *P, uint8_t *refined, int stride,
+                           uint8_t *tmp, void *scratch, size_t scratch_size,
+                           const fuse_refine_stats *first);
 #endif

@@ -523,6 +523,7 @@ static void free_eyes(pipe_ctx *p)
         free(p->eye[e].layer);
         free(p->eye[e].cam_rgba);
         free(p->eye[e].refined);
+        free(p->eye[e].regrow);
         free(p->eye[e].prior);
         free(p->eye[e].shifted);
         free(p->eye[e].unsmoothed);
@@ -666,10 +667,11 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
             s->refine_scratch_size = rs && fs > rs ? fs : rs;
             if (rs && ss > s->refine_scratch_size) s->refine_scratch_size = ss;
             s->refined = malloc(px);
+            s->regrow = malloc(px);
             s->refine_scratch = s->refine_scratch_size
                                     ? aligned_alloc(16, (s->refine_scratch_size + 15) & ~(size_t)15)
                                     : NULL;
-            ok = s->refined && s->refine_scratch;
+            ok = s->refined && s->regrow && s->refine_scratch;
             if (ok && p->desc.refine_prior == 0 && p->desc.fit_rig) {
                 s->prior = malloc(px);
                 ok = s->prior != NULL;

@@ -25,6 +25,8 @@ typedef struct eye_state {
     void *nfill_scratch;      /* refine_band, normal_smooth >= 0 */
     uint8_t *soft;            /* soft_edge: the softened mask */
     uint8_t *refined;         /* the refined mask (refine_band) */
+    uint8_t *regrow;          /* refine_band: the refined mask refined once
+                                 more from (pipe_fit_refine_regrow) */
     void *refine_scratch;
     size_t refine_scratch_size;
     int have_refined;         /* refined holds the last frame's mask */

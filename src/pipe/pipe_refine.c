@@ -100,6 +100,18 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
                  e->eye ? "right" : "left", fuse_result_str(rr2));
         return -1;
     }
+    /* once more from its own edge where it let in much: the hand beyond
+     * the band (fit_narrow.h; eval's refine does the same) */
+    if (pipe_fit_refine_regrow(&rp,
+                               p->fit && pipe_fit_learned(p->fit, e->eye)
+                                   ? pipe_fit_colour(p->fit, e->eye) : NULL,
+                               0.5f, &fe->P, e->refined, cw, e->regrow, e->refine_scratch,
+                               e->refine_scratch_size, &rs) < 0) {
+        e->result = PIPE_ERR_FUSE;
+        snprintf(e->why, sizeof e->why, "%s eye: mask refinement: %s",
+                 e->eye ? "right" : "left", fuse_result_str(FUSE_ERR_ARGS));
+        return -1;
+    }
     /* the pixels the vote let in beyond a prior must look like the
      * hand too (fit_band.h) */
     if (from_prior && rs.used_colour && p->fit && pipe_fit_learned(p->fit, e->eye))
