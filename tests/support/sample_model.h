@@ -64,10 +64,10 @@ static inline void tu_sample_group_teardown(tu_sample_group *g)
 }
 
 /* Defines the file's group `static tu_sample_group var` of the samples
- * name (frames) and its cmocka group fixtures group_setup and
- * group_teardown, which load and free it. */
-#define TU_SAMPLE_GROUP(var, name, frames)                                  \
-    static tu_sample_group var = { name, frames };                          \
+ * named samples (nframes frames) and its cmocka group fixtures
+ * group_setup and group_teardown, which load and free it. */
+#define TU_SAMPLE_GROUP(var, samples, nframes)                              \
+    static tu_sample_group var = { .name = samples, .frames = nframes };    \
     static int group_setup(void **state)                                    \
     {                                                                       \
         (void)state;                                                        \
