@@ -258,27 +258,7 @@ static void validity_replay_args(void **state)
 
 /* ---------------------------------------------------------- calibrate */
 
-static kin_model g_model;
-static int g_loaded;
-static char g_model_path[1200], g_skip[3000];
-
-static int group_setup(void **state)
-{
-    (void)state;
-    char dir[1024];
-    int r = tu_sample_model_load("calib_samples", 3, &g_model, dir, sizeof dir, g_model_path,
-                                 sizeof g_model_path, g_skip, sizeof g_skip);
-    if (r <= 0) return r;
-    g_loaded = 1;
-    return 0;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    tu_sample_model_free("calib_samples", &g_model, g_loaded);
-    return 0;
-}
+TU_SAMPLE_GROUP(g_samples, "calib_samples", 3)
 
 #define TRUE_ARM 1.10f
 #define TRUE_SHOULDER 1.05f
@@ -342,13 +322,13 @@ static int calib_recording(kin_track_sample *s, const kin_arm_rig *rig, const ki
  * the model). */
 static void calib_rig(kin_arm_rig *rig, kin_vec3 tip[2])
 {
-    if (g_skip[0]) {
-        printf("%s\n", g_skip);
+    if (g_samples.skip[0]) {
+        printf("%s\n", g_samples.skip);
         skip();
     }
     char why[256];
-    if (kin_arm_rig_init(rig, &g_model, why, sizeof why)) fail_msg("%s", why);
-    if (kin_user_calib_hand_tips(rig, &g_model, tip, why, sizeof why)) fail_msg("%s", why);
+    if (kin_arm_rig_init(rig, &g_samples.model, why, sizeof why)) fail_msg("%s", why);
+    if (kin_user_calib_hand_tips(rig, &g_samples.model, tip, why, sizeof why)) fail_msg("%s", why);
 }
 
 static void result_calibrate(void **state)
@@ -374,7 +354,7 @@ static void result_calibrate(void **state)
     }
     fclose(f);
     remove(cal);
-    char *argv[] = { (char *)tu_bin(), "calibrate", "--model", g_model_path, "--recording", rec,
+    char *argv[] = { (char *)tu_bin(), "calibrate", "--model", g_samples.path, "--recording", rec,
                      "--glove-left", glove, "--out", cal, NULL };
     if (tu_run(argv, out, sizeof out) != 0) fail_msg("%s", out);
     assert_non_null(strstr(out, "(fingertip gesture)"));
@@ -412,7 +392,7 @@ static void validity_calibrate(void **state)
     /* too few samples: named, nothing written */
     assert_int_equal(io_track_save(rec, s, 10, &err), IO_OK);
     remove(cal);
-    char *a1[] = { (char *)tu_bin(), "calibrate", "--model", g_model_path, "--recording", rec,
+    char *a1[] = { (char *)tu_bin(), "calibrate", "--model", g_samples.path, "--recording", rec,
                    "--out", cal, NULL };
     assert_int_equal(tu_run(a1, out, sizeof out), 1);
     assert_non_null(strstr(out, "calib_short.txt: left arm: 10 samples with shoulder and hand, "
@@ -421,7 +401,7 @@ static void validity_calibrate(void **state)
     /* a folder that does not exist: the write fails, named */
     tu_tmp_path("calib_rec_ok.txt", rec, sizeof rec);
     assert_int_equal(io_track_save(rec, s, 800, &err), IO_OK);
-    char *a2[] = { (char *)tu_bin(), "calibrate", "--model", g_model_path, "--recording", rec,
+    char *a2[] = { (char *)tu_bin(), "calibrate", "--model", g_samples.path, "--recording", rec,
                    "--out", "/nonexistent-dir/calib.txt", NULL };
     assert_int_equal(tu_run(a2, out, sizeof out), 1);
     assert_non_null(strstr(out, "/nonexistent-dir/calib.txt"));
@@ -430,7 +410,7 @@ static void validity_calibrate(void **state)
     FILE *f = fopen(glove, "w");
     fprintf(f, "0.1 0.2 0.3 0.4 0.5\n0.1 0.2 x\n");
     fclose(f);
-    char *a3[] = { (char *)tu_bin(), "calibrate", "--model", g_model_path, "--recording", rec,
+    char *a3[] = { (char *)tu_bin(), "calibrate", "--model", g_samples.path, "--recording", rec,
                    "--glove-right", glove, "--out", cal, NULL };
     assert_int_equal(tu_run(a3, out, sizeof out), 1);
     assert_non_null(strstr(out, "calib_glove_bad.txt:2: reading 3: needs 5 numbers"));

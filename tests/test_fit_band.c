@@ -66,15 +66,7 @@ static void scene_make(scene *s)
     assert_non_null(s->truth && s->kin && s->prev && s->out && s->region && s->prior);
     disc(s->truth, W / 2.0f, H / 2.0f, 64.0f);
     disc(s->kin, W / 2.0f, H / 2.0f, 40.0f);
-    for (int k = 0; k < W * H; k++) {
-        const int skin = s->truth[k] != 0;
-        const float base[3] = { skin ? 200.0f : 30.0f, skin ? 150.0f : 40.0f, skin ? 120.0f : 90.0f };
-        for (int c = 0; c < 3; c++) {
-            float v = base[c] + tu_range(&rng, -10.0f, 10.0f);
-            s->img[4 * k + c] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
-        }
-        s->img[4 * k + 3] = 255;
-    }
+    fit_scene_paint(s->img, s->truth, (long)W * H, &rng);
     s->rp = fuse_refine_params_default();
     s->rp.band = 16;
     s->rp.bits = 5;

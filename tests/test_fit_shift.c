@@ -66,16 +66,7 @@ static void scene_make(scene *s)
     /* the model's hand at the image centre, the true one offset */
     disc(s->truth, W / 2.0f + DX, H / 2.0f + DY, 40.0f, 1);
     disc(s->kin, W / 2.0f, H / 2.0f, 40.0f, 1);
-    for (int k = 0; k < W * H; k++) {
-        const int skin = s->truth[k] != 0;
-        const float base[3] = { skin ? 200.0f : 30.0f, skin ? 150.0f : 40.0f,
-                                skin ? 120.0f : 90.0f };
-        for (int c = 0; c < 3; c++) {
-            float v = base[c] + tu_range(&rng, -10.0f, 10.0f);
-            s->img[4 * k + c] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
-        }
-        s->img[4 * k + 3] = 255;
-    }
+    fit_scene_paint(s->img, s->truth, (long)W * H, &rng);
     s->scratch_size = pipe_fit_shift_scratch_size(W, H);
     s->scratch = aligned_alloc(16, (s->scratch_size + 15) & ~(size_t)15);
     s->cscratch = malloc(fuse_colour_model_scratch_size(5));

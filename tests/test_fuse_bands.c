@@ -16,6 +16,7 @@
 
 #include "../src/fuse/fuse.h"
 #include "../src/pipe/pipe.h"
+#include "support/fuse_eye_data.h"
 #include "support/pipe_frames.h"
 
 /* crop CW x CH, output OW x OH, viewport (OX, OY, OPW, OPH): upscaled by
@@ -23,22 +24,9 @@
  * fall in the middle of a layer row's rows) */
 enum { CW = 150, CH = 97, OW = 320, OH = 216, OX = 7, OY = 5, OPW = 300, OPH = 203 };
 
-typedef struct eye_data {
-    uint8_t *P, *M, *Q, *V, *out;
-    float *N, *hand, *scene;
-} eye_data;
-
-static void eye_fill(eye_data *e, tu_rng *r)
+static void eye_fill(tu_eye_data *e, tu_rng *r)
 {
-    e->P = malloc(CW * CH * 4);
-    e->M = malloc(CW * CH);
-    e->Q = malloc(CW * CH * 4);
-    e->V = malloc(OW * OH * 4);
-    e->out = malloc(OW * OH * 4);
-    e->N = malloc(sizeof(float) * CW * CH * 3);
-    e->hand = malloc(sizeof(float) * CW * CH);
-    e->scene = malloc(sizeof(float) * OW * OH);
-    assert_true(e->P && e->M && e->Q && e->V && e->out && e->N && e->hand && e->scene);
+    tu_eye_alloc(e, CW, CH, OW, OH);
     for (int i = 0; i < CW * CH * 4; i++) e->P[i] = (uint8_t)tu_int(r, 256);
     for (int i = 0; i < CW * CH; i++) {
         /* a hand off the centre, over the lower left; some rows empty */
@@ -55,12 +43,6 @@ static void eye_fill(eye_data *e, tu_rng *r)
         e->V[i] = (i & 3) == 3 ? 255 : (uint8_t)tu_int(r, 256);   /* opaque */
     for (int i = 0; i < OW * OH; i++)   /* a bar in front across the middle */
         e->scene[i] = (i / OW) > OH / 2 && (i / OW) < OH / 2 + 20 ? 0.1f : 1.0f;
-}
-
-static void eye_free(eye_data *e)
-{
-    free(e->P); free(e->M); free(e->Q); free(e->V); free(e->out);
-    free(e->N); free(e->hand); free(e->scene);
 }
 
 typedef struct band_share {
@@ -89,7 +71,7 @@ static void bands_equal_frame(void **state)
     tu_rng r = {0xBA1A7CEu};
     fuse_lighting L = fuse_lighting_default();
     const fuse_intrinsics K = {90.0f, 90.0f, CW / 2.0f, CH / 2.0f};
-    eye_data e;
+    tu_eye_data e;
     eye_fill(&e, &r);
     const fuse_depth dd = {e.hand, CW, 0.05f, 10.0f, 0.0f, e.scene, OW, OW, OH};
     uint8_t *want = malloc(OW * OH * 4), *wantq = malloc(CW * CH * 4);
@@ -157,7 +139,7 @@ static void bands_equal_frame(void **state)
     }
     free(want);
     free(wantq);
-    eye_free(&e);
+    tu_eye_free(&e);
 }
 
 /* A quad off to the left, close: the left eye sees far more of it than

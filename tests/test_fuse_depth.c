@@ -13,6 +13,7 @@
 
 #include "../src/fuse/fuse.h"
 #include "../src/kin/kin.h"
+#include "support/fuse_eye_data.h"
 
 enum { QW = 16, QH = 10, VW = 40, VH = 30, VX = 3, VY = 2, VPW = 31, VPH = 25 };
 static const float ZN = 0.01f, ZF = 100.0f;
@@ -202,25 +203,12 @@ static void test_bad_input(void **state)
 
 /* ---- fuse_context_frame ------------------------------------------------- */
 
-typedef struct eye_data {
-    uint8_t *P, *M, *Q, *V, *out;
-    float *N, *hand, *scene;
-} eye_data;
-
 enum { CW = 67, CH = 41, OW = 130, OH = 84, OX = 5, OY = 3, OPW = 121, OPH = 77 };
 
-static void eye_fill(eye_data *e, tu_rng *r)
+static void eye_fill(tu_eye_data *e, tu_rng *r)
 {
     int i;
-    e->P = malloc(CW * CH * 4);
-    e->M = malloc(CW * CH);
-    e->Q = malloc(CW * CH * 4);
-    e->V = malloc(OW * OH * 4);
-    e->out = malloc(OW * OH * 4);
-    e->N = malloc(sizeof(float) * CW * CH * 3);
-    e->hand = malloc(sizeof(float) * CW * CH);
-    e->scene = malloc(sizeof(float) * OW * OH);
-    assert_true(e->P && e->M && e->Q && e->V && e->out && e->N && e->hand && e->scene);
+    tu_eye_alloc(e, CW, CH, OW, OH);
     for (i = 0; i < CW * CH * 4; i++) e->P[i] = (uint8_t)tu_int(r, 256);
     for (i = 0; i < CW * CH; i++) {
         const int x = i % CW, y = i / CW;
@@ -237,19 +225,13 @@ static void eye_fill(eye_data *e, tu_rng *r)
         e->scene[i] = (i / OW) > OH / 3 && (i / OW) < OH / 2 ? 0.2f : 0.0f;
 }
 
-static void eye_free(eye_data *e)
-{
-    free(e->P); free(e->M); free(e->Q); free(e->V); free(e->out);
-    free(e->N); free(e->hand); free(e->scene);
-}
-
 static void test_frame(void **state)
 {
     static const ef_isa isas[] = { EF_ISA_REF, EF_ISA_DEFAULT };
     tu_rng r = { 0xF7A3Eu };
     const fuse_lighting L = fuse_lighting_default();
     const fuse_intrinsics K = { 60.0f, 60.0f, CW / 2.0f, CH / 2.0f };
-    eye_data e[2];
+    tu_eye_data e[2];
     uint8_t *want[2];
     fuse_depth dd[2];
     int i, ii, t;
@@ -313,7 +295,7 @@ static void test_frame(void **state)
             fuse_context_destroy(ctx);
         }
     for (i = 0; i < 2; i++) {
-        eye_free(&e[i]);
+        tu_eye_free(&e[i]);
         free(want[i]);
     }
 }

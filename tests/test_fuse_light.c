@@ -596,43 +596,33 @@ static void test_bad_input(void **state)
         assert_int_equal(fuse_light(&L, &K, &Pb, mask, 4, n, 12, &Ob), FUSE_ERR_ARGS);
         assert_memory_equal(keep, big, sizeof keep);
     }
-    /* Parameters. */
-    B = L; B.light_count = -1;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
-    B = L; B.light_count = FUSE_MAX_LIGHTS + 1;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
-    B = L; B.shininess = 0.99f;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
-    B = L; B.shininess = NAN;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
-    B = L; B.kd = INFINITY;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
-    B = L; B.ks = NAN;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
-    B = L; B.kf = -INFINITY;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
-    B = L; B.ambient[1] = NAN;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
-    B = L; B.tone[2] = 2e6f;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
-    B = L; B.lights[0].color[0] = NAN;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
-    B = L; B.lights[0].dir[0] = B.lights[0].dir[1] = B.lights[0].dir[2] = 0;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
-    B = L; B.lights[0].dir[1] = INFINITY;
-    BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi));
+    /* Parameters: L or K with one field changed (BAD_L, BAD_K). */
+#define BAD_L(change) do { B = L; change; \
+        BAD(FUSE_ERR_ARGS, fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi)); } while (0)
+#define BAD_K(change) do { KB = K; change; \
+        BAD(FUSE_ERR_ARGS, fuse_light(&L, &KB, &Pi, mask, 4, n, 12, &Oi)); } while (0)
+    BAD_L(B.light_count = -1);
+    BAD_L(B.light_count = FUSE_MAX_LIGHTS + 1);
+    BAD_L(B.shininess = 0.99f);
+    BAD_L(B.shininess = NAN);
+    BAD_L(B.kd = INFINITY);
+    BAD_L(B.ks = NAN);
+    BAD_L(B.kf = -INFINITY);
+    BAD_L(B.ambient[1] = NAN);
+    BAD_L(B.tone[2] = 2e6f);
+    BAD_L(B.lights[0].color[0] = NAN);
+    BAD_L(B.lights[0].dir[0] = B.lights[0].dir[1] = B.lights[0].dir[2] = 0);
+    BAD_L(B.lights[0].dir[1] = INFINITY);
     /* An unused light slot is not looked at. */
     B = L; B.lights[3].dir[0] = NAN;
     assert_int_equal(fuse_light(&B, &K, &Pi, mask, 4, n, 12, &Oi), FUSE_OK);
     memset(out, 0xEE, sizeof out);
-    KB = K; KB.fx = 0;
-    BAD(FUSE_ERR_ARGS, fuse_light(&L, &KB, &Pi, mask, 4, n, 12, &Oi));
-    KB = K; KB.fy = NAN;
-    BAD(FUSE_ERR_ARGS, fuse_light(&L, &KB, &Pi, mask, 4, n, 12, &Oi));
-    KB = K; KB.cx = INFINITY;
-    BAD(FUSE_ERR_ARGS, fuse_light(&L, &KB, &Pi, mask, 4, n, 12, &Oi));
-    KB = K; KB.cy = NAN;
-    BAD(FUSE_ERR_ARGS, fuse_light(&L, &KB, &Pi, mask, 4, n, 12, &Oi));
+    BAD_K(KB.fx = 0);
+    BAD_K(KB.fy = NAN);
+    BAD_K(KB.cx = INFINITY);
+    BAD_K(KB.cy = NAN);
+#undef BAD_K
+#undef BAD_L
 #undef BAD
     assert_string_not_equal(fuse_result_str(FUSE_ERR_ARGS), fuse_result_str(FUSE_ERR_SIZE));
     assert_non_null(fuse_result_str((fuse_result)99));

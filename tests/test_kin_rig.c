@@ -25,31 +25,9 @@
 #include "../src/kin/kin.h"
 #include "support/sample_model.h"
 
-static kin_model g_model;
-static int g_loaded;
-static char g_skip[3000];
-static char g_track[1200];   /* the samples' track.txt */
+TU_SAMPLE_GROUP(g_samples, "rig_samples", 3)
 
-static int group_setup(void **state)
-{
-    (void)state;
-    char dir[1024], path[1200];
-    int r = tu_sample_model_load("rig_samples", 3, &g_model, dir, sizeof dir, path, sizeof path,
-                                 g_skip, sizeof g_skip);
-    if (r <= 0) return r;
-    snprintf(g_track, sizeof g_track, "%s/track.txt", dir);
-    g_loaded = 1;
-    return 0;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    tu_sample_model_free("rig_samples", &g_model, g_loaded);
-    return 0;
-}
-
-#define NEED_MODEL() TU_NEED_MODEL(g_loaded, g_skip)
+#define NEED_MODEL() TU_NEED_MODEL(g_samples.loaded, g_samples.skip)
 
 static kin_vec3 wpos(const kin_mat4 *m) { return kin_v3(m->m[12], m->m[13], m->m[14]); }
 
@@ -83,23 +61,24 @@ static void test_rig_finds_every_joint(void **state)
     NEED_MODEL();
     kin_arm_rig rig;
     char why[512];
-    int rc = kin_arm_rig_init(&rig, &g_model, why, sizeof why);
+    int rc = kin_arm_rig_init(&rig, &g_samples.model, why, sizeof why);
     if (rc) fail_msg("kin_arm_rig_init: %s", why);
-    assert_int_equal(g_model.names[rig.body][0], 'b');
-    assert_string_equal(g_model.names[rig.body], "body");
-    assert_string_equal(g_model.names[rig.head], "head");
+    assert_int_equal(g_samples.model.names[rig.body][0], 'b');
+    assert_string_equal(g_samples.model.names[rig.body], "body");
+    assert_string_equal(g_samples.model.names[rig.head], "head");
     char name[KIN_NAME_MAX];
     for (int s = 0; s < 2; s++)
         for (int j = 0; j < KIN_RIG_SIDE_JOINTS; j++) {
             int n = rig.joint[s][j];
-            assert_true(n >= 0 && n < g_model.node_count);
-            assert_string_equal(g_model.names[n], kin_arm_rig_joint_name((kin_side)s, j, name, sizeof name));
+            assert_true(n >= 0 && n < g_samples.model.node_count);
+            assert_string_equal(g_samples.model.names[n],
+                                kin_arm_rig_joint_name((kin_side)s, j, name, sizeof name));
         }
     /* bone lengths: the rest-pose distances of the joint nodes */
-    kin_transform *loc = malloc(sizeof *loc * (size_t)g_model.node_count);
-    kin_mat4 *world = malloc(sizeof *world * (size_t)g_model.node_count);
-    kin_pose_rest(&g_model, loc);
-    kin_fk(g_model.parents, g_model.node_count, loc, NULL, world);
+    kin_transform *loc = malloc(sizeof *loc * (size_t)g_samples.model.node_count);
+    kin_mat4 *world = malloc(sizeof *world * (size_t)g_samples.model.node_count);
+    kin_pose_rest(&g_samples.model, loc);
+    kin_fk(g_samples.model.parents, g_samples.model.node_count, loc, NULL, world);
     for (int s = 0; s < 2; s++) {
         kin_vec3 u = wpos(&world[rig.joint[s][KIN_RIG_UPPER_ARM]]);
         kin_vec3 e = wpos(&world[rig.joint[s][KIN_RIG_FOREARM]]);
@@ -121,16 +100,16 @@ static void test_rig_names_missing_joints(void **state)
 {
     (void)state;
     NEED_MODEL();
-    int n = g_model.node_count;
+    int n = g_samples.model.node_count;
     char (*names)[KIN_NAME_MAX] = malloc(sizeof *names * (size_t)n);
-    memcpy(names, g_model.names, sizeof *names * (size_t)n);
+    memcpy(names, g_samples.model.names, sizeof *names * (size_t)n);
     static const char *const gone[] = { "R_palm", "L_thumb_3", "head" };
     for (int k = 0; k < 3; k++) {
-        int i = kin_model_find_node(&g_model, gone[k]);
+        int i = kin_model_find_node(&g_samples.model, gone[k]);
         assert_true(i >= 0);
         snprintf(names[i], KIN_NAME_MAX, "renamed_%d", k);
     }
-    kin_model m = g_model;
+    kin_model m = g_samples.model;
     m.names = (const char(*)[KIN_NAME_MAX])names;
     m.block = NULL;
     kin_arm_rig rig;
@@ -154,11 +133,11 @@ typedef struct poser {
 static void poser_init(poser *p)
 {
     char why[512];
-    if (kin_arm_rig_init(&p->rig, &g_model, why, sizeof why)) fail_msg("%s", why);
-    p->loc = malloc(sizeof *p->loc * (size_t)g_model.node_count);
-    p->world = malloc(sizeof *p->world * (size_t)g_model.node_count);
-    kin_pose_rest(&g_model, p->loc);
-    kin_fk(g_model.parents, g_model.node_count, p->loc, NULL, p->world);
+    if (kin_arm_rig_init(&p->rig, &g_samples.model, why, sizeof why)) fail_msg("%s", why);
+    p->loc = malloc(sizeof *p->loc * (size_t)g_samples.model.node_count);
+    p->world = malloc(sizeof *p->world * (size_t)g_samples.model.node_count);
+    kin_pose_rest(&g_samples.model, p->loc);
+    kin_fk(g_samples.model.parents, g_samples.model.node_count, p->loc, NULL, p->world);
     for (int s = 0; s < 2; s++) p->shoulder[s] = wpos(&p->world[p->rig.joint[s][KIN_RIG_UPPER_ARM]]);
     p->head = wpos(&p->world[p->rig.head]);
 }
@@ -187,9 +166,9 @@ static kin_track_sample base_sample(const poser *p)
 /* Poses from s, runs FK; returns the IK jobs. */
 static void pose(poser *p, const kin_track_sample *s, kin_arm_ik_job ik[2])
 {
-    kin_pose_rest(&g_model, p->loc);
-    assert_int_equal(kin_arm_rig_pose(&p->rig, &g_model, NULL, NULL, s, p->loc, ik), 1);
-    kin_fk(g_model.parents, g_model.node_count, p->loc, NULL, p->world);
+    kin_pose_rest(&g_samples.model, p->loc);
+    assert_int_equal(kin_arm_rig_pose(&p->rig, &g_samples.model, NULL, NULL, s, p->loc, ik), 1);
+    kin_fk(g_samples.model.parents, g_samples.model.node_count, p->loc, NULL, p->world);
 }
 
 static void test_ik_wrists_on_targets(void **state)
@@ -278,20 +257,20 @@ static void test_ik_retargets_the_animation(void **state)
 {
     (void)state;
     NEED_MODEL();
-    assert_true(g_model.anim_count >= 1);
+    assert_true(g_samples.model.anim_count >= 1);
     poser p;
     poser_init(&p);
-    int n = g_model.node_count;
+    int n = g_samples.model.node_count;
     kin_transform *aloc = malloc(sizeof *aloc * (size_t)n);
     kin_mat4 *aw = malloc(sizeof *aw * (size_t)n);
-    const kin_animation *an = &g_model.anims[0];
+    const kin_animation *an = &g_samples.model.anims[0];
     double worst_w = 0, sum_e = 0, worst_e = 0;
     int count = 0;
     for (int f = 0; f <= 60; f++) {
         float t = an->duration * (float)f / 60.0f;
-        kin_pose_rest(&g_model, aloc);
+        kin_pose_rest(&g_samples.model, aloc);
         kin_anim_sample(an, n, t, aloc);
-        kin_fk(g_model.parents, n, aloc, NULL, aw);
+        kin_fk(g_samples.model.parents, n, aloc, NULL, aw);
         kin_track_sample s = base_sample(&p);
         s.head_pos = wpos(&aw[p.rig.head]);
         s.head_rot = wrot(&aw[p.rig.head]);
@@ -339,9 +318,9 @@ static void test_skin_under_ik_finite(void **state)
     NEED_MODEL();
     poser p;
     poser_init(&p);
-    const kin_mesh *me = &g_model.meshes[0];
+    const kin_mesh *me = &g_samples.model.meshes[0];
     assert_true(me->skin >= 0);
-    const kin_skin *sk = &g_model.skins[me->skin];
+    const kin_skin *sk = &g_samples.model.skins[me->skin];
     kin_mat4 *jm = malloc(sizeof *jm * (size_t)sk->joint_count);
     kin_dualquat *dq = malloc(sizeof *dq * (size_t)sk->joint_count);
     size_t n3 = (size_t)me->vertex_count * 3;
@@ -380,23 +359,25 @@ static void test_generated_tracking_drives_the_rig(void **state)
 {
     (void)state;
     NEED_MODEL();
+    char track[1200];
+    snprintf(track, sizeof track, "%s/track.txt", g_samples.dir);
     kin_track_sample *s = NULL;
     int n = 0;
     io_error err;
-    if (io_track_load(g_track, &s, &n, &err) != IO_OK) fail_msg("%s", err.msg);
+    if (io_track_load(track, &s, &n, &err) != IO_OK) fail_msg("%s", err.msg);
     assert_true(n >= 1);
     poser p;
     poser_init(&p);
-    int nn = g_model.node_count;
+    int nn = g_samples.model.node_count;
     kin_transform *aloc = malloc(sizeof *aloc * (size_t)nn);
     kin_mat4 *aw = malloc(sizeof *aw * (size_t)nn);
     double worst = 0;
     for (int f = 0; f < n; f++) {
         assert_true(fabs(s[f].t - f / 60.0) < 1e-9);
         assert_int_equal(s[f].valid, KIN_TRACK_ALL);
-        kin_pose_rest(&g_model, aloc);
-        kin_anim_sample(&g_model.anims[0], nn, (float)s[f].t, aloc);
-        kin_fk(g_model.parents, nn, aloc, NULL, aw);
+        kin_pose_rest(&g_samples.model, aloc);
+        kin_anim_sample(&g_samples.model.anims[0], nn, (float)s[f].t, aloc);
+        kin_fk(g_samples.model.parents, nn, aloc, NULL, aw);
         kin_arm_ik_job ik[2];
         pose(&p, &s[f], ik);
         for (int k = 0; k < 2; k++) {
@@ -410,7 +391,7 @@ static void test_generated_tracking_drives_the_rig(void **state)
         }
     }
     print_message("NOTE %s: %d samples, worst wrist distance to the animation %.3f mm\n",
-                  g_track, n, worst * 1e3);
+                  track, n, worst * 1e3);
     free(aloc);
     free(aw);
     io_track_free(s);

@@ -30,29 +30,9 @@
 #include "support/pipe_frames.h"
 #include "support/sample_model.h"
 
-static kin_model g_model;
-static int g_loaded;
-static char g_skip[3000];
+TU_SAMPLE_GROUP(g_samples, "parts_samples", 1)
 
-static int group_setup(void **state)
-{
-    (void)state;
-    char dir[1024], path[1200];
-    int r = tu_sample_model_load("parts_samples", 1, &g_model, dir, sizeof dir, path, sizeof path,
-                                 g_skip, sizeof g_skip);
-    if (r <= 0) return r;
-    g_loaded = 1;
-    return 0;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    tu_sample_model_free("parts_samples", &g_model, g_loaded);
-    return 0;
-}
-
-#define NEED_MODEL() TU_NEED_MODEL(g_loaded, g_skip)
+#define NEED_MODEL() TU_NEED_MODEL(g_samples.loaded, g_samples.skip)
 
 /* ------------------------------------------------------------ frames */
 
@@ -70,9 +50,9 @@ static void bufs_free(bufs *b) { tu_frame_free(b); }
 /* The sample's reach_grasp at t with the head node's cameras. */
 static void sample_pose(pipe_frame_in *in, float t)
 {
-    in->anim = g_model.anim_count > 0 ? &g_model.anims[0] : NULL;
+    in->anim = g_samples.model.anim_count > 0 ? &g_samples.model.anims[0] : NULL;
     in->time = t;
-    in->head_node = kin_model_find_node(&g_model, "head");
+    in->head_node = kin_model_find_node(&g_samples.model, "head");
     assert_true(in->head_node >= 0);
 }
 
@@ -280,19 +260,19 @@ static void names_sample(void **state)
 {
     (void)state;
     NEED_MODEL();
-    unsigned char *part = malloc((size_t)g_model.node_count);
-    assert_int_equal(pipe_parts_of_nodes(&g_model, NULL, part), PIPE_PART_ALL);
-    for (int i = 0; i < g_model.node_count; i++)
-        if (part[i] != node_part_by_walk(&g_model, i))
-            fail_msg("node '%s': part %u, expected %u", g_model.names[i], part[i],
-                     node_part_by_walk(&g_model, i));
+    unsigned char *part = malloc((size_t)g_samples.model.node_count);
+    assert_int_equal(pipe_parts_of_nodes(&g_samples.model, NULL, part), PIPE_PART_ALL);
+    for (int i = 0; i < g_samples.model.node_count; i++)
+        if (part[i] != node_part_by_walk(&g_samples.model, i))
+            fail_msg("node '%s': part %u, expected %u", g_samples.model.names[i], part[i],
+                     node_part_by_walk(&g_samples.model, i));
     /* the rig's joints come first: its "hand" is the palm here */
     kin_arm_rig rig;
     char why[300];
-    assert_int_equal(kin_arm_rig_init(&rig, &g_model, why, sizeof why), 0);
+    assert_int_equal(kin_arm_rig_init(&rig, &g_samples.model, why, sizeof why), 0);
     int palm = rig.joint[0][KIN_RIG_PALM], hand = rig.joint[0][KIN_RIG_HAND];
     rig.joint[0][KIN_RIG_HAND] = palm;
-    kin_model renamed = g_model;
+    kin_model renamed = g_samples.model;
     pipe_parts_of_nodes(&renamed, &rig, part);
     assert_int_equal(part[palm], PIPE_PART_HAND_L);
     assert_int_equal(part[hand], PIPE_PART_HAND_L); /* still named L_hand */
@@ -432,16 +412,16 @@ static void hide_each_part(void **state)
 {
     (void)state;
     NEED_MODEL();
-    unsigned char **cls = classify(&g_model);
+    unsigned char **cls = classify(&g_samples.model);
     long tris[16] = {0};
-    for (int i = 0; i < g_model.mesh_count; i++)
-        for (int t = 0; t < g_model.meshes[i].index_count / 3; t++) tris[cls[i][t]]++;
+    for (int i = 0; i < g_samples.model.mesh_count; i++)
+        for (int t = 0; t < g_samples.model.meshes[i].index_count / 3; t++) tris[cls[i][t]]++;
     print_message("NOTE sample triangles: left hand %ld, left arm %ld, right hand %ld, right arm "
                   "%ld, none %ld\n", tris[1], tris[2], tris[4], tris[8], tris[0]);
     for (unsigned b = 1; b <= 8; b <<= 1) assert_true(tris[b] > 100);
 
     pipe_desc d = {0};
-    pipe_ctx *p = pipe_create(&d, &g_model);
+    pipe_ctx *p = pipe_create(&d, &g_samples.model);
     assert_non_null(p);
     assert_int_equal(pipe_parts_present(p), PIPE_PART_ALL);
     bufs b;
@@ -457,7 +437,7 @@ static void hide_each_part(void **state)
                                     PIPE_PART_ARM_L | PIPE_PART_HAND_R};
     for (size_t k = 0; k < sizeof sets / sizeof sets[0]; k++) {
         filtered f;
-        filtered_make(&f, &g_model, cls, sets[k]);
+        filtered_make(&f, &g_samples.model, cls, sets[k]);
         pipe_ctx *q = pipe_create(&d, &f.m);
         assert_non_null(q);
         pipe_frame_in iq = in;
@@ -511,7 +491,7 @@ static void hide_each_part(void **state)
     kept_free(m0, o0);
     bufs_free(&b);
     pipe_destroy(p);
-    for (int i = 0; i < g_model.mesh_count; i++) free(cls[i]);
+    for (int i = 0; i < g_samples.model.mesh_count; i++) free(cls[i]);
     free(cls);
 }
 
@@ -547,16 +527,16 @@ static void hidden_not_refined_back(void **state)
 {
     (void)state;
     NEED_MODEL();
-    unsigned char **cls = classify(&g_model);
+    unsigned char **cls = classify(&g_samples.model);
     const unsigned hide = PIPE_PART_HAND_R;
     filtered f;
-    filtered_make(&f, &g_model, cls, hide);
+    filtered_make(&f, &g_samples.model, cls, hide);
     bufs b;
     pipe_frame_in in;
     bufs_make(&b, &in, 43);
     sample_pose(&in, 1.5f);
     /* the kinematic masks: whole, and without the hand */
-    pipe_ctx *k = pipe_create(NULL, &g_model);
+    pipe_ctx *k = pipe_create(NULL, &g_samples.model);
     uint8_t *full[2], *vis[2], *o[2], *o2[2];
     run_keep(k, &in, &b, full, o);
     in.hide = hide;
@@ -588,7 +568,7 @@ static void hidden_not_refined_back(void **state)
     pipe_destroy(q);
     /* hidden: none of it, and elsewhere the refined mask is the one of the
      * model without the hand */
-    pipe_ctx *p = pipe_create(&d, &g_model);
+    pipe_ctx *p = pipe_create(&d, &g_samples.model);
     uint8_t *mp[2], *op[2];
     run_keep(p, &in, &b, mp, op);
     for (int e = 0; e < 2; e++) {
@@ -601,13 +581,13 @@ static void hidden_not_refined_back(void **state)
     /* with the elbow fit, tracked-style frames (locals): the same */
     kin_arm_rig rig;
     char why[300];
-    assert_int_equal(kin_arm_rig_init(&rig, &g_model, why, sizeof why), 0);
+    assert_int_equal(kin_arm_rig_init(&rig, &g_samples.model, why, sizeof why), 0);
     d.fit_rig = &rig;
-    p = pipe_create(&d, &g_model);
+    p = pipe_create(&d, &g_samples.model);
     assert_non_null(p);
-    kin_transform *loc = malloc(sizeof *loc * (size_t)g_model.node_count);
-    kin_pose_rest(&g_model, loc);
-    kin_anim_sample(in.anim, g_model.node_count, in.time, loc);
+    kin_transform *loc = malloc(sizeof *loc * (size_t)g_samples.model.node_count);
+    kin_pose_rest(&g_samples.model, loc);
+    kin_anim_sample(in.anim, g_samples.model.node_count, in.time, loc);
     in.locals = loc;
     for (int fr = 0; fr < 3; fr++) {
         run_keep(p, &in, &b, mp, op);
@@ -628,7 +608,7 @@ static void hidden_not_refined_back(void **state)
     kept_free(full, vis);
     bufs_free(&b);
     filtered_free(&f);
-    for (int i = 0; i < g_model.mesh_count; i++) free(cls[i]);
+    for (int i = 0; i < g_samples.model.mesh_count; i++) free(cls[i]);
     free(cls);
 }
 

@@ -105,6 +105,15 @@ static method_cfg named_cfg(const eval_opts *o, method_kind k, const char *group
     return c;
 }
 
+/* One configuration of a sweep added to L: kind k with field = v, in
+ * group `name` with the setting "name=" x unit (make_configs). */
+#define SWEEP(k, name, x, unit, field, v) \
+    do { \
+        c = named_cfg(o, k, name, x, name, unit); \
+        c.field = v; \
+        n = add_cfg(L, n, cap, c); \
+    } while (0)
+
 /* PH_METHODS: the selected methods at the given tracking; PH_KNOBS: the
  * same (group "knobs") with every speed knob; PH_TRACK: the tracking sweeps (and the methods at the
  * given tracking, group "track"); PH_SEQ: the methods on sequence seq. */
@@ -147,37 +156,19 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
         }
     if (phase == PH_KNOBS) {
         static const int bands[] = { 4, 8, 12, 24, 32 };
-        for (int i = 0; i < 5; i++) {
-            c = named_cfg(o, M_REFINE, "band", (float)bands[i], "band", "");
-            c.band = bands[i];
-            n = add_cfg(L, n, cap, c);
-        }
-        c = named_cfg(o, M_REFINE, "fit", 0.0f, "fit", "");
-        c.fit = 0;
-        n = add_cfg(L, n, cap, c);
-        c = named_cfg(o, M_REFINE, "global", 0.0f, "global", "");
-        c.global = 0.0f;
-        n = add_cfg(L, n, cap, c);
+        for (int i = 0; i < 5; i++)
+            SWEEP(M_REFINE, "band", (float)bands[i], "", band, bands[i]);
+        SWEEP(M_REFINE, "fit", 0.0f, "", fit, 0);
+        SWEEP(M_REFINE, "global", 0.0f, "", global, 0.0f);
         /* issue 14 item 2: refine without the prior, without the adaptive
          * lag compensation, and with the band from the projected
          * uncertainty (docs/accuracy.md) */
-        c = named_cfg(o, M_REFINE, "prior", 0.0f, "prior", "");
-        c.prior_radius = 0.0f;
-        n = add_cfg(L, n, cap, c);
-        c = named_cfg(o, M_REFINE, "priormc", 0.0f, "priormc", "");
-        c.prior_mc = 0;
-        n = add_cfg(L, n, cap, c);
-        c = named_cfg(o, M_REFINE, "lagadapt", 0.0f, "lagadapt", "");
-        c.lag_adapt_v1 = 0.0f;
-        n = add_cfg(L, n, cap, c);
-        c = named_cfg(o, M_REFINE, "bandauto", 1.0f, "bandauto", "");
-        c.band_auto = 1;
-        n = add_cfg(L, n, cap, c);
-        for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
-            c = named_cfg(o, (method_kind)k, "lagcomp", 1.0f, "lagcomp", "");
-            c.lag_comp = 1;
-            n = add_cfg(L, n, cap, c);
-        }
+        SWEEP(M_REFINE, "prior", 0.0f, "", prior_radius, 0.0f);
+        SWEEP(M_REFINE, "priormc", 0.0f, "", prior_mc, 0);
+        SWEEP(M_REFINE, "lagadapt", 0.0f, "", lag_adapt_v1, 0.0f);
+        SWEEP(M_REFINE, "bandauto", 1.0f, "", band_auto, 1);
+        for (int k = M_KIN_CAL; k <= M_REFINE; k += 2)
+            SWEEP((method_kind)k, "lagcomp", 1.0f, "", lag_comp, 1);
         for (int k = M_KIN_CAL; k <= M_REFINE; k += 2) {
             for (int div = 2; div <= 4; div *= 2) {
                 c = named_cfg(o, (method_kind)k, "res", (float)div, "div", "");
@@ -185,14 +176,9 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
                 c.div = div;
                 n = add_cfg(L, n, cap, c);
             }
-            for (int aa = 4; aa <= 16; aa *= 2) {
-                c = named_cfg(o, (method_kind)k, "aa", (float)aa, "aa", "");
-                c.aa = aa;
-                n = add_cfg(L, n, cap, c);
-            }
-            c = named_cfg(o, (method_kind)k, "tris", 4.0f, "tris", "x");
-            c.fine = 1;
-            n = add_cfg(L, n, cap, c);
+            for (int aa = 4; aa <= 16; aa *= 2)
+                SWEEP((method_kind)k, "aa", (float)aa, "", aa, aa);
+            SWEEP((method_kind)k, "tris", 4.0f, "x", fine, 1);
             c = named_cfg(o, (method_kind)k, "dqs", 1.0f, "dqs", "");
             snprintf(c.setting, sizeof c.setting, "dqs");
             c.dqs = 1;
@@ -229,33 +215,23 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
             c = eval__base_cfg(o, (method_kind)k);
             snprintf(c.group, sizeof c.group, "track");
             n = add_cfg(L, n, cap, c);
-            for (int i = 0; i < 3; i++) {
-                c = named_cfg(o, (method_kind)k, "noise", noise[i], "noise", "mm");
-                c.track.noise_mm = noise[i];
-                n = add_cfg(L, n, cap, c);
-            }
-            for (int i = 0; i < 3; i++) {
-                c = named_cfg(o, (method_kind)k, "latency", lat[i], "latency", "ms");
-                c.track.latency_ms = lat[i];
-                n = add_cfg(L, n, cap, c);
-            }
+            for (int i = 0; i < 3; i++)
+                SWEEP((method_kind)k, "noise", noise[i], "mm", track.noise_mm, noise[i]);
+            for (int i = 0; i < 3; i++)
+                SWEEP((method_kind)k, "latency", lat[i], "ms", track.latency_ms, lat[i]);
             static const float drop[] = { 0.0f, 0.1f, 0.3f };
-            for (int i = 0; i < 3; i++) {
-                c = named_cfg(o, (method_kind)k, "dropout", 100.0f * drop[i], "dropout", "%");
-                c.track.dropout = drop[i];
-                n = add_cfg(L, n, cap, c);
-            }
+            for (int i = 0; i < 3; i++)
+                SWEEP((method_kind)k, "dropout", 100.0f * drop[i], "%", track.dropout, drop[i]);
             if (k == M_KIN) continue;    /* the paper's method has no calibration */
             for (int i = 0; i < 4; i++) {
-                c = named_cfg(o, (method_kind)k, "calib", 100.0f * (o->calib_error + cal[i]),
-                              "calib", "%");
-                c.calib_error = o->calib_error + cal[i];
-                n = add_cfg(L, n, cap, c);
+                SWEEP((method_kind)k, "calib", 100.0f * (o->calib_error + cal[i]), "%", calib_error,
+                      o->calib_error + cal[i]);
             }
         }
     }
     return n;
 }
+#undef SWEEP
 
 
 /* ---------------------------------------------------------------- run */

@@ -15,6 +15,7 @@
 #include <map>
 #include <new>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -81,35 +82,29 @@ static int type_comps(int type)
     }
 }
 
-/* One component at p (little-endian, as glTF stores it), normalised to
- * [0,1] / [-1,1] by the glTF rules when `normalized`. */
+/* One component of type T at p (little-endian, as glTF stores it); an
+ * integer one normalised to [0,1] / [-1,1] by the glTF rules when
+ * `normalized` (v / max, at least -1). */
+template <typename T>
+static double read_as(const unsigned char *p, bool normalized)
+{
+    T v;
+    memcpy(&v, p, sizeof v);
+    if (!normalized || !std::is_integral<T>::value) return (double)v;
+    const double q = v / (double)std::numeric_limits<T>::max();
+    return std::is_signed<T>::value ? std::max(q, -1.0) : q;
+}
+
+/* One component of component type ct at p (read_as). */
 static double read_comp(const unsigned char *p, int ct, bool normalized)
 {
     switch (ct) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-        int8_t v; memcpy(&v, p, 1);
-        return normalized ? std::max(v / 127.0, -1.0) : (double)v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
-        uint8_t v; memcpy(&v, p, 1);
-        return normalized ? v / 255.0 : (double)v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-        int16_t v; memcpy(&v, p, 2);
-        return normalized ? std::max(v / 32767.0, -1.0) : (double)v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-        uint16_t v; memcpy(&v, p, 2);
-        return normalized ? v / 65535.0 : (double)v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-        uint32_t v; memcpy(&v, p, 4);
-        return normalized ? v / 4294967295.0 : (double)v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: {
-        float v; memcpy(&v, p, 4);
-        return (double)v;
-    }
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return read_as<int8_t>(p, normalized);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return read_as<uint8_t>(p, normalized);
+    case TINYGLTF_COMPONENT_TYPE_SHORT: return read_as<int16_t>(p, normalized);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return read_as<uint16_t>(p, normalized);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return read_as<uint32_t>(p, normalized);
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return read_as<float>(p, normalized);
     default: return 0.0;
     }
 }

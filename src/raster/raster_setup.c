@@ -262,6 +262,35 @@ static inline int area_test(int64_t area, rast_cull cull)
     return RAST__SETUP_OK;
 }
 
+/* The area test of triangle fx, fy (area_test); when it passes, *area
+ * the absolute snapped area and X, Y the vertices normalised to area > 0
+ * by swapping vertices 1 and 2, whose source indices go to *s1, *s2. */
+static inline int orient(const int32_t fx[3], const int32_t fy[3], rast_cull cull,
+                         int64_t *area, int *s1, int *s2, int32_t X[3], int32_t Y[3])
+{
+    const int64_t a = snapped_area(fx[0], fy[0], fx[1], fy[1], fx[2], fy[2]);
+    const int r = area_test(a, cull);
+    if (r != RAST__SETUP_OK)
+        return r;
+    *s1 = a < 0 ? 2 : 1, *s2 = a < 0 ? 1 : 2;
+    X[0] = fx[0], X[1] = fx[*s1], X[2] = fx[*s2];
+    Y[0] = fy[0], Y[1] = fy[*s1], Y[2] = fy[*s2];
+    *area = a < 0 ? -a : a;
+    return RAST__SETUP_OK;
+}
+
+/* Clamps the pixel box x0..x1, y0..y1 (inclusive) to the view; 0 when
+ * nothing of it is left (the triangle is off the screen). */
+static inline int box_in_view(const rast__view *v, int32_t *x0, int32_t *y0, int32_t *x1,
+                              int32_t *y1)
+{
+    *x0 = *x0 < 0 ? 0 : *x0;
+    *y0 = *y0 < 0 ? 0 : *y0;
+    *x1 = *x1 > v->width - 1 ? v->width - 1 : *x1;
+    *y1 = *y1 > v->height - 1 ? v->height - 1 : *y1;
+    return *x0 <= *x1 && *y0 <= *y1;
+}
+
 /* Bounds of the snapped vertices. */
 static inline void snapped_bounds(const int32_t X[3], const int32_t Y[3], int32_t *xmin,
                                   int32_t *xmax, int32_t *ymin, int32_t *ymax)
@@ -322,11 +351,7 @@ static inline int setup_box_edges(const rast__view *v, const int32_t X[3],
     int32_t bx1 = (xmax - RAST__FIX_HALF) >> RAST_SUBPIXEL_BITS;
     int32_t by0 = (ymin - RAST__FIX_HALF + RAST__FIX_ONE - 1) >> RAST_SUBPIXEL_BITS;
     int32_t by1 = (ymax - RAST__FIX_HALF) >> RAST_SUBPIXEL_BITS;
-    bx0 = bx0 < 0 ? 0 : bx0;
-    by0 = by0 < 0 ? 0 : by0;
-    bx1 = bx1 > v->width - 1 ? v->width - 1 : bx1;
-    by1 = by1 > v->height - 1 ? v->height - 1 : by1;
-    if (bx0 > bx1 || by0 > by1)
+    if (!box_in_view(v, &bx0, &by0, &bx1, &by1))
         return RAST__SETUP_OFFSCREEN;
     setup_edges(tri, X, Y, bx0, by0, bx1, by1);
     /* A box of at most 2x2 pixels none of whose centres is inside (at
@@ -428,16 +453,15 @@ static int setup_core(const rast__view *v, const int32_t fx[3], const int32_t fy
                       const double zwv[3], const double iwv[3],
                       const float *const attr[3], rast_cull cull, rast__tri *tri)
 {
-    int64_t area = snapped_area(fx[0], fy[0], fx[1], fy[1], fx[2], fy[2]);
-    const int r = area_test(area, cull);
+    int64_t area;
+    int s1, s2;
+    int32_t X[3], Y[3];
+    const int r = orient(fx, fy, cull, &area, &s1, &s2, X, Y);
     if (r != RAST__SETUP_OK)
         return r;
-    /* Normalise to area > 0 by swapping vertices 1 and 2. */
-    const int s1 = area < 0 ? 2 : 1, s2 = area < 0 ? 1 : 2;
-    const int32_t X[3] = { fx[0], fx[s1], fx[s2] }, Y[3] = { fy[0], fy[s1], fy[s2] };
     const double zw[3] = { zwv[0], zwv[s1], zwv[s2] }, iw[3] = { iwv[0], iwv[s1], iwv[s2] };
     const float *const at[3] = { attr[0], attr[s1], attr[s2] };
-    return setup_oriented(v, X, Y, area < 0 ? -area : area, zw, iw, at, tri);
+    return setup_oriented(v, X, Y, area, zw, iw, at, tri);
 }
 
 /* Per-vertex plane inputs (docs/raster.md section 6.1). */
@@ -835,21 +859,17 @@ int rast__prepare_range(const rast__view *view, const rast_mesh_desc *m, int ti0
 static int setup_aa(const rast__view *v, const int32_t fx[3], const int32_t fy[3],
                     rast_cull cull, rast__tri *tri)
 {
-    int64_t area = snapped_area(fx[0], fy[0], fx[1], fy[1], fx[2], fy[2]);
-    const int r = area_test(area, cull);
+    int64_t area;
+    int s1, s2;
+    int32_t X[3], Y[3];
+    const int r = orient(fx, fy, cull, &area, &s1, &s2, X, Y);
     if (r != RAST__SETUP_OK)
         return r;
-    const int s1 = area < 0 ? 2 : 1, s2 = area < 0 ? 1 : 2;
-    const int32_t X[3] = { fx[0], fx[s1], fx[s2] }, Y[3] = { fy[0], fy[s1], fy[s2] };
     int32_t xmin, xmax, ymin, ymax;
     snapped_bounds(X, Y, &xmin, &xmax, &ymin, &ymax);
     int32_t bx0 = (xmin + 15) >> RAST_SUBPIXEL_BITS, bx1 = xmax >> RAST_SUBPIXEL_BITS;
     int32_t by0 = (ymin + 15) >> RAST_SUBPIXEL_BITS, by1 = ymax >> RAST_SUBPIXEL_BITS;
-    bx0 = bx0 < 0 ? 0 : bx0;
-    by0 = by0 < 0 ? 0 : by0;
-    bx1 = bx1 > v->width - 1 ? v->width - 1 : bx1;
-    by1 = by1 > v->height - 1 ? v->height - 1 : by1;
-    if (bx0 > bx1 || by0 > by1)
+    if (!box_in_view(v, &bx0, &by0, &bx1, &by1))
         return RAST__SETUP_OFFSCREEN;
     memset(tri, 0, sizeof *tri);
     setup_edges(tri, X, Y, bx0, by0, bx1, by1);

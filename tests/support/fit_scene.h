@@ -1,7 +1,9 @@
 /* fit_scene.h - the small synthetic scene of the fit tests (test_fit_band,
  * test_fit_shift): a pinhole camera at the origin looking down -Z (view =
  * identity), a rig whose every hand joint of side s is node s, world
- * matrices that only translate, and the IoU of two masks. Header-only (static inline). */
+ * matrices that only translate, the camera image painted from the true
+ * mask, and the IoU of two masks. Header-only (static inline); include
+ * after support/testutil.h. */
 #ifndef EGOFUSE_TEST_FIT_SCENE_H
 #define EGOFUSE_TEST_FIT_SCENE_H
 
@@ -45,6 +47,23 @@ static inline kin_mat4 fit_scene_at(float x, float y, float z)
     m.m[13] = y;
     m.m[14] = z;
     return m;
+}
+
+/* img (RGBA, n pixels): skin (200, 150, 120) where truth is set, the
+ * background (30, 40, 90) elsewhere, each colour channel plus uniform
+ * noise in [-10, 10) from rng (clamped to 0..255, truncated), alpha 255. */
+static inline void fit_scene_paint(uint8_t *img, const uint8_t *truth, long n, tu_rng *rng)
+{
+    for (long k = 0; k < n; k++) {
+        const int skin = truth[k] != 0;
+        const float base[3] = { skin ? 200.0f : 30.0f, skin ? 150.0f : 40.0f,
+                                skin ? 120.0f : 90.0f };
+        for (int c = 0; c < 3; c++) {
+            float v = base[c] + tu_range(rng, -10.0f, 10.0f);
+            img[4 * k + c] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
+        }
+        img[4 * k + 3] = 255;
+    }
 }
 
 /* The IoU of two masks of n bytes (set: >= 128); 1 when both are empty. */
