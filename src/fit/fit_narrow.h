@@ -19,6 +19,10 @@
  *   refinement once more from its own result (the band re-centred on the
  *   refined edge reaches band px further) when the first let in more than
  *   PIPE_REGROW_PER_MILLE / 1000 of the image's pixels.
+ *   Behind a fast hand (fast: the hand trailing its kinematic model over a
+ *   skin-coloured box) the regrow takes in where the hand was;
+ *   pipe_fit_regrow_trail takes back what it added behind the hands' image
+ *   motion.
  *
  * WHAT IT DOES NOT
  *   No allocation (the caller's scratch and buffer), no threads; never
