@@ -12,10 +12,17 @@
  *   than PIPE_REGROW_PER_MILLE of the image, the second from its result
  *   (the same bytes as a plain refinement of it) brings the last 2 px in;
  *   below the limit, or after a fallback, the refined mask is left as it
- *   is. */
+ *   is;
+ * - the regrow's trail (pipe_fit_regrow_trail): a disc hand moving right by
+ *   6 px a frame, the regrow 10 px all round: the pixels within 6 px
+ *   behind it (left) are cleared, those ahead and beside it kept; a hand
+ *   at rest, an untracked hand, bad arguments clear nothing; 300 seeded
+ *   masks (blobs, two hands, random motions and steps) against a direct
+ *   reference. */
 #include "support/testutil.h"
 
 #include <cmocka.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -153,6 +160,130 @@ static void test_regrow(void **st)
                      -1);
 }
 
+static int in_disc(int x, int y, int cx, int cy, int r)
+{
+    return (x - cx) * (x - cx) + (y - cy) * (y - cy) <= r * r;
+}
+
+static void test_trail(void **st)
+{
+    (void)st;
+    static uint8_t first[W * H], reg[W * H], keep[W * H];
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            first[y * W + x] = in_disc(x, y, 80, 40, 20) ? 255 : 0;
+            reg[y * W + x] = in_disc(x, y, 80, 40, 30) ? 255 : 0;
+        }
+    memcpy(keep, reg, sizeof reg);
+    const float hp[2][2] = { { 80, 40 }, { 0, 0 } };
+    const float mv[2][2] = { { 6, 0 }, { 0, 0 } };
+    const long n = pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, mv, 1);
+    assert_true(n > 0);
+    long cl = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            const int was = keep[y * W + x] >= 128, now = reg[y * W + x] >= 128;
+            if (first[y * W + x]) assert_int_equal(now, 1);   /* the first's kept */
+            if (was && !now) {
+                cl++;
+                assert_true(x < 80);                            /* behind only */
+                assert_true(in_disc(x + 6, y, 80, 40, 20));     /* within 6 px of it */
+            }
+        }
+    assert_int_equal(cl, n);
+    assert_int_equal(reg[40 * W + 57], 0);      /* 3 px behind: cleared */
+    assert_int_equal(reg[40 * W + 103], 255);   /* 3 px ahead: kept */
+    assert_int_equal(reg[17 * W + 80], 255);    /* 3 px beside: kept */
+    assert_int_equal(reg[40 * W + 52], 255);    /* 8 px behind, beyond 1 step: kept */
+    /* two steps reach 12 px behind */
+    memcpy(reg, keep, sizeof reg);
+    assert_true(pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, mv, 2) > n);
+    assert_int_equal(reg[40 * W + 52], 0);
+    /* at rest, untracked, bad arguments: nothing cleared */
+    const float rest[2][2] = { { 0.4f, -0.3f }, { 0, 0 } };
+    memcpy(reg, keep, sizeof reg);
+    assert_int_equal(pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, rest, 1), 0);
+    assert_int_equal(pipe_fit_regrow_trail(first, W, reg, W, W, H, 2u, hp, mv, 1), 0);
+    assert_int_equal(pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, mv, 0), -1);
+    assert_int_equal(pipe_fit_regrow_trail(NULL, W, reg, W, W, H, 1u, hp, mv, 1), -1);
+    assert_int_equal(pipe_fit_regrow_trail(first, W - 1, reg, W, W, H, 1u, hp, mv, 1), -1);
+    assert_memory_equal(reg, keep, sizeof reg);
+}
+
+/* the rule written out directly (fit_narrow.h) */
+static long trail_ref(const uint8_t *first, uint8_t *reg, unsigned sides, const float hp[2][2],
+                      const float mv[2][2], int steps)
+{
+    static uint8_t src[W * H];
+    memcpy(src, reg, sizeof src);
+    long n = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            if (src[y * W + x] < 128 || first[y * W + x] >= 128) continue;
+            int k = -1;
+            double best = 1e30;
+            for (int j = 0; j < 2; j++) {
+                if (!(sides & (1u << j))) continue;
+                const double d2 = (x - hp[j][0]) * (x - hp[j][0]) + (y - hp[j][1]) * (y - hp[j][1]);
+                if (d2 < best) { best = d2; k = j; }
+            }
+            if (k < 0) continue;
+            const int dx = (int)lrintf(mv[k][0]), dy = (int)lrintf(mv[k][1]);
+            if (!dx && !dy) continue;
+            int behind = 0, ahead = 0;
+            for (int j = 1; j <= steps; j++) {
+                const int bx = x + j * dx, by = y + j * dy, ax = x - j * dx, ay = y - j * dy;
+                if (bx >= 0 && by >= 0 && bx < W && by < H && first[by * W + bx] >= 128) behind = 1;
+                if (ax >= 0 && ay >= 0 && ax < W && ay < H && first[ay * W + ax] >= 128) ahead = 1;
+            }
+            if (behind && !ahead) {
+                reg[y * W + x] = 0;
+                n++;
+            }
+        }
+    return n;
+}
+
+static void test_trail_reference(void **st)
+{
+    (void)st;
+    static uint8_t first[W * H], a[W * H], b[W * H];
+    rng = 777u;
+    long total = 0;
+    for (int c = 0; c < 300; c++) {
+        memset(first, 0, sizeof first);
+        memset(a, 0, sizeof a);
+        const int nb = 1 + (int)(rnd() % 4);
+        for (int i = 0; i < nb; i++) {
+            const int cx = (int)(rnd() * W / 256), cy = (int)(rnd() * H / 256);
+            const int r = 4 + (int)(rnd() % 20), g = 1 + (int)(rnd() % 12);
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < W; x++) {
+                    if (in_disc(x, y, cx, cy, r)) first[y * W + x] = (uint8_t)(128 + rnd() % 128);
+                    if (in_disc(x, y, cx, cy, r + g)) a[y * W + x] = (uint8_t)(128 + rnd() % 128);
+                }
+        }
+        for (int i = 0; i < W * H; i++)
+            if (rnd() < 4) a[i] = (uint8_t)rnd();   /* specks, values below 128 too */
+        float hp[2][2], mv[2][2];
+        for (int k = 0; k < 2; k++) {
+            hp[k][0] = (float)(rnd() * W / 256);
+            hp[k][1] = (float)(rnd() * H / 256);
+            mv[k][0] = ((float)rnd() - 128.0f) / 12.0f;
+            mv[k][1] = ((float)rnd() - 128.0f) / 12.0f;
+        }
+        const unsigned sides = rnd() % 4;
+        const int steps = 1 + (int)(rnd() % 3);
+        memcpy(b, a, sizeof a);
+        const long na = pipe_fit_regrow_trail(first, W, a, W, W, H, sides, hp, mv, steps);
+        const long nb2 = trail_ref(first, b, sides, hp, mv, steps);
+        assert_int_equal(na, nb2);
+        assert_memory_equal(a, b, sizeof a);
+        total += na;
+    }
+    assert_true(total > 1000);   /* the cases do clear pixels */
+}
+
 int main(void)
 {
     fuse_refine_params p = fuse_refine_params_default();
@@ -162,6 +293,8 @@ int main(void)
         cmocka_unit_test(test_thin_halves),
         cmocka_unit_test(test_wide_unchanged),
         cmocka_unit_test(test_regrow),
+        cmocka_unit_test(test_trail),
+        cmocka_unit_test(test_trail_reference),
     };
     const int r = cmocka_run_group_tests(tests, NULL, NULL);
     free(scratch);

@@ -295,6 +295,63 @@ static void fast_hands_and_threads(void **state)
     scene_close(S);
 }
 
+/* The regrow's trail (fit_narrow.h, pipe_fit_regrow_trail) in pipe_frame:
+ * a disc 2.5x the prior's (the first refinement lets in more than the
+ * regrow's limit), the head moving 8 mm a frame along x (the hand moves in
+ * the image). Hands at 0.35 m/s (no prior, no trail) against 0.45 m/s (no
+ * prior, the trail): at the first frame where the masks differ, every
+ * difference is a pixel the trail cleared (set at 0.35, clear at 0.45),
+ * and they lie behind the hand's image motion. */
+static void regrow_trail_fast_hands(void **state)
+{
+    (void)state;
+    scene *S = scene_open(47);
+    pipe_ctx *slow = make_pipe(S, 0, 1), *fast = make_pipe(S, 0, 1);
+    kin_sthmd_geometry g = pipe_geometry(slow);
+    const float v_slow[2] = {0.35f, 0.35f}, v_fast[2] = {0.45f, 0.45f};
+    uint8_t *m = malloc(W * H);
+    assert_non_null(m);
+    const kin_mat4 head0 = S->head;
+    char why[200];
+    long cleared = 0;
+    for (int f = 0; f < 6 && !cleared; f++) {
+        S->head = head0;
+        S->head.m[12] += 0.008f * (float)f;
+        paint_disc(&S->A, &S->head, g, &S->b, 48 + (uint64_t)f, S->sil, S->disc_px, 2.5f);
+        S->in.hand_speed = v_slow;
+        assert_int_equal(pipe_frame(slow, &S->in, NULL, why, sizeof why), PIPE_OK);
+        S->in.hand_speed = v_fast;
+        assert_int_equal(pipe_frame(fast, &S->in, NULL, why, sizeof why), PIPE_OK);
+        for (int e = 0; e < 2; e++) {
+            memcpy(m, pipe_mask(slow, e, NULL, NULL), W * H);
+            const uint8_t *q = pipe_mask(fast, e, NULL, NULL);
+            double sx = 0, cx = 0;
+            long n = 0, nm = 0;
+            for (int i = 0; i < W * H; i++) {
+                if (m[i] >= 128) { sx += i % W; nm++; }
+                if ((m[i] >= 128) == (q[i] >= 128)) continue;
+                assert_true(m[i] >= 128 && q[i] < 128);   /* only cleared */
+                cx += i % W;
+                n++;
+            }
+            if (n) {
+                /* the head moves +x: the hand moves -x in the image, the
+                 * cleared pixels lie on its +x side */
+                print_message("frame %d eye %d: %ld px cleared, their mean x %.1f, the mask's %.1f\n",
+                              f, e, n, cx / (double)n, sx / (double)nm);
+                assert_true(cx / (double)n > sx / (double)nm);
+                cleared += n;
+            }
+        }
+    }
+    assert_true(cleared > 0);
+    free(m);
+    pipe_destroy(slow);
+    pipe_destroy(fast);
+    S->head = head0;
+    scene_close(S);
+}
+
 static void bad_switches(void **state)
 {
     (void)state;
@@ -333,6 +390,7 @@ int main(void)
         cmocka_unit_test(prior_reaches_beyond_band),
         cmocka_unit_test(fast_hands_and_threads),
         cmocka_unit_test(prior_keeps_no_rim),
+        cmocka_unit_test(regrow_trail_fast_hands),
         cmocka_unit_test(bad_switches),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -600,9 +600,21 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                                           &c->rig, ss, mask, c->mask_shift, CW,
                                           c->refine_scratch, c->refine_scratch_size, NULL);
                 }
-                for (int k = 0; k < 2; k++)
+                /* the hands' image motion since the last frame (for the
+                 * regrow's trail below) */
+                float hmot[2][2] = { { 0, 0 }, { 0, 0 } };
+                unsigned hseen = 0;
+                for (int k = 0; k < 2; k++) {
+                    const int had = r->have_hand_px[e][k];
+                    const float ox = r->hand_px[e][k][0], oy = r->hand_px[e][k][1];
                     r->have_hand_px[e][k] =
                         posed && pipe_fit_hand_px(&cam, c->ps.world, &c->rig, k, r->hand_px[e][k]);
+                    if (r->have_hand_px[e][k]) hseen |= 1u << k;
+                    if (had && r->have_hand_px[e][k]) {
+                        hmot[k][0] = r->hand_px[e][k][0] - ox;
+                        hmot[k][1] = r->hand_px[e][k][1] - oy;
+                    }
+                }
                 /* the global term only once the fit has a colour model
                  * (as pipe_frame): an all-zero one would halve the local
                  * term */
@@ -619,13 +631,23 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 if (fr != FUSE_OK) return -1;
                 /* once more from its own edge where it let in much: the
                  * hand beyond the band (fit_narrow.h, as pipe_frame) */
-                if (pipe_fit_refine_regrow(&rp,
-                                           cfg->fit && cfg->global > 0.0f &&
-                                                   pipe_fit_learned(r->fit, e)
-                                               ? pipe_fit_colour(r->fit, e) : NULL,
-                                           cfg->global, &P, c->refined, CW, c->mask_smooth,
-                                           c->refine_scratch, c->refine_scratch_size, &rs) < 0)
-                    return -1;
+                const int regrown = pipe_fit_refine_regrow(
+                    &rp,
+                    cfg->fit && cfg->global > 0.0f && pipe_fit_learned(r->fit, e)
+                        ? pipe_fit_colour(r->fit, e) : NULL,
+                    cfg->global, &P, c->refined, CW, c->mask_smooth, c->refine_scratch,
+                    c->refine_scratch_size, &rs);
+                if (regrown < 0) return -1;
+                /* what it added behind a moving hand taken back: where
+                 * the hand was, not where it is (fit_narrow.h) */
+                if (regrown > 0 && posed) {
+                    for (int k = 0; k < 2; k++)
+                        if (r->speed[k] < PIPE_TRAIL_SPEED) hmot[k][0] = hmot[k][1] = 0.0f;
+                    if (pipe_fit_regrow_trail(c->mask_smooth, CW, c->refined, CW, CW, CH,
+                                              r->sides & hseen, r->hand_px[e], hmot,
+                                              PIPE_TRAIL_STEPS) < 0)
+                        return -1;
+                }
                 /* and so must the pixels the vote let in beyond it */
                 if (from_prior && rs.used_colour && cfg->fit &&
                     pipe_fit_learned(r->fit, e))

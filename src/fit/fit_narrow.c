@@ -2,6 +2,7 @@
  * (fit_narrow.h). */
 #include "fit_narrow.h"
 
+#include <math.h>
 #include <string.h>
 
 static fuse_result run(const fuse_refine_params *p, const fuse_colour_model *g, float weight,
@@ -53,4 +54,54 @@ int pipe_fit_refine_regrow(const fuse_refine_params *p, const fuse_colour_model 
     fuse_result r = pipe_fit_refine_narrow(p, g, weight, PIPE_NARROW_MIN_BAND, P, tmp, P->width,
                                            refined, stride, scratch, scratch_size, &st, NULL);
     return r == FUSE_OK ? 1 : -1;
+}
+
+static int set_at(const uint8_t *m, int stride, int w, int h, int x, int y)
+{
+    return x >= 0 && y >= 0 && x < w && y < h && m[(size_t)y * (size_t)stride + (size_t)x] >= 128;
+}
+
+long pipe_fit_regrow_trail(const uint8_t *first, int first_stride, uint8_t *refined, int stride,
+                           int w, int h, unsigned sides, const float hand_px[2][2],
+                           const float motion[2][2], int steps)
+{
+    if (!first || !refined || !hand_px || !motion || w <= 0 || h <= 0 || first_stride < w ||
+        stride < w || steps < 1)
+        return -1;
+    int dx[2], dy[2];
+    unsigned moving = 0;
+    for (int k = 0; k < 2; k++) {
+        dx[k] = (int)lrintf(motion[k][0]);
+        dy[k] = (int)lrintf(motion[k][1]);
+        if ((sides >> k & 1u) && (dx[k] || dy[k])) moving |= 1u << k;
+    }
+    if (!moving) return 0;
+    long cleared = 0;
+    for (int y = 0; y < h; y++) {
+        uint8_t *row = refined + (size_t)y * (size_t)stride;
+        const uint8_t *frow = first + (size_t)y * (size_t)first_stride;
+        for (int x = 0; x < w; x++) {
+            if (row[x] < 128 || frow[x] >= 128) continue;
+            /* the nearest tracked hand */
+            int k = -1;
+            float best = 0.0f;
+            for (int j = 0; j < 2; j++)
+                if (sides >> j & 1u) {
+                    const float ex = (float)x - hand_px[j][0], ey = (float)y - hand_px[j][1];
+                    const float d2 = ex * ex + ey * ey;
+                    if (k < 0 || d2 < best) { k = j; best = d2; }
+                }
+            if (k < 0 || !(moving >> k & 1u)) continue;
+            int ahead = 0, behind = 0;
+            for (int j = 1; j <= steps; j++) {
+                behind |= set_at(first, first_stride, w, h, x + j * dx[k], y + j * dy[k]);
+                ahead |= set_at(first, first_stride, w, h, x - j * dx[k], y - j * dy[k]);
+            }
+            if (behind && !ahead) {
+                row[x] = 0;
+                cleared++;
+            }
+        }
+    }
+    return cleared;
 }

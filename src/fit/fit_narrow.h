@@ -19,6 +19,10 @@
  *   refinement once more from its own result (the band re-centred on the
  *   refined edge reaches band px further) when the first let in more than
  *   PIPE_REGROW_PER_MILLE / 1000 of the image's pixels.
+ *   Behind a fast hand (fast: the hand trailing its kinematic model over a
+ *   skin-coloured box) the regrow takes in where the hand was;
+ *   pipe_fit_regrow_trail takes back what it added behind the hands' image
+ *   motion.
  *
  * WHAT IT DOES NOT
  *   No allocation (the caller's scratch and buffer), no threads; never
@@ -60,4 +64,29 @@ int pipe_fit_refine_regrow(const fuse_refine_params *p, const fuse_colour_model 
                            float weight, const fuse_image *P, uint8_t *refined, int stride,
                            uint8_t *tmp, void *scratch, size_t scratch_size,
                            const fuse_refine_stats *first);
+
+/* How far behind a moving hand the regrow's pixels are taken back, in
+ * frames of the hand's image motion (measured on fast: docs/accuracy.md
+ * "Where fast's boundary misses sit"). */
+#define PIPE_TRAIL_STEPS 1
+/* Only hands at least this fast (m/s, the filtered wrist speed): slower
+ * hands lag less than a pixel or two, and a hand coming nearer grows on
+ * every side (near: measured). */
+#define PIPE_TRAIL_SPEED 0.4f
+
+/* The regrow's pixels behind a moving hand taken back. A hand moving fast
+ * trails its kinematic model; what the regrow (above) adds behind it is
+ * where the hand was a frame before, over a skin-coloured object (fast: the
+ * cardboard box), not hand. For every pixel set in refined (stride bytes
+ * per row, w x h) and clear in first (the refinement before the regrow,
+ * first_stride): k the nearest hand of sides (bit k: hand_px[k] valid, the
+ * hand's image position in this frame), d = motion[k] (its image motion
+ * since the last frame, px; hands moving less than 1 px per frame are
+ * skipped); the pixel is cleared when first is set at p + j d for some j
+ * in 1..steps (the hand lies ahead of it along its motion) and at no
+ * p - j d (not between two parts of the hand). Returns the pixels cleared,
+ * -1 on bad arguments (refined unchanged). */
+long pipe_fit_regrow_trail(const uint8_t *first, int first_stride, uint8_t *refined, int stride,
+                           int w, int h, unsigned sides, const float hand_px[2][2],
+                           const float motion[2][2], int steps);
 #endif

@@ -81,11 +81,24 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
                                  e->refine_scratch, e->refine_scratch_size, NULL);
         }
     }
+    /* the hands' image motion since the last frame (the regrow's trail
+     * below) */
+    float hmot[2][2] = {{0, 0}, {0, 0}};
+    unsigned hseen = 0;
     if (e->prior) {
         /* where the hands are in this frame's refined mask */
-        for (int k = 0; k < 2; k++)
+        for (int k = 0; k < 2; k++) {
+            const int had = e->have_hand_px[k];
+            const float ox = e->hand_px[k][0], oy = e->hand_px[k][1];
             e->have_hand_px[k] =
                 pipe_fit_hand_px(&e->cam, p->pose.world, &p->fit_rig, k, e->hand_px[k]);
+            if (e->have_hand_px[k]) hseen |= 1u << k;
+            if (had && e->have_hand_px[k] && in->locals && in->hand_speed &&
+                in->hand_speed[k] >= PIPE_TRAIL_SPEED) {
+                hmot[k][0] = e->hand_px[k][0] - ox;
+                hmot[k][1] = e->hand_px[k][1] - oy;
+            }
+        }
     }
     fuse_refine_stats rs;
     /* the band halved where the hand is too thin for its learning ring
@@ -102,16 +115,21 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
     }
     /* once more from its own edge where it let in much: the hand beyond
      * the band (fit_narrow.h; eval's refine does the same) */
-    if (pipe_fit_refine_regrow(&rp,
-                               p->fit && pipe_fit_learned(p->fit, e->eye)
-                                   ? pipe_fit_colour(p->fit, e->eye) : NULL,
-                               0.5f, &fe->P, e->refined, cw, e->regrow, e->refine_scratch,
-                               e->refine_scratch_size, &rs) < 0) {
+    const int regrown = pipe_fit_refine_regrow(
+        &rp, p->fit && pipe_fit_learned(p->fit, e->eye) ? pipe_fit_colour(p->fit, e->eye) : NULL,
+        0.5f, &fe->P, e->refined, cw, e->regrow, e->refine_scratch, e->refine_scratch_size, &rs);
+    if (regrown < 0) {
         e->result = PIPE_ERR_FUSE;
         snprintf(e->why, sizeof e->why, "%s eye: mask refinement: %s",
                  e->eye ? "right" : "left", fuse_result_str(FUSE_ERR_ARGS));
         return -1;
     }
+    /* what the regrow added behind a fast hand taken back: where the
+     * hand was, not where it is (fit_narrow.h; eval's refine does the
+     * same); e->regrow holds the refinement before it */
+    if (regrown > 0 && in->locals)
+        pipe_fit_regrow_trail(e->regrow, cw, e->refined, cw, cw, ch, sides & hseen, e->hand_px,
+                              hmot, PIPE_TRAIL_STEPS);
     /* the pixels the vote let in beyond a prior must look like the
      * hand too (fit_band.h) */
     if (from_prior && rs.used_colour && p->fit && pipe_fit_learned(p->fit, e->eye))
