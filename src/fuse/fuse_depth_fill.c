@@ -51,9 +51,33 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
                 continue;
             }
             if (known(z[x])) continue;
+            /* ring 1 away from the borders: the 4-neighbours (d2 1), then
+             * the diagonals (d2 2), each in the ties' order (upper row,
+             * then left): the ring search's result, which stops there */
+            r = 1;
+            if (x > 0 && y > 0 && x + 1 < width && y + 1 < height) {
+                const float *u = z - depth_stride, *d = z + depth_stride;
+                const int c = R * side + R;
+                best = known(u[x])       ? c - side
+                       : known(z[x - 1]) ? c - 1
+                       : known(z[x + 1]) ? c + 1
+                       : known(d[x])     ? c + side
+                                         : -1;
+                bd2 = 1;
+                if (best < 0) {
+                    best = known(u[x - 1])   ? c - side - 1
+                           : known(u[x + 1]) ? c - side + 1
+                           : known(d[x - 1]) ? c + side - 1
+                           : known(d[x + 1]) ? c + side + 1
+                                             : -1;
+                    bd2 = 2;
+                }
+                if (best < 0) bd2 = 0;
+                r = best >= 0 ? R + 1 : 2;
+            }
             /* rings of growing Chebyshev radius; a pixel of ring r is at
              * least r away, so stop once the best is nearer than r + 1 */
-            for (r = 1; r <= R; r++) {
+            for (; r <= R; r++) {
                 int dy;
                 for (dy = -r; dy <= r; dy++) {
                     const int yy = y + dy, edge = dy == -r || dy == r;
