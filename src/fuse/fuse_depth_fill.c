@@ -12,6 +12,15 @@
 /* Known depth: z in [0, 1) (the depth test's rule, fuse.h); NaN fails. */
 static int known(float z) { return z >= 0.0f && z < 1.0f; }
 
+/* 1 when the 8 mask bytes at m are all set and the 8 depths at z all
+ * known: nothing to do there (branch-free, one test for the block) */
+static int block_done(const uint8_t *m, const float *z)
+{
+    int k = 1;
+    for (int i = 0; i < 8; i++) k &= (m[i] != 0) & (z[i] >= 0.0f) & (z[i] < 1.0f);
+    return k;
+}
+
 /* The largest float below 1: the far plane; any scene object is nearer. */
 static float far_depth(void)
 {
@@ -48,6 +57,10 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
             long bd2 = 0;
             if (m[x] == 0) {   /* on to the next set byte (8 at a time) */
                 x = ef_row_first_set(m, x + 1, width) - 1;
+                continue;
+            }
+            if (x + 8 <= width && block_done(m + x, z + x)) {
+                x += 7;
                 continue;
             }
             if (known(z[x])) continue;
@@ -116,6 +129,10 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
             int code, dx, dy;
             if (m[x] == 0) {
                 x = ef_row_first_set(m, x + 1, x1) - 1;
+                continue;
+            }
+            if (x + 8 <= x1 && block_done(m + x, z + x)) {
+                x += 7;
                 continue;
             }
             if (known(z[x])) continue;
