@@ -4,7 +4,8 @@
  *   the model's normals over its window (against a direct sum);
  * - every other pixel of the refined mask connected to those (8-connected,
  *   through the mask) gets exactly the sum of one of them, no farther (3-4
- *   chamfer) than its shortest path through the mask; an unconnected one
+ *   chamfer) than its shortest path through the mask (the seeds: the
+ *   mask's pixels with a model pixel in their window); an unconnected one
  *   stays 0 (the lighting's view vector);
  * - a jump of the model's normal becomes a ramp 2 r + 1 px wide.
  * (pipe_frame's refined bytes on every ISA and thread count:
@@ -41,11 +42,12 @@ static void direct(int r)
         }
 }
 
-/* shortest 3-4 chamfer path from a seed (cnt > 0) through mask pixels
+/* shortest 3-4 chamfer path from a seed (a mask pixel with cnt > 0)
+ * through mask pixels
  * (Bellman-Ford until stable); INT32 max: none */
 static void geodesic(void)
 {
-    for (int i = 0; i < W * H; i++) geo[i] = cnt[i] > 0 ? 0 : 0x7fffffff;
+    for (int i = 0; i < W * H; i++) geo[i] = cnt[i] > 0 && rm[i] ? 0 : 0x7fffffff;
     for (int changed = 1; changed;) {
         changed = 0;
         for (int y = 0; y < H; y++)
@@ -137,7 +139,7 @@ static void against_reference(void **state)
                     for (int yy = 0; yy < H && !found; yy++)
                         for (int xx = 0; xx < W && !found; xx++) {
                             const int j = yy * W + xx;
-                            found = cnt[j] > 0 && chamfer(x, y, xx, yy) <= geo[i] &&
+                            found = cnt[j] > 0 && rm[j] && chamfer(x, y, xx, yy) <= geo[i] &&
                                     fabsf(o[0] - ref[3 * j]) <= 1e-4f * (float)cnt[j] &&
                                     fabsf(o[1] - ref[3 * j + 1]) <= 1e-4f * (float)cnt[j] &&
                                     fabsf(o[2] - ref[3 * j + 2]) <= 1e-4f * (float)cnt[j];

@@ -12,6 +12,15 @@
 /* Known depth: z in [0, 1) (the depth test's rule, fuse.h); NaN fails. */
 static int known(float z) { return z >= 0.0f && z < 1.0f; }
 
+/* 1 when the 8 mask bytes at m are all set and the 8 depths at z all
+ * known: nothing to do there (branch-free, one test for the block) */
+static int block_done(const uint8_t *m, const float *z)
+{
+    int k = 1;
+    for (int i = 0; i < 8; i++) k &= (m[i] != 0) & (z[i] >= 0.0f) & (z[i] < 1.0f);
+    return k;
+}
+
 /* The largest float below 1: the far plane; any scene object is nearer. */
 static float far_depth(void)
 {
@@ -50,10 +59,38 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
                 x = ef_row_first_set(m, x + 1, width) - 1;
                 continue;
             }
+            if (x + 8 <= width && block_done(m + x, z + x)) {
+                x += 7;
+                continue;
+            }
             if (known(z[x])) continue;
+            /* ring 1 away from the borders: the 4-neighbours (d2 1), then
+             * the diagonals (d2 2), each in the ties' order (upper row,
+             * then left): the ring search's result, which stops there */
+            r = 1;
+            if (x > 0 && y > 0 && x + 1 < width && y + 1 < height) {
+                const float *u = z - depth_stride, *d = z + depth_stride;
+                const int c = R * side + R;
+                best = known(u[x])       ? c - side
+                       : known(z[x - 1]) ? c - 1
+                       : known(z[x + 1]) ? c + 1
+                       : known(d[x])     ? c + side
+                                         : -1;
+                bd2 = 1;
+                if (best < 0) {
+                    best = known(u[x - 1])   ? c - side - 1
+                           : known(u[x + 1]) ? c - side + 1
+                           : known(d[x - 1]) ? c + side - 1
+                           : known(d[x + 1]) ? c + side + 1
+                                             : -1;
+                    bd2 = 2;
+                }
+                if (best < 0) bd2 = 0;
+                r = best >= 0 ? R + 1 : 2;
+            }
             /* rings of growing Chebyshev radius; a pixel of ring r is at
              * least r away, so stop once the best is nearer than r + 1 */
-            for (r = 1; r <= R; r++) {
+            for (; r <= R; r++) {
                 int dy;
                 for (dy = -r; dy <= r; dy++) {
                     const int yy = y + dy, edge = dy == -r || dy == r;
@@ -92,6 +129,10 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
             int code, dx, dy;
             if (m[x] == 0) {
                 x = ef_row_first_set(m, x + 1, x1) - 1;
+                continue;
+            }
+            if (x + 8 <= x1 && block_done(m + x, z + x)) {
+                x += 7;
                 continue;
             }
             if (known(z[x])) continue;

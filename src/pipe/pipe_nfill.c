@@ -6,15 +6,14 @@
 
 #define NFILL_FAR 0xFFFFu
 
-/* scratch: horizontal sums (3 w h floats; a ring of 2 r + 2 rows of them
- * is used), the vertical accumulator (3 w floats), the window counts (w
- * ints vertically, w h bytes per row), the fill's spans (2 h ints) and
+/* scratch: the vertical window sums of the current row (3 w floats),
+ * their model pixel counts (w bytes), the fill's spans (2 h ints) and
  * distances (w h uint16) */
 size_t pipe__nfill_scratch_size(int w, int h)
 {
     const size_t px = (size_t)w * (size_t)h;
-    return sizeof(float) * 3 * px + sizeof(float) * 3 * (size_t)w + sizeof(int) * (size_t)w +
-           sizeof(uint16_t) * px + px + sizeof(int) * 2 * (size_t)h;
+    return sizeof(float) * 3 * (size_t)w + sizeof(int) * 2 * (size_t)h + sizeof(uint16_t) * px +
+           (size_t)w + 16;
 }
 
 static void bbox(const uint8_t *m, int w, int h, int b[4])
@@ -31,6 +30,20 @@ static void bbox(const uint8_t *m, int w, int h, int b[4])
     }
 }
 
+#define NFILL_B01 0x0101010101010101ull
+#define NFILL_B80 0x8080808080808080ull
+
+/* 1 when one of the 8 bytes of v is 0 */
+static int has_zero(uint64_t v) { return ((v - NFILL_B01) & ~v & NFILL_B80) != 0; }
+
+/* the end of the run of set bytes of r that starts at x (x1 at most) */
+static int run_end(const uint8_t *r, int x, int x1)
+{
+    while (x + 8 <= x1 && !has_zero(ef_ld8(r + x))) x += 8;
+    while (x < x1 && r[x]) x++;
+    return x;
+}
+
 /* the neighbour (x + dx, y + dy) of a fill candidate: a shorter path */
 static int relax(uint16_t *dist, float *out, int w, const int b[4], int x,
                   int y, int dx, int dy, unsigned cost)
@@ -44,73 +57,6 @@ static int relax(uint16_t *dist, float *out, int w, const int b[4], int x,
     dist[i] = (uint16_t)d;
     memcpy(out + 3 * i, out + 3 * j, 3 * sizeof(float));
     return 1;
-}
-
-/* The horizontal window sums of row y (hs: 3 floats, hc: counts per
- * column of the box's, b[0] .. b[2] - 1), the model's pixels within r of
- * each column: running sums in the columns' order (the bytes' definition). */
-static void window_hrow(const float *restrict n, const uint8_t *restrict k, float *restrict o,
-                        uint8_t *restrict c, int w, int r, const int b[4])
-{
-    float s0 = 0.0f, s1 = 0.0f, s2 = 0.0f;
-    int cnt = 0;
-    for (int x = b[0] - r < 0 ? 0 : b[0] - r; x <= b[0] + r && x < w; x++)
-        if (k[x]) {
-            s0 = s0 + n[3 * x];
-            s1 = s1 + n[3 * x + 1];
-            s2 = s2 + n[3 * x + 2];
-            cnt++;
-        }
-    /* b[0], then the columns whose window enters and leaves the row
-     * (xa .. xb - 1: no bound checks), then the rest */
-    int xa = r + 1 > b[0] + 1 ? r + 1 : b[0] + 1, xb = w - r < b[2] ? w - r : b[2];
-    if (xb < xa) xb = xa;
-    for (int x = b[0]; x < b[2]; x++) {
-        if (x == xa) {
-            for (; x < xb; x++) {
-                const int xi = x + r, xo = x - r - 1;
-                if (k[xi]) {
-                    s0 = s0 + n[3 * xi];
-                    s1 = s1 + n[3 * xi + 1];
-                    s2 = s2 + n[3 * xi + 2];
-                    cnt++;
-                }
-                if (k[xo]) {
-                    s0 = s0 - n[3 * xo];
-                    s1 = s1 - n[3 * xo + 1];
-                    s2 = s2 - n[3 * xo + 2];
-                    cnt--;
-                }
-                if (cnt == 0) s0 = s1 = s2 = 0.0f;
-                o[3 * x] = s0;
-                o[3 * x + 1] = s1;
-                o[3 * x + 2] = s2;
-                c[x] = (uint8_t)cnt;
-            }
-            if (x >= b[2]) break;
-        }
-        if (x > b[0]) {
-            const int xi = x + r, xo = x - r - 1;
-            if (xi < w && k[xi]) {
-                s0 = s0 + n[3 * xi];
-                s1 = s1 + n[3 * xi + 1];
-                s2 = s2 + n[3 * xi + 2];
-                cnt++;
-            }
-            if (xo >= 0 && k[xo]) {
-                s0 = s0 - n[3 * xo];
-                s1 = s1 - n[3 * xo + 1];
-                s2 = s2 - n[3 * xo + 2];
-                cnt--;
-            }
-        }
-        /* an empty window is exactly 0, not a running sum's residue */
-        if (cnt == 0) s0 = s1 = s2 = 0.0f;
-        o[3 * x] = s0;
-        o[3 * x + 1] = s1;
-        o[3 * x + 2] = s2;
-        c[x] = (uint8_t)cnt;
-    }
 }
 
 /* 4 floats in one register (GCC/Clang vector extension): the same IEEE
@@ -152,24 +98,26 @@ static void acc_addsub(float *restrict acc, const float *restrict si, const floa
     for (; i < i1; i++) acc[i] = (acc[i] + si[i]) - so[i];
 }
 
-/* counts: accc[x] + ci[x] - co[x] (either may be NULL) */
-static void cnt_row(int *restrict accc, const uint8_t *restrict ci, const uint8_t *restrict co,
+/* 1 in each byte of v that is not 0, else 0 */
+static uint64_t nz8(uint64_t v)
+{
+    const uint64_t l7 = 0x7F7F7F7F7F7F7F7Full;
+    return ((((v & l7) + l7) | v) >> 7) & NFILL_B01;
+}
+
+/* counts: c[x] + (ci[x] != 0) - (co[x] != 0) (either may be NULL), 8
+ * bytes a step (a count stays in 0 .. 2 r + 1: no carry between bytes) */
+static void cnt_row(uint8_t *restrict c, const uint8_t *restrict ci, const uint8_t *restrict co,
                     int x0, int x1)
 {
-    if (ci && co) {
-        int x = x0;
-        for (; x + 4 <= x1; x += 4) {
-            accc[x] += (int)ci[x] - (int)co[x];
-            accc[x + 1] += (int)ci[x + 1] - (int)co[x + 1];
-            accc[x + 2] += (int)ci[x + 2] - (int)co[x + 2];
-            accc[x + 3] += (int)ci[x + 3] - (int)co[x + 3];
-        }
-        for (; x < x1; x++) accc[x] += (int)ci[x] - (int)co[x];
+    int x = x0;
+    for (; x + 8 <= x1; x += 8) {
+        uint64_t v = ef_ld8(c + x);
+        if (ci) v += nz8(ef_ld8(ci + x));
+        if (co) v -= nz8(ef_ld8(co + x));
+        memcpy(c + x, &v, 8);
     }
-    else if (ci)
-        for (int x = x0; x < x1; x++) accc[x] += (int)ci[x];
-    else if (co)
-        for (int x = x0; x < x1; x++) accc[x] -= (int)co[x];
+    for (; x < x1; x++) c[x] = (uint8_t)(c[x] + (ci && ci[x] != 0) - (co && co[x] != 0));
 }
 
 void pipe__nfill_refined(const uint8_t *mask, const uint8_t *kmask, const float *nrm,
@@ -178,70 +126,94 @@ void pipe__nfill_refined(const uint8_t *mask, const uint8_t *kmask, const float 
     int b[4] = {w, h, 0, 0};
     bbox(mask, w, h, b);
     if (b[2] <= b[0]) return;
-    const size_t px = (size_t)w * (size_t)h;
-    float *hs = (float *)scratch;
-    float *acc = hs + 3 * px;
-    int *accc = (int *)(acc + 3 * (size_t)w);
-    int *span = accc + w; /* per row: the fill's candidates' x0, x1 */
+    float *acc = (float *)scratch;
+    int *span = (int *)(acc + 3 * (size_t)w); /* per row: the fill's candidates' x0, x1 */
     uint16_t *dist = (uint16_t *)(span + 2 * (size_t)h);
-    uint8_t *hc = (uint8_t *)(dist + px);
+    uint8_t *vc = (uint8_t *)(dist + (size_t)w * (size_t)h);
+    /* the columns the windows of the box's pixels read */
+    const int c0 = b[0] - r < 0 ? 0 : b[0] - r, c1 = b[2] + r > w ? w : b[2] + r;
+    const size_t i0 = 3 * (size_t)c0, i1 = 3 * (size_t)c1;
     const int ya = b[1] - r < 0 ? 0 : b[1] - r;
-    /* the horizontal sums live in a ring of the 2 r + 2 rows the vertical
-     * window reads (the row coming in and the one going out): written just
-     * before they are added, still in the caches when taken out */
-    const int ring = 2 * r + 2 < h ? 2 * r + 2 : h;
-#define HS(y) (hs + 3 * (size_t)((y) % ring) * (size_t)w)
-#define HC(y) (hc + (size_t)((y) % ring) * (size_t)w)
-#define HROW(y)                                                                                    \
-    window_hrow(nrm + 3 * (size_t)(y) * (size_t)w, kmask + (size_t)(y) * (size_t)w, HS(y), HC(y), w, \
-                r, b)
-    const size_t i0 = 3 * (size_t)b[0], i1 = 3 * (size_t)b[2];
-    /* vertical window sums of the horizontal ones, row by row */
-    memset(acc, 0, sizeof(float) * 3 * (size_t)w);
-    memset(accc, 0, sizeof(int) * (size_t)w);
+#define NROW(y) (nrm + 3 * (size_t)(y) * (size_t)w)
+#define KROW(y) (kmask + (size_t)(y) * (size_t)w)
+    /* vertical window sums of the normals (0 outside the model), row by
+     * row: the row coming in added, the one going out taken */
+    memset(acc + i0, 0, sizeof(float) * (i1 - i0));
+    memset(vc + c0, 0, (size_t)(c1 - c0));
     for (int y = ya; y <= b[1] + r && y < h; y++) {
-        HROW(y);
-        acc_add(acc, HS(y), i0, i1);
-        cnt_row(accc, HC(y), NULL, b[0], b[2]);
+        acc_add(acc, NROW(y), i0, i1);
+        cnt_row(vc, KROW(y), NULL, c0, c1);
     }
+    /* only the refined mask's pixels are sources of the fill */
+    memset(dist + (size_t)b[1] * (size_t)w, 0xFF, sizeof(uint16_t) * (size_t)w * (size_t)(b[3] - b[1]));
     for (int y = b[1]; y < b[3]; y++) {
         if (y > b[1]) {
             const int yi = y + r, yo = y - r - 1;
-            if (yi < h) HROW(yi);
             if (yi < h && yo >= 0)
-                acc_addsub(acc, HS(yi), HS(yo), i0, i1);
+                acc_addsub(acc, NROW(yi), NROW(yo), i0, i1);
             else if (yi < h)
-                acc_add(acc, HS(yi), i0, i1);
+                acc_add(acc, NROW(yi), i0, i1);
             else if (yo >= 0)
-                acc_sub(acc, HS(yo), i0, i1);
-            cnt_row(accc, yi < h ? HC(yi) : NULL, yo >= 0 ? HC(yo) : NULL, b[0], b[2]);
+                acc_sub(acc, NROW(yo), i0, i1);
+            cnt_row(vc, yi < h ? KROW(yi) : NULL, yo >= 0 ? KROW(yo) : NULL, c0, c1);
         }
         float *o = out + 3 * (size_t)y * (size_t)w;
         uint16_t *d = dist + (size_t)y * (size_t)w;
         const uint8_t *m = mask + (size_t)y * (size_t)w;
         int s0 = b[2], s1 = b[0];
-        for (int x = b[0]; x < b[2]; x++) {
-            if (accc[x] == 0) {
-                acc[3 * x] = acc[3 * x + 1] = acc[3 * x + 2] = 0.0f;
-                o[3 * x] = o[3 * x + 1] = o[3 * x + 2] = 0.0f;
-                d[x] = NFILL_FAR;
-                if (m[x]) {
+        /* the horizontal window sums over the refined mask's runs only */
+        for (int a = ef_row_first_set(m, b[0], b[2]); a < b[2];
+             a = ef_row_first_set(m, a, b[2])) {
+            const int e = run_end(m, a, b[2]);
+            float t0 = 0.0f, t1 = 0.0f, t2 = 0.0f;
+            int cnt = 0;
+            for (int x = a - r < 0 ? 0 : a - r; x <= a + r && x < w; x++) {
+                t0 = t0 + acc[3 * x];
+                t1 = t1 + acc[3 * x + 1];
+                t2 = t2 + acc[3 * x + 2];
+                cnt += vc[x];
+            }
+            for (int x = a; x < e; x++) {
+                if (x > a) {
+                    const int xi = x + r, xo = x - r - 1;
+                    if (xi < w && xo >= 0) {
+                        t0 = (t0 + acc[3 * xi]) - acc[3 * xo];
+                        t1 = (t1 + acc[3 * xi + 1]) - acc[3 * xo + 1];
+                        t2 = (t2 + acc[3 * xi + 2]) - acc[3 * xo + 2];
+                        cnt += vc[xi] - vc[xo];
+                    } else if (xi < w) {
+                        t0 = t0 + acc[3 * xi];
+                        t1 = t1 + acc[3 * xi + 1];
+                        t2 = t2 + acc[3 * xi + 2];
+                        cnt += vc[xi];
+                    } else if (xo >= 0) {
+                        t0 = t0 - acc[3 * xo];
+                        t1 = t1 - acc[3 * xo + 1];
+                        t2 = t2 - acc[3 * xo + 2];
+                        cnt -= vc[xo];
+                    }
+                }
+                if (cnt == 0) {
+                    /* an empty window is exactly 0, not a running sum's
+                     * residue */
+                    t0 = t1 = t2 = 0.0f;
+                    o[3 * x] = o[3 * x + 1] = o[3 * x + 2] = 0.0f;
                     if (s0 > x) s0 = x;
                     s1 = x + 1;
+                } else {
+                    o[3 * x] = t0;
+                    o[3 * x + 1] = t1;
+                    o[3 * x + 2] = t2;
+                    d[x] = 0;
                 }
-            } else {
-                o[3 * x] = acc[3 * x];
-                o[3 * x + 1] = acc[3 * x + 1];
-                o[3 * x + 2] = acc[3 * x + 2];
-                d[x] = 0;
             }
+            a = e;
         }
         span[2 * y] = s0;
         span[2 * y + 1] = s1;
     }
-#undef HROW
-#undef HC
-#undef HS
+#undef KROW
+#undef NROW
     /* the mask's pixels with no model pixel in their window: the normal
      * of the nearest that has one (3-4 chamfer, through the mask) */
     /* forward and backward until nothing changes (two passes for a

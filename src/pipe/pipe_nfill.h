@@ -19,26 +19,27 @@
  *   model's normals only need to say where the scene's light comes from.
  *
  * WHAT IT DOES
- *   pipe__nfill_refined() writes, for every pixel of the bounding box of
- *   mask (the refined mask) and the model's mask kmask, out = the sum of
- *   the model's normals nrm over the (2 r + 1)^2 window (0 outside the
- *   model: the rasterizer's clear value); a jump of the model's normal
- *   becomes a ramp 2 r + 1 px wide, wider than the lag it must hide. A
- *   pixel of mask whose window holds no model pixel gets the normal of
- *   the nearest one that has (3-4 chamfer distance, through mask pixels
- *   only, forward and backward passes until none changes): the model's rim normal continued outwards instead
- *   of the view vector. A refined blob not connected to the model keeps 0
- *   (the lighting uses the view vector, as before).
+ *   pipe__nfill_refined() writes, for every pixel of mask (the refined
+ *   mask), out = the sum of the model's normals nrm over the
+ *   (2 r + 1)^2 window (nrm is 0 outside the model's mask kmask: the
+ *   rasterizer's clear value); a jump of the model's normal becomes a
+ *   ramp 2 r + 1 px wide, wider than the lag it must hide. A pixel of
+ *   mask whose window holds no model pixel (kmask) gets the normal of the
+ *   nearest pixel of mask that has one (3-4 chamfer distance, through
+ *   mask pixels only, forward and backward passes until none changes):
+ *   the model's rim normal continued outwards instead of the view vector.
+ *   A refined blob not connected to the model keeps 0 (the lighting uses
+ *   the view vector, as before).
  *
  * NUMBERS
- *   Horizontal then vertical running sums in IEEE single, no FMA, one
+ *   Vertical then horizontal running sums in IEEE single, no FMA, one
  *   scalar code: the same bytes on every ISA and thread count. The
  *   window's model pixels are counted in integers, so an empty window is
  *   known exactly (not from a sum that rounds to a tiny non-zero).
- *   Cost: 4 additions per component and pixel of the box (running sums;
- *   the horizontal ones in a ring of 2 r + 2 rows, the vertical ones 4
- *   floats at a time, the same additions in the same order), and 2-3
- *   pairs of the fill's passes over each row's span of candidates (no
+ *   Cost: the vertical sums over the box's columns (the row coming in
+ *   added, the one going out taken, 4 floats at a time; the counts 8
+ *   bytes at a time), the horizontal ones over the mask's runs only, and
+ *   2-3 pairs of the fill's passes over each row's span of candidates (no
  *   allocation). docs/accuracy.md, "Refine's cost inside the pipeline".
  */
 #ifndef EGOFUSE_PIPE_NFILL_H
@@ -53,9 +54,9 @@
 size_t pipe__nfill_scratch_size(int w, int h);
 
 /* mask, kmask: w x h bytes (stride w); nrm, out: 3 floats per pixel
- * (stride 3 w), out not overlapping nrm; r in 1..8; scratch of
- * pipe__nfill_scratch_size(w, h) bytes, 16-byte aligned. out is written
- * inside the box only; pixels of mask 0 there may get any value. */
+ * (stride 3 w), out not overlapping nrm, nrm 0 where kmask is 0; r in
+ * 1..8; scratch of pipe__nfill_scratch_size(w, h) bytes, 16-byte
+ * aligned. out is written at mask's pixels only. */
 void pipe__nfill_refined(const uint8_t *mask, const uint8_t *kmask, const float *nrm,
                          float *out, int w, int h, int r, void *scratch);
 
