@@ -316,10 +316,13 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     e->shown = fe.mask;
     fe.normal = rp ? e->rp.nrm : e->nrm;
     fe.normal_stride = 3 * cw;
+    /* the refined mask's normals come from the model's alone (nfill
+     * below: nrm must be 0 outside the model's mask) */
+    const int nfill = !rp && refined_in && e->nfill_scratch;
     /* coverage beyond the model's pixel centres: its neighbours' normals */
-    if (e->aa.count && p->desc.normal_smooth == 0)
+    if (e->aa.count && p->desc.normal_smooth == 0 && !nfill)
         pipe__aa_fill_normals(&e->aa, fe.mask, e->mask, e->nrm);
-    if (!rp && refined_in && e->nfill_scratch) {
+    if (nfill) {
         /* the refined mask's normals: the model's, smoothed over the lag
          * and continued beyond its rim (pipe_nfill.h) */
         pipe__nfill_refined(e->refined, e->mask, e->nrm, e->snrm, cw, ch,
