@@ -177,7 +177,8 @@ static void test_trail(void **st)
     memcpy(keep, reg, sizeof reg);
     const float hp[2][2] = { { 80, 40 }, { 0, 0 } };
     const float mv[2][2] = { { 6, 0 }, { 0, 0 } };
-    const long n = pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, mv, 1);
+    const float fast[2] = { PIPE_TRAIL_SPEED, 0.0f };
+    const long n = pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, mv, fast, 1);
     assert_true(n > 0);
     long cl = 0;
     for (int y = 0; y < H; y++)
@@ -197,16 +198,18 @@ static void test_trail(void **st)
     assert_int_equal(reg[40 * W + 52], 255);    /* 8 px behind, beyond 1 step: kept */
     /* two steps reach 12 px behind */
     memcpy(reg, keep, sizeof reg);
-    assert_true(pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, mv, 2) > n);
+    assert_true(pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, mv, fast, 2) > n);
     assert_int_equal(reg[40 * W + 52], 0);
     /* at rest, untracked, bad arguments: nothing cleared */
     const float rest[2][2] = { { 0.4f, -0.3f }, { 0, 0 } };
     memcpy(reg, keep, sizeof reg);
-    assert_int_equal(pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, rest, 1), 0);
-    assert_int_equal(pipe_fit_regrow_trail(first, W, reg, W, W, H, 2u, hp, mv, 1), 0);
-    assert_int_equal(pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, mv, 0), -1);
-    assert_int_equal(pipe_fit_regrow_trail(NULL, W, reg, W, W, H, 1u, hp, mv, 1), -1);
-    assert_int_equal(pipe_fit_regrow_trail(first, W - 1, reg, W, W, H, 1u, hp, mv, 1), -1);
+    assert_int_equal(pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, rest, fast, 1), 0);
+    assert_int_equal(pipe_fit_regrow_trail(first, W, reg, W, W, H, 2u, hp, mv, fast, 1), 0);
+    const float slow[2] = { 0.5f * PIPE_TRAIL_SPEED, 0.0f };   /* slower than the gate */
+    assert_int_equal(pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, mv, slow, 1), 0);
+    assert_int_equal(pipe_fit_regrow_trail(first, W, reg, W, W, H, 1u, hp, mv, fast, 0), -1);
+    assert_int_equal(pipe_fit_regrow_trail(NULL, W, reg, W, W, H, 1u, hp, mv, fast, 1), -1);
+    assert_int_equal(pipe_fit_regrow_trail(first, W - 1, reg, W, W, H, 1u, hp, mv, fast, 1), -1);
     assert_memory_equal(reg, keep, sizeof reg);
 }
 
@@ -275,7 +278,7 @@ static void test_trail_reference(void **st)
         const unsigned sides = rnd() % 4;
         const int steps = 1 + (int)(rnd() % 3);
         memcpy(b, a, sizeof a);
-        const long na = pipe_fit_regrow_trail(first, W, a, W, W, H, sides, hp, mv, steps);
+        const long na = pipe_fit_regrow_trail(first, W, a, W, W, H, sides, hp, mv, NULL, steps);
         const long nb2 = trail_ref(first, b, sides, hp, mv, steps);
         assert_int_equal(na, nb2);
         assert_memory_equal(a, b, sizeof a);

@@ -640,14 +640,11 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
                 if (regrown < 0) return -1;
                 /* what it added behind a moving hand taken back: where
                  * the hand was, not where it is (fit_narrow.h) */
-                if (regrown > 0 && posed) {
-                    for (int k = 0; k < 2; k++)
-                        if (r->speed[k] < PIPE_TRAIL_SPEED) hmot[k][0] = hmot[k][1] = 0.0f;
-                    if (pipe_fit_regrow_trail(c->mask_smooth, CW, c->refined, CW, CW, CH,
-                                              r->sides & hseen, r->hand_px[e], hmot,
-                                              PIPE_TRAIL_STEPS) < 0)
-                        return -1;
-                }
+                if (regrown > 0 && posed &&
+                    pipe_fit_regrow_trail(c->mask_smooth, CW, c->refined, CW, CW, CH,
+                                          r->sides & hseen, r->hand_px[e], hmot, r->speed,
+                                          PIPE_TRAIL_STEPS) < 0)
+                    return -1;
                 /* and so must the pixels the vote let in beyond it */
                 if (from_prior && rs.used_colour && cfg->fit &&
                     pipe_fit_learned(r->fit, e))

@@ -63,7 +63,7 @@ static int set_at(const uint8_t *m, int stride, int w, int h, int x, int y)
 
 long pipe_fit_regrow_trail(const uint8_t *first, int first_stride, uint8_t *refined, int stride,
                            int w, int h, unsigned sides, const float hand_px[2][2],
-                           const float motion[2][2], int steps)
+                           const float motion[2][2], const float *speed, int steps)
 {
     if (!first || !refined || !hand_px || !motion || w <= 0 || h <= 0 || first_stride < w ||
         stride < w || steps < 1)
@@ -73,7 +73,8 @@ long pipe_fit_regrow_trail(const uint8_t *first, int first_stride, uint8_t *refi
     for (int k = 0; k < 2; k++) {
         dx[k] = (int)lrintf(motion[k][0]);
         dy[k] = (int)lrintf(motion[k][1]);
-        if ((sides >> k & 1u) && (dx[k] || dy[k])) moving |= 1u << k;
+        if ((sides >> k & 1u) && (dx[k] || dy[k]) && (!speed || speed[k] >= PIPE_TRAIL_SPEED))
+            moving |= 1u << k;
     }
     if (!moving) return 0;
     long cleared = 0;

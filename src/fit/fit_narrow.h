@@ -81,12 +81,13 @@ int pipe_fit_refine_regrow(const fuse_refine_params *p, const fuse_colour_model 
  * per row, w x h) and clear in first (the refinement before the regrow,
  * first_stride): k the nearest hand of sides (bit k: hand_px[k] valid, the
  * hand's image position in this frame), d = motion[k] (its image motion
- * since the last frame, px; hands moving less than 1 px per frame are
- * skipped); the pixel is cleared when first is set at p + j d for some j
+ * since the last frame, px; hands moving less than 1 px per frame, or
+ * slower than PIPE_TRAIL_SPEED by speed[k] (m/s; speed NULL: every hand)
+ * are skipped); the pixel is cleared when first is set at p + j d for some j
  * in 1..steps (the hand lies ahead of it along its motion) and at no
  * p - j d (not between two parts of the hand). Returns the pixels cleared,
  * -1 on bad arguments (refined unchanged). */
 long pipe_fit_regrow_trail(const uint8_t *first, int first_stride, uint8_t *refined, int stride,
                            int w, int h, unsigned sides, const float hand_px[2][2],
-                           const float motion[2][2], int steps);
+                           const float motion[2][2], const float *speed, int steps);
 #endif

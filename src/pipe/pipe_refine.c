@@ -93,8 +93,7 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
             e->have_hand_px[k] =
                 pipe_fit_hand_px(&e->cam, p->pose.world, &p->fit_rig, k, e->hand_px[k]);
             if (e->have_hand_px[k]) hseen |= 1u << k;
-            if (had && e->have_hand_px[k] && in->locals && in->hand_speed &&
-                in->hand_speed[k] >= PIPE_TRAIL_SPEED) {
+            if (had && e->have_hand_px[k]) {
                 hmot[k][0] = e->hand_px[k][0] - ox;
                 hmot[k][1] = e->hand_px[k][1] - oy;
             }
@@ -127,9 +126,9 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
     /* what the regrow added behind a fast hand taken back: where the
      * hand was, not where it is (fit_narrow.h; eval's refine does the
      * same); e->regrow holds the refinement before it */
-    if (regrown > 0 && in->locals)
+    if (regrown > 0 && in->locals && in->hand_speed)
         pipe_fit_regrow_trail(e->regrow, cw, e->refined, cw, cw, ch, sides & hseen, e->hand_px,
-                              hmot, PIPE_TRAIL_STEPS);
+                              hmot, in->hand_speed, PIPE_TRAIL_STEPS);
     /* the pixels the vote let in beyond a prior must look like the
      * hand too (fit_band.h) */
     if (from_prior && rs.used_colour && p->fit && pipe_fit_learned(p->fit, e->eye))
