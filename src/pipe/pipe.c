@@ -158,12 +158,8 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
     int level = e->lod_level;
     rast_result rr = eye_draw(p, e, NULL, &r->cam, &tg, 1, NULL);
     e->lod_level = level;
-    if (rr != RAST_OK) {
-        e->result = PIPE_ERR_RASTER;
-        snprintf(e->why, sizeof e->why, "%s eye: rasterizer (eye view): %s",
-                 e->eye ? "right" : "left", rast_result_str(rr));
-        return -1;
-    }
+    if (rr != RAST_OK)
+        return pipe__eye_fail(e, PIPE_ERR_RASTER, "rasterizer (eye view)", rast_result_str(rr));
     r->isa = rast_context_isa(e->rast);
     /* the whole sensor (the rows above and below the crop of eq. 1 too):
      * the RGBA image as given, or the raw frame's other rows converted
@@ -204,12 +200,9 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
             rast_context_forget(e->rast);
             rr = eye_draw(p, e, NULL, &e->cam, &ct, 1, NULL);
             e->lod_level = level;
-            if (rr != RAST_OK) {
-                e->result = PIPE_ERR_RASTER;
-                snprintf(e->why, sizeof e->why, "%s eye: rasterizer (fallback normals): %s",
-                         e->eye ? "right" : "left", rast_result_str(rr));
-                return -1;
-            }
+            if (rr != RAST_OK)
+                return pipe__eye_fail(e, PIPE_ERR_RASTER, "rasterizer (fallback normals)",
+                                      rast_result_str(rr));
         }
         return 0;
     }
@@ -257,9 +250,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     double t1 = now_ms();
     e->ms_raster = t1 - t0;
     if (rr != RAST_OK) {
-        e->result = PIPE_ERR_RASTER;
-        snprintf(e->why, sizeof e->why, "%s eye: rasterizer: %s",
-                 e->eye ? "right" : "left", rast_result_str(rr));
+        pipe__eye_fail(e, PIPE_ERR_RASTER, "rasterizer", rast_result_str(rr));
         return;
     }
     e->coverage = (double)covered / (double)(cw * ch);
@@ -288,9 +279,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         fe.P = crop_cols(p, rows);
         e->ms_convert = now_ms() - tc;
         if (cr != FUSE_OK) {
-            e->result = PIPE_ERR_ARGS;
-            snprintf(e->why, sizeof e->why, "%s eye: camera frame: %s",
-                     e->eye ? "right" : "left", fuse_result_str(cr));
+            pipe__eye_fail(e, PIPE_ERR_ARGS, "camera frame", fuse_result_str(cr));
             return;
         }
     } else {
@@ -405,11 +394,8 @@ static void eye_finish(pipe_ctx *p, eye_state *e)
             if (e->mask[(size_t)y * cw + x] == 0) e->depth[(size_t)y * cw + x] = 1.0f;
     if (e->aa.count) pipe__aa_unfill(&e->aa, e->mask, e->nrm);
     e->ms_fuse += now_ms() - t;
-    if (e->fr != FUSE_OK) {
-        e->result = PIPE_ERR_FUSE;
-        snprintf(e->why, sizeof e->why, "%s eye: lighting/composite: %s",
-                 e->eye ? "right" : "left", fuse_result_str(e->fr));
-    }
+    if (e->fr != FUSE_OK)
+        pipe__eye_fail(e, PIPE_ERR_FUSE, "lighting/composite", fuse_result_str(e->fr));
 }
 
 /* With p->mu held: the eyes' work of the current JOB_EYE on this thread

@@ -103,4 +103,8 @@ enum { JOB_SKIN, JOB_EYE };
  * e->result and e->why set. */
 int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe);
 
+/* Eye e's error: e->result = r, e->why = "<left|right> eye: what: detail"
+ * (detail NULL: "<left|right> eye: what"); returns -1 (pipe_fail.c). */
+int pipe__eye_fail(eye_state *e, pipe_result r, const char *what, const char *detail);
+
 #endif

@@ -106,23 +106,15 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
         &rp, p->fit && pipe_fit_learned(p->fit, e->eye) ? pipe_fit_colour(p->fit, e->eye) : NULL,
         0.5f, PIPE_NARROW_MIN_BAND, &fe->P, rin, cw, e->refined, cw, e->refine_scratch,
         e->refine_scratch_size, &rs, NULL);
-    if (rr2 != FUSE_OK) {
-        e->result = PIPE_ERR_FUSE;
-        snprintf(e->why, sizeof e->why, "%s eye: mask refinement: %s",
-                 e->eye ? "right" : "left", fuse_result_str(rr2));
-        return -1;
-    }
+    if (rr2 != FUSE_OK)
+        return pipe__eye_fail(e, PIPE_ERR_FUSE, "mask refinement", fuse_result_str(rr2));
     /* once more from its own edge where it let in much: the hand beyond
      * the band (fit_narrow.h; eval's refine does the same) */
     const int regrown = pipe_fit_refine_regrow(
         &rp, p->fit && pipe_fit_learned(p->fit, e->eye) ? pipe_fit_colour(p->fit, e->eye) : NULL,
         0.5f, &fe->P, e->refined, cw, e->regrow, e->refine_scratch, e->refine_scratch_size, &rs);
-    if (regrown < 0) {
-        e->result = PIPE_ERR_FUSE;
-        snprintf(e->why, sizeof e->why, "%s eye: mask refinement: %s",
-                 e->eye ? "right" : "left", fuse_result_str(FUSE_ERR_ARGS));
-        return -1;
-    }
+    if (regrown < 0)
+        return pipe__eye_fail(e, PIPE_ERR_FUSE, "mask refinement", fuse_result_str(FUSE_ERR_ARGS));
     /* what the regrow added behind a fast hand taken back: where the
      * hand was, not where it is (fit_narrow.h; eval's refine does the
      * same); e->regrow holds the refinement before it */
@@ -171,12 +163,8 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
          * the refinement fell back to the kinematic mask (out = M):
          * its widths would be the model's own, samples equal to the
          * factor in use */
-        if (pipe_fit_learn(p->fit, e->eye, &fe->P, e->mask, cw, learned, cw) != FUSE_OK) {
-            e->result = PIPE_ERR_FUSE;
-            snprintf(e->why, sizeof e->why, "%s eye: elbow fit: colour model",
-                     e->eye ? "right" : "left");
-            return -1;
-        }
+        if (pipe_fit_learn(p->fit, e->eye, &fe->P, e->mask, cw, learned, cw) != FUSE_OK)
+            return pipe__eye_fail(e, PIPE_ERR_FUSE, "elbow fit: colour model", NULL);
         pipe_fit_measure(p->fit, e->eye, &e->cam, p->pose.world, e->mask, cw, learned, cw);
     }
     return 0;
