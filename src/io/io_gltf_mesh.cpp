@@ -47,6 +47,22 @@ static io_result load_vec3(Loader &L, int acc, const char *what, unsigned ints,
     return check_finite(L, v, acc, what);
 }
 
+/* Decodes one VEC4 skinning attribute (JOINTS_n, WEIGHTS_n) of the
+ * component types `types`, normalized as `norm` says; checks that it has
+ * n elements. */
+static io_result load_vec4(Loader &L, int acc, const char *what, unsigned types, int norm,
+                           size_t n, std::vector<double> &v)
+{
+    size_t k = 0;
+    io_result r = decode(L, acc, Want{what, TINYGLTF_TYPE_VEC4, types, norm}, v, &k);
+    if (r != IO_OK) return r;
+    if (k != n)
+        return io_fail(L.err, IO_ERR_FORMAT,
+                       "%s: accessor %d (%s) has %zu elements for %zu "
+                       "vertices", L.path, acc, what, k, n);
+    return IO_OK;
+}
+
 /* Converts one primitive of mode TRIANGLES, TRIANGLE_STRIP or
  * TRIANGLE_FAN (arrays only; node, skin and morph weights are set by the
  * caller). `skinned` requires JOINTS_0 and WEIGHTS_0. */
@@ -118,29 +134,15 @@ static io_result load_primitive(Loader &L, int mi, int pi, bool skinned,
         }
         if (set > 0 && !skinned) break;  /* only set 0 is kept unskinned */
         snprintf(what, sizeof what, "%s of %s", jn, label);
-        r = decode(L, jnt, Want{what, TINYGLTF_TYPE_VEC4,
-                                ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) |
-                                ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT),
-                                NORM_FORBIDDEN}, v, &k);
-        if (r != IO_OK) return r;
-        if (k != n)
-            return io_fail(L.err, IO_ERR_FORMAT,
-                           "%s: accessor %d (%s) has %zu elements for %zu "
-                           "vertices", L.path, jnt, what, k, n);
+        const unsigned u8_16 = ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) |
+                               ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+        if ((r = load_vec4(L, jnt, what, u8_16, NORM_FORBIDDEN, n, v)) != IO_OK) return r;
         std::vector<uint16_t> js(v.size());
         for (size_t i = 0; i < v.size(); i++) js[i] = (uint16_t)v[i];
 
         snprintf(what, sizeof what, "%s of %s", wn, label);
-        r = decode(L, wgt, Want{what, TINYGLTF_TYPE_VEC4,
-                                CT_FLOAT |
-                                ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) |
-                                ct_bit(TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT),
-                                NORM_REQUIRED}, v, &k);
-        if (r != IO_OK) return r;
-        if (k != n)
-            return io_fail(L.err, IO_ERR_FORMAT,
-                           "%s: accessor %d (%s) has %zu elements for %zu "
-                           "vertices", L.path, wgt, what, k, n);
+        if ((r = load_vec4(L, wgt, what, CT_FLOAT | u8_16, NORM_REQUIRED, n, v)) != IO_OK)
+            return r;
         if ((r = check_finite(L, v, wgt, what)) != IO_OK) return r;
         if (set == 0) {
             uint16_t *j = alloc_n<uint16_t>(L, js.size());

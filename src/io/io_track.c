@@ -203,12 +203,20 @@ static io_result addr_of(const char *addr, int port, struct sockaddr_in *sa, io_
     return IO_OK;
 }
 
+/* The opening of io_track_udp_listen and _connect (fn, for the message):
+ * u checked and reset, sa the address. */
+static io_result udp_begin(io_track_udp *u, const char *fn, const char *addr, int port,
+                           struct sockaddr_in *sa, io_error *err)
+{
+    if (!u) return io_fail(err, IO_ERR_ARGS, "%s: NULL argument", fn);
+    udp_reset(u);
+    return addr_of(addr, port, sa, err);
+}
+
 io_result io_track_udp_listen(io_track_udp *u, const char *addr, int port, io_error *err)
 {
-    if (!u) return io_fail(err, IO_ERR_ARGS, "io_track_udp_listen: NULL argument");
-    udp_reset(u);
     struct sockaddr_in sa;
-    io_result r = addr_of(addr, port, &sa, err);
+    io_result r = udp_begin(u, "io_track_udp_listen", addr, port, &sa, err);
     if (r != IO_OK) return r;
     int fd = socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
     if (fd < 0) return io_fail(err, IO_ERR_DEVICE, "udp socket: %s", strerror(errno));
@@ -298,10 +306,8 @@ io_result io_track_udp_poll(io_track_udp *u, int timeout_ms, kin_track_sample *o
 
 io_result io_track_udp_connect(io_track_udp *u, const char *addr, int port, io_error *err)
 {
-    if (!u) return io_fail(err, IO_ERR_ARGS, "io_track_udp_connect: NULL argument");
-    udp_reset(u);
     struct sockaddr_in sa;
-    io_result r = addr_of(addr, port, &sa, err);
+    io_result r = udp_begin(u, "io_track_udp_connect", addr, port, &sa, err);
     if (r != IO_OK) return r;
     if (port == 0) return io_fail(err, IO_ERR_ARGS, "udp sender needs a port");
     int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
