@@ -142,19 +142,16 @@ fuse_result fuse_frame_to_rgba_isa(const fuse_frame *s, int y0, fuse_image *out,
         uint8_t *d = out->pixels + (size_t)y * (size_t)out->stride;
         switch (s->format) {
         case FUSE_FMT_YUYV:
-            x = yuv_row_fast(isa, r, s->width, 0, d);
+        case FUSE_FMT_UYVY: {
+            /* Y0 U Y1 V, or (uyvy) U Y0 V Y1: the lumas at uy and 2 + uy */
+            const int uy = s->format == FUSE_FMT_UYVY;
+            x = yuv_row_fast(isa, r, s->width, uy, d);
             for (r += 2 * x, d += 4 * x; x < s->width; x += 2, r += 4, d += 8) {
-                yuv_px(r[0], r[1], r[3], d);
-                yuv_px(r[2], r[1], r[3], d + 4);
+                yuv_px(r[uy], r[1 - uy], r[3 - uy], d);
+                yuv_px(r[2 + uy], r[1 - uy], r[3 - uy], d + 4);
             }
             break;
-        case FUSE_FMT_UYVY:
-            x = yuv_row_fast(isa, r, s->width, 1, d);
-            for (r += 2 * x, d += 4 * x; x < s->width; x += 2, r += 4, d += 8) {
-                yuv_px(r[1], r[0], r[2], d);
-                yuv_px(r[3], r[0], r[2], d + 4);
-            }
-            break;
+        }
         case FUSE_FMT_GREY:
             for (x = 0; x < s->width; x++, d += 4) {
                 d[0] = d[1] = d[2] = r[x];
