@@ -100,22 +100,15 @@ void kin__skin_lbs_ref(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
 void kin__skin_dqs_ref(const kin_mesh *mesh, const kin_dualquat *dq,
                        float *pos_out, float *nrm_out, int v0, int v1);
 
-int kin__skin_lbs_sse2(const kin_mesh *mesh, const kin_mat4 *jm,
-                       float *pos_out, float *nrm_out, int v0, int v1);
-int kin__skin_lbs_avx2(const kin_mesh *mesh, const kin_mat4 *jm,
-                       float *pos_out, float *nrm_out, int v0, int v1);
-int kin__skin_lbs_avx512(const kin_mesh *mesh, const kin_mat4 *jm,
-                         float *pos_out, float *nrm_out, int v0, int v1);
-int kin__skin_dqs_sse2(const kin_mesh *mesh, const kin_dualquat *dq,
-                       float *pos_out, float *nrm_out, int v0, int v1);
-int kin__skin_dqs_avx2(const kin_mesh *mesh, const kin_dualquat *dq,
-                       float *pos_out, float *nrm_out, int v0, int v1);
-int kin__skin_dqs_avx512(const kin_mesh *mesh, const kin_dualquat *dq,
-                         float *pos_out, float *nrm_out, int v0, int v1);
-int kin__skin_lbs_neon(const kin_mesh *mesh, const kin_mat4 *jm,
-                       float *pos_out, float *nrm_out, int v0, int v1);
-int kin__skin_dqs_neon(const kin_mesh *mesh, const kin_dualquat *dq,
-                       float *pos_out, float *nrm_out, int v0, int v1);
+/* The SIMD kernels over vertices [v0, v1), one per ISA (the body
+ * kin_skin_simd.inl compiled per ISA), each its method's function type;
+ * they return the first vertex not done. */
+typedef int kin__lbs_fn(const kin_mesh *mesh, const kin_mat4 *jm, float *pos_out,
+                        float *nrm_out, int v0, int v1);
+typedef int kin__dqs_fn(const kin_mesh *mesh, const kin_dualquat *dq, float *pos_out,
+                        float *nrm_out, int v0, int v1);
+kin__lbs_fn kin__skin_lbs_sse2, kin__skin_lbs_avx2, kin__skin_lbs_avx512, kin__skin_lbs_neon;
+kin__dqs_fn kin__skin_dqs_sse2, kin__skin_dqs_avx2, kin__skin_dqs_avx512, kin__skin_dqs_neon;
 
 /* ---- skin plan (kin_skin_plan.c) -----------------------------------
  * One batch: up to KIN__PLAN_W vertices that read the same joints with
