@@ -536,19 +536,15 @@ static inline void fuse__depth_col(const fuse__depth_prep *p, int x, int32_t *ox
  * scene row's distances from the viewport's left edge (scene + oy stride
  * + vp_x0). The ISA paths give the bytes of fuse__depth_row_ref: the same
  * IEEE operations in the same order, ordered compares. */
-typedef void (*fuse__depth_fn)(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+typedef void fuse__depth_row_f(const fuse__depth_prep *p, uint8_t *q, const float *hz,
                                const float *sc, int w);
+typedef fuse__depth_row_f *fuse__depth_fn;
+fuse__depth_row_f fuse__depth_row_ref, fuse__depth_row_sse2, fuse__depth_row_avx2,
+    fuse__depth_row_avx512;
 /* Pixels x0 <= x < x1 of the row only (q, hz, sc still at pixel 0). */
-void fuse__depth_span_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                          const float *sc, int x0, int x1);
-void fuse__depth_row_ref(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                         const float *sc, int w);
-void fuse__depth_row_sse2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                          const float *sc, int w);
-void fuse__depth_row_avx2(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                          const float *sc, int w);
-void fuse__depth_row_avx512(const fuse__depth_prep *p, uint8_t *q, const float *hz,
-                            const float *sc, int w);
+typedef void fuse__depth_span_f(const fuse__depth_prep *p, uint8_t *q, const float *hz,
+                                const float *sc, int x0, int x1);
+fuse__depth_span_f fuse__depth_span_ref;
 
 /* The same test on a row of the coverage mask before lighting (what
  * fuse_context_frame runs): m holds the w mask bytes of a layer row (a
@@ -558,30 +554,14 @@ void fuse__depth_row_avx512(const fuse__depth_prep *p, uint8_t *q, const float *
  * hidden pixel is 0 either way, a pixel with M = 0 is 0 and not looked at
  * either way, and the others are lit the same (docs/fuse.md, "Depth"). The
  * ISA paths give the bytes of fuse__depth_mrow_ref. */
-typedef void (*fuse__depth_mask_fn)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                                    const float *sc, int w);
-void fuse__depth_mspan_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                           const float *sc, int x0, int x1);
-void fuse__depth_mrow_ref(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                          const float *sc, int w);
+typedef fuse__depth_row_f *fuse__depth_mask_fn;     /* q is the mask row m */
+fuse__depth_row_f fuse__depth_mrow_ref, fuse__depth_mrow_sse2, fuse__depth_mrow_avx2,
+    fuse__depth_mrow_avx512;
 /* Pixels x0 <= x < x1 of the mask row only (m, hz, sc at pixel 0): the
  * bytes of fuse__depth_mspan_ref. */
-typedef void (*fuse__depth_mspan_fn)(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                                     const float *sc, int x0, int x1);
-void fuse__depth_mspan_sse2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                            const float *sc, int x0, int x1);
-void fuse__depth_mspan_avx2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                            const float *sc, int x0, int x1);
-void fuse__depth_mspan_avx512(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                              const float *sc, int x0, int x1);
-void fuse__depth_mspan_neon(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                            const float *sc, int x0, int x1);
-void fuse__depth_mrow_sse2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                           const float *sc, int w);
-void fuse__depth_mrow_avx2(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                           const float *sc, int w);
-void fuse__depth_mrow_avx512(const fuse__depth_prep *p, uint8_t *m, const float *hz,
-                             const float *sc, int w);
+typedef fuse__depth_span_f *fuse__depth_mspan_fn;   /* q is the mask row m */
+fuse__depth_span_f fuse__depth_mspan_ref, fuse__depth_mspan_sse2, fuse__depth_mspan_avx2,
+    fuse__depth_mspan_avx512, fuse__depth_mspan_neon;
 
 /* The scene row (from the viewport's left edge) that layer row y of a
  * layer sh rows high reads: oy = vp_y0 + floor((2y + 1) vp_h / (2 sh)). */
