@@ -228,6 +228,18 @@ static fuse_lighting scene_lighting(void)
 /* Writes and reads 64 MB (more than the last-level cache) so that the
  * next call finds its inputs in memory. Untimed. */
 static volatile uint64_t evict_sink;
+static void evict_caches(void);
+
+/* One stereo frame of stage `stage` (if wanted) in ms; cold: the caches
+ * evicted before it (not timed). */
+static double frame_ms(fuse_context *ctx, const char *stage, fuse_eye *eyes, int cold)
+{
+    if (cold && want(stage)) evict_caches();
+    double t0 = now_ms();
+    if (want(stage) && fuse_context_frame(ctx, eyes, 2) != FUSE_OK) exit(3);
+    return now_ms() - t0;
+}
+
 static void evict_caches(void)
 {
     static uint64_t *buf;
@@ -269,9 +281,12 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
         like[i].V = eyes[i].V;
         like[i].out = eyes[i].out;
     }
+    /* the frames' times (index 0) and their ratios to memcpy (1) */
+    static const int ratio[5][2] = { { 2, 5 }, { 3, 6 }, { 7, 8 }, { 9, 10 }, { 11, 12 } };
     if (threads > 1) copier_start(&cp, &e[1]);
     for (k = -3; k < runs; k++) {   /* 3 warm-up runs */
-        double m, t0, t1, t2, t3, t4, t5, t6, t7, t8, t9, t10, t11, t12, t13, t14;
+        double m, t0, t1, t2;
+        const int k0 = k < 0 ? 0 : k;   /* the warm-up runs' times: overwritten */
         m = only_stage == NULL || !strcmp(only_stage, "memcpy") ? time_memcpy(e, threads > 1 ? &cp : NULL) : 1.0;
         t0 = now_ms();
         for (i = 0; i < 2 && want("light"); i++)
@@ -282,48 +297,20 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
             if (fuse_context_composite(ctx, &eyes[i].Q, &eyes[i].V, VX, VY, VW, VHH,
                                        &eyes[i].out) != FUSE_OK) exit(3);
         t2 = now_ms();
-        if (want("frame") && fuse_context_frame(ctx, eyes, 2) != FUSE_OK) exit(3);
-        t3 = now_ms();
-        if (want("ip") && fuse_context_frame(ctx, ip, 2) != FUSE_OK) exit(3);
-        t4 = now_ms();
-        if (want("dp") && fuse_context_frame(ctx, dp, 2) != FUSE_OK) exit(3);
-        t5 = now_ms();
-        if (want("op") && fuse_context_frame(ctx, op, 2) != FUSE_OK) exit(3);
-        t6 = now_ms();
-        if (want("dop") && fuse_context_frame(ctx, dop, 2) != FUSE_OK) exit(3);
-        t7 = now_ms();
-        if (want("l2") && fuse_context_frame(ctx, dop2, 2) != FUSE_OK) exit(3);
-        t8 = now_ms();
-        if (want("cold")) evict_caches();
-        t9 = now_ms();
-        if (want("cold") && fuse_context_frame(ctx, dop, 2) != FUSE_OK) exit(3);
-        t10 = now_ms();
-        if (want("l2c")) evict_caches();
-        t11 = now_ms();
-        if (want("l2c") && fuse_context_frame(ctx, dop2, 2) != FUSE_OK) exit(3);
-        t12 = now_ms();
-        if (want("like")) evict_caches();
-        t13 = now_ms();
-        if (want("like") && fuse_context_frame(ctx, like, 2) != FUSE_OK) exit(3);
-        t14 = now_ms();
+        t[2][k0] = frame_ms(ctx, "frame", eyes, 0);
+        t[3][k0] = frame_ms(ctx, "ip", ip, 0);
+        t[7][k0] = frame_ms(ctx, "dp", dp, 0);
+        t[9][k0] = frame_ms(ctx, "op", op, 0);
+        t[11][k0] = frame_ms(ctx, "dop", dop, 0);
+        t[13][k0] = frame_ms(ctx, "l2", dop2, 0);
+        t[14][k0] = frame_ms(ctx, "cold", dop, 1);
+        t[15][k0] = frame_ms(ctx, "l2c", dop2, 1);
+        t[16][k0] = frame_ms(ctx, "like", like, 1);
         if (k < 0) continue;
-        t[16][k] = t14 - t13;
-        t[13][k] = t8 - t7;
-        t[14][k] = t10 - t9;
-        t[15][k] = t12 - t11;
         t[0][k] = t1 - t0;
         t[1][k] = t2 - t1;
-        t[2][k] = t3 - t2;
-        t[3][k] = t4 - t3;
         t[4][k] = m;
-        t[5][k] = (t3 - t2) / m;
-        t[6][k] = (t4 - t3) / m;
-        t[7][k] = t5 - t4;
-        t[8][k] = (t5 - t4) / m;
-        t[9][k] = t6 - t5;
-        t[10][k] = (t6 - t5) / m;
-        t[11][k] = t7 - t6;
-        t[12][k] = (t7 - t6) / m;
+        for (i = 0; i < 5; i++) t[ratio[i][1]][k] = t[ratio[i][0]][k] / m;
     }
     if (threads > 1) copier_stop(&cp);
     {   /* t[i] -> its field */
