@@ -62,6 +62,7 @@
 #include "../src/io/io.h"
 #include "../src/pipe/pipe.h"
 #include "bench_mesh.h"
+#include "bench_sample.h"
 #include "bench_util.h"
 
 #if defined(__has_include)
@@ -336,17 +337,7 @@ static void make_samples(bench *b)
 
 static int load_rgba(const char *path, int w, int h, io_image *img)
 {
-    io_error err;
-    if (io_image_load(path, IO_U8, 4, img, &err) != IO_OK) {
-        fprintf(stderr, "bench_frame: %s\n", err.msg);
-        return 0;
-    }
-    if (img->width != w || img->height != h) {
-        fprintf(stderr, "bench_frame: %s is %dx%d, expected %dx%d\n", path, img->width,
-                img->height, w, h);
-        return 0;
-    }
-    return 1;
+    return bench_load_image(path, IO_U8, 4, w, h, img, "bench_frame");
 }
 
 /* Scene, model, tracking samples and the window of frames. */
@@ -393,35 +384,10 @@ static int preload(bench *b, const char *samples_dir, int window)
         /* spread the window over the sequence */
         int fr = (int)((long)f * sc.frames / window);
         b->window_frame[f] = fr;
-        for (int e = 0; e < 2; e++) {
-            io_image img = {0};
-            io_scene_frame_path(&sc, sc.camera[e], fr, path, sizeof path);
-            if (!load_rgba(path, cw, ch, &img)) return 0;
-            b->yuyv[f][e] = xmalloc(b->yuyv_size);
-            bench_rgba_to_yuyv(img.data, cw, ch, img.stride, b->yuyv[f][e]);
-            io_image_free(&img);
-            io_scene_frame_path(&sc, sc.virt[e], fr, path, sizeof path);
-            if (!load_rgba(path, lw, lh, &img)) return 0;
-            b->base.virt[f][e] = xmalloc((size_t)lw * lh * 4);
-            for (int y = 0; y < lh; y++)
-                memcpy(b->base.virt[f][e] + (size_t)y * lw * 4,
-                       (uint8_t *)img.data + (size_t)y * img.stride, (size_t)lw * 4);
-            io_image_free(&img);
-            b->base.depth[f][e] = NULL;
-            if (sc.virt_depth[e][0]) {
-                io_scene_frame_path(&sc, sc.virt_depth[e], fr, path, sizeof path);
-                if (io_image_load(path, IO_F32, 1, &img, &err) != IO_OK || img.width != lw ||
-                    img.height != lh) {
-                    fprintf(stderr, "bench_frame: %s: cannot use the depth image\n", path);
-                    return 0;
-                }
-                b->base.depth[f][e] = xmalloc(sizeof(float) * lw * lh);
-                for (int y = 0; y < lh; y++)
-                    memcpy(b->base.depth[f][e] + (size_t)y * lw,
-                           (uint8_t *)img.data + (size_t)y * img.stride, sizeof(float) * lw);
-                io_image_free(&img);
-            }
-        }
+        for (int e = 0; e < 2; e++)
+            if (!bench_sample_eye(&sc, fr, e, cw, ch, lw, lh, "bench_frame", &b->yuyv[f][e],
+                                  &b->base.virt[f][e], &b->base.depth[f][e]))
+                return 0;
     }
     b->base.opaque = imgset_opaque(&b->base);
     for (int e = 0; e < 2; e++) b->cam_rgba[e] = xmalloc((size_t)cw * ch * 4);

@@ -43,6 +43,7 @@
  * Exit status: 0 (benchmarks report, they do not judge), 1 the samples
  * cannot be read, 2 usage, 3 llvmpipe unavailable. */
 #include "egl_harness.h"
+#include "../bench_sample.h"
 #include "../bench_util.h"
 
 #include "../../src/cpu/cpu.h"
@@ -212,43 +213,10 @@ static int load(inputs *in, const char *dir, int window)
     for (int f = 0; f < in->window; f++) {
         int fr = (int)((long)f * sc.frames / in->window);
         in->frame_of[f] = fr;
-        for (int e = 0; e < 2; e++) {
-            io_image img = {0};
-            io_scene_frame_path(&sc, sc.camera[e], fr, path, sizeof path);
-            if (io_image_load(path, IO_U8, 4, &img, &err) != IO_OK || img.width != cw ||
-                img.height != ch) {
-                fprintf(stderr, "llvmpipe_frame: %s: cannot use the camera image\n", path);
+        for (int e = 0; e < 2; e++)
+            if (!bench_sample_eye(&sc, fr, e, cw, ch, lw, lh, "llvmpipe_frame", &in->yuyv[f][e],
+                                  &in->virt[f][e], &in->depth[f][e]))
                 return 0;
-            }
-            in->yuyv[f][e] = xmalloc((size_t)cw * ch * 2);
-            bench_rgba_to_yuyv(img.data, cw, ch, img.stride, in->yuyv[f][e]);
-            io_image_free(&img);
-            io_scene_frame_path(&sc, sc.virt[e], fr, path, sizeof path);
-            if (io_image_load(path, IO_U8, 4, &img, &err) != IO_OK || img.width != lw ||
-                img.height != lh) {
-                fprintf(stderr, "llvmpipe_frame: %s: cannot use the virtual image\n", path);
-                return 0;
-            }
-            in->virt[f][e] = xmalloc((size_t)lw * lh * 4);
-            for (int y = 0; y < lh; y++)
-                memcpy(in->virt[f][e] + (size_t)y * lw * 4,
-                       (uint8_t *)img.data + (size_t)y * img.stride, (size_t)lw * 4);
-            io_image_free(&img);
-            in->depth[f][e] = NULL;
-            if (sc.virt_depth[e][0]) {
-                io_scene_frame_path(&sc, sc.virt_depth[e], fr, path, sizeof path);
-                if (io_image_load(path, IO_F32, 1, &img, &err) != IO_OK || img.width != lw ||
-                    img.height != lh) {
-                    fprintf(stderr, "llvmpipe_frame: %s: cannot use the depth image\n", path);
-                    return 0;
-                }
-                in->depth[f][e] = xmalloc(sizeof(float) * lw * lh);
-                for (int y = 0; y < lh; y++)
-                    memcpy(in->depth[f][e] + (size_t)y * lw,
-                           (uint8_t *)img.data + (size_t)y * img.stride, sizeof(float) * lw);
-                io_image_free(&img);
-            }
-        }
     }
     return 1;
 }
