@@ -100,6 +100,16 @@ static int yuv_row_fast(ef_isa isa, const uint8_t *r, int width, int uyvy, uint8
     }
 }
 
+/* Pixels x .. w-1 (x even) of a YUYV row r (Y0 U Y1 V), or (uy 1) UYVY
+ * (U Y0 V Y1): the lumas at uy and 2 + uy; d at pixel 0. */
+static inline void yuv422_px(const uint8_t *r, int x, int w, int uy, uint8_t *d)
+{
+    for (r += 2 * x, d += 4 * x; x < w; x += 2, r += 4, d += 8) {
+        yuv_px(r[uy], r[1 - uy], r[3 - uy], d);
+        yuv_px(r[2 + uy], r[1 - uy], r[3 - uy], d + 4);
+    }
+}
+
 fuse_result fuse_frame_to_rgba(const fuse_frame *s, int y0, fuse_image *out)
 {
     return fuse_frame_to_rgba_isa(s, y0, out, EF_ISA_DEFAULT);
@@ -143,13 +153,11 @@ fuse_result fuse_frame_to_rgba_isa(const fuse_frame *s, int y0, fuse_image *out,
         switch (s->format) {
         case FUSE_FMT_YUYV:
         case FUSE_FMT_UYVY: {
-            /* Y0 U Y1 V, or (uyvy) U Y0 V Y1: the lumas at uy and 2 + uy */
             const int uy = s->format == FUSE_FMT_UYVY;
             x = yuv_row_fast(isa, r, s->width, uy, d);
-            for (r += 2 * x, d += 4 * x; x < s->width; x += 2, r += 4, d += 8) {
-                yuv_px(r[uy], r[1 - uy], r[3 - uy], d);
-                yuv_px(r[2 + uy], r[1 - uy], r[3 - uy], d + 4);
-            }
+            /* a constant uy in each call: the offsets stay immediates */
+            if (uy) yuv422_px(r, x, s->width, 1, d);
+            else yuv422_px(r, x, s->width, 0, d);
             break;
         }
         case FUSE_FMT_GREY:
