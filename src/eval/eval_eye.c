@@ -476,11 +476,12 @@ static void print_table(FILE *f, const eye_ctx *c, const eye_run *R, int n, int 
     }
 }
 
-static int write_csv(const char *path, const eye_ctx *c, const eye_run *R, int n)
+/* dir/name, or (dir NULL) the file name */
+static int write_csv(const char *dir, const char *name, const eye_ctx *c, const eye_run *R,
+                     int n)
 {
     io_out of;
-    io_error err;
-    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (!eval__out_open(&of, dir, "%s", name)) return IO_EXIT_FAIL;
     fprintf(of.f, "distance_cm,hand_depth_cm,method,noise_mm,pos_px,size_pct,size_abs_pct,"
                   "height_pct,crop_geometry_pct,iou,iou_camera_view,psnr_db,ms_per_stereo_frame,"
                   "frames,eyes_with_hand,fallbacks\n");
@@ -491,7 +492,7 @@ static int write_csv(const char *path, const eye_ctx *c, const eye_run *R, int n
                 s.size_abs, s.height, crop_predicted(c, s.depth_cm / 100.0), s.iou, s.iou_seen,
                 s.psnr, s.ms, R[i].n_frames, R[i].n_shape, R[i].fallbacks);
     }
-    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (eval__out_commit(&of)) return IO_EXIT_FAIL;
     return IO_EXIT_OK;
 }
 
@@ -502,13 +503,9 @@ static int write_csv(const char *path, const eye_ctx *c, const eye_run *R, int n
 static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int n,
                         const eval_opts *o)
 {
-    char path[IO_PATH_MAX + 64];
-    snprintf(path, sizeof path, "%s/eyeview.csv", dir);
-    if (write_csv(path, c, R, n)) return IO_EXIT_FAIL;
+    if (write_csv(dir, "eyeview.csv", c, R, n)) return IO_EXIT_FAIL;
     io_out of;
-    io_error err;
-    snprintf(path, sizeof path, "%s/eyeview.md", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (!eval__out_open(&of, dir, "eyeview.md")) return IO_EXIT_FAIL;
     int fr = o->frames < 180 ? o->frames : 180;
     fprintf(of.f, "Eye viewpoint: sequences hold15/20/30/40, %d frames each (one display frame "
                   "in %d of the 3 s), seed %d; tracking noise 0 (the true pose), 5, 10, 20 mm (One "
@@ -521,9 +518,8 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
                   "fingertip depth; ms: pipe_frame, one thread, thread CPU time.\n\n",
             fr, 180 / fr, o->seed);
     print_table(of.f, c, R, n, 1);
-    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
-    snprintf(path, sizeof path, "%s/eyeview.dat", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (eval__out_commit(&of)) return IO_EXIT_FAIL;
+    if (!eval__out_open(&of, dir, "eyeview.dat")) return IO_EXIT_FAIL;
     int blocks = 0;
     char titles[EM_COUNT * NNOISE][48];
     for (int mth = 0; mth < EM_COUNT; mth++)
@@ -543,9 +539,8 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
                      (double)noise_mm[k]);
             fprintf(of.f, "\n\n");
         }
-    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
-    snprintf(path, sizeof path, "%s/eyeview.gp", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (eval__out_commit(&of)) return IO_EXIT_FAIL;
+    if (!eval__out_open(&of, dir, "eyeview.gp")) return IO_EXIT_FAIL;
     FILE *f = of.f;
     static const char *const charts[] = { "eyeview_pos", "eyeview_size", "eyeview_iou",
                                           "eyeview_psnr" };
@@ -581,7 +576,7 @@ static int write_report(const char *dir, const eye_ctx *c, const eye_run *R, int
         if (!blocks) fprintf(f, "NaN notitle");
         fprintf(f, "\n");
     }
-    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (eval__out_commit(&of)) return IO_EXIT_FAIL;
     return eval__gnuplot(dir, "eyeview.gp", charts, NCH);
 }
 
@@ -650,7 +645,7 @@ int eval_eye_run(const eval_opts *o)
            "errors of the hand in the 1280x800 display against the true eye's view\n",
            frames);
     print_table(stdout, &c, R, n, 0);
-    if (o->csv && write_csv(o->csv, &c, R, n)) goto done;
+    if (o->csv && write_csv(NULL, o->csv, &c, R, n)) goto done;
     if (o->report && write_report(o->report, &c, R, n, o)) goto done;
     if (o->report) printf("egofuse eval --eyeview: report in %s (eyeview.csv, eyeview.md, eyeview_pos/size/iou/psnr.png)\n", o->report);
     rc = IO_EXIT_OK;

@@ -278,6 +278,15 @@ void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int 
  * the true mask gets small (a hand leaving the view, docs/accuracy.md). */
 void eval__print_error_area(FILE *f, const method_run *R, int n);
 int eval__write_csv(const char *path, const method_run *R, int n);
+/* Report files go through io_out: complete or absent, a failed write is
+ * "path: write failed: reason" and exit 1 (io.h, OUTPUT FILES).
+ * eval__out_open: the file dir/name (name printf-style; dir NULL: name
+ * alone); its stream, or NULL after the message on stderr.
+ * eval__out_commit: IO_EXIT_OK, or IO_EXIT_FAIL after the message. */
+struct io_out;
+FILE *eval__out_open(struct io_out *o, const char *dir, const char *name, ...)
+    __attribute__((format(printf, 3, 4)));
+int eval__out_commit(struct io_out *o);
 int eval__write_report(const char *dir, const method_run *R, int n, const eval_opts *o,
                        const eval_ctx *c);
 

@@ -41,14 +41,11 @@ int eval__kf_configs(const method_cfg base[4], method_cfg *L, int cap)
 int eval__write_kf(const char *dir, const method_run *R, int n)
 {
     io_out of;
-    io_error err;
     FILE *f = stdout;
     for (int pass = 0; pass < 2; pass++) {
         if (pass == 1) {
-            char path[IO_PATH_MAX + 64];
             if (!dir) break;
-            snprintf(path, sizeof path, "%s/kf.md", dir);
-            if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
+            if (!eval__out_open(&of, dir, "kf.md")) return IO_EXIT_FAIL;
             f = of.f;
         }
         fprintf(f, "%sThe Fresnel fade kf against the opaque ideal composite (the true "
@@ -87,6 +84,6 @@ int eval__write_kf(const char *dir, const method_run *R, int n)
             fprintf(f, "%s%s%g%s\n", row, pass ? " " : "  ", bkf, pass ? " |" : "");
         }
     }
-    if (dir && io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (dir && eval__out_commit(&of)) return IO_EXIT_FAIL;
     return IO_EXIT_OK;
 }

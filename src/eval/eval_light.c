@@ -225,8 +225,7 @@ int eval__write_light(const char *dir, const method_run *R, int n)
     for (int pass = 0; pass < 2; pass++) {
         if (pass == 1) {
             if (!dir) break;
-            snprintf(path, sizeof path, "%s/light.md", dir);
-            if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
+            if (!eval__out_open(&of, dir, "light.md")) return IO_EXIT_FAIL;
             f = of.f;
         }
         fprintf(f, "%sLighting mismatch between the cockpit and the virtual scene (the ideal "
@@ -285,8 +284,7 @@ int eval__write_light(const char *dir, const method_run *R, int n)
         }
     /* light_<axis>.dat: per curve a block of x iou bf3 psnr */
     for (int a = 0; a < 3; a++) {
-        snprintf(path, sizeof path, "%s/light_%s.dat", dir, axes[a]);
-        if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
+        if (!eval__out_open(&of, dir, "light_%s.dat", axes[a])) return IO_EXIT_FAIL;
         for (int q = 0; q < NCURVE; q++) {
             fprintf(of.f, "# %s: %s iou bf3 psnr\n", curve_name[q], axes[a]);
             int any = 0;
@@ -308,11 +306,10 @@ int eval__write_light(const char *dir, const method_run *R, int n)
             if (!any) fprintf(of.f, "nan nan nan nan\n");
             fprintf(of.f, "\n\n");
         }
-        if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
+        if (eval__out_commit(&of)) return IO_EXIT_FAIL;
     }
     /* the chart: IoU (top) and PSNR (bottom) per axis */
-    snprintf(path, sizeof path, "%s/light.gp", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (!eval__out_open(&of, dir, "light.gp")) return IO_EXIT_FAIL;
     f = of.f;
     static const char *const xlab[3] = {"cockpit light intensity, x the matched",
                                         "cockpit light colour temperature, K (matched: 6500)",
@@ -392,7 +389,7 @@ int eval__write_light(const char *dir, const method_run *R, int n)
                 q == 2 ? "refine (refine+tone: the same masks)" : curve_name[q]);
     fprintf(f, "\nunset multiplot\nset border\nset tics\nset grid\nset autoscale\n"
                "set origin 0, 0\nset size 1, 1\n");
-    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (eval__out_commit(&of)) return IO_EXIT_FAIL;
     /* gnuplot, then the chart named only once it decodes whole */
     char cmd[3 * IO_PATH_MAX], tmp[IO_PATH_MAX + 96];
     const long pid = (long)getpid();

@@ -99,11 +99,8 @@ void eval__print_lod(FILE *f, const method_run *R, int n, int markdown)
 
 int eval__write_lod(const char *dir, const method_run *R, int n)
 {
-    char path[IO_PATH_MAX + 64];
-    io_error err;
     io_out of;
-    snprintf(path, sizeof path, "%s/lod.csv", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (!eval__out_open(&of, dir, "lod.csv")) return IO_EXIT_FAIL;
     fprintf(of.f, "method,setting,level_mean,tris_mean,ms_raster_per_eye,iou_vs_full,"
                   "bf1_vs_full,iou,bf1,bf3\n");
     for (int i = 0; i < n; i++) {
@@ -113,12 +110,11 @@ int eval__write_lod(const char *dir, const method_run *R, int n)
                 kind_name[R[i].cfg.kind], R[i].cfg.setting, s.level, s.tris, s.ms_raster,
                 s.iou_full, s.bf1_full, s.iou, s.bf1, s.bf3);
     }
-    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (eval__out_commit(&of)) return IO_EXIT_FAIL;
     /* DIR/lod.dat: per method a block (gnuplot index 0 kin-cal-pred, 1
      * refine) of: triangles, raster ms, IoU vs full, IoU, BF1 vs full,
      * BF1, "setting" */
-    snprintf(path, sizeof path, "%s/lod.dat", dir);
-    if (io_out_open(&of, path, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (!eval__out_open(&of, dir, "lod.dat")) return IO_EXIT_FAIL;
     static const method_kind kinds[2] = {M_KIN_CAL, M_REFINE};
     for (int k = 0; k < 2; k++) {
         fprintf(of.f, "# %s\n", kind_name[kinds[k]]);
@@ -150,6 +146,6 @@ int eval__write_lod(const char *dir, const method_run *R, int n)
         if (!rows) fprintf(of.f, "nan nan nan nan nan nan \"\"\n");
         fprintf(of.f, "\n\n");
     }
-    if (io_out_commit(&of, &err) != IO_OK) return io_term_fail("%s", err.msg);
+    if (eval__out_commit(&of)) return IO_EXIT_FAIL;
     return IO_EXIT_OK;
 }

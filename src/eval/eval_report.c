@@ -7,6 +7,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -43,10 +44,15 @@ void eval__print_calib(FILE *f, const eval_ctx *c)
             (double)c->calib.shoulder_scale, (double)sh);
 }
 
-/* Report files go through io_out: complete or absent, a failed write is
- * "path: write failed: reason" and exit 1 (io.h, OUTPUT FILES). */
-static FILE *out_open(io_out *o, const char *path)
+FILE *eval__out_open(io_out *o, const char *dir, const char *name, ...)
 {
+    char path[IO_PATH_MAX + 128], nm[IO_PATH_MAX + 64];
+    va_list ap;
+    va_start(ap, name);
+    vsnprintf(nm, sizeof nm, name, ap);
+    va_end(ap);
+    if (dir) snprintf(path, sizeof path, "%s/%s", dir, nm);
+    else snprintf(path, sizeof path, "%s", nm);
     io_error err;
     if (io_out_open(o, path, &err) != IO_OK) {
         io_term_fail("%s", err.msg);
@@ -55,7 +61,7 @@ static FILE *out_open(io_out *o, const char *path)
     return o->f;
 }
 
-static int out_commit(io_out *o)
+int eval__out_commit(io_out *o)
 {
     io_error err;
     if (io_out_commit(o, &err) != IO_OK) return io_term_fail("%s", err.msg);
@@ -65,7 +71,7 @@ static int out_commit(io_out *o)
 int eval__write_csv(const char *path, const method_run *R, int n)
 {
     io_out of;
-    FILE *f = out_open(&of, path);
+    FILE *f = eval__out_open(&of, NULL, "%s", path);
     if (!f) return IO_EXIT_FAIL;
     fprintf(f, "method,setting,iou,bf1,bf3,fp_area,fn_area,psnr,ms_per_frame,flicker,group\n");
     for (int i = 0; i < n; i++) {
@@ -74,7 +80,7 @@ int eval__write_csv(const char *path, const method_run *R, int n)
                 kind_name[R[i].cfg.kind], R[i].cfg.setting, s.iou, s.bf1, s.bf3, s.fp, s.fn,
                 s.psnr, s.ms, s.flicker, R[i].cfg.group);
     }
-    return out_commit(&of);
+    return eval__out_commit(&of);
 }
 
 void eval__print_error_area(FILE *f, const method_run *R, int n)
@@ -162,10 +168,8 @@ static int write_group(const char *dir, const char *group, const method_run *R, 
                        const eval_opts *o, sweep_info *si)
 {
     memset(si, 0, sizeof *si);
-    char path[IO_PATH_MAX + 64];
-    snprintf(path, sizeof path, "%s/%s.dat", dir, group);
     io_out of;
-    FILE *f = out_open(&of, path);
+    FILE *f = eval__out_open(&of, dir, "%s.dat", group);
     if (!f) return IO_EXIT_FAIL;
     for (int k = 0; k < 4; k++) {
         fprintf(f, "# %s\n", kind_name[k]);
@@ -210,7 +214,7 @@ static int write_group(const char *dir, const char *group, const method_run *R, 
         if (!m) fprintf(f, "nan nan nan nan nan\n");
         fprintf(f, "\n\n");
     }
-    return out_commit(&of);
+    return eval__out_commit(&of);
 }
 
 /* DIR/sequences.dat: per sequence, IoU then BF(3 px) of the four methods. */
@@ -218,10 +222,8 @@ static int write_sequences(const char *dir, const method_run *R, int n, const ev
                            int has[4])
 {
     memset(has, 0, 4 * sizeof has[0]);
-    char path[IO_PATH_MAX + 64];
-    snprintf(path, sizeof path, "%s/sequences.dat", dir);
     io_out of;
-    FILE *f = out_open(&of, path);
+    FILE *f = eval__out_open(&of, dir, "sequences.dat");
     if (!f) return IO_EXIT_FAIL;
     fprintf(f, "# sequence iou(kin kin-cal-pred skin refine) bf3(same)\n");
     for (int q = 0; gt_sequence_name(q); q++) {
@@ -250,7 +252,7 @@ static int write_sequences(const char *dir, const method_run *R, int n, const ev
         for (int k = 0; k < 4; k++) fprintf(f, " %.5f", bf3[k]);
         fprintf(f, "\n");
     }
-    return out_commit(&of);
+    return eval__out_commit(&of);
 }
 
 /* Runs gnuplot on DIR/charts.gp with its outputs named "<chart>.tmp.<pid>",
@@ -554,9 +556,8 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
     char path[IO_PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/summary.csv", dir);
     if (eval__write_csv(path, R, n)) return IO_EXIT_FAIL;
-    snprintf(path, sizeof path, "%s/table.md", dir);
     io_out of;
-    FILE *f = out_open(&of, path);
+    FILE *f = eval__out_open(&of, dir, "table.md");
     if (!f) return IO_EXIT_FAIL;
     fprintf(f, "Ground truth: sequence %s, tracking noise %g mm, latency %g ms, dropout %g, "
                "calibration error %g, speed %g, seed %d. Frames: %d for the methods (group "
@@ -571,10 +572,9 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
     eval__print_thickness(f, c, R, n);
     fprintf(f, "\n");
     eval__print_table(f, R, n, 1);
-    if (out_commit(&of)) return IO_EXIT_FAIL;
+    if (eval__out_commit(&of)) return IO_EXIT_FAIL;
     /* speed-accuracy points: label, ms, iou, bf3 */
-    snprintf(path, sizeof path, "%s/speed.dat", dir);
-    f = out_open(&of, path);
+    f = eval__out_open(&of, dir, "speed.dat");
     if (!f) return IO_EXIT_FAIL;
     sp_pt *piou = malloc(sizeof *piou * (size_t)(n > 0 ? n : 1));
     sp_pt *pbf = malloc(sizeof *pbf * (size_t)(n > 0 ? n : 1));
@@ -611,7 +611,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
         if (np == np0) fprintf(f, "nan nan nan \"\"\n");
         fprintf(f, "\n\n");
     }
-    if (out_commit(&of)) {
+    if (eval__out_commit(&of)) {
         free(piou);
         free(pbf);
         return IO_EXIT_FAIL;
@@ -631,8 +631,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
         free(pbf);
         return IO_EXIT_FAIL;
     }
-    snprintf(path, sizeof path, "%s/charts.gp", dir);
-    f = out_open(&of, path);
+    f = eval__out_open(&of, dir, "charts.gp");
     if (!f) {
         free(piou);
         free(pbf);
@@ -740,7 +739,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
     }
     if (first) empty_plot(f, "no sequence ran");
     else fprintf(f, "\n");
-    if (out_commit(&of)) return IO_EXIT_FAIL;
+    if (eval__out_commit(&of)) return IO_EXIT_FAIL;
     return write_charts(dir);
 }
 
