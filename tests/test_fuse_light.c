@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../src/cpu/cpu.h"
 #include "../src/fuse/fuse.h"
 #include "../src/fuse/fuse_internal.h"
 
@@ -400,6 +401,107 @@ static void test_light_vs_double_spec(void **state)
     tally_end(", specular cases", &t);
 }
 
+/* The vector kernels' shortcuts for common parameters (fuse_simd.inl): kf
+ * == 0 (+0 or -0) computes no fade, kd, ks, ambient and colours >= 0 no
+ * max0 in the output clamp, an integer s >= 4 no 2^-100 test of the
+ * power, and x2 >= 1 is min(x2, 1) before it. Each ISA of this machine
+ * (EGOFUSE_ISA caps it) gives the reference's bytes on scenes made for
+ * them: the sample scene's two lights, one to four lights with lights
+ * near -V, large colours (P C > 1), every s from 1 to 9 and 20, 64. */
+static void test_light_shortcuts_isa(void **state)
+{
+    static const ef_isa isas[] = { EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512, EF_ISA_NEON };
+    static const float shin[] = { 1, 2, 3, 4, 5, 6, 7, 8, 9, 20, 64, 2.5f };
+    tu_rng r = { 0x5EED0017u };
+    fuse_intrinsics K = intrinsics_for(77, 41);
+    fuse_context_desc d = { EF_ISA_REF, 1 };
+    fuse_context *ref = fuse_context_create(&d), *ctx[4];
+    uint8_t *want = malloc((size_t)77 * 41 * 4);
+    int k, i, c, j, tested = 0, bad = 0;
+    scene s;
+    (void)state;
+    assert_non_null(ref);
+    assert_non_null(want);
+    for (j = 0; j < 4; j++) {
+        d.max_isa = isas[j];
+        ctx[j] = fuse_context_create(&d);
+        assert_non_null(ctx[j]);
+        if (fuse_context_isa(ctx[j]) != isas[j]) {   /* not here, or capped */
+            fuse_context_destroy(ctx[j]);
+            ctx[j] = NULL;
+        }
+    }
+    scene_alloc(&s, 77, 41);
+    for (k = 0; k < 96; k++) {
+        fuse_lighting L = fuse_lighting_default();
+        L.light_count = k % 8 == 0 ? 2 : 1 + k % 4;
+        for (i = 0; i < L.light_count; i++)
+            for (c = 0; c < 3; c++) {
+                L.lights[i].dir[c] = tu_range(&r, -1, 1);
+                L.lights[i].color[c] = tu_range(&r, 0, k % 3 == 0 ? 4.0f : 1.0f);
+            }
+        if (k % 5 == 0) {   /* about -V of the image centre */
+            L.lights[0].dir[0] = tu_range(&r, -0.05f, 0.05f);
+            L.lights[0].dir[1] = tu_range(&r, -0.05f, 0.05f);
+            L.lights[0].dir[2] = -1.0f;
+        }
+        for (c = 0; c < 3; c++) {
+            L.ambient[c] = tu_range(&r, 0, 0.4f);
+            L.tone[c] = tu_range(&r, 0.5f, 1.5f);
+        }
+        L.kd = tu_range(&r, 0, 1);
+        L.ks = tu_range(&r, 0, 1);
+        L.shininess = shin[k % 12];
+        L.kf = k % 4 == 3 ? tu_range(&r, 0, 1) : k % 4 == 2 ? -0.0f : 0.0f;
+        if (k % 8 == 7) L.lights[0].color[k / 8 % 3] = -0.0f;   /* -0: still >= 0 */
+        if (k % 16 == 5) L.ambient[1] = -0.25f;                 /* a negative: the clamp */
+        if (k % 8 == 0) {   /* the sample scene's lighting (build/samples/scene.txt) */
+            static const float dir[2][3] = { { -0.7884f, 0.5781f, 0.2102f },
+                                             { 0.3271f, 0.9345f, 0.1402f } };
+            static const float col[2][3] = { { 0.620f, 0.700f, 0.820f },
+                                             { 0.450f, 0.380f, 0.280f } };
+            for (i = 0; i < 2; i++)
+                for (c = 0; c < 3; c++) {
+                    L.lights[i].dir[c] = dir[i][c];
+                    L.lights[i].color[c] = col[i][c];
+                }
+            L.ambient[0] = 0.28f;
+            L.ambient[1] = 0.30f;
+            L.ambient[2] = 0.32f;
+            L.kd = 0.8f;
+            L.ks = 0.12f;
+            L.shininess = 20.0f;
+            L.kf = 0.0f;
+            L.tone[0] = 1.0f;
+            L.tone[1] = 0.98f;
+            L.tone[2] = 0.96f;
+        }
+        scene_random(&s, &r);
+        assert_int_equal(fuse_context_light(ref, &L, &K, &s.Pi, s.mask, s.w, s.nrm, 3 * s.w, &s.Oi),
+                         FUSE_OK);
+        memcpy(want, s.out, (size_t)77 * 41 * 4);
+        for (j = 0; j < 4; j++) {
+            if (ctx[j] == NULL) continue;
+            memset(s.out, 0xA5, (size_t)77 * 41 * 4);
+            assert_int_equal(fuse_context_light(ctx[j], &L, &K, &s.Pi, s.mask, s.w, s.nrm,
+                                                3 * s.w, &s.Oi), FUSE_OK);
+            tested++;
+            if (memcmp(want, s.out, (size_t)77 * 41 * 4) != 0) {
+                printf("case %d (lights %d, s %g, kf %g) %s: bytes differ from the reference\n",
+                       k, L.light_count, L.shininess, L.kf, ef_isa_name(isas[j]));
+                bad++;
+            }
+        }
+    }
+    printf("NOTE lighting shortcuts: %d case-ISA pairs against the reference, %d differ\n",
+           tested, bad);
+    for (j = 0; j < 4; j++) fuse_context_destroy(ctx[j]);
+    fuse_context_destroy(ref);
+    scene_free(&s);
+    free(want);
+    assert_int_equal(bad, 0);
+}
+
 /* ---- hand-worked single pixels --------------------------------------- */
 
 typedef struct px1 {
@@ -713,6 +815,7 @@ int main(void)
         cmocka_unit_test(test_pow01),
         cmocka_unit_test(test_spec01),
         cmocka_unit_test(test_light_vs_double_spec),
+        cmocka_unit_test(test_light_shortcuts_isa),
         cmocka_unit_test(test_facing_viewer),
         cmocka_unit_test(test_grazing),
         cmocka_unit_test(test_mask_zero),

@@ -251,6 +251,10 @@ typedef struct fuse__light_prep {
     float ambient_t[3];                  /* ambient[c] * kt[c] */
     float kd, ks, shininess, kf;
     int ipow;                 /* fuse__pow_int(shininess) */
+    int c_nonneg;             /* kd, ks, every ambient_t and color_t >= 0 (-0
+                               * included): every C[c] >= -0, so the max0 of
+                               * clamp01(P_c C[c]) changes no output byte (the
+                               * vector kernels skip it; fuse_simd.inl) */
     float tone[3];
     float kt[3];              /* tone[c] * FUSE__INV255 */
     float ifx, ify, cx, cy;   /* 1.0f / fx, 1.0f / fy (one IEEE division) */

@@ -129,6 +129,12 @@ fuse_result fuse__light_prepare(const fuse_lighting *L,
     p->shininess = L->shininess;
     p->ipow = fuse__pow_int(L->shininess);
     p->kf = L->kf;
+    p->c_nonneg = p->kd >= 0.0f && p->ks >= 0.0f;
+    for (c = 0; c < 3; c++) {
+        p->c_nonneg = p->c_nonneg && p->ambient_t[c] >= 0.0f;
+        for (i = 0; i < L->light_count; i++)
+            p->c_nonneg = p->c_nonneg && p->color_t[i][c] >= 0.0f;
+    }
     p->ifx = 1.0f / K->fx;
     p->nifx = -p->ifx;
     p->mo = (0.5f - K->cx) * p->nifx;

@@ -200,6 +200,9 @@ static inline __attribute__((always_inline)) void spec01_lanes(int nl, VF (*x2)[
             pow01_lanes(x2[j], F1(s * 0.5f), fuse__pow_int(s * 0.5f), nu, r[j]);
         return;
     }
+    /* x2 >= 1 -> 1: x2 = min(x2, 1) first (1^k = sqrtf(1) = 1), one
+     * operation instead of a compare and a select */
+    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH x2[j][u] = FMIN1(x2[j][u]);
     _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = F1(1.0f);
     if (n >= 2) {
         VF b[2][U_MAX];
@@ -213,10 +216,12 @@ static inline __attribute__((always_inline)) void spec01_lanes(int nl, VF (*x2)[
         }
     }
     if (n & 1) _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = FMUL(p[j][u], FSQRT(x2[j][u]));
-    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH {   /* the early returns of fuse__spec01 */
-        const VF q = FSEL(FGE(x2[j][u], F1(1.0f)), F1(1.0f), p[j][u]);
-        r[j][u] = FZERO_UNLESS(FGT(x2[j][u], F1(FUSE__POW_MIN)), q);
-    }
+    /* x2 <= 2^-100 -> 0: with n >= 4 (n >> 1 >= 2) every product holds a
+     * factor x2^(2^j), j >= 1, <= 2^-200, which rounds to +0: the result
+     * is +0 without the test (x2 >= +0: a square times a positive). */
+    if (n < 4) _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH
+        r[j][u] = FZERO_UNLESS(FGT(x2[j][u], F1(FUSE__POW_MIN)), p[j][u]);
+    else _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH r[j][u] = p[j][u];
 }
 
 /* Lights i .. i + nl - 1 (nl = 1 or 2, a constant at each call) added to
@@ -275,7 +280,8 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
                                                               VF pyy, int x, int nu,
                                                               const uint8_t *P,
                                                               const uint8_t *mask,
-                                                              const float *normal, uint8_t *out)
+                                                              const float *normal, uint8_t *out,
+                                                              int fres, int nonneg)
 {
     const VF one = F1(1.0f);
     VI Mi[U_MAX], pix;
@@ -321,16 +327,30 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
     if (i < p->light_count)
         light_pair_lanes(p, i, 1, nu, nx, ny, nz, inv, vx, vy, vz, ndv, C0, C1, C2);
     EACH {
-        const VF t = clamp01_lanes(FSUB(one, ndv[u]));
-        const VF t2 = FMUL(t, t);
-        const VF fade = clamp01_lanes(FSUB(one, FMUL(F1(p->kf), FMUL(FMUL(t2, t2), t))));
-        const VF m = FMUL(I2F(Mi[u]), fade);
+        VF m = I2F(Mi[u]);
         VF v0, v1, v2;
         VI rgba;
+        /* kf == 0: fade = clamp01(1 - (+-0)) = 1 and M * 1 = M exactly */
+        if (fres) {
+            const VF t = clamp01_lanes(FSUB(one, ndv[u]));
+            const VF t2 = FMUL(t, t);
+            m = FMUL(m, clamp01_lanes(FSUB(one, FMUL(F1(p->kf), FMUL(FMUL(t2, t2), t)))));
+        }
         pix = LOAD_RGBA(P + 4 * (size_t)(x + u * LANES));
-        v0 = clamp01_lanes(FMUL(I2F(IAND(pix, I1(255))), C0[u]));
-        v1 = clamp01_lanes(FMUL(I2F(IAND(ISRL(pix, 8), I1(255))), C1[u]));
-        v2 = clamp01_lanes(FMUL(I2F(IAND(ISRL(pix, 16), I1(255))), C2[u]));
+        v0 = FMUL(I2F(IAND(pix, I1(255))), C0[u]);
+        v1 = FMUL(I2F(IAND(ISRL(pix, 8), I1(255))), C1[u]);
+        v2 = FMUL(I2F(IAND(ISRL(pix, 16), I1(255))), C2[u]);
+        /* c_nonneg: P_c C[c] >= -0, and max0 would only turn -0 into +0,
+         * which round8 writes as 0 either way (m >= +0: m v is +-0) */
+        if (nonneg) {
+            v0 = FMIN1(v0);
+            v1 = FMIN1(v1);
+            v2 = FMIN1(v2);
+        } else {
+            v0 = clamp01_lanes(v0);
+            v1 = clamp01_lanes(v1);
+            v2 = clamp01_lanes(v2);
+        }
         /* the shifts left by 8, 16, 24 drop the 0x4B of the upper bytes */
         rgba = IOR(IOR(IAND(round_lanes(FMUL(m, v0)), I1(255)), ISLL(round_lanes(FMUL(m, v1)), 8)),
                    IOR(ISLL(round_lanes(FMUL(m, v2)), 16), ISLL(round_lanes(m), 24)));
@@ -345,31 +365,46 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
 
 /* Two vectors a step where both have mask bytes, one where only one has,
  * a zero store where neither has (the reference's M == 0 pixels). Pixels
- * x0 <= x < x1 of the row (fuse__light_span_ref; the pointers at pixel 0). */
+ * x0 <= x < x1 of the row (fuse__light_span_ref; the pointers at pixel 0).
+ * fres: p->kf != 0 (else the fade, exactly 1, is not computed); nonneg:
+ * p->c_nonneg (the output clamp without max0); constants at each call, so
+ * each of the four bodies is compiled without the other cases' work. */
+static inline __attribute__((always_inline)) void light_span_body(
+    const fuse__light_prep *p, int y, VF py, VF pyy, int x, int width, const uint8_t *P,
+    const uint8_t *mask, const float *normal, uint8_t *out, int fres, int nonneg)
+{
+    for (; x + 2 * LANES <= width; x += 2 * LANES) {
+        const int z0 = MASK_ZERO(mask + x), z1 = MASK_ZERO(mask + x + LANES);
+        if (!z0 && !z1) {
+            light_lanes(p, py, pyy, x, 2, P, mask, normal, out, fres, nonneg);
+            continue;
+        }
+        if (z0) STORE_ZERO(out + 4 * (size_t)x);
+        else light_lanes(p, py, pyy, x, 1, P, mask, normal, out, fres, nonneg);
+        if (z1) STORE_ZERO(out + 4 * (size_t)(x + LANES));
+        else light_lanes(p, py, pyy, x + LANES, 1, P, mask, normal, out, fres, nonneg);
+    }
+    for (; x + LANES <= width; x += LANES) {
+        if (MASK_ZERO(mask + x)) STORE_ZERO(out + 4 * (size_t)x);
+        else light_lanes(p, py, pyy, x, 1, P, mask, normal, out, fres, nonneg);
+    }
+    if (x < width)
+        fuse__light_span_ref(p, y, x, width, P, mask, normal, out);
+}
+
 void SIMD_FN(fuse__light_span)(const fuse__light_prep *p, int y, int x0, int width,
                                const uint8_t *P, const uint8_t *mask,
                                const float *normal, uint8_t *out)
 {
     const float pys = (((float)y + 0.5f) - p->cy) * p->ify;
     const VF py = F1(pys), pyy = F1(pys * pys + 1.0f);
-    int x = x0;
-    for (; x + 2 * LANES <= width; x += 2 * LANES) {
-        const int z0 = MASK_ZERO(mask + x), z1 = MASK_ZERO(mask + x + LANES);
-        if (!z0 && !z1) {
-            light_lanes(p, py, pyy, x, 2, P, mask, normal, out);
-            continue;
-        }
-        if (z0) STORE_ZERO(out + 4 * (size_t)x);
-        else light_lanes(p, py, pyy, x, 1, P, mask, normal, out);
-        if (z1) STORE_ZERO(out + 4 * (size_t)(x + LANES));
-        else light_lanes(p, py, pyy, x + LANES, 1, P, mask, normal, out);
+    if (p->kf != 0.0f) {
+        if (p->c_nonneg) light_span_body(p, y, py, pyy, x0, width, P, mask, normal, out, 1, 1);
+        else light_span_body(p, y, py, pyy, x0, width, P, mask, normal, out, 1, 0);
+    } else {
+        if (p->c_nonneg) light_span_body(p, y, py, pyy, x0, width, P, mask, normal, out, 0, 1);
+        else light_span_body(p, y, py, pyy, x0, width, P, mask, normal, out, 0, 0);
     }
-    for (; x + LANES <= width; x += LANES) {
-        if (MASK_ZERO(mask + x)) STORE_ZERO(out + 4 * (size_t)x);
-        else light_lanes(p, py, pyy, x, 1, P, mask, normal, out);
-    }
-    if (x < width)
-        fuse__light_span_ref(p, y, x, width, P, mask, normal, out);
 }
 
 void LIGHT_ROW_NAME(const fuse__light_prep *p, int y, int width,
