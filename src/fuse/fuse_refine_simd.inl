@@ -258,26 +258,28 @@ static void SIMD_FN(refine_decide_row)(const float *s, ptrdiff_t ss, int rad, co
                                        const uint16_t *d, unsigned band3, uint8_t *out, int a,
                                        int b, long cnt[3])
 {
-    const vint vb3 = vi_set1((int)band3), v127 = vi_set1(127);
+    const vint vb3 = vi_set1((int)band3), v127 = vi_set1(127), ff = vi_set1(255);
     long nb = 0, fi = 0, fo = 0;
     int x = a;
     for (; x + SIMD_W - 1 <= b; x += SIMD_W) {
-        const unsigned band = SIMD_FULL & ~vm_bits(vi_gt(vi_load_u16(d + x), vb3));
-        const unsigned in = vm_bits(vi_gt(vi_load_u8(m + x), v127));
-        unsigned v = in;
-        if (band) {
+        const vmask bandm = vm_not(vi_gt(vi_load_u16(d + x), vb3));
+        const vmask inm = vi_gt(vi_load_u8(m + x), v127);
+        vmask v = inm;
+        if (vm_any(bandm)) {
             vfloat sum = vf_zero();
             for (int dy = -rad; dy <= rad; dy++) {
                 const float *r = s + dy * ss + x;
                 for (int dx = -rad; dx <= rad; dx++) sum = vf_add(sum, vf_loadu(r + dx));
             }
-            const unsigned pos = vm_bits(vf_gt(sum, vf_zero()));
-            v = (in & ~band) | (pos & band);
+            const vmask posm = vf_gt(sum, vf_zero());
+            v = vm_or(vm_andnot(bandm, inm), vm_and(posm, bandm));
+            const unsigned band = vm_bits(bandm), in = vm_bits(inm), pos = vm_bits(posm);
             nb += __builtin_popcount(band);
             fi += __builtin_popcount(band & pos & ~in);
             fo += __builtin_popcount(band & ~pos & in & SIMD_FULL);
         }
-        for (int j = 0; j < SIMD_W; j++) out[x + j] = (v >> j) & 1u ? 255 : 0;
+        /* the lanes' bytes: 255 where set, else 0 */
+        vi_store_u8(out + x, vi_sel(v, ff, vi_zero()));
     }
     cnt[0] += nb;
     cnt[1] += fi;
