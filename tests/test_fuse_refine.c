@@ -540,9 +540,10 @@ static void chamfer_row(tu_rng *g, uint16_t *r, int n, unsigned cap)
 static void test_chamfer_rows(void **state)
 {
     (void)state;
-    /* capped: the kernel takes r[a - 1] / r[b + 1] as the cap (AVX-512's
-     * own scan; the driver's rows hold the cap outside [a, b]): only the
-     * rows with the cap there; the others read them, any value */
+    /* capped: the kernel does not read r[a - 1] / r[b + 1] (AVX-512's own
+     * scan: right where they hold the cap, as the driver's rows do outside
+     * [a, b]): only the rows with the cap there; the others read them,
+     * any value */
     struct { const char *name; ef_isa isa; const fuse__refine_kern *k; int capped; } paths[] = {
         { "portable", EF_ISA_SSE2, &fuse__refine_kern_c, 0 },
         { "avx2", EF_ISA_AVX2, fuse__refine_kern_avx2(), 0 },
