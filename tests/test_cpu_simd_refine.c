@@ -1,7 +1,7 @@
 /* test_cpu_simd_refine.c - the refine ops of the vector layer
  * (src/cpu/simd.h, "REFINE OPS": vb_loadu/storeu, vb_sign_bits,
  * vb_sign_fill, vh_load_u8, vh_loadu/storeu, vh_min_u, vh_adds_u,
- * vh_any_leu, vi_load_u16) of every implementation this machine runs
+ * vh_any_leu, vi_load_u16, vh_runmin3_up/_dn) of every implementation this machine runs
  * (sse2, avx2, avx512 on x86-64; neon on aarch64, under qemu-aarch64 in
  * CI) against a scalar model of the contract, lane by lane. Seeded inputs
  * with the edges mixed in (0, 1, 127, 128, 255, 0x7FFF, 0x8000, 0xFFFF);
@@ -18,7 +18,7 @@
 
 static const char *const names[QC_COUNT] = {
     "vb_sign_bits", "vb_sign_fill", "vh_load_u8", "vh_min_u", "vh_adds_u", "vh_any_leu",
-    "vi_load_u16",
+    "vi_load_u16", "vh_runmin3_up", "vh_runmin3_dn",
 };
 
 /* the model of element k of op's output, as uint32 */
@@ -39,6 +39,23 @@ static uint32_t model(int op, const uint16_t *a, const uint16_t *b, int k, int W
         return 0;
     }
     case QC_LOAD_U16: return a[k];
+    case QC_H_RUNMIN3_UP: case QC_H_RUNMIN3_DN: {
+        /* the chamfer's scalar running minimum over the vector's lanes, in
+         * exact integers, the carry b[first lane] before lane 0 / after
+         * the last lane */
+        const int v0 = k - k % vh;
+        uint32_t m = a[k];
+        if (op == QC_H_RUNMIN3_UP) {
+            for (int j = v0; j < k; j++)
+                if (a[j] + 3u * (uint32_t)(k - j) < m) m = a[j] + 3u * (uint32_t)(k - j);
+            if (b[v0] + 3u * (uint32_t)(k - v0 + 1) < m) m = b[v0] + 3u * (uint32_t)(k - v0 + 1);
+        } else {
+            for (int j = k + 1; j < v0 + vh; j++)
+                if (a[j] + 3u * (uint32_t)(j - k) < m) m = a[j] + 3u * (uint32_t)(j - k);
+            if (b[v0] + 3u * (uint32_t)(v0 + vh - k) < m) m = b[v0] + 3u * (uint32_t)(v0 + vh - k);
+        }
+        return m;
+    }
     }
     return 0xDEADBEEFu;
 }
@@ -73,6 +90,14 @@ static void check_isa(void **state)
                        : (uint16_t)tu_xorshift(&s);
                 /* odd rounds: b below a, so that a row's any-<= is often false
                  * (and true by a single lane where a is 0 or a planted one) */
+                /* the running minima: half the rounds chamfer-like rows
+                 * (small rising / falling values, caps), so that long
+                 * chains of +3 win; the others the full range */
+                if ((op == QC_H_RUNMIN3_UP || op == QC_H_RUNMIN3_DN) && round % 2) {
+                    const unsigned r = tu_xorshift(&s) % 8u;
+                    a[i] = r == 0 ? 387u : r == 1 ? 3u : (uint16_t)(tu_xorshift(&s) % 400u);
+                    b[i] = (uint16_t)(tu_xorshift(&s) % 64u);
+                }
                 if (op == QC_H_ANY_LEU && round % 2) {
                     a[i] = (uint16_t)(a[i] | 1u);
                     b[i] = (uint16_t)(a[i] - 1u);

@@ -10,7 +10,9 @@
  * refinement that mixes it in; the band-only paths (portable, AVX2,
  * AVX-512, NEON under qemu-aarch64: fuse_refine_mask_isa) byte for byte and stat for stat against
  * the scalar reference on 400 seeded random cases each (skipped where the
- * CPU lacks the ISA), and the reference's CRC on the disc scene. */
+ * CPU lacks the ISA), each path's chamfer row passes (dt_fwd / dt_bwd, the
+ * vertical part and the running minimum) against a scalar model on seeded
+ * rows, and the reference's CRC on the disc scene. */
 #include "support/testutil.h"
 #include <cmocka.h>
 
@@ -20,6 +22,7 @@
 
 #include "../src/fuse/fuse_metrics.h"
 #include "../src/fuse/fuse_refine.h"
+#include "../src/fuse/fuse_refine_kern.h"
 
 enum { W = 160, H = 120 };
 /* CRC-32 of the reference's output in test_refine_crc */
@@ -493,6 +496,114 @@ static void test_fast_avx2(void **state) { (void)state; check_isa(EF_ISA_AVX2); 
 static void test_fast_avx512(void **state) { (void)state; check_isa(EF_ISA_AVX512); }
 static void test_fast_neon(void **state) { (void)state; check_isa(EF_ISA_NEON); }
 
+/* The chamfer row passes of fuse_refine_kern.h as the reference
+ * (fuse_refine.c) states them: the vertical part on [a, b], then the
+ * running minimum, the row's first (forward) / last (backward) pixel kept. */
+static unsigned min3u(unsigned m, unsigned v) { return v < m ? v : m; }
+static void model_pass(uint16_t *r, const uint16_t *v, int w, int a, int b, int fwd)
+{
+    if (v)
+        for (int x = a; x <= b; x++) {
+            unsigned m = min3u(r[x], v[x] + 3u);
+            if (x > 0) m = min3u(m, v[x - 1] + 4u);
+            if (x + 1 < w) m = min3u(m, v[x + 1] + 4u);
+            r[x] = (uint16_t)m;
+        }
+    if (fwd)
+        for (int x = a > 0 ? a : 1; x <= b; x++) r[x] = (uint16_t)min3u(r[x], r[x - 1] + 3u);
+    else
+        for (int x = b + 1 < w ? b : w - 2; x >= a; x--)
+            r[x] = (uint16_t)min3u(r[x], r[x + 1] + 3u);
+}
+
+/* a chamfer-like row: edges (3), caps, short slopes and noise in 0..cap */
+static void chamfer_row(tu_rng *g, uint16_t *r, int n, unsigned cap)
+{
+    for (int x = 0; x < n;) {
+        const int run = 1 + tu_int(g, 40), kind = tu_int(g, 5);
+        unsigned v = (unsigned)tu_int(g, (int)cap + 1);
+        for (int i = 0; i < run && x < n; i++, x++) {
+            unsigned o = kind == 0 ? cap : kind == 1 ? 3u : kind == 2 ? (unsigned)tu_int(g, (int)cap + 1)
+                                                                     : v;
+            if (kind == 3) v = v + 3u + (unsigned)tu_int(g, 3) > cap ? cap : v + 3u + (unsigned)tu_int(g, 3);
+            if (kind == 4) v = v < 4u ? 3u : v - 3u - (unsigned)tu_int(g, 2);
+            r[x] = (uint16_t)o;
+        }
+    }
+}
+
+/* Every path's dt_fwd / dt_bwd against model_pass on 6000 seeded rows:
+ * widths 1..300 (not multiples of the vectors), [a, b] anywhere (both
+ * borders included), with and without the neighbouring row, caps
+ * 3 (band + margin + 1) for band, margin 1..64; the whole row compared
+ * (outside [a, b] untouched), guards around it. */
+static void test_chamfer_rows(void **state)
+{
+    (void)state;
+    /* capped: the kernel does not read r[a - 1] / r[b + 1] (AVX-512's own
+     * scan: right where they hold the cap, as the driver's rows do outside
+     * [a, b]): only the rows with the cap there; the others read them,
+     * any value */
+    struct { const char *name; ef_isa isa; const fuse__refine_kern *k; int capped; } paths[] = {
+        { "portable", EF_ISA_SSE2, &fuse__refine_kern_c, 0 },
+        { "avx2", EF_ISA_AVX2, fuse__refine_kern_avx2(), 0 },
+        { "avx512", EF_ISA_AVX512, fuse__refine_kern_avx512(), 1 },
+        { "neon", EF_ISA_NEON, fuse__refine_kern_neon(), 0 },
+    };
+    enum { MAXW = 300, G = 40 };
+    static uint16_t r0[MAXW + 2 * G], v0[MAXW + 2 * G], want[MAXW + 2 * G], got[MAXW + 2 * G];
+    int ran = 0;
+    for (size_t p = 0; p < sizeof paths / sizeof paths[0]; p++) {
+        if (!paths[p].k || (paths[p].isa != EF_ISA_SSE2 &&
+                            (!ef_cpu_has(paths[p].isa) || ef_isa_choose(paths[p].isa) != paths[p].isa))) {
+            print_message("SKIP chamfer rows %s: not available here (or capped by EGOFUSE_ISA)\n",
+                          paths[p].name);
+            continue;
+        }
+        tu_rng g = { 0xC4A3F3u };
+        long px = 0, changed = 0, rows = 0;
+        for (int c = 0; c < 6000; c++) {
+            const int w = c < 300 ? 1 + c : 1 + tu_int(&g, MAXW);
+            int a = tu_int(&g, w), b = tu_int(&g, w);
+            if (tu_int(&g, 4) == 0) a = 0;
+            if (tu_int(&g, 4) == 0) b = w - 1;
+            if (a > b) { const int t = a; a = b; b = t; }
+            const unsigned cap = 3u * (unsigned)(2 + tu_int(&g, 64) + tu_int(&g, 64));
+            const int fwd = c & 1, hasv = tu_int(&g, 4) != 0;
+            for (int i = 0; i < MAXW + 2 * G; i++) r0[i] = v0[i] = (uint16_t)(0xA000u + (unsigned)i);
+            chamfer_row(&g, r0 + G, w, cap);
+            chamfer_row(&g, v0 + G, w, cap);
+            /* half the rows: the cap outside [a, b], as the driver's */
+            if (tu_int(&g, 2) == 0) {
+                for (int x = 0; x < a; x++) r0[G + x] = (uint16_t)cap;
+                for (int x = b + 1; x < w; x++) r0[G + x] = (uint16_t)cap;
+            } else if (paths[p].capped) {
+                continue;
+            }
+            memcpy(want, r0, sizeof r0);
+            memcpy(got, r0, sizeof r0);
+            model_pass(want + G, hasv ? v0 + G : NULL, w, a, b, fwd);
+            (fwd ? paths[p].k->dt_fwd : paths[p].k->dt_bwd)(got + G, hasv ? v0 + G : NULL, w, a, b);
+            for (int i = 0; i < MAXW + 2 * G; i++) {
+                if (got[i] != want[i]) {
+                    print_message("FAIL chamfer rows %s case %d (%s, w %d, [%d, %d], %s): "
+                                  "x %d got %u want %u\n", paths[p].name, c, fwd ? "fwd" : "bwd",
+                                  w, a, b, hasv ? "row" : "no row", i - G, got[i], want[i]);
+                    fail();
+                }
+                changed += want[i] != r0[i];
+            }
+            px += b - a + 1;
+            rows++;
+        }
+        print_message("chamfer rows %s: %ld rows, %ld pixels, %ld changed by the passes\n",
+                      paths[p].name, rows, px, changed);
+        assert_true(changed > px / 20);
+        ran++;
+    }
+    assert_true(ran >= 1);
+}
+
 /* The disc scene with a shifted kinematic mask (defaults, band 5 and 16):
  * the reference's bytes as a constant (the result of the whole-image
  * implementation this path replaced), and every path available gives them. */
@@ -542,6 +653,7 @@ int main(void)
         cmocka_unit_test(test_fast_avx2),
         cmocka_unit_test(test_fast_neon),
         cmocka_unit_test(test_fast_avx512),
+        cmocka_unit_test(test_chamfer_rows),
         cmocka_unit_test(test_refine_crc),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

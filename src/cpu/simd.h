@@ -284,6 +284,18 @@
  *   vi_load_u16(p)           int32 lane l = p[l] (uint16_t *p, any
  *                            alignment), zero-extended; reads exactly
  *                            SIMD_W uint16
+ *   vh_runmin3_up(i, c)      16-bit lane l = min(i_l, i_j + 3 (l - j) for
+ *                            j < l, c + 3 (l + 1)): the chamfer's forward
+ *                            running minimum r[x] = min(r[x], r[x-1] + 3)
+ *                            over the VH_W lanes, c (0..65535) being
+ *                            r[x - 1] before lane 0 (65535: none); exact
+ *                            (the sums saturate at 65535, which never wins
+ *                            against i_l); a log-step scan, shifts of 1, 2,
+ *                            4, ... lanes filled with 65535 and +3, +6,
+ *                            +12, ... saturating
+ *   vh_runmin3_dn(i, c)      the mirror: lane l = min(i_l, i_j + 3 (j - l)
+ *                            for j > l, c + 3 (VH_W - l)), c the value
+ *                            after the last lane (the backward pass)
  *
  * REPROJ OPS (added for src/pipe's reprojection taps, pipe_reproj_simd.inl;
  * a separate block at the end of each implementation)

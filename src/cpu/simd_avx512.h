@@ -333,6 +333,41 @@ SIMD_INL vint vi_load_u16(const uint16_t *p)
 {
     return _mm512_cvtepu16_epi32(_mm256_loadu_si256((const __m256i *)(const void *)p));
 }
+/* the chamfer's running minima: lane l takes lane l - k (up) or l + k
+ * (dn) by vpermw, the lanes beyond the vector 65535 (the mask's blend) */
+SIMD_INL __m512i vh__lane_idx(int k)
+{
+    static const uint16_t iota[32] = { 0,  1,  2,  3,  4,  5,  6,  7,  8,  9,  10,
+                                       11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21,
+                                       22, 23, 24, 25, 26, 27, 28, 29, 30, 31 };
+    return _mm512_sub_epi16(_mm512_loadu_si512((const void *)iota), _mm512_set1_epi16((short)k));
+}
+SIMD_INL vint vh_runmin3_up(vint i, unsigned c)
+{
+    const __m512i f = _mm512_set1_epi16(-1);
+    __m512i t = i;
+    for (int k = 1, s = 3; k < 32; k *= 2, s *= 2)
+        t = _mm512_min_epu16(t, _mm512_adds_epu16(_mm512_mask_permutexvar_epi16(
+                                                      f, (__mmask32)(0xFFFFFFFFu << k),
+                                                      vh__lane_idx(k), t),
+                                                  _mm512_set1_epi16((short)s)));
+    const __m512i l3 = _mm512_mullo_epi16(vh__lane_idx(-1), _mm512_set1_epi16(3));   /* 3 (l + 1) */
+    return _mm512_min_epu16(t, _mm512_adds_epu16(_mm512_set1_epi16((short)c), l3));
+}
+SIMD_INL vint vh_runmin3_dn(vint i, unsigned c)
+{
+    const __m512i f = _mm512_set1_epi16(-1);
+    __m512i t = i;
+    for (int k = 1, s = 3; k < 32; k *= 2, s *= 2)
+        t = _mm512_min_epu16(t, _mm512_adds_epu16(_mm512_mask_permutexvar_epi16(
+                                                      f, (__mmask32)(0xFFFFFFFFu >> k),
+                                                      vh__lane_idx(-k), t),
+                                                  _mm512_set1_epi16((short)s)));
+    /* 3 (32 - l) */
+    const __m512i l3 = _mm512_mullo_epi16(_mm512_sub_epi16(_mm512_set1_epi16(32), vh__lane_idx(0)),
+                                          _mm512_set1_epi16(3));
+    return _mm512_min_epu16(t, _mm512_adds_epu16(_mm512_set1_epi16((short)c), l3));
+}
 
 
 /* ---- reprojection ops (src/pipe's taps, pipe_reproj_simd.inl; simd.h

@@ -39,7 +39,9 @@ typedef struct fuse__refine_kern {
                     int w, int a, int b, uint16_t cap, uint16_t *d);
     /* Forward chamfer pass on [a, b] of row r (u: the row above, NULL on
      * the first row); r[a - 1] (when a > 0) and u[a - 1 .. b + 1] hold
-     * valid values. */
+     * valid values (the AVX-512 kernel does not read r[a - 1] / r[b + 1]:
+     * right where they hold the cap, as the driver's rows do outside
+     * [a, b]; the others read them). */
     void (*dt_fwd)(uint16_t *r, const uint16_t *u, int w, int a, int b);
     /* Backward pass, dn the row below (NULL on the last row). */
     void (*dt_bwd)(uint16_t *r, const uint16_t *dn, int w, int a, int b);

@@ -4,13 +4,14 @@
  * look-ups) and included by fuse_refine_avx2.c, fuse_refine_avx512.c and
  * fuse_refine_neon.c after their simd_*.h. Same bytes as the reference
  * (tests/test_fuse_refine.c). Whole vectors inside the row; the few pixels
- * at a row's ends (and the histogram, the running minimum of the chamfer
- * passes) go through the portable kernels, which give the same values:
+ * at a row's ends (and the histogram) go through the portable kernels,
+ * which give the same values:
  *   edges      VB_W mask pixels per step: inside is the byte's bit 7, so
  *              the edge is bit 7 of (m^l)|(m^r)|(m^u)|(m^d), its bits by
  *              vb_sign_bits (pmovmskb);
  *   dt_init    VH_W per step, the same rule on 16-bit lanes;
- *   chamfer    the vertical minimum VH_W distances per step;
+ *   chamfer    the vertical minimum and the running minimum (a log-step
+ *              scan, vh_runmin3_up / _dn) VH_W distances per step;
  *   ring skip  VH_W distances per step;
  *   scores     SIMD_W per step: colour bins in lanes (refine_bins), the
  *              table look-ups by vf_gather_m (the band's lanes), the
@@ -128,34 +129,66 @@ static void SIMD_FN(refine_dt_init)(const uint8_t *up, const uint8_t *row, const
     if (x <= b) KC.dt_init(up, row, dn, w, x, b, cap, d);
 }
 
-/* the vertical part on [a, b]: min(r, v + 3, v[-1] + 4, v[+1] + 4), vectors
- * inside, the portable rule at the ends; the saturating add gives the
- * reference's minimum (v + k > 65535 never wins against r <= 65535) */
-static void SIMD_FN(refine_vert_row)(uint16_t *r, const uint16_t *v, int w, int a, int b)
+/* the vertical part of VH_W lanes at x (1 <= x, x + VH_W < w): min(r, v + 3,
+ * v[-1] + 4, v[+1] + 4); the saturating add gives the reference's minimum
+ * (v + k > 65535 never wins against r <= 65535) */
+SIMD_INL vint SIMD_FN(refine_vert)(vint m, const uint16_t *v, int x)
 {
-    const vint three = vh_set1(3), four = vh_set1(4);
-    int x = a;
-    for (; x <= b && x < 1; x++) r[x] = fuse__refine_vert_px(r, v, w, x);
-    for (; x + VH_W - 1 <= b && x + VH_W < w; x += VH_W) {
-        vint m = vh_loadu(r + x);
-        m = vh_min_u(m, vh_adds_u(vh_loadu(v + x), three));
-        m = vh_min_u(m, vh_adds_u(vh_loadu(v + x - 1), four));
-        m = vh_min_u(m, vh_adds_u(vh_loadu(v + x + 1), four));
-        vh_storeu(r + x, m);
-    }
-    for (; x <= b; x++) r[x] = fuse__refine_vert_px(r, v, w, x);
+    m = vh_min_u(m, vh_adds_u(vh_loadu(v + x), vh_set1(3)));
+    m = vh_min_u(m, vh_adds_u(vh_loadu(v + x - 1), vh_set1(4)));
+    return vh_min_u(m, vh_adds_u(vh_loadu(v + x + 1), vh_set1(4)));
 }
 
+/* A chamfer row pass in one sweep: VH_W lanes per step get the vertical
+ * part (v: the row above / below, NULL: none), then the running minimum
+ * (vh_runmin3_up / _dn, the carry the pixel before the vector, 65535 when
+ * the reference's loop leaves the row's first / last pixel alone); pixel
+ * 0 / w - 1 and what the vectors do not cover go through the portable
+ * kernel, which then reads the neighbour already final. Pixel x's vertical
+ * part reads only r[x] and v, so doing it per vector gives the portable
+ * kernel's values. */
 static void SIMD_FN(refine_dt_fwd)(uint16_t *r, const uint16_t *u, int w, int a, int b)
 {
-    if (u) SIMD_FN(refine_vert_row)(r, u, w, a, b);
-    KC.dt_fwd(r, NULL, w, a, b);   /* the running minimum */
+    int x = a;
+    if (x == 0 && u) {   /* pixel 0: no left neighbour; the running minimum keeps it */
+        r[0] = fuse__refine_vert_px(r, u, w, 0);
+        x = 1;
+    }
+    unsigned c = x > 0 ? r[x - 1] : 0xFFFFu;
+    if (u)
+        for (; x + VH_W - 1 <= b && x + VH_W < w; x += VH_W) {
+            vh_storeu(r + x, vh_runmin3_up(SIMD_FN(refine_vert)(vh_loadu(r + x), u, x), c));
+            c = r[x + VH_W - 1];
+        }
+    else
+        for (; x + VH_W - 1 <= b; x += VH_W) {
+            vh_storeu(r + x, vh_runmin3_up(vh_loadu(r + x), c));
+            c = r[x + VH_W - 1];
+        }
+    if (x <= b) KC.dt_fwd(r, u, w, x, b);
 }
 
 static void SIMD_FN(refine_dt_bwd)(uint16_t *r, const uint16_t *dn, int w, int a, int b)
 {
-    if (dn) SIMD_FN(refine_vert_row)(r, dn, w, a, b);
-    KC.dt_bwd(r, NULL, w, a, b);
+    int x = b;   /* the last pixel not done */
+    if (x == w - 1 && dn) {   /* pixel w - 1: no right neighbour; kept by the minimum */
+        r[x] = fuse__refine_vert_px(r, dn, w, x);
+        x--;
+    }
+    unsigned c = x + 1 < w ? r[x + 1] : 0xFFFFu;
+    if (dn)
+        for (; x - (VH_W - 1) >= a && x - (VH_W - 1) >= 1; x -= VH_W) {
+            const int x0 = x - (VH_W - 1);
+            vh_storeu(r + x0, vh_runmin3_dn(SIMD_FN(refine_vert)(vh_loadu(r + x0), dn, x0), c));
+            c = r[x0];
+        }
+    else
+        for (; x - (VH_W - 1) >= a; x -= VH_W) {
+            const int x0 = x - (VH_W - 1);
+            vh_storeu(r + x0, vh_runmin3_dn(vh_loadu(r + x0), c));
+            c = r[x0];
+        }
+    if (x >= a) KC.dt_bwd(r, dn, w, a, x);
 }
 
 static void SIMD_FN(refine_hist_row)(const uint8_t *px, const uint8_t *m, const uint16_t *d,
@@ -225,26 +258,28 @@ static void SIMD_FN(refine_decide_row)(const float *s, ptrdiff_t ss, int rad, co
                                        const uint16_t *d, unsigned band3, uint8_t *out, int a,
                                        int b, long cnt[3])
 {
-    const vint vb3 = vi_set1((int)band3), v127 = vi_set1(127);
+    const vint vb3 = vi_set1((int)band3), v127 = vi_set1(127), ff = vi_set1(255);
     long nb = 0, fi = 0, fo = 0;
     int x = a;
     for (; x + SIMD_W - 1 <= b; x += SIMD_W) {
-        const unsigned band = SIMD_FULL & ~vm_bits(vi_gt(vi_load_u16(d + x), vb3));
-        const unsigned in = vm_bits(vi_gt(vi_load_u8(m + x), v127));
-        unsigned v = in;
-        if (band) {
+        const vmask bandm = vm_not(vi_gt(vi_load_u16(d + x), vb3));
+        const vmask inm = vi_gt(vi_load_u8(m + x), v127);
+        vmask v = inm;
+        if (vm_any(bandm)) {
             vfloat sum = vf_zero();
             for (int dy = -rad; dy <= rad; dy++) {
                 const float *r = s + dy * ss + x;
                 for (int dx = -rad; dx <= rad; dx++) sum = vf_add(sum, vf_loadu(r + dx));
             }
-            const unsigned pos = vm_bits(vf_gt(sum, vf_zero()));
-            v = (in & ~band) | (pos & band);
+            const vmask posm = vf_gt(sum, vf_zero());
+            v = vm_or(vm_andnot(bandm, inm), vm_and(posm, bandm));
+            const unsigned band = vm_bits(bandm), in = vm_bits(inm), pos = vm_bits(posm);
             nb += __builtin_popcount(band);
             fi += __builtin_popcount(band & pos & ~in);
             fo += __builtin_popcount(band & ~pos & in & SIMD_FULL);
         }
-        for (int j = 0; j < SIMD_W; j++) out[x + j] = (v >> j) & 1u ? 255 : 0;
+        /* the lanes' bytes: 255 where set, else 0 */
+        vi_store_u8(out + x, vi_sel(v, ff, vi_zero()));
     }
     cnt[0] += nb;
     cnt[1] += fi;

@@ -17,6 +17,8 @@ enum {
     QC_H_ADDS_U,   /* uint16: vh_adds_u(a, b) */
     QC_H_ANY_LEU,  /* uint16: out[first lane of each VH_W] = vh_any_leu(a, b), others 0 */
     QC_LOAD_U16,   /* a's uint16 to out's uint32: vi_storeu(vi_load_u16) */
+    QC_H_RUNMIN3_UP, /* uint16: vh_runmin3_up(a, b[first lane of the vector]) */
+    QC_H_RUNMIN3_DN, /* uint16: vh_runmin3_dn(a, b[first lane of the vector]) */
     QC_COUNT
 };
 

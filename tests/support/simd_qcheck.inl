@@ -47,6 +47,12 @@ int QC_NAME(int op, const uint16_t *a, const uint16_t *b, int n, uint32_t *out)
         for (int v = 0; v + SIMD_W <= n; v += SIMD_W)
             vi_storeu((int32_t *)(void *)(out + v), vi_load_u16(a + v));
         break;
+    case QC_H_RUNMIN3_UP:
+        for (int v = 0; v + VH_W <= n; v += VH_W) vh_storeu(oh + v, vh_runmin3_up(vh_loadu(a + v), b[v]));
+        break;
+    case QC_H_RUNMIN3_DN:
+        for (int v = 0; v + VH_W <= n; v += VH_W) vh_storeu(oh + v, vh_runmin3_dn(vh_loadu(a + v), b[v]));
+        break;
     default: return -1;
     }
     return SIMD_W;
