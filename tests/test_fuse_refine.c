@@ -568,7 +568,8 @@ static void test_chamfer_rows(void **state)
             if (tu_int(&g, 4) == 0) a = 0;
             if (tu_int(&g, 4) == 0) b = w - 1;
             if (a > b) { const int t = a; a = b; b = t; }
-            const unsigned cap = 3u * (unsigned)(2 + tu_int(&g, 64) + tu_int(&g, 64));
+            const int c1 = tu_int(&g, 64), c2 = tu_int(&g, 64); /* in this order */
+            const unsigned cap = 3u * (unsigned)(2 + c1 + c2);
             const int fwd = c & 1, hasv = tu_int(&g, 4) != 0;
             for (int i = 0; i < MAXW + 2 * G; i++) r0[i] = v0[i] = (uint16_t)(0xA000u + (unsigned)i);
             chamfer_row(&g, r0 + G, w, cap);
