@@ -455,7 +455,7 @@ static void test_light_shortcuts_isa(void **state)
         L.kf = k % 4 == 3 ? tu_range(&r, 0, 1) : k % 4 == 2 ? -0.0f : 0.0f;
         if (k % 8 == 7) L.lights[0].color[k / 8 % 3] = -0.0f;   /* -0: still >= 0 */
         if (k % 16 == 5) L.ambient[1] = -0.25f;                 /* a negative: the clamp */
-        if (k % 8 == 0) {   /* the sample scene's lighting (build/samples/scene.txt) */
+        if (k % 8 == 0) {   /* the sample scene's two lights, as its scene file gives them */
             static const float dir[2][3] = { { -0.7884f, 0.5781f, 0.2102f },
                                              { 0.3271f, 0.9345f, 0.1402f } };
             static const float col[2][3] = { { 0.620f, 0.700f, 0.820f },
