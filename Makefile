@@ -75,8 +75,9 @@ EVAL_SRC := $(wildcard src/eval/*.c)
 GEN_SRC  := $(wildcard samples/gen/*.c)
 GT_SRC   := $(wildcard samples/gt/*.c)
 TEST_SRC := $(wildcard tests/test_*.c)
-# Tests of the io library, the samples or the VM: not part of core-tests.
-IO_TEST_SRC := $(shell grep -lE 'src/io/|samples/' $(TEST_SRC)) tests/test_vm.c
+# Tests of the io library, the samples, the program or the VM: not part of
+# core-tests. scripts/io_tests.pl reads the code without its comments.
+IO_TEST_SRC := $(shell perl scripts/io_tests.pl $(TEST_SRC)) tests/test_vm.c
 CORE_TEST_SRC := $(filter-out $(IO_TEST_SRC),$(TEST_SRC))
 TEST_SHARED := $(wildcard tests/support/*.c)
 BENCH_SRC := $(wildcard bench/bench_*.c)
