@@ -386,13 +386,18 @@ static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
                 if ((c == 0 || c == ~0ull) &&
                     ((c ^ fit_ld8(row + x - margin)) | (c ^ fit_ld8(row + x + margin)) |
                      (c ^ fit_ld8(up + x)) | (c ^ fit_ld8(dn + x))) == 0) {
-                    float *hist = c ? af : ab;
-                    for (int k = 0; k < 8; k += 2) {
-                        const unsigned bb = fit_bin(src + 4 * (x + k), bits);
-                        if (c && old && old[bb] < rej) continue;
-                        hist[bb] += 1.0f;
-                        if (c) nf++;
-                        else nb++;
+                    if (!c || !old) {
+                        float *hist = c ? af : ab;
+                        for (int k = 0; k < 8; k += 2) hist[fit_bin(src + 4 * (x + k), bits)] += 1.0f;
+                        if (c) nf += 4;
+                        else nb += 4;
+                    } else {
+                        for (int k = 0; k < 8; k += 2) {
+                            const unsigned bb = fit_bin(src + 4 * (x + k), bits);
+                            if (old[bb] < rej) continue;
+                            af[bb] += 1.0f;
+                            nf++;
+                        }
                     }
                     x += 6;
                     continue;
