@@ -592,6 +592,65 @@ static void learn_memory_keeps_background(void **state)
     arms_free(&A);
 }
 
+/* The learning's rejection (PIPE_FIT_LEARN_REJECT, edge6): the beige pad
+ * of the test above, background for 10 frames, then inside both masks for
+ * 30 frames (egofuse eval's edge: the kinematic hand beside the true one
+ * over the skin-coloured folder, the refined mask keeping it). Kept over
+ * frames alone (learn_memory), the pad's background counts decay and its
+ * arm counts grow, and it becomes arm (llr > 0 from about frame 16); the
+ * rejection leaves its samples out while the model calls it background,
+ * so it stays so. Skin stays arm; a colour the model has never seen (the
+ * bins' offset, >= -1) is still learned as arm. */
+static void learn_rejects_background_bins(void **state)
+{
+    (void)state;
+    arms A;
+    arms_build(&A);
+    uint8_t *rgba = malloc(4 * W * H), *arm = malloc(W * H), *pad = malloc(W * H);
+    assert_true(rgba && arm && pad);
+    const uint8_t skin[3] = { 200, 120, 100 }, beige[3] = { 190, 165, 120 }, bg[3] = { 60, 90, 150 };
+    const uint8_t fresh[3] = { 230, 200, 20 };
+    tu_rng g = { 0x666f6c64 };
+    for (int i = 0; i < W * H; i++) {
+        int x = i % W, k = x < W / 3 ? 0 : x < 2 * W / 3 ? 1 : 2;
+        const uint8_t *c = k == 0 ? skin : k == 1 ? beige : bg;
+        for (int j = 0; j < 3; j++) rgba[i * 4 + j] = (uint8_t)(c[j] + (int)(tu_next(&g) % 5) - 2);
+        rgba[i * 4 + 3] = 255;
+        arm[i] = k == 0 ? 255 : 0;
+        pad[i] = k < 2 ? 255 : 0;
+    }
+    fuse_image P = { rgba, W, H, 4 * W };
+    const unsigned bp = fuse_colour_bin(beige, PIPE_FIT_BITS), bs = fuse_colour_bin(skin, PIPE_FIT_BITS);
+    const unsigned bf = fuse_colour_bin(fresh, PIPE_FIT_BITS);
+    pipe_fit *f = pipe_fit_create(NULL, &A.m, &A.rig, W, H);
+    assert_non_null(f);
+    for (int t = 0; t < 10; t++) assert_int_equal(pipe_fit_learn(f, 0, &P, arm, W, arm, W), FUSE_OK);
+    assert_true(pipe_fit_colour(f, 0)->llr[bp] < -2.0f);
+    assert_true(pipe_fit_colour(f, 0)->llr[bf] >= -PIPE_FIT_LEARN_REJECT);
+    float worst = -INFINITY;
+    for (int t = 0; t < 30; t++) {
+        assert_int_equal(pipe_fit_learn(f, 0, &P, pad, W, pad, W), FUSE_OK);
+        const float v = pipe_fit_colour(f, 0)->llr[bp];
+        if (v > worst) worst = v;
+    }
+    printf("rejection: the pad's llr at most %.3f over 30 frames inside both masks\n", (double)worst);
+    const float *llr = pipe_fit_colour(f, 0)->llr;
+    assert_true(pipe_fit_learned(f, 0));
+    assert_true(llr[bs] > 2.0f);
+    assert_true(worst < -1.0f);   /* still background */
+    /* a new colour inside both masks is learned as arm */
+    for (int i = 0; i < W * H; i++)
+        if (i % W < W / 6)
+            for (int j = 0; j < 3; j++) rgba[i * 4 + j] = fresh[j];
+    assert_int_equal(pipe_fit_learn(f, 0, &P, arm, W, arm, W), FUSE_OK);
+    assert_true(pipe_fit_colour(f, 0)->llr[bf] > 1.0f);
+    pipe_fit_destroy(f);
+    free(rgba);
+    free(arm);
+    free(pad);
+    arms_free(&A);
+}
+
 /* pipe_fit_learn's colour model (learn_memory, the default) against a
  * scalar reference of its definition (the learning mask, the histograms
  * decayed by the memory, the samples of every 2nd row and column whose
@@ -603,6 +662,10 @@ static void ref_learn(float *af, float *ab, double accn[2], float *llr, long ns[
                       const uint8_t *rgba, int w, int h, const uint8_t *mask, const uint8_t *prev,
                       uint8_t *L)
 {
+    /* the model so far (learned: both kept counts >= 64) rejects arm
+     * samples of bins it calls background by more than
+     * PIPE_FIT_LEARN_REJECT */
+    const int learned = ns[0] >= 64 && ns[1] >= 64;
     const int bits = PIPE_FIT_BITS, bins = 1 << (3 * bits), sh = 8 - bits, mg = 4;
     const float m = PIPE_FIT_LEARN_MEMORY;
     for (int i = 0; i < w * h; i++) {
@@ -623,8 +686,14 @@ static void ref_learn(float *af, float *ab, double accn[2], float *llr, long ns[
             const uint8_t *px = rgba + 4 * (y * w + x);
             const unsigned b = ((unsigned)(px[0] >> sh) << (2 * bits)) |
                                ((unsigned)(px[1] >> sh) << bits) | (unsigned)(px[2] >> sh);
-            if (v == 255) { af[b] += 1.0f; nf++; }
-            else { ab[b] += 1.0f; nb++; }
+            if (v == 255) {
+                if (learned && llr[b] < -PIPE_FIT_LEARN_REJECT) continue;
+                af[b] += 1.0f;
+                nf++;
+            } else {
+                ab[b] += 1.0f;
+                nb++;
+            }
         }
     accn[0] = accn[0] * m + (double)nf;
     accn[1] = accn[1] * m + (double)nb;
@@ -664,6 +733,7 @@ static void learn_matches_reference(void **state)
         assert_non_null(f);
         memset(af, 0, sizeof(float) * 2 * (size_t)bins);
         double accn[2] = { 0.0, 0.0 };
+        long ns[2] = { 0, 0 };
         for (int t = 0; t < 8; t++) {
             const float cx = (float)(w / 3 + (int)(tu_next(&g) % (unsigned)(w / 3)));
             const float cy = (float)(h / 3 + (int)(tu_next(&g) % (unsigned)(h / 3)));
@@ -686,7 +756,6 @@ static void learn_matches_reference(void **state)
             const fuse_image P = { rgba, w, h, 4 * w };
             const int noprev = t == 3;
             assert_int_equal(pipe_fit_learn(f, 1, &P, m, w, noprev ? NULL : pv, w), FUSE_OK);
-            long ns[2];
             ref_learn(af, af + bins, accn, llr, ns, rgba, w, h, m, noprev ? NULL : pv, L);
             const fuse_colour_model *cm = pipe_fit_colour(f, 1);
             assert_int_equal(cm->fg_samples, ns[0]);
@@ -977,6 +1046,7 @@ int main(void)
         cmocka_unit_test(thickness_from_masks),
         cmocka_unit_test(learned_flag),
         cmocka_unit_test(learn_memory_keeps_background),
+        cmocka_unit_test(learn_rejects_background_bins),
         cmocka_unit_test(learn_matches_reference),
         cmocka_unit_test(bad_arguments),
         cmocka_unit_test(fit_through_wrist_node),

@@ -362,6 +362,13 @@ static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
     const float m = f->d.learn_memory;
     float *af = f->acc[eye], *ab = af + bins;
     const uint8_t *mask = f->learn[eye];
+    /* an arm sample whose bin the model so far calls clearly background
+     * (llr < -PIPE_FIT_LEARN_REJECT) is not counted: where the kinematic
+     * mask lies beside the hand over a skin-coloured prop, the refined mask
+     * and the kinematic one agree on the prop, and without this it is
+     * learned as arm frame after frame (edge: the folder) */
+    const float *old = f->learned[eye] ? f->cm[eye].llr : NULL;
+    const float rej = -PIPE_FIT_LEARN_REJECT;
     for (int b = 0; b < 2 * bins; b++) af[b] *= m;
     long nf = 0, nb = 0;
     for (int y = 0; y < h; y += 2) {
@@ -379,10 +386,19 @@ static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
                 if ((c == 0 || c == ~0ull) &&
                     ((c ^ fit_ld8(row + x - margin)) | (c ^ fit_ld8(row + x + margin)) |
                      (c ^ fit_ld8(up + x)) | (c ^ fit_ld8(dn + x))) == 0) {
-                    float *hist = c ? af : ab;
-                    for (int k = 0; k < 8; k += 2) hist[fit_bin(src + 4 * (x + k), bits)] += 1.0f;
-                    if (c) nf += 4;
-                    else nb += 4;
+                    if (!c || !old) {
+                        float *hist = c ? af : ab;
+                        for (int k = 0; k < 8; k += 2) hist[fit_bin(src + 4 * (x + k), bits)] += 1.0f;
+                        if (c) nf += 4;
+                        else nb += 4;
+                    } else {
+                        for (int k = 0; k < 8; k += 2) {
+                            const unsigned bb = fit_bin(src + 4 * (x + k), bits);
+                            if (old[bb] < rej) continue;
+                            af[bb] += 1.0f;
+                            nf++;
+                        }
+                    }
                     x += 6;
                     continue;
                 }
@@ -392,7 +408,11 @@ static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
             int xl = x - margin < 0 ? 0 : x - margin, xr = x + margin >= w ? w - 1 : x + margin;
             if (row[xl] != v || row[xr] != v || up[x] != v || dn[x] != v) continue;
             unsigned b = fit_bin(src + 4 * x, bits);
-            if (v == 255) { af[b] += 1.0f; nf++; }
+            if (v == 255) {
+                if (old && old[b] < rej) continue;
+                af[b] += 1.0f;
+                nf++;
+            }
             else { ab[b] += 1.0f; nb++; }
         }
     }

@@ -98,6 +98,9 @@ extern "C" {
  * eval` (60 frames, refine): cross IoU 0.916 -> 0.935, edge 0.707 ->
  * 0.729 (docs/accuracy.md, Every sequence). */
 #define PIPE_FIT_LEARN_MEMORY 0.95f
+/* the learning skips arm samples whose bin the kept model calls background
+ * by more than this (nats; the model is clamped to +-3) */
+#define PIPE_FIT_LEARN_REJECT 1.0f
 
 typedef struct pipe_fit_desc {
     float range_deg;          /* default 60; (0, PIPE_FIT_MAX_RANGE_DEG] */
