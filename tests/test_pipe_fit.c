@@ -544,6 +544,25 @@ static void learned_flag(void **state)
     arms_free(&A);
 }
 
+/* Three vertical thirds, skin, a beige pad and a blue background, each
+ * colour +-2 per channel from a seeded draw (pixel by pixel, R G B); arm
+ * covers the skin third, pad the skin and the pad. */
+static const uint8_t STRIPE_SKIN[3] = { 200, 120, 100 }, STRIPE_BEIGE[3] = { 190, 165, 120 },
+                     STRIPE_BG[3] = { 60, 90, 150 };
+
+static void stripes(uint8_t *rgba, uint8_t *arm, uint8_t *pad, uint64_t seed)
+{
+    tu_rng g = { seed };
+    for (int i = 0; i < W * H; i++) {
+        int x = i % W, k = x < W / 3 ? 0 : x < 2 * W / 3 ? 1 : 2;
+        const uint8_t *c = k == 0 ? STRIPE_SKIN : k == 1 ? STRIPE_BEIGE : STRIPE_BG;
+        for (int j = 0; j < 3; j++) rgba[i * 4 + j] = (uint8_t)(c[j] + (int)(tu_next(&g) % 5) - 2);
+        rgba[i * 4 + 3] = 255;
+        arm[i] = k == 0 ? 255 : 0;
+        pad[i] = k < 2 ? 255 : 0;
+    }
+}
+
 /* The colour model kept over frames (learn_memory, issue 14 item 2): a
  * beige pad beside a skin-red arm, background for 10 frames (outside
  * both masks), then inside both the kinematic and the refined mask for
@@ -559,16 +578,8 @@ static void learn_memory_keeps_background(void **state)
     arms_build(&A);
     uint8_t *rgba = malloc(4 * W * H), *arm = malloc(W * H), *pad = malloc(W * H);
     assert_true(rgba && arm && pad);
-    const uint8_t skin[3] = { 200, 120, 100 }, beige[3] = { 190, 165, 120 }, bg[3] = { 60, 90, 150 };
-    tu_rng g = { 0x70616421 };
-    for (int i = 0; i < W * H; i++) {
-        int x = i % W, k = x < W / 3 ? 0 : x < 2 * W / 3 ? 1 : 2;
-        const uint8_t *c = k == 0 ? skin : k == 1 ? beige : bg;
-        for (int j = 0; j < 3; j++) rgba[i * 4 + j] = (uint8_t)(c[j] + (int)(tu_next(&g) % 5) - 2);
-        rgba[i * 4 + 3] = 255;
-        arm[i] = k == 0 ? 255 : 0;
-        pad[i] = k < 2 ? 255 : 0;
-    }
+    const uint8_t *skin = STRIPE_SKIN, *beige = STRIPE_BEIGE;
+    stripes(rgba, arm, pad, 0x70616421);
     fuse_image P = { rgba, W, H, 4 * W };
     const unsigned bp = fuse_colour_bin(beige, PIPE_FIT_BITS), bs = fuse_colour_bin(skin, PIPE_FIT_BITS);
     const pipe_fit_desc once = { .learn_memory = -1.0f };
@@ -608,17 +619,9 @@ static void learn_rejects_background_bins(void **state)
     arms_build(&A);
     uint8_t *rgba = malloc(4 * W * H), *arm = malloc(W * H), *pad = malloc(W * H);
     assert_true(rgba && arm && pad);
-    const uint8_t skin[3] = { 200, 120, 100 }, beige[3] = { 190, 165, 120 }, bg[3] = { 60, 90, 150 };
+    const uint8_t *skin = STRIPE_SKIN, *beige = STRIPE_BEIGE;
     const uint8_t fresh[3] = { 230, 200, 20 };
-    tu_rng g = { 0x666f6c64 };
-    for (int i = 0; i < W * H; i++) {
-        int x = i % W, k = x < W / 3 ? 0 : x < 2 * W / 3 ? 1 : 2;
-        const uint8_t *c = k == 0 ? skin : k == 1 ? beige : bg;
-        for (int j = 0; j < 3; j++) rgba[i * 4 + j] = (uint8_t)(c[j] + (int)(tu_next(&g) % 5) - 2);
-        rgba[i * 4 + 3] = 255;
-        arm[i] = k == 0 ? 255 : 0;
-        pad[i] = k < 2 ? 255 : 0;
-    }
+    stripes(rgba, arm, pad, 0x666f6c64);
     fuse_image P = { rgba, W, H, 4 * W };
     const unsigned bp = fuse_colour_bin(beige, PIPE_FIT_BITS), bs = fuse_colour_bin(skin, PIPE_FIT_BITS);
     const unsigned bf = fuse_colour_bin(fresh, PIPE_FIT_BITS);
