@@ -154,26 +154,33 @@ else
     fi
 
     # second run: V from a real producer on a pipe, ending after 4 frames
-    # of its own; the tracker replays 2 samples and stops
+    # of its own; the tracker replays 2 samples and stops (40 frames: at
+    # least 0.67 s at 60 Hz, past the tracker's 0.5 s staleness, however
+    # fast the guest runs)
     if command -v gst-launch-1.0 >/dev/null 2>&1; then
         export GST_REGISTRY=/tmp/gst-registry.bin XDG_CACHE_HOME=/tmp
         # the plugin registry once, before the timed pipeline (slow under TCG)
         gst-inspect-1.0 videotestsrc > /dev/null 2>&1
+        # gst-launch-1.0 writes its 4 frames first and a pipe carries them:
+        # started live beside the run, its start-up under TCG on a busy host
+        # outlasted the run's 16 frames once (CI, "V waiting"), a race
+        gst-launch-1.0 -q videotestsrc num-buffers=4 pattern=smpte ! \
+            video/x-raw,format=I420,width=640,height=200,framerate=30/1 ! y4menc ! \
+            filesink location="$CK/v.y4m" 2> "$CK/gst.err"
         "$EGOFUSE" replay-track "$S/track.txt" --to natnet:127.0.0.1:1510 > "$CK/replay2.log" 2>&1 &
         RP=$!
-        gst-launch-1.0 -q videotestsrc num-buffers=4 pattern=smpte ! \
-            video/x-raw,format=I420,width=640,height=200,framerate=30/1 ! y4menc ! fdsink fd=1 2> "$CK/gst.err" |
+        cat "$CK/v.y4m" |
             "$EGOFUSE" run --scene "$S/scene.txt" --left /dev/video0 --right /dev/video1 --input 1 --dv \
-            --fps 60 --virt-source stream:- --natnet 127.0.0.1 --frames 16 --raw \
+            --fps 60 --virt-source stream:- --natnet 127.0.0.1 --frames 40 --raw \
             > /dev/null 2> "$CK/run2.err"
         rc=$?
         kill $RP 2>/dev/null
         wait $RP 2>/dev/null
         sum=$(tr '\r' '\n' < "$CK/run2.err" | grep 'stereo frames' | tail -n 1)
         echo "VMINFO cockpit2 $sum"
-        if [ $rc -eq 0 ] && echo "$sum" | grep -q '^egofuse run: 16 stereo frames' &&
+        if [ $rc -eq 0 ] && echo "$sum" | grep -q '^egofuse run: 40 stereo frames' &&
             echo "$sum" | grep -q 'V ended (last good held' && echo "$sum" | grep -q 'tracker stale'; then
-            echo "VMTEST cockpit_sources_end PASS V from gst-launch-1.0 ended and the tracker stopped mid-run: reported, 16 frames composited"
+            echo "VMTEST cockpit_sources_end PASS V from gst-launch-1.0 ended and the tracker stopped mid-run: reported, 40 frames composited"
         else
             echo "VMTEST cockpit_sources_end FAIL exit $rc: $sum $(tail -c 300 "$CK/run2.err") $(cat "$CK/gst.err")"
             fail=1
