@@ -3,9 +3,9 @@
  * WHAT IT DOES
  *   Scalar helpers shared by the rooms that skip the empty parts of a mask
  *   row (the depth fill, the refined mask's normal fill, the anti-aliased
- *   coverage, the fit's colour checks): an unaligned 8-byte load, the
- *   first and one past the last non-zero byte of a range. Plain C, the
- *   same answer on every ISA and compiler.
+ *   coverage, the fit's colour checks): an unaligned 8-byte load, whether
+ *   8 bytes hold a zero, the first and one past the last non-zero byte of
+ *   a range. Plain C, the same answer on every ISA and compiler.
  *
  * WHAT IT DOES NOT
  *   No SIMD (the kernels' vector layer is simd.h), no state.
@@ -26,6 +26,13 @@ static inline uint64_t ef_ld8(const uint8_t *p)
     uint64_t v;
     memcpy(&v, p, 8);
     return v;
+}
+
+/* 1 when one of the 8 bytes of v is zero (exact: a borrow can only run
+ * on from a zero byte). */
+static inline int ef_has_zero8(uint64_t v)
+{
+    return ((v - 0x0101010101010101ull) & ~v & 0x8080808080808080ull) != 0;
 }
 
 /* The first non-zero byte of r[x0 .. x1 - 1]; x1 if none. */

@@ -209,9 +209,6 @@ const uint8_t *pipe_fit_prior(const pipe_fit_band_desc *dp, const kin_camera *ca
 #define B01 0x0101010101010101ull
 #define B80 0x8080808080808080ull
 
-/* 1 when one of the 8 bytes of v is 0 */
-static int has_zero(uint64_t v) { return ((v - B01) & ~v & B80) != 0; }
-
 static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const uint8_t *in,
                          uint8_t *out, int stride)
 {
@@ -221,12 +218,21 @@ static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const 
         return 0;
     const int W = P->width, H = P->height, bits = g->bits, sh = 8 - bits;
     long n = 0;
+    /* the box of the cleared pixels (for the second pass) */
+    int cx0 = W, cx1 = 0, cy0 = H, cy1 = 0;
     for (int y = 0; y < H; y++) {
         const uint8_t *s = P->pixels + (size_t)y * (size_t)P->stride;
         const uint8_t *i = in ? in + (size_t)y * (size_t)stride : NULL;
         uint8_t *o = out + (size_t)y * (size_t)stride;
         const uint8_t *up = y > 0 ? o - stride : NULL, *dn = y + 1 < H ? o + stride : NULL;
-        for (int x0 = 0; x0 < W; x0 += 8) {
+        /* the blocks of 8 (from column 0) that hold a set byte of out:
+         * the others have nothing to test (clearing turns set bytes into
+         * 1, still set, so the span holds while the row is worked) */
+        const int first = ef_row_first_set(o, 0, W);
+        if (first == W) continue;
+        const int last = ef_row_last_set(o, first, W);
+        const long n_row = n;
+        for (int x0 = first & ~7; x0 < last; x0 += 8) {
             /* 8 pixels at a time past those that cannot be tested (out
              * below 128, or in at >= 128); the bytes from x0 on are not
              * written yet */
@@ -237,7 +243,7 @@ static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const 
                  * zero byte in the block, the row above and below, nor
                  * beside it), no pixel is on the rim */
                 if (!i && x0 > 0 && x0 + 8 < W && up && dn && o[x0 - 1] && o[x0 + 8] &&
-                    !has_zero(ef_ld8(o + x0)) && !has_zero(ef_ld8(up + x0)) && !has_zero(ef_ld8(dn + x0)))
+                    !ef_has_zero8(ef_ld8(o + x0)) && !ef_has_zero8(ef_ld8(up + x0)) && !ef_has_zero8(ef_ld8(dn + x0)))
                     continue;
             }
             const int x1 = x0 + 8 < W ? x0 + 8 : W;
@@ -254,23 +260,30 @@ static long colour_clear(const fuse_colour_model *g, const fuse_image *P, const 
                 if (g->llr[bin] <= 0.0f) {
                     o[x] = 1;
                     n++;
+                    if (x < cx0) cx0 = x;
+                    if (x >= cx1) cx1 = x + 1;
                 }
             }
         }
-    }
-    if (n)
-        for (int y = 0; y < H; y++) {
-            uint8_t *o = out + (size_t)y * (size_t)stride;
-            int x = 0;
-            for (; x + 8 <= W; x += 8) {
-                /* no byte equal to 1: none of (v ^ 0x01..) is zero */
-                if (!has_zero(ef_ld8(o + x) ^ B01)) continue;
-                for (int k = x; k < x + 8; k++)
-                    if (o[k] == 1) o[k] = 0;
-            }
-            for (; x < W; x++)
-                if (o[x] == 1) o[x] = 0;
+        if (n != n_row) {
+            if (y < cy0) cy0 = y;
+            cy1 = y + 1;
         }
+    }
+    /* the marks (1) back to 0 over their box, 8 at a time from its first
+     * column */
+    for (int y = cy0; y < cy1; y++) {
+        uint8_t *o = out + (size_t)y * (size_t)stride;
+        int x = cx0;
+        for (; x + 8 <= cx1; x += 8) {
+            /* no byte equal to 1: none of (v ^ 0x01..) is zero */
+            if (!ef_has_zero8(ef_ld8(o + x) ^ B01)) continue;
+            for (int k = x; k < x + 8; k++)
+                if (o[k] == 1) o[k] = 0;
+        }
+        for (; x < cx1; x++)
+            if (o[x] == 1) o[x] = 0;
+    }
     return n;
 }
 

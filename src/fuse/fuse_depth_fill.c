@@ -16,9 +16,16 @@ static int known(float z) { return z >= 0.0f && z < 1.0f; }
  * known: nothing to do there (branch-free, one test for the block) */
 static int block_done(const uint8_t *m, const float *z)
 {
-    int k = 1;
-    for (int i = 0; i < 8; i++) k &= (m[i] != 0) & (z[i] >= 0.0f) & (z[i] < 1.0f);
-    return k;
+    if (ef_has_zero8(ef_ld8(m))) return 0;
+    /* known() on the float's bits: +0 .. the largest float below 1 are
+     * 0 .. 0x3F7FFFFF, and -0 (0x80000000) is >= 0 too; every other
+     * pattern (1 and above, infinities, NaN, negatives) is not known */
+    uint32_t u[8];
+    memcpy(u, z, sizeof u);
+    uint32_t bad = 0;
+    for (int i = 0; i < 8; i++) bad |= (uint32_t)(u[i] >= 0x3F800000u) &
+                                            (uint32_t)(u[i] != 0x80000000u);
+    return !bad;
 }
 
 /* The largest float below 1: the far plane; any scene object is nearer. */

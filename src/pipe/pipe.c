@@ -9,6 +9,7 @@
 #include "pipe_nfill.h"
 #include "pipe_soft.h"
 #include "pipe_reproj.h"
+#include "../cpu/mask_rows.h"
 #include "../fit/fit_band.h"
 #include "../fit/fit_holes.h"
 #include "../fit/fit_shift.h"
@@ -388,10 +389,24 @@ static void eye_finish(pipe_ctx *p, eye_state *e)
     const int cw = p->geo.crop_width;
     double t = now_ms();
     if (e->fr == FUSE_OK) fuse_context_frame_finish(e->fuse);
-    /* the raster's planes as it left them (it clears only what it drew) */
-    for (int y = e->filled[1]; y < e->filled[3]; y++)
-        for (int x = e->filled[0]; x < e->filled[2]; x++)
-            if (e->mask[(size_t)y * cw + x] == 0) e->depth[(size_t)y * cw + x] = 1.0f;
+    /* the raster's planes as it left them (it clears only what it drew):
+     * 8 pixels at a time where the model covers them all (nothing to do)
+     * or none (all 1) */
+    static const float far8[8] = {1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+    for (int y = e->filled[1]; y < e->filled[3]; y++) {
+        const uint8_t *m = e->mask + (size_t)y * cw;
+        float *z = e->depth + (size_t)y * cw;
+        int x = e->filled[0];
+        for (; x + 8 <= e->filled[2]; x += 8) {
+            const uint64_t v = ef_ld8(m + x);
+            if (v == 0) memcpy(z + x, far8, sizeof far8);
+            else if (ef_has_zero8(v))
+                for (int k = x; k < x + 8; k++)
+                    if (m[k] == 0) z[k] = 1.0f;
+        }
+        for (; x < e->filled[2]; x++)
+            if (m[x] == 0) z[x] = 1.0f;
+    }
     if (e->aa.count) pipe__aa_unfill(&e->aa, e->mask, e->nrm);
     e->ms_fuse += now_ms() - t;
     if (e->fr != FUSE_OK)

@@ -31,15 +31,11 @@ static void bbox(const uint8_t *m, int w, int h, int b[4])
 }
 
 #define NFILL_B01 0x0101010101010101ull
-#define NFILL_B80 0x8080808080808080ull
-
-/* 1 when one of the 8 bytes of v is 0 */
-static int has_zero(uint64_t v) { return ((v - NFILL_B01) & ~v & NFILL_B80) != 0; }
 
 /* the end of the run of set bytes of r that starts at x (x1 at most) */
 static int run_end(const uint8_t *r, int x, int x1)
 {
-    while (x + 8 <= x1 && !has_zero(ef_ld8(r + x))) x += 8;
+    while (x + 8 <= x1 && !ef_has_zero8(ef_ld8(r + x))) x += 8;
     while (x < x1 && r[x]) x++;
     return x;
 }
