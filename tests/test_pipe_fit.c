@@ -611,7 +611,7 @@ static void learn_memory_keeps_background(void **state)
  * arm counts grow, and it becomes arm (llr > 0 from about frame 16); the
  * rejection leaves its samples out while the model calls it background,
  * so it stays so. Skin stays arm; a colour the model has never seen (the
- * bins' offset, >= -1) is still learned as arm. */
+ * bins' offset, >= -PIPE_FIT_LEARN_REJECT) is still learned as arm. */
 static void learn_rejects_background_bins(void **state)
 {
     (void)state;
@@ -640,7 +640,7 @@ static void learn_rejects_background_bins(void **state)
     const float *llr = pipe_fit_colour(f, 0)->llr;
     assert_true(pipe_fit_learned(f, 0));
     assert_true(llr[bs] > 2.0f);
-    assert_true(worst < -1.0f);   /* still background */
+    assert_true(worst < -PIPE_FIT_LEARN_REJECT);   /* still background */
     /* a new colour inside both masks is learned as arm */
     for (int i = 0; i < W * H; i++)
         if (i % W < W / 6)
