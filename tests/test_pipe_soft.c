@@ -2,7 +2,8 @@
  * (src/pipe/pipe_soft.h, pipe_desc.soft_edge; issue 14 item 3):
  * - against a direct count of the 3x3 window on seeded masks (values 0,
  *   255 and other non-zero bytes, the image's border counting as set), the
- *   box limiting what is written;
+ *   box limiting what is written; the boxed form over 120 frames of one
+ *   output equal to the whole image's, frame by frame;
  * - a straight edge becomes a one-pixel ramp inside the mask, a stair a
  *   ramp whose corners differ (not a hard step), the mask never grows;
  * - pipe_create refuses soft_edge with aa_samples, the eye view or a
@@ -75,6 +76,51 @@ static void against_reference(void **state)
     }
 }
 
+/* pipe__soft_edge_boxed over 120 frames of one persistent output (its
+ * bytes unknown at first: held = the whole image): blobs that move, grow,
+ * vanish (empty frames) and touch the borders; after each frame out is,
+ * byte for byte, pipe__soft_edge of the whole image, and held is the box
+ * of the frame's set pixels. */
+static void boxed_over_frames(void **state)
+{
+    (void)state;
+    static uint8_t ref[W * H];
+    tu_rng g = {0x50f7b0c5};
+    int held[4] = {0, 0, W, H};
+    memset(o, 0x5A, sizeof o);
+    long empty = 0;
+    for (int f = 0; f < 120; f++) {
+        memset(m, 0, sizeof m);
+        const int blobs = f % 7 == 3 ? 0 : 1 + tu_int(&g, 3);
+        for (int k = 0; k < blobs; k++) {
+            const int cx = tu_int(&g, W + 10) - 5, cy = tu_int(&g, H + 10) - 5, r = 1 + tu_int(&g, 12);
+            for (int y = 0; y < H; y++)
+                for (int x = 0; x < W; x++)
+                    if ((x - cx) * (x - cx) + (y - cy) * (y - cy) < r * r) m[y * W + x] = 255;
+        }
+        for (int k = blobs ? tu_int(&g, 4) : 0; k > 0; k--)
+            m[tu_int(&g, H) * W + tu_int(&g, W)] = (uint8_t)(1 + tu_int(&g, 255));
+        int bx[4] = {W, H, 0, 0};
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++)
+                if (m[y * W + x]) {
+                    if (x < bx[0]) bx[0] = x;
+                    if (x + 1 > bx[2]) bx[2] = x + 1;
+                    if (y < bx[1]) bx[1] = y;
+                    bx[3] = y + 1;
+                }
+        if (bx[2] == 0) {
+            bx[0] = bx[1] = bx[3] = 0;
+            empty++;
+        }
+        pipe__soft_edge_boxed(m, o, W, H, held);
+        pipe__soft_edge(m, ref, W, H, NULL);
+        if (memcmp(o, ref, sizeof ref)) fail_msg("frame %d: out differs from the whole image's", f);
+        assert_memory_equal(held, bx, sizeof bx);
+    }
+    assert_true(empty > 10);
+}
+
 static void edges_become_ramps(void **state)
 {
     (void)state;
@@ -128,6 +174,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(against_reference),
+        cmocka_unit_test(boxed_over_frames),
         cmocka_unit_test(edges_become_ramps),
         cmocka_unit_test(create_refuses),
     };

@@ -294,7 +294,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     /* soft silhouettes: a one-pixel ramp inside the binary mask's edge
      * (pipe_soft.h; not with aa_samples or the eye view: pipe_create) */
     if (e->soft) {
-        pipe__soft_edge(fe.mask, e->soft, cw, ch, NULL);
+        pipe__soft_edge_boxed(fe.mask, e->soft, cw, ch, e->soft_box);
         fe.mask = e->soft;
     }
     /* the eye's view instead of the camera's crop (pipe_reproj.h) */
@@ -652,6 +652,10 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         if (ok && p->desc.soft_edge == 1) {
             s->soft = malloc(px);
             ok = s->soft != NULL;
+            /* its bytes unknown: all of it cleared at the first frame */
+            s->soft_box[0] = s->soft_box[1] = 0;
+            s->soft_box[2] = p->geo.crop_width;
+            s->soft_box[3] = p->geo.crop_height;
         }
         if (ok && p->desc.refine_band > 0 && p->desc.normal_smooth >= 0) {
             const size_t ns = pipe__nfill_scratch_size(p->geo.crop_width, p->geo.crop_height);

@@ -24,6 +24,7 @@ typedef struct eye_state {
                                  the refined mask's (pipe_nfill.h) */
     void *nfill_scratch;      /* refine_band, normal_smooth >= 0 */
     uint8_t *soft;            /* soft_edge: the softened mask */
+    int soft_box[4];          /* where soft may be non-zero (pipe_soft.h) */
     uint8_t *refined;         /* the refined mask (refine_band) */
     uint8_t *regrow;          /* refine_band: the refined mask refined once
                                  more from (pipe_fit_refine_regrow) */

@@ -1,5 +1,6 @@
 /* pipe_soft.c - soft silhouettes from a binary mask (pipe_soft.h). */
 #include "pipe_soft.h"
+#include "../cpu/mask_rows.h"
 
 #include <string.h>
 
@@ -52,4 +53,35 @@ void pipe__soft_edge(const uint8_t *mask, uint8_t *out, int w, int h, const int 
             o[x] = n == 9 ? m[x] : (uint8_t)(((unsigned)m[x] * (unsigned)n + 4u) / 9u);
         }
     }
+}
+
+void pipe__soft_edge_boxed(const uint8_t *mask, uint8_t *out, int w, int h, int held[4])
+{
+    /* the box of the set pixels ({0, 0, 0, 0}: none) */
+    int b[4] = {w, h, 0, 0};
+    for (int y = 0; y < h; y++) {
+        const uint8_t *m = mask + (size_t)y * (size_t)w;
+        const int x0 = ef_row_first_set(m, 0, w);
+        if (x0 == w) continue;
+        const int x1 = ef_row_last_set(m, x0, w);
+        if (x0 < b[0]) b[0] = x0;
+        if (x1 > b[2]) b[2] = x1;
+        if (y < b[1]) b[1] = y;
+        b[3] = y + 1;
+    }
+    if (b[2] == 0) b[0] = b[1] = b[3] = 0;
+    /* what the held box has outside the new one */
+    for (int y = held[1]; y < held[3]; y++) {
+        uint8_t *o = out + (size_t)y * (size_t)w;
+        if (y < b[1] || y >= b[3] || b[0] >= b[2]) {
+            memset(o + held[0], 0, (size_t)(held[2] - held[0]));
+            continue;
+        }
+        const int l = b[0] < held[2] ? b[0] : held[2];
+        if (l > held[0]) memset(o + held[0], 0, (size_t)(l - held[0]));
+        const int r = b[2] > held[0] ? b[2] : held[0];
+        if (held[2] > r) memset(o + r, 0, (size_t)(held[2] - r));
+    }
+    if (b[0] < b[2]) pipe__soft_edge(mask, out, w, h, b);
+    memcpy(held, b, sizeof b);
 }

@@ -24,7 +24,10 @@
  *   Integers only: out = (M n + 4) / 9. The same bytes on every ISA and
  *   thread count. Pixels of M 0 are written 0. The work is one scan of
  *   the box, 8 pixels at a time where they are all clear, or all 255 with
- *   every neighbour (the hand's inside), one by one at the edge.
+ *   every neighbour (the hand's inside), one by one at the edge. The
+ *   pipeline gives the box of the mask's set pixels (found 8 bytes a step
+ *   from each row's ends) and clears only what the last frame's box left
+ *   outside it (pipe__soft_edge_boxed).
  */
 #ifndef EGOFUSE_PIPE_SOFT_H
 #define EGOFUSE_PIPE_SOFT_H
@@ -35,5 +38,12 @@
  * y0, x1, y1, exclusive ends) limits the work to where mask may be set
  * (NULL: the whole image); out outside the box is not written. */
 void pipe__soft_edge(const uint8_t *mask, uint8_t *out, int w, int h, const int box[4]);
+
+/* The same bytes of out over the whole image, worked only over the box of
+ * mask's set pixels: out keeps the box it was last given in held (x0, y0,
+ * x1, y1; the whole image, {0, 0, w, h}, when out's bytes are unknown),
+ * zeroes what of it lies outside the new box, writes the new box
+ * (pipe__soft_edge) and leaves the new box in held. */
+void pipe__soft_edge_boxed(const uint8_t *mask, uint8_t *out, int w, int h, int held[4]);
 
 #endif
