@@ -333,7 +333,10 @@ static void colour_checks_match_rule(void **state)
             const int y = tu_int(&r, H), x0 = tu_int(&r, W), len = 1 + tu_int(&r, 24);
             for (int x = x0; x < W && x < x0 + len; x++) o[(size_t)y * (size_t)stride + (size_t)x] = 255;
         }
-        for (int b = 0; b < dots; b++) o[(size_t)tu_int(&r, H) * (size_t)stride + (size_t)tu_int(&r, W)] = 255;
+        for (int b = 0; b < dots; b++) {
+            const int y = tu_int(&r, H), x = tu_int(&r, W);
+            o[(size_t)y * (size_t)stride + (size_t)x] = 255;
+        }
         /* the refinement's input: the mask less a few pixels of its own */
         for (size_t i = 0; i < nb; i++) in[i] = o[i] && tu_int(&r, 4) ? 255 : 0;
         const fuse_colour_model g = { 3, 100, 100, llr };

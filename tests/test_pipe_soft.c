@@ -98,8 +98,10 @@ static void boxed_over_frames(void **state)
                 for (int x = 0; x < W; x++)
                     if ((x - cx) * (x - cx) + (y - cy) * (y - cy) < r * r) m[y * W + x] = 255;
         }
-        for (int k = blobs ? tu_int(&g, 4) : 0; k > 0; k--)
-            m[tu_int(&g, H) * W + tu_int(&g, W)] = (uint8_t)(1 + tu_int(&g, 255));
+        for (int k = blobs ? tu_int(&g, 4) : 0; k > 0; k--) {
+            const int y = tu_int(&g, H), x = tu_int(&g, W), v = 1 + tu_int(&g, 255);
+            m[y * W + x] = (uint8_t)v;
+        }
         int bx[4] = {W, H, 0, 0};
         for (int y = 0; y < H; y++)
             for (int x = 0; x < W; x++)
