@@ -277,7 +277,7 @@ static void lag_adapts_to_speed(void **state)
 static long clear_rule(const fuse_colour_model *g, const fuse_image *P, const uint8_t *in,
                        const uint8_t *o, uint8_t *want, int stride)
 {
-    const int W = P->width, H = P->height, sh = 8 - g->bits;
+    const int W = P->width, H = P->height;
     long n = 0;
     for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x++) {
@@ -288,9 +288,7 @@ static long clear_rule(const fuse_colour_model *g, const fuse_image *P, const ui
             const int border = (x > 0) + (x + 1 < W) + (y > 0) + (y + 1 < H);
             if (in ? nb > 2 : nb >= border) continue;
             const uint8_t *px = P->pixels + (size_t)y * (size_t)P->stride + 4 * (size_t)x;
-            const unsigned bin = ((unsigned)(px[0] >> sh) << (2 * g->bits)) |
-                                 ((unsigned)(px[1] >> sh) << g->bits) | (unsigned)(px[2] >> sh);
-            if (g->llr[bin] <= 0.0f) {
+            if (g->llr[fuse_colour_bin(px, g->bits)] <= 0.0f) {
                 want[k] = 0;
                 n++;
             }

@@ -5,7 +5,8 @@
  *   row (the depth fill, the refined mask's normal fill, the anti-aliased
  *   coverage, the fit's colour checks): an unaligned 8-byte load, whether
  *   8 bytes hold a zero, the first and one past the last non-zero byte of
- *   a range. Plain C, the same answer on every ISA and compiler.
+ *   a range, the box of a mask's non-zero bytes. Plain C, the same answer
+ *   on every ISA and compiler.
  *
  * WHAT IT DOES NOT
  *   No SIMD (the kernels' vector layer is simd.h), no state.
@@ -13,6 +14,7 @@
  * USAGE
  *   int x0 = ef_row_first_set(r, 0, w);      // w if the row is empty
  *   int x1 = ef_row_last_set(r, x0, w);      // one past the last set
+ *   int box[4]; ef_mask_box(m, w, h, box);   // x0, y0, x1, y1
  */
 #ifndef EGOFUSE_MASK_ROWS_H
 #define EGOFUSE_MASK_ROWS_H
@@ -49,6 +51,27 @@ static inline int ef_row_last_set(const uint8_t *r, int x0, int x1)
     while (x1 - 8 >= x0 && ef_ld8(r + x1 - 8) == 0) x1 -= 8;
     while (x1 > x0 && r[x1 - 1] == 0) x1--;
     return x1;
+}
+
+/* The box (x0, y0, x1, y1; ends exclusive) of the non-zero bytes of the
+ * w x h mask m (stride w), found from each row's two ends; {0, 0, 0, 0}
+ * when there is none. */
+static inline void ef_mask_box(const uint8_t *m, int w, int h, int b[4])
+{
+    b[0] = w;
+    b[1] = h;
+    b[2] = b[3] = 0;
+    for (int y = 0; y < h; y++) {
+        const uint8_t *r = m + (size_t)y * (size_t)w;
+        const int x0 = ef_row_first_set(r, 0, w);
+        if (x0 == w) continue;
+        const int x1 = ef_row_last_set(r, x0, w);
+        if (x0 < b[0]) b[0] = x0;
+        if (x1 > b[2]) b[2] = x1;
+        if (y < b[1]) b[1] = y;
+        b[3] = y + 1;
+    }
+    if (b[2] == 0) b[0] = b[1] = b[3] = 0;
 }
 
 #endif

@@ -16,20 +16,6 @@ size_t pipe__nfill_scratch_size(int w, int h)
            (size_t)w + 16;
 }
 
-static void bbox(const uint8_t *m, int w, int h, int b[4])
-{
-    for (int y = 0; y < h; y++) {
-        const uint8_t *r = m + (size_t)y * (size_t)w;
-        const int x0 = ef_row_first_set(r, 0, w);
-        if (x0 == w) continue;
-        const int x1 = ef_row_last_set(r, x0, w) - 1;
-        if (b[0] > x0) b[0] = x0;
-        if (b[2] < x1 + 1) b[2] = x1 + 1;
-        if (b[1] > y) b[1] = y;
-        b[3] = y + 1;
-    }
-}
-
 #define NFILL_B01 0x0101010101010101ull
 
 /* the end of the run of set bytes of r that starts at x (x1 at most) */
@@ -119,8 +105,8 @@ static void cnt_row(uint8_t *restrict c, const uint8_t *restrict ci, const uint8
 void pipe__nfill_refined(const uint8_t *mask, const uint8_t *kmask, const float *nrm,
                          float *out, int w, int h, int r, void *scratch)
 {
-    int b[4] = {w, h, 0, 0};
-    bbox(mask, w, h, b);
+    int b[4];
+    ef_mask_box(mask, w, h, b);
     if (b[2] <= b[0]) return;
     float *acc = (float *)scratch;
     int *span = (int *)(acc + 3 * (size_t)w); /* per row: the fill's candidates' x0, x1 */

@@ -58,18 +58,8 @@ void pipe__soft_edge(const uint8_t *mask, uint8_t *out, int w, int h, const int 
 void pipe__soft_edge_boxed(const uint8_t *mask, uint8_t *out, int w, int h, int held[4])
 {
     /* the box of the set pixels ({0, 0, 0, 0}: none) */
-    int b[4] = {w, h, 0, 0};
-    for (int y = 0; y < h; y++) {
-        const uint8_t *m = mask + (size_t)y * (size_t)w;
-        const int x0 = ef_row_first_set(m, 0, w);
-        if (x0 == w) continue;
-        const int x1 = ef_row_last_set(m, x0, w);
-        if (x0 < b[0]) b[0] = x0;
-        if (x1 > b[2]) b[2] = x1;
-        if (y < b[1]) b[1] = y;
-        b[3] = y + 1;
-    }
-    if (b[2] == 0) b[0] = b[1] = b[3] = 0;
+    int b[4];
+    ef_mask_box(mask, w, h, b);
     /* what the held box has outside the new one */
     for (int y = held[1]; y < held[3]; y++) {
         uint8_t *o = out + (size_t)y * (size_t)w;
