@@ -719,63 +719,154 @@ static void ref_learn(float *af, float *ab, double accn[2], float *llr, long ns[
     }
 }
 
+/* One seeded frame of the learning tests: a disc of arm (mask m, the
+ * previous mask pv a few pixels off, both with stray bytes) over a
+ * background; palette 0: the arm reddish and the background wide, palette
+ * 1: colours whose red bins palette 0 never uses. */
+static void learn_frame(tu_rng *g, int w, int h, int palette, uint8_t *m, uint8_t *pv,
+                        uint8_t *rgba)
+{
+    const float cx = (float)(w / 3 + (int)(tu_next(g) % (unsigned)(w / 3)));
+    const float cy = (float)(h / 3 + (int)(tu_next(g) % (unsigned)(h / 3)));
+    const float r = (float)(h / 6 + (int)(tu_next(g) % (unsigned)(h / 6)));
+    const float dx = (float)((int)(tu_next(g) % 9) - 4), dy = (float)((int)(tu_next(g) % 9) - 4);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const int i = y * w + x;
+            const float ex = (float)x - cx, ey = (float)y - cy, fx = ex - dx, fy = ey - dy;
+            const int in = ex * ex + ey * ey < r * r, inp = fx * fx + fy * fy < r * r;
+            const uint32_t n = tu_next(g);
+            m[i] = n % 40 == 0 ? (uint8_t)(n >> 8) : in ? 255 : 0;
+            pv[i] = n % 53 == 1 ? (uint8_t)(n >> 12) : inp ? 255 : 0;
+            const uint32_t c = tu_next(g);
+            if (palette == 0) {
+                rgba[4 * i] = (uint8_t)(in ? 200 + (c & 31) : 40 + (c & 127));
+                rgba[4 * i + 1] = (uint8_t)(in ? 110 + ((c >> 5) & 31) : 60 + ((c >> 7) & 127));
+                rgba[4 * i + 2] = (uint8_t)(in ? 90 + ((c >> 10) & 31) : 100 + ((c >> 14) & 127));
+            } else {
+                rgba[4 * i] = (uint8_t)(in ? (c & 31) : 232 + (c & 15));
+                rgba[4 * i + 1] = (uint8_t)(in ? 200 + ((c >> 5) & 31) : 60 + ((c >> 7) & 127));
+                rgba[4 * i + 2] = (uint8_t)(in ? (c >> 10) & 31 : 100 + ((c >> 14) & 127));
+            }
+            rgba[4 * i + 3] = 255;
+        }
+}
+
+/* The learning tests' buffers (images up to w x h) and the reference's
+ * state for one pipe_fit eye. */
+typedef struct learn_run {
+    float *af, *llr;          /* the reference's histograms (arm, background), llr */
+    uint8_t *rgba, *m, *pv, *L;
+    double accn[2];
+    long ns[2];
+} learn_run;
+
+static void learn_run_reset(learn_run *r);
+
+static void learn_run_init(learn_run *r, int w, int h)
+{
+    const int bins = 1 << (3 * PIPE_FIT_BITS);
+    r->af = calloc(2 * (size_t)bins, sizeof(float));
+    r->llr = malloc(sizeof(float) * (size_t)bins);
+    r->rgba = malloc(4 * (size_t)w * (size_t)h);
+    r->m = malloc((size_t)w * (size_t)h);
+    r->pv = malloc((size_t)w * (size_t)h);
+    r->L = malloc((size_t)w * (size_t)h);
+    assert_true(r->af && r->llr && r->rgba && r->m && r->pv && r->L);
+    learn_run_reset(r);
+}
+
+/* The reference's state back to nothing learned. */
+static void learn_run_reset(learn_run *r)
+{
+    memset(r->af, 0, sizeof(float) * 2 * (size_t)(1 << (3 * PIPE_FIT_BITS)));
+    r->accn[0] = r->accn[1] = 0.0;
+    r->ns[0] = r->ns[1] = 0;
+}
+
+static void learn_run_free(learn_run *r)
+{
+    free(r->af);
+    free(r->llr);
+    free(r->rgba);
+    free(r->m);
+    free(r->pv);
+    free(r->L);
+}
+
+/* One frame (r's image and masks, w x h; prev 0: without the previous
+ * mask) learned by f's eye and by the reference: the same sample counts
+ * and llr bytes. Returns the kept samples. */
+static long learn_step(pipe_fit *f, int eye, learn_run *r, int w, int h, int prev)
+{
+    const int bins = 1 << (3 * PIPE_FIT_BITS);
+    const fuse_image P = { r->rgba, w, h, 4 * w };
+    assert_int_equal(pipe_fit_learn(f, eye, &P, r->m, w, prev ? r->pv : NULL, w), FUSE_OK);
+    ref_learn(r->af, r->af + bins, r->accn, r->llr, r->ns, r->rgba, w, h, r->m,
+              prev ? r->pv : NULL, r->L);
+    const fuse_colour_model *cm = pipe_fit_colour(f, eye);
+    assert_int_equal(cm->fg_samples, r->ns[0]);
+    assert_int_equal(cm->bg_samples, r->ns[1]);
+    assert_memory_equal(cm->llr, r->llr, sizeof(float) * (size_t)bins);
+    return r->ns[0] + r->ns[1];
+}
+
 static void learn_matches_reference(void **state)
 {
     (void)state;
     arms A;
     arms_build(&A);
-    const int bins = 1 << (3 * PIPE_FIT_BITS);
-    float *af = malloc(sizeof(float) * 2 * (size_t)bins), *llr = malloc(sizeof(float) * (size_t)bins);
-    uint8_t *rgba = malloc(4 * W * H), *m = malloc(W * H), *pv = malloc(W * H), *L = malloc(W * H);
-    assert_true(af && llr && rgba && m && pv && L);
+    learn_run r;
+    learn_run_init(&r, W, H);
     tu_rng g = { 0x6c6561726eu };
     long checked = 0;
     for (int sz = 0; sz < 2; sz++) {
         const int w = sz ? W - 5 : W, h = sz ? H - 3 : H;
         pipe_fit *f = pipe_fit_create(NULL, &A.m, &A.rig, w, h);
         assert_non_null(f);
-        memset(af, 0, sizeof(float) * 2 * (size_t)bins);
-        double accn[2] = { 0.0, 0.0 };
-        long ns[2] = { 0, 0 };
+        learn_run_reset(&r);
         for (int t = 0; t < 8; t++) {
-            const float cx = (float)(w / 3 + (int)(tu_next(&g) % (unsigned)(w / 3)));
-            const float cy = (float)(h / 3 + (int)(tu_next(&g) % (unsigned)(h / 3)));
-            const float r = (float)(h / 6 + (int)(tu_next(&g) % (unsigned)(h / 6)));
-            const float dx = (float)((int)(tu_next(&g) % 9) - 4), dy = (float)((int)(tu_next(&g) % 9) - 4);
-            for (int y = 0; y < h; y++)
-                for (int x = 0; x < w; x++) {
-                    const int i = y * w + x;
-                    const float ex = (float)x - cx, ey = (float)y - cy, fx = ex - dx, fy = ey - dy;
-                    const int in = ex * ex + ey * ey < r * r, inp = fx * fx + fy * fy < r * r;
-                    const uint32_t n = tu_next(&g);
-                    m[i] = n % 40 == 0 ? (uint8_t)(n >> 8) : in ? 255 : 0;
-                    pv[i] = n % 53 == 1 ? (uint8_t)(n >> 12) : inp ? 255 : 0;
-                    const uint32_t c = tu_next(&g);
-                    rgba[4 * i] = (uint8_t)(in ? 200 + (c & 31) : 40 + (c & 127));
-                    rgba[4 * i + 1] = (uint8_t)(in ? 110 + ((c >> 5) & 31) : 60 + ((c >> 7) & 127));
-                    rgba[4 * i + 2] = (uint8_t)(in ? 90 + ((c >> 10) & 31) : 100 + ((c >> 14) & 127));
-                    rgba[4 * i + 3] = 255;
-                }
-            const fuse_image P = { rgba, w, h, 4 * w };
-            const int noprev = t == 3;
-            assert_int_equal(pipe_fit_learn(f, 1, &P, m, w, noprev ? NULL : pv, w), FUSE_OK);
-            ref_learn(af, af + bins, accn, llr, ns, rgba, w, h, m, noprev ? NULL : pv, L);
-            const fuse_colour_model *cm = pipe_fit_colour(f, 1);
-            assert_int_equal(cm->fg_samples, ns[0]);
-            assert_int_equal(cm->bg_samples, ns[1]);
-            assert_memory_equal(cm->llr, llr, sizeof(float) * (size_t)bins);
-            checked += ns[0] + ns[1];
+            learn_frame(&g, w, h, 0, r.m, r.pv, r.rgba);
+            checked += learn_step(f, 1, &r, w, h, t != 3);
         }
         pipe_fit_destroy(f);
     }
     printf("learn: the reference's llr bytes, %ld kept samples\n", checked);
     assert_true(checked > 10000);
-    free(af);
-    free(llr);
-    free(rgba);
-    free(m);
-    free(pv);
-    free(L);
+    learn_run_free(&r);
+    arms_free(&A);
+}
+
+/* A long run (768 frames at 64 x 48): after 8 frames of one palette and
+ * 760 of another, the first palette's counts have decayed below the
+ * learning's floor, where it sets them to 0 (no subnormal floats, fewer
+ * bins to take the log of); the reference keeps them: the same llr bytes
+ * and sample counts on every frame, and the reference does hold counts
+ * under the floor at the end (the floor was reached). */
+static void learn_long_run_matches_reference(void **state)
+{
+    (void)state;
+    enum { LW = 64, LH = 48, LONG = 768 };
+    arms A;
+    arms_build(&A);
+    learn_run r;
+    learn_run_init(&r, LW, LH);
+    pipe_fit *f = pipe_fit_create(NULL, &A.m, &A.rig, LW, LH);
+    assert_non_null(f);
+    tu_rng g = { 0x6c6f6e67u };
+    for (int t = 0; t < LONG; t++) {
+        learn_frame(&g, LW, LH, t >= 8, r.m, r.pv, r.rgba);
+        learn_step(f, 0, &r, LW, LH, t != 0);
+    }
+    const int bins = 1 << (3 * PIPE_FIT_BITS);
+    const float tiny = (4.0f / (float)bins) * 0x1p-30f;
+    int under = 0;
+    for (int b = 0; b < 2 * bins; b++) under += r.af[b] > 0.0f && r.af[b] < tiny;
+    printf("learn, long run: the reference's llr bytes over %d frames; %d reference counts "
+           "under the floor at the end\n", LONG, under);
+    assert_true(under > 0);
+    pipe_fit_destroy(f);
+    learn_run_free(&r);
     arms_free(&A);
 }
 
@@ -1051,6 +1142,7 @@ int main(void)
         cmocka_unit_test(learn_memory_keeps_background),
         cmocka_unit_test(learn_rejects_background_bins),
         cmocka_unit_test(learn_matches_reference),
+        cmocka_unit_test(learn_long_run_matches_reference),
         cmocka_unit_test(bad_arguments),
         cmocka_unit_test(fit_through_wrist_node),
         cmocka_unit_test(fit_uses_mesh_skin),

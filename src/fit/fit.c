@@ -369,7 +369,18 @@ static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
      * learned as arm frame after frame (edge: the folder) */
     const float *old = f->learned[eye] ? f->cm[eye].llr : NULL;
     const float rej = -PIPE_FIT_LEARN_REJECT;
-    for (int b = 0; b < 2 * bins; b++) af[b] *= m;
+    /* a count decayed below tiny is set to 0: tiny lies far below half an
+     * ulp of a (the llr's pseudo-count below), so a + count rounds to a
+     * either way and every llr keeps its bytes, and a later sample's +1
+     * absorbs it either way; in a long run the histograms then hold no
+     * subnormal floats, and a colour sampled once and not again for 590
+     * frames (about 10 s at 60 Hz: 0.95^590 < 2^-43 = tiny) drops out of
+     * the per-bin logf below */
+    const float tiny = (4.0f / (float)bins) * 0x1p-30f;
+    for (int b = 0; b < 2 * bins; b++) {
+        const float v = af[b] * m;
+        af[b] = v < tiny ? 0.0f : v;
+    }
     long nf = 0, nb = 0;
     for (int y = 0; y < h; y += 2) {
         const uint8_t *row = mask + (size_t)y * (size_t)w;
