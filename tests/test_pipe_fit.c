@@ -859,9 +859,8 @@ static void learn_long_run_matches_reference(void **state)
         learn_step(f, 0, &r, LW, LH, t != 0);
     }
     const int bins = 1 << (3 * PIPE_FIT_BITS);
-    const float tiny = (4.0f / (float)bins) * 0x1p-30f;
     int under = 0;
-    for (int b = 0; b < 2 * bins; b++) under += r.af[b] > 0.0f && r.af[b] < tiny;
+    for (int b = 0; b < 2 * bins; b++) under += r.af[b] > 0.0f && r.af[b] < PIPE_FIT_COUNT_FLOOR;
     printf("learn, long run: the reference's llr bytes over %d frames; %d reference counts "
            "under the floor at the end\n", LONG, under);
     assert_true(under > 0);

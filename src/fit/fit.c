@@ -369,17 +369,16 @@ static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
      * learned as arm frame after frame (edge: the folder) */
     const float *old = f->learned[eye] ? f->cm[eye].llr : NULL;
     const float rej = -PIPE_FIT_LEARN_REJECT;
-    /* a count decayed below tiny is set to 0: tiny lies far below half an
-     * ulp of a (the llr's pseudo-count below), so a + count rounds to a
-     * either way and every llr keeps its bytes, and a later sample's +1
-     * absorbs it either way; in a long run the histograms then hold no
-     * subnormal floats, and a colour sampled once and not again for 590
-     * frames (about 10 s at 60 Hz: 0.95^590 < 2^-43 = tiny) drops out of
-     * the per-bin logf below */
-    const float tiny = (4.0f / (float)bins) * 0x1p-30f;
+    /* a count decayed below PIPE_FIT_COUNT_FLOOR is set to 0: the floor
+     * lies far below half an ulp of a (the llr's pseudo-count below), so
+     * a + count rounds to a either way and every llr keeps its bytes, and
+     * a later sample's +1 absorbs it either way; in a long run the
+     * histograms then hold no subnormal floats, and a colour sampled once
+     * and not again for 590 frames (about 10 s at 60 Hz: 0.95^590 < 2^-43,
+     * the floor) drops out of the per-bin logf below */
     for (int b = 0; b < 2 * bins; b++) {
         const float v = af[b] * m;
-        af[b] = v < tiny ? 0.0f : v;
+        af[b] = v < PIPE_FIT_COUNT_FLOOR ? 0.0f : v;
     }
     long nf = 0, nb = 0;
     for (int y = 0; y < h; y += 2) {
@@ -437,7 +436,7 @@ static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
         memset(cm->llr, 0, (size_t)bins * sizeof(float));
         return;
     }
-    const float a = 4.0f / (float)bins;
+    const float a = PIPE_FIT_PSEUDO_COUNT;
     const float off = logf((float)f->accn[eye][1] + 4.0f) - logf((float)f->accn[eye][0] + 4.0f);
     /* a bin never seen by either class (both 0) has the ratio a / a = 1
      * exactly, logf 0: its entry is the offset, clamped */

@@ -79,6 +79,12 @@ extern "C" {
  * pipe_desc.refine_band and fit_rig are set (docs/accuracy.md). No
  * allocation after pipe_fit_create. */
 #define PIPE_FIT_BITS 5
+/* The learning's pseudo-count per bin (4 / bins) in the log ratio, and the
+ * floor under which a kept, decayed count is set to 0 (2^-30 of it: far
+ * below half an ulp of the pseudo-count and of a sample's +1, so no llr
+ * byte depends on the counts under it; fit_learn_memory). */
+#define PIPE_FIT_PSEUDO_COUNT (4.0f / (float)(1 << (3 * PIPE_FIT_BITS)))
+#define PIPE_FIT_COUNT_FLOOR (PIPE_FIT_PSEUDO_COUNT * 0x1p-30f)
 
 /* Bounds of pipe_fit_desc (pipe_fit_create refuses a setting outside
  * them: the search must end and its buffers stay small). */
