@@ -512,71 +512,90 @@ static void fill_rule(void **state)
     assert_int_equal(fuse_depth_fill(m, w, z, w, w, h, FUSE_DEPTH_FILL_MAX_RADIUS + 1, box), -1);
 }
 
-/* fuse_depth_fill against a brute-force reference of its rule (every
- * pixel of the square, in the ties' order) on seeded masks and depths:
- * the same bytes (its ring-1 shortcut away from the borders, the ring
- * search elsewhere); blobs of known depths, masks grown around them,
- * specks and unknown depths of every kind. */
+/* One seeded case of fill_reference: blobs of known depths, masks grown
+ * around them, specks and unknown depths of every kind on a w x h image;
+ * fuse_depth_fill with radius R against a brute-force reference of its
+ * rule (every pixel of the square, in the ties' order). Counts the pixels
+ * filled from a source and with the far plane. */
+enum { FILL_MAX_PX = 700 * 37 };
+
+static void fill_case(tu_rng *g, int w, int h, int R, int nb, const char *what, int c,
+                      long *near, long *far)
+{
+    static uint8_t m[FILL_MAX_PX];
+    static float z[FILL_MAX_PX], z0[FILL_MAX_PX], want[FILL_MAX_PX];
+    assert_true(w * h <= FILL_MAX_PX);
+    for (int i = 0; i < w * h; i++) {
+        const int k = tu_int(g, 50);
+        z0[i] = k == 0 ? NAN : k == 1 ? -0.0f : k == 2 ? 2.5f : 1.0f;
+        m[i] = tu_int(g, 30) == 0 ? 255 : 0;
+    }
+    for (int b = 0; b < nb; b++) {
+        const float cx = tu_range(g, 0, w), cy = tu_range(g, 0, h);
+        const float rad = tu_range(g, 1, 8), grow = tu_range(g, 0, 6);
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                const float dx = x + 0.5f - cx, dy = y + 0.5f - cy, d2 = dx * dx + dy * dy;
+                if (d2 < rad * rad) z0[y * w + x] = tu_range(g, 0.0f, 0.999f);
+                if (d2 < (rad + grow) * (rad + grow)) m[y * w + x] = 255;
+            }
+    }
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            const int i = y * w + x;
+            const float v = z0[i];
+            want[i] = v;
+            if (!m[i] || (v >= 0.0f && v < 1.0f)) continue;
+            long bd = -1;
+            float src = 0.0f;
+            for (int dy = -R; dy <= R; dy++)
+                for (int dx = -R; dx <= R; dx++) {
+                    const int xx = x + dx, yy = y + dy;
+                    if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+                    const float s = z0[yy * w + xx];
+                    if (!(s >= 0.0f && s < 1.0f)) continue;
+                    const long d2 = (long)dx * dx + (long)dy * dy;
+                    if (bd < 0 || d2 < bd) {
+                        bd = d2;
+                        src = s;
+                    }
+                }
+            if (bd < 0) {
+                const uint32_t bits = 0x3F7FFFFFu;
+                memcpy(&src, &bits, sizeof src);
+                (*far)++;
+            } else
+                (*near)++;
+            want[i] = src;
+        }
+    memcpy(z, z0, sizeof z[0] * (size_t)(w * h));
+    assert_true(fuse_depth_fill(m, w, z, w, w, h, R, NULL) >= 0);
+    if (memcmp(z, want, sizeof z[0] * (size_t)(w * h)) != 0)
+        fail_msg("%s case %d (%dx%d, radius %d): other bytes", what, c, w, h, R);
+}
+
+/* fuse_depth_fill against the brute-force reference (fill_case): 400
+ * small images with radii 1-9, 150 with the pipeline's radii (10-24, the
+ * sample's band 16 gives 20) and 12 wide ones, whose column state is
+ * allocated rather than on the stack. */
 static void fill_reference(void **state)
 {
     (void)state;
-    enum { w = 37, h = 29 };
-    static uint8_t m[w * h];
-    static float z[w * h], z0[w * h], want[w * h];
     tu_rng g = {77};
-    long cases_near = 0, cases_far = 0;
+    long near = 0, far = 0, near_big = 0, far_big = 0;
     for (int c = 0; c < 400; c++) {
         const int R = 1 + c % 9;
-        const int nb = tu_int(&g, 4);
-        for (int i = 0; i < w * h; i++) {
-            const int k = tu_int(&g, 50);
-            z0[i] = k == 0 ? NAN : k == 1 ? -0.0f : k == 2 ? 2.5f : 1.0f;
-            m[i] = tu_int(&g, 30) == 0 ? 255 : 0;
-        }
-        for (int b = 0; b < nb; b++) {
-            const float cx = tu_range(&g, 0, w), cy = tu_range(&g, 0, h);
-            const float rad = tu_range(&g, 1, 8), grow = tu_range(&g, 0, 6);
-            for (int y = 0; y < h; y++)
-                for (int x = 0; x < w; x++) {
-                    const float dx = x + 0.5f - cx, dy = y + 0.5f - cy, d2 = dx * dx + dy * dy;
-                    if (d2 < rad * rad) z0[y * w + x] = tu_range(&g, 0.0f, 0.999f);
-                    if (d2 < (rad + grow) * (rad + grow)) m[y * w + x] = 255;
-                }
-        }
-        for (int y = 0; y < h; y++)
-            for (int x = 0; x < w; x++) {
-                const int i = y * w + x;
-                const float v = z0[i];
-                want[i] = v;
-                if (!m[i] || (v >= 0.0f && v < 1.0f)) continue;
-                long bd = -1;
-                float src = 0.0f;
-                for (int dy = -R; dy <= R; dy++)
-                    for (int dx = -R; dx <= R; dx++) {
-                        const int xx = x + dx, yy = y + dy;
-                        if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-                        const float s = z0[yy * w + xx];
-                        if (!(s >= 0.0f && s < 1.0f)) continue;
-                        const long d2 = (long)dx * dx + (long)dy * dy;
-                        if (bd < 0 || d2 < bd) {
-                            bd = d2;
-                            src = s;
-                        }
-                    }
-                if (bd < 0) {
-                    const uint32_t bits = 0x3F7FFFFFu;
-                    memcpy(&src, &bits, sizeof src);
-                    cases_far++;
-                } else
-                    cases_near++;
-                want[i] = src;
-            }
-        memcpy(z, z0, sizeof z);
-        assert_true(fuse_depth_fill(m, w, z, w, w, h, R, NULL) >= 0);
-        if (memcmp(z, want, sizeof z) != 0) fail_msg("case %d (radius %d): other bytes", c, R);
+        fill_case(&g, 37, 29, R, tu_int(&g, 4), "small", c, &near, &far);
     }
-    printf("fill_reference: %ld filled from a source, %ld the far plane\n", cases_near, cases_far);
-    assert_true(cases_near > 10000 && cases_far > 100);
+    printf("fill_reference: %ld filled from a source, %ld the far plane\n", near, far);
+    assert_true(near > 10000 && far > 100);
+    for (int c = 0; c < 150; c++)
+        fill_case(&g, 61, 47, 10 + c % 15, 1 + tu_int(&g, 6), "radius", c, &near_big, &far_big);
+    for (int c = 0; c < 12; c++)
+        fill_case(&g, 700, 37, 4 + 2 * c, 20 + tu_int(&g, 40), "wide", c, &near_big, &far_big);
+    printf("fill_reference, large radii and wide: %ld from a source, %ld the far plane\n",
+           near_big, far_big);
+    assert_true(near_big > 10000 && far_big > 100);
 }
 
 int main(void)

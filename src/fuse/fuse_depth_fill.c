@@ -7,6 +7,8 @@
 #include "fuse_refine.h"
 #include "../cpu/mask_rows.h"
 
+#include <limits.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Known depth: z in [0, 1) (the depth test's rule, fuse.h); NaN fails. */
@@ -37,16 +39,123 @@ static float far_depth(void)
     return f;
 }
 
+/* The nearest known depth of one column, looked up lazily row after row
+ * (pass 1's rows only grow, so each direction reads a pixel of the column
+ * at most once; the codes pass 1 writes are unknown as the depths they
+ * replace, so they change no answer). up_row: the last known row found
+ * at or above up_scan (the last row looked at; INT_MIN / 2: none);
+ * dn_row: the first known row found at or below the row of the last
+ * query, dn_scan the last row looked at (dn_row INT_MAX: none up to it). */
+typedef struct {
+    int up_row, up_scan, dn_row, dn_scan;
+} fill_col;
+
+enum { FILL_NONE = -1, FILL_STACK_COLS = 512 };
+
+/* the distance from row y to the nearest known depth of column x at or
+ * above it, at most R; FILL_NONE: none */
+static int col_up(fill_col *c, const float *depth, size_t stride, int x, int y, int R)
+{
+    int r = c->up_scan + 1 > y - R ? c->up_scan + 1 : y - R;
+    if (r < 0) r = 0;
+    for (; r <= y; r++)
+        if (known(depth[(size_t)r * stride + (size_t)x])) c->up_row = r;
+    c->up_scan = y;
+    return c->up_row >= y - R ? y - c->up_row : FILL_NONE;
+}
+
+/* the same at or below row y (rows 0 .. h - 1) */
+static int col_down(fill_col *c, const float *depth, size_t stride, int x, int y, int R, int h)
+{
+    if (c->dn_row == INT_MAX || c->dn_row < y) {
+        const int last = y + R < h - 1 ? y + R : h - 1;
+        int r = c->dn_scan + 1 > y ? c->dn_scan + 1 : y;
+        if (c->dn_row != INT_MAX) {   /* found earlier, now above y: look again from y */
+            r = y;
+            c->dn_row = INT_MAX;
+        }
+        for (; r <= last; r++)
+            if (known(depth[(size_t)r * stride + (size_t)x])) {
+                c->dn_row = r;
+                break;
+            }
+        c->dn_scan = r <= last ? r : (last > c->dn_scan ? last : c->dn_scan);
+    }
+    return c->dn_row != INT_MAX && c->dn_row <= y + R ? c->dn_row - y : FILL_NONE;
+}
+
+/* The source of the unknown pixel (x, y), as an index into the (2R+1)^2
+ * window (dy + R) * side + dx + R, or -1 for none: over the columns of the
+ * window from the pixel's own outwards, each column's nearest known depth
+ * (the upper one of two as near), the smallest squared distance, ties to
+ * the smaller index (the upper row, then the left column); a column dx
+ * away is at least dx^2 away, so the search stops past the best. Exactly
+ * the nearest pixel of the square with that tie rule: a column's other
+ * known pixels are farther than its nearest. */
+static int fill_source(fill_col *cols, const float *depth, size_t stride, int x, int y,
+                       int R, int w, int h)
+{
+    const int side = 2 * R + 1;
+    long bd2 = 0;
+    int best = -1, dx;
+    for (dx = 0; dx <= R; dx++) {
+        int k;
+        if (best >= 0 && (long)dx * dx > bd2) break;
+        for (k = 0; k < (dx ? 2 : 1); k++) {
+            const int xx = k ? x + dx : x - dx;
+            int u, d, dy, code;
+            long d2;
+            if (xx < 0 || xx >= w) continue;
+            u = col_up(&cols[xx], depth, stride, xx, y, R);
+            d = col_down(&cols[xx], depth, stride, xx, y, R, h);
+            if (u == FILL_NONE && d == FILL_NONE) continue;
+            dy = u != FILL_NONE && (d == FILL_NONE || u <= d) ? -u : d;
+            d2 = (long)(xx - x) * (xx - x) + (long)dy * dy;
+            code = (dy + R) * side + (xx - x + R);
+            if (best < 0 || d2 < bd2 || (d2 == bd2 && code < best)) {
+                bd2 = d2;
+                best = code;
+            }
+        }
+    }
+    return best;
+}
+
+/* The source of (x, y) when a known depth is among its 8 neighbours (and
+ * the pixel not on the border): the 4-neighbours (d2 1), then the
+ * diagonals (d2 2), each in the ties' order (the upper row, then the
+ * left); -1 otherwise. What fill_source gives there, without its column
+ * look-ups. */
+static int fill_ring1(const float *z, size_t stride, int x, int y, int w, int h, int R)
+{
+    const int side = 2 * R + 1, c = R * side + R;
+    if (x == 0 || y == 0 || x + 1 == w || y + 1 == h) return -1;
+    const float *u = z - stride, *d = z + stride;
+    return known(u[x])       ? c - side
+           : known(z[x - 1]) ? c - 1
+           : known(z[x + 1]) ? c + 1
+           : known(d[x])     ? c + side
+           : known(u[x - 1]) ? c - side - 1
+           : known(u[x + 1]) ? c - side + 1
+           : known(d[x - 1]) ? c + side - 1
+           : known(d[x + 1]) ? c + side + 1
+                             : -1;
+}
+
 /* Pass 1 writes into each unknown mask pixel a code >= 2 (still unknown,
  * so never taken as a source): 2 + index of the source's offset in the
  * (2R+1)^2 window, or 2 + (2R+1)^2 for none. Integers below 2^24 are
  * exact in a float. Pass 2 replaces each code by the source's depth
- * (sources are known pixels: pass 1 never wrote them). */
+ * (sources are known pixels: pass 1 never wrote them). Pass 1 finds a
+ * source among the 8 neighbours (fill_ring1) or else by columns
+ * (fill_source), whose state every column keeps from its first look-up
+ * on. */
 long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int depth_stride,
                      int width, int height, int radius, int box[4])
 {
     const int R = radius, side = 2 * radius + 1;
     int x0 = width, y0 = height, x1 = 0, y1 = 0;
+    fill_col stack_cols[FILL_STACK_COLS], *cols = stack_cols;
     long n = 0;
     int x, y;
     if (box) {
@@ -56,12 +165,16 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
         height > FUSE_MAX_DIM || mask_stride < width || depth_stride < width ||
         radius < 1 || radius > FUSE_DEPTH_FILL_MAX_RADIUS)
         return -1;
+    /* the columns' state: every column, looked up lazily from the first
+     * query on (no memory for a wide image: every unknown pixel gets the
+     * far plane, hidden by any virtual object, never drawn over one) */
+    if (width > FILL_STACK_COLS) cols = malloc(sizeof *cols * (size_t)width);
+    for (x = 0; cols && x < width; x++) cols[x] = (fill_col){INT_MIN / 2, INT_MIN / 2, INT_MAX, -1};
     for (y = 0; y < height; y++) {
         const uint8_t *m = mask + (size_t)y * (size_t)mask_stride;
         float *z = depth + (size_t)y * (size_t)depth_stride;
         for (x = 0; x < width; x++) {
-            int r, best = -1;
-            long bd2 = 0;
+            int best;
             if (m[x] == 0) {   /* on to the next set byte (8 at a time) */
                 x = ef_row_first_set(m, x + 1, width) - 1;
                 continue;
@@ -71,55 +184,9 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
                 continue;
             }
             if (known(z[x])) continue;
-            /* ring 1 away from the borders: the 4-neighbours (d2 1), then
-             * the diagonals (d2 2), each in the ties' order (upper row,
-             * then left): the ring search's result, which stops there */
-            r = 1;
-            if (x > 0 && y > 0 && x + 1 < width && y + 1 < height) {
-                const float *u = z - depth_stride, *d = z + depth_stride;
-                const int c = R * side + R;
-                best = known(u[x])       ? c - side
-                       : known(z[x - 1]) ? c - 1
-                       : known(z[x + 1]) ? c + 1
-                       : known(d[x])     ? c + side
-                                         : -1;
-                bd2 = 1;
-                if (best < 0) {
-                    best = known(u[x - 1])   ? c - side - 1
-                           : known(u[x + 1]) ? c - side + 1
-                           : known(d[x - 1]) ? c + side - 1
-                           : known(d[x + 1]) ? c + side + 1
-                                             : -1;
-                    bd2 = 2;
-                }
-                if (best < 0) bd2 = 0;
-                r = best >= 0 ? R + 1 : 2;
-            }
-            /* rings of growing Chebyshev radius; a pixel of ring r is at
-             * least r away, so stop once the best is nearer than r + 1 */
-            for (; r <= R; r++) {
-                int dy;
-                for (dy = -r; dy <= r; dy++) {
-                    const int yy = y + dy, edge = dy == -r || dy == r;
-                    int dx;
-                    if (yy < 0 || yy >= height) continue;
-                    for (dx = -r; dx <= r; dx += edge ? 1 : 2 * r) {
-                        const int xx = x + dx;
-                        long d2;
-                        if (xx < 0 || xx >= width) continue;
-                        if (!known(depth[(size_t)yy * (size_t)depth_stride + (size_t)xx]))
-                            continue;
-                        d2 = (long)dx * dx + (long)dy * dy;
-                        /* nearest; ties: the upper row, then the left */
-                        if (best < 0 || d2 < bd2 ||
-                            (d2 == bd2 && (dy + R) * side + (dx + R) < best)) {
-                            bd2 = d2;
-                            best = (dy + R) * side + (dx + R);
-                        }
-                    }
-                }
-                if (best >= 0 && bd2 < (long)(r + 1) * (r + 1)) break;
-            }
+            best = fill_ring1(z, (size_t)depth_stride, x, y, width, height, R);
+            if (best < 0 && cols)
+                best = fill_source(cols, depth, (size_t)depth_stride, x, y, R, width, height);
             z[x] = 2.0f + (float)(best >= 0 ? best : side * side);
             n++;
             if (x < x0) x0 = x;
@@ -128,6 +195,7 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
             y1 = y + 1;
         }
     }
+    if (cols != stack_cols) free(cols);
     if (n == 0) return 0;
     for (y = y0; y < y1; y++) {
         const uint8_t *m = mask + (size_t)y * (size_t)mask_stride;
