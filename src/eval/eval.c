@@ -83,6 +83,7 @@ void eval__ctx_free(eval_ctx *c)
     free(c->depth_lo); free(c->nrm_lo); free(c->mnrm);
     free(c->refine_scratch);
     free(c->stereo_scratch);
+    rast_context_destroy(c->rast);
     memset(c, 0, sizeof *c);
 }
 
@@ -175,7 +176,9 @@ static int ctx_init(eval_ctx *c, uint64_t seed, const char *sequence, const gt_t
     c->refine_scratch = aligned_alloc(16, (c->refine_scratch_size + 15) & ~(size_t)15);
     c->stereo_scratch_size = pipe_fit_stereo_scratch_size(CW, CH);
     c->stereo_scratch = aligned_alloc(16, (c->stereo_scratch_size + 15) & ~(size_t)15);
-    ok = ok && c->aa_samples && c->mask_lo && c->mask_up && c->refined && 
+    const rast_context_desc rd = {0, 1};
+    c->rast = rast_context_create(&rd);
+    ok = ok && c->rast && c->aa_samples && c->mask_lo && c->mask_up && c->refined && 
          c->mask_prior && c->mask_shift && c->mask_smooth && c->layer && c->out && c->depth_lo &&
          c->nrm_lo && c->mnrm && c->refine_scratch && c->stereo_scratch;
     if (!ok) return -1;
@@ -386,7 +389,9 @@ static int draw_mask(eval_ctx *c, const method_cfg *cfg, const kin_mesh *me, int
 {
     int div = cfg->div, w = CW / div, h = CH / div;
     rast_target tg = { w, h, c->depth_lo, w, c->mask_lo, w, c->nrm_lo, 3 * w, 3 };
-    rast_target_clear(&tg);
+    /* as pipe_frame: through a context (the same bytes as rast_draw),
+     * clearing what its last draw of this target touched */
+    rast_context_clear(c->rast, &tg);
     if (posed) {
         rast_transform_points(cam->view_proj.m, c->ps.pos, me->vertex_count, c->ps.clip);
         rast_transform_dirs(cam->view.m, c->ps.nrm, me->vertex_count, c->ps.vnrm);
@@ -396,12 +401,15 @@ static int draw_mask(eval_ctx *c, const method_cfg *cfg, const kin_mesh *me, int
         const kin_mesh *lm = c->lod_drawn ? &c->lod.level[c->lod_drawn].meshes[0] : me;
         rast_mesh_desc d = { c->ps.clip, me->vertex_count, c->ps.vnrm, 3, lm->indices,
                              lm->index_count / 3, RAST_CULL_NONE };
-        if (rast_draw(&tg, &d, NULL) != RAST_OK) return -1;
+        if (rast_context_draw(c->rast, &tg, &d, NULL) != RAST_OK) return -1;
         if (cfg->aa > 1) {
             /* the mask from cfg->aa coverage samples per pixel (depth and
              * normals stay those of the centres) */
             rast_aa_target at = { w, h, c->aa_samples, w, cfg->aa };
             rast_aa_clear(&at);
+            /* (the resolve writes the mask beyond the draw's record: the
+             * next clear of it is whole) */
+            rast_context_forget(c->rast);
             if (rast_draw_aa(&at, &d, NULL) != RAST_OK ||
                 rast_aa_resolve(&at, c->mask_lo, w) != RAST_OK)
                 return -1;

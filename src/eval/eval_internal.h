@@ -199,6 +199,9 @@ typedef struct eval_ctx {
     /* levels of detail of c->mask (eval_lod.c), when a method uses them */
     pipe_lod lod;
     int lod_drawn;            /* the level the last draw_mask drew */
+    /* the mask draws' context (one thread), as pipe_frame draws: its
+     * vector front end and a clear of what the last draw touched */
+    rast_context *rast;
     uint8_t *full_mask;       /* the full model's mask, 640x400 */
     float *full_depth;
     /* the lighting-mismatch sweep (eval_light.c): the ideal composite is
