@@ -166,8 +166,9 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
         radius < 1 || radius > FUSE_DEPTH_FILL_MAX_RADIUS)
         return -1;
     /* the columns' state: every column, looked up lazily from the first
-     * query on (no memory for a wide image: every unknown pixel gets the
-     * far plane, hidden by any virtual object, never drawn over one) */
+     * query on (no memory for a wide image: an unknown pixel without a
+     * known 8-neighbour gets the far plane, hidden by any virtual object,
+     * never drawn over one) */
     if (width > FILL_STACK_COLS) cols = malloc(sizeof *cols * (size_t)width);
     for (x = 0; cols && x < width; x++) cols[x] = (fill_col){INT_MIN / 2, INT_MIN / 2, INT_MAX, -1};
     for (y = 0; y < height; y++) {
