@@ -517,7 +517,7 @@ static void fill_rule(void **state)
  * fuse_depth_fill with radius R against a brute-force reference of its
  * rule (every pixel of the square, in the ties' order). Counts the pixels
  * filled from a source and with the far plane. */
-enum { FILL_MAX_PX = 700 * 37 };
+enum { FILL_MAX_PX = 1300 * 37 };
 
 static void fill_case(tu_rng *g, int w, int h, int R, int nb, const char *what, int c,
                       long *near, long *far)
@@ -576,8 +576,8 @@ static void fill_case(tu_rng *g, int w, int h, int R, int nb, const char *what, 
 
 /* fuse_depth_fill against the brute-force reference (fill_case): 400
  * small images with radii 1-9, 150 with the pipeline's radii (10-24, the
- * sample's band 16 gives 20) and 12 wide ones, whose column state is
- * allocated rather than on the stack. */
+ * sample's band 16 gives 20) and 12 wider than the depth fill's cache of
+ * column states (1024), where columns x and x + 1024 share a slot. */
 static void fill_reference(void **state)
 {
     (void)state;
@@ -592,7 +592,7 @@ static void fill_reference(void **state)
     for (int c = 0; c < 150; c++)
         fill_case(&g, 61, 47, 10 + c % 15, 1 + tu_int(&g, 6), "radius", c, &near_big, &far_big);
     for (int c = 0; c < 12; c++)
-        fill_case(&g, 700, 37, 4 + 2 * c, 20 + tu_int(&g, 40), "wide", c, &near_big, &far_big);
+        fill_case(&g, 1300, 37, 4 + 2 * c, 20 + tu_int(&g, 40), "wide", c, &near_big, &far_big);
     printf("fill_reference, large radii and wide: %ld from a source, %ld the far plane\n",
            near_big, far_big);
     assert_true(near_big > 10000 && far_big > 100);

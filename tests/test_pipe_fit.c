@@ -761,7 +761,13 @@ typedef struct learn_run {
     long ns[2];
 } learn_run;
 
-static void learn_run_reset(learn_run *r);
+/* The reference's state back to nothing learned. */
+static void learn_run_reset(learn_run *r)
+{
+    memset(r->af, 0, sizeof(float) * 2 * (size_t)(1 << (3 * PIPE_FIT_BITS)));
+    r->accn[0] = r->accn[1] = 0.0;
+    r->ns[0] = r->ns[1] = 0;
+}
 
 static void learn_run_init(learn_run *r, int w, int h)
 {
@@ -774,14 +780,6 @@ static void learn_run_init(learn_run *r, int w, int h)
     r->L = malloc((size_t)w * (size_t)h);
     assert_true(r->af && r->llr && r->rgba && r->m && r->pv && r->L);
     learn_run_reset(r);
-}
-
-/* The reference's state back to nothing learned. */
-static void learn_run_reset(learn_run *r)
-{
-    memset(r->af, 0, sizeof(float) * 2 * (size_t)(1 << (3 * PIPE_FIT_BITS)));
-    r->accn[0] = r->accn[1] = 0.0;
-    r->ns[0] = r->ns[1] = 0;
 }
 
 static void learn_run_free(learn_run *r)

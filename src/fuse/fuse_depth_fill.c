@@ -8,7 +8,6 @@
 #include "../cpu/mask_rows.h"
 
 #include <limits.h>
-#include <stdlib.h>
 #include <string.h>
 
 /* Known depth: z in [0, 1) (the depth test's rule, fuse.h); NaN fails. */
@@ -45,12 +44,24 @@ static float far_depth(void)
  * replace, so they change no answer). up_row: the last known row found
  * at or above up_scan (the last row looked at; INT_MIN / 2: none);
  * dn_row: the first known row found at or below the row of the last
- * query, dn_scan the last row looked at (dn_row INT_MAX: none up to it). */
+ * query, dn_scan the last row looked at (dn_row INT_MAX: none up to it).
+ * The states are a cache, FILL_COLS of them on the stack, column x in slot
+ * x % FILL_COLS (col: the column it holds, -1: none): a column that finds
+ * its slot taken starts afresh, which only costs its first look-ups again
+ * (no allocation; images up to FILL_COLS wide never share a slot). */
 typedef struct {
-    int up_row, up_scan, dn_row, dn_scan;
+    int col, up_row, up_scan, dn_row, dn_scan;
 } fill_col;
 
-enum { FILL_NONE = -1, FILL_STACK_COLS = 512 };
+enum { FILL_NONE = -1, FILL_COLS = 1024 };
+
+/* column x's state, fresh if its slot held another column */
+static fill_col *col_state(fill_col *cols, int x)
+{
+    fill_col *c = &cols[x % FILL_COLS];
+    if (c->col != x) *c = (fill_col){x, INT_MIN / 2, INT_MIN / 2, INT_MAX, -1};
+    return c;
+}
 
 /* the distance from row y to the nearest known depth of column x at or
  * above it, at most R; FILL_NONE: none */
@@ -68,12 +79,11 @@ static int col_up(fill_col *c, const float *depth, size_t stride, int x, int y, 
 static int col_down(fill_col *c, const float *depth, size_t stride, int x, int y, int R, int h)
 {
     if (c->dn_row == INT_MAX || c->dn_row < y) {
+        /* none found yet, or the one found is above y (dn_scan is then
+         * that row): look on from the row after the last looked at */
         const int last = y + R < h - 1 ? y + R : h - 1;
         int r = c->dn_scan + 1 > y ? c->dn_scan + 1 : y;
-        if (c->dn_row != INT_MAX) {   /* found earlier, now above y: look again from y */
-            r = y;
-            c->dn_row = INT_MAX;
-        }
+        c->dn_row = INT_MAX;
         for (; r <= last; r++)
             if (known(depth[(size_t)r * stride + (size_t)x])) {
                 c->dn_row = r;
@@ -106,8 +116,9 @@ static int fill_source(fill_col *cols, const float *depth, size_t stride, int x,
             int u, d, dy, code;
             long d2;
             if (xx < 0 || xx >= w) continue;
-            u = col_up(&cols[xx], depth, stride, xx, y, R);
-            d = col_down(&cols[xx], depth, stride, xx, y, R, h);
+            fill_col *c = col_state(cols, xx);
+            u = col_up(c, depth, stride, xx, y, R);
+            d = col_down(c, depth, stride, xx, y, R, h);
             if (u == FILL_NONE && d == FILL_NONE) continue;
             dy = u != FILL_NONE && (d == FILL_NONE || u <= d) ? -u : d;
             d2 = (long)(xx - x) * (xx - x) + (long)dy * dy;
@@ -148,14 +159,13 @@ static int fill_ring1(const float *z, size_t stride, int x, int y, int w, int h,
  * exact in a float. Pass 2 replaces each code by the source's depth
  * (sources are known pixels: pass 1 never wrote them). Pass 1 finds a
  * source among the 8 neighbours (fill_ring1) or else by columns
- * (fill_source), whose state every column keeps from its first look-up
- * on. */
+ * (fill_source, with the columns' cached state). */
 long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int depth_stride,
                      int width, int height, int radius, int box[4])
 {
     const int R = radius, side = 2 * radius + 1;
     int x0 = width, y0 = height, x1 = 0, y1 = 0;
-    fill_col stack_cols[FILL_STACK_COLS], *cols = stack_cols;
+    fill_col cols[FILL_COLS];
     long n = 0;
     int x, y;
     if (box) {
@@ -165,12 +175,7 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
         height > FUSE_MAX_DIM || mask_stride < width || depth_stride < width ||
         radius < 1 || radius > FUSE_DEPTH_FILL_MAX_RADIUS)
         return -1;
-    /* the columns' state: every column, looked up lazily from the first
-     * query on (no memory for a wide image: an unknown pixel without a
-     * known 8-neighbour gets the far plane, hidden by any virtual object,
-     * never drawn over one) */
-    if (width > FILL_STACK_COLS) cols = malloc(sizeof *cols * (size_t)width);
-    for (x = 0; cols && x < width; x++) cols[x] = (fill_col){INT_MIN / 2, INT_MIN / 2, INT_MAX, -1};
+    for (x = 0; x < FILL_COLS; x++) cols[x].col = -1;
     for (y = 0; y < height; y++) {
         const uint8_t *m = mask + (size_t)y * (size_t)mask_stride;
         float *z = depth + (size_t)y * (size_t)depth_stride;
@@ -186,7 +191,7 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
             }
             if (known(z[x])) continue;
             best = fill_ring1(z, (size_t)depth_stride, x, y, width, height, R);
-            if (best < 0 && cols)
+            if (best < 0)
                 best = fill_source(cols, depth, (size_t)depth_stride, x, y, R, width, height);
             z[x] = 2.0f + (float)(best >= 0 ? best : side * side);
             n++;
@@ -196,7 +201,6 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
             y1 = y + 1;
         }
     }
-    if (cols != stack_cols) free(cols);
     if (n == 0) return 0;
     for (y = y0; y < y1; y++) {
         const uint8_t *m = mask + (size_t)y * (size_t)mask_stride;

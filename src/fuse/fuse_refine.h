@@ -193,9 +193,7 @@ fuse_result fuse_refine_mask_global(const fuse_refine_params *p,
  * clears only what the draws touched) sets the box's pixels outside the
  * kinematic mask back to 1 after the depth test. -1 for NULL pointers, a
  * size outside 1..FUSE_MAX_DIM, strides below width, radius outside
- * 1..FUSE_DEPTH_FILL_MAX_RADIUS (nothing written). An image wider than
- * 512 px needs 16 bytes a column from malloc; without them a pixel whose
- * nearest source is not one of its 8 neighbours gets the far plane. */
+ * 1..FUSE_DEPTH_FILL_MAX_RADIUS (nothing written). */
 #define FUSE_DEPTH_FILL_MAX_RADIUS 128
 long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int depth_stride,
                      int width, int height, int radius, int box[4]);
