@@ -403,7 +403,12 @@ static int emit_side(builder *b, const gen_arms *a, int side)
      * crossing surfaces with their own normals: a shading seam with a
      * staircase boundary, issue 14.) The wrist is at s = 0.56, the palm's
      * profile follows from s = 0.58 and the cross section turns from an
-     * ellipse into the palm's boxy super-ellipse between them. */
+     * ellipse into the palm's boxy super-ellipse between them. The
+     * knuckle end is capped at 0.4 of its radius: a rounder end (0.8)
+     * came out between the finger tubes' bases at a shallow angle, and
+     * the depth test took one surface or the other pixel by pixel there,
+     * a dotted dark line along the index finger's base (frames 0, 140
+     * and 179 of the samples, both eyes). */
     static const prof_key arm_prof[] = {
         { -0.040f, 0.046f, 0.048f, 0.004f },
         { 0.000f, 0.053f, 0.055f, 0.004f },
@@ -429,7 +434,7 @@ static int emit_side(builder *b, const gen_arms *a, int side)
     tube arm = {
         .bone = J[GEN_J_UPPER_ARM], .prof = arm_prof, .prof_count = 14,
         .spans = arm_spans, .span_count = 4, .around = 28, .along = 84,
-        .cap_rings = 5, .cap0 = 0.9f, .cap1 = 0.8f, .squareness = 2.0f,
+        .cap_rings = 5, .cap0 = 0.9f, .cap1 = 0.4f, .squareness = 2.0f,
         .square2 = 2.8f, .square2_from = 0.555f, .square2_to = 0.59f,
         .albedo = { sleeve_rgb[0], sleeve_rgb[1], sleeve_rgb[2] },
         .albedo2 = { skin_rgb[0], skin_rgb[1], skin_rgb[2] },
