@@ -478,10 +478,16 @@ fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint
         return FUSE_ERR_ARGS;
     const uint8_t *learn = f->learn[eye];
     const int stride = f->width;
+    /* fit_learn_memory samples the even rows and reads the rows 4 above
+     * and below, clamped to 0 and height - 1: only those rows are built
+     * (fuse_colour_model_learn, without memory, gets every row) */
+    const int odd_skip = f->d.learn_memory > 0.0f;
+#define FIT_LEARN_ROW_SKIPPED(y) (odd_skip && ((y) & 1) && (y) != f->height - 1)
     if (!prev) {
         /* inside = >= 128: 255 or 0 (fuse_colour_model_learn leaves any
          * other value out) */
         for (int y = 0; y < f->height; y++) {
+            if (FIT_LEARN_ROW_SKIPPED(y)) continue;
             const uint8_t *a = mask + (size_t)y * (size_t)mask_stride;
             uint8_t *L = f->learn[eye] + (size_t)y * (size_t)f->width;
             int x = 0;
@@ -495,6 +501,7 @@ fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint
         /* 255 where both hold the pixel, 0 where neither does, else 128
          * (branch-free, so that the compiler vectorises the rows) */
         for (int y = 0; y < f->height; y++) {
+            if (FIT_LEARN_ROW_SKIPPED(y)) continue;
             const uint8_t *a = mask + (size_t)y * (size_t)mask_stride;
             const uint8_t *b = prev + (size_t)y * (size_t)prev_stride;
             uint8_t *L = f->learn[eye] + (size_t)y * (size_t)f->width;
@@ -524,6 +531,7 @@ fuse_result pipe_fit_learn(pipe_fit *f, int eye, const fuse_image *P, const uint
             }
         }
     }
+#undef FIT_LEARN_ROW_SKIPPED
     if (f->d.learn_memory > 0.0f) {
         fit_learn_memory(f, eye, P);
         return FUSE_OK;
