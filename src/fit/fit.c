@@ -358,7 +358,7 @@ static uint64_t fit_ld8(const uint8_t *p)
 static void fit_learn_memory(pipe_fit *f, int eye, const fuse_image *P)
 {
     const int w = f->width, h = f->height, bits = PIPE_FIT_BITS, bins = 1 << (3 * bits);
-    const int margin = 4;
+    const int margin = 4;   /* even: pipe_fit_learn builds only the even rows (and the last) */
     const float m = f->d.learn_memory;
     float *af = f->acc[eye], *ab = af + bins;
     const uint8_t *mask = f->learn[eye];
