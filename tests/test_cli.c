@@ -405,9 +405,7 @@ static void render_pose_options(void **state)
     assert_true(tu_exists(png));
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(usage_errors),
         cmocka_unit_test(mask_bad_models),
         cmocka_unit_test(mask_exact_quad),
@@ -415,7 +413,4 @@ int main(void)
         cmocka_unit_test(render_end_to_end),
         cmocka_unit_test(render_bad_inputs),
         cmocka_unit_test(render_pose_options),
-        cmocka_unit_test(eval_small),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(eval_small))

@@ -223,11 +223,6 @@ static void hide_and_props(void **state)
     shot_free(&both);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(group_setup, group_teardown,
         cmocka_unit_test(bad_values),
-        cmocka_unit_test(hide_and_props),
-    };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
-}
+        cmocka_unit_test(hide_and_props))

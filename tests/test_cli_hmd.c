@@ -259,13 +259,8 @@ static void unknown_names(void **st)
     assert_false(tu_exists(sc));
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(setup, NULL,
         cmocka_unit_test(sequence),
         cmocka_unit_test(render),
         cmocka_unit_test(run),
-        cmocka_unit_test(unknown_names),
-    };
-    return cmocka_run_group_tests(tests, setup, NULL);
-}
+        cmocka_unit_test(unknown_names))

@@ -233,13 +233,8 @@ static void validity_render_named_hmd(void **state)
     assert_int_equal(tu_rm_rf(dir), 0);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(result_mask_through_barrel),
-        cmocka_unit_test(validity_mask_bad_calibration),
-        cmocka_unit_test(validity_run_bad_calibration),
-        cmocka_unit_test(validity_render_named_hmd),
-    };
-    return cmocka_run_group_tests_name("cli_lens", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("cli_lens", NULL, NULL,
+              cmocka_unit_test(result_mask_through_barrel),
+              cmocka_unit_test(validity_mask_bad_calibration),
+              cmocka_unit_test(validity_run_bad_calibration),
+              cmocka_unit_test(validity_render_named_hmd))

@@ -221,13 +221,8 @@ static void no_cameras(void **st)
     assert_non_null(strstr(out, "egofuse render"));
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(setup, NULL,
         cmocka_unit_test(dry_run_equals_render),
         cmocka_unit_test(config_file),
         cmocka_unit_test(bad_inputs),
-        cmocka_unit_test(no_cameras),
-    };
-    return cmocka_run_group_tests(tests, setup, NULL);
-}
+        cmocka_unit_test(no_cameras))

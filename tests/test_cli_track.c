@@ -421,15 +421,10 @@ static void validity_calibrate(void **state)
     assert_non_null(strstr(out, "give --model or --scene"));
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(group_setup, group_teardown,
         cmocka_unit_test(validity_replay_args),
         cmocka_unit_test(result_replay_udp),
         cmocka_unit_test(result_replay_natnet_4_1),
         cmocka_unit_test(result_replay_natnet_3_1_zup_mm),
         cmocka_unit_test(result_calibrate),
-        cmocka_unit_test(validity_calibrate),
-    };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
-}
+        cmocka_unit_test(validity_calibrate))

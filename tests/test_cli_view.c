@@ -217,12 +217,7 @@ static void validity_bad_options(void **state)
     expect_usage("(--hmd-camera-offset) 0.3 m is outside 0..0.25 m", o, a8, 3);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(result_render_both_views),
-        cmocka_unit_test(result_soft_edges_default),
-        cmocka_unit_test(validity_bad_options),
-    };
-    return cmocka_run_group_tests_name("cli_view", tests, setup, teardown);
-}
+TU_MAIN_NAMED("cli_view", setup, teardown,
+              cmocka_unit_test(result_render_both_views),
+              cmocka_unit_test(result_soft_edges_default),
+              cmocka_unit_test(validity_bad_options))

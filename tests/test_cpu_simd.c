@@ -335,14 +335,9 @@ static void test_levels(void **state)
         if (ef_cpu_has((ef_isa)i)) assert_int_equal(ef_cpu_cap((ef_isa)i), i);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_levels),
         tu_simd_isa_test(check_isa, 0),
         tu_simd_isa_test(check_isa, 1),
         tu_simd_isa_test(check_isa, 2),
-        tu_simd_isa_test(check_isa, 3),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        tu_simd_isa_test(check_isa, 3))

@@ -106,11 +106,6 @@ static void test_isa(void **state)
     check_isa(isas[i], fns[i]);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test_prestate(test_isa, &idx4[0]), cmocka_unit_test_prestate(test_isa, &idx4[1]),
-        cmocka_unit_test_prestate(test_isa, &idx4[2]), cmocka_unit_test_prestate(test_isa, &idx4[3]),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test_prestate(test_isa, &idx4[2]), cmocka_unit_test_prestate(test_isa, &idx4[3]))

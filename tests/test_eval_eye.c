@@ -350,15 +350,10 @@ static void cli_eyeview_bad(void **state)
     remove(path);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(moments_known),
         cmocka_unit_test(hold_names),
         cmocka_unit_test(crop_geometry_20cm),
         cmocka_unit_test(crop_geometry_40cm),
         cmocka_unit_test(cli_eyeview_bad),
-        cmocka_unit_test(cli_eyeview),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(cli_eyeview))

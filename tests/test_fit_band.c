@@ -359,14 +359,9 @@ static void colour_checks_match_rule(void **state)
     assert_true(cleared > 1000);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(prior_reaches_beyond_band),
-        cmocka_unit_test(band_follows_depth_and_speed),
-        cmocka_unit_test(region_and_merge),
-        cmocka_unit_test(lag_adapts_to_speed),
-        cmocka_unit_test(colour_checks_match_rule),
-    };
-    return cmocka_run_group_tests_name("fit_band", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("fit_band", NULL, NULL,
+              cmocka_unit_test(prior_reaches_beyond_band),
+              cmocka_unit_test(band_follows_depth_and_speed),
+              cmocka_unit_test(region_and_merge),
+              cmocka_unit_test(lag_adapts_to_speed),
+              cmocka_unit_test(colour_checks_match_rule))

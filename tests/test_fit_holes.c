@@ -178,11 +178,6 @@ static void sizes_and_off(void **state)
     free(scratch);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(against_reference),
-        cmocka_unit_test(sizes_and_off),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(sizes_and_off))

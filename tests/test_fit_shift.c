@@ -191,13 +191,8 @@ static void bad_inputs(void **state)
     scene_free(&s);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(finds_the_offset),
-        cmocka_unit_test(stays_where_right),
-        cmocka_unit_test(outside_the_region_unchanged),
-        cmocka_unit_test(bad_inputs),
-    };
-    return cmocka_run_group_tests_name("fit_shift", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("fit_shift", NULL, NULL,
+              cmocka_unit_test(finds_the_offset),
+              cmocka_unit_test(stays_where_right),
+              cmocka_unit_test(outside_the_region_unchanged),
+              cmocka_unit_test(bad_inputs))

@@ -156,11 +156,6 @@ static void cracks_and_gaps(void **state)
     free(scratch);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(against_reference),
-        cmocka_unit_test(cracks_and_gaps),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(cracks_and_gaps))

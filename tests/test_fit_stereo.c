@@ -373,15 +373,10 @@ static void bad_arguments(void **state)
     scene_free(&s);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(setup, NULL,
         cmocka_unit_test(rejects_background_behind_the_hand),
         cmocka_unit_test(plain_background_is_ambiguous),
         cmocka_unit_test(accepts_the_hand_beyond_the_mask),
         cmocka_unit_test(enclosed_background_is_kept),
         cmocka_unit_test(grid_decides_like_every_pixel),
-        cmocka_unit_test(bad_arguments),
-    };
-    return cmocka_run_group_tests(tests, setup, NULL);
-}
+        cmocka_unit_test(bad_arguments))

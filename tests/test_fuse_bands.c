@@ -201,11 +201,6 @@ static void pipe_shared_eyes_same_bytes(void **state)
     kin_model_free(&m);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(bands_equal_frame),
-        cmocka_unit_test(pipe_shared_eyes_same_bytes),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(pipe_shared_eyes_same_bytes))

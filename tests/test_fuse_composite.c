@@ -480,9 +480,7 @@ static void test_crc(void **state)
     assert_int_equal(crc, COMPOSITE_CRC);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_vs_double),
         cmocka_unit_test(test_zero_layer),
         cmocka_unit_test(test_opaque_layer),
@@ -493,7 +491,4 @@ int main(void)
         cmocka_unit_test(test_positions),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_rgb24),
-        cmocka_unit_test(test_crc),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_crc))

@@ -350,15 +350,10 @@ static void test_tone(void **state)
     assert_int_equal(fuse_tone_match(&Pi, M, PW, &Vi, 10, 5, 80, 50, 1.0f, NULL), FUSE_ERR_ARGS);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_front_behind),
         cmocka_unit_test(test_mapping),
         cmocka_unit_test(test_random_vs_double),
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_frame),
-        cmocka_unit_test(test_tone),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_tone))

@@ -349,15 +349,10 @@ static void pipe_default_soft(void **state)
     kin_model_free(&m);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(against_reference),
         cmocka_unit_test(exact_every_width),
         cmocka_unit_test(weight_at_centres),
         cmocka_unit_test(bad_args),
         cmocka_unit_test(frame_every_isa),
-        cmocka_unit_test(pipe_default_soft),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(pipe_default_soft))

@@ -360,9 +360,7 @@ static void test_yuv_isa(void **state)
     if (ran == 0) skip();
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_yuyv_hand),
         cmocka_unit_test(test_yuv_vs_double),
         cmocka_unit_test(test_grey_rgb),
@@ -370,7 +368,4 @@ int main(void)
         cmocka_unit_test(test_bayer_ramp),
         cmocka_unit_test(test_crop),
         cmocka_unit_test(test_bad_input),
-        cmocka_unit_test(test_yuv_isa),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_yuv_isa))

@@ -808,9 +808,7 @@ static void test_crc(void **state)
     assert_int_equal(crc, LIGHT_CRC);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_light_vs_double),
         cmocka_unit_test(test_pow01),
         cmocka_unit_test(test_spec01),
@@ -824,7 +822,4 @@ int main(void)
         cmocka_unit_test(test_bad_input),
         cmocka_unit_test(test_in_place),
         cmocka_unit_test(test_strided_views),
-        cmocka_unit_test(test_crc),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_crc))

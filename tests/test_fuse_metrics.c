@@ -220,16 +220,11 @@ static void test_flicker(void **state)
     assert_true(isnan(fuse_edge_flicker(NULL, p1, t1, t1, W, W, H)));
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_confusion_rectangles),
         cmocka_unit_test(test_iou_known),
         cmocka_unit_test(test_boundary_shifted_edge),
         cmocka_unit_test(test_boundary_partial),
         cmocka_unit_test(test_boundary_empty_and_disjoint),
         cmocka_unit_test(test_psnr_constant),
-        cmocka_unit_test(test_flicker),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_flicker))

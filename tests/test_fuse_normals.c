@@ -132,12 +132,7 @@ static void bad_arguments(void **state)
     assert_null(pipe_create(&d, &km));
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(window_sum),
         cmocka_unit_test(seam_becomes_ramp),
-        cmocka_unit_test(bad_arguments),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(bad_arguments))

@@ -642,9 +642,7 @@ static void test_refine_crc(void **state)
     free(img); free(truth); free(km); free(out);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_skin_key),
         cmocka_unit_test(test_refine_recovers_disc),
         cmocka_unit_test(test_refine_keeps_mask),
@@ -655,7 +653,4 @@ int main(void)
         cmocka_unit_test(test_fast_neon),
         cmocka_unit_test(test_fast_avx512),
         cmocka_unit_test(test_chamfer_rows),
-        cmocka_unit_test(test_refine_crc),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_refine_crc))

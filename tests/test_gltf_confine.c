@@ -288,16 +288,11 @@ static void cli_render(void **state)
     assert_true(tu_exists(png));
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(setup, NULL,
         cmocka_unit_test(inside_loads),
         cmocka_unit_test(outside_refused),
         cmocka_unit_test(glb_external_buffer),
         cmocka_unit_test(current_folder_not_searched),
         cmocka_unit_test_teardown(opt_in_allows, teardown),
         cmocka_unit_test(cli_mask),
-        cmocka_unit_test(cli_render),
-    };
-    return cmocka_run_group_tests(tests, setup, NULL);
-}
+        cmocka_unit_test(cli_render))

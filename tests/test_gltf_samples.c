@@ -1029,9 +1029,7 @@ static void synthetic_features_match_their_crcs(void **state)
     if (!record) assert_int_equal(bad, 0);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(every_model_matches_its_crcs),
         cmocka_unit_test(morph_weights_drive_the_geometry),
         cmocka_unit_test(primitive_modes_in_spec_order),
@@ -1040,7 +1038,4 @@ int main(void)
         cmocka_unit_test(gltfpack_variants),
         cmocka_unit_test(synthetic_features_match_their_crcs),
         cmocka_unit_test(bad_input_named),
-        cmocka_unit_test(cli_refuses_without_output),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(cli_refuses_without_output))

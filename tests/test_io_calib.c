@@ -327,13 +327,8 @@ static void validity_files(void **state)
     remove(p);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(result_samples),
-        cmocka_unit_test(result_variants),
-        cmocka_unit_test(validity_bad_inputs),
-        cmocka_unit_test(validity_files),
-    };
-    return cmocka_run_group_tests_name("io_calib", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("io_calib", NULL, NULL,
+              cmocka_unit_test(result_samples),
+              cmocka_unit_test(result_variants),
+              cmocka_unit_test(validity_bad_inputs),
+              cmocka_unit_test(validity_files))

@@ -473,14 +473,9 @@ static void test_sdl_window(void **st)
     assert_int_equal(fds_after, fds);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_parse),
         cmocka_unit_test(test_blit),
         cmocka_unit_test(test_kms_refusals),
         cmocka_unit_test(test_sdl_missing),
-        cmocka_unit_test(test_sdl_window),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_sdl_window))

@@ -278,12 +278,7 @@ static void test_refusals(void **state)
     assert_int_equal(tu_count_fds(), fds);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(setup, NULL,
         cmocka_unit_test(test_written_files_read_alike),
         cmocka_unit_test(test_oiiotool_files_read_alike),
-        cmocka_unit_test(test_refusals),
-    };
-    return cmocka_run_group_tests(tests, setup, NULL);
-}
+        cmocka_unit_test(test_refusals))

@@ -147,12 +147,7 @@ static void test_open_errors(void **st)
     io_glove_close(&g); /* harmless */
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_layout),          cmocka_unit_test(test_round_trip),
         cmocka_unit_test(test_bad_reports),     cmocka_unit_test(test_feed_calibrated),
-        cmocka_unit_test(test_open_errors),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_open_errors))

@@ -709,21 +709,16 @@ static void flipped_bytes_never_crash(void **state)
     free(orig);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(shared_models_load_with_counts),
-        cmocka_unit_test(fox_is_not_indexed_and_names_animations),
-        cmocka_unit_test(rigged_simple_known_values),
-        cmocka_unit_test(simple_skin_known_values),
-        cmocka_unit_test(synthetic_loads_in_every_container),
-        cmocka_unit_test(synthetic_variants),
-        cmocka_unit_test(missing_and_empty_files),
-        cmocka_unit_test(truncated_glb),
-        cmocka_unit_test(corrupt_json),
-        cmocka_unit_test(json_without_meshes),
-        cmocka_unit_test(broken_synthetic_models),
-        cmocka_unit_test(flipped_bytes_never_crash),
-    };
-    return cmocka_run_group_tests_name("io_gltf", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("io_gltf", NULL, NULL,
+              cmocka_unit_test(shared_models_load_with_counts),
+              cmocka_unit_test(fox_is_not_indexed_and_names_animations),
+              cmocka_unit_test(rigged_simple_known_values),
+              cmocka_unit_test(simple_skin_known_values),
+              cmocka_unit_test(synthetic_loads_in_every_container),
+              cmocka_unit_test(synthetic_variants),
+              cmocka_unit_test(missing_and_empty_files),
+              cmocka_unit_test(truncated_glb),
+              cmocka_unit_test(corrupt_json),
+              cmocka_unit_test(json_without_meshes),
+              cmocka_unit_test(broken_synthetic_models),
+              cmocka_unit_test(flipped_bytes_never_crash))

@@ -303,17 +303,12 @@ static void save_errors_leave_files_untouched(void **state)
     io_image_free(&img);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(png_round_trips_exactly),
-        cmocka_unit_test(exr_float_round_trips_exactly),
-        cmocka_unit_test(alloc_is_zeroed_and_checked),
-        cmocka_unit_test(channel_conversion),
-        cmocka_unit_test(float_to_png_is_clamped_and_scaled),
-        cmocka_unit_test(padded_stride_is_honoured),
-        cmocka_unit_test(read_errors),
-        cmocka_unit_test(save_errors_leave_files_untouched),
-    };
-    return cmocka_run_group_tests_name("io_image", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("io_image", NULL, NULL,
+              cmocka_unit_test(png_round_trips_exactly),
+              cmocka_unit_test(exr_float_round_trips_exactly),
+              cmocka_unit_test(alloc_is_zeroed_and_checked),
+              cmocka_unit_test(channel_conversion),
+              cmocka_unit_test(float_to_png_is_clamped_and_scaled),
+              cmocka_unit_test(padded_stride_is_honoured),
+              cmocka_unit_test(read_errors),
+              cmocka_unit_test(save_errors_leave_files_untouched))

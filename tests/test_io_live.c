@@ -202,14 +202,9 @@ static void stats_log_full_disk(void **state)
     assert_false(tu_exists(s.tmp));
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(conf_options),
         cmocka_unit_test(conf_errors),
         cmocka_unit_test(lat_quantiles),
         cmocka_unit_test(stats_log),
-        cmocka_unit_test(stats_log_full_disk),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(stats_log_full_disk))

@@ -729,9 +729,7 @@ static void test_cli(void **state)
     tu_samples_remove("lod_samples");
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_choose),
         cmocka_unit_test(test_px_per_m),
         cmocka_unit_test(test_bad_inputs),
@@ -740,7 +738,4 @@ int main(void)
         cmocka_unit_test(test_draw),
         cmocka_unit_test(test_shared_models),
         cmocka_unit_test(test_pipe),
-        cmocka_unit_test(test_cli),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_cli))

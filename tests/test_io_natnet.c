@@ -632,9 +632,7 @@ static void validity_truncations(void **state)
     }
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(group_setup, group_teardown,
         cmocka_unit_test(validity_config),
         cmocka_unit_test(validity_no_answer),
         cmocka_unit_test(validity_bad_packets),
@@ -643,7 +641,4 @@ int main(void)
         cmocka_unit_test(result_stream_3_1),
         cmocka_unit_test(result_stream_4_1),
         cmocka_unit_test(result_axes_and_units),
-        cmocka_unit_test(result_multicast),
-    };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
-}
+        cmocka_unit_test(result_multicast))

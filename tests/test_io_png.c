@@ -221,13 +221,8 @@ static void truncated_png_says_so(void **state)
     assert_null(img.data);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(reads_what_ffmpeg_writes),
         cmocka_unit_test(ffmpeg_reads_what_we_write),
         cmocka_unit_test(float_conversion_matches_oiio),
-        cmocka_unit_test(truncated_png_says_so),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(truncated_png_says_so))

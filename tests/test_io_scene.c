@@ -350,16 +350,11 @@ static void tracking_key(void **state)
     }
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(full_file_parses),
-        cmocka_unit_test(minimal_file_and_lighting_defaults),
-        cmocka_unit_test(relative_scene_path),
-        cmocka_unit_test(errors_name_file_and_line),
-        cmocka_unit_test(frames_and_fps_checks),
-        cmocka_unit_test(header_and_file_errors),
-        cmocka_unit_test(tracking_key),
-    };
-    return cmocka_run_group_tests_name("io_scene", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("io_scene", NULL, NULL,
+              cmocka_unit_test(full_file_parses),
+              cmocka_unit_test(minimal_file_and_lighting_defaults),
+              cmocka_unit_test(relative_scene_path),
+              cmocka_unit_test(errors_name_file_and_line),
+              cmocka_unit_test(frames_and_fps_checks),
+              cmocka_unit_test(header_and_file_errors),
+              cmocka_unit_test(tracking_key))

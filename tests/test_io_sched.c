@@ -299,13 +299,8 @@ static void test_sched_arithmetic(void **st)
     assert_int_equal(s.period_ns, before);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_sched_arithmetic),
         cmocka_unit_test(test_sched_free_running),
         cmocka_unit_test(test_sched_60hz),
-        cmocka_unit_test(test_sched_90hz),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_sched_90hz))

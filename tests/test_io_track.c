@@ -216,17 +216,14 @@ static void result_udp_stream_in_order_and_wrap(void **state)
 
 int main(void)
 {
-    const struct CMUnitTest validity[] = {
-        cmocka_unit_test(validity_file_errors),
-        cmocka_unit_test(validity_udp_bad_packets_keep_last_good),
-        cmocka_unit_test(validity_udp_arguments),
-    };
-    const struct CMUnitTest results[] = {
-        cmocka_unit_test(result_file_round_trip),
-        cmocka_unit_test(result_calib_round_trip),
-        cmocka_unit_test(result_udp_stream_in_order_and_wrap),
-    };
-    int f = cmocka_run_group_tests_name("io_track validity", validity, NULL, NULL);
-    f += cmocka_run_group_tests_name("io_track results", results, NULL, NULL);
+    int f = 0;
+    TU_GROUP(f, "io_track validity",
+             cmocka_unit_test(validity_file_errors),
+             cmocka_unit_test(validity_udp_bad_packets_keep_last_good),
+             cmocka_unit_test(validity_udp_arguments));
+    TU_GROUP(f, "io_track results",
+             cmocka_unit_test(result_file_round_trip),
+             cmocka_unit_test(result_calib_round_trip),
+             cmocka_unit_test(result_udp_stream_in_order_and_wrap));
     return f ? 1 : 0;
 }

@@ -251,12 +251,7 @@ static void test_diff(void **st)
     assert_int_equal(nrem, 2);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(setup, teardown,
         cmocka_unit_test(test_port_path),  cmocka_unit_test(test_list_sysfs),
         cmocka_unit_test(test_video_node), cmocka_unit_test(test_selectors),
-        cmocka_unit_test(test_assign),     cmocka_unit_test(test_diff),
-    };
-    return cmocka_run_group_tests(tests, setup, teardown);
-}
+        cmocka_unit_test(test_assign),     cmocka_unit_test(test_diff))

@@ -495,9 +495,7 @@ static void test_run_without_cameras(void **st)
     assert_non_null(strstr(out, "USB devices:"));
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_grab_newest_and_pixels),
         cmocka_unit_test(test_gaps_short_corrupt),
         cmocka_unit_test(test_unplug_and_reopen),
@@ -508,7 +506,4 @@ int main(void)
         cmocka_unit_test(test_convert),
         cmocka_unit_test(test_v4l2_not_cameras),
         cmocka_unit_test(test_template_backend),
-        cmocka_unit_test(test_run_without_cameras),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_run_without_cameras))

@@ -956,9 +956,7 @@ static void test_file_cam_video(void **st)
     assert_int_equal(tu_count_fds(), fds0);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_egfv_basic_sbs_depth),
         cmocka_unit_test(test_egfv_tb_u16_depth),
         cmocka_unit_test(test_egfv_scaled),
@@ -970,7 +968,4 @@ int main(void)
         cmocka_unit_test(test_raw_ffmpeg),
         cmocka_unit_test(test_regular_file_paced),
         cmocka_unit_test(test_file_cam_sequence),
-        cmocka_unit_test(test_file_cam_video),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_file_cam_video))

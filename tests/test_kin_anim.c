@@ -284,22 +284,17 @@ static void result_several_channels(void **state)
     NEAR3(loc[1].s, 1, 1, 1, 0);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(validity_node_out_of_range_ignored),
-        cmocka_unit_test(validity_weights_ignored),
-        cmocka_unit_test(validity_only_animated_paths_change),
-        cmocka_unit_test(validity_pose_rest),
-        cmocka_unit_test(result_linear_translation),
-        cmocka_unit_test(result_linear_many_keys),
-        cmocka_unit_test(result_rotation_slerp),
-        cmocka_unit_test(result_step),
-        cmocka_unit_test(result_cubicspline),
-        cmocka_unit_test(result_cubicspline_rotation),
-        cmocka_unit_test(result_clamp),
-        cmocka_unit_test(result_one_key),
-        cmocka_unit_test(result_several_channels),
-    };
-    return cmocka_run_group_tests_name("kin_anim", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("kin_anim", NULL, NULL,
+              cmocka_unit_test(validity_node_out_of_range_ignored),
+              cmocka_unit_test(validity_weights_ignored),
+              cmocka_unit_test(validity_only_animated_paths_change),
+              cmocka_unit_test(validity_pose_rest),
+              cmocka_unit_test(result_linear_translation),
+              cmocka_unit_test(result_linear_many_keys),
+              cmocka_unit_test(result_rotation_slerp),
+              cmocka_unit_test(result_step),
+              cmocka_unit_test(result_cubicspline),
+              cmocka_unit_test(result_cubicspline_rotation),
+              cmocka_unit_test(result_clamp),
+              cmocka_unit_test(result_one_key),
+              cmocka_unit_test(result_several_channels))

@@ -349,19 +349,16 @@ static void result_calibration_lets_the_arm_reach(void **state)
 
 int main(void)
 {
-    const struct CMUnitTest validity[] = {
-        cmocka_unit_test(validity_estimate_rejects),
-        cmocka_unit_test(validity_file_errors),
-        cmocka_unit_test(validity_gesture_missing_falls_back),
-    };
-    const struct CMUnitTest results[] = {
-        cmocka_unit_test(result_estimate_user_size),
-        cmocka_unit_test(result_hand_scale_from_gesture),
-        cmocka_unit_test(result_hand_tips_of_a_model),
-        cmocka_unit_test(result_file_round_trip),
-        cmocka_unit_test(result_calibration_lets_the_arm_reach),
-    };
-    int f = cmocka_run_group_tests_name("kin_calib validity", validity, NULL, NULL);
-    f += cmocka_run_group_tests_name("kin_calib results", results, NULL, NULL);
+    int f = 0;
+    TU_GROUP(f, "kin_calib validity",
+             cmocka_unit_test(validity_estimate_rejects),
+             cmocka_unit_test(validity_file_errors),
+             cmocka_unit_test(validity_gesture_missing_falls_back));
+    TU_GROUP(f, "kin_calib results",
+             cmocka_unit_test(result_estimate_user_size),
+             cmocka_unit_test(result_hand_scale_from_gesture),
+             cmocka_unit_test(result_hand_tips_of_a_model),
+             cmocka_unit_test(result_file_round_trip),
+             cmocka_unit_test(result_calibration_lets_the_arm_reach));
     return f ? 1 : 0;
 }

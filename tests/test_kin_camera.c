@@ -262,17 +262,12 @@ static void result_look_at_camera(void **state)
     }
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(validity_desc_defaults),
-        cmocka_unit_test(validity_wide_camera_crop),
-        cmocka_unit_test(result_paper_numbers),
-        cmocka_unit_test(result_camera_intrinsics),
-        cmocka_unit_test(result_camera_centres),
-        cmocka_unit_test(result_projection_pinhole),
-        cmocka_unit_test(result_pixel_ray_round_trip),
-        cmocka_unit_test(result_look_at_camera),
-    };
-    return cmocka_run_group_tests_name("kin_camera", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("kin_camera", NULL, NULL,
+              cmocka_unit_test(validity_desc_defaults),
+              cmocka_unit_test(validity_wide_camera_crop),
+              cmocka_unit_test(result_paper_numbers),
+              cmocka_unit_test(result_camera_intrinsics),
+              cmocka_unit_test(result_camera_centres),
+              cmocka_unit_test(result_projection_pinhole),
+              cmocka_unit_test(result_pixel_ray_round_trip),
+              cmocka_unit_test(result_look_at_camera))

@@ -359,18 +359,15 @@ static void sweep_wrist_twist_volume(void **state)
 
 int main(void)
 {
-    const struct CMUnitTest validity[] = {
-        cmocka_unit_test(validity_zero_weights_and_no_skin),
-        cmocka_unit_test(validity_zero_real_part_keeps_bind_pose),
-    };
-    const struct CMUnitTest results[] = {
-        cmocka_unit_test(result_dualquat_matches_matrix),
-        cmocka_unit_test(result_rigid_vertices_equal_lbs),
-        cmocka_unit_test(result_translation_blend),
-        cmocka_unit_test(result_matches_normalised_kavan_in_double),
-        cmocka_unit_test(sweep_wrist_twist_volume),
-    };
-    int f = cmocka_run_group_tests_name("kin_dqs validity", validity, NULL, NULL);
-    f += cmocka_run_group_tests_name("kin_dqs results", results, NULL, NULL);
+    int f = 0;
+    TU_GROUP(f, "kin_dqs validity",
+             cmocka_unit_test(validity_zero_weights_and_no_skin),
+             cmocka_unit_test(validity_zero_real_part_keeps_bind_pose));
+    TU_GROUP(f, "kin_dqs results",
+             cmocka_unit_test(result_dualquat_matches_matrix),
+             cmocka_unit_test(result_rigid_vertices_equal_lbs),
+             cmocka_unit_test(result_translation_blend),
+             cmocka_unit_test(result_matches_normalised_kavan_in_double),
+             cmocka_unit_test(sweep_wrist_twist_volume));
     return f ? 1 : 0;
 }

@@ -225,16 +225,13 @@ static void result_jitter_reduced(void **state)
 
 int main(void)
 {
-    const struct CMUnitTest validity[] = {
-        cmocka_unit_test(validity_nan_parts_and_old_samples),
-    };
-    const struct CMUnitTest results[] = {
-        cmocka_unit_test(result_first_updates_hand_worked),
-        cmocka_unit_test(result_constant_velocity_predicted),
-        cmocka_unit_test(result_dropout_hold_then_fade),
-        cmocka_unit_test(result_jitter_reduced),
-    };
-    int f = cmocka_run_group_tests_name("kin_filter validity", validity, NULL, NULL);
-    f += cmocka_run_group_tests_name("kin_filter results", results, NULL, NULL);
+    int f = 0;
+    TU_GROUP(f, "kin_filter validity",
+             cmocka_unit_test(validity_nan_parts_and_old_samples));
+    TU_GROUP(f, "kin_filter results",
+             cmocka_unit_test(result_first_updates_hand_worked),
+             cmocka_unit_test(result_constant_velocity_predicted),
+             cmocka_unit_test(result_dropout_hold_then_fade),
+             cmocka_unit_test(result_jitter_reduced));
     return f ? 1 : 0;
 }

@@ -279,16 +279,11 @@ static void result_fk_mat_agrees(void **state)
     }
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(validity_empty_and_bad_parent),
-        cmocka_unit_test(validity_model_validate),
-        cmocka_unit_test(validity_find_node),
-        cmocka_unit_test(result_chain_90),
-        cmocka_unit_test(result_root_and_scale),
-        cmocka_unit_test(result_branching_tree),
-        cmocka_unit_test(result_fk_mat_agrees),
-    };
-    return cmocka_run_group_tests_name("kin_fk", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("kin_fk", NULL, NULL,
+              cmocka_unit_test(validity_empty_and_bad_parent),
+              cmocka_unit_test(validity_model_validate),
+              cmocka_unit_test(validity_find_node),
+              cmocka_unit_test(result_chain_90),
+              cmocka_unit_test(result_root_and_scale),
+              cmocka_unit_test(result_branching_tree),
+              cmocka_unit_test(result_fk_mat_agrees))

@@ -176,16 +176,13 @@ static void result_hand_monotone_and_continuous(void **state)
 
 int main(void)
 {
-    const struct CMUnitTest validity[] = {
-        cmocka_unit_test(validity_glove_calib),
-        cmocka_unit_test(validity_hand_job),
-    };
-    const struct CMUnitTest results[] = {
-        cmocka_unit_test(result_glove_calib_percentiles),
-        cmocka_unit_test(result_hand_mapping_hand_worked),
-        cmocka_unit_test(result_hand_monotone_and_continuous),
-    };
-    int f = cmocka_run_group_tests_name("kin_hand validity", validity, NULL, NULL);
-    f += cmocka_run_group_tests_name("kin_hand results", results, NULL, NULL);
+    int f = 0;
+    TU_GROUP(f, "kin_hand validity",
+             cmocka_unit_test(validity_glove_calib),
+             cmocka_unit_test(validity_hand_job));
+    TU_GROUP(f, "kin_hand results",
+             cmocka_unit_test(result_glove_calib_percentiles),
+             cmocka_unit_test(result_hand_mapping_hand_worked),
+             cmocka_unit_test(result_hand_monotone_and_continuous));
     return f ? 1 : 0;
 }

@@ -349,13 +349,8 @@ static void small_portrait_frame(void **state)
     kin_model_free(&m);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(presets),
         cmocka_unit_test(three_hmds),
         cmocka_unit_test(crop_rule_random),
-        cmocka_unit_test(small_portrait_frame),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(small_portrait_frame))

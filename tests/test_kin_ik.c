@@ -537,25 +537,20 @@ static void rig_pose_reaches_the_tracked_points(void **state)
 
 int main(void)
 {
-    const struct CMUnitTest validity[] = {
-        cmocka_unit_test(validity_rejects_bad_jobs),
-        cmocka_unit_test(rig_missing_joints_listed),
-    };
-    const struct CMUnitTest results[] = {
-        cmocka_unit_test(result_hand_worked_elbow),
-        cmocka_unit_test(result_swivel_follows_hand),
-        cmocka_unit_test(result_reach_limits),
-        cmocka_unit_test(result_twist_share_and_limit),
-        cmocka_unit_test(result_left_mirrors_right),
-        cmocka_unit_test(rig_pose_reaches_the_tracked_points),
-    };
-    const struct CMUnitTest sweeps[] = {
-        cmocka_unit_test(sweep_targets_through_and_beyond_reach),
-        cmocka_unit_test(sweep_straight_arm_and_shoulder),
-        cmocka_unit_test(sweep_hand_rotation),
-    };
-    int f = cmocka_run_group_tests_name("kin_ik validity", validity, NULL, NULL);
-    f += cmocka_run_group_tests_name("kin_ik results", results, NULL, NULL);
-    f += cmocka_run_group_tests_name("kin_ik stability sweeps", sweeps, NULL, NULL);
+    int f = 0;
+    TU_GROUP(f, "kin_ik validity",
+             cmocka_unit_test(validity_rejects_bad_jobs),
+             cmocka_unit_test(rig_missing_joints_listed));
+    TU_GROUP(f, "kin_ik results",
+             cmocka_unit_test(result_hand_worked_elbow),
+             cmocka_unit_test(result_swivel_follows_hand),
+             cmocka_unit_test(result_reach_limits),
+             cmocka_unit_test(result_twist_share_and_limit),
+             cmocka_unit_test(result_left_mirrors_right),
+             cmocka_unit_test(rig_pose_reaches_the_tracked_points));
+    TU_GROUP(f, "kin_ik stability sweeps",
+             cmocka_unit_test(sweep_targets_through_and_beyond_reach),
+             cmocka_unit_test(sweep_straight_arm_and_shoulder),
+             cmocka_unit_test(sweep_hand_rotation));
     return f ? 1 : 0;
 }

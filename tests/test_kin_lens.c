@@ -388,17 +388,12 @@ static void validity_bad_lenses(void **state)
     assert_false(kin_lens_check(&L, why, sizeof why));
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(result_brown_matches_opencv_formula),
-        cmocka_unit_test(result_fisheye_matches_opencv_formula),
-        cmocka_unit_test(result_hand_computed_values),
-        cmocka_unit_test(result_round_trips),
-        cmocka_unit_test(result_pinhole_is_kin_camera),
-        cmocka_unit_test(result_scaled_and_cropped),
-        cmocka_unit_test(result_fold),
-        cmocka_unit_test(validity_bad_lenses),
-    };
-    return cmocka_run_group_tests_name("kin_lens", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("kin_lens", NULL, NULL,
+              cmocka_unit_test(result_brown_matches_opencv_formula),
+              cmocka_unit_test(result_fisheye_matches_opencv_formula),
+              cmocka_unit_test(result_hand_computed_values),
+              cmocka_unit_test(result_round_trips),
+              cmocka_unit_test(result_pinhole_is_kin_camera),
+              cmocka_unit_test(result_scaled_and_cropped),
+              cmocka_unit_test(result_fold),
+              cmocka_unit_test(validity_bad_lenses))

@@ -277,20 +277,15 @@ static void result_perspective(void **state)
 
 /* One cmocka group (tests/run_tests.sh counts the last summary line);
  * the validity_ and result_ prefixes name the two kinds of test. */
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(validity_zero_vectors),
-        cmocka_unit_test(validity_singular_inverse),
-        cmocka_unit_test(validity_small_scale_inverse),
-        cmocka_unit_test(result_vectors),
-        cmocka_unit_test(result_quat_rotate_analytic),
-        cmocka_unit_test(result_quat_vs_matrix),
-        cmocka_unit_test(result_transform_order),
-        cmocka_unit_test(result_inverse_random),
-        cmocka_unit_test(result_slerp),
-        cmocka_unit_test(result_look_at),
-        cmocka_unit_test(result_perspective),
-    };
-    return cmocka_run_group_tests_name("kin_math", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("kin_math", NULL, NULL,
+              cmocka_unit_test(validity_zero_vectors),
+              cmocka_unit_test(validity_singular_inverse),
+              cmocka_unit_test(validity_small_scale_inverse),
+              cmocka_unit_test(result_vectors),
+              cmocka_unit_test(result_quat_rotate_analytic),
+              cmocka_unit_test(result_quat_vs_matrix),
+              cmocka_unit_test(result_transform_order),
+              cmocka_unit_test(result_inverse_random),
+              cmocka_unit_test(result_slerp),
+              cmocka_unit_test(result_look_at),
+              cmocka_unit_test(result_perspective))

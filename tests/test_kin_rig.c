@@ -398,15 +398,10 @@ static void test_generated_tracking_drives_the_rig(void **state)
     poser_free(&p);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(group_setup, group_teardown,
         cmocka_unit_test(test_rig_finds_every_joint),
         cmocka_unit_test(test_rig_names_missing_joints),
         cmocka_unit_test(test_ik_wrists_on_targets),
         cmocka_unit_test(test_ik_retargets_the_animation),
         cmocka_unit_test(test_skin_under_ik_finite),
-        cmocka_unit_test(test_generated_tracking_drives_the_rig),
-    };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
-}
+        cmocka_unit_test(test_generated_tracking_drives_the_rig))

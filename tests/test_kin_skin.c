@@ -274,17 +274,12 @@ static void result_bent_cylinder(void **state)
     }
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(validity_identity_joints_bind_pose),
-        cmocka_unit_test(validity_zero_weights_keep_bind),
-        cmocka_unit_test(validity_no_normals),
-        cmocka_unit_test(result_joint_matrices),
-        cmocka_unit_test(result_two_joint_blend),
-        cmocka_unit_test(result_normals_nonuniform_scale),
-        cmocka_unit_test(result_mesh_transform),
-        cmocka_unit_test(result_bent_cylinder),
-    };
-    return cmocka_run_group_tests_name("kin_skin", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("kin_skin", NULL, NULL,
+              cmocka_unit_test(validity_identity_joints_bind_pose),
+              cmocka_unit_test(validity_zero_weights_keep_bind),
+              cmocka_unit_test(validity_no_normals),
+              cmocka_unit_test(result_joint_matrices),
+              cmocka_unit_test(result_two_joint_blend),
+              cmocka_unit_test(result_normals_nonuniform_scale),
+              cmocka_unit_test(result_mesh_transform),
+              cmocka_unit_test(result_bent_cylinder))

@@ -240,16 +240,11 @@ static void test_dqs_weight_scale(void **state)
     assert_true(exact > 1000 && near > 1000);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_sse2),
         cmocka_unit_test(test_avx2),
         cmocka_unit_test(test_avx512),
         cmocka_unit_test(test_neon),
         cmocka_unit_test(test_dispatch_equal),
         cmocka_unit_test(test_no_normal_output),
-        cmocka_unit_test(test_dqs_weight_scale),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_dqs_weight_scale))

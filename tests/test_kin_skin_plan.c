@@ -366,9 +366,7 @@ static void test_invalid(void **state)
     tu_skin_case_free(&k);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_ref),
         cmocka_unit_test(test_sse2),
         cmocka_unit_test(test_avx2),
@@ -378,7 +376,4 @@ int main(void)
         cmocka_unit_test(test_structure),
         cmocka_unit_test(test_parts),
         cmocka_unit_test(test_bind_pose),
-        cmocka_unit_test(test_invalid),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_invalid))

@@ -304,19 +304,16 @@ static void result_body_frame(void **state)
 
 int main(void)
 {
-    const struct CMUnitTest validity[] = {
-        cmocka_unit_test(validity_file_errors_name_the_line),
-        cmocka_unit_test(validity_capacity_and_count),
-        cmocka_unit_test(validity_sample_validate),
-        cmocka_unit_test(validity_packet_rejects),
-    };
-    const struct CMUnitTest results[] = {
-        cmocka_unit_test(result_parse_hand_written_file),
-        cmocka_unit_test(result_format_parse_round_trip),
-        cmocka_unit_test(result_packet_layout_and_round_trip),
-        cmocka_unit_test(result_body_frame),
-    };
-    int f = cmocka_run_group_tests_name("kin_track validity", validity, NULL, NULL);
-    f += cmocka_run_group_tests_name("kin_track results", results, NULL, NULL);
+    int f = 0;
+    TU_GROUP(f, "kin_track validity",
+             cmocka_unit_test(validity_file_errors_name_the_line),
+             cmocka_unit_test(validity_capacity_and_count),
+             cmocka_unit_test(validity_sample_validate),
+             cmocka_unit_test(validity_packet_rejects));
+    TU_GROUP(f, "kin_track results",
+             cmocka_unit_test(result_parse_hand_written_file),
+             cmocka_unit_test(result_format_parse_round_trip),
+             cmocka_unit_test(result_packet_layout_and_round_trip),
+             cmocka_unit_test(result_body_frame));
     return f ? 1 : 0;
 }

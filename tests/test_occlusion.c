@@ -598,9 +598,7 @@ static void fill_reference(void **state)
     assert_true(near_big > 10000 && far_big > 100);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(setup, teardown,
         cmocka_unit_test(fill_rule),
         cmocka_unit_test(fill_reference),
         cmocka_unit_test(occl_kin),
@@ -614,7 +612,4 @@ int main(void)
         cmocka_unit_test(occl_refine_anim_aa),
         cmocka_unit_test(occl_kin_pred_soft),
         cmocka_unit_test(occl_refine_soft),
-        cmocka_unit_test(occl_refine_fast),
-    };
-    return cmocka_run_group_tests(tests, setup, teardown);
-}
+        cmocka_unit_test(occl_refine_fast))

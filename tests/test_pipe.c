@@ -801,9 +801,7 @@ static void fit_state_across_frames(void **state)
     fit_scene_close(&S);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(frame_equals_stages),
         cmocka_unit_test_prestate(threads_same_bytes, NULL),
         cmocka_unit_test_prestate(threads_same_bytes, (void *)1),
@@ -816,7 +814,4 @@ int main(void)
         cmocka_unit_test(fit_anim_same_bytes),
         cmocka_unit_test(fit_state_across_frames),
         cmocka_unit_test(virt_opaque_same_bytes),
-        cmocka_unit_test(image_opaque),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(image_opaque))

@@ -528,13 +528,8 @@ static void aa_args(void **state)
     kin_model_free(&m);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(aa_area),     cmocka_unit_test(aa_interior),
         cmocka_unit_test(aa_state),    cmocka_unit_test(aa_refined),
         cmocka_unit_test(aa_resolve),  cmocka_unit_test(aa_args),
-        cmocka_unit_test(aa_band),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(aa_band))

@@ -1128,25 +1128,20 @@ static void review_arguments(void **state)
     arms_free(&T);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(finds_turned_elbows),
-        cmocka_unit_test(stays_when_right),
-        cmocka_unit_test(out_of_view_points_do_not_bias),
-        cmocka_unit_test(thickness_from_masks),
-        cmocka_unit_test(learned_flag),
-        cmocka_unit_test(learn_memory_keeps_background),
-        cmocka_unit_test(learn_rejects_background_bins),
-        cmocka_unit_test(learn_matches_reference),
-        cmocka_unit_test(learn_long_run_matches_reference),
-        cmocka_unit_test(bad_arguments),
-        cmocka_unit_test(fit_through_wrist_node),
-        cmocka_unit_test(fit_uses_mesh_skin),
-        cmocka_unit_test(settings_bounded),
-        cmocka_unit_test(bad_models),
-        cmocka_unit_test(huge_projections),
-        cmocka_unit_test(review_arguments),
-    };
-    return cmocka_run_group_tests_name("pipe_fit", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("pipe_fit", NULL, NULL,
+              cmocka_unit_test(finds_turned_elbows),
+              cmocka_unit_test(stays_when_right),
+              cmocka_unit_test(out_of_view_points_do_not_bias),
+              cmocka_unit_test(thickness_from_masks),
+              cmocka_unit_test(learned_flag),
+              cmocka_unit_test(learn_memory_keeps_background),
+              cmocka_unit_test(learn_rejects_background_bins),
+              cmocka_unit_test(learn_matches_reference),
+              cmocka_unit_test(learn_long_run_matches_reference),
+              cmocka_unit_test(bad_arguments),
+              cmocka_unit_test(fit_through_wrist_node),
+              cmocka_unit_test(fit_uses_mesh_skin),
+              cmocka_unit_test(settings_bounded),
+              cmocka_unit_test(bad_models),
+              cmocka_unit_test(huge_projections),
+              cmocka_unit_test(review_arguments))

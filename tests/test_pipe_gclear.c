@@ -111,14 +111,9 @@ static void large_then_small(void **state)
     kin_model_free(&m);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test_prestate(large_then_small, (void *)0),
         cmocka_unit_test_prestate(large_then_small, (void *)1),
         cmocka_unit_test_prestate(large_then_small, (void *)2),
         cmocka_unit_test_prestate(large_then_small, (void *)3),
-        cmocka_unit_test_prestate(large_then_small, (void *)4),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test_prestate(large_then_small, (void *)4))

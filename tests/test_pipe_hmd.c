@@ -267,13 +267,8 @@ static void raw_and_threads(void **state)
     kin_model_free(&m);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(geometry_numbers),
         cmocka_unit_test(cameras_and_eyes),
         cmocka_unit_test(frame_end_to_end),
-        cmocka_unit_test(raw_and_threads),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(raw_and_threads))

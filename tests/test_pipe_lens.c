@@ -462,14 +462,9 @@ static void result_pipe_frame_through_lens(void **state)
     kin_model_free(&m);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(result_barrel_silhouette),
-        cmocka_unit_test(result_fisheye_silhouette),
-        cmocka_unit_test(result_attributes),
-        cmocka_unit_test(validity_bad_maps),
-        cmocka_unit_test(result_pipe_frame_through_lens),
-    };
-    return cmocka_run_group_tests_name("pipe_lens", tests, NULL, NULL);
-}
+TU_MAIN_NAMED("pipe_lens", NULL, NULL,
+              cmocka_unit_test(result_barrel_silhouette),
+              cmocka_unit_test(result_fisheye_silhouette),
+              cmocka_unit_test(result_attributes),
+              cmocka_unit_test(validity_bad_maps),
+              cmocka_unit_test(result_pipe_frame_through_lens))

@@ -184,11 +184,6 @@ static void jump_becomes_ramp(void **state)
     free(scratch);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(against_reference),
-        cmocka_unit_test(jump_becomes_ramp),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(jump_becomes_ramp))

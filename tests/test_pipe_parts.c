@@ -858,9 +858,7 @@ static void prop_arm_depth(void **state)
     kin_model_free(&cube);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(group_setup, group_teardown,
         cmocka_unit_test(names_generic),
         cmocka_unit_test(names_sample),
         cmocka_unit_test(names_shared_models),
@@ -869,7 +867,4 @@ int main(void)
         cmocka_unit_test(hide_each_part),
         cmocka_unit_test(hidden_not_refined_back),
         cmocka_unit_test(prop_cube_mask),
-        cmocka_unit_test(prop_arm_depth),
-    };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
-}
+        cmocka_unit_test(prop_arm_depth))

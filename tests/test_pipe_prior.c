@@ -384,14 +384,9 @@ static void bad_switches(void **state)
     free(A);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(prior_reaches_beyond_band),
         cmocka_unit_test(fast_hands_and_threads),
         cmocka_unit_test(prior_keeps_no_rim),
         cmocka_unit_test(regrow_trail_fast_hands),
-        cmocka_unit_test(bad_switches),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(bad_switches))

@@ -874,9 +874,7 @@ static void validity_nan_virtual_depth(void **state)
     rig_end(&r);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(result_mask_equals_eye_draw),
         cmocka_unit_test(result_mask_other_hmd),
         cmocka_unit_test(result_point_lands_by_geometry),
@@ -889,7 +887,4 @@ int main(void)
         cmocka_unit_test(validity_bad_desc),
         cmocka_unit_test(validity_eye_inside_model),
         cmocka_unit_test(validity_fallback_alternating),
-        cmocka_unit_test(validity_nan_virtual_depth),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(validity_nan_virtual_depth))

@@ -172,13 +172,8 @@ static void create_refuses(void **state)
     assert_null(pipe_create(&d, &km));
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(against_reference),
         cmocka_unit_test(boxed_over_frames),
         cmocka_unit_test(edges_become_ramps),
-        cmocka_unit_test(create_refuses),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(create_refuses))

@@ -405,15 +405,10 @@ static void test_isa_equal(void **state)
         skip();
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_positions),
         cmocka_unit_test(test_edge_area),
         cmocka_unit_test(test_watertight),
         cmocka_unit_test(test_resolve),
         cmocka_unit_test(test_errors),
-        cmocka_unit_test(test_isa_equal),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_isa_equal))

@@ -429,9 +429,7 @@ static void test_stats_accumulate(void **state)
     rt_free(&t);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_validation),
         cmocka_unit_test(test_index_out_of_range),
         cmocka_unit_test(test_index_every_position),
@@ -444,7 +442,4 @@ int main(void)
         cmocka_unit_test(test_culling_and_winding),
         cmocka_unit_test(test_degenerate),
         cmocka_unit_test(test_determinism_crc),
-        cmocka_unit_test(test_stats_accumulate),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_stats_accumulate))

@@ -395,15 +395,10 @@ static void test_shared_edge_clip_bits(void **state)
     assert_int_equal(found, 500);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_near_plane_crossing),
         cmocka_unit_test(test_vertex_behind_camera),
         cmocka_unit_test(test_w_zero),
         cmocka_unit_test(test_huge_triangles),
         cmocka_unit_test(test_clipped_grids_watertight),
-        cmocka_unit_test(test_shared_edge_clip_bits),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_shared_edge_clip_bits))

@@ -611,14 +611,9 @@ static void test_corner_avx512(void **state) { (void)state; corner_isa(EF_ISA_AV
 static void test_fixed_neon(void **state) { (void)state; fixed_case(EF_ISA_NEON); }
 static void test_corner_neon(void **state) { (void)state; corner_isa(EF_ISA_NEON); }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_fixed_ref),    cmocka_unit_test(test_fixed_sse2),
         cmocka_unit_test(test_fixed_avx2),   cmocka_unit_test(test_fixed_avx512),
         cmocka_unit_test(test_corner_ref),   cmocka_unit_test(test_corner_sse2),
         cmocka_unit_test(test_corner_avx2),  cmocka_unit_test(test_corner_avx512),
-        cmocka_unit_test(test_fixed_neon),   cmocka_unit_test(test_corner_neon),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_fixed_neon),   cmocka_unit_test(test_corner_neon))

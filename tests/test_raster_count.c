@@ -194,12 +194,7 @@ static void test_count_tiles_only(void **state)
     rast_context_destroy(c);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_count_frames),
         cmocka_unit_test(test_count_bytes),
-        cmocka_unit_test(test_count_tiles_only),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_count_tiles_only))

@@ -277,14 +277,9 @@ static void test_attribute_at_vertex(void **state)
     rt_free(&t);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_depth_plane_exact),
         cmocka_unit_test(test_depth_order),
         cmocka_unit_test(test_no_depth_later_wins),
         cmocka_unit_test(test_perspective_attributes),
-        cmocka_unit_test(test_attribute_at_vertex),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_attribute_at_vertex))

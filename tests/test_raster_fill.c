@@ -449,16 +449,11 @@ static void test_tiny_triangles(void **state)
     rt_free(&t);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_known_triangles),
         cmocka_unit_test(test_full_screen_quad),
         cmocka_unit_test(test_offscreen),
         cmocka_unit_test(test_watertight_grid),
         cmocka_unit_test(test_watertight_fan),
         cmocka_unit_test(test_closed_mesh_once),
-        cmocka_unit_test(test_tiny_triangles),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_tiny_triangles))

@@ -412,19 +412,14 @@ static void test_hidden_sse2(void **state) { (void)state; hidden_isa(EF_ISA_SSE2
 static void test_hidden_avx2(void **state) { (void)state; hidden_isa(EF_ISA_AVX2); }
 static void test_hidden_avx512(void **state) { (void)state; hidden_isa(EF_ISA_AVX512); }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_hidden_sse2),
         cmocka_unit_test(test_hidden_avx2),
         cmocka_unit_test(test_hidden_avx512),
         cmocka_unit_test(test_front_draw_avx2),
         cmocka_unit_test(test_front_draw_avx512),
         cmocka_unit_test(test_front_records_avx2),
-        cmocka_unit_test(test_front_records_avx512),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_front_records_avx512))
 
 #else
 EF_TEST_X86_SKIP("the SIMD scans' box depth test against the reference")

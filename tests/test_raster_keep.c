@@ -181,11 +181,6 @@ static void test_keep_attr_null(void **state)
     free_target(&t);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_keep_attr_frames),
-        cmocka_unit_test(test_keep_attr_null),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_keep_attr_null))

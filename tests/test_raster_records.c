@@ -251,14 +251,9 @@ static void test_frontv_patterned_avx512(void **state)
     check_isa(EF_ISA_AVX512, &rast__setup_isa_avx512);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_frontv_patterned_avx2),
-        cmocka_unit_test(test_frontv_patterned_avx512),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_frontv_patterned_avx512))
 
 #else
 EF_TEST_X86_SKIP("the vector front ends' records")

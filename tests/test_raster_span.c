@@ -275,14 +275,9 @@ static void test_span_avx2(void **state) { (void)state; span_isa(EF_ISA_AVX2); }
 static void test_span_avx512(void **state) { (void)state; span_isa(EF_ISA_AVX512); }
 static void test_span_neon(void **state) { (void)state; span_isa(EF_ISA_NEON); }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_span_reference),
         cmocka_unit_test(test_span_sse2),
         cmocka_unit_test(test_span_avx2),
         cmocka_unit_test(test_span_avx512),
-        cmocka_unit_test(test_span_neon),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_span_neon))

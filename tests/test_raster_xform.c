@@ -273,16 +273,11 @@ static void test_dirs_contract(void **state)
     }
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_xform_public),
         cmocka_unit_test(test_xform_avx512),
         cmocka_unit_test(test_xform_avx2),
-        cmocka_unit_test(test_dirs_contract),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+        cmocka_unit_test(test_dirs_contract))
 
 #else
 EF_TEST_X86_SKIP("the AVX-512 vertex transforms")

@@ -440,9 +440,7 @@ static void test_bad_output_dir(void **state)
     remove(file);
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(group_setup, group_teardown,
         cmocka_unit_test(test_generator_runs),
         cmocka_unit_test(test_model_skeleton),
         cmocka_unit_test(test_model_proportions),
@@ -451,7 +449,4 @@ int main(void)
         cmocka_unit_test(test_images_and_scene),
         cmocka_unit_test(test_mask_matches_camera_images),
         cmocka_unit_test(test_deterministic),
-        cmocka_unit_test(test_bad_output_dir),
-    };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
-}
+        cmocka_unit_test(test_bad_output_dir))

@@ -561,9 +561,7 @@ static void test_vm_all_passed(void **st)
     assert_int_equal(vm_exit, 1); /* (0 << 1) | 1 */
 }
 
-int main(void)
-{
-    const struct CMUnitTest tests[] = {
+TU_MAIN(setup, teardown,
         cmocka_unit_test(test_vm_capture),
         cmocka_unit_test(test_vm_usb),
         cmocka_unit_test(test_vm_glove),
@@ -572,7 +570,4 @@ int main(void)
         cmocka_unit_test(test_vm_display_two),
         cmocka_unit_test(test_vm_vsrc),
         cmocka_unit_test(test_vm_cockpit),
-        cmocka_unit_test(test_vm_all_passed),
-    };
-    return cmocka_run_group_tests(tests, setup, teardown);
-}
+        cmocka_unit_test(test_vm_all_passed))

@@ -3,7 +3,7 @@
  * compares every lane's bits with a scalar model of the contract.
  * simd_check.inl is the one body; simd_check_<isa>.c compile it once per
  * ISA (the Makefile gives *_avx2.c / *_avx512.c their -m flags), each to
- * nothing where the ISA's architecture is not the target's. */
+ * a stub that returns 0 where the ISA's architecture is not the target's. */
 #ifndef EGOFUSE_TU_SIMD_CHECK_H
 #define EGOFUSE_TU_SIMD_CHECK_H
 

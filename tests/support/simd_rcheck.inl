@@ -1,8 +1,16 @@
 /* simd_rcheck.inl - the body of tu_simd_rcheck_<isa> (simd_rcheck.h), on
- * the vector layer included before it. */
+ * the vector layer included before it (named RC_NAME); without one (the ISA
+ * is not this target's) a stub that returns 0. */
 #include "simd_rcheck.h"
 
-int SIMD_FN(tu_simd_rcheck)(int op, const uint32_t *a, unsigned k, int n, void *out)
+#ifndef SIMD_W
+int RC_NAME(int op, const uint32_t *a, unsigned k, int n, void *out)
+{
+    (void)op, (void)a, (void)k, (void)n, (void)out;
+    return 0;
+}
+#else
+int RC_NAME(int op, const uint32_t *a, unsigned k, int n, void *out)
 {
     const int W = SIMD_W;
     switch (op) {
@@ -126,3 +134,4 @@ int SIMD_FN(tu_simd_rcheck)(int op, const uint32_t *a, unsigned k, int n, void *
     default: return -1;
     }
 }
+#endif

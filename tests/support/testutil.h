@@ -88,4 +88,34 @@ void tu_samples_remove(const char *name);
     do { NEAR((v).x, X, tol); NEAR((v).y, Y, tol); NEAR((v).z, Z, tol); } while (0)
 #define PI_F 3.14159265358979f
 
+/* The test binary's main: one group of cmocka entries, run with the group's
+ * setup and teardown (NULL for none), as cmocka_run_group_tests would with
+ * an array named tests; TU_MAIN_NAMED names the group in cmocka's output.
+ *     TU_MAIN(setup, NULL,
+ *             cmocka_unit_test(first),
+ *             cmocka_unit_test(second))
+ * A binary with several groups runs each with TU_GROUP, adding the group's
+ * failures to failed:
+ *     int f = 0;
+ *     TU_GROUP(f, "validity", cmocka_unit_test(bad_input));
+ *     TU_GROUP(f, "results", cmocka_unit_test(first), cmocka_unit_test(second));
+ *     return f ? 1 : 0; */
+#define TU_MAIN(setup, teardown, ...)                                         \
+    int main(void)                                                            \
+    {                                                                         \
+        const struct CMUnitTest tests[] = {__VA_ARGS__};                      \
+        return cmocka_run_group_tests(tests, setup, teardown);                \
+    }
+#define TU_MAIN_NAMED(name, setup, teardown, ...)                             \
+    int main(void)                                                            \
+    {                                                                         \
+        const struct CMUnitTest tests[] = {__VA_ARGS__};                      \
+        return cmocka_run_group_tests_name(name, tests, setup, teardown);     \
+    }
+#define TU_GROUP(failed, name, ...)                                           \
+    do {                                                                      \
+        const struct CMUnitTest group_[] = {__VA_ARGS__};                     \
+        (failed) += cmocka_run_group_tests_name(name, group_, NULL, NULL);    \
+    } while (0)
+
 #endif
