@@ -12,31 +12,16 @@
 
 gt_operator_desc gt_operator_default(void)
 {
-    gt_operator_desc d;
-    d.shoulder_scale = 1.03f;
-    d.upper_scale = 1.07f;
-    d.fore_scale = 0.95f;
-    d.hand_scale = 1.05f;
-    d.upper_thick = 1.12f;
-    d.fore_thick = 0.93f;
-    d.hand_thick = 1.04f;
-    d.subdivide = 1;
-    return d;
+    return (gt_operator_desc){.shoulder_scale = 1.03f, .upper_scale = 1.07f, .fore_scale = 0.95f,
+                              .hand_scale = 1.05f, .upper_thick = 1.12f, .fore_thick = 0.93f,
+                              .hand_thick = 1.04f, .subdivide = 1};
 }
 
 gt_track_desc gt_track_default(void)
 {
-    gt_track_desc d;
-    d.noise_mm = 5.0f;
-    d.rot_noise_deg = 0.5f;
-    d.head_rot_noise_deg = 0.1f;
-    d.glove_noise = 0.03f;
-    d.latency_ms = 20.0f;
-    d.dropout = 0.02f;
-    d.rate_hz = 90.0f;
-    d.speed = 1.0f;
-    d.seed = 1;
-    return d;
+    return (gt_track_desc){.noise_mm = 5.0f, .rot_noise_deg = 0.5f, .head_rot_noise_deg = 0.1f,
+                           .glove_noise = 0.03f, .latency_ms = 20.0f, .dropout = 0.02f,
+                           .rate_hz = 90.0f, .speed = 1.0f, .seed = 1};
 }
 
 /* ------------------------------------------------------------ the body */

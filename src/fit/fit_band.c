@@ -8,14 +8,8 @@
 
 pipe_fit_band_desc pipe_fit_band_desc_default(void)
 {
-    pipe_fit_band_desc d;
-    d.sigma = 0.02f;
-    d.tau = 0.0f;
-    d.reach = 32.0f;
-    d.band_min = 16;
-    d.band_max = 64;
-    d.hand_radius = 0.04f;
-    return d;
+    return (pipe_fit_band_desc){.sigma = 0.02f, .tau = 0.0f, .reach = 32.0f, .band_min = 16,
+                                .band_max = 64, .hand_radius = 0.04f};
 }
 
 static int clampi(int v, int lo, int hi) { return v < lo ? lo : v > hi ? hi : v; }

@@ -7,13 +7,8 @@
 
 pipe_fit_shift_desc pipe_fit_shift_desc_default(void)
 {
-    pipe_fit_shift_desc d;
-    d.range = 24;
-    d.max_points = 1500;
-    d.min_gain = 0.1f;
-    d.cost = 0.004f;
-    d.hand_radius = 0.04f;
-    return d;
+    return (pipe_fit_shift_desc){.range = 24, .max_points = 1500, .min_gain = 0.1f, .cost = 0.004f,
+                                 .hand_radius = 0.04f};
 }
 
 static size_t point_cap(int stride, int height)

@@ -9,20 +9,10 @@
 
 pipe_fit_stereo_desc pipe_fit_stereo_desc_default(void)
 {
-    pipe_fit_stereo_desc d;
-    d.radius = 2;
-    d.step = 2;
-    d.hand_dz = 0.04f;
-    d.gap = 0.06f;
-    d.far_m = 3.0f;
-    d.min_texture = 4.0f;
-    d.margin = 2.0f;
-    d.match = 1.0f;
-    d.ratio = 1.0f;
-    d.fill_radius = 32;
-    d.accept = 0;
-    d.connected = 1;
-    return d;
+    return (pipe_fit_stereo_desc){.radius = 2, .step = 2, .hand_dz = 0.04f, .gap = 0.06f,
+                                  .far_m = 3.0f, .min_texture = 4.0f, .margin = 2.0f,
+                                  .match = 1.0f, .ratio = 1.0f, .fill_radius = 32, .accept = 0,
+                                  .connected = 1};
 }
 
 static size_t align16(size_t n) { return (n + 15u) & ~(size_t)15u; }

@@ -61,14 +61,8 @@ fuse_result fuse_skin_key(const fuse_skin_params *p, const fuse_image *P,
 
 fuse_refine_params fuse_refine_params_default(void)
 {
-    fuse_refine_params p;
-    p.band = 16;
-    p.margin = 8;
-    p.bits = 4;
-    p.prior = 1.0f;
-    p.smooth = 1;
-    p.min_samples = 64;
-    return p;
+    return (fuse_refine_params){.band = 16, .margin = 8, .bits = 4, .prior = 1.0f, .smooth = 1,
+                                .min_samples = 64};
 }
 
 static int params_ok(const fuse_refine_params *p)
