@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "../eval/eval.h"
+#include "../fit/fit_narrow.h"
 #include "cli_lod.h"
 
 static const char *eval_usage =
@@ -54,7 +55,8 @@ static const char *eval_usage =
     "                   smoothing's other placements, docs/accuracy.md)\n"
     "  --band PX        refinement band half width, 1..64 (default 16)\n"
     "  --global W       refine: weight of the image-wide colour model against\n"
-    "                   the band's local one, 0..1 (default 0.5)\n"
+    "                   the band's local one, 0..1 (default 1: the global\n"
+    "                   model alone)\n"
     "  --stereo         refine: also the stereo pair's depth test (refined pixels\n"
     "                   that the other camera finds behind the hand are\n"
     "                   cleared; off by default: measured, it did not pay)\n"
@@ -141,7 +143,7 @@ int cmd_eval(int argc, char **argv)
         {0, 0, 0, 0},
     };
     eval_opts o = { 60, 0, 0, 5.0f, 20.0f, 0.02f, 0.0f, 1.0f, 1, NULL, NULL, NULL, 15u,
-                    GEN_ANIM_NAME, 60, 90, 0.5f, 16, CLI_LOD_DEFAULT, CLI_LOD_PX_DEFAULT, 0, 0, 0, NULL, 0, 0 };
+                    GEN_ANIM_NAME, 60, 90, PIPE_GLOBAL_WEIGHT, 16, CLI_LOD_DEFAULT, CLI_LOD_PX_DEFAULT, 0, 0, 0, NULL, 0, 0 };
     const cli_float_opt fl[] = {
         {O_NOISE, "--noise", 0.0f, 200.0f, "not in 0..200 mm", &o.noise},
         {O_LATENCY, "--latency", 0.0f, 1000.0f, "not in 0..1000 ms", &o.latency},

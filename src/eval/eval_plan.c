@@ -160,6 +160,7 @@ static int make_configs(const eval_opts *o, int phase, const char *seq, float sp
             SWEEP(M_REFINE, "band", (float)bands[i], "", band, bands[i]);
         SWEEP(M_REFINE, "fit", 0.0f, "", fit, 0);
         SWEEP(M_REFINE, "global", 0.0f, "", global, 0.0f);
+        SWEEP(M_REFINE, "global", 0.5f, "", global, 0.5f);   /* the default until 2026-11-29 */
         /* issue 14 item 2: refine without the prior, without the adaptive
          * lag compensation, and with the band from the projected
          * uncertainty (docs/accuracy.md) */

@@ -38,6 +38,13 @@
 /* The narrowest band tried (px; edge: 4 measured, docs/accuracy.md). */
 #define PIPE_NARROW_MIN_BAND 4
 
+/* The weight of the fit's global colour model (pipe_fit_colour) against
+ * the band's local histograms in the refinement, pipeline and eval alike
+ * (eval --global): 1, the global model alone (the local histograms then
+ * only gate it by their counts). Measured against 0.5, 0.75 and 0.9 on
+ * every sequence (docs/accuracy.md, "The global colour model alone"). */
+#define PIPE_GLOBAL_WEIGHT 1.0f
+
 /* fuse_refine_mask_global (g not NULL) or fuse_refine_mask with p; when
  * that falls back (stats->used_colour 0), again with the band halved while
  * the band stays >= min_band and the scratch suffices for it. *band_used
