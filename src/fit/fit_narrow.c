@@ -24,6 +24,10 @@ fuse_result pipe_fit_refine_narrow(const fuse_refine_params *p, const fuse_colou
 {
     if (!p || !P || !stats) return FUSE_ERR_ARGS;
     fuse_refine_params q = *p;
+    /* the global model alone: the ring's histograms decide nothing, any
+     * hand and background pixel in it let the global model decide */
+    if (g && weight >= 1.0f && q.min_samples > PIPE_GLOBAL_MIN_SAMPLES)
+        q.min_samples = PIPE_GLOBAL_MIN_SAMPLES;
     fuse_result r = run(&q, g, weight, P, mask, mask_stride, out, out_stride, scratch,
                         scratch_size, stats);
     while (r == FUSE_OK && !stats->used_colour && min_band > 0 && q.band / 2 >= min_band) {
