@@ -63,6 +63,13 @@ static void run_subset(const char *name, const char *methods, int swept, int wan
         if (!tu_exists(p)) printf("missing: %s\n", p);
         assert_true(tu_exists(p));
     }
+    /* the tables table.md's header names (light.md and kf.md: their own) */
+    static const char *const tables[] = {"table.md", "summary.csv", "light.md", "kf.md"};
+    for (size_t i = 0; i < sizeof tables / sizeof tables[0]; i++) {
+        snprintf(p, sizeof p, "%s/%s", dir, tables[i]);
+        if (!tu_exists(p)) printf("missing: %s\n", p);
+        assert_true(tu_exists(p));
+    }
     /* every method of a sweep chart says in its legend entry where its
      * IoU is at or above 0.9 (issue 14 item 5), the legend sits below the
      * plot; the speed charts have tics between the decades */

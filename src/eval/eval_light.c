@@ -258,6 +258,7 @@ int eval__write_light(const char *dir, const method_run *R, int n)
         }
     }
     if (!dir) return IO_EXIT_OK;
+    if (eval__out_commit(&of)) return IO_EXIT_FAIL;   /* light.md */
     /* where each curve falls below IoU 0.9 / its matched PSNR - drop */
     double below_iou[3][NCURVE], below_psnr[3][NCURVE];
     for (int a = 0; a < 3; a++)
