@@ -53,8 +53,8 @@
 /* fuse_refine_mask_global (g not NULL) or fuse_refine_mask with p (its
  * min_samples at most PIPE_GLOBAL_MIN_SAMPLES when g is not NULL and
  * weight >= 1); when that falls back (stats->used_colour 0), again with
- * the band halved while
- * the band stays >= min_band and the scratch suffices for it. *band_used
+ * the band halved while the band stays >= min_band and the scratch
+ * suffices for it. *band_used
  * (not NULL) receives the band of the result. stats must not be NULL
  * (FUSE_ERR_ARGS). Returns what the last refinement returned. */
 fuse_result pipe_fit_refine_narrow(const fuse_refine_params *p, const fuse_colour_model *g,

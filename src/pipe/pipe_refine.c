@@ -104,15 +104,16 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
      * (fit_narrow.h; eval's refine does the same) */
     fuse_result rr2 = pipe_fit_refine_narrow(
         &rp, p->fit && pipe_fit_learned(p->fit, e->eye) ? pipe_fit_colour(p->fit, e->eye) : NULL,
-        PIPE_GLOBAL_WEIGHT, PIPE_NARROW_MIN_BAND, &fe->P, rin, cw, e->refined, cw, e->refine_scratch,
-        e->refine_scratch_size, &rs, NULL);
+        PIPE_GLOBAL_WEIGHT, PIPE_NARROW_MIN_BAND, &fe->P, rin, cw, e->refined, cw,
+        e->refine_scratch, e->refine_scratch_size, &rs, NULL);
     if (rr2 != FUSE_OK)
         return pipe__eye_fail(e, PIPE_ERR_FUSE, "mask refinement", fuse_result_str(rr2));
     /* once more from its own edge where it let in much: the hand beyond
      * the band (fit_narrow.h; eval's refine does the same) */
     const int regrown = pipe_fit_refine_regrow(
         &rp, p->fit && pipe_fit_learned(p->fit, e->eye) ? pipe_fit_colour(p->fit, e->eye) : NULL,
-        PIPE_GLOBAL_WEIGHT, &fe->P, e->refined, cw, e->regrow, e->refine_scratch, e->refine_scratch_size, &rs);
+        PIPE_GLOBAL_WEIGHT, &fe->P, e->refined, cw, e->regrow, e->refine_scratch,
+        e->refine_scratch_size, &rs);
     if (regrown < 0)
         return pipe__eye_fail(e, PIPE_ERR_FUSE, "mask refinement", fuse_result_str(FUSE_ERR_ARGS));
     /* what the regrow added behind a fast hand taken back: where the
