@@ -70,8 +70,11 @@ typedef struct pipe_desc {
                                  around its edge (fuse_refine_mask; with
                                  fit_rig, once the eye's colour model is
                                  learned (pipe_fit_learned), fuse_refine_mask_global
-                                 with it, weight 0.5: `egofuse eval`'s
-                                 refine method; before that, and for a
+                                 with it, weight PIPE_GLOBAL_WEIGHT (1:
+                                 the global model alone, the band's local
+                                 histograms only gate it; fit_narrow.h):
+                                 `egofuse eval`'s refine method; before
+                                 that, and for a
                                  fresh pipe on animation-posed frames, the
                                  bytes of no fit_rig) */
     const kin_arm_rig *fit_rig; /* with refine_band, and frames posed by
