@@ -53,6 +53,7 @@
 #include "../src/fuse/fuse_metrics.h"
 #include "../src/pipe/pipe.h"
 #include "bench_util.h"
+#include "../src/cpu/ef_mem.h"
 
 enum { CW = 640, CH = 400, OW = GEN_VIRT_W, OH = GEN_VIRT_H };
 enum { M_KIN, M_REFINE, M_KIN_TRACK, M_REFINE_TRACK, M_COUNT };
@@ -417,32 +418,10 @@ int main(int argc, char **argv)
         }
     }
     for (int e = 0; e < 2; e++) {
-        free(cam[e]);
-        free(V[e]);
-        free(out[e]);
-        free(Ibin[e]);
-        free(Isoft[e]);
-        free(pIsoft[e]);
-        free(sil[e]);
-        free(soft[e]);
-        free(psoft[e]);
+        EF_FREE_ALL(cam[e], V[e], out[e], Ibin[e], Isoft[e], pIsoft[e], sil[e], soft[e], psoft[e]);
     }
-    free(ms);
-    free(cpu);
-    free(samples);
-    free(tl);
-    free(tw);
-    free(locals);
-    free(rgb);
-    free(tnrm);
-    free(snrm);
-    free(sd);
-    free(sm);
-    free(aas);
-    free(cov);
-    free(layer);
-    free(vdepth);
-    free(vrgb);
+    EF_FREE_ALL(ms, cpu, samples, tl, tw, locals, rgb, tnrm, snrm, sd, sm, aas, cov, layer, vdepth,
+                vrgb);
     gen_frame_ctx_free(&gctx);
     gen_scene_free(&cockpit);
     gen_scene_free(&workshop);

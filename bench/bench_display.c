@@ -9,6 +9,7 @@
 #include "bench_util.h"
 
 #include "../src/io/io_display_impl.h"
+#include "../src/cpu/ef_mem.h"
 
 static void run(int ew, int eh, int runs)
 {
@@ -34,11 +35,7 @@ static void run(int ew, int eh, int runs)
     double med = bench_median(t, runs), cmed = bench_median(c, runs);
     printf("present conversion 2 x %dx%d RGBA -> %dx%d XRGB8888: median %.3f ms wall (min %.3f), %.3f ms CPU "
            "(min %.3f), %d runs [%u]\n", ew, eh, 2 * ew, eh, med, t[0], cmed, c[0], runs, sum & 1);
-    free(dst);
-    free(eye[0]);
-    free(eye[1]);
-    free(t);
-    free(c);
+    EF_FREE_ALL(dst, eye[0], eye[1], t, c);
 }
 
 int main(int argc, char **argv)

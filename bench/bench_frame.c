@@ -64,6 +64,7 @@
 #include "bench_mesh.h"
 #include "bench_sample.h"
 #include "bench_util.h"
+#include "../src/cpu/ef_mem.h"
 
 #if defined(__has_include)
 #if __has_include(<pixman.h>)
@@ -980,12 +981,7 @@ static void run_composite(bench *b, int n)
         free(Q[e]);
         free(R[e]);
     }
-    free(v);
-    free(depth);
-    free(nrm);
-    free(clip);
-    free(vn);
-    free(mask);
+    EF_FREE_ALL(v, depth, nrm, clip, vn, mask);
     pipe_pose_free(&ps);
 }
 

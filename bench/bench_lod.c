@@ -32,6 +32,7 @@
 #include "../src/raster/raster.h"
 #include "bench_sample.h"
 #include "bench_util.h"
+#include "../src/cpu/ef_mem.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -293,14 +294,7 @@ int main(int argc, char **argv)
         free(b.pos[i]);
         free(b.nrm[i]);
     }
-    free(b.pos);
-    free(b.nrm);
-    free(b.cam);
-    free(b.clip);
-    free(b.vn);
-    free(b.junk);
-    free(ref);
-    free(ts);
+    EF_FREE_ALL(b.pos, b.nrm, b.cam, b.clip, b.vn, b.junk, ref, ts);
     for (int e = 0; e < 2; e++) free(planes[e]);
     pipe_pose_free(&ps);
     io_lod_free(&lod);

@@ -42,6 +42,7 @@
 #include "bench_mesh.h"
 #include "bench_sample.h"
 #include "bench_util.h"
+#include "../src/cpu/ef_mem.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -316,10 +317,7 @@ static int pipe_samples(int csv, const char *dir, int np, int runs, int only_isa
             same &= memcmp(a, b, plane) == 0;
         }
         rast_context_destroy(c);
-        free(a);
-        free(b);
-        free(clip);
-        free(vn);
+        EF_FREE_ALL(a, b, clip, vn);
     }
     printf("%ssample model %s: %ld triangles in %d mesh%s, %d poses over '%s', %dx%d per eye; "
            "stage equal to pipe_pose_draw: %s\n",
@@ -330,14 +328,7 @@ static int pipe_samples(int csv, const char *dir, int np, int runs, int only_isa
         free(pos[i]);
         free(nrm[i]);
     }
-    free(pos);
-    free(nrm);
-    free(idx);
-    free(vcount);
-    free(icount);
-    free(vp);
-    free(view);
-    free(poses);
+    EF_FREE_ALL(pos, nrm, idx, vcount, icount, vp, view, poses);
     pipe_pose_free(&ps);
     kin_model_free(&model);
     return 1;
@@ -520,10 +511,7 @@ int main(int argc, char **argv)
         bm_free(&mesh);
     }
     bm_eyes_free(&eyes);
-    free(t_draw);
-    free(t_clear);
-    free(t_xf);
-    free(t_cclear);
+    EF_FREE_ALL(t_draw, t_clear, t_xf, t_cclear);
     if (!pipe || only_threads > 1)
         return 0;
 

@@ -29,6 +29,7 @@
 #include "../src/io/io_vsrc.h"
 #include "../src/io/io_vstream.h"
 #include "bench_util.h"
+#include "../src/cpu/ef_mem.h"
 
 static uint64_t mono_ns(void)
 {
@@ -81,12 +82,7 @@ static int bench_convert(int w, int h)
     qsort(t, 30, sizeof t[0], bench_cmp_double);
     printf("scale      %dx%d -> 1280x800 bilinear, one eye: %.2f ms (median CPU time)\n", sw, sh,
            t[15]);
-    free(xt);
-    free(yt);
-    free(eye);
-    free(rows);
-    free(src);
-    free(dst);
+    EF_FREE_ALL(xt, yt, eye, rows, src, dst);
     return 0;
 }
 

@@ -42,6 +42,7 @@
 #include "../samples/gt/gt_eye.h"
 #include "../src/fuse/fuse.h"
 #include "../src/fuse/fuse_moments.h"
+#include "../src/cpu/ef_mem.h"
 
 /* ------------------------------------------------------------ metrics */
 
@@ -209,11 +210,7 @@ static void crop_geometry_at(int cm, double expect_pct)
         }
     }
     assert_int_equal(checked, 8);
-    free(sil);
-    free(tip_cam);
-    free(tip_disp);
-    free(tip_eye);
-    free(scratch);
+    EF_FREE_ALL(sil, tip_cam, tip_disp, tip_eye, scratch);
     world_free(&w);
 }
 

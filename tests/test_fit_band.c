@@ -30,6 +30,7 @@
 
 #include "../src/fit/fit_band.h"
 #include "../src/fuse/fuse_refine.h"
+#include "../src/cpu/ef_mem.h"
 
 enum { W = 320, H = 240 };
 static const float F = 300.0f;
@@ -349,11 +350,7 @@ static void colour_checks_match_rule(void **state)
             assert_memory_equal(got, want, nb);
             cleared += n;
         }
-        free(pix);
-        free(o);
-        free(in);
-        free(got);
-        free(want);
+        EF_FREE_ALL(pix, o, in, got, want);
     }
     print_message("colour checks: %ld pixels cleared in 600 calls, all as the rule\n", cleared);
     assert_true(cleared > 1000);

@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "../src/fit/fit_stereo.h"
+#include "../src/cpu/ef_mem.h"
 
 static kin_camera cams[2];
 static int W, H;
@@ -153,11 +154,7 @@ static void scene_make(scene *s, int plain)
 
 static void scene_free(scene *s)
 {
-    free(s->P);
-    free(s->Q);
-    free(s->mask);
-    free(s->depth);
-    free(s->scratch);
+    EF_FREE_ALL(s->P, s->Q, s->mask, s->depth, s->scratch);
 }
 
 /* The mask: the hand's columns [x0, x1] on its rows. */

@@ -21,6 +21,7 @@
 #include "../src/fuse/fuse_edge.h"
 #include "../src/pipe/pipe.h"
 #include "support/pipe_frames.h"
+#include "../src/cpu/ef_mem.h"
 
 /* the ramp by its definition, in double: clamp(d / k) at the pixel's
  * centre, d the distance to the nearest faded side; q * weight rounded
@@ -257,15 +258,7 @@ static void frame_every_isa(void **state)
                 ran++;
             }
         }
-        free(P);
-        free(M);
-        free(Q);
-        free(V);
-        free(want);
-        free(got);
-        free(N);
-        free(hd);
-        free(sd);
+        EF_FREE_ALL(P, M, Q, V, want, got, N, hd, sd);
     }
     assert_true(ran >= 40 * 3);
 }

@@ -21,6 +21,7 @@
 #include "../src/cpu/cpu.h"
 #include "../src/fuse/fuse.h"
 #include "../src/fuse/fuse_internal.h"
+#include "../src/cpu/ef_mem.h"
 
 /* CRC32 of the reference outputs of cases 0 .. CASES-1 (light, then
  * composite, per case). Changes only with the rules of docs/fuse.md. */
@@ -294,13 +295,7 @@ static int run_case(const ctxs *cx, int n, uint32_t *crc)
         free(lo.p);
         free(co.p);
     }
-    free(lref.p);
-    free(cref.p);
-    free(lc.P.p);
-    free(lc.M.p);
-    free(lc.N.p);
-    free(cc.Q.p);
-    free(cc.V.p);
+    EF_FREE_ALL(lref.p, cref.p, lc.P.p, lc.M.p, lc.N.p, cc.Q.p, cc.V.p);
     return bad;
 }
 

@@ -12,6 +12,7 @@
 #include "../src/cpu/cpu.h"
 #include "../src/fuse/fuse.h"
 #include "../src/fuse/fuse_internal.h"
+#include "../src/cpu/ef_mem.h"
 
 /* CRC32 over the outputs of crc_cases(). It changes only when the rules
  * of docs/fuse.md change on purpose; then record the printed value. */
@@ -44,10 +45,7 @@ static void scene_alloc(scene *s, int w, int h)
 
 static void scene_free(scene *s)
 {
-    free(s->P);
-    free(s->out);
-    free(s->mask);
-    free(s->nrm);
+    EF_FREE_ALL(s->P, s->out, s->mask, s->nrm);
 }
 
 /* Random P, a mask with 0, 255 and soft values, normals: unit, scaled

@@ -23,6 +23,7 @@
 #include "../src/fuse/fuse_metrics.h"
 #include "../src/fuse/fuse_refine.h"
 #include "../src/fuse/fuse_refine_kern.h"
+#include "../src/cpu/ef_mem.h"
 
 enum { W = 160, H = 120 };
 /* CRC-32 of the reference's output in test_refine_crc */
@@ -141,11 +142,7 @@ static void test_refine_recovers_disc(void **state)
         assert_true(bf_after > 0.95);
         assert_true(bf_before < 0.5);
     }
-    free(scratch);
-    free(img);
-    free(truth);
-    free(km);
-    free(out);
+    EF_FREE_ALL(scratch, img, truth, km, out);
 }
 
 /* One colour everywhere: the colour model cannot decide, the prior keeps
@@ -184,10 +181,7 @@ static void test_refine_keeps_mask(void **state)
     rp = fuse_refine_params_default();
     assert_int_equal(fuse_refine_mask(&rp, &P, km, W - 1, out, W, scratch, ss, &st),
                      FUSE_ERR_ARGS);
-    free(scratch);
-    free(img);
-    free(km);
-    free(out);
+    EF_FREE_ALL(scratch, img, km, out);
 }
 
 /* Two flat colours, counts known: a 40x40 "arm" square of colour A in a
@@ -269,10 +263,7 @@ static void test_colour_model_counts(void **state)
     cm.bits = 7;
     assert_int_equal(fuse_colour_model_learn(&cm, &P, m, W, 2, 1, 5.0f, 10, scratch, ss),
                      FUSE_ERR_ARGS);
-    free(img);
-    free(m);
-    free(llr);
-    free(scratch);
+    EF_FREE_ALL(img, m, llr, scratch);
 }
 
 /* The disc of test_refine_recovers_disc, but the kinematic mask is shifted

@@ -28,6 +28,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "../src/cpu/ef_mem.h"
 #include "../src/io/io.h"
 #include "../src/kin/kin.h"
 #include "../src/pipe/pipe.h"
@@ -495,13 +496,7 @@ static void pipeline_draws_morphs_and_strips(void **state)
         printf("NOTE: %s through pipe_frame: %d of %d frames changed the left mask\n",
                cases[c].rel + 5, changed, TIMES);
         pipe_destroy(p);
-        free(cam);
-        free(virt);
-        free(out[0]);
-        free(out[1]);
-        free(mask);
-        free(prev);
-        free(depth);
+        EF_FREE_ALL(cam, virt, out[0], out[1], mask, prev, depth);
         unload(&l);
         ran++;
     }

@@ -29,6 +29,7 @@
 #include "../src/fuse/fuse_metrics.h"
 #include "../src/io/io_lod.h"
 #include "../src/pipe/pipe.h"
+#include "../src/cpu/ef_mem.h"
 
 /* ------------------------------------------------------------ helpers */
 
@@ -227,10 +228,7 @@ static void test_draw(void **state)
         assert_int_equal(drawn, want);
         if (k == 5) assert_true(want > 0);
     }
-    free(buf);
-    free(mk);
-    free(clip);
-    free(vn);
+    EF_FREE_ALL(buf, mk, clip, vn);
     pipe_pose_free(&ps);
     io_lod_free(&lod);
     gen_arms_free(&arms);

@@ -24,6 +24,7 @@
 
 #include "../src/pipe/pipe.h"
 #include "support/pipe_frames.h"
+#include "../src/cpu/ef_mem.h"
 
 #define D2R 0.017453292519943295
 
@@ -341,10 +342,7 @@ static void small_portrait_frame(void **state)
     tu_stages_free(&s);
     free(expect);
     for (int e = 0; e < 2; e++) {
-        free(cam[e]);
-        free(virt[e]);
-        free(out[0][e]);
-        free(out[1][e]);
+        EF_FREE_ALL(cam[e], virt[e], out[0][e], out[1][e]);
     }
     kin_model_free(&m);
 }

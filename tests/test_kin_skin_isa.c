@@ -20,6 +20,7 @@
 #include "../src/cpu/cpu.h"
 #include "../src/kin/kin.h"
 #include "support/kin_testmesh.h"
+#include "../src/cpu/ef_mem.h"
 
 /* CRC32 of the reference's positions and normals (LBS then DQS) over all
  * NCASES cases; update it (and docs/kin.md) when the reference changes. */
@@ -92,10 +93,7 @@ static void skin_run_make(skin_run *s, int c)
 
 static void skin_run_free(skin_run *s)
 {
-    free(s->rp);
-    free(s->rn);
-    free(s->sp);
-    free(s->sn);
+    EF_FREE_ALL(s->rp, s->rn, s->sp, s->sn);
     tu_skin_case_free(&s->k);
 }
 

@@ -42,6 +42,7 @@
 
 #include "../samples/gt/gt.h"
 #include "../src/pipe/pipe.h"
+#include "../src/cpu/ef_mem.h"
 
 #define NF 5
 #define F0 136
@@ -157,12 +158,7 @@ static int setup(void **state)
     kin_mat4 *tw = malloc(sizeof *tw * (size_t)W.truth.model.node_count);
     if (!W.samples || !tl || !tw) return -1;
     for (int k = 0; k < W.nsamples; k++) gt_track_sample(&W.truth, &td, k, tl, tw, &W.samples[k]);
-    free(tl);
-    free(tw);
-    free(rgb);
-    free(sil);
-    free(sd);
-    free(sm);
+    EF_FREE_ALL(tl, tw, rgb, sil, sd, sm);
     return 0;
 }
 
@@ -361,11 +357,7 @@ static long run_skin(ef_isa isa, int with_depth, uint64_t crc[NF], long *min_sho
             crc[f] = hash64(crc[f], layer, (size_t)CW * CH * 4);
         }
     }
-    free(mask);
-    free(layer);
-    free(out);
-    free(nrm);
-    free(hz);
+    EF_FREE_ALL(mask, layer, out, nrm, hz);
     fuse_context_destroy(ctx);
     return bad;
 }

@@ -28,6 +28,7 @@
 
 #include "../src/pipe/pipe.h"
 #include "support/pipe_testrig.h"
+#include "../src/cpu/ef_mem.h"
 
 enum { W = 320, H = 240 };
 #define D2R 0.01745329252f
@@ -128,12 +129,7 @@ static void arms_build_opt(arms *A, float ku, float kf, int wrist)
 
 static void arms_free(arms *A)
 {
-    free(A->pos);
-    free(A->jnt);
-    free(A->wgt);
-    free(A->side);
-    free(A->part);
-    free(A->idx);
+    EF_FREE_ALL(A->pos, A->jnt, A->wgt, A->side, A->part, A->idx);
 }
 
 /* pos with the upper arm and forearm vertices of side s turned by phi[s]
@@ -784,12 +780,7 @@ static void learn_run_init(learn_run *r, int w, int h)
 
 static void learn_run_free(learn_run *r)
 {
-    free(r->af);
-    free(r->llr);
-    free(r->rgba);
-    free(r->m);
-    free(r->pv);
-    free(r->L);
+    EF_FREE_ALL(r->af, r->llr, r->rgba, r->m, r->pv, r->L);
 }
 
 /* One frame (r's image and masks, w x h; prev 0: without the previous
@@ -1117,13 +1108,7 @@ static void review_arguments(void **state)
     NEAR(th[0][0], 1.0, 0.0);
     pipe_fit_measure(NULL, 0, &cam[0], world, kin, W, sil, W);
     pipe_fit_destroy(f);
-    free(rgba);
-    free(m);
-    free(g);
-    free(kin);
-    free(sil);
-    free(kb);
-    free(sb);
+    EF_FREE_ALL(rgba, m, g, kin, sil, kb, sb);
     arms_free(&A);
     arms_free(&T);
 }

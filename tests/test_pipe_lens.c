@@ -23,6 +23,7 @@
 #include "../src/pipe/pipe_lens.h"
 #include "../src/raster/raster.h"
 #include "support/pipe_frames.h"
+#include "../src/cpu/ef_mem.h"
 
 #define NV 12 /* polygon vertices */
 
@@ -215,10 +216,7 @@ static void run_case(const char *name, const kin_lens *L, const poly *p, int ss)
                   f.max_dist_pin, f.max_dist_cam, f.differ_straight);
     assert_true(f.truth > 1000);
     assert_true(f.differ_straight > 20 * (f.differ + 1)); /* the lens matters here */
-    free(mask);
-    free(straight);
-    free(depth);
-    free(d2);
+    EF_FREE_ALL(mask, straight, depth, d2);
     pipe_lens_map_free(&m);
 }
 

@@ -19,6 +19,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
+#include "../src/cpu/ef_mem.h"
 
 /* Recorded CRC32 of the reference's sample bits over the AA soup. */
 #define AA_CRC 0xFE42DF31u /* issue 20: inputs drawn in a defined order (before: 0x97661E8A, gcc only) */
@@ -386,10 +387,7 @@ static void test_isa_equal(void **state)
                          ef_isa_name((ef_isa)isas[i]));
             compared[i]++;
         }
-        free(ref);
-        free(t.samples);
-        free(clip);
-        free(idx);
+        EF_FREE_ALL(ref, t.samples, clip, idx);
     }
     for (int i = 0; i < 4; i++)
         if (!compared[i])

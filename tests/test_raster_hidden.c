@@ -30,6 +30,7 @@
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
 #include "support/x86_only.h"
+#include "../src/cpu/ef_mem.h"
 
 #if EF_TEST_X86
 
@@ -255,12 +256,7 @@ static void hidden_isa(int isa)
             fail();
         }
         written += sr.pixels_written;
-        free(ref.mask);
-        free(ref.depth);
-        free(ref.attr);
-        free(got.mask);
-        free(got.depth);
-        free(got.attr);
+        EF_FREE_ALL(ref.mask, ref.depth, ref.attr, got.mask, got.depth, got.attr);
         free_case(&k);
     }
     assert_true(written > 0);

@@ -22,6 +22,7 @@
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
 #include "support/x86_only.h"
+#include "../src/cpu/ef_mem.h"
 
 #if EF_TEST_X86
 
@@ -196,12 +197,7 @@ static void reset_target(const rast_target *t)
 
 static void free_case(rcase *k)
 {
-    free(k->t.mask);
-    free(k->t.depth);
-    free(k->t.attr);
-    free(k->clip);
-    free(k->attr);
-    free(k->idx);
+    EF_FREE_ALL(k->t.mask, k->t.depth, k->t.attr, k->clip, k->attr, k->idx);
 }
 
 typedef struct snapshot {
@@ -435,12 +431,7 @@ static void test_threads_equal(void **state)
     }
     print_message("NOTE threads: %d runs equal (pixels %ld)\n", runs, s.st.pixels_written);
     drop(&s);
-    free(t.depth);
-    free(t.mask);
-    free(t.attr);
-    free(clip);
-    free(attr);
-    free(idx);
+    EF_FREE_ALL(t.depth, t.mask, t.attr, clip, attr, idx);
 }
 
 /* Contexts: bad descs, errors like rast_draw, the EGOFUSE_ISA cap. */

@@ -29,6 +29,7 @@
 #include "../../src/cpu/cpu.h"
 #include "../../src/raster/raster.h"
 #include "../bench_mesh.h"
+#include "../../src/cpu/ef_mem.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -406,9 +407,6 @@ int main(int argc, char **argv)
     eh_close(&gl);
     free(rgba);
     bm_eyes_free(&eyes);
-    free(tg);
-    free(te);
-    free(tc);
-    free(td);
+    EF_FREE_ALL(tg, te, tc, td);
     return bad_total ? 1 : 0;
 }

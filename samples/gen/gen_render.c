@@ -5,6 +5,7 @@
  * LBS, the STHMD camera) and raster (rast_draw with depth and attributes);
  * this file only shades the pixels the rasterizer wrote. */
 #include "gen.h"
+#include "../../src/cpu/ef_mem.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -157,16 +158,8 @@ static uint8_t to_u8(float x)
 
 void gen_frame_ctx_free(gen_frame_ctx *c)
 {
-    free(c->locals);
-    free(c->world);
-    free(c->jm);
-    free(c->skin_pos);
-    free(c->skin_nrm);
-    free(c->arm_attr);
-    free(c->clip);
-    free(c->depth);
-    free(c->tattr);
-    free(c->mask);
+    EF_FREE_ALL(c->locals, c->world, c->jm, c->skin_pos, c->skin_nrm, c->arm_attr, c->clip,
+                c->depth, c->tattr, c->mask);
     memset(c, 0, sizeof *c);
 }
 

@@ -19,6 +19,7 @@
 #include "../fit/fit_narrow.h"
 #include "../fit/fit_shift.h"
 #include "../fit/fit_smooth.h"
+#include "../cpu/ef_mem.h"
 
 /* The ground truth comes from samples/gt/ and the sample generator
  * (samples/gen/), linked into the program as build/libegofuse_samples.a. */
@@ -287,10 +288,7 @@ static void error_area_stats(method_run *r)
 static void run_free(method_run *r)
 {
     error_area_stats(r);
-    free(r->locals);
-    free(r->prev[0]);
-    free(r->prev[1]);
-    free(r->err);
+    EF_FREE_ALL(r->locals, r->prev[0], r->prev[1], r->err);
     r->err = NULL;
     pipe_fit_destroy(r->fit);
 }

@@ -1,6 +1,7 @@
 /* fit.c - the fit of the arm model to the camera images: elbow swivel,
  * colour learning, limb thickness (see fit.h). */
 #include "fit.h"
+#include "../cpu/ef_mem.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -269,14 +270,8 @@ void pipe_fit_destroy(pipe_fit *f)
 {
     if (!f) return;
     for (int e = 0; e < 2; e++) {
-        free(f->llr[e]);
-        free(f->v[e]);
-        free(f->use[e]);
-        free(f->sv[e]);
-        free(f->sw[e]);
-        free(f->scratch[e]);
-        free(f->acc[e]);
-        free(f->learn[e]);
+        EF_FREE_ALL(f->llr[e], f->v[e], f->use[e], f->sv[e], f->sw[e], f->scratch[e], f->acc[e],
+                    f->learn[e]);
         for (int s = 0; s < 2; s++)
             for (int g = 0; g < 2; g++) free(f->samples[e][s][g]);
     }

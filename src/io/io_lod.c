@@ -1,6 +1,7 @@
 /* io_lod.c - the level-of-detail chain of a model with meshoptimizer
  * (io_lod.h). */
 #include "io_lod.h"
+#include "../cpu/ef_mem.h"
 
 #include <math.h>
 #include <meshoptimizer.h>
@@ -38,13 +39,7 @@ typedef struct mesh_groups {
 
 static void groups_free(mesh_groups *g)
 {
-    free(g->start);
-    free(g->idx);
-    free(g->lidx);
-    free(g->vstart);
-    free(g->gv);
-    free(g->gpos);
-    free(g->scale);
+    EF_FREE_ALL(g->start, g->idx, g->lidx, g->vstart, g->gv, g->gpos, g->scale);
     memset(g, 0, sizeof *g);
 }
 
@@ -175,10 +170,7 @@ static int groups_build(const kin_mesh *me, int whole, mesh_groups *g)
     free(at);
     rc = groups_compact(me, g);
 done:
-    free(acc);
-    free(touched);
-    free(tj);
-    free(cnt);
+    EF_FREE_ALL(acc, touched, tj, cnt);
     return rc;
 }
 

@@ -14,6 +14,7 @@
 #include "../fit/fit_holes.h"
 #include "../fit/fit_shift.h"
 #include "../fit/fit_smooth.h"
+#include "../cpu/ef_mem.h"
 
 #include <math.h>
 #include <pthread.h>
@@ -516,22 +517,10 @@ static void wait_job(pipe_ctx *p, int job)
 static void free_eyes(pipe_ctx *p)
 {
     for (int e = 0; e < 2; e++) {
-        free(p->eye[e].depth);
-        free(p->eye[e].nrm);
-        free(p->eye[e].snrm);
-        free(p->eye[e].nfill_scratch);
-        free(p->eye[e].soft);
-        free(p->eye[e].clip);
-        free(p->eye[e].vnrm);
-        free(p->eye[e].mask);
-        free(p->eye[e].layer);
-        free(p->eye[e].cam_rgba);
-        free(p->eye[e].refined);
-        free(p->eye[e].regrow);
-        free(p->eye[e].prior);
-        free(p->eye[e].shifted);
-        free(p->eye[e].unsmoothed);
-        free(p->eye[e].refine_scratch);
+        EF_FREE_ALL(p->eye[e].depth, p->eye[e].nrm, p->eye[e].snrm, p->eye[e].nfill_scratch,
+                    p->eye[e].soft, p->eye[e].clip, p->eye[e].vnrm, p->eye[e].mask, p->eye[e].layer,
+                    p->eye[e].cam_rgba, p->eye[e].refined, p->eye[e].regrow, p->eye[e].prior,
+                    p->eye[e].shifted, p->eye[e].unsmoothed, p->eye[e].refine_scratch);
         pipe__aa_free(&p->eye[e].aa);
         pipe__reproj_free(&p->eye[e].rp);
         rast_context_destroy(p->eye[e].rast);

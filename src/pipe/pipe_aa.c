@@ -1,6 +1,7 @@
 /* pipe_aa.c - the anti-aliased coverage mask of an eye (pipe_aa.h). */
 #include "pipe_aa.h"
 #include "../cpu/mask_rows.h"
+#include "../cpu/ef_mem.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -59,15 +60,8 @@ int pipe__aa_init(pipe__aa *a, int count, int width, int height, int with_soft)
 
 void pipe__aa_free(pipe__aa *a)
 {
-    free(a->samples);
-    free(a->cov);
-    free(a->soft);
-    free(a->colsum);
-    free(a->colflip);
-    free(a->tile);
-    free(a->tsat);
-    free(a->idx);
-    free(a->sxy);
+    EF_FREE_ALL(a->samples, a->cov, a->soft, a->colsum, a->colflip, a->tile, a->tsat, a->idx,
+                a->sxy);
     memset(a, 0, sizeof *a);
 }
 

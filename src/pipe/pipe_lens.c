@@ -2,6 +2,7 @@
  * per-pixel gather (pipe_lens.h). */
 #include "pipe_lens.h"
 #include "pipe_internal.h"
+#include "../cpu/ef_mem.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -11,10 +12,7 @@
 void pipe_lens_map_free(pipe_lens_map *m)
 {
     if (!m) return;
-    free(m->src);
-    free(m->depth);
-    free(m->mask);
-    free(m->attr);
+    EF_FREE_ALL(m->src, m->depth, m->mask, m->attr);
     memset(m, 0, sizeof *m);
 }
 

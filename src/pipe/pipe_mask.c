@@ -10,6 +10,7 @@
 #include "pipe.h"
 #include "pipe_lens.h"
 #include "pipe_internal.h"
+#include "../cpu/ef_mem.h"
 
 static int finite3(const float v[3])
 {
@@ -124,11 +125,7 @@ int pipe_mask_render(const kin_model *model, const pipe_mask_desc *d,
     if (depth) memcpy(depth, dep, sizeof(float) * npx);
     rc = 0;
 done:
-    free(dep);
-    free(nrm);
-    free(msk);
-    free(clip);
-    free(vnrm);
+    EF_FREE_ALL(dep, nrm, msk, clip, vnrm);
     pipe_lens_map_free(&lm);
     pipe_pose_free(&ps);
     return rc;

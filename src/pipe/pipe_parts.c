@@ -2,6 +2,7 @@
  * the arm model a frame hides and the props (pipe.h, "the operator's
  * cockpit"; internal interface in pipe_parts.h). */
 #include "pipe_parts.h"
+#include "../cpu/ef_mem.h"
 
 #include <ctype.h>
 #include <stdio.h>
@@ -348,12 +349,7 @@ void pipe__cockpit_destroy(pipe__cockpit *c)
     for (int k = 0; k < c->nprops; k++) prop_free(&c->props[k]);
     free(c->props);
     for (int e = 0; e < 2; e++) {
-        free(c->pclip[e]);
-        free(c->pvnrm[e]);
-        free(c->hmask[e]);
-        free(c->htmp[e]);
-        free(c->hgrow[e]);
-        free(c->hsum[e]);
+        EF_FREE_ALL(c->pclip[e], c->pvnrm[e], c->hmask[e], c->htmp[e], c->hgrow[e], c->hsum[e]);
     }
     free(c);
 }

@@ -2,6 +2,7 @@
 #include "pipe_pose.h"
 #include "pipe_morph.h"
 #include "pipe_internal.h"
+#include "../cpu/ef_mem.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -89,13 +90,8 @@ void pipe_pose_free(pipe_pose *ps)
         }
     }
     pipe__morph_free(ps);
-    free(ps->joint_mats);
-    free(ps->own_normals);
-    free(ps->meshes);
-    free(ps->pos);
-    free(ps->nrm);
-    free(ps->locals);
-    free(ps->world);
+    EF_FREE_ALL(ps->joint_mats, ps->own_normals, ps->meshes, ps->pos, ps->nrm, ps->locals,
+                ps->world);
     memset(ps, 0, sizeof *ps);
 }
 

@@ -3,6 +3,7 @@
 #include "pipe_reproj.h"
 
 #include "../cpu/cpu.h"
+#include "../cpu/ef_mem.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -69,14 +70,7 @@ int pipe__reproj_init(pipe__reproj *r, int width, int height)
 
 void pipe__reproj_free(pipe__reproj *r)
 {
-    free(r->depth);
-    free(r->nrm);
-    free(r->mask);
-    free(r->P);
-    free(r->M);
-    free(r->row);
-    free(r->lanes);
-    free(r->kind);
+    EF_FREE_ALL(r->depth, r->nrm, r->mask, r->P, r->M, r->row, r->lanes, r->kind);
     memset(r, 0, sizeof *r);
 }
 
