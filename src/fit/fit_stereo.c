@@ -209,19 +209,10 @@ int pipe_fit_stereo(const pipe_fit_stereo_desc *dp, const kin_camera *cam, const
     to_grey(P, gp);
     to_grey(Q, gq);
 
-    st_ctx c;
-    memset(&c, 0, sizeof c);
-    c.d = d;
-    c.w = w;
-    c.h = h;
-    c.gp = gp;
-    c.gq = gq;
-    c.in = in;
-    c.dep = dep;
-    c.p10 = cam->proj.m[10];
-    c.p14 = cam->proj.m[14];
-    c.fx = cam->fx; c.fy = cam->fy; c.cx = cam->cx; c.cy = cam->cy;
-    c.ofx = other->fx; c.ofy = other->fy; c.ocx = other->cx; c.ocy = other->cy;
+    st_ctx c = { .d = d, .w = w, .h = h, .gp = gp, .gq = gq, .in = in, .dep = dep,
+                 .p10 = cam->proj.m[10], .p14 = cam->proj.m[14],
+                 .fx = cam->fx, .fy = cam->fy, .cx = cam->cx, .cy = cam->cy,
+                 .ofx = other->fx, .ofy = other->fy, .ocx = other->cx, .ocy = other->cy };
     kin_mat4 M = kin_mat4_mul(&other->view, &cam->world_from_cam);
     memcpy(c.M, M.m, sizeof c.M);
 

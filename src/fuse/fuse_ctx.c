@@ -192,26 +192,40 @@ static void light_span(const light_job *j, int y, int x0, int x1, const uint8_t 
                      j->normal + (size_t)y * (size_t)j->normal_stride, o);
 }
 
+/* Row y of a light job: its mask row *m, output row *o and the mask's
+ * span x0..x1, recorded in span (NULL: none); prefetches the next row's
+ * inputs. Returns 0, the output row cleared, for a row without hand
+ * (above and below the hand). */
+static inline int row_begin(const light_job *j, int y, int32_t (*span)[3], const uint8_t **m,
+                            uint8_t **o, int *x0, int *x1)
+{
+    const int w = j->P.width;
+    *m = j->mask + (size_t)y * (size_t)j->mask_stride;
+    *o = row_of(&j->out, y);
+    mask_span(*m, w, x0, x1);
+    if (span != NULL) {
+        span[y % SPAN_RING][0] = y;
+        span[y % SPAN_RING][1] = *x0;
+        span[y % SPAN_RING][2] = *x1;
+    }
+    if (*x0 >= *x1) {
+        memset(*o, 0, 4u * (size_t)w);
+        return 0;
+    }
+    light_prefetch(j, y + 1, *x0, *x1);
+    return 1;
+}
+
 /* span: as eye_light_depth_rows (NULL: none) */
 static void light_rows(const light_job *j, int y0, int y1, int32_t (*span)[3])
 {
     const int w = j->P.width;
     int y;
     for (y = y0; y < y1; y++) {
-        const uint8_t *m = j->mask + (size_t)y * (size_t)j->mask_stride;
-        uint8_t *o = row_of(&j->out, y);
+        const uint8_t *m;
+        uint8_t *o;
         int x0, x1;
-        mask_span(m, w, &x0, &x1);
-        if (span != NULL) {
-            span[y % SPAN_RING][0] = y;
-            span[y % SPAN_RING][1] = x0;
-            span[y % SPAN_RING][2] = x1;
-        }
-        if (x0 >= x1) {     /* the rows above and below the hand */
-            memset(o, 0, 4u * (size_t)w);
-            continue;
-        }
-        light_prefetch(j, y + 1, x0, x1);
+        if (!row_begin(j, y, span, &m, &o, &x0, &x1)) continue;
         span_widen(w, &x0, &x1);
         light_span(j, y, x0, x1, m, o);
     }
@@ -791,20 +805,10 @@ static void eye_light_depth_rows(const eye_job *e, int y0, int y1, int32_t (*spa
     }
     fuse__depth_prepare(d, w, e->comp.vw, &dp);
     for (y = y0; y < y1; y++) {
-        const uint8_t *m0 = j->mask + (size_t)y * (size_t)j->mask_stride;
-        uint8_t *o = row_of(&j->out, y);
+        const uint8_t *m0;
+        uint8_t *o;
         int x0, x1;
-        mask_span(m0, w, &x0, &x1);
-        if (span != NULL) {
-            span[y % SPAN_RING][0] = y;
-            span[y % SPAN_RING][1] = x0;
-            span[y % SPAN_RING][2] = x1;
-        }
-        if (x0 >= x1) {
-            memset(o, 0, 4u * (size_t)w);
-            continue;
-        }
-        light_prefetch(j, y + 1, x0, x1);
+        if (!row_begin(j, y, span, &m0, &o, &x0, &x1)) continue;
         if (y + 1 < sh) {   /* and the next row's depths, hand and scene */
             const int32_t c0 = (int32_t)(((int64_t)2 * x0 + 1) * dp.vw / dp.den);
             const int32_t c1 = (int32_t)(((int64_t)2 * (x1 - 1) + 1) * dp.vw / dp.den);

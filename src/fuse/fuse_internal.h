@@ -362,27 +362,20 @@ typedef void (*fuse__composite_fn)(const uint8_t *q0, const uint8_t *q1,
                                    uint32_t fy, const fuse__cols *cols, int c,
                                    int n, int sw, const uint8_t *v,
                                    uint8_t *out);
-typedef void (*fuse__light_fn)(const fuse__light_prep *p, int y, int width,
-                               const uint8_t *P, const uint8_t *mask,
-                               const float *normal, uint8_t *out);
+/* A row's lighting (fuse__light_row_ref); the ISA paths below are declared
+ * by this function type. */
+typedef void fuse__light_f(const fuse__light_prep *p, int y, int width, const uint8_t *P,
+                           const uint8_t *mask, const float *normal, uint8_t *out);
+typedef fuse__light_f *fuse__light_fn;
 
 /* The lighting of pixels x0 <= x < x1 of a row only (pointers at pixel 0),
  * the bytes of fuse__light_span_ref. */
-typedef void (*fuse__light_span_fn)(const fuse__light_prep *p, int y, int x0, int x1,
-                                    const uint8_t *P, const uint8_t *mask,
-                                    const float *normal, uint8_t *out);
-void fuse__light_span_sse2(const fuse__light_prep *p, int y, int x0, int x1,
-                           const uint8_t *P, const uint8_t *mask, const float *normal,
-                           uint8_t *out);
-void fuse__light_span_avx2(const fuse__light_prep *p, int y, int x0, int x1,
-                           const uint8_t *P, const uint8_t *mask, const float *normal,
-                           uint8_t *out);
-void fuse__light_span_avx512(const fuse__light_prep *p, int y, int x0, int x1,
-                             const uint8_t *P, const uint8_t *mask, const float *normal,
-                             uint8_t *out);
-void fuse__light_span_neon(const fuse__light_prep *p, int y, int x0, int x1,
-                           const uint8_t *P, const uint8_t *mask, const float *normal,
-                           uint8_t *out);
+typedef void fuse__light_span_f(const fuse__light_prep *p, int y, int x0, int x1,
+                                const uint8_t *P, const uint8_t *mask, const float *normal,
+                                uint8_t *out);
+typedef fuse__light_span_f *fuse__light_span_fn;
+fuse__light_span_f fuse__light_span_sse2, fuse__light_span_avx2, fuse__light_span_avx512,
+    fuse__light_span_neon;
 
 void fuse__composite_cols_ref(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
                               const fuse__cols *cols, int c, int n, int sw,
@@ -391,15 +384,7 @@ void fuse__composite_cols_ref(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
 /* The ISA paths (fuse_sse2.c, fuse_avx2.c, fuse_avx512.c). Each gives the
  * bytes of the reference kernels. The table-driven composite per output
  * row is SSE2's; AVX2 and AVX-512 composite through the row cache below. */
-void fuse__light_row_sse2(const fuse__light_prep *p, int y, int width,
-                          const uint8_t *P, const uint8_t *mask,
-                          const float *normal, uint8_t *out);
-void fuse__light_row_avx2(const fuse__light_prep *p, int y, int width,
-                          const uint8_t *P, const uint8_t *mask,
-                          const float *normal, uint8_t *out);
-void fuse__light_row_avx512(const fuse__light_prep *p, int y, int width,
-                            const uint8_t *P, const uint8_t *mask,
-                            const float *normal, uint8_t *out);
+fuse__light_f fuse__light_row_sse2, fuse__light_row_avx2, fuse__light_row_avx512;
 void fuse__composite_cols_sse2(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
                                const fuse__cols *cols, int c, int n, int sw,
                                const uint8_t *v, uint8_t *out);
@@ -611,9 +596,7 @@ int fuse__yuv422_row_neon(const uint8_t *src, int width, int uyvy, uint8_t *dst)
 /* NEON (fuse_neon.c: fuse_simd.inl on src/cpu/simd_neon.h; on other
  * targets the reference under these names). The composite: per output
  * row, as SSE2 (no row cache). */
-void fuse__light_row_neon(const fuse__light_prep *p, int y, int width,
-                          const uint8_t *P, const uint8_t *mask,
-                          const float *normal, uint8_t *out);
+fuse__light_f fuse__light_row_neon;
 void fuse__pow01_row_neon(const float *x, int n, float s, float *out);
 void fuse__depth_row_neon(const fuse__depth_prep *p, uint8_t *q, const float *hz,
                           const float *sc, int w);

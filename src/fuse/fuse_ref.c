@@ -48,20 +48,14 @@ static uint8_t *row_ptr(const fuse_image *im, int y)
 
 fuse_lighting fuse_lighting_default(void)
 {
-    fuse_lighting L;
-    memset(&L, 0, sizeof L);
-    L.light_count = 1;
-    L.lights[0].dir[0] = 0.0f;   /* above (+y) and in front (+z, towards */
-    L.lights[0].dir[1] = 0.6f;   /* the viewer) of the surface           */
-    L.lights[0].dir[2] = 0.8f;
-    L.lights[0].color[0] = L.lights[0].color[1] = L.lights[0].color[2] = 1.0f;
-    L.ambient[0] = L.ambient[1] = L.ambient[2] = 0.35f;
-    L.kd = 0.75f;
-    L.ks = 0.15f;
-    L.shininess = 16.0f;
-    L.kf = 0.6f;
-    L.tone[0] = L.tone[1] = L.tone[2] = 1.0f;
-    return L;
+    /* one light above (+y) and in front (+z, towards the viewer) of the
+     * surface */
+    return (fuse_lighting){ .light_count = 1,
+                            .lights = { { .dir = { 0.0f, 0.6f, 0.8f },
+                                          .color = { 1.0f, 1.0f, 1.0f } } },
+                            .ambient = { 0.35f, 0.35f, 0.35f },
+                            .kd = 0.75f, .ks = 0.15f, .shininess = 16.0f, .kf = 0.6f,
+                            .tone = { 1.0f, 1.0f, 1.0f } };
 }
 
 fuse_image fuse_image_rows(const fuse_image *img, int y0, int h)

@@ -10,16 +10,9 @@
 
 fuse_skin_params fuse_skin_params_default(void)
 {
-    fuse_skin_params p;
-    p.mean_cb = 117.4316f;
-    p.mean_cr = 156.5599f;
-    p.cov[0] = 160.1301f;
-    p.cov[1] = 12.1430f;
-    p.cov[2] = 299.4574f;
-    p.max_dist2 = 2.5f;
-    p.min_luma = 40.0f;
-    p.max_luma = 250.0f;
-    return p;
+    return (fuse_skin_params){ .mean_cb = 117.4316f, .mean_cr = 156.5599f,
+                               .cov = { 160.1301f, 12.1430f, 299.4574f },
+                               .max_dist2 = 2.5f, .min_luma = 40.0f, .max_luma = 250.0f };
 }
 
 static int image_ok(const fuse_image *P)

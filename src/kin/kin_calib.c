@@ -19,12 +19,8 @@
 
 kin_user_calib kin_user_calib_identity(void)
 {
-    kin_user_calib c;
-    memset(&c, 0, sizeof c);
-    c.arm_scale[0] = c.arm_scale[1] = 1.0f;
-    c.hand_scale[0] = c.hand_scale[1] = 1.0f;
-    c.shoulder_scale = 1.0f;
-    return c;
+    return (kin_user_calib){ .arm_scale = { 1.0f, 1.0f }, .hand_scale = { 1.0f, 1.0f },
+                             .shoulder_scale = 1.0f };
 }
 
 static int cmp_float(const void *a, const void *b)

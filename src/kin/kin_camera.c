@@ -135,15 +135,8 @@ kin_mat4 kin_proj_from_intrinsics(double fx, double fy, double cx, double cy, do
 /* The pinhole kin_lens of kin_camera intrinsics (egofuse pixels). */
 static kin_lens pinhole_lens(double fx, double fy, double cx, double cy, int w, int h)
 {
-    kin_lens l;
-    memset(&l, 0, sizeof l);
-    l.model = KIN_LENS_PINHOLE;
-    l.width = w;
-    l.height = h;
-    l.fx = fx;
-    l.fy = fy;
-    l.cx = cx - 0.5;
-    l.cy = cy - 0.5;
+    kin_lens l = { .model = KIN_LENS_PINHOLE, .width = w, .height = h,
+                   .fx = fx, .fy = fy, .cx = cx - 0.5, .cy = cy - 0.5 };
     kin_lens_check(&l, NULL, 0);
     return l;
 }

@@ -143,12 +143,9 @@ int kin_skin_plan_init(kin_skin_plan *plan, const kin_mesh *mesh, void *scratch,
         }
         s = e;
     }
-    plan->vertex_count = mesh->vertex_count;
-    plan->batch_count = nb;
-    plan->normals = do_n;
-    plan->max_joint = max_joint;
-    plan->group_count = groups;
-    plan->batches = bt;
+    *plan = (kin_skin_plan){ .vertex_count = mesh->vertex_count, .batch_count = nb,
+                             .normals = do_n, .max_joint = max_joint, .group_count = groups,
+                             .batches = bt };
     return 0;
 }
 
@@ -175,13 +172,8 @@ static void lane_of(const kin__plan_batch *B, int l, int normals, lane_mesh *o)
     memset(o, 0, sizeof *o);
     for (int c = 0; c < 3; c++) { o->p[c] = B->p[c][l]; o->n[c] = B->nrm[c][l]; }
     for (int i = 0; i < B->n; i++) { o->w[i] = B->w[i][l]; o->j[i] = (uint16_t)B->joint[i]; }
-    o->m.vertex_count = 1;
-    o->m.positions = o->p;
-    o->m.normals = normals ? o->n : NULL;
-    o->m.joints = o->j;
-    o->m.weights = o->w;
-    o->m.skin = 0;
-    o->m.node = -1;
+    o->m = (kin_mesh){ .vertex_count = 1, .positions = o->p, .normals = normals ? o->n : NULL,
+                       .joints = o->j, .weights = o->w, .skin = 0, .node = -1 };
 }
 
 static void out_lane(const float r[6], int v, float *pos_out, float *nrm_out)

@@ -515,30 +515,57 @@ static int mesh_tris(const pipe__cockpit *c, const kin_mesh *me, int i, const ui
     return me->index_count / 3;
 }
 
+/* One mesh an eye draws: the model's (its level's triangles, the caller's
+ * cull) or a visible prop's (every triangle, no cull). */
+typedef struct draw_item {
+    const float *pos, *nrm;
+    int nv;
+    const uint32_t *ix;
+    int nt;
+    rast_cull cull;
+    int is_prop;
+} draw_item;
+
+/* The next non-empty mesh in drawing order, the model's meshes first, then
+ * each visible prop's; 0 after the last. Start with *k = -1, *i = 0. */
+static int next_item(const pipe__cockpit *c, const pipe_pose *ps, rast_cull cull, int *k,
+                     int *i, draw_item *d)
+{
+    while (*k < c->nprops) {
+        if (*k < 0 && *i < ps->model->mesh_count) {
+            const kin_mesh *me = &ps->meshes[*i];
+            *d = (draw_item){ .pos = ps->pos[*i], .nrm = ps->nrm[*i], .nv = me->vertex_count,
+                              .cull = cull };
+            d->nt = mesh_tris(c, me, (*i)++, &d->ix);
+        } else if (*k >= 0 && c->props[*k].visible &&
+                   *i < c->props[*k].model->mesh_count) {
+            const prop *pr = &c->props[*k];
+            const kin_mesh *me = &pr->pose.meshes[*i];
+            *d = (draw_item){ .pos = pr->pos[*i], .nrm = pr->nrm[*i], .nv = me->vertex_count,
+                              .ix = me->indices, .nt = me->index_count / 3,
+                              .cull = RAST_CULL_NONE, .is_prop = 1 };
+            (*i)++;
+        } else {
+            (*k)++;
+            *i = 0;
+            continue;
+        }
+        if (d->nt > 0) return 1;
+    }
+    return 0;
+}
+
 rast_result pipe__cockpit_draw(pipe__cockpit *c, const pipe_pose *ps, int eye,
                                rast_context *ctx, const kin_camera *cam,
                                const rast_target *target, rast_cull cull, float *clip,
                                float *vnrm)
 {
-    const kin_model *m = ps->model;
-    for (int i = 0; i < m->mesh_count; i++) {
-        const kin_mesh *me = &ps->meshes[i];
-        const uint32_t *ix;
-        int nt = mesh_tris(c, me, i, &ix);
-        rast_result r = draw_mesh(ctx, cam, target, cull, ps->pos[i], ps->nrm[i],
-                                  me->vertex_count, ix, nt, clip, vnrm);
+    draw_item d;
+    for (int k = -1, i = 0; next_item(c, ps, cull, &k, &i, &d);) {
+        rast_result r = draw_mesh(ctx, cam, target, d.cull, d.pos, d.nrm, d.nv, d.ix, d.nt,
+                                  d.is_prop ? c->pclip[eye] : clip,
+                                  d.is_prop ? c->pvnrm[eye] : vnrm);
         if (r != RAST_OK) return r;
-    }
-    for (int k = 0; k < c->nprops; k++) {
-        const prop *pr = &c->props[k];
-        if (!pr->visible) continue;
-        for (int i = 0; i < pr->model->mesh_count; i++) {
-            const kin_mesh *me = &pr->pose.meshes[i];
-            rast_result r = draw_mesh(ctx, cam, target, RAST_CULL_NONE, pr->pos[i], pr->nrm[i],
-                                      me->vertex_count, me->indices, me->index_count / 3,
-                                      c->pclip[eye], c->pvnrm[eye]);
-            if (r != RAST_OK) return r;
-        }
     }
     return RAST_OK;
 }
@@ -547,26 +574,12 @@ rast_result pipe__cockpit_draw_aa(pipe__cockpit *c, const pipe_pose *ps, int eye
                                   rast_context *ctx, const kin_camera *cam, pipe__aa *aa,
                                   rast_cull cull, float *clip)
 {
-    const kin_model *m = ps->model;
-    for (int i = 0; i < m->mesh_count; i++) {
-        const kin_mesh *me = &ps->meshes[i];
-        const uint32_t *ix;
-        int nt = mesh_tris(c, me, i, &ix);
-        if (nt <= 0) continue;
-        rast_transform_points(cam->view_proj.m, ps->pos[i], me->vertex_count, clip);
-        rast_result r = pipe__aa_draw(aa, ctx, clip, me->vertex_count, ix, nt, cull);
+    draw_item d;
+    for (int k = -1, i = 0; next_item(c, ps, cull, &k, &i, &d);) {
+        float *cl = d.is_prop ? c->pclip[eye] : clip;
+        rast_transform_points(cam->view_proj.m, d.pos, d.nv, cl);
+        rast_result r = pipe__aa_draw(aa, ctx, cl, d.nv, d.ix, d.nt, d.cull);
         if (r != RAST_OK) return r;
-    }
-    for (int k = 0; k < c->nprops; k++) {
-        const prop *pr = &c->props[k];
-        if (!pr->visible) continue;
-        for (int i = 0; i < pr->model->mesh_count; i++) {
-            const kin_mesh *me = &pr->pose.meshes[i];
-            rast_transform_points(cam->view_proj.m, pr->pos[i], me->vertex_count, c->pclip[eye]);
-            rast_result r = pipe__aa_draw(aa, ctx, c->pclip[eye], me->vertex_count, me->indices,
-                                          me->index_count / 3, RAST_CULL_NONE);
-            if (r != RAST_OK) return r;
-        }
     }
     return RAST_OK;
 }
