@@ -17,6 +17,7 @@
 #include "support/testutil.h"
 #include <cmocka.h>
 #include "support/fit_scene.h"
+#include "support/fixture.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -83,21 +84,7 @@ static void scene_free(scene *s)
 }
 
 /* Each test's fixture: a fresh scene (scene_make) as its state. */
-static int scene_setup(void **state)
-{
-    scene *s = malloc(sizeof *s);
-    assert_non_null(s);
-    scene_make(s);
-    *state = s;
-    return 0;
-}
-
-static int scene_teardown(void **state)
-{
-    scene_free(*state);
-    free(*state);
-    return 0;
-}
+TU_FIXTURE(scene, scene, s, scene_make(s), scene_free(s))
 
 /* pipe_fit_shift of in on the scene's image with the colour model g and
  * scratch_size bytes of the scene's scratch. */

@@ -25,6 +25,7 @@
 
 #include "../src/fit/fit_stereo.h"
 #include "../src/cpu/ef_mem.h"
+#include "support/fixture.h"
 
 static kin_camera cams[2];
 static int W, H;
@@ -210,30 +211,19 @@ static int setup(void **state)
     return 0;
 }
 
-/* Each test's fixture: a fresh scene (scene_make) as its state, of the
- * textured background, the plain one, or the textured one seen through a
- * hole in the hand. */
-static int scene_setup_as(void **state, int plain, int with_hole)
+/* A scene with a hole in the hand, the background seen through it. */
+static void scene_make_hole(scene *s)
 {
-    scene *s = malloc(sizeof *s);
-    assert_non_null(s);
-    hole = with_hole;
-    scene_make(s, plain);
+    hole = 1;
+    scene_make(s, 0);
     hole = 0;
-    *state = s;
-    return 0;
 }
 
-static int scene_setup(void **state) { return scene_setup_as(state, 0, 0); }
-static int scene_setup_plain(void **state) { return scene_setup_as(state, 1, 0); }
-static int scene_setup_hole(void **state) { return scene_setup_as(state, 0, 1); }
-
-static int scene_teardown(void **state)
-{
-    scene_free(*state);
-    free(*state);
-    return 0;
-}
+/* Each test's fixture: a fresh scene as its state, of the textured
+ * background, the plain one, or the textured one seen through a hole. */
+TU_FIXTURE(scene, scene, s, scene_make(s, 0), scene_free(s))
+TU_FIXTURE(plain, scene, s, scene_make(s, 1), scene_free(s))
+TU_FIXTURE(hole, scene, s, scene_make_hole(s), scene_free(s))
 
 static void rejects_background_behind_the_hand(void **state)
 {
@@ -382,12 +372,12 @@ static void bad_arguments(void **state)
 TU_MAIN(setup, NULL,
         cmocka_unit_test_setup_teardown(rejects_background_behind_the_hand, scene_setup,
                                         scene_teardown),
-        cmocka_unit_test_setup_teardown(plain_background_is_ambiguous, scene_setup_plain,
-                                        scene_teardown),
+        cmocka_unit_test_setup_teardown(plain_background_is_ambiguous, plain_setup,
+                                        plain_teardown),
         cmocka_unit_test_setup_teardown(accepts_the_hand_beyond_the_mask, scene_setup,
                                         scene_teardown),
-        cmocka_unit_test_setup_teardown(enclosed_background_is_kept, scene_setup_hole,
-                                        scene_teardown),
+        cmocka_unit_test_setup_teardown(enclosed_background_is_kept, hole_setup,
+                                        hole_teardown),
         cmocka_unit_test_setup_teardown(grid_decides_like_every_pixel, scene_setup,
                                         scene_teardown),
         cmocka_unit_test_setup_teardown(bad_arguments, scene_setup, scene_teardown))

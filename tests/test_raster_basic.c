@@ -7,6 +7,7 @@
 #include <cmocka.h>
 
 #include "test_raster_util.h"
+#include "support/fixture.h"
 
 /* CRC32 of depth, mask and attributes of the seeded soup below. Update it
  * (the test prints the new value) only when the rasterization rules change
@@ -117,21 +118,7 @@ static void test_validation(void **state)
 
 /* The index tests' fixture: a 16 x 16 target with depth, 2 attributes
  * and 1 byte of padding as the test's state. */
-static int index_setup(void **state)
-{
-    rast_target *t = malloc(sizeof *t);
-    assert_non_null(t);
-    *t = rt_make(16, 16, 1, 2, 1);
-    *state = t;
-    return 0;
-}
-
-static int index_teardown(void **state)
-{
-    rt_free(*state);
-    free(*state);
-    return 0;
-}
+TU_FIXTURE(index, rast_target, t, *t = rt_make(16, 16, 1, 2, 1), rt_free(t))
 
 /* One bad index at every position of a longer index list (the check
  * runs 4 indices at a time plus a scalar tail), for the smallest bad
