@@ -135,6 +135,22 @@ static inline void rt_expect_clipped_away(const rast_target *t, const float clip
     assert_int_equal(rt_count_mask(t, NULL), 0);
 }
 
+/* Draws m[0] on t[0] and m[1] on t[1] in the context c: in one
+ * rast_context_draw_jobs call when jobs is set, else with one
+ * rast_context_draw each; every call must succeed. */
+static inline void rt_context_draw_two(rast_context *c, int jobs, const rast_target t[2],
+                                       const rast_mesh_desc m[2])
+{
+    if (jobs) {
+        const rast_target *tp[2] = { &t[0], &t[1] };
+        const rast_mesh_desc *mp[2] = { &m[0], &m[1] };
+        assert_int_equal(rast_context_draw_jobs(c, 2, tp, mp, NULL), RAST_OK);
+    } else {
+        for (int e = 0; e < 2; e++)
+            assert_int_equal(rast_context_draw(c, &t[e], &m[e], NULL), RAST_OK);
+    }
+}
+
 /* Column-major perspective matrix (OpenGL glFrustum-like, symmetric). */
 static inline void rt_perspective(double fovy_rad, double aspect, double n, double f,
                            float m[16])
