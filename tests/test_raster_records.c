@@ -29,7 +29,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
-#include "support/isa_skip.h"
+#include "support/isa_tests.h"
 #include "support/x86_only.h"
 
 #if EF_TEST_X86
