@@ -21,9 +21,9 @@
  *     additions: byte for byte their per-pixel rule, 300 seeded masks.
  */
 #include "support/testutil.h"
+#include <cmocka.h>
 #include "support/fit_scene.h"
 
-#include <cmocka.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -57,34 +57,18 @@ typedef struct scene {
 
 static void scene_make(scene *s)
 {
-    tu_rng rng = { 0x5eed0f17ull };
-    s->img = malloc((size_t)W * H * 4);
-    s->truth = malloc(W * H);
-    s->kin = malloc(W * H);
+    fit_scene_alloc(W, H, &s->img, &s->truth, &s->kin, &s->out);
     s->prev = malloc(W * H);
-    s->out = malloc(W * H);
     s->region = malloc(W * H);
     s->prior = malloc(W * H);
-    assert_non_null(s->img);
-    assert_non_null(s->truth && s->kin && s->prev && s->out && s->region && s->prior);
+    assert_non_null(s->prev && s->region && s->prior);
     disc(s->truth, W / 2.0f, H / 2.0f, 64.0f);
     disc(s->kin, W / 2.0f, H / 2.0f, 40.0f);
-    fit_scene_paint(s->img, s->truth, (long)W * H, &rng);
-    s->rp = fuse_refine_params_default();
-    s->rp.band = 16;
-    s->rp.bits = 5;
-    s->scratch_size = fuse_refine_scratch_size(&s->rp, W, H);
-    s->scratch = aligned_alloc(16, (s->scratch_size + 15) & ~(size_t)15);
-    s->cscratch = malloc(fuse_colour_model_scratch_size(5));
-    s->llr = malloc(sizeof(float) << 15);
-    assert_non_null(s->scratch && s->cscratch && s->llr);
     /* the image-wide colour model, learned from the true mask */
-    s->g.bits = 5;
-    s->g.llr = s->llr;
-    fuse_image P = { s->img, W, H, 4 * W };
-    assert_int_equal(fuse_colour_model_learn(&s->g, &P, s->truth, W, 4, 1, 3.0f, 64, s->cscratch,
-                                             fuse_colour_model_scratch_size(5)),
-                     FUSE_OK);
+    fit_scene_learn(&s->g, s->img, s->truth, W, H, 0x5eed0f17ull, &s->llr, &s->cscratch);
+    s->rp = fit_scene_refine_params();
+    s->scratch_size = fuse_refine_scratch_size(&s->rp, W, H);
+    s->scratch = fit_scene_scratch(s->scratch_size);
 }
 
 static void scene_free(scene *s)

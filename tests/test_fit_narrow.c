@@ -65,37 +65,61 @@ static long errors(const uint8_t *m, int x0, int x1)
 static void *scratch;
 static size_t scratch_size;
 
+/* fuse_refine_mask of in into o on the scene's image, with the default
+ * parameters but a band of band px; fails the test unless FUSE_OK. */
+static fuse_refine_stats plain(int band, const uint8_t *in, uint8_t *o)
+{
+    fuse_refine_params p = fuse_refine_params_default();
+    p.band = band;
+    fuse_image P = { img, W, H, 4 * W };
+    fuse_refine_stats rs;
+    assert_int_equal(fuse_refine_mask(&p, &P, in, W, o, W, scratch, scratch_size, &rs), FUSE_OK);
+    return rs;
+}
+
+/* pipe_fit_refine_narrow (default parameters) of the scene's mask into out
+ * with min_band; *band: the band it used. Fails the test unless FUSE_OK. */
+static fuse_refine_stats narrow(int min_band, int *band)
+{
+    const fuse_refine_params p = fuse_refine_params_default();
+    fuse_image P = { img, W, H, 4 * W };
+    fuse_refine_stats rs;
+    assert_int_equal(pipe_fit_refine_narrow(&p, NULL, 0.0f, min_band, &P, mask, W, out, W,
+                                            scratch, scratch_size, &rs, band),
+                     FUSE_OK);
+    return rs;
+}
+
+/* pipe_fit_refine_regrow (default parameters) of out, refined with the
+ * stats first, tmp its scratch mask: its return value. */
+static int regrow(uint8_t *tmp_mask, const fuse_refine_stats *first)
+{
+    const fuse_refine_params p = fuse_refine_params_default();
+    fuse_image P = { img, W, H, 4 * W };
+    return pipe_fit_refine_regrow(&p, NULL, 0.0f, &P, out, W, tmp_mask, scratch, scratch_size,
+                                  first);
+}
+
 static void test_thin_halves(void **st)
 {
     (void)st;
     scene(50, 70);   /* 20 px stripe, mask 26 px: nothing deeper than 13 px */
-    fuse_refine_params p = fuse_refine_params_default();
-    fuse_image P = { img, W, H, 4 * W };
-    fuse_refine_stats rs, rs2;
-    assert_int_equal(fuse_refine_mask(&p, &P, mask, W, out2, W, scratch, scratch_size, &rs2),
-                     FUSE_OK);
-    assert_int_equal(rs2.used_colour, 0);
+    const int band16 = fuse_refine_params_default().band;
+    assert_int_equal(plain(band16, mask, out2).used_colour, 0);
     assert_memory_equal(out2, mask, sizeof mask);
     int band = 0;
-    assert_int_equal(pipe_fit_refine_narrow(&p, NULL, 0.0f, 4, &P, mask, W, out, W, scratch,
-                                            scratch_size, &rs, &band),
-                     FUSE_OK);
+    fuse_refine_stats rs = narrow(4, &band);
     assert_int_equal(rs.used_colour, 1);
     assert_int_equal(band, 8);
-    assert_true(rs.fg_samples >= p.min_samples);
+    assert_true(rs.fg_samples >= fuse_refine_params_default().min_samples);
     const long e_in = errors(mask, 50, 70), e_out = errors(out, 50, 70);
     assert_int_equal(e_in, 6 * H);
     assert_true(e_out * 4 < e_in);
     /* the same as the plain refinement with band 8 */
-    fuse_refine_params p8 = p;
-    p8.band = 8;
-    assert_int_equal(fuse_refine_mask(&p8, &P, mask, W, out2, W, scratch, scratch_size, &rs2),
-                     FUSE_OK);
+    plain(8, mask, out2);
     assert_memory_equal(out, out2, sizeof out);
     /* min_band 16: no halving, the fallback's bytes */
-    assert_int_equal(pipe_fit_refine_narrow(&p, NULL, 0.0f, 16, &P, mask, W, out, W, scratch,
-                                            scratch_size, &rs, &band),
-                     FUSE_OK);
+    rs = narrow(16, &band);
     assert_int_equal(rs.used_colour, 0);
     assert_int_equal(band, 16);
     assert_memory_equal(out, mask, sizeof mask);
@@ -105,17 +129,11 @@ static void test_wide_unchanged(void **st)
 {
     (void)st;
     scene(30, 90);   /* 60 px: band 16 learns */
-    fuse_refine_params p = fuse_refine_params_default();
-    fuse_image P = { img, W, H, 4 * W };
-    fuse_refine_stats rs, rs2;
     int band = 0;
-    assert_int_equal(pipe_fit_refine_narrow(&p, NULL, 0.0f, 4, &P, mask, W, out, W, scratch,
-                                            scratch_size, &rs, &band),
-                     FUSE_OK);
+    const fuse_refine_stats rs = narrow(4, &band);
     assert_int_equal(band, 16);
     assert_int_equal(rs.used_colour, 1);
-    assert_int_equal(fuse_refine_mask(&p, &P, mask, W, out2, W, scratch, scratch_size, &rs2),
-                     FUSE_OK);
+    plain(fuse_refine_params_default().band, mask, out2);
     assert_memory_equal(out, out2, sizeof out);
     assert_true(errors(out, 30, 90) * 4 < errors(mask, 30, 90));
 }
@@ -124,40 +142,28 @@ static void test_regrow(void **st)
 {
     (void)st;
     scene_grow(30, 130, -18);   /* the hand 18 px beyond the band's 16 */
-    fuse_refine_params p = fuse_refine_params_default();
-    fuse_image P = { img, W, H, 4 * W };
-    fuse_refine_stats rs, rs2;
-    assert_int_equal(fuse_refine_mask(&p, &P, mask, W, out, W, scratch, scratch_size, &rs),
-                     FUSE_OK);
+    const int band16 = fuse_refine_params_default().band;
+    fuse_refine_stats rs = plain(band16, mask, out);
     assert_int_equal(rs.used_colour, 1);
     assert_true((double)rs.flipped_in > PIPE_REGROW_PER_MILLE / 1000.0 * W * H);
     const long e1 = errors(out, 30, 130);
     assert_true(e1 >= 3 * H);   /* the band left the last 2 px on each side out */
     /* the plain second refinement, from the first's result */
-    assert_int_equal(fuse_refine_mask(&p, &P, out, W, out2, W, scratch, scratch_size, &rs2),
-                     FUSE_OK);
-    assert_int_equal(pipe_fit_refine_regrow(&p, NULL, 0.0f, &P, out, W, tmp, scratch,
-                                            scratch_size, &rs),
-                     1);
+    plain(band16, out, out2);
+    assert_int_equal(regrow(tmp, &rs), 1);
     assert_memory_equal(out, out2, sizeof out);
     assert_true(errors(out, 30, 130) * 4 < e1);
     /* below the limit: left as it is */
     memcpy(out2, out, sizeof out);
     rs.flipped_in = (long)(PIPE_REGROW_PER_MILLE / 1000.0 * W * H);
-    assert_int_equal(pipe_fit_refine_regrow(&p, NULL, 0.0f, &P, out, W, tmp, scratch,
-                                            scratch_size, &rs),
-                     0);
+    assert_int_equal(regrow(tmp, &rs), 0);
     assert_memory_equal(out, out2, sizeof out);
     /* after a fallback: left as it is */
     rs.flipped_in = W * H;
     rs.used_colour = 0;
-    assert_int_equal(pipe_fit_refine_regrow(&p, NULL, 0.0f, &P, out, W, tmp, scratch,
-                                            scratch_size, &rs),
-                     0);
+    assert_int_equal(regrow(tmp, &rs), 0);
     assert_memory_equal(out, out2, sizeof out);
-    assert_int_equal(pipe_fit_refine_regrow(&p, NULL, 0.0f, &P, out, W, NULL, scratch,
-                                            scratch_size, &rs),
-                     -1);
+    assert_int_equal(regrow(NULL, &rs), -1);
 }
 
 static int in_disc(int x, int y, int cx, int cy, int r)

@@ -15,9 +15,10 @@
  *     returned, shift 0.
  */
 #include "support/testutil.h"
-#include "support/fit_scene.h"
-
 #include <cmocka.h>
+#include "support/fit_scene.h"
+#include "support/fixture.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -56,33 +57,18 @@ typedef struct scene {
 
 static void scene_make(scene *s)
 {
-    tu_rng rng = { 0x5eed5417ull };
-    s->img = malloc((size_t)W * H * 4);
-    s->truth = malloc(W * H);
-    s->kin = malloc(W * H);
-    s->out = malloc(W * H);
+    fit_scene_alloc(W, H, &s->img, &s->truth, &s->kin, &s->out);
     s->ref = malloc(W * H);
-    assert_true(s->img && s->truth && s->kin && s->out && s->ref);
+    assert_non_null(s->ref);
     /* the model's hand at the image centre, the true one offset */
     disc(s->truth, W / 2.0f + DX, H / 2.0f + DY, 40.0f, 1);
     disc(s->kin, W / 2.0f, H / 2.0f, 40.0f, 1);
-    fit_scene_paint(s->img, s->truth, (long)W * H, &rng);
+    fit_scene_learn(&s->g, s->img, s->truth, W, H, 0x5eed5417ull, &s->llr, &s->cscratch);
     s->scratch_size = pipe_fit_shift_scratch_size(W, H);
-    s->scratch = aligned_alloc(16, (s->scratch_size + 15) & ~(size_t)15);
-    s->cscratch = malloc(fuse_colour_model_scratch_size(5));
-    s->llr = malloc(sizeof(float) << 15);
-    fuse_refine_params rp = fuse_refine_params_default();
-    rp.band = 16;
-    rp.bits = 5;
+    s->scratch = fit_scene_scratch(s->scratch_size);
+    const fuse_refine_params rp = fit_scene_refine_params();
     s->rscratch_size = fuse_refine_scratch_size(&rp, W, H);
-    s->rscratch = aligned_alloc(16, (s->rscratch_size + 15) & ~(size_t)15);
-    assert_true(s->scratch && s->cscratch && s->llr && s->rscratch);
-    s->g.bits = 5;
-    s->g.llr = s->llr;
-    fuse_image P = { s->img, W, H, 4 * W };
-    assert_int_equal(fuse_colour_model_learn(&s->g, &P, s->truth, W, 4, 1, 3.0f, 64, s->cscratch,
-                                             fuse_colour_model_scratch_size(5)),
-                     FUSE_OK);
+    s->rscratch = fit_scene_scratch(s->rscratch_size);
     s->cam = fit_scene_camera(W, H, F);
     fit_scene_rig(&s->rig);
     s->world[0] = fit_scene_at(0, 0, -0.4f);      /* the left hand: the image centre */
@@ -97,18 +83,28 @@ static void scene_free(scene *s)
     free(s->llr); free(s->scratch); free(s->cscratch); free(s->rscratch);
 }
 
-static const uint8_t *shift_of(scene *s, unsigned sides, const uint8_t *in, int sh[2][2])
+/* Each test's fixture: a fresh scene (scene_make) as its state. */
+TU_FIXTURE(scene, scene, s, scene_make(s), scene_free(s))
+
+/* pipe_fit_shift of in on the scene's image with the colour model g and
+ * scratch_size bytes of the scene's scratch. */
+static const uint8_t *shift_with(scene *s, const fuse_colour_model *g, unsigned sides,
+                                 const uint8_t *in, size_t scratch_size, int sh[2][2])
 {
     fuse_image P = { s->img, W, H, 4 * W };
-    return pipe_fit_shift(&s->d, &s->g, &P, &s->cam, s->world, &s->rig, sides, in, s->out, W,
-                          s->scratch, s->scratch_size, sh);
+    return pipe_fit_shift(&s->d, g, &P, &s->cam, s->world, &s->rig, sides, in, s->out, W,
+                          s->scratch, scratch_size, sh);
+}
+
+/* pipe_fit_shift of in with the scene's model and whole scratch. */
+static const uint8_t *shift_of(scene *s, unsigned sides, const uint8_t *in, int sh[2][2])
+{
+    return shift_with(s, &s->g, sides, in, s->scratch_size, sh);
 }
 
 static double refined_iou(scene *s, const uint8_t *in)
 {
-    fuse_refine_params rp = fuse_refine_params_default();
-    rp.band = 16;
-    rp.bits = 5;
+    const fuse_refine_params rp = fit_scene_refine_params();
     fuse_image P = { s->img, W, H, 4 * W };
     fuse_refine_stats st;
     assert_int_equal(fuse_refine_mask_global(&rp, &s->g, 1.0f, &P, in, W, s->ref, W, s->rscratch,
@@ -119,80 +115,62 @@ static double refined_iou(scene *s, const uint8_t *in)
 
 static void finds_the_offset(void **state)
 {
-    (void)state;
-    scene s;
-    scene_make(&s);
+    scene *s = *state;
     int sh[2][2];
-    assert_true(iou(s.kin, s.truth) < 0.6);
-    const uint8_t *m = shift_of(&s, 3u, s.kin, sh);
-    assert_ptr_equal(m, s.out);
+    assert_true(iou(s->kin, s->truth) < 0.6);
+    const uint8_t *m = shift_of(s, 3u, s->kin, sh);
+    assert_ptr_equal(m, s->out);
     assert_true(abs(sh[0][0] - DX) <= 2 && abs(sh[0][1] - DY) <= 2);
     assert_int_equal(sh[1][0], 0);
     assert_int_equal(sh[1][1], 0);
-    assert_true(iou(m, s.truth) > 0.95);
-    const double before = refined_iou(&s, s.kin), after = refined_iou(&s, m);
+    assert_true(iou(m, s->truth) > 0.95);
+    const double before = refined_iou(s, s->kin), after = refined_iou(s, m);
     assert_true(after > before + 0.05);
     assert_true(after > 0.97);
-    scene_free(&s);
 }
 
 static void stays_where_right(void **state)
 {
-    (void)state;
-    scene s;
-    scene_make(&s);
+    scene *s = *state;
     int sh[2][2];
-    memcpy(s.kin, s.truth, W * H);
-    assert_ptr_equal(shift_of(&s, 3u, s.kin, sh), s.kin);
+    memcpy(s->kin, s->truth, W * H);
+    assert_ptr_equal(shift_of(s, 3u, s->kin, sh), s->kin);
     assert_int_equal(sh[0][0], 0);
     assert_int_equal(sh[0][1], 0);
-    scene_free(&s);
 }
 
 static void outside_the_region_unchanged(void **state)
 {
-    (void)state;
-    scene s;
-    scene_make(&s);
+    scene *s = *state;
     int sh[2][2];
-    disc(s.kin, 20.0f, 200.0f, 15.0f, 0);   /* another arm, far from the hand */
-    const uint8_t *m = shift_of(&s, 1u, s.kin, sh);
-    assert_ptr_equal(m, s.out);
+    disc(s->kin, 20.0f, 200.0f, 15.0f, 0);   /* another arm, far from the hand */
+    const uint8_t *m = shift_of(s, 1u, s->kin, sh);
+    assert_ptr_equal(m, s->out);
     long differ = 0;
     for (int y = 180; y < H; y++)
-        for (int x = 0; x < 40; x++) differ += m[y * W + x] != s.kin[y * W + x];
+        for (int x = 0; x < 40; x++) differ += m[y * W + x] != s->kin[y * W + x];
     assert_int_equal(differ, 0);
     assert_int_equal(m[200 * W + 20], 255);
-    scene_free(&s);
 }
 
 static void bad_inputs(void **state)
 {
-    (void)state;
-    scene s;
-    scene_make(&s);
+    scene *s = *state;
     int sh[2][2];
-    fuse_image P = { s.img, W, H, 4 * W };
-    assert_ptr_equal(shift_of(&s, 2u, s.kin, sh), s.kin);   /* the right hand: out of view */
-    assert_ptr_equal(shift_of(&s, 0u, s.kin, sh), s.kin);
-    assert_ptr_equal(pipe_fit_shift(&s.d, &s.g, &P, &s.cam, s.world, &s.rig, 1u, s.kin, s.out, W,
-                                    s.scratch, s.scratch_size - 1, sh),
-                     s.kin);
+    assert_ptr_equal(shift_of(s, 2u, s->kin, sh), s->kin);   /* the right hand: out of view */
+    assert_ptr_equal(shift_of(s, 0u, s->kin, sh), s->kin);
+    assert_ptr_equal(shift_with(s, &s->g, 1u, s->kin, s->scratch_size - 1, sh), s->kin);
     assert_int_equal(sh[0][0], 0);
-    fuse_colour_model none = s.g;
+    fuse_colour_model none = s->g;
     none.fg_samples = 0;
-    assert_ptr_equal(pipe_fit_shift(&s.d, &none, &P, &s.cam, s.world, &s.rig, 1u, s.kin, s.out,
-                                    W, s.scratch, s.scratch_size, sh),
-                     s.kin);
-    assert_ptr_equal(pipe_fit_shift(&s.d, NULL, &P, &s.cam, s.world, &s.rig, 1u, s.kin, s.out,
-                                    W, s.scratch, s.scratch_size, sh),
-                     s.kin);
+    assert_ptr_equal(shift_with(s, &none, 1u, s->kin, s->scratch_size, sh), s->kin);
+    assert_ptr_equal(shift_with(s, NULL, 1u, s->kin, s->scratch_size, sh), s->kin);
     assert_int_equal(pipe_fit_shift_scratch_size(0, H), 0);
-    scene_free(&s);
 }
 
 TU_MAIN_NAMED("fit_shift", NULL, NULL,
-              cmocka_unit_test(finds_the_offset),
-              cmocka_unit_test(stays_where_right),
-              cmocka_unit_test(outside_the_region_unchanged),
-              cmocka_unit_test(bad_inputs))
+              cmocka_unit_test_setup_teardown(finds_the_offset, scene_setup, scene_teardown),
+              cmocka_unit_test_setup_teardown(stays_where_right, scene_setup, scene_teardown),
+              cmocka_unit_test_setup_teardown(outside_the_region_unchanged, scene_setup,
+                                              scene_teardown),
+              cmocka_unit_test_setup_teardown(bad_inputs, scene_setup, scene_teardown))

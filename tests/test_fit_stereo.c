@@ -25,6 +25,7 @@
 
 #include "../src/fit/fit_stereo.h"
 #include "../src/cpu/ef_mem.h"
+#include "support/fixture.h"
 
 static kin_camera cams[2];
 static int W, H;
@@ -184,11 +185,21 @@ static long rows_inner(void)
     return n;
 }
 
+/* pipe_fit_stereo on the scene with the left camera cam, the right image
+ * q_width wide, the depth's stride depth_stride and scratch_size bytes of
+ * the scene's scratch (the arguments bad_arguments varies). */
+static int run_args(scene *s, const pipe_fit_stereo_desc *d, const kin_camera *cam, int q_width,
+                    int depth_stride, size_t scratch_size, pipe_fit_stereo_stats *st)
+{
+    fuse_image P = { s->P, W, H, 4 * W }, Q = { s->Q, q_width, H, 4 * W };
+    return pipe_fit_stereo(d, cam, &P, &cams[1], &Q, s->depth, depth_stride, s->mask, W,
+                           s->scratch, scratch_size, st);
+}
+
+/* pipe_fit_stereo on the scene as it is. */
 static int run(scene *s, const pipe_fit_stereo_desc *d, pipe_fit_stereo_stats *st)
 {
-    fuse_image P = { s->P, W, H, 4 * W }, Q = { s->Q, W, H, 4 * W };
-    return pipe_fit_stereo(d, &cams[0], &P, &cams[1], &Q, s->depth, W, s->mask, W, s->scratch,
-                           s->scratch_size, st);
+    return run_args(s, d, &cams[0], W, W, s->scratch_size, st);
 }
 
 static int setup(void **state)
@@ -200,72 +211,77 @@ static int setup(void **state)
     return 0;
 }
 
+/* A scene with a hole in the hand, the background seen through it. */
+static void scene_make_hole(scene *s)
+{
+    hole = 1;
+    scene_make(s, 0);
+    hole = 0;
+}
+
+/* Each test's fixture: a fresh scene as its state, of the textured
+ * background, the plain one, or the textured one seen through a hole. */
+TU_FIXTURE(scene, scene, s, scene_make(s, 0), scene_free(s))
+TU_FIXTURE(plain, scene, s, scene_make(s, 1), scene_free(s))
+TU_FIXTURE(hole, scene, s, scene_make_hole(s), scene_free(s))
+
 static void rejects_background_behind_the_hand(void **state)
 {
-    (void)state;
-    scene s;
-    scene_make(&s, 0);
+    scene *s = *state;
     /* refined: the hand and a strip of 24 px of the background beside it */
-    mask_cols(&s, s.hx0, s.hx1 + 24);
-    const long hand0 = count(&s, s.hx0 + 3, s.hx1 - 3, 1);
-    const long strip0 = count(&s, s.hx1 + 4, s.hx1 + 24, 1);
+    mask_cols(s, s->hx0, s->hx1 + 24);
+    const long hand0 = count(s, s->hx0 + 3, s->hx1 - 3, 1);
+    const long strip0 = count(s, s->hx1 + 4, s->hx1 + 24, 1);
     assert_true(strip0 == rows_inner() * 21);
     pipe_fit_stereo_stats st;
     pipe_fit_stereo_desc d = pipe_fit_stereo_desc_default();
-    assert_int_equal(run(&s, &d, &st), 0);
-    const long hand1 = count(&s, s.hx0 + 3, s.hx1 - 3, 1);
-    const long strip1 = count(&s, s.hx1 + 4, s.hx1 + 24, 1);
+    assert_int_equal(run(s, &d, &st), 0);
+    const long hand1 = count(s, s->hx0 + 3, s->hx1 - 3, 1);
+    const long strip1 = count(s, s->hx1 + 4, s->hx1 + 24, 1);
     print_message("stereo: strip %ld -> %ld px, hand %ld -> %ld px (tested %ld, cleared %ld)\n",
                   strip0, strip1, hand0, hand1, st.tested, st.cleared);
     assert_true(strip1 * 100 <= strip0 * 15);
     assert_true(hand1 * 100 >= hand0 * 98);
     assert_int_equal(st.added, 0);
-    scene_free(&s);
 }
 
 static void plain_background_is_ambiguous(void **state)
 {
-    (void)state;
-    scene s;
-    scene_make(&s, 1);
-    mask_cols(&s, s.hx0, s.hx1 + 24);
-    const long strip0 = count(&s, s.hx1 + 4, s.hx1 + 24, 1);
+    scene *s = *state;
+    mask_cols(s, s->hx0, s->hx1 + 24);
+    const long strip0 = count(s, s->hx1 + 4, s->hx1 + 24, 1);
     pipe_fit_stereo_stats st;
-    assert_int_equal(run(&s, NULL, &st), 0);
-    const long strip1 = count(&s, s.hx1 + 4, s.hx1 + 24, 1);
+    assert_int_equal(run(s, NULL, &st), 0);
+    const long strip1 = count(s, s->hx1 + 4, s->hx1 + 24, 1);
     print_message("plain: strip %ld -> %ld px (textureless %ld of %ld)\n", strip0, strip1,
                   st.textureless, st.tested);
     assert_true(strip1 * 100 >= strip0 * 98);
     assert_true(st.textureless > 0);
-    scene_free(&s);
 }
 
 static void accepts_the_hand_beyond_the_mask(void **state)
 {
-    (void)state;
-    scene s;
-    scene_make(&s, 0);
+    scene *s = *state;
     /* the model's hand stops 12 px short of the true right edge: the
      * depth covers only the mask */
-    mask_cols(&s, s.hx0, s.hx1 - 12);
+    mask_cols(s, s->hx0, s->hx1 - 12);
     for (int y = 0; y < H; y++)
-        for (int x = s.hx1 - 11; x <= s.hx1; x++) s.depth[(size_t)y * W + x] = 1.0f;
+        for (int x = s->hx1 - 11; x <= s->hx1; x++) s->depth[(size_t)y * W + x] = 1.0f;
     pipe_fit_stereo_desc d = pipe_fit_stereo_desc_default();
     d.accept = 16;
     pipe_fit_stereo_stats st;
-    assert_int_equal(run(&s, &d, &st), 0);
-    const long cut = count(&s, s.hx1 - 9, s.hx1 - 3, 1);
-    const long beyond = count(&s, s.hx1 + 4, s.hx1 + 16, 1);
+    assert_int_equal(run(s, &d, &st), 0);
+    const long cut = count(s, s->hx1 - 9, s->hx1 - 3, 1);
+    const long beyond = count(s, s->hx1 + 4, s->hx1 + 16, 1);
     print_message("accept: %ld of %ld hand px back, %ld background px taken (added %ld)\n", cut,
                   rows_inner() * 7, beyond, st.added);
     assert_true(cut * 100 >= rows_inner() * 7 * 85);
     assert_true(beyond * 100 <= rows_inner() * 13 * 5);
     /* without accept nothing outside the mask changes */
-    mask_cols(&s, s.hx0, s.hx1 - 12);
+    mask_cols(s, s->hx0, s->hx1 - 12);
     d.accept = 0;
-    assert_int_equal(run(&s, &d, &st), 0);
-    assert_int_equal(count(&s, s.hx1 - 11, s.hx1 + 16, 0), 0);
-    scene_free(&s);
+    assert_int_equal(run(s, &d, &st), 0);
+    assert_int_equal(count(s, s->hx1 - 11, s->hx1 + 16, 0), 0);
 }
 
 /* The left camera's pixels of the hole (x, y ranges). */
@@ -284,50 +300,43 @@ static void hole_px(int *x0, int *x1, int *y0, int *y1)
  * (connected 1); without the rule it is cleared. */
 static void enclosed_background_is_kept(void **state)
 {
-    (void)state;
-    hole = 1;
-    scene s;
-    scene_make(&s, 0);
-    hole = 0;
+    scene *s = *state;
     int x0, x1, y0, y1;
     hole_px(&x0, &x1, &y0, &y1);
     const long area = (long)(x1 - x0 - 5) * (y1 - y0 - 5);
     long kept[2];
     for (int conn = 1; conn >= 0; conn--) {
-        mask_cols(&s, s.hx0, s.hx1);
+        mask_cols(s, s->hx0, s->hx1);
         pipe_fit_stereo_desc d = pipe_fit_stereo_desc_default();
         d.connected = conn;
-        assert_int_equal(run(&s, &d, NULL), 0);
+        assert_int_equal(run(s, &d, NULL), 0);
         long k = 0;
         for (int y = y0 + 3; y < y1 - 2; y++)
-            for (int x = x0 + 3; x < x1 - 2; x++) k += s.mask[(size_t)y * W + x] >= 128;
+            for (int x = x0 + 3; x < x1 - 2; x++) k += s->mask[(size_t)y * W + x] >= 128;
         kept[conn] = k;
     }
     print_message("hole: %ld px, kept %ld connected, %ld not\n", area, kept[1], kept[0]);
     assert_true(kept[1] * 100 >= area * 98);
     assert_true(kept[0] * 100 <= area * 75);   /* the half the other camera sees */
-    scene_free(&s);
 }
 
 static void grid_decides_like_every_pixel(void **state)
 {
-    (void)state;
-    scene s;
-    scene_make(&s, 0);
-    mask_cols(&s, s.hx0, s.hx1 + 24);
+    scene *s = *state;
+    mask_cols(s, s->hx0, s->hx1 + 24);
     pipe_fit_stereo_desc d = pipe_fit_stereo_desc_default();
     d.step = 1;
     pipe_fit_stereo_stats st1, st4;
-    assert_int_equal(run(&s, &d, &st1), 0);
+    assert_int_equal(run(s, &d, &st1), 0);
     uint8_t *m1 = malloc((size_t)W * H);
     assert_non_null(m1);
-    memcpy(m1, s.mask, (size_t)W * H);
-    mask_cols(&s, s.hx0, s.hx1 + 24);
+    memcpy(m1, s->mask, (size_t)W * H);
+    mask_cols(s, s->hx0, s->hx1 + 24);
     d.step = 4;
-    assert_int_equal(run(&s, &d, &st4), 0);
+    assert_int_equal(run(s, &d, &st4), 0);
     long diff = 0, set = 0;
     for (size_t i = 0; i < (size_t)W * H; i++) {
-        diff += (m1[i] >= 128) != (s.mask[i] >= 128);
+        diff += (m1[i] >= 128) != (s->mask[i] >= 128);
         set += m1[i] >= 128;
     }
     print_message("grid: %ld of %ld px differ, tested %ld -> %ld\n", diff, set, st1.tested,
@@ -335,45 +344,40 @@ static void grid_decides_like_every_pixel(void **state)
     assert_true(diff * 100 <= set * 3);
     assert_true(st4.tested * 2 < st1.tested);
     free(m1);
-    scene_free(&s);
 }
 
 static void bad_arguments(void **state)
 {
-    (void)state;
-    scene s;
-    scene_make(&s, 0);
-    mask_cols(&s, s.hx0, s.hx1 + 24);
+    scene *s = *state;
+    mask_cols(s, s->hx0, s->hx1 + 24);
     uint8_t *m0 = malloc((size_t)W * H);
     assert_non_null(m0);
-    memcpy(m0, s.mask, (size_t)W * H);
-    fuse_image P = { s.P, W, H, 4 * W }, Q = { s.Q, W, H, 4 * W }, Qs = { s.Q, W - 1, H, 4 * W };
+    memcpy(m0, s->mask, (size_t)W * H);
+    const size_t sz = s->scratch_size;
     pipe_fit_stereo_desc d = pipe_fit_stereo_desc_default();
-    assert_int_equal(pipe_fit_stereo(&d, NULL, &P, &cams[1], &Q, s.depth, W, s.mask, W,
-                                     s.scratch, s.scratch_size, NULL), -1);
-    assert_int_equal(pipe_fit_stereo(&d, &cams[0], &P, &cams[1], &Qs, s.depth, W, s.mask, W,
-                                     s.scratch, s.scratch_size, NULL), -1);
-    assert_int_equal(pipe_fit_stereo(&d, &cams[0], &P, &cams[1], &Q, s.depth, W, s.mask, W,
-                                     s.scratch, s.scratch_size - 1, NULL), -1);
-    assert_int_equal(pipe_fit_stereo(&d, &cams[0], &P, &cams[1], &Q, s.depth, W - 1, s.mask, W,
-                                     s.scratch, s.scratch_size, NULL), -1);
+    assert_int_equal(run_args(s, &d, NULL, W, W, sz, NULL), -1);
+    assert_int_equal(run_args(s, &d, &cams[0], W - 1, W, sz, NULL), -1);
+    assert_int_equal(run_args(s, &d, &cams[0], W, W, sz - 1, NULL), -1);
+    assert_int_equal(run_args(s, &d, &cams[0], W, W - 1, sz, NULL), -1);
     d.radius = 5;
-    assert_int_equal(pipe_fit_stereo(&d, &cams[0], &P, &cams[1], &Q, s.depth, W, s.mask, W,
-                                     s.scratch, s.scratch_size, NULL), -1);
+    assert_int_equal(run_args(s, &d, &cams[0], W, W, sz, NULL), -1);
     d = pipe_fit_stereo_desc_default();
     d.gap = 0.01f;   /* must not overlap the hand's range */
-    assert_int_equal(pipe_fit_stereo(&d, &cams[0], &P, &cams[1], &Q, s.depth, W, s.mask, W,
-                                     s.scratch, s.scratch_size, NULL), -1);
-    assert_memory_equal(m0, s.mask, (size_t)W * H);
+    assert_int_equal(run_args(s, &d, &cams[0], W, W, sz, NULL), -1);
+    assert_memory_equal(m0, s->mask, (size_t)W * H);
     assert_int_equal(pipe_fit_stereo_scratch_size(0, 10), 0);
     free(m0);
-    scene_free(&s);
 }
 
 TU_MAIN(setup, NULL,
-        cmocka_unit_test(rejects_background_behind_the_hand),
-        cmocka_unit_test(plain_background_is_ambiguous),
-        cmocka_unit_test(accepts_the_hand_beyond_the_mask),
-        cmocka_unit_test(enclosed_background_is_kept),
-        cmocka_unit_test(grid_decides_like_every_pixel),
-        cmocka_unit_test(bad_arguments))
+        cmocka_unit_test_setup_teardown(rejects_background_behind_the_hand, scene_setup,
+                                        scene_teardown),
+        cmocka_unit_test_setup_teardown(plain_background_is_ambiguous, plain_setup,
+                                        plain_teardown),
+        cmocka_unit_test_setup_teardown(accepts_the_hand_beyond_the_mask, scene_setup,
+                                        scene_teardown),
+        cmocka_unit_test_setup_teardown(enclosed_background_is_kept, hole_setup,
+                                        hole_teardown),
+        cmocka_unit_test_setup_teardown(grid_decides_like_every_pixel, scene_setup,
+                                        scene_teardown),
+        cmocka_unit_test_setup_teardown(bad_arguments, scene_setup, scene_teardown))

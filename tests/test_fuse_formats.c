@@ -22,6 +22,15 @@ static fuse_frame frame(const uint8_t *d, size_t size, int w, int h, int stride,
     return (fuse_frame){d, size, w, h, stride, f};
 }
 
+/* Converts the frame (d, size, w x h, stride, format f) from row y0 into
+ * o; fails the test unless FUSE_OK. */
+static void convert(const uint8_t *d, size_t size, int w, int h, int stride, fuse_format f,
+                    int y0, fuse_image *o)
+{
+    fuse_frame s = frame(d, size, w, h, stride, f);
+    assert_int_equal(fuse_frame_to_rgba(&s, y0, o), FUSE_OK);
+}
+
 static void expect_px(const fuse_image *o, int x, int y, int r, int g, int b)
 {
     const uint8_t *p = px(o, x, y);
@@ -43,9 +52,8 @@ static void test_yuyv_hand(void **state)
                              90, 81, 240, 81,     0, 0, 0, 0 };
     uint8_t buf[4 * 4 * 2];
     fuse_image o = { buf, 4, 2, 16 };
-    fuse_frame s = frame(yuyv, sizeof yuyv, 4, 2, 8, FUSE_FMT_YUYV);
     (void)state;
-    assert_int_equal(fuse_frame_to_rgba(&s, 0, &o), FUSE_OK);
+    convert(yuyv, sizeof yuyv, 4, 2, 8, FUSE_FMT_YUYV, 0, &o);
     expect_px(&o, 0, 0, 0, 0, 0);
     expect_px(&o, 1, 0, 255, 255, 255);        /* 298 * 219 + 128 >> 8 = 255 */
     expect_px(&o, 2, 0, 130, 130, 130);        /* (128 - 16) 255 / 219 = 130.4 */
@@ -53,11 +61,10 @@ static void test_yuyv_hand(void **state)
     expect_px(&o, 1, 1, 255, 0, 0);
     /* U = V = 0, Y = 0: 298 * -16 + 409 * -128 < 0 -> 0; G = ... + 100*128 + 208*128 */
     expect_px(&o, 2, 1, 0, (298 * -16 + 100 * 128 + 208 * 128 + 128) >> 8, 0);
-    s = frame(uyvy, sizeof uyvy, 4, 2, 8, FUSE_FMT_UYVY);
     {
         uint8_t buf2[sizeof buf];
         fuse_image o2 = { buf2, 4, 2, 16 };
-        assert_int_equal(fuse_frame_to_rgba(&s, 0, &o2), FUSE_OK);
+        convert(uyvy, sizeof uyvy, 4, 2, 8, FUSE_FMT_UYVY, 0, &o2);
         assert_memory_equal(buf, buf2, sizeof buf);
     }
 }
@@ -117,21 +124,18 @@ static void test_grey_rgb(void **state)
     const uint8_t rgb[] = { 1, 2, 3, 4, 5, 6, 200, 201, 202 };
     uint8_t buf[4 * 4 * 2];
     fuse_image o = { buf, 3, 2, 16 };
-    fuse_frame s = frame(grey, sizeof grey, 3, 2, 6, FUSE_FMT_GREY);
     (void)state;
-    assert_int_equal(fuse_frame_to_rgba(&s, 0, &o), FUSE_OK);
+    convert(grey, sizeof grey, 3, 2, 6, FUSE_FMT_GREY, 0, &o);
     expect_px(&o, 0, 0, 0, 0, 0);
     expect_px(&o, 1, 0, 7, 7, 7);
     expect_px(&o, 2, 0, 255, 255, 255);
     expect_px(&o, 0, 1, 3, 3, 3);   /* row 1 starts at byte 6 */
     expect_px(&o, 2, 1, 5, 5, 5);
     o.height = 1;
-    s = frame(rgb, sizeof rgb, 3, 1, 9, FUSE_FMT_RGB24);
-    assert_int_equal(fuse_frame_to_rgba(&s, 0, &o), FUSE_OK);
+    convert(rgb, sizeof rgb, 3, 1, 9, FUSE_FMT_RGB24, 0, &o);
     expect_px(&o, 0, 0, 1, 2, 3);
     expect_px(&o, 2, 0, 200, 201, 202);
-    s.format = FUSE_FMT_BGR24;
-    assert_int_equal(fuse_frame_to_rgba(&s, 0, &o), FUSE_OK);
+    convert(rgb, sizeof rgb, 3, 1, 9, FUSE_FMT_BGR24, 0, &o);
     expect_px(&o, 0, 0, 3, 2, 1);
     expect_px(&o, 1, 0, 6, 5, 4);
     assert_int_equal(fuse_format_row_bytes(FUSE_FMT_RGB24, 640), 1920);
@@ -187,7 +191,6 @@ static void test_bayer_vs_double(void **state)
             uint8_t *raw = malloc((size_t)w * h), *src = malloc((size_t)(w + pad) * h);
             uint8_t *out = malloc((size_t)w * h * 4 + 16);
             fuse_image o = { out, w, h, 4 * w };
-            fuse_frame s = frame(src, (size_t)(w + pad) * h, w, h, w + pad, fmts[f]);
             int x, y, c;
             assert_true(raw && src && out);
             for (x = 0; x < w * h; x++) raw[x] = (uint8_t)tu_int(&r, 256);
@@ -195,7 +198,7 @@ static void test_bayer_vs_double(void **state)
                 memcpy(src + (size_t)y * (w + pad), raw + (size_t)y * w, (size_t)w);
                 memset(src + (size_t)y * (w + pad) + w, 0xEE, (size_t)pad);
             }
-            assert_int_equal(fuse_frame_to_rgba(&s, 0, &o), FUSE_OK);
+            convert(src, (size_t)(w + pad) * h, w, h, w + pad, fmts[f], 0, &o);
             for (y = 0; y < h; y++)
                 for (x = 0; x < w; x++) {
                     for (c = 0; c < 3; c++) {
@@ -224,13 +227,12 @@ static void test_bayer_ramp(void **state)
     int f, x, y;
     (void)state;
     for (f = 0; f < 4; f++) {
-        fuse_frame s = frame(raw, sizeof raw, W, H, W, (fuse_format)(FUSE_FMT_BAYER_RGGB + f));
         for (y = 0; y < H; y++)
             for (x = 0; x < W; x++) {
                 const int c = pat_colour(f, x, y);
                 raw[y * W + x] = (uint8_t)(c == 0 ? 4 * x + 2 * y : c == 1 ? 100 + 2 * x + 3 * y : 200 - 3 * x - 2 * y);
             }
-        assert_int_equal(fuse_frame_to_rgba(&s, 0, &o), FUSE_OK);
+        convert(raw, sizeof raw, W, H, W, (fuse_format)(FUSE_FMT_BAYER_RGGB + f), 0, &o);
         for (y = 1; y < H - 1; y++)
             for (x = 1; x < W - 1; x++) {
                 expect_px(&o, x, y, 4 * x + 2 * y, 100 + 2 * x + 3 * y, 200 - 3 * x - 2 * y);
@@ -252,10 +254,9 @@ static void test_crop(void **state)
     assert_true(src && full && crop);
     for (i = 0; i < stride * H; i++) src[i] = (uint8_t)tu_int(&r, 256);
     for (f = FUSE_FMT_YUYV; f <= FUSE_FMT_BGR24; f++) {
-        fuse_frame s = frame(src, (size_t)stride * H, W, H, stride, (fuse_format)f);
         fuse_image F = { full, W, H, 4 * W }, C = { crop, W, CH, 4 * W };
-        assert_int_equal(fuse_frame_to_rgba(&s, 0, &F), FUSE_OK);
-        assert_int_equal(fuse_frame_to_rgba(&s, Y0, &C), FUSE_OK);
+        convert(src, (size_t)stride * H, W, H, stride, (fuse_format)f, 0, &F);
+        convert(src, (size_t)stride * H, W, H, stride, (fuse_format)f, Y0, &C);
         assert_memory_equal(crop, full + (size_t)Y0 * 4 * W, (size_t)W * CH * 4);
     }
     free(src);

@@ -85,26 +85,59 @@ static int gesture(kin_track_sample *s, int n, float scale, float gap, float noi
     return n;
 }
 
+/* What the estimation tests share: a recording of up to 1000 samples, its
+ * scratch, the model's rig and fingertips, the result and its reason. */
+typedef struct calib_run {
+    kin_track_sample s[1000];
+    float scratch[1000];
+    kin_arm_rig rig;
+    kin_vec3 tips[2];
+    kin_user_calib c;
+    char why[256];
+} calib_run;
+
+/* The run of an estimation test (static: too big for the stack): the
+ * model's rig and fingertips, and the first n samples recorded (record())
+ * of a user 1.1x the model's size (arms 0.616 m, shoulders 0.42 m). */
+static calib_run *calib_start(int n, tu_rng *g)
+{
+    static calib_run r;
+    r.rig = model_rig();
+    r.tips[0] = TIP_L;
+    r.tips[1] = TIP_R;
+    record(r.s, n, 0.616f, 0.42f, g);
+    return &r;
+}
+
+/* kin_user_calib_estimate of r's first n samples into r->c, r->why. */
+static int estimate(calib_run *r, int n)
+{
+    return kin_user_calib_estimate(r->s, n, &r->rig, r->scratch, &r->c, r->why, sizeof r->why);
+}
+
+/* kin_user_calib_estimate_tips of r's first n samples with the fingertip
+ * reference tips (NULL: none) into r->c, r->why. */
+static int estimate_tips(calib_run *r, int n, const kin_vec3 *tips)
+{
+    return kin_user_calib_estimate_tips(r->s, n, &r->rig, tips, r->scratch, &r->c, r->why,
+                                        sizeof r->why);
+}
+
 /* ------------------------------------------------------------ validity */
 
 static void validity_estimate_rejects(void **state)
 {
     (void)state;
-    static kin_track_sample s[500];
-    float scratch[500];
     tu_rng g = { 0x63616c31 };
-    kin_arm_rig rig = model_rig();
-    kin_user_calib c;
-    char why[256];
-    record(s, 500, 0.616f, 0.42f, &g);
-    assert_int_equal(kin_user_calib_estimate(s, 19, &rig, scratch, &c, why, sizeof why), -1);
-    assert_non_null(strstr(why, "left arm: 19 samples"));
-    for (int i = 0; i < 500; i++) s[i].valid &= ~(uint32_t)KIN_TRACK_HAND_R;
-    assert_int_equal(kin_user_calib_estimate(s, 500, &rig, scratch, &c, why, sizeof why), -1);
-    assert_non_null(strstr(why, "right arm: 0 samples"));
-    record(s, 500, 0.2f, 0.42f, &g);            /* never stretched */
-    assert_int_equal(kin_user_calib_estimate(s, 500, &rig, scratch, &c, why, sizeof why), -1);
-    assert_non_null(strstr(why, "were the arms stretched"));
+    calib_run *r = calib_start(500, &g);
+    assert_int_equal(estimate(r, 19), -1);
+    assert_non_null(strstr(r->why, "left arm: 19 samples"));
+    for (int i = 0; i < 500; i++) r->s[i].valid &= ~(uint32_t)KIN_TRACK_HAND_R;
+    assert_int_equal(estimate(r, 500), -1);
+    assert_non_null(strstr(r->why, "right arm: 0 samples"));
+    record(r->s, 500, 0.2f, 0.42f, &g);            /* never stretched */
+    assert_int_equal(estimate(r, 500), -1);
+    assert_non_null(strstr(r->why, "were the arms stretched"));
 }
 
 /* Without the gesture (or without a fingertip reference) the hand scale
@@ -112,32 +145,26 @@ static void validity_estimate_rejects(void **state)
 static void validity_gesture_missing_falls_back(void **state)
 {
     (void)state;
-    static kin_track_sample s[700];
-    float scratch[700];
     tu_rng g = { 0x63616c33 };
-    kin_arm_rig rig = model_rig();
-    const kin_vec3 tips[2] = { TIP_L, TIP_R };
-    kin_user_calib c;
-    char why[256];
-    record(s, 500, 0.616f, 0.42f, &g);
-    assert_int_equal(kin_user_calib_estimate_tips(s, 500, &rig, tips, scratch, &c, why, sizeof why), 1);
-    assert_non_null(strstr(why, "fingertip gesture: 0 samples"));
-    assert_non_null(strstr(why, "hand scale = arm scale"));
-    NEAR(c.hand_scale[0], c.arm_scale[0], 0);
-    NEAR(c.hand_scale[1], c.arm_scale[1], 0);
-    NEAR(c.hand_length[0], 0, 0);
-    assert_int_equal(kin_user_calib_estimate_tips(s, 500, &rig, NULL, scratch, &c, why, sizeof why), 1);
-    assert_non_null(strstr(why, "no fingertip reference"));
+    calib_run *r = calib_start(500, &g);
+    assert_int_equal(estimate_tips(r, 500, r->tips), 1);
+    assert_non_null(strstr(r->why, "fingertip gesture: 0 samples"));
+    assert_non_null(strstr(r->why, "hand scale = arm scale"));
+    NEAR(r->c.hand_scale[0], r->c.arm_scale[0], 0);
+    NEAR(r->c.hand_scale[1], r->c.arm_scale[1], 0);
+    NEAR(r->c.hand_length[0], 0, 0);
+    assert_int_equal(estimate_tips(r, 500, NULL), 1);
+    assert_non_null(strstr(r->why, "no fingertip reference"));
     /* 19 gesture samples are too few; the hands 4 cm apart are no touch */
-    gesture(s + 500, 19, 1.05f, 0.0f, 0.0f, &g);
-    assert_int_equal(kin_user_calib_estimate_tips(s, 519, &rig, tips, scratch, &c, why, sizeof why), 1);
-    assert_non_null(strstr(why, "19 samples"));
-    gesture(s + 500, 200, 1.05f, 0.04f, 0.0f, &g);
-    for (int i = 500; i < 700; i++) s[i].hand_pos[1].y += 0.03f;   /* 3 cm off the line */
-    assert_int_equal(kin_user_calib_estimate_tips(s, 700, &rig, tips, scratch, &c, why, sizeof why), 1);
-    NEAR(c.hand_scale[1], c.arm_scale[1], 0);
+    gesture(r->s + 500, 19, 1.05f, 0.0f, 0.0f, &g);
+    assert_int_equal(estimate_tips(r, 519, r->tips), 1);
+    assert_non_null(strstr(r->why, "19 samples"));
+    gesture(r->s + 500, 200, 1.05f, 0.04f, 0.0f, &g);
+    for (int i = 500; i < 700; i++) r->s[i].hand_pos[1].y += 0.03f;   /* 3 cm off the line */
+    assert_int_equal(estimate_tips(r, 700, r->tips), 1);
+    NEAR(r->c.hand_scale[1], r->c.arm_scale[1], 0);
     /* a failing arm estimate still fails */
-    assert_int_equal(kin_user_calib_estimate_tips(s, 19, &rig, tips, scratch, &c, why, sizeof why), -1);
+    assert_int_equal(estimate_tips(r, 19, r->tips), -1);
 }
 
 static void expect_parse_error(const char *text, int line, const char *in_why)
@@ -181,32 +208,26 @@ static void validity_file_errors(void **state)
 static void result_hand_scale_from_gesture(void **state)
 {
     (void)state;
-    static kin_track_sample s[800];
-    float scratch[800];
     tu_rng g = { 0x63616c34 };
-    kin_arm_rig rig = model_rig();
-    const kin_vec3 tips[2] = { TIP_L, TIP_R };
-    record(s, 500, 0.616f, 0.42f, &g);
-    gesture(s + 500, 240, 1.05f, 0.0f, 0.0f, &g);
+    calib_run *r = calib_start(500, &g);
+    gesture(r->s + 500, 240, 1.05f, 0.0f, 0.0f, &g);
     for (int i = 0; i < 60; i++)
-        gesture(s + 740 + i, 1, 1.05f, 0.01f + 0.04f * (float)i / 59.0f, 0.0f, &g);
-    kin_user_calib c;
-    char why[256];
-    int rc = kin_user_calib_estimate_tips(s, 800, &rig, tips, scratch, &c, why, sizeof why);
-    if (rc != 0) fail_msg("%d: %s", rc, why);
-    NEAR(c.hand_scale[0], 1.05, 2e-6);
-    NEAR(c.hand_scale[1], 1.05, 2e-6);
-    NEAR(c.arm_scale[1], 1.1, 0.006);
-    NEAR(c.hand_length[0], 1.05 * sqrt(0.008 * 0.008 + 0.004 * 0.004 + 0.195 * 0.195), 1e-6);
-    NEAR(c.hand_length[1], c.hand_length[0], 1e-7);
+        gesture(r->s + 740 + i, 1, 1.05f, 0.01f + 0.04f * (float)i / 59.0f, 0.0f, &g);
+    int rc = estimate_tips(r, 800, r->tips);
+    if (rc != 0) fail_msg("%d: %s", rc, r->why);
+    NEAR(r->c.hand_scale[0], 1.05, 2e-6);
+    NEAR(r->c.hand_scale[1], 1.05, 2e-6);
+    NEAR(r->c.arm_scale[1], 1.1, 0.006);
+    NEAR(r->c.hand_length[0], 1.05 * sqrt(0.008 * 0.008 + 0.004 * 0.004 + 0.195 * 0.195), 1e-6);
+    NEAR(r->c.hand_length[1], r->c.hand_length[0], 1e-7);
     /* hands 0.92x, 3 mm wrist noise per axis: each sample's s is off by
      * about 3 mm * 1.4 / 0.39 m; the shortest half of 240 within 0.005 */
-    gesture(s + 500, 240, 0.92f, 0.0f, 0.003f, &g);
+    gesture(r->s + 500, 240, 0.92f, 0.0f, 0.003f, &g);
     for (int i = 0; i < 60; i++)
-        gesture(s + 740 + i, 1, 0.92f, 0.01f + 0.04f * (float)i / 59.0f, 0.003f, &g);
-    rc = kin_user_calib_estimate_tips(s, 800, &rig, tips, scratch, &c, why, sizeof why);
-    if (rc != 0) fail_msg("%d: %s", rc, why);
-    NEAR(c.hand_scale[0], 0.92, 0.005);
+        gesture(r->s + 740 + i, 1, 0.92f, 0.01f + 0.04f * (float)i / 59.0f, 0.003f, &g);
+    rc = estimate_tips(r, 800, r->tips);
+    if (rc != 0) fail_msg("%d: %s", rc, r->why);
+    NEAR(r->c.hand_scale[0], 0.92, 0.005);
 }
 
 /* The fingertip reference of a hand-built model: hand joint at
@@ -269,22 +290,18 @@ static void result_hand_tips_of_a_model(void **state)
 static void result_estimate_user_size(void **state)
 {
     (void)state;
-    static kin_track_sample s[1000];
-    float scratch[1000];
     tu_rng g = { 0x63616c32 };
-    kin_arm_rig rig = model_rig();
-    record(s, 1000, 0.616f, 0.42f, &g);
-    kin_user_calib c;
-    char why[256];
-    if (kin_user_calib_estimate(s, 1000, &rig, scratch, &c, why, sizeof why)) fail_msg("%s", why);
+    calib_run *r = calib_start(1000, &g);
+    if (estimate(r, 1000)) fail_msg("%s", r->why);
     /* 0.616 / 0.56 = 1.1; the 95th percentile of the stretched distance
      * sits within the 2 mm noise */
-    NEAR(c.arm_scale[0], 1.1, 0.006);
-    NEAR(c.arm_scale[1], 1.1, 0.006);
-    NEAR(c.hand_scale[1], c.arm_scale[1], 0);
-    NEAR(c.arm_length[0], 0.616, 0.003);
-    NEAR(c.shoulder_width, 0.42, 0.003);
-    NEAR(c.shoulder_scale, 0.42 / 0.38, 0.008);
+    const kin_user_calib *c = &r->c;
+    NEAR(c->arm_scale[0], 1.1, 0.006);
+    NEAR(c->arm_scale[1], 1.1, 0.006);
+    NEAR(c->hand_scale[1], c->arm_scale[1], 0);
+    NEAR(c->arm_length[0], 0.616, 0.003);
+    NEAR(c->shoulder_width, 0.42, 0.003);
+    NEAR(c->shoulder_scale, 0.42 / 0.38, 0.008);
 }
 
 static void result_file_round_trip(void **state)

@@ -123,27 +123,47 @@ static int checkerboard(double pts[][3], double tilt_deg, double dist)
     return n;
 }
 
+/* The corners of three checkerboards (checkerboard()), board k tilted
+ * tilt0 + k dtilt degrees at the distance dist0 + k ddist, into pts (in
+ * OpenCV's frame, 3 x 54 at most); returns their number. */
+static int three_boards(double pts[][3], double tilt0, double dtilt, double dist0, double ddist)
+{
+    int n = 0;
+    for (int pose = 0; pose < 3; pose++)
+        n += checkerboard(pts + n, tilt0 + dtilt * pose, dist0 + ddist * pose);
+    return n;
+}
+
+/* L projects the point P (OpenCV's frame) to OpenCV's pixel (eu, ev) moved
+ * to the pixel centre (+ 0.5), within 1e-9 px. */
+static void expect_pixel(const kin_lens *L, const double P[3], double eu, double ev)
+{
+    double p[3], u, v;
+    to_ego(P, p);
+    assert_true(kin_lens_project(L, p, &u, &v));
+    NEAR(u, eu + 0.5, 1e-9);
+    NEAR(v, ev + 0.5, 1e-9);
+}
+
 static void result_brown_matches_opencv_formula(void **state)
 {
     (void)state;
-    kin_lens L5 = brown_lens(K_B, D_B, 5, 640, 480);
-    kin_lens L12 = brown_lens(K_R, D_R, 12, 1280, 800);
-    double pts[54][3];
-    for (int pose = 0; pose < 3; pose++) {
-        int n = checkerboard(pts, -30.0 + 30.0 * pose, 0.35 + 0.1 * pose);
-        for (int i = 0; i < n; i++) {
-            double p[3], u, v, eu, ev;
-            to_ego(pts[i], p);
-            assert_true(kin_lens_project(&L5, p, &u, &v));
-            cv_project(K_B, D_B, 5, pts[i], &eu, &ev);
-            NEAR(u, eu + 0.5, 1e-9);
-            NEAR(v, ev + 0.5, 1e-9);
-            assert_true(kin_lens_project(&L12, p, &u, &v));
-            cv_project(K_R, D_R, 12, pts[i], &eu, &ev);
-            NEAR(u, eu + 0.5, 1e-9);
-            NEAR(v, ev + 0.5, 1e-9);
+    /* the 5- and the 12-coefficient models */
+    static const struct { const double *K, *D; int nd, w, h; } lens[2] = {
+        { K_B, D_B, 5, 640, 480 },
+        { K_R, D_R, 12, 1280, 800 },
+    };
+    kin_lens L[2];
+    for (int c = 0; c < 2; c++)
+        L[c] = brown_lens(lens[c].K, lens[c].D, lens[c].nd, lens[c].w, lens[c].h);
+    double pts[3 * 54][3];
+    const int n = three_boards(pts, -30.0, 30.0, 0.35, 0.1);
+    for (int i = 0; i < n; i++)
+        for (int c = 0; c < 2; c++) {
+            double eu, ev;
+            cv_project(lens[c].K, lens[c].D, lens[c].nd, pts[i], &eu, &ev);
+            expect_pixel(&L[c], pts[i], eu, ev);
         }
-    }
 }
 
 static void result_fisheye_matches_opencv_formula(void **state)
@@ -151,21 +171,16 @@ static void result_fisheye_matches_opencv_formula(void **state)
     (void)state;
     const double alpha = 0.002;
     kin_lens L = fisheye_lens(K_F, alpha, D_F, 848, 800);
-    double pts[54][3];
-    for (int pose = 0; pose < 3; pose++) {
-        int n = checkerboard(pts, -50.0 + 50.0 * pose, 0.2 + 0.05 * pose);
-        for (int i = 0; i < n; i++) {
-            double p[3], u, v, eu, ev;
-            to_ego(pts[i], p);
-            assert_true(kin_lens_project(&L, p, &u, &v));
-            cv_fisheye(K_F, alpha, D_F, pts[i], &eu, &ev);
-            NEAR(u, eu + 0.5, 1e-9);
-            NEAR(v, ev + 0.5, 1e-9);
-            /* and the normalized building block */
-            double xd, yd;
-            assert_true(kin_lens_distort(&L, pts[i][0] / pts[i][2], pts[i][1] / pts[i][2], &xd, &yd));
-            NEAR(L.fx * xd + L.skew * yd + L.cx, eu, 1e-9);
-        }
+    double pts[3 * 54][3];
+    const int n = three_boards(pts, -50.0, 50.0, 0.2, 0.05);
+    for (int i = 0; i < n; i++) {
+        double eu, ev;
+        cv_fisheye(K_F, alpha, D_F, pts[i], &eu, &ev);
+        expect_pixel(&L, pts[i], eu, ev);
+        /* and the normalized building block */
+        double xd, yd;
+        assert_true(kin_lens_distort(&L, pts[i][0] / pts[i][2], pts[i][1] / pts[i][2], &xd, &yd));
+        NEAR(L.fx * xd + L.skew * yd + L.cx, eu, 1e-9);
     }
 }
 

@@ -19,6 +19,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/kin/kin.h"
+#include "support/isa_tests.h"
 #include "support/kin_testmesh.h"
 #include "../src/cpu/ef_mem.h"
 
@@ -132,10 +133,7 @@ static void isa_equal(int isa)
     assert_int_equal(crc, SKIN_CRC);
 }
 
-static void test_sse2(void **state) { (void)state; isa_equal(EF_ISA_SSE2); }
-static void test_avx2(void **state) { (void)state; isa_equal(EF_ISA_AVX2); }
-static void test_avx512(void **state) { (void)state; isa_equal(EF_ISA_AVX512); }
-static void test_neon(void **state) { (void)state; isa_equal(EF_ISA_NEON); }
+TU_ISA_TESTS(test_, isa_equal)
 
 /* kin_skin_lbs / kin_skin_dqs (the dispatching entry points) give the
  * reference's bytes, and kin_skin_isa() names a path the CPU runs. */
@@ -239,10 +237,7 @@ static void test_dqs_weight_scale(void **state)
 }
 
 TU_MAIN(NULL, NULL,
-        cmocka_unit_test(test_sse2),
-        cmocka_unit_test(test_avx2),
-        cmocka_unit_test(test_avx512),
-        cmocka_unit_test(test_neon),
+        TU_ISA_UNIT_TESTS(test_),
         cmocka_unit_test(test_dispatch_equal),
         cmocka_unit_test(test_no_normal_output),
         cmocka_unit_test(test_dqs_weight_scale))

@@ -21,6 +21,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/kin/kin.h"
+#include "support/isa_tests.h"
 #include "support/kin_testmesh.h"
 
 #define NCASES 40
@@ -138,10 +139,7 @@ static void plan_equal(int isa)
 }
 
 static void test_ref(void **state) { (void)state; plan_equal(EF_ISA_REF); }
-static void test_sse2(void **state) { (void)state; plan_equal(EF_ISA_SSE2); }
-static void test_avx2(void **state) { (void)state; plan_equal(EF_ISA_AVX2); }
-static void test_avx512(void **state) { (void)state; plan_equal(EF_ISA_AVX512); }
-static void test_neon(void **state) { (void)state; plan_equal(EF_ISA_NEON); }
+TU_ISA_TESTS(test_, plan_equal)
 
 /* DQS with the weight sums at the ends of the float range (vertex v's
  * weights scaled by tu_skin_weight_scale(v), mixed within every batch):
@@ -368,10 +366,7 @@ static void test_invalid(void **state)
 
 TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_ref),
-        cmocka_unit_test(test_sse2),
-        cmocka_unit_test(test_avx2),
-        cmocka_unit_test(test_avx512),
-        cmocka_unit_test(test_neon),
+        TU_ISA_UNIT_TESTS(test_),
         cmocka_unit_test(test_dqs_weight_scale),
         cmocka_unit_test(test_structure),
         cmocka_unit_test(test_parts),

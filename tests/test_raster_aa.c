@@ -37,6 +37,27 @@ static rast_aa_target aa_make(int w, int h, int pad, int n)
     return t;
 }
 
+/* Runs check(n, r) for each sample count n of counts, in order, with one
+ * rng r seeded with seed for all of them. */
+static void for_each_count(void (*check)(int n, tu_rng *r), uint64_t seed)
+{
+    tu_rng r = { seed };
+    for (int c = 0; c < 3; c++) check(counts[c], &r);
+}
+
+/* Draws the triangle of the fixed-point vertices (X[i], Y[i]) (1/256 px)
+ * alone on t, cleared first. */
+static void aa_draw_fixed(rast_aa_target *t, const int64_t X[3], const int64_t Y[3])
+{
+    float clip[12];
+    for (int i = 0; i < 3; i++)
+        rt_clip_at(X[i], Y[i], t->width, t->height, 0.0f, 1.0f, clip + 4 * i);
+    static const uint32_t idx[3] = { 0, 1, 2 };
+    rast_mesh_desc m = { clip, 3, NULL, 0, idx, 1, RAST_CULL_NONE };
+    rast_aa_clear(t);
+    assert_int_equal(rast_draw_aa(t, &m, NULL), RAST_OK);
+}
+
 /* Area of the unit pixel square [x, x+1] x [y, y+1] where
  * nx*px + ny*py + c >= 0 (double, polygon clip). */
 static double half_plane_area(double nx, double ny, double c, double x, double y)
@@ -94,133 +115,126 @@ static void test_positions(void **state)
 /* One straight edge through a 64x64 target at a random angle and offset
  * (vertices on the 1/256 grid, far outside): every pixel the edge crosses,
  * and every other pixel, against the exact area inside the edge. */
+static void edge_area(int n, tu_rng *r)
+{
+    enum { W = 64, H = 64, CASES = 300 };
+    const double B = bound_for(n);
+    rast_aa_target t = aa_make(W, H, 3, n);
+    uint8_t *mask = malloc((size_t)W * H);
+    double worst = 0, sum = 0;
+    long cut = 0, full = 0;
+    for (int k = 0; k < CASES; k++) {
+        /* Edge A -> B through a point of the target; C far on one side. */
+        double px = tu_range(r, 4, W - 4), py = tu_range(r, 4, H - 4);
+        double th = tu_range(r, 0, 6.2831853);
+        double dx = cos(th), dy = sin(th);
+        int64_t X[3] = { llround((px - 300 * dx) * 256), llround((px + 300 * dx) * 256),
+                         llround((px - 300 * dy) * 256) };
+        int64_t Y[3] = { llround((py - 300 * dy) * 256), llround((py + 300 * dy) * 256),
+                         llround((py + 300 * dx) * 256) };
+        aa_draw_fixed(&t, X, Y);
+        assert_int_equal(rast_aa_resolve(&t, mask, W), RAST_OK);
+        /* The inside of edge A->B: the side of C (pixel units). */
+        double ax = X[0] / 256.0, ay = Y[0] / 256.0, bx = X[1] / 256.0, by = Y[1] / 256.0;
+        double nx = -(by - ay), ny = bx - ax, cc = -(nx * ax + ny * ay);
+        if (nx * (X[2] / 256.0) + ny * (Y[2] / 256.0) + cc < 0) {
+            nx = -nx;
+            ny = -ny;
+            cc = -cc;
+        }
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                double a = half_plane_area(nx, ny, cc, x, y);
+                int cov = __builtin_popcount(t.samples[(size_t)y * t.stride + x]);
+                double e = fabs((double)cov / n - a);
+                if (e > B + 1e-9)
+                    fail_msg("%d samples, case %d pixel (%d,%d): %d/%d covered, area "
+                             "%.5f, error %.5f > %.5f", n, k, x, y, cov, n, a, e, B);
+                double em = fabs(mask[y * W + x] / 255.0 - a);
+                assert_true(em <= B + 0.5 / 255 + 1e-9);
+                if (a == 1.0) {
+                    assert_int_equal(cov, n);
+                    assert_int_equal(mask[y * W + x], 255);
+                    full++;
+                } else if (a == 0.0) {
+                    assert_int_equal(cov, 0);
+                    assert_int_equal(mask[y * W + x], 0);
+                } else {
+                    cut++;
+                    sum += e;
+                    if (e > worst)
+                        worst = e;
+                }
+            }
+    }
+    print_message("NOTE %2d samples: %ld cut pixels, mean |coverage - area| %.4f, "
+                  "max %.4f (bound %.4f); %ld full pixels exact\n", n, cut, sum / cut,
+                  worst, B, full);
+    /* The estimate is useful: well below the bound on average (a wrong
+     * pattern or offset gives a mean near 0.25). */
+    assert_true(sum / cut < B / 2);
+    assert_true(worst > B / 2);   /* the bound is not vacuous */
+    free(t.samples);
+    free(mask);
+}
+
 static void test_edge_area(void **state)
 {
     (void)state;
-    enum { W = 64, H = 64, CASES = 300 };
-    tu_rng r = { 0xAA11 };
-    for (int c = 0; c < 3; c++) {
-        const int n = counts[c];
-        const double B = bound_for(n);
-        rast_aa_target t = aa_make(W, H, 3, n);
-        uint8_t *mask = malloc((size_t)W * H);
-        double worst = 0, sum = 0;
-        long cut = 0, full = 0;
-        for (int k = 0; k < CASES; k++) {
-            /* Edge A -> B through a point of the target; C far on one side. */
-            double px = tu_range(&r, 4, W - 4), py = tu_range(&r, 4, H - 4);
-            double th = tu_range(&r, 0, 6.2831853);
-            double dx = cos(th), dy = sin(th);
-            int64_t X[3] = { llround((px - 300 * dx) * 256), llround((px + 300 * dx) * 256),
-                             llround((px - 300 * dy) * 256) };
-            int64_t Y[3] = { llround((py - 300 * dy) * 256), llround((py + 300 * dy) * 256),
-                             llround((py + 300 * dx) * 256) };
-            float clip[12];
-            for (int i = 0; i < 3; i++)
-                rt_clip_at(X[i], Y[i], W, H, 0.0f, 1.0f, clip + 4 * i);
-            static const uint32_t idx[3] = { 0, 1, 2 };
-            rast_mesh_desc m = { clip, 3, NULL, 0, idx, 1, RAST_CULL_NONE };
-            rast_aa_clear(&t);
-            assert_int_equal(rast_draw_aa(&t, &m, NULL), RAST_OK);
-            assert_int_equal(rast_aa_resolve(&t, mask, W), RAST_OK);
-            /* The inside of edge A->B: the side of C (pixel units). */
-            double ax = X[0] / 256.0, ay = Y[0] / 256.0, bx = X[1] / 256.0, by = Y[1] / 256.0;
-            double nx = -(by - ay), ny = bx - ax, cc = -(nx * ax + ny * ay);
-            if (nx * (X[2] / 256.0) + ny * (Y[2] / 256.0) + cc < 0) {
-                nx = -nx;
-                ny = -ny;
-                cc = -cc;
-            }
-            for (int y = 0; y < H; y++)
-                for (int x = 0; x < W; x++) {
-                    double a = half_plane_area(nx, ny, cc, x, y);
-                    int cov = __builtin_popcount(t.samples[(size_t)y * t.stride + x]);
-                    double e = fabs((double)cov / n - a);
-                    if (e > B + 1e-9)
-                        fail_msg("%d samples, case %d pixel (%d,%d): %d/%d covered, area "
-                                 "%.5f, error %.5f > %.5f", n, k, x, y, cov, n, a, e, B);
-                    double em = fabs(mask[y * W + x] / 255.0 - a);
-                    assert_true(em <= B + 0.5 / 255 + 1e-9);
-                    if (a == 1.0) {
-                        assert_int_equal(cov, n);
-                        assert_int_equal(mask[y * W + x], 255);
-                        full++;
-                    } else if (a == 0.0) {
-                        assert_int_equal(cov, 0);
-                        assert_int_equal(mask[y * W + x], 0);
-                    } else {
-                        cut++;
-                        sum += e;
-                        if (e > worst)
-                            worst = e;
-                    }
-                }
-        }
-        print_message("NOTE %2d samples: %ld cut pixels, mean |coverage - area| %.4f, "
-                      "max %.4f (bound %.4f); %ld full pixels exact\n", n, cut, sum / cut,
-                      worst, B, full);
-        /* The estimate is useful: well below the bound on average (a wrong
-         * pattern or offset gives a mean near 0.25). */
-        assert_true(sum / cut < B / 2);
-        assert_true(worst > B / 2);   /* the bound is not vacuous */
-        free(t.samples);
-        free(mask);
-    }
+    for_each_count(edge_area, 0xAA11);
 }
 
 /* A jittered grid of triangles sharing edges and vertices, each drawn
  * alone: no sample is covered twice and every sample inside the grid's
  * outline is covered (pixels one pixel inside the outline are full). */
+static void watertight(int n, tu_rng *r)
+{
+    enum { W = 64, H = 64, G = 7 };
+    rast_aa_target acc = aa_make(W, H, 0, n), one = aa_make(W, H, 0, n);
+    rast_aa_clear(&acc);
+    int64_t X[G + 1][G + 1], Y[G + 1][G + 1];
+    for (int j = 0; j <= G; j++)
+        for (int i = 0; i <= G; i++) {
+            int edge = i == 0 || j == 0 || i == G || j == G;
+            X[j][i] = (int64_t)(4 + i * 8) * 256 + (edge ? 0 : tu_int(r, 1400) - 700);
+            Y[j][i] = (int64_t)(4 + j * 8) * 256 + (edge ? 0 : tu_int(r, 1400) - 700);
+        }
+    long drawn = 0;
+    for (int j = 0; j < G; j++)
+        for (int i = 0; i < G; i++)
+            for (int h = 0; h < 2; h++) {
+                int q[2][3][2] = { { { 0, 0 }, { 1, 0 }, { 1, 1 } },
+                                   { { 0, 0 }, { 1, 1 }, { 0, 1 } } };
+                int64_t tx[3], ty[3];
+                for (int v = 0; v < 3; v++) {
+                    tx[v] = X[j + q[h][v][1]][i + q[h][v][0]];
+                    ty[v] = Y[j + q[h][v][1]][i + q[h][v][0]];
+                }
+                aa_draw_fixed(&one, tx, ty);
+                for (int p = 0; p < W * H; p++) {
+                    if (acc.samples[p] & one.samples[p])
+                        fail_msg("%d samples: pixel (%d,%d) sample covered twice", n,
+                                 p % W, p / W);
+                    acc.samples[p] |= one.samples[p];
+                }
+                drawn++;
+            }
+    /* Outline [4, 60) px: pixels 4..59 hold only inside samples. */
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            int cov = __builtin_popcount(acc.samples[y * W + x]);
+            int inside = x >= 4 && x < 60 && y >= 4 && y < 60;
+            assert_int_equal(cov, inside ? n : 0);
+        }
+    print_message("NOTE %2d samples: %ld triangles, every sample once\n", n, drawn);
+    free(acc.samples);
+    free(one.samples);
+}
+
 static void test_watertight(void **state)
 {
     (void)state;
-    enum { W = 64, H = 64, G = 7 };
-    tu_rng r = { 0xAA22 };
-    for (int c = 0; c < 3; c++) {
-        const int n = counts[c];
-        rast_aa_target acc = aa_make(W, H, 0, n), one = aa_make(W, H, 0, n);
-        rast_aa_clear(&acc);
-        int64_t X[G + 1][G + 1], Y[G + 1][G + 1];
-        for (int j = 0; j <= G; j++)
-            for (int i = 0; i <= G; i++) {
-                int edge = i == 0 || j == 0 || i == G || j == G;
-                X[j][i] = (int64_t)(4 + i * 8) * 256 + (edge ? 0 : tu_int(&r, 1400) - 700);
-                Y[j][i] = (int64_t)(4 + j * 8) * 256 + (edge ? 0 : tu_int(&r, 1400) - 700);
-            }
-        long drawn = 0;
-        for (int j = 0; j < G; j++)
-            for (int i = 0; i < G; i++)
-                for (int h = 0; h < 2; h++) {
-                    int q[2][3][2] = { { { 0, 0 }, { 1, 0 }, { 1, 1 } },
-                                       { { 0, 0 }, { 1, 1 }, { 0, 1 } } };
-                    float clip[12];
-                    for (int v = 0; v < 3; v++)
-                        rt_clip_at(X[j + q[h][v][1]][i + q[h][v][0]],
-                                   Y[j + q[h][v][1]][i + q[h][v][0]], W, H, 0.0f, 1.0f,
-                                   clip + 4 * v);
-                    static const uint32_t idx[3] = { 0, 1, 2 };
-                    rast_mesh_desc m = { clip, 3, NULL, 0, idx, 1, RAST_CULL_NONE };
-                    rast_aa_clear(&one);
-                    assert_int_equal(rast_draw_aa(&one, &m, NULL), RAST_OK);
-                    for (int p = 0; p < W * H; p++) {
-                        if (acc.samples[p] & one.samples[p])
-                            fail_msg("%d samples: pixel (%d,%d) sample covered twice", n,
-                                     p % W, p / W);
-                        acc.samples[p] |= one.samples[p];
-                    }
-                    drawn++;
-                }
-        /* Outline [4, 60) px: pixels 4..59 hold only inside samples. */
-        for (int y = 0; y < H; y++)
-            for (int x = 0; x < W; x++) {
-                int cov = __builtin_popcount(acc.samples[y * W + x]);
-                int inside = x >= 4 && x < 60 && y >= 4 && y < 60;
-                assert_int_equal(cov, inside ? n : 0);
-            }
-        print_message("NOTE %2d samples: %ld triangles, every sample once\n", n, drawn);
-        free(acc.samples);
-        free(one.samples);
-    }
+    for_each_count(watertight, 0xAA22);
 }
 
 static void test_resolve(void **state)

@@ -7,6 +7,7 @@
 #include <cmocka.h>
 
 #include "test_raster_util.h"
+#include "support/fixture.h"
 
 /* CRC32 of depth, mask and attributes of the seeded soup below. Update it
  * (the test prints the new value) only when the rasterization rules change
@@ -115,13 +116,16 @@ static void test_validation(void **state)
     rt_free(&t);
 }
 
+/* The index tests' fixture: a 16 x 16 target with depth, 2 attributes
+ * and 1 byte of padding as the test's state. */
+TU_FIXTURE(index, rast_target, t, *t = rt_make(16, 16, 1, 2, 1), rt_free(t))
+
 /* One bad index at every position of a longer index list (the check
  * runs 4 indices at a time plus a scalar tail), for the smallest bad
  * value, one with the top bit set and the largest. */
 static void test_index_every_position(void **state)
 {
-    (void)state;
-    rast_target t = rt_make(16, 16, 1, 2, 1);
+    rast_target *t = *state;
     rast_mesh_desc d = valid_mesh();
     enum { NT = 11 };
     uint32_t idx[3 * NT];
@@ -132,37 +136,34 @@ static void test_index_every_position(void **state)
         for (int b = 0; b < 3; b++) {
             for (int i = 0; i < 3 * NT; i++)
                 idx[i] = (uint32_t)(i % 4);
-            assert_int_equal(rast_draw(&t, &d, NULL), RAST_OK);
+            assert_int_equal(rast_draw(t, &d, NULL), RAST_OK);
             idx[pos] = bad[b];
-            assert_int_equal(rast_draw(&t, &d, NULL), RAST_ERR_INDEX);
+            assert_int_equal(rast_draw(t, &d, NULL), RAST_ERR_INDEX);
         }
     d.vertex_count = 0;   /* no vertex: every index is out of range */
     idx[0] = 0;
-    assert_int_equal(rast_draw(&t, &d, NULL), RAST_ERR_INDEX);
+    assert_int_equal(rast_draw(t, &d, NULL), RAST_ERR_INDEX);
     d.tri_count = 0;
-    assert_int_equal(rast_draw(&t, &d, NULL), RAST_OK);
-    rt_free(&t);
+    assert_int_equal(rast_draw(t, &d, NULL), RAST_OK);
 }
 
 static void test_index_out_of_range(void **state)
 {
-    (void)state;
-    rast_target t = rt_make(16, 16, 1, 2, 1);
+    rast_target *t = *state;
     rast_mesh_desc d = valid_mesh();
     uint32_t idx[6] = { 0, 1, 2, 0, 2, 4 };   /* 4 == vertex_count */
     d.indices = idx;
-    uint32_t crc0 = buffer_crc(&t);
+    uint32_t crc0 = buffer_crc(t);
     rast_stats st;
     memset(&st, 0, sizeof st);
-    assert_int_equal(rast_draw(&t, &d, &st), RAST_ERR_INDEX);
-    assert_int_equal(buffer_crc(&t), crc0);   /* first triangle not drawn */
+    assert_int_equal(rast_draw(t, &d, &st), RAST_ERR_INDEX);
+    assert_int_equal(buffer_crc(t), crc0);   /* first triangle not drawn */
     assert_int_equal(st.tris_in, 0);
     idx[5] = 0xFFFFFFFFu;
-    assert_int_equal(rast_draw(&t, &d, &st), RAST_ERR_INDEX);
+    assert_int_equal(rast_draw(t, &d, &st), RAST_ERR_INDEX);
     idx[5] = 3;
-    assert_int_equal(rast_draw(&t, &d, &st), RAST_OK);
-    assert_int_not_equal(buffer_crc(&t), crc0);
-    rt_free(&t);
+    assert_int_equal(rast_draw(t, &d, &st), RAST_OK);
+    assert_int_not_equal(buffer_crc(t), crc0);
 }
 
 static void test_zero_size_and_empty(void **state)
@@ -334,11 +335,7 @@ static void test_culling_and_winding(void **state)
      * the eye, where it is clipped away entirely. */
     float neg[12];
     for (int i = 0; i < 12; i++) neg[i] = -ccw[i];
-    memset(&st, 0, sizeof st);
-    rast_target_clear(&t);
-    rt_draw_tri(&t, neg, NULL, RAST_CULL_NONE, &st);
-    assert_int_equal(st.tris_clipped_away, 1);
-    assert_int_equal(rt_count_mask(&t, NULL), 0);
+    rt_expect_clipped_away(&t, neg);
     rt_free(&t);
 }
 
@@ -431,8 +428,8 @@ static void test_stats_accumulate(void **state)
 
 TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_validation),
-        cmocka_unit_test(test_index_out_of_range),
-        cmocka_unit_test(test_index_every_position),
+        cmocka_unit_test_setup_teardown(test_index_out_of_range, index_setup, index_teardown),
+        cmocka_unit_test_setup_teardown(test_index_every_position, index_setup, index_teardown),
         cmocka_unit_test(test_zero_size_and_empty),
         cmocka_unit_test(test_clear_keeps_padding),
         cmocka_unit_test(test_result_str),

@@ -196,12 +196,7 @@ static void test_vertex_behind_camera(void **state)
     float pos[9], clip[12];
     for (int i = 0; i < 9; i++) pos[i] = (float)e[i / 3][i % 3];
     rast_transform_points(c.proj, pos, 3, clip);
-    rast_stats st;
-    memset(&st, 0, sizeof st);
-    rast_target_clear(&t);
-    rt_draw_tri(&t, clip, NULL, RAST_CULL_NONE, &st);
-    assert_int_equal(st.tris_clipped_away, 1);
-    assert_int_equal(rt_count_mask(&t, NULL), 0);
+    rt_expect_clipped_away(&t, clip);
     rt_free(&t);
 }
 

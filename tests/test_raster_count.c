@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "../src/raster/raster.h"
+#include "test_raster_util.h"
 
 static long count_ref(const rast_target *t)
 {
@@ -111,13 +112,7 @@ static void test_count_frames(void **state)
                                           (rast_cull)tu_int(&r, 3) };
                     m[e] = md;
                 }
-                const rast_target *tp[2] = { &t[0], &t[1] };
-                const rast_mesh_desc *mp[2] = { &m[0], &m[1] };
-                if (frame % 2)
-                    assert_int_equal(rast_context_draw_jobs(c, 2, tp, mp, NULL), RAST_OK);
-                else
-                    for (int e = 0; e < 2; e++)
-                        assert_int_equal(rast_context_draw(c, &t[e], &m[e], NULL), RAST_OK);
+                rt_context_draw_two(c, frame % 2, t, m);
                 for (int e = 0; e < 2; e++) {
                     const long want = count_ref(&t[e]);
                     assert_int_equal(rast_context_count(c, &t[e]), want);

@@ -29,6 +29,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
+#include "support/isa_tests.h"
 #include "support/x86_only.h"
 #include "../src/cpu/ef_mem.h"
 
@@ -262,21 +263,24 @@ static void hidden_isa(int isa)
     assert_true(written > 0);
 }
 
-static int front_skip(int isa)
+/* The vector front end of isa (avx2 or avx512); NULL, with the skip's
+ * reason printed, when this CPU does not run it. */
+static const rast__setup_isa *front_setup(int isa)
 {
     if (!ef_cpu_has((ef_isa)isa)) {
         print_message("SKIP raster hidden front %s: this CPU does not run it\n",
                       ef_isa_name((ef_isa)isa));
-        return 1;
+        return NULL;
     }
-    return 0;
+    return isa == EF_ISA_AVX512 ? &rast__setup_isa_avx512 : &rast__setup_isa_avx2;
 }
 
 /* The whole draw through the vector front end against the reference;
  * dirty tiles against the scalar set-up's with the same scan. */
-static void front_draw_isa(int isa, const rast__setup_isa *si)
+static void front_draw_isa(int isa)
 {
-    if (front_skip(isa))
+    const rast__setup_isa *si = front_setup(isa);
+    if (!si)
         skip();
     const rast__scan_rows_fn scan = rast__scan_for_isa(isa);
     rast__vbuf *vb = rast__vbuf_alloc(12000);
@@ -320,9 +324,10 @@ static void front_draw_isa(int isa, const rast__setup_isa *si)
 
 /* Record by record: chunks set up with and without the test against the
  * depth of the chunks before (scanned by the reference). */
-static void front_records_isa(int isa, const rast__setup_isa *si)
+static void front_records_isa(int isa)
 {
-    if (front_skip(isa))
+    const rast__setup_isa *si = front_setup(isa);
+    if (!si)
         skip();
     const size_t nout = (size_t)RAST__VX_CHUNK * RAST__MAX_FAN;
     rast__vbuf *vb = rast__vbuf_alloc(12000);
@@ -383,39 +388,14 @@ static void front_records_isa(int isa, const rast__setup_isa *si)
     rast__vbuf_free(vb);
 }
 
-static void test_front_draw_avx2(void **state)
-{
-    (void)state;
-    front_draw_isa(EF_ISA_AVX2, &rast__setup_isa_avx2);
-}
-static void test_front_draw_avx512(void **state)
-{
-    (void)state;
-    front_draw_isa(EF_ISA_AVX512, &rast__setup_isa_avx512);
-}
-static void test_front_records_avx2(void **state)
-{
-    (void)state;
-    front_records_isa(EF_ISA_AVX2, &rast__setup_isa_avx2);
-}
-static void test_front_records_avx512(void **state)
-{
-    (void)state;
-    front_records_isa(EF_ISA_AVX512, &rast__setup_isa_avx512);
-}
-
-static void test_hidden_sse2(void **state) { (void)state; hidden_isa(EF_ISA_SSE2); }
-static void test_hidden_avx2(void **state) { (void)state; hidden_isa(EF_ISA_AVX2); }
-static void test_hidden_avx512(void **state) { (void)state; hidden_isa(EF_ISA_AVX512); }
+TU_AVX_ISA_TESTS(test_front_draw_, front_draw_isa)
+TU_AVX_ISA_TESTS(test_front_records_, front_records_isa)
+TU_X86_ISA_TESTS(test_hidden_, hidden_isa)
 
 TU_MAIN(NULL, NULL,
-        cmocka_unit_test(test_hidden_sse2),
-        cmocka_unit_test(test_hidden_avx2),
-        cmocka_unit_test(test_hidden_avx512),
-        cmocka_unit_test(test_front_draw_avx2),
-        cmocka_unit_test(test_front_draw_avx512),
-        cmocka_unit_test(test_front_records_avx2),
-        cmocka_unit_test(test_front_records_avx512))
+        TU_X86_ISA_UNIT_TESTS(test_hidden_),
+        TU_AVX_ISA_UNIT_TESTS(test_front_draw_),
+        TU_AVX_ISA_UNIT_TESTS(test_front_records_))
 
 #else
 EF_TEST_X86_SKIP("the SIMD scans' box depth test against the reference")

@@ -21,6 +21,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
+#include "test_raster_util.h"
 #include "support/x86_only.h"
 #include "../src/cpu/ef_mem.h"
 
@@ -61,6 +62,20 @@ static void make_vertex(tu_rng *r, float cx, float cy, float s, float *c)
     c[1] = (cy + tu_range(r, -s, s)) * aw;
     c[2] = tu_range(r, -1.3f, 1.3f) * aw;
     c[3] = w;
+}
+
+/* k's mesh: its nv vertices (na attributes each) and nt triangles, the
+ * culling mode drawn from r. */
+static void case_mesh(rcase *k, int nv, int na, int nt, tu_rng *r)
+{
+    rast_mesh_desc *m = &k->m;
+    m->clip = k->clip;
+    m->vertex_count = nv;
+    m->attr = k->attr;
+    m->attr_count = na;
+    m->indices = k->idx;
+    m->tri_count = nt;
+    m->cull = (rast_cull)tu_int(r, 3);
 }
 
 /* Builds case n (seeded by n alone). */
@@ -173,14 +188,7 @@ static void make_case(int n, rcase *k)
     }
     for (int i = 0; i < v * na; i++)
         k->attr[i] = tu_int(&r, 16) == 0 ? 1e5f * tu_range(&r, -1, 1) : tu_range(&r, -1, 1);
-    rast_mesh_desc *m = &k->m;
-    m->clip = k->clip;
-    m->vertex_count = v;
-    m->attr = k->attr;
-    m->attr_count = na;
-    m->indices = k->idx;
-    m->tri_count = ti;
-    m->cull = (rast_cull)tu_int(&r, 3);
+    case_mesh(k, v, na, ti, &r);
 }
 
 /* Fills every byte of the planes (padding included) with a pattern, then
@@ -228,6 +236,33 @@ static void drop(snapshot *s)
     free(s->attr);
 }
 
+/* The first ISA from isa on (in the order of ef_isa) that this CPU runs,
+ * or EF_ISA_COUNT when there is none. */
+static int cpu_isa_from(int isa)
+{
+    while (isa < EF_ISA_COUNT && !ef_cpu_has((ef_isa)isa)) isa++;
+    return isa;
+}
+
+/* A new context of the ISA isa with th threads (the test fails when it
+ * cannot be made). */
+static rast_context *context_of(int isa, int th)
+{
+    rast_context_desc d = { isa, th };
+    rast_context *c = rast_context_create(&d);
+    assert_non_null(c);
+    return c;
+}
+
+/* The index of the first of the n elements (size bytes each) where a and b
+ * differ, or n when none does. */
+static size_t first_diff(const void *a, const void *b, size_t n, size_t size)
+{
+    for (size_t i = 0; i < n; i++)
+        if (memcmp((const char *)a + i * size, (const char *)b + i * size, size)) return i;
+    return n;
+}
+
 /* 0 if t equals the snapshot; else prints (when verbose) the first
  * differing element and returns 1. */
 static int differs(const rast_target *t, const rast_stats *st, const snapshot *s,
@@ -238,40 +273,26 @@ static int differs(const rast_target *t, const rast_stats *st, const snapshot *s
         (!t->attr || !memcmp(t->attr, s->attr, attr_n(t) * sizeof(float))) &&
         !memcmp(st, &s->st, sizeof *st))
         return 0;
-    for (size_t i = 0; i < mask_bytes(t); i++)
-        if (t->mask[i] != s->mask[i]) {
-            if (verbose)
-                printf("%s: mask differs at x=%d y=%d: ref %d, got %d\n", what,
-                       (int)(i % t->mask_stride), (int)(i / t->mask_stride),
-                       s->mask[i], t->mask[i]);
-            return 1;
-        }
-    for (size_t i = 0; i < depth_n(t); i++)
-        if (memcmp(&t->depth[i], &s->depth[i], sizeof(float))) {
-            if (verbose)
-                printf("%s: depth differs at x=%d y=%d: ref %.9g, got %.9g\n", what,
-                       (int)(i % t->depth_stride), (int)(i / t->depth_stride),
-                       s->depth[i], t->depth[i]);
-            return 1;
-        }
-    for (size_t i = 0; i < attr_n(t); i++)
-        if (memcmp(&t->attr[i], &s->attr[i], sizeof(float))) {
-            if (verbose) {
-                size_t col = i % t->attr_stride;
-                printf("%s: attribute %d differs at x=%d y=%d: ref %.9g, got %.9g\n",
-                       what, (int)(col % t->attr_count), (int)(col / t->attr_count),
-                       (int)(i / t->attr_stride), s->attr[i], t->attr[i]);
-            }
-            return 1;
-        }
-    if (memcmp(st, &s->st, sizeof *st)) {
-        if (verbose)
-            printf("%s: stats differ: pixels ref %ld got %ld, drawn ref %ld got %ld\n",
-                   what, s->st.pixels_written, st->pixels_written, s->st.tris_drawn,
-                   st->tris_drawn);
+    if (!verbose)
         return 1;
+    const size_t nm = mask_bytes(t), nd = depth_n(t), na = attr_n(t);
+    size_t i;
+    if ((i = first_diff(t->mask, s->mask, nm, 1)) < nm) {
+        printf("%s: mask differs at x=%d y=%d: ref %d, got %d\n", what,
+               (int)(i % t->mask_stride), (int)(i / t->mask_stride), s->mask[i], t->mask[i]);
+    } else if ((i = first_diff(t->depth, s->depth, nd, sizeof(float))) < nd) {
+        printf("%s: depth differs at x=%d y=%d: ref %.9g, got %.9g\n", what,
+               (int)(i % t->depth_stride), (int)(i / t->depth_stride), s->depth[i], t->depth[i]);
+    } else if ((i = first_diff(t->attr, s->attr, na, sizeof(float))) < na) {
+        const size_t col = i % t->attr_stride;
+        printf("%s: attribute %d differs at x=%d y=%d: ref %.9g, got %.9g\n", what,
+               (int)(col % t->attr_count), (int)(col / t->attr_count),
+               (int)(i / t->attr_stride), s->attr[i], t->attr[i]);
+    } else {
+        printf("%s: stats differ: pixels ref %ld got %ld, drawn ref %ld got %ld\n", what,
+               s->st.pixels_written, st->pixels_written, s->st.tris_drawn, st->tris_drawn);
     }
-    return 0;
+    return 1;
 }
 
 /* 64-bit digest of a buffer (word-wise multiply-xorshift; tu_crc32 is
@@ -407,13 +428,9 @@ static void test_threads_equal(void **state)
     take(&t, &st, &s);
     assert_true(st.pixels_written > 2 * W * H);
     int runs = 0;
-    for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {
-        if (!ef_cpu_has((ef_isa)isa))
-            continue;
+    for (int isa = cpu_isa_from(EF_ISA_REF); isa < EF_ISA_COUNT; isa = cpu_isa_from(isa + 1)) {
         for (int th = 1; th <= 4; th++) {
-            rast_context_desc d = { isa, th };
-            rast_context *c = rast_context_create(&d);
-            assert_non_null(c);
+            rast_context *c = context_of(isa, th);
             assert_int_equal(rast_context_threads(c), th);
             assert_true(rast_context_isa(c) <= isa);
             for (int rep = 0; rep < 2; rep++) {   /* reuse of the pool */
@@ -819,13 +836,9 @@ static void test_jobs_equal(void **state)
     }
     assert_true(sum.pixels_written > 100);
     int runs = 0;
-    for (int isa = EF_ISA_REF; isa < EF_ISA_COUNT; isa++) {
-        if (!ef_cpu_has((ef_isa)isa))
-            continue;
+    for (int isa = cpu_isa_from(EF_ISA_REF); isa < EF_ISA_COUNT; isa = cpu_isa_from(isa + 1)) {
         for (int th = 1; th <= 3; th++) {
-            rast_context_desc d = { isa, th };
-            rast_context *c = rast_context_create(&d);
-            assert_non_null(c);
+            rast_context *c = context_of(isa, th);
             for (int nj = 1; nj <= 3; nj++) {
                 for (int j = 0; j < 3; j++)
                     reset_target(&k[j].t);
@@ -952,13 +965,7 @@ static void test_context_clear(void **state)
                 } while (1);
                 m[e] = k[e].m;
             }
-            const rast_target *tp[2] = { &a[0], &a[1] };
-            const rast_mesh_desc *mp[2] = { &m[0], &m[1] };
-            if (frame % 2)
-                assert_int_equal(rast_context_draw_jobs(c, 2, tp, mp, NULL), RAST_OK);
-            else
-                for (int e = 0; e < 2; e++)
-                    assert_int_equal(rast_context_draw(c, &a[e], &m[e], NULL), RAST_OK);
+            rt_context_draw_two(c, frame % 2, a, m);
             for (int e = 0; e < 2; e++) {
                 assert_int_equal(rast_draw(&b[e], &m[e], NULL), RAST_OK);
                 assert_memory_equal(a[e].mask, b[e].mask, (size_t)a[e].mask_stride * H);
@@ -1073,14 +1080,7 @@ static void make_mesh(int n, rcase *k)
             memcpy(k->idx + 3 * ti, k->idx + 3 * o, sizeof s);
             memcpy(k->idx + 3 * o, s, sizeof s);
         }
-    rast_mesh_desc *m = &k->m;
-    m->clip = k->clip;
-    m->vertex_count = nv;
-    m->attr = k->attr;
-    m->attr_count = na;
-    m->indices = k->idx;
-    m->tri_count = nt;
-    m->cull = (rast_cull)tu_int(&r, 3);
+    case_mesh(k, nv, na, nt, &r);
 }
 
 /* One case through the vector front end of an ISA against the scalar

@@ -29,6 +29,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
+#include "support/isa_tests.h"
 #include "support/x86_only.h"
 
 #if EF_TEST_X86
@@ -232,22 +233,16 @@ static void check_isa(ef_isa which, const rast__setup_isa *isa)
 static void test_frontv_patterned_avx2(void **state)
 {
     (void)state;
-    if (!ef_cpu_has(EF_ISA_AVX2)) {
-        print_message("SKIP avx2: not supported by this CPU; untested: the patterned vector "
-                      "front end of src/raster/raster_front_avx2.c\n");
-        skip();
-    }
+    tu_skip_unless_isa(EF_ISA_AVX2, "the patterned vector front end of "
+                                    "src/raster/raster_front_avx2.c");
     check_isa(EF_ISA_AVX2, &rast__setup_isa_avx2);
 }
 
 static void test_frontv_patterned_avx512(void **state)
 {
     (void)state;
-    if (!ef_cpu_has(EF_ISA_AVX512)) {
-        print_message("SKIP avx512: not supported by this CPU; untested: the patterned vector "
-                      "front end of src/raster/raster_front_avx512.c\n");
-        skip();
-    }
+    tu_skip_unless_isa(EF_ISA_AVX512, "the patterned vector front end of "
+                                      "src/raster/raster_front_avx512.c");
     check_isa(EF_ISA_AVX512, &rast__setup_isa_avx512);
 }
 

@@ -29,6 +29,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
+#include "support/isa_tests.h"
 #include "support/raster_planes.h"
 
 #define NCASES 2500
@@ -270,14 +271,8 @@ static void span_isa(int isa)
     assert_true(cases > 1000 && written > 100000);
 }
 
-static void test_span_sse2(void **state) { (void)state; span_isa(EF_ISA_SSE2); }
-static void test_span_avx2(void **state) { (void)state; span_isa(EF_ISA_AVX2); }
-static void test_span_avx512(void **state) { (void)state; span_isa(EF_ISA_AVX512); }
-static void test_span_neon(void **state) { (void)state; span_isa(EF_ISA_NEON); }
+TU_ISA_TESTS(test_span_, span_isa)
 
 TU_MAIN(NULL, NULL,
         cmocka_unit_test(test_span_reference),
-        cmocka_unit_test(test_span_sse2),
-        cmocka_unit_test(test_span_avx2),
-        cmocka_unit_test(test_span_avx512),
-        cmocka_unit_test(test_span_neon))
+        TU_ISA_UNIT_TESTS(test_span_))

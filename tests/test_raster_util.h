@@ -1,7 +1,7 @@
 /* test_raster_util.h - helpers shared by tests/test_raster_*.c (static,
- * header only): targets with padded strides, clip coordinates that land
- * exactly on a chosen sub-pixel position, and an independent coverage
- * reference for the top-left rule.
+ * header only; include after <cmocka.h>): targets with padded strides,
+ * clip coordinates that land exactly on a chosen sub-pixel position, and
+ * an independent coverage reference for the top-left rule.
  *
  * The reference coverage uses the equivalent "perturbed sample" form of
  * the top-left rule instead of the rasterizer's bias: a pixel centre p is
@@ -121,6 +121,34 @@ static inline long rt_count_mask(const rast_target *t, int *bad)
             else if (m != 0 && bad) *bad = 1;
         }
     return n;
+}
+
+/* Draws the triangle clip (no culling) on t, cleared first, and checks
+ * that it is clipped away entirely: counted so, and nothing drawn. */
+static inline void rt_expect_clipped_away(const rast_target *t, const float clip[12])
+{
+    rast_stats st;
+    memset(&st, 0, sizeof st);
+    rast_target_clear(t);
+    rt_draw_tri(t, clip, NULL, RAST_CULL_NONE, &st);
+    assert_int_equal(st.tris_clipped_away, 1);
+    assert_int_equal(rt_count_mask(t, NULL), 0);
+}
+
+/* Draws m[0] on t[0] and m[1] on t[1] in the context c: in one
+ * rast_context_draw_jobs call when jobs is set, else with one
+ * rast_context_draw each; every call must succeed. */
+static inline void rt_context_draw_two(rast_context *c, int jobs, const rast_target t[2],
+                                       const rast_mesh_desc m[2])
+{
+    if (jobs) {
+        const rast_target *tp[2] = { &t[0], &t[1] };
+        const rast_mesh_desc *mp[2] = { &m[0], &m[1] };
+        assert_int_equal(rast_context_draw_jobs(c, 2, tp, mp, NULL), RAST_OK);
+    } else {
+        for (int e = 0; e < 2; e++)
+            assert_int_equal(rast_context_draw(c, &t[e], &m[e], NULL), RAST_OK);
+    }
 }
 
 /* Column-major perspective matrix (OpenGL glFrustum-like, symmetric). */

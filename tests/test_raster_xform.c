@@ -28,6 +28,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/raster/raster_internal.h"
+#include "support/isa_tests.h"
 #include "support/x86_only.h"
 
 #if EF_TEST_X86
@@ -221,11 +222,7 @@ static void test_xform_public(void **state)
 static void test_xform_avx512(void **state)
 {
     (void)state;
-    if (!ef_cpu_has(EF_ISA_AVX512)) {
-        print_message("SKIP avx512: not supported by this CPU; untested: the AVX-512 vertex "
-                      "transforms (src/raster/raster_avx512.c)\n");
-        skip();
-    }
+    tu_skip_unless_isa(EF_ISA_AVX512, "the AVX-512 vertex transforms (src/raster/raster_avx512.c)");
     run_cases(rast__transform_points_avx512, rast__transform_dirs_avx512,
               "rast__transform_*_avx512");
 }
@@ -233,11 +230,7 @@ static void test_xform_avx512(void **state)
 static void test_xform_avx2(void **state)
 {
     (void)state;
-    if (!ef_cpu_has(EF_ISA_AVX2)) {
-        print_message("SKIP avx2: not supported by this CPU; untested: the AVX2 vertex "
-                      "transforms (src/raster/raster_xform.inl)\n");
-        skip();
-    }
+    tu_skip_unless_isa(EF_ISA_AVX2, "the AVX2 vertex transforms (src/raster/raster_xform.inl)");
     run_cases(rast__transform_points_avx2, rast__transform_dirs_avx2, "rast__transform_*_avx2");
 }
 

@@ -2,14 +2,17 @@
  * test_fit_shift): a pinhole camera at the origin looking down -Z (view =
  * identity), a rig whose every hand joint of side s is node s, world
  * matrices that only translate, the camera image painted from the true
- * mask, and the IoU of two masks. Header-only (static inline); include
- * after support/testutil.h. */
+ * mask, the image-wide colour model learned from it, the refinement's
+ * parameters and scratch, and the IoU of two masks. Header-only (static
+ * inline); include after support/testutil.h and <cmocka.h>. */
 #ifndef EGOFUSE_TEST_FIT_SCENE_H
 #define EGOFUSE_TEST_FIT_SCENE_H
 
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
+#include "../../src/fuse/fuse_refine.h"
 #include "../../src/kin/kin.h"
 
 /* A w x h camera of focal length f (pixels), principal point the centre. */
@@ -64,6 +67,58 @@ static inline void fit_scene_paint(uint8_t *img, const uint8_t *truth, long n, t
         }
         img[4 * k + 3] = 255;
     }
+}
+
+/* Allocates the camera image *img (w x h RGBA), the true and the kinematic
+ * masks *truth and *kin and the output mask *out (w x h bytes each;
+ * contents undefined); fails the test when out of memory. */
+static inline void fit_scene_alloc(int w, int h, uint8_t **img, uint8_t **truth, uint8_t **kin,
+                                   uint8_t **out)
+{
+    *img = malloc((size_t)w * h * 4);
+    *truth = malloc((size_t)w * h);
+    *kin = malloc((size_t)w * h);
+    *out = malloc((size_t)w * h);
+    assert_true(*img && *truth && *kin && *out);
+}
+
+/* img (w x h) painted from truth by fit_scene_paint (the noise seeded with
+ * seed), and the image-wide colour model g (5 bits) learned from it where
+ * truth is set; *llr (g's table) and *cscratch (the learning's scratch)
+ * are allocated here, for the caller to free. */
+static inline void fit_scene_learn(fuse_colour_model *g, uint8_t *img, const uint8_t *truth,
+                                   int w, int h, uint64_t seed, float **llr, void **cscratch)
+{
+    tu_rng rng = { seed };
+    fit_scene_paint(img, truth, (long)w * h, &rng);
+    *cscratch = malloc(fuse_colour_model_scratch_size(5));
+    *llr = malloc(sizeof(float) << 15);
+    assert_true(*cscratch && *llr);
+    g->bits = 5;
+    g->llr = *llr;
+    fuse_image P = { img, w, h, 4 * w };
+    assert_int_equal(fuse_colour_model_learn(g, &P, truth, w, 4, 1, 3.0f, 64, *cscratch,
+                                             fuse_colour_model_scratch_size(5)),
+                     FUSE_OK);
+}
+
+/* The band refinement's parameters of the tests: the defaults with a
+ * 16 px band and 5-bit colour bins. */
+static inline fuse_refine_params fit_scene_refine_params(void)
+{
+    fuse_refine_params rp = fuse_refine_params_default();
+    rp.band = 16;
+    rp.bits = 5;
+    return rp;
+}
+
+/* size bytes of 16-byte aligned scratch (free()); fails the test when out
+ * of memory. */
+static inline void *fit_scene_scratch(size_t size)
+{
+    void *p = aligned_alloc(16, (size + 15) & ~(size_t)15);
+    assert_non_null(p);
+    return p;
 }
 
 /* The IoU of two masks of n bytes (set: >= 128); 1 when both are empty. */
