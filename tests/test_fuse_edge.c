@@ -233,24 +233,11 @@ static void frame_every_isa(void **state)
                 fuse_context_desc cd = {isas[ii], th};
                 fuse_context *ctx = fuse_context_create(&cd);
                 assert_non_null(ctx);
-                fuse_eye e = {0};
-                e.lighting = &L;
-                e.intrinsics = &K;
-                e.P = Pi;
-                e.mask = M;
-                e.mask_stride = w;
-                e.normal = N;
-                e.normal_stride = 3 * w;
-                e.Q = Qi;
-                e.depth = use_depth ? &dt : NULL;
-                e.V = Vi;
-                e.vp_x0 = vx;
-                e.vp_y0 = vy;
-                e.vp_w = vw;
-                e.vp_h = vh;
-                e.out = Gi;
-                e.edge_fade = k;
-                e.edge_sides = sides;
+                fuse_eye e = { .lighting = &L, .intrinsics = &K, .P = Pi, .mask = M,
+                               .mask_stride = w, .normal = N, .normal_stride = 3 * w, .Q = Qi,
+                               .depth = use_depth ? &dt : NULL, .V = Vi, .vp_x0 = vx,
+                               .vp_y0 = vy, .vp_w = vw, .vp_h = vh, .out = Gi, .edge_fade = k,
+                               .edge_sides = sides };
                 memset(got, 0xCD, (size_t)ow * oh * 4);
                 assert_int_equal(fuse_context_frame(ctx, &e, 1), FUSE_OK);
                 assert_memory_equal(got, want, (size_t)ow * oh * 4);

@@ -332,22 +332,12 @@ static long run_skin(ef_isa isa, int with_depth, uint64_t crc[NF], long *min_sho
             fuse_intrinsics K = {500.0f, 500.0f, 320.0f, 200.0f};
             fuse_depth dt = {hz, CW, hd.znear, hd.zfar, hd.cam_offset_m,
                              W.vdepth[f][e], OW, OW, OH};
-            fuse_eye fe = {0};
-            fe.lighting = &L;
-            fe.intrinsics = &K;
-            fe.P = P;
-            fe.mask = mask;
-            fe.mask_stride = CW;
-            fe.normal = nrm;
-            fe.normal_stride = 3 * CW;
-            fe.Q = (fuse_image){layer, CW, CH, 4 * CW};
-            fe.depth = with_depth ? &dt : NULL;
-            fe.V = (fuse_image){W.V, OW, OH, 4 * OW};
-            fe.vp_x0 = W.g.vp_x0;
-            fe.vp_y0 = W.g.vp_y0;
-            fe.vp_w = W.g.vp_width;
-            fe.vp_h = W.g.vp_height;
-            fe.out = (fuse_image){out, OW, OH, 4 * OW};
+            fuse_eye fe = { .lighting = &L, .intrinsics = &K, .P = P, .mask = mask,
+                            .mask_stride = CW, .normal = nrm, .normal_stride = 3 * CW,
+                            .Q = { layer, CW, CH, 4 * CW }, .depth = with_depth ? &dt : NULL,
+                            .V = { W.V, OW, OH, 4 * OW }, .vp_x0 = W.g.vp_x0,
+                            .vp_y0 = W.g.vp_y0, .vp_w = W.g.vp_width, .vp_h = W.g.vp_height,
+                            .out = { out, OW, OH, 4 * OW } };
             assert_int_equal(fuse_context_frame(ctx, &fe, 1), FUSE_OK);
             long shown;
             long b = check_eye(layer, out, W.band[f][e], &shown);
