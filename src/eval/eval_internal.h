@@ -272,6 +272,14 @@ int eval__kf_configs(const method_cfg base[4], method_cfg *L, int cap);
 int eval__write_kf(const char *dir, const method_run *R, int n);
 
 /* eval_report.c: the tables, the CSV and the report folder. */
+/* A run's figures per eye (mask IoU, boundary F within 1 and 3 px, false
+ * positive and negative area, composite PSNR), per stereo frame (ms) and
+ * its edge flicker: eval__summarise divides its sums by their counts (a
+ * count of 0 counts as 1; no flicker samples: flicker 0). */
+typedef struct eval_summary {
+    double iou, bf1, bf3, fp, fn, psnr, ms, flicker;
+} eval_summary;
+eval_summary eval__summarise(const method_run *r);
 void eval__print_calib(FILE *f, const eval_ctx *c);
 void eval__print_table(FILE *f, const method_run *R, int n, int markdown);
 void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int n);

@@ -73,8 +73,8 @@ int eval__write_kf(const char *dir, const method_run *R, int n)
                     len += snprintf(row + len, sizeof row - (size_t)len, pass ? " - |" : "  %-15s", "-");
                     continue;
                 }
-                const double ne = R[hit].n_eye > 0 ? (double)R[hit].n_eye : 1.0;
-                const double psnr = fuse_psnr_of_mse(R[hit].mse / ne), iou = R[hit].iou / ne;
+                const eval_summary m = eval__summarise(&R[hit]);
+                const double psnr = m.psnr, iou = m.iou;
                 len += snprintf(row + len, sizeof row - (size_t)len,
                                 pass ? " %.2f (%.4f) |" : "  %6.2f (%.4f)", psnr, iou);
                 if (psnr > best) { best = psnr; bkf = kfs[i]; }

@@ -174,8 +174,8 @@ typedef struct lsum { double iou, bf3, psnr; int have; } lsum;
 
 static lsum sum_of(const method_run *r)
 {
-    const double n = r->n_eye > 0 ? (double)r->n_eye : 1.0;
-    lsum s = {r->iou / n, r->bf3 / n, fuse_psnr_of_mse(r->mse / n), 1};
+    const eval_summary m = eval__summarise(r);
+    lsum s = {m.iou, m.bf3, m.psnr, 1};
     return s;
 }
 
