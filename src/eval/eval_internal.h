@@ -298,6 +298,11 @@ struct io_out;
 FILE *eval__out_open(struct io_out *o, const char *dir, const char *name, ...)
     __attribute__((format(printf, 3, 4)));
 int eval__out_commit(struct io_out *o);
+/* The passes of a table printed twice: pass 0 as text on stdout, pass 1
+ * as Markdown into DIR/name (opened into *o; no pass 1 without dir). Sets
+ * *f to the pass's stream and returns 1; 0 when there is no such pass;
+ * -1 when DIR/name did not open (the message printed). */
+int eval__table_pass(int pass, const char *dir, const char *name, struct io_out *o, FILE **f);
 int eval__write_report(const char *dir, const method_run *R, int n, const eval_opts *o,
                        const eval_ctx *c);
 

@@ -41,13 +41,9 @@ int eval__kf_configs(const method_cfg base[4], method_cfg *L, int cap)
 int eval__write_kf(const char *dir, const method_run *R, int n)
 {
     io_out of;
-    FILE *f = stdout;
-    for (int pass = 0; pass < 2; pass++) {
-        if (pass == 1) {
-            if (!dir) break;
-            if (!eval__out_open(&of, dir, "kf.md")) return IO_EXIT_FAIL;
-            f = of.f;
-        }
+    FILE *f;
+    int go;
+    for (int pass = 0; (go = eval__table_pass(pass, dir, "kf.md", &of, &f)) > 0; pass++) {
         fprintf(f, "%sThe Fresnel fade kf against the opaque ideal composite (the true "
                    "silhouette, no fade): composite PSNR dB (IoU)%s\n",
                 pass ? "" : "egofuse eval: ", pass ? "\n" : "");
@@ -84,6 +80,7 @@ int eval__write_kf(const char *dir, const method_run *R, int n)
             fprintf(f, "%s%s%g%s\n", row, pass ? " " : "  ", bkf, pass ? " |" : "");
         }
     }
+    if (go < 0) return IO_EXIT_FAIL;
     if (dir && eval__out_commit(&of)) return IO_EXIT_FAIL;
     return IO_EXIT_OK;
 }

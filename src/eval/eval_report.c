@@ -64,6 +64,17 @@ int eval__out_commit(io_out *o)
     return IO_EXIT_OK;
 }
 
+int eval__table_pass(int pass, const char *dir, const char *name, io_out *o, FILE **f)
+{
+    if (pass == 0) {
+        *f = stdout;
+        return 1;
+    }
+    if (pass > 1 || !dir) return 0;
+    *f = eval__out_open(o, dir, "%s", name);
+    return *f ? 1 : -1;
+}
+
 int eval__write_csv(const char *path, const method_run *R, int n)
 {
     io_out of;
