@@ -68,6 +68,9 @@ int cli_soft_edges(const char *cmd, int *soft, int aa, int view);
 int cli_parse_int(const char *s, int lo, int hi, int *out);
 int cli_parse_float(const char *s, float *out);
 int cli_parse_vec3(const char *s, float out[3]);
+/* A keyword option's value: the index of s in words (a list ending in
+ * NULL), or -1 when s is none of them. */
+int cli_pick(const char *s, const char *const *words);
 
 /* A float option checked against a closed range, one row of a command's
  * table of them (instead of a case each): getopt's value for it, its name

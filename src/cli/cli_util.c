@@ -45,6 +45,13 @@ int cli_parse_float(const char *s, float *out)
     return 1;
 }
 
+int cli_pick(const char *s, const char *const *words)
+{
+    for (int i = 0; words[i]; i++)
+        if (!strcmp(s, words[i])) return i;
+    return -1;
+}
+
 const cli_float_opt *cli_float_opt_find(const cli_float_opt *t, int n, int id)
 {
     for (int i = 0; i < n; i++)

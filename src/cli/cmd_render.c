@@ -706,9 +706,10 @@ int cmd_render(int argc, char **argv)
                 return cli_usage_error("render", "--tone-match '%s': a strength in [0, 1]", optarg);
             break;
         case O_POSE:
-            if (!strcmp(optarg, "tracking")) o.pose_tracking = 1;
-            else if (!strcmp(optarg, "animation")) o.pose_tracking = 0;
-            else return cli_usage_error("render", "--pose '%s': 'animation' or 'tracking'", optarg);
+            o.pose_tracking =
+                cli_pick(optarg, (const char *const[]){"animation", "tracking", NULL});
+            if (o.pose_tracking < 0)
+                return cli_usage_error("render", "--pose '%s': 'animation' or 'tracking'", optarg);
             break;
         case O_CALIB: o.calib = optarg; tracking_only = O_CALIB; break;
         case O_PREDICT:
