@@ -178,21 +178,9 @@ typedef struct inputs {
 
 static int load(inputs *in, const char *dir, int window)
 {
-    char path[IO_PATH_MAX + 64];
     io_scene sc;
-    io_error err;
-    snprintf(path, sizeof path, "%s/scene.txt", dir);
-    if (io_scene_load(path, &sc, &err) != IO_OK) {
-        fprintf(stderr, "llvmpipe_frame: %s\n", err.msg);
+    if (!bench_sample_posed(dir, "llvmpipe_frame", 0, &sc, &in->model, &in->anim, &in->head))
         return 0;
-    }
-    io_scene_frame_path(&sc, sc.model, 0, path, sizeof path);
-    if (io_gltf_load(path, &in->model, &err) != IO_OK) {
-        fprintf(stderr, "llvmpipe_frame: %s\n", err.msg);
-        return 0;
-    }
-    in->anim = kin_model_find_anim(&in->model, sc.animation);
-    in->head = kin_model_find_node(&in->model, sc.head_node[0] ? sc.head_node : "head");
     if (in->head < 0) {
         fprintf(stderr, "llvmpipe_frame: no head node\n");
         return 0;
@@ -202,11 +190,7 @@ static int load(inputs *in, const char *dir, int window)
             fprintf(stderr, "llvmpipe_frame: a skin has more than %d joints\n", MAX_JOINTS);
             return 0;
         }
-    in->fps = sc.fps > 0 ? sc.fps : 60.0f;
-    in->seq_frames = sc.frames;
-    in->hmd = kin_sthmd_desc_resolved(NULL);
-    in->geo = kin_sthmd_geometry_of(&in->hmd);
-    in->lighting.light = io_scene_lighting(&sc);
+    bench_sample_play(&sc, &in->fps, &in->seq_frames, &in->hmd, &in->geo, &in->lighting.light);
     const int cw = in->hmd.cam_width, ch = in->hmd.cam_height;
     const int lw = in->hmd.lcd_width, lh = in->hmd.lcd_height;
     in->window = window < sc.frames ? window : sc.frames;
