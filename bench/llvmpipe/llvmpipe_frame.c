@@ -240,6 +240,15 @@ static GLuint tex2d(GLenum ifmt, int w, int h, GLenum filter)
     return t;
 }
 
+/* Texture tex on texture unit `unit` and the sampler uniform loc of the
+ * program in use reading that unit. */
+static void bind_sampler(GLint loc, int unit, GLuint tex)
+{
+    glActiveTexture(GL_TEXTURE0 + (GLenum)unit);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glUniform1i(loc, unit);
+}
+
 static int gl_setup(gl_state *g, const inputs *in)
 {
     memset(g, 0, sizeof *g);
@@ -427,15 +436,9 @@ static void gl_frame(gl_state *g, const inputs *in, int w, float t, uint8_t *out
         glBindFramebuffer(GL_FRAMEBUFFER, g->fb_q[e]);
         glUseProgram(g->prog_light);
         glBindVertexArray(g->vao_empty);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, g->cam_tex[e]);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, g->g_tex[e]);
-        glActiveTexture(GL_TEXTURE2);
-        glBindTexture(GL_TEXTURE_2D, g->vd_tex[e]);
-        glUniform1i(g->l_cam, 0);
-        glUniform1i(g->l_g, 1);
-        glUniform1i(g->l_vd, 2);
+        bind_sampler(g->l_cam, 0, g->cam_tex[e]);
+        bind_sampler(g->l_g, 1, g->g_tex[e]);
+        bind_sampler(g->l_vd, 2, g->vd_tex[e]);
         glUniform1i(g->l_crop, in->geo.crop_y0);
         glUniform4f(g->l_K, cam[e].fx, cam[e].fy, cam[e].cx, cam[e].cy);
         float ld[8][3], lc[8][3];
@@ -464,12 +467,8 @@ static void gl_frame(gl_state *g, const inputs *in, int w, float t, uint8_t *out
         glBindFramebuffer(GL_FRAMEBUFFER, g->fb_out[e]);
         glViewport(0, 0, lw, lh);
         glUseProgram(g->prog_comp);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, g->q_tex[e]);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, g->v_tex[e]);
-        glUniform1i(g->c_q, 0);
-        glUniform1i(g->c_v, 1);
+        bind_sampler(g->c_q, 0, g->q_tex[e]);
+        bind_sampler(g->c_v, 1, g->v_tex[e]);
         glUniform4i(g->c_vp, in->geo.vp_x0, in->geo.vp_y0, in->geo.vp_width, in->geo.vp_height);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glFlush();
