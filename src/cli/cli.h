@@ -34,6 +34,18 @@ int cli_usage_error(const char *cmd, const char *fmt, ...)
  * option is argv[optind - 1]). */
 int cli_option_error(const char *cmd, int c, char *const *argv);
 
+/* A subcommand's option loop: cli_getopt_begin, then cli_getopt until it
+ * returns 0 or less. cli_getopt_begin: getopt_long starts again at
+ * argv[1], with its own messages off. cli_getopt: the next option's value
+ * for the command's switch (getopt_long with -h the only short option); 0
+ * after the last option; -1 when the command is to return *rc: after -h or
+ * --help (cmd's usage printed on stdout; EXIT_OK) or a bad option
+ * (cli_option_error; EXIT_USAGE). */
+struct option;
+void cli_getopt_begin(void);
+int cli_getopt(const char *cmd, const char *usage, int argc, char **argv,
+               const struct option *opts, int *rc);
+
 /* Reads OpenCV calibration files (io_calib.h) into hmd->lens: both for
  * both cameras (a stereo file: its first camera left, its second right),
  * left / right for one each (they win over both); NULL = none. Checks the

@@ -4,6 +4,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -27,6 +28,29 @@ int cli_option_error(const char *cmd, int c, char *const *argv)
 {
     if (c == ':') return cli_usage_error(cmd, "option %s needs a value", argv[optind - 1]);
     return cli_usage_error(cmd, "unknown option '%s'", argv[optind - 1]);
+}
+
+void cli_getopt_begin(void)
+{
+    optind = 1;
+    opterr = 0;
+}
+
+int cli_getopt(const char *cmd, const char *usage, int argc, char **argv,
+               const struct option *opts, int *rc)
+{
+    int c = getopt_long(argc, argv, "h", opts, NULL);
+    if (c == -1) return 0;
+    if (c == 'h') {
+        fputs(usage, stdout);
+        *rc = EXIT_OK;
+        return -1;
+    }
+    if (c == '?' || c == ':') {
+        *rc = cli_option_error(cmd, c, argv);
+        return -1;
+    }
+    return c;
 }
 
 int cli_parse_int(const char *s, int lo, int hi, int *out)

@@ -510,13 +510,11 @@ int cmd_replay(int argc, char **argv)
     o.major = 4;
     o.minor = 1;
     o.unit_scale = 1.0f;
-    optind = 1;
-    opterr = 0;
-    int c, k;
+    int c, k, rc;
     float f;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    cli_getopt_begin();
+    while ((c = cli_getopt("replay-track", replay_usage, argc, argv, opts, &rc)) > 0) {
         switch (c) {
-        case 'h': fputs(replay_usage, stdout); return EXIT_OK;
         case O_TO: o.to = optarg; break;
         case O_SPEED:
             if (!cli_parse_float(optarg, &f) || !(f > 0) || f > 1e6f)
@@ -549,9 +547,9 @@ int cmd_replay(int argc, char **argv)
             o.wait_s = f;
             break;
         case O_QUIET: o.quiet = 1; break;
-        default: return cli_option_error("replay-track", c, argv);
         }
     }
+    if (c < 0) return rc;
     if (optind >= argc) return cli_usage_error("replay-track", "no tracking FILE given");
     o.file = argv[optind++];
     if (optind < argc)
