@@ -349,28 +349,14 @@ static int preload(bench *b, const char *samples_dir, int window)
     io_error err;
     snprintf(path, sizeof path, "%s/scene.txt", samples_dir);
     if (io_scene_load(path, &b->sc, &err) != IO_OK) memset(&b->sc, 0, sizeof b->sc);
-    if (io_scene_load(path, &sc, &err) != IO_OK) {
-        fprintf(stderr, "bench_frame: %s (make build/gen_samples && build/gen_samples --out %s)\n",
-                err.msg, samples_dir);
+    if (!bench_sample_posed(samples_dir, "bench_frame", 1, &sc, &b->model, &b->anim, &b->head))
         return 0;
-    }
-    io_scene_frame_path(&sc, sc.model, 0, path, sizeof path);
-    if (io_gltf_load(path, &b->model, &err) != IO_OK) {
-        fprintf(stderr, "bench_frame: %s\n", err.msg);
-        return 0;
-    }
-    b->anim = kin_model_find_anim(&b->model, sc.animation);
-    b->head = kin_model_find_node(&b->model, sc.head_node[0] ? sc.head_node : "head");
     char why[256];
     if (!b->anim || b->head < 0 || kin_arm_rig_init(&b->rig, &b->model, why, sizeof why) != 0) {
         fprintf(stderr, "bench_frame: the sample model lacks the animation, head or rig\n");
         return 0;
     }
-    b->fps = sc.fps > 0 ? sc.fps : 60.0f;
-    b->seq_frames = sc.frames;
-    b->hmd = kin_sthmd_desc_resolved(NULL);
-    b->geo = kin_sthmd_geometry_of(&b->hmd);
-    b->lighting.light = io_scene_lighting(&sc);
+    bench_sample_play(&sc, &b->fps, &b->seq_frames, &b->hmd, &b->geo, &b->lighting.light);
     make_samples(b);
 
     const int cw = b->hmd.cam_width, ch = b->hmd.cam_height;

@@ -163,6 +163,23 @@ static void gnuplot(const char *dir, const char *name, const char *script)
     if (system(cmd) != 0) printf("  (gnuplot failed for %s; CSV written)\n", name);
 }
 
+/* The chart DIR/NAME.png of DIR/NAME.csv (gnuplot): the title, the axes'
+ * labels, and one curve a column after the first (the x), drawn with
+ * style and titled by titles (a list ending in NULL). */
+static void plot_csv(const char *dir, const char *name, const char *title, const char *xlabel,
+                     const char *ylabel, const char *style, const char *const *titles)
+{
+    char script[2048];
+    size_t n = (size_t)snprintf(script, sizeof script,
+                                "set title '%s'\nset xlabel '%s'\nset ylabel '%s'\nplot '%s.csv'",
+                                title, xlabel, ylabel, name);
+    for (int i = 0; titles[i] && n < sizeof script; i++) /* after the first, '' is the file */
+        n += (size_t)snprintf(script + n, sizeof script - n,
+                              "%s every ::1 using 1:%d with %s title '%s'", i ? ", ''" : "", i + 2,
+                              style, titles[i]);
+    gnuplot(dir, name, script);
+}
+
 static FILE *csv(const char *dir, const char *name, const char *header)
 {
     char path[1024];
@@ -186,12 +203,9 @@ static void fig_noise(const char *dir)
         printf("  %3d %7.2f %7.2f\n", k, raw * 1e3, fil * 1e3);
     }
     fclose(f);
-    gnuplot(dir, "ik_noise",
-            "set title 'Elbow error of the IK vs tracking noise (true arm 0.32+0.28 m)'\n"
-            "set xlabel 'noise sigma per axis (mm; rotations 2x in mrad)'\n"
-            "set ylabel 'mean elbow error (mm)'\n"
-            "plot 'ik_noise.csv' every ::1 using 1:2 with linespoints title 'raw samples', "
-            "'' every ::1 using 1:3 with linespoints title 'One Euro + prediction'");
+    plot_csv(dir, "ik_noise", "Elbow error of the IK vs tracking noise (true arm 0.32+0.28 m)",
+             "noise sigma per axis (mm; rotations 2x in mrad)", "mean elbow error (mm)",
+             "linespoints", (const char *const[]){"raw samples", "One Euro + prediction", NULL});
 }
 
 static void fig_latency(const char *dir)
@@ -204,11 +218,10 @@ static void fig_latency(const char *dir)
         printf("  %3d %8.2f %6.2f\n", ms, a * 1e3, b * 1e3);
     }
     fclose(f);
-    gnuplot(dir, "ik_latency",
-            "set title 'Elbow error vs tracking latency (noise 1 mm)'\n"
-            "set xlabel 'latency (ms)'\nset ylabel 'mean elbow error (mm)'\n"
-            "plot 'ik_latency.csv' every ::1 using 1:2 with linespoints title 'filtered, no prediction', "
-            "'' every ::1 using 1:3 with linespoints title 'filtered + prediction to display time'");
+    plot_csv(dir, "ik_latency", "Elbow error vs tracking latency (noise 1 mm)", "latency (ms)",
+             "mean elbow error (mm)", "linespoints",
+             (const char *const[]){"filtered, no prediction",
+                                   "filtered + prediction to display time", NULL});
 }
 
 static void fig_twist(const char *dir)
@@ -246,11 +259,9 @@ static void fig_twist(const char *dir)
     }
     fclose(f);
     printf("wrist twist: LBS ring radius error up to %.1f mm (radius 30 mm), DQS 0\n", worst * 1e3);
-    gnuplot(dir, "twist",
-            "set title 'Wrist ring (r = 30 mm, weights 50/50) under twist: LBS vs DQS'\n"
-            "set xlabel 'wrist twist (deg)'\nset ylabel 'radius error (mm)'\n"
-            "plot 'twist.csv' every ::1 using 1:2 with lines lw 2 title 'LBS', "
-            "'' every ::1 using 1:3 with lines lw 2 title 'DQS'");
+    plot_csv(dir, "twist", "Wrist ring (r = 30 mm, weights 50/50) under twist: LBS vs DQS",
+             "wrist twist (deg)", "radius error (mm)", "lines lw 2",
+             (const char *const[]){"LBS", "DQS", NULL});
 }
 
 static void fig_predict(const char *dir)
@@ -287,12 +298,10 @@ static void fig_predict(const char *dir)
         printf("  %3d %8.2f %7.2f %7.2f\n", hms, e[0] * 1e3, e[1] * 1e3, e[2] * 1e3);
     }
     fclose(f);
-    gnuplot(dir, "predict",
-            "set title 'Hand position error vs prediction horizon (90 Hz, noise 1 mm)'\n"
-            "set xlabel 'horizon (ms)'\nset ylabel 'mean error (mm)'\n"
-            "plot 'predict.csv' every ::1 using 1:2 with linespoints title 'One Euro output, no prediction', "
-            "'' every ::1 using 1:3 with linespoints title 'prediction + lag compensation', "
-            "'' every ::1 using 1:4 with linespoints title 'prediction only'");
+    plot_csv(dir, "predict", "Hand position error vs prediction horizon (90 Hz, noise 1 mm)",
+             "horizon (ms)", "mean error (mm)", "linespoints",
+             (const char *const[]){"One Euro output, no prediction",
+                                   "prediction + lag compensation", "prediction only", NULL});
 }
 
 /* -------------------------------------------------------------- timing */

@@ -1,7 +1,8 @@
 /* bench_sample.h - the sample model the benchmarks pose (header only):
  * DIR/scene.txt of samples/gen (build/gen_samples --out DIR) and the glTF
- * of its first frame (bench_raster.c, bench_lod.c); the images of one eye
- * of a sample frame as the frame benchmarks feed them (bench_frame.c,
+ * of its first frame (bench_raster.c, bench_lod.c); the posed model, the
+ * sequence's timing, HMD and lighting, and the images of one eye of a
+ * sample frame as the frame benchmarks feed them (bench_frame.c,
  * llvmpipe/llvmpipe_frame.c). */
 #ifndef EGOFUSE_BENCH_SAMPLE_H
 #define EGOFUSE_BENCH_SAMPLE_H
@@ -29,6 +30,50 @@ static inline int bench_sample_model(const char *dir, const char *pfx, io_scene 
         return 0;
     }
     return 1;
+}
+
+/* DIR/scene.txt into sc, the glTF of its first frame into model, the
+ * scene's animation into *anim (NULL when the model has none) and its head
+ * node (default "head") into *head (-1 when none): what the frame
+ * benchmarks pose. 1 when loaded; else 0 after a line "<who>: why" on
+ * stderr (with gen_hint, for a missing scene, how to generate the
+ * samples), nothing held. */
+static inline int bench_sample_posed(const char *dir, const char *who, int gen_hint, io_scene *sc,
+                                     kin_model *model, const kin_animation **anim, int *head)
+{
+    char path[IO_PATH_MAX + 64];
+    io_error err;
+    snprintf(path, sizeof path, "%s/scene.txt", dir);
+    if (io_scene_load(path, sc, &err) != IO_OK) {
+        if (gen_hint)
+            fprintf(stderr, "%s: %s (make build/gen_samples && build/gen_samples --out %s)\n", who,
+                    err.msg, dir);
+        else
+            fprintf(stderr, "%s: %s\n", who, err.msg);
+        return 0;
+    }
+    io_scene_frame_path(sc, sc->model, 0, path, sizeof path);
+    if (io_gltf_load(path, model, &err) != IO_OK) {
+        fprintf(stderr, "%s: %s\n", who, err.msg);
+        return 0;
+    }
+    *anim = kin_model_find_anim(model, sc->animation);
+    *head = kin_model_find_node(model, sc->head_node[0] ? sc->head_node : "head");
+    return 1;
+}
+
+/* How the frame benchmarks play the sequence of sc: its frame rate (60
+ * when it gives none) and number of frames, on the paper's HMD (its
+ * description and geometry), under the scene's lighting. */
+static inline void bench_sample_play(const io_scene *sc, float *fps, int *frames,
+                                     kin_sthmd_desc *hmd, kin_sthmd_geometry *geo,
+                                     fuse_lighting *light)
+{
+    *fps = sc->fps > 0 ? sc->fps : 60.0f;
+    *frames = sc->frames;
+    *hmd = kin_sthmd_desc_resolved(NULL);
+    *geo = kin_sthmd_geometry_of(hmd);
+    *light = io_scene_lighting(sc);
 }
 
 /* The image at path as w x h pixels of `channels` of `type` into img: 1

@@ -178,21 +178,9 @@ typedef struct inputs {
 
 static int load(inputs *in, const char *dir, int window)
 {
-    char path[IO_PATH_MAX + 64];
     io_scene sc;
-    io_error err;
-    snprintf(path, sizeof path, "%s/scene.txt", dir);
-    if (io_scene_load(path, &sc, &err) != IO_OK) {
-        fprintf(stderr, "llvmpipe_frame: %s\n", err.msg);
+    if (!bench_sample_posed(dir, "llvmpipe_frame", 0, &sc, &in->model, &in->anim, &in->head))
         return 0;
-    }
-    io_scene_frame_path(&sc, sc.model, 0, path, sizeof path);
-    if (io_gltf_load(path, &in->model, &err) != IO_OK) {
-        fprintf(stderr, "llvmpipe_frame: %s\n", err.msg);
-        return 0;
-    }
-    in->anim = kin_model_find_anim(&in->model, sc.animation);
-    in->head = kin_model_find_node(&in->model, sc.head_node[0] ? sc.head_node : "head");
     if (in->head < 0) {
         fprintf(stderr, "llvmpipe_frame: no head node\n");
         return 0;
@@ -202,11 +190,7 @@ static int load(inputs *in, const char *dir, int window)
             fprintf(stderr, "llvmpipe_frame: a skin has more than %d joints\n", MAX_JOINTS);
             return 0;
         }
-    in->fps = sc.fps > 0 ? sc.fps : 60.0f;
-    in->seq_frames = sc.frames;
-    in->hmd = kin_sthmd_desc_resolved(NULL);
-    in->geo = kin_sthmd_geometry_of(&in->hmd);
-    in->lighting.light = io_scene_lighting(&sc);
+    bench_sample_play(&sc, &in->fps, &in->seq_frames, &in->hmd, &in->geo, &in->lighting.light);
     const int cw = in->hmd.cam_width, ch = in->hmd.cam_height;
     const int lw = in->hmd.lcd_width, lh = in->hmd.lcd_height;
     in->window = window < sc.frames ? window : sc.frames;
@@ -254,6 +238,15 @@ static GLuint tex2d(GLenum ifmt, int w, int h, GLenum filter)
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     return t;
+}
+
+/* Texture tex on texture unit `unit` and the sampler uniform loc of the
+ * program in use reading that unit. */
+static void bind_sampler(GLint loc, int unit, GLuint tex)
+{
+    glActiveTexture(GL_TEXTURE0 + (GLenum)unit);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glUniform1i(loc, unit);
 }
 
 static int gl_setup(gl_state *g, const inputs *in)
@@ -443,15 +436,9 @@ static void gl_frame(gl_state *g, const inputs *in, int w, float t, uint8_t *out
         glBindFramebuffer(GL_FRAMEBUFFER, g->fb_q[e]);
         glUseProgram(g->prog_light);
         glBindVertexArray(g->vao_empty);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, g->cam_tex[e]);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, g->g_tex[e]);
-        glActiveTexture(GL_TEXTURE2);
-        glBindTexture(GL_TEXTURE_2D, g->vd_tex[e]);
-        glUniform1i(g->l_cam, 0);
-        glUniform1i(g->l_g, 1);
-        glUniform1i(g->l_vd, 2);
+        bind_sampler(g->l_cam, 0, g->cam_tex[e]);
+        bind_sampler(g->l_g, 1, g->g_tex[e]);
+        bind_sampler(g->l_vd, 2, g->vd_tex[e]);
         glUniform1i(g->l_crop, in->geo.crop_y0);
         glUniform4f(g->l_K, cam[e].fx, cam[e].fy, cam[e].cx, cam[e].cy);
         float ld[8][3], lc[8][3];
@@ -480,12 +467,8 @@ static void gl_frame(gl_state *g, const inputs *in, int w, float t, uint8_t *out
         glBindFramebuffer(GL_FRAMEBUFFER, g->fb_out[e]);
         glViewport(0, 0, lw, lh);
         glUseProgram(g->prog_comp);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, g->q_tex[e]);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, g->v_tex[e]);
-        glUniform1i(g->c_q, 0);
-        glUniform1i(g->c_v, 1);
+        bind_sampler(g->c_q, 0, g->q_tex[e]);
+        bind_sampler(g->c_v, 1, g->v_tex[e]);
         glUniform4i(g->c_vp, in->geo.vp_x0, in->geo.vp_y0, in->geo.vp_width, in->geo.vp_height);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glFlush();

@@ -34,6 +34,18 @@ int cli_usage_error(const char *cmd, const char *fmt, ...)
  * option is argv[optind - 1]). */
 int cli_option_error(const char *cmd, int c, char *const *argv);
 
+/* A subcommand's option loop: cli_getopt_begin, then cli_getopt until it
+ * returns 0 or less. cli_getopt_begin: getopt_long starts again at
+ * argv[1], with its own messages off. cli_getopt: the next option's value
+ * for the command's switch (getopt_long with -h the only short option); 0
+ * after the last option; -1 when the command is to return *rc: after -h or
+ * --help (cmd's usage printed on stdout; EXIT_OK) or a bad option
+ * (cli_option_error; EXIT_USAGE). */
+struct option;
+void cli_getopt_begin(void);
+int cli_getopt(const char *cmd, const char *usage, int argc, char **argv,
+               const struct option *opts, int *rc);
+
 /* Reads OpenCV calibration files (io_calib.h) into hmd->lens: both for
  * both cameras (a stereo file: its first camera left, its second right),
  * left / right for one each (they win over both); NULL = none. Checks the
@@ -68,6 +80,9 @@ int cli_soft_edges(const char *cmd, int *soft, int aa, int view);
 int cli_parse_int(const char *s, int lo, int hi, int *out);
 int cli_parse_float(const char *s, float *out);
 int cli_parse_vec3(const char *s, float out[3]);
+/* A keyword option's value: the index of s in words (a list ending in
+ * NULL), or -1 when s is none of them. */
+int cli_pick(const char *s, const char *const *words);
 
 /* A float option checked against a closed range, one row of a command's
  * table of them (instead of a case each): getopt's value for it, its name

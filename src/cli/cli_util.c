@@ -4,6 +4,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -29,6 +30,29 @@ int cli_option_error(const char *cmd, int c, char *const *argv)
     return cli_usage_error(cmd, "unknown option '%s'", argv[optind - 1]);
 }
 
+void cli_getopt_begin(void)
+{
+    optind = 1;
+    opterr = 0;
+}
+
+int cli_getopt(const char *cmd, const char *usage, int argc, char **argv,
+               const struct option *opts, int *rc)
+{
+    int c = getopt_long(argc, argv, "h", opts, NULL);
+    if (c == -1) return 0;
+    if (c == 'h') {
+        fputs(usage, stdout);
+        *rc = EXIT_OK;
+        return -1;
+    }
+    if (c == '?' || c == ':') {
+        *rc = cli_option_error(cmd, c, argv);
+        return -1;
+    }
+    return c;
+}
+
 int cli_parse_int(const char *s, int lo, int hi, int *out)
 {
     return io_parse_int(s, lo, hi, out);
@@ -43,6 +67,13 @@ int cli_parse_float(const char *s, float *out)
     if (errno || *end || !isfinite(v) || fabs(v) > 3.0e38) return 0;
     *out = (float)v;
     return 1;
+}
+
+int cli_pick(const char *s, const char *const *words)
+{
+    for (int i = 0; words[i]; i++)
+        if (!strcmp(s, words[i])) return i;
+    return -1;
 }
 
 const cli_float_opt *cli_float_opt_find(const cli_float_opt *t, int n, int id)

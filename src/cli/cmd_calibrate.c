@@ -97,12 +97,10 @@ int cmd_calibrate(int argc, char **argv)
     };
     const char *model_arg = NULL, *scene = NULL, *rec = NULL, *out = NULL, *glove[2] = {0, 0};
     int invert = 0;
-    optind = 1;
-    opterr = 0;
-    int c;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    int c, rc;
+    cli_getopt_begin();
+    while ((c = cli_getopt("calibrate", calib_usage, argc, argv, opts, &rc)) > 0) {
         switch (c) {
-        case 'h': fputs(calib_usage, stdout); return EXIT_OK;
         case O_MODEL: model_arg = optarg; break;
         case O_SCENE: scene = optarg; break;
         case O_REC: rec = optarg; break;
@@ -113,9 +111,9 @@ int cmd_calibrate(int argc, char **argv)
             if (!cli_parse_int(optarg, 0, 31, &invert))
                 return cli_usage_error("calibrate", "--glove-invert '%s': a mask 0..31", optarg);
             break;
-        default: return cli_option_error("calibrate", c, argv);
         }
     }
+    if (c < 0) return rc;
     if (optind < argc) return cli_usage_error("calibrate", "unexpected argument '%s'", argv[optind]);
     if (!model_arg == !scene) return cli_usage_error("calibrate", "give --model or --scene (one)");
     if (!rec) return cli_usage_error("calibrate", "--recording FILE is required");
@@ -132,7 +130,7 @@ int cmd_calibrate(int argc, char **argv)
     }
     kin_model model;
     if (io_gltf_load(model_path, &model, &err) != IO_OK) return io_term_fail("%s", err.msg);
-    int rc = EXIT_FAIL;
+    rc = EXIT_FAIL;
     kin_track_sample *smp = NULL;
     float *scratch = NULL, *raw = NULL;
     int count = 0;

@@ -29,16 +29,11 @@ int cmd_devices(int argc, char **argv)
 {
     static const struct option opts[] = {
         {"all", no_argument, 0, 'a'}, {"help", no_argument, 0, 'h'}, {0, 0, 0, 0}};
-    int all = 0, c;
-    optind = 1;
-    opterr = 0;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
-        switch (c) {
-        case 'h': fputs(devices_usage, stdout); return EXIT_OK;
-        case 'a': all = 1; break;
-        default: return cli_option_error("devices", c, argv);
-        }
-    }
+    int all = 0, c, rc;
+    cli_getopt_begin();
+    while ((c = cli_getopt("devices", devices_usage, argc, argv, opts, &rc)) > 0)
+        if (c == 'a') all = 1;
+    if (c < 0) return rc;
     if (optind < argc) return cli_usage_error("devices", "unexpected argument '%s'", argv[optind]);
 
     io_error err;

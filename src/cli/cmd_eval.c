@@ -153,12 +153,10 @@ int cmd_eval(int argc, char **argv)
         {O_GLOBAL, "--global", 0.0f, 1.0f, "not in 0..1", &o.global},
     };
     enum { NFL = (int)(sizeof fl / sizeof fl[0]) };
-    optind = 1;
-    opterr = 0;
-    int ch;
-    while ((ch = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    int ch, rc;
+    cli_getopt_begin();
+    while ((ch = cli_getopt("eval", eval_usage, argc, argv, opts, &rc)) > 0) {
         switch (ch) {
-        case 'h': fputs(eval_usage, stdout); return EXIT_OK;
         case O_FRAMES:
             if (!cli_parse_int(optarg, 1, 100000, &o.frames))
                 return cli_usage_error("eval", "--frames '%s': not a positive count", optarg);
@@ -229,6 +227,7 @@ int cmd_eval(int argc, char **argv)
         }
         }
     }
+    if (ch < 0) return rc;
     if (optind < argc) return cli_usage_error("eval", "unexpected argument '%s'", argv[optind]);
     if (o.eyeview && o.frames > 180)
         return cli_usage_error("eval", "--eyeview --frames %d: at most 180 (the 3 s of a "

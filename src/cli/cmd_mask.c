@@ -89,13 +89,11 @@ int cmd_mask(int argc, char **argv)
     int have_eye = 0, have_target = 0;
     const char *out = NULL, *out_n = NULL, *out_d = NULL, *calib = NULL;
 
-    optind = 1;
-    opterr = 0;
-    int c;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    int c, rc;
+    cli_getopt_begin();
+    while ((c = cli_getopt("mask", usage, argc, argv, opts, &rc)) > 0) {
         const char *a = optarg;
         switch (c) {
-        case 'h': fputs(usage, stdout); return EXIT_OK;
         case O_WIDTH:
             if (!cli_parse_int(a, 1, RAST_MAX_DIM, &width))
                 return cli_usage_error("mask", "--width '%s': not an integer in 1..%d", a, RAST_MAX_DIM);
@@ -143,9 +141,9 @@ int cmd_mask(int argc, char **argv)
         case O_OUT: out = a; break;
         case O_NORMALS: out_n = a; break;
         case O_DEPTH: out_d = a; break;
-        default: return cli_option_error("mask", c, argv);
         }
     }
+    if (c < 0) return rc;
     if (optind >= argc) return cli_usage_error("mask", "no model file given");
     if (optind + 1 < argc) return cli_usage_error("mask", "unexpected argument '%s'", argv[optind + 1]);
     const char *model_path = argv[optind];
@@ -208,7 +206,7 @@ int cmd_mask(int argc, char **argv)
         an = &model.anims[anim];
     }
 
-    int rc = EXIT_FAIL;
+    rc = EXIT_FAIL;
     io_image mask = {0}, nimg = {0}, dimg = {0};
     if (io_image_alloc(&mask, width, height, 1, IO_U8, &err) != IO_OK) { io_term_fail("%s", err.msg); goto done; }
     if (out_n && io_image_alloc(&nimg, width, height, 3, IO_U8, &err) != IO_OK) { io_term_fail("%s", err.msg); goto done; }

@@ -645,12 +645,10 @@ int cmd_render(int argc, char **argv)
     o.soft_edge = -1; /* the default: cli_soft_edges */
     char why[200];
     int tracking_only = 0;   /* an option that needs --pose tracking */
-    optind = 1;
-    opterr = 0;
-    int c;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    int c, rc;
+    cli_getopt_begin();
+    while ((c = cli_getopt("render", render_usage, argc, argv, opts, &rc)) > 0) {
         switch (c) {
-        case 'h': fputs(render_usage, stdout); return EXIT_OK;
         case O_SCENE: o.scene = optarg; break;
         case O_OUT: o.out = optarg; break;
         case O_FIRST:
@@ -706,9 +704,10 @@ int cmd_render(int argc, char **argv)
                 return cli_usage_error("render", "--tone-match '%s': a strength in [0, 1]", optarg);
             break;
         case O_POSE:
-            if (!strcmp(optarg, "tracking")) o.pose_tracking = 1;
-            else if (!strcmp(optarg, "animation")) o.pose_tracking = 0;
-            else return cli_usage_error("render", "--pose '%s': 'animation' or 'tracking'", optarg);
+            o.pose_tracking =
+                cli_pick(optarg, (const char *const[]){"animation", "tracking", NULL});
+            if (o.pose_tracking < 0)
+                return cli_usage_error("render", "--pose '%s': 'animation' or 'tracking'", optarg);
             break;
         case O_CALIB: o.calib = optarg; tracking_only = O_CALIB; break;
         case O_PREDICT:
@@ -750,9 +749,9 @@ int cmd_render(int argc, char **argv)
             if (vr != EXIT_OK) return vr;
             break;
         }
-        default: return cli_option_error("render", c, argv);
         }
     }
+    if (c < 0) return rc;
     if (optind < argc) return cli_usage_error("render", "unexpected argument '%s'", argv[optind]);
     if (!o.scene) return cli_usage_error("render", "--scene is required");
     if (!o.out) return cli_usage_error("render", "--out is required");
@@ -794,21 +793,19 @@ int cmd_demo(int argc, char **argv)
     o.out = "out/demo";
     o.cull_back = 1; /* the sample arms are closed: same masks, half the setups */
     o.soft_edge = 1; /* no stair-steps (issue 14 item 3; docs/antialias.md) */
-    optind = 1;
-    opterr = 0;
-    int c;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    int c, rc;
+    cli_getopt_begin();
+    while ((c = cli_getopt("demo", demo_usage, argc, argv, opts, &rc)) > 0) {
         switch (c) {
-        case 'h': fputs(demo_usage, stdout); return EXIT_OK;
         case O_SAMPLES: samples = optarg; break;
         case O_OUT: o.out = optarg; break;
         case O_FRAMES:
             if (!cli_parse_int(optarg, 1, 1 << 24, &o.frames))
                 return cli_usage_error("demo", "--frames '%s': not a positive count", optarg);
             break;
-        default: return cli_option_error("demo", c, argv);
         }
     }
+    if (c < 0) return rc;
     if (optind < argc) return cli_usage_error("demo", "unexpected argument '%s'", argv[optind]);
     char scene[IO_PATH_MAX + 32];
     snprintf(scene, sizeof scene, "%s/scene.txt", samples);

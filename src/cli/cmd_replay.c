@@ -510,13 +510,11 @@ int cmd_replay(int argc, char **argv)
     o.major = 4;
     o.minor = 1;
     o.unit_scale = 1.0f;
-    optind = 1;
-    opterr = 0;
-    int c;
+    int c, k, rc;
     float f;
-    while ((c = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
+    cli_getopt_begin();
+    while ((c = cli_getopt("replay-track", replay_usage, argc, argv, opts, &rc)) > 0) {
         switch (c) {
-        case 'h': fputs(replay_usage, stdout); return EXIT_OK;
         case O_TO: o.to = optarg; break;
         case O_SPEED:
             if (!cli_parse_float(optarg, &f) || !(f > 0) || f > 1e6f)
@@ -525,20 +523,23 @@ int cmd_replay(int argc, char **argv)
             break;
         case O_LOOP: o.loop = 1; break;
         case O_MCAST: o.multicast = optarg; break;
-        case O_VER:
-            if (!strcmp(optarg, "3.1")) { o.major = 3; o.minor = 1; }
-            else if (!strcmp(optarg, "4.1")) { o.major = 4; o.minor = 1; }
-            else return cli_usage_error("replay-track", "--natnet-version '%s': 3.1 or 4.1", optarg);
+        case O_VER: /* 3.1 or 4.1 */
+            k = cli_pick(optarg, (const char *const[]){"3.1", "4.1", NULL});
+            if (k < 0)
+                return cli_usage_error("replay-track", "--natnet-version '%s': 3.1 or 4.1", optarg);
+            o.major = 3 + k;
+            o.minor = 1;
             break;
         case O_UP:
-            if (!strcmp(optarg, "y")) o.z_up = 0;
-            else if (!strcmp(optarg, "z")) o.z_up = 1;
-            else return cli_usage_error("replay-track", "--natnet-up '%s': y or z", optarg);
+            o.z_up = cli_pick(optarg, (const char *const[]){"y", "z", NULL});
+            if (o.z_up < 0)
+                return cli_usage_error("replay-track", "--natnet-up '%s': y or z", optarg);
             break;
         case O_UNITS:
-            if (!strcmp(optarg, "m")) o.unit_scale = 1.0f;
-            else if (!strcmp(optarg, "mm")) o.unit_scale = 0.001f;
-            else return cli_usage_error("replay-track", "--natnet-units '%s': m or mm", optarg);
+            k = cli_pick(optarg, (const char *const[]){"m", "mm", NULL});
+            if (k < 0)
+                return cli_usage_error("replay-track", "--natnet-units '%s': m or mm", optarg);
+            o.unit_scale = k == 0 ? 1.0f : 0.001f;
             break;
         case O_WAIT:
             if (!cli_parse_float(optarg, &f) || !(f > 0))
@@ -546,9 +547,9 @@ int cmd_replay(int argc, char **argv)
             o.wait_s = f;
             break;
         case O_QUIET: o.quiet = 1; break;
-        default: return cli_option_error("replay-track", c, argv);
         }
     }
+    if (c < 0) return rc;
     if (optind >= argc) return cli_usage_error("replay-track", "no tracking FILE given");
     o.file = argv[optind++];
     if (optind < argc)

@@ -272,6 +272,14 @@ int eval__kf_configs(const method_cfg base[4], method_cfg *L, int cap);
 int eval__write_kf(const char *dir, const method_run *R, int n);
 
 /* eval_report.c: the tables, the CSV and the report folder. */
+/* A run's figures per eye (mask IoU, boundary F within 1 and 3 px, false
+ * positive and negative area, composite PSNR), per stereo frame (ms) and
+ * its edge flicker: eval__summarise divides its sums by their counts (a
+ * count of 0 counts as 1; no flicker samples: flicker 0). */
+typedef struct eval_summary {
+    double iou, bf1, bf3, fp, fn, psnr, ms, flicker;
+} eval_summary;
+eval_summary eval__summarise(const method_run *r);
 void eval__print_calib(FILE *f, const eval_ctx *c);
 void eval__print_table(FILE *f, const method_run *R, int n, int markdown);
 void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int n);
@@ -290,6 +298,11 @@ struct io_out;
 FILE *eval__out_open(struct io_out *o, const char *dir, const char *name, ...)
     __attribute__((format(printf, 3, 4)));
 int eval__out_commit(struct io_out *o);
+/* The passes of a table printed twice: pass 0 as text on stdout, pass 1
+ * as Markdown into DIR/name (opened into *o; no pass 1 without dir). Sets
+ * *f to the pass's stream and returns 1; 0 when there is no such pass;
+ * -1 when DIR/name did not open (the message printed). */
+int eval__table_pass(int pass, const char *dir, const char *name, struct io_out *o, FILE **f);
 int eval__write_report(const char *dir, const method_run *R, int n, const eval_opts *o,
                        const eval_ctx *c);
 

@@ -41,13 +41,9 @@ int eval__kf_configs(const method_cfg base[4], method_cfg *L, int cap)
 int eval__write_kf(const char *dir, const method_run *R, int n)
 {
     io_out of;
-    FILE *f = stdout;
-    for (int pass = 0; pass < 2; pass++) {
-        if (pass == 1) {
-            if (!dir) break;
-            if (!eval__out_open(&of, dir, "kf.md")) return IO_EXIT_FAIL;
-            f = of.f;
-        }
+    FILE *f;
+    int go;
+    for (int pass = 0; (go = eval__table_pass(pass, dir, "kf.md", &of, &f)) > 0; pass++) {
         fprintf(f, "%sThe Fresnel fade kf against the opaque ideal composite (the true "
                    "silhouette, no fade): composite PSNR dB (IoU)%s\n",
                 pass ? "" : "egofuse eval: ", pass ? "\n" : "");
@@ -73,8 +69,8 @@ int eval__write_kf(const char *dir, const method_run *R, int n)
                     len += snprintf(row + len, sizeof row - (size_t)len, pass ? " - |" : "  %-15s", "-");
                     continue;
                 }
-                const double ne = R[hit].n_eye > 0 ? (double)R[hit].n_eye : 1.0;
-                const double psnr = fuse_psnr_of_mse(R[hit].mse / ne), iou = R[hit].iou / ne;
+                const eval_summary m = eval__summarise(&R[hit]);
+                const double psnr = m.psnr, iou = m.iou;
                 len += snprintf(row + len, sizeof row - (size_t)len,
                                 pass ? " %.2f (%.4f) |" : "  %6.2f (%.4f)", psnr, iou);
                 if (psnr > best) { best = psnr; bkf = kfs[i]; }
@@ -84,6 +80,7 @@ int eval__write_kf(const char *dir, const method_run *R, int n)
             fprintf(f, "%s%s%g%s\n", row, pass ? " " : "  ", bkf, pass ? " |" : "");
         }
     }
+    if (go < 0) return IO_EXIT_FAIL;
     if (dir && eval__out_commit(&of)) return IO_EXIT_FAIL;
     return IO_EXIT_OK;
 }

@@ -174,8 +174,8 @@ typedef struct lsum { double iou, bf3, psnr; int have; } lsum;
 
 static lsum sum_of(const method_run *r)
 {
-    const double n = r->n_eye > 0 ? (double)r->n_eye : 1.0;
-    lsum s = {r->iou / n, r->bf3 / n, fuse_psnr_of_mse(r->mse / n), 1};
+    const eval_summary m = eval__summarise(r);
+    lsum s = {m.iou, m.bf3, m.psnr, 1};
     return s;
 }
 
@@ -220,14 +220,10 @@ int eval__write_light(const char *dir, const method_run *R, int n)
     /* the table */
     io_out of;
     io_error err;
-    FILE *f = stdout;
+    FILE *f;
     char path[IO_PATH_MAX + 64];
-    for (int pass = 0; pass < 2; pass++) {
-        if (pass == 1) {
-            if (!dir) break;
-            if (!eval__out_open(&of, dir, "light.md")) return IO_EXIT_FAIL;
-            f = of.f;
-        }
+    int go;
+    for (int pass = 0; (go = eval__table_pass(pass, dir, "light.md", &of, &f)) > 0; pass++) {
         fprintf(f, "%sLighting mismatch between the cockpit and the virtual scene (the ideal "
                    "composite made under the cockpit's own light): IoU / BF(3 px) / PSNR dB%s\n%s",
                 pass ? "" : "egofuse eval: ", pass ? "\n" : "", pass ? "\n" : "");
@@ -257,6 +253,7 @@ int eval__write_light(const char *dir, const method_run *R, int n)
             fprintf(f, "\n");
         }
     }
+    if (go < 0) return IO_EXIT_FAIL;
     if (!dir) return IO_EXIT_OK;
     if (eval__out_commit(&of)) return IO_EXIT_FAIL;   /* light.md */
     /* where each curve falls below IoU 0.9 / its matched PSNR - drop */

@@ -60,12 +60,12 @@ typedef struct lod_sum {
 static lod_sum lod_summary(const method_run *r)
 {
     lod_sum s;
-    double ne = r->n_eye > 0 ? (double)r->n_eye : 1.0;
+    const eval_summary m = eval__summarise(r);
     double nf = r->n_full > 0 ? (double)r->n_full : 1.0;
     double nr = r->n_raster > 0 ? (double)r->n_raster : 1.0;
-    s.iou = r->iou / ne;
-    s.bf1 = r->bf1 / ne;
-    s.bf3 = r->bf3 / ne;
+    s.iou = m.iou;
+    s.bf1 = m.bf1;
+    s.bf3 = m.bf3;
     s.iou_full = r->n_full ? r->iou_full / nf : 1.0;
     s.bf1_full = r->n_full ? r->bf1_full / nf : 1.0;
     s.level = r->lod_sum / nr;

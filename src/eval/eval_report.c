@@ -14,13 +14,9 @@
 
 /* ---------------------------------------------------------- reporting */
 
-typedef struct summary {
-    double iou, bf1, bf3, fp, fn, psnr, ms, flicker;
-} summary;
-
-static summary summarise(const method_run *r)
+eval_summary eval__summarise(const method_run *r)
 {
-    summary s;
+    eval_summary s;
     double n = r->n_eye > 0 ? (double)r->n_eye : 1.0;
     s.iou = r->iou / n;
     s.bf1 = r->bf1 / n;
@@ -68,6 +64,17 @@ int eval__out_commit(io_out *o)
     return IO_EXIT_OK;
 }
 
+int eval__table_pass(int pass, const char *dir, const char *name, io_out *o, FILE **f)
+{
+    if (pass == 0) {
+        *f = stdout;
+        return 1;
+    }
+    if (pass > 1 || !dir) return 0;
+    *f = eval__out_open(o, dir, "%s", name);
+    return *f ? 1 : -1;
+}
+
 int eval__write_csv(const char *path, const method_run *R, int n)
 {
     io_out of;
@@ -75,7 +82,7 @@ int eval__write_csv(const char *path, const method_run *R, int n)
     if (!f) return IO_EXIT_FAIL;
     fprintf(f, "method,setting,iou,bf1,bf3,fp_area,fn_area,psnr,ms_per_frame,flicker,group\n");
     for (int i = 0; i < n; i++) {
-        summary s = summarise(&R[i]);
+        eval_summary s = eval__summarise(&R[i]);
         fprintf(f, "%s,%s,%.5f,%.5f,%.5f,%.1f,%.1f,%.3f,%.3f,%.4f,%s\n",
                 kind_name[R[i].cfg.kind], R[i].cfg.setting, s.iou, s.bf1, s.bf3, s.fp, s.fn,
                 s.psnr, s.ms, s.flicker, R[i].cfg.group);
@@ -133,7 +140,7 @@ void eval__print_table(FILE *f, const method_run *R, int n, int markdown)
          * (light.md, kf.md: eval_light.c, eval_kf.c) */
         if (markdown && (!strcmp(R[i].cfg.group, "light") || !strcmp(R[i].cfg.group, "kf")))
             continue;
-        summary s = summarise(&R[i]);
+        eval_summary s = eval__summarise(&R[i]);
         /* the method's own thread's CPU time (ms/frame is the wall clock,
          * which a shared machine inflates) */
         const double cpu_ms = 1e3 * R[i].cpu_secs / (R[i].n_frames > 0 ? (double)R[i].n_frames : 1.0);
@@ -198,7 +205,7 @@ static int write_group(const char *dir, const char *group, const method_run *R, 
         si->has[k] = m > 0;
         double px = 0.0, piou = 0.0;
         for (int j = 0; j < m; j++) {
-            summary s = summarise(&R[idx[j]]);
+            eval_summary s = eval__summarise(&R[idx[j]]);
             fprintf(f, "%g %.5f %.5f %.3f %.3f\n", (double)xs[j], s.iou, s.bf3, s.ms, s.psnr);
             if (j == 0) {
                 si->x0[k] = (double)xs[j];
@@ -240,7 +247,7 @@ static int write_sequences(const char *dir, const method_run *R, int n, const ev
                 int hit = !strcmp(name, o->sequence) ? !strcmp(c->group, "methods")
                                                      : !strcmp(c->setting, want);
                 if (!hit) continue;
-                summary s = summarise(&R[i]);
+                eval_summary s = eval__summarise(&R[i]);
                 iou[k] = s.iou;
                 bf3[k] = s.bf3;
                 any = has[k] = 1;
@@ -596,7 +603,7 @@ int eval__write_report(const char *dir, const method_run *R, int n, const eval_o
                 strcmp(cf->group, "dqs") && strcmp(cf->group, "fit") && strcmp(cf->group, "aa") &&
                 strcmp(cf->group, "global") && strcmp(cf->group, "lagcomp"))
                 continue;
-            summary s = summarise(&R[i]);
+            eval_summary s = eval__summarise(&R[i]);
             /* the method's own thread's CPU time: the wall clock of a
              * batch of knobs run side by side on a shared machine is
              * 2-3x the CPU time and moves with the load */

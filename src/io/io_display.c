@@ -188,6 +188,9 @@ void io_display_close(io_display **pd)
     if (!pd || !*pd) return;
     io_display *d = *pd;
     *pd = NULL;
-    d->ops->close(d);
+    if (d->be) {
+        d->ops->release(d->be);
+        free(d->be);
+    }
     free(d);
 }

@@ -17,7 +17,9 @@ typedef struct io_display_ops {
     io_result (*wait)(io_display *d, int timeout_ms, io_error *err);
     int (*fd)(const io_display *d);
     int (*busy)(const io_display *d);
-    void (*close)(io_display *d);
+    /* frees what the backend's state be holds, not be itself (which
+     * io_display_close frees after it) */
+    void (*release)(void *be);
 } io_display_ops;
 
 struct io_display {

@@ -340,8 +340,9 @@ static io_result kms_present(io_display *d, const uint8_t *const rgba[2], const 
     return IO_OK;
 }
 
-static void kms_release(kms *k)
+static void kms_release(void *be)
 {
+    kms *k = be;
     io_error ignore;
     if (k->fd >= 0 && any_pending(k)) kms_drain(k, 200, &ignore);
     for (int i = 0; i < k->nout; i++) {
@@ -369,16 +370,7 @@ static void kms_release(kms *k)
     k->fd = -1;
 }
 
-static void kms_close(io_display *d)
-{
-    kms *k = d->be;
-    if (!k) return;
-    kms_release(k);
-    free(k);
-    d->be = NULL;
-}
-
-static const io_display_ops kms_ops = {kms_present, kms_wait, kms_fd, kms_busy, kms_close};
+static const io_display_ops kms_ops = {kms_present, kms_wait, kms_fd, kms_busy, kms_release};
 
 /* ------------------------------------------------------------- opening */
 

@@ -137,8 +137,9 @@ static io_result sdl_wait(io_display *d, int timeout_ms, io_error *err)
 static int sdl_fd(const io_display *d) { (void)d; return -1; }
 static int sdl_busy(const io_display *d) { (void)d; return 0; }
 
-static void sdl_release(sdl *s)
+static void sdl_release(void *be)
 {
+    sdl *s = be;
     if (s->tex) api.SDL_DestroyTexture(s->tex);
     if (s->ren) api.SDL_DestroyRenderer(s->ren);
     if (s->win) api.SDL_DestroyWindow(s->win);
@@ -149,16 +150,7 @@ static void sdl_release(sdl *s)
     s->inited = 0;
 }
 
-static void sdl_close(io_display *d)
-{
-    sdl *s = d->be;
-    if (!s) return;
-    sdl_release(s);
-    free(s);
-    d->be = NULL;
-}
-
-static const io_display_ops sdl_ops = {sdl_present, sdl_wait, sdl_fd, sdl_busy, sdl_close};
+static const io_display_ops sdl_ops = {sdl_present, sdl_wait, sdl_fd, sdl_busy, sdl_release};
 
 io_result io_display_sdl_open(io_display *d, const io_display_spec *sp, io_error *err)
 {
