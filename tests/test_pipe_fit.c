@@ -583,6 +583,7 @@ typedef struct stripe_scene {
     unsigned bp, bs;
 } stripe_scene;
 
+/* S := the scene of seed (its buffers freed by stripe_scene_free). */
 static void stripe_scene_make(stripe_scene *S, uint64_t seed)
 {
     arms_build(&S->A);
@@ -596,6 +597,7 @@ static void stripe_scene_make(stripe_scene *S, uint64_t seed)
     S->bs = fuse_colour_bin(STRIPE_SKIN, PIPE_FIT_BITS);
 }
 
+/* Frees what stripe_scene_make made. */
 static void stripe_scene_free(stripe_scene *S)
 {
     free(S->rgba);

@@ -41,6 +41,7 @@ static inline void tu_quad_rig_run(tu_quad_rig *r, const kin_mat4 *head, pipe_fr
     if (pipe_frame(r->p, &r->in, st, why, sizeof why) != PIPE_OK) fail_msg("pipe_frame: %s", why);
 }
 
+/* Frees the frame, the pipe and the model of r. */
 static inline void tu_quad_rig_close(tu_quad_rig *r)
 {
     tu_frame_free(&r->b);
