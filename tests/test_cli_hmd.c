@@ -58,6 +58,32 @@ static int rgb_diff(const io_image *a, const io_image *b, int x, int y)
     return m;
 }
 
+/* Pixels of two RGBA images that differ (rgb_diff): n[k] of them by more
+ * than k (k = 0, 1), in[k] of those inside a rectangle. */
+typedef struct image_diff { long n[2], in[2]; } image_diff;
+
+/* The image at a (asserted of the consumer display's 2064 x 2208) against
+ * the one at b, the rectangle r = x, y, width, height (NULL: none). */
+static image_diff display_diff(const char *a, const char *b, const int *r)
+{
+    io_image A = load(a), B = load(b);
+    assert_int_equal(A.width, 2064);
+    assert_int_equal(A.height, 2208);
+    image_diff d = {{0, 0}, {0, 0}};
+    for (int y = 0; y < A.height; y++)
+        for (int x = 0; x < A.width; x++) {
+            const int m = rgb_diff(&A, &B, x, y);
+            const int inside = r && x >= r[0] && x < r[0] + r[2] && y >= r[1] && y < r[1] + r[3];
+            for (int k = 0; k < 2; k++) {
+                d.n[k] += m > k;
+                d.in[k] += inside && m > k;
+            }
+        }
+    io_image_free(&A);
+    io_image_free(&B);
+    return d;
+}
+
 static void check_size(const char *path, int w, int h)
 {
     io_image im = load(path);
@@ -106,7 +132,7 @@ static void render(void **st)
     int rc = ego("render", "--scene", scene, "--out", o, "--masks", NULL);
     if (rc != 0) fail_msg("render: exit %d: %s", rc, out);
     assert_non_null(strstr(out, "2064x2208 per eye"));
-    const int vx = 262, vy = 280, vw = 1539, vh = 1647;
+    const int vp[4] = {262, 280, 1539, 1647}; /* the viewport */
     for (int e = 0; e < 2; e++) {
         const char *eye = e ? "right" : "left";
         char p[700], v[700], m[700];
@@ -114,21 +140,11 @@ static void render(void **st)
         snprintf(v, sizeof v, "%s/virt/%s_0000.png", seq, eye);
         snprintf(m, sizeof m, "%s/mask_%s_0000.png", o, eye);
         check_size(m, 957, 1024);
-        io_image R = load(p), V = load(v);
-        assert_int_equal(R.width, 2064);
-        assert_int_equal(R.height, 2208);
-        long outside_diff = 0, inside_diff = 0;
-        for (int y = 0; y < R.height; y++)
-            for (int x = 0; x < R.width; x++) {
-                int d = rgb_diff(&R, &V, x, y) != 0;
-                if (x >= vx && x < vx + vw && y >= vy && y < vy + vh) inside_diff += d;
-                else outside_diff += d;
-            }
-        io_image_free(&R);
-        io_image_free(&V);
+        const image_diff d = display_diff(p, v, vp);
+        const long inside_diff = d.in[0], outside_diff = d.n[0] - d.in[0];
         if (outside_diff) fail_msg("%s: %ld pixels outside the viewport are not V's", eye, outside_diff);
         /* the arms: several percent of the viewport (about 15% of the crop) */
-        if (inside_diff < (long)vw * vh / 50)
+        if (inside_diff < (long)vp[2] * vp[3] / 50)
             fail_msg("%s: only %ld pixels of the viewport show the camera", eye, inside_diff);
     }
 }
@@ -163,21 +179,10 @@ static void run(void **st)
         char a[700], b[700];
         snprintf(a, sizeof a, "%s/%s_0000.png", o, e ? "right" : "left");
         snprintf(b, sizeof b, "%s/%s_0000.png", rd, e ? "right" : "left");
-        io_image x = load(a), y = load(b);
-        assert_int_equal(y.width, 2064);
-        assert_int_equal(y.height, 2208);
-        long differ = 0, big = 0;
-        for (int r = 0; r < x.height; r++)
-            for (int c = 0; c < x.width; c++) {
-                const int m = rgb_diff(&x, &y, c, r);
-                differ += m > 0;
-                big += m > 1;
-            }
-        io_image_free(&x);
-        io_image_free(&y);
-        if (differ)
+        const image_diff d = display_diff(b, a, NULL);
+        if (d.n[0])
             fail_msg("%s eye: run and the render of its dump differ at %ld pixels (%ld by > 1)",
-                     e ? "right" : "left", differ, big);
+                     e ? "right" : "left", d.n[0], d.n[1]);
     }
     /* without the preset: the paper's sizes, which the images do not have */
     char o3[600];

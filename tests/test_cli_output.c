@@ -10,6 +10,7 @@
 
 #include <cmocka.h>
 #include "support/files.h"
+#include "support/tu_bin_main.h"
 #include <dirent.h>
 #include <errno.h>
 #include <signal.h>
@@ -153,6 +154,15 @@ static void mask_args(const char **a, const char *model, const char *mask, const
     a[n] = NULL;
 }
 
+/* quad_files of name and, in a[40], the mask command of its quad into
+ * mask (mask_args, no normals or depth). */
+static void quad_mask(const char *name, char dir[1024], char model[1100], char mask[1100],
+                      const char **a)
+{
+    quad_files(name, dir, model, mask);
+    mask_args(a, model, mask, NULL, NULL);
+}
+
 static void mask_write_fails_cleanly(void **state)
 {
     (void)state;
@@ -230,9 +240,8 @@ static void mask_killed_leaves_nothing(void **state)
 {
     (void)state;
     char dir[1024], model[1100], mask[1100];
-    quad_files("out_kill", dir, model, mask);
     const char *a[40];
-    mask_args(a, model, mask, NULL, NULL);
+    quad_mask("out_kill", dir, model, mask, a);
     int rc = run_limited(100, XFSZ_KILL, a);
     assert_int_equal(rc, -SIGXFSZ);
     assert_false(tu_exists(mask));
@@ -345,9 +354,8 @@ static void eye_overflow_names_eye(void **state)
 {
     (void)state;
     char dir[1024], model[1100], mask[1100];
-    quad_files("msg_eye", dir, model, mask);
     const char *a[40];
-    mask_args(a, model, mask, NULL, NULL);
+    quad_mask("msg_eye", dir, model, mask, a);
     a[9] = "1e30,1,0";  /* --eye */
     assert_string_equal(a[8], "--eye");
     assert_int_equal(run_limited(-1, XFSZ_IGNORE, a), 2);
@@ -447,22 +455,13 @@ static void unwritable_folder_says_why(void **state)
     }
 }
 
-int main(void)
-{
-    if (!tu_exists(tu_bin())) {
-        printf("SKIP: %s not built\n", tu_bin());
-        return 0;
-    }
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(mask_write_fails_cleanly),
-        cmocka_unit_test(plugin_write_fails_cleanly),
-        cmocka_unit_test(mask_killed_leaves_nothing),
-        cmocka_unit_test(render_write_fails_cleanly),
-        cmocka_unit_test(eval_report_write_fails_cleanly),
-        cmocka_unit_test(eye_overflow_names_eye),
-        cmocka_unit_test(truncated_glb_says_where),
-        cmocka_unit_test(folder_as_input_says_so),
-        cmocka_unit_test(unwritable_folder_says_why),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+TU_MAIN_NEEDS_BIN(NULL, NULL,
+                  cmocka_unit_test(mask_write_fails_cleanly),
+                  cmocka_unit_test(plugin_write_fails_cleanly),
+                  cmocka_unit_test(mask_killed_leaves_nothing),
+                  cmocka_unit_test(render_write_fails_cleanly),
+                  cmocka_unit_test(eval_report_write_fails_cleanly),
+                  cmocka_unit_test(eye_overflow_names_eye),
+                  cmocka_unit_test(truncated_glb_says_where),
+                  cmocka_unit_test(folder_as_input_says_so),
+                  cmocka_unit_test(unwritable_folder_says_why))

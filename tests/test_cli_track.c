@@ -16,6 +16,7 @@
 #include <math.h>
 #include <netinet/in.h>
 #include <signal.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
@@ -49,10 +50,12 @@ static int free_port(void)
 }
 
 /* A recording: n samples at 100 Hz, every part moving; the left hand
- * missing in samples 10..14 (a dropout the stream must carry). */
+ * missing in samples 10..14 (a dropout the stream must carry), saved in
+ * the scratch file name (its path in path[512]). */
 #define NS 40
-static void make_recording(const char *path, kin_track_sample *s)
+static void make_recording(const char *name, char *path, kin_track_sample *s)
 {
+    tu_tmp_path(name, path, 512);
     for (int i = 0; i < NS; i++) {
         memset(&s[i], 0, sizeof s[i]);
         s[i].t = 2.0 + 0.01 * i;
@@ -106,10 +109,9 @@ static pid_t spawn(char *const argv[], const char *log)
 static void replay_natnet(const char *version, int z_mm)
 {
     char path[512], log[512];
-    tu_tmp_path("replay_track.txt", path, sizeof path);
     tu_tmp_path("replay_natnet.log", log, sizeof log);
     kin_track_sample s[NS];
-    make_recording(path, s);
+    make_recording("replay_track.txt", path, s);
     int port = free_port();
     char to[64], ps[16];
     snprintf(to, sizeof to, "natnet:127.0.0.1:%d", port);
@@ -187,9 +189,8 @@ static void result_replay_udp(void **state)
 {
     (void)state;
     char path[512];
-    tu_tmp_path("replay_udp.txt", path, sizeof path);
     kin_track_sample s[NS];
-    make_recording(path, s);
+    make_recording("replay_udp.txt", path, s);
     io_track_udp u;
     io_error err;
     assert_int_equal(io_track_udp_listen(&u, "127.0.0.1", 0, &err), IO_OK);
@@ -215,45 +216,46 @@ static void result_replay_udp(void **state)
     io_track_udp_close(&u);
 }
 
+/* egofuse replay-track with the arguments given (NULL-terminated, at most
+ * 12): the exit status rc and, unless msg is NULL, msg in its output. */
+static void replay_says(int rc, const char *msg, ...)
+{
+    char *argv[16] = { (char *)tu_bin(), "replay-track" };
+    int n = 2;
+    va_list ap;
+    va_start(ap, msg);
+    for (const char *a; n < 14 && (a = va_arg(ap, const char *)) != NULL;) argv[n++] = (char *)a;
+    va_end(ap);
+    argv[n] = NULL;
+    int got = tu_run(argv, out, sizeof out);
+    if (got != rc || (msg && !strstr(out, msg)))
+        fail_msg("replay-track %s %s: exit %d (want %d), output: %s", argv[2], argv[3], got, rc,
+                 out);
+}
+
 static void validity_replay_args(void **state)
 {
     (void)state;
     char path[512];
-    tu_tmp_path("replay_args.txt", path, sizeof path);
     kin_track_sample s[NS];
-    make_recording(path, s);
-    char *a1[] = { (char *)tu_bin(), "replay-track", path, "--to", "tcp:x:1", NULL };
-    assert_int_equal(tu_run(a1, out, sizeof out), 2);
-    assert_non_null(strstr(out, "--to 'tcp:x:1': udp:HOST:PORT or natnet:ADDR[:PORT]"));
-    char *a2[] = { (char *)tu_bin(), "replay-track", "/nonexistent/track.txt", "--to", "udp:127.0.0.1:9",
-                   NULL };
-    assert_int_equal(tu_run(a2, out, sizeof out), 1);
-    assert_non_null(strstr(out, "/nonexistent/track.txt: No such file"));
-    char *a3[] = { (char *)tu_bin(), "replay-track", path, "--to", "natnet:no-such-host.invalid", NULL };
-    assert_int_equal(tu_run(a3, out, sizeof out), 1);
-    assert_non_null(strstr(out, "'no-such-host.invalid' is neither an IPv4 address nor a known host"));
-    char *a4[] = { (char *)tu_bin(), "replay-track", path, "--to", "natnet:127.0.0.1:1", "--wait",
-                   "0.2", NULL };
+    make_recording("replay_args.txt", path, s);
+    replay_says(2, "--to 'tcp:x:1': udp:HOST:PORT or natnet:ADDR[:PORT]", path, "--to", "tcp:x:1",
+                NULL);
+    replay_says(1, "/nonexistent/track.txt: No such file", "/nonexistent/track.txt", "--to",
+                "udp:127.0.0.1:9", NULL);
+    replay_says(1, "'no-such-host.invalid' is neither an IPv4 address nor a known host", path,
+                "--to", "natnet:no-such-host.invalid", NULL);
     int port = free_port();
     char to[64];
     snprintf(to, sizeof to, "natnet:127.0.0.1:%d", port);
-    a4[4] = to;
-    assert_int_equal(tu_run(a4, out, sizeof out), 1);
-    assert_non_null(strstr(out, "no NatNet client connected within 0.2 s"));
-    char *a5[] = { (char *)tu_bin(), "replay-track", path, "--to", "udp:127.0.0.1:9", "--speed", "0",
-                   NULL };
-    assert_int_equal(tu_run(a5, out, sizeof out), 2);
+    replay_says(1, "no NatNet client connected within 0.2 s", path, "--to", to, "--wait", "0.2",
+                NULL);
+    replay_says(2, NULL, path, "--to", "udp:127.0.0.1:9", "--speed", "0", NULL);
     /* a malformed HOST:PORT is a command-line error (2), found before the file is read */
-    char *a6[] = { (char *)tu_bin(), "replay-track", "/nonexistent/track.txt", "--to", "udp:127.0.0.1",
-                   NULL };
-    assert_int_equal(tu_run(a6, out, sizeof out), 2);
-    assert_non_null(strstr(out, "--to '127.0.0.1': needs HOST:PORT"));
-    char *a7[] = { (char *)tu_bin(), "replay-track", path, "--to", "natnet:127.0.0.1:99999", NULL };
-    assert_int_equal(tu_run(a7, out, sizeof out), 2);
-    assert_non_null(strstr(out, "'99999' is not a port"));
-    char *a8[] = { (char *)tu_bin(), "replay-track", path, "--to", "udp::9", NULL };
-    assert_int_equal(tu_run(a8, out, sizeof out), 2);
-    assert_non_null(strstr(out, "no host"));
+    replay_says(2, "--to '127.0.0.1': needs HOST:PORT", "/nonexistent/track.txt", "--to",
+                "udp:127.0.0.1", NULL);
+    replay_says(2, "'99999' is not a port", path, "--to", "natnet:127.0.0.1:99999", NULL);
+    replay_says(2, "no host", path, "--to", "udp::9", NULL);
 }
 
 /* ---------------------------------------------------------- calibrate */
@@ -319,8 +321,9 @@ static int calib_recording(kin_track_sample *s, const kin_arm_rig *rig, const ki
 }
 
 /* The sample model's arm rig and hand tips (the test skipped without
- * the model). */
-static void calib_rig(kin_arm_rig *rig, kin_vec3 tip[2])
+ * the model) and the calibration recording of them in s (800 samples):
+ * calib_recording's count. */
+static int calib_setup(kin_arm_rig *rig, kin_vec3 tip[2], kin_track_sample *s)
 {
     if (g_samples.skip[0]) {
         printf("%s\n", g_samples.skip);
@@ -329,6 +332,7 @@ static void calib_rig(kin_arm_rig *rig, kin_vec3 tip[2])
     char why[256];
     if (kin_arm_rig_init(rig, &g_samples.model, why, sizeof why)) fail_msg("%s", why);
     if (kin_user_calib_hand_tips(rig, &g_samples.model, tip, why, sizeof why)) fail_msg("%s", why);
+    return calib_recording(s, rig, tip);
 }
 
 static void result_calibrate(void **state)
@@ -337,8 +341,7 @@ static void result_calibrate(void **state)
     kin_arm_rig rig;
     kin_vec3 tip[2];
     static kin_track_sample s[800];
-    calib_rig(&rig, tip);
-    int n = calib_recording(s, &rig, tip);
+    int n = calib_setup(&rig, tip, s);
     char rec[512], cal[512], glove[512];
     tu_tmp_path("calib_rec.txt", rec, sizeof rec);
     tu_tmp_path("calib_out.txt", cal, sizeof cal);
@@ -383,8 +386,7 @@ static void validity_calibrate(void **state)
     kin_arm_rig rig;
     kin_vec3 tip[2];
     static kin_track_sample s[800];
-    calib_rig(&rig, tip);
-    calib_recording(s, &rig, tip);
+    calib_setup(&rig, tip, s);
     char rec[512], cal[512], glove[512];
     tu_tmp_path("calib_short.txt", rec, sizeof rec);
     tu_tmp_path("calib_bad_out.txt", cal, sizeof cal);

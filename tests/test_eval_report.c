@@ -22,6 +22,7 @@
 #include "support/testutil.h"
 
 #include <cmocka.h>
+#include "support/tu_bin_main.h"
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -108,15 +109,6 @@ static void subset_skin(void **state)
     run_subset("report_skin", "skin", 0, 0);
 }
 
-int main(void)
-{
-    if (!tu_exists(tu_bin())) {
-        printf("SKIP: %s not built\n", tu_bin());
-        return 0;
-    }
-    const struct CMUnitTest tests[] = {
-        cmocka_unit_test(subset_kin_refine),
-        cmocka_unit_test(subset_skin),
-    };
-    return cmocka_run_group_tests(tests, NULL, NULL);
-}
+TU_MAIN_NEEDS_BIN(NULL, NULL,
+                  cmocka_unit_test(subset_kin_refine),
+                  cmocka_unit_test(subset_skin))

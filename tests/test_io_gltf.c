@@ -24,6 +24,17 @@ static int shared_model(const char *rel, char *buf, size_t n)
     return 1;
 }
 
+/* m := the shared model rel, which must load: 1; 0 (said) when the file
+ * is missing. */
+static int load_shared(const char *rel, kin_model *m)
+{
+    char path[1024];
+    if (!shared_model(rel, path, sizeof path)) return 0;
+    io_error err;
+    assert_int_equal(io_gltf_load(path, m, &err), IO_OK);
+    return 1;
+}
+
 static int all_zero(const void *p, size_t n)
 {
     const unsigned char *b = p;
@@ -171,11 +182,8 @@ static void shared_models_load_with_counts(void **state)
 static void fox_is_not_indexed_and_names_animations(void **state)
 {
     (void)state;
-    char path[1024];
-    if (!shared_model("gltf/Fox/Fox.glb", path, sizeof path)) skip();
     kin_model m;
-    io_error err;
-    assert_int_equal(io_gltf_load(path, &m, &err), IO_OK);
+    if (!load_shared("gltf/Fox/Fox.glb", &m)) skip();
     const kin_mesh *me = &m.meshes[0];
     assert_int_equal(me->index_count, me->vertex_count);
     for (int i = 0; i < me->index_count; i++)
@@ -196,11 +204,8 @@ static void fox_is_not_indexed_and_names_animations(void **state)
 static void rigged_simple_known_values(void **state)
 {
     (void)state;
-    char path[1024];
-    if (!shared_model("gltf/RiggedSimple/RiggedSimple.glb", path, sizeof path)) skip();
     kin_model m;
-    io_error err;
-    assert_int_equal(io_gltf_load(path, &m, &err), IO_OK);
+    if (!load_shared("gltf/RiggedSimple/RiggedSimple.glb", &m)) skip();
     /* source order Z_UP, Armature, Cylinder, Bone, Bone.001; Armature's
      * children are [Bone, Cylinder], so depth first gives: */
     static const int src[5] = {0, 1, 3, 4, 2};
@@ -256,11 +261,8 @@ static void rigged_simple_known_values(void **state)
 static void simple_skin_known_values(void **state)
 {
     (void)state;
-    char path[1024];
-    if (!shared_model("gltf/SimpleSkin/SimpleSkin.gltf", path, sizeof path)) skip();
     kin_model m;
-    io_error err;
-    assert_int_equal(io_gltf_load(path, &m, &err), IO_OK);
+    if (!load_shared("gltf/SimpleSkin/SimpleSkin.gltf", &m)) skip();
     assert_int_equal(m.node_count, 3);
     assert_string_equal(m.names[0], "node0");  /* unnamed nodes */
     assert_string_equal(m.names[2], "node2");

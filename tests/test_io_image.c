@@ -168,18 +168,26 @@ static void channel_conversion(void **state)
     io_image_free(&c4);
 }
 
+/* img saved as the scratch file name, and loaded back into back as 8 bits
+ * with ch channels (0: the file's). */
+static void save_load(const char *name, const io_image *img, int ch, io_image *back)
+{
+    char path[1024];
+    tu_tmp_path(name, path, sizeof path);
+    io_error err;
+    assert_int_equal(io_image_save(path, img, &err), IO_OK);
+    assert_int_equal(io_image_load(path, IO_U8, ch, back, &err), IO_OK);
+}
+
 static void float_to_png_is_clamped_and_scaled(void **state)
 {
     (void)state;
-    char path[1024];
-    tu_tmp_path("clamp.png", path, sizeof path);
     io_image f, back;
     io_error err;
     assert_int_equal(io_image_alloc(&f, 4, 1, 1, IO_F32, &err), IO_OK);
     float *v = f.data;
     v[0] = -0.5f; v[1] = 2.0f; v[2] = 51.0f / 255.0f; v[3] = 1.0f;
-    assert_int_equal(io_image_save(path, &f, &err), IO_OK);
-    assert_int_equal(io_image_load(path, IO_U8, 0, &back, &err), IO_OK);
+    save_load("clamp.png", &f, 0, &back);
     assert_int_equal(back.channels, 1);
     const unsigned char *b = back.data;
     assert_int_equal(b[0], 0);
@@ -193,8 +201,6 @@ static void float_to_png_is_clamped_and_scaled(void **state)
 static void padded_stride_is_honoured(void **state)
 {
     (void)state;
-    char path[1024];
-    tu_tmp_path("stride.png", path, sizeof path);
     io_image big, view, back;
     io_error err;
     tu_rng rng = {77};
@@ -202,8 +208,7 @@ static void padded_stride_is_honoured(void **state)
     fill_random(&big, &rng);
     view = big;
     view.width = 7;  /* a 7-pixel view of 10-pixel rows */
-    assert_int_equal(io_image_save(path, &view, &err), IO_OK);
-    assert_int_equal(io_image_load(path, IO_U8, 3, &back, &err), IO_OK);
+    save_load("stride.png", &view, 3, &back);
     tu_same_image(&view, &back);
     io_image_free(&back);
     io_image_free(&big);

@@ -159,16 +159,24 @@ static void handshake(server *s, io_natnet *n, const char *v)
     assert_true(n->have_server_info);
 }
 
-/* A fake server and a client of the default configuration connected to
- * it, past the version 4.1 handshake. */
-static void connected(server *s, io_natnet *n)
+/* A fake server and the default configuration of a client of it. */
+static void server_and_config(server *s, io_natnet_config *c)
 {
     server_open(s);
+    client_config(c, s);
+}
+
+/* A fake server and a client of the default configuration connected to
+ * it, past the version 4.1 handshake; then the server sends the model
+ * definitions of the file modeldef (not handled yet). */
+static void connected(server *s, io_natnet *n, const char *modeldef)
+{
     io_natnet_config c;
-    client_config(&c, s);
+    server_and_config(s, &c);
     io_error err;
     assert_int_equal(io_natnet_open(n, &c, &err), IO_OK);
     handshake(s, n, "4.1");
+    server_send(s, modeldef);
 }
 
 /* The point k of s against body id of file (identity axes, metres). */
@@ -239,9 +247,8 @@ static int group_teardown(void **state)
 static void stream_version(const char *v, int major, int minor)
 {
     server s;
-    server_open(&s);
     io_natnet_config c;
-    client_config(&c, &s);
+    server_and_config(&s, &c);
     io_error err;
     assert_int_equal(io_natnet_config_set(&c, "body", "head=#11", &err), IO_OK);
     io_natnet n;
@@ -344,9 +351,8 @@ static void result_axes_and_units(void **state)
     for (int vi = 0; vi < 2; vi++) {
         const char *v = vi ? "4.1" : "3.1";
         server s;
-        server_open(&s);
         io_natnet_config c;
-        client_config(&c, &s);
+        server_and_config(&s, &c);
         io_error err;
         assert_int_equal(io_natnet_config_set(&c, "up", "z", &err), IO_OK);
         assert_int_equal(io_natnet_config_set(&c, "units", "mm", &err), IO_OK);
@@ -437,8 +443,7 @@ static void validity_bad_packets(void **state)
     server s;
     io_natnet n;
     io_error err;
-    connected(&s, &n);
-    server_send(&s, "modeldef_4.1.bin");
+    connected(&s, &n, "modeldef_4.1.bin");
     server_send(&s, "frame_4.1_1.bin");
     kin_track_sample good;
     pump(&n, 2, &good);
@@ -476,9 +481,8 @@ static void validity_bad_packets(void **state)
     close(s.fd);
 
     /* frames before any server info, no version configured: refused, named */
-    server_open(&s);
     io_natnet_config c;
-    client_config(&c, &s);
+    server_and_config(&s, &c);
     assert_int_equal(io_natnet_open(&n, &c, &err), IO_OK);
     server_expect(&s, IO_NATNET_CONNECT);
     server_send(&s, "frame_3.1_1.bin");
@@ -510,8 +514,7 @@ static void validity_unknown_names(void **state)
     server s;
     io_natnet n;
     io_error err;
-    connected(&s, &n);
-    server_send(&s, "modeldef_nohands_4.1.bin");
+    connected(&s, &n, "modeldef_nohands_4.1.bin");
     pump(&n, 1, NULL);
     assert_int_equal(io_natnet_wait_ready(&n, 100, &err), IO_ERR_MISSING);
     assert_non_null(strstr(err.msg, "'HandL' (hand-left), 'HandR' (hand-right)"));
@@ -538,9 +541,8 @@ static void validity_no_answer(void **state)
 {
     (void)state;
     server s;
-    server_open(&s);   /* bound, never answers */
     io_natnet_config c;
-    client_config(&c, &s);
+    server_and_config(&s, &c);   /* bound, never answers */
     c.resend_ms = 50;
     io_error err;
     io_natnet n;

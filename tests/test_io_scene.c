@@ -12,6 +12,16 @@
 
 #include "../src/io/io.h"
 
+/* Writes text to the scratch file name and loads it as a scene into s:
+ * io_scene_load's result. */
+static io_result scene_text(const char *name, const char *text, io_scene *s, io_error *err)
+{
+    char path[1024];
+    tu_tmp_path(name, path, sizeof path);
+    tu_write_text(path, text);
+    return io_scene_load(path, s, err);
+}
+
 static const char *full_scene =
     "egofuse-scene 1\n"
     "# a recorded sequence\n"
@@ -98,10 +108,8 @@ static void full_file_parses(void **state)
 static void minimal_file_and_lighting_defaults(void **state)
 {
     (void)state;
-    char path[1024];
     io_scene s;
     io_error err;
-    tu_tmp_path("scene_min.txt", path, sizeof path);
     const char *base =
         "egofuse-scene 1\n"
         "model=m.gltf\n"
@@ -111,8 +119,7 @@ static void minimal_file_and_lighting_defaults(void **state)
         "camera_right=r%d.png\n"
         "virtual_left=vl%d.png\n"
         "virtual_right=vr%d.png\n";
-    tu_write_text(path, base);
-    assert_int_equal(io_scene_load(path, &s, &err), IO_OK);
+    assert_int_equal(scene_text("scene_min.txt", base, &s, &err), IO_OK);
     assert_int_equal(s.has_lighting, 0);
     assert_int_equal(s.light_count, 0);
     assert_string_equal(s.animation, "");
@@ -122,8 +129,7 @@ static void minimal_file_and_lighting_defaults(void **state)
     /* one lighting key: the rest takes fuse_lighting_default()'s values */
     char text[1024];
     snprintf(text, sizeof text, "%sks = 0.5\n", base);
-    tu_write_text(path, text);
-    assert_int_equal(io_scene_load(path, &s, &err), IO_OK);
+    assert_int_equal(scene_text("scene_min.txt", text, &s, &err), IO_OK);
     assert_int_equal(s.has_lighting, 1);
     assert_true(s.ks == 0.5f);
     assert_true(s.kd == 0.75f && s.shininess == 16.0f && s.kf == 0.6f);
@@ -211,16 +217,13 @@ static void errors_name_file_and_line(void **state)
         {"frames = 5\n", IO_ERR_FORMAT, 9, "duplicate key 'frames' (first on line 3)"},
         {"", IO_ERR_MISSING, 8, "missing required key 'virtual_right'"},
     };
-    char path[1024];
-    tu_tmp_path("bad_scene.txt", path, sizeof path);
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
         char text[2048], want[64];
         snprintf(text, sizeof text, "%s%s", head, cases[i].line);
-        tu_write_text(path, text);
         io_scene s;
         io_error err;
         memset(&s, 0x33, sizeof s);
-        io_result r = io_scene_load(path, &s, &err);
+        io_result r = scene_text("bad_scene.txt", text, &s, &err);
         snprintf(want, sizeof want, "bad_scene.txt:%d: ", cases[i].line_no);
         if (r != cases[i].code || !strstr(err.msg, want) ||
             !strstr(err.msg, cases[i].needle))
@@ -240,8 +243,6 @@ static void frames_and_fps_checks(void **state)
         "frames = ", "fps = 0", "fps = -1", "fps = 3O",
         "animation_start = -1", "animation_start = nan", "animation_start = 2e6",
     };
-    char path[1024];
-    tu_tmp_path("bad_numbers.txt", path, sizeof path);
     for (size_t i = 0; i < sizeof bad_values / sizeof bad_values[0]; i++) {
         char text[1024];
         int is_frames = strncmp(bad_values[i], "frames", 6) == 0;
@@ -250,10 +251,9 @@ static void frames_and_fps_checks(void **state)
                  "camera_left = l%%d.png\ncamera_right = r%%d.png\n"
                  "virtual_left = vl%%d.png\nvirtual_right = vr%%d.png\n",
                  bad_values[i], is_frames ? "fps = 30" : "frames = 3");
-        tu_write_text(path, text);
         io_scene s;
         io_error err;
-        io_result r = io_scene_load(path, &s, &err);
+        io_result r = scene_text("bad_numbers.txt", text, &s, &err);
         assert_true(r == IO_ERR_FORMAT || r == IO_ERR_VALUE);
         assert_non_null(strstr(err.msg, "bad_numbers.txt:3: "));
     }
@@ -262,26 +262,23 @@ static void frames_and_fps_checks(void **state)
 static void header_and_file_errors(void **state)
 {
     (void)state;
-    char path[1024];
     io_scene s;
     io_error err;
-    tu_tmp_path("hdr.txt", path, sizeof path);
     static const char *const headers[] = {
         "egofuse-scene 2\n", "egofuse-scene 1 \n", "# egofuse-scene 1\n",
         "\negofuse-scene 1\n", "",
     };
     for (size_t i = 0; i < sizeof headers / sizeof headers[0]; i++) {
-        tu_write_text(path, headers[i]);
-        assert_int_equal(io_scene_load(path, &s, &err), IO_ERR_FORMAT);
+        assert_int_equal(scene_text("hdr.txt", headers[i], &s, &err), IO_ERR_FORMAT);
         assert_non_null(strstr(err.msg, "hdr.txt:1: "));
     }
     /* nine lights */
     char text[2048] = "egofuse-scene 1\n";
     for (int i = 0; i < 9; i++) strcat(text, "light = 0 1 0 1 1 1\n");
-    tu_write_text(path, text);
-    assert_int_equal(io_scene_load(path, &s, &err), IO_ERR_VALUE);
+    assert_int_equal(scene_text("hdr.txt", text, &s, &err), IO_ERR_VALUE);
     assert_non_null(strstr(err.msg, "hdr.txt:10: "));
 
+    char path[1024];
     tu_tmp_path("no_such_scene.txt", path, sizeof path);
     assert_int_equal(io_scene_load(path, &s, &err), IO_ERR_NOT_FOUND);
     assert_non_null(strstr(err.msg, "no_such_scene.txt"));
@@ -293,10 +290,9 @@ static void header_and_file_errors(void **state)
 static void tracking_key(void **state)
 {
     (void)state;
-    char path[1024], text[2048], out[2200];
+    char text[2048], out[2200];
     io_scene s;
     io_error err;
-    tu_tmp_path("scene_track.txt", path, sizeof path);
     const char *base =
         "egofuse-scene 1\n"
         "model = m.glb\n"
@@ -306,13 +302,11 @@ static void tracking_key(void **state)
         "camera_right = r%d.png\n"
         "virtual_left = vl%d.png\n"
         "virtual_right = vr%d.png\n";
-    tu_write_text(path, base);
-    assert_int_equal(io_scene_load(path, &s, &err), IO_OK);
+    assert_int_equal(scene_text("scene_track.txt", base, &s, &err), IO_OK);
     assert_string_equal(s.tracking, "");
 
     snprintf(text, sizeof text, "%stracking = rec/track.txt   # the true motion\n", base);
-    tu_write_text(path, text);
-    io_result r = io_scene_load(path, &s, &err);
+    io_result r = scene_text("scene_track.txt", text, &s, &err);
     if (r != IO_OK) fprintf(stderr, "%s\n", err.msg);
     assert_int_equal(r, IO_OK);
     assert_string_equal(s.tracking, "rec/track.txt");
@@ -323,8 +317,7 @@ static void tracking_key(void **state)
 
     /* a literal percent sign */
     snprintf(text, sizeof text, "%stracking = /abs/100%%%%.txt\n", base);
-    tu_write_text(path, text);
-    assert_int_equal(io_scene_load(path, &s, &err), IO_OK);
+    assert_int_equal(scene_text("scene_track.txt", text, &s, &err), IO_OK);
     assert_string_equal(s.tracking, "/abs/100%%.txt");
     io_scene_frame_path(&s, s.tracking, 7, out, sizeof out);
     assert_string_equal(out, "/abs/100%.txt");
@@ -339,8 +332,7 @@ static void tracking_key(void **state)
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         snprintf(text, sizeof text, "%s%s", base, bad[i].line);
-        tu_write_text(path, text);
-        r = io_scene_load(path, &s, &err);
+        r = scene_text("scene_track.txt", text, &s, &err);
         if (r != bad[i].code || !strstr(err.msg, bad[i].needle))
             fprintf(stderr, "case %zu: %s: %s\n", i, io_result_str(r), err.msg);
         assert_int_equal(r, bad[i].code);

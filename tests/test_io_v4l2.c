@@ -42,6 +42,34 @@ static void grab_expect(io_cam *cam, io_frame *f, int want)
     assert_int_equal(got, want);
 }
 
+/* A dummy camera under test: its options o (clocked: 60 FPS on clock),
+ * its config c (dummy_cfg of o), the camera and the error of the calls. */
+typedef struct dummy_cam {
+    uint64_t clock;
+    io_dummy_cam_opts o;
+    io_cam_config c;
+    io_cam cam;
+    io_error err;
+} dummy_cam;
+
+/* A dummy camera of the name: its clock at 0, its options clocked (or
+ * all defaults), its config dummy_cfg of them; nothing opened. */
+static dummy_cam *dummy_new(const char *name, int is_clocked)
+{
+    dummy_cam *d = calloc(1, sizeof *d);
+    assert_non_null(d);
+    if (is_clocked) d->o = clocked(&d->clock);
+    d->c = dummy_cfg(name, &d->o);
+    return d;
+}
+
+/* Closes d's camera (closing again is fine) and frees d. */
+static void dummy_done(dummy_cam *d)
+{
+    io_cam_close(&d->cam);
+    free(d);
+}
+
 static void open_start(io_cam *cam, const io_cam_config *c)
 {
     io_error err;
@@ -53,28 +81,24 @@ static void open_start(io_cam *cam, const io_cam_config *c)
 static void test_grab_newest_and_pixels(void **st)
 {
     (void)st;
-    uint64_t clock = 0;
-    io_dummy_cam_opts o = clocked(&clock);
-    o.t0_ns = 1000 * MS;
-    io_cam_config c = dummy_cfg("dummy0", &o);
-    io_cam cam;
-    io_error err;
+    dummy_cam *d = dummy_new("dummy0", 1);
+    d->o.t0_ns = 1000 * MS;
     io_frame f;
     int got;
-    open_start(&cam, &c);
-    assert_int_equal(cam.fourcc, IO_FMT_YUYV);
-    assert_int_equal(cam.stride, 128);
+    open_start(&d->cam, &d->c);
+    assert_int_equal(d->cam.fourcc, IO_FMT_YUYV);
+    assert_int_equal(d->cam.stride, 128);
 
     /* nothing before the first frame time */
-    grab_expect(&cam, &f, 0);
+    grab_expect(&d->cam, &f, 0);
 
     /* 3 frames ready: the newest comes out, 2 are skipped */
-    clock = o.t0_ns + 2 * PERIOD;
-    grab_expect(&cam, &f, 1);
+    d->clock = d->o.t0_ns + 2 * PERIOD;
+    grab_expect(&d->cam, &f, 1);
     assert_int_equal(f.sequence, 2);
-    assert_true(f.t_ns == o.t0_ns + 2 * PERIOD);
-    assert_int_equal(cam.stats.skipped, 2);
-    assert_int_equal(cam.stats.frames, 3);
+    assert_true(f.t_ns == d->o.t0_ns + 2 * PERIOD);
+    assert_int_equal(d->cam.stats.skipped, 2);
+    assert_int_equal(d->cam.stats.frames, 3);
     assert_int_equal(f.width, 64);
     for (int y = 0; y < 48; y += 7)
         for (int x = 0; x < 64; x += 5) {
@@ -82,189 +106,176 @@ static void test_grab_newest_and_pixels(void **st)
             assert_int_equal(f.data[y * f.stride + 2 * x + 1], 128);
         }
     /* while held, the buffer is ours */
-    assert_int_equal(cam.queued[f.index], 0);
+    assert_int_equal(d->cam.queued[f.index], 0);
     int idx = f.index;
-    assert_int_equal(io_cam_release(&cam, &f, &err), IO_OK);
-    assert_int_equal(cam.queued[idx], 1);
+    assert_int_equal(io_cam_release(&d->cam, &f, &d->err), IO_OK);
+    assert_int_equal(d->cam.queued[idx], 1);
     assert_int_equal(f.index, -1);
     /* releasing twice is harmless */
-    assert_int_equal(io_cam_release(&cam, &f, &err), IO_OK);
+    assert_int_equal(io_cam_release(&d->cam, &f, &d->err), IO_OK);
 
     /* every buffer held by the caller: frames are lost, counted as gaps */
     io_frame held[4];
-    clock += PERIOD;
+    d->clock += PERIOD;
     int n = 0;
     for (int i = 0; i < 4; i++) {
-        assert_int_equal(io_cam_dequeue(&cam, &held[n], &got, &err), IO_OK);
+        assert_int_equal(io_cam_dequeue(&d->cam, &held[n], &got, &d->err), IO_OK);
         if (got) n++;
-        clock += PERIOD;
+        d->clock += PERIOD;
     }
     assert_int_equal(n, 4);
-    clock += 3 * PERIOD; /* 4 more frames pass with no buffer queued */
-    for (int i = 0; i < n; i++) assert_int_equal(io_cam_release(&cam, &held[i], &err), IO_OK);
-    clock += PERIOD;
-    grab_expect(&cam, &f, 1);
-    assert_true(cam.stats.dropped >= 3);
-    io_cam_release(&cam, &f, &err);
-    io_cam_close(&cam);
-    assert_int_equal(cam.state, IO_CAM_CLOSED);
-    assert_int_equal(cam.nbuf, 0);
-    io_cam_close(&cam); /* twice is fine */
+    d->clock += 3 * PERIOD; /* 4 more frames pass with no buffer queued */
+    for (int i = 0; i < n; i++) assert_int_equal(io_cam_release(&d->cam, &held[i], &d->err), IO_OK);
+    d->clock += PERIOD;
+    grab_expect(&d->cam, &f, 1);
+    assert_true(d->cam.stats.dropped >= 3);
+    io_cam_release(&d->cam, &f, &d->err);
+    io_cam_close(&d->cam);
+    assert_int_equal(d->cam.state, IO_CAM_CLOSED);
+    assert_int_equal(d->cam.nbuf, 0);
+    dummy_done(d); /* twice is fine */
 }
 
 static void test_gaps_short_corrupt(void **st)
 {
     (void)st;
-    uint64_t clock = 0;
-    io_dummy_cam_opts o = clocked(&clock);
-    o.drop_every = 4;   /* frames 3, 7, 11 ... lost */
-    o.short_at = 5;
-    o.corrupt_at = 6;
-    io_cam_config c = dummy_cfg("dummy1", &o);
-    io_cam cam;
-    io_error err;
+    dummy_cam *d = dummy_new("dummy1", 1);
+    d->o.drop_every = 4;   /* frames 3, 7, 11 ... lost */
+    d->o.short_at = 5;
+    d->o.corrupt_at = 6;
     io_frame f;
     int got;
-    open_start(&cam, &c);
+    open_start(&d->cam, &d->c);
     uint32_t seen[32];
     int n = 0;
     for (int k = 0; k < 12; k++) {
-        clock = (uint64_t)k * PERIOD;
-        assert_int_equal(io_cam_dequeue(&cam, &f, &got, &err), IO_OK);
+        d->clock = (uint64_t)k * PERIOD;
+        assert_int_equal(io_cam_dequeue(&d->cam, &f, &got, &d->err), IO_OK);
         if (got) {
             seen[n++] = f.sequence;
-            assert_true(f.bytes >= cam.image_bytes);
-            io_cam_release(&cam, &f, &err);
+            assert_true(f.bytes >= d->cam.image_bytes);
+            io_cam_release(&d->cam, &f, &d->err);
         }
     }
     /* 0 1 2 4 8 9 10: 3, 7, 11 lost; 5 short; 6 corrupt */
     static const uint32_t want[] = {0, 1, 2, 4, 8, 9, 10};
     assert_int_equal(n, 7);
     for (int i = 0; i < n; i++) assert_int_equal(seen[i], want[i]);
-    assert_int_equal(cam.stats.dropped, 2); /* the gaps 2->4 and 6->8; 11 not yet seen */
-    assert_int_equal(cam.stats.short_frames, 1);
-    assert_int_equal(cam.stats.corrupt, 1);
-    assert_int_equal(cam.stats.frames, 9);
-    assert_non_null(strstr(cam.status, "dummy1"));
-    assert_non_null(strstr(cam.status, "frame 6"));
+    assert_int_equal(d->cam.stats.dropped, 2); /* the gaps 2->4 and 6->8; 11 not yet seen */
+    assert_int_equal(d->cam.stats.short_frames, 1);
+    assert_int_equal(d->cam.stats.corrupt, 1);
+    assert_int_equal(d->cam.stats.frames, 9);
+    assert_non_null(strstr(d->cam.status, "dummy1"));
+    assert_non_null(strstr(d->cam.status, "frame 6"));
     /* every buffer came back to the driver */
-    for (int i = 0; i < cam.nbuf; i++) assert_int_equal(cam.queued[i], 1);
-    io_cam_close(&cam);
+    for (int i = 0; i < d->cam.nbuf; i++) assert_int_equal(d->cam.queued[i], 1);
+    dummy_done(d);
 }
 
 static void test_unplug_and_reopen(void **st)
 {
     (void)st;
-    uint64_t clock = 0;
-    io_dummy_cam_opts o = clocked(&clock);
-    o.unplug_at = 3;
-    io_cam_config c = dummy_cfg("dummy2", &o);
-    io_cam cam;
-    io_error err;
+    dummy_cam *d = dummy_new("dummy2", 1);
+    d->o.unplug_at = 3;
     io_frame f;
     int got;
-    open_start(&cam, &c);
-    clock = 2 * PERIOD;
-    grab_expect(&cam, &f, 1);
-    assert_int_equal(io_cam_release(&cam, &f, &err), IO_OK);
-    clock = 3 * PERIOD;
-    memset(&err, 0, sizeof err);
-    assert_int_equal(io_cam_grab(&cam, 0, &f, &got, &err), IO_ERR_DEVICE);
+    open_start(&d->cam, &d->c);
+    d->clock = 2 * PERIOD;
+    grab_expect(&d->cam, &f, 1);
+    assert_int_equal(io_cam_release(&d->cam, &f, &d->err), IO_OK);
+    d->clock = 3 * PERIOD;
+    memset(&d->err, 0, sizeof d->err);
+    assert_int_equal(io_cam_grab(&d->cam, 0, &f, &got, &d->err), IO_ERR_DEVICE);
     assert_int_equal(got, 0);
-    assert_int_equal(cam.state, IO_CAM_FAILED);
-    assert_non_null(strstr(err.msg, "dummy2"));
-    assert_non_null(strstr(err.msg, "No such device"));
+    assert_int_equal(d->cam.state, IO_CAM_FAILED);
+    assert_non_null(strstr(d->err.msg, "dummy2"));
+    assert_non_null(strstr(d->err.msg, "No such device"));
     /* further calls report it again, no crash */
-    assert_int_equal(io_cam_grab(&cam, 0, &f, &got, &err), IO_ERR_DEVICE);
-    assert_non_null(strstr(err.msg, "not streaming"));
+    assert_int_equal(io_cam_grab(&d->cam, 0, &f, &got, &d->err), IO_ERR_DEVICE);
+    assert_non_null(strstr(d->err.msg, "not streaming"));
 
     /* still gone: reopen fails and keeps the camera ready for another try */
-    o.fail_open = 1;
-    assert_int_equal(io_cam_reopen(&cam, NULL, &err), IO_ERR_NOT_FOUND);
-    assert_int_equal(cam.state, IO_CAM_FAILED);
-    assert_int_equal(cam.nbuf, 0);
+    d->o.fail_open = 1;
+    assert_int_equal(io_cam_reopen(&d->cam, NULL, &d->err), IO_ERR_NOT_FOUND);
+    assert_int_equal(d->cam.state, IO_CAM_FAILED);
+    assert_int_equal(d->cam.nbuf, 0);
     /* back, under another name (its /dev/videoN changed) */
-    o.fail_open = 0;
-    o.unplug_at = 0;
-    clock = 10 * PERIOD;
-    assert_int_equal(io_cam_reopen(&cam, "dummy7", &err), IO_OK);
-    assert_int_equal(cam.state, IO_CAM_STREAMING);
-    assert_string_equal(cam.cfg.path, "dummy7");
-    assert_int_equal(cam.stats.reopens, 1);
-    assert_int_equal(cam.stats.errors, 1);
-    clock = 11 * PERIOD;
-    grab_expect(&cam, &f, 1);
+    d->o.fail_open = 0;
+    d->o.unplug_at = 0;
+    d->clock = 10 * PERIOD;
+    assert_int_equal(io_cam_reopen(&d->cam, "dummy7", &d->err), IO_OK);
+    assert_int_equal(d->cam.state, IO_CAM_STREAMING);
+    assert_string_equal(d->cam.cfg.path, "dummy7");
+    assert_int_equal(d->cam.stats.reopens, 1);
+    assert_int_equal(d->cam.stats.errors, 1);
+    d->clock = 11 * PERIOD;
+    grab_expect(&d->cam, &f, 1);
     assert_int_equal(f.sequence, 11);
-    io_cam_release(&cam, &f, &err);
-    io_cam_close(&cam);
+    io_cam_release(&d->cam, &f, &d->err);
+    dummy_done(d);
 }
 
 static void test_open_failures(void **st)
 {
     (void)st;
-    io_dummy_cam_opts o = {0};
-    io_cam_config c = dummy_cfg("dummy3", &o);
-    io_cam cam;
-    io_error err;
-    o.fail_open = 2;
-    assert_int_equal(io_cam_open(&cam, &io_cam_dummy, &c, &err), IO_ERR_DEVICE);
-    assert_non_null(strstr(err.msg, "dummy3"));
-    assert_non_null(strstr(err.msg, "busy"));
-    assert_int_equal(cam.state, IO_CAM_CLOSED);
-    o.fail_open = 0;
+    dummy_cam *d = dummy_new("dummy3", 0);
+    d->o.fail_open = 2;
+    assert_int_equal(io_cam_open(&d->cam, &io_cam_dummy, &d->c, &d->err), IO_ERR_DEVICE);
+    assert_non_null(strstr(d->err.msg, "dummy3"));
+    assert_non_null(strstr(d->err.msg, "busy"));
+    assert_int_equal(d->cam.state, IO_CAM_CLOSED);
+    d->o.fail_open = 0;
 
-    o.formats_mask = 2; /* GREY only */
-    c.fourcc = IO_FMT_YUYV;
-    assert_int_equal(io_cam_open(&cam, &io_cam_dummy, &c, &err), IO_ERR_FORMAT);
-    assert_non_null(strstr(err.msg, "YUYV not offered"));
-    assert_non_null(strstr(err.msg, "GREY"));
-    assert_int_equal(cam.nbuf, 0);
-    c.fourcc = 0; /* first offered */
-    assert_int_equal(io_cam_open(&cam, &io_cam_dummy, &c, &err), IO_OK);
-    assert_int_equal(cam.fourcc, IO_FMT_GREY);
-    assert_int_equal(cam.stride, 64);
-    io_cam_close(&cam);
+    d->o.formats_mask = 2; /* GREY only */
+    d->c.fourcc = IO_FMT_YUYV;
+    assert_int_equal(io_cam_open(&d->cam, &io_cam_dummy, &d->c, &d->err), IO_ERR_FORMAT);
+    assert_non_null(strstr(d->err.msg, "YUYV not offered"));
+    assert_non_null(strstr(d->err.msg, "GREY"));
+    assert_int_equal(d->cam.nbuf, 0);
+    d->c.fourcc = 0; /* first offered */
+    assert_int_equal(io_cam_open(&d->cam, &io_cam_dummy, &d->c, &d->err), IO_OK);
+    assert_int_equal(d->cam.fourcc, IO_FMT_GREY);
+    assert_int_equal(d->cam.stride, 64);
+    io_cam_close(&d->cam);
 
-    c.buffers = 1;
-    assert_int_equal(io_cam_open(&cam, &io_cam_dummy, &c, &err), IO_ERR_ARGS);
-    assert_non_null(strstr(err.msg, "buffers"));
-    c.buffers = 4;
-    c.width = 0;
-    assert_int_equal(io_cam_open(&cam, &io_cam_dummy, &c, &err), IO_ERR_ARGS);
+    d->c.buffers = 1;
+    assert_int_equal(io_cam_open(&d->cam, &io_cam_dummy, &d->c, &d->err), IO_ERR_ARGS);
+    assert_non_null(strstr(d->err.msg, "buffers"));
+    d->c.buffers = 4;
+    d->c.width = 0;
+    assert_int_equal(io_cam_open(&d->cam, &io_cam_dummy, &d->c, &d->err), IO_ERR_ARGS);
     /* not streaming: grab says so */
-    c.width = 64;
-    assert_int_equal(io_cam_open(&cam, &io_cam_dummy, &c, &err), IO_OK);
+    d->c.width = 64;
+    assert_int_equal(io_cam_open(&d->cam, &io_cam_dummy, &d->c, &d->err), IO_OK);
     io_frame f;
     int got;
-    assert_int_equal(io_cam_grab(&cam, 0, &f, &got, &err), IO_ERR_DEVICE);
-    assert_non_null(strstr(err.msg, "not streaming"));
-    io_cam_close(&cam);
+    assert_int_equal(io_cam_grab(&d->cam, 0, &f, &got, &d->err), IO_ERR_DEVICE);
+    assert_non_null(strstr(d->err.msg, "not streaming"));
+    dummy_done(d);
 }
 
 static void test_controls(void **st)
 {
     (void)st;
-    io_dummy_cam_opts o = {0};
-    io_cam_config c = dummy_cfg("dummy4", &o);
-    io_cam cam;
-    io_error err;
+    dummy_cam *d = dummy_new("dummy4", 0);
     int v = -1;
-    assert_int_equal(io_cam_open(&cam, &io_cam_dummy, &c, &err), IO_OK);
-    assert_int_equal(io_cam_set_ctrl(&cam, IO_CTRL_GAIN, 77, &err), IO_OK);
-    assert_int_equal(io_cam_get_ctrl(&cam, IO_CTRL_GAIN, &v, &err), IO_OK);
+    assert_int_equal(io_cam_open(&d->cam, &io_cam_dummy, &d->c, &d->err), IO_OK);
+    assert_int_equal(io_cam_set_ctrl(&d->cam, IO_CTRL_GAIN, 77, &d->err), IO_OK);
+    assert_int_equal(io_cam_get_ctrl(&d->cam, IO_CTRL_GAIN, &v, &d->err), IO_OK);
     assert_int_equal(v, 77);
-    assert_int_equal(io_cam_set_ctrl(&cam, IO_CTRL_WHITE_BALANCE, 99999, &err), IO_OK);
-    assert_int_equal(io_cam_get_ctrl(&cam, IO_CTRL_WHITE_BALANCE, &v, &err), IO_OK);
+    assert_int_equal(io_cam_set_ctrl(&d->cam, IO_CTRL_WHITE_BALANCE, 99999, &d->err), IO_OK);
+    assert_int_equal(io_cam_get_ctrl(&d->cam, IO_CTRL_WHITE_BALANCE, &v, &d->err), IO_OK);
     assert_int_equal(v, 6500); /* clamped to the range */
-    assert_int_equal(io_cam_set_ctrl(&cam, (io_cam_ctrl)99, 1, &err), IO_ERR_ARGS);
-    io_cam_close(&cam);
-    o.lacks_ctrls = 1;
-    assert_int_equal(io_cam_open(&cam, &io_cam_dummy, &c, &err), IO_OK);
-    assert_int_equal(io_cam_set_ctrl(&cam, IO_CTRL_EXPOSURE, 10, &err), IO_ERR_VALUE);
-    assert_non_null(strstr(err.msg, "dummy4"));
-    assert_non_null(strstr(err.msg, "exposure"));
-    io_cam_close(&cam);
-    assert_int_equal(io_cam_set_ctrl(&cam, IO_CTRL_GAIN, 1, &err), IO_ERR_ARGS);
+    assert_int_equal(io_cam_set_ctrl(&d->cam, (io_cam_ctrl)99, 1, &d->err), IO_ERR_ARGS);
+    io_cam_close(&d->cam);
+    d->o.lacks_ctrls = 1;
+    assert_int_equal(io_cam_open(&d->cam, &io_cam_dummy, &d->c, &d->err), IO_OK);
+    assert_int_equal(io_cam_set_ctrl(&d->cam, IO_CTRL_EXPOSURE, 10, &d->err), IO_ERR_VALUE);
+    assert_non_null(strstr(d->err.msg, "dummy4"));
+    assert_non_null(strstr(d->err.msg, "exposure"));
+    io_cam_close(&d->cam);
+    assert_int_equal(io_cam_set_ctrl(&d->cam, IO_CTRL_GAIN, 1, &d->err), IO_ERR_ARGS);
+    dummy_done(d);
 }
 
 static void test_match_rule(void **st)
@@ -282,6 +293,26 @@ static void test_match_rule(void **st)
     assert_int_equal(drop, -1);
     assert_int_equal(io_stereo_match(1, 100, 0, 0, 5, &drop), 0);
     assert_int_equal(drop, -1);
+}
+
+/* steps grabs of s, *clock a frame period on before each, every frame
+ * released: n[got] counts the grabs of each outcome (1 the left eye
+ * alone, 2 the right one alone, 3 a pair). */
+static void stereo_steps(io_stereo *s, int steps, uint64_t *clock, int n[4])
+{
+    io_error err;
+    io_frame out[2];
+    int got;
+    for (int k = 0; k < 4; k++) n[k] = 0;
+    for (int step = 0; step < steps; step++) {
+        *clock += PERIOD;
+        assert_int_equal(io_stereo_grab(s, 0, out, &got, &err), IO_OK);
+        assert_true(got >= 0 && got <= 3);
+        n[got]++;
+        if (got == 1) io_cam_release(s->cam[0], &out[0], &err);
+        else if (got == 2) io_cam_release(s->cam[1], &out[1], &err);
+        else if (got == 3) io_stereo_release(s, out, &err);
+    }
 }
 
 static void test_stereo_pairs(void **st)
@@ -326,18 +357,9 @@ static void test_stereo_pairs(void **st)
 
     /* right camera unplugged: the left eye keeps going alone */
     orr.unplug_at = (int)((clock - orr.t0_ns) / PERIOD) + 2;
-    int left_only = 0;
-    for (int step = 0; step < 20; step++) {
-        clock += PERIOD;
-        assert_int_equal(io_stereo_grab(&s, 0, out, &got, &err), IO_OK);
-        if (got == 1) {
-            left_only++;
-            io_cam_release(&L, &out[0], &err);
-        } else if (got == 3) {
-            io_stereo_release(&s, out, &err);
-        }
-    }
-    assert_true(left_only >= 15);
+    int n[4];
+    stereo_steps(&s, 20, &clock, n);
+    assert_true(n[1] >= 15); /* the left eye alone */
     assert_int_equal(s.failed[1], 1);
     assert_int_equal(s.failed[0], 0);
     assert_non_null(strstr(s.status, "right"));
@@ -347,18 +369,9 @@ static void test_stereo_pairs(void **st)
     io_stereo_flush(&s);
     assert_int_equal(io_cam_reopen(&R, NULL, &err), IO_OK);
     clock += PERIOD;
-    int again = 0;
-    for (int step = 0; step < 10; step++) {
-        clock += PERIOD;
-        assert_int_equal(io_stereo_grab(&s, 0, out, &got, &err), IO_OK);
-        if (got == 3) {
-            again++;
-            io_stereo_release(&s, out, &err);
-        } else if (got) {
-            fail_msg("single-eye frame after the reopen");
-        }
-    }
-    assert_true(again >= 8);
+    stereo_steps(&s, 10, &clock, n);
+    if (n[1] || n[2]) fail_msg("single-eye frame after the reopen");
+    assert_true(n[3] >= 8); /* pairs */
     assert_int_equal(s.failed[1], 0);
     /* both gone */
     ol.unplug_at = orr.unplug_at = 1;
@@ -469,6 +482,17 @@ static void test_template_backend(void **st)
     assert_int_equal(cam.nbuf, 0);
 }
 
+/* bin with the one argument cmd: the exit status rc, and w1 and w2 in its
+ * output. */
+static void egofuse_says(const char *bin, const char *cmd, int rc, const char *w1, const char *w2)
+{
+    char out[8192];
+    char *argv[] = {(char *)bin, (char *)cmd, NULL};
+    assert_int_equal(tu_run(argv, out, sizeof out), rc);
+    assert_non_null(strstr(out, w1));
+    assert_non_null(strstr(out, w2));
+}
+
 /* `egofuse run` on a machine without cameras says so and points at the
  * recorded-input commands (skipped where cameras exist). */
 static void test_run_without_cameras(void **st)
@@ -484,15 +508,8 @@ static void test_run_without_cameras(void **st)
         printf("SKIP: %s\n", capture >= 2 ? "this machine has cameras" : "EGOFUSE_BIN not built");
         skip();
     }
-    char out[8192];
-    char *argv[] = {(char *)bin, "run", NULL};
-    assert_int_equal(tu_run(argv, out, sizeof out), 1);
-    assert_non_null(strstr(out, "no cameras found"));
-    assert_non_null(strstr(out, "egofuse render --scene"));
-    char *argv2[] = {(char *)bin, "devices", NULL};
-    assert_int_equal(tu_run(argv2, out, sizeof out), 0);
-    assert_non_null(strstr(out, "video nodes:"));
-    assert_non_null(strstr(out, "USB devices:"));
+    egofuse_says(bin, "run", 1, "no cameras found", "egofuse render --scene");
+    egofuse_says(bin, "devices", 0, "video nodes:", "USB devices:");
 }
 
 TU_MAIN(NULL, NULL,

@@ -547,6 +547,29 @@ static const char *tmp(const char *name, char *buf, size_t n)
     return buf;
 }
 
+/* path[n] := the scratch file name: `frames` frames of ffmpeg's testsrc2
+ * at w x h and 30 FPS in the pixel format pix (and any output options
+ * after it), as YUV4MPEG2. */
+static void testsrc_y4m(const char *name, int w, int h, int frames, const char *pix, char *path,
+                        size_t n)
+{
+    char cmd[2048];
+    tmp(name, path, n);
+    snprintf(cmd, sizeof cmd, "ffmpeg -loglevel error -y -f lavfi -i testsrc2=size=%dx%d:rate=30 "
+             "-frames:v %d -pix_fmt %s -f yuv4mpegpipe '%s'", w, h, frames, pix, path);
+    assert_int_equal(system(cmd), 0);
+}
+
+/* out[n] := the scratch file name, the file in converted by ffmpeg with
+ * the output options opts. */
+static void ffmpeg_convert(const char *in, const char *opts, const char *name, char *out, size_t n)
+{
+    char cmd[2048];
+    tmp(name, out, n);
+    snprintf(cmd, sizeof cmd, "ffmpeg -loglevel error -y -i '%s' %s '%s'", in, opts, out);
+    assert_int_equal(system(cmd), 0);
+}
+
 /* Feeds a file's bytes through a pipe in chunks (partial frames), polling
  * after each; returns the source after the writer closed. */
 static io_vsrc *feed(const char *prefix, const char *path, int ew, int eh, int layout,
@@ -606,11 +629,10 @@ static void test_y4m_gstreamer(void **st)
     NEED_TOOL("ffmpeg");
     char y4m[600], ref[600], cmd[2048];
     tmp("gst.y4m", y4m, sizeof y4m);
-    tmp("gst.rgb", ref, sizeof ref);
     snprintf(cmd, sizeof cmd, "gst-launch-1.0 -q videotestsrc num-buffers=3 pattern=smpte ! "
-             "video/x-raw,format=I420,width=96,height=64 ! y4menc ! fdsink fd=1 > '%s' && "
-             "ffmpeg -loglevel error -y -i '%s' -f rawvideo -pix_fmt rgb24 '%s'", y4m, y4m, ref);
+             "video/x-raw,format=I420,width=96,height=64 ! y4menc ! fdsink fd=1 > '%s'", y4m);
     assert_int_equal(system(cmd), 0);
+    ffmpeg_convert(y4m, "-f rawvideo -pix_fmt rgb24", "gst.rgb", ref, sizeof ref);
     io_vsrc_stat s;
     io_vsrc *v = feed("stream:", y4m, 96, 64, IO_VSRC_MONO, 1000, &s);
     assert_string_equal(s.kind, "y4m");
@@ -630,13 +652,9 @@ static void test_y4m_ffmpeg(void **st)
     NEED_TOOL("ffmpeg");
     static const char *const pix[] = {"yuv420p", "yuv422p", "yuv444p", "yuvj420p", "gray"};
     for (int p = 0; p < 5; p++) {
-        char y4m[600], ref[600], cmd[2048];
-        tmp("ff.y4m", y4m, sizeof y4m);
-        tmp("ff.rgb", ref, sizeof ref);
-        snprintf(cmd, sizeof cmd, "ffmpeg -loglevel error -y -f lavfi -i testsrc2=size=80x48:rate=30 "
-                 "-frames:v 3 -pix_fmt %s -f yuv4mpegpipe '%s' && ffmpeg -loglevel error -y -i '%s' "
-                 "-f rawvideo -pix_fmt rgb24 '%s'", pix[p], y4m, y4m, ref);
-        assert_int_equal(system(cmd), 0);
+        char y4m[600], ref[600];
+        testsrc_y4m("ff.y4m", 80, 48, 3, pix[p], y4m, sizeof y4m);
+        ffmpeg_convert(y4m, "-f rawvideo -pix_fmt rgb24", "ff.rgb", ref, sizeof ref);
         io_vsrc_stat s;
         io_vsrc *v = feed("stream:", y4m, 80, 48, IO_VSRC_MONO, 777, &s);
         assert_int_equal(s.frames + s.skipped, 3);
@@ -647,11 +665,8 @@ static void test_y4m_ffmpeg(void **st)
         io_vsrc_close(v);
     }
     /* 10-bit: refused with the reason */
-    char y4m[600], cmd[1024];
-    tmp("ff10.y4m", y4m, sizeof y4m);
-    snprintf(cmd, sizeof cmd, "ffmpeg -loglevel error -y -f lavfi -i testsrc2=size=64x48:rate=30 "
-             "-frames:v 1 -pix_fmt yuv420p10le -strict -1 -f yuv4mpegpipe '%s'", y4m);
-    assert_int_equal(system(cmd), 0);
+    char y4m[600];
+    testsrc_y4m("ff10.y4m", 64, 48, 1, "yuv420p10le -strict -1", y4m, sizeof y4m);
     io_vsrc_stat s;
     io_vsrc *v = feed("stream:", y4m, 64, 48, IO_VSRC_MONO, 100000, &s);
     assert_int_equal(s.state, IO_VSRC_FAILED);
@@ -727,11 +742,8 @@ static void test_regular_file_paced(void **st)
 {
     (void)st;
     NEED_TOOL("ffmpeg");
-    char y4m[600], cmd[1024], spec[700];
-    tmp("paced.y4m", y4m, sizeof y4m);
-    snprintf(cmd, sizeof cmd, "ffmpeg -loglevel error -y -f lavfi -i testsrc2=size=64x48:rate=30 "
-             "-frames:v 3 -pix_fmt yuv420p -f yuv4mpegpipe '%s'", y4m);
-    assert_int_equal(system(cmd), 0);
+    char y4m[600], spec[700];
+    testsrc_y4m("paced.y4m", 64, 48, 3, "yuv420p", y4m, sizeof y4m);
     snprintf(spec, sizeof spec, "stream:%s", y4m);
     for (int loop = 0; loop < 2; loop++) {
         uint64_t clock = 1000 * MS;
@@ -909,13 +921,9 @@ static void test_file_cam_video(void **st)
 {
     (void)st;
     NEED_TOOL("ffmpeg");
-    char y4m[600], mkv[600], cmd[2048];
-    tmp("vid.y4m", y4m, sizeof y4m);
-    tmp("vid.mkv", mkv, sizeof mkv);
-    snprintf(cmd, sizeof cmd, "ffmpeg -loglevel error -y -f lavfi -i testsrc2=size=64x48:rate=30 "
-             "-frames:v 5 -pix_fmt yuv420p -f yuv4mpegpipe '%s' && ffmpeg -loglevel error -y -i '%s' "
-             "-c:v ffv1 '%s'", y4m, y4m, mkv);
-    assert_int_equal(system(cmd), 0);
+    char y4m[600], mkv[600];
+    testsrc_y4m("vid.y4m", 64, 48, 5, "yuv420p", y4m, sizeof y4m);
+    ffmpeg_convert(y4m, "-c:v ffv1", "vid.mkv", mkv, sizeof mkv);
     int fds0 = tu_count_fds();
     uint8_t first[2][64 * 48 * 3];
     for (int m = 0; m < 2; m++) {

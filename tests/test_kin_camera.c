@@ -65,19 +65,25 @@ static void validity_desc_defaults(void **state)
     assert_int_equal(r.cam_height, 480);
 }
 
+/* The geometry of the paper's HMD with a camera of w x h pixels. */
+static kin_sthmd_geometry sensor_geometry(int w, int h)
+{
+    kin_sthmd_desc d;
+    memset(&d, 0, sizeof d);
+    d.cam_width = w;
+    d.cam_height = h;
+    return kin_sthmd_geometry_of(&d);
+}
+
 static void validity_wide_camera_crop(void **state)
 {
     (void)state;
     /* a 16:9 camera is wider than the 1.6 LCD: the crop keeps all rows */
-    kin_sthmd_desc d;
-    memset(&d, 0, sizeof d);
-    d.cam_width = 640; d.cam_height = 360;
-    kin_sthmd_geometry g = kin_sthmd_geometry_of(&d);
+    kin_sthmd_geometry g = sensor_geometry(640, 360);
     assert_int_equal(g.crop_height, 360);
     assert_int_equal(g.crop_y0, 0);
     /* a 4:3 sensor of another size still crops to 1.6 */
-    d.cam_width = 1280; d.cam_height = 960;
-    g = kin_sthmd_geometry_of(&d);
+    g = sensor_geometry(1280, 960);
     assert_int_equal(g.crop_width, 1280);
     assert_int_equal(g.crop_height, 800);
     assert_int_equal(g.crop_y0, 80);

@@ -20,6 +20,7 @@
 #include "../src/pipe/pipe.h"
 #include "support/pipe_frames.h"
 #include "support/pipe_testrig.h"
+#include "support/pipe_quad_check.h"
 
 /* A model of one node ("head" at the origin) and one unskinned quad
  * [-s,s]^2 at depth z (metres, in front of the head), normals +Z. */
@@ -71,47 +72,22 @@ static void free_frame(frame_bufs *b) { tu_frame_free(b); }
 static void frame_equals_stages(void **state)
 {
     (void)state;
-    kin_model m;
-    quad_model(&m, 0.08f, -0.5f);
     pipe_desc d = {0};
     d.threads = 1;
-    pipe_ctx *p = pipe_create(&d, &m);
-    assert_non_null(p);
-    frame_bufs b;
-    pipe_frame_in in;
-    make_frame(&b, &in, 7);
+    tu_quad_rig r;
+    tu_quad_rig_open(&r, 0.08f, -0.5f, 0.0f, &d, 7, 640, 480, 1280, 800);
     /* A head turned a little and moved: the cameras must follow it. */
     kin_mat4 head = kin_mat4_from_tr(kin_v3(0.01f, -0.02f, 0.03f),
                                      kin_quat_axis_angle(kin_v3(0, 1, 0), 0.1f));
-    in.head_node = -1;
-    in.world_from_head = &head;
     pipe_frame_stats st;
-    char why[200] = "";
-    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    tu_quad_rig_run(&r, &head, &st);
     assert_true(st.coverage[0] > 0.01 && st.coverage[0] < 0.5);
 
     kin_sthmd_geometry g = kin_sthmd_geometry_of(NULL);
     assert_int_equal(g.crop_y0, 40);
-    tu_stages s;
-    tu_stages_make(&s, 640, 400);
-    uint8_t *expect = malloc(1280 * 800 * 4);
-    for (int e = 0; e < 2; e++) {
-        kin_camera cam = kin_sthmd_camera(NULL, &head, (kin_eye)e);
-        kin_camera pc = pipe_camera(p, e);
-        assert_memory_equal(&cam.view_proj, &pc.view_proj, sizeof cam.view_proj);
-        fuse_image P = {b.cam[e] + 40 * 640 * 4, 640, 400, 640 * 4};
-        fuse_image V = {b.virt[e], 1280, 800, 1280 * 4};
-        fuse_image R = {expect, 1280, 800, 1280 * 4};
-        tu_quad_stages(&m, &cam, &s, &P, &V, 43, 27, 1194, 746, &R);
-        int mw, mh;
-        assert_memory_equal(pipe_mask(p, e, &mw, &mh), s.mask, 640 * 400);
-        assert_memory_equal(expect, b.out[e], 1280 * 800 * 4);
-    }
-    tu_stages_free(&s);
-    free(expect);
-    free_frame(&b);
-    pipe_destroy(p);
-    kin_model_free(&m);
+    static const int crop[4] = {0, 40, 640, 400}, vp[4] = {43, 27, 1194, 746};
+    tu_quad_frame_equals_stages(r.p, &r.m, &r.b, NULL, &head, 640, crop, 1280, 800, vp);
+    tu_quad_rig_close(&r);
 }
 
 /* One or two threads: the same bytes, frame after frame. */
@@ -269,36 +245,31 @@ static void image_opaque(void **state)
 static void virtual_depth(void **state)
 {
     (void)state;
-    kin_model m;
-    quad_model(&m, 0.1f, -0.5f);
-    pipe_ctx *p = pipe_create(NULL, &m);
-    assert_non_null(p);
+    tu_quad_rig r;
+    tu_quad_rig_open(&r, 0.1f, -0.5f, 0.0f, NULL, 11, 640, 480, 1280, 800);
     float *wall = malloc(sizeof(float) * 1280 * 800);
     assert_non_null(wall);
-    frame_bufs b, c;
-    pipe_frame_in in, ref;
-    make_frame(&b, &in, 11);
+    frame_bufs c;
+    pipe_frame_in ref;
     make_frame(&c, &ref, 11);
-    assert_int_equal(pipe_frame(p, &ref, NULL, NULL, 0), PIPE_OK); /* no depth */
+    assert_int_equal(pipe_frame(r.p, &ref, NULL, NULL, 0), PIPE_OK); /* no depth */
     for (int i = 0; i < 1280 * 800; i++) wall[i] = 50.0f;
     for (int e = 0; e < 2; e++) {
-        in.virt_depth[e] = wall;
-        in.virt_depth_stride[e] = 1280;
+        r.in.virt_depth[e] = wall;
+        r.in.virt_depth_stride[e] = 1280;
     }
-    assert_int_equal(pipe_frame(p, &in, NULL, NULL, 0), PIPE_OK);
-    for (int e = 0; e < 2; e++) assert_memory_equal(b.out[e], c.out[e], 1280 * 800 * 4);
+    assert_int_equal(pipe_frame(r.p, &r.in, NULL, NULL, 0), PIPE_OK);
+    for (int e = 0; e < 2; e++) assert_memory_equal(r.b.out[e], c.out[e], 1280 * 800 * 4);
     for (int i = 0; i < 1280 * 800; i++) wall[i] = 0.2f; /* nearer than the quad */
-    assert_int_equal(pipe_frame(p, &in, NULL, NULL, 0), PIPE_OK);
+    assert_int_equal(pipe_frame(r.p, &r.in, NULL, NULL, 0), PIPE_OK);
     for (int e = 0; e < 2; e++) {
-        assert_memory_not_equal(b.out[e], c.out[e], 1280 * 800 * 4);
+        assert_memory_not_equal(r.b.out[e], c.out[e], 1280 * 800 * 4);
         for (int i = 0; i < 1280 * 800 * 4; i++)
-            if ((i & 3) != 3) assert_int_equal(b.out[e][i], b.virt[e][i]);
+            if ((i & 3) != 3) assert_int_equal(r.b.out[e][i], r.b.virt[e][i]);
     }
     free(wall);
-    free_frame(&b);
     free_frame(&c);
-    pipe_destroy(p);
-    kin_model_free(&m);
+    tu_quad_rig_close(&r);
 }
 
 /* A closed, outward-wound box: culling back faces leaves the mask as it
@@ -401,13 +372,8 @@ static void raw_camera_frames(void **state)
         make_frame(&c, &ref, 21 + (uint64_t)k);
         tu_rng r = {5};
         uint8_t *yuyv[2];
-        for (int e = 0; e < 2; e++) {
-            yuyv[e] = malloc(640 * 480 * 2);
-            for (int i = 0; i < 640 * 480 * 2; i++) yuyv[e][i] = (uint8_t)tu_next(&r);
-            in.camera_raw[e] = (fuse_frame){yuyv[e], 640 * 480 * 2, 640, 480, 1280, FUSE_FMT_YUYV};
-            fuse_image full = {c.cam[e], 640, 480, 640 * 4};
-            assert_int_equal(fuse_frame_to_rgba(&in.camera_raw[e], 0, &full), FUSE_OK);
-        }
+        tu_yuyv_frames(yuyv, 640, 480, &r);
+        tu_raw_cameras(&in, yuyv, 640, 480, &c);
         assert_int_equal(pipe_frame(p, &ref, NULL, NULL, 0), PIPE_OK);
         assert_int_equal(pipe_frame(p, &in, NULL, NULL, 0), PIPE_OK);
         for (int e = 0; e < 2; e++) assert_memory_equal(b.out[e], c.out[e], 1280 * 800 * 4);
@@ -435,35 +401,28 @@ static void raw_camera_frames(void **state)
 static void bad_inputs(void **state)
 {
     (void)state;
-    kin_model m;
-    quad_model(&m, 0.1f, -0.4f);
-    pipe_ctx *p = pipe_create(NULL, &m);
-    assert_non_null(p);
+    tu_quad_rig r;
+    tu_quad_rig_open(&r, 0.1f, -0.4f, 0.0f, NULL, 3, 640, 480, 1280, 800);
     assert_null(pipe_create(NULL, NULL));
-    frame_bufs b;
-    pipe_frame_in in;
-    make_frame(&b, &in, 3);
     char why[200];
-    in.camera[1].height = 400; /* a cropped image where the sensor is due */
-    memset(b.out[0], 0x5A, 1280 * 800 * 4);
-    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_ERR_ARGS);
+    r.in.camera[1].height = 400; /* a cropped image where the sensor is due */
+    memset(r.b.out[0], 0x5A, 1280 * 800 * 4);
+    assert_int_equal(pipe_frame(r.p, &r.in, NULL, why, sizeof why), PIPE_ERR_ARGS);
     assert_non_null(strstr(why, "right eye"));
     assert_non_null(strstr(why, "camera image is 640x400"));
     /* Nothing was written. */
-    for (int i = 0; i < 1280 * 800 * 4; i++) assert_int_equal(b.out[0][i], 0x5A);
-    in.camera[1].height = 480;
-    in.virt[0].pixels = NULL;
-    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_ERR_ARGS);
+    for (int i = 0; i < 1280 * 800 * 4; i++) assert_int_equal(r.b.out[0][i], 0x5A);
+    r.in.camera[1].height = 480;
+    r.in.virt[0].pixels = NULL;
+    assert_int_equal(pipe_frame(r.p, &r.in, NULL, why, sizeof why), PIPE_ERR_ARGS);
     assert_non_null(strstr(why, "left eye: the virtual image"));
-    in.virt[0].pixels = b.virt[0];
-    in.head_node = 5;
-    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_ERR_ARGS);
+    r.in.virt[0].pixels = r.b.virt[0];
+    r.in.head_node = 5;
+    assert_int_equal(pipe_frame(r.p, &r.in, NULL, why, sizeof why), PIPE_ERR_ARGS);
     assert_non_null(strstr(why, "head node 5"));
-    in.head_node = 0;
-    assert_int_equal(pipe_frame(p, &in, NULL, why, sizeof why), PIPE_OK);
-    free_frame(&b);
-    pipe_destroy(p);
-    kin_model_free(&m);
+    r.in.head_node = 0;
+    assert_int_equal(pipe_frame(r.p, &r.in, NULL, why, sizeof why), PIPE_OK);
+    tu_quad_rig_close(&r);
 }
 
 /* refine_band: the eye's mask is fuse_refine_mask of the G-buffer mask

@@ -540,6 +540,20 @@ static void learned_flag(void **state)
     arms_free(&A);
 }
 
+/* Nothing measured (or nothing in view): the thickness is not frozen and
+ * both factors of both sides are exactly 1. */
+static void assert_thickness_unmeasured(const pipe_fit *f)
+{
+    float th[2][2];
+    int frozen = 1;
+    pipe_fit_thickness(f, th, &frozen);
+    assert_false(frozen);
+    for (int s = 0; s < 2; s++) {
+        NEAR(th[s][0], 1.0, 0.0);
+        NEAR(th[s][1], 1.0, 0.0);
+    }
+}
+
 /* Three vertical thirds, skin, a beige pad and a blue background, each
  * colour +-2 per channel from a seeded draw (pixel by pixel, R G B); arm
  * covers the skin third, pad the skin and the pad. */
@@ -559,6 +573,39 @@ static void stripes(uint8_t *rgba, uint8_t *arm, uint8_t *pad, uint64_t seed)
     }
 }
 
+/* The scene of the colour-model tests below: the arms, stripes() of a
+ * seed in rgba (the image P) with its arm and pad masks, and the colour
+ * bins of the beige pad (bp) and of skin (bs). */
+typedef struct stripe_scene {
+    arms A;
+    uint8_t *rgba, *arm, *pad;
+    fuse_image P;
+    unsigned bp, bs;
+} stripe_scene;
+
+/* S := the scene of seed (its buffers freed by stripe_scene_free). */
+static void stripe_scene_make(stripe_scene *S, uint64_t seed)
+{
+    arms_build(&S->A);
+    S->rgba = malloc(4 * W * H);
+    S->arm = malloc(W * H);
+    S->pad = malloc(W * H);
+    assert_true(S->rgba && S->arm && S->pad);
+    stripes(S->rgba, S->arm, S->pad, seed);
+    S->P = (fuse_image){ S->rgba, W, H, 4 * W };
+    S->bp = fuse_colour_bin(STRIPE_BEIGE, PIPE_FIT_BITS);
+    S->bs = fuse_colour_bin(STRIPE_SKIN, PIPE_FIT_BITS);
+}
+
+/* Frees what stripe_scene_make made. */
+static void stripe_scene_free(stripe_scene *S)
+{
+    free(S->rgba);
+    free(S->arm);
+    free(S->pad);
+    arms_free(&S->A);
+}
+
 /* The colour model kept over frames (learn_memory, issue 14 item 2): a
  * beige pad beside a skin-red arm, background for 10 frames (outside
  * both masks), then inside both the kinematic and the refined mask for
@@ -570,33 +617,24 @@ static void stripes(uint8_t *rgba, uint8_t *arm, uint8_t *pad, uint64_t seed)
 static void learn_memory_keeps_background(void **state)
 {
     (void)state;
-    arms A;
-    arms_build(&A);
-    uint8_t *rgba = malloc(4 * W * H), *arm = malloc(W * H), *pad = malloc(W * H);
-    assert_true(rgba && arm && pad);
-    const uint8_t *skin = STRIPE_SKIN, *beige = STRIPE_BEIGE;
-    stripes(rgba, arm, pad, 0x70616421);
-    fuse_image P = { rgba, W, H, 4 * W };
-    const unsigned bp = fuse_colour_bin(beige, PIPE_FIT_BITS), bs = fuse_colour_bin(skin, PIPE_FIT_BITS);
+    stripe_scene S;
+    stripe_scene_make(&S, 0x70616421);
     const pipe_fit_desc once = { .learn_memory = -1.0f };
     for (int mem = 0; mem < 2; mem++) {
-        pipe_fit *f = pipe_fit_create(mem ? NULL : &once, &A.m, &A.rig, W, H);
+        pipe_fit *f = pipe_fit_create(mem ? NULL : &once, &S.A.m, &S.A.rig, W, H);
         assert_non_null(f);
         for (int t = 0; t < 10; t++)
-            assert_int_equal(pipe_fit_learn(f, 0, &P, arm, W, arm, W), FUSE_OK);
-        assert_true(pipe_fit_colour(f, 0)->llr[bp] < -2.0f);
-        assert_int_equal(pipe_fit_learn(f, 0, &P, pad, W, pad, W), FUSE_OK);
+            assert_int_equal(pipe_fit_learn(f, 0, &S.P, S.arm, W, S.arm, W), FUSE_OK);
+        assert_true(pipe_fit_colour(f, 0)->llr[S.bp] < -2.0f);
+        assert_int_equal(pipe_fit_learn(f, 0, &S.P, S.pad, W, S.pad, W), FUSE_OK);
         const float *llr = pipe_fit_colour(f, 0)->llr;
         assert_true(pipe_fit_learned(f, 0));
-        assert_true(llr[bs] > 2.0f);
-        if (mem) assert_true(llr[bp] < -1.0f);   /* still background */
-        else assert_true(llr[bp] > 2.0f);        /* learned as arm */
+        assert_true(llr[S.bs] > 2.0f);
+        if (mem) assert_true(llr[S.bp] < -1.0f);   /* still background */
+        else assert_true(llr[S.bp] > 2.0f);        /* learned as arm */
         pipe_fit_destroy(f);
     }
-    free(rgba);
-    free(arm);
-    free(pad);
-    arms_free(&A);
+    stripe_scene_free(&S);
 }
 
 /* The learning's rejection (PIPE_FIT_LEARN_REJECT, edge6): the beige pad
@@ -611,43 +649,35 @@ static void learn_memory_keeps_background(void **state)
 static void learn_rejects_background_bins(void **state)
 {
     (void)state;
-    arms A;
-    arms_build(&A);
-    uint8_t *rgba = malloc(4 * W * H), *arm = malloc(W * H), *pad = malloc(W * H);
-    assert_true(rgba && arm && pad);
-    const uint8_t *skin = STRIPE_SKIN, *beige = STRIPE_BEIGE;
     const uint8_t fresh[3] = { 230, 200, 20 };
-    stripes(rgba, arm, pad, 0x666f6c64);
-    fuse_image P = { rgba, W, H, 4 * W };
-    const unsigned bp = fuse_colour_bin(beige, PIPE_FIT_BITS), bs = fuse_colour_bin(skin, PIPE_FIT_BITS);
+    stripe_scene S;
+    stripe_scene_make(&S, 0x666f6c64);
     const unsigned bf = fuse_colour_bin(fresh, PIPE_FIT_BITS);
-    pipe_fit *f = pipe_fit_create(NULL, &A.m, &A.rig, W, H);
+    pipe_fit *f = pipe_fit_create(NULL, &S.A.m, &S.A.rig, W, H);
     assert_non_null(f);
-    for (int t = 0; t < 10; t++) assert_int_equal(pipe_fit_learn(f, 0, &P, arm, W, arm, W), FUSE_OK);
-    assert_true(pipe_fit_colour(f, 0)->llr[bp] < -2.0f);
+    for (int t = 0; t < 10; t++)
+        assert_int_equal(pipe_fit_learn(f, 0, &S.P, S.arm, W, S.arm, W), FUSE_OK);
+    assert_true(pipe_fit_colour(f, 0)->llr[S.bp] < -2.0f);
     assert_true(pipe_fit_colour(f, 0)->llr[bf] >= -PIPE_FIT_LEARN_REJECT);
     float worst = -INFINITY;
     for (int t = 0; t < 30; t++) {
-        assert_int_equal(pipe_fit_learn(f, 0, &P, pad, W, pad, W), FUSE_OK);
-        const float v = pipe_fit_colour(f, 0)->llr[bp];
+        assert_int_equal(pipe_fit_learn(f, 0, &S.P, S.pad, W, S.pad, W), FUSE_OK);
+        const float v = pipe_fit_colour(f, 0)->llr[S.bp];
         if (v > worst) worst = v;
     }
     printf("rejection: the pad's llr at most %.3f over 30 frames inside both masks\n", (double)worst);
     const float *llr = pipe_fit_colour(f, 0)->llr;
     assert_true(pipe_fit_learned(f, 0));
-    assert_true(llr[bs] > 2.0f);
+    assert_true(llr[S.bs] > 2.0f);
     assert_true(worst < -PIPE_FIT_LEARN_REJECT);   /* still background */
     /* a new colour inside both masks is learned as arm */
     for (int i = 0; i < W * H; i++)
         if (i % W < W / 6)
-            for (int j = 0; j < 3; j++) rgba[i * 4 + j] = fresh[j];
-    assert_int_equal(pipe_fit_learn(f, 0, &P, arm, W, arm, W), FUSE_OK);
+            for (int j = 0; j < 3; j++) S.rgba[i * 4 + j] = fresh[j];
+    assert_int_equal(pipe_fit_learn(f, 0, &S.P, S.arm, W, S.arm, W), FUSE_OK);
     assert_true(pipe_fit_colour(f, 0)->llr[bf] > 1.0f);
     pipe_fit_destroy(f);
-    free(rgba);
-    free(arm);
-    free(pad);
-    arms_free(&A);
+    stripe_scene_free(&S);
 }
 
 /* pipe_fit_learn's colour model (learn_memory, the default) against a
@@ -1018,14 +1048,7 @@ static void huge_projections(void **state)
         pipe_fit_elbows(f, world, A.pos, cam, P, 3u, locals, found);
         assert_true(found[0] == 0.0f && found[1] == 0.0f);
     }
-    float th[2][2];
-    int frozen = 1;
-    pipe_fit_thickness(f, th, &frozen);
-    assert_false(frozen);
-    for (int s = 0; s < 2; s++) {
-        NEAR(th[s][0], 1.0, 0.0);
-        NEAR(th[s][1], 1.0, 0.0);
-    }
+    assert_thickness_unmeasured(f);
     pipe_fit_destroy(f);
     free(rgba);
     free(m);
@@ -1070,8 +1093,6 @@ static void review_arguments(void **state)
     kin_mat4 world[MAX_NODES];
     kin_fk(A.parents, A.nodes, A.rest, NULL, world);
     const fuse_image P2[2] = { P, P };
-    float th[2][2];
-    int frozen = 1;
     for (int frame = 0; frame < 6; frame++) {
         for (int e = 0; e < 2; e++) {
             draw(&A, A.pos, &cam[e], kin);
@@ -1088,12 +1109,7 @@ static void review_arguments(void **state)
         memcpy(locals, A.rest, sizeof locals);
         pipe_fit_elbows(f, world, A.pos, cam, P2, 0u, locals, NULL);
     }
-    pipe_fit_thickness(f, th, &frozen);
-    assert_false(frozen);
-    for (int s = 0; s < 2; s++) {
-        NEAR(th[s][0], 1.0, 0.0);
-        NEAR(th[s][1], 1.0, 0.0);
-    }
+    assert_thickness_unmeasured(f);
     /* f NULL */
     pipe_fit_reset(NULL);
     pipe_fit_reset_shape(NULL);
@@ -1101,8 +1117,9 @@ static void review_arguments(void **state)
     assert_null(pipe_fit_colour(NULL, 0));
     assert_false(pipe_fit_learned(NULL, 0));
     pipe_fit_shape(NULL, world, T.pos);
+    float th[2][2];
+    int frozen = 1;
     th[0][0] = 0.5f;
-    frozen = 1;
     pipe_fit_thickness(NULL, th, &frozen);
     assert_false(frozen);
     NEAR(th[0][0], 1.0, 0.0);

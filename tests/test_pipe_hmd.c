@@ -25,6 +25,7 @@
 
 #include "../src/pipe/pipe.h"
 #include "support/pipe_frames.h"
+#include "support/pipe_quad_check.h"
 
 enum { CAMW = 1280, CAMH = 720, LCDW = 1440, LCDH = 1600 };
 #define D2R 0.017453292519943295
@@ -144,48 +145,27 @@ static void bufs_free(bufs *b) { tu_frame_free(b); }
 static void frame_end_to_end(void **state)
 {
     (void)state;
-    kin_model m;
-    quad_model(&m, 0.12f, -0.45f);
     pipe_desc pd = {0};
     pd.hmd = vr_desc();
     pd.threads = 1;
-    pipe_ctx *p = pipe_create(&pd, &m);
-    assert_non_null(p);
-    kin_sthmd_desc hd = pipe_hmd(p);
+    tu_quad_rig r;
+    tu_quad_rig_open(&r, 0.12f, -0.45f, 0.4f, &pd, 3, CAMW, CAMH, LCDW, LCDH);
+    kin_sthmd_desc hd = pipe_hmd(r.p);
     assert_int_equal(hd.lcd_width, LCDW);
     assert_int_equal(hd.cam_height, CAMH);
     NEAR(hd.ipd_m, 0.068f, 0);
-    const kin_sthmd_geometry g = pipe_geometry(p);
-    bufs b;
-    pipe_frame_in in;
-    bufs_make(&b, &in, 3);
+    const kin_sthmd_geometry g = pipe_geometry(r.p);
     kin_mat4 head = kin_mat4_from_tr(kin_v3(0.01f, -0.02f, 0.0f),
                                      kin_quat_axis_angle(kin_v3(0, 1, 0), 0.08f));
-    in.head_node = -1;
-    in.world_from_head = &head;
     pipe_frame_stats st;
-    char why[300] = "";
-    if (pipe_frame(p, &in, &st, why, sizeof why) != PIPE_OK) fail_msg("pipe_frame: %s", why);
+    tu_quad_rig_run(&r, &head, &st);
     assert_true(st.coverage[0] > 0.02 && st.coverage[0] < 0.6);
 
-    tu_stages s;
-    tu_stages_make(&s, g.crop_width, g.crop_height);
-    uint8_t *expect = malloc((size_t)LCDW * LCDH * 4);
+    /* the crop: rows 0..719, columns 316..963 */
+    const int crop[4] = {316, 0, 648, 720};
+    const int vp[4] = {g.vp_x0, g.vp_y0, g.vp_width, g.vp_height};
+    tu_quad_frame_equals_stages(r.p, &r.m, &r.b, &pd.hmd, &head, CAMW, crop, LCDW, LCDH, vp);
     for (int e = 0; e < 2; e++) {
-        int mw, mh;
-        const uint8_t *pm = pipe_mask(p, e, &mw, &mh);
-        assert_int_equal(mw, 648);
-        assert_int_equal(mh, 720);
-        kin_camera cam = kin_sthmd_camera(&pd.hmd, &head, (kin_eye)e);
-        kin_camera pc = pipe_camera(p, e);
-        assert_memory_equal(&cam.view_proj, &pc.view_proj, sizeof cam.view_proj);
-        /* the crop: rows 0..719, columns 316..963 */
-        fuse_image P = {b.cam[e] + 316 * 4, 648, 720, CAMW * 4};
-        fuse_image V = {b.virt[e], LCDW, LCDH, LCDW * 4};
-        fuse_image R = {expect, LCDW, LCDH, LCDW * 4};
-        tu_quad_stages(&m, &cam, &s, &P, &V, g.vp_x0, g.vp_y0, g.vp_width, g.vp_height, &R);
-        assert_memory_equal(pm, s.mask, (size_t)s.w * s.h);
-        assert_memory_equal(expect, b.out[e], (size_t)LCDW * LCDH * 4);
         /* outside the viewport: V */
         for (int y = 0; y < LCDH; y++)
             for (int x = 0; x < LCDW; x++) {
@@ -193,28 +173,25 @@ static void frame_end_to_end(void **state)
                     y < g.vp_y0 + g.vp_height)
                     continue;
                 size_t o = ((size_t)y * LCDW + (size_t)x) * 4;
-                if (memcmp(b.out[e] + o, b.virt[e] + o, 4))
+                if (memcmp(r.b.out[e] + o, r.b.virt[e] + o, 4))
                     fail_msg("eye %d pixel (%d, %d) outside the viewport is not V's", e, x, y);
             }
     }
-    tu_stages_free(&s);
-    free(expect);
 
     /* the paper's sizes are refused, naming the expected ones */
-    pipe_frame_in bad = in;
+    char why[300];
+    pipe_frame_in bad = r.in;
     uint8_t *small = calloc(640 * 480, 4);
     bad.camera[1] = (fuse_image){small, 640, 480, 640 * 4};
-    assert_int_equal(pipe_frame(p, &bad, NULL, why, sizeof why), PIPE_ERR_ARGS);
+    assert_int_equal(pipe_frame(r.p, &bad, NULL, why, sizeof why), PIPE_ERR_ARGS);
     assert_non_null(strstr(why, "right eye: the camera image is 640x480"));
     assert_non_null(strstr(why, "expected 1280x720"));
-    bad = in;
+    bad = r.in;
     bad.out[0] = (fuse_image){small, 1280, 240, 1280 * 4};
-    assert_int_equal(pipe_frame(p, &bad, NULL, why, sizeof why), PIPE_ERR_ARGS);
+    assert_int_equal(pipe_frame(r.p, &bad, NULL, why, sizeof why), PIPE_ERR_ARGS);
     assert_non_null(strstr(why, "expected 1440x1600"));
     free(small);
-    bufs_free(&b);
-    pipe_destroy(p);
-    kin_model_free(&m);
+    tu_quad_rig_close(&r);
 }
 
 /* Raw YUYV 1280x720 frames give the bytes of their RGBA conversion, with
@@ -228,10 +205,7 @@ static void raw_and_threads(void **state)
     tu_rng r = {9};
     uint8_t *yuyv[2];
     uint32_t crc[2][2] = {{0, 0}, {0, 0}};
-    for (int e = 0; e < 2; e++) {
-        yuyv[e] = malloc((size_t)CAMW * CAMH * 2);
-        for (size_t i = 0; i < (size_t)CAMW * CAMH * 2; i++) yuyv[e][i] = (uint8_t)tu_next(&r);
-    }
+    tu_yuyv_frames(yuyv, CAMW, CAMH, &r);
     for (int refine = 0; refine < 2; refine++)
         for (int th = 1; th <= 2; th++) {
             pipe_desc pd = {0};
@@ -244,12 +218,7 @@ static void raw_and_threads(void **state)
             pipe_frame_in in, ref;
             bufs_make(&b, &in, 17);
             bufs_make(&c, &ref, 17);
-            for (int e = 0; e < 2; e++) {
-                in.camera_raw[e] = (fuse_frame){yuyv[e], (size_t)CAMW * CAMH * 2, CAMW, CAMH,
-                                                CAMW * 2, FUSE_FMT_YUYV};
-                fuse_image full = {c.cam[e], CAMW, CAMH, CAMW * 4};
-                assert_int_equal(fuse_frame_to_rgba(&in.camera_raw[e], 0, &full), FUSE_OK);
-            }
+            tu_raw_cameras(&in, yuyv, CAMW, CAMH, &c);
             char why[300];
             if (pipe_frame(p, &ref, NULL, why, sizeof why) != PIPE_OK) fail_msg("%s", why);
             if (pipe_frame(p, &in, NULL, why, sizeof why) != PIPE_OK) fail_msg("%s", why);

@@ -220,53 +220,77 @@ static void run_case(const char *name, const kin_lens *L, const poly *p, int ss)
     pipe_lens_map_free(&m);
 }
 
-static kin_lens barrel(void)
+/* A checked lens of the model at w x h with focal lengths, centre and
+ * coefficients k[0..nk). */
+static kin_lens lens_of(kin_lens_model model, int w, int h, double fx, double fy, double cx,
+                        double cy, const double *k, int nk)
 {
     kin_lens L;
     memset(&L, 0, sizeof L);
-    L.model = KIN_LENS_BROWN;
-    L.width = 640, L.height = 480;
-    L.fx = 531.8, L.fy = 532.4, L.cx = 318.2, L.cy = 241.7;
-    L.k[0] = -0.291, L.k[1] = 0.102, L.k[2] = 0.0007, L.k[3] = -0.0011, L.k[4] = -0.0173;
+    L.model = model;
+    L.width = w, L.height = h;
+    L.fx = fx, L.fy = fy, L.cx = cx, L.cy = cy;
+    for (int i = 0; i < nk; i++) L.k[i] = k[i];
     assert_true(kin_lens_check(&L, NULL, 0));
     return L;
 }
 
+static kin_lens barrel(void)
+{
+    static const double k[5] = {-0.291, 0.102, 0.0007, -0.0011, -0.0173};
+    return lens_of(KIN_LENS_BROWN, 640, 480, 531.8, 532.4, 318.2, 241.7, k, 5);
+}
+
 static kin_lens fisheye(void)
 {
-    kin_lens L;
-    memset(&L, 0, sizeof L);
-    L.model = KIN_LENS_FISHEYE;
-    L.width = 848, L.height = 800;
-    L.fx = 286.18, L.fy = 286.33, L.cx = 421.3, L.cy = 403.1;
-    L.k[0] = -0.00825, L.k[1] = 0.0453, L.k[2] = -0.0428, L.k[3] = 0.00777;
-    assert_true(kin_lens_check(&L, NULL, 0));
-    return L;
+    static const double k[4] = {-0.00825, 0.0453, -0.0428, 0.00777};
+    return lens_of(KIN_LENS_FISHEYE, 848, 800, 286.18, 286.33, 421.3, 403.1, k, 4);
+}
+
+/* One silhouette case: the polygon of make_poly's arguments, drawn with
+ * ss samples per pixel. */
+typedef struct silhouette_case {
+    const char *name;
+    double cx, cy, cz, rmin, rmax, yaw, pitch;
+    uint64_t seed;
+    int ss;
+} silhouette_case;
+
+/* run_case of each of the n cases through the lens L. */
+static void run_silhouettes(const kin_lens *L, const silhouette_case *c, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        poly p = make_poly(c[i].cx, c[i].cy, c[i].cz, c[i].rmin, c[i].rmax, c[i].yaw, c[i].pitch,
+                           c[i].seed);
+        run_case(c[i].name, L, &p, c[i].ss);
+    }
 }
 
 static void result_barrel_silhouette(void **state)
 {
     (void)state;
-    kin_lens L = barrel();
     /* a hand-sized star off-centre, and a large tilted one reaching the corners */
-    poly a = make_poly(0.12, 0.05, -0.45, 0.05, 0.09, 0.4, -0.3, 1);
-    poly b = make_poly(-0.05, -0.02, -0.5, 0.22, 0.42, -0.5, 0.6, 2);
-    run_case("barrel, hand off-centre", &L, &a, 1);
-    run_case("barrel, hand off-centre", &L, &a, 2);
-    run_case("barrel, large, to the corners", &L, &b, 1);
-    run_case("barrel, large, to the corners", &L, &b, 2);
+    static const silhouette_case cases[] = {
+        {"barrel, hand off-centre", 0.12, 0.05, -0.45, 0.05, 0.09, 0.4, -0.3, 1, 1},
+        {"barrel, hand off-centre", 0.12, 0.05, -0.45, 0.05, 0.09, 0.4, -0.3, 1, 2},
+        {"barrel, large, to the corners", -0.05, -0.02, -0.5, 0.22, 0.42, -0.5, 0.6, 2, 1},
+        {"barrel, large, to the corners", -0.05, -0.02, -0.5, 0.22, 0.42, -0.5, 0.6, 2, 2},
+    };
+    kin_lens L = barrel();
+    run_silhouettes(&L, cases, sizeof cases / sizeof cases[0]);
 }
 
 static void result_fisheye_silhouette(void **state)
 {
     (void)state;
-    kin_lens L = fisheye();
     /* 55 degrees off the axis, and across the centre */
-    poly a = make_poly(0.3, -0.12, -0.25, 0.06, 0.1, 0.9, 0.2, 3);
-    poly b = make_poly(0.0, 0.0, -0.3, 0.2, 0.35, 0.3, -0.4, 4);
-    run_case("fisheye, 55 degrees off the axis", &L, &a, 1);
-    run_case("fisheye, 55 degrees off the axis", &L, &a, 2);
-    run_case("fisheye, across the centre", &L, &b, 1);
+    static const silhouette_case cases[] = {
+        {"fisheye, 55 degrees off the axis", 0.3, -0.12, -0.25, 0.06, 0.1, 0.9, 0.2, 3, 1},
+        {"fisheye, 55 degrees off the axis", 0.3, -0.12, -0.25, 0.06, 0.1, 0.9, 0.2, 3, 2},
+        {"fisheye, across the centre", 0.0, 0.0, -0.3, 0.2, 0.35, 0.3, -0.4, 4, 1},
+    };
+    kin_lens L = fisheye();
+    run_silhouettes(&L, cases, sizeof cases / sizeof cases[0]);
 }
 
 /* Depth and normals come through unchanged: a plane of constant normal

@@ -107,6 +107,8 @@ typedef struct scene {
     kin_mat4 head;
     uint8_t *sil[2];
     float disc_px[2][2];
+    pipe_ctx *pipes[4]; /* make_pipe's, destroyed by scene_close */
+    int npipes;
 } scene;
 
 static scene *scene_open(uint64_t seed)
@@ -140,11 +142,13 @@ static scene *scene_open(uint64_t seed)
 
 static void scene_close(scene *S)
 {
+    for (int k = 0; k < S->npipes; k++) pipe_destroy(S->pipes[k]);
     tu_frame_free(&S->b);
     for (int e = 0; e < 2; e++) free(S->sil[e]);
     free(S);
 }
 
+/* A pipe on the scene (the scene's: scene_close destroys it). */
 static pipe_ctx *make_pipe_isa(scene *S, int prior, int threads, int isa)
 {
     pipe_desc d = {0};
@@ -155,6 +159,8 @@ static pipe_ctx *make_pipe_isa(scene *S, int prior, int threads, int isa)
     d.refine_prior = prior;
     pipe_ctx *p = pipe_create(&d, &S->A.m);
     assert_non_null(p);
+    assert_true(S->npipes < 4);
+    S->pipes[S->npipes++] = p;
     return p;
 }
 
@@ -188,8 +194,6 @@ static void prior_reaches_beyond_band(void **state)
         assert_true(i_on[e] > 0.97);
         assert_true(i_on[e] > i_off[e] + 0.02);
     }
-    pipe_destroy(on);
-    pipe_destroy(off);
     scene_close(S);
 }
 
@@ -247,9 +251,27 @@ static void prior_keeps_no_rim(void **state)
      * the kinematic input */
     print_message("frames 10-13: rim pixels prior %ld, kinematic input %ld\n", sp_on, sp_off);
     assert_true(sp_on <= 120);
-    pipe_destroy(on);
-    pipe_destroy(off);
     scene_close(S);
+}
+
+/* A frame of S through the pipe a with the hands at speed_a, then through
+ * b at speed_b (NULL: 0 m/s): the same output and mask of eye e. */
+static void same_bytes(scene *S, pipe_ctx *a, const float *speed_a, pipe_ctx *b,
+                       const float *speed_b, int e)
+{
+    uint8_t *keep = malloc(1280 * 800 * 4), *m = malloc(W * H);
+    assert_true(keep && m);
+    char why[200];
+    S->in.hand_speed = speed_a;
+    assert_int_equal(pipe_frame(a, &S->in, NULL, why, sizeof why), PIPE_OK);
+    memcpy(keep, S->b.out[e], 1280 * 800 * 4);
+    memcpy(m, pipe_mask(a, e, NULL, NULL), W * H);
+    S->in.hand_speed = speed_b;
+    assert_int_equal(pipe_frame(b, &S->in, NULL, why, sizeof why), PIPE_OK);
+    assert_memory_equal(keep, S->b.out[e], 1280 * 800 * 4);
+    assert_memory_equal(m, pipe_mask(b, e, NULL, NULL), W * H);
+    free(keep);
+    free(m);
 }
 
 /* Hands faster than PIPE_PRIOR_SPEED keep the kinematic input: the bytes
@@ -263,35 +285,10 @@ static void fast_hands_and_threads(void **state)
     pipe_ctx *on = make_pipe(S, 0, 1), *on2 = make_pipe_isa(S, 0, 2, EF_ISA_REF),
              *off = make_pipe(S, -1, 1);
     const float fast[2] = {0.31f, 0.5f};
-    uint8_t *keep = malloc(1280 * 800 * 4), *m = malloc(W * H);
-    assert_true(keep && m);
-    char why[200];
-    for (int f = 0; f < 3; f++) {
-        S->in.hand_speed = fast;
-        assert_int_equal(pipe_frame(on, &S->in, NULL, why, sizeof why), PIPE_OK);
-        memcpy(keep, S->b.out[0], 1280 * 800 * 4);
-        memcpy(m, pipe_mask(on, 0, NULL, NULL), W * H);
-        S->in.hand_speed = NULL;
-        assert_int_equal(pipe_frame(off, &S->in, NULL, why, sizeof why), PIPE_OK);
-        assert_memory_equal(keep, S->b.out[0], 1280 * 800 * 4);
-        assert_memory_equal(m, pipe_mask(off, 0, NULL, NULL), W * H);
-    }
+    for (int f = 0; f < 3; f++) same_bytes(S, on, fast, off, NULL, 0);
     /* slow (NULL: 0 m/s) from here: one thread against two, ISAs */
     pipe_ctx *on1 = make_pipe(S, 0, 1);
-    for (int f = 0; f < 3; f++) {
-        assert_int_equal(pipe_frame(on2, &S->in, NULL, why, sizeof why), PIPE_OK);
-        memcpy(keep, S->b.out[1], 1280 * 800 * 4);
-        memcpy(m, pipe_mask(on2, 1, NULL, NULL), W * H);
-        assert_int_equal(pipe_frame(on1, &S->in, NULL, why, sizeof why), PIPE_OK);
-        assert_memory_equal(keep, S->b.out[1], 1280 * 800 * 4);
-        assert_memory_equal(m, pipe_mask(on1, 1, NULL, NULL), W * H);
-    }
-    free(keep);
-    free(m);
-    pipe_destroy(on);
-    pipe_destroy(on1);
-    pipe_destroy(on2);
-    pipe_destroy(off);
+    for (int f = 0; f < 3; f++) same_bytes(S, on2, NULL, on1, NULL, 1);
     scene_close(S);
 }
 
@@ -346,8 +343,6 @@ static void regrow_trail_fast_hands(void **state)
     }
     assert_true(cleared > 0);
     free(m);
-    pipe_destroy(slow);
-    pipe_destroy(fast);
     S->head = head0;
     scene_close(S);
 }

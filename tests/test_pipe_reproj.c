@@ -31,6 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../src/cpu/ef_mem.h"
 #include "../src/pipe/pipe.h"
 #include "support/pipe_frames.h"
 
@@ -142,6 +143,13 @@ static void rig_frame(reproj_rig *r)
     assert_int_equal(pipe_frame(r->p, &r->in, &r->st, r->why, sizeof r->why), PIPE_OK);
 }
 
+/* rig_quad, and its frame run (rig_frame). */
+static void rig_quad_frame(reproj_rig *r, float s, float z, uint64_t seed)
+{
+    rig_quad(r, s, z, seed);
+    rig_frame(r);
+}
+
 static void rig_end(reproj_rig *r)
 {
     tu_frame_free(&r->b);
@@ -175,6 +183,58 @@ static long draw_from_eye(const kin_model *m, int e, uint8_t *mask)
     free(depth);
     free(clip);
     return n;
+}
+
+/* The eye-view mask M against the model drawn from the eye (ref), both
+ * of n pixels: the pixels ref covers, those where M and ref disagree on
+ * covered or not (*diff) and those of M at 255 (*full). */
+static long mask_vs_ref(const uint8_t *M, const uint8_t *ref, size_t n, long *diff, long *full)
+{
+    long covered = 0;
+    *diff = *full = 0;
+    for (size_t i = 0; i < n; i++) {
+        covered += ref[i] != 0;
+        *diff += (M[i] != 0) != (ref[i] != 0);
+        *full += M[i] == 255;
+    }
+    return covered;
+}
+
+/* Eye pixel (x, y) of the eye camera ec (CW x CH) when the mask M is 255
+ * there: 1, with (*X, *Y) where the eye ray through the pixel's centre
+ * meets the plane z = -d; else 0. */
+static int eye_hit(const uint8_t *M, const kin_camera *ec, int x, int y, double d, double *X,
+                   double *Y)
+{
+    if (M[(size_t)y * CW + (size_t)x] != 255) return 0;
+    double rx = (x + 0.5 - ec->cx) / ec->fx, ry = -(y + 0.5 - ec->cy) / ec->fy;
+    *X = ec->world_from_cam.m[12] + d * rx;
+    *Y = d * ry;
+    return 1;
+}
+
+/* A virtual depth of both eyes (LCDW x LCDH, freed by the caller) set in
+ * in: left on the left half of the display, right on the right half. */
+static float *virt_depth_halves(pipe_frame_in *in, float left, float right)
+{
+    float *vd = malloc(sizeof(float) * LCDW * LCDH);
+    assert_non_null(vd);
+    for (int y = 0; y < LCDH; y++)
+        for (int x = 0; x < LCDW; x++) vd[(size_t)y * LCDW + x] = x < LCDW / 2 ? left : right;
+    for (int e = 0; e < 2; e++) {
+        in->virt_depth[e] = vd;
+        in->virt_depth_stride[e] = LCDW;
+    }
+    return vd;
+}
+
+/* Two frames of the same seed at the paper's HMD sizes: (a, ia) for the
+ * pipe under test, (b, ib) for the one it is compared with. */
+static void twin_frames(tu_frame_bufs *a, pipe_frame_in *ia, tu_frame_bufs *b, pipe_frame_in *ib,
+                        uint64_t seed)
+{
+    tu_frame_make(a, ia, seed, CAMW, CAMH, LCDW, LCDH);
+    tu_frame_make(b, ib, seed, CAMW, CAMH, LCDW, LCDH);
 }
 
 /* The same on the "consumer" HMD (kin_sthmd_preset: 1280x1024 cameras
@@ -211,20 +271,15 @@ static void result_mask_other_hmd(void **state)
         rast_transform_points(c.view_proj.m, r.m.meshes[0].positions, 4, clip);
         rast_mesh_desc md = {clip, 4, NULL, 0, r.m.meshes[0].indices, 2, RAST_CULL_NONE};
         assert_int_equal(rast_draw(&t, &md, NULL), RAST_OK);
-        long n = 0, diff = 0, full = 0;
-        for (size_t i = 0; i < (size_t)w * h; i++) {
-            n += ref[i] != 0;
-            diff += (M[i] != 0) != (ref[i] != 0);
-            full += M[i] == 255;
-        }
+        long diff, full;
+        const long n = mask_vs_ref(M, ref, (size_t)w * h, &diff, &full);
         print_message("NOTE consumer HMD, eye %d: layer %dx%d, %ld eye pixels, %ld differ, "
                       "%ld filled\n", e, w, h, n, diff, r.st.view_filled[e]);
         assert_true(n > 20000);
         assert_int_equal(diff, 0);
         assert_int_equal(full, n);
     }
-    free(ref);
-    free(depth);
+    EF_FREE_ALL(ref, depth);
     rig_end(&r);
 }
 
@@ -235,8 +290,7 @@ static void result_mask_equals_eye_draw(void **state)
 {
     (void)state;
     reproj_rig r;
-    rig_quad(&r, 0.06f, -0.35f, 11);
-    rig_frame(&r);
+    rig_quad_frame(&r, 0.06f, -0.35f, 11);
     uint8_t *ref = malloc(CW * CH);
     assert_non_null(ref);
     for (int e = 0; e < 2; e++) {
@@ -246,11 +300,9 @@ static void result_mask_equals_eye_draw(void **state)
         assert_non_null(M);
         assert_int_equal(w, CW);
         assert_int_equal(h, CH);
-        long n = draw_from_eye(&r.m, e, ref), diff = 0, full = 0;
-        for (int i = 0; i < CW * CH; i++) {
-            diff += (M[i] != 0) != (ref[i] != 0);
-            full += M[i] == 255;
-        }
+        long diff, full;
+        const long n = draw_from_eye(&r.m, e, ref);
+        mask_vs_ref(M, ref, (size_t)CW * CH, &diff, &full);
         print_message("NOTE eye %d: %ld eye pixels, %ld differ from the direct draw, %ld sampled, "
                       "%ld filled, %ld outside\n", e, n, diff, r.st.view_sampled[e],
                       r.st.view_filled[e], r.st.view_outside[e]);
@@ -331,17 +383,14 @@ static void point_lands(double k1)
         const uint8_t *M = pipe_view_mask(r.p, e, NULL, NULL);
         kin_camera ec = eye_cam(e), cc = pipe_camera(r.p, e);
         assert_int_equal(kin_lens_distorts(&cc.lens), k1 != 0.0);
-        const double ex = ec.world_from_cam.m[12];
         const double cx = cc.world_from_cam.m[12], cz = cc.world_from_cam.m[14];
         long checked = 0;
         double worst = 0.0;
         for (int y = 0; y < CH; y++)
             for (int x = 0; x < CW; x++) {
                 size_t i = (size_t)y * CW + (size_t)x;
-                if (M[i] != 255) continue;
-                /* the eye ray to the plane z = -0.35 */
-                double rx = (x + 0.5 - ec.cx) / ec.fx, ry = -(y + 0.5 - ec.cy) / ec.fy;
-                double X = ex + 0.35 * rx, Y = 0.35 * ry;
+                double X, Y; /* the eye ray to the plane z = -0.35 */
+                if (!eye_hit(M, &ec, x, y, 0.35, &X, &Y)) continue;
                 if (fabs(X) > 0.048 || fabs(Y) > 0.048) continue; /* away from the edge */
                 /* into the camera (same orientation) and through its lens */
                 double pc[3] = {X - cx, Y, -0.35 - cz}, u, v;
@@ -412,14 +461,12 @@ static void result_disocclusion_fill(void **state)
         const uint8_t *Q = pipe_layer(r.p, e, NULL, NULL);
         const uint8_t *M = pipe_view_mask(r.p, e, NULL, NULL);
         kin_camera ec = eye_cam(e);
-        const double ex = ec.world_from_cam.m[12];
         long back = 0, red = 0, front = 0, front_red = 0;
         for (int y = 0; y < CH; y++)
             for (int x = 0; x < CW; x++) {
                 size_t i = (size_t)y * CW + (size_t)x;
-                if (M[i] != 255) continue;
-                double rx = (x + 0.5 - ec.cx) / ec.fx, ry = -(y + 0.5 - ec.cy) / ec.fy;
-                double fX = ex + 0.3 * rx, fY = 0.3 * ry;
+                double fX, fY;
+                if (!eye_hit(M, &ec, x, y, 0.3, &fX, &fY)) continue;
                 /* 2 eye px clear of the front quad's silhouette either way */
                 double margin = 2.0 * 0.3 / ec.fx;
                 if (fabs(fX) < 0.03 - margin && fabs(fY) < 0.03 - margin) {
@@ -515,9 +562,7 @@ static void result_full_sensor(void **state)
         assert_memory_equal(pipe_layer(r.p, e, NULL, NULL), layer0 + (size_t)e * CW * CH * 4,
                             (size_t)CW * CH * 4);
     }
-    free(layer0);
-    free(rgb);
-    free(ref);
+    EF_FREE_ALL(layer0, rgb, ref);
     rig_end(&r);
 }
 
@@ -527,8 +572,7 @@ static void result_border_fade(void **state)
 {
     (void)state;
     reproj_rig r;
-    rig_quad(&r, 0.4f, -0.25f, 14);
-    rig_frame(&r);
+    rig_quad_frame(&r, 0.4f, -0.25f, 14);
     for (int e = 0; e < 2; e++) {
         const uint8_t *M = pipe_view_mask(r.p, e, NULL, NULL);
         /* the middle row: 0 at both ends, 255 in the middle, and between
@@ -562,14 +606,7 @@ static uint32_t frame_crc(const kin_model *m, int view, int threads, int isa)
     tu_frame_bufs b;
     pipe_frame_in in;
     tu_frame_make(&b, &in, 21, CAMW, CAMH, LCDW, LCDH);
-    float *vd = malloc(sizeof(float) * LCDW * LCDH);
-    assert_non_null(vd);
-    for (int y = 0; y < LCDH; y++)
-        for (int x = 0; x < LCDW; x++) vd[(size_t)y * LCDW + x] = x < LCDW / 2 ? 0.4f : 60.0f;
-    for (int e = 0; e < 2; e++) {
-        in.virt_depth[e] = vd;
-        in.virt_depth_stride[e] = LCDW;
-    }
+    float *vd = virt_depth_halves(&in, 0.4f, 60.0f);
     pipe_frame_stats st;
     char why[200];
     assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
@@ -665,8 +702,7 @@ static void validity_eye_inside_model(void **state)
     assert_non_null(c);
     tu_frame_bufs b, bc;
     pipe_frame_in in, ic;
-    tu_frame_make(&b, &in, 15, CAMW, CAMH, LCDW, LCDH);
-    tu_frame_make(&bc, &ic, 15, CAMW, CAMH, LCDW, LCDH);
+    twin_frames(&b, &in, &bc, &ic, 15);
     pipe_frame_stats st;
     char why[200];
     assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
@@ -790,8 +826,7 @@ static void validity_fallback_alternating(void **state)
         assert_non_null(p);
         tu_frame_bufs b, bf;
         pipe_frame_in in, inf;
-        tu_frame_make(&b, &in, 21, CAMW, CAMH, LCDW, LCDH);
-        tu_frame_make(&bf, &inf, 21, CAMW, CAMH, LCDW, LCDH);
+        twin_frames(&b, &in, &bf, &inf, 21);
         pipe_frame_stats st;
         char why[200];
         long fallbacks = 0;
@@ -837,15 +872,8 @@ static void validity_nan_virtual_depth(void **state)
     tu_frame_bufs b0;
     pipe_frame_in i0;
     tu_frame_make(&b0, &i0, 16, CAMW, CAMH, LCDW, LCDH);
-    float *vd = malloc(sizeof(float) * LCDW * LCDH);
-    assert_non_null(vd);
     /* NaN on the left half, 0.2 m (in front of the hand) on the right */
-    for (int y = 0; y < LCDH; y++)
-        for (int x = 0; x < LCDW; x++) vd[(size_t)y * LCDW + x] = x < LCDW / 2 ? NAN : 0.2f;
-    for (int e = 0; e < 2; e++) {
-        r.in.virt_depth[e] = vd;
-        r.in.virt_depth_stride[e] = LCDW;
-    }
+    float *vd = virt_depth_halves(&r.in, NAN, 0.2f);
     assert_int_equal(pipe_frame(r.p, &r.in, NULL, r.why, sizeof r.why), PIPE_OK);
     assert_int_equal(pipe_frame(r.p, &i0, NULL, r.why, sizeof r.why), PIPE_OK);
     for (int e = 0; e < 2; e++) {

@@ -461,6 +461,21 @@ static int write_sys(const char *path, const char *val)
     return k == (ssize_t)strlen(val) ? 0 : -1;
 }
 
+/* The config of the vivid source spec: fourcc frames of w x h at 25 FPS
+ * from input 0, scaled to eyes of VS_EW x VS_EH. */
+static io_vsrc_config vsrc_config(const char *spec, uint32_t fourcc, int w, int h)
+{
+    io_vsrc_config c = io_vsrc_config_default(spec);
+    c.fourcc = fourcc;
+    c.width = w;
+    c.height = h;
+    c.eye_width = VS_EW;
+    c.eye_height = VS_EH;
+    c.fps = 25;
+    c.input = 0;
+    return c;
+}
+
 static int cmd_vsrc(void)
 {
     io_error err;
@@ -470,14 +485,7 @@ static int cmd_vsrc(void)
     static const uint32_t fmts[] = {IO_FMT_YUYV, IO_FMT_NV12, IO_FMT_RGB3, IO_FMT_BGR4, IO_FMT_XR24};
     for (size_t k = 0; k < sizeof fmts / sizeof fmts[0]; k++) {
         char fs[5];
-        io_vsrc_config c = io_vsrc_config_default("v4l2:/dev/video2,/dev/video3");
-        c.fourcc = fmts[k];
-        c.eye_width = VS_EW;
-        c.eye_height = VS_EH;
-        c.width = 640;
-        c.height = 360;
-        c.fps = 25;
-        c.input = 0;
+        io_vsrc_config c = vsrc_config("v4l2:/dev/video2,/dev/video3", fmts[k], 640, 360);
         io_vsrc *v;
         io_result r = io_vsrc_open(&v, &c, &err);
         if (r == IO_ERR_FORMAT && strstr(err.msg, "not offered")) {
@@ -510,15 +518,8 @@ static int cmd_vsrc(void)
 
     /* one device carrying both eyes side by side: 1280x720 -> 2 x 640x720 */
     {
-        io_vsrc_config c = io_vsrc_config_default("v4l2:/dev/video2");
-        c.fourcc = IO_FMT_YUYV;
-        c.width = 1280;
-        c.height = 720;
-        c.fps = 25;
-        c.input = 0;
+        io_vsrc_config c = vsrc_config("v4l2:/dev/video2", IO_FMT_YUYV, 1280, 720);
         c.layout = IO_VSRC_SBS;
-        c.eye_width = VS_EW;
-        c.eye_height = VS_EH;
         io_vsrc *v;
         io_result r = io_vsrc_open(&v, &c, &err);
         uint64_t n = r == IO_OK ? vsrc_run(v, 4, 6.0) : 0;
@@ -544,14 +545,7 @@ static int cmd_vsrc(void)
     if (!vivid_sysfs(pdev, sizeof pdev)) {
         check(0, "vsrc_unplug", "no vivid device under /sys/bus/platform/drivers/vivid");
     } else {
-        io_vsrc_config c = io_vsrc_config_default("v4l2:/dev/video2,/dev/video3");
-        c.fourcc = IO_FMT_YUYV;
-        c.width = 640;
-        c.height = 360;
-        c.eye_width = VS_EW;
-        c.eye_height = VS_EH;
-        c.fps = 25;
-        c.input = 0;
+        io_vsrc_config c = vsrc_config("v4l2:/dev/video2,/dev/video3", IO_FMT_YUYV, 640, 360);
         io_vsrc *v;
         io_result r = io_vsrc_open(&v, &c, &err);
         uint64_t n = r == IO_OK ? vsrc_run(v, 4, 6.0) : 0;

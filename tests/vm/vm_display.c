@@ -126,15 +126,45 @@ static int wait_flip(io_display *d, io_display_flip *ev, io_error *err)
     return -1;
 }
 
+/* io_display_open of spec with ew x eh eyes and 2 buffers into *d (err
+ * cleared first). */
+static io_result display_open(const char *spec, int ew, int eh, io_display **d, io_error *err)
+{
+    io_display_config c = {spec, ew, eh, 2};
+    *d = NULL;
+    memset(err, 0, sizeof *err);
+    return io_display_open(d, &c, err);
+}
+
+/* display_open of spec at the eyes' size: the display; or NULL when it
+ * failed, the check `name` failed with the reason and cfd closed. */
+static io_display *open_checked(const char *spec, const char *name, int cfd, io_error *err)
+{
+    io_display *d;
+    if (display_open(spec, VMD_EYE_W, VMD_EYE_H, &d, err) == IO_OK) return d;
+    check(0, name, "%s", err->msg);
+    close(cfd);
+    return NULL;
+}
+
+/* The CRTCs of cfd as found, into before and printed after `what`: the
+ * first opener became master and gives it up, the watcher only reads. */
+static void watch_start(int cfd, crtc_state *before, const char *what)
+{
+    drmDropMaster(cfd);
+    snapshot(cfd, before);
+    char desc[1024];
+    describe(before, desc, sizeof desc);
+    printf("VMINFO %s: %s\n", what, desc);
+}
+
 static void expect_fail(const char *name, const char *spec, int ew, int eh, const char *want, const crtc_state *before,
                         int cfd)
 {
-    io_display_config c = {spec, ew, eh, 2};
-    io_display *d = NULL;
+    io_display *d;
     io_error err;
-    memset(&err, 0, sizeof err);
     int fds = count_fds();
-    io_result r = io_display_open(&d, &c, &err);
+    io_result r = display_open(spec, ew, eh, &d, &err);
     crtc_state after;
     snapshot(cfd, &after);
     int ok = r != IO_OK && d == NULL && strstr(err.msg, want) && count_fds() == fds && same(before, &after);
@@ -183,22 +213,13 @@ static int cmd_two(const char *outdir)
         return 1;
     }
     int cfd = open(card, O_RDWR | O_CLOEXEC);
-    drmDropMaster(cfd);
     crtc_state before, now;
-    snapshot(cfd, &before);
-    char desc[1024];
-    describe(&before, desc, sizeof desc);
-    printf("VMINFO display two before: %s\n", desc);
+    watch_start(cfd, &before, "display two before");
     snprintf(spec, sizeof spec, "kms:%s,layout=two", card);
-    io_display_config c = {spec, VMD_EYE_W, VMD_EYE_H, 2};
-    io_display *d = NULL;
     io_error err;
-    memset(&err, 0, sizeof err);
-    if (io_display_open(&d, &c, &err) != IO_OK) {
-        check(0, "display_two_open", "%s", err.msg);
-        close(cfd);
-        return 1;
-    }
+    io_display *d = open_checked(spec, "display_two_open", cfd, &err);
+    if (!d) return 1;
+    char desc[1024];
     snapshot(cfd, &now);
     describe(&now, desc, sizeof desc);
     check(1, "display_two_open", "%s; %s", io_display_describe(d), desc);
@@ -264,13 +285,8 @@ int main(int argc, char **argv)
               strerror(errno));
         return 1;
     }
-    /* the first opener became master: give it up, the watcher only reads */
-    drmDropMaster(cfd);
     crtc_state before, now;
-    snapshot(cfd, &before);
-    char desc[1024];
-    describe(&before, desc, sizeof desc);
-    printf("VMINFO display before: %s\n", desc);
+    watch_start(cfd, &before, "display before");
 
     /* refusals first: nothing may change on screen. The specs name the
      * card (virtio-gpu is another card in the same VM); the default
@@ -293,15 +309,10 @@ int main(int argc, char **argv)
                 &before, cfd);
 
     /* open: the default card, connector, mode and layout */
-    io_display_config c = {"kms", VMD_EYE_W, VMD_EYE_H, 2};
-    io_display *d = NULL;
     io_error err;
-    memset(&err, 0, sizeof err);
-    if (io_display_open(&d, &c, &err) != IO_OK) {
-        check(0, "display_open", "%s", err.msg);
-        close(cfd);
-        return 1;
-    }
+    io_display *d = open_checked("kms", "display_open", cfd, &err);
+    if (!d) return 1;
+    char desc[1024];
     int w, h;
     io_display_size(d, &w, &h);
     uint64_t period = io_display_refresh_ns(d);
@@ -313,7 +324,7 @@ int main(int argc, char **argv)
     check(!strncmp(io_display_describe(d), "kms /dev/dri/card0 Virtual-1 ", 29) && !strcmp(card, "/dev/dri/card0"),
           "display_default", "kms -> %s (bochs is %s)", io_display_describe(d), card);
     snprintf(spec, sizeof spec, "kms:%s", card);
-    c.spec = spec;
+    io_display_config c = {spec, VMD_EYE_W, VMD_EYE_H, 2}; /* the card named */
 
     /* busy: a second open while the first holds master */
     {
