@@ -113,19 +113,6 @@ SIMD_INL vfloat vf_neg(vfloat a) { return _mm_xor_ps(a, _mm_set1_ps(-0.0f)); }
 SIMD_INL vfloat vf_abs(vfloat a) { return _mm_and_ps(a, _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF))); }
 SIMD_INL vfloat vf_neg_if(vmask m, vfloat a) { return _mm_xor_ps(a, _mm_and_ps(m, _mm_set1_ps(-0.0f))); }
 
-/* floorf: truncate, subtract 1 where that rounded up, put back the sign
- * of -0.0 (the truncation gives +0), keep lanes with !(|a| < 2^23)
- * (already integers, inf, NaN) as they are. */
-SIMD_INL vfloat vf_floor(vfloat a)
-{
-    const __m128 sign = _mm_set1_ps(-0.0f);
-    __m128 t = _mm_cvtepi32_ps(_mm_cvttps_epi32(a));
-    t = _mm_sub_ps(t, _mm_and_ps(_mm_cmpgt_ps(t, a), _mm_set1_ps(1.0f)));
-    t = _mm_or_ps(t, _mm_and_ps(a, sign));
-    const __m128 small = _mm_cmplt_ps(_mm_andnot_ps(sign, a), _mm_set1_ps(8388608.0f));
-    return _mm_or_ps(_mm_and_ps(small, t), _mm_andnot_ps(small, a));
-}
-
 /* ---- compares */
 SIMD_INL vmask vf_eq(vfloat a, vfloat b) { return _mm_cmpeq_ps(a, b); }
 SIMD_INL vmask vf_ne(vfloat a, vfloat b) { return _mm_cmpneq_ps(a, b); }
@@ -154,6 +141,19 @@ SIMD_INL vint vi_xor(vint i, vint j) { return _mm_xor_si128(i, j); }
 SIMD_INL vint vi_andnot(vint i, vint j) { return _mm_andnot_si128(i, j); }
 SIMD_INL vint vf_as_vi(vfloat a) { return _mm_castps_si128(a); }
 SIMD_INL vfloat vi_as_vf(vint i) { return _mm_castsi128_ps(i); }
+
+/* floorf: truncate, subtract 1 where that rounded up, put back the sign
+ * of -0.0 (the truncation gives +0), keep lanes with !(|a| < 2^23)
+ * (already integers, inf, NaN) as they are (a select: after vf_sel). */
+SIMD_INL vfloat vf_floor(vfloat a)
+{
+    const __m128 sign = _mm_set1_ps(-0.0f);
+    __m128 t = _mm_cvtepi32_ps(_mm_cvttps_epi32(a));
+    t = _mm_sub_ps(t, _mm_and_ps(_mm_cmpgt_ps(t, a), _mm_set1_ps(1.0f)));
+    t = _mm_or_ps(t, _mm_and_ps(a, sign));
+    const __m128 small = _mm_cmplt_ps(_mm_andnot_ps(sign, a), _mm_set1_ps(8388608.0f));
+    return vf_sel(small, t, a);
+}
 
 /* ---- integer arithmetic */
 SIMD_INL vint vi_add(vint i, vint j) { return _mm_add_epi32(i, j); }
@@ -253,8 +253,9 @@ SIMD_INL void vd_store_f(float *p, vdouble a)
 
 /* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
 SIMD_INL vdouble vd_sqrt(vdouble a) { return _mm_sqrt_pd(a); }
-SIMD_INL vint vi_min(vint i, vint j) { const __m128i g = _mm_cmpgt_epi32(i, j); return _mm_or_si128(_mm_and_si128(g, j), _mm_andnot_si128(g, i)); }
-SIMD_INL vint vi_max(vint i, vint j) { const __m128i g = _mm_cmpgt_epi32(i, j); return _mm_or_si128(_mm_and_si128(g, i), _mm_andnot_si128(g, j)); }
+/* no pminsd / pmaxsd: a compare and a select */
+SIMD_INL vint vi_min(vint i, vint j) { return vi_sel(vi_gt(i, j), j, i); }
+SIMD_INL vint vi_max(vint i, vint j) { return vi_sel(vi_gt(i, j), i, j); }
 SIMD_INL vdouble vd_from_vf(vfloat a, int h) { return _mm_cvtps_pd(h ? _mm_movehl_ps(a, a) : a); }
 SIMD_INL vdouble vd_from_vi(vint i, int h) { return _mm_cvtepi32_pd(h ? _mm_shuffle_epi32(i, 0xEE) : i); }
 SIMD_INL vfloat vf_from_vd(vdouble lo, vdouble hi) { return _mm_movelh_ps(_mm_cvtpd_ps(lo), _mm_cvtpd_ps(hi)); }
