@@ -347,33 +347,26 @@ SIMD_INL vint vi_load_u16(const uint16_t *p)
 }
 /* the chamfer's running minima: lane l takes lane l - k (up; the lanes
  * below k take the fill f) by a 128-bit block permute and a byte align,
- * and lane l + k (dn) the same mirrored */
+ * and lane l + k (dn) the same mirrored. VH__RUNMIN3 writes both: SH the
+ * shift, the rest the 16 lanes the carry c is added to, 3 (l + 1) (up) or
+ * 3 (16 - l) (dn). */
 #define VH__UP(t, f, k) _mm256_alignr_epi8(t, _mm256_permute2x128_si256(t, f, 0x02), 16 - 2 * (k))
 #define VH__DN(t, f, k) _mm256_alignr_epi8(_mm256_permute2x128_si256(t, f, 0x31), t, 2 * (k))
-SIMD_INL vint vh_runmin3_up(vint i, unsigned c)
-{
-    const __m256i f = _mm256_set1_epi16(-1);
-    __m256i t = i;
-    t = _mm256_min_epu16(t, _mm256_adds_epu16(VH__UP(t, f, 1), _mm256_set1_epi16(3)));
-    t = _mm256_min_epu16(t, _mm256_adds_epu16(VH__UP(t, f, 2), _mm256_set1_epi16(6)));
-    t = _mm256_min_epu16(t, _mm256_adds_epu16(VH__UP(t, f, 4), _mm256_set1_epi16(12)));
-    t = _mm256_min_epu16(t, _mm256_adds_epu16(VH__UP(t, f, 8), _mm256_set1_epi16(24)));
-    const __m256i l3 = _mm256_setr_epi16(3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 33, 36, 39, 42,
-                                         45, 48);
-    return _mm256_min_epu16(t, _mm256_adds_epu16(_mm256_set1_epi16((short)c), l3));
-}
-SIMD_INL vint vh_runmin3_dn(vint i, unsigned c)
-{
-    const __m256i f = _mm256_set1_epi16(-1);
-    __m256i t = i;
-    t = _mm256_min_epu16(t, _mm256_adds_epu16(VH__DN(t, f, 1), _mm256_set1_epi16(3)));
-    t = _mm256_min_epu16(t, _mm256_adds_epu16(VH__DN(t, f, 2), _mm256_set1_epi16(6)));
-    t = _mm256_min_epu16(t, _mm256_adds_epu16(VH__DN(t, f, 4), _mm256_set1_epi16(12)));
-    t = _mm256_min_epu16(t, _mm256_adds_epu16(VH__DN(t, f, 8), _mm256_set1_epi16(24)));
-    const __m256i l3 = _mm256_setr_epi16(48, 45, 42, 39, 36, 33, 30, 27, 24, 21, 18, 15, 12, 9,
-                                         6, 3);
-    return _mm256_min_epu16(t, _mm256_adds_epu16(_mm256_set1_epi16((short)c), l3));
-}
+#define VH__RUNMIN3(name, SH, ...)                                                      \
+    SIMD_INL vint name(vint i, unsigned c)                                              \
+    {                                                                                   \
+        const __m256i f = _mm256_set1_epi16(-1);                                        \
+        __m256i t = i;                                                                  \
+        t = _mm256_min_epu16(t, _mm256_adds_epu16(SH(t, f, 1), _mm256_set1_epi16(3)));  \
+        t = _mm256_min_epu16(t, _mm256_adds_epu16(SH(t, f, 2), _mm256_set1_epi16(6)));  \
+        t = _mm256_min_epu16(t, _mm256_adds_epu16(SH(t, f, 4), _mm256_set1_epi16(12))); \
+        t = _mm256_min_epu16(t, _mm256_adds_epu16(SH(t, f, 8), _mm256_set1_epi16(24))); \
+        const __m256i l3 = _mm256_setr_epi16(__VA_ARGS__);                              \
+        return _mm256_min_epu16(t, _mm256_adds_epu16(_mm256_set1_epi16((short)c), l3)); \
+    }
+VH__RUNMIN3(vh_runmin3_up, VH__UP, 3, 6, 9, 12, 15, 18, 21, 24, 27, 30, 33, 36, 39, 42, 45, 48)
+VH__RUNMIN3(vh_runmin3_dn, VH__DN, 48, 45, 42, 39, 36, 33, 30, 27, 24, 21, 18, 15, 12, 9, 6, 3)
+#undef VH__RUNMIN3
 #undef VH__UP
 #undef VH__DN
 

@@ -317,29 +317,25 @@ SIMD_INL vint vi_load_u16(const uint16_t *p)
     return _mm_unpacklo_epi16(_mm_loadl_epi64((const __m128i *)(const void *)p), _mm_setzero_si128());
 }
 /* the chamfer's running minima: byte shifts of the vector, the lanes
- * shifted in set to 65535 by an or (the unsigned minimum as above) */
+ * shifted in set to 65535 by an or (the unsigned minimum as above).
+ * VH__RUNMIN3 writes both directions: SH the shift, the rest the 8 lanes
+ * the carry c is added to, 3 (l + 1) (up) or 3 (8 - l) (dn). */
 #define VH__UP(t, f, k) _mm_or_si128(_mm_slli_si128(t, 2 * (k)), _mm_srli_si128(f, 16 - 2 * (k)))
 #define VH__DN(t, f, k) _mm_or_si128(_mm_srli_si128(t, 2 * (k)), _mm_slli_si128(f, 16 - 2 * (k)))
-SIMD_INL vint vh_runmin3_up(vint i, unsigned c)
-{
-    const __m128i f = _mm_set1_epi16(-1);
-    __m128i t = i;
-    t = vh_min_u(t, _mm_adds_epu16(VH__UP(t, f, 1), _mm_set1_epi16(3)));
-    t = vh_min_u(t, _mm_adds_epu16(VH__UP(t, f, 2), _mm_set1_epi16(6)));
-    t = vh_min_u(t, _mm_adds_epu16(VH__UP(t, f, 4), _mm_set1_epi16(12)));
-    const __m128i l3 = _mm_setr_epi16(3, 6, 9, 12, 15, 18, 21, 24);
-    return vh_min_u(t, _mm_adds_epu16(_mm_set1_epi16((short)c), l3));
-}
-SIMD_INL vint vh_runmin3_dn(vint i, unsigned c)
-{
-    const __m128i f = _mm_set1_epi16(-1);
-    __m128i t = i;
-    t = vh_min_u(t, _mm_adds_epu16(VH__DN(t, f, 1), _mm_set1_epi16(3)));
-    t = vh_min_u(t, _mm_adds_epu16(VH__DN(t, f, 2), _mm_set1_epi16(6)));
-    t = vh_min_u(t, _mm_adds_epu16(VH__DN(t, f, 4), _mm_set1_epi16(12)));
-    const __m128i l3 = _mm_setr_epi16(24, 21, 18, 15, 12, 9, 6, 3);
-    return vh_min_u(t, _mm_adds_epu16(_mm_set1_epi16((short)c), l3));
-}
+#define VH__RUNMIN3(name, SH, ...)                                        \
+    SIMD_INL vint name(vint i, unsigned c)                                \
+    {                                                                     \
+        const __m128i f = _mm_set1_epi16(-1);                             \
+        __m128i t = i;                                                    \
+        t = vh_min_u(t, _mm_adds_epu16(SH(t, f, 1), _mm_set1_epi16(3)));  \
+        t = vh_min_u(t, _mm_adds_epu16(SH(t, f, 2), _mm_set1_epi16(6)));  \
+        t = vh_min_u(t, _mm_adds_epu16(SH(t, f, 4), _mm_set1_epi16(12))); \
+        const __m128i l3 = _mm_setr_epi16(__VA_ARGS__);                   \
+        return vh_min_u(t, _mm_adds_epu16(_mm_set1_epi16((short)c), l3)); \
+    }
+VH__RUNMIN3(vh_runmin3_up, VH__UP, 3, 6, 9, 12, 15, 18, 21, 24)
+VH__RUNMIN3(vh_runmin3_dn, VH__DN, 24, 21, 18, 15, 12, 9, 6, 3)
+#undef VH__RUNMIN3
 #undef VH__UP
 #undef VH__DN
 
