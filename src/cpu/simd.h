@@ -9,6 +9,8 @@
  *   simd_avx512.h  AVX-512 F/BW/DQ/VL  SIMD_W 16   (built with -mavx512*)
  *   simd_neon.h    AArch64 Advanced SIMD (NEON)  SIMD_W 4 (no flag: baseline)
  *
+ * (the three x86 headers include simd_x86.h, the operations they write
+ * alike, once, under each ISA's intrinsic names)
  * and then the kernel body (a .inl) written on the names below. Each
  * operation's result is defined here, lane by lane, bit for bit; every
  * implementation gives those bits (tests/test_cpu_simd.c checks each op of

@@ -23,24 +23,23 @@
 typedef __m512 vfloat;
 typedef __m512i vint;
 typedef __mmask16 vmask;
+typedef __m512d vdouble;   /* raster's doubles: VD_W = 8 lanes */
+#define VD_W 8
+
+/* what the x86 ISAs write alike: simd_x86.h, with this ISA's intrinsic
+ * names and its halves of a vector (h 0: the low half) and their join */
+#define SIMD_X86_P _mm512
+#define SIMD_X86_B 512
+#define SIMD_X86_HALF_PS(a, h) ((h) ? _mm512_extractf32x8_ps(a, 1) : _mm512_castps512_ps256(a))
+#define SIMD_X86_HALF_SI(i, h) ((h) ? _mm512_extracti32x8_epi32(i, 1) : _mm512_castsi512_si256(i))
+#define SIMD_X86_JOIN_PS(lo, hi) _mm512_insertf32x8(_mm512_castps256_ps512(lo), hi, 1)
+#include "simd_x86.h"
 
 /* ---- memory */
-SIMD_INL vfloat vf_set1(float x) { return _mm512_set1_ps(x); }
-SIMD_INL vint vi_set1(int32_t x) { return _mm512_set1_epi32(x); }
-SIMD_INL vfloat vf_zero(void) { return _mm512_setzero_ps(); }
-SIMD_INL vint vi_zero(void) { return _mm512_setzero_si512(); }
 SIMD_INL vint vi_lanes(void)
 {
     return _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
 }
-SIMD_INL vfloat vf_load(const float *p) { return _mm512_load_ps(p); }
-SIMD_INL vfloat vf_loadu(const float *p) { return _mm512_loadu_ps(p); }
-SIMD_INL void vf_store(float *p, vfloat a) { _mm512_store_ps(p, a); }
-SIMD_INL void vf_storeu(float *p, vfloat a) { _mm512_storeu_ps(p, a); }
-SIMD_INL vint vi_load(const int32_t *p) { return _mm512_load_si512((const void *)p); }
-SIMD_INL vint vi_loadu(const int32_t *p) { return _mm512_loadu_si512((const void *)p); }
-SIMD_INL void vi_store(int32_t *p, vint i) { _mm512_store_si512((void *)p, i); }
-SIMD_INL void vi_storeu(int32_t *p, vint i) { _mm512_storeu_si512((void *)p, i); }
 /* masked lanes are not accessed (fault suppression) */
 SIMD_INL vint vi_load_u8(const uint8_t *p)
 {
@@ -84,33 +83,7 @@ SIMD_INL void vf_store3(float *p, vfloat x, vfloat y, vfloat z)
     _mm512_storeu_ps(p + 32, _mm512_mask_blend_ps(0x9249, _mm512_mask_blend_ps(0x4924, x, y), z));
 }
 
-/* ---- zips (per 128-bit block) */
-SIMD_INL vint vi_zip_lo(vint i, vint j) { return _mm512_unpacklo_epi32(i, j); }
-SIMD_INL vint vi_zip_hi(vint i, vint j) { return _mm512_unpackhi_epi32(i, j); }
-
-/* ---- 16-bit lanes (simd.h, "16-bit lanes"; per 128-bit block, AVX-512BW) */
-SIMD_INL vint vh_set1(int x) { return _mm512_set1_epi16((short)x); }
-SIMD_INL vint vh_add(vint i, vint j) { return _mm512_add_epi16(i, j); }
-SIMD_INL vint vh_sub(vint i, vint j) { return _mm512_sub_epi16(i, j); }
-SIMD_INL vint vh_mullo(vint i, vint j) { return _mm512_mullo_epi16(i, j); }
-#define vh_srli(i, k) _mm512_srli_epi16(i, k)
-SIMD_INL vint vh_from_u8_lo(vint i) { return _mm512_unpacklo_epi8(i, _mm512_setzero_si512()); }
-SIMD_INL vint vh_from_u8_hi(vint i) { return _mm512_unpackhi_epi8(i, _mm512_setzero_si512()); }
-SIMD_INL vint vh_packus(vint i, vint j) { return _mm512_packus_epi16(i, j); }
-SIMD_INL vint vh_bcast3(vint i) { return _mm512_shufflehi_epi16(_mm512_shufflelo_epi16(i, 0xFF), 0xFF); }
-
 /* ---- shuffles */
-SIMD_INL void vf_tr4(vfloat a, vfloat b, vfloat c, vfloat d, vfloat o[4])
-{
-    const __m512d t0 = _mm512_castps_pd(_mm512_unpacklo_ps(a, b));
-    const __m512d t1 = _mm512_castps_pd(_mm512_unpacklo_ps(c, d));
-    const __m512d t2 = _mm512_castps_pd(_mm512_unpackhi_ps(a, b));
-    const __m512d t3 = _mm512_castps_pd(_mm512_unpackhi_ps(c, d));
-    o[0] = _mm512_castpd_ps(_mm512_unpacklo_pd(t0, t1));
-    o[1] = _mm512_castpd_ps(_mm512_unpackhi_pd(t0, t1));
-    o[2] = _mm512_castpd_ps(_mm512_unpacklo_pd(t2, t3));
-    o[3] = _mm512_castpd_ps(_mm512_unpackhi_pd(t2, t3));
-}
 /* 4 x 4 blocks: two rounds of vshuff32x4 */
 SIMD_INL void vf_tr_blocks(const vfloat in[4], vfloat out[4])
 {
@@ -141,26 +114,11 @@ SIMD_INL void vf_scatter3(float *out, const int32_t *dest, vfloat x, vfloat y, v
 #undef SIMD__SCAT
 }
 
-/* ---- float arithmetic */
-SIMD_INL vfloat vf_add(vfloat a, vfloat b) { return _mm512_add_ps(a, b); }
-SIMD_INL vfloat vf_sub(vfloat a, vfloat b) { return _mm512_sub_ps(a, b); }
-SIMD_INL vfloat vf_mul(vfloat a, vfloat b) { return _mm512_mul_ps(a, b); }
-SIMD_INL vfloat vf_div(vfloat a, vfloat b) { return _mm512_div_ps(a, b); }
-SIMD_INL vfloat vf_sqrt(vfloat a) { return _mm512_sqrt_ps(a); }
-SIMD_INL vfloat vf_min(vfloat a, vfloat b) { return _mm512_min_ps(a, b); }
-SIMD_INL vfloat vf_max(vfloat a, vfloat b) { return _mm512_max_ps(a, b); }
-SIMD_INL vfloat vf_neg(vfloat a) { return _mm512_xor_ps(a, _mm512_set1_ps(-0.0f)); }
-SIMD_INL vfloat vf_abs(vfloat a) { return _mm512_and_ps(a, _mm512_castsi512_ps(_mm512_set1_epi32(0x7FFFFFFF))); }
+/* ---- float arithmetic (vf_neg_if: a masked xor) */
 SIMD_INL vfloat vf_neg_if(vmask m, vfloat a) { return _mm512_mask_xor_ps(a, m, a, _mm512_set1_ps(-0.0f)); }
 SIMD_INL vfloat vf_floor(vfloat a) { return _mm512_roundscale_ps(a, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC); }
 
-/* ---- compares */
-SIMD_INL vmask vf_eq(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_EQ_OQ); }
-SIMD_INL vmask vf_ne(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_NEQ_UQ); }
-SIMD_INL vmask vf_lt(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ); }
-SIMD_INL vmask vf_le(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_LE_OQ); }
-SIMD_INL vmask vf_gt(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ); }
-SIMD_INL vmask vf_ge(vfloat a, vfloat b) { return _mm512_cmp_ps_mask(a, b, _CMP_GE_OQ); }
+/* ---- compares (the float ones: simd_x86.h) */
 SIMD_INL vmask vi_eq(vint i, vint j) { return _mm512_cmpeq_epi32_mask(i, j); }
 SIMD_INL vmask vi_gt(vint i, vint j) { return _mm512_cmpgt_epi32_mask(i, j); }
 
@@ -168,31 +126,6 @@ SIMD_INL vmask vi_gt(vint i, vint j) { return _mm512_cmpgt_epi32_mask(i, j); }
 SIMD_INL vfloat vf_sel(vmask m, vfloat a, vfloat b) { return _mm512_mask_blend_ps(m, b, a); }
 SIMD_INL vfloat vf_selz(vmask m, vfloat a) { return _mm512_maskz_mov_ps(m, a); }
 SIMD_INL vint vi_sel(vmask m, vint i, vint j) { return _mm512_mask_blend_epi32(m, j, i); }
-SIMD_INL vfloat vf_and(vfloat a, vfloat b) { return _mm512_and_ps(a, b); }
-SIMD_INL vfloat vf_or(vfloat a, vfloat b) { return _mm512_or_ps(a, b); }
-SIMD_INL vfloat vf_xor(vfloat a, vfloat b) { return _mm512_xor_ps(a, b); }
-SIMD_INL vfloat vf_andnot(vfloat a, vfloat b) { return _mm512_andnot_ps(a, b); }
-SIMD_INL vint vi_and(vint i, vint j) { return _mm512_and_si512(i, j); }
-SIMD_INL vint vi_or(vint i, vint j) { return _mm512_or_si512(i, j); }
-SIMD_INL vint vi_xor(vint i, vint j) { return _mm512_xor_si512(i, j); }
-SIMD_INL vint vi_andnot(vint i, vint j) { return _mm512_andnot_si512(i, j); }
-SIMD_INL vint vf_as_vi(vfloat a) { return _mm512_castps_si512(a); }
-SIMD_INL vfloat vi_as_vf(vint i) { return _mm512_castsi512_ps(i); }
-
-/* ---- integer arithmetic */
-SIMD_INL vint vi_add(vint i, vint j) { return _mm512_add_epi32(i, j); }
-SIMD_INL vint vi_sub(vint i, vint j) { return _mm512_sub_epi32(i, j); }
-SIMD_INL vint vi_mullo(vint i, vint j) { return _mm512_mullo_epi32(i, j); }
-#define vi_slli(i, k) _mm512_slli_epi32(i, k)
-#define vi_srli(i, k) _mm512_srli_epi32(i, k)
-#define vi_srai(i, k) _mm512_srai_epi32(i, k)
-SIMD_INL vint vi_sll(vint i, int k) { return _mm512_sll_epi32(i, _mm_cvtsi32_si128(k)); }
-SIMD_INL vint vi_srl(vint i, int k) { return _mm512_srl_epi32(i, _mm_cvtsi32_si128(k)); }
-
-/* ---- conversions */
-SIMD_INL vfloat vf_from_vi(vint i) { return _mm512_cvtepi32_ps(i); }
-SIMD_INL vint vi_from_vf_trunc(vfloat a) { return _mm512_cvttps_epi32(a); }
-SIMD_INL vint vi_from_vf_round(vfloat a) { return _mm512_cvtps_epi32(a); }
 
 /* ---- masks */
 SIMD_INL vmask vm_and(vmask m, vmask n) { return (vmask)(m & n); }
@@ -237,63 +170,23 @@ SIMD_INL void vf_store3_bits(float *p, unsigned bits, vfloat x, vfloat y, vfloat
 }
 
 
-/* doubles (raster's plane set-up): VD_W = 8 lanes */
-#define VD_W 8
-typedef __m512d vdouble;
-SIMD_INL vdouble vd_set1(double x) { return _mm512_set1_pd(x); }
-SIMD_INL vdouble vd_loadu(const double *p) { return _mm512_loadu_pd(p); }
-SIMD_INL void vd_storeu(double *p, vdouble a) { _mm512_storeu_pd(p, a); }
-SIMD_INL vdouble vd_add(vdouble a, vdouble b) { return _mm512_add_pd(a, b); }
-SIMD_INL vdouble vd_sub(vdouble a, vdouble b) { return _mm512_sub_pd(a, b); }
-SIMD_INL vdouble vd_mul(vdouble a, vdouble b) { return _mm512_mul_pd(a, b); }
-SIMD_INL vdouble vd_div(vdouble a, vdouble b) { return _mm512_div_pd(a, b); }
-SIMD_INL vdouble vd_max(vdouble a, vdouble b) { return _mm512_max_pd(a, b); }
+/* ---- doubles (raster's plane set-up) */
 SIMD_INL vdouble vd_load_f(const float *p) { return _mm512_cvtps_pd(_mm256_loadu_ps(p)); }
 SIMD_INL void vd_store_f(float *p, vdouble a) { _mm256_storeu_ps(p, _mm512_cvtpd_ps(a)); }
 
 
 /* ---- raster front-end ops (simd.h "RASTER FRONT-END OPS") */
-SIMD_INL vdouble vd_sqrt(vdouble a) { return _mm512_sqrt_pd(a); }
-SIMD_INL vint vi_min(vint i, vint j) { return _mm512_min_epi32(i, j); }
-SIMD_INL vint vi_max(vint i, vint j) { return _mm512_max_epi32(i, j); }
-SIMD_INL vdouble vd_from_vf(vfloat a, int h)
-{
-    return _mm512_cvtps_pd(h ? _mm512_extractf32x8_ps(a, 1) : _mm512_castps512_ps256(a));
-}
-SIMD_INL vdouble vd_from_vi(vint i, int h)
-{
-    return _mm512_cvtepi32_pd(h ? _mm512_extracti32x8_epi32(i, 1) : _mm512_castsi512_si256(i));
-}
-SIMD_INL vfloat vf_from_vd(vdouble lo, vdouble hi)
-{
-    return _mm512_insertf32x8(_mm512_castps256_ps512(_mm512_cvtpd_ps(lo)), _mm512_cvtpd_ps(hi), 1);
-}
 SIMD_INL unsigned vd_gt_bits(vdouble a, vdouble b)
 {
     return (unsigned)_mm512_cmp_pd_mask(a, b, _CMP_GT_OQ);
 }
 /* ---- raster edge ops (x86 only; simd.h "RASTER EDGE OPS") */
-#define SIMD_HAS_VL 1
-typedef __m512i vlong;   /* VD_W = 8 int64 lanes */
-SIMD_INL vlong vl_zero(void) { return _mm512_setzero_si512(); }
-SIMD_INL vlong vl_from_vi(vint i, int h)
-{
-    return _mm512_cvtepi32_epi64(h ? _mm512_extracti32x8_epi32(i, 1) : _mm512_castsi512_si256(i));
-}
-SIMD_INL vlong vl_add(vlong a, vlong b) { return _mm512_add_epi64(a, b); }
-SIMD_INL vlong vl_sub(vlong a, vlong b) { return _mm512_sub_epi64(a, b); }
-SIMD_INL vlong vl_or(vlong a, vlong b) { return _mm512_or_si512(a, b); }
-SIMD_INL vlong vl_mul32(vlong a, vlong b) { return _mm512_mul_epi32(a, b); }
-#define vl_slli(a, k) _mm512_slli_epi64(a, k)
 SIMD_INL unsigned vl_sign_bits(vlong a) { return (unsigned)_mm512_movepi64_mask(a); }
 /* one masked subtract: the lanes of half h whose flag is clear */
 SIMD_INL vlong vl_dec_unless(vlong a, vmask m, int h)
 {
     return _mm512_mask_sub_epi64(a, (__mmask8)~(m >> (8 * h)), a, _mm512_set1_epi64(1));
 }
-SIMD_INL vlong vl_zip_lo(vlong a, vlong b) { return _mm512_unpacklo_epi64(a, b); }
-SIMD_INL vlong vl_zip_hi(vlong a, vlong b) { return _mm512_unpackhi_epi64(a, b); }
-SIMD_INL void vl_store(int64_t *p, vlong a) { _mm512_store_si512((void *)p, a); }
 SIMD_INL vint vi_compress_lanes(unsigned bits)
 {
     return _mm512_maskz_compress_epi32((__mmask16)bits, vi_lanes());
@@ -304,11 +197,6 @@ SIMD_INL vint vi_gather(const int32_t *p, vint idx)
 {
     return _mm512_i32gather_epi32(idx, (const void *)p, 4);
 }
-SIMD_INL vint vh_zip_lo(vint i, vint j) { return _mm512_unpacklo_epi16(i, j); }
-SIMD_INL vint vh_zip_hi(vint i, vint j) { return _mm512_unpackhi_epi16(i, j); }
-SIMD_INL vint vh_madd(vint i, vint j) { return _mm512_madd_epi16(i, j); }
-SIMD_INL vint vh_packus32(vint i, vint j) { return _mm512_packus_epi32(i, j); }
-SIMD_INL vint vh_mulhi(vint i, vint j) { return _mm512_mulhi_epu16(i, j); }
 
 
 /* ---- refine ops (src/fuse's band refinement, fuse_refine_simd.inl;
@@ -316,18 +204,12 @@ SIMD_INL vint vh_mulhi(vint i, vint j) { return _mm512_mulhi_epu16(i, j); }
  * algorithm) */
 #define VB_W 64
 #define VH_W 32
-SIMD_INL vint vb_loadu(const uint8_t *p) { return _mm512_loadu_si512((const void *)p); }
-SIMD_INL void vb_storeu(uint8_t *p, vint i) { _mm512_storeu_si512((void *)p, i); }
 SIMD_INL uint64_t vb_sign_bits(vint i) { return (uint64_t)_mm512_movepi8_mask(i); }
 SIMD_INL vint vb_sign_fill(vint i) { return _mm512_movm_epi8(_mm512_movepi8_mask(i)); }
 SIMD_INL vint vh_load_u8(const uint8_t *p)
 {
     return _mm512_cvtepu8_epi16(_mm256_loadu_si256((const __m256i *)(const void *)p));
 }
-SIMD_INL vint vh_loadu(const uint16_t *p) { return _mm512_loadu_si512((const void *)p); }
-SIMD_INL void vh_storeu(uint16_t *p, vint i) { _mm512_storeu_si512((void *)p, i); }
-SIMD_INL vint vh_min_u(vint i, vint j) { return _mm512_min_epu16(i, j); }
-SIMD_INL vint vh_adds_u(vint i, vint j) { return _mm512_adds_epu16(i, j); }
 SIMD_INL int vh_any_leu(vint i, vint j) { return _mm512_cmple_epu16_mask(i, j) != 0; }
 SIMD_INL vint vi_load_u16(const uint16_t *p)
 {

@@ -389,28 +389,30 @@ SIMD_INL int vh_any_leu(vint i, vint j)
     return vmaxvq_u16(vcleq_u16(vreinterpretq_u16_s32(i), vreinterpretq_u16_s32(j))) != 0;
 }
 SIMD_INL vint vi_load_u16(const uint16_t *p) { return vreinterpretq_s32_u32(vmovl_u16(vld1_u16(p))); }
-/* the chamfer's running minima: vext with a vector of 65535 */
+/* the chamfer's running minima: vext with a vector of 65535. VH__RUNMIN3
+ * writes both directions: SH the shift of k lanes up (lane l takes l - k)
+ * or down, the rest the 8 lanes the carry c is added to, 3 (l + 1) (up) or
+ * 3 (8 - l) (dn). */
 #define VH__STEP(t, sh, s) vminq_u16(t, vqaddq_u16(sh, vdupq_n_u16(s)))
-SIMD_INL vint vh_runmin3_up(vint i, unsigned c)
-{
-    const uint16x8_t f = vdupq_n_u16(0xFFFF);
-    uint16x8_t t = vreinterpretq_u16_s32(i);
-    t = VH__STEP(t, vextq_u16(f, t, 7), 3);
-    t = VH__STEP(t, vextq_u16(f, t, 6), 6);
-    t = VH__STEP(t, vextq_u16(f, t, 4), 12);
-    static const uint16_t l3[8] = { 3, 6, 9, 12, 15, 18, 21, 24 };
-    return vreinterpretq_s32_u16(vminq_u16(t, vqaddq_u16(vdupq_n_u16((uint16_t)c), vld1q_u16(l3))));
-}
-SIMD_INL vint vh_runmin3_dn(vint i, unsigned c)
-{
-    const uint16x8_t f = vdupq_n_u16(0xFFFF);
-    uint16x8_t t = vreinterpretq_u16_s32(i);
-    t = VH__STEP(t, vextq_u16(t, f, 1), 3);
-    t = VH__STEP(t, vextq_u16(t, f, 2), 6);
-    t = VH__STEP(t, vextq_u16(t, f, 4), 12);
-    static const uint16_t l3[8] = { 24, 21, 18, 15, 12, 9, 6, 3 };
-    return vreinterpretq_s32_u16(vminq_u16(t, vqaddq_u16(vdupq_n_u16((uint16_t)c), vld1q_u16(l3))));
-}
+#define VH__UP(t, f, k) vextq_u16(f, t, 8 - (k))
+#define VH__DN(t, f, k) vextq_u16(t, f, k)
+#define VH__RUNMIN3(name, SH, ...)                                                     \
+    SIMD_INL vint name(vint i, unsigned c)                                             \
+    {                                                                                  \
+        const uint16x8_t f = vdupq_n_u16(0xFFFF);                                      \
+        uint16x8_t t = vreinterpretq_u16_s32(i);                                       \
+        t = VH__STEP(t, SH(t, f, 1), 3);                                               \
+        t = VH__STEP(t, SH(t, f, 2), 6);                                               \
+        t = VH__STEP(t, SH(t, f, 4), 12);                                              \
+        static const uint16_t l3[8] = { __VA_ARGS__ };                                 \
+        return vreinterpretq_s32_u16(vminq_u16(t, vqaddq_u16(vdupq_n_u16((uint16_t)c), \
+                                                             vld1q_u16(l3))));         \
+    }
+VH__RUNMIN3(vh_runmin3_up, VH__UP, 3, 6, 9, 12, 15, 18, 21, 24)
+VH__RUNMIN3(vh_runmin3_dn, VH__DN, 24, 21, 18, 15, 12, 9, 6, 3)
+#undef VH__RUNMIN3
+#undef VH__UP
+#undef VH__DN
 #undef VH__STEP
 
 
