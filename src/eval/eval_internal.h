@@ -271,7 +271,9 @@ int eval__write_light(const char *dir, const method_run *R, int n);
 int eval__kf_configs(const method_cfg base[4], method_cfg *L, int cap);
 int eval__write_kf(const char *dir, const method_run *R, int n);
 
-/* eval_report.c: the tables, the CSV and the report folder. */
+/* eval_out.c (the bottom of the room: eval_report.c and the sweeps call
+ * it, it calls nothing above it): a run's means, the report files' open
+ * and commit, a table's two passes. */
 /* A run's figures per eye (mask IoU, boundary F within 1 and 3 px, false
  * positive and negative area, composite PSNR), per stereo frame (ms) and
  * its edge flicker: eval__summarise divides its sums by their counts (a
@@ -280,15 +282,6 @@ typedef struct eval_summary {
     double iou, bf1, bf3, fp, fn, psnr, ms, flicker;
 } eval_summary;
 eval_summary eval__summarise(const method_run *r);
-void eval__print_calib(FILE *f, const eval_ctx *c);
-void eval__print_table(FILE *f, const method_run *R, int n, int markdown);
-void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int n);
-/* Per method: the error area per eye and frame (FP + FN pixels: mean,
- * 95th percentile, max) and the pooled IoU (the sum of intersections
- * over the sum of unions, every eye and frame): the fair figures where
- * the true mask gets small (a hand leaving the view, docs/accuracy.md). */
-void eval__print_error_area(FILE *f, const method_run *R, int n);
-int eval__write_csv(const char *path, const method_run *R, int n);
 /* Report files go through io_out: complete or absent, a failed write is
  * "path: write failed: reason" and exit 1 (io.h, OUTPUT FILES).
  * eval__out_open: the file dir/name (name printf-style; dir NULL: name
@@ -303,6 +296,17 @@ int eval__out_commit(struct io_out *o);
  * *f to the pass's stream and returns 1; 0 when there is no such pass;
  * -1 when DIR/name did not open (the message printed). */
 int eval__table_pass(int pass, const char *dir, const char *name, struct io_out *o, FILE **f);
+
+/* eval_report.c: the tables, the CSV and the report folder. */
+void eval__print_calib(FILE *f, const eval_ctx *c);
+void eval__print_table(FILE *f, const method_run *R, int n, int markdown);
+void eval__print_thickness(FILE *f, const eval_ctx *c, const method_run *R, int n);
+/* Per method: the error area per eye and frame (FP + FN pixels: mean,
+ * 95th percentile, max) and the pooled IoU (the sum of intersections
+ * over the sum of unions, every eye and frame): the fair figures where
+ * the true mask gets small (a hand leaving the view, docs/accuracy.md). */
+void eval__print_error_area(FILE *f, const method_run *R, int n);
+int eval__write_csv(const char *path, const method_run *R, int n);
 int eval__write_report(const char *dir, const method_run *R, int n, const eval_opts *o,
                        const eval_ctx *c);
 
