@@ -69,6 +69,8 @@ static image_diff display_diff(const char *a, const char *b, const int *r)
     io_image A = load(a), B = load(b);
     assert_int_equal(A.width, 2064);
     assert_int_equal(A.height, 2208);
+    assert_int_equal(B.width, A.width);
+    assert_int_equal(B.height, A.height);
     image_diff d = {{0, 0}, {0, 0}};
     for (int y = 0; y < A.height; y++)
         for (int x = 0; x < A.width; x++) {

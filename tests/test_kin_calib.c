@@ -102,6 +102,7 @@ typedef struct calib_run {
 static calib_run *calib_start(int n, tu_rng *g)
 {
     static calib_run r;
+    memset(&r, 0, sizeof r);   /* nothing of the last test's run survives */
     r.rig = model_rig();
     r.tips[0] = TIP_L;
     r.tips[1] = TIP_R;

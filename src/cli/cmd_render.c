@@ -764,8 +764,8 @@ int cmd_render(int argc, char **argv)
                                tracking_only == O_CALIB ? "--calib"
                                : tracking_only == O_PREDICT ? "--predict" : "--no-filter");
     if (o.hmd_calib[0] || o.hmd_calib[1] || o.hmd_calib[2]) {
-        int rc = cli_lens_load(o.hmd_calib[0], o.hmd_calib[1], o.hmd_calib[2], &o.hmd);
-        if (rc != EXIT_OK) return rc;
+        int lr = cli_lens_load(o.hmd_calib[0], o.hmd_calib[1], o.hmd_calib[2], &o.hmd);
+        if (lr != EXIT_OK) return lr;
     }
     {
         kin_sthmd_desc h = o.hmd;

@@ -10,7 +10,9 @@
  *   (half h of a vector, h 0 or 1) and SIMD_X86_JOIN_PS(lo, hi)
  * defined. Three parts: what all three write alike; what SSE2 and AVX2
  * write alike (their masks are vectors); what AVX2 and AVX-512 write
- * alike. What one ISA does its own way stays in its header. */
+ * alike. What one ISA does its own way stays in its header. The operation
+ * names pasted (SIMD_MM_SI(and), ...) are plain C tokens: the header is C
+ * only, and must not follow <iso646.h> (whose and, or, xor are macros). */
 #if !defined(SIMD_X86_P) || !defined(SIMD_X86_B)
 #error "simd_x86.h: include simd_sse2.h, simd_avx2.h or simd_avx512.h instead"
 #endif

@@ -29,24 +29,6 @@ static int block_done(const uint8_t *m, const float *z)
     return !bad;
 }
 
-/* The first x' in [x, x1) whose mask byte is set and whose depth is not
- * known yet (x1 if none): unset bytes are skipped 8 at a time, and so are
- * blocks of 8 set bytes whose depths are all known. */
-static inline int next_unknown(const uint8_t *m, const float *z, int x, int x1)
-{
-    while (x < x1) {
-        if (m[x] == 0)
-            x = ef_row_first_set(m, x + 1, x1);
-        else if (x + 8 <= x1 && block_done(m + x, z + x))
-            x += 8;
-        else if (known(z[x]))
-            x++;
-        else
-            return x;
-    }
-    return x1;
-}
-
 /* The largest float below 1: the far plane; any scene object is nearer. */
 static float far_depth(void)
 {
@@ -197,8 +179,17 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
     for (y = 0; y < height; y++) {
         const uint8_t *m = mask + (size_t)y * (size_t)mask_stride;
         float *z = depth + (size_t)y * (size_t)depth_stride;
-        for (x = next_unknown(m, z, 0, width); x < width; x = next_unknown(m, z, x + 1, width)) {
+        for (x = 0; x < width; x++) {
             int best;
+            if (m[x] == 0) {   /* on to the next set byte (8 at a time) */
+                x = ef_row_first_set(m, x + 1, width) - 1;
+                continue;
+            }
+            if (x + 8 <= width && block_done(m + x, z + x)) {
+                x += 7;
+                continue;
+            }
+            if (known(z[x])) continue;
             best = fill_ring1(z, (size_t)depth_stride, x, y, width, height, R);
             if (best < 0)
                 best = fill_source(cols, depth, (size_t)depth_stride, x, y, R, width, height);
@@ -214,8 +205,17 @@ long fuse_depth_fill(const uint8_t *mask, int mask_stride, float *depth, int dep
     for (y = y0; y < y1; y++) {
         const uint8_t *m = mask + (size_t)y * (size_t)mask_stride;
         float *z = depth + (size_t)y * (size_t)depth_stride;
-        for (x = next_unknown(m, z, x0, x1); x < x1; x = next_unknown(m, z, x + 1, x1)) {
+        for (x = x0; x < x1; x++) {
             int code, dx, dy;
+            if (m[x] == 0) {
+                x = ef_row_first_set(m, x + 1, x1) - 1;
+                continue;
+            }
+            if (x + 8 <= x1 && block_done(m + x, z + x)) {
+                x += 7;
+                continue;
+            }
+            if (known(z[x])) continue;
             code = (int)(z[x] - 2.0f);
             if (code >= side * side) {
                 z[x] = far_depth();

@@ -262,25 +262,20 @@ static inline int area_test(int64_t area, rast_cull cull)
     return RAST__SETUP_OK;
 }
 
-/* A triangle that passed the area test: its absolute snapped area and its
- * vertices X, Y normalised to area > 0 by swapping vertices 1 and 2, whose
- * source indices are s1, s2. */
-typedef struct oriented {
-    int64_t area;
-    int s1, s2;
-    int32_t X[3], Y[3];
-} oriented;
-
-/* The area test of triangle fx, fy (area_test); when it passes, *o. */
-static inline int orient(const int32_t fx[3], const int32_t fy[3], rast_cull cull, oriented *o)
+/* The area test of triangle fx, fy (area_test); when it passes, *area
+ * the absolute snapped area and X, Y the vertices normalised to area > 0
+ * by swapping vertices 1 and 2, whose source indices go to *s1, *s2. */
+static inline int orient(const int32_t fx[3], const int32_t fy[3], rast_cull cull,
+                         int64_t *area, int *s1, int *s2, int32_t X[3], int32_t Y[3])
 {
     const int64_t a = snapped_area(fx[0], fy[0], fx[1], fy[1], fx[2], fy[2]);
     const int r = area_test(a, cull);
     if (r != RAST__SETUP_OK)
         return r;
-    const int s1 = a < 0 ? 2 : 1, s2 = a < 0 ? 1 : 2;
-    *o = (oriented){ .area = a < 0 ? -a : a, .s1 = s1, .s2 = s2,
-                     .X = { fx[0], fx[s1], fx[s2] }, .Y = { fy[0], fy[s1], fy[s2] } };
+    *s1 = a < 0 ? 2 : 1, *s2 = a < 0 ? 1 : 2;
+    X[0] = fx[0], X[1] = fx[*s1], X[2] = fx[*s2];
+    Y[0] = fy[0], Y[1] = fy[*s1], Y[2] = fy[*s2];
+    *area = a < 0 ? -a : a;
     return RAST__SETUP_OK;
 }
 
@@ -458,14 +453,15 @@ static int setup_core(const rast__view *v, const int32_t fx[3], const int32_t fy
                       const double zwv[3], const double iwv[3],
                       const float *const attr[3], rast_cull cull, rast__tri *tri)
 {
-    oriented o;
-    const int r = orient(fx, fy, cull, &o);
+    int64_t area;
+    int s1, s2;
+    int32_t X[3], Y[3];
+    const int r = orient(fx, fy, cull, &area, &s1, &s2, X, Y);
     if (r != RAST__SETUP_OK)
         return r;
-    const double zw[3] = { zwv[0], zwv[o.s1], zwv[o.s2] };
-    const double iw[3] = { iwv[0], iwv[o.s1], iwv[o.s2] };
-    const float *const at[3] = { attr[0], attr[o.s1], attr[o.s2] };
-    return setup_oriented(v, o.X, o.Y, o.area, zw, iw, at, tri);
+    const double zw[3] = { zwv[0], zwv[s1], zwv[s2] }, iw[3] = { iwv[0], iwv[s1], iwv[s2] };
+    const float *const at[3] = { attr[0], attr[s1], attr[s2] };
+    return setup_oriented(v, X, Y, area, zw, iw, at, tri);
 }
 
 /* Per-vertex plane inputs (docs/raster.md section 6.1). */
@@ -863,18 +859,20 @@ int rast__prepare_range(const rast__view *view, const rast_mesh_desc *m, int ti0
 static int setup_aa(const rast__view *v, const int32_t fx[3], const int32_t fy[3],
                     rast_cull cull, rast__tri *tri)
 {
-    oriented o;
-    const int r = orient(fx, fy, cull, &o);
+    int64_t area;
+    int s1, s2;
+    int32_t X[3], Y[3];
+    const int r = orient(fx, fy, cull, &area, &s1, &s2, X, Y);
     if (r != RAST__SETUP_OK)
         return r;
     int32_t xmin, xmax, ymin, ymax;
-    snapped_bounds(o.X, o.Y, &xmin, &xmax, &ymin, &ymax);
+    snapped_bounds(X, Y, &xmin, &xmax, &ymin, &ymax);
     int32_t bx0 = (xmin + 15) >> RAST_SUBPIXEL_BITS, bx1 = xmax >> RAST_SUBPIXEL_BITS;
     int32_t by0 = (ymin + 15) >> RAST_SUBPIXEL_BITS, by1 = ymax >> RAST_SUBPIXEL_BITS;
     if (!box_in_view(v, &bx0, &by0, &bx1, &by1))
         return RAST__SETUP_OFFSCREEN;
     memset(tri, 0, sizeof *tri);
-    setup_edges(tri, o.X, o.Y, bx0, by0, bx1, by1);
+    setup_edges(tri, X, Y, bx0, by0, bx1, by1);
     return RAST__SETUP_OK;
 }
 

@@ -6,7 +6,11 @@
  *   TU_FIXTURE(scene, scene, s, scene_make(s), scene_free(s))
  *   ... cmocka_unit_test_setup_teardown(a_test, scene_setup, scene_teardown)
  *
- * and in the test: scene *s = *state; */
+ * and in the test: scene *s = *state;
+ *
+ * What MAKE asserts runs in cmocka's setup: a failure there is reported as
+ * the test's setup failing (the run still fails) and its teardown is not
+ * run, so keep the checks a test is about in the test's body. */
 #ifndef EGOFUSE_TU_FIXTURE_H
 #define EGOFUSE_TU_FIXTURE_H
 
