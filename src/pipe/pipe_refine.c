@@ -31,8 +31,12 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
     rp.band = p->desc.refine_band;
     /* the elbow fit's colour model as the global term only once it
      * has one: before that (or when the last learning found too few
-     * samples) its all-zero model would only halve the local term.
-     * The refinement's input: the kinematic mask, or on tracked frames
+     * samples) its all-zero model would only halve the local term; the
+     * colour checks of the prior, the shift and the refined pixels need
+     * it too (NULL: none of them runs) */
+    const fuse_colour_model *g =
+        p->fit && pipe_fit_learned(p->fit, e->eye) ? pipe_fit_colour(p->fit, e->eye) : NULL;
+    /* The refinement's input: the kinematic mask, or on tracked frames
      * (the fit's) around the slow hands the last refined mask moved
      * with the hand (pipe_fit_prior; e->refined still holds it until
      * the refinement below) */
@@ -61,24 +65,23 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
                                  cw);
             /* its rim must look like the hand (last frame's edge a
              * pixel off: fit_band.h) */
-            if (rin == e->prior && p->fit && pipe_fit_learned(p->fit, e->eye))
-                pipe_fit_prior_colour(pipe_fit_colour(p->fit, e->eye), &fe->P, e->prior, cw);
+            if (rin == e->prior && g) pipe_fit_prior_colour(g, &fe->P, e->prior, cw);
         }
     }
     const int from_prior = rin == e->prior;
     /* the hands that did not take the prior moved to where the colour
      * says they are (fit_shift.h: the tracking's error beyond the
      * band, docs/accuracy.md); eval's refine does the same */
-    if (e->shifted && in->locals && p->fit && pipe_fit_learned(p->fit, e->eye)) {
+    if (e->shifted && in->locals && g) {
         unsigned ss = sides;
         if (from_prior)
             for (int k = 0; k < 2; k++)
                 if (!in->hand_speed || in->hand_speed[k] < PIPE_PRIOR_SPEED) ss &= ~(1u << k);
         if (ss) {
             const pipe_fit_shift_desc sd = pipe_fit_shift_desc_default();
-            rin = pipe_fit_shift(&sd, pipe_fit_colour(p->fit, e->eye), &fe->P, &e->cam,
-                                 p->pose.world, &p->fit_rig, ss, rin, e->shifted, cw,
-                                 e->refine_scratch, e->refine_scratch_size, NULL);
+            rin = pipe_fit_shift(&sd, g, &fe->P, &e->cam, p->pose.world, &p->fit_rig, ss, rin,
+                                 e->shifted, cw, e->refine_scratch, e->refine_scratch_size,
+                                 NULL);
         }
     }
     /* the hands' image motion since the last frame (the regrow's trail
@@ -102,18 +105,16 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
     fuse_refine_stats rs;
     /* the band halved where the hand is too thin for its learning ring
      * (fit_narrow.h; eval's refine does the same) */
-    fuse_result rr2 = pipe_fit_refine_narrow(
-        &rp, p->fit && pipe_fit_learned(p->fit, e->eye) ? pipe_fit_colour(p->fit, e->eye) : NULL,
-        PIPE_GLOBAL_WEIGHT, PIPE_NARROW_MIN_BAND, &fe->P, rin, cw, e->refined, cw,
-        e->refine_scratch, e->refine_scratch_size, &rs, NULL);
+    fuse_result rr2 = pipe_fit_refine_narrow(&rp, g, PIPE_GLOBAL_WEIGHT, PIPE_NARROW_MIN_BAND,
+                                             &fe->P, rin, cw, e->refined, cw, e->refine_scratch,
+                                             e->refine_scratch_size, &rs, NULL);
     if (rr2 != FUSE_OK)
         return pipe__eye_fail(e, PIPE_ERR_FUSE, "mask refinement", fuse_result_str(rr2));
     /* once more from its own edge where it let in much: the hand beyond
      * the band (fit_narrow.h; eval's refine does the same) */
-    const int regrown = pipe_fit_refine_regrow(
-        &rp, p->fit && pipe_fit_learned(p->fit, e->eye) ? pipe_fit_colour(p->fit, e->eye) : NULL,
-        PIPE_GLOBAL_WEIGHT, &fe->P, e->refined, cw, e->regrow, e->refine_scratch,
-        e->refine_scratch_size, &rs);
+    const int regrown = pipe_fit_refine_regrow(&rp, g, PIPE_GLOBAL_WEIGHT, &fe->P, e->refined, cw,
+                                               e->regrow, e->refine_scratch,
+                                               e->refine_scratch_size, &rs);
     if (regrown < 0)
         return pipe__eye_fail(e, PIPE_ERR_FUSE, "mask refinement", fuse_result_str(FUSE_ERR_ARGS));
     /* what the regrow added behind a fast hand taken back: where the
@@ -124,8 +125,8 @@ int pipe__refine_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe)
                               hmot, in->hand_speed, PIPE_TRAIL_STEPS);
     /* the pixels the vote let in beyond a prior must look like the
      * hand too (fit_band.h) */
-    if (from_prior && rs.used_colour && p->fit && pipe_fit_learned(p->fit, e->eye))
-        pipe_fit_refined_colour(pipe_fit_colour(p->fit, e->eye), &fe->P, rin, e->refined, cw);
+    if (from_prior && rs.used_colour && g)
+        pipe_fit_refined_colour(g, &fe->P, rin, e->refined, cw);
     /* its small islands cleared (and holes filled, PIPE_FILL_HOLE:
      * fit_holes.h); the refinement's scratch is free again */
     if (rs.used_colour && p->fit && p->desc.refine_fill == 0)
