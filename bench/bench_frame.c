@@ -42,6 +42,8 @@
  *               [--isa I] [--threads T]   (the grid: only that ISA / thread count)
  *               [--inplace]  (the grid composites in place, V copied into the
  *                             output untimed before each frame)
+ *               [--hard-edges] (the binary mask's edges instead of the soft
+ *                             silhouettes that render, run and demo draw)
  *               [--cpu-time] (frame and stage times in thread CPU time)
  *
  * Writes DIR/bench.csv (header + egofuse, memcpy and pixman rows),
@@ -571,6 +573,10 @@ static void csv_row(bench *b, const char *cs, const char *impl, const char *isa,
     fflush(b->csv);
 }
 
+/* --hard-edges: the pipes draw the binary mask's stair-stepped edges
+ * (pipe_desc.soft_edge 0) instead of the default soft silhouettes */
+static int grid_hard_edges = 0;
+
 static pipe_ctx *make_pipe(bench *b, const kin_model *m, ef_isa isa, int threads,
                            const kin_sthmd_desc *hmd)
 {
@@ -582,6 +588,10 @@ static pipe_ctx *make_pipe(bench *b, const kin_model *m, ef_isa isa, int threads
      * faces gives the same masks (checked over the whole sequence) for
      * about half the triangle setups, as `egofuse demo` runs it. */
     d.cull = RAST_CULL_BACK;
+    /* The default path of `render`, `run` and `demo`: soft silhouettes
+     * (one pass over the mask, counted in the fuse stage); --hard-edges
+     * measures the binary mask's frame. */
+    d.soft_edge = !grid_hard_edges;
     (void)b;
     return pipe_create(&d, m);
 }
@@ -724,7 +734,9 @@ static void run_grid(bench *b, const budget *bu)
     printf("\nWhole stereo frame (ms; stage columns are medians, raster and fuse summed over\n"
            "both eyes, which run in parallel with 2 threads; raster = context clear + vertex\n"
            "transforms + draw with normals, back faces culled, as bench_raster's \"pipe\" rows;\n"
-           "headroom = 16.67 - p99):\n");
+           "fuse includes the %s; headroom = 16.67 - p99):\n",
+           grid_hard_edges ? "binary mask's hard edges (--hard-edges)"
+                           : "soft silhouettes (render's and run's default)");
     if (grid_inplace)
         printf("(in place: V copied into the output before each frame, untimed, as a renderer's "
                "fresh buffer)\n");
@@ -1405,6 +1417,7 @@ int main(int argc, char **argv)
             ok = grid_isa != EF_ISA_DEFAULT;
         } else if (!strcmp(o, "--threads") && v) ok = parse_int(v, 1, 2, &grid_threads), a++;
         else if (!strcmp(o, "--inplace")) grid_inplace = 1;
+        else if (!strcmp(o, "--hard-edges")) grid_hard_edges = 1;
         else if (!strcmp(o, "--cpu-time")) frame_cpu_clock = 1;
         else ok = 0;
         if (!ok) {
@@ -1413,7 +1426,8 @@ int main(int argc, char **argv)
                     "       [--scale-frames N] [--seconds S] [--window N] [--quick] "
                     "[--no-scaling]\n"
                     "       [--no-hmds] [--hmds-only] [--hmd-frames N] [--hmd NAME]\n"
-                    "       [--isa ref|sse2|avx2|avx512] [--threads 1|2] [--inplace] [--cpu-time]\n",
+                    "       [--isa ref|sse2|avx2|avx512] [--threads 1|2] [--inplace] [--hard-edges]\n"
+                    "       [--cpu-time]\n",
                     argv[0]);
             return 2;
         }
