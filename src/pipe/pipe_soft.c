@@ -86,11 +86,12 @@ static int soft_row(const uint8_t *u, const uint8_t *m, const uint8_t *d, uint8_
     int x = xa;
     if (u && d) {   /* the 8-pixel steps whose windows lie inside the image */
         const int gmax = w - 9 < x1 - 8 ? w - 9 : x1 - 8;
+        const int last = xb - 1 < gmax ? xb - 1 : gmax;   /* of a step's start */
         if (x == 0 && x < xb) {
             o[0] = soft1(u, m, d, 0, w);
             x = 1;
         }
-        for (; x < xb && x <= gmax; x += 8) {
+        for (; x <= last; x += 8) {
             const uint64_t a = ef_ld8(m + x);
             if (a == 0)
                 memset(o + x, 0, 8);
