@@ -125,10 +125,15 @@ static void prefetch(const void *p, size_t n, int write)
 {
     const uintptr_t a = (uintptr_t)p & ~(uintptr_t)63, e = (uintptr_t)p + n;
     uintptr_t q;
-    if (write)
+    /* unrolled: a span is tens of lines, and the loop's own test and step
+     * were three of the four instructions per line */
+    if (write) {
+#pragma GCC unroll 4
         for (q = a; q < e; q += 64) __builtin_prefetch((const void *)q, 1, 3);
-    else
+    } else {
+#pragma GCC unroll 4
         for (q = a; q < e; q += 64) __builtin_prefetch((const void *)q, 0, 3);
+    }
 }
 
 /* [*x0, *x1): a span of the mask row (w bytes) that holds every non-zero
@@ -137,7 +142,13 @@ static void prefetch(const void *p, size_t n, int write)
 static void mask_span(const uint8_t *m, int w, int *x0, int *x1)
 {
     int a = 0, b = w;
-    uint64_t t;
+    uint64_t t, q[4];
+    /* 32 bytes a step over the clear run (the rows above and below the
+     * hand, its margins), then 8: the same words found */
+    for (; a + 32 <= w; a += 32) {
+        memcpy(q, m + a, 32);
+        if (q[0] | q[1] | q[2] | q[3]) break;
+    }
     for (; a + 8 <= w; a += 8) {
         memcpy(&t, m + a, 8);
         if (t) break;
@@ -147,6 +158,10 @@ static void mask_span(const uint8_t *m, int w, int *x0, int *x1)
     if (a >= w) {
         *x0 = *x1 = 0;
         return;
+    }
+    for (; b - 32 >= a; b -= 32) {
+        memcpy(q, m + b - 32, 32);
+        if (q[0] | q[1] | q[2] | q[3]) break;
     }
     for (; b - 8 >= a; b -= 8) {   /* every byte at b and beyond is 0 */
         memcpy(&t, m + b - 8, 8);
@@ -392,7 +407,11 @@ static void scratch_hrow(comp_scratch *s, const comp_job *j, int r, int slot)
         c = g0 * GROUP;
         e = (g1 + 1) * GROUP < n ? (g1 + 1) * GROUP : n;
         j->k->hrow(q, &s->cols, c, e - c, sw, s->h[slot] + 4 * (size_t)c);
-        for (g = g0; g <= g1; g++) s->grp[slot][g >> 6] |= (uint64_t)1 << (g & 63);
+        for (g = g0; g <= g1;) {   /* bits g0 .. g1, a word's share at a time */
+            const int top = (g | 63) < g1 ? (g | 63) : g1;
+            s->grp[slot][g >> 6] |= (~(uint64_t)0 >> (63 - (top - g))) << (g & 63);
+            g = top + 1;
+        }
         done = g1 + 1;
     }
 }
@@ -777,12 +796,30 @@ static void eye_light_depth_rows(const eye_job *e, int y0, int y1, int32_t (*spa
 static void eye_light_depth(const eye_job *e, int y0, int y1, int32_t (*span)[3])
 {
     const int k = e->edge_fade, w = e->light.out.width, h = e->light.out.height;
-    int y;
-    eye_light_depth_rows(e, y0, y1, span);
-    if (k < 1 || e->edge_sides == 0) return;
-    for (y = y0; y < y1; y++)
-        if ((e->edge_sides & (FUSE_EDGE_LEFT | FUSE_EDGE_RIGHT)) || y < k || h - 1 - y < k)
-            fuse_edge_fade_row(row_of(&e->light.out, y), y, w, h, k, e->edge_sides);
+    int32_t own[SPAN_RING][3];
+    int y, c, c1;
+    if (k < 1 || e->edge_sides == 0) {
+        eye_light_depth_rows(e, y0, y1, span);
+        return;
+    }
+    /* the fade visits only each row's mask span (the row is 0 outside it,
+     * and all of a row without hand): the spans come from the ring, the
+     * caller's or this one, SPAN_RING rows at a time */
+    if (span == NULL) span = own;
+    for (c = y0; c < y1; c = c1) {
+        c1 = y1 - c < SPAN_RING ? y1 : c + SPAN_RING;
+        eye_light_depth_rows(e, c, c1, span);
+        for (y = c; y < c1; y++) {
+            const int32_t *sp = span[y % SPAN_RING];
+            if (!(e->edge_sides & (FUSE_EDGE_LEFT | FUSE_EDGE_RIGHT)) && y >= k && h - 1 - y >= k)
+                continue;
+            if (sp[0] != y)
+                fuse_edge_fade_row(row_of(&e->light.out, y), y, w, h, k, e->edge_sides);
+            else if (sp[1] < sp[2])
+                fuse__edge_fade_cols(row_of(&e->light.out, y), y, w, h, k, e->edge_sides, sp[1],
+                                     sp[2]);
+        }
+    }
 }
 
 /* span (NULL: none): a ring of SPAN_RING (row, x0, x1) where each lit row

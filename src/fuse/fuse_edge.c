@@ -44,30 +44,39 @@ static int col_dist(int x, int w, int cap, unsigned sides)
     return i;
 }
 
-void fuse_edge_fade_row(uint8_t *row, int y, int w, int h, int k, unsigned sides)
+void fuse__edge_fade_cols(uint8_t *row, int y, int w, int h, int k, unsigned sides, int c0, int c1)
 {
     int iy = k, x, xl, xr;   /* iy: pixels from the nearest faded side, rows only */
     if (k < 1 || k > FUSE_EDGE_FADE_MAX || (sides & FUSE_EDGE_ALL) == 0 || row == NULL || w < 1 ||
         y < 0 || y >= h)
         return;
+    if (c0 < 0) c0 = 0;
+    if (c1 > w) c1 = w;
     const uint64_t m = 0xFFFFFFFFu / (2u * (unsigned)k) + 1u;
     if ((sides & FUSE_EDGE_TOP) && y < iy) iy = y;
     if ((sides & FUSE_EDGE_BOTTOM) && h - 1 - y < iy) iy = h - 1 - y;
     /* the left strip [0, xl), the middle [xl, xr), the right strip [xr, w)
-     * (each pixel once); the middle is faded only in a top or bottom strip,
-     * where its pixels are all iy from the nearest side */
+     * (each pixel once), each cut to [c0, c1); the middle is faded only in
+     * a top or bottom strip, where its pixels are all iy from the nearest
+     * side */
     xl = (sides & FUSE_EDGE_LEFT) ? (k < w ? k : w) : 0;
     xr = (sides & FUSE_EDGE_RIGHT) ? (w - k > xl ? w - k : xl) : w;
-    for (x = 0; x < xl; x++) {
+    for (x = c0; x < xl && x < c1; x++) {
         const int i = col_dist(x, w, iy, sides);
         if (i < k) fade_px(row + 4 * (size_t)x, 2u * (unsigned)i + 1u, (unsigned)k, m);
     }
     if (iy < k)
-        for (x = xl; x < xr; x++) fade_px(row + 4 * (size_t)x, 2u * (unsigned)iy + 1u, (unsigned)k, m);
-    for (x = xr; x < w; x++) {
+        for (x = xl > c0 ? xl : c0; x < xr && x < c1; x++)
+            fade_px(row + 4 * (size_t)x, 2u * (unsigned)iy + 1u, (unsigned)k, m);
+    for (x = xr > c0 ? xr : c0; x < c1; x++) {
         const int i = col_dist(x, w, iy, sides);
         if (i < k) fade_px(row + 4 * (size_t)x, 2u * (unsigned)i + 1u, (unsigned)k, m);
     }
+}
+
+void fuse_edge_fade_row(uint8_t *row, int y, int w, int h, int k, unsigned sides)
+{
+    fuse__edge_fade_cols(row, y, w, h, k, sides, 0, w);
 }
 
 fuse_result fuse_edge_fade(fuse_image *Q, int k, unsigned sides)

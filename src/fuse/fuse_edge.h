@@ -65,6 +65,11 @@ float fuse_edge_weight(float sx, float sy, int w, int h, int k, unsigned sides);
  * a faded side are touched. No checks (the caller's are fuse_edge_fade's). */
 void fuse_edge_fade_row(uint8_t *row, int y, int w, int h, int k, unsigned sides);
 
+/* Internal (the frame's driver, fuse_ctx.c): fuse_edge_fade_row on the
+ * columns [c0, c1) of the row only, for a row known to be 0 outside them
+ * (a zero pixel stays zero): the same bytes with fewer pixels visited. */
+void fuse__edge_fade_cols(uint8_t *row, int y, int w, int h, int k, unsigned sides, int c0, int c1);
+
 /* fuse_edge_fade_row on every row of Q (only the rows and columns of the
  * border strips are visited). FUSE_ERR_ARGS: Q NULL or not a valid image
  * (NULL pixels, size outside 1..FUSE_MAX_DIM, stride below 4 width), k

@@ -22,12 +22,14 @@
  *
  * NUMBERS
  *   Integers only: out = (M n + 4) / 9. The same bytes on every ISA and
- *   thread count. Pixels of M 0 are written 0. The work is one scan of
- *   the box, 8 pixels at a time where they are all clear, or all 255 with
- *   every neighbour (the hand's inside), one by one at the edge. The
- *   pipeline gives the box of the mask's set pixels (found 8 bytes a step
- *   from each row's ends) and clears only what the last frame's box left
- *   outside it (pipe__soft_edge_boxed).
+ *   thread count (plain C, the counts summed one per byte of a 64-bit
+ *   word). Pixels of M 0 are written 0. The work is one pass over each
+ *   row's set span, 8 pixels at a time: all clear, all 255 with every
+ *   neighbour (the hand's inside), or the edge, whose 8 counts are summed
+ *   at once; one by one only in the image's first and last columns. The
+ *   pipeline's form (pipe__soft_edge_boxed) finds the box of the mask's
+ *   set pixels from the same spans and clears only what the last frame's
+ *   box left outside them.
  */
 #ifndef EGOFUSE_PIPE_SOFT_H
 #define EGOFUSE_PIPE_SOFT_H
