@@ -216,6 +216,31 @@ SIMD_INL void fv_micro_values(const vfloat *P, vfloat Z[4], vfloat B1[4], vfloat
 
 #include "raster_hidden.inl"
 
+/* fv_hidden's lanes one at a time through the scan's whole test (a
+ * depth plane too large for the gather's int32 offsets). */
+static unsigned fv_hidden_lanes(const rast_target *t, const vfloat *P, vint bx0, vint by0,
+                                vint bx1, vint by1, unsigned lanes)
+{
+    _Alignas(64) float zc[SIMD_W], zx[SIMD_W], zy[SIMD_W];
+    _Alignas(64) int32_t b[4][SIMD_W];
+    vf_store(zc, P[0]);
+    vf_store(zx, P[1]);
+    vf_store(zy, P[2]);
+    vi_store(b[0], bx0);
+    vi_store(b[1], by0);
+    vi_store(b[2], bx1);
+    vi_store(b[3], by1);
+    unsigned hid = 0;
+    for (unsigned bits = lanes; bits; bits &= bits - 1) {
+        const int l = __builtin_ctz(bits);
+        const int nx = b[2][l] - b[0][l] + 1;
+        if (nx <= 4 * SIMD_W &&
+            simd_zbox_hidden(t, zc[l], zx[l], zy[l], b[0][l], b[1][l], b[1][l], b[3][l], nx))
+            hid |= 1u << l;
+    }
+    return hid;
+}
+
 /* The lanes (of lanes) whose record the scan would find hidden: the box
  * depth test of the scan (simd_zbox_hidden) on the lane's float z plane
  * (P[0 .. 2] as fv_planes: the record's z.c, z.dx, z.dy) and clamped box,
@@ -233,19 +258,51 @@ SIMD_INL unsigned fv_hidden(const rast_target *t, const vfloat *P, vint bx0, vin
      * z.c at the box's first pixel (most visible triangles) ends the
      * lane's test; one gather (unused lanes read pixel 0) instead of a
      * data-dependent branch per lane. Offsets in int32: the plane's
-     * size checked. */
-    if ((size_t)t->depth_stride * (size_t)t->height <= (size_t)INT32_MAX) {
-        const vint at = vi_add(vi_mullo(by0, vi_set1(t->depth_stride)), bx0);
-        const vfloat d0 = vf_gather(t->depth, vi_sel(vm_from_bits(lanes), at, vi_zero()));
-        lanes &= ~vm_bits(vf_gt(d0, P[0]));
-        if (!lanes)
-            return 0;
+     * size checked; otherwise every lane takes simd_zbox_hidden whole. */
+    if ((size_t)t->depth_stride * (size_t)t->height > (size_t)INT32_MAX)
+        return fv_hidden_lanes(t, P, bx0, by0, bx1, by1, lanes);
+    const vint at = vi_add(vi_mullo(by0, vi_set1(t->depth_stride)), bx0);
+    const vfloat d0 = vf_gather(t->depth, vi_sel(vm_from_bits(lanes), at, vi_zero()));
+    lanes &= ~vm_bits(vf_gt(d0, P[0]));
+    if (!lanes)
+        return 0;
+    /* The bound zf of simd_zbox_hidden (rows y0 .. y1 of the box, so
+     * ys - y0 = 0) for every lane at once, per lane its double
+     * operations: min(a, b) = a < b ? a : b as -max(-a, -b) (negation
+     * is exact) and |a| as max(a, -a), which differs from a < 0 ? -a : a
+     * only in the sign of a zero or a NaN: that reaches zb only when S
+     * is 0 or NaN, where zb is zmin (so the same) or NaN. The first-pixel
+     * test above is simd_zbox_hidden's (z.c + z.dy * 0 compares as z.c
+     * when finite; when not, it never ends the test), so the lanes left
+     * go straight to the rows. */
+    const vdouble zero = vd_set1(0.0), nzero = vd_set1(-0.0), neg1 = vd_set1(-1.0);
+    const vdouble margin = vd_set1(0x1p-18), nlim1 = vd_set1(-1.0), big = vd_set1(1e30);
+    const vint w1 = vi_sub(bx1, bx0), h1 = vi_sub(by1, by0);
+    vdouble zf[2];
+    unsigned ok = 0;
+#pragma GCC unroll 2
+    for (int h = 0; h < 2; h++) {
+        const vdouble c = vd_from_vf(P[0], h), zdx = vd_from_vf(P[1], h);
+        const vdouble zdy = vd_from_vf(P[2], h);
+        const vdouble ay = vd_mul(zdy, zero), by = vd_mul(zdy, vd_from_vi(h1, h));
+        const vdouble ax = vd_mul(zdx, vd_from_vi(w1, h));
+        const vdouble nay = vd_mul(ay, neg1), nby = vd_mul(by, neg1), nax = vd_mul(ax, neg1);
+        /* c + (ay < by ? ay : by) + (ax < 0 ? ax : 0) */
+        const vdouble mn = vd_mul(vd_max(nay, nby), neg1);
+        const vdouble zmin = vd_add(vd_add(c, mn), vd_mul(vd_max(nax, nzero), neg1));
+        const vdouble aay = vd_max(ay, nay), aby = vd_max(by, nby);
+        const vdouble sy = vd_max(aay, aby);
+        const vdouble S = vd_add(vd_add(vd_max(c, vd_mul(c, neg1)), sy), vd_max(ax, nax));
+        const vdouble zb = vd_sub(zmin, vd_mul(S, margin));
+        ok |= (vd_gt_bits(zb, zero) & vd_gt_bits(big, zb)) << (VD_W * h);
+        zf[h] = vd_mul(vd_max(vd_mul(zb, neg1), nlim1), neg1);   /* zb < 1 ? zb : 1 */
     }
-    _Alignas(64) float zc[SIMD_W], zx[SIMD_W], zy[SIMD_W];
+    lanes &= ok;
+    if (!lanes)
+        return 0;
+    _Alignas(64) float zq[SIMD_W];
     _Alignas(64) int32_t b[4][SIMD_W];
-    vf_store(zc, P[0]);
-    vf_store(zx, P[1]);
-    vf_store(zy, P[2]);
+    vf_store(zq, vf_from_vd(zf[0], zf[1]));
     vi_store(b[0], bx0);
     vi_store(b[1], by0);
     vi_store(b[2], bx1);
@@ -254,8 +311,9 @@ SIMD_INL unsigned fv_hidden(const rast_target *t, const vfloat *P, vint bx0, vin
     for (unsigned bits = lanes; bits; bits &= bits - 1) {
         const int l = __builtin_ctz(bits);
         const int nx = b[2][l] - b[0][l] + 1;
+        const float *d = t->depth + (size_t)b[1][l] * (size_t)t->depth_stride + b[0][l];
         if (nx <= 4 * SIMD_W &&
-            simd_zbox_hidden(t, zc[l], zx[l], zy[l], b[0][l], b[1][l], b[1][l], b[3][l], nx))
+            simd_zbox_rows(t, d, vf_set1(zq[l]), b[0][l], b[1][l], b[3][l], nx))
             hid |= 1u << l;
     }
     return hid;

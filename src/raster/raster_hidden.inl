@@ -29,6 +29,55 @@ static inline double simd_absd(double a)
     return a < 0.0 ? -a : a;
 }
 
+/* The rows of the box test: 1 when every depth value of the box x0 ..
+ * x0+nx-1 (nx <= 4 * SIMD_W) x ys .. ye, row ys at d, is <= zv (ordered).
+ * The result is the conjunction over the box, so the rows are tested two
+ * at a time (one mask extraction and one branch per pair; a visible box
+ * reads at most one row more). Inlined: called out of line, the calls
+ * cost more than the rows of most boxes. */
+static inline __attribute__((always_inline)) int simd_zbox_rows(const rast_target *t,
+                                                                const float *d, vfloat zv,
+                                                                int x0, int ys, int ye, int nx)
+{
+    const size_t s = (size_t)t->depth_stride;
+    int y = ys;
+    if (nx <= SIMD_W) {
+        const unsigned valid = nx >= SIMD_W ? SIMD_FULL : (1u << nx) - 1u;
+        if (x0 + SIMD_W <= t->width) {
+            for (; y < ye; y += 2, d += 2 * s)
+                if (~vm_bits(vm_and(vf_le(vf_loadu(d), zv), vf_le(vf_loadu(d + s), zv))) & valid)
+                    return 0;
+            if (y == ye && (~vm_bits(vf_le(vf_loadu(d), zv)) & valid))
+                return 0;
+        } else {
+            for (; y <= ye; y++, d += s)
+                if (~vm_bits(vf_le(vf_load_bits(d, valid), zv)) & valid)
+                    return 0;
+        }
+        return 1;
+    }
+    /* Wider boxes: whole vectors, the last one's lanes masked to the box
+     * (a masked load when it would cross the row's end); the lanes past
+     * the box count as passing, so a row is one mask extraction. */
+    const int nfull = nx / SIMD_W, rem = nx % SIMD_W;
+    const unsigned lastvalid = (1u << rem) - 1u;
+    const vmask pastbox = vm_from_bits(~lastvalid & SIMD_FULL);
+    const int lastin = x0 + nfull * SIMD_W + SIMD_W <= t->width;
+    for (; y <= ye; y++, d += s) {
+        vmask le = vf_le(vf_loadu(d), zv);
+        for (int v = 1; v < nfull; v++)
+            le = vm_and(le, vf_le(vf_loadu(d + v * SIMD_W), zv));
+        if (rem) {
+            const float *p = d + nfull * SIMD_W;
+            const vfloat dv = lastin ? vf_loadu(p) : vf_load_bits(p, lastvalid);
+            le = vm_and(le, vm_or(vf_le(dv, zv), pastbox));
+        }
+        if (~vm_bits(le) & SIMD_FULL)
+            return 0;
+    }
+    return 1;
+}
+
 static inline int simd_zbox_hidden(const rast_target *t, float zc, float zdx, float zdy, int x0,
                                    int y0, int ys, int ye, int nx)
 {
@@ -47,36 +96,6 @@ static inline int simd_zbox_hidden(const rast_target *t, float zc, float zdx, fl
     const double zb = zmin - (simd_absd(c) + sy + simd_absd(ax)) * 0x1p-18;
     if (!(zb > 0.0 && zb < 1e30))
         return 0;
-    const vfloat zv = vf_set1(zb < 1.0 ? (float)zb : 1.0f);
-    if (nx <= SIMD_W) {
-        const unsigned valid = nx >= SIMD_W ? SIMD_FULL : (1u << nx) - 1u;
-        if (x0 + SIMD_W <= t->width) {
-            for (int y = ys; y <= ye; y++, d += t->depth_stride)
-                if (~vm_bits(vf_le(vf_loadu(d), zv)) & valid)
-                    return 0;
-        } else {
-            for (int y = ys; y <= ye; y++, d += t->depth_stride)
-                if (~vm_bits(vf_le(vf_load_bits(d, valid), zv)) & valid)
-                    return 0;
-        }
-        return 1;
-    }
-    /* Wider boxes: whole vectors, the last one's lanes masked to the box
-     * (a masked load when it would cross the row's end). */
-    const int nfull = nx / SIMD_W, rem = nx % SIMD_W;
-    const unsigned lastvalid = (1u << rem) - 1u;
-    const int lastin = x0 + nfull * SIMD_W + SIMD_W <= t->width;
-    for (int y = ys; y <= ye; y++, d += t->depth_stride) {
-        for (int v = 0; v < nfull; v++)
-            if (~vm_bits(vf_le(vf_loadu(d + v * SIMD_W), zv)) & SIMD_FULL)
-                return 0;
-        if (rem) {
-            const float *p = d + nfull * SIMD_W;
-            const vfloat dv = lastin ? vf_loadu(p) : vf_load_bits(p, lastvalid);
-            if (~vm_bits(vf_le(dv, zv)) & lastvalid)
-                return 0;
-        }
-    }
-    return 1;
+    return simd_zbox_rows(t, d, vf_set1(zb < 1.0 ? (float)zb : 1.0f), x0, ys, ye, nx);
 }
 #endif /* RAST_HIDDEN_INL */
