@@ -8,8 +8,9 @@
  *   fv_marked              the triangles with a marked vertex, and those of
  *                          three marked vertices dropped as non-finite or
  *                          clipped away (clip_snap's first steps);
- *   fv_planes              planes_one per lane (the double plane set-up of
- *                          section 6.1, one triangle per double lane);
+ *   fv_planes_z, _qb       planes_one per lane (the double plane set-up of
+ *                          section 6.1, one triangle per double lane): the
+ *                          z plane, then q, b1, b2;
  *   fv_micro_values        the scan's per-pixel values of the micro records
  *                          (boxes of at most 2x2 pixels).
  *
@@ -131,63 +132,98 @@ SIMD_INL void fv_plane(vdouble f0, vdouble f1, vdouble f2, vdouble ex1, vdouble 
     r[2] = gy;
 }
 
-/* planes_one (raster_setup.c) per lane: the planes z, q, b1, b2 of the
- * queue lanes 0 .. k-1 as vectors P[plane * 3 + {c, dx, dy}] (the same
- * operations per lane; rounded to float once, at the end, both halves
- * joined in registers). Lanes past k compute garbage (never stored); with
- * k <= VD_W the upper half is not computed (its lanes copy the lower's). */
-SIMD_INL void fv_planes(const vint X[3], const vint Y[3], const vint V[3], vint bx0, vint by0,
-                        int k, const rast__vbuf *vb, vfloat P[12])
+/* planes_one (raster_setup.c) per lane, in two steps so that a flush
+ * whose lanes all turn out hidden (about half of them with the sample
+ * model, where only the z plane is tested) skips the rest: fv_planes_z
+ * the z plane, fv_planes_qb the planes q, b1, b2, as vectors
+ * P[plane * 3 + {c, dx, dy}] (the same operations per lane; rounded to
+ * float once, at the end, both halves joined in registers). Lanes past k
+ * compute garbage (never stored); with k <= VD_W the upper half is not
+ * computed (its lanes copy the lower's). */
+typedef struct fv_geom {   /* what the four planes share, per half */
+    vdouble ex1, ey1, ex2, ey2, area, ox, oy;
+} fv_geom;
+
+SIMD_INL void fv_planes_z(const vint X[3], const vint Y[3], const vint V[3], vint bx0, vint by0,
+                          int k, const rast__vbuf *vb, fv_geom g[2], vfloat P[12])
 {
-    const vdouble inv256 = vd_set1(1.0 / RAST__FIX_ONE), dzero = vd_set1(0.0);
-    const vdouble dhalf = vd_set1(0.5);
-    vdouble r[2][12];
+    const vdouble inv256 = vd_set1(1.0 / RAST__FIX_ONE), dhalf = vd_set1(0.5);
+    vdouble r[2][3];
 #pragma GCC unroll 2
     for (int h = 0; h < 2; h++) {
         if (h && k <= VD_W) {
-#pragma GCC unroll 12
-            for (int j = 0; j < 12; j++)
+#pragma GCC unroll 3
+            for (int j = 0; j < 3; j++)
                 r[1][j] = r[0][j];
             break;
         }
-        vdouble Xd[3], Yd[3], zw[3], iw[3];
+        vdouble Xd[3], Yd[3], zw[3];
 #pragma GCC unroll 3
-        for (int i = 0; i < 3; i++) {
+        for (int i = 0; i < 3; i++)
             zw[i] = fv_gather_d(vb->zw, V[i], h);
-            iw[i] = fv_gather_d(vb->iw, V[i], h);
-        }
 #pragma GCC unroll 3
         for (int i = 0; i < 3; i++) {
             /* (double)X / 256: exact, as a multiplication by 2^-8 */
             Xd[i] = vd_mul(vd_from_vi(X[i], h), inv256);
             Yd[i] = vd_mul(vd_from_vi(Y[i], h), inv256);
         }
-        const vdouble ex1 = vd_sub(Xd[1], Xd[0]), ey1 = vd_sub(Yd[1], Yd[0]);
-        const vdouble ex2 = vd_sub(Xd[2], Xd[0]), ey2 = vd_sub(Yd[2], Yd[0]);
+        fv_geom *G = &g[h];
+        G->ex1 = vd_sub(Xd[1], Xd[0]);
+        G->ey1 = vd_sub(Yd[1], Yd[0]);
+        G->ex2 = vd_sub(Xd[2], Xd[0]);
+        G->ey2 = vd_sub(Yd[2], Yd[0]);
         /* |snapped area| / 65536, exact (raster_front.inl) */
-        const vdouble area = vd_sub(vd_mul(ex1, ey2), vd_mul(ey1, ex2));
+        G->area = vd_sub(vd_mul(G->ex1, G->ey2), vd_mul(G->ey1, G->ex2));
         const vdouble ocx = vd_add(vd_from_vi(bx0, h), dhalf);
         const vdouble ocy = vd_add(vd_from_vi(by0, h), dhalf);
-        const vdouble ox = vd_sub(ocx, Xd[0]), oy = vd_sub(ocy, Yd[0]);
+        G->ox = vd_sub(ocx, Xd[0]);
+        G->oy = vd_sub(ocy, Yd[0]);
+        fv_plane(zw[0], zw[1], zw[2], G->ex1, G->ey1, G->ex2, G->ey2, G->ox, G->oy, G->area,
+                 r[h]);
+    }
+#pragma GCC unroll 3
+    for (int j = 0; j < 3; j++)
+        P[j] = vf_from_vd(r[0][j], r[1][j]);
+}
+
+SIMD_INL void fv_planes_qb(const vint V[3], int k, const rast__vbuf *vb, const fv_geom g[2],
+                           vfloat P[12])
+{
+    const vdouble dzero = vd_set1(0.0);
+    vdouble r[2][9];
+#pragma GCC unroll 2
+    for (int h = 0; h < 2; h++) {
+        if (h && k <= VD_W) {
+#pragma GCC unroll 9
+            for (int j = 0; j < 9; j++)
+                r[1][j] = r[0][j];
+            break;
+        }
+        vdouble iw[3];
+#pragma GCC unroll 3
+        for (int i = 0; i < 3; i++)
+            iw[i] = fv_gather_d(vb->iw, V[i], h);
+        const fv_geom *G = &g[h];
         /* max(a, b) = a > b ? a : b, as the scalar loop */
         const vdouble qmax = vd_max(iw[2], vd_max(iw[1], vd_max(iw[0], dzero)));
         const vdouble q0 = vd_div(iw[0], qmax), q1 = vd_div(iw[1], qmax);
         const vdouble q2 = vd_div(iw[2], qmax);
-        fv_plane(zw[0], zw[1], zw[2], ex1, ey1, ex2, ey2, ox, oy, area, r[h]);
-        fv_plane(q0, q1, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 3);
-        fv_plane(dzero, q1, dzero, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 6);
-        fv_plane(dzero, dzero, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 9);
+        fv_plane(q0, q1, q2, G->ex1, G->ey1, G->ex2, G->ey2, G->ox, G->oy, G->area, r[h]);
+        fv_plane(dzero, q1, dzero, G->ex1, G->ey1, G->ex2, G->ey2, G->ox, G->oy, G->area,
+                 r[h] + 3);
+        fv_plane(dzero, dzero, q2, G->ex1, G->ey1, G->ex2, G->ey2, G->ox, G->oy, G->area,
+                 r[h] + 6);
     }
-#pragma GCC unroll 12
-    for (int j = 0; j < 12; j++)
-        P[j] = vf_from_vd(r[0][j], r[1][j]);
+#pragma GCC unroll 9
+    for (int j = 0; j < 9; j++)
+        P[3 + j] = vf_from_vd(r[0][j], r[1][j]);
 }
 
 /* The scan's values at the four pixels (i, j) of a micro record's box,
  * p = i + 2j: the clamped depth Z[p] and the barycentrics B1[p], B2[p],
  * per lane with the float operations of rast__scan_rows_ref in its order
  * (fi, fj are 0.0f or 1.0f, multiplied as the scan multiplies them; P as
- * fv_planes; lanes that are not micro compute garbage). */
+ * fv_planes_z and fv_planes_qb; lanes that are not micro compute garbage). */
 SIMD_INL void fv_micro_values(const vfloat *P, vfloat Z[4], vfloat B1[4], vfloat B2[4])
 {
     const vfloat zero = vf_zero(), fone = vf_set1(1.0f);
@@ -243,7 +279,7 @@ static unsigned fv_hidden_lanes(const rast_target *t, const vfloat *P, vint bx0,
 
 /* The lanes (of lanes) whose record the scan would find hidden: the box
  * depth test of the scan (simd_zbox_hidden) on the lane's float z plane
- * (P[0 .. 2] as fv_planes: the record's z.c, z.dx, z.dy) and clamped box,
+ * (P[0 .. 2] as fv_planes_z: the record's z.c, z.dx, z.dy) and clamped box,
  * over all its rows, against t's depth plane as it is now (before the
  * scans of this chunk's earlier records: depth only decreases during a
  * draw, so an older state is conservative). Boxes wider than four vectors
