@@ -56,9 +56,30 @@ static inline __attribute__((always_inline)) int simd_zbox_rows(const rast_targe
         }
         return 1;
     }
-    /* Wider boxes: whole vectors, the last one's lanes masked to the box
-     * (a masked load when it would cross the row's end); the lanes past
-     * the box count as passing, so a row is one mask extraction. */
+    /* Boxes of two vectors inside the row (most wide ones): both loaded
+     * whole, the second one's lanes past the box counted as passing,
+     * rows in pairs. */
+    if (nx <= 2 * SIMD_W && x0 + 2 * SIMD_W <= t->width) {
+        const int n2 = nx - SIMD_W;
+        const unsigned v2 = n2 >= SIMD_W ? SIMD_FULL : (1u << n2) - 1u;
+        const vmask past = vm_from_bits(~v2 & SIMD_FULL);
+        for (; y < ye; y += 2, d += 2 * s) {
+            const vmask r0 = vm_and(vf_le(vf_loadu(d), zv),
+                                    vm_or(vf_le(vf_loadu(d + SIMD_W), zv), past));
+            const vmask r1 = vm_and(vf_le(vf_loadu(d + s), zv),
+                                    vm_or(vf_le(vf_loadu(d + s + SIMD_W), zv), past));
+            if (~vm_bits(vm_and(r0, r1)) & SIMD_FULL)
+                return 0;
+        }
+        if (y == ye && (~vm_bits(vm_and(vf_le(vf_loadu(d), zv),
+                                        vm_or(vf_le(vf_loadu(d + SIMD_W), zv), past))) &
+                        SIMD_FULL))
+            return 0;
+        return 1;
+    }
+    /* Other wide boxes: whole vectors, the last one's lanes masked to the
+     * box (a masked load when it would cross the row's end); the lanes
+     * past the box count as passing, so a row is one mask extraction. */
     const int nfull = nx / SIMD_W, rem = nx % SIMD_W;
     const unsigned lastvalid = (1u << rem) - 1u;
     const vmask pastbox = vm_from_bits(~lastvalid & SIMD_FULL);
