@@ -19,8 +19,8 @@
  * equal rast__prepare_range with the scalar set-up at every lane width.
  *
  * Included after one layer implementation, raster_front.inl,
- * raster_frontv.inl and the includer's two further helpers (what the ISAs
- * do their own way):
+ * raster_frontv.inl and the includer's three further helpers (what the
+ * ISAs do their own way):
  *   void fv_load_group(const uint32_t *ix, const long long *xyb, int cnt,
  *                      vint iv[3], vint X[3], vint Y[3])
  *        the vertex indices of cnt (1..SIMD_W) triangles at ix
@@ -32,7 +32,10 @@
  *        setup_attrs for one record: a0 = attribute of v0, d1 = a1 - a0,
  *        d2 = a2 - a0 (ac = 1..RAST_MAX_ATTRS floats each); no byte past
  *        a vertex's ac floats is read, none past t->a0[ac - 1],
- *        t->d1[ac - 1], t->d2[ac - 1] written. */
+ *        t->d1[ac - 1], t->d2[ac - 1] written;
+ *   vint fv_compress_lanes(unsigned bits)
+ *        vi_compress_lanes: the lane numbers of the set bits of bits in
+ *        order, then 0. */
 
 #ifndef SIMD_HAS_VL
 #error "raster_frontq.inl: the vector layer has no RASTER EDGE OPS (x86 AVX2 / AVX-512 only)"
@@ -268,7 +271,7 @@ int SIMD_FN(rast__frontv)(const rast__view *v, const rast_mesh_desc *m, const ra
          * SIMD_W); lanes j < qn of the same permutation hold the survivors
          * past the last lane (survivor j - qn + SIMD_W), the next queue. */
         const vint rot = vi_sub(iota, vi_set1(qn));
-        const vint pr = vi_permute(vi_compress_lanes(surv), rot);
+        const vint pr = vi_permute(fv_compress_lanes(surv), rot);
         /* Record slots in submission order; special triangles through the
          * scalar path at their place. */
         vint slot;
