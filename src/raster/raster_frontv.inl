@@ -308,11 +308,11 @@ SIMD_INL unsigned fv_hidden(const rast_target *t, const vfloat *P, vint bx0, vin
      * is exact) and |a| as max(a, -a), which differs from a < 0 ? -a : a
      * only in the sign of a zero or a NaN: that reaches zb only when S
      * is 0 or NaN, where zb is zmin (so the same) or NaN. The first-pixel
-     * test above is simd_zbox_hidden's (z.c + z.dy * 0 compares as z.c
-     * when finite; when not, it never ends the test), so the lanes left
-     * go straight to the rows. */
+     * test above is simd_zbox_hidden's (its z.c + z.dy * 0 compares as
+     * z.c for a finite z.dy; for another it is NaN and never ends the
+     * test), so the lanes left go straight to the rows. */
     const vdouble zero = vd_set1(0.0), nzero = vd_set1(-0.0), neg1 = vd_set1(-1.0);
-    const vdouble margin = vd_set1(0x1p-18), nlim1 = vd_set1(-1.0), big = vd_set1(1e30);
+    const vdouble margin = vd_set1(0x1p-18), big = vd_set1(1e30);
     const vint w1 = vi_sub(bx1, bx0), h1 = vi_sub(by1, by0);
     vdouble zf[2];
     unsigned ok = 0;
@@ -331,7 +331,7 @@ SIMD_INL unsigned fv_hidden(const rast_target *t, const vfloat *P, vint bx0, vin
         const vdouble S = vd_add(vd_add(vd_max(c, vd_mul(c, neg1)), sy), vd_max(ax, nax));
         const vdouble zb = vd_sub(zmin, vd_mul(S, margin));
         ok |= (vd_gt_bits(zb, zero) & vd_gt_bits(big, zb)) << (VD_W * h);
-        zf[h] = vd_mul(vd_max(vd_mul(zb, neg1), nlim1), neg1);   /* zb < 1 ? zb : 1 */
+        zf[h] = vd_mul(vd_max(vd_mul(zb, neg1), neg1), neg1);   /* zb < 1 ? zb : 1 */
     }
     lanes &= ok;
     if (!lanes)
@@ -349,7 +349,7 @@ SIMD_INL unsigned fv_hidden(const rast_target *t, const vfloat *P, vint bx0, vin
         const int nx = b[2][l] - b[0][l] + 1;
         const float *d = t->depth + (size_t)b[1][l] * (size_t)t->depth_stride + b[0][l];
         if (nx <= 4 * SIMD_W &&
-            simd_zbox_rows(t, d, vf_set1(zq[l]), b[0][l], b[1][l], b[3][l], nx))
+            simd_zbox_rows(t, d, vf_set1(zq[l]), b[0][l], b[1][l], b[3][l], nx, 1))
             hid |= 1u << l;
     }
     return hid;

@@ -31,24 +31,33 @@ static inline double simd_absd(double a)
 
 /* The rows of the box test: 1 when every depth value of the box x0 ..
  * x0+nx-1 (nx <= 4 * SIMD_W) x ys .. ye, row ys at d, is <= zv (ordered).
- * The result is the conjunction over the box, so the rows are tested two
- * at a time (one mask extraction and one branch per pair; a visible box
- * reads at most one row more). Inlined: called out of line, the calls
- * cost more than the rows of most boxes. */
+ * The result is the conjunction over the box. With pairs (a constant: the
+ * vector front end, whose boxes are mostly hidden, so every row is read)
+ * rows are tested two at a time and boxes of two vectors as one, one mask
+ * extraction and one branch per pair of rows; without (the scan, whose
+ * boxes mostly end at their first row or vector) one row and one vector
+ * at a time. Inlined: called out of line, the calls cost more than the
+ * rows of most boxes. */
 static inline __attribute__((always_inline)) int simd_zbox_rows(const rast_target *t,
                                                                 const float *d, vfloat zv,
-                                                                int x0, int ys, int ye, int nx)
+                                                                int x0, int ys, int ye, int nx,
+                                                                int pairs)
 {
     const size_t s = (size_t)t->depth_stride;
     int y = ys;
     if (nx <= SIMD_W) {
         const unsigned valid = nx >= SIMD_W ? SIMD_FULL : (1u << nx) - 1u;
         if (x0 + SIMD_W <= t->width) {
-            for (; y < ye; y += 2, d += 2 * s)
-                if (~vm_bits(vm_and(vf_le(vf_loadu(d), zv), vf_le(vf_loadu(d + s), zv))) & valid)
+            if (pairs) {
+                for (; y < ye; y += 2, d += 2 * s)
+                    if (~vm_bits(vm_and(vf_le(vf_loadu(d), zv), vf_le(vf_loadu(d + s), zv))) &
+                        valid)
+                        return 0;
+                return !(y == ye && (~vm_bits(vf_le(vf_loadu(d), zv)) & valid));
+            }
+            for (; y <= ye; y++, d += s)
+                if (~vm_bits(vf_le(vf_loadu(d), zv)) & valid)
                     return 0;
-            if (y == ye && (~vm_bits(vf_le(vf_loadu(d), zv)) & valid))
-                return 0;
         } else {
             for (; y <= ye; y++, d += s)
                 if (~vm_bits(vf_le(vf_load_bits(d, valid), zv)) & valid)
@@ -56,10 +65,10 @@ static inline __attribute__((always_inline)) int simd_zbox_rows(const rast_targe
         }
         return 1;
     }
-    /* Boxes of two vectors inside the row (most wide ones): both loaded
-     * whole, the second one's lanes past the box counted as passing,
-     * rows in pairs. */
-    if (nx <= 2 * SIMD_W && x0 + 2 * SIMD_W <= t->width) {
+    /* Boxes of two vectors inside the row (most wide ones), with pairs:
+     * both loaded whole, the second one's lanes past the box counted as
+     * passing. */
+    if (pairs && nx <= 2 * SIMD_W && x0 + 2 * SIMD_W <= t->width) {
         const int n2 = nx - SIMD_W;
         const unsigned v2 = n2 >= SIMD_W ? SIMD_FULL : (1u << n2) - 1u;
         const vmask past = vm_from_bits(~v2 & SIMD_FULL);
@@ -71,30 +80,25 @@ static inline __attribute__((always_inline)) int simd_zbox_rows(const rast_targe
             if (~vm_bits(vm_and(r0, r1)) & SIMD_FULL)
                 return 0;
         }
-        if (y == ye && (~vm_bits(vm_and(vf_le(vf_loadu(d), zv),
-                                        vm_or(vf_le(vf_loadu(d + SIMD_W), zv), past))) &
-                        SIMD_FULL))
-            return 0;
-        return 1;
+        return !(y == ye && (~vm_bits(vm_and(vf_le(vf_loadu(d), zv),
+                                             vm_or(vf_le(vf_loadu(d + SIMD_W), zv), past))) &
+                             SIMD_FULL));
     }
     /* Other wide boxes: whole vectors, the last one's lanes masked to the
-     * box (a masked load when it would cross the row's end); the lanes
-     * past the box count as passing, so a row is one mask extraction. */
+     * box (a masked load when it would cross the row's end). */
     const int nfull = nx / SIMD_W, rem = nx % SIMD_W;
     const unsigned lastvalid = (1u << rem) - 1u;
-    const vmask pastbox = vm_from_bits(~lastvalid & SIMD_FULL);
     const int lastin = x0 + nfull * SIMD_W + SIMD_W <= t->width;
     for (; y <= ye; y++, d += s) {
-        vmask le = vf_le(vf_loadu(d), zv);
-        for (int v = 1; v < nfull; v++)
-            le = vm_and(le, vf_le(vf_loadu(d + v * SIMD_W), zv));
+        for (int v = 0; v < nfull; v++)
+            if (~vm_bits(vf_le(vf_loadu(d + v * SIMD_W), zv)) & SIMD_FULL)
+                return 0;
         if (rem) {
             const float *p = d + nfull * SIMD_W;
             const vfloat dv = lastin ? vf_loadu(p) : vf_load_bits(p, lastvalid);
-            le = vm_and(le, vm_or(vf_le(dv, zv), pastbox));
+            if (~vm_bits(vf_le(dv, zv)) & lastvalid)
+                return 0;
         }
-        if (~vm_bits(le) & SIMD_FULL)
-            return 0;
     }
     return 1;
 }
@@ -117,6 +121,6 @@ static inline int simd_zbox_hidden(const rast_target *t, float zc, float zdx, fl
     const double zb = zmin - (simd_absd(c) + sy + simd_absd(ax)) * 0x1p-18;
     if (!(zb > 0.0 && zb < 1e30))
         return 0;
-    return simd_zbox_rows(t, d, vf_set1(zb < 1.0 ? (float)zb : 1.0f), x0, ys, ye, nx);
+    return simd_zbox_rows(t, d, vf_set1(zb < 1.0 ? (float)zb : 1.0f), x0, ys, ye, nx, 0);
 }
 #endif /* RAST_HIDDEN_INL */
