@@ -475,11 +475,8 @@ static known_target *find_known(rast_context *c, const rast_target *t)
 static void clear_span(const rast_target *t, int y, int x0, int x1, int attr)
 {
     const size_t n = (size_t)(x1 - x0 + 1);
-    if (t->depth) {
-        float *d = t->depth + (size_t)y * (size_t)t->depth_stride + x0;
-        for (size_t x = 0; x < n; x++)
-            d[x] = 1.0f;
-    }
+    if (t->depth)
+        rast__fill_depth(t->depth + (size_t)y * (size_t)t->depth_stride + x0, n);
     memset(t->mask + (size_t)y * (size_t)t->mask_stride + x0, 0, n);
     if (attr && t->attr && t->attr_count > 0)
         memset(t->attr + (size_t)y * (size_t)t->attr_stride +

@@ -27,24 +27,33 @@ int rast__draw_na(const rast_target *t, const rast_mesh_desc *m)
     return (t->attr && m->attr) ? m->attr_count : 0;
 }
 
-void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1)
+/* Marks tiles tx0..tx1 x ty0..ty1 (inclusive, not empty). */
+static inline void tiles_mark(rast__tiles *tl, unsigned ty0, unsigned ty1, unsigned tx0,
+                              unsigned tx1)
 {
-    const int t0 = x0 / RAST__TILE, t1 = x1 / RAST__TILE;
-    if (t0 / 64 == t1 / 64) {   /* the usual case: one word per tile row */
-        const int w = t0 / 64, lo = t0 % 64, hi = t1 % 64;
+    if (tx0 / 64 == tx1 / 64) {   /* the usual case: one word per tile row */
+        const unsigned w = tx0 / 64, lo = tx0 % 64, hi = tx1 % 64;
         const uint64_t bits = (hi == 63 ? ~(uint64_t)0 : ((uint64_t)1 << (hi + 1)) - 1u) &
                               ~(((uint64_t)1 << lo) - 1u);
-        for (int ty = ya / RAST__TILE; ty <= yb / RAST__TILE; ty++)
+        for (unsigned ty = ty0; ty <= ty1; ty++)
             tl->bits[ty][w] |= bits;
         return;
     }
-    for (int ty = ya / RAST__TILE; ty <= yb / RAST__TILE; ty++)
-        for (int w = t0 / 64; w <= t1 / 64; w++) {
-            const int lo = w * 64 > t0 ? 0 : t0 - w * 64;
-            const int hi = w * 64 + 63 < t1 ? 63 : t1 - w * 64;
+    for (unsigned ty = ty0; ty <= ty1; ty++)
+        for (unsigned w = tx0 / 64; w <= tx1 / 64; w++) {
+            const unsigned lo = w * 64 > tx0 ? 0 : tx0 - w * 64;
+            const unsigned hi = w * 64 + 63 < tx1 ? 63 : tx1 - w * 64;
             const uint64_t upto = hi == 63 ? ~(uint64_t)0 : ((uint64_t)1 << (hi + 1)) - 1u;
             tl->bits[ty][w] |= upto & ~(((uint64_t)1 << lo) - 1u);
         }
+}
+
+/* Pixel coordinates are never negative here (clamped boxes and bands):
+ * the tile numbers by unsigned division, a shift. */
+void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1)
+{
+    tiles_mark(tl, (unsigned)ya / RAST__TILE, (unsigned)yb / RAST__TILE,
+               (unsigned)x0 / RAST__TILE, (unsigned)x1 / RAST__TILE);
 }
 
 /* The pixels of a micro record (r->micro != 0): the depth test and the
@@ -80,6 +89,9 @@ long rast__scan_list(const rast_target *t, const rast__tri *tri, int n,
                      rast__scan_rows_fn scan, rast__tiles *tiles, int last[4], int micro)
 {
     long px = 0;
+    /* the tile rectangle marked last, in locals (the scan is called
+     * through a pointer: last[] would be reloaded after every call) */
+    int l0 = last[0], l1 = last[1], l2 = last[2], l3 = last[3];
     for (int i = 0; i < n; i++) {
         const rast__tri *r = &tri[i];
         if (micro && r->micro) {
@@ -97,17 +109,24 @@ long rast__scan_list(const rast_target *t, const rast__tri *tri, int n,
             continue;
         /* Neighbouring triangles mostly lie in the tiles just marked:
          * skip the marking when the tile rectangle is inside the last
-         * one marked (those bits are set already). */
-        const int tx0 = r->x0 / RAST__TILE, tx1 = r->x1 / RAST__TILE;
-        const int ty0 = r->y0 / RAST__TILE, ty1 = r->y1 / RAST__TILE;
-        if (tx0 >= last[0] && tx1 <= last[1] && ty0 >= last[2] && ty1 <= last[3])
+         * one marked (those bits are set already). A record's box is
+         * clamped to the target: no coordinate is negative. */
+        const int tx0 = (int)((unsigned)r->x0 / RAST__TILE);
+        const int tx1 = (int)((unsigned)r->x1 / RAST__TILE);
+        const int ty0 = (int)((unsigned)r->y0 / RAST__TILE);
+        const int ty1 = (int)((unsigned)r->y1 / RAST__TILE);
+        if (tx0 >= l0 && tx1 <= l1 && ty0 >= l2 && ty1 <= l3)
             continue;
-        rast__tiles_add(tiles, r->y0, r->y1, r->x0, r->x1);
-        last[0] = tx0;
-        last[1] = tx1;
-        last[2] = ty0;
-        last[3] = ty1;
+        tiles_mark(tiles, (unsigned)ty0, (unsigned)ty1, (unsigned)tx0, (unsigned)tx1);
+        l0 = tx0;
+        l1 = tx1;
+        l2 = ty0;
+        l3 = ty1;
     }
+    last[0] = l0;
+    last[1] = l1;
+    last[2] = l2;
+    last[3] = l3;
     return px;
 }
 

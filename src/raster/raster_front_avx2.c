@@ -215,6 +215,28 @@ static inline __attribute__((always_inline)) void fv_load_group(const uint32_t *
     }
 }
 
+/* vi_compress_lanes by two 16-entry tables instead of its loop over the
+ * set bits (1.2 M of the 13.5 M instructions of rast__frontv_avx2 in 8
+ * stereo frames of egofuse render): the lane numbers of the set bits of
+ * a nibble, 3 bits each in order, for lanes 0-3 (lo) and lanes 4-7 (hi);
+ * the high nibble's numbers follow the low nibble's. The same packed
+ * index, so the same vector. */
+static const uint16_t compress_lo[16] = { 0x000, 0x000, 0x001, 0x008, 0x002, 0x010,
+                                          0x011, 0x088, 0x003, 0x018, 0x019, 0x0c8,
+                                          0x01a, 0x0d0, 0x0d1, 0x688 };
+static const uint16_t compress_hi[16] = { 0x000, 0x004, 0x005, 0x02c, 0x006, 0x034,
+                                          0x035, 0x1ac, 0x007, 0x03c, 0x03d, 0x1ec,
+                                          0x03e, 0x1f4, 0x1f5, 0xfac };
+static inline vint fv_compress_lanes(unsigned bits)
+{
+    const unsigned lo = bits & 15u, hi = (bits >> 4) & 15u;
+    const uint32_t p = (uint32_t)compress_lo[lo] |
+                       ((uint32_t)compress_hi[hi] << (3 * __builtin_popcount(lo)));
+    const __m256i sh = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21);
+    return _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32((int)p), sh),
+                            _mm256_set1_epi32(7));
+}
+
 /* The group loop, the survivor queue and set-up written once. */
 #include "raster_frontq.inl"
 

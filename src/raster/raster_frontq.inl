@@ -10,7 +10,7 @@
  *                          queue kept in vectors (one permutation and one
  *                          select per field), set up SIMD_W at a time;
  *   fq_flush               setup_edges (int64 edges, VD_W lanes per half),
- *                          planes_one (fv_planes), micro records, hidden
+ *                          planes_one (fv_planes_z, _qb), micro records, hidden
  *                          records, and the records by 16-byte copies
  *                          (raster_front_rec.inl);
  *   fq_micro_lanes         the micro records' coverage and values.
@@ -19,8 +19,8 @@
  * equal rast__prepare_range with the scalar set-up at every lane width.
  *
  * Included after one layer implementation, raster_front.inl,
- * raster_frontv.inl and the includer's two further helpers (what the ISAs
- * do their own way):
+ * raster_frontv.inl and the includer's three further helpers (what the
+ * ISAs do their own way):
  *   void fv_load_group(const uint32_t *ix, const long long *xyb, int cnt,
  *                      vint iv[3], vint X[3], vint Y[3])
  *        the vertex indices of cnt (1..SIMD_W) triangles at ix
@@ -32,7 +32,10 @@
  *        setup_attrs for one record: a0 = attribute of v0, d1 = a1 - a0,
  *        d2 = a2 - a0 (ac = 1..RAST_MAX_ATTRS floats each); no byte past
  *        a vertex's ac floats is read, none past t->a0[ac - 1],
- *        t->d1[ac - 1], t->d2[ac - 1] written. */
+ *        t->d1[ac - 1], t->d2[ac - 1] written;
+ *   vint fv_compress_lanes(unsigned bits)
+ *        vi_compress_lanes: the lane numbers of the set bits of bits in
+ *        order, then 0. */
 
 #ifndef SIMD_HAS_VL
 #error "raster_frontq.inl: the vector layer has no RASTER EDGE OPS (x86 AVX2 / AVX-512 only)"
@@ -40,24 +43,30 @@
 
 #include "raster_front_rec.inl"
 
-/* Micro lanes (clamped box at most 2x2 pixels): the covered pixels and,
- * for each of the box's four pixels (i, j), the scan's values (the clamped
+/* The micro lanes (of L): clamped box at most 2x2 pixels. */
+SIMD_INL unsigned fq_micro_box(const vint *qf, unsigned L)
+{
+    const vint two = vi_set1(2);
+    const vint w1 = vi_sub(qf[Q_BX1], qf[Q_BX0]);
+    const vint h1 = vi_sub(qf[Q_BY1], qf[Q_BY0]);
+    return L & vm_bits(vm_and(vi_gt(two, w1), vi_gt(two, h1)));
+}
+
+/* The micro lanes mic (fq_micro_box, not 0): the covered pixels and, for
+ * each of the box's four pixels (i, j), the scan's values (the clamped
  * depth z and the barycentrics b1, b2, fv_micro_values). cov[l]: bit
  * i + 2j for a covered pixel (the int64 edge test of the scan at that
  * pixel, E as in fq_flush); the values of lane l as quads (mz, mb1, mb2 of
  * its record) at mq + QUAD_AT(l), mq + 4 SIMD_W + QUAD_AT(l),
- * mq + 8 SIMD_W + QUAD_AT(l). Returns the micro lanes (of L). */
-SIMD_INL unsigned fq_micro_lanes(const vint *qf, unsigned L, const vlong (*E)[2],
-                                 const vfloat *P, int32_t *cov, float *mq)
+ * mq + 8 SIMD_W + QUAD_AT(l). */
+SIMD_INL void fq_micro_lanes(const vint *qf, unsigned mic, const vlong (*E)[2], const vfloat *P,
+                             int32_t *cov, float *mq)
 {
-    const vint one = vi_set1(1), two = vi_set1(2);
+    const vint one = vi_set1(1);
     const vint w1 = vi_sub(qf[Q_BX1], qf[Q_BX0]);
     const vint h1 = vi_sub(qf[Q_BY1], qf[Q_BY0]);
     const unsigned wide = vm_bits(vi_eq(w1, one));   /* 2 columns */
     const unsigned tall = vm_bits(vi_eq(h1, one));   /* 2 rows */
-    const unsigned mic = L & vm_bits(vm_and(vi_gt(two, w1), vi_gt(two, h1)));
-    if (!mic)
-        return 0;
     /* Coverage: E = e_c + i*e_dx + j*e_dy, int64, at the four pixels. */
     unsigned cv[4] = { 0, 0, 0, 0 };
 #pragma GCC unroll 2
@@ -81,7 +90,7 @@ SIMD_INL unsigned fq_micro_lanes(const vint *qf, unsigned L, const vlong (*E)[2]
     cv[2] &= mic & tall;
     cv[3] &= mic & wide & tall;
     if (!(cv[0] | cv[1] | cv[2] | cv[3]))
-        return mic;
+        return;
     vint cb = vi_zero();
 #pragma GCC unroll 4
     for (int p = 0; p < 4; p++)
@@ -93,7 +102,6 @@ SIMD_INL unsigned fq_micro_lanes(const vint *qf, unsigned L, const vlong (*E)[2]
     quads(Z[0], Z[1], Z[2], Z[3], mq);
     quads(B1[0], B1[1], B1[2], B1[3], mq + 4 * SIMD_W);
     quads(B2[0], B2[1], B2[2], B2[3], mq + 8 * SIMD_W);
-    return mic;
 }
 
 /* Sets up queue lanes 0 .. k-1 (k = 1..SIMD_W; qf[field] as in the queue)
@@ -122,6 +130,25 @@ static void fq_flush(const rast__view *v, const rast_mesh_desc *m, const rast__v
     const vint c128 = vi_set1(RAST__FIX_HALF);
     const vint cx = vi_add(vi_slli(bx0, RAST_SUBPIXEL_BITS), c128);
     const vint cy = vi_add(vi_slli(by0, RAST_SUBPIXEL_BITS), c128);
+    const unsigned Lb = k >= SIMD_W ? SIMD_FULL : (1u << k) - 1u;
+
+    /* The z plane first: when every lane's record is hidden (no micro
+     * lane; about half of the flushes with the sample model) the rest,
+     * edges, the other planes and micro values, is not needed. */
+    fv_geom g[2];
+    vfloat P[12];
+    fv_planes_z(X, Y, V, bx0, by0, k, vb, g, P);
+    const unsigned mic = micro ? fq_micro_box(qf, Lb) : 0u;
+    const unsigned hid =
+        fv_hidden(micro ? v->hz : NULL, P, bx0, by0, qf[Q_BX1], qf[Q_BY1], Lb & ~mic);
+    _Alignas(SIMD_ALIGN) int32_t bq[4 * SIMD_W];
+    quads(vi_as_vf(bx0), vi_as_vf(by0), vi_as_vf(qf[Q_BX1]), vi_as_vf(qf[Q_BY1]),
+          (float *)(void *)bq);
+    if (hid == Lb) {
+        for (int l = 0; l < k; l++)
+            front_hidden_record(out + qs[Q_SLOT][l], l, bq);
+        return;
+    }
 
     /* setup_edges: edge e from vertex ea[e] to eb[e]; E[f][h] the int64
      * lanes of half h of e_c[e] (f = e), e_dx[e] (3 + e), e_dy[e] (6 + e),
@@ -145,23 +172,16 @@ static void fq_flush(const rast__view *v, const rast_mesh_desc *m, const rast__v
         }
     }
 
-    /* planes_one per lane. */
-    vfloat P[12];
-    fv_planes(X, Y, V, bx0, by0, k, vb, P);
+    /* the planes q, b1, b2 */
+    fv_planes_qb(V, k, vb, g, P);
 
     /* The records: lane l -> out[slot l]. */
-    const unsigned Lb = k >= SIMD_W ? SIMD_FULL : (1u << k) - 1u;
     _Alignas(SIMD_ALIGN) int32_t cov[SIMD_W] = { 0 };
     _Alignas(SIMD_ALIGN) float mq[3 * 4 * SIMD_W];
-    const unsigned mic =
-        micro ? fq_micro_lanes(qf, Lb, (const vlong (*)[2])E, P, cov, mq) : 0u;
-    const unsigned hid =
-        fv_hidden(micro ? v->hz : NULL, P, bx0, by0, qf[Q_BX1], qf[Q_BY1], Lb & ~mic);
-    /* box; the planes z.c .. q.c, q.dx .. b1.dx, b1.dy .. b2.dy */
-    _Alignas(SIMD_ALIGN) int32_t bq[4 * SIMD_W];
+    if (mic)
+        fq_micro_lanes(qf, mic, (const vlong (*)[2])E, P, cov, mq);
+    /* the planes z.c .. q.c, q.dx .. b1.dx, b1.dy .. b2.dy */
     _Alignas(SIMD_ALIGN) float pq[3 * 4 * SIMD_W];
-    quads(vi_as_vf(bx0), vi_as_vf(by0), vi_as_vf(qf[Q_BX1]), vi_as_vf(qf[Q_BY1]),
-          (float *)(void *)bq);
     /* the edge pairs (e_c[0], e_c[1]) .. (e_dy[0], e_dy[1]) and e_dy[2] */
     _Alignas(SIMD_ALIGN) int64_t eq[4][2 * SIMD_W], e8[SIMD_W];
     if ((mic | hid) != Lb) {
@@ -251,7 +271,7 @@ int SIMD_FN(rast__frontv)(const rast__view *v, const rast_mesh_desc *m, const ra
          * SIMD_W); lanes j < qn of the same permutation hold the survivors
          * past the last lane (survivor j - qn + SIMD_W), the next queue. */
         const vint rot = vi_sub(iota, vi_set1(qn));
-        const vint pr = vi_permute(vi_compress_lanes(surv), rot);
+        const vint pr = vi_permute(fv_compress_lanes(surv), rot);
         /* Record slots in submission order; special triangles through the
          * scalar path at their place. */
         vint slot;

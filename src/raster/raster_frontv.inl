@@ -8,8 +8,9 @@
  *   fv_marked              the triangles with a marked vertex, and those of
  *                          three marked vertices dropped as non-finite or
  *                          clipped away (clip_snap's first steps);
- *   fv_planes              planes_one per lane (the double plane set-up of
- *                          section 6.1, one triangle per double lane);
+ *   fv_planes_z, _qb       planes_one per lane (the double plane set-up of
+ *                          section 6.1, one triangle per double lane): the
+ *                          z plane, then q, b1, b2;
  *   fv_micro_values        the scan's per-pixel values of the micro records
  *                          (boxes of at most 2x2 pixels).
  *
@@ -131,63 +132,98 @@ SIMD_INL void fv_plane(vdouble f0, vdouble f1, vdouble f2, vdouble ex1, vdouble 
     r[2] = gy;
 }
 
-/* planes_one (raster_setup.c) per lane: the planes z, q, b1, b2 of the
- * queue lanes 0 .. k-1 as vectors P[plane * 3 + {c, dx, dy}] (the same
- * operations per lane; rounded to float once, at the end, both halves
- * joined in registers). Lanes past k compute garbage (never stored); with
- * k <= VD_W the upper half is not computed (its lanes copy the lower's). */
-SIMD_INL void fv_planes(const vint X[3], const vint Y[3], const vint V[3], vint bx0, vint by0,
-                        int k, const rast__vbuf *vb, vfloat P[12])
+/* planes_one (raster_setup.c) per lane, in two steps so that a flush
+ * whose lanes all turn out hidden (about half of them with the sample
+ * model, where only the z plane is tested) skips the rest: fv_planes_z
+ * the z plane, fv_planes_qb the planes q, b1, b2, as vectors
+ * P[plane * 3 + {c, dx, dy}] (the same operations per lane; rounded to
+ * float once, at the end, both halves joined in registers). Lanes past k
+ * compute garbage (never stored); with k <= VD_W the upper half is not
+ * computed (its lanes copy the lower's). */
+typedef struct fv_geom {   /* what the four planes share, per half */
+    vdouble ex1, ey1, ex2, ey2, area, ox, oy;
+} fv_geom;
+
+SIMD_INL void fv_planes_z(const vint X[3], const vint Y[3], const vint V[3], vint bx0, vint by0,
+                          int k, const rast__vbuf *vb, fv_geom g[2], vfloat P[12])
 {
-    const vdouble inv256 = vd_set1(1.0 / RAST__FIX_ONE), dzero = vd_set1(0.0);
-    const vdouble dhalf = vd_set1(0.5);
-    vdouble r[2][12];
+    const vdouble inv256 = vd_set1(1.0 / RAST__FIX_ONE), dhalf = vd_set1(0.5);
+    vdouble r[2][3];
 #pragma GCC unroll 2
     for (int h = 0; h < 2; h++) {
         if (h && k <= VD_W) {
-#pragma GCC unroll 12
-            for (int j = 0; j < 12; j++)
+#pragma GCC unroll 3
+            for (int j = 0; j < 3; j++)
                 r[1][j] = r[0][j];
             break;
         }
-        vdouble Xd[3], Yd[3], zw[3], iw[3];
+        vdouble Xd[3], Yd[3], zw[3];
 #pragma GCC unroll 3
-        for (int i = 0; i < 3; i++) {
+        for (int i = 0; i < 3; i++)
             zw[i] = fv_gather_d(vb->zw, V[i], h);
-            iw[i] = fv_gather_d(vb->iw, V[i], h);
-        }
 #pragma GCC unroll 3
         for (int i = 0; i < 3; i++) {
             /* (double)X / 256: exact, as a multiplication by 2^-8 */
             Xd[i] = vd_mul(vd_from_vi(X[i], h), inv256);
             Yd[i] = vd_mul(vd_from_vi(Y[i], h), inv256);
         }
-        const vdouble ex1 = vd_sub(Xd[1], Xd[0]), ey1 = vd_sub(Yd[1], Yd[0]);
-        const vdouble ex2 = vd_sub(Xd[2], Xd[0]), ey2 = vd_sub(Yd[2], Yd[0]);
+        fv_geom *G = &g[h];
+        G->ex1 = vd_sub(Xd[1], Xd[0]);
+        G->ey1 = vd_sub(Yd[1], Yd[0]);
+        G->ex2 = vd_sub(Xd[2], Xd[0]);
+        G->ey2 = vd_sub(Yd[2], Yd[0]);
         /* |snapped area| / 65536, exact (raster_front.inl) */
-        const vdouble area = vd_sub(vd_mul(ex1, ey2), vd_mul(ey1, ex2));
+        G->area = vd_sub(vd_mul(G->ex1, G->ey2), vd_mul(G->ey1, G->ex2));
         const vdouble ocx = vd_add(vd_from_vi(bx0, h), dhalf);
         const vdouble ocy = vd_add(vd_from_vi(by0, h), dhalf);
-        const vdouble ox = vd_sub(ocx, Xd[0]), oy = vd_sub(ocy, Yd[0]);
+        G->ox = vd_sub(ocx, Xd[0]);
+        G->oy = vd_sub(ocy, Yd[0]);
+        fv_plane(zw[0], zw[1], zw[2], G->ex1, G->ey1, G->ex2, G->ey2, G->ox, G->oy, G->area,
+                 r[h]);
+    }
+#pragma GCC unroll 3
+    for (int j = 0; j < 3; j++)
+        P[j] = vf_from_vd(r[0][j], r[1][j]);
+}
+
+SIMD_INL void fv_planes_qb(const vint V[3], int k, const rast__vbuf *vb, const fv_geom g[2],
+                           vfloat P[12])
+{
+    const vdouble dzero = vd_set1(0.0);
+    vdouble r[2][9];
+#pragma GCC unroll 2
+    for (int h = 0; h < 2; h++) {
+        if (h && k <= VD_W) {
+#pragma GCC unroll 9
+            for (int j = 0; j < 9; j++)
+                r[1][j] = r[0][j];
+            break;
+        }
+        vdouble iw[3];
+#pragma GCC unroll 3
+        for (int i = 0; i < 3; i++)
+            iw[i] = fv_gather_d(vb->iw, V[i], h);
+        const fv_geom *G = &g[h];
         /* max(a, b) = a > b ? a : b, as the scalar loop */
         const vdouble qmax = vd_max(iw[2], vd_max(iw[1], vd_max(iw[0], dzero)));
         const vdouble q0 = vd_div(iw[0], qmax), q1 = vd_div(iw[1], qmax);
         const vdouble q2 = vd_div(iw[2], qmax);
-        fv_plane(zw[0], zw[1], zw[2], ex1, ey1, ex2, ey2, ox, oy, area, r[h]);
-        fv_plane(q0, q1, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 3);
-        fv_plane(dzero, q1, dzero, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 6);
-        fv_plane(dzero, dzero, q2, ex1, ey1, ex2, ey2, ox, oy, area, r[h] + 9);
+        fv_plane(q0, q1, q2, G->ex1, G->ey1, G->ex2, G->ey2, G->ox, G->oy, G->area, r[h]);
+        fv_plane(dzero, q1, dzero, G->ex1, G->ey1, G->ex2, G->ey2, G->ox, G->oy, G->area,
+                 r[h] + 3);
+        fv_plane(dzero, dzero, q2, G->ex1, G->ey1, G->ex2, G->ey2, G->ox, G->oy, G->area,
+                 r[h] + 6);
     }
-#pragma GCC unroll 12
-    for (int j = 0; j < 12; j++)
-        P[j] = vf_from_vd(r[0][j], r[1][j]);
+#pragma GCC unroll 9
+    for (int j = 0; j < 9; j++)
+        P[3 + j] = vf_from_vd(r[0][j], r[1][j]);
 }
 
 /* The scan's values at the four pixels (i, j) of a micro record's box,
  * p = i + 2j: the clamped depth Z[p] and the barycentrics B1[p], B2[p],
  * per lane with the float operations of rast__scan_rows_ref in its order
  * (fi, fj are 0.0f or 1.0f, multiplied as the scan multiplies them; P as
- * fv_planes; lanes that are not micro compute garbage). */
+ * fv_planes_z and fv_planes_qb; lanes that are not micro compute garbage). */
 SIMD_INL void fv_micro_values(const vfloat *P, vfloat Z[4], vfloat B1[4], vfloat B2[4])
 {
     const vfloat zero = vf_zero(), fone = vf_set1(1.0f);
@@ -216,31 +252,11 @@ SIMD_INL void fv_micro_values(const vfloat *P, vfloat Z[4], vfloat B1[4], vfloat
 
 #include "raster_hidden.inl"
 
-/* The lanes (of lanes) whose record the scan would find hidden: the box
- * depth test of the scan (simd_zbox_hidden) on the lane's float z plane
- * (P[0 .. 2] as fv_planes: the record's z.c, z.dx, z.dy) and clamped box,
- * over all its rows, against t's depth plane as it is now (before the
- * scans of this chunk's earlier records: depth only decreases during a
- * draw, so an older state is conservative). Boxes wider than four vectors
- * are not tested (as in the scan). Only on the single-thread driver
- * (rast__draw_valid_vb: no other thread writes t). t NULL: none. */
-SIMD_INL unsigned fv_hidden(const rast_target *t, const vfloat *P, vint bx0, vint by0, vint bx1,
-                            vint by1, unsigned lanes)
+/* fv_hidden's lanes one at a time through the scan's whole test (a
+ * depth plane too large for the gather's int32 offsets). */
+static unsigned fv_hidden_lanes(const rast_target *t, const vfloat *P, vint bx0, vint by0,
+                                vint bx1, vint by1, unsigned lanes)
 {
-    if (!t || !lanes)
-        return 0;
-    /* simd_zbox_hidden's first step for every lane at once: a depth above
-     * z.c at the box's first pixel (most visible triangles) ends the
-     * lane's test; one gather (unused lanes read pixel 0) instead of a
-     * data-dependent branch per lane. Offsets in int32: the plane's
-     * size checked. */
-    if ((size_t)t->depth_stride * (size_t)t->height <= (size_t)INT32_MAX) {
-        const vint at = vi_add(vi_mullo(by0, vi_set1(t->depth_stride)), bx0);
-        const vfloat d0 = vf_gather(t->depth, vi_sel(vm_from_bits(lanes), at, vi_zero()));
-        lanes &= ~vm_bits(vf_gt(d0, P[0]));
-        if (!lanes)
-            return 0;
-    }
     _Alignas(64) float zc[SIMD_W], zx[SIMD_W], zy[SIMD_W];
     _Alignas(64) int32_t b[4][SIMD_W];
     vf_store(zc, P[0]);
@@ -256,6 +272,84 @@ SIMD_INL unsigned fv_hidden(const rast_target *t, const vfloat *P, vint bx0, vin
         const int nx = b[2][l] - b[0][l] + 1;
         if (nx <= 4 * SIMD_W &&
             simd_zbox_hidden(t, zc[l], zx[l], zy[l], b[0][l], b[1][l], b[1][l], b[3][l], nx))
+            hid |= 1u << l;
+    }
+    return hid;
+}
+
+/* The lanes (of lanes) whose record the scan would find hidden: the box
+ * depth test of the scan (simd_zbox_hidden) on the lane's float z plane
+ * (P[0 .. 2] as fv_planes_z: the record's z.c, z.dx, z.dy) and clamped box,
+ * over all its rows, against t's depth plane as it is now (before the
+ * scans of this chunk's earlier records: depth only decreases during a
+ * draw, so an older state is conservative). Boxes wider than four vectors
+ * are not tested (as in the scan). Only on the single-thread driver
+ * (rast__draw_valid_vb: no other thread writes t). t NULL: none. */
+SIMD_INL unsigned fv_hidden(const rast_target *t, const vfloat *P, vint bx0, vint by0, vint bx1,
+                            vint by1, unsigned lanes)
+{
+    if (!t || !lanes)
+        return 0;
+    /* simd_zbox_hidden's first step for every lane at once: a depth above
+     * z.c at the box's first pixel (most visible triangles) ends the
+     * lane's test; one gather (unused lanes read pixel 0) instead of a
+     * data-dependent branch per lane. Offsets in int32: the plane's
+     * size checked; otherwise every lane takes simd_zbox_hidden whole. */
+    if ((size_t)t->depth_stride * (size_t)t->height > (size_t)INT32_MAX)
+        return fv_hidden_lanes(t, P, bx0, by0, bx1, by1, lanes);
+    const vint at = vi_add(vi_mullo(by0, vi_set1(t->depth_stride)), bx0);
+    const vfloat d0 = vf_gather(t->depth, vi_sel(vm_from_bits(lanes), at, vi_zero()));
+    lanes &= ~vm_bits(vf_gt(d0, P[0]));
+    if (!lanes)
+        return 0;
+    /* The bound zf of simd_zbox_hidden (rows y0 .. y1 of the box, so
+     * ys - y0 = 0) for every lane at once, per lane its double
+     * operations: min(a, b) = a < b ? a : b as -max(-a, -b) (negation
+     * is exact) and |a| as max(a, -a), which differs from a < 0 ? -a : a
+     * only in the sign of a zero or a NaN: that reaches zb only when S
+     * is 0 or NaN, where zb is zmin (so the same) or NaN. The first-pixel
+     * test above is simd_zbox_hidden's (its z.c + z.dy * 0 compares as
+     * z.c for a finite z.dy; for another it is NaN and never ends the
+     * test), so the lanes left go straight to the rows. */
+    const vdouble zero = vd_set1(0.0), nzero = vd_set1(-0.0), neg1 = vd_set1(-1.0);
+    const vdouble margin = vd_set1(0x1p-18), big = vd_set1(1e30);
+    const vint w1 = vi_sub(bx1, bx0), h1 = vi_sub(by1, by0);
+    vdouble zf[2];
+    unsigned ok = 0;
+#pragma GCC unroll 2
+    for (int h = 0; h < 2; h++) {
+        const vdouble c = vd_from_vf(P[0], h), zdx = vd_from_vf(P[1], h);
+        const vdouble zdy = vd_from_vf(P[2], h);
+        const vdouble ay = vd_mul(zdy, zero), by = vd_mul(zdy, vd_from_vi(h1, h));
+        const vdouble ax = vd_mul(zdx, vd_from_vi(w1, h));
+        const vdouble nay = vd_mul(ay, neg1), nby = vd_mul(by, neg1), nax = vd_mul(ax, neg1);
+        /* c + (ay < by ? ay : by) + (ax < 0 ? ax : 0) */
+        const vdouble mn = vd_mul(vd_max(nay, nby), neg1);
+        const vdouble zmin = vd_add(vd_add(c, mn), vd_mul(vd_max(nax, nzero), neg1));
+        const vdouble aay = vd_max(ay, nay), aby = vd_max(by, nby);
+        const vdouble sy = vd_max(aay, aby);
+        const vdouble S = vd_add(vd_add(vd_max(c, vd_mul(c, neg1)), sy), vd_max(ax, nax));
+        const vdouble zb = vd_sub(zmin, vd_mul(S, margin));
+        ok |= (vd_gt_bits(zb, zero) & vd_gt_bits(big, zb)) << (VD_W * h);
+        zf[h] = vd_mul(vd_max(vd_mul(zb, neg1), neg1), neg1);   /* zb < 1 ? zb : 1 */
+    }
+    lanes &= ok;
+    if (!lanes)
+        return 0;
+    _Alignas(64) float zq[SIMD_W];
+    _Alignas(64) int32_t b[4][SIMD_W];
+    vf_store(zq, vf_from_vd(zf[0], zf[1]));
+    vi_store(b[0], bx0);
+    vi_store(b[1], by0);
+    vi_store(b[2], bx1);
+    vi_store(b[3], by1);
+    unsigned hid = 0;
+    for (unsigned bits = lanes; bits; bits &= bits - 1) {
+        const int l = __builtin_ctz(bits);
+        const int nx = b[2][l] - b[0][l] + 1;
+        const float *d = t->depth + (size_t)b[1][l] * (size_t)t->depth_stride + b[0][l];
+        if (nx <= 4 * SIMD_W &&
+            simd_zbox_rows(t, d, vf_set1(zq[l]), b[0][l], b[1][l], b[3][l], nx, 1))
             hid |= 1u << l;
     }
     return hid;

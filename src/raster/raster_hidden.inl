@@ -29,6 +29,80 @@ static inline double simd_absd(double a)
     return a < 0.0 ? -a : a;
 }
 
+/* The rows of the box test: 1 when every depth value of the box x0 ..
+ * x0+nx-1 (nx <= 4 * SIMD_W) x ys .. ye, row ys at d, is <= zv (ordered).
+ * The result is the conjunction over the box. With pairs (a constant: the
+ * vector front end, whose boxes are mostly hidden, so every row is read)
+ * rows are tested two at a time and boxes of two vectors as one, one mask
+ * extraction and one branch per pair of rows; without (the scan, whose
+ * boxes mostly end at their first row or vector) one row and one vector
+ * at a time. Inlined: called out of line, the calls cost more than the
+ * rows of most boxes. */
+static inline __attribute__((always_inline)) int simd_zbox_rows(const rast_target *t,
+                                                                const float *d, vfloat zv,
+                                                                int x0, int ys, int ye, int nx,
+                                                                int pairs)
+{
+    const size_t s = (size_t)t->depth_stride;
+    int y = ys;
+    if (nx <= SIMD_W) {
+        const unsigned valid = nx >= SIMD_W ? SIMD_FULL : (1u << nx) - 1u;
+        if (x0 + SIMD_W <= t->width) {
+            if (pairs) {
+                for (; y < ye; y += 2, d += 2 * s)
+                    if (~vm_bits(vm_and(vf_le(vf_loadu(d), zv), vf_le(vf_loadu(d + s), zv))) &
+                        valid)
+                        return 0;
+                return !(y == ye && (~vm_bits(vf_le(vf_loadu(d), zv)) & valid));
+            }
+            for (; y <= ye; y++, d += s)
+                if (~vm_bits(vf_le(vf_loadu(d), zv)) & valid)
+                    return 0;
+        } else {
+            for (; y <= ye; y++, d += s)
+                if (~vm_bits(vf_le(vf_load_bits(d, valid), zv)) & valid)
+                    return 0;
+        }
+        return 1;
+    }
+    /* Boxes of two vectors inside the row (most wide ones), with pairs:
+     * both loaded whole, the second one's lanes past the box counted as
+     * passing. */
+    if (pairs && nx <= 2 * SIMD_W && x0 + 2 * SIMD_W <= t->width) {
+        const int n2 = nx - SIMD_W;
+        const unsigned v2 = n2 >= SIMD_W ? SIMD_FULL : (1u << n2) - 1u;
+        const vmask past = vm_from_bits(~v2 & SIMD_FULL);
+        for (; y < ye; y += 2, d += 2 * s) {
+            const vmask r0 = vm_and(vf_le(vf_loadu(d), zv),
+                                    vm_or(vf_le(vf_loadu(d + SIMD_W), zv), past));
+            const vmask r1 = vm_and(vf_le(vf_loadu(d + s), zv),
+                                    vm_or(vf_le(vf_loadu(d + s + SIMD_W), zv), past));
+            if (~vm_bits(vm_and(r0, r1)) & SIMD_FULL)
+                return 0;
+        }
+        return !(y == ye && (~vm_bits(vm_and(vf_le(vf_loadu(d), zv),
+                                             vm_or(vf_le(vf_loadu(d + SIMD_W), zv), past))) &
+                             SIMD_FULL));
+    }
+    /* Other wide boxes: whole vectors, the last one's lanes masked to the
+     * box (a masked load when it would cross the row's end). */
+    const int nfull = nx / SIMD_W, rem = nx % SIMD_W;
+    const unsigned lastvalid = (1u << rem) - 1u;
+    const int lastin = x0 + nfull * SIMD_W + SIMD_W <= t->width;
+    for (; y <= ye; y++, d += s) {
+        for (int v = 0; v < nfull; v++)
+            if (~vm_bits(vf_le(vf_loadu(d + v * SIMD_W), zv)) & SIMD_FULL)
+                return 0;
+        if (rem) {
+            const float *p = d + nfull * SIMD_W;
+            const vfloat dv = lastin ? vf_loadu(p) : vf_load_bits(p, lastvalid);
+            if (~vm_bits(vf_le(dv, zv)) & lastvalid)
+                return 0;
+        }
+    }
+    return 1;
+}
+
 static inline int simd_zbox_hidden(const rast_target *t, float zc, float zdx, float zdy, int x0,
                                    int y0, int ys, int ye, int nx)
 {
@@ -47,36 +121,6 @@ static inline int simd_zbox_hidden(const rast_target *t, float zc, float zdx, fl
     const double zb = zmin - (simd_absd(c) + sy + simd_absd(ax)) * 0x1p-18;
     if (!(zb > 0.0 && zb < 1e30))
         return 0;
-    const vfloat zv = vf_set1(zb < 1.0 ? (float)zb : 1.0f);
-    if (nx <= SIMD_W) {
-        const unsigned valid = nx >= SIMD_W ? SIMD_FULL : (1u << nx) - 1u;
-        if (x0 + SIMD_W <= t->width) {
-            for (int y = ys; y <= ye; y++, d += t->depth_stride)
-                if (~vm_bits(vf_le(vf_loadu(d), zv)) & valid)
-                    return 0;
-        } else {
-            for (int y = ys; y <= ye; y++, d += t->depth_stride)
-                if (~vm_bits(vf_le(vf_load_bits(d, valid), zv)) & valid)
-                    return 0;
-        }
-        return 1;
-    }
-    /* Wider boxes: whole vectors, the last one's lanes masked to the box
-     * (a masked load when it would cross the row's end). */
-    const int nfull = nx / SIMD_W, rem = nx % SIMD_W;
-    const unsigned lastvalid = (1u << rem) - 1u;
-    const int lastin = x0 + nfull * SIMD_W + SIMD_W <= t->width;
-    for (int y = ys; y <= ye; y++, d += t->depth_stride) {
-        for (int v = 0; v < nfull; v++)
-            if (~vm_bits(vf_le(vf_loadu(d + v * SIMD_W), zv)) & SIMD_FULL)
-                return 0;
-        if (rem) {
-            const float *p = d + nfull * SIMD_W;
-            const vfloat dv = lastin ? vf_loadu(p) : vf_load_bits(p, lastvalid);
-            if (~vm_bits(vf_le(dv, zv)) & lastvalid)
-                return 0;
-        }
-    }
-    return 1;
+    return simd_zbox_rows(t, d, vf_set1(zb < 1.0 ? (float)zb : 1.0f), x0, ys, ye, nx, 0);
 }
 #endif /* RAST_HIDDEN_INL */

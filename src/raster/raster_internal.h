@@ -48,6 +48,7 @@
 #ifndef EGOFUSE_RASTER_INTERNAL_H
 #define EGOFUSE_RASTER_INTERNAL_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "raster.h"
@@ -198,6 +199,20 @@ rast_result rast__draw_with(const rast_target *t, const rast_mesh_desc *m,
 typedef struct rast__tiles {
     uint64_t bits[RAST__TILE_ROWS][RAST__TILE_WORDS];
 } rast__tiles;
+/* n floats of 1.0f (the cleared depth) from d, eight at a time by 32-byte
+ * copies of a constant: gcc -O2 leaves the plain loop as one 4-byte store
+ * per float (the context clear's depth spans were 96% of its
+ * instructions). */
+static inline void rast__fill_depth(float *d, size_t n)
+{
+    static const float ones[8] = { 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f };
+    size_t x = 0;
+    for (; x + 8 <= n; x += 8)
+        __builtin_memcpy(d + x, ones, sizeof ones);
+    for (; x < n; x++)
+        d[x] = 1.0f;
+}
+
 /* Marks the tiles of pixels x0..x1 x ya..yb (inclusive, not empty). */
 void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1);
 

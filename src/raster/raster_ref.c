@@ -73,11 +73,9 @@ void rast_target_clear(const rast_target *t)
     if (!t || t->width <= 0 || t->height <= 0)
         return;
     for (int y = 0; y < t->height; y++) {
-        if (t->depth) {
-            float *d = t->depth + (size_t)y * (size_t)t->depth_stride;
-            for (int x = 0; x < t->width; x++)
-                d[x] = 1.0f;
-        }
+        if (t->depth)
+            rast__fill_depth(t->depth + (size_t)y * (size_t)t->depth_stride,
+                             (size_t)t->width);
         if (t->mask)
             memset(t->mask + (size_t)y * (size_t)t->mask_stride, 0, (size_t)t->width);
         if (t->attr && t->attr_count > 0)   /* all-zero bytes are 0.0f */
