@@ -20,21 +20,30 @@
 
 /* The scene values of the lanes in has: when the 8 columns lie in a window
  * of 16 (always when the layer is enlarged), two loads of the window
- * (masked to the viewport's width: nothing beyond it is read), two vpermps
- * and a blend; otherwise a gather. Lanes outside has are never used. */
+ * (masked to the viewport's width where it ends inside the window: nothing
+ * beyond it is read), two vpermps and a blend; otherwise a gather. Lanes
+ * outside has are never used. */
 static inline __m256 scene_avx2(const fuse__depth_prep *p, const float *sc, __m256i ox, __m256 has)
 {
     const int32_t c0 = _mm_cvtsi128_si32(_mm256_castsi256_si128(ox));
     const int32_t c7 = _mm_extract_epi32(_mm256_extracti128_si256(ox, 1), 3);
     if (c7 - c0 < 16) {
-        const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-        const __m256i left = _mm256_set1_epi32(p->vw - c0);
-        const __m256 lo = _mm256_maskload_ps(sc + c0, _mm256_cmpgt_epi32(left, lane));
-        const __m256 hi = _mm256_maskload_ps(sc + c0 + 8, _mm256_cmpgt_epi32(
-            left, _mm256_add_epi32(lane, _mm256_set1_epi32(8))));
         const __m256i idx = _mm256_sub_epi32(ox, _mm256_set1_epi32(c0));
-        return _mm256_blendv_ps(_mm256_permutevar8x32_ps(lo, idx), _mm256_permutevar8x32_ps(hi, idx),
-                                _mm256_castsi256_ps(_mm256_cmpgt_epi32(idx, _mm256_set1_epi32(7))));
+        __m256 lo, hi;
+        if (p->vw - c0 >= 16) {   /* (loads that vpermps takes as operands) */
+            lo = _mm256_permutevar8x32_ps(_mm256_loadu_ps(sc + c0), idx);
+            hi = _mm256_permutevar8x32_ps(_mm256_loadu_ps(sc + c0 + 8), idx);
+        } else {
+            const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+            const __m256i left = _mm256_set1_epi32(p->vw - c0);
+            lo = _mm256_permutevar8x32_ps(_mm256_maskload_ps(sc + c0, _mm256_cmpgt_epi32(left, lane)),
+                                          idx);
+            hi = _mm256_permutevar8x32_ps(_mm256_maskload_ps(sc + c0 + 8, _mm256_cmpgt_epi32(
+                left, _mm256_add_epi32(lane, _mm256_set1_epi32(8)))), idx);
+        }
+        /* idx in [0, 15]: bit 3 (idx >= 8, from hi) shifted into the sign
+         * bit, which is what blendv reads (no constant to compare with) */
+        return _mm256_blendv_ps(lo, hi, _mm256_castsi256_ps(_mm256_slli_epi32(idx, 28)));
     }
     return _mm256_mask_i32gather_ps(_mm256_setzero_ps(), sc, ox, has, 4);
 }

@@ -599,9 +599,10 @@ SIMD_INL void depth_row(const fuse__depth_prep *p, uint8_t *q, const float *hz, 
             qq = any ? vi_load_u8(q + x) : vi_zero();
         }
         if (any) {
-            const vmask nz = vm_not(vi_eq(qq, vi_zero()));
             const vfloat z = vf_loadu(hz + x);
-            const vmask has = vm_and(nz, vm_and(vf_ge(z, zero), vf_lt(z, one)));
+            /* qq != 0 as ~(qq == 0) inside the andnot (no all-ones
+             * constant, one operation fewer) */
+            const vmask has = vm_andnot(vi_eq(qq, vi_zero()), vm_and(vf_ge(z, zero), vf_lt(z, one)));
             if (vm_any(has)) {
                 const vfloat s = FUSE_SCENE_LANES(p, sc, ox, has);
                 const vfloat dist = vf_add(
