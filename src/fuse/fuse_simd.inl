@@ -664,15 +664,23 @@ void SIMD_FN(fuse__cover_span)(const uint8_t *q, int w, int x0, int x1, uint64_t
     memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
     if (x0 >= x1) return;
 #if SIMD_W >= 8
-    /* SIMD_W / 8 blocks per vector: the lanes' non-zero bits, 8 a block */
-    for (x = xa; x + SIMD_W <= xe; x += SIMD_W, b += SIMD_W / 8) {
-        const vint t = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
-        const unsigned nzb = vm_bits(vi_eq(t, vi_zero())) ^ SIMD_FULL;
-        unsigned pat = 0;
-        int j;
-        for (j = 0; j < SIMD_W / 8; j++) pat |= (unsigned)(((nzb >> (8 * j)) & 0xFFu) != 0) << j;
-        /* b is a multiple of SIMD_W / 8, which divides 64: one word */
-        bits[b >> 6] |= (uint64_t)pat << (b & 63);
+    /* SIMD_W / 8 blocks per vector: the lanes' non-zero bits, 8 a block;
+     * the 64 blocks (512 pixels) of one word of bits at a time, the word in
+     * a register (b = x / 8 throughout: x is a multiple of SIMD_W) */
+    x = xa;
+    while (x + SIMD_W <= xe) {
+        const int wi = b >> 6, xw = 512 * (wi + 1) < xe ? 512 * (wi + 1) : xe;
+        uint64_t word = 0;
+        for (; x + SIMD_W <= xw; x += SIMD_W, b += SIMD_W / 8) {
+            const vint t = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
+            const unsigned nzb = vm_bits(vi_eq(t, vi_zero())) ^ SIMD_FULL;
+            unsigned pat = 0;
+            int j;
+            for (j = 0; j < SIMD_W / 8; j++) pat |= (unsigned)(((nzb >> (8 * j)) & 0xFFu) != 0) << j;
+            /* b is a multiple of SIMD_W / 8, which divides 64: one word */
+            word |= (uint64_t)pat << (b & 63);
+        }
+        bits[wi] |= word;
     }
 #else
     /* 8 / SIMD_W vectors per block, or-ed */
