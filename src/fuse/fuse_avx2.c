@@ -5,7 +5,7 @@
  * Lighting, depth test, coverage bits, opaque copies: fuse_simd.inl on the
  * vector layer (src/cpu/simd_avx2.h, 8 lanes); AVX2's own part there is
  * the depth test's scene values (a window of the row and vpermps, or a
- * gather).
+ * gather) and the lighting's normals (128-bit loads and shufps).
  * The row-cached composite (fuse__hrow_avx2 once per layer row,
  * fuse__vrow_avx2 per output row; fuse_internal.h) is fuse_simd.inl's too
  * (FUSE_ROWCACHE_ON_LAYER: the layer's "ROW-CACHE OPS"), as for AVX-512.
@@ -20,25 +20,53 @@
 
 /* The scene values of the lanes in has: when the 8 columns lie in a window
  * of 16 (always when the layer is enlarged), two loads of the window
- * (masked to the viewport's width: nothing beyond it is read), two vpermps
- * and a blend; otherwise a gather. Lanes outside has are never used. */
+ * (masked to the viewport's width where it ends inside the window: nothing
+ * beyond it is read), two vpermps and a blend; otherwise a gather. Lanes
+ * outside has are never used. */
 static inline __m256 scene_avx2(const fuse__depth_prep *p, const float *sc, __m256i ox, __m256 has)
 {
     const int32_t c0 = _mm_cvtsi128_si32(_mm256_castsi256_si128(ox));
     const int32_t c7 = _mm_extract_epi32(_mm256_extracti128_si256(ox, 1), 3);
     if (c7 - c0 < 16) {
-        const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-        const __m256i left = _mm256_set1_epi32(p->vw - c0);
-        const __m256 lo = _mm256_maskload_ps(sc + c0, _mm256_cmpgt_epi32(left, lane));
-        const __m256 hi = _mm256_maskload_ps(sc + c0 + 8, _mm256_cmpgt_epi32(
-            left, _mm256_add_epi32(lane, _mm256_set1_epi32(8))));
         const __m256i idx = _mm256_sub_epi32(ox, _mm256_set1_epi32(c0));
-        return _mm256_blendv_ps(_mm256_permutevar8x32_ps(lo, idx), _mm256_permutevar8x32_ps(hi, idx),
-                                _mm256_castsi256_ps(_mm256_cmpgt_epi32(idx, _mm256_set1_epi32(7))));
+        __m256 lo, hi;
+        if (p->vw - c0 >= 16) {   /* (loads that vpermps takes as operands) */
+            lo = _mm256_permutevar8x32_ps(_mm256_loadu_ps(sc + c0), idx);
+            hi = _mm256_permutevar8x32_ps(_mm256_loadu_ps(sc + c0 + 8), idx);
+        } else {
+            const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+            const __m256i left = _mm256_set1_epi32(p->vw - c0);
+            lo = _mm256_permutevar8x32_ps(_mm256_maskload_ps(sc + c0, _mm256_cmpgt_epi32(left, lane)),
+                                          idx);
+            hi = _mm256_permutevar8x32_ps(_mm256_maskload_ps(sc + c0 + 8, _mm256_cmpgt_epi32(
+                left, _mm256_add_epi32(lane, _mm256_set1_epi32(8)))), idx);
+        }
+        /* idx in [0, 15]: bit 3 (idx >= 8, from hi) shifted into the sign
+         * bit, which is what blendv reads (no constant to compare with) */
+        return _mm256_blendv_ps(lo, hi, _mm256_castsi256_ps(_mm256_slli_epi32(idx, 28)));
     }
     return _mm256_mask_i32gather_ps(_mm256_setzero_ps(), sc, ox, has, 4);
 }
 #define FUSE_SCENE_LANES(p, sc, ox, has) scene_avx2(p, sc, ox, has)
+
+/* 8 interleaved xyz normals -> x, y, z for the lighting: the 128-bit
+ * thirds of the first 12 floats in the low halves, of the next 12 in the
+ * high halves (m03: x0 y0 z0 x1, m14: y1 z1 x2 y2, m25: z2 x3 y3 z3, and
+ * pixels 4-7 alike), then five in-block shufps: 11 instructions where the
+ * layer's vf_load3 (blends and vpermps, for any use) takes 12 and three
+ * index vectors. */
+static inline void normals_avx2(const float *p, __m256 *x, __m256 *y, __m256 *z)
+{
+    const __m256 m03 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p)), _mm_loadu_ps(p + 12), 1);
+    const __m256 m14 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 4)), _mm_loadu_ps(p + 16), 1);
+    const __m256 m25 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 8)), _mm_loadu_ps(p + 20), 1);
+    const __m256 xy = _mm256_shuffle_ps(m14, m25, _MM_SHUFFLE(2, 1, 3, 2));   /* x2 y2 x3 y3 */
+    const __m256 yz = _mm256_shuffle_ps(m03, m14, _MM_SHUFFLE(1, 0, 2, 1));   /* y0 z0 y1 z1 */
+    *x = _mm256_shuffle_ps(m03, xy, _MM_SHUFFLE(2, 0, 3, 0));
+    *y = _mm256_shuffle_ps(yz, xy, _MM_SHUFFLE(3, 1, 2, 0));
+    *z = _mm256_shuffle_ps(yz, m25, _MM_SHUFFLE(3, 0, 3, 1));
+}
+#define FUSE_LOAD_NORMALS(p, x, y, z) normals_avx2(p, &(x), &(y), &(z))
 
 #define FUSE_ROWCACHE_ON_LAYER 1
 #include "fuse_simd.inl"

@@ -29,7 +29,8 @@
  *   FUSE_LOAD_NORMALS(p, x, y, z)  SIMD_W interleaved normals into three
  *       vfloat lvalues; default vf_load3. SSE2 builds each vector from
  *       scalar loads (the layer's vf_load3 goes through a stack buffer,
- *       which made the SSE2 lighting about 20% slower). */
+ *       which made the SSE2 lighting about 20% slower); AVX2 from 128-bit
+ *       loads and shufps (fewer instructions than its vf_load3). */
 #include <string.h>
 
 /* 1 if the SIMD_W mask bytes at p are all 0 */
@@ -180,13 +181,6 @@ static inline VF clamp01_lanes(VF v)
     return FMAX0(FMIN1(v));
 }
 
-/* fuse__round8 before its last step: the bits of v + 2^23 (v in [0, 255]),
- * 0x4B000000 | round(v); the byte is the low 8 bits. */
-static inline VI round_lanes(VF v)
-{
-    return FBITS(FADD(v, F1(FUSE__MAGIC)));
-}
-
 /* fuse__spec01 in lanes, for nl lights (1 or 2, a constant at each call)
  * of nu vectors x2[j][u] (the squared cosines); n = fuse__pow_int(s)
  * (uniform). The squarings of the lights and vectors interleave. */
@@ -203,17 +197,24 @@ static inline __attribute__((always_inline)) void spec01_lanes(int nl, VF (*x2)[
     /* x2 >= 1 -> 1: x2 = min(x2, 1) first (1^k = sqrtf(1) = 1), one
      * operation instead of a compare and a select */
     _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH x2[j][u] = FMIN1(x2[j][u]);
-    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = F1(1.0f);
     if (n >= 2) {
         VF b[2][U_MAX];
         int k = n >> 1;
         _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH b[j][u] = x2[j][u];
-        for (;;) {
-            if (k & 1) _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = FMUL(p[j][u], b[j][u]);
+        /* fuse__powi01's first product, 1 * b at the lowest set bit of k,
+         * is b itself (the same bits): the squarings up to that bit, then
+         * p = b, then the reference's loop from the next bit on */
+        while (!(k & 1)) {
             k >>= 1;
-            if (k == 0) break;
             _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH b[j][u] = FMUL(b[j][u], b[j][u]);
         }
+        _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = b[j][u];
+        for (k >>= 1; k != 0; k >>= 1) {
+            _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH b[j][u] = FMUL(b[j][u], b[j][u]);
+            if (k & 1) _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = FMUL(p[j][u], b[j][u]);
+        }
+    } else {
+        _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = F1(1.0f);
     }
     if (n & 1) _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH p[j][u] = FMUL(p[j][u], FSQRT(x2[j][u]));
     /* x2 <= 2^-100 -> 0: with n >= 4 (n >> 1 >= 2) every product holds a
@@ -224,32 +225,92 @@ static inline __attribute__((always_inline)) void spec01_lanes(int nl, VF (*x2)[
     else _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH r[j][u] = p[j][u];
 }
 
+/* The lighting's parameters for one span call, the floats broadcast once
+ * into vectors in memory. The steps read them from here (as memory
+ * operands where the registers run out) instead of broadcasting p's
+ * floats again at every step, which the compiler must do while they are
+ * read through p: a store to out (a byte pointer) may change *p. */
+typedef struct light_vk {
+    VF nifx, mo, kd, ks, kf;
+    VF lanes;                     /* 0, 1, .. LANES - 1 */
+    VF nn_min, nn_max, hh_min, magic;   /* the rule's constants */
+    VI b255;
+    VF amb[3];
+    VF dir[FUSE_MAX_LIGHTS][3];   /* the first nl only */
+    VF col[FUSE_MAX_LIGHTS][3];   /* color_t */
+    float ks_s, shininess;
+    int nl, ipow;
+} light_vk;
+
+static inline void light_vk_fill(light_vk *k, const fuse__light_prep *p)
+{
+    int i, c;
+    k->nifx = F1(p->nifx);
+    k->lanes = I2F(LANE_INDEX);
+    k->nn_min = F1(1.0e-30f);
+    k->nn_max = F1(1.0e30f);
+    k->hh_min = F1(1.0e-12f);
+    k->magic = F1(FUSE__MAGIC);
+    k->b255 = I1(255);
+    k->mo = F1(p->mo);
+    k->kd = F1(p->kd);
+    k->ks = F1(p->ks);
+    k->kf = F1(p->kf);
+    for (c = 0; c < 3; c++) k->amb[c] = F1(p->ambient_t[c]);
+    for (i = 0; i < p->light_count; i++)
+        for (c = 0; c < 3; c++) {
+            k->dir[i][c] = F1(p->dir[i][c]);
+            k->col[i][c] = F1(p->color_t[i][c]);
+        }
+    k->ks_s = p->ks;
+    k->shininess = p->shininess;
+    k->nl = p->light_count;
+    k->ipow = p->ipow;
+}
+
+/* fuse__round8 before its last step: the bits of v + 2^23 (v in [0, 255]),
+ * 0x4B000000 | round(v); the byte is the low 8 bits. */
+static inline VI round_lanes(const light_vk *k, VF v)
+{
+    return FBITS(FADD(v, k->magic));
+}
+
+/* What lights i .. i + nl - 1 (nl = 1 or 2, a constant at each call) take
+ * from V and N, for one vector (fuse__light_span_ref's light_terms):
+ * hh_j = |L_j + V|^2, then nd_j = N.L_j / |n|. */
+static inline __attribute__((always_inline)) void light_geom(const light_vk *k, int i, int nl,
+                                                             VF vx, VF vy, VF vz, VF nx, VF ny,
+                                                             VF nz, VF inv, VF *nd, VF *hh)
+{
+    int j;
+    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) {
+        const VF hx = FADD(k->dir[i + j][0], vx), hy = FADD(k->dir[i + j][1], vy);
+        const VF hz = FADD(k->dir[i + j][2], vz);
+        hh[j] = FADD(FADD(FMUL(hx, hx), FMUL(hy, hy)), FMUL(hz, hz));
+    }
+    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
+        nd[j] = FMUL(FADD(FADD(FMUL(nx, k->dir[i + j][0]), FMUL(ny, k->dir[i + j][1])),
+                          FMUL(nz, k->dir[i + j][2])), inv);
+}
+
 /* Lights i .. i + nl - 1 (nl = 1 or 2, a constant at each call) added to
- * C0..C2: the diffuse weights, the specular terms with one division for
- * both 1 / hh of a pair (fuse__light_span_ref). */
+ * C0..C2 from their nd and hh (light_geom): the diffuse weights, the
+ * specular terms with one division for both 1 / hh of a pair
+ * (fuse__light_span_ref). */
 static inline __attribute__((always_inline)) void light_pair_lanes(
-    const fuse__light_prep *p, int i, int nl, int nu, const VF *nx, const VF *ny, const VF *nz,
-    const VF *inv, const VF *vx, const VF *vy, const VF *vz, const VF *ndv, VF *C0, VF *C1, VF *C2)
+    const light_vk *k, int i, int nl, int nu, VF (*nd)[U_MAX], VF (*hh)[U_MAX], const VF *ndv,
+    VF *C0, VF *C1, VF *C2)
 {
     const VF one = F1(1.0f);
-    VF w[2][U_MAX], nd[2][U_MAX], hh[2][U_MAX];
+    VF w[2][U_MAX];
     int j, u;
-    _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) {
-        const VF lx = F1(p->dir[i + j][0]), ly = F1(p->dir[i + j][1]), lz = F1(p->dir[i + j][2]);
-        EACH {
-            const VF hx = FADD(lx, vx[u]), hy = FADD(ly, vy[u]), hz = FADD(lz, vz[u]);
-            nd[j][u] = FMUL(FADD(FADD(FMUL(nx[u], lx), FMUL(ny[u], ly)), FMUL(nz[u], lz)), inv[u]);
-            w[j][u] = FMUL(F1(p->kd), FMAX0(nd[j][u]));
-            hh[j][u] = FADD(FADD(FMUL(hx, hx), FMUL(hy, hy)), FMUL(hz, hz));
-        }
-    }
-    if (p->ks != 0.0f) {
+    if (k->ks_s != 0.0f) {
         VF x2[2][U_MAX], sp[2][U_MAX];
         VM g[2][U_MAX];
         _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
             EACH {
                 const VF n0 = FMAX0(FADD(nd[j][u], ndv[u]));
-                g[j][u] = FGT(hh[j][u], F1(1.0e-12f));
+                g[j][u] = FGT(hh[j][u], k->hh_min);
                 x2[j][u] = FMUL(n0, n0);
             }
         if (nl == 2) {
@@ -262,43 +323,51 @@ static inline __attribute__((always_inline)) void light_pair_lanes(
         } else {
             EACH x2[0][u] = FDIV(x2[0][u], hh[0][u]);
         }
-        spec01_lanes(nl, x2, p->shininess, p->ipow, nu, sp);
+        spec01_lanes(nl, x2, k->shininess, k->ipow, nu, sp);
+        /* g ? wd + ks sp : wd as wd + (g ? ks sp : +0): the same float
+         * but where wd is -0 (kd <= -0), which becomes +0; C's sign of
+         * zero never reaches a byte (round8 writes +-0 as 0). One select
+         * on g fewer: with two, the compiler builds a second mask (AVX2) */
         _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
-            EACH w[j][u] = FSEL(g[j][u], FADD(w[j][u], FMUL(F1(p->ks), sp[j][u])), w[j][u]);
+            EACH w[j][u] = FADD(FMUL(k->kd, FMAX0(nd[j][u])), FZERO_UNLESS(g[j][u], FMUL(k->ks, sp[j][u])));
+    } else {
+        _Pragma("GCC unroll 2") for (j = 0; j < nl; j++) EACH w[j][u] = FMUL(k->kd, FMAX0(nd[j][u]));
     }
     _Pragma("GCC unroll 2") for (j = 0; j < nl; j++)
         EACH {
-            C0[u] = FADD(C0[u], FMUL(F1(p->color_t[i + j][0]), w[j][u]));
-            C1[u] = FADD(C1[u], FMUL(F1(p->color_t[i + j][1]), w[j][u]));
-            C2[u] = FADD(C2[u], FMUL(F1(p->color_t[i + j][2]), w[j][u]));
+            C0[u] = FADD(C0[u], FMUL(k->col[i + j][0], w[j][u]));
+            C1[u] = FADD(C1[u], FMUL(k->col[i + j][1], w[j][u]));
+            C2[u] = FADD(C2[u], FMUL(k->col[i + j][2], w[j][u]));
         }
 }
 
 /* The pixels x .. x + nu LANES - 1 of the row (fuse__light_span_ref lane
- * by lane), stored to out. pyy = py * py + 1 of the row. */
-static inline __attribute__((always_inline)) void light_lanes(const fuse__light_prep *p, VF py,
-                                                              VF pyy, int x, int nu,
-                                                              const uint8_t *P,
+ * by lane), stored to out. pyy = py * py + 1 of the row. two: k->nl == 2
+ * (a constant at each call). */
+static inline __attribute__((always_inline)) void light_lanes(const light_vk *k, VF py, VF pyy,
+                                                              int x, int nu, const uint8_t *P,
                                                               const uint8_t *mask,
                                                               const float *normal, uint8_t *out,
-                                                              int fres, int nonneg)
+                                                              int fres, int nonneg, int two)
 {
     const VF one = F1(1.0f);
-    VI Mi[U_MAX], pix;
     VF mpx[U_MAX], vv[U_MAX], sv[U_MAX], sn[U_MAX], r[U_MAX], il[U_MAX], inv[U_MAX];
-    VF vx[U_MAX], vy[U_MAX], vz[U_MAX], nx[U_MAX], ny[U_MAX], nz[U_MAX];
-    VF nn[U_MAX], ndv[U_MAX], C0[U_MAX], C1[U_MAX], C2[U_MAX];
+    VF nx[U_MAX], ny[U_MAX], nz[U_MAX], nn[U_MAX], ndv[U_MAX], C0[U_MAX], C1[U_MAX], C2[U_MAX];
+    VF nd[2][U_MAX], hh[2][U_MAX], xf[U_MAX];
     VM ok[U_MAX];
     int u, i;
+    /* (float)(x + l) of lane l, as (float)x + l: exact (integers below
+     * 2^24), one conversion a step */
+    xf[0] = FADD(F1((float)x), k->lanes);
+    if (nu == 2) xf[1] = FADD(xf[0], F1((float)LANES));
     EACH {
-        Mi[u] = LOAD_MASK(mask + x + u * LANES);
-        mpx[u] = FADD(FMUL(I2F(IADD(I1(x + u * LANES), LANE_INDEX)), F1(p->nifx)), F1(p->mo));
+        mpx[u] = FADD(FMUL(xf[u], k->nifx), k->mo);
         vv[u] = FADD(FMUL(mpx[u], mpx[u]), pyy);
     }
     EACH {
         LOAD_NORMALS(normal + 3 * (size_t)(x + u * LANES), nx[u], ny[u], nz[u]);
         nn[u] = FADD(FADD(FMUL(nx[u], nx[u]), FMUL(ny[u], ny[u])), FMUL(nz[u], nz[u]));
-        ok[u] = MAND(FGT(nn[u], F1(1.0e-30f)), FLT(nn[u], F1(1.0e30f)));
+        ok[u] = MAND(FGT(nn[u], k->nn_min), FLT(nn[u], k->nn_max));
     }
     EACH {
         sv[u] = FSQRT(vv[u]);
@@ -314,32 +383,63 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
     EACH {
         il[u] = FMUL(sn[u], r[u]);
         inv[u] = FMUL(sv[u], r[u]);
-        vx[u] = FMUL(mpx[u], il[u]);
-        vy[u] = FMUL(py, il[u]);
-        vz[u] = il[u];
         ndv[u] = FMUL(FADD(FADD(FMUL(nx[u], mpx[u]), FMUL(ny[u], py)), nz[u]), r[u]);
-        C0[u] = F1(p->ambient_t[0]);
-        C1[u] = F1(p->ambient_t[1]);
-        C2[u] = F1(p->ambient_t[2]);
+        C0[u] = k->amb[0];
+        C1[u] = k->amb[1];
+        C2[u] = k->amb[2];
     }
-    for (i = 0; i + 2 <= p->light_count; i += 2)
-        light_pair_lanes(p, i, 2, nu, nx, ny, nz, inv, vx, vy, vz, ndv, C0, C1, C2);
-    if (i < p->light_count)
-        light_pair_lanes(p, i, 1, nu, nx, ny, nz, inv, vx, vy, vz, ndv, C0, C1, C2);
+    if (two) {
+        /* the two lights in one pass: V's and N's terms are used up here
+         * (fewer live vectors during the rest) */
+        EACH {
+            VF ndj[2], hhj[2];
+            light_geom(k, 0, 2, FMUL(mpx[u], il[u]), FMUL(py, il[u]), il[u], nx[u], ny[u], nz[u],
+                       inv[u], ndj, hhj);
+            nd[0][u] = ndj[0];
+            nd[1][u] = ndj[1];
+            hh[0][u] = hhj[0];
+            hh[1][u] = hhj[1];
+        }
+        light_pair_lanes(k, 0, 2, nu, nd, hh, ndv, C0, C1, C2);
+    } else {
+        VF vx[U_MAX], vy[U_MAX];
+        EACH {
+            vx[u] = FMUL(mpx[u], il[u]);
+            vy[u] = FMUL(py, il[u]);
+        }
+        for (i = 0; i < k->nl; i += 2) {
+            const int nl = i + 2 <= k->nl ? 2 : 1;
+            EACH {
+                VF ndj[2], hhj[2];
+                if (nl == 2)
+                    light_geom(k, i, 2, vx[u], vy[u], il[u], nx[u], ny[u], nz[u], inv[u], ndj, hhj);
+                else
+                    light_geom(k, i, 1, vx[u], vy[u], il[u], nx[u], ny[u], nz[u], inv[u], ndj, hhj);
+                nd[0][u] = ndj[0];
+                hh[0][u] = hhj[0];
+                if (nl == 2) {
+                    nd[1][u] = ndj[1];
+                    hh[1][u] = hhj[1];
+                }
+            }
+            if (nl == 2) light_pair_lanes(k, i, 2, nu, nd, hh, ndv, C0, C1, C2);
+            else light_pair_lanes(k, i, 1, nu, nd, hh, ndv, C0, C1, C2);
+        }
+    }
     EACH {
-        VF m = I2F(Mi[u]);
+        VF m = I2F(LOAD_MASK(mask + x + u * LANES));
         VF v0, v1, v2;
-        VI rgba;
+        VI pix, rgba;
         /* kf == 0: fade = clamp01(1 - (+-0)) = 1 and M * 1 = M exactly */
         if (fres) {
             const VF t = clamp01_lanes(FSUB(one, ndv[u]));
             const VF t2 = FMUL(t, t);
-            m = FMUL(m, clamp01_lanes(FSUB(one, FMUL(F1(p->kf), FMUL(FMUL(t2, t2), t)))));
+            m = FMUL(m, clamp01_lanes(FSUB(one, FMUL(k->kf, FMUL(FMUL(t2, t2), t)))));
         }
         pix = LOAD_RGBA(P + 4 * (size_t)(x + u * LANES));
-        v0 = FMUL(I2F(IAND(pix, I1(255))), C0[u]);
-        v1 = FMUL(I2F(IAND(ISRL(pix, 8), I1(255))), C1[u]);
-        v2 = FMUL(I2F(IAND(ISRL(pix, 16), I1(255))), C2[u]);
+        v0 = FMUL(I2F(IAND(pix, k->b255)), C0[u]);
+        v1 = FMUL(I2F(IAND(ISRL(pix, 8), k->b255)), C1[u]);
+        v2 = FMUL(I2F(IAND(ISRL(pix, 16), k->b255)), C2[u]);
         /* c_nonneg: P_c C[c] >= -0, and max0 would only turn -0 into +0,
          * which round8 writes as 0 either way (m >= +0: m v is +-0) */
         if (nonneg) {
@@ -352,8 +452,8 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
             v2 = clamp01_lanes(v2);
         }
         /* the shifts left by 8, 16, 24 drop the 0x4B of the upper bytes */
-        rgba = IOR(IOR(IAND(round_lanes(FMUL(m, v0)), I1(255)), ISLL(round_lanes(FMUL(m, v1)), 8)),
-                   IOR(ISLL(round_lanes(FMUL(m, v2)), 16), ISLL(round_lanes(m), 24)));
+        rgba = IOR(IOR(IAND(round_lanes(k, FMUL(m, v0)), k->b255), ISLL(round_lanes(k, FMUL(m, v1)), 8)),
+                   IOR(ISLL(round_lanes(k, FMUL(m, v2)), 16), ISLL(round_lanes(k, m), 24)));
         /* A lane with M == 0 is (0, 0, 0, 0) without a select: every value
          * above is finite there (a normal without a usable length is
          * replaced by v, P is a byte, the parameters are bounded), fade and
@@ -367,29 +467,41 @@ static inline __attribute__((always_inline)) void light_lanes(const fuse__light_
  * a zero store where neither has (the reference's M == 0 pixels). Pixels
  * x0 <= x < x1 of the row (fuse__light_span_ref; the pointers at pixel 0).
  * fres: p->kf != 0 (else the fade, exactly 1, is not computed); nonneg:
- * p->c_nonneg (the output clamp without max0); constants at each call, so
- * each of the four bodies is compiled without the other cases' work. */
+ * p->c_nonneg (the output clamp without max0); two: p->light_count == 2;
+ * constants at each call, so each of the eight bodies is compiled without
+ * the other cases' work. */
 static inline __attribute__((always_inline)) void light_span_body(
-    const fuse__light_prep *p, int y, VF py, VF pyy, int x, int width, const uint8_t *P,
-    const uint8_t *mask, const float *normal, uint8_t *out, int fres, int nonneg)
+    const fuse__light_prep *p, const light_vk *k, int y, VF py, VF pyy, int x, int width,
+    const uint8_t *P, const uint8_t *mask, const float *normal, uint8_t *out, int fres,
+    int nonneg, int two)
 {
     for (; x + 2 * LANES <= width; x += 2 * LANES) {
         const int z0 = MASK_ZERO(mask + x), z1 = MASK_ZERO(mask + x + LANES);
         if (!z0 && !z1) {
-            light_lanes(p, py, pyy, x, 2, P, mask, normal, out, fres, nonneg);
+            light_lanes(k, py, pyy, x, 2, P, mask, normal, out, fres, nonneg, two);
             continue;
         }
         if (z0) STORE_ZERO(out + 4 * (size_t)x);
-        else light_lanes(p, py, pyy, x, 1, P, mask, normal, out, fres, nonneg);
+        else light_lanes(k, py, pyy, x, 1, P, mask, normal, out, fres, nonneg, two);
         if (z1) STORE_ZERO(out + 4 * (size_t)(x + LANES));
-        else light_lanes(p, py, pyy, x + LANES, 1, P, mask, normal, out, fres, nonneg);
+        else light_lanes(k, py, pyy, x + LANES, 1, P, mask, normal, out, fres, nonneg, two);
     }
     for (; x + LANES <= width; x += LANES) {
         if (MASK_ZERO(mask + x)) STORE_ZERO(out + 4 * (size_t)x);
-        else light_lanes(p, py, pyy, x, 1, P, mask, normal, out, fres, nonneg);
+        else light_lanes(k, py, pyy, x, 1, P, mask, normal, out, fres, nonneg, two);
     }
     if (x < width)
         fuse__light_span_ref(p, y, x, width, P, mask, normal, out);
+}
+
+/* one body per (fres, nonneg) pair, for two lights or any number */
+static inline __attribute__((always_inline)) void light_span_lights(
+    const fuse__light_prep *p, const light_vk *k, int y, VF py, VF pyy, int x, int width,
+    const uint8_t *P, const uint8_t *mask, const float *normal, uint8_t *out, int fres,
+    int nonneg)
+{
+    if (k->nl == 2) light_span_body(p, k, y, py, pyy, x, width, P, mask, normal, out, fres, nonneg, 1);
+    else light_span_body(p, k, y, py, pyy, x, width, P, mask, normal, out, fres, nonneg, 0);
 }
 
 void SIMD_FN(fuse__light_span)(const fuse__light_prep *p, int y, int x0, int width,
@@ -398,12 +510,14 @@ void SIMD_FN(fuse__light_span)(const fuse__light_prep *p, int y, int x0, int wid
 {
     const float pys = (((float)y + 0.5f) - p->cy) * p->ify;
     const VF py = F1(pys), pyy = F1(pys * pys + 1.0f);
+    light_vk k;
+    light_vk_fill(&k, p);
     if (p->kf != 0.0f) {
-        if (p->c_nonneg) light_span_body(p, y, py, pyy, x0, width, P, mask, normal, out, 1, 1);
-        else light_span_body(p, y, py, pyy, x0, width, P, mask, normal, out, 1, 0);
+        if (p->c_nonneg) light_span_lights(p, &k, y, py, pyy, x0, width, P, mask, normal, out, 1, 1);
+        else light_span_lights(p, &k, y, py, pyy, x0, width, P, mask, normal, out, 1, 0);
     } else {
-        if (p->c_nonneg) light_span_body(p, y, py, pyy, x0, width, P, mask, normal, out, 0, 1);
-        else light_span_body(p, y, py, pyy, x0, width, P, mask, normal, out, 0, 0);
+        if (p->c_nonneg) light_span_lights(p, &k, y, py, pyy, x0, width, P, mask, normal, out, 0, 1);
+        else light_span_lights(p, &k, y, py, pyy, x0, width, P, mask, normal, out, 0, 0);
     }
 }
 
@@ -485,9 +599,10 @@ SIMD_INL void depth_row(const fuse__depth_prep *p, uint8_t *q, const float *hz, 
             qq = any ? vi_load_u8(q + x) : vi_zero();
         }
         if (any) {
-            const vmask nz = vm_not(vi_eq(qq, vi_zero()));
             const vfloat z = vf_loadu(hz + x);
-            const vmask has = vm_and(nz, vm_and(vf_ge(z, zero), vf_lt(z, one)));
+            /* qq != 0 as ~(qq == 0) inside the andnot (no all-ones
+             * constant, one operation fewer) */
+            const vmask has = vm_andnot(vi_eq(qq, vi_zero()), vm_and(vf_ge(z, zero), vf_lt(z, one)));
             if (vm_any(has)) {
                 const vfloat s = FUSE_SCENE_LANES(p, sc, ox, has);
                 const vfloat dist = vf_add(
@@ -549,15 +664,23 @@ void SIMD_FN(fuse__cover_span)(const uint8_t *q, int w, int x0, int x1, uint64_t
     memset(bits, 0, 8u * (size_t)((nb + 63) / 64));
     if (x0 >= x1) return;
 #if SIMD_W >= 8
-    /* SIMD_W / 8 blocks per vector: the lanes' non-zero bits, 8 a block */
-    for (x = xa; x + SIMD_W <= xe; x += SIMD_W, b += SIMD_W / 8) {
-        const vint t = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
-        const unsigned nzb = vm_bits(vi_eq(t, vi_zero())) ^ SIMD_FULL;
-        unsigned pat = 0;
-        int j;
-        for (j = 0; j < SIMD_W / 8; j++) pat |= (unsigned)(((nzb >> (8 * j)) & 0xFFu) != 0) << j;
-        /* b is a multiple of SIMD_W / 8, which divides 64: one word */
-        bits[b >> 6] |= (uint64_t)pat << (b & 63);
+    /* SIMD_W / 8 blocks per vector: the lanes' non-zero bits, 8 a block;
+     * the 64 blocks (512 pixels) of one word of bits at a time, the word in
+     * a register (b = x / 8 throughout: x is a multiple of SIMD_W) */
+    x = xa;
+    while (x + SIMD_W <= xe) {
+        const int wi = b >> 6, xw = 512 * (wi + 1) < xe ? 512 * (wi + 1) : xe;
+        uint64_t word = 0;
+        for (; x + SIMD_W <= xw; x += SIMD_W, b += SIMD_W / 8) {
+            const vint t = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)x));
+            const unsigned nzb = vm_bits(vi_eq(t, vi_zero())) ^ SIMD_FULL;
+            unsigned pat = 0;
+            int j;
+            for (j = 0; j < SIMD_W / 8; j++) pat |= (unsigned)(((nzb >> (8 * j)) & 0xFFu) != 0) << j;
+            /* b is a multiple of SIMD_W / 8, which divides 64: one word */
+            word |= (uint64_t)pat << (b & 63);
+        }
+        bits[wi] |= word;
     }
 #else
     /* 8 / SIMD_W vectors per block, or-ed */
