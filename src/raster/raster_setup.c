@@ -41,24 +41,13 @@ void rast__view_init(rast__view *v, int width, int height, int attr_count)
 
 /* ---- clipping ---------------------------------------------------------- */
 
-/* Signed distance to plane i; >= 0 is inside. One fixed formula per plane
- * (float, no contraction), so the same vertex always gives the same value. */
-static float plane_dist(const rast__view *v, const rast__vert *p, int i)
-{
-    switch (i) {
-    case RAST__PLANE_NEAR:   return p->z + p->w;
-    case RAST__PLANE_FAR:    return p->w - p->z;
-    case RAST__PLANE_LEFT:   return v->gx * p->w + p->x;
-    case RAST__PLANE_RIGHT:  return v->gx * p->w - p->x;
-    case RAST__PLANE_BOTTOM: return v->gy * p->w + p->y;
-    default:                 return v->gy * p->w - p->y;
-    }
-}
-
+/* Signed distance to each plane (>= 0 inside): one fixed formula per
+ * plane (float, no contraction; the table of RAST__PLANE_*), so the same
+ * vertex always gives the same value. */
 static inline unsigned outcode_inl(const rast__view *v, const rast__vert *p)
 {
-    /* The six distances of plane_dist (the same float expressions, so the
-     * same bits), tested without branches. */
+    /* The six distances (the same float expressions as clip_plane's, so
+     * the same bits), tested without branches. */
     const float x = p->x, y = p->y, z = p->z, w = p->w;
     const float gxw = v->gx * w, gyw = v->gy * w;
     return (unsigned)((z + w) < 0.0f) << RAST__PLANE_NEAR |
@@ -93,12 +82,25 @@ static void intersect(const rast__vert *in, float d_in, const rast__vert *out,
 static int clip_plane(const rast__view *v, int plane, const rast__vert *src,
                       int n, rast__vert *dst)
 {
+    /* Each vertex's distance once (every vertex starts one edge and ends
+     * another), as k*w + s*c with the plane's k (1, gx or gy), sign s and
+     * coordinate c chosen once: 1*w = w, (-1)*c = -c and a - b = a + (-b)
+     * are exact and the sum commutes, so every d has the bits of the
+     * plane's formula. */
+    float d[RAST__MAX_POLY];
+    const float k = plane <= RAST__PLANE_FAR ? 1.0f : plane <= RAST__PLANE_RIGHT ? v->gx : v->gy;
+    const float sg = (plane & 1) ? -1.0f : 1.0f;
+    const int axis = plane <= RAST__PLANE_FAR ? 2 : plane <= RAST__PLANE_RIGHT ? 0 : 1;
+    for (int i = 0; i < n; i++) {
+        const float c[3] = { src[i].x, src[i].y, src[i].z };
+        d[i] = k * src[i].w + sg * c[axis];
+    }
     int m = 0;
     for (int i = 0; i < n; i++) {
+        const int j = i + 1 < n ? i + 1 : 0;
         const rast__vert *a = &src[i];
-        const rast__vert *b = &src[i + 1 < n ? i + 1 : 0];
-        float da = plane_dist(v, a, plane);
-        float db = plane_dist(v, b, plane);
+        const rast__vert *b = &src[j];
+        const float da = d[i], db = d[j];
         int ina = da >= 0.0f, inb = db >= 0.0f;
         if (ina)
             dst[m++] = *a;
@@ -114,10 +116,10 @@ int rast__clip_polygon(const rast__view *v, unsigned planes, rast__vert *poly,
                        int n, rast__vert *tmp)
 {
     rast__vert *src = poly, *dst = tmp;
-    for (int i = 0; i < RAST__PLANE_COUNT && n >= 3; i++) {
-        if (!(planes & (1u << i)))
-            continue;
-        n = clip_plane(v, i, src, n, dst);
+    /* The planes in order, over the set bits only (mostly one or two). */
+    for (unsigned left = planes & ((1u << RAST__PLANE_COUNT) - 1u); left && n >= 3;
+         left &= left - 1) {
+        n = clip_plane(v, __builtin_ctz(left), src, n, dst);
         rast__vert *s = src;
         src = dst;
         dst = s;
@@ -448,22 +450,6 @@ void rast__planes_ref(rast__pbatch *b)
     b->n = 0;
 }
 
-/* The whole setup of one triangle in submission order. */
-static int setup_core(const rast__view *v, const int32_t fx[3], const int32_t fy[3],
-                      const double zwv[3], const double iwv[3],
-                      const float *const attr[3], rast_cull cull, rast__tri *tri)
-{
-    int64_t area;
-    int s1, s2;
-    int32_t X[3], Y[3];
-    const int r = orient(fx, fy, cull, &area, &s1, &s2, X, Y);
-    if (r != RAST__SETUP_OK)
-        return r;
-    const double zw[3] = { zwv[0], zwv[s1], zwv[s2] }, iw[3] = { iwv[0], iwv[s1], iwv[s2] };
-    const float *const at[3] = { attr[0], attr[s1], attr[s2] };
-    return setup_oriented(v, X, Y, area, zw, iw, at, tri);
-}
-
 /* Per-vertex plane inputs (docs/raster.md section 6.1). */
 static double vert_zw(const rast__vert *p)
 {
@@ -479,14 +465,24 @@ int rast__setup_tri(const rast__view *v, const rast__vert *const p[3],
                     const int32_t fx[3], const int32_t fy[3], rast_cull cull,
                     rast__tri *tri)
 {
+    /* The area test first: the plane inputs (two divisions per vertex)
+     * only for the pieces it keeps (with back faces culled, about half of
+     * the clipped fans' pieces are dropped here). */
+    int64_t area;
+    int s1, s2;
+    int32_t X[3], Y[3];
+    const int r = orient(fx, fy, cull, &area, &s1, &s2, X, Y);
+    if (r != RAST__SETUP_OK)
+        return r;
+    const rast__vert *const q[3] = { p[0], p[s1], p[s2] };
     double zw[3], iw[3];
     const float *attr[3];
     for (int i = 0; i < 3; i++) {
-        zw[i] = vert_zw(p[i]);
-        iw[i] = vert_iw(p[i]);
-        attr[i] = p[i]->a;
+        zw[i] = vert_zw(q[i]);
+        iw[i] = vert_iw(q[i]);
+        attr[i] = q[i]->a;
     }
-    return setup_core(v, fx, fy, zw, iw, attr, cull, tri);
+    return setup_oriented(v, X, Y, area, zw, iw, attr, tri);
 }
 
 /* ---- validation and the driver ----------------------------------------- */
