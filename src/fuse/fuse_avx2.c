@@ -68,6 +68,14 @@ static inline void normals_avx2(const float *p, __m256 *x, __m256 *y, __m256 *z)
 }
 #define FUSE_LOAD_NORMALS(p, x, y, z) normals_avx2(p, &(x), &(y), &(z))
 
+/* vrow's alpha in each pixel's four 16-bit lanes: bytes 6-7 (14-15) of
+ * each block copied by one pshufb where vh_bcast3 takes pshuflw and
+ * pshufhw (qq's lanes hold 0..255, any copy of the word is exact). */
+#define FUSE_ALPHA4(q)                                                           \
+    _mm256_shuffle_epi8(q, _mm256_setr_epi8(6, 7, 6, 7, 6, 7, 6, 7, 14, 15, 14, 15, 14, 15, \
+                                            14, 15, 6, 7, 6, 7, 6, 7, 6, 7, 14, 15, 14, 15, \
+                                            14, 15, 14, 15))
+
 #define FUSE_ROWCACHE_ON_LAYER 1
 #include "fuse_simd.inl"
 

@@ -37,6 +37,11 @@ static inline __m512 scene_avx512(const fuse__depth_prep *p, const float *sc, __
 }
 #define FUSE_SCENE_LANES(p, sc, ox, has) scene_avx512(p, sc, ox, has)
 
+/* vrow's alpha in each pixel's four 16-bit lanes by one pshufb (as AVX2) */
+#define FUSE_ALPHA4(q)                                                                        \
+    _mm512_shuffle_epi8(q, _mm512_broadcast_i32x4(_mm_setr_epi8(6, 7, 6, 7, 6, 7, 6, 7, 14, 15, \
+                                                                14, 15, 14, 15, 14, 15)))
+
 #define FUSE_ROWCACHE_ON_LAYER 1
 #include "fuse_simd.inl"
 

@@ -310,11 +310,13 @@ typedef struct fuse__cols {
      * sw - 1) of each column, relative to hbase (absolute for a gather);
      * hw the column weights fx as two 16-bit copies per int32, in the
      * layer's block order (2 SIMD_W int32 per step: the low then the high
-     * halves of the blocks, as vh_from_u8_lo / hi widen the pixels). */
+     * halves of the blocks, as vh_from_u8_lo / hi widen the pixels); hwc
+     * the same for the other tap's weight 256 - fx (read as a multiply's
+     * operand instead of a subtraction per step). */
     int hprep_w;
     int32_t hbase[FUSE__TILE / 4];
     int32_t hidx0[FUSE__TILE], hidx1[FUSE__TILE];
-    int32_t hw[2 * FUSE__TILE];
+    int32_t hw[2 * FUSE__TILE], hwc[2 * FUSE__TILE];
 } fuse__cols;
 
 /* Fills cols for viewport columns [c0, c0 + n), n <= FUSE__TILE. */

@@ -30,7 +30,10 @@
  *       vfloat lvalues; default vf_load3. SSE2 builds each vector from
  *       scalar loads (the layer's vf_load3 goes through a stack buffer,
  *       which made the SSE2 lighting about 20% slower); AVX2 from 128-bit
- *       loads and shufps (fewer instructions than its vf_load3). */
+ *       loads and shufps (fewer instructions than its vf_load3).
+ *   FUSE_ALPHA4(q)  (the row cache's vrow) each pixel's alpha, 16-bit
+ *       lane 3 of its 4, in all 4 lanes; default vh_bcast3 (two word
+ *       shuffles). AVX2 and AVX-512 use one pshufb. */
 #include <string.h>
 
 /* 1 if the SIMD_W mask bytes at p are all 0 */
@@ -890,7 +893,7 @@ void SIMD_FN(fuse__composite_cols)(const uint8_t *q0, const uint8_t *q1, uint32_
  * per tile instead of once per layer row. */
 void SIMD_FN(fuse__hprep)(fuse__cols *cols, int n, int sw)
 {
-    const vint one = vi_set1(1), last = vi_set1(sw - 1);
+    const vint one = vi_set1(1), last = vi_set1(sw - 1), w256 = vh_set1(256);
     int i;
     for (i = 0; i + SIMD_W <= n; i += SIMD_W) {
         const vint ix = vi_loadu(cols->ix + i);
@@ -905,6 +908,8 @@ void SIMD_FN(fuse__hprep)(fuse__cols *cols, int n, int sw)
         wh = vi_or(wh, vi_slli(wh, 16));
         vi_storeu(cols->hw + 2 * i, wl);
         vi_storeu(cols->hw + 2 * i + SIMD_W, wh);
+        vi_storeu(cols->hwc + 2 * i, vh_sub(w256, wl));
+        vi_storeu(cols->hwc + 2 * i + SIMD_W, vh_sub(w256, wh));
         if (base >= 0 && hi - base < SIMD_W) {
             const vint bb = vi_set1(base);
             cols->hbase[i / SIMD_W] = base;
@@ -922,15 +927,15 @@ void SIMD_FN(fuse__hprep)(fuse__cols *cols, int n, int sw)
 void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
                          uint16_t *h)
 {
-    const vint w256 = vh_set1(256), bias = vh_set1((int)FUSE__H_BIAS);
+    const vint bias = vh_set1((int)FUSE__H_BIAS);
     const int32_t *ixs = cols->ix + c, *fxs = cols->fx + c;
     int i = 0;
     if (cols->hprep_w == SIMD_W && c % SIMD_W == 0) {
         const int32_t *base = cols->hbase + c / SIMD_W;
-        const int32_t *i0s = cols->hidx0 + c, *i1s = cols->hidx1 + c, *ws = cols->hw + 2 * c;
-        for (; i + SIMD_W <= n; i += SIMD_W, base++) {
+        const int32_t *i0s = cols->hidx0 + c, *i1s = cols->hidx1 + c, *ws = cols->hw + 2 * c,
+                      *wcs = cols->hwc + 2 * c;
+        for (; i + SIMD_W <= n; i += SIMD_W, base++, ws += 2 * SIMD_W, wcs += 2 * SIMD_W) {
             const vint i0 = vi_loadu(i0s + i), i1 = vi_loadu(i1s + i);
-            const vint wl = vi_loadu(ws + 2 * i), wh = vi_loadu(ws + 2 * i + SIMD_W);
             vint a, b;
             if (*base >= 0) {
                 const vint s0 = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)*base));
@@ -945,12 +950,15 @@ void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n,
                 a = vi_gather((const int32_t *)(const void *)q, i0);
                 b = vi_gather((const int32_t *)(const void *)q, i1);
             }
+            /* the weights only here: loaded as the multiplies' operands,
+             * not before the all-zero test */
             vi_storeu((int32_t *)(void *)(h + 4 * i),
-                      vi_xor(vh_add(vh_mullo(vh_from_u8_lo(a), vh_sub(w256, wl)),
-                                    vh_mullo(vh_from_u8_lo(b), wl)), bias));
+                      vi_xor(vh_add(vh_mullo(vh_from_u8_lo(a), vi_loadu(wcs)),
+                                    vh_mullo(vh_from_u8_lo(b), vi_loadu(ws))), bias));
             vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W),
-                      vi_xor(vh_add(vh_mullo(vh_from_u8_hi(a), vh_sub(w256, wh)),
-                                    vh_mullo(vh_from_u8_hi(b), wh)), bias));
+                      vi_xor(vh_add(vh_mullo(vh_from_u8_hi(a), vi_loadu(wcs + SIMD_W)),
+                                    vh_mullo(vh_from_u8_hi(b), vi_loadu(ws + SIMD_W))),
+                             bias));
         }
     }
     /* the last n % SIMD_W columns (all of them without the tables: the
@@ -963,6 +971,9 @@ void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n,
  * w holds the pairs (w0, w1)), then over with V's two pixels in vw (16-bit
  * lanes). vh_zip_lo/hi pair the channels of the block's first and second
  * pixel; vh_packus32 puts them back in order. */
+#ifndef FUSE_ALPHA4
+#define FUSE_ALPHA4(q) vh_bcast3(q)
+#endif
 SIMD_INL vint vblend_rc(vint a, vint b, vint vw, vint w)
 {
     const vint lo8 = vh_set1(255), r128 = vh_set1(128);
@@ -970,7 +981,7 @@ SIMD_INL vint vblend_rc(vint a, vint b, vint vw, vint w)
     const vint sl = vi_srli(vi_add(vh_madd(vh_zip_lo(a, b), w), k), 16);
     const vint sh = vi_srli(vi_add(vh_madd(vh_zip_hi(a, b), w), k), 16);
     const vint qq = vh_packus32(sl, sh);
-    vint t = vh_mullo(vh_sub(lo8, vh_bcast3(qq)), vw);
+    vint t = vh_mullo(vh_sub(lo8, FUSE_ALPHA4(qq)), vw);
     /* div255: ((t + 128) + ((t + 128) >> 8)) >> 8 is ((t + 128) 257) >> 16 (the
      * inner floor cannot move the outer one: an integer plus a fraction
      * below 1 never crosses a multiple of 256), one pmulhuw */
