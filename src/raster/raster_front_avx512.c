@@ -145,13 +145,13 @@ static inline __attribute__((always_inline)) void fv_record_attrs(rast__tri *t,
 
 _Static_assert(RAST__FRONT_GROUP == 16, "one group per 16-lane vector");
 
-/* The group loop, the survivor queue and set-up written once. */
 /* The survivors' lane numbers: the layer's vpcompressd. */
 static inline vint fv_compress_lanes(unsigned bits)
 {
     return vi_compress_lanes(bits);
 }
 
+/* The group loop, the survivor queue and set-up written once. */
 #include "raster_frontq.inl"
 
 #else
