@@ -6,7 +6,8 @@
  * threads. Then the pipe: two threads sharing the fuse of both eyes give
  * the bytes of one thread on a frame where one eye sees far more of the
  * model than the other. A band dropped or done twice, or a band border's
- * rows lost, changes the bytes. */
+ * rows lost, changes the bytes. And fuse_eye.q_zero_rows (the layer's
+ * empty rows not cleared again) over frames where the hand moves. */
 #include "support/testutil.h"
 
 #include <cmocka.h>
@@ -87,7 +88,7 @@ static void bands_equal_frame(void **state)
                            {e.Q, CW, CH, 4 * CW}, (variant & 1) ? &dd : NULL,
                            {e.V, OW, OH, 4 * OW}, OX, OY, OPW, OPH,
                            {e.out, OW, OH, 4 * OW}, (variant & 2) != 0,
-                           (variant & 1) ? 4 : 0, (variant & 1) ? FUSE_EDGE_ALL : 0u};
+                           (variant & 1) ? 4 : 0, (variant & 1) ? FUSE_EDGE_ALL : 0u, NULL};
             memset(e.Q, 0x55, CW * CH * 4);
             memset(e.out, 0x66, OW * OH * 4);
             assert_int_equal(fuse_context_frame(ctx, &fe, 1), FUSE_OK);
@@ -128,7 +129,7 @@ static void bands_equal_frame(void **state)
         fuse_context *ctx = fuse_context_create(NULL);
         fuse_eye fe = {&L, &K, {e.P, CW, CH, 4 * CW}, e.M, CW, e.N, 3 * CW,
                        {e.P, CW, CH, 4 * CW}, NULL, {e.V, OW, OH, 4 * OW}, OX, OY, OPW, OPH,
-                       {e.out, OW, OH, 4 * OW}, 0, 0, 0};
+                       {e.out, OW, OH, 4 * OW}, 0, 0, 0, NULL};
         int n = 0;
         assert_int_equal(fuse_context_frame_prepare(ctx, &fe, 32, &n), FUSE_ERR_ARGS); /* P == Q */
         fe.Q.pixels = e.Q;
@@ -137,6 +138,93 @@ static void bands_equal_frame(void **state)
         assert_int_equal(fuse_context_frame_prepare(ctx, &fe, 32, NULL), FUSE_ERR_ARGS);
         fuse_context_destroy(ctx);
     }
+    free(want);
+    free(wantq);
+    tu_eye_free(&e);
+}
+
+/* The mask of frame f: the hand of eye_fill moved down by 9 rows a frame
+ * and back (rows empty in one frame and lit in the next, and the reverse). */
+static void mask_at(uint8_t *M, int f)
+{
+    static const int shift[] = {0, 9, 18, 9, 0, -12};
+    for (int i = 0; i < CW * CH; i++) {
+        const double dx = (i % CW - CW / 3.0) / (CW / 4.0);
+        const double dy = (i / CW - shift[f] - CH * 0.6) / (CH / 3.0);
+        const double d2 = dx * dx + dy * dy;
+        M[i] = d2 < 0.8 ? 255 : d2 < 1.0 ? (uint8_t)(1275 * (1.0 - d2)) : 0;
+    }
+}
+
+/* fuse_eye.q_zero_rows over a sequence of frames whose hand moves: the
+ * layer and the output are those of NULL (every row written, the layer
+ * filled with garbage before each frame) on every ISA, whole and in bands
+ * on two threads; byte y is 1 exactly where the mask row is empty. A row
+ * left as the last frame lit it, or a byte not reset where the hand came
+ * back, changes the layer. */
+static void zero_rows_same_bytes(void **state)
+{
+    (void)state;
+    static const ef_isa isas[] = {EF_ISA_REF, EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_DEFAULT};
+    tu_rng r = {0x2E50F00Du};
+    fuse_lighting L = fuse_lighting_default();
+    const fuse_intrinsics K = {90.0f, 90.0f, CW / 2.0f, CH / 2.0f};
+    tu_eye_data e;
+    eye_fill(&e, &r);
+    const fuse_depth dd = {e.hand, CW, 0.05f, 10.0f, 0.0f, e.scene, OW, OW, OH};
+    uint8_t *want = malloc(OW * OH * 4), *wantq = malloc(CW * CH * 4), zero[CH];
+    assert_true(want && wantq);
+    int kept = 0;
+    for (int ii = 0; ii < 4; ii++)
+        for (int mode = 0; mode < 2; mode++) {   /* 0: whole, 1: bands on two threads */
+            fuse_context_desc d = {isas[ii], 1};
+            fuse_context *ctx = fuse_context_create(&d);
+            assert_non_null(ctx);
+            memset(zero, 0, sizeof zero);
+            memset(e.Q, 0x55, CW * CH * 4);   /* garbage at first: the bytes say nothing */
+            for (int f = 0; f < 6; f++) {
+                mask_at(e.M, f);
+                fuse_eye fe = {&L, &K, {e.P, CW, CH, 4 * CW}, e.M, CW, e.N, 3 * CW,
+                               {e.Q, CW, CH, 4 * CW}, (f & 1) ? &dd : NULL,
+                               {e.V, OW, OH, 4 * OW}, OX, OY, OPW, OPH,
+                               {e.out, OW, OH, 4 * OW}, f & 1, 0, 0u, NULL};
+                uint8_t *q_keep = malloc(CW * CH * 4);
+                assert_non_null(q_keep);
+                memcpy(q_keep, e.Q, CW * CH * 4);
+                memset(e.Q, 0x55, CW * CH * 4);
+                memset(e.out, 0x66, OW * OH * 4);
+                assert_int_equal(fuse_context_frame(ctx, &fe, 1), FUSE_OK);
+                memcpy(want, e.out, OW * OH * 4);
+                memcpy(wantq, e.Q, CW * CH * 4);
+                memcpy(e.Q, q_keep, CW * CH * 4);   /* the layer as the last frame left it */
+                free(q_keep);
+                memset(e.out, 0x66, OW * OH * 4);
+                fe.q_zero_rows = zero;
+                if (mode == 0) {
+                    assert_int_equal(fuse_context_frame(ctx, &fe, 1), FUSE_OK);
+                } else {
+                    int n = 0;
+                    assert_int_equal(fuse_context_frame_prepare(ctx, &fe, 16, &n), FUSE_OK);
+                    band_share s = {ctx, PTHREAD_MUTEX_INITIALIZER, 0, n};
+                    pthread_t th;
+                    assert_int_equal(pthread_create(&th, NULL, band_thread, &s), 0);
+                    band_thread(&s);
+                    pthread_join(th, NULL);
+                    pthread_mutex_destroy(&s.mu);
+                    fuse_context_frame_finish(ctx);
+                }
+                assert_memory_equal(e.out, want, OW * OH * 4);
+                assert_memory_equal(e.Q, wantq, CW * CH * 4);
+                for (int y = 0; y < CH; y++) {
+                    int empty = 1;
+                    for (int x = 0; x < CW; x++) empty &= e.M[y * CW + x] == 0;
+                    assert_int_equal(zero[y], empty);
+                    kept += f > 0 && empty && zero[y];
+                }
+            }
+            fuse_context_destroy(ctx);
+        }
+    assert_true(kept > 4 * 2 * 5 * 10);   /* rows that the flags spared */
     free(want);
     free(wantq);
     tu_eye_free(&e);
@@ -203,4 +291,5 @@ static void pipe_shared_eyes_same_bytes(void **state)
 
 TU_MAIN(NULL, NULL,
         cmocka_unit_test(bands_equal_frame),
+        cmocka_unit_test(zero_rows_same_bytes),
         cmocka_unit_test(pipe_shared_eyes_same_bytes))

@@ -367,6 +367,15 @@ typedef struct fuse_eye {
      * composite reads it. */
     int edge_fade;
     unsigned edge_sides;
+    /* NULL (the default): every row of Q is written. Otherwise Q.height
+     * bytes that the caller keeps with Q from one call to the next, 0 at
+     * first (or whenever Q was written by anything else): the call sets
+     * byte y to 1 when it leaves row y of Q all 0 because the mask's row
+     * is empty, to 0 otherwise, and does not clear again a row whose byte
+     * is 1 and whose mask row is still empty. Q's bytes are those of NULL;
+     * the hand's rows only are written (issue 17: the empty rows were
+     * about 1 MB of memset per stereo frame). */
+    uint8_t *q_zero_rows;
 } fuse_eye;
 
 /* Every stage of count eyes (1..FUSE_MAX_THREADS) on ctx's threads: with

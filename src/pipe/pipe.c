@@ -325,6 +325,7 @@ static void run_eye(pipe_ctx *p, eye_state *e)
                            p->desc.normal_smooth) == FUSE_OK)
         fe.normal = e->snrm;
     fe.Q = (fuse_image){e->layer, cw, ch, 4 * cw};
+    fe.q_zero_rows = e->layer_zero;   /* only fuse writes the layer */
     fe.V = in->virt[e->eye];
     fe.vp_x0 = rp ? 0 : p->geo.vp_x0;
     fe.vp_y0 = rp ? 0 : p->geo.vp_y0;
@@ -519,8 +520,9 @@ static void free_eyes(pipe_ctx *p)
     for (int e = 0; e < 2; e++) {
         EF_FREE_ALL(p->eye[e].depth, p->eye[e].nrm, p->eye[e].snrm, p->eye[e].nfill_scratch,
                     p->eye[e].soft, p->eye[e].clip, p->eye[e].vnrm, p->eye[e].mask, p->eye[e].layer,
-                    p->eye[e].cam_rgba, p->eye[e].refined, p->eye[e].regrow, p->eye[e].prior,
-                    p->eye[e].shifted, p->eye[e].unsmoothed, p->eye[e].refine_scratch);
+                    p->eye[e].layer_zero, p->eye[e].cam_rgba, p->eye[e].refined,
+                    p->eye[e].regrow, p->eye[e].prior, p->eye[e].shifted, p->eye[e].unsmoothed,
+                    p->eye[e].refine_scratch);
         pipe__aa_free(&p->eye[e].aa);
         pipe__reproj_free(&p->eye[e].rp);
         rast_context_destroy(p->eye[e].rast);
@@ -607,6 +609,7 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         s->nrm = malloc(sizeof(float) * 3 * px);
         s->mask = malloc(px);
         s->layer = malloc(4 * px);
+        s->layer_zero = calloc((size_t)p->geo.crop_height, 1);
         s->cam_rgba = malloc(4 * (size_t)p->hmd.cam_width *
                              (size_t)(p->desc.eye_view == PIPE_VIEW_REPROJECT
                                           ? p->hmd.cam_height
@@ -617,7 +620,7 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         fuse_context_desc fd = {(ef_isa)p->desc.max_isa, 1};
         s->rast = rast_context_create(&rd);
         s->fuse = fuse_context_create(&fd);
-        ok = ok && s->depth && s->nrm && s->mask && s->layer && s->cam_rgba && s->clip && s->vnrm &&
+        ok = ok && s->depth && s->nrm && s->mask && s->layer && s->layer_zero && s->cam_rgba && s->clip && s->vnrm &&
              s->rast && s->fuse;
         if (ok) {
             /* a calibrated, distorting lens: the mask through it */

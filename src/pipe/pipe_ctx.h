@@ -19,6 +19,7 @@ typedef struct eye_state {
     int eye;
     float *depth, *nrm, *clip, *vnrm;
     uint8_t *mask, *layer;
+    uint8_t *layer_zero;      /* fuse_eye.q_zero_rows of layer */
     uint8_t *cam_rgba;        /* the cropped camera image, when given raw */
     float *snrm;              /* smoothed normals (normal_smooth), or
                                  the refined mask's (pipe_nfill.h) */
