@@ -192,18 +192,28 @@ static inline int shows(const uint8_t *cmask, int cms, const float *cdepth, int 
            !(cdepth[(size_t)gy * (size_t)cds + (size_t)gx] < zmin);
 }
 
+/* The 32 mask bytes from p are all 0. */
+static inline int empty32(const uint8_t *p)
+{
+    uint64_t v[4];
+    memcpy(v, p, sizeof v);
+    return (v[0] | v[1] | v[2] | v[3]) == 0;
+}
+
 /* The first covered column of the eye mask row em (w columns), w when
- * there is none; *xe: one past the last. 8 bytes at a time. */
+ * there is none; *xe: one past the last. 32, then 8 bytes at a time. */
 static int covered_span(const uint8_t *em, int w, int *xe)
 {
     uint64_t word;
     int a = 0, b = w;
+    while (a + 32 <= w && empty32(em + a)) a += 32;
     while (a + 8 <= w && (memcpy(&word, em + a, 8), word == 0)) a += 8;
     while (a < w && !em[a]) a++;
     if (a == w) {
         *xe = w;
         return w;
     }
+    while (b - 32 >= a && empty32(em + b - 32)) b -= 32;
     while (b - 8 >= a && (memcpy(&word, em + b - 8, 8), word == 0)) b -= 8;
     while (!em[b - 1]) b--;
     *xe = b;
