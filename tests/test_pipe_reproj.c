@@ -31,6 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../src/cpu/cpu.h"
 #include "../src/cpu/ef_mem.h"
 #include "../src/pipe/pipe.h"
 #include "support/pipe_frames.h"
@@ -789,6 +790,80 @@ static void result_fill_row_rule(void **state)
     assert_true(empty_rows > 50);
 }
 
+/* The sampling pass (pipe__reproj_sample) alone on every ISA against the
+ * scalar reference, on seeded eye and camera G-buffers (most eye pixels
+ * covered, a tenth of the camera's mask empty, the camera's depths around
+ * the eye's so that both kinds occur) with the G-buffer's columns inside
+ * a wider camera image (ox > 0, as the consumer preset's crop by columns,
+ * but on every row): bilinear taps with one column inside the G-buffer
+ * and the other beyond it (the vector taps' pair test has its own path
+ * for them), at both sides. P, M and the counts equal. */
+static void determinism_sample_isa(void **state)
+{
+    (void)state;
+    tu_rng g = {0x7a95u};
+    kin_sthmd_desc d = {0};
+    d = kin_sthmd_desc_resolved(&d);
+    const kin_mat4 I = kin_mat4_identity();
+    const kin_camera cam = kin_sthmd_camera(&d, &I, KIN_EYE_LEFT);
+    const int w = 640, h = 400, gw = cam.width, gh = cam.height;
+    const float n = d.znear, f = d.zfar;
+    const ef_isa caps[4] = {EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512, EF_ISA_DEFAULT};
+    pipe__reproj r[2];
+    assert_int_equal(pipe__reproj_init(&r[0], w, h), 0);
+    assert_int_equal(pipe__reproj_init(&r[1], w, h), 0);
+    long sampled = 0, filled = 0;
+    for (int it = 0; it < 3; it++) {
+        const int ox = 1 + tu_int(&g, 40), oy = tu_int(&g, 41);
+        const int pw = gw + ox + 1 + tu_int(&g, 40), ph = gh + oy + tu_int(&g, 40);
+        uint8_t *P = malloc((size_t)pw * (size_t)ph * 4), *cm = malloc((size_t)gw * (size_t)gh);
+        float *cd = malloc(sizeof(float) * (size_t)gw * (size_t)gh);
+        assert_non_null(P);
+        assert_non_null(cm);
+        assert_non_null(cd);
+        const float dm = tu_range(&g, 0.15f, 0.6f);
+        for (long i = 0; i < (long)pw * ph * 4; i++) P[i] = (uint8_t)tu_int(&g, 256);
+        for (long i = 0; i < (long)gw * gh; i++) {
+            cm[i] = tu_int(&g, 10) ? 255 : 0;
+            const float z = dm * tu_range(&g, 0.9f, 1.1f);
+            cd[i] = 0.5f * ((f + n) - 2.0f * f * n / z) / (f - n) + 0.5f;
+        }
+        for (long i = 0; i < (long)w * h; i++) {
+            r[0].mask[i] = tu_int(&g, 10) ? 255 : 0;
+            const float z = dm * tu_range(&g, 0.9f, 1.1f);
+            r[0].depth[i] = 0.5f * ((f + n) - 2.0f * f * n / z) / (f - n) + 0.5f;
+            for (int j = 0; j < 3; j++) r[0].nrm[3 * i + j] = tu_range(&g, -0.5f, 0.5f);
+            r[0].nrm[3 * i + 2] += 0.5f;
+        }
+        memcpy(r[1].mask, r[0].mask, (size_t)w * (size_t)h);
+        memcpy(r[1].depth, r[0].depth, sizeof(float) * (size_t)w * (size_t)h);
+        memcpy(r[1].nrm, r[0].nrm, sizeof(float) * 3 * (size_t)w * (size_t)h);
+        const fuse_image im = {P, pw, ph, 4 * pw};
+        for (int k = -1; k < 4; k++) {
+            pipe__reproj *q = &r[k < 0 ? 0 : 1];
+            q->cam = kin_sthmd_eye_camera(&d, &I, KIN_EYE_LEFT, w, h);
+            q->isa = k < 0 ? EF_ISA_REF : ef_isa_choose(caps[k]);
+            memset(q->P, 0, (size_t)w * (size_t)h * 4);
+            assert_int_equal(
+                pipe__reproj_sample(q, &cam, &im, ox, oy, cm, gw, cd, gw, gw, gh, n, f), 0);
+            if (k < 0) continue;
+            assert_memory_equal(r[1].P, r[0].P, (size_t)w * (size_t)h * 4);
+            assert_memory_equal(r[1].M, r[0].M, (size_t)w * (size_t)h);
+            assert_int_equal(r[1].sampled, r[0].sampled);
+            assert_int_equal(r[1].filled, r[0].filled);
+            assert_int_equal(r[1].outside, r[0].outside);
+        }
+        sampled += r[0].sampled, filled += r[0].filled;
+        free(P);
+        free(cm);
+        free(cd);
+    }
+    assert_true(sampled > 100000);
+    assert_true(filled > 20000);
+    pipe__reproj_free(&r[0]);
+    pipe__reproj_free(&r[1]);
+}
+
 /* A closed cube of half size s around the origin (normals outward) and a
  * quad of half size q facing +Z at depth z, one mesh: from inside the
  * cube an eye falls back while its camera, D in front and outside the
@@ -912,6 +987,7 @@ TU_MAIN(NULL, NULL,
         cmocka_unit_test(result_border_fade),
         cmocka_unit_test(result_full_sensor),
         cmocka_unit_test(determinism_isa_threads),
+        cmocka_unit_test(determinism_sample_isa),
         cmocka_unit_test(validity_bad_desc),
         cmocka_unit_test(validity_eye_inside_model),
         cmocka_unit_test(validity_fallback_alternating),

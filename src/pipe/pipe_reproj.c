@@ -192,6 +192,34 @@ static inline int shows(const uint8_t *cmask, int cms, const float *cdepth, int 
            !(cdepth[(size_t)gy * (size_t)cds + (size_t)gx] < zmin);
 }
 
+/* The 32 mask bytes from p are all 0. */
+static inline int empty32(const uint8_t *p)
+{
+    uint64_t v[4];
+    memcpy(v, p, sizeof v);
+    return (v[0] | v[1] | v[2] | v[3]) == 0;
+}
+
+/* The first covered column of the eye mask row em (w columns), w when
+ * there is none; *xe: one past the last. 32, then 8 bytes at a time. */
+static int covered_span(const uint8_t *em, int w, int *xe)
+{
+    uint64_t word;
+    int a = 0, b = w;
+    while (a + 32 <= w && empty32(em + a)) a += 32;
+    while (a + 8 <= w && (memcpy(&word, em + a, 8), word == 0)) a += 8;
+    while (a < w && !em[a]) a++;
+    if (a == w) {
+        *xe = w;
+        return w;
+    }
+    while (b - 32 >= a && empty32(em + b - 32)) b -= 32;
+    while (b - 8 >= a && (memcpy(&word, em + b - 8, 8), word == 0)) b -= 8;
+    while (!em[b - 1]) b--;
+    *xe = b;
+    return a;
+}
+
 /* 8 kind bytes (K) from p. */
 static inline uint64_t kind8(const uint8_t *p)
 {
@@ -316,22 +344,32 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         const float ry = -((float)y + 0.5f - ecy) / efy;
         const long filled0 = filled;
         memset(M, 0, (size_t)w);
-        memset(K, 0, (size_t)w);
+        /* only the row's span of covered pixels, its ends out to
+         * multiples of 16 (of every SIMD_W) so that the vector kernels
+         * do it whole: [xs, xe); their blocks outside it would each test
+         * 4 to 16 empty mask bytes */
+        int xe;
+        int xs = covered_span(em, w, &xe);
+        row_fill[y] = 0;
+        if (xs == xe) continue;
+        xs &= ~15;
+        xe = xe + 15 < w ? (xe + 15) & ~15 : w;
+        memset(K + xs, 0, (size_t)(xe - xs));
         /* the geometry of the row's covered pixels (vector, then the tail) */
-        int x1 = kernel ? kernel(&g, em, ed, en, ry, w, &o, &back, &mind) : 0;
-        row_ref(&g, em, ed, en, ry, x1, w, &o, &back, &mind);
+        int x1 = kernel ? kernel(&g, em, ed, en, ry, xs, xe, &o, &back, &mind) : xs;
+        row_ref(&g, em, ed, en, ry, x1, xe, &o, &back, &mind);
         /* the taps (vector, then the tail) */
-        int xt = 0;
+        int xt = xs;
         if (taps) {
             long cnt[4] = {0, 0, 0, 0};
-            xt = taps(&td, em, &o, w, M, Po, K, cnt, sum);
+            xt = taps(&td, em, &o, xs, xe, M, Po, K, cnt, sum);
             covered += cnt[0], outside += cnt[1], filled += cnt[2], sampled += cnt[3];
         }
-        for (int x = xt; x < w; x++) {
+        for (int x = xt; x < xe; x++) {
             if (!em[x]) {
                 /* 8 empty mask bytes at a time */
                 uint64_t word;
-                while (x + 9 <= w && (memcpy(&word, em + x + 1, 8), word == 0)) x += 8;
+                while (x + 9 <= xe && (memcpy(&word, em + x + 1, 8), word == 0)) x += 8;
                 continue;
             }
             covered++;
@@ -400,7 +438,8 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
             sampled++;
         }
         /* the fill from the row's own sampled pixels, while it is warm */
-        row_fill[y] = filled != filled0 && !pipe__reproj_fill_row(K, w, Po, ed, n, f);
+        row_fill[y] = filled != filled0 &&
+                      !pipe__reproj_fill_row(K + xs, xe - xs, Po + 4 * (size_t)xs, ed + xs, n, f);
     }
     r->sampled = sampled;
     r->outside = outside;

@@ -159,11 +159,11 @@ typedef struct pipe__reproj_geo {
     const float *rxs;       /* the eye rays' x per column */
 } pipe__reproj_geo;
 
-/* The vector geometry pass per ISA (pipe_reproj_simd.inl): the first
- * column it did not do. The pinhole camera only. */
+/* The vector geometry pass per ISA (pipe_reproj_simd.inl) over columns
+ * [x0, w): the first column it did not do. The pinhole camera only. */
 typedef int pipe__reproj_row_t(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                               const float *en, float ry, int w, const pipe__reproj_lanes *o,
-                               long *back, float *mind);
+                               const float *en, float ry, int x0, int w,
+                               const pipe__reproj_lanes *o, long *back, float *mind);
 typedef pipe__reproj_row_t *pipe__reproj_row_fn;
 pipe__reproj_row_t pipe__reproj_row_sse2, pipe__reproj_row_avx2, pipe__reproj_row_avx512,
     pipe__reproj_row_neon;
@@ -178,17 +178,17 @@ typedef struct pipe__reproj_tapd {
     int cms, cds, gw, gh, ox, oy, ps4, icw1, ich1, mlim;
 } pipe__reproj_tapd;
 
-/* The taps pass per ISA (pipe_reproj_simd.inl): from one eye row's
- * geometry (o, the covered pixels em), M (the mask composited: the fade
- * or 0), Po (RGBA + the kind in alpha, written where the scalar
- * reference writes), K (the kind: 1 sampled, 2 filled, written where it
- * is one of them; the caller zeroes the row first), cnt[] += covered,
- * outside, filled, sampled and sum[] += the sampled colours; the first
- * column not done (the scalar taps finish). Equal to the scalar taps in
- * pipe_reproj.c. */
+/* The taps pass per ISA (pipe_reproj_simd.inl) over columns [x0, w):
+ * from one eye row's geometry (o, the covered pixels em), M (the mask
+ * composited: the fade or 0), Po (RGBA + the kind in alpha, written
+ * where the scalar reference writes), K (the kind: 1 sampled, 2 filled,
+ * written where it is one of them; the caller zeroes the row first),
+ * cnt[] += covered, outside, filled, sampled and sum[] += the sampled
+ * colours; the first column not done (the scalar taps finish). Equal to
+ * the scalar taps in pipe_reproj.c. */
 typedef int pipe__reproj_taps_t(const pipe__reproj_tapd *t, const uint8_t *em,
-                                const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
-                                uint8_t *K, long cnt[4], uint64_t sum[3]);
+                                const pipe__reproj_lanes *o, int x0, int w, uint8_t *M,
+                                uint8_t *Po, uint8_t *K, long cnt[4], uint64_t sum[3]);
 typedef pipe__reproj_taps_t *pipe__reproj_taps_fn;
 pipe__reproj_taps_t pipe__reproj_taps_sse2, pipe__reproj_taps_avx2, pipe__reproj_taps_avx512,
     pipe__reproj_taps_neon;

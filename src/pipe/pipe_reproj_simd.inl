@@ -10,13 +10,13 @@
  * AVX2/AVX-512 gathers, SSE2/NEON lane by lane), the bilinear in int32
  * lanes, the renormalising division in float (exact, see there). */
 
-/* Columns [0, w) of one eye row, SIMD_W at a time, skipping blocks with
+/* Columns [x0, w) of one eye row, SIMD_W at a time, skipping blocks with
  * no covered pixel; the first column not done (row_ref finishes). back:
  * covered pixels facing away added; *mind: the least distance of a
  * covered pixel. The pinhole camera only (g->pinhole). */
 int SIMD_FN(pipe__reproj_row)(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                              const float *en, float ry_s, int w, const pipe__reproj_lanes *o,
-                              long *back, float *mind)
+                              const float *en, float ry_s, int x0, int w,
+                              const pipe__reproj_lanes *o, long *back, float *mind)
 {
     const vfloat zero = vf_zero(), one = vf_set1(1.0f), two = vf_set1(2.0f);
     const vfloat ry = vf_set1(ry_s), two_fn = vf_set1(g->two_fn), fpn = vf_set1(g->fpn),
@@ -34,7 +34,7 @@ int SIMD_FN(pipe__reproj_row)(const pipe__reproj_geo *g, const uint8_t *em, cons
     const vint icw1 = vi_set1(g->icw1), ich1 = vi_set1(g->ich1), i255 = vi_set1(255);
     vfloat vmind = vf_set1(*mind);
     long bk = 0;
-    int x = 0;
+    int x = x0;
     for (; w - x >= SIMD_W; x += SIMD_W) {
         const vmask cov = vm_not(vi_eq(vi_load_u8(em + x), vi_zero()));
         if (!vm_any(cov)) continue;
@@ -125,12 +125,60 @@ static inline vmask rp_shows(const pipe__reproj_tapd *t, vmask valid, vint gx, v
     return vm_or(vm_andnot(in, valid), vm_and(in, sh));
 }
 
+/* rp_shows for the two taps (gx, gy) and (gx + dx, gy) of one row of the
+ * bilinear (dx 0 or 1) at once: where both are inside the G-buffer, one
+ * 4-byte mask gather gives both mask bytes and the depths are two
+ * gathers of one offset; a lane with one of them inside and the other
+ * not (the G-buffer's side edges inside the image: a crop by columns)
+ * goes through rp_shows tap by tap. */
+SIMD_INL void rp_shows2(const pipe__reproj_tapd *t, vmask valid, vint gx, vint dx, vint gy,
+                             vfloat zmin, vmask *s0, vmask *s1)
+{
+    const vint gw = vi_set1(t->gw), gh = vi_set1(t->gh), m1 = vi_set1(-1);
+    const vint gx1 = vi_add(gx, dx);
+    const vmask row = vm_and(valid, vm_and(vi_gt(gy, m1), vi_gt(gh, gy)));
+    const vmask c0 = vm_and(vi_gt(gx, m1), vi_gt(gw, gx));
+    const vmask c1 = vm_and(vi_gt(gx1, m1), vi_gt(gw, gx1));
+    const vmask in = vm_and(row, vm_and(c0, c1));
+    vmask a = vm_andnot(in, valid), b = a;
+    if (vm_any(in)) {
+        const vint mo = vi_sel(in, vi_add(vi_mullo(gy, vi_set1(t->cms)), gx), vi_zero());
+        const vint dof = vi_sel(in, vi_add(vi_mullo(gy, vi_set1(t->cds)), gx), vi_zero());
+        const vmask late = vm_and(in, vi_gt(mo, vi_set1(t->mlim)));
+        vint mb = vi_gather_u8x4(t->cmask, vi_sel(late, vi_zero(), mo));
+        if (vm_any(late)) { /* fewer than 4 readable bytes: the two alone */
+            _Alignas(64) int32_t off[SIMD_W], d[SIMD_W], bb[SIMD_W];
+            vi_storeu(off, mo);
+            vi_storeu(d, dx);
+            vi_storeu(bb, mb);
+            for (unsigned k = vm_bits(late); k; k &= k - 1) {
+                const int l = __builtin_ctz(k);
+                bb[l] = t->cmask[off[l]] | t->cmask[off[l] + d[l]] << 8;
+            }
+            mb = vi_loadu(bb);
+        }
+        const vint k255 = vi_set1(0xFF), zero = vi_zero();
+        const vint mb0 = vi_and(mb, k255);
+        const vint mb1 = vi_sel(vi_eq(dx, zero), mb0, vi_and(vi_srli(mb, 8), k255));
+        const vfloat d0 = vf_gather(t->cdepth, dof), d1 = vf_gather(t->cdepth, vi_add(dof, dx));
+        a = vm_or(a, vm_and(in, vm_andnot(vi_eq(mb0, zero), vm_not(vf_lt(d0, zmin)))));
+        b = vm_or(b, vm_and(in, vm_andnot(vi_eq(mb1, zero), vm_not(vf_lt(d1, zmin)))));
+    }
+    const vmask mixed = vm_andnot(in, vm_and(row, vm_or(c0, c1)));
+    if (vm_any(mixed)) {
+        a = vm_or(vm_andnot(mixed, a), rp_shows(t, mixed, gx, gy, zmin));
+        b = vm_or(vm_andnot(mixed, b), rp_shows(t, mixed, gx1, gy, zmin));
+    }
+    *s0 = a;
+    *s1 = b;
+}
+
 #define RP_CH(p, k) vi_and(vi_srli(p, 8 * (k)), vi_set1(0xFF))
 
-/* Columns [0, w) of one eye row, SIMD_W at a time (the scalar taps of
+/* Columns [x0, w) of one eye row, SIMD_W at a time (the scalar taps of
  * pipe_reproj.c lane by lane); the first column not done. */
 int SIMD_FN(pipe__reproj_taps)(const pipe__reproj_tapd *t, const uint8_t *em,
-                               const pipe__reproj_lanes *o, int w, uint8_t *M, uint8_t *Po,
+                               const pipe__reproj_lanes *o, int x0, int w, uint8_t *M, uint8_t *Po,
                                uint8_t *K, long cnt[4], uint64_t sum[3])
 {
     const vint zero = vi_zero(), one = vi_set1(1), two = vi_set1(2), k256 = vi_set1(256);
@@ -140,7 +188,7 @@ int SIMD_FN(pipe__reproj_taps)(const pipe__reproj_tapd *t, const uint8_t *em,
     const int32_t *P = (const int32_t *)(const void *)t->P;
     vint s0 = zero, s1 = zero, s2 = zero;
     long ncov = 0, nout = 0, nfill = 0, nsamp = 0;
-    int x = 0;
+    int x = x0;
     for (; w - x >= SIMD_W; x += SIMD_W) {
         const vmask cov = vm_not(vi_eq(vi_load_u8(em + x), zero));
         const unsigned cb = vm_bits(cov);
@@ -152,10 +200,25 @@ int SIMD_FN(pipe__reproj_taps)(const pipe__reproj_tapd *t, const uint8_t *em,
         ncov += __builtin_popcount(cb);
         nout += __builtin_popcount(cb & ~vb);
         if (!vb) continue;
-        /* the nearest camera pixel: does the camera see this point? */
+        /* the four bilinear taps: which show the point. The nearest camera
+         * pixel (iu, iv) is one of them (fu - 0.5 is exact below 2^23, so
+         * trunc(fu) is tx + 1 exactly where the fraction fx is >= 128, and
+         * likewise for y), so its test, whether the camera sees the point
+         * at all, is read from theirs */
         const vfloat zmin = vf_loadu(o->zmin + x);
-        const vint iu = vi_loadu(o->iu + x), iv = vi_loadu(o->iv + x);
-        const vmask seen = rp_shows(t, valid, vi_sub(iu, ox), vi_sub(iv, oy), zmin);
+        const vint tx = vi_loadu(o->tx + x), ty = vi_loadu(o->ty + x);
+        const vint fx = vi_loadu(o->fx + x), fy = vi_loadu(o->fy + x);
+        const vint dx = vi_sel(vi_gt(icw1, tx), one, zero);
+        const vint y1 = vi_add(ty, vi_sel(vi_gt(ich1, ty), one, zero));
+        const vint gx = vi_sub(tx, ox);
+        vmask t00, t01, t10, t11;
+        rp_shows2(t, valid, gx, dx, vi_sub(ty, oy), zmin, &t00, &t01);
+        rp_shows2(t, valid, gx, dx, vi_sub(y1, oy), zmin, &t10, &t11);
+        const vint h127 = vi_set1(127);
+        const vmask right = vi_gt(fx, h127), down = vi_gt(fy, h127);
+        const vmask seen =
+            vm_and(valid, vm_or(vm_and(down, vm_or(vm_and(right, t11), vm_andnot(right, t10))),
+                                vm_andnot(down, vm_or(vm_and(right, t01), vm_andnot(right, t00)))));
         const vmask fill = vm_andnot(seen, valid);
         const unsigned sb = vm_bits(seen);
         nfill += __builtin_popcount(vm_bits(fill));
@@ -166,21 +229,16 @@ int SIMD_FN(pipe__reproj_taps)(const pipe__reproj_tapd *t, const uint8_t *em,
         vint out = vi_sel(fill, vi_or(vi_and(old, rgb), a_fill), old);
         if (sb) {
             /* bilinear, the taps that show the point, renormalised */
-            const vint tx = vi_loadu(o->tx + x), ty = vi_loadu(o->ty + x);
-            const vint fx = vi_loadu(o->fx + x), fy = vi_loadu(o->fy + x);
-            const vint dx = vi_sel(vi_gt(icw1, tx), one, zero);
-            const vint y1 = vi_add(ty, vi_sel(vi_gt(ich1, ty), one, zero));
-            const vint gx = vi_sub(tx, ox), gx1 = vi_add(gx, dx);
-            const vint gy0 = vi_sub(ty, oy), gy1 = vi_sub(y1, oy);
-            const vmask t00 = rp_shows(t, seen, gx, gy0, zmin);
-            const vmask t01 = rp_shows(t, seen, gx1, gy0, zmin);
-            const vmask t10 = rp_shows(t, seen, gx, gy1, zmin);
-            const vmask t11 = rp_shows(t, seen, gx1, gy1, zmin);
+            t00 = vm_and(t00, seen), t01 = vm_and(t01, seen);
+            t10 = vm_and(t10, seen), t11 = vm_and(t11, seen);
             const vint ifx = vi_sub(k256, fx), ify = vi_sub(k256, fy);
             const vint w00 = vi_sel(t00, vi_mullo(ifx, ify), zero);
             const vint w01 = vi_sel(t01, vi_mullo(fx, ify), zero);
             const vint w10 = vi_sel(t10, vi_mullo(ifx, fy), zero);
             const vint w11 = vi_sel(t11, vi_mullo(fx, fy), zero);
+            /* never 0 where seen: the nearest pixel's tap shows the point
+             * and its weight is not 0 (the scalar's "only the nearest
+             * pixel" case cannot arise) */
             vint ws = vi_add(vi_add(vi_add(w00, w01), w10), w11);
             const vint r0 = vi_sel(seen, vi_mullo(ty, ps4), zero);
             const vint r1 = vi_sel(seen, vi_mullo(y1, ps4), zero);
@@ -191,16 +249,8 @@ int SIMD_FN(pipe__reproj_taps)(const pipe__reproj_tapd *t, const uint8_t *em,
     vi_add(vi_add(vi_add(vi_mullo(w00, RP_CH(p00, k)), vi_mullo(w01, RP_CH(p01, k))),       \
                   vi_mullo(w10, RP_CH(p10, k))),                                            \
            vi_mullo(w11, RP_CH(p11, k)))
-            vint a0 = RP_ACC(0), a1 = RP_ACC(1), a2 = RP_ACC(2);
+            const vint a0 = RP_ACC(0), a1 = RP_ACC(1), a2 = RP_ACC(2);
 #undef RP_ACC
-            const vmask none = vm_and(seen, vi_eq(ws, zero));
-            if (vm_any(none)) { /* only the nearest pixel is the model's */
-                const vint pn = vi_gather(P, vi_sel(none, vi_add(vi_mullo(iv, ps4), iu), zero));
-                a0 = vi_sel(none, RP_CH(pn, 0), a0);
-                a1 = vi_sel(none, RP_CH(pn, 1), a1);
-                a2 = vi_sel(none, RP_CH(pn, 2), a2);
-                ws = vi_sel(none, one, ws);
-            }
             /* (acc + ws / 2) / ws: below 2^24 over at most 2^16, so the
              * float quotient truncates to the integer one */
             ws = vi_sel(seen, ws, one);
