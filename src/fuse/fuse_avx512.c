@@ -47,6 +47,9 @@ static inline __m512 scene_avx512(const fuse__depth_prep *p, const float *sc, __
     (_mm512_mask_cmpneq_epu16_mask((__mmask32)0x88888888u, _mm512_and_si512(q0, q1), \
                                    _mm512_set1_epi16(255)) == 0)
 
+/* hrow's empty window: one vptestmd */
+#define FUSE_ZERO(v) (_mm512_test_epi32_mask(v, v) == 0)
+
 #define FUSE_ROWCACHE_ON_LAYER 1
 #include "fuse_simd.inl"
 

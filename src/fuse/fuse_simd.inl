@@ -36,7 +36,10 @@
  *       shuffles). AVX2 and AVX-512 use one pshufb.
  *   FUSE_ALPHA255(q0, q1)  (vrow) 1 when every alpha lane of q0 and q1 is
  *       255; default FUSE_ALPHA4 and a compare. AVX2: one vptest;
- *       AVX-512: one masked word compare. */
+ *       AVX-512: one masked word compare.
+ *   FUSE_ZERO(v)  (hrow) 1 when v is all zero bits; default vi_eq and
+ *       vm_all (compare, movemask, compare). AVX2: vptest; AVX-512:
+ *       vptestmd. */
 #include <string.h>
 
 /* 1 if the SIMD_W mask bytes at p are all 0 */
@@ -927,6 +930,10 @@ void SIMD_FN(fuse__hprep)(fuse__cols *cols, int n, int sw)
     cols->hprep_w = SIMD_W;
 }
 
+/* 1 when every bit of v is 0 (hrow's empty window) */
+#ifndef FUSE_ZERO
+#define FUSE_ZERO(v) vm_all(vi_eq(v, vi_zero()))
+#endif
 void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
                          uint16_t *h)
 {
@@ -942,7 +949,7 @@ void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n,
             vint a, b;
             if (*base >= 0) {
                 const vint s0 = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)*base));
-                if (vm_all(vi_eq(s0, vi_zero()))) {   /* every tap 0: h = 0 */
+                if (FUSE_ZERO(s0)) {   /* every tap 0: h = 0 */
                     vi_storeu((int32_t *)(void *)(h + 4 * i), bias);
                     vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W), bias);
                     continue;
