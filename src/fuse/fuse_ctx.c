@@ -283,7 +283,7 @@ static void *(*volatile copy_fn)(void *, const void *, size_t) = memcpy;
 /* n pixels that the layer does not reach: out = V with alpha 255. With the
  * caller's promise that V is opaque that is V itself: nothing to do in
  * place, a copy otherwise. */
-static void transparent(const comp_job *j, const uint8_t *v, uint8_t *o, int n)
+static inline void transparent(const comp_job *j, const uint8_t *v, uint8_t *o, int n)
 {
     if (!j->v_opaque) j->k->opaque(v, o, n);
     else if (!j->in_place) copy_fn(o, v, 4u * (size_t)n);
