@@ -972,8 +972,8 @@ void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n,
         }
     }
     /* the last n % SIMD_W columns (all of them without the tables: the
-     * same bytes, pixel by pixel) */
-    for (; i < n; i++) fuse__hpx(q, ixs[i], (uint32_t)fxs[i], sw, h + 4 * i);
+     * same bytes, pixel by pixel), each in its step's block order */
+    for (; i < n; i++) fuse__hpx(q, ixs[i], (uint32_t)fxs[i], sw, h + fuse__hslot(i, SIMD_W));
 }
 
 /* Two pixels per block: q = ((h0 - 32768) w0 + (h1 - 32768) w1 + 32768 *
@@ -1033,6 +1033,22 @@ void SIMD_FN(fuse__vrow)(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
         }
         vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i), r);
     }
-    for (; i < n; i++) fuse__vpx(h0 + 4 * i, h1 + 4 * i, fy, v + 4 * i, out + 4 * i);
+    if (i < n) {
+        /* the last n - i columns (the tile's end) as one step: h holds them
+         * in block order (fuse__hslot) and the step's other values lie
+         * inside the tile's h arrays (their lanes are computed, never
+         * stored, and take no part in a branch); V and out through the
+         * lane mask */
+        const unsigned bits = (1u << (n - i)) - 1u;
+        const vint vv = vf_as_vi(vf_load_bits((const float *)(const void *)(v + 4 * (size_t)i), bits));
+        const vint q0 = vsum_rc(vi_loadu((const int32_t *)(const void *)(h0 + 4 * i)),
+                                vi_loadu((const int32_t *)(const void *)(h1 + 4 * i)), w);
+        const vint q1 = vsum_rc(vi_loadu((const int32_t *)(const void *)(h0 + 4 * i + 2 * SIMD_W)),
+                                vi_loadu((const int32_t *)(const void *)(h1 + 4 * i + 2 * SIMD_W)), w);
+        vf_store_bits((float *)(void *)(out + 4 * (size_t)i), bits,
+                      vi_as_vf(vi_or(vh_packus(vover_rc(q0, vh_from_u8_lo(vv)),
+                                               vover_rc(q1, vh_from_u8_hi(vv))),
+                                     opaque)));
+    }
 }
 #endif
