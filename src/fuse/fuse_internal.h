@@ -425,7 +425,9 @@ static inline int fuse__hslot(int i, int w)
 typedef void (*fuse__hrow_fn)(const uint8_t *q, const fuse__cols *cols, int c,
                               int n, int sw, uint16_t *h);
 /* The vertical blend of h0 (upper row) and h1 (lower row) with weight fy
- * and the over onto n pixels of V: the bytes of fuse__composite_px. */
+ * and the over onto n pixels of V: the bytes of fuse__composite_px. h0 and
+ * h1 are read to the end of the last step of SIMD_W columns, past n when n
+ * is not a multiple of SIMD_W (the driver's tile arrays hold whole steps). */
 typedef void (*fuse__vrow_fn)(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
                               const uint8_t *v, uint8_t *out, int n);
 
