@@ -76,6 +76,14 @@ static inline void normals_avx2(const float *p, __m256 *x, __m256 *y, __m256 *z)
                                             14, 15, 6, 7, 6, 7, 6, 7, 6, 7, 14, 15, 14, 15, \
                                             14, 15, 14, 15))
 
+/* vrow's all-opaque test: (q0 & q1) has every bit of each pixel's alpha
+ * byte (lane 3 of 4, 0..255), one vptest */
+#define FUSE_ALPHA255(q0, q1)                                                    \
+    _mm256_testc_si256(_mm256_and_si256(q0, q1), _mm256_set1_epi64x(0x00FF000000000000LL))
+
+/* hrow's empty window: one vptest */
+#define FUSE_ZERO(v) _mm256_testz_si256(v, v)
+
 #define FUSE_ROWCACHE_ON_LAYER 1
 #include "fuse_simd.inl"
 

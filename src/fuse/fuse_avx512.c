@@ -42,6 +42,14 @@ static inline __m512 scene_avx512(const fuse__depth_prep *p, const float *sc, __
     _mm512_shuffle_epi8(q, _mm512_broadcast_i32x4(_mm_setr_epi8(6, 7, 6, 7, 6, 7, 6, 7, 14, 15, \
                                                                 14, 15, 14, 15, 14, 15)))
 
+/* vrow's all-opaque test: no alpha lane (3 of 4) of q0 & q1 below 255 */
+#define FUSE_ALPHA255(q0, q1)                                                       \
+    (_mm512_mask_cmpneq_epu16_mask((__mmask32)0x88888888u, _mm512_and_si512(q0, q1), \
+                                   _mm512_set1_epi16(255)) == 0)
+
+/* hrow's empty window: one vptestmd */
+#define FUSE_ZERO(v) (_mm512_test_epi32_mask(v, v) == 0)
+
 #define FUSE_ROWCACHE_ON_LAYER 1
 #include "fuse_simd.inl"
 

@@ -328,7 +328,7 @@ static void copy_stream_done(void)
 /* n pixels that the layer does not reach: out = V with alpha 255. With the
  * caller's promise that V is opaque that is V itself: nothing to do in
  * place, a copy otherwise. */
-static void transparent(const comp_job *j, const uint8_t *v, uint8_t *o, int n)
+static inline void transparent(const comp_job *j, const uint8_t *v, uint8_t *o, int n)
 {
     if (!j->v_opaque) j->k->opaque(v, o, n);
     else if (!j->in_place) copy_fn(o, v, 4u * (size_t)n);
@@ -397,9 +397,10 @@ static void defer_flush(const comp_job *j, comp_scratch *s, const uint8_t *o, co
  * blo(g) .. bhi(g); both grow with g. */
 static void scratch_tile(comp_scratch *s, const kernels *k, int sw, int vw, int c0, int n)
 {
-    const int ng = (n + GROUP - 1) / GROUP, nb = (sw + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
-    int g, b;
-    if (s->tile_n == n && s->tile_c0 == c0) return;
+    int ng, nb, g, b;
+    if (s->tile_n == n && s->tile_c0 == c0) return;   /* every row but the first */
+    ng = (n + GROUP - 1) / GROUP;
+    nb = (sw + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
     s->cov_row[0] = s->cov_row[1] = -1;   /* h depends on the tile */
     if (s->tile_n == 0) {
         int i;
@@ -461,24 +462,29 @@ static void scratch_hrow(comp_scratch *s, const comp_job *j, int r, int slot)
     }
 }
 
-/* Coverage bits (and with a row cache, h) of layer row r, computed into
- * the slot that does not hold row keep; *slot_out: the slot. */
-static const uint64_t *scratch_cover(comp_scratch *s, const comp_job *j, int r, int keep,
-                                     int *slot_out)
+/* Coverage bits (and with a row cache, h) of layer row r into the slot
+ * that does not hold row keep; returns the slot. */
+static int scratch_fill(comp_scratch *s, const comp_job *j, int r, int keep)
 {
-    int slot;
-    if (s->cov_row[0] == r) slot = 0;
-    else if (s->cov_row[1] == r) slot = 1;
-    else {
-        const int32_t *sp = s->span[r % SPAN_RING];
-        slot = s->cov_row[0] == keep ? 1 : 0;
-        if (sp[0] == r)
-            j->k->cover_span(row_of(&j->Q, r), j->Q.width, sp[1], sp[2], s->cov[slot]);
-        else
-            j->k->cover(row_of(&j->Q, r), j->Q.width, s->cov[slot]);
-        if (j->k->hrow != NULL) scratch_hrow(s, j, r, slot);
-        s->cov_row[slot] = r;
-    }
+    const int32_t *sp = s->span[r % SPAN_RING];
+    const int slot = s->cov_row[0] == keep ? 1 : 0;
+    if (sp[0] == r)
+        j->k->cover_span(row_of(&j->Q, r), j->Q.width, sp[1], sp[2], s->cov[slot]);
+    else
+        j->k->cover(row_of(&j->Q, r), j->Q.width, s->cov[slot]);
+    if (j->k->hrow != NULL) scratch_hrow(s, j, r, slot);
+    s->cov_row[slot] = r;
+    return slot;
+}
+
+/* Coverage bits (and with a row cache, h) of layer row r, computed into
+ * the slot that does not hold row keep; *slot_out: the slot. Inline: a
+ * layer row is read by about two output rows, so most calls find it and
+ * only scratch_fill's are a call. */
+static inline const uint64_t *scratch_cover(comp_scratch *s, const comp_job *j, int r, int keep,
+                                            int *slot_out)
+{
+    const int slot = s->cov_row[0] == r ? 0 : s->cov_row[1] == r ? 1 : scratch_fill(s, j, r, keep);
     *slot_out = slot;
     return s->cov[slot];
 }
@@ -601,7 +607,7 @@ static void comp_row_tiled(const comp_job *j, comp_scratch *s, int y, int c0, in
     const int nb = (sw + FUSE__COV_BLOCK - 1) / FUSE__COV_BLOCK;
     const int32_t pos = fuse__src_pos(y - j->vy, sh, j->vh);
     const int iy = pos >> 16, iy1 = iy + 1 < sh ? iy + 1 : sh - 1;
-    int s0, s1;
+    int s0, s1 = -1;
     const uint64_t *b0 = scratch_cover(s, j, iy, -1, &s0);
     const uint64_t *b1 = iy1 == iy ? b0 : scratch_cover(s, j, iy1, iy, &s1);
     const size_t off = 4 * ((size_t)j->vx + (size_t)c0);

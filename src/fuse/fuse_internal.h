@@ -406,16 +406,28 @@ void fuse__composite_cols_sse2(const uint8_t *q0, const uint8_t *q1, uint32_t fy
  * the pixel's channel order (r, g, b, a); the columns of each step of
  * SIMD_W (from a multiple of 16 of the tile: both kernels start every call
  * there) in the vector layer's block order (fuse_simd.inl), the scalar tail
- * at 4 * i + k for column i. Only the hrow and vrow of one ISA read and
- * write it. A layer row without taps there (h = 0) holds FUSE__H_BIAS. */
+ * too (fuse__hslot: vrow reads it as one more step). Only the hrow and vrow
+ * of one ISA read and write it. A layer row without taps there (h = 0)
+ * holds FUSE__H_BIAS. */
 #define FUSE__H_BIAS 0x8000u
+
+/* Where column i of a call keeps its 4 values (w = SIMD_W, a power of 2):
+ * in its step, the block order of vh_from_u8_lo / hi (pixels 4B, 4B + 1 of
+ * block B in the step's first 2 w values, 4B + 2, 4B + 3 in the next 2 w). */
+static inline int fuse__hslot(int i, int w)
+{
+    const int k = i & (w - 1);
+    return 4 * (i - k) + ((k & 2) ? 2 * w : 0) + 8 * (k >> 2) + 4 * (k & 1);
+}
 
 /* h of columns c .. c + n - 1 of cols from layer row q (h points at column
  * c's entry). */
 typedef void (*fuse__hrow_fn)(const uint8_t *q, const fuse__cols *cols, int c,
                               int n, int sw, uint16_t *h);
 /* The vertical blend of h0 (upper row) and h1 (lower row) with weight fy
- * and the over onto n pixels of V: the bytes of fuse__composite_px. */
+ * and the over onto n pixels of V: the bytes of fuse__composite_px. h0 and
+ * h1 are read to the end of the last step of SIMD_W columns, past n when n
+ * is not a multiple of SIMD_W (the driver's tile arrays hold whole steps). */
 typedef void (*fuse__vrow_fn)(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
                               const uint8_t *v, uint8_t *out, int n);
 

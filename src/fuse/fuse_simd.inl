@@ -33,7 +33,13 @@
  *       loads and shufps (fewer instructions than its vf_load3).
  *   FUSE_ALPHA4(q)  (the row cache's vrow) each pixel's alpha, 16-bit
  *       lane 3 of its 4, in all 4 lanes; default vh_bcast3 (two word
- *       shuffles). AVX2 and AVX-512 use one pshufb. */
+ *       shuffles). AVX2 and AVX-512 use one pshufb.
+ *   FUSE_ALPHA255(q0, q1)  (vrow) 1 when every alpha lane of q0 and q1 is
+ *       255; default FUSE_ALPHA4 and a compare. AVX2: one vptest;
+ *       AVX-512: one masked word compare.
+ *   FUSE_ZERO(v)  (hrow) 1 when v is all zero bits; default vi_eq and
+ *       vm_all (compare, movemask, compare). AVX2: vptest; AVX-512:
+ *       vptestmd. */
 #include <string.h>
 
 /* 1 if the SIMD_W mask bytes at p are all 0 */
@@ -924,6 +930,10 @@ void SIMD_FN(fuse__hprep)(fuse__cols *cols, int n, int sw)
     cols->hprep_w = SIMD_W;
 }
 
+/* 1 when every bit of v is 0 (hrow's empty window) */
+#ifndef FUSE_ZERO
+#define FUSE_ZERO(v) vm_all(vi_eq(v, vi_zero()))
+#endif
 void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n, int sw,
                          uint16_t *h)
 {
@@ -939,7 +949,7 @@ void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n,
             vint a, b;
             if (*base >= 0) {
                 const vint s0 = vi_loadu((const int32_t *)(const void *)(q + 4 * (size_t)*base));
-                if (vm_all(vi_eq(s0, vi_zero()))) {   /* every tap 0: h = 0 */
+                if (FUSE_ZERO(s0)) {   /* every tap 0: h = 0 */
                     vi_storeu((int32_t *)(void *)(h + 4 * i), bias);
                     vi_storeu((int32_t *)(void *)(h + 4 * i + 2 * SIMD_W), bias);
                     continue;
@@ -962,25 +972,35 @@ void SIMD_FN(fuse__hrow)(const uint8_t *q, const fuse__cols *cols, int c, int n,
         }
     }
     /* the last n % SIMD_W columns (all of them without the tables: the
-     * same bytes, pixel by pixel) */
-    for (; i < n; i++) fuse__hpx(q, ixs[i], (uint32_t)fxs[i], sw, h + 4 * i);
+     * same bytes, pixel by pixel), each in its step's block order */
+    for (; i < n; i++) fuse__hpx(q, ixs[i], (uint32_t)fxs[i], sw, h + fuse__hslot(i, SIMD_W));
 }
 
 /* Two pixels per block: q = ((h0 - 32768) w0 + (h1 - 32768) w1 + 32768 *
  * 257) >> 16 per channel (fuse_internal.h: the stored values are h - 32768;
- * w holds the pairs (w0, w1)), then over with V's two pixels in vw (16-bit
- * lanes). vh_zip_lo/hi pair the channels of the block's first and second
- * pixel; vh_packus32 puts them back in order. */
+ * w holds the pairs (w0, w1)), in 16-bit lanes. vh_zip_lo/hi pair the
+ * channels of the block's first and second pixel; vh_packus32 puts them
+ * back in order. */
 #ifndef FUSE_ALPHA4
 #define FUSE_ALPHA4(q) vh_bcast3(q)
 #endif
-SIMD_INL vint vblend_rc(vint a, vint b, vint vw, vint w)
+/* 1 when every pixel of the two vectors of q (vsum_rc) has alpha 255
+ * (lanes 0..255); default: the alphas of q0 & q1 compared with 255. */
+#ifndef FUSE_ALPHA255
+#define FUSE_ALPHA255(q0, q1) vm_all(vi_eq(FUSE_ALPHA4(vi_and(q0, q1)), vh_set1(255)))
+#endif
+SIMD_INL vint vsum_rc(vint a, vint b, vint w)
 {
-    const vint lo8 = vh_set1(255), r128 = vh_set1(128);
     const vint k = vi_set1(32768 * 257);
     const vint sl = vi_srli(vi_add(vh_madd(vh_zip_lo(a, b), w), k), 16);
     const vint sh = vi_srli(vi_add(vh_madd(vh_zip_hi(a, b), w), k), 16);
-    const vint qq = vh_packus32(sl, sh);
+    return vh_packus32(sl, sh);
+}
+
+/* q over V's two pixels per block in vw (16-bit lanes). */
+SIMD_INL vint vover_rc(vint qq, vint vw)
+{
+    const vint lo8 = vh_set1(255), r128 = vh_set1(128);
     vint t = vh_mullo(vh_sub(lo8, FUSE_ALPHA4(qq)), vw);
     /* div255: ((t + 128) + ((t + 128) >> 8)) >> 8 is ((t + 128) 257) >> 16 (the
      * inner floor cannot move the outer one: an integer plus a fraction
@@ -989,6 +1009,9 @@ SIMD_INL vint vblend_rc(vint a, vint b, vint vw, vint w)
     return vh_add(qq, t);
 }
 
+/* A step whose pixels all have alpha 255 (the inside of an opaque layer:
+ * most steps of a hand) is q itself: the over adds div255(0 v) = 0 and
+ * the alpha is already 255, so V is not read. */
 void SIMD_FN(fuse__vrow)(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
                          const uint8_t *v, uint8_t *out, int n)
 {
@@ -996,15 +1019,36 @@ void SIMD_FN(fuse__vrow)(const uint16_t *h0, const uint16_t *h1, uint32_t fy,
     const vint opaque = vi_set1((int32_t)0xFF000000u);
     int i = 0;
     for (; i + SIMD_W <= n; i += SIMD_W) {
-        const vint vv = vi_loadu((const int32_t *)(const void *)(v + 4 * (size_t)i));
-        const vint r0 = vblend_rc(vi_loadu((const int32_t *)(const void *)(h0 + 4 * i)),
-                                  vi_loadu((const int32_t *)(const void *)(h1 + 4 * i)),
-                                  vh_from_u8_lo(vv), w);
-        const vint r1 = vblend_rc(vi_loadu((const int32_t *)(const void *)(h0 + 4 * i + 2 * SIMD_W)),
-                                  vi_loadu((const int32_t *)(const void *)(h1 + 4 * i + 2 * SIMD_W)),
-                                  vh_from_u8_hi(vv), w);
-        vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i), vi_or(vh_packus(r0, r1), opaque));
+        const vint q0 = vsum_rc(vi_loadu((const int32_t *)(const void *)(h0 + 4 * i)),
+                                vi_loadu((const int32_t *)(const void *)(h1 + 4 * i)), w);
+        const vint q1 = vsum_rc(vi_loadu((const int32_t *)(const void *)(h0 + 4 * i + 2 * SIMD_W)),
+                                vi_loadu((const int32_t *)(const void *)(h1 + 4 * i + 2 * SIMD_W)), w);
+        vint r;
+        if (FUSE_ALPHA255(q0, q1)) {
+            r = vh_packus(q0, q1);
+        } else {
+            const vint vv = vi_loadu((const int32_t *)(const void *)(v + 4 * (size_t)i));
+            r = vi_or(vh_packus(vover_rc(q0, vh_from_u8_lo(vv)), vover_rc(q1, vh_from_u8_hi(vv))),
+                      opaque);
+        }
+        vi_storeu((int32_t *)(void *)(out + 4 * (size_t)i), r);
     }
-    for (; i < n; i++) fuse__vpx(h0 + 4 * i, h1 + 4 * i, fy, v + 4 * i, out + 4 * i);
+    if (i < n) {
+        /* the last n - i columns (the tile's end) as one step: h holds them
+         * in block order (fuse__hslot) and the step's other values lie
+         * inside the tile's h arrays (their lanes are computed, never
+         * stored, and take no part in a branch); V and out through the
+         * lane mask */
+        const unsigned bits = (1u << (n - i)) - 1u;
+        const vint vv = vf_as_vi(vf_load_bits((const float *)(const void *)(v + 4 * (size_t)i), bits));
+        const vint q0 = vsum_rc(vi_loadu((const int32_t *)(const void *)(h0 + 4 * i)),
+                                vi_loadu((const int32_t *)(const void *)(h1 + 4 * i)), w);
+        const vint q1 = vsum_rc(vi_loadu((const int32_t *)(const void *)(h0 + 4 * i + 2 * SIMD_W)),
+                                vi_loadu((const int32_t *)(const void *)(h1 + 4 * i + 2 * SIMD_W)), w);
+        vf_store_bits((float *)(void *)(out + 4 * (size_t)i), bits,
+                      vi_as_vf(vi_or(vh_packus(vover_rc(q0, vh_from_u8_lo(vv)),
+                                               vover_rc(q1, vh_from_u8_hi(vv))),
+                                     opaque)));
+    }
 }
 #endif
