@@ -25,6 +25,10 @@
  * fall in the middle of a layer row's rows) */
 enum { CW = 150, CH = 97, OW = 320, OH = 216, OX = 7, OY = 5, OPW = 300, OPH = 203 };
 
+/* the ISAs each test runs on, and the camera's intrinsics */
+static const ef_isa isas[] = {EF_ISA_REF, EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_DEFAULT};
+static const fuse_intrinsics K = {90.0f, 90.0f, CW / 2.0f, CH / 2.0f};
+
 static void eye_fill(tu_eye_data *e, tu_rng *r)
 {
     tu_eye_alloc(e, CW, CH, OW, OH);
@@ -64,14 +68,23 @@ static void *band_thread(void *arg)
     }
 }
 
+/* The n prepared bands of ctx on this thread and one more, as they come. */
+static void bands_two_threads(fuse_context *ctx, int n)
+{
+    band_share s = {ctx, PTHREAD_MUTEX_INITIALIZER, 0, n};
+    pthread_t th;
+    assert_int_equal(pthread_create(&th, NULL, band_thread, &s), 0);
+    band_thread(&s);
+    pthread_join(th, NULL);
+    pthread_mutex_destroy(&s.mu);
+}
+
 static void bands_equal_frame(void **state)
 {
     (void)state;
-    static const ef_isa isas[] = {EF_ISA_REF, EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_DEFAULT};
     static const int rows[] = {1, 3, 7, 32, 48, 1000};
     tu_rng r = {0xBA1A7CEu};
     fuse_lighting L = fuse_lighting_default();
-    const fuse_intrinsics K = {90.0f, 90.0f, CW / 2.0f, CH / 2.0f};
     tu_eye_data e;
     eye_fill(&e, &r);
     const fuse_depth dd = {e.hand, CW, 0.05f, 10.0f, 0.0f, e.scene, OW, OW, OH};
@@ -107,14 +120,8 @@ static void bands_equal_frame(void **state)
                         for (int b = 0; b < n; b++) fuse_context_frame_band(ctx, b);
                     else if (mode == 1)
                         for (int b = n - 1; b >= 0; b--) fuse_context_frame_band(ctx, b);
-                    else {
-                        band_share s = {ctx, PTHREAD_MUTEX_INITIALIZER, 0, n};
-                        pthread_t th;
-                        assert_int_equal(pthread_create(&th, NULL, band_thread, &s), 0);
-                        band_thread(&s);
-                        pthread_join(th, NULL);
-                        pthread_mutex_destroy(&s.mu);
-                    }
+                    else
+                        bands_two_threads(ctx, n);
                     fuse_context_frame_finish(ctx);
                     assert_memory_equal(e.out, want, OW * OH * 4);
                     assert_memory_equal(e.Q, wantq, CW * CH * 4);
@@ -165,10 +172,8 @@ static void mask_at(uint8_t *M, int f)
 static void zero_rows_same_bytes(void **state)
 {
     (void)state;
-    static const ef_isa isas[] = {EF_ISA_REF, EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_DEFAULT};
     tu_rng r = {0x2E50F00Du};
     fuse_lighting L = fuse_lighting_default();
-    const fuse_intrinsics K = {90.0f, 90.0f, CW / 2.0f, CH / 2.0f};
     tu_eye_data e;
     eye_fill(&e, &r);
     const fuse_depth dd = {e.hand, CW, 0.05f, 10.0f, 0.0f, e.scene, OW, OW, OH};
@@ -205,12 +210,7 @@ static void zero_rows_same_bytes(void **state)
                 } else {
                     int n = 0;
                     assert_int_equal(fuse_context_frame_prepare(ctx, &fe, 16, &n), FUSE_OK);
-                    band_share s = {ctx, PTHREAD_MUTEX_INITIALIZER, 0, n};
-                    pthread_t th;
-                    assert_int_equal(pthread_create(&th, NULL, band_thread, &s), 0);
-                    band_thread(&s);
-                    pthread_join(th, NULL);
-                    pthread_mutex_destroy(&s.mu);
+                    bands_two_threads(ctx, n);
                     fuse_context_frame_finish(ctx);
                 }
                 assert_memory_equal(e.out, want, OW * OH * 4);
