@@ -620,8 +620,8 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         fuse_context_desc fd = {(ef_isa)p->desc.max_isa, 1};
         s->rast = rast_context_create(&rd);
         s->fuse = fuse_context_create(&fd);
-        ok = ok && s->depth && s->nrm && s->mask && s->layer && s->layer_zero && s->cam_rgba && s->clip && s->vnrm &&
-             s->rast && s->fuse;
+        ok = ok && s->depth && s->nrm && s->mask && s->layer && s->layer_zero && s->cam_rgba &&
+             s->clip && s->vnrm && s->rast && s->fuse;
         if (ok) {
             /* a calibrated, distorting lens: the mask through it */
             kin_camera c0 = kin_sthmd_camera(&p->hmd, NULL, (kin_eye)e);
