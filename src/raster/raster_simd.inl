@@ -29,6 +29,11 @@
  *   VF_DIV_LANES(a, b, lanes)  a / b in the first `lanes` lanes (the
  *                          others: any value; nothing derived from them is
  *                          stored).
+ *   DEPTH_RUN(p, rem, z)   the depth test of a run vector: the lanes
+ *                          l < rem (rem >= 1) with z < p[l] (ordered) get
+ *                          p[l] = z and are returned as bits; no float of p
+ *                          outside the first rem is accessed (the generic
+ *                          one below, on lane bits).
  * (raster_avx512.c defines them with AVX-512 permutes and masks.)
  *
  * COVERAGE. The reference tests E >= 0 with int64 E stepped by multiples of
@@ -60,6 +65,18 @@
 #define ATTR3_STORE_M(p, bits, lanes, a, b, c) vf_store3_bits(p, bits, a, b, c)
 #endif
 #define ATTR3_STORE_FULL(p, a, b, c) vf_store3(p, a, b, c)
+
+#ifndef DEPTH_RUN
+static inline unsigned simd_depth_run(float *p, int rem, vfloat z)
+{
+    const unsigned run = rem >= SIMD_W ? SIMD_FULL : (1u << rem) - 1u;
+    const unsigned pass = run & vm_bits(vf_lt(z, vf_load_bits(p, run)));
+    if (pass)
+        vf_store_bits(p, pass, z);
+    return pass;
+}
+#define DEPTH_RUN(p, rem, z) simd_depth_run(p, rem, z)
+#endif
 
 /* Lanes l with a < b (ordered), as bits. */
 SIMD_INL unsigned simd_lt_bits(vfloat a, vfloat b)
@@ -194,19 +211,37 @@ typedef struct simd_vec1 {
  * the target's row: the caller checked), the others written back with the
  * values read: no per-pixel loop and no data-dependent branch. Rows
  * belong to one thread (bands are rows), so the bytes written back are
- * never another thread's. Byte k of (b * 0x0101..01) & 0x8040..0201 is
- * nonzero iff bit k of b is set; + 0x7F per byte carries into bit 7 of the
- * byte exactly then (no carry leaves a byte: at most 0x80 + 0x7F). */
+ * never another thread's. With 8 lanes the bytes come from a table of the
+ * 256 masks (2 KB: a load and an OR into memory); with 4, byte k of
+ * (b * 0x01010101) & 0x08040201 is nonzero iff bit k of b is set, and
+ * + 0x7F per byte carries into bit 7 of the byte exactly then (no carry
+ * leaves a byte: at most 0x80 + 0x7F). */
+#if SIMD_W == 8
+#define SIMD_MB1(n) ((((n) & 1) ? 0xFFull : 0) | (((n) & 2) ? 0xFF00ull : 0) | \
+                     (((n) & 4) ? 0xFF0000ull : 0) | (((n) & 8) ? 0xFF000000ull : 0) | \
+                     (((n) & 16) ? 0xFF00000000ull : 0) | (((n) & 32) ? 0xFF0000000000ull : 0) | \
+                     (((n) & 64) ? 0xFF000000000000ull : 0) | \
+                     (((n) & 128) ? 0xFF00000000000000ull : 0))
+#define SIMD_MB4(n) SIMD_MB1(n), SIMD_MB1((n) + 1), SIMD_MB1((n) + 2), SIMD_MB1((n) + 3)
+#define SIMD_MB16(n) SIMD_MB4(n), SIMD_MB4((n) + 4), SIMD_MB4((n) + 8), SIMD_MB4((n) + 12)
+#define SIMD_MB64(n) SIMD_MB16(n), SIMD_MB16((n) + 16), SIMD_MB16((n) + 32), SIMD_MB16((n) + 48)
+static const uint64_t simd_mask_bytes8[256] = {
+    SIMD_MB64(0), SIMD_MB64(64), SIMD_MB64(128), SIMD_MB64(192)
+};
+#undef SIMD_MB64
+#undef SIMD_MB16
+#undef SIMD_MB4
+#undef SIMD_MB1
+#endif
+
 static inline void simd_mask_or(uint8_t *p, unsigned bits)
 {
 #if SIMD_W == 16
     vb_store_bits(p, bits);
 #elif SIMD_W == 8
-    uint64_t m = ((uint64_t)(bits & 0xFFu) * 0x0101010101010101ull) & 0x8040201008040201ull;
-    m = (((m + 0x7F7F7F7F7F7F7F7Full) & 0x8080808080808080ull) >> 7) * 0xFFu;
     uint64_t v;
     memcpy(&v, p, 8);
-    v |= m;
+    v |= simd_mask_bytes8[bits & 0xFFu];
     memcpy(p, &v, 8);
 #else
     uint32_t m = ((uint32_t)(bits & 0xFu) * 0x01010101u) & 0x08040201u;
@@ -351,20 +386,40 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
  * the reduced edge values at (x0, ys) and their steps. The covered pixels
  * of a row are one run: each E'_k is affine in i, so E'_k >= 0 holds on a
  * half-line of i and the three intersect in an interval (the box one too).
- * The row's coverage vectors (aligned at x0) are tested first, from the
- * left: leading empty vectors are skipped and the run ends in the first
- * vector whose last lane is not covered. Then the float work runs on
- * vectors starting at the run's first pixel (lane l = pixel xf + l,
- * fi = (float)(xf + l): the same ops per pixel), so a run of at most
- * SIMD_W pixels takes one vector however it straddles the aligned ones
- * (the slivers of capsule sides: runs of 4-10 pixels in boxes up to
- * hundreds wide). Loads and stores are masked to the run; no other pixel
- * is accessed. As in simd_scan_vec1, the attribute set-up waits for the
- * first pixel written and a row's attribute bases for its first vector
- * that writes (hidden rows and triangles never pay for them); a run
- * vector of at most half the lanes divides on half a vector where the
- * lane macros allow it (VF_DIV_LANES). */
-static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, int ye,
+ * The rows go in chunks of SIMD_WIDE_ROWS, each in two passes:
+ *   1. the runs: a row's coverage vectors (aligned at x0) are tested from
+ *      the left, leading empty vectors skipped, and the run ends in the
+ *      first vector whose last lane is not covered; the rows with a run
+ *      are listed (row, first pixel, last + 1). Only the edge vectors are
+ *      live in this loop.
+ *   2. the float work of the listed rows, on vectors that start at the
+ *      run's first pixel (lane l = pixel xf + l, fi = (float)(xf + l): the
+ *      same ops per pixel), so a run of at most SIMD_W pixels takes one
+ *      vector however it straddles the aligned ones (the slivers of capsule
+ *      sides: runs of 4-10 pixels in boxes up to hundreds wide). Only the
+ *      planes' values are live here: the edge vectors of pass 1 stay out
+ *      of the registers this loop needs (on AVX2's 16 they were spilled and
+ *      reloaded at every row, about a sixth of the AVX2 scan).
+ * Loads and stores are masked to the run; no other pixel is accessed,
+ * except the mask bytes of a vector that lies inside the row, which are
+ * read and written back (simd_mask_or; rows belong to one thread). As in
+ * simd_scan_vec1, the attribute set-up waits for the first pixel written
+ * and a row's attribute bases for its first vector that writes (hidden
+ * rows and triangles never pay for them); a run vector of at most half the
+ * lanes divides on half a vector where the lane macros allow it
+ * (VF_DIV_LANES). Not inlined into the dispatcher: with its own register
+ * allocation it runs 0.1 % fewer instructions in the sample's frame
+ * (callgrind, AVX2). */
+#define SIMD_WIDE_ROWS 32
+
+#if defined(__GNUC__) && !defined(__clang__)
+/* a3 below is set at the first written pixel (aset) before any use, which
+ * gcc cannot see (-Wmaybe-uninitialized); zeroing it cost a 300-byte
+ * memset per triangle. */
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+__attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, int ye,
                            int nx, int nvec, int na, const int64_t *c, const int32_t *sx,
                            const int32_t *sy)
 {
@@ -377,134 +432,145 @@ static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, i
     vint r0 = vi_add(vi_set1((int32_t)c[0]), simd_lane_mul(lanev, sx[0]));
     vint r1 = vi_add(vi_set1((int32_t)c[1]), simd_lane_mul(lanev, sx[1]));
     vint r2 = vi_add(vi_set1((int32_t)c[2]), simd_lane_mul(lanev, sx[2]));
-    const vfloat zdx = vf_set1(tri->z.dx);
+    /* run vectors starting at i0 <= inrow lie inside the target's row */
+    const int inrow = t->width - tri->x0 - SIMD_W;
     long written = 0;
-    uint8_t *mrow = t->mask + (size_t)ys * (size_t)t->mask_stride + tri->x0;
-    float *drow = t->depth ? t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0
-                           : NULL;
-    float *arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride +
-                           (size_t)tri->x0 * (size_t)na
-                     : NULL;
     /* Attribute state, set up at the first pixel written (aset). */
     int aset = 0;
     vfloat qdx = vf_set1(0.0f), b1dx = qdx, b2dx = qdx;
     vfloat av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
 #if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
     ATTR3_STATE a3;
-    /* Set at the first written pixel (aset) before any use; zeroed here
-     * as well, which gcc -O3 cannot see (-Wmaybe-uninitialized). */
-    memset(&a3, 0, sizeof a3);
 #endif
-    for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
-             drow = drow ? drow + t->depth_stride : NULL,
-             arow = arow ? arow + t->attr_stride : NULL) {
-        vint e0 = r0, e1 = r1, e2 = r2;
-        r0 = vi_add(r0, sy0);
-        r1 = vi_add(r1, sy1);
-        r2 = vi_add(r2, sy2);
-        int v = 0;
-        unsigned cov;
-        for (;;) {
-            cov = ~vi_sign_bits(vi_or(vi_or(e0, e1), e2)) &
-                  (v == nvec - 1 ? lastvalid : SIMD_FULL);
-            if (cov || v == nvec - 1)
-                break;
-            v++;
-            e0 = vi_add(e0, st0);
-            e1 = vi_add(e1, st1);
-            e2 = vi_add(e2, st2);
+    for (int yc = ys; yc <= ye; yc += SIMD_WIDE_ROWS) {
+        const int n = ye - yc + 1 < SIMD_WIDE_ROWS ? ye - yc + 1 : SIMD_WIDE_ROWS;
+        int32_t ry[SIMD_WIDE_ROWS], rf[SIMD_WIDE_ROWS], re[SIMD_WIDE_ROWS];
+        int nrun = 0;
+        for (int k = 0; k < n; k++) {
+            vint e0 = r0, e1 = r1, e2 = r2;
+            r0 = vi_add(r0, sy0);
+            r1 = vi_add(r1, sy1);
+            r2 = vi_add(r2, sy2);
+            int v = 0;
+            unsigned cov;
+            for (;;) {
+                cov = ~vi_sign_bits(vi_or(vi_or(e0, e1), e2)) &
+                      (v == nvec - 1 ? lastvalid : SIMD_FULL);
+                if (cov || v == nvec - 1)
+                    break;
+                v++;
+                e0 = vi_add(e0, st0);
+                e1 = vi_add(e1, st1);
+                e2 = vi_add(e2, st2);
+            }
+            if (!cov)
+                continue;
+            const int xf = v * SIMD_W + __builtin_ctz(cov);
+            while ((cov >> (SIMD_W - 1)) && v < nvec - 1) {
+                e0 = vi_add(e0, st0);
+                e1 = vi_add(e1, st1);
+                e2 = vi_add(e2, st2);
+                const unsigned nc = ~vi_sign_bits(vi_or(vi_or(e0, e1), e2)) &
+                                    (v + 1 == nvec - 1 ? lastvalid : SIMD_FULL);
+                if (!nc)
+                    break;
+                cov = nc;
+                v++;
+            }
+            ry[nrun] = yc + k;
+            rf[nrun] = xf;
+            re[nrun] = v * SIMD_W + 32 - __builtin_clz(cov);   /* last + 1 */
+            nrun++;
         }
-        if (!cov)
-            continue;
-        const int xf = v * SIMD_W + __builtin_ctz(cov);
-        while ((cov >> (SIMD_W - 1)) && v < nvec - 1) {
-            e0 = vi_add(e0, st0);
-            e1 = vi_add(e1, st1);
-            e2 = vi_add(e2, st2);
-            const unsigned nc = ~vi_sign_bits(vi_or(vi_or(e0, e1), e2)) &
-                                (v + 1 == nvec - 1 ? lastvalid : SIMD_FULL);
-            if (!nc)
-                break;
-            cov = nc;
-            v++;
-        }
-        const int xe = v * SIMD_W + 32 - __builtin_clz(cov);   /* last + 1 */
 
-        /* Row bases: the reference's scalar expressions (the attribute
-         * ones at the row's first vector that writes). */
-        const float fj = (float)(y - tri->y0);
-        const vfloat zrv = vf_set1(tri->z.c + tri->z.dy * fj);
-        vfloat qrv = zrv, b1rv = zrv, b2rv = zrv;
-        int rowset = 0;
-        for (int i0 = xf; i0 < xe; i0 += SIMD_W) {
-            const int rem = xe - i0;
-            const int lanes = rem < SIMD_W ? rem : SIMD_W;
-            const unsigned run = rem >= SIMD_W ? SIMD_FULL : (1u << rem) - 1u;
-            const vfloat fi = vf_from_vi(vi_add(vi_set1(i0), lanev));
-            vfloat z = vf_add(zrv, vf_mul(zdx, fi));
-            z = vf_max(vf_set1(0.0f), z);
-            z = vf_min(vf_set1(1.0f), z);
-            unsigned pass = run;
-            if (drow) {
-                const vfloat d = vf_load_bits(drow + i0, run);
-                pass = run & simd_lt_bits(z, d);
-                if (!pass)
-                    continue;
-                vf_store_bits(drow + i0, pass, z);
-            }
-            vb_store_bits(mrow + i0, pass);
-            written += simd_popcount(pass);
-            if (!na)
-                continue;
-            if (!aset) {
-                aset = 1;
-                qdx = vf_set1(tri->q.dx);
-                b1dx = vf_set1(tri->b1.dx);
-                b2dx = vf_set1(tri->b2.dx);
-#if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
-                if (na == 3)
-                    ATTR3_PREP(&a3, tri, SIMD_W);
+        for (int q = 0; q < nrun; q++) {
+            const int y = ry[q], xf = rf[q], xe = re[q];
+            uint8_t *mrow = t->mask + (size_t)y * (size_t)t->mask_stride + tri->x0;
+            float *drow = t->depth ? t->depth + (size_t)y * (size_t)t->depth_stride + tri->x0
+                                   : NULL;
+            /* Row bases: the reference's scalar expressions (the attribute
+             * ones at the row's first vector that writes). */
+            const float fj = (float)(y - tri->y0);
+            const vfloat zrv = vf_set1(tri->z.c + tri->z.dy * fj);
+            const vfloat zdx = vf_set1(tri->z.dx);
+            vfloat qrv = zrv, b1rv = zrv, b2rv = zrv;
+            float *arow = NULL;   /* at the row's first vector that writes */
+            for (int i0 = xf; i0 < xe; i0 += SIMD_W) {
+                const int rem = xe - i0;
+                const int lanes = rem < SIMD_W ? rem : SIMD_W;
+                const vfloat fi = vf_from_vi(vi_add(vi_set1(i0), lanev));
+                vfloat z = vf_add(zrv, vf_mul(zdx, fi));
+                z = vf_max(vf_set1(0.0f), z);
+                z = vf_min(vf_set1(1.0f), z);
+                unsigned pass;
+                if (drow) {
+                    pass = DEPTH_RUN(drow + i0, rem, z);
+                    if (!pass)
+                        continue;
+                } else {
+                    pass = rem >= SIMD_W ? SIMD_FULL : (1u << rem) - 1u;
+                }
+                if (i0 <= inrow)
+                    simd_mask_or(mrow + i0, pass);
                 else
-#endif
-                    for (int k = 0; k < na; k++) {
-                        av0[k] = vf_set1(tri->a0[k]);
-                        av1[k] = vf_set1(tri->d1[k]);
-                        av2[k] = vf_set1(tri->d2[k]);
-                    }
-            }
-            if (!rowset) {
-                rowset = 1;
-                qrv = vf_set1(tri->q.c + tri->q.dy * fj);
-                b1rv = vf_set1(tri->b1.c + tri->b1.dy * fj);
-                b2rv = vf_set1(tri->b2.c + tri->b2.dy * fj);
-            }
-#ifdef VF_DIV_LANES
-            const vfloat r = VF_DIV_LANES(vf_set1(1.0f), vf_add(qrv, vf_mul(qdx, fi)), lanes);
-#else
-            const vfloat r = vf_div(vf_set1(1.0f), vf_add(qrv, vf_mul(qdx, fi)));
-#endif
-            const vfloat b1 = vf_mul(vf_add(b1rv, vf_mul(b1dx, fi)), r);
-            const vfloat b2 = vf_mul(vf_add(b2rv, vf_mul(b2dx, fi)), r);
-            float *dst = arow + (size_t)i0 * (size_t)na;
+                    vb_store_bits(mrow + i0, pass);
+                written += simd_popcount(pass);
+                if (!na)
+                    continue;
+                if (!aset) {
+                    aset = 1;
+                    qdx = vf_set1(tri->q.dx);
+                    b1dx = vf_set1(tri->b1.dx);
+                    b2dx = vf_set1(tri->b2.dx);
 #if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
-            if (na == 3) {
-                ATTR3_STORE_PL(dst, pass, lanes, &a3, b1, b2);
-                continue;
-            }
-#elif defined(ATTR3_STORE_FULL)
-            if (na == 3 && pass == SIMD_FULL) {
-                ATTR3_STORE_FULL(dst,
-                    vf_add(vf_add(av0[0], vf_mul(b1, av1[0])), vf_mul(b2, av2[0])),
-                    vf_add(vf_add(av0[1], vf_mul(b1, av1[1])), vf_mul(b2, av2[1])),
-                    vf_add(vf_add(av0[2], vf_mul(b1, av1[2])), vf_mul(b2, av2[2])));
-                continue;
-            }
+                    if (na == 3)
+                        ATTR3_PREP(&a3, tri, SIMD_W);
+                    else
 #endif
-            simd_attr_store(dst, na, pass, lanes, b1, b2, av0, av1, av2);
+                        for (int k = 0; k < na; k++) {
+                            av0[k] = vf_set1(tri->a0[k]);
+                            av1[k] = vf_set1(tri->d1[k]);
+                            av2[k] = vf_set1(tri->d2[k]);
+                        }
+                }
+                if (!arow) {
+                    arow = t->attr + (size_t)y * (size_t)t->attr_stride +
+                           (size_t)tri->x0 * (size_t)na;
+                    qrv = vf_set1(tri->q.c + tri->q.dy * fj);
+                    b1rv = vf_set1(tri->b1.c + tri->b1.dy * fj);
+                    b2rv = vf_set1(tri->b2.c + tri->b2.dy * fj);
+                }
+#ifdef VF_DIV_LANES
+                const vfloat r = VF_DIV_LANES(vf_set1(1.0f), vf_add(qrv, vf_mul(qdx, fi)), lanes);
+#else
+                const vfloat r = vf_div(vf_set1(1.0f), vf_add(qrv, vf_mul(qdx, fi)));
+#endif
+                const vfloat b1 = vf_mul(vf_add(b1rv, vf_mul(b1dx, fi)), r);
+                const vfloat b2 = vf_mul(vf_add(b2rv, vf_mul(b2dx, fi)), r);
+                float *dst = arow + (size_t)i0 * (size_t)na;
+#if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
+                if (na == 3) {
+                    ATTR3_STORE_PL(dst, pass, lanes, &a3, b1, b2);
+                    continue;
+                }
+#elif defined(ATTR3_STORE_FULL)
+                if (na == 3 && pass == SIMD_FULL) {
+                    ATTR3_STORE_FULL(dst,
+                        vf_add(vf_add(av0[0], vf_mul(b1, av1[0])), vf_mul(b2, av2[0])),
+                        vf_add(vf_add(av0[1], vf_mul(b1, av1[1])), vf_mul(b2, av2[1])),
+                        vf_add(vf_add(av0[2], vf_mul(b1, av1[2])), vf_mul(b2, av2[2])));
+                    continue;
+                }
+#endif
+                simd_attr_store(dst, na, pass, lanes, b1, b2, av0, av1, av2);
+            }
         }
     }
     return written;
 }
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
 
 long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya, int yb)
 {
