@@ -419,9 +419,10 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
-__attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const rast__tri *tri, int ys, int ye,
-                           int nx, int nvec, int na, const int64_t *c, const int32_t *sx,
-                           const int32_t *sy)
+__attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const rast__tri *tri,
+                                                     int ys, int ye, int nx, int nvec, int na,
+                                                     const int64_t *c, const int32_t *sx,
+                                                     const int32_t *sy)
 {
     const vint lanev = vi_lanes();
     const unsigned lastvalid = SIMD_FULL >> (nvec * SIMD_W - nx);
