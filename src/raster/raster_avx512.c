@@ -136,8 +136,8 @@ static inline __m512 div_lanes(__m512 a, __m512 b, int lanes)
 #define VF_DIV_LANES(a, b, lanes) div_lanes(a, b, lanes)
 #define ATTR3_STATE attr3_state
 #define ATTR3_PREP(st, tri, lanes) attr3_prep(st, tri, lanes)
-#define ATTR3_STORE_P(p, bits, st, b1, b2) attr3_store_p(p, bits, st, b1, b2)
-#define ATTR3_STORE_PL(p, bits, lanes, st, b1, b2) attr3_store_pl(p, bits, lanes, st, b1, b2)
+#define ATTR3_STORE_P(p, bits, st, b1, b2, in) attr3_store_p(p, bits, st, b1, b2)
+#define ATTR3_STORE_PL(p, bits, lanes, st, b1, b2, in) attr3_store_pl(p, bits, lanes, st, b1, b2)
 
 #include "raster_simd.inl"
 
