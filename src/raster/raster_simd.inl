@@ -72,10 +72,16 @@
 #endif
 #define ATTR3_STORE_FULL(p, a, b, c) vf_store3(p, a, b, c)
 
+/* The bits of lanes 0 .. n - 1 (n >= 0; every lane from SIMD_W on). */
+static inline unsigned simd_first_lanes(int n)
+{
+    return n >= SIMD_W ? SIMD_FULL : (1u << n) - 1u;
+}
+
 #ifndef DEPTH_RUN
 static inline unsigned simd_depth_run(float *p, int rem, vfloat z)
 {
-    const unsigned run = rem >= SIMD_W ? SIMD_FULL : (1u << rem) - 1u;
+    const unsigned run = simd_first_lanes(rem);
     const unsigned pass = run & vm_bits(vf_lt(z, vf_load_bits(p, run)));
     if (pass)
         vf_store_bits(p, pass, z);
@@ -321,7 +327,7 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
                            int32_t sx0, int32_t sx1, int32_t sx2, int32_t sy0,
                            int32_t sy1, int32_t sy2)
 {
-    const unsigned valid = nx >= SIMD_W ? SIMD_FULL : (1u << nx) - 1u;
+    const unsigned valid = simd_first_lanes(nx);
     const vint lanev = vi_lanes();
     simd_vec1 s;
     s.e0 = vi_add(vi_set1(c0), simd_lane_mul(lanev, sx0));
@@ -441,6 +447,9 @@ __attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const
     vint r2 = vi_add(vi_set1((int32_t)c[2]), simd_lane_mul(lanev, sx[2]));
     /* run vectors starting at i0 <= inrow lie inside the target's row */
     const int inrow = t->width - tri->x0 - SIMD_W;
+    /* once, not per row: the stores to the float planes may alias *tri
+     * for the compiler, which would load and broadcast it again */
+    const vfloat zdx = vf_set1(tri->z.dx);
     long written = 0;
     /* Attribute state, set up at the first pixel written (aset). */
     int aset = 0;
@@ -499,7 +508,6 @@ __attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const
              * ones at the row's first vector that writes). */
             const float fj = (float)(y - tri->y0);
             const vfloat zrv = vf_set1(tri->z.c + tri->z.dy * fj);
-            const vfloat zdx = vf_set1(tri->z.dx);
             vfloat qrv = zrv, b1rv = zrv, b2rv = zrv;
             float *arow = NULL;   /* at the row's first vector that writes */
             for (int i0 = xf; i0 < xe; i0 += SIMD_W) {
@@ -515,7 +523,7 @@ __attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const
                     if (!pass)
                         continue;
                 } else {
-                    pass = rem >= SIMD_W ? SIMD_FULL : (1u << rem) - 1u;
+                    pass = simd_first_lanes(rem);
                 }
                 if (i0 <= inrow)
                     simd_mask_or(mrow + i0, pass);
@@ -678,7 +686,7 @@ long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya
         for (int v = 0; v < nvec; v++) {
             const int i0 = v * SIMD_W;
             const int rem = nx - i0;
-            const unsigned valid = rem >= SIMD_W ? SIMD_FULL : (1u << rem) - 1u;
+            const unsigned valid = simd_first_lanes(rem);
             const vint t0 = vi_add(vi_set1(simd_clamp29(eb0)), off0);
             const vint t1 = vi_add(vi_set1(simd_clamp29(eb1)), off1);
             const vint t2 = vi_add(vi_set1(simd_clamp29(eb2)), off2);
