@@ -454,6 +454,7 @@ __attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const
     /* Attribute state, set up at the first pixel written (aset). */
     int aset = 0;
     vfloat qdx = vf_set1(0.0f), b1dx = qdx, b2dx = qdx;
+    vfloat qrv = qdx, b1rv = qdx, b2rv = qdx;   /* a row's, at its first vector that writes */
     vfloat av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
 #if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
     ATTR3_STATE a3;
@@ -508,7 +509,6 @@ __attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const
              * ones at the row's first vector that writes). */
             const float fj = (float)(y - tri->y0);
             const vfloat zrv = vf_set1(tri->z.c + tri->z.dy * fj);
-            vfloat qrv = zrv, b1rv = zrv, b2rv = zrv;
             float *arow = NULL;   /* at the row's first vector that writes */
             for (int i0 = xf; i0 < xe; i0 += SIMD_W) {
                 const int rem = xe - i0;
