@@ -45,6 +45,9 @@
  *               [--hard-edges] (the binary mask's edges instead of the soft
  *                             silhouettes that render, run and demo draw)
  *               [--cpu-time] (frame and stage times in thread CPU time)
+ *               [--lod N|auto] [--lod-px PX] (the sample model's levels of
+ *                             detail, as egofuse render --lod: level N, or
+ *                             the rule at PX pixels, default 2)
  *
  * Writes DIR/bench.csv (header + egofuse, memcpy and pixman rows),
  * DIR/frame_tris.csv, DIR/frame_cover.csv, DIR/frame_res.csv,
@@ -62,6 +65,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/io/io.h"
+#include "../src/io/io_lod.h"
 #include "../src/pipe/pipe.h"
 #include "bench_mesh.h"
 #include "bench_sample.h"
@@ -577,6 +581,13 @@ static void csv_row(bench *b, const char *cs, const char *impl, const char *isa,
  * (pipe_desc.soft_edge 0) instead of the default soft silhouettes */
 static int grid_hard_edges = 0;
 
+/* --lod N|auto, --lod-px PX: the pipes of the sample model draw its levels
+ * of detail as `egofuse render --lod` does (pipe_set_lod; the chain built
+ * once at load by io_lod_build); 0: the full model (the default path). */
+static int grid_lod = 0;
+static float grid_lod_px = 2.0f;
+static pipe_lod grid_lod_chain;
+
 static pipe_ctx *make_pipe(bench *b, const kin_model *m, ef_isa isa, int threads,
                            const kin_sthmd_desc *hmd)
 {
@@ -592,8 +603,14 @@ static pipe_ctx *make_pipe(bench *b, const kin_model *m, ef_isa isa, int threads
      * (one pass over the mask, counted in the fuse stage); --hard-edges
      * measures the binary mask's frame. */
     d.soft_edge = !grid_hard_edges;
-    (void)b;
-    return pipe_create(&d, m);
+    pipe_ctx *p = pipe_create(&d, m);
+    if (p && grid_lod && m == &b->model &&
+        pipe_set_lod(p, &grid_lod_chain, grid_lod, grid_lod_px) != 0) {
+        fprintf(stderr, "bench_frame: the levels of detail do not fit the sample model\n");
+        pipe_destroy(p);
+        return NULL;
+    }
+    return p;
 }
 
 /* -------------------------------------------------------- worst case */
@@ -1419,6 +1436,16 @@ int main(int argc, char **argv)
         else if (!strcmp(o, "--inplace")) grid_inplace = 1;
         else if (!strcmp(o, "--hard-edges")) grid_hard_edges = 1;
         else if (!strcmp(o, "--cpu-time")) frame_cpu_clock = 1;
+        else if (!strcmp(o, "--lod") && v) {
+            if (!strcmp(v, "auto")) grid_lod = PIPE_LOD_AUTO;
+            else ok = parse_int(v, 0, PIPE_LOD_MAX - 1, &grid_lod);
+            a++;
+        } else if (!strcmp(o, "--lod-px") && v) {
+            char *e = NULL;
+            grid_lod_px = strtof(v, &e);
+            ok = e != v && *e == 0 && grid_lod_px > 0.0f && grid_lod_px <= 1000.0f;
+            a++;
+        }
         else ok = 0;
         if (!ok) {
             fprintf(stderr,
@@ -1427,7 +1454,7 @@ int main(int argc, char **argv)
                     "[--no-scaling]\n"
                     "       [--no-hmds] [--hmds-only] [--hmd-frames N] [--hmd NAME]\n"
                     "       [--isa ref|sse2|avx2|avx512] [--threads 1|2] [--inplace] [--hard-edges]\n"
-                    "       [--cpu-time]\n",
+                    "       [--cpu-time] [--lod N|auto] [--lod-px PX]\n",
                     argv[0]);
             return 2;
         }
@@ -1482,6 +1509,22 @@ int main(int argc, char **argv)
            bu.frames_best, ef_isa_name(ef_isa_choose(EF_ISA_DEFAULT)), bu.frames, bu.ref_frames,
            bu.scale_frames, bu.s_best, bu.s_other, bu.s_ref, bu.s_scale, b.seq_frames);
 
+    if (grid_lod) {
+        io_error err;
+        char ln[32];
+        double t0 = now_ms();
+        if (io_lod_build(samples, &b.model, NULL, &grid_lod_chain, &err) != IO_OK) {
+            fprintf(stderr, "bench_frame: %s\n", err.msg);
+            return 1;
+        }
+        if (grid_lod == PIPE_LOD_AUTO) snprintf(ln, sizeof ln, "auto@%gpx", (double)grid_lod_px);
+        else snprintf(ln, sizeof ln, "L%d", grid_lod);
+        printf("levels of detail (--lod): %s of %d levels (", ln, grid_lod_chain.level_count);
+        for (int l = 0; l < grid_lod_chain.level_count; l++)
+            printf("%s%ld", l ? ", " : "", grid_lod_chain.level[l].triangles);
+        printf(" triangles), built in %.1f ms; the scaling rows' models draw whole\n",
+               now_ms() - t0);
+    }
     ef_isa best = ef_isa_choose(EF_ISA_DEFAULT);
     if (hmds == 2) {   /* --hmds-only */
         run_hmds(&b, hmd_frames, hmd_s, hmd_only);
