@@ -1448,6 +1448,10 @@ int main(int argc, char **argv)
         }
         else ok = 0;
         if (!ok) {
+            if (v && strncmp(o, "--", 2) == 0 && !(v[0] == '-' && v[1] == '-'))
+                fprintf(stderr, "bench_frame: %s '%s': not a valid value, or not an option\n", o, v);
+            else
+                fprintf(stderr, "bench_frame: %s: not an option, or its value is missing\n", o);
             fprintf(stderr,
                     "usage: %s [--samples DIR] [--out DIR] [--frames N] [--ref-frames N]\n"
                     "       [--scale-frames N] [--seconds S] [--window N] [--quick] "
