@@ -1534,6 +1534,7 @@ int main(int argc, char **argv)
         run_hmds(&b, hmd_frames, hmd_s, hmd_only);
         if (b.csv) fclose(b.csv);
         helper_stop(&b.help);
+        io_lod_free(&grid_lod_chain);
         return 0;
     }
     pipe_ctx *p = make_pipe(&b, &b.model, best, 2, NULL);
@@ -1572,5 +1573,6 @@ int main(int argc, char **argv)
            "frame_tris.csv, frame_cover.csv, frame_res.csv in %s/\n",
            path, outdir);
     helper_stop(&b.help);
+    io_lod_free(&grid_lod_chain);
     return 0;
 }
