@@ -47,7 +47,8 @@
  *               [--cpu-time] (frame and stage times in thread CPU time)
  *               [--lod N|auto] [--lod-px PX] (the sample model's levels of
  *                             detail, as egofuse render --lod: level N, or
- *                             the rule at PX pixels, default 2)
+ *                             the rule at PX pixels, default 2; its CSV rows
+ *                             say egofuse_lodN or egofuse_lodauto@PXpx)
  *
  * Writes DIR/bench.csv (header + egofuse, memcpy and pixman rows),
  * DIR/frame_tris.csv, DIR/frame_cover.csv, DIR/frame_res.csv,
@@ -587,6 +588,10 @@ static int grid_hard_edges = 0;
 static int grid_lod = 0;
 static float grid_lod_px = 2.0f;
 static pipe_lod grid_lod_chain;
+/* the impl column of the sample model's rows: "egofuse", or with --lod
+ * "egofuse_lodN" / "egofuse_lodauto@PXpx", so that no chart or summary
+ * takes them for the default path */
+static char grid_impl[48] = "egofuse";
 
 static pipe_ctx *make_pipe(bench *b, const kin_model *m, ef_isa isa, int threads,
                            const kin_sthmd_desc *hmd)
@@ -787,7 +792,7 @@ static void run_grid(bench *b, const budget *bu)
                     print_row(c ? "worst" : "typical", ef_isa_name(isas[i]), t, &r);
                     print_breakdown(&r, t);
                     if (isas[i] == best) b->lat[c][t - 1] = r;
-                    csv_row(b, c ? "frame_worst" : "frame_typical", "egofuse", ef_isa_name(isas[i]),
+                    csv_row(b, c ? "frame_worst" : "frame_typical", grid_impl, ef_isa_name(isas[i]),
                             t, &r, -1, b->hmd.lcd_width, b->hmd.lcd_height);
                 }
                 pipe_destroy(p);
@@ -1339,7 +1344,7 @@ static void run_hmds(bench *b, int n, double max_s, const char *only)
                 printf("  %-8s CPU time of the process per frame (median): %.3f ms%s\n", "",
                        r.cpu, cases[c].t == 2 ? " (both threads)" : "");
                 cpu[c] = r.cpu;
-                csv_row(b, cases[c].inplace ? "frame_hmd_inplace" : "frame_hmd", "egofuse",
+                csv_row(b, cases[c].inplace ? "frame_hmd_inplace" : "frame_hmd", grid_impl,
                         ef_isa_name(cases[c].isa), cases[c].t, &r, -1, hd.lcd_width,
                         hd.lcd_height);
                 ms[c] = r.total.median;
@@ -1523,6 +1528,7 @@ int main(int argc, char **argv)
         }
         if (grid_lod == PIPE_LOD_AUTO) snprintf(ln, sizeof ln, "auto@%gpx", (double)grid_lod_px);
         else snprintf(ln, sizeof ln, "L%d", grid_lod);
+        snprintf(grid_impl, sizeof grid_impl, "egofuse_lod%s", ln[0] == 'L' ? ln + 1 : ln);
         printf("levels of detail (--lod): %s of %d levels (", ln, grid_lod_chain.level_count);
         for (int l = 0; l < grid_lod_chain.level_count; l++)
             printf("%s%ld", l ? ", " : "", grid_lod_chain.level[l].triangles);
