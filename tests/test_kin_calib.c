@@ -197,6 +197,9 @@ static void validity_file_errors(void **state)
     expect_parse_error("egofuse-calib 1\narm_length 1 -1\n", 2, "outside [0, 5]");
     expect_parse_error("egofuse-calib 1\nglove_left 1 2 3 4 5 1 7 8 9 10\n", 2,
                        "sensor 1: open and fist readings are equal");
+    /* above 1e30 as a float (1.0000001e30 rounds to the float after 1e30f) */
+    expect_parse_error("egofuse-calib 1\nglove_left 1 2 3 1.0000001e30 5 6 7 8 9 10\n", 2,
+                       "value 4: bad number");
     expect_parse_error("egofuse-calib 1\narm_scale 1 1\n", 0, "missing key 'hand_scale'");
 }
 
@@ -338,6 +341,19 @@ static void result_file_round_trip(void **state)
     NEAR(back.hand_scale[1], 1.1f, 0);
     NEAR(back.hand_length[0], 0, 0);
     NEAR(back.hand_length[1], 0, 0);
+    /* A reading next to the 1e30 limit (fuzz_kin_calib's find): 1e30 as a
+     * double, 1e30f = 1.00000002e30 as the float kept; the file written
+     * from it reads back to the same values. */
+    const char *edge = "egofuse-calib 1\narm_scale 1.1 1.1\nhand_scale 1.1 1.1\nshoulder_scale 1\n"
+                       "arm_length 0 0\nshoulder_width 0.42\n"
+                       "glove_left 0.1 0.1 0.1 1000000000000000000084467440731 0.1 0.9 0.9 0.9 0.9 "
+                       "0.9\n";
+    if (kin_user_calib_parse(edge, strlen(edge), &c, &line, why, sizeof why)) fail_msg("%s", why);
+    assert_true(c.glove[0].raw_open[3] == 1e30f);
+    n = kin_user_calib_format(&c, buf, sizeof buf);
+    assert_true(n > 0 && n < (int)sizeof buf);
+    if (kin_user_calib_parse(buf, (size_t)n, &back, &line, why, sizeof why)) fail_msg("%s: %s", why, buf);
+    assert_memory_equal(&back, &c, sizeof c);
 }
 
 /* The calibrated rig reaches a stretched-arm target of the bigger user;
