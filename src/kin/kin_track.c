@@ -147,9 +147,9 @@ int kin_track_parse_line(const char *line, size_t len, kin_track_sample *out,
             if (parse_number(tok[at], &d) < 0)
                 return fail(why, why_size, "%s value %d: bad number '%.32s'",
                             tags[tag].name, k + 1, tok[at]);
-            /* the float kept at most 1e30 (as kin_calib.c's number(): a
-             * double check lets 1e30f = 1.00000002e30 through, which a
-             * formatted line would then carry past the limit) */
+            /* the float kept at most 1e30 (as kin_calib.c's number()): a
+             * check of the double passes "1e30" itself, whose float 1e30f
+             * = 1.00000002e30 the formatted line then carries past it */
             if (!(fabs(d) <= 2e30) || !(fabsf((float)d) <= 1e30f))
                 return fail(why, why_size, "%s value %d out of range", tags[tag].name, k + 1);
             v[k] = (float)d;
