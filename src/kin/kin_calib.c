@@ -243,22 +243,6 @@ static const char *const keys[K_COUNT] = { "arm_scale", "hand_scale", "shoulder_
 static const int key_count[K_COUNT] = { 2, 2, 1, 2, 1, 10, 10, 2 };
 #define REQUIRED_KEYS 5 /* the first five */
 
-/* Strict decimal number (kin__parse_number), at most 1e30 in magnitude as
- * the float that is kept. The float, not the parsed double, is checked:
- * "1000000000000000000084467440731" is 1e30 as a double but 1e30f =
- * 1.00000002e30 as a float, which kin_user_calib_format writes and a
- * double check would then refuse (found by fuzz_kin_calib: every file
- * this accepts must format to one it accepts again). */
-static int number(const char *tok, float *out)
-{
-    double v;
-    if (kin__parse_number(tok, &v) != 0 || !(fabs(v) <= 2e30)) return -1;
-    const float f = (float)v;   /* |v| <= 2e30: within float range */
-    if (!(fabsf(f) <= 1e30f)) return -1;
-    *out = f;
-    return 0;
-}
-
 int kin_user_calib_parse(const char *text, size_t len, kin_user_calib *out, int *err_line,
                          char *why, size_t why_size)
 {
@@ -299,7 +283,7 @@ int kin_user_calib_parse(const char *text, size_t len, kin_user_calib *out, int 
                         key_count[key], nt - 1);
         float v[10] = { 0 };
         for (int i = 0; i < key_count[key]; i++)
-            if (number(tok[1 + i], &v[i]) < 0)
+            if (kin__parse_float(tok[1 + i], &v[i]) != 0)
                 return fail(why, why_size, "'%s' value %d: bad number '%.32s'", keys[key], i + 1,
                             tok[1 + i]);
         switch (key) {

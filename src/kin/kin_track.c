@@ -137,22 +137,18 @@ int kin_track_parse_line(const char *line, size_t len, kin_track_sample *out,
         float v[7];
         for (int k = 0; k < tags[tag].count; k++) {
             int at = i + 1 + k;
-            double d;
             int is_tag = 0;
             for (int q = 0; at < nt && q < TAG_COUNT; q++)
                 if (strcmp(tok[at], tags[q].name) == 0) is_tag = 1;
             if (at >= nt || is_tag)
                 return fail(why, why_size, "%s needs %d numbers, got %d",
                             tags[tag].name, tags[tag].count, k);
-            if (parse_number(tok[at], &d) < 0)
+            const int r = kin__parse_float(tok[at], &v[k]);
+            if (r == -1)
                 return fail(why, why_size, "%s value %d: bad number '%.32s'",
                             tags[tag].name, k + 1, tok[at]);
-            /* the float kept at most 1e30 (as kin_calib.c's number()): a
-             * check of the double passes "1e30" itself, whose float 1e30f
-             * = 1.00000002e30 the formatted line then carries past it */
-            if (!(fabs(d) <= 2e30) || !(fabsf((float)d) <= 1e30f))
+            if (r != 0)
                 return fail(why, why_size, "%s value %d out of range", tags[tag].name, k + 1);
-            v[k] = (float)d;
         }
         store(&s, tag, v);
         s.valid |= tags[tag].bit;

@@ -54,6 +54,17 @@ int kin__parse_number(const char *tok, double *out)
     return 0;
 }
 
+int kin__parse_float(const char *tok, float *out)
+{
+    double v;
+    if (kin__parse_number(tok, &v) != 0) return -1;
+    if (!(fabs(v) <= 2e30)) return -2;   /* then within float range */
+    const float f = (float)v;
+    if (!(fabsf(f) <= 1e30f)) return -2;
+    *out = f;
+    return 0;
+}
+
 int kin__tokens(char *buf, char **tok, int cap)
 {
     int nt = 0;
