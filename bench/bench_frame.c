@@ -71,6 +71,7 @@
 #include "bench_mesh.h"
 #include "bench_sample.h"
 #include "bench_util.h"
+#include "bench_worst.h"
 #include "../src/cpu/ef_mem.h"
 
 #if defined(__has_include)
@@ -291,11 +292,8 @@ typedef struct bench {
     const char *outdir;
     /* worst case */
     int worst_frame;
-    kin_mat4 worst_head;
-    double worst_d, worst_cover;
+    bench_worst worst;        /* the head of the worst case (bench_worst.h) */
     result lat[2][2];         /* best ISA: [worst][threads - 1] */
-    int worst_target;         /* 0 right palm, 1 left palm, 2 between */
-    kin_vec3 hands_c, head0;
 } bench;
 
 static fuse_image img_of(uint8_t *px, int w, int h) { return (fuse_image){px, w, h, 4 * w}; }
@@ -620,83 +618,33 @@ static pipe_ctx *make_pipe(bench *b, const kin_model *m, ef_isa isa, int threads
 
 /* -------------------------------------------------------- worst case */
 
-static kin_mat4 head_looking_at(kin_vec3 eye, kin_vec3 target)
+typedef struct worst_ctx {
+    bench *b;
+    pipe_ctx *p;
+    posesrc src;
+} worst_ctx;
+
+/* The coverage of one frame of the worst case's pose with head h. */
+static double worst_cover(void *ctx, const kin_mat4 *h)
 {
-    kin_mat4 v = kin_mat4_look_at(eye, target, kin_v3(0, 1, 0)), w;
-    kin_mat4_inverse(&v, &w);
-    return w;
+    worst_ctx *w = ctx;
+    posesrc src = w->src;
+    src.head = h;
+    kin_filter_init(&w->b->filt, NULL);   /* the pose at once, no filter lag */
+    if (!frame_step(w->b, w->p, &w->b->base, &src, w->b->tick, 0)) return 0;
+    return w->b->tm.cover[0];
 }
 
-/* Head at distance d from the hands' centre, on the line from the
- * recorded head, looking at it. */
-static kin_mat4 worst_head_at(const bench *b, double d)
-{
-    kin_vec3 dir = kin_v3_norm(kin_v3_sub(b->hands_c, b->head0));
-    return head_looking_at(kin_v3_sub(b->hands_c, kin_v3_scale(dir, (float)d)), b->hands_c);
-}
-
-static double coverage_at(bench *b, pipe_ctx *p, const posesrc *src0, double d)
-{
-    kin_mat4 h = worst_head_at(b, d);
-    posesrc src = *src0;
-    src.head = &h;
-    kin_filter_init(&b->filt, NULL);   /* the pose at once, no filter lag */
-    if (!frame_step(b, p, &b->base, &src, b->tick, 0)) return 0;
-    return b->tm.cover[0];
-}
-
-/* The worst case: at the pose of the grasp (1.5 s), the head moves from
- * its recorded place towards a target (the right palm, the left palm or
- * their midpoint) and looks at it; a scan of distances per target, then
- * bisection between the two scanned distances around 70% coverage. */
+/* The worst case (bench_worst.h): the pose of the grasp (1.5 s), the head
+ * moved towards a palm or between them until about 70% is covered. */
 static void find_worst(bench *b, pipe_ctx *p)
 {
     b->worst_frame = (int)(1.5f * b->fps) < b->seq_frames ? (int)(1.5f * b->fps) : 0;
-    pipe_pose ps;
-    if (pipe_pose_init(&ps, &b->model) != 0) exit(1);
-    pipe_pose_anim(&ps, b->anim, (float)b->worst_frame / b->fps);
-    kin_vec3 l = kin_mat4_translation(&ps.world[b->rig.joint[0][KIN_RIG_PALM]]);
-    kin_vec3 r = kin_mat4_translation(&ps.world[b->rig.joint[1][KIN_RIG_PALM]]);
-    const kin_vec3 targets[3] = {r, l, kin_v3_scale(kin_v3_add(l, r), 0.5f)};
-    b->head0 = kin_mat4_translation(&ps.world[b->head]);
-    pipe_pose_free(&ps);
-    posesrc src = {&b->samples[b->worst_frame], 1, NULL, 0};
-    enum { STEPS = 14 };
-    double best_err = 1e9;
-    for (int t = 0; t < 3; t++) {
-        b->hands_c = targets[t];
-        const double d0 = kin_v3_len(kin_v3_sub(targets[t], b->head0)), dmin = 0.09;
-        double prev_d = d0, prev_c = coverage_at(b, p, &src, d0);
-        for (int k = 1; k <= STEPS; k++) {
-            double d = d0 + (dmin - d0) * k / STEPS, c = coverage_at(b, p, &src, d);
-            if (fabs(c - 0.70) < best_err) {
-                best_err = fabs(c - 0.70);
-                b->worst_d = d;
-                b->worst_cover = c;
-                b->worst_target = t;
-            }
-            if (prev_c < 0.70 && c >= 0.70) {   /* bracketed: bisect */
-                double lo = d, hi = prev_d;
-                for (int it = 0; it < 10; it++) {
-                    double mid = 0.5 * (lo + hi), cm = coverage_at(b, p, &src, mid);
-                    if (fabs(cm - 0.70) < best_err) {
-                        best_err = fabs(cm - 0.70);
-                        b->worst_d = mid;
-                        b->worst_cover = cm;
-                        b->worst_target = t;
-                    }
-                    if (cm < 0.70) hi = mid;
-                    else lo = mid;
-                }
-                break;
-            }
-            prev_d = d;
-            prev_c = c;
-        }
-        if (best_err < 0.01) break;
-    }
-    b->hands_c = targets[b->worst_target];
-    b->worst_head = worst_head_at(b, b->worst_d);
+    if (bench_worst_init(&b->worst, &b->model, &b->rig, b->anim,
+                         (float)b->worst_frame / b->fps) != 0)
+        exit(1);
+    worst_ctx w = {b, p, {&b->samples[b->worst_frame], 1, NULL, 0}};
+    bench_worst_find(&b->worst, worst_cover, &w);
 }
 
 /* ---------------------------------------------------------- the grid */
@@ -752,7 +700,7 @@ static void run_grid(bench *b, const budget *bu)
     const ef_isa best = ef_isa_choose(EF_ISA_DEFAULT);
     static const ef_isa isas[] = {EF_ISA_REF, EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512};
     posesrc typical = {b->samples, b->seq_frames, NULL, 0};
-    posesrc worst = {&b->samples[b->worst_frame], 1, &b->worst_head, 0};
+    posesrc worst = {&b->samples[b->worst_frame], 1, &b->worst.head, 0};
     printf("\nWhole stereo frame (ms; stage columns are medians, raster and fuse summed over\n"
            "both eyes, which run in parallel with 2 threads; raster = context clear + vertex\n"
            "transforms + draw with normals, back faces culled, as bench_raster's \"pipe\" rows;\n"
@@ -1113,13 +1061,13 @@ static void scale_cover(bench *b, int n, double max_s, ef_isa isa)
 {
     FILE *f = open_csv(b, "frame_cover.csv",
                        "coverage,head_dist_m,median_1t_ms,p99_1t_ms,median_2t_ms,p99_2t_ms");
-    double d0 = kin_v3_len(kin_v3_sub(b->hands_c, b->head0));
+    double d0 = bench_worst_d0(&b->worst);
     printf("\nScaling with the covered area (pose of frame %d, the head moved towards the hands; "
            "%s, medians of up to %d frames):\n  %7s %8s %10s %10s\n",
            b->worst_frame, ef_isa_name(isa), n, "cover", "dist m", "1 thread", "2 threads");
     for (int s = 0; s < 7; s++) {
-        double d = d0 + (b->worst_d * 0.85 - d0) * s / 6.0;
-        kin_mat4 h = worst_head_at(b, d);
+        double d = d0 + (b->worst.d * 0.85 - d0) * s / 6.0;
+        kin_mat4 h = bench_worst_head_at(&b->worst, b->worst.target, d);
         posesrc src = {&b->samples[b->worst_frame], 1, &h, 0};
         double med[2] = {0, 0}, p99[2] = {0, 0}, cov = 0;
         for (int t = 1; t <= 2; t++) {
@@ -1547,11 +1495,10 @@ int main(int argc, char **argv)
     if (!p) return 1;
     find_worst(&b, p);
     pipe_destroy(p);
-    static const char *tname[3] = {"the right palm", "the left palm", "between the palms"};
     printf("worst case: pose of frame %d, head %.3f m from %s (%.3f m recorded), looking at it: "
            "%.1f%% of the camera pixels covered\n",
-           b.worst_frame, b.worst_d, tname[b.worst_target],
-           kin_v3_len(kin_v3_sub(b.hands_c, b.head0)), 100 * b.worst_cover);
+           b.worst_frame, b.worst.d, bench_worst_target_name[b.worst.target],
+           bench_worst_d0(&b.worst), 100 * b.worst.cover);
 
     run_grid(&b, &bu);
     printf("\nLatency: the pipeline's processing latency (camera frame in memory -> both "

@@ -51,7 +51,7 @@ fi
 if [ -x "$BUILD/bench/llvmpipe_frame" ]; then
     for t in 1 2; do
         echo "==== llvmpipe_frame --threads $t (the same frame as GL shaders on Mesa llvmpipe, side by side with egofuse)"
-        "$BUILD/bench/llvmpipe_frame" --samples "$SAMPLES" --threads "$t" \
+        "$BUILD/bench/llvmpipe_frame" --samples "$SAMPLES" --threads "$t" --case both \
             --frames "$LLVMPIPE_FRAMES" --csv "$OUT/bench.csv" --diff-csv "$OUT/llvmpipe_diff.csv"
         case $? in
             0) ;;
@@ -164,6 +164,8 @@ if [ -f "$OUT/bench.csv" ]; then
                      if ($1 == "frame_worst" && $2 == "egofuse" && (!(("w", $4) in be) || $5 < be["w", $4])) { be["w", $4] = $5; bi["w", $4] = $3 }
                      if ($1 == "frame_typical" && $2 == "llvmpipe") lp[$4] = $5
                      if ($1 == "frame_anim" && $2 == "egofuse") ea[$4] = $5
+                     if ($1 == "frame_worst" && $2 == "llvmpipe") lpw[$4] = $5
+                     if ($1 == "frame_worst_anim" && $2 == "egofuse") eaw[$4] = $5
                      if ($1 == "memcpy_floor") mc[$4] = $5
                      if ($1 == "composite" && $2 == "pixman") px = $5
                      if ($1 == "composite" && $2 == "egofuse" && $4 == 1 && (cb == "" || $5 < cb)) { cb = $5; ci = $3 } }
@@ -172,6 +174,7 @@ if [ -f "$OUT/bench.csv" ]; then
                          if (("t", t) in be) printf "- typical, %d thread%s: best egofuse %.3f ms (%s)%s\n", t, (t > 1 ? "s" : ""), be["t", t], bi["t", t], ((t == 2) ? sprintf(" - target <= 1.0 ms: %s", (be["t", t] <= 1.0 ? "met" : "missed")) : "")
                          if (("w", t) in be) printf "- worst case, %d thread%s: best egofuse %.3f ms (%s)%s\n", t, (t > 1 ? "s" : ""), be["w", t], bi["w", t], ((t == 2) ? sprintf(" - target <= 2.0 ms: %s", (be["w", t] <= 2.0 ? "met" : "missed")) : "")
                          if ((t in lp) && (t in ea)) printf "- llvmpipe, %d thread%s: %.3f ms per frame; egofuse on the same frames, interleaved: %.3f ms; llvmpipe / egofuse = %.1fx (target >= 20x)\n", t, (t > 1 ? "s" : ""), lp[t], ea[t], lp[t] / ea[t]
+                         if ((t in lpw) && (t in eaw)) printf "- llvmpipe, worst case (70%%), %d thread%s: %.3f ms per frame; egofuse interleaved: %.3f ms; llvmpipe / egofuse = %.1fx\n", t, (t > 1 ? "s" : ""), lpw[t], eaw[t], lpw[t] / eaw[t]
                          if ((t in mc) && (("t", t) in be)) printf "- memory floor (memcpy of both outputs), %d thread%s: %.3f ms; typical frame / floor = %.1fx (target <= 2.5x)\n", t, (t > 1 ? "s" : ""), mc[t], be["t", t] / mc[t]
                      }
                      if (px != "" && cb != "") printf "- composite stage: pixman %.3f ms, egofuse (%s, 1 thread) %.3f ms; pixman / egofuse = %.1fx\n", px, ci, cb, px / cb
@@ -192,7 +195,7 @@ if [ -f "$OUT/bench.csv" ]; then
                                    $27, $27 / 2, ($27 / 2 <= 5.5 ? "met" : sprintf("missed by >= %.1fx", $27 / 11)), $29, $29 / 2, ($29 / 2 <= 5.5 ? "met" : sprintf("missed by >= %.1fx", $29 / 11)) }' "$OUT/frame_hmd.csv"
         fi
         if [ -f "$OUT/llvmpipe_diff.csv" ]; then
-            awk -F, 'NR > 1 { printf "- llvmpipe output vs egofuse (%d thread%s, %d stereo frames): mean |d| %.3f, max %d, %.3f%% of all pixels differ by > 8 (hand pixels: mean |d| %.2f, %.2f%% > 8)\n", $1, ($1 > 1 ? "s" : ""), $2, $3, $4, $5, $7, $8 }' "$OUT/llvmpipe_diff.csv"
+            awk -F, 'NR > 1 { printf "- llvmpipe output vs egofuse (%s, %d thread%s, %d stereo frames): mean |d| %.3f, max %d, %.3f%% of all pixels differ by > 8 (hand pixels: mean |d| %.2f, %.2f%% > 8)\n", $9, $1, ($1 > 1 ? "s" : ""), $2, $3, $4, $5, $7, $8 }' "$OUT/llvmpipe_diff.csv"
         fi
     } > "$OUT/summary.md"
     echo

@@ -28,16 +28,24 @@
  * (where either output differs from V).
  *
  *   llvmpipe_frame [--samples DIR] [--threads N] [--frames N] [--window N]
- *                  [--csv FILE] [--diff-csv FILE] [--images DIR]
+ *                  [--case typical|worst|both] [--csv FILE] [--diff-csv FILE]
+ *                  [--images DIR]
+ *
+ * --case: the typical sequence (default), bench_frame's worst case
+ * (bench_worst.h: the pose of the grasp, the head moved towards the hands
+ * until about 70% of the cameras' pixels are covered; the images still
+ * cycle through the window), or both, one after the other.
  *
  * --threads N sets LP_NUM_THREADS=N (llvmpipe's rasterizer threads; its
  * vertex processing and setup stay on the calling thread) and gives
  * egofuse N threads. --csv appends rows (bench_frame writes the header):
  * frame_typical,llvmpipe,... and frame_anim,egofuse,... (the interleaved
- * egofuse run); in llvmpipe rows skin_ms is the CPU pose, raster_ms the
+ * egofuse run), frame_worst,llvmpipe and frame_worst_anim,egofuse for the
+ * worst case; in llvmpipe rows skin_ms is the CPU pose, raster_ms the
  * uploads and draw calls, fuse_ms the wait for the frame and the
- * read-back. --diff-csv appends the image comparison. --images writes
- * eye 0 of the last compared frame from both.
+ * read-back. --diff-csv appends the image comparison (its last column
+ * names the case). --images writes eye 0 of the last compared frame from
+ * both (CASE_llvmpipe_left.png, CASE_egofuse_left.png).
  * LLVMPIPE_FRAME_PROFILE=1 finishes and times every step apart (uploads,
  * pass 1, 2, 3, read-back) to show where llvmpipe's time goes.
  * Exit status: 0 (benchmarks report, they do not judge), 1 the samples
@@ -45,6 +53,7 @@
 #include "egl_harness.h"
 #include "../bench_sample.h"
 #include "../bench_util.h"
+#include "../bench_worst.h"
 
 #include "../../src/cpu/cpu.h"
 #include "../../src/io/io.h"
@@ -375,10 +384,11 @@ static void prof_mark(int k)
     prof_t = t;
 }
 
-/* One stereo frame on llvmpipe: window slot w, time t; outputs into
+/* One stereo frame on llvmpipe: window slot w, time t, the head node's
+ * pose or *head (world_from_head) when head is not NULL; outputs into
  * out[2] (1280x800 RGBA). */
-static void gl_frame(gl_state *g, const inputs *in, int w, float t, uint8_t *out[2],
-                     gl_times *tm)
+static void gl_frame(gl_state *g, const inputs *in, int w, float t, const kin_mat4 *head,
+                     uint8_t *out[2], gl_times *tm)
 {
     const kin_model *m = &in->model;
     const int cw = in->geo.crop_width, ch = in->geo.crop_height;
@@ -390,7 +400,8 @@ static void gl_frame(gl_state *g, const inputs *in, int w, float t, uint8_t *out
     for (int s = 0; s < m->skin_count; s++)
         kin_skin_joint_matrices(&m->skins[s], g->world, g->jm[s]);
     kin_camera cam[2];
-    for (int e = 0; e < 2; e++) cam[e] = kin_sthmd_camera(&in->hmd, &g->world[in->head], (kin_eye)e);
+    for (int e = 0; e < 2; e++)
+        cam[e] = kin_sthmd_camera(&in->hmd, head ? head : &g->world[in->head], (kin_eye)e);
     double t1 = eh_now_ms();
     const fuse_lighting *L = &in->lighting.light;
     prof_t = eh_now_ms();
@@ -495,8 +506,8 @@ typedef struct ego_state {
     uint8_t *cam[2];   /* 640x480 RGBA (rows of the crop filled) */
 } ego_state;
 
-static double ego_frame(ego_state *s, const inputs *in, int w, float t, uint8_t *out[2],
-                        double *coverage)
+static double ego_frame(ego_state *s, const inputs *in, int w, float t, const kin_mat4 *head,
+                        uint8_t *out[2], double *coverage)
 {
     const int cw = in->hmd.cam_width, ch = in->hmd.cam_height;
     const int lw = in->hmd.lcd_width, lh = in->hmd.lcd_height;
@@ -515,7 +526,8 @@ static double ego_frame(ego_state *s, const inputs *in, int w, float t, uint8_t 
     }
     fi.anim = in->anim;
     fi.time = t;
-    fi.head_node = in->head;
+    fi.head_node = head ? -1 : in->head;
+    fi.world_from_head = head;
     fi.lighting = in->lighting;
     pipe_frame_stats st;
     char why[256];
@@ -587,10 +599,158 @@ static void summary_of(double *v, int n, double *med, double *p99, double *max, 
     *max = v[n - 1];
 }
 
+/* One case, timed: frames stereo frames, llvmpipe and egofuse interleaved
+ * frame by frame, the images cycling through the window. Typical (head
+ * NULL): the sequence's poses at the window's frames, the recorded head.
+ * Worst: the pose at time t_fixed, the head *head. Prints the medians and
+ * the ratio, compares the outputs of up to 4 window frames, appends the
+ * CSV rows. */
+typedef struct run_ctx {
+    gl_state *g;
+    ego_state *es;
+    const inputs *in;
+    uint8_t *go[2], *eo[2];
+    long tris;
+    int threads, ego_threads, frames;
+    const char *csv_path, *diff_path, *images;
+} run_ctx;
+
+static void run_case(run_ctx *c, const char *name, const kin_mat4 *head, float t_fixed)
+{
+    const inputs *in = c->in;
+    gl_state *g = c->g;
+    ego_state *es = c->es;
+    const int frames = c->frames, threads = c->threads;
+    const int lw = in->hmd.lcd_width, lh = in->hmd.lcd_height;
+    uint8_t **go = c->go, **eo = c->eo;
+    double *tg = xmalloc(sizeof(double) * frames), *te = xmalloc(sizeof(double) * frames);
+    double *tp = xmalloc(sizeof(double) * frames), *ts = xmalloc(sizeof(double) * frames),
+           *tf = xmalloc(sizeof(double) * frames);
+    double cover_sum = 0, wall_g = 0, wall_e = 0;
+    printf("%s:\n", name);
+    for (int k = -3; k < frames; k++) {
+        int i = k < 0 ? 0 : k, w = i % in->window;
+        float t = head ? t_fixed : (float)in->frame_of[w] / in->fps;
+        gl_times gt;
+        double t0 = eh_now_ms();
+        gl_frame(g, in, w, t, head, go, &gt);
+        double t1 = eh_now_ms(), cov = 0;
+        double te_k = ego_frame(es, in, w, t, head, eo, &cov);
+        if (k < 0) continue;
+        tg[k] = t1 - t0;
+        te[k] = te_k;
+        tp[k] = gt.pose;
+        ts[k] = gt.submit;
+        tf[k] = gt.finish;
+        wall_g += tg[k];
+        wall_e += te[k];
+        cover_sum += cov;
+    }
+    if (glGetError() != GL_NO_ERROR) fprintf(stderr, "llvmpipe_frame: a GL error occurred\n");
+    if (profiling)
+        printf("  profile (LLVMPIPE_FRAME_PROFILE, each step finished; ms per frame incl. warm-up): "
+               "uploads %.3f, pass 1 (skin + raster) %.3f, pass 2 (light) %.3f, pass 3 "
+               "(composite) %.3f, read-back %.3f\n",
+               prof[0] / (frames + 3), prof[1] / (frames + 3), prof[2] / (frames + 3),
+               prof[3] / (frames + 3), prof[4] / (frames + 3));
+    memset(prof, 0, sizeof prof);
+
+    /* the outputs of the window's frames, compared */
+    diff d;
+    memset(&d, 0, sizeof d);
+    int cmp_frames = in->window < 4 ? in->window : 4;
+    for (int w = 0; w < cmp_frames; w++) {
+        float t = head ? t_fixed : (float)in->frame_of[w] / in->fps;
+        gl_frame(g, in, w, t, head, go, NULL);
+        ego_frame(es, in, w, t, head, eo, NULL);
+        for (int e = 0; e < 2; e++) compare(&d, go[e], eo[e], in->virt[w][e], lw * lh);
+        if (c->images && w == cmp_frames - 1) {
+            char path[1024];
+            snprintf(path, sizeof path, "%s/%s_llvmpipe_left.png", c->images, name);
+            save_rgba(path, go[0], lw, lh);
+            snprintf(path, sizeof path, "%s/%s_egofuse_left.png", c->images, name);
+            save_rgba(path, eo[0], lw, lh);
+        }
+    }
+
+    double gm, g99, gmax, gmean, em, e99, emax, emean;
+    summary_of(tg, frames, &gm, &g99, &gmax, &gmean);
+    summary_of(te, frames, &em, &e99, &emax, &emean);
+    double pose = eh_median(tp, frames), submit = eh_median(ts, frames),
+           finish = eh_median(tf, frames);
+    const double cov = cover_sum / frames;
+    printf("  %-9s %7s %7s %7s %7s %6s %8s %6s\n", "impl", "median", "p99", "max", "mean", "fps",
+           "headroom", "cover");
+    printf("  %-9s %7.3f %7.3f %7.3f %7.3f %6.0f %8.2f %5.1f%%   (pose %.3f, uploads + draws %.3f, "
+           "finish + read-back %.3f ms)\n",
+           "llvmpipe", gm, g99, gmax, gmean, 1e3 * frames / wall_g, BUDGET_MS - g99, 100 * cov,
+           pose, submit, finish);
+    printf("  %-9s %7.3f %7.3f %7.3f %7.3f %6.0f %8.2f %5.1f%%   (same frames, pipe_frame + YUYV "
+           "conversion)\n",
+           "egofuse", em, e99, emax, emean, 1e3 * frames / wall_e, BUDGET_MS - e99, 100 * cov);
+    printf("  llvmpipe / egofuse (median, side by side): %.1fx\n", gm / em);
+    printf("  output difference over %d stereo frames: mean |d| %.3f, max %d, %.3f%% of all "
+           "pixels differ by > 8;\n  on the %ld hand pixels (either differs from V): mean |d| "
+           "%.2f, %.2f%% differ by > 8\n",
+           cmp_frames, d.sum / (double)d.n, d.max, 100.0 * d.px_big / (double)d.px, d.hand_px,
+           d.hand_px ? d.hand_sum / (3.0 * d.hand_px) : 0.0,
+           d.hand_px ? 100.0 * d.hand_big / (double)d.hand_px : 0.0);
+    if (c->csv_path) {
+        FILE *f = fopen(c->csv_path, "a");
+        if (f) {
+            /* the llvmpipe row under the case's name (frame_typical,
+             * frame_worst); the interleaved egofuse row as frame_anim /
+             * frame_worst_anim: egofuse posed by the animation, not by the
+             * tracking as in bench_frame's rows of the same case */
+            fprintf(f, "frame_%s,llvmpipe,-,%d,%.4f,%.4f,%.4f,%.4f,%d,%.1f,%.3f,%.4f,0,0,%.4f,"
+                       "%.4f,%.4f,%ld,%d,%d\n",
+                    name, threads, gm, g99, gmax, gmean, frames, 1e3 * frames / wall_g,
+                    BUDGET_MS - g99, cov, pose, submit, finish, c->tris, lw, lh);
+            fprintf(f, "frame_%s,egofuse,%s,%d,%.4f,%.4f,%.4f,%.4f,%d,%.1f,%.3f,%.4f,0,0,0,0,0,"
+                       "%ld,%d,%d\n",
+                    head ? "worst_anim" : "anim", ef_isa_name((ef_isa)pipe_isa(es->p)),
+                    c->ego_threads, em, e99, emax, emean, frames, 1e3 * frames / wall_e,
+                    BUDGET_MS - e99, cov, c->tris, lw, lh);
+            fclose(f);
+        }
+    }
+    if (c->diff_path) {
+        FILE *f = fopen(c->diff_path, "a");
+        if (f) {
+            fseek(f, 0, SEEK_END);
+            if (ftell(f) == 0)
+                fprintf(f, "threads,stereo_frames,mean_abs,max_abs,pct_px_gt8,hand_px,"
+                           "hand_mean_abs,hand_pct_gt8,case\n");
+            fprintf(f, "%d,%d,%.4f,%d,%.4f,%ld,%.4f,%.4f,%s\n", threads, cmp_frames,
+                    d.sum / (double)d.n, d.max, 100.0 * d.px_big / (double)d.px, d.hand_px,
+                    d.hand_px ? d.hand_sum / (3.0 * d.hand_px) : 0.0,
+                    d.hand_px ? 100.0 * d.hand_big / (double)d.hand_px : 0.0, name);
+            fclose(f);
+        }
+    }
+    free(tg), free(te), free(tp), free(ts), free(tf);
+}
+
+/* The worst case's search renders egofuse alone (its coverage). */
+typedef struct worst_ctx {
+    ego_state *es;
+    const inputs *in;
+    uint8_t **eo;
+    float t;
+} worst_ctx;
+
+static double worst_cover(void *ctx, const kin_mat4 *head)
+{
+    worst_ctx *w = ctx;
+    double cov = 0;
+    ego_frame(w->es, w->in, 0, w->t, head, w->eo, &cov);
+    return cov;
+}
+
 int main(int argc, char **argv)
 {
     const char *samples = "build/samples", *csv_path = NULL, *images = NULL, *diff_path = NULL;
-    int threads = 2, frames = 100, window = 8;
+    int threads = 2, frames = 100, window = 8, cases = 1;
     for (int a = 1; a < argc; a++) {
         const char *o = argv[a], *v = a + 1 < argc ? argv[a + 1] : NULL;
         int ok = 1;
@@ -601,10 +761,16 @@ int main(int argc, char **argv)
         else if (!strcmp(o, "--csv") && v) csv_path = v, a++;
         else if (!strcmp(o, "--images") && v) images = v, a++;
         else if (!strcmp(o, "--diff-csv") && v) diff_path = v, a++;
-        else ok = 0;
+        else if (!strcmp(o, "--case") && v) {
+            cases = !strcmp(v, "typical") ? 1 : !strcmp(v, "worst") ? 2 : !strcmp(v, "both") ? 3 : 0;
+            ok = cases != 0, a++;
+        } else ok = 0;
         if (!ok) {
+            fprintf(stderr, "llvmpipe_frame: %s%s%s: not a valid value, or not an option\n", o,
+                    v ? " " : "", v ? v : "");
             fprintf(stderr, "usage: %s [--samples DIR] [--threads N] [--frames N] [--window N]\n"
-                            "       [--csv FILE] [--diff-csv FILE] [--images DIR]\n", argv[0]);
+                            "       [--case typical|worst|both] [--csv FILE] [--diff-csv FILE]\n"
+                            "       [--images DIR]\n", argv[0]);
             return 2;
         }
     }
@@ -640,103 +806,27 @@ int main(int argc, char **argv)
            threads, ef_isa_name((ef_isa)pipe_isa(es.p)), pd.threads, pd.threads > 1 ? "s" : "",
            tris, in.window, frames);
 
-    double *tg = xmalloc(sizeof(double) * frames), *te = xmalloc(sizeof(double) * frames);
-    double *tp = xmalloc(sizeof(double) * frames), *ts = xmalloc(sizeof(double) * frames),
-           *tf = xmalloc(sizeof(double) * frames);
-    double cover_sum = 0, wall_g = 0, wall_e = 0;
-    for (int k = -3; k < frames; k++) {
-        int i = k < 0 ? 0 : k, w = i % in.window;
-        float t = (float)in.frame_of[w] / in.fps;
-        gl_times gt;
-        double t0 = eh_now_ms();
-        gl_frame(&g, &in, w, t, go, &gt);
-        double t1 = eh_now_ms(), cov = 0;
-        double te_k = ego_frame(&es, &in, w, t, eo, &cov);
-        if (k < 0) continue;
-        tg[k] = t1 - t0;
-        te[k] = te_k;
-        tp[k] = gt.pose;
-        ts[k] = gt.submit;
-        tf[k] = gt.finish;
-        wall_g += tg[k];
-        wall_e += te[k];
-        cover_sum += cov;
-    }
-    if (glGetError() != GL_NO_ERROR) fprintf(stderr, "llvmpipe_frame: a GL error occurred\n");
-    if (profiling)
-        printf("  profile (LLVMPIPE_FRAME_PROFILE, each step finished; ms per frame incl. warm-up): "
-               "uploads %.3f, pass 1 (skin + raster) %.3f, pass 2 (light) %.3f, pass 3 "
-               "(composite) %.3f, read-back %.3f\n",
-               prof[0] / (frames + 3), prof[1] / (frames + 3), prof[2] / (frames + 3),
-               prof[3] / (frames + 3), prof[4] / (frames + 3));
-
-    /* the outputs of the window's frames, compared */
-    diff d;
-    memset(&d, 0, sizeof d);
-    int cmp_frames = in.window < 4 ? in.window : 4;
-    for (int w = 0; w < cmp_frames; w++) {
-        float t = (float)in.frame_of[w] / in.fps;
-        gl_frame(&g, &in, w, t, go, NULL);
-        ego_frame(&es, &in, w, t, eo, NULL);
-        for (int e = 0; e < 2; e++) compare(&d, go[e], eo[e], in.virt[w][e], lw * lh);
-        if (images && w == cmp_frames - 1) {
-            char path[1024];
-            snprintf(path, sizeof path, "%s/frame_llvmpipe_left.png", images);
-            save_rgba(path, go[0], lw, lh);
-            snprintf(path, sizeof path, "%s/frame_egofuse_left.png", images);
-            save_rgba(path, eo[0], lw, lh);
+    run_ctx rx = {&g, &es, &in, {go[0], go[1]}, {eo[0], eo[1]}, tris, threads, pd.threads, frames,
+                  csv_path, diff_path, images};
+    if (cases & 1) run_case(&rx, "typical", NULL, 0);
+    if (cases & 2) {
+        /* bench_frame's worst case (bench_worst.h), posed by the animation */
+        kin_arm_rig rig;
+        char why[256];
+        bench_worst wc;
+        const int wf = (int)(1.5f * in.fps) < in.seq_frames ? (int)(1.5f * in.fps) : 0;
+        const float tw = (float)wf / in.fps;
+        if (kin_arm_rig_init(&rig, &in.model, why, sizeof why) != 0) {
+            fprintf(stderr, "llvmpipe_frame: the worst case needs the arm rig: %s\n", why);
+            return 1;
         }
-    }
-
-    double gm, g99, gmax, gmean, em, e99, emax, emean;
-    summary_of(tg, frames, &gm, &g99, &gmax, &gmean);
-    summary_of(te, frames, &em, &e99, &emax, &emean);
-    double pose = eh_median(tp, frames), submit = eh_median(ts, frames),
-           finish = eh_median(tf, frames);
-    printf("  %-9s %7s %7s %7s %7s %6s %8s\n", "impl", "median", "p99", "max", "mean", "fps",
-           "headroom");
-    printf("  %-9s %7.3f %7.3f %7.3f %7.3f %6.0f %8.2f   (pose %.3f, uploads + draws %.3f, "
-           "finish + read-back %.3f ms)\n",
-           "llvmpipe", gm, g99, gmax, gmean, 1e3 * frames / wall_g, BUDGET_MS - g99, pose, submit,
-           finish);
-    printf("  %-9s %7.3f %7.3f %7.3f %7.3f %6.0f %8.2f   (same frames, pipe_frame + YUYV "
-           "conversion)\n",
-           "egofuse", em, e99, emax, emean, 1e3 * frames / wall_e, BUDGET_MS - e99);
-    printf("  llvmpipe / egofuse (median, side by side): %.1fx\n", gm / em);
-    printf("  output difference over %d stereo frames: mean |d| %.3f, max %d, %.3f%% of all "
-           "pixels differ by > 8;\n  on the %ld hand pixels (either differs from V): mean |d| "
-           "%.2f, %.2f%% differ by > 8\n",
-           cmp_frames, d.sum / (double)d.n, d.max, 100.0 * d.px_big / (double)d.px, d.hand_px,
-           d.hand_px ? d.hand_sum / (3.0 * d.hand_px) : 0.0,
-           d.hand_px ? 100.0 * d.hand_big / (double)d.hand_px : 0.0);
-    if (csv_path) {
-        FILE *f = fopen(csv_path, "a");
-        if (f) {
-            double cov = cover_sum / frames;
-            fprintf(f, "frame_typical,llvmpipe,-,%d,%.4f,%.4f,%.4f,%.4f,%d,%.1f,%.3f,%.4f,0,0,%.4f,"
-                       "%.4f,%.4f,%ld,%d,%d\n",
-                    threads, gm, g99, gmax, gmean, frames, 1e3 * frames / wall_g, BUDGET_MS - g99,
-                    cov, pose, submit, finish, tris, lw, lh);
-            fprintf(f, "frame_anim,egofuse,%s,%d,%.4f,%.4f,%.4f,%.4f,%d,%.1f,%.3f,%.4f,0,0,0,0,0,"
-                       "%ld,%d,%d\n",
-                    ef_isa_name((ef_isa)pipe_isa(es.p)), pd.threads, em, e99, emax, emean, frames,
-                    1e3 * frames / wall_e, BUDGET_MS - e99, cov, tris, lw, lh);
-            fclose(f);
-        }
-    }
-    if (diff_path) {
-        FILE *f = fopen(diff_path, "a");
-        if (f) {
-            fseek(f, 0, SEEK_END);
-            if (ftell(f) == 0)
-                fprintf(f, "threads,stereo_frames,mean_abs,max_abs,pct_px_gt8,hand_px,"
-                           "hand_mean_abs,hand_pct_gt8\n");
-            fprintf(f, "%d,%d,%.4f,%d,%.4f,%ld,%.4f,%.4f\n", threads, cmp_frames,
-                    d.sum / (double)d.n, d.max, 100.0 * d.px_big / (double)d.px, d.hand_px,
-                    d.hand_px ? d.hand_sum / (3.0 * d.hand_px) : 0.0,
-                    d.hand_px ? 100.0 * d.hand_big / (double)d.hand_px : 0.0);
-            fclose(f);
-        }
+        if (bench_worst_init(&wc, &in.model, &rig, in.anim, tw) != 0) return 1;
+        worst_ctx wx = {&es, &in, eo, tw};
+        bench_worst_find(&wc, worst_cover, &wx);
+        printf("worst case: the pose of frame %d, head %.3f m from %s (%.3f m recorded), looking "
+               "at it: %.1f%% of the camera pixels covered\n",
+               wf, wc.d, bench_worst_target_name[wc.target], bench_worst_d0(&wc), 100 * wc.cover);
+        run_case(&rx, "worst", &wc.head, tw);
     }
     pipe_destroy(es.p);
     eh_close(&gl);
