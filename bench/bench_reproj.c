@@ -132,7 +132,7 @@ int main(int argc, char **argv)
         d.threads = threads;
         d.cull = RAST_CULL_BACK;
         d.eye_view = m ? PIPE_VIEW_REPROJECT : PIPE_VIEW_CROP;
-        d.soft_edge = !m;   /* each view's default in render and run */
+        d.soft_edge = 1;    /* each view's default in render and run */
         if (sc.hmd[0]) kin_sthmd_preset(sc.hmd, &d.hmd);
         p[m] = pipe_create(&d, &model);
         if (!p[m]) {

@@ -14,8 +14,12 @@
  *   - disocclusion: a small quad in front of a large one; the ring of the
  *     back quad the eye sees around the front one but the camera does not
  *     is filled from the back quad (green), never the front one's red;
- *     the fill of a row against its rule written plainly (seeded rows);
+ *     the fill of a row against its rule written plainly (seeded rows),
+ *     and of the rows without a sampled pixel from the nearest row that
+ *     has some (seeded layers);
  *   - the border of the camera's view fades over PIPE_REPROJ_FADE_PX;
+ *   - soft silhouettes (pipe_desc.soft_edge) soften the eye view's mask,
+ *     byte for byte pipe__soft_edge of the hard one;
  *   - the same bytes with 1 and 2 threads and every ISA cap (a recorded
  *     CRC); the crop method's bytes do not depend on the new code;
  *   - bad input: IPD and D out of range, reprojection with AA, an unknown
@@ -34,6 +38,7 @@
 #include "../src/cpu/cpu.h"
 #include "../src/cpu/ef_mem.h"
 #include "../src/pipe/pipe.h"
+#include "../src/pipe/pipe_soft.h"
 #include "support/pipe_frames.h"
 
 enum { CAMW = 640, CAMH = 480, CW = 640, CH = 400, LCDW = 1280, LCDH = 800, CROP_Y0 = 40 };
@@ -325,6 +330,55 @@ static void result_mask_equals_eye_draw(void **state)
     assert_int_equal(r.st.view_fallbacks, 0);
     free(ref);
     rig_end(&r);
+}
+
+/* Soft silhouettes in the eye view (pipe_desc.soft_edge): the mask
+ * composited (pipe_view_mask) is pipe__soft_edge of the same frame's eye
+ * mask without them, byte for byte, in both eyes: the same pixels set, a
+ * ramp at the quad's edges (values between 0 and 255 where the hard mask
+ * is 255), 255 inside; the layer is lit under it. */
+static void result_soft_edges(void **state)
+{
+    (void)state;
+    reproj_rig h, s;
+    rig_quad_frame(&h, 0.06f, -0.35f, 11);
+    const float qs[1] = {0.06f}, qz[1] = {-0.35f};
+    quads_model(&s.m, 1, qs, qz);
+    pipe_desc d = reproj_desc(PIPE_VIEW_REPROJECT, 2, 0);
+    d.soft_edge = 1;
+    rig_start(&s, &d, 11);
+    rig_frame(&s);
+    uint8_t *ref = malloc(CW * CH);
+    assert_non_null(ref);
+    for (int e = 0; e < 2; e++) {
+        assert_int_equal(s.st.view[e], PIPE_VIEW_REPROJECT);
+        const uint8_t *Mh = pipe_view_mask(h.p, e, NULL, NULL);
+        const uint8_t *Ms = pipe_view_mask(s.p, e, NULL, NULL);
+        assert_non_null(Mh);
+        assert_non_null(Ms);
+        pipe__soft_edge(Mh, ref, CW, CH, NULL);
+        assert_memory_equal(Ms, ref, (size_t)CW * CH);
+        long set_h = 0, set_s = 0, ramp = 0, inside = 0;
+        for (int i = 0; i < CW * CH; i++) {
+            set_h += Mh[i] != 0;
+            set_s += Ms[i] != 0;
+            ramp += Mh[i] == 255 && Ms[i] > 0 && Ms[i] < 255;
+            inside += Ms[i] == 255;
+        }
+        print_message("NOTE eye %d: %ld pixels set, %ld on the ramp, %ld inside\n", e, set_s,
+                      ramp, inside);
+        assert_int_equal(set_s, set_h);
+        assert_true(ramp > 200);
+        assert_true(inside > set_s / 2);
+        /* the layer's alpha follows the softened mask */
+        const uint8_t *L = pipe_layer(s.p, e, NULL, NULL);
+        long lit_partial = 0;
+        for (int i = 0; i < CW * CH; i++) lit_partial += L[4 * i + 3] > 0 && L[4 * i + 3] < 255;
+        assert_true(lit_partial >= ramp / 2);
+    }
+    free(ref);
+    rig_end(&s);
+    rig_end(&h);
 }
 
 /* A camera image whose colour names its pixel: R = x - xoff, G = y - yoff
@@ -624,7 +678,9 @@ static uint32_t frame_crc(const kin_model *m, int view, int threads, int isa)
     return crc;
 }
 
-#define REPROJ_CRC 0x3ca5d031u /* issue 17: the cheaper lighting rule (was 0xda19e5c9) */
+/* issue 18: the rows without a sampled pixel filled from the nearest row
+ * that has some, not with the eye's mean colour (was 0x3ca5d031) */
+#define REPROJ_CRC 0x167baf7eu
 
 static void determinism_isa_threads(void **state)
 {
@@ -788,6 +844,71 @@ static void result_fill_row_rule(void **state)
     }
     assert_true(filled > 10000);
     assert_true(empty_rows > 50);
+}
+
+/* The rows without a sampled pixel (pipe__reproj_fill_cols) against the
+ * rule written plainly: seeded layers of rows of kinds 0, 1 (filled
+ * pixels, none sampled) and 2 (sampled pixels, at least one pixel of M set),
+ * M set on runs, P's alpha marking filled pixels among them; each filled
+ * pixel of a row of kind 1 takes the RGB of the nearest M != 0 pixel (the
+ * left on a tie) of the nearest row of kind 2 (above on a tie); with no
+ * row of kind 2 the filled pixels' M becomes 0. Nothing else changes. */
+static void result_fill_cols_rule(void **state)
+{
+    (void)state;
+    tu_rng g = {0xf111c015u};
+    enum { FW = 37, FH = 23 };
+    uint8_t rows[FH], M[FW * FH], P[4 * FW * FH], EM[FW * FH], EP[4 * FW * FH];
+    int32_t near[FW];
+    long from_row = 0, hidden = 0;
+    for (int it = 0; it < 2000; it++) {
+        const int w = 1 + tu_int(&g, FW), h = 1 + tu_int(&g, FH);
+        const int p2 = it % 7 == 0 ? 0 : 1 + tu_int(&g, 4); /* weight of sampled rows */
+        for (int y = 0; y < h; y++) {
+            int k = tu_int(&g, p2 + 4);
+            rows[y] = (uint8_t)(k < p2 ? 2 : k < p2 + 3 ? 1 : 0);
+            for (int x = 0; x < w; x++) {
+                const int i = y * w + x;
+                M[i] = (uint8_t)(tu_int(&g, 3) ? 0 : 1 + tu_int(&g, 255));
+                for (int j = 0; j < 4; j++) P[4 * i + j] = (uint8_t)tu_int(&g, 256);
+                if (rows[y] == 1 && M[i] && tu_int(&g, 4)) P[4 * i + 3] = 2; /* ST_FILL */
+                else if (P[4 * i + 3] == 2) P[4 * i + 3] = 1;
+            }
+            if (rows[y] == 2) M[y * w + tu_int(&g, w)] = 200;
+        }
+        memcpy(EM, M, (size_t)(w * h));
+        memcpy(EP, P, (size_t)(4 * w * h));
+        for (int y = 0; y < h; y++) {
+            if (rows[y] != 1) continue;
+            int src = -1;
+            for (int d = 1; d < h && src < 0; d++) {
+                if (y - d >= 0 && rows[y - d] == 2) src = y - d;
+                else if (y + d < h && rows[y + d] == 2) src = y + d;
+            }
+            for (int x = 0; x < w; x++) {
+                const int i = y * w + x;
+                if (!M[i] || P[4 * i + 3] != 2) continue;
+                if (src < 0) {
+                    EM[i] = 0;
+                    hidden++;
+                    continue;
+                }
+                int xs = -1;
+                for (int d = 0; d < w && xs < 0; d++) {
+                    if (x - d >= 0 && M[src * w + x - d]) xs = x - d;
+                    else if (x + d < w && M[src * w + x + d]) xs = x + d;
+                }
+                for (int j = 0; j < 3; j++) EP[4 * i + j] = P[4 * (src * w + xs) + j];
+                from_row++;
+            }
+        }
+        pipe__reproj_fill_cols(rows, w, h, M, P, near);
+        assert_memory_equal(M, EM, (size_t)(w * h));
+        assert_memory_equal(P, EP, (size_t)(4 * w * h));
+    }
+    print_message("NOTE %ld pixels filled from another row, %ld hidden\n", from_row, hidden);
+    assert_true(from_row > 20000);
+    assert_true(hidden > 500);
 }
 
 /* The sampling pass (pipe__reproj_sample) alone on every ISA against the
@@ -984,7 +1105,9 @@ TU_MAIN(NULL, NULL,
         cmocka_unit_test(result_point_lands_through_lens),
         cmocka_unit_test(result_disocclusion_fill),
         cmocka_unit_test(result_fill_row_rule),
+        cmocka_unit_test(result_fill_cols_rule),
         cmocka_unit_test(result_border_fade),
+        cmocka_unit_test(result_soft_edges),
         cmocka_unit_test(result_full_sensor),
         cmocka_unit_test(determinism_isa_threads),
         cmocka_unit_test(determinism_sample_isa),

@@ -70,11 +70,10 @@ int cli_hmd_len_parse(const char *cmd, const char *opt, const char *arg, float l
                       float *out);
 /* Soft silhouettes of render and run (pipe_desc.soft_edge, issue 14 item
  * 3): *soft is 1 (--soft-edges), 0 (--hard-edges) or -1 (neither: the
- * default). The default is on where the pipe can do it (the camera's crop
- * view without --aa, whose coverage samples are soft already) and off
- * elsewhere; --soft-edges with --aa or --view reproject is EXIT_USAGE with
- * a message. On EXIT_OK *soft is 0 or 1. */
-int cli_soft_edges(const char *cmd, int *soft, int aa, int view);
+ * default). The default is on without --aa (whose coverage samples are
+ * soft already), in either view, and off with it; --soft-edges with --aa
+ * is EXIT_USAGE with a message. On EXIT_OK *soft is 0 or 1. */
+int cli_soft_edges(const char *cmd, int *soft, int aa);
 
 /* Strict parsers: the whole string must be the number(s); finite. */
 int cli_parse_int(const char *s, int lo, int hi, int *out);

@@ -32,14 +32,12 @@ int cli_view_check(const char *cmd, int view, int aa, const kin_sthmd_desc *hmd)
     return EXIT_OK;
 }
 
-int cli_soft_edges(const char *cmd, int *soft, int aa, int view)
+int cli_soft_edges(const char *cmd, int *soft, int aa)
 {
-    int can = !aa && view == PIPE_VIEW_CROP;
-    if (*soft == 1 && !can)
-        return cli_usage_error(cmd, "--soft-edges: not with %s (it softens the binary mask "
-                                    "of the camera's crop)",
-                               aa ? "--aa" : "--view reproject");
-    if (*soft < 0) *soft = can;
+    if (*soft == 1 && aa)
+        return cli_usage_error(cmd, "--soft-edges: not with --aa (its coverage samples are "
+                                    "soft edges already)");
+    if (*soft < 0) *soft = !aa;
     return EXIT_OK;
 }
 

@@ -99,7 +99,7 @@ static const char *render_usage =
     "  --soft-edges   soft silhouettes at the cost of one pass over the mask:\n"
     "                 its edge pixels fade by the share of their 3x3 window\n"
     "                 inside it, a one-pixel ramp instead of stair-steps\n"
-    "                 (the default, except with --aa or --view reproject)\n"
+    "                 (the default, except with --aa), in either --view\n"
     "  --hard-edges   the binary mask's stair-stepped silhouettes\n"
     "  --edge-fade K  soft viewport edges: where the camera image ends inside\n"
     "                 the display, the hands fade over its last K pixels\n"
@@ -756,7 +756,7 @@ int cmd_render(int argc, char **argv)
     if (!o.scene) return cli_usage_error("render", "--scene is required");
     if (!o.out) return cli_usage_error("render", "--out is required");
     {
-        int sr = cli_soft_edges("render", &o.soft_edge, o.aa, o.view);
+        int sr = cli_soft_edges("render", &o.soft_edge, o.aa);
         if (sr != EXIT_OK) return sr;
     }
     if (tracking_only && !o.pose_tracking)

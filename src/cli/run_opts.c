@@ -106,7 +106,7 @@ const char *run_usage =
     "                   (4, 8 or 16; 0: off, the binary mask); default 0\n"
     "  --soft-edges     soft silhouettes: the mask's edge pixels fade by the\n"
     "                   share of their 3x3 window inside it (the default,\n"
-    "                   except with --aa or --view reproject; docs/antialias.md)\n"
+    "                   except with --aa; in either --view; docs/antialias.md)\n"
     "  --hard-edges     the binary mask's stair-stepped silhouettes\n"
     "  --edge-fade K    soft viewport edges: the hands fade over the last K\n"
     "                   camera pixels (1..64; 0: off, a hard cut); default 4\n"
@@ -523,7 +523,7 @@ int run_parse(int argc, char **argv, run_opts *o)
     {
         int vr = cli_view_check("run", o->view, o->aa, &o->hmd);
         if (vr != EXIT_OK) return vr;
-        vr = cli_soft_edges("run", &o->soft_edge, o->aa, o->view);
+        vr = cli_soft_edges("run", &o->soft_edge, o->aa);
         if (vr != EXIT_OK) return vr;
     }
     if (!o->sel[0] != !o->sel[1]) return cli_usage_error("run", "give both --left and --right");

@@ -292,18 +292,21 @@ static void run_eye(pipe_ctx *p, eye_state *e)
     if (p->desc.refine_band > 0 && pipe__refine_eye(p, e, &fe) < 0) return;
     /* the binary mask lit (the G-buffer's or the refined one) */
     const int refined_in = fe.mask == e->refined;
-    /* soft silhouettes: a one-pixel ramp inside the binary mask's edge
-     * (pipe_soft.h; not with aa_samples or the eye view: pipe_create) */
-    if (e->soft) {
-        pipe__soft_edge_boxed(fe.mask, e->soft, cw, ch, e->soft_box);
-        fe.mask = e->soft;
-    }
-    /* the eye's view instead of the camera's crop (pipe_reproj.h) */
+    /* the eye's view instead of the camera's crop (pipe_reproj.h; it
+     * reads the camera's G-buffer mask, not fe.mask) */
     const fuse_image Pcam = fe.P;
     fuse_intrinsics EK;
     e->view_used = PIPE_VIEW_CROP;
     if (p->desc.eye_view == PIPE_VIEW_REPROJECT && reproj_eye(p, e, &fe, &EK) < 0) return;
     const int rp = e->view_used == PIPE_VIEW_REPROJECT;
+    /* soft silhouettes: a one-pixel ramp inside the shown mask's edge
+     * (pipe_soft.h; not with aa_samples: pipe_create): the camera's
+     * binary or refined mask, or the eye view's (the same size: its
+     * border fade is kept, scaled by the ramp) */
+    if (e->soft) {
+        pipe__soft_edge_boxed(fe.mask, e->soft, cw, ch, e->soft_box);
+        fe.mask = e->soft;
+    }
     e->shown = fe.mask;
     fe.normal = rp ? e->rp.nrm : e->nrm;
     fe.normal_stride = 3 * cw;
@@ -571,7 +574,7 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
 {
     if (!model) return NULL;
     if (desc && (desc->soft_edge < 0 || desc->soft_edge > 1 ||
-                 (desc->soft_edge && (desc->aa_samples || desc->eye_view != PIPE_VIEW_CROP))))
+                 (desc->soft_edge && desc->aa_samples)))
         return NULL;
     if (desc && (desc->normal_smooth < -1 || desc->normal_smooth > FUSE_NORMAL_SMOOTH_MAX))
         return NULL;

@@ -164,8 +164,10 @@ typedef struct pipe_desc {
                                  the share of their 3x3 window inside it,
                                  a one-pixel ramp instead of stair-steps
                                  (src/pipe/pipe_soft.h, docs/antialias.md),
-                                 one pass over the mask. With aa_samples,
-                                 eye_view REPROJECT or another value:
+                                 one pass over the mask; with eye_view
+                                 REPROJECT the eye view's mask (its
+                                 border fade scaled by the ramp). With
+                                 aa_samples or another value:
                                  pipe_create returns NULL. */
     int refine_fill;          /* with refine_band and a fit (fit_rig): 0 =
                                  the default, on: the refined mask's
@@ -381,8 +383,9 @@ pipe_result pipe_frame(pipe_ctx *p, const pipe_frame_in *in,
                        pipe_frame_stats *stats, char *why, int why_size);
 /* The last frame's mask of one eye (valid until the next frame): the
  * refined one with pipe_desc.refine_band, else the G-buffer's; with
- * pipe_desc.aa_samples the coverage mask composited (0..255), with
- * pipe_desc.soft_edge that mask softened at its edge (0..255). */
+ * pipe_desc.aa_samples the coverage mask composited (0..255); with
+ * pipe_desc.soft_edge the mask before its softening (binary or refined;
+ * the softened one is composited). */
 const uint8_t *pipe_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The last frame's lit layer of one eye (premultiplied RGBA8, the
  * mask's size, 4 * width bytes per row; valid until the next frame):
@@ -398,7 +401,8 @@ kin_camera pipe_camera(const pipe_ctx *p, int eye);
  * border fade, 0 outside the camera's view; width x height = the crop's
  * size, covering the whole display). pipe_view_mask is NULL, and
  * pipe_view_camera the camera's, for the crop method and for an eye that
- * fell back to it in the last frame. */
+ * fell back to it in the last frame. With pipe_desc.soft_edge the
+ * eye-view mask is the softened one (pipe_soft.h), as composited. */
 kin_camera pipe_view_camera(const pipe_ctx *p, int eye);
 const uint8_t *pipe_view_mask(const pipe_ctx *p, int eye, int *width, int *height);
 /* The ISA that raster and fuse use (an ef_isa value). */

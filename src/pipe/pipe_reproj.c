@@ -291,6 +291,51 @@ int pipe__reproj_fill_row(const uint8_t *K, int w, uint8_t *Po, const float *ed,
     return 1;
 }
 
+/* (pipe_reproj.h) The nearest coloured pixel of the source row per
+ * column is built once per source row (two passes), so a frame costs
+ * O(w) per row to fill however many filled pixels it holds. */
+void pipe__reproj_fill_cols(const uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P,
+                            int32_t *near)
+{
+    int built = -1;
+    for (int y = 0; y < h; y++) {
+        if (rows[y] != 1) continue;
+        int ya = y - 1, yb = y + 1;
+        while (ya >= 0 && rows[ya] != 2) ya--;
+        while (yb < h && rows[yb] != 2) yb++;
+        uint8_t *My = M + (size_t)y * (size_t)w;
+        uint8_t *Py = P + (size_t)y * (size_t)w * 4;
+        const int src = ya >= 0 && (yb >= h || y - ya <= yb - y) ? ya : yb < h ? yb : -1;
+        if (src < 0) {
+            for (int x = 0; x < w; x++)
+                if (My[x] && Py[4 * x + 3] == ST_FILL) My[x] = 0; /* nothing seen at all */
+            continue;
+        }
+        const uint8_t *Ms = M + (size_t)src * (size_t)w;
+        const uint8_t *Ps = P + (size_t)src * (size_t)w * 4;
+        if (src != built) {
+            /* near[x]: the nearest column of Ms != 0 (the left on a tie);
+             * the row has at least one (its sampled pixels) */
+            int last = -1;
+            for (int x = 0; x < w; x++) {
+                if (Ms[x]) last = x;
+                near[x] = last;
+            }
+            int next = -1;
+            for (int x = w - 1; x >= 0; x--) {
+                if (Ms[x]) next = x;
+                if (next >= 0 && (near[x] < 0 || next - x < x - near[x])) near[x] = next;
+            }
+            built = src;
+        }
+        for (int x = 0; x < w; x++) {
+            if (!My[x] || Py[4 * x + 3] != ST_FILL) continue;
+            const uint8_t *c = Ps + 4 * (size_t)near[x];
+            for (int j = 0; j < 3; j++) Py[4 * x + j] = c[j];
+        }
+    }
+}
+
 int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image *P, int ox,
                         int oy, const uint8_t *cmask, int cmask_stride, const float *cdepth,
                         int cdepth_stride, int gw, int gh, float n, float f)
@@ -327,9 +372,8 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
                                   r->lanes + 6 * lw, (float *)(r->lanes + 7 * lw)};
     long covered = 0, back = 0, sampled = 0, filled = 0, outside = 0;
     float mind = INFINITY;
-    uint64_t sum[3] = {0, 0, 0};
-    /* the eye rays' x per column, and per row: filled pixels left for
-     * the mean (no sampled pixel in the row) */
+    /* the eye rays' x per column, and per row: 2 sampled pixels, 1 filled
+     * pixels but no sampled one (pipe__reproj_fill_cols), 0 neither */
     float *rxs = (float *)(r->row + 2 * w);
     uint8_t *row_fill = (uint8_t *)(r->row + 3 * w);
     uint8_t *K = r->kind;
@@ -342,7 +386,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         const float *ed = r->depth + (size_t)y * (size_t)w;
         const float *en = r->nrm + (size_t)y * (size_t)w * 3;
         const float ry = -((float)y + 0.5f - ecy) / efy;
-        const long filled0 = filled;
+        const long filled0 = filled, sampled0 = sampled;
         memset(M, 0, (size_t)w);
         /* only the row's span of covered pixels, its ends out to
          * multiples of 16 (of every SIMD_W) so that the vector kernels
@@ -362,7 +406,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         int xt = xs;
         if (taps) {
             long cnt[4] = {0, 0, 0, 0};
-            xt = taps(&td, em, &o, xs, xe, M, Po, K, cnt, sum);
+            xt = taps(&td, em, &o, xs, xe, M, Po, K, cnt);
             covered += cnt[0], outside += cnt[1], filled += cnt[2], sampled += cnt[3];
         }
         for (int x = xt; x < xe; x++) {
@@ -431,15 +475,17 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
                 uint8_t c = ws == 65536u ? (uint8_t)((acc[j] + 32768u) >> 16)
                                          : (uint8_t)((acc[j] + ws / 2) / ws);
                 Po[4 * x + j] = c;
-                sum[j] += c;
             }
             Po[4 * x + 3] = ST_SAMPLED;
             K[x] = ST_SAMPLED;
             sampled++;
         }
-        /* the fill from the row's own sampled pixels, while it is warm */
-        row_fill[y] = filled != filled0 &&
-                      !pipe__reproj_fill_row(K + xs, xe - xs, Po + 4 * (size_t)xs, ed + xs, n, f);
+        /* the fill from the row's own sampled pixels, while it is warm
+         * (a row of filled pixels without any: pipe__reproj_fill_cols) */
+        const int has_sampled = sampled != sampled0;
+        if (filled != filled0 && has_sampled)
+            pipe__reproj_fill_row(K + xs, xe - xs, Po + 4 * (size_t)xs, ed + xs, n, f);
+        row_fill[y] = (uint8_t)(has_sampled ? 2 : filled != filled0);
     }
     r->sampled = sampled;
     r->outside = outside;
@@ -448,26 +494,9 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         r->filled = 0;
         return 1;
     }
-    /* the rows without a sampled pixel: the mean of the eye's sampled
-     * pixels, or (none at all) not shown */
-    uint8_t mean[3] = {0, 0, 0};
-    if (sampled)
-        for (int j = 0; j < 3; j++)
-            mean[j] = (uint8_t)((sum[j] + (uint64_t)sampled / 2) / (uint64_t)sampled);
-    for (int y = 0; y < h; y++) {
-        if (!row_fill[y]) continue;
-        const uint8_t *em = r->mask + (size_t)y * (size_t)w;
-        uint8_t *M = r->M + (size_t)y * (size_t)w;
-        uint8_t *Po = r->P + (size_t)y * (size_t)w * 4;
-        for (int x = 0; x < w; x++) {
-            if (!em[x] || !M[x] || Po[4 * x + 3] != ST_FILL) continue;
-            if (sampled) {
-                for (int j = 0; j < 3; j++) Po[4 * x + j] = mean[j];
-            } else {
-                M[x] = 0; /* nothing seen at all: not shown */
-            }
-        }
-    }
+    /* the rows without a sampled pixel: from the nearest row with some,
+     * or (none at all) not shown */
+    pipe__reproj_fill_cols(row_fill, w, h, r->M, r->P, r->lanes);
     r->filled = filled; /* P's alpha keeps the markers: fuse_light ignores it */
     return 0;
 }

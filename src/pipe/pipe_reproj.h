@@ -39,8 +39,10 @@
  *              to its own (the left one on a tie; the one there is when
  *              only one side has any), so the background that a
  *              disocclusion reveals is filled from the background, not
- *              from the hand in front; a row without any takes the mean
- *              colour of all sampled pixels of the eye; an eye without
+ *              from the hand in front; a row without any (the top or
+ *              bottom row of a part the camera sees less of) takes the
+ *              colour of the nearest pixel of the nearest row that has
+ *              sampled pixels (pipe__reproj_fill_cols); an eye without
  *              any is not shown (mask 0);
  *     outside  its point projects outside the camera image (or behind
  *              the camera, or beyond the lens's valid region): mask 0.
@@ -125,7 +127,7 @@ typedef struct pipe__reproj {
     uint8_t *mask;
     uint8_t *P;               /* RGBA8: camera colours seen from the eye */
     uint8_t *M;               /* the mask composited (fade, fill) */
-    int32_t *row;             /* the eye rays' x, the rows to fill with the mean */
+    int32_t *row;             /* the eye rays' x, the rows' kinds (fill_cols) */
     uint8_t *kind;            /* width + 64: one row's kinds (1 sampled, 2 filled) */
     int32_t *lanes;           /* 8 * width: one row's geometry (pipe__reproj_lanes) */
     int isa;                  /* the geometry pass's ISA (ef_isa; pipe.c sets it) */
@@ -183,12 +185,11 @@ typedef struct pipe__reproj_tapd {
  * composited: the fade or 0), Po (RGBA + the kind in alpha, written
  * where the scalar reference writes), K (the kind: 1 sampled, 2 filled,
  * written where it is one of them; the caller zeroes the row first),
- * cnt[] += covered, outside, filled, sampled and sum[] += the sampled
- * colours; the first column not done (the scalar taps finish). Equal to
- * the scalar taps in pipe_reproj.c. */
+ * cnt[] += covered, outside, filled, sampled; the first column not done
+ * (the scalar taps finish). Equal to the scalar taps in pipe_reproj.c. */
 typedef int pipe__reproj_taps_t(const pipe__reproj_tapd *t, const uint8_t *em,
                                 const pipe__reproj_lanes *o, int x0, int w, uint8_t *M,
-                                uint8_t *Po, uint8_t *K, long cnt[4], uint64_t sum[3]);
+                                uint8_t *Po, uint8_t *K, long cnt[4]);
 typedef pipe__reproj_taps_t *pipe__reproj_taps_fn;
 pipe__reproj_taps_t pipe__reproj_taps_sse2, pipe__reproj_taps_avx2, pipe__reproj_taps_avx512,
     pipe__reproj_taps_neon;
@@ -199,10 +200,22 @@ pipe__reproj_taps_t pipe__reproj_taps_sse2, pipe__reproj_taps_avx2, pipe__reproj
  * its left or to its right, the one whose eye distance (ed: window
  * depths, near n, far f) is nearer to its own (the left one on a tie; the
  * one there is when only one side has any). 0 when the row has filled
- * pixels but no sampled one: nothing written (the caller fills with the
- * mean). */
+ * pixels but no sampled one: nothing written (pipe__reproj_fill_cols
+ * fills it). */
 int pipe__reproj_fill_row(const uint8_t *K, int w, uint8_t *Po, const float *ed, float n,
                           float f);
+
+/* The rows of the eye layer (w x h) that have filled pixels but no sampled
+ * one (rows[y] == 1; 2: the row has sampled pixels, its filled ones filled
+ * from them by pipe__reproj_fill_row; 0: neither), filled from the nearest
+ * row above or below that has sampled pixels (the one above on a tie):
+ * each filled pixel (M != 0, P's alpha the filled kind) takes the RGB of
+ * that row's nearest pixel of M != 0 (sampled or filled from its row: every
+ * one has its colour), the left one on a tie. near: w ints of scratch.
+ * Without any row of sampled pixels the filled pixels get M = 0 (not
+ * shown). */
+void pipe__reproj_fill_cols(const uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P,
+                            int32_t *near);
 
 int pipe__reproj_init(pipe__reproj *r, int width, int height);
 void pipe__reproj_free(pipe__reproj *r);

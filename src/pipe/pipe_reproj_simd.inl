@@ -179,14 +179,13 @@ SIMD_INL void rp_shows2(const pipe__reproj_tapd *t, vmask valid, vint gx, vint d
  * pipe_reproj.c lane by lane); the first column not done. */
 int SIMD_FN(pipe__reproj_taps)(const pipe__reproj_tapd *t, const uint8_t *em,
                                const pipe__reproj_lanes *o, int x0, int w, uint8_t *M, uint8_t *Po,
-                               uint8_t *K, long cnt[4], uint64_t sum[3])
+                               uint8_t *K, long cnt[4])
 {
     const vint zero = vi_zero(), one = vi_set1(1), two = vi_set1(2), k256 = vi_set1(256);
     const vint ox = vi_set1(t->ox), oy = vi_set1(t->oy), ps4 = vi_set1(t->ps4);
     const vint icw1 = vi_set1(t->icw1), ich1 = vi_set1(t->ich1);
     const vint rgb = vi_set1(0x00FFFFFF), a_fill = vi_set1(2 << 24), a_samp = vi_set1(1 << 24);
     const int32_t *P = (const int32_t *)(const void *)t->P;
-    vint s0 = zero, s1 = zero, s2 = zero;
     long ncov = 0, nout = 0, nfill = 0, nsamp = 0;
     int x = x0;
     for (; w - x >= SIMD_W; x += SIMD_W) {
@@ -261,20 +260,8 @@ int SIMD_FN(pipe__reproj_taps)(const pipe__reproj_tapd *t, const uint8_t *em,
             const vint q2 = vi_from_vf_trunc(vf_div(vf_from_vi(vi_add(a2, hw)), fw));
             const vint px = vi_or(vi_or(q0, vi_slli(q1, 8)), vi_or(vi_slli(q2, 16), a_samp));
             out = vi_sel(seen, px, out);
-            s0 = vi_add(s0, vi_sel(seen, q0, zero));
-            s1 = vi_add(s1, vi_sel(seen, q1, zero));
-            s2 = vi_add(s2, vi_sel(seen, q2, zero));
         }
         vi_storeu(po, out);
-    }
-    _Alignas(64) int32_t l0[SIMD_W], l1[SIMD_W], l2[SIMD_W];
-    vi_storeu(l0, s0);
-    vi_storeu(l1, s1);
-    vi_storeu(l2, s2);
-    for (int l = 0; l < SIMD_W; l++) {
-        sum[0] += (uint64_t)(uint32_t)l0[l];
-        sum[1] += (uint64_t)(uint32_t)l1[l];
-        sum[2] += (uint64_t)(uint32_t)l2[l];
     }
     cnt[0] += ncov;
     cnt[1] += nout;
