@@ -81,6 +81,17 @@ static inline double bench_worst_d0(const bench_worst *w)
     return kin_v3_len(kin_v3_sub(w->targets[w->target], w->head0));
 }
 
+/* Distance d of target t, of coverage c: kept when nearer 70% than the best. */
+static inline void bench_worst_keep(bench_worst *w, double *best_err, int t, double d, double c)
+{
+    if (fabs(c - BENCH_WORST_COVER) < *best_err) {
+        *best_err = fabs(c - BENCH_WORST_COVER);
+        w->d = d;
+        w->cover = c;
+        w->target = t;
+    }
+}
+
 static inline void bench_worst_find(bench_worst *w, bench_worst_cover_fn cover, void *ctx)
 {
     enum { STEPS = 14 };
@@ -93,24 +104,14 @@ static inline void bench_worst_find(bench_worst *w, bench_worst_cover_fn cover, 
             const double d = d0 + (dmin - d0) * k / STEPS;
             h = bench_worst_head_at(w, t, d);
             const double c = cover(ctx, &h);
-            if (fabs(c - BENCH_WORST_COVER) < best_err) {
-                best_err = fabs(c - BENCH_WORST_COVER);
-                w->d = d;
-                w->cover = c;
-                w->target = t;
-            }
+            bench_worst_keep(w, &best_err, t, d, c);
             if (prev_c < BENCH_WORST_COVER && c >= BENCH_WORST_COVER) {   /* bracketed */
                 double lo = d, hi = prev_d;
                 for (int it = 0; it < 10; it++) {
                     const double mid = 0.5 * (lo + hi);
                     h = bench_worst_head_at(w, t, mid);
                     const double cm = cover(ctx, &h);
-                    if (fabs(cm - BENCH_WORST_COVER) < best_err) {
-                        best_err = fabs(cm - BENCH_WORST_COVER);
-                        w->d = mid;
-                        w->cover = cm;
-                        w->target = t;
-                    }
+                    bench_worst_keep(w, &best_err, t, mid, cm);
                     if (cm < BENCH_WORST_COVER) hi = mid;
                     else lo = mid;
                 }
