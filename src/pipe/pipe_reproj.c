@@ -292,8 +292,9 @@ int pipe__reproj_fill_row(const uint8_t *K, int w, uint8_t *Po, const float *ed,
 }
 
 /* (pipe_reproj.h) The nearest coloured pixel of the source row per
- * column is built once per source row (two passes), so a frame costs
- * O(w) per row to fill however many filled pixels it holds. */
+ * column is built once per source row (two passes), so a row to fill
+ * costs O(w + h) (the search for its source row) however many filled
+ * pixels it holds; such rows are few (a part's top or bottom rows). */
 void pipe__reproj_fill_cols(const uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P,
                             int32_t *near)
 {
