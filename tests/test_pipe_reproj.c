@@ -14,9 +14,9 @@
  *   - disocclusion: a small quad in front of a large one; the ring of the
  *     back quad the eye sees around the front one but the camera does not
  *     is filled from the back quad (green), never the front one's red;
- *     the fill of a row against its rule written plainly (seeded rows),
- *     and of the rows without a sampled pixel from the nearest row that
- *     has some (seeded layers);
+ *     the fill against its rule written plainly (seeded layers: the
+ *     nearest sampled pixel on the same surface in the row or column,
+ *     else from the nearest row that has some);
  *   - the border of the camera's view fades over PIPE_REPROJ_FADE_PX;
  *   - soft silhouettes (pipe_desc.soft_edge) soften the eye view's mask,
  *     byte for byte pipe__soft_edge of the hard one;
@@ -678,9 +678,10 @@ static uint32_t frame_crc(const kin_model *m, int view, int threads, int isa)
     return crc;
 }
 
-/* issue 18: the rows without a sampled pixel filled from the nearest row
- * that has some, not with the eye's mean colour (was 0x3ca5d031) */
-#define REPROJ_CRC 0x167baf7eu
+/* issue 18: the filled pixels from the nearest sampled one on their surface
+ * in their row or column, else from the nearest row with some (was
+ * 0x3ca5d031: the row's only, else the eye's mean colour) */
+#define REPROJ_CRC 0x87fe27eau
 
 static void determinism_isa_threads(void **state)
 {
@@ -784,75 +785,112 @@ static void validity_eye_inside_model(void **state)
     kin_model_free(&m);
 }
 
-/* The fill of one row (pipe__reproj_fill_row, the word skipping) against
- * the rule written plainly: seeded rows of runs of sampled, filled and
- * empty pixels, of widths around the 8-pixel words, random colours and
- * depths; a row with filled pixels but no sampled one is left alone (0). */
+/* The fill (pipe__reproj_fill) against its rule written plainly: seeded
+ * layers of sampled (kind 1) and filled (kind 2) pixels on runs of the
+ * mask, their eye depths from two surfaces (near and far, a little noise),
+ * random colours; each filled pixel of a flagged row takes the colour of
+ * the nearest of its row's and column's nearest sampled pixels (left,
+ * right, above, below; a pixel of mask 0 ends each search) among those
+ * within the slack of the nearest in eye distance, or gets kind 3 when it
+ * has none (its row keeps bit 0). */
 static float ref_lin(float z, float n, float f)
 {
     float zn = 2.0f * z - 1.0f;
     return 2.0f * f * n / ((f + n) - zn * (f - n));
 }
 
-static void result_fill_row_rule(void **state)
+static void result_fill_rule(void **state)
 {
     (void)state;
     tu_rng g = {0x5eed18u};
     const float n = 0.05f, f = 100.0f;
-    const int widths[9] = {1, 7, 8, 9, 16, 17, 63, 64, 301};
-    uint8_t K[320], P[4 * 320], E[4 * 320];
-    float ed[320];
-    long filled = 0, empty_rows = 0;
-    for (int it = 0; it < 3000; it++) {
-        const int w = widths[it % 9];
-        /* runs: long ones of each kind, or (every 3rd) single pixels */
-        const int maxrun = it % 3 == 0 ? 1 : 1 + tu_int(&g, 20);
-        int pk[3];
-        for (int i = 0; i < 3; i++) pk[i] = tu_int(&g, 4);
-        for (int x = 0; x < w;) {
-            int k = tu_int(&g, pk[0] + pk[1] + pk[2] + 1), run = 1 + tu_int(&g, maxrun);
-            k = k < pk[0] ? 0 : k < pk[0] + pk[1] ? 1 : 2;
-            for (; run > 0 && x < w; run--, x++) K[x] = (uint8_t)k;
+    enum { FW = 41, FH = 27 };
+    uint8_t rows[FH], erows[FH], M[FW * FH], P[4 * FW * FH], E[4 * FW * FH];
+    float ed[FW * FH];
+    long filled = 0, unresolved = 0, vertical = 0, far_skipped = 0;
+    for (int it = 0; it < 1500; it++) {
+        const int w = 1 + tu_int(&g, FW), h = 1 + tu_int(&g, FH);
+        const int psamp = 1 + tu_int(&g, 8); /* in 10: sampled among the set pixels */
+        for (int i = 0; i < w * h; i++) {
+            M[i] = (uint8_t)(tu_int(&g, 4) ? 1 + tu_int(&g, 255) : 0);
+            const int farp = (i / w + i % w / 7) % 3 == 0;   /* patches of the far surface */
+            ed[i] = (farp ? 0.999f : 0.99f) + tu_range(&g, -0.0002f, 0.0002f);
+            for (int j = 0; j < 4; j++) P[4 * i + j] = (uint8_t)tu_int(&g, 256);
+            P[4 * i + 3] = (uint8_t)(M[i] ? (tu_int(&g, 10) < psamp ? 1 : 2) : tu_int(&g, 4));
         }
-        for (int x = 0; x < w; x++) {
-            ed[x] = tu_range(&g, 0.9f, 0.9999f);
-            for (int j = 0; j < 4; j++) P[4 * x + j] = (uint8_t)tu_int(&g, 256);
-        }
-        memcpy(E, P, (size_t)(4 * w));
-        int any = 0;
-        for (int x = 0; x < w; x++) any |= K[x] == 1;
-        for (int x = 0; x < w && any; x++) {
-            if (K[x] != 2) continue;
-            int l = -1, r = -1;
-            for (int i = x - 1; i >= 0 && l < 0; i--)
-                if (K[i] == 1) l = i;
-            for (int i = x + 1; i < w && r < 0; i++)
-                if (K[i] == 1) r = i;
-            int src = l >= 0 ? l : r;
-            if (l >= 0 && r >= 0) {
-                float d0 = ref_lin(ed[x], n, f);
-                if (fabsf(ref_lin(ed[r], n, f) - d0) < fabsf(ref_lin(ed[l], n, f) - d0)) src = r;
+        for (int y = 0; y < h; y++) {
+            int s2 = 0, s1 = 0;
+            for (int x = 0; x < w; x++) {
+                s2 |= M[y * w + x] && P[4 * (y * w + x) + 3] == 1;
+                s1 |= M[y * w + x] && P[4 * (y * w + x) + 3] == 2;
             }
-            for (int j = 0; j < 3; j++) E[4 * x + j] = P[4 * src + j];
-            filled++;
+            rows[y] = (uint8_t)((s2 ? 2 : 0) | (s1 && tu_int(&g, 8) ? 1 : 0));
         }
-        int fills = 0;
-        for (int x = 0; x < w; x++) fills |= K[x] == 2;
-        empty_rows += !any && fills;
-        assert_int_equal(pipe__reproj_fill_row(K, w, P, ed, n, f), any || !fills);
-        assert_memory_equal(P, E, (size_t)(4 * w));
+        memcpy(E, P, (size_t)(4 * w * h));
+        memcpy(erows, rows, (size_t)h);
+#define SAMP(i) (M[i] && P[4 * (i) + 3] == 1)
+        for (int y = 0; y < h; y++) {
+            if (!(rows[y] & 1)) continue;
+            int unres = 0;
+            for (int x = 0; x < w; x++) {
+                const int i = y * w + x;
+                if (!M[i] || P[4 * i + 3] != 2) continue;
+                int c[4], dist[4], nc = 0;
+                /* each search ends at a pixel of mask 0 */
+                for (int k = x - 1; k >= 0 && M[y * w + k]; k--)
+                    if (SAMP(y * w + k)) { c[nc] = y * w + k, dist[nc++] = x - k; break; }
+                for (int k = x + 1; k < w && M[y * w + k]; k++)
+                    if (SAMP(y * w + k)) { c[nc] = y * w + k, dist[nc++] = k - x; break; }
+                for (int k = y - 1; k >= 0 && M[k * w + x]; k--)
+                    if (SAMP(k * w + x)) { c[nc] = k * w + x, dist[nc++] = y - k; break; }
+                for (int k = y + 1; k < h && M[k * w + x]; k++)
+                    if (SAMP(k * w + x)) { c[nc] = k * w + x, dist[nc++] = k - y; break; }
+                if (!nc) {
+                    E[4 * i + 3] = 3;
+                    unres = 1;
+                    unresolved++;
+                    continue;
+                }
+                const float d0 = ref_lin(ed[i], n, f);
+                float dd[4], dmin = INFINITY;
+                for (int k = 0; k < nc; k++) {
+                    dd[k] = fabsf(ref_lin(ed[c[k]], n, f) - d0);
+                    if (dd[k] < dmin) dmin = dd[k];
+                }
+                const float lim = dmin + (PIPE_REPROJ_TOL_M + PIPE_REPROJ_TOL_REL * d0);
+                int best = -1, nearest = -1;
+                for (int k = 0; k < nc; k++) {
+                    if (dd[k] <= lim && (best < 0 || dist[k] < dist[best])) best = k;
+                    if (nearest < 0 || dist[k] < dist[nearest]) nearest = k;
+                }
+                far_skipped += dd[nearest] > lim;
+                vertical += c[best] % w == x && c[best] / w != y;
+                for (int j = 0; j < 3; j++) E[4 * i + j] = P[4 * c[best] + j];
+                filled++;
+            }
+            erows[y] = (uint8_t)((rows[y] & 2) | unres);
+        }
+#undef SAMP
+        pipe__reproj_fill(rows, w, h, M, P, ed, n, f);
+        assert_memory_equal(P, E, (size_t)(4 * w * h));
+        assert_memory_equal(rows, erows, (size_t)h);
     }
-    assert_true(filled > 10000);
-    assert_true(empty_rows > 50);
+    print_message("NOTE %ld filled (%ld from above or below, %ld where the nearest candidate lay "
+                  "on another surface), %ld without a candidate\n",
+                  filled, vertical, far_skipped, unresolved);
+    assert_true(filled > 20000);
+    assert_true(vertical > 3000);
+    assert_true(far_skipped > 1000);
+    assert_true(unresolved > 50);
 }
 
-/* The rows without a sampled pixel (pipe__reproj_fill_cols) against the
- * rule written plainly: seeded layers of rows of kinds 0, 1 (filled
- * pixels, none sampled) and 2 (sampled pixels, at least one pixel of M set),
- * M set on runs, P's alpha marking filled pixels among them; each filled
- * pixel of a row of kind 1 takes the RGB of the nearest M != 0 pixel (the
- * left on a tie) of the nearest row of kind 2 (above on a tie); with no
- * row of kind 2 the filled pixels' M becomes 0. Nothing else changes. */
+/* The pixels the fill found no candidate for (pipe__reproj_fill_cols)
+ * against the rule written plainly: seeded layers of rows flagged 0, 1
+ * (pixels of kind 3 to fill, none sampled) and 2 (sampled pixels, at least
+ * one pixel of M set), P's alpha marking kind 3 among the set pixels of
+ * rows flagged 1; each takes the RGB of the nearest M != 0 pixel (the left
+ * on a tie) of the nearest row flagged 2 (above on a tie), and kind 2; with
+ * no row flagged 2 its M becomes 0 (and its kind 2). Nothing else changes. */
 static void result_fill_cols_rule(void **state)
 {
     (void)state;
@@ -871,8 +909,8 @@ static void result_fill_cols_rule(void **state)
                 const int i = y * w + x;
                 M[i] = (uint8_t)(tu_int(&g, 3) ? 0 : 1 + tu_int(&g, 255));
                 for (int j = 0; j < 4; j++) P[4 * i + j] = (uint8_t)tu_int(&g, 256);
-                if (rows[y] == 1 && M[i] && tu_int(&g, 4)) P[4 * i + 3] = 2; /* ST_FILL */
-                else if (P[4 * i + 3] == 2) P[4 * i + 3] = 1;
+                if (rows[y] == 1 && M[i] && tu_int(&g, 4)) P[4 * i + 3] = 3; /* unresolved */
+                else if (P[4 * i + 3] == 3) P[4 * i + 3] = 1;
             }
             if (rows[y] == 2) M[y * w + tu_int(&g, w)] = 200;
         }
@@ -887,7 +925,8 @@ static void result_fill_cols_rule(void **state)
             }
             for (int x = 0; x < w; x++) {
                 const int i = y * w + x;
-                if (!M[i] || P[4 * i + 3] != 2) continue;
+                if (!M[i] || P[4 * i + 3] != 3) continue;
+                EP[4 * i + 3] = 2;
                 if (src < 0) {
                     EM[i] = 0;
                     hidden++;
@@ -1104,7 +1143,7 @@ TU_MAIN(NULL, NULL,
         cmocka_unit_test(result_point_lands_by_geometry),
         cmocka_unit_test(result_point_lands_through_lens),
         cmocka_unit_test(result_disocclusion_fill),
-        cmocka_unit_test(result_fill_row_rule),
+        cmocka_unit_test(result_fill_rule),
         cmocka_unit_test(result_fill_cols_rule),
         cmocka_unit_test(result_border_fade),
         cmocka_unit_test(result_soft_edges),

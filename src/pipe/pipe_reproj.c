@@ -60,8 +60,7 @@ int pipe__reproj_init(pipe__reproj *r, int width, int height)
     r->M = calloc(px, 1);
     r->row = malloc(sizeof(int32_t) * 3 * (size_t)width + (size_t)height);
     r->lanes = malloc(sizeof(int32_t) * 8 * ((size_t)width + 16));
-    r->kind = calloc((size_t)width + 64, 1);
-    if (!r->depth || !r->nrm || !r->mask || !r->P || !r->M || !r->row || !r->lanes || !r->kind) {
+    if (!r->depth || !r->nrm || !r->mask || !r->P || !r->M || !r->row || !r->lanes) {
         pipe__reproj_free(r);
         return -1;
     }
@@ -70,7 +69,7 @@ int pipe__reproj_init(pipe__reproj *r, int width, int height)
 
 void pipe__reproj_free(pipe__reproj *r)
 {
-    EF_FREE_ALL(r->depth, r->nrm, r->mask, r->P, r->M, r->row, r->lanes, r->kind);
+    EF_FREE_ALL(r->depth, r->nrm, r->mask, r->P, r->M, r->row, r->lanes);
     memset(r, 0, sizeof *r);
 }
 
@@ -81,7 +80,7 @@ static float lin_depth(float z, float n, float f)
     return 2.0f * f * n / ((f + n) - zn * (f - n));
 }
 
-enum { ST_NONE = 0, ST_SAMPLED = 1, ST_FILL = 2 };
+enum { ST_NONE = 0, ST_SAMPLED = 1, ST_FILL = 2, ST_UNRESOLVED = 3 };
 
 /* The scalar reference of the geometry pass (pipe_reproj_simd.inl is
  * this, lane by lane): columns [x, w) of one eye row, the covered ones. */
@@ -220,75 +219,90 @@ static int covered_span(const uint8_t *em, int w, int *xe)
     return a;
 }
 
-/* 8 kind bytes (K) from p. */
-static inline uint64_t kind8(const uint8_t *p)
+/* 8 mask bytes from p. */
+static inline uint64_t ld8(const uint8_t *p)
 {
     uint64_t v;
     memcpy(&v, p, 8);
     return v;
 }
 
-#define KIND_ONES 0x0101010101010101ull /* the ST_SAMPLED bit of each byte */
-#define KIND_TWOS 0x0202020202020202ull /* the ST_FILL bit */
-
-/* The first column >= x of row K (w columns) that is sampled, or -1. */
-static int next_sampled(const uint8_t *K, int x, int w)
+/* (pipe_reproj.h) One pass over each flagged row's span of set mask bytes
+ * (8 clear ones at a time skipped) keeps the last sampled pixel of the
+ * run; the next one is searched when the pass has gone beyond the one
+ * found before, so a row costs O(span) plus the column walks from its
+ * filled pixels, each within its run. Fills write colours but keep the
+ * filled kind, so no filled pixel is the source of another: the result
+ * does not depend on the order. */
+void pipe__reproj_fill(uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P, const float *ed,
+                       float n, float f)
 {
-    for (; x + 8 <= w && !(kind8(K + x) & KIND_ONES); x += 8) {
-    }
-    for (; x < w; x++)
-        if (K[x] == ST_SAMPLED) return x;
-    return -1;
-}
-
-/* (pipe_reproj.h) Blocks of 8 pixels without a filled one are passed by
- * a word test, keeping the last sampled one; the next sampled one is
- * searched once per run of filled pixels. */
-int pipe__reproj_fill_row(const uint8_t *K, int w, uint8_t *Po, const float *ed, float n, float f)
-{
-    int last = -1, nxt = -2; /* last sampled before x; the next from x on (-2: unknown) */
-    int x = 0;
-    while (x < w) {
-        if (x + 8 <= w) {
-            const uint64_t k = kind8(K + x);
-            if (!(k & KIND_TWOS)) {
-                const uint64_t sm = k & KIND_ONES;
-                if (sm) {
-#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
-                    last = x + (63 - __builtin_clzll(sm)) / 8;
-#else
-                    for (int i = 7; i >= 0; i--)
-                        if (K[x + i] == ST_SAMPLED) {
-                            last = x + i;
-                            break;
-                        }
-#endif
-                }
-                x += 8;
+    for (int y = 0; y < h; y++) {
+        if (!(rows[y] & 1)) continue;
+        const size_t r0 = (size_t)y * (size_t)w;
+        const uint8_t *My = M + r0;
+        int a = 0, b = w;
+        while (a + 8 <= b && ld8(My + a) == 0) a += 8;
+        while (a < b && !My[a]) a++;
+        while (b - 8 >= a && ld8(My + b - 8) == 0) b -= 8;
+        while (b > a && !My[b - 1]) b--;
+        int last = -1, nxt = -2, unresolved = 0; /* nxt -2: not searched yet */
+        for (int x = a; x < b; x++) {
+            if (!My[x]) { /* a run ends: its sampled pixels are no candidates */
+                last = -1, nxt = -2;
+                while (x + 9 <= b && ld8(My + x + 1) == 0) x += 8;
                 continue;
             }
-        }
-        const int end = x + 8 < w ? x + 8 : w;
-        for (; x < end; x++) {
-            if (K[x] == ST_SAMPLED) {
+            const size_t i = r0 + (size_t)x;
+            if (P[4 * i + 3] == ST_SAMPLED) {
                 last = x;
                 continue;
             }
-            if (K[x] != ST_FILL) continue;
-            if (nxt != -1 && nxt < x) nxt = next_sampled(K, x + 1, w);
-            const int l = last, rr = nxt;
-            int src = l >= 0 ? l : rr;
-            if (src < 0) return 0; /* no sampled pixel in the row */
-            if (l >= 0 && rr >= 0) {
-                const float d0 = lin_depth(ed[x], n, f);
-                const float dl = fabsf(lin_depth(ed[l], n, f) - d0);
-                const float dr = fabsf(lin_depth(ed[rr], n, f) - d0);
-                if (dr < dl) src = rr;
+            if (P[4 * i + 3] != ST_FILL) continue;
+            if (nxt != -1 && nxt <= x) {
+                nxt = -1;
+                for (int k = x + 1; k < b && My[k]; k++)
+                    if (P[4 * (r0 + (size_t)k) + 3] == ST_SAMPLED) {
+                        nxt = k;
+                        break;
+                    }
             }
-            for (int j = 0; j < 3; j++) Po[4 * x + j] = Po[4 * src + j];
+            /* the candidates: left, right, above, below */
+            size_t c[4];
+            int dist[4], nc = 0;
+            if (last >= 0) c[nc] = r0 + (size_t)last, dist[nc++] = x - last;
+            if (nxt >= 0) c[nc] = r0 + (size_t)nxt, dist[nc++] = nxt - x;
+            for (size_t yy = (size_t)y, k = i; yy-- > 0 && M[k -= (size_t)w];)
+                if (P[4 * k + 3] == ST_SAMPLED) {
+                    c[nc] = k, dist[nc++] = y - (int)yy;
+                    break;
+                }
+            for (size_t yy = (size_t)y, k = i; ++yy < (size_t)h && M[k += (size_t)w];)
+                if (P[4 * k + 3] == ST_SAMPLED) {
+                    c[nc] = k, dist[nc++] = (int)yy - y;
+                    break;
+                }
+            if (nc == 0) {
+                P[4 * i + 3] = ST_UNRESOLVED;
+                unresolved = 1;
+                continue;
+            }
+            /* of those on the pixel's surface (eye distance within the
+             * occlusion test's slack of the nearest in depth), the nearest */
+            const float d0 = lin_depth(ed[i], n, f);
+            float dd[4], dmin = INFINITY;
+            for (int k = 0; k < nc; k++) {
+                dd[k] = fabsf(lin_depth(ed[c[k]], n, f) - d0);
+                if (dd[k] < dmin) dmin = dd[k];
+            }
+            const float lim = dmin + (PIPE_REPROJ_TOL_M + PIPE_REPROJ_TOL_REL * d0);
+            int best = -1;
+            for (int k = 0; k < nc; k++)
+                if (dd[k] <= lim && (best < 0 || dist[k] < dist[best])) best = k;
+            for (int j = 0; j < 3; j++) P[4 * i + j] = P[4 * c[best] + j];
         }
+        rows[y] = (uint8_t)((rows[y] & 2) | unresolved);
     }
-    return 1;
 }
 
 /* (pipe_reproj.h) The nearest coloured pixel of the source row per
@@ -300,16 +314,19 @@ void pipe__reproj_fill_cols(const uint8_t *rows, int w, int h, uint8_t *M, uint8
 {
     int built = -1;
     for (int y = 0; y < h; y++) {
-        if (rows[y] != 1) continue;
+        if (!(rows[y] & 1)) continue;
         int ya = y - 1, yb = y + 1;
-        while (ya >= 0 && rows[ya] != 2) ya--;
-        while (yb < h && rows[yb] != 2) yb++;
+        while (ya >= 0 && !(rows[ya] & 2)) ya--;
+        while (yb < h && !(rows[yb] & 2)) yb++;
         uint8_t *My = M + (size_t)y * (size_t)w;
         uint8_t *Py = P + (size_t)y * (size_t)w * 4;
         const int src = ya >= 0 && (yb >= h || y - ya <= yb - y) ? ya : yb < h ? yb : -1;
         if (src < 0) {
             for (int x = 0; x < w; x++)
-                if (My[x] && Py[4 * x + 3] == ST_FILL) My[x] = 0; /* nothing seen at all */
+                if (My[x] && Py[4 * x + 3] == ST_UNRESOLVED) {
+                    My[x] = 0; /* nothing seen at all */
+                    Py[4 * x + 3] = ST_FILL;
+                }
             continue;
         }
         const uint8_t *Ms = M + (size_t)src * (size_t)w;
@@ -330,9 +347,10 @@ void pipe__reproj_fill_cols(const uint8_t *rows, int w, int h, uint8_t *M, uint8
             built = src;
         }
         for (int x = 0; x < w; x++) {
-            if (!My[x] || Py[4 * x + 3] != ST_FILL) continue;
+            if (!My[x] || Py[4 * x + 3] != ST_UNRESOLVED) continue;
             const uint8_t *c = Ps + 4 * (size_t)near[x];
             for (int j = 0; j < 3; j++) Py[4 * x + j] = c[j];
+            Py[4 * x + 3] = ST_FILL;
         }
     }
 }
@@ -373,11 +391,10 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
                                   r->lanes + 6 * lw, (float *)(r->lanes + 7 * lw)};
     long covered = 0, back = 0, sampled = 0, filled = 0, outside = 0;
     float mind = INFINITY;
-    /* the eye rays' x per column, and per row: 2 sampled pixels, 1 filled
-     * pixels but no sampled one (pipe__reproj_fill_cols), 0 neither */
+    /* the eye rays' x per column, and per row: bit 1 sampled pixels, bit 0
+     * filled ones (pipe__reproj_fill, pipe__reproj_fill_cols) */
     float *rxs = (float *)(r->row + 2 * w);
     uint8_t *row_fill = (uint8_t *)(r->row + 3 * w);
-    uint8_t *K = r->kind;
     for (int x = 0; x < w; x++) rxs[x] = ((float)x + 0.5f - ecx) / efx;
     g.rxs = rxs;
     for (int y = 0; y < h; y++) {
@@ -399,7 +416,6 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         if (xs == xe) continue;
         xs &= ~15;
         xe = xe + 15 < w ? (xe + 15) & ~15 : w;
-        memset(K + xs, 0, (size_t)(xe - xs));
         /* the geometry of the row's covered pixels (vector, then the tail) */
         int x1 = kernel ? kernel(&g, em, ed, en, ry, xs, xe, &o, &back, &mind) : xs;
         row_ref(&g, em, ed, en, ry, x1, xe, &o, &back, &mind);
@@ -407,7 +423,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         int xt = xs;
         if (taps) {
             long cnt[4] = {0, 0, 0, 0};
-            xt = taps(&td, em, &o, xs, xe, M, Po, K, cnt);
+            xt = taps(&td, em, &o, xs, xe, M, Po, cnt);
             covered += cnt[0], outside += cnt[1], filled += cnt[2], sampled += cnt[3];
         }
         for (int x = xt; x < xe; x++) {
@@ -430,7 +446,6 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
                              zmin);
             if (!seen) {
                 Po[4 * x + 3] = ST_FILL;
-                K[x] = ST_FILL;
                 filled++;
                 continue;
             }
@@ -478,15 +493,9 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
                 Po[4 * x + j] = c;
             }
             Po[4 * x + 3] = ST_SAMPLED;
-            K[x] = ST_SAMPLED;
             sampled++;
         }
-        /* the fill from the row's own sampled pixels, while it is warm
-         * (a row of filled pixels without any: pipe__reproj_fill_cols) */
-        const int has_sampled = sampled != sampled0;
-        if (filled != filled0 && has_sampled)
-            pipe__reproj_fill_row(K + xs, xe - xs, Po + 4 * (size_t)xs, ed + xs, n, f);
-        row_fill[y] = (uint8_t)(has_sampled ? 2 : filled != filled0);
+        row_fill[y] = (uint8_t)((sampled != sampled0 ? 2 : 0) | (filled != filled0 ? 1 : 0));
     }
     r->sampled = sampled;
     r->outside = outside;
@@ -495,8 +504,10 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         r->filled = 0;
         return 1;
     }
-    /* the rows without a sampled pixel: from the nearest row with some,
-     * or (none at all) not shown */
+    /* the filled pixels from the nearest sampled ones on their surface in
+     * their row and column; those with none there from the nearest row
+     * that has some, or (none at all) not shown */
+    pipe__reproj_fill(row_fill, w, h, r->M, r->P, r->depth, n, f);
     pipe__reproj_fill_cols(row_fill, w, h, r->M, r->P, r->lanes);
     r->filled = filled; /* P's alpha keeps the markers: fuse_light ignores it */
     return 0;

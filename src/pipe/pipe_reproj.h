@@ -33,17 +33,19 @@
  *     filled   it projects inside the camera image but the camera does not
  *              see it (hidden behind another part: a finger behind the
  *              palm, the disocclusion at a hand's edge): it takes the
- *              colour of a sampled pixel of its own eye row on the same
- *              surface: of the nearest sampled pixel to its left and the
- *              nearest to its right, the one whose eye distance is nearer
- *              to its own (the left one on a tie; the one there is when
- *              only one side has any), so the background that a
- *              disocclusion reveals is filled from the background, not
- *              from the hand in front; a row without any (the top or
- *              bottom row of a part the camera sees less of) takes the
- *              colour of the nearest pixel of the nearest row that has
- *              sampled pixels (pipe__reproj_fill_cols); an eye without
- *              any is not shown (mask 0);
+ *              colour of a sampled pixel on its own surface
+ *              (pipe__reproj_fill): of the nearest sampled pixels to its
+ *              left and right in its eye row and above and below in its
+ *              column (each search ends where the eye's mask does: a run
+ *              of the part's pixels), those whose eye distance is within the occlusion
+ *              test's slack of the nearest one in distance, the nearest
+ *              in pixels (left, right, above, below on a tie), so the
+ *              background that a disocclusion reveals is filled from the
+ *              background, not from the hand in front, and not from
+ *              another part far along the row; a pixel with none of the
+ *              four takes the colour of the nearest pixel of the nearest
+ *              row that has sampled pixels (pipe__reproj_fill_cols); an
+ *              eye without any is not shown (mask 0);
  *     outside  its point projects outside the camera image (or behind
  *              the camera, or beyond the lens's valid region): mask 0.
  *   Near the camera image's border the mask fades: M = 255 * min(1, b /
@@ -127,8 +129,7 @@ typedef struct pipe__reproj {
     uint8_t *mask;
     uint8_t *P;               /* RGBA8: camera colours seen from the eye */
     uint8_t *M;               /* the mask composited (fade, fill) */
-    int32_t *row;             /* the eye rays' x, the rows' kinds (fill_cols) */
-    uint8_t *kind;            /* width + 64: one row's kinds (1 sampled, 2 filled) */
+    int32_t *row;             /* the eye rays' x, the rows' kinds (the fill) */
     int32_t *lanes;           /* 8 * width: one row's geometry (pipe__reproj_lanes) */
     int isa;                  /* the geometry pass's ISA (ef_isa; pipe.c sets it) */
     kin_camera cam;           /* this frame's eye camera */
@@ -183,37 +184,36 @@ typedef struct pipe__reproj_tapd {
 /* The taps pass per ISA (pipe_reproj_simd.inl) over columns [x0, w):
  * from one eye row's geometry (o, the covered pixels em), M (the mask
  * composited: the fade or 0), Po (RGBA + the kind in alpha, written
- * where the scalar reference writes), K (the kind: 1 sampled, 2 filled,
- * written where it is one of them; the caller zeroes the row first),
- * cnt[] += covered, outside, filled, sampled; the first column not done
+ * where the scalar reference writes), cnt[] += covered, outside, filled, sampled; the first column not done
  * (the scalar taps finish). Equal to the scalar taps in pipe_reproj.c. */
 typedef int pipe__reproj_taps_t(const pipe__reproj_tapd *t, const uint8_t *em,
                                 const pipe__reproj_lanes *o, int x0, int w, uint8_t *M,
-                                uint8_t *Po, uint8_t *K, long cnt[4]);
+                                uint8_t *Po, long cnt[4]);
 typedef pipe__reproj_taps_t *pipe__reproj_taps_fn;
 pipe__reproj_taps_t pipe__reproj_taps_sse2, pipe__reproj_taps_avx2, pipe__reproj_taps_avx512,
     pipe__reproj_taps_neon;
 
-/* The fill of one eye row (THE FILL above) from its kinds K (w bytes:
- * 1 sampled, 2 filled, else 0; 8 bytes readable past w not needed): each
- * filled pixel of Po (RGBA) takes the RGB of the nearest sampled pixel to
- * its left or to its right, the one whose eye distance (ed: window
- * depths, near n, far f) is nearer to its own (the left one on a tie; the
- * one there is when only one side has any). 0 when the row has filled
- * pixels but no sampled one: nothing written (pipe__reproj_fill_cols
- * fills it). */
-int pipe__reproj_fill_row(const uint8_t *K, int w, uint8_t *Po, const float *ed, float n,
-                          float f);
+/* The filled pixels (THE FILL above) of the eye layer (w x h: M the mask,
+ * P the RGBA image whose alpha holds each pixel's kind, 1 sampled, 2
+ * filled, where M != 0; ed the eye's window depths, near n, far f), in
+ * the rows whose rows[y] has bit 0 set (bit 1: the row has sampled
+ * pixels): each takes the RGB of the nearest sampled pixel on its surface
+ * to its left or right in its row or above or below in its column, each
+ * search ending at a pixel of M 0 (THE FILL above for the rule). A
+ * filled pixel with none of the four gets the kind 3 and its row keeps
+ * bit 0 (pipe__reproj_fill_cols then fills it); the other rows' bit 0 is
+ * cleared. */
+void pipe__reproj_fill(uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P, const float *ed,
+                       float n, float f);
 
-/* The rows of the eye layer (w x h) that have filled pixels but no sampled
- * one (rows[y] == 1; 2: the row has sampled pixels, its filled ones filled
- * from them by pipe__reproj_fill_row; 0: neither), filled from the nearest
- * row above or below that has sampled pixels (the one above on a tie):
- * each filled pixel (M != 0, P's alpha the filled kind) takes the RGB of
- * that row's nearest pixel of M != 0 (sampled or filled from its row: every
- * one has its colour), the left one on a tie. near: w ints of scratch.
- * Without any row of sampled pixels the filled pixels get M = 0 (not
- * shown). */
+/* After pipe__reproj_fill: the rows whose rows[y] has bit 0 set (their
+ * pixels of kind 3 have no sampled pixel in their row or column), filled
+ * from the nearest row above or below that has sampled pixels (bit 1; the
+ * one above on a tie): each pixel of kind 3 (M != 0) takes the RGB of that
+ * row's nearest pixel of M != 0 (sampled or filled: in a row with sampled
+ * pixels every filled one has its colour), the left one on a tie, and the
+ * kind 2. near: w ints of scratch. Without any row of sampled pixels those
+ * pixels get M = 0 (not shown). */
 void pipe__reproj_fill_cols(const uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P,
                             int32_t *near);
 

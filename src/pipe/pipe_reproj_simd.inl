@@ -179,9 +179,9 @@ SIMD_INL void rp_shows2(const pipe__reproj_tapd *t, vmask valid, vint gx, vint d
  * pipe_reproj.c lane by lane); the first column not done. */
 int SIMD_FN(pipe__reproj_taps)(const pipe__reproj_tapd *t, const uint8_t *em,
                                const pipe__reproj_lanes *o, int x0, int w, uint8_t *M, uint8_t *Po,
-                               uint8_t *K, long cnt[4])
+                               long cnt[4])
 {
-    const vint zero = vi_zero(), one = vi_set1(1), two = vi_set1(2), k256 = vi_set1(256);
+    const vint zero = vi_zero(), one = vi_set1(1), k256 = vi_set1(256);
     const vint ox = vi_set1(t->ox), oy = vi_set1(t->oy), ps4 = vi_set1(t->ps4);
     const vint icw1 = vi_set1(t->icw1), ich1 = vi_set1(t->ich1);
     const vint rgb = vi_set1(0x00FFFFFF), a_fill = vi_set1(2 << 24), a_samp = vi_set1(1 << 24);
@@ -222,7 +222,6 @@ int SIMD_FN(pipe__reproj_taps)(const pipe__reproj_tapd *t, const uint8_t *em,
         const unsigned sb = vm_bits(seen);
         nfill += __builtin_popcount(vm_bits(fill));
         nsamp += __builtin_popcount(sb);
-        vi_store_u8(K + x, vi_or(vi_sel(seen, one, zero), vi_sel(fill, two, zero)));
         int32_t *po = (int32_t *)(void *)(Po + 4 * (size_t)x);
         const vint old = vi_loadu(po);
         vint out = vi_sel(fill, vi_or(vi_and(old, rgb), a_fill), old);
