@@ -886,11 +886,13 @@ static void result_fill_rule(void **state)
 
 /* The pixels the fill found no candidate for (pipe__reproj_fill_cols)
  * against the rule written plainly: seeded layers of rows flagged 0, 1
- * (pixels of kind 3 to fill, none sampled) and 2 (sampled pixels, at least
- * one pixel of M set), P's alpha marking kind 3 among the set pixels of
- * rows flagged 1; each takes the RGB of the nearest M != 0 pixel (the left
- * on a tie) of the nearest row flagged 2 (above on a tie), and kind 2; with
- * no row flagged 2 its M becomes 0 (and its kind 2). Nothing else changes. */
+ * (pixels of kind 3 to fill, none sampled), 2 (sampled pixels, at least
+ * one pixel of M set) and 3 (both: kind 3 in one run, sampled ones in
+ * another), P's alpha marking kinds 1-3 among the set pixels; each pixel
+ * of kind 3 in a row with bit 0 takes the RGB of the nearest coloured
+ * pixel (M != 0, not kind 3; the left on a tie) of the nearest other row
+ * with bit 1 (above on a tie); with no such row its M becomes 0; every
+ * kind 3 of those rows becomes 2. Nothing else changes. */
 static void result_fill_cols_rule(void **state)
 {
     (void)state;
@@ -898,35 +900,43 @@ static void result_fill_cols_rule(void **state)
     enum { FW = 37, FH = 23 };
     uint8_t rows[FH], M[FW * FH], P[4 * FW * FH], EM[FW * FH], EP[4 * FW * FH];
     int32_t near[FW];
-    long from_row = 0, hidden = 0;
+    long from_row = 0, hidden = 0, both = 0;
     for (int it = 0; it < 2000; it++) {
         const int w = 1 + tu_int(&g, FW), h = 1 + tu_int(&g, FH);
         const int p2 = it % 7 == 0 ? 0 : 1 + tu_int(&g, 4); /* weight of sampled rows */
         for (int y = 0; y < h; y++) {
-            int k = tu_int(&g, p2 + 4);
-            rows[y] = (uint8_t)(k < p2 ? 2 : k < p2 + 3 ? 1 : 0);
+            int k = tu_int(&g, p2 + 5);
+            rows[y] = (uint8_t)(k < p2 ? 2 : k < p2 + 3 ? 1 : k < p2 + 4 ? 3 : 0);
             for (int x = 0; x < w; x++) {
                 const int i = y * w + x;
                 M[i] = (uint8_t)(tu_int(&g, 3) ? 0 : 1 + tu_int(&g, 255));
-                for (int j = 0; j < 4; j++) P[4 * i + j] = (uint8_t)tu_int(&g, 256);
-                if (rows[y] == 1 && M[i] && tu_int(&g, 4)) P[4 * i + 3] = 3; /* unresolved */
-                else if (P[4 * i + 3] == 3) P[4 * i + 3] = 1;
+                for (int j = 0; j < 3; j++) P[4 * i + j] = (uint8_t)tu_int(&g, 256);
+                /* kinds: 3 only in rows with bit 0, 1 only in rows with bit 1 */
+                const int kk = tu_int(&g, 4);
+                P[4 * i + 3] = (uint8_t)(!M[i] ? 0 : (rows[y] & 1) && kk < 2 ? 3
+                                                   : (rows[y] & 2) && kk < 3 ? 1 : 2);
             }
-            if (rows[y] == 2) M[y * w + tu_int(&g, w)] = 200;
+            if (rows[y] & 2) {
+                const int i = y * w + tu_int(&g, w);
+                M[i] = 200;
+                P[4 * i + 3] = 1;
+            }
+            both += rows[y] == 3;
         }
         memcpy(EM, M, (size_t)(w * h));
         memcpy(EP, P, (size_t)(4 * w * h));
         for (int y = 0; y < h; y++) {
-            if (rows[y] != 1) continue;
+            if (!(rows[y] & 1)) continue;
             int src = -1;
             for (int d = 1; d < h && src < 0; d++) {
-                if (y - d >= 0 && rows[y - d] == 2) src = y - d;
-                else if (y + d < h && rows[y + d] == 2) src = y + d;
+                if (y - d >= 0 && (rows[y - d] & 2)) src = y - d;
+                else if (y + d < h && (rows[y + d] & 2)) src = y + d;
             }
             for (int x = 0; x < w; x++) {
                 const int i = y * w + x;
-                if (!M[i] || P[4 * i + 3] != 3) continue;
+                if (P[4 * i + 3] != 3) continue;
                 EP[4 * i + 3] = 2;
+                if (!M[i]) continue;
                 if (src < 0) {
                     EM[i] = 0;
                     hidden++;
@@ -934,8 +944,9 @@ static void result_fill_cols_rule(void **state)
                 }
                 int xs = -1;
                 for (int d = 0; d < w && xs < 0; d++) {
-                    if (x - d >= 0 && M[src * w + x - d]) xs = x - d;
-                    else if (x + d < w && M[src * w + x + d]) xs = x + d;
+                    const int l = src * w + x - d, r = src * w + x + d;
+                    if (x - d >= 0 && M[l] && P[4 * l + 3] != 3) xs = x - d;
+                    else if (x + d < w && M[r] && P[4 * r + 3] != 3) xs = x + d;
                 }
                 for (int j = 0; j < 3; j++) EP[4 * i + j] = P[4 * (src * w + xs) + j];
                 from_row++;
@@ -945,9 +956,11 @@ static void result_fill_cols_rule(void **state)
         assert_memory_equal(M, EM, (size_t)(w * h));
         assert_memory_equal(P, EP, (size_t)(4 * w * h));
     }
-    print_message("NOTE %ld pixels filled from another row, %ld hidden\n", from_row, hidden);
+    print_message("NOTE %ld pixels filled from another row, %ld hidden; %ld rows with both "
+                  "kinds\n", from_row, hidden, both);
     assert_true(from_row > 20000);
     assert_true(hidden > 500);
+    assert_true(both > 1000);
 }
 
 /* The sampling pass (pipe__reproj_sample) alone on every ISA against the

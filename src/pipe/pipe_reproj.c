@@ -307,11 +307,14 @@ void pipe__reproj_fill(uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P, cons
 
 /* (pipe_reproj.h) The nearest coloured pixel of the source row per
  * column is built once per source row (two passes), so a row to fill
- * costs O(w + h) (the search for its source row) however many filled
- * pixels it holds; such rows are few (a part's top or bottom rows). */
+ * costs O(w + h) (the search for its source row) however many pixels it
+ * fills; such pixels are few (none of the four searches of
+ * pipe__reproj_fill found a sampled one). The pixels filled keep kind 3
+ * until every row is done, so none is the source of another. */
 void pipe__reproj_fill_cols(const uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P,
                             int32_t *near)
 {
+#define RP_COLOURED(m, p) ((m) && (p)[3] != ST_UNRESOLVED)
     int built = -1;
     for (int y = 0; y < h; y++) {
         if (!(rows[y] & 1)) continue;
@@ -323,25 +326,23 @@ void pipe__reproj_fill_cols(const uint8_t *rows, int w, int h, uint8_t *M, uint8
         const int src = ya >= 0 && (yb >= h || y - ya <= yb - y) ? ya : yb < h ? yb : -1;
         if (src < 0) {
             for (int x = 0; x < w; x++)
-                if (My[x] && Py[4 * x + 3] == ST_UNRESOLVED) {
-                    My[x] = 0; /* nothing seen at all */
-                    Py[4 * x + 3] = ST_FILL;
-                }
+                if (My[x] && Py[4 * x + 3] == ST_UNRESOLVED) My[x] = 0; /* nothing seen at all */
             continue;
         }
         const uint8_t *Ms = M + (size_t)src * (size_t)w;
         const uint8_t *Ps = P + (size_t)src * (size_t)w * 4;
         if (src != built) {
-            /* near[x]: the nearest column of Ms != 0 (the left on a tie);
-             * the row has at least one (its sampled pixels) */
+            /* near[x]: the nearest coloured column (M != 0, not kind 3;
+             * the left on a tie); the row has at least one (its sampled
+             * pixels) */
             int last = -1;
             for (int x = 0; x < w; x++) {
-                if (Ms[x]) last = x;
+                if (RP_COLOURED(Ms[x], Ps + 4 * x)) last = x;
                 near[x] = last;
             }
             int next = -1;
             for (int x = w - 1; x >= 0; x--) {
-                if (Ms[x]) next = x;
+                if (RP_COLOURED(Ms[x], Ps + 4 * x)) next = x;
                 if (next >= 0 && (near[x] < 0 || next - x < x - near[x])) near[x] = next;
             }
             built = src;
@@ -350,8 +351,15 @@ void pipe__reproj_fill_cols(const uint8_t *rows, int w, int h, uint8_t *M, uint8
             if (!My[x] || Py[4 * x + 3] != ST_UNRESOLVED) continue;
             const uint8_t *c = Ps + 4 * (size_t)near[x];
             for (int j = 0; j < 3; j++) Py[4 * x + j] = c[j];
-            Py[4 * x + 3] = ST_FILL;
         }
+    }
+#undef RP_COLOURED
+    /* the kind of the pixels filled (and hidden) back to filled */
+    for (int y = 0; y < h; y++) {
+        if (!(rows[y] & 1)) continue;
+        uint8_t *Py = P + (size_t)y * (size_t)w * 4;
+        for (int x = 0; x < w; x++)
+            if (Py[4 * x + 3] == ST_UNRESOLVED) Py[4 * x + 3] = ST_FILL;
     }
 }
 

@@ -37,14 +37,15 @@
  *              (pipe__reproj_fill): of the nearest sampled pixels to its
  *              left and right in its eye row and above and below in its
  *              column (each search ends where the eye's mask does: a run
- *              of the part's pixels), those whose eye distance is within the occlusion
- *              test's slack of the nearest one in distance, the nearest
+ *              of the part's pixels), those whose eye distance is within
+ *              the occlusion test's slack of the nearest one, the nearest
  *              in pixels (left, right, above, below on a tie), so the
  *              background that a disocclusion reveals is filled from the
  *              background, not from the hand in front, and not from
  *              another part far along the row; a pixel with none of the
- *              four takes the colour of the nearest pixel of the nearest
- *              row that has sampled pixels (pipe__reproj_fill_cols); an
+ *              four takes the colour of the nearest coloured pixel of the
+ *              nearest other row that has sampled pixels
+ *              (pipe__reproj_fill_cols); an
  *              eye without any is not shown (mask 0);
  *     outside  its point projects outside the camera image (or behind
  *              the camera, or beyond the lens's valid region): mask 0.
@@ -206,14 +207,14 @@ pipe__reproj_taps_t pipe__reproj_taps_sse2, pipe__reproj_taps_avx2, pipe__reproj
 void pipe__reproj_fill(uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P, const float *ed,
                        float n, float f);
 
-/* After pipe__reproj_fill: the rows whose rows[y] has bit 0 set (their
- * pixels of kind 3 have no sampled pixel in their row or column), filled
- * from the nearest row above or below that has sampled pixels (bit 1; the
- * one above on a tie): each pixel of kind 3 (M != 0) takes the RGB of that
- * row's nearest pixel of M != 0 (sampled or filled: in a row with sampled
- * pixels every filled one has its colour), the left one on a tie, and the
- * kind 2. near: w ints of scratch. Without any row of sampled pixels those
- * pixels get M = 0 (not shown). */
+/* After pipe__reproj_fill: the pixels of kind 3 (M != 0; none of the four
+ * searches found a sampled pixel) in the rows whose rows[y] has bit 0 set,
+ * filled from the nearest other row above or below that has sampled
+ * pixels (bit 1; the one above on a tie): each takes the RGB of that row's
+ * nearest coloured pixel (M != 0 and not of kind 3: sampled or filled),
+ * the left one on a tie. Without any row of sampled pixels they get M = 0
+ * (not shown). At the end every kind 3 of the flagged rows becomes 2.
+ * near: w ints of scratch. */
 void pipe__reproj_fill_cols(const uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P,
                             int32_t *near);
 
