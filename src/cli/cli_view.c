@@ -16,8 +16,9 @@ int cli_view_check(const char *cmd, int view, int aa, const kin_sthmd_desc *hmd)
 {
     if (view != PIPE_VIEW_REPROJECT) return EXIT_OK;
     if (aa)
-        return cli_usage_error(cmd, "--view reproject: not with --aa %d (the eye's view has "
-                                    "binary edges with a faded border)", aa);
+        return cli_usage_error(cmd, "--view reproject: not with --aa %d (the eye's view takes "
+                                    "no coverage samples; its edges are soft by default, "
+                                    "--soft-edges)", aa);
     kin_sthmd_desc r = kin_sthmd_desc_resolved(hmd);
     float ipd = hmd->ipd_m != 0.0f ? hmd->ipd_m : r.ipd_m;
     float d = hmd->cam_offset_m != 0.0f ? hmd->cam_offset_m : r.cam_offset_m;

@@ -50,8 +50,9 @@ const uint8_t *pipe_view_mask(const pipe_ctx *p, int eye, int *width, int *heigh
     const eye_state *e = &p->eye[eye ? 1 : 0];
     if (width) *width = e->rp.width;
     if (height) *height = e->rp.height;
-    /* the mask composited: the eye view's, softened with soft_edge */
-    return e->view_used == PIPE_VIEW_REPROJECT ? (e->shown ? e->shown : e->rp.M) : NULL;
+    /* the mask composited (run_eye sets shown in every frame that
+     * reprojects): the eye view's, softened with soft_edge */
+    return e->view_used == PIPE_VIEW_REPROJECT ? e->shown : NULL;
 }
 
 kin_sthmd_geometry pipe_geometry(const pipe_ctx *p) { return p->geo; }

@@ -58,7 +58,7 @@ int pipe__reproj_init(pipe__reproj *r, int width, int height)
     r->mask = malloc(px);
     r->P = calloc(px, 4);
     r->M = calloc(px, 1);
-    r->row = malloc(sizeof(int32_t) * 3 * (size_t)width + (size_t)height);
+    r->row = malloc(sizeof(int32_t) * (size_t)width + (size_t)height);
     r->lanes = malloc(sizeof(int32_t) * 8 * ((size_t)width + 16));
     if (!r->depth || !r->nrm || !r->mask || !r->P || !r->M || !r->row || !r->lanes) {
         pipe__reproj_free(r);
@@ -401,8 +401,8 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
     float mind = INFINITY;
     /* the eye rays' x per column, and per row: bit 1 sampled pixels, bit 0
      * filled ones (pipe__reproj_fill, pipe__reproj_fill_cols) */
-    float *rxs = (float *)(r->row + 2 * w);
-    uint8_t *row_fill = (uint8_t *)(r->row + 3 * w);
+    float *rxs = (float *)r->row;
+    uint8_t *row_fill = (uint8_t *)(r->row + w);
     for (int x = 0; x < w; x++) rxs[x] = ((float)x + 0.5f - ecx) / efx;
     g.rxs = rxs;
     for (int y = 0; y < h; y++) {

@@ -130,7 +130,7 @@ typedef struct pipe__reproj {
     uint8_t *mask;
     uint8_t *P;               /* RGBA8: camera colours seen from the eye */
     uint8_t *M;               /* the mask composited (fade, fill) */
-    int32_t *row;             /* the eye rays' x, the rows' kinds (the fill) */
+    int32_t *row;             /* width: the eye rays' x; then height bytes: the rows' kinds */
     int32_t *lanes;           /* 8 * width: one row's geometry (pipe__reproj_lanes) */
     int isa;                  /* the geometry pass's ISA (ef_isa; pipe.c sets it) */
     kin_camera cam;           /* this frame's eye camera */
