@@ -834,7 +834,7 @@ static void run_composite(bench *b, int n)
         Q[e] = xmalloc((size_t)cw * ch * 4);
         R[e] = xmalloc((size_t)lw * lh * 4);
         kin_camera cam = kin_sthmd_camera(&b->hmd, &ps.world[b->head], (kin_eye)e);
-        rast_target tg = {cw, ch, depth, cw, mask, cw, nrm, 3 * cw, 3};
+        rast_target tg = {cw, ch, depth, cw, mask, cw, nrm, 3 * cw, 3, NULL, 0};
         rast_target_clear(&tg);
         pipe_pose_draw(&ps, NULL, &cam, &tg, RAST_CULL_NONE, clip, vn, NULL);
         long on = 0;

@@ -196,7 +196,7 @@ int main(int argc, char **argv)
         planes[e] = malloc(plane * 16 + plane);
         if (!planes[e]) exit(1);
         rast_target t = {b.W, b.H, planes[e], b.W, (uint8_t *)(planes[e] + plane * 4), b.W,
-                         planes[e] + plane, 3 * b.W, 3};
+                         planes[e] + plane, 3 * b.W, 3, NULL, 0};
         b.tg[e] = t;
     }
     /* reference masks: level 0 of every pose and eye */

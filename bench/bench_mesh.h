@@ -164,7 +164,7 @@ static inline int bm_eyes_init(bm_eyes *b, int W, int H)
     }
     for (int e = 0; e < 2; e++) {
         rast_target t = { W, H, b->depth + (size_t)e * W * H, W, b->mask + (size_t)e * W * H, W,
-                          b->nrm + (size_t)e * W * H * 3, 3 * W, 3 };
+                          b->nrm + (size_t)e * W * H * 3, 3 * W, 3, NULL, 0 };
         b->tg[e] = t;
     }
     return 1;

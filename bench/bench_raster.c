@@ -26,12 +26,14 @@
  *                [--isa ref|sse2|avx2|avx512] [--threads 1|2]
  *                [--samples DIR|none] [--cold MB] [--no-pipe]
  *                [--sample-only] [--cull back|none] [--clear-normals]
- *                [--cpu-time]
+ *                [--cpu-time] [--n10]
  *
  * --sample-only skips the bench scene (its draw rows and pipe rows), --cull
  * runs one cull mode of the pipe rows: for counting instructions of the
  * sample model's stage alone (valgrind --tool=callgrind
  * --toggle-collect=rast_context_draw, docs/bench.md raster section).
+ * --n10: the pipe rows draw the normals packed into an attr_n10 plane
+ * (rast_target.attr_n10, 4 bytes per pixel) instead of 3 floats.
  *
  * The same scene through Mesa llvmpipe, with the ratio, is
  * bench/llvmpipe/llvmpipe_raster (built separately: it needs EGL/GLES). */
@@ -76,6 +78,7 @@ typedef struct pipe_scene {
  * reprojected mask, or a lens), else not (rast_context_clear_keep_attr,
  * the pipe's default path, docs/raster.md section 13). */
 static int clear_normals = 0;
+static int use_n10 = 0;   /* --n10 */
 
 typedef struct pipe_eye {
     rast_context *ctx;
@@ -174,7 +177,13 @@ static void pipe_rows(int csv, const char *model, int tris, const pipe_scene *po
             exit(1);
         }
         rast_target t = { W, H, planes[e], W, (uint8_t *)(planes[e] + (size_t)W * H * 4), W,
-                          planes[e] + (size_t)W * H, 3 * W, 3 };
+                          planes[e] + (size_t)W * H, 3 * W, 3, NULL, 0 };
+        if (use_n10) {
+            t.attr_n10 = (uint32_t *)(void *)t.attr;
+            t.attr_n10_stride = W;
+            t.attr = NULL;
+            t.attr_stride = 0;
+        }
         eye[e].tg = t;
     }
     double *ts = malloc((size_t)runs * 4 * sizeof(double));
@@ -300,7 +309,7 @@ static int pipe_samples(int csv, const char *dir, int np, int runs, int only_isa
             for (int k = 0; k < 2; k++) {
                 uint8_t *m = k ? b : a;
                 rast_target t = { W, H, (float *)(void *)m, W, m + (size_t)W * H * 16, W,
-                                  (float *)(void *)(m + (size_t)W * H * 4), 3 * W, 3 };
+                                  (float *)(void *)(m + (size_t)W * H * 4), 3 * W, 3, NULL, 0 };
                 if (k == 0) {
                     kin_camera cam = kin_sthmd_camera(&hmd, &ps.world[head], KIN_EYE_LEFT);
                     rast_target_clear(&t);
@@ -347,6 +356,8 @@ int main(int argc, char **argv)
             pipe = 0;
         else if (!strcmp(argv[i], "--clear-normals"))
             clear_normals = 1;
+        else if (!strcmp(argv[i], "--n10"))
+            use_n10 = 1;
         else if (!strcmp(argv[i], "--sample-only"))
             ntl = 0;
         else if (!strcmp(argv[i], "--cpu-time"))
@@ -379,7 +390,8 @@ int main(int argc, char **argv)
         } else {
             fprintf(stderr, "usage: %s [--csv] [--runs N] [--tris N,N,...] [--size WxH] "
                             "[--isa NAME] [--threads N] [--samples DIR|none] [--cold MB] "
-                            "[--no-pipe] [--sample-only] [--cull back|none] [--clear-normals] [--cpu-time]\n",
+                            "[--no-pipe] [--sample-only] [--cull back|none] [--clear-normals] "
+                            "[--cpu-time] [--n10]\n",
                     argv[0]);
             return 2;
         }

@@ -169,7 +169,7 @@ static void draw(const loaded *l, const shot *s, uint8_t *mask, float *depth)
 {
     kin_camera cam = kin_camera_look_at(s->eye, s->target, kin_v3(0.0f, 1.0f, 0.0f), FOVY, W, H,
                                         s->znear, s->zfar);
-    rast_target tg = {W, H, depth, W, mask, W, NULL, 0, 0};
+    rast_target tg = {W, H, depth, W, mask, W, NULL, 0, 0, NULL, 0};
     rast_target_clear(&tg);
     assert_int_equal(pipe_pose_draw(&l->ps, NULL, &cam, &tg, RAST_CULL_NONE, l->clip, l->vnrm, NULL),
                      RAST_OK);
@@ -471,7 +471,7 @@ static void pipeline_draws_morphs_and_strips(void **state)
                 assert_int_equal(mw, cw);
                 assert_int_equal(mh, ch);
                 kin_camera kc = pipe_camera(p, e);
-                rast_target tg = {cw, ch, depth, cw, mask, cw, NULL, 0, 0};
+                rast_target tg = {cw, ch, depth, cw, mask, cw, NULL, 0, 0, NULL, 0};
                 rast_target_clear(&tg);
                 assert_int_equal(pipe_pose_draw(&l.ps, NULL, &kc, &tg, RAST_CULL_NONE, l.clip,
                                                 l.vnrm, NULL), RAST_OK);

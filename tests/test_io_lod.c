@@ -184,8 +184,8 @@ static void test_draw(void **state)
     assert_non_null(mk);
     assert_non_null(clip);
     assert_non_null(vn);
-    rast_target ta = {W, H, buf, W, mk, W, buf + np, 3 * W, 3};
-    rast_target tb = {W, H, buf + 4 * np, W, mk + np, W, buf + 5 * np, 3 * W, 3};
+    rast_target ta = {W, H, buf, W, mk, W, buf + np, 3 * W, 3, NULL, 0};
+    rast_target tb = {W, H, buf + 4 * np, W, mk + np, W, buf + 5 * np, 3 * W, 3, NULL, 0};
     rast_target_clear(&ta);
     assert_int_equal(pipe_pose_draw(&ps, NULL, &cam, &ta, RAST_CULL_NONE, clip, vn, NULL),
                      RAST_OK);

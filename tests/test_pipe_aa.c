@@ -455,7 +455,7 @@ static void aa_band(void **state)
         clip[4 * 5 + 3] = -0.5f; /* triangle 1: a vertex behind the eye */
         clip[4 * 5 + 2] = -0.7f;
         uint8_t mask[W * H];
-        rast_target tg = {W, H, NULL, 0, mask, W, NULL, 0, 0};
+        rast_target tg = {W, H, NULL, 0, mask, W, NULL, 0, 0, NULL, 0};
         rast_target_clear(&tg);
         rast_mesh_desc d = {clip, 3 * NT, NULL, 0, idx, NT, RAST_CULL_NONE};
         assert_int_equal(rast_draw(&tg, &d, NULL), RAST_OK);

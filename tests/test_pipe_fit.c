@@ -155,7 +155,7 @@ static void draw(const arms *A, const float *pos, const kin_camera *cam, uint8_t
     float *clip = malloc(sizeof(float) * 4 * (size_t)A->nv);
     float *depth = malloc(sizeof(float) * W * H);
     assert_true(clip && depth);
-    rast_target t = { W, H, depth, W, mask, W, NULL, 0, 0 };
+    rast_target t = { W, H, depth, W, mask, W, NULL, 0, 0, NULL, 0 };
     rast_target_clear(&t);
     rast_transform_points(cam->view_proj.m, pos, A->nv, clip);
     rast_mesh_desc d = { clip, A->nv, NULL, 0, A->idx, A->nt, RAST_CULL_NONE };
@@ -295,7 +295,7 @@ static void draw_some(const arms *A, const float *pos, const kin_camera *cam, ui
         memcpy(&idx[nt * 3], v, sizeof(uint32_t) * 3);
         nt++;
     }
-    rast_target t = { W, H, depth, W, mask, W, NULL, 0, 0 };
+    rast_target t = { W, H, depth, W, mask, W, NULL, 0, 0, NULL, 0 };
     rast_target_clear(&t);
     rast_transform_points(cam->view_proj.m, pos, A->nv, clip);
     rast_mesh_desc d = { clip, A->nv, NULL, 0, idx, nt, RAST_CULL_NONE };

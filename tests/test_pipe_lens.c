@@ -191,11 +191,12 @@ static void run_case(const char *name, const kin_lens *L, const poly *p, int ss)
     assert_non_null(mask);
     assert_non_null(straight);
     assert_non_null(depth);
-    rast_target out = {L->width, L->height, depth, L->width, mask, L->width, NULL, 0, 0};
+    rast_target out = {L->width, L->height, depth, L->width, mask, L->width, NULL, 0, 0, NULL, 0};
     memset(mask, 0x77, n);
     long set = pipe_lens_warp(&m, &out);
     /* the straight drawing: the lens's pinhole part, no warp */
-    rast_target st = {L->width, L->height, depth, L->width, straight, L->width, NULL, 0, 0};
+    rast_target st = {L->width, L->height, depth, L->width, straight, L->width, NULL, 0, 0,
+                      NULL, 0};
     float *d2 = malloc(sizeof(float) * n);
     assert_non_null(d2);
     st.depth = d2;
@@ -323,7 +324,8 @@ static void result_attributes(void **state)
     uint8_t *mask = malloc(n);
     float *depth = malloc(sizeof(float) * n), *attr = malloc(sizeof(float) * 3 * n);
     assert_non_null(mask), assert_non_null(depth), assert_non_null(attr);
-    rast_target out = {L.width, L.height, depth, L.width, mask, L.width, attr, 3 * L.width, 3};
+    rast_target out = {L.width, L.height, depth, L.width, mask, L.width, attr, 3 * L.width, 3,
+                       NULL, 0};
     rast_target_clear(&out);
     assert_true(pipe_lens_warp(&m, &out) > 10000);
     /* window depth of z = -0.6 with the camera's projection */
@@ -352,7 +354,8 @@ static void result_attributes(void **state)
     uint8_t *mask2 = malloc(n);
     float *depth2 = malloc(sizeof(float) * n), *attr2 = malloc(sizeof(float) * 3 * n);
     assert_non_null(mask2), assert_non_null(depth2), assert_non_null(attr2);
-    rast_target out2 = {L.width, L.height, depth2, L.width, mask2, L.width, attr2, 3 * L.width, 3};
+    rast_target out2 = {L.width, L.height, depth2, L.width, mask2, L.width, attr2, 3 * L.width, 3,
+                        NULL, 0};
     rast_target_clear(&out2);
     assert_int_equal(pipe_lens_warp(&m, &out2), n2);
     assert_true(n2 > 1000);

@@ -692,7 +692,7 @@ static void prop_cube_mask(void **state)
     for (int e = 0; e < 2; e++) {
         kin_camera cam = kin_sthmd_camera(NULL, &head, (kin_eye)e);
         /* (1) the rasterizer on the same triangles */
-        rast_target t = {MW, MH, depth, MW, ref, MW, NULL, 0, 0};
+        rast_target t = {MW, MH, depth, MW, ref, MW, NULL, 0, 0, NULL, 0};
         rast_target_clear(&t);
         float clip[32];
         rast_transform_points(cam.view_proj.m, world, 8, clip);

@@ -177,7 +177,7 @@ static long draw_from_eye(const kin_model *m, int e, uint8_t *mask)
     float *clip = malloc(sizeof(float) * 4 * (size_t)me->vertex_count);
     assert_non_null(depth);
     assert_non_null(clip);
-    rast_target t = {CW, CH, depth, CW, mask, CW, NULL, 0, 0};
+    rast_target t = {CW, CH, depth, CW, mask, CW, NULL, 0, 0, NULL, 0};
     rast_target_clear(&t);
     kin_camera c = eye_cam(e);
     rast_transform_points(c.view_proj.m, me->positions, me->vertex_count, clip);
@@ -272,7 +272,7 @@ static void result_mask_other_hmd(void **state)
         assert_int_equal(mw, w);
         assert_int_equal(mh, h);
         kin_camera c = kin_sthmd_eye_camera(&hd, NULL, (kin_eye)e, w, h);
-        rast_target t = {w, h, depth, w, ref, w, NULL, 0, 0};
+        rast_target t = {w, h, depth, w, ref, w, NULL, 0, 0, NULL, 0};
         rast_target_clear(&t);
         rast_transform_points(c.view_proj.m, r.m.meshes[0].positions, 4, clip);
         rast_mesh_desc md = {clip, 4, NULL, 0, r.m.meshes[0].indices, 2, RAST_CULL_NONE};

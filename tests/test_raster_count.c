@@ -73,7 +73,7 @@ static rast_target make_target(tu_rng *r, int big)
     const int H = big ? 100 + tu_int(r, 201) : 1 + tu_int(r, 60);
     const int ms = W + tu_int(r, 9), ds = W + tu_int(r, 5);
     rast_target t = { W, H, malloc((size_t)ds * H * sizeof(float)), ds, malloc((size_t)ms * H),
-                      ms, NULL, 0, 0 };
+                      ms, NULL, 0, 0, NULL, 0 };
     assert_non_null(t.depth);
     assert_non_null(t.mask);
     memset(t.mask, 0x5A, (size_t)ms * H);   /* padding stays nonzero */
@@ -149,16 +149,16 @@ static void test_count_bytes(void **state)
                 buf[k] = density == 0   ? 0
                          : density == 3 ? (uint8_t)(1 + tu_int(&r, 255))
                          : tu_int(&r, density + 1) ? (uint8_t)tu_int(&r, 256) : 0;
-            rast_target t = { W, H, NULL, W, buf + off, stride, NULL, 0, 0 };
+            rast_target t = { W, H, NULL, W, buf + off, stride, NULL, 0, 0, NULL, 0 };
             assert_int_equal(rast_context_count(NULL, &t), count_ref(&t));
             free(buf);
         }
     }
-    rast_target bad = { 0, 4, NULL, 4, NULL, 4, NULL, 0, 0 };
+    rast_target bad = { 0, 4, NULL, 4, NULL, 4, NULL, 0, 0, NULL, 0 };
     assert_int_equal(rast_context_count(NULL, NULL), 0);
     assert_int_equal(rast_context_count(NULL, &bad), 0);
     uint8_t m[16] = { 1 };
-    rast_target narrow = { 4, 4, NULL, 4, m, 3, NULL, 0, 0 };   /* stride < width */
+    rast_target narrow = { 4, 4, NULL, 4, m, 3, NULL, 0, 0, NULL, 0 };   /* stride < width */
     assert_int_equal(rast_context_count(NULL, &narrow), 0);
 }
 
@@ -169,7 +169,7 @@ static void test_count_tiles_only(void **state)
     enum { W = 64, H = 48 };
     float depth[W * H];
     uint8_t mask[W * H];
-    rast_target t = { W, H, depth, W, mask, W, NULL, 0, 0 };
+    rast_target t = { W, H, depth, W, mask, W, NULL, 0, 0, NULL, 0 };
     rast_context *c = rast_context_create(NULL);
     assert_non_null(c);
     rast_context_clear(c, &t);

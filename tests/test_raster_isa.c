@@ -419,7 +419,7 @@ static void test_threads_equal(void **state)
     rast_mesh_desc m = { clip, nv, attr, 3, idx, nt, RAST_CULL_NONE };
     rast_target t = { W, H, malloc((size_t)(W + 3) * H * sizeof(float)), W + 3,
                       malloc((size_t)(W + 1) * H), W + 1,
-                      malloc((size_t)(W * 3 + 2) * H * sizeof(float)), W * 3 + 2, 3 };
+                      malloc((size_t)(W * 3 + 2) * H * sizeof(float)), W * 3 + 2, 3, NULL, 0 };
     rast_stats st;
     memset(&st, 0, sizeof st);
     reset_target(&t);
@@ -477,7 +477,7 @@ static void test_context_api(void **state)
     uint8_t mask[4 * 4];
     const float clip[12] = { -1, -1, 0, 1, 1, -1, 0, 1, -1, 1, 0, 1 };
     const uint32_t bad_idx[3] = { 0, 1, 3 }, idx[3] = { 0, 1, 2 };
-    rast_target t = { 4, 4, NULL, 4, mask, 4, NULL, 0, 0 };
+    rast_target t = { 4, 4, NULL, 4, mask, 4, NULL, 0, 0, NULL, 0 };
     rast_mesh_desc m = { clip, 3, NULL, 0, bad_idx, 1, RAST_CULL_NONE };
     rast_stats st;
     memset(&st, 0, sizeof st);
@@ -499,7 +499,7 @@ static void test_context_api(void **state)
      * smaller, or whose indices differ, is checked on its own: an error,
      * nothing drawn, stats untouched. */
     uint8_t mask2[4 * 4];
-    rast_target t2 = { 4, 4, NULL, 4, mask2, 4, NULL, 0, 0 };
+    rast_target t2 = { 4, 4, NULL, 4, mask2, 4, NULL, 0, 0, NULL, 0 };
     rast_mesh_desc m2 = m;
     const rast_target *tj[2] = { &t, &t2 };
     const rast_mesh_desc *mj[2] = { &m, &m2 };
@@ -919,11 +919,13 @@ static void test_context_clear(void **state)
         for (int e = 0; e < 2; e++) {
             rast_target t = { W, H, malloc((size_t)(W + 5) * H * sizeof(float)), W + 5,
                               malloc((size_t)(W + 3) * H), W + 3,
-                              malloc((size_t)(3 * W + 2) * H * sizeof(float)), 3 * W + 2, 3 };
+                              malloc((size_t)(3 * W + 2) * H * sizeof(float)), 3 * W + 2, 3,
+                              NULL, 0 };
             a[e] = t;
             rast_target u = { W, H, malloc((size_t)(W + 5) * H * sizeof(float)), W + 5,
                               malloc((size_t)(W + 3) * H), W + 3,
-                              malloc((size_t)(3 * W + 2) * H * sizeof(float)), 3 * W + 2, 3 };
+                              malloc((size_t)(3 * W + 2) * H * sizeof(float)), 3 * W + 2, 3,
+                              NULL, 0 };
             b[e] = u;
             reset_target(&a[e]);   /* pattern in the padding, then clear */
             reset_target(&b[e]);

@@ -62,7 +62,7 @@ static rast_target make_target(int W, int H, int pad)
 {
     const int ds = W + pad, ms = W + 2 * pad, as = 3 * W + pad;
     rast_target t = { W, H, malloc((size_t)ds * H * sizeof(float)), ds, malloc((size_t)ms * H), ms,
-                      malloc((size_t)as * H * sizeof(float)), as, 3 };
+                      malloc((size_t)as * H * sizeof(float)), as, 3, NULL, 0 };
     assert_non_null(t.depth);
     assert_non_null(t.mask);
     assert_non_null(t.attr);

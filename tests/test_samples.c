@@ -349,7 +349,7 @@ static void test_mask_matches_camera_images(void **state)
         assert_int_equal(cam.width, W);
         assert_int_equal(cam.height, H);
         rast_transform_points(cam.view_proj.m, pos, me->vertex_count, clip);
-        rast_target t = { W, H, depth, W, mask, W, NULL, 0, 0 };
+        rast_target t = { W, H, depth, W, mask, W, NULL, 0, 0, NULL, 0 };
         rast_target_clear(&t);
         rast_mesh_desc d = { clip, me->vertex_count, NULL, 0, me->indices,
                              me->index_count / 3, RAST_CULL_NONE };

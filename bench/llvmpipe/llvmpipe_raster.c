@@ -297,8 +297,10 @@ int main(int argc, char **argv)
                 rast_context_forget(c);
             }
             if (th == 2) {
-                static const rast_target empty_t[2] = { { 1, 1, NULL, 1, NULL, 1, NULL, 0, 0 },
-                                                        { 1, 1, NULL, 1, NULL, 1, NULL, 0, 0 } };
+                static const rast_target empty_t[2] = {
+                    { 1, 1, NULL, 1, NULL, 1, NULL, 0, 0, NULL, 0 },
+                    { 1, 1, NULL, 1, NULL, 1, NULL, 0, 0, NULL, 0 }
+                };
                 static uint8_t em[2];
                 rast_target et[2] = { empty_t[0], empty_t[1] };
                 et[0].mask = &em[0];

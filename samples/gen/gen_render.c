@@ -255,7 +255,7 @@ void gen_pose(gen_frame_ctx *c, float t, kin_mat4 *world_from_head)
 
 static rast_target target_of(gen_frame_ctx *c, int w, int h)
 {
-    rast_target t = { w, h, c->depth, w, c->mask, w, c->tattr, w * GEN_ATTRS, GEN_ATTRS };
+    rast_target t = { w, h, c->depth, w, c->mask, w, c->tattr, w * GEN_ATTRS, GEN_ATTRS, NULL, 0 };
     return t;
 }
 

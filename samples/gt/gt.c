@@ -394,7 +394,7 @@ void gt_render_eye(gen_frame_ctx *c, const kin_mat4 *world_from_head,
     kin_mat4 vp = kin_mat4_mul(&proj, &cam.view);
     const kin_mesh *me = &c->arms->model.meshes[0];
     rast_target t = { GEN_CAM_W, GEN_CAM_H, scratch_depth, GEN_CAM_W, scratch_mask, GEN_CAM_W,
-                      NULL, 0, 0 };
+                      NULL, 0, 0, NULL, 0 };
     rast_target_clear(&t);
     rast_transform_points(vp.m, c->skin_pos, me->vertex_count, c->clip);
     rast_mesh_desc d = { c->clip, me->vertex_count, NULL, 0, me->indices, me->index_count / 3,

@@ -86,7 +86,7 @@ void gt_render_view(gen_frame_ctx *c, const kin_camera *cam, const uint32_t *han
 {
     const int w = cam->width, h = cam->height;
     const kin_mesh *me = &c->arms->model.meshes[0];
-    rast_target t = { w, h, c->depth, w, c->mask, w, c->tattr, w * GEN_ATTRS, GEN_ATTRS };
+    rast_target t = { w, h, c->depth, w, c->mask, w, c->tattr, w * GEN_ATTRS, GEN_ATTRS, NULL, 0 };
     rast_target_clear(&t);
     rast_transform_points(cam->view_proj.m, c->skin_pos, me->vertex_count, c->clip);
     rast_mesh_desc d = { c->clip, me->vertex_count, c->arm_attr, GEN_ATTRS, me->indices,
@@ -113,7 +113,7 @@ void gt_render_view(gen_frame_ctx *c, const kin_camera *cam, const uint32_t *han
         }
     }
     if (hand && hand_idx && hand_tris > 0) {
-        rast_target th = { w, h, scratch_depth, w, hand, w, NULL, 0, 0 };
+        rast_target th = { w, h, scratch_depth, w, hand, w, NULL, 0, 0, NULL, 0 };
         rast_target_clear(&th);
         rast_mesh_desc dh = { c->clip, me->vertex_count, NULL, 0, hand_idx, hand_tris,
                               RAST_CULL_NONE };

@@ -386,7 +386,7 @@ static int draw_mask(eval_ctx *c, const method_cfg *cfg, const kin_mesh *me, int
                      const kin_camera *cam, const uint8_t **mask, const float **nrm)
 {
     int div = cfg->div, w = CW / div, h = CH / div;
-    rast_target tg = { w, h, c->depth_lo, w, c->mask_lo, w, c->nrm_lo, 3 * w, 3 };
+    rast_target tg = { w, h, c->depth_lo, w, c->mask_lo, w, c->nrm_lo, 3 * w, 3, NULL, 0 };
     /* as pipe_frame: through a context (the same bytes as rast_draw),
      * clearing what its last draw of this target touched */
     rast_context_clear(c->rast, &tg);
@@ -729,7 +729,7 @@ static int run_frame(eval_ctx *c, method_run *r, int frame, int per_frame, const
             cfg->kind != M_SKIN) {
             /* the kinematic mask (c->mask_lo) against the full model's in
              * the same pose (not timed) */
-            rast_target ft = { CW, CH, c->full_depth, CW, c->full_mask, CW, NULL, 0, 0 };
+            rast_target ft = { CW, CH, c->full_depth, CW, c->full_mask, CW, NULL, 0, 0, NULL, 0 };
             rast_target_clear(&ft);
             rast_transform_points(cam.view_proj.m, c->ps.pos, me->vertex_count, c->ps.clip);
             rast_mesh_desc d = { c->ps.clip, me->vertex_count, NULL, 0, me->indices,

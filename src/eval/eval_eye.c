@@ -363,7 +363,7 @@ static int run_frame(eye_ctx *c, eye_run *r, int fi, int per_frame, const char *
         double iou_seen = fuse_confusion_iou(&cf);
         /* the fingertip's part of the layer: the model's fingertip drawn
          * through the layer's camera, where the layer shows the hand */
-        rast_target th = { CW, CH, c->depth_c, CW, c->hmask_c, CW, NULL, 0, 0 };
+        rast_target th = { CW, CH, c->depth_c, CW, c->hmask_c, CW, NULL, 0, 0, NULL, 0 };
         rast_target_clear(&th);
         rast_transform_points(cam.view_proj.m, c->ps.pos, me->vertex_count, c->ps.clip);
         rast_mesh_desc dh = { c->ps.clip, me->vertex_count, NULL, 0, c->hand_m, c->ntri_m,

@@ -143,8 +143,8 @@ static rast_target cam_target(const pipe_ctx *p, const eye_state *e)
 {
     const int cw = p->geo.crop_width, ch = p->geo.crop_height;
     if (p->desc.eye_view == PIPE_VIEW_REPROJECT && !e->lens)
-        return (rast_target){cw, ch, e->depth, cw, e->mask, cw, NULL, 0, 0};
-    return (rast_target){cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
+        return (rast_target){cw, ch, e->depth, cw, e->mask, cw, NULL, 0, 0, NULL, 0};
+    return (rast_target){cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3, NULL, 0};
 }
 
 /* Reprojection (pipe_reproj.h): the model drawn from the eye, the camera
@@ -156,7 +156,7 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
     pipe__reproj *r = &e->rp;
     const int w = r->width, h = r->height, cw = p->geo.crop_width, ch = p->geo.crop_height;
     r->cam = kin_sthmd_eye_camera(&p->hmd, &e->head, (kin_eye)e->eye, w, h);
-    rast_target tg = {w, h, r->depth, w, r->mask, w, r->nrm, 3 * w, 3};
+    rast_target tg = {w, h, r->depth, w, r->mask, w, r->nrm, 3 * w, 3, NULL, 0};
     int level = e->lod_level;
     rast_result rr = eye_draw(p, e, NULL, &r->cam, &tg, 1, NULL);
     e->lod_level = level;
@@ -198,7 +198,7 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
              * would not hold for it across the other's draws: the
              * context forgets its targets first, and this one is cleared
              * whole (the others next frame) */
-            rast_target ct = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3};
+            rast_target ct = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3, NULL, 0};
             rast_context_forget(e->rast);
             rr = eye_draw(p, e, NULL, &e->cam, &ct, 1, NULL);
             e->lod_level = level;
@@ -634,7 +634,7 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
                 if (ok) { /* the warp writes only what changes: start clear */
                     rast_target t0 = {p->geo.crop_width, p->geo.crop_height, s->depth,
                                       p->geo.crop_width, s->mask, p->geo.crop_width, s->nrm,
-                                      3 * p->geo.crop_width, 3};
+                                      3 * p->geo.crop_width, 3, NULL, 0};
                     rast_target_clear(&t0);
                 }
             }

@@ -152,7 +152,7 @@ kin_camera pipe_lens_pinhole(const pipe_lens_map *m, const kin_camera *cam)
 rast_target pipe_lens_target(const pipe_lens_map *m)
 {
     rast_target t = {m->pin_width, m->pin_height, m->depth, m->pin_width, m->mask, m->pin_width,
-                     m->attr, m->attr_count * m->pin_width, m->attr_count};
+                     m->attr, m->attr_count * m->pin_width, m->attr_count, NULL, 0};
     return t;
 }
 

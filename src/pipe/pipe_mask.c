@@ -91,7 +91,7 @@ int pipe_mask_render(const kin_model *model, const pipe_mask_desc *d,
             goto done;
         }
     }
-    rast_target tg = {width, height, dep, width, msk, width, nrm, 3 * width, 3};
+    rast_target tg = {width, height, dep, width, msk, width, nrm, 3 * width, 3, NULL, 0};
     rast_target_clear(&tg);
     pipe_pose_anim(&ps, d->anim, d->time);
     rast_result rr;

@@ -605,7 +605,7 @@ void pipe__cockpit_clamp(pipe__cockpit *c, const pipe_pose *ps, int eye, rast_co
     const int W = c->width, H = c->height;
     const kin_model *m = ps->model;
     /* the hidden triangles' silhouette: no depth, no normals */
-    rast_target tg = {W, H, NULL, 0, c->hmask[eye], W, NULL, 0, 0};
+    rast_target tg = {W, H, NULL, 0, c->hmask[eye], W, NULL, 0, 0, NULL, 0};
     rast_context_clear(ctx, &tg);
     int any = 0;
     for (int i = 0; i < m->mesh_count; i++) {

@@ -53,11 +53,13 @@
  *
  * USAGE
  *   float depth[W*H], nrm[W*H*3]; uint8_t mask[W*H];
- *   rast_target t = { W, H, depth, W, mask, W, nrm, W*3, 3 };
+ *   rast_target t = { W, H, depth, W, mask, W, nrm, W*3, 3, NULL, 0 };
  *   rast_target_clear(&t);
  *   rast_mesh_desc d = { clip, nverts, normals, 3, indices, ntris };
  *   rast_stats st;
  *   if (rast_draw(&t, &d, &st) != RAST_OK) ...;
+ * or with the normals packed (src/cpu/ef_n10.h), uint32_t n10[W*H]:
+ *   rast_target t = { W, H, depth, W, mask, W, NULL, 0, 3, n10, W };
  */
 #ifndef EGOFUSE_RASTER_H
 #define EGOFUSE_RASTER_H
@@ -86,7 +88,14 @@ typedef enum rast_cull {
     RAST_CULL_FRONT
 } rast_cull;
 
-/* The render target: caller-owned planes. depth and attr may be NULL. */
+/* The render target: caller-owned planes. depth and attr may be NULL.
+ * The attributes go to at most one plane: attr (attr_count floats per
+ * pixel) or attr_n10 (attr_count 3 only: a normal packed in one uint32_t
+ * per pixel, a third of the bytes). The value written to attr_n10 for a
+ * pixel is exactly ef_n10_pack(a0, a1, a2) of the three floats the same
+ * draw writes to attr (so it is the same on every ISA, a NaN attribute
+ * included: it packs as -511). The fields are last, so positional
+ * initialisers of the earlier ones stay valid (the later are zero). */
 typedef struct rast_target {
     int width, height;        /* 1..RAST_MAX_DIM */
     float *depth;             /* window depth in [0,1], cleared to 1; NULL =
@@ -97,6 +106,12 @@ typedef struct rast_target {
     float *attr;              /* attr_count floats per pixel, or NULL */
     int attr_stride;          /* floats per row, >= width * attr_count */
     int attr_count;           /* 0..RAST_MAX_ATTRS, must match the mesh */
+    uint32_t *attr_n10;       /* with attr NULL and attr_count 3: the three
+                                 attributes of each pixel packed as
+                                 ef_n10_pack (src/cpu/ef_n10.h), one
+                                 uint32_t per pixel (cleared to 0, the
+                                 packed zero); NULL = not used */
+    int attr_n10_stride;      /* uint32_t per row, >= width */
 } rast_target;
 
 typedef struct rast_mesh_desc {
@@ -128,7 +143,7 @@ typedef struct rast_stats {
 
 /* Sets depth to 1.0, mask to 0 and attributes to 0 (the first width
  * elements of each row; padding is left alone). NULL planes are skipped. */
-void rast_target_clear(const rast_target *t);
+void rast_target_clear(const rast_target *t);   /* attr_n10: to 0 */
 
 /* Draws the mesh (see the steps above) on the calling thread with the ISA
  * of rast_draw_isa(). Stats are added to *stats when it
@@ -136,14 +151,16 @@ void rast_target_clear(const rast_target *t);
  * error nothing is drawn and *stats is untouched:
  *   RAST_ERR_ARGS  t, mesh or t->mask NULL; mask/depth stride < width;
  *                  attr stride < width*attr_count (when t->attr is set);
+ *                  t->attr_n10 set with t->attr also set, with attr_count
+ *                  other than 3 or with attr_n10_stride < width;
  *                  attr_count outside 0..RAST_MAX_ATTRS or different in
  *                  target and mesh; negative counts; clip/indices NULL with
  *                  a count > 0; mesh->attr NULL with attr_count > 0; a cull
  *                  value out of range.
  *   RAST_ERR_SIZE  width or height <= 0 or > RAST_MAX_DIM.
  *   RAST_ERR_INDEX an index >= vertex_count.
- * With t->attr NULL the mesh attributes are ignored (attr_count must
- * still match). */
+ * With t->attr and t->attr_n10 NULL the mesh attributes are ignored
+ * (attr_count must still match). */
 rast_result rast_draw(const rast_target *t, const rast_mesh_desc *mesh,
                       rast_stats *stats);
 
@@ -209,8 +226,8 @@ rast_result rast_context_draw_jobs(rast_context *ctx, int n,
  * or rast_context_forget). ctx NULL: rast_target_clear. */
 #define RAST_CONTEXT_TARGETS 4
 void rast_context_clear(rast_context *ctx, const rast_target *t);
-/* rast_context_clear without the attribute plane: depth and mask as
- * above; the attributes are cleared only where the target is unknown
+/* rast_context_clear without the attribute plane (attr or attr_n10):
+ * depth and mask as above; the attributes are cleared only where the target is unknown
  * (cleared whole), elsewhere they keep what earlier draws wrote. After
  * the next draws (all with the target's attributes), every pixel whose
  * mask is nonzero holds this frame's attributes, the others may hold an

@@ -65,7 +65,7 @@ static rast_result validate_aa(const rast_aa_target *t, const rast_mesh_desc *m)
     /* The checks of rast_draw, with the sample plane in the mask's place
      * and no attribute plane. */
     rast_target v = { t->width, t->height, NULL, 0, (uint8_t *)(void *)t->samples,
-                      t->stride, NULL, 0, m->attr_count };
+                      t->stride, NULL, 0, m->attr_count, NULL, 0 };
     return rast__validate(&v, m);
 }
 

@@ -148,6 +148,26 @@ static inline __attribute__((always_inline)) unsigned depth_run(float *p, int re
 #define ATTR3_STORE_P(p, bits, st, b1, b2, in) attr3_store_p(p, bits, st, b1, b2, in)
 #define ATTR3_STORE_PL(p, bits, lanes, st, b1, b2, in) attr3_store_pl(p, bits, lanes, st, b1, b2, in)
 
+/* The n10 plane's store (N10_STORE, raster_simd.inl): the packed lanes of
+ * the pixels in bits; one plain store for a full vector, inside the row a
+ * load, a blend and a store, else one vpmaskmovd. */
+static inline __attribute__((always_inline)) void n10_store(uint32_t *p, unsigned bits,
+                                                            __m256i v, int in)
+{
+    if (bits == 0xFFu) {
+        _mm256_storeu_si256((__m256i *)(void *)p, v);
+        return;
+    }
+    const __m256i k = simd__lanes_of(bits);
+    if (in) {
+        const __m256i old = _mm256_loadu_si256((const __m256i *)(const void *)p);
+        _mm256_storeu_si256((__m256i *)(void *)p, _mm256_blendv_epi8(old, v, k));
+        return;
+    }
+    _mm256_maskstore_epi32((int *)(void *)p, k, v);
+}
+#define N10_STORE(p, bits, v, in) n10_store(p, bits, v, in)
+
 #include "raster_simd.inl"
 
 /* The vertex transforms (raster_xform.inl): four component vectors

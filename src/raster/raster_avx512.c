@@ -138,6 +138,9 @@ static inline __m512 div_lanes(__m512 a, __m512 b, int lanes)
 #define ATTR3_PREP(st, tri, lanes) attr3_prep(st, tri, lanes)
 #define ATTR3_STORE_P(p, bits, st, b1, b2, in) attr3_store_p(p, bits, st, b1, b2)
 #define ATTR3_STORE_PL(p, bits, lanes, st, b1, b2, in) attr3_store_pl(p, bits, lanes, st, b1, b2)
+/* The n10 plane's store (N10_STORE, raster_simd.inl): one masked store of
+ * the packed lanes in bits (no other uint32_t touched). */
+#define N10_STORE(p, bits, v, in) _mm512_mask_storeu_epi32(p, (__mmask16)(bits), v)
 
 #include "raster_simd.inl"
 

@@ -459,7 +459,8 @@ static int same_target(const rast_target *a, const rast_target *b)
            a->mask == b->mask && a->attr == b->attr && a->attr_count == b->attr_count &&
            (!a->depth || a->depth_stride == b->depth_stride) &&
            a->mask_stride == b->mask_stride &&
-           (!a->attr || a->attr_stride == b->attr_stride);
+           (!a->attr || a->attr_stride == b->attr_stride) && a->attr_n10 == b->attr_n10 &&
+           (!a->attr_n10 || a->attr_n10_stride == b->attr_n10_stride);
 }
 
 static known_target *find_known(rast_context *c, const rast_target *t)
@@ -482,6 +483,9 @@ static void clear_span(const rast_target *t, int y, int x0, int x1, int attr)
         memset(t->attr + (size_t)y * (size_t)t->attr_stride +
                    (size_t)x0 * (size_t)t->attr_count,
                0, n * (size_t)t->attr_count * sizeof(float));
+    if (attr && t->attr_n10)
+        memset(t->attr_n10 + (size_t)y * (size_t)t->attr_n10_stride + x0, 0,
+               n * sizeof(uint32_t));
 }
 
 /* Asks for the lines of columns x0..x1 of row y of every plane (a hint:
@@ -503,6 +507,11 @@ static void prefetch_span(const rast_target *t, int y, int x0, int x1, int attr)
         const char *a = (const char *)(t->attr + (size_t)y * (size_t)t->attr_stride +
                                        (size_t)x0 * (size_t)t->attr_count);
         for (size_t o = 0; o < n * (size_t)t->attr_count * sizeof(float); o += 64)
+            __builtin_prefetch(a + o, 1, 3);
+    }
+    if (attr && t->attr_n10) {
+        const char *a = (const char *)(t->attr_n10 + (size_t)y * (size_t)t->attr_n10_stride + x0);
+        for (size_t o = 0; o < n * sizeof(uint32_t); o += 64)
             __builtin_prefetch(a + o, 1, 3);
     }
 }
@@ -565,7 +574,7 @@ static void context_clear(rast_context *c, const rast_target *t, int attr)
                 }
             }
         }
-        if (!attr && t->attr && t->attr_count > 0)
+        if (!attr && ((t->attr && t->attr_count > 0) || t->attr_n10))
             k->attr_stale = 1;
     } else {
         rast_target_clear(t);
@@ -663,18 +672,20 @@ static size_t plane_bytes(int h, int stride, size_t row, size_t elem)
 /* 1 when two valid targets share memory (any plane with any plane). */
 static int targets_overlap(const rast_target *a, const rast_target *b)
 {
-    const void *pa[3] = { a->depth, a->mask, a->attr_count > 0 ? a->attr : NULL };
-    const void *pb[3] = { b->depth, b->mask, b->attr_count > 0 ? b->attr : NULL };
-    size_t sa[3] = { a->depth ? plane_bytes(a->height, a->depth_stride, (size_t)a->width, 4) : 0,
+    const void *pa[4] = { a->depth, a->mask, a->attr_count > 0 ? a->attr : NULL, a->attr_n10 };
+    const void *pb[4] = { b->depth, b->mask, b->attr_count > 0 ? b->attr : NULL, b->attr_n10 };
+    size_t sa[4] = { a->depth ? plane_bytes(a->height, a->depth_stride, (size_t)a->width, 4) : 0,
                      plane_bytes(a->height, a->mask_stride, (size_t)a->width, 1),
                      pa[2] ? plane_bytes(a->height, a->attr_stride,
-                                         (size_t)a->width * (size_t)a->attr_count, 4) : 0 };
-    size_t sb[3] = { b->depth ? plane_bytes(b->height, b->depth_stride, (size_t)b->width, 4) : 0,
+                                         (size_t)a->width * (size_t)a->attr_count, 4) : 0,
+                     pa[3] ? plane_bytes(a->height, a->attr_n10_stride, (size_t)a->width, 4) : 0 };
+    size_t sb[4] = { b->depth ? plane_bytes(b->height, b->depth_stride, (size_t)b->width, 4) : 0,
                      plane_bytes(b->height, b->mask_stride, (size_t)b->width, 1),
                      pb[2] ? plane_bytes(b->height, b->attr_stride,
-                                         (size_t)b->width * (size_t)b->attr_count, 4) : 0 };
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
+                                         (size_t)b->width * (size_t)b->attr_count, 4) : 0,
+                     pb[3] ? plane_bytes(b->height, b->attr_n10_stride, (size_t)b->width, 4) : 0 };
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
             if (ranges_overlap(pa[i], sa[i], pb[j], sb[j]))
                 return 1;
     return 0;

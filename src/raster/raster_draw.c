@@ -7,6 +7,8 @@
  * one place of ISA dispatch). */
 #include "raster_internal.h"
 
+#include "../cpu/ef_n10.h"
+
 #include <stddef.h>
 #include <stdlib.h>
 
@@ -24,7 +26,7 @@ void rast__stats_add(rast_stats *dst, const rast_stats *s)
 int rast__draw_na(const rast_target *t, const rast_mesh_desc *m)
 {
     /* Attributes go through clipping only if both sides have them. */
-    return (t->attr && m->attr) ? m->attr_count : 0;
+    return ((t->attr || t->attr_n10) && m->attr) ? m->attr_count : 0;
 }
 
 /* Marks tiles tx0..tx1 x ty0..ty1 (inclusive, not empty). */
@@ -62,7 +64,7 @@ void rast__tiles_add(rast__tiles *tl, int ya, int yb, int x0, int x1)
 static long micro_apply(const rast_target *t, const rast__tri *r)
 {
     long n = 0;
-    const int na = t->attr ? r->attr_count : 0;
+    const int na = (t->attr || t->attr_n10) ? r->attr_count : 0;
     for (unsigned bits = (unsigned)r->micro & 15u; bits; bits &= bits - 1) {
         const int p = __builtin_ctz(bits);
         const int x = r->x0 + (p & 1), y = r->y0 + (p >> 1);
@@ -77,6 +79,14 @@ static long micro_apply(const rast_target *t, const rast__tri *r)
         n++;
         if (na) {
             const float b1 = r->mb1[p], b2 = r->mb2[p];
+            if (t->attr_n10) {   /* na == 3 (validated) */
+                float a[3];
+                for (int k = 0; k < 3; k++)
+                    a[k] = (r->a0[k] + b1 * r->d1[k]) + b2 * r->d2[k];
+                t->attr_n10[(size_t)y * (size_t)t->attr_n10_stride + x] =
+                    ef_n10_pack(a[0], a[1], a[2]);
+                continue;
+            }
             float *a = t->attr + (size_t)y * (size_t)t->attr_stride + (size_t)x * (size_t)na;
             for (int k = 0; k < na; k++)
                 a[k] = (r->a0[k] + b1 * r->d1[k]) + b2 * r->d2[k];

@@ -4,6 +4,8 @@
  * op order is in raster_internal.h and docs/raster.md). */
 #include "raster_internal.h"
 
+#include "../cpu/ef_n10.h"
+
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
@@ -16,7 +18,7 @@ long rast__scan_ref(const rast_target *t, const rast__tri *tri)
 long rast__scan_rows_ref(const rast_target *t, const rast__tri *tri, int ya,
                          int yb)
 {
-    const int na = t->attr ? tri->attr_count : 0;
+    const int na = (t->attr || t->attr_n10) ? tri->attr_count : 0;
     long written = 0;
     const int ys = ya > tri->y0 ? ya : tri->y0;
     const int ye = yb < tri->y1 ? yb : tri->y1;
@@ -35,7 +37,10 @@ long rast__scan_rows_ref(const rast_target *t, const rast__tri *tri, int ya,
         uint8_t *mrow = t->mask + (size_t)y * (size_t)t->mask_stride;
         float *drow = t->depth ? t->depth + (size_t)y * (size_t)t->depth_stride
                                : NULL;
-        float *arow = na ? t->attr + (size_t)y * (size_t)t->attr_stride : NULL;
+        float *arow = na && t->attr ? t->attr + (size_t)y * (size_t)t->attr_stride : NULL;
+        uint32_t *nrow = na && t->attr_n10
+                             ? t->attr_n10 + (size_t)y * (size_t)t->attr_n10_stride
+                             : NULL;
         int64_t e0 = er[0], e1 = er[1], e2 = er[2];
         for (int x = tri->x0; x <= tri->x1; x++) {
             if ((e0 | e1 | e2) >= 0) {   /* all sign bits clear */
@@ -51,9 +56,12 @@ long rast__scan_rows_ref(const rast_target *t, const rast__tri *tri, int ya,
                         const float r = 1.0f / (qr + tri->q.dx * fi);
                         const float b1 = (b1r + tri->b1.dx * fi) * r;
                         const float b2 = (b2r + tri->b2.dx * fi) * r;
-                        float *a = arow + (size_t)x * (size_t)na;
+                        float a3[RAST_MAX_ATTRS];
+                        float *a = arow ? arow + (size_t)x * (size_t)na : a3;
                         for (int k = 0; k < na; k++)
                             a[k] = (tri->a0[k] + b1 * tri->d1[k]) + b2 * tri->d2[k];
+                        if (nrow)   /* na == 3 (validated) */
+                            nrow[x] = ef_n10_pack(a[0], a[1], a[2]);
                     }
                     written++;
                 }
@@ -81,6 +89,9 @@ void rast_target_clear(const rast_target *t)
         if (t->attr && t->attr_count > 0)   /* all-zero bytes are 0.0f */
             memset(t->attr + (size_t)y * (size_t)t->attr_stride, 0,
                    (size_t)t->width * (size_t)t->attr_count * sizeof(float));
+        if (t->attr_n10)   /* 0 is ef_n10_pack(0, 0, 0) */
+            memset(t->attr_n10 + (size_t)y * (size_t)t->attr_n10_stride, 0,
+                   (size_t)t->width * sizeof(uint32_t));
     }
 }
 

@@ -507,6 +507,8 @@ rast_result rast__validate_desc(const rast_target *t, const rast_mesh_desc *m)
         return RAST_ERR_ARGS;
     if (t->attr && t->attr_count > 0 && t->attr_stride < t->width * t->attr_count)
         return RAST_ERR_ARGS;
+    if (t->attr_n10 && (t->attr || t->attr_count != 3 || t->attr_n10_stride < t->width))
+        return RAST_ERR_ARGS;
     if (m->vertex_count < 0 || m->tri_count < 0)
         return RAST_ERR_ARGS;
     if ((m->vertex_count > 0 && !m->clip) || (m->tri_count > 0 && !m->indices))

@@ -34,7 +34,12 @@
  *                          p[l] = z and are returned as bits; no float of p
  *                          outside the first rem is written (the generic
  *                          one below, on lane bits).
- * in (ATTR3_STORE_P, _PL, DEPTH_RUN): nonzero when the SIMD_W pixels of the
+ *   N10_STORE(p, bits, v, in)  the n10 plane's store (rast_target.attr_n10):
+ *                          p[l] = lane l of the vint v for the lanes l in
+ *                          bits, no other uint32_t written (the generic
+ *                          one below: a whole vector, or read, select and
+ *                          write back when in, else lane by lane).
+ * in (ATTR3_STORE_P, _PL, DEPTH_RUN, N10_STORE): nonzero when the SIMD_W pixels of the
  * vector lie inside the target's row, so that an implementation may read
  * all of the vector's depths and attributes and write back the ones it
  * does not change (rows belong to one thread: bands are rows) instead of
@@ -66,6 +71,8 @@
  *     15 * 2^23 < 2^27. A clamped value keeps its sign, and so does every
  *     lane: 2^29 - 2^27 > 0. Lanes with an unclamped start are exact.
  */
+
+#include "../cpu/ef_n10.h"
 
 #ifndef ATTR3_STORE_M
 #define ATTR3_STORE_M(p, bits, lanes, a, b, c) vf_store3_bits(p, bits, a, b, c)
@@ -162,13 +169,69 @@ static inline void simd_attr_store(float *dst, int na, unsigned pass, int lanes,
     }
 }
 
+/* THE N10 PLANE (rast_target.attr_n10). The three attributes of a vector
+ * of pixels as three SoA vectors, each lane by the expression (and order)
+ * of the float plane's, (a0 + b1 * d1) + b2 * d2, so they are the floats
+ * the float plane gets, then packed as ef_n10_pack (src/cpu/ef_n10.h)
+ * into one vint stored as one vector: no interleaving. ef_n10_quant per
+ * lane: v = a * 511; v > -511 ? v : -511 is vf_max(v, -511) (the layer's
+ * x86 semantics on every ISA: the second operand when v is NaN, so NaN
+ * gives -511); v > 511 ? 511 : v is vf_min(511, v) (v is no NaN now);
+ * vi_from_vf_round converts to nearest, ties to even (cvtps2dq with the
+ * default MXCSR, NEON's vcvtnq; lrintf in ef_n10.h), exact here
+ * (|v| <= 511). Then the low 10 bits of each, shifted by 0, 10, 20. */
+SIMD_INL vint simd_n10_quant(vfloat a)
+{
+    const vfloat lim = vf_set1(EF_N10_SCALE);
+    vfloat v = vf_mul(a, lim);
+    v = vf_max(v, vf_set1(-EF_N10_SCALE));
+    v = vf_min(lim, v);
+    return vi_and(vi_from_vf_round(v), vi_set1(0x3ff));
+}
+
+SIMD_INL vint simd_n10_pack(vfloat x, vfloat y, vfloat z)
+{
+    return vi_or(vi_or(simd_n10_quant(x), vi_slli(simd_n10_quant(y), 10)),
+                 vi_slli(simd_n10_quant(z), 20));
+}
+
+/* The packed attributes of the pixels of b1, b2 (the float plane's three
+ * expressions, as simd_attr_store). */
+SIMD_INL vint simd_attr_n10(vfloat b1, vfloat b2, const vfloat *av0, const vfloat *av1,
+                            const vfloat *av2)
+{
+    return simd_n10_pack(vf_add(vf_add(av0[0], vf_mul(b1, av1[0])), vf_mul(b2, av2[0])),
+                         vf_add(vf_add(av0[1], vf_mul(b1, av1[1])), vf_mul(b2, av2[1])),
+                         vf_add(vf_add(av0[2], vf_mul(b1, av1[2])), vf_mul(b2, av2[2])));
+}
+
+#ifndef N10_STORE
+SIMD_INL void simd_n10_store(uint32_t *p, unsigned bits, vint v, int in)
+{
+    if (bits == SIMD_FULL) {
+        vi_storeu((int32_t *)p, v);
+    } else if (in) {   /* the lanes not written get back the values read */
+        const vint old = vi_loadu((const int32_t *)p);
+        vi_storeu((int32_t *)p, vi_sel(vm_from_bits(bits), v, old));
+    } else {
+        _Alignas(64) int32_t l[SIMD_W];
+        vi_store(l, v);
+        for (; bits; bits &= bits - 1)
+            p[__builtin_ctz(bits)] = (uint32_t)l[__builtin_ctz(bits)];
+    }
+}
+#define N10_STORE(p, bits, v, in) simd_n10_store(p, bits, v, in)
+#endif
+
 /* One pixel (x, y) of the box: the reference's scalar expressions for
  * that pixel (fi, fj are the same floats, every op the same IEEE op),
  * without the vector set-up of the row scan. Used for boxes of one or two
  * pixels (1x1, 2x1, 1x2), whose vector set-up costs more than their
  * pixels. (Drawn through a context with the vector front end, such boxes
  * come as micro records instead and are not scanned.) */
-static inline long simd_scan_pixel(const rast_target *t, const rast__tri *tri, int x, int y)
+static inline __attribute__((always_inline)) long simd_scan_pixel(const rast_target *t,
+                                                                  const rast__tri *tri, int x,
+                                                                  int y, const int n10)
 {
     const int64_t i = x - tri->x0, j = y - tri->y0;
     if (((tri->e_c[0] + j * tri->e_dy[0] + i * tri->e_dx[0]) |
@@ -186,11 +249,18 @@ static inline long simd_scan_pixel(const rast_target *t, const rast__tri *tri, i
         *d = z;
     }
     t->mask[(size_t)y * (size_t)t->mask_stride + x] = 255;
-    const int na = t->attr ? tri->attr_count : 0;
+    const int na = n10 ? 3 : t->attr ? tri->attr_count : 0;
     if (na) {
         const float r = 1.0f / ((tri->q.c + tri->q.dy * fj) + tri->q.dx * fi);
         const float b1 = ((tri->b1.c + tri->b1.dy * fj) + tri->b1.dx * fi) * r;
         const float b2 = ((tri->b2.c + tri->b2.dy * fj) + tri->b2.dx * fi) * r;
+        if (n10) {
+            float a[3];
+            for (int k = 0; k < 3; k++)
+                a[k] = (tri->a0[k] + b1 * tri->d1[k]) + b2 * tri->d2[k];
+            t->attr_n10[(size_t)y * (size_t)t->attr_n10_stride + x] = ef_n10_pack(a[0], a[1], a[2]);
+            return 1;
+        }
         float *a = t->attr + (size_t)y * (size_t)t->attr_stride + (size_t)x * (size_t)na;
         for (int k = 0; k < na; k++)
             a[k] = (tri->a0[k] + b1 * tri->d1[k]) + b2 * tri->d2[k];
@@ -214,6 +284,7 @@ typedef struct simd_vec1 {
     vint e0, e1, e2;                /* reduced edges of the current row */
     uint8_t *mrow;
     float *drow, *arow;           /* NULL without depth / attributes */
+    uint32_t *nrow;               /* the n10 plane's row (scans with n10 only) */
     long written;
     int inrow;                    /* the SIMD_W pixels from x0 lie in the row */
 } simd_vec1;
@@ -266,9 +337,12 @@ static inline void simd_mask_or(uint8_t *p, unsigned bits)
 }
 
 /* Coverage, depth and mask of row y (the reference's z per lane), the
- * edges stepped to the next row; returns the lanes written. */
-static inline unsigned simd_vec1_row(simd_vec1 *s, const rast__tri *tri, int y,
-                                     unsigned valid, vint dy0, vint dy1, vint dy2, vfloat zfi)
+ * edges stepped to the next row; returns the lanes written. Always
+ * inlined: called from both copies of simd_scan_vec1_body (floats, n10),
+ * the compilers would otherwise make it a call per row. */
+static inline __attribute__((always_inline)) unsigned simd_vec1_row(
+    simd_vec1 *s, const rast__tri *tri, int y, unsigned valid, vint dy0, vint dy1, vint dy2,
+    vfloat zfi)
 {
     const unsigned cov = ~vi_sign_bits(vi_or(vi_or(s->e0, s->e1), s->e2)) & valid;
     s->e0 = vi_add(s->e0, dy0);
@@ -306,12 +380,15 @@ static inline unsigned simd_vec1_row(simd_vec1 *s, const rast__tri *tri, int y,
     return pass;
 }
 
-static inline void simd_vec1_next(simd_vec1 *s, const rast_target *t)
+static inline __attribute__((always_inline)) void simd_vec1_next(simd_vec1 *s,
+                                                                 const rast_target *t, int n10)
 {
     s->mrow += t->mask_stride;
     if (s->drow)
         s->drow += t->depth_stride;
-    if (s->arow)
+    if (n10)
+        s->nrow += t->attr_n10_stride;
+    else if (s->arow)
         s->arow += t->attr_stride;
 }
 
@@ -321,11 +398,14 @@ static inline void simd_vec1_next(simd_vec1 *s, const rast_target *t)
  * float work only for rows with covered pixels, and nothing is set up for
  * the attributes before the first row that writes a pixel (many scanned
  * triangles are hidden). Every row-invariant product (dx * fi) is computed
- * once: the same IEEE product in every row. */
-static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, int ye,
-                           int nx, int na, int32_t c0, int32_t c1, int32_t c2,
-                           int32_t sx0, int32_t sx1, int32_t sx2, int32_t sy0,
-                           int32_t sy1, int32_t sy2)
+ * once: the same IEEE product in every row. n10 (a constant: the body is
+ * compiled into both copies of the scan, see SIMD_FN(rast__scan_rows)):
+ * the attributes go to the n10 plane (na is 3), else to the float plane
+ * (if na). */
+static inline __attribute__((always_inline)) long simd_scan_vec1_body(
+    const rast_target *t, const rast__tri *tri, int ys, int ye, int nx, int na, int32_t c0,
+    int32_t c1, int32_t c2, int32_t sx0, int32_t sx1, int32_t sx2, int32_t sy0, int32_t sy1,
+    int32_t sy2, const int n10)
 {
     const unsigned valid = simd_first_lanes(nx);
     const vint lanev = vi_lanes();
@@ -337,14 +417,16 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
     s.inrow = tri->x0 + SIMD_W <= t->width;
     s.mrow = t->mask + (size_t)ys * (size_t)t->mask_stride + tri->x0;
     s.drow = t->depth ? t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0 : NULL;
-    s.arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride + (size_t)tri->x0 * (size_t)na
-                : NULL;
+    s.arow = !n10 && na ? t->attr + (size_t)ys * (size_t)t->attr_stride +
+                              (size_t)tri->x0 * (size_t)na
+                        : NULL;
+    s.nrow = n10 ? t->attr_n10 + (size_t)ys * (size_t)t->attr_n10_stride + tri->x0 : NULL;
     const vint dy0 = vi_set1(sy0), dy1 = vi_set1(sy1), dy2 = vi_set1(sy2);
     const vfloat fi = vf_from_vi(lanev);
     const vfloat zfi = vf_mul(vf_set1(tri->z.dx), fi);
     int y = ys;
     unsigned pass = 0;
-    for (; y <= ye; y++, simd_vec1_next(&s, t))
+    for (; y <= ye; y++, simd_vec1_next(&s, t, n10))
         if ((pass = simd_vec1_row(&s, tri, y, valid, dy0, dy1, dy2, zfi)) && na)
             break;
     if (y > ye)
@@ -358,7 +440,7 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
     vfloat av0[RAST_MAX_ATTRS], av1[RAST_MAX_ATTRS], av2[RAST_MAX_ATTRS];
 #ifdef ATTR3_PREP
     ATTR3_STATE a3;
-    if (na == 3)
+    if (na == 3 && !n10)
         ATTR3_PREP(&a3, tri, nx);
     else
 #endif
@@ -379,6 +461,9 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
 #endif
         const vfloat b1 = vf_mul(vf_add(vf_set1(b1r), b1fi), r);
         const vfloat b2 = vf_mul(vf_add(vf_set1(b2r), b2fi), r);
+        if (n10)
+            N10_STORE(s.nrow, pass, simd_attr_n10(b1, b2, av0, av1, av2), s.inrow);
+        else
 #ifdef ATTR3_PREP
         if (na == 3)
             ATTR3_STORE_P(s.arow, pass, &a3, b1, b2, s.inrow);
@@ -388,7 +473,7 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
         do {
             if (++y > ye)
                 return s.written;
-            simd_vec1_next(&s, t);
+            simd_vec1_next(&s, t, n10);
         } while (!(pass = simd_vec1_row(&s, tri, y, valid, dy0, dy1, dy2, zfi)));
     }
 }
@@ -431,10 +516,9 @@ static long simd_scan_vec1(const rast_target *t, const rast__tri *tri, int ys, i
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #endif
-__attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const rast__tri *tri,
-                                                     int ys, int ye, int nx, int nvec, int na,
-                                                     const int64_t *c, const int32_t *sx,
-                                                     const int32_t *sy)
+static inline __attribute__((always_inline)) long simd_scan_wide_body(
+    const rast_target *t, const rast__tri *tri, int ys, int ye, int nx, int nvec, int na,
+    const int64_t *c, const int32_t *sx, const int32_t *sy, const int n10)
 {
     const vint lanev = vi_lanes();
     const unsigned lastvalid = SIMD_FULL >> (nvec * SIMD_W - nx);
@@ -510,6 +594,7 @@ __attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const
             const float fj = (float)(y - tri->y0);
             const vfloat zrv = vf_set1(tri->z.c + tri->z.dy * fj);
             float *arow = NULL;   /* at the row's first vector that writes */
+            uint32_t *nrow = NULL;   /* with n10: the same */
             for (int i0 = xf; i0 < xe; i0 += SIMD_W) {
                 const int rem = xe - i0;
                 const int lanes = rem < SIMD_W ? rem : SIMD_W;
@@ -538,7 +623,7 @@ __attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const
                     b1dx = vf_set1(tri->b1.dx);
                     b2dx = vf_set1(tri->b2.dx);
 #if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
-                    if (na == 3)
+                    if (na == 3 && !n10)
                         ATTR3_PREP(&a3, tri, SIMD_W);
                     else
 #endif
@@ -548,9 +633,12 @@ __attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const
                             av2[k] = vf_set1(tri->d2[k]);
                         }
                 }
-                if (!arow) {
-                    arow = t->attr + (size_t)y * (size_t)t->attr_stride +
-                           (size_t)tri->x0 * (size_t)na;
+                if (n10 ? !nrow : !arow) {
+                    if (n10)
+                        nrow = t->attr_n10 + (size_t)y * (size_t)t->attr_n10_stride + tri->x0;
+                    else
+                        arow = t->attr + (size_t)y * (size_t)t->attr_stride +
+                               (size_t)tri->x0 * (size_t)na;
                     qrv = vf_set1(tri->q.c + tri->q.dy * fj);
                     b1rv = vf_set1(tri->b1.c + tri->b1.dy * fj);
                     b2rv = vf_set1(tri->b2.c + tri->b2.dy * fj);
@@ -562,6 +650,11 @@ __attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const
 #endif
                 const vfloat b1 = vf_mul(vf_add(b1rv, vf_mul(b1dx, fi)), r);
                 const vfloat b2 = vf_mul(vf_add(b2rv, vf_mul(b2dx, fi)), r);
+                if (n10) {
+                    N10_STORE(nrow + i0, pass, simd_attr_n10(b1, b2, av0, av1, av2),
+                              i0 <= inrow);
+                    continue;
+                }
                 float *dst = arow + (size_t)i0 * (size_t)na;
 #if defined(ATTR3_PREP) && defined(ATTR3_STORE_PL)
                 if (na == 3) {
@@ -583,11 +676,35 @@ __attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const
     }
     return written;
 }
+
+__attribute__((noinline)) static long simd_scan_wide(const rast_target *t, const rast__tri *tri,
+                                                     int ys, int ye, int nx, int nvec, int na,
+                                                     const int64_t *c, const int32_t *sx,
+                                                     const int32_t *sy)
+{
+    return simd_scan_wide_body(t, tri, ys, ye, nx, nvec, na, c, sx, sy, 0);
+}
+
+/* The same into the n10 plane (na is 3). */
+__attribute__((noinline)) static long simd_scan_wide_n10(const rast_target *t,
+                                                         const rast__tri *tri, int ys, int ye,
+                                                         int nx, int nvec, const int64_t *c,
+                                                         const int32_t *sx, const int32_t *sy)
+{
+    return simd_scan_wide_body(t, tri, ys, ye, nx, nvec, 3, c, sx, sy, 1);
+}
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
 #endif
 
-long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya, int yb)
+/* The scan of the rows ya..yb (SIMD_FN(rast__scan_rows) below), its
+ * attributes to the float plane (n10 0) or to the n10 plane (n10 1, a
+ * constant: two copies, so the float path's code is what it was without
+ * the n10 plane). */
+static inline __attribute__((always_inline)) long simd_scan_rows_body(const rast_target *t,
+                                                                      const rast__tri *tri,
+                                                                      int ya, int yb,
+                                                                      const int n10)
 {
     const int ys = ya > tri->y0 ? ya : tri->y0;
     const int ye = yb < tri->y1 ? yb : tri->y1;
@@ -595,13 +712,15 @@ long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya
         return 0;
     if (tri->x0 == tri->x1) {
         if (ys == ye)
-            return simd_scan_pixel(t, tri, tri->x0, ys);
+            return simd_scan_pixel(t, tri, tri->x0, ys, n10);
         if (ys + 1 == ye)
-            return simd_scan_pixel(t, tri, tri->x0, ys) + simd_scan_pixel(t, tri, tri->x0, ye);
+            return simd_scan_pixel(t, tri, tri->x0, ys, n10) +
+                   simd_scan_pixel(t, tri, tri->x0, ye, n10);
     } else if (tri->x0 + 1 == tri->x1 && ys == ye) {
-        return simd_scan_pixel(t, tri, tri->x0, ys) + simd_scan_pixel(t, tri, tri->x1, ys);
+        return simd_scan_pixel(t, tri, tri->x0, ys, n10) +
+               simd_scan_pixel(t, tri, tri->x1, ys, n10);
     }
-    const int na = t->attr ? tri->attr_count : 0;
+    const int na = n10 ? 3 : t->attr ? tri->attr_count : 0;
     const int nx = tri->x1 - tri->x0 + 1;
     if (nx <= SIMD_W) {
         if (t->depth && simd_box_hidden(t, tri, ys, ye, nx))
@@ -620,8 +739,8 @@ long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya
         if (simd_abs64(c0) + rows * simd_abs64(sy0) + cols * simd_abs64(sx0) <= SIMD_LIM30 &&
             simd_abs64(c1) + rows * simd_abs64(sy1) + cols * simd_abs64(sx1) <= SIMD_LIM30 &&
             simd_abs64(c2) + rows * simd_abs64(sy2) + cols * simd_abs64(sx2) <= SIMD_LIM30)
-            return simd_scan_vec1(t, tri, ys, ye, nx, na, (int32_t)c0, (int32_t)c1,
-                                  (int32_t)c2, sx0, sx1, sx2, sy0, sy1, sy2);
+            return simd_scan_vec1_body(t, tri, ys, ye, nx, na, (int32_t)c0, (int32_t)c1,
+                                       (int32_t)c2, sx0, sx1, sx2, sy0, sy1, sy2, n10);
     }
     const int nvec = (nx + SIMD_W - 1) / SIMD_W;
     if (t->depth && nx > SIMD_W && nvec <= 4 && simd_box_hidden(t, tri, ys, ye, nx))
@@ -645,7 +764,8 @@ long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya
                 SIMD_LIM30;
     }
     if (fits)
-        return simd_scan_wide(t, tri, ys, ye, nx, nvec, na, c, sx, sy);
+        return n10 ? simd_scan_wide_n10(t, tri, ys, ye, nx, nvec, c, sx, sy)
+                   : simd_scan_wide(t, tri, ys, ye, nx, nvec, na, c, sx, sy);
     const vint lanev = vi_lanes();
     const vint off0 = simd_lane_mul(lanev, sx[0]), off1 = simd_lane_mul(lanev, sx[1]),
              off2 = simd_lane_mul(lanev, sx[2]);
@@ -663,9 +783,11 @@ long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya
     uint8_t *mrow = t->mask + (size_t)ys * (size_t)t->mask_stride + tri->x0;
     float *drow = t->depth ? t->depth + (size_t)ys * (size_t)t->depth_stride + tri->x0
                            : NULL;
-    float *arow = na ? t->attr + (size_t)ys * (size_t)t->attr_stride +
-                           (size_t)tri->x0 * (size_t)na
-                     : NULL;
+    float *arow = na && !n10 ? t->attr + (size_t)ys * (size_t)t->attr_stride +
+                                     (size_t)tri->x0 * (size_t)na
+                               : NULL;
+    uint32_t *nrow = n10 ? t->attr_n10 + (size_t)ys * (size_t)t->attr_n10_stride + tri->x0
+                         : NULL;
     const vfloat qdx = vf_set1(tri->q.dx);
     const vfloat b1dx = vf_set1(tri->b1.dx), b2dx = vf_set1(tri->b2.dx);
 
@@ -674,7 +796,8 @@ long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya
     int64_t rb[3] = { c[0], c[1], c[2] };
     for (int y = ys; y <= ye; y++, mrow += t->mask_stride,
              drow = drow ? drow + t->depth_stride : NULL,
-             arow = arow ? arow + t->attr_stride : NULL) {
+             arow = arow ? arow + t->attr_stride : NULL,
+             nrow = nrow ? nrow + t->attr_n10_stride : NULL) {
         /* Row bases: the reference's scalar expressions. */
         const float fj = (float)(y - tri->y0);
         const float zr = tri->z.c + tri->z.dy * fj;
@@ -716,6 +839,10 @@ long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya
             const vfloat r = vf_div(one, vf_add(vf_set1(qr), vf_mul(qdx, fi)));
             const vfloat b1 = vf_mul(vf_add(vf_set1(b1r), vf_mul(b1dx, fi)), r);
             const vfloat b2 = vf_mul(vf_add(vf_set1(b2r), vf_mul(b2dx, fi)), r);
+            if (n10) {   /* masked: no lane outside the row is read */
+                N10_STORE(nrow + i0, pass, simd_attr_n10(b1, b2, av0, av1, av2), 0);
+                continue;
+            }
             float *dst = arow + (size_t)i0 * (size_t)na;
 #ifdef ATTR3_STORE_FULL
             if (na == 3 && pass == SIMD_FULL) {
@@ -733,4 +860,21 @@ long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya
         rb[2] += sy[2];
     }
     return written;
+}
+
+/* The n10 copy, not inlined into the float one. */
+__attribute__((noinline)) static long simd_scan_rows_n10(const rast_target *t,
+                                                         const rast__tri *tri, int ya, int yb)
+{
+    return simd_scan_rows_body(t, tri, ya, yb, 1);
+}
+
+/* attr_n10 set: the n10 copy (validated: attr_count 3, attr NULL; a
+ * record with another count would have no attributes, as the float copy
+ * gives it with attr NULL). */
+long SIMD_FN(rast__scan_rows)(const rast_target *t, const rast__tri *tri, int ya, int yb)
+{
+    if (t->attr_n10 && tri->attr_count == 3)
+        return simd_scan_rows_n10(t, tri, ya, yb);
+    return simd_scan_rows_body(t, tri, ya, yb, 0);
 }

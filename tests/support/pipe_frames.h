@@ -154,7 +154,7 @@ static inline void tu_quad_stages(const kin_model *m, const kin_camera *cam, tu_
                                   int vw, int vh, fuse_image *R)
 {
     const int cw = s->w, ch = s->h;
-    rast_target t = {cw, ch, s->depth, cw, s->mask, cw, s->nrm, cw * 3, 3};
+    rast_target t = {cw, ch, s->depth, cw, s->mask, cw, s->nrm, cw * 3, 3, NULL, 0};
     rast_target_clear(&t);
     float clip[16], vn[12], wpos[12], wn[12];
     kin_mat4 qw = kin_mat4_from_transform(&m->rest[1]);

@@ -163,7 +163,7 @@ static inline kin_camera tu_arms_silhouette(const tu_arms *A, const kin_mat4 *he
 {
     kin_sthmd_desc hd = kin_sthmd_desc_resolved(NULL);
     kin_camera cam = kin_sthmd_camera(&hd, head, (kin_eye)e);
-    rast_target t = {640, 400, depth, 640, sil, 640, NULL, 0, 0};
+    rast_target t = {640, 400, depth, 640, sil, 640, NULL, 0, 0, NULL, 0};
     rast_target_clear(&t);
     rast_transform_points(cam.view_proj.m, A->pos, A->nv, clip);
     rast_mesh_desc md = {clip, A->nv, NULL, 0, A->idx, A->nt, RAST_CULL_NONE};
