@@ -265,7 +265,7 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
     for (i = 0; i < 2; i++) {
         eyes[i] = (fuse_eye){ &L, &K, { e[i].P, CW, CH, 4 * CW }, e[i].M, CW, e[i].N, 3 * CW,
                               { e[i].Q, CW, CH, 4 * CW }, NULL, { e[i].V, W, H, 4 * W },
-                              VX, VY, VW, VHH, { e[i].out, W, H, 4 * W }, 0, 0, 0u, NULL };
+                              VX, VY, VW, VHH, { e[i].out, W, H, 4 * W }, 0, 0, 0u, NULL, NULL, 0 };
         ip[i] = eyes[i];
         ip[i].V = ip[i].out = (fuse_image){ e[i].Vip, W, H, 4 * W };
         depth[i] = (fuse_depth){ e[i].hz, CW, ZNEAR, ZFAR, 0.0f, e[i].sd, W, W, H };
