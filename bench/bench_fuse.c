@@ -5,7 +5,7 @@
  *
  *   bench_fuse [--csv] [--runs N] [--isa ref|sse2|avx2|avx512]
  *              [--threads 1|2] [--case typical|worst] [--no-pixman] [--cpu-time]
- *              [--stage NAME]
+ *              [--stage NAME] [--n10]
  *
  * Per stereo frame (two eyes: 640x400 camera images lit, resampled into
  * the 1194x746 viewport at (43, 27) of 1280x800, composited over V):
@@ -39,6 +39,10 @@
  *                the viewport (PAD edges): what fuse_composite does
  *     pm_scaled_mask  the camera image (x8r8g8b8) through the a8 mask, both
  *                bilinear into the viewport (a composite without lighting)
+ * --n10: the lighting reads the normals packed as ef_n10 (src/cpu/ef_n10.h,
+ * packed once at setup with ef_n10_pack): fuse_context_light_n10 and
+ * fuse_eye.normal_n10, 4 bytes a pixel instead of 12 (the bytes differ from
+ * the float normals' by the packing's rounding only).
  * Every number is the median over --runs runs; the ratios are medians of
  * the per-run ratios (each run times memcpy, then the stages, back to
  * back), which cancels most of the noise of a shared machine. The scene V
@@ -53,6 +57,7 @@
 #include <unistd.h>
 
 #include "../src/cpu/cpu.h"
+#include "../src/cpu/ef_n10.h"
 #include "../src/fuse/fuse.h"
 #include "bench_util.h"
 
@@ -76,6 +81,9 @@ static clockid_t clock_id = CLOCK_MONOTONIC;
 static const char *only_stage;
 static int want(const char *name) { return only_stage == NULL || !strcmp(only_stage, name); }
 
+/* --n10: the lighting reads eye_buf.Nq (ef_n10) instead of N (floats). */
+static int use_n10;
+
 static double now_ms(void) { return bench_now_ms(clock_id); }
 
 static uint64_t rng = 0x1234567u;
@@ -86,6 +94,7 @@ static void *xmalloc(size_t n) { return bench_xmalloc(n, "bench_fuse"); }
 typedef struct eye_buf {
     uint8_t *P, *M, *Q, *V, *out, *Vip;   /* Vip: V for the in-place runs */
     float *N;
+    uint32_t *Nq;                         /* N packed as ef_n10 */
     float *hz, *sd;                       /* hand window depth, scene metres */
 } eye_buf;
 
@@ -111,6 +120,7 @@ static double make_eye(eye_buf *e, double cover)
     e->M = xmalloc(CW * CH);
     e->Q = xmalloc(CW * CH * 4);
     e->N = xmalloc(sizeof(float) * CW * CH * 3);
+    e->Nq = xmalloc(sizeof(uint32_t) * CW * CH);
     e->V = xmalloc(W * H * 4);
     e->out = xmalloc(W * H * 4);
     e->Vip = xmalloc(W * H * 4);
@@ -133,6 +143,7 @@ static double make_eye(eye_buf *e, double cover)
             e->N[3 * k] = (float)dx;
             e->N[3 * k + 1] = (float)-dy;
             e->N[3 * k + 2] = (float)sqrt(fmax(0.05, 1 - d * d));
+            e->Nq[k] = ef_n10_pack(e->N[3 * k], e->N[3 * k + 1], e->N[3 * k + 2]);
             e->hz[k] = d < 1 ? window_z(0.45 - 0.12 * sqrt(1 - d * d)) : 1.0f;
             on += e->M[k] != 0;
         }
@@ -141,7 +152,7 @@ static double make_eye(eye_buf *e, double cover)
 
 static void free_eye(eye_buf *e)
 {
-    free(e->P); free(e->M); free(e->Q); free(e->N); free(e->V); free(e->out); free(e->Vip);
+    free(e->P); free(e->M); free(e->Q); free(e->N); free(e->Nq); free(e->V); free(e->out); free(e->Vip);
     free(e->hz); free(e->sd);
 }
 
@@ -265,7 +276,12 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
     for (i = 0; i < 2; i++) {
         eyes[i] = (fuse_eye){ &L, &K, { e[i].P, CW, CH, 4 * CW }, e[i].M, CW, e[i].N, 3 * CW,
                               { e[i].Q, CW, CH, 4 * CW }, NULL, { e[i].V, W, H, 4 * W },
-                              VX, VY, VW, VHH, { e[i].out, W, H, 4 * W }, 0, 0, 0u, NULL };
+                              VX, VY, VW, VHH, { e[i].out, W, H, 4 * W }, 0, 0, 0u, NULL, NULL, 0 };
+        if (use_n10) {
+            eyes[i].normal = NULL;
+            eyes[i].normal_n10 = e[i].Nq;
+            eyes[i].normal_n10_stride = CW;
+        }
         ip[i] = eyes[i];
         ip[i].V = ip[i].out = (fuse_image){ e[i].Vip, W, H, 4 * W };
         depth[i] = (fuse_depth){ e[i].hz, CW, ZNEAR, ZFAR, 0.0f, e[i].sd, W, W, H };
@@ -290,8 +306,10 @@ static void run_stages(fuse_context *ctx, eye_buf e[2], int threads, int runs, s
         m = only_stage == NULL || !strcmp(only_stage, "memcpy") ? time_memcpy(e, threads > 1 ? &cp : NULL) : 1.0;
         t0 = now_ms();
         for (i = 0; i < 2 && want("light"); i++)
-            if (fuse_context_light(ctx, &L, &K, &eyes[i].P, e[i].M, CW, e[i].N, 3 * CW,
-                                   &eyes[i].Q) != FUSE_OK) exit(3);
+            if ((use_n10 ? fuse_context_light_n10(ctx, &L, &K, &eyes[i].P, e[i].M, CW, e[i].Nq, CW,
+                                                  &eyes[i].Q)
+                         : fuse_context_light(ctx, &L, &K, &eyes[i].P, e[i].M, CW, e[i].N, 3 * CW,
+                                              &eyes[i].Q)) != FUSE_OK) exit(3);
         t1 = now_ms();
         for (i = 0; i < 2 && want("comp"); i++)
             if (fuse_context_composite(ctx, &eyes[i].Q, &eyes[i].V, VX, VY, VW, VHH,
@@ -405,7 +423,9 @@ static void bench_pixman(eye_buf e[2], int runs, pm_stats *s)
 static void usage(const char *argv0)
 {
     fprintf(stderr, "usage: %s [--csv] [--runs N] [--isa ref|sse2|avx2|avx512] "
-            "[--threads 1|2] [--case typical|worst] [--no-pixman] [--cpu-time] [--stage NAME]\n"
+            "[--threads 1|2] [--case typical|worst] [--no-pixman] [--cpu-time] [--stage NAME] "
+            "[--n10]\n"
+            "  --n10: the lighting reads the normals packed as ef_n10\n"
             "  --stage light|comp|frame|ip|dp|op|dop|l2|cold|l2c|like|memcpy: only that stage\n", argv0);
     exit(2);
 }
@@ -435,6 +455,8 @@ int main(int argc, char **argv)
             no_pixman = 1;
         else if (!strcmp(argv[a], "--cpu-time"))
             clock_id = CLOCK_THREAD_CPUTIME_ID;
+        else if (!strcmp(argv[a], "--n10"))
+            use_n10 = 1;
         else if (!strcmp(argv[a], "--stage") && a + 1 < argc) {
             only_stage = argv[++a];
             no_pixman = 1;
@@ -461,6 +483,8 @@ int main(int argc, char **argv)
            "not built in",
 #endif
            runs, clock_id == CLOCK_MONOTONIC ? "wall clock" : "CPU time of the calling thread");
+    printf("%snormals: %s\n", csv ? "# " : "",
+           use_n10 ? "ef_n10 (4 bytes a pixel)" : "3 floats (12 bytes a pixel)");
     if (csv)
         printf("case,coverage,isa,threads,light_ms,composite_ms,light_plus_composite_ms,frame_ms,"
                "frame_inplace_ms,memcpy_ms,frame_over_memcpy,frame_inplace_over_memcpy,"

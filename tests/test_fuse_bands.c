@@ -101,7 +101,7 @@ static void bands_equal_frame(void **state)
                            {e.Q, CW, CH, 4 * CW}, (variant & 1) ? &dd : NULL,
                            {e.V, OW, OH, 4 * OW}, OX, OY, OPW, OPH,
                            {e.out, OW, OH, 4 * OW}, (variant & 2) != 0,
-                           (variant & 1) ? 4 : 0, (variant & 1) ? FUSE_EDGE_ALL : 0u, NULL};
+                           (variant & 1) ? 4 : 0, (variant & 1) ? FUSE_EDGE_ALL : 0u, NULL, NULL, 0};
             memset(e.Q, 0x55, CW * CH * 4);
             memset(e.out, 0x66, OW * OH * 4);
             assert_int_equal(fuse_context_frame(ctx, &fe, 1), FUSE_OK);
@@ -136,7 +136,7 @@ static void bands_equal_frame(void **state)
         fuse_context *ctx = fuse_context_create(NULL);
         fuse_eye fe = {&L, &K, {e.P, CW, CH, 4 * CW}, e.M, CW, e.N, 3 * CW,
                        {e.P, CW, CH, 4 * CW}, NULL, {e.V, OW, OH, 4 * OW}, OX, OY, OPW, OPH,
-                       {e.out, OW, OH, 4 * OW}, 0, 0, 0, NULL};
+                       {e.out, OW, OH, 4 * OW}, 0, 0, 0, NULL, NULL, 0};
         int n = 0;
         assert_int_equal(fuse_context_frame_prepare(ctx, &fe, 32, &n), FUSE_ERR_ARGS); /* P == Q */
         fe.Q.pixels = e.Q;
@@ -192,7 +192,7 @@ static void zero_rows_same_bytes(void **state)
                 fuse_eye fe = {&L, &K, {e.P, CW, CH, 4 * CW}, e.M, CW, e.N, 3 * CW,
                                {e.Q, CW, CH, 4 * CW}, (f & 1) ? &dd : NULL,
                                {e.V, OW, OH, 4 * OW}, OX, OY, OPW, OPH,
-                               {e.out, OW, OH, 4 * OW}, f & 1, 0, 0u, NULL};
+                               {e.out, OW, OH, 4 * OW}, f & 1, 0, 0u, NULL, NULL, 0};
                 uint8_t *q_keep = malloc(CW * CH * 4);
                 assert_non_null(q_keep);
                 memcpy(q_keep, e.Q, CW * CH * 4);

@@ -276,7 +276,7 @@ static void test_frame(void **state)
                     eyes[i] = (fuse_eye){ &L, &K, { e[i].P, CW, CH, 4 * CW }, e[i].M, CW,
                                           e[i].N, 3 * CW, { e[i].Q, CW, CH, 4 * CW }, &dd[i],
                                           { e[i].V, OW, OH, 4 * OW }, OX, OY, OPW, OPH,
-                                          { e[i].out, OW, OH, 4 * OW }, 0, 0, 0, NULL };
+                                          { e[i].out, OW, OH, 4 * OW }, 0, 0, 0, NULL, NULL, 0 };
                 }
                 assert_int_equal(fuse_context_frame(ctx, eyes, count), FUSE_OK);
                 for (i = 0; i < count; i++) assert_memory_equal(e[i].out, want[i], OW * OH * 4);

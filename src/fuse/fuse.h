@@ -49,7 +49,8 @@
  *   Nothing is written unless the call returns FUSE_OK. FUSE_ERR_ARGS: a
  *   NULL pointer, an image with NULL pixels, a width or height outside
  *   1..FUSE_MAX_DIM, a stride below 4 * width (mask: width, normal:
- *   3 * width floats, RGB24: 3 * width bytes), light_count outside
+ *   3 * width floats, n10 normals: width uint32_t, RGB24: 3 * width
+ *   bytes), both or neither of fuse_eye's normal forms, light_count outside
  *   0..FUSE_MAX_LIGHTS, shininess outside [1, FUSE_PARAM_MAX], another
  *   lighting float non-finite or beyond +-FUSE_PARAM_MAX, a light
  *   direction of (near) zero length, intrinsics with fx or fy outside
@@ -143,6 +144,21 @@ fuse_result fuse_light(const fuse_lighting *L, const fuse_intrinsics *K,
                        const fuse_image *P, const uint8_t *mask,
                        int mask_stride, const float *normal,
                        int normal_stride, fuse_image *out);
+
+/* fuse_light with the normals packed as ef_n10 (src/cpu/ef_n10.h: one
+ * uint32_t per pixel, bits 0-9 x, 10-19 y, 20-29 z, each k in -511..511
+ * meaning k / 511), normal_n10_stride uint32_t per row (>= P's width, else
+ * FUSE_ERR_ARGS; NULL normal_n10: FUSE_ERR_ARGS). Bits 30-31 are ignored
+ * (ef_n10_pack writes 0 there); k = -512 (0x200), which ef_n10_pack never
+ * writes, stands for -512 / 511. The bytes are, on every ISA, those of
+ * fuse_light given the floats ef_n10_unpack makes of the same normals:
+ * (float)k * (1.0f / 511.0f) per component (a zero normal, as any normal
+ * without a usable length, is replaced by V). Same checks, overlaps and
+ * errors otherwise. */
+fuse_result fuse_light_n10(const fuse_lighting *L, const fuse_intrinsics *K,
+                           const fuse_image *P, const uint8_t *mask,
+                           int mask_stride, const uint32_t *normal_n10,
+                           int normal_n10_stride, fuse_image *out);
 
 /* Resample the premultiplied layer Q into the viewport (vp_x0, vp_y0,
  * vp_w, vp_h) of V and composite; out has V's size (out may be V itself,
@@ -322,6 +338,12 @@ fuse_result fuse_context_light(fuse_context *ctx, const fuse_lighting *L,
                                const uint8_t *mask, int mask_stride,
                                const float *normal, int normal_stride,
                                fuse_image *out);
+/* fuse_light_n10 on ctx's ISA and threads; ctx NULL -> FUSE_ERR_ARGS. */
+fuse_result fuse_context_light_n10(fuse_context *ctx, const fuse_lighting *L,
+                                   const fuse_intrinsics *K, const fuse_image *P,
+                                   const uint8_t *mask, int mask_stride,
+                                   const uint32_t *normal_n10, int normal_n10_stride,
+                                   fuse_image *out);
 fuse_result fuse_context_composite(fuse_context *ctx, const fuse_image *Q,
                                    const fuse_image *V, int vp_x0, int vp_y0,
                                    int vp_w, int vp_h, fuse_image *out);
@@ -376,6 +398,16 @@ typedef struct fuse_eye {
      * the hand's rows only are written (issue 17: the empty rows were
      * about 1 MB of memset per stereo frame). */
     uint8_t *q_zero_rows;
+    /* With normal NULL: the normals packed as ef_n10 (src/cpu/ef_n10.h; as
+     * fuse_light_n10), normal_n10_stride uint32_t per row >= P's width.
+     * Exactly one of normal and normal_n10 is set (both or neither:
+     * FUSE_ERR_ARGS); the stride of the one not set is not looked at. At
+     * the end of the struct, so positional initialisers written before it
+     * still mean what they meant (normal_n10 then 0). fuse_normal_smooth
+     * (fuse_normals.h) reads and writes float normals only: a caller that
+     * smooths passes the smoothed floats in normal. */
+    const uint32_t *normal_n10;
+    int normal_n10_stride;
 } fuse_eye;
 
 /* Every stage of count eyes (1..FUSE_MAX_THREADS) on ctx's threads: with

@@ -32,7 +32,8 @@
  * AVX-512 through the row cache (hrow, vrow, per ISA). */
 #define SIMD_KERNELS(sfx) fuse__light_row_##sfx, fuse__depth_row_##sfx, fuse__depth_mrow_##sfx
 #define SIMD_COVER(sfx) fuse__cover_row_##sfx, fuse__opaque_##sfx
-#define SIMD_SPANS(sfx) fuse__light_span_##sfx, fuse__depth_mspan_##sfx, fuse__cover_span_##sfx
+#define SIMD_SPANS(sfx) fuse__light_span_##sfx, fuse__depth_mspan_##sfx, fuse__cover_span_##sfx, \
+    fuse__light_span_n10_##sfx
 
 kernels fuse__kernels_for(ef_isa isa)
 {
@@ -113,10 +114,26 @@ typedef struct light_job {
     fuse__light_prep prep;
     fuse_image P, out;
     const uint8_t *mask;
-    const float *normal;
+    /* the normals: floats (n10 0: 3 a pixel) or ef_n10 (n10 1: one
+     * uint32_t a pixel); normal_stride in those units */
+    const void *normal;
+    int n10;
     int mask_stride, normal_stride;
     uint8_t *zero_rows;   /* fuse_eye.q_zero_rows (NULL: none) */
 } light_job;
+
+/* Where row y's pixel x of j's normals starts, and a pixel's bytes. */
+static const void *normal_at(const light_job *j, int y, int x)
+{
+    const size_t i = (size_t)y * (size_t)j->normal_stride;
+    if (j->n10) return (const uint32_t *)j->normal + i + (size_t)x;
+    return (const float *)j->normal + i + 3 * (size_t)x;
+}
+
+static size_t normal_px_bytes(int n10)
+{
+    return n10 ? sizeof(uint32_t) : 3 * sizeof(float);
+}
 
 /* Asks for the bytes [p, p + n) in cache (a hint: no fault, no effect on
  * the result). The lit and blended spans of a row start in its middle, where
@@ -192,8 +209,7 @@ static void span_widen(int w, int *x0, int *x1)
 static void light_prefetch(const light_job *j, int y, int x0, int x1)
 {
     if (y >= j->P.height || x0 >= x1) return;
-    prefetch(j->normal + (size_t)y * (size_t)j->normal_stride + 3 * (size_t)x0,
-             12u * (size_t)(x1 - x0), 0);
+    prefetch(normal_at(j, y, x0), normal_px_bytes(j->n10) * (size_t)(x1 - x0), 0);
     prefetch(row_of(&j->P, y) + 4 * (size_t)x0, 4u * (size_t)(x1 - x0), 0);
 }
 
@@ -204,8 +220,12 @@ static void light_span(const light_job *j, int y, int x0, int x1, const uint8_t 
     const int w = j->P.width;
     if (x0 > 0) memset(o, 0, 4u * (size_t)x0);
     if (x1 < w) memset(o + 4 * (size_t)x1, 0, 4u * (size_t)(w - x1));
-    j->k->light_span(&j->prep, y, x0, x1, row_of(&j->P, y), m,
-                     j->normal + (size_t)y * (size_t)j->normal_stride, o);
+    if (j->n10)
+        j->k->light_span_n10(&j->prep, y, x0, x1, row_of(&j->P, y), m,
+                             (const uint32_t *)normal_at(j, y, 0), o);
+    else
+        j->k->light_span(&j->prep, y, x0, x1, row_of(&j->P, y), m,
+                         (const float *)normal_at(j, y, 0), o);
 }
 
 /* Row y of a light job: its mask row *m, output row *o and the mask's
@@ -259,17 +279,21 @@ typedef struct comp_job {
 } comp_job;
 
 /* The jobs' inputs (fuse_light, fuse_composite, fuse_context_frame). */
+/* The normals are normal's (floats) or, with normal NULL, normal_n10's
+ * (checked by fuse__light_check: exactly one is set). */
 static void light_job_set(light_job *j, const kernels *k, const fuse_image *P,
                           const uint8_t *mask, int mask_stride, const float *normal,
-                          int normal_stride, const fuse_image *out)
+                          int normal_stride, const uint32_t *normal_n10, int normal_n10_stride,
+                          const fuse_image *out)
 {
     j->k = k;
     j->P = *P;
     j->out = *out;
     j->mask = mask;
-    j->normal = normal;
+    j->n10 = normal == NULL;
+    j->normal = j->n10 ? (const void *)normal_n10 : (const void *)normal;
     j->mask_stride = mask_stride;
-    j->normal_stride = normal_stride;
+    j->normal_stride = j->n10 ? normal_n10_stride : normal_stride;
     j->zero_rows = NULL;
 }
 
@@ -754,17 +778,20 @@ static void comp_task(void *arg, int t, int n)
 
 /* ---- public entries ---------------------------------------------------- */
 
+/* normal or normal_n10 (the other NULL), as fuse__light_check */
 static fuse_result light_with(fuse_context *ctx, const kernels *k,
                               const fuse_lighting *L, const fuse_intrinsics *K,
                               const fuse_image *P, const uint8_t *mask,
                               int mask_stride, const float *normal,
-                              int normal_stride, fuse_image *out)
+                              int normal_stride, const uint32_t *normal_n10,
+                              int normal_n10_stride, fuse_image *out)
 {
     light_job j;
-    fuse_result r = fuse__light_check(L, K, P, mask, mask_stride, normal,
-                                      normal_stride, out, &j.prep);
+    fuse_result r = fuse__light_check(L, K, P, mask, mask_stride, normal, normal_stride,
+                                      normal_n10, normal_n10_stride, out, &j.prep);
     if (r != FUSE_OK) return r;
-    light_job_set(&j, k, P, mask, mask_stride, normal, normal_stride, out);
+    light_job_set(&j, k, P, mask, mask_stride, normal, normal_stride, normal_n10,
+                  normal_n10_stride, out);
     fuse__ctx_run(ctx, light_task, &j);
     return FUSE_OK;
 }
@@ -789,7 +816,17 @@ fuse_result fuse_light(const fuse_lighting *L, const fuse_intrinsics *K,
 {
     const kernels k = fuse__kernels_for(ef_isa_choose(EF_ISA_DEFAULT));
     return light_with(NULL, &k, L, K, P, mask, mask_stride, normal,
-                      normal_stride, out);
+                      normal_stride, NULL, 0, out);
+}
+
+fuse_result fuse_light_n10(const fuse_lighting *L, const fuse_intrinsics *K,
+                           const fuse_image *P, const uint8_t *mask,
+                           int mask_stride, const uint32_t *normal_n10,
+                           int normal_n10_stride, fuse_image *out)
+{
+    const kernels k = fuse__kernels_for(ef_isa_choose(EF_ISA_DEFAULT));
+    return light_with(NULL, &k, L, K, P, mask, mask_stride, NULL, 0, normal_n10,
+                      normal_n10_stride, out);
 }
 
 fuse_result fuse_composite(const fuse_image *Q, const fuse_image *V,
@@ -808,7 +845,18 @@ fuse_result fuse_context_light(fuse_context *ctx, const fuse_lighting *L,
 {
     if (ctx == NULL) return FUSE_ERR_ARGS;
     return light_with(ctx, &ctx->k, L, K, P, mask, mask_stride, normal,
-                      normal_stride, out);
+                      normal_stride, NULL, 0, out);
+}
+
+fuse_result fuse_context_light_n10(fuse_context *ctx, const fuse_lighting *L,
+                                   const fuse_intrinsics *K, const fuse_image *P,
+                                   const uint8_t *mask, int mask_stride,
+                                   const uint32_t *normal_n10, int normal_n10_stride,
+                                   fuse_image *out)
+{
+    if (ctx == NULL) return FUSE_ERR_ARGS;
+    return light_with(ctx, &ctx->k, L, K, P, mask, mask_stride, NULL, 0, normal_n10,
+                      normal_n10_stride, out);
 }
 
 fuse_result fuse_context_composite(fuse_context *ctx, const fuse_image *Q,
@@ -1009,11 +1057,17 @@ static int may_interleave(const fuse_eye *s)
 {
     const size_t ob = image_bytes(&s->out);
     const size_t mb = (size_t)(s->P.height - 1) * (size_t)s->mask_stride + (size_t)s->P.width;
-    const size_t nb = sizeof(float) * ((size_t)(s->P.height - 1) * (size_t)s->normal_stride +
-                                       3u * (size_t)s->P.width);
+    /* the normals' bytes, of the form in use (fuse__light_check: one) */
+    const size_t nb = s->normal != NULL
+                          ? sizeof(float) * ((size_t)(s->P.height - 1) * (size_t)s->normal_stride +
+                                             3u * (size_t)s->P.width)
+                          : sizeof(uint32_t) * ((size_t)(s->P.height - 1) *
+                                                    (size_t)s->normal_n10_stride +
+                                                (size_t)s->P.width);
+    const void *np = s->normal != NULL ? (const void *)s->normal : (const void *)s->normal_n10;
     if (bytes_overlap(s->out.pixels, ob, s->P.pixels, image_bytes(&s->P)) ||
         bytes_overlap(s->out.pixels, ob, s->mask, mb) ||
-        bytes_overlap(s->out.pixels, ob, s->normal, nb) ||
+        bytes_overlap(s->out.pixels, ob, np, nb) ||
         bytes_overlap(s->V.pixels, image_bytes(&s->V), s->Q.pixels, image_bytes(&s->Q)))
         return 0;
     if (s->depth != NULL) {
@@ -1034,7 +1088,8 @@ static fuse_result eye_prepare(fuse_context *ctx, const fuse_eye *s, eye_job *j)
 {
     fuse_result r = fuse__light_check(s->lighting, s->intrinsics, &s->P, s->mask,
                                       s->mask_stride, s->normal, s->normal_stride,
-                                      &s->Q, &j->light.prep);
+                                      s->normal_n10, s->normal_n10_stride, &s->Q,
+                                      &j->light.prep);
     if (r == FUSE_OK && s->depth != NULL)
         r = fuse__depth_check(s->depth, &s->Q, s->vp_x0, s->vp_y0, s->vp_w, s->vp_h);
     if (r == FUSE_OK)
@@ -1050,7 +1105,7 @@ static fuse_result eye_prepare(fuse_context *ctx, const fuse_eye *s, eye_job *j)
         r = FUSE_ERR_ARGS;
     if (r != FUSE_OK) return r;
     light_job_set(&j->light, &ctx->k, &s->P, s->mask, s->mask_stride, s->normal,
-                  s->normal_stride, &s->Q);
+                  s->normal_stride, s->normal_n10, s->normal_n10_stride, &s->Q);
     j->light.zero_rows = s->q_zero_rows;
     comp_job_set(&j->comp, &ctx->k, &s->Q, &s->V, s->vp_x0, s->vp_y0, s->vp_w, s->vp_h,
                  &s->out, s->v_opaque != 0);

@@ -26,6 +26,7 @@ typedef struct kernels {
     fuse__light_span_fn light_span;    /* the same kernels on a span of a row */
     fuse__depth_mspan_fn depth_mspan;
     fuse__cover_span_fn cover_span;
+    fuse__light_span_n10_fn light_span_n10;   /* light_span on ef_n10 normals */
 } kernels;
 
 struct fuse_context {

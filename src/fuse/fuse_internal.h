@@ -281,6 +281,13 @@ void fuse__light_row_ref(const fuse__light_prep *p, int y, int width,
 void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
                           const uint8_t *P, const uint8_t *mask,
                           const float *normal, uint8_t *out);
+/* The same with the normals packed as ef_n10 (src/cpu/ef_n10.h; one
+ * uint32_t per pixel, normal at the row's pixel 0): the bytes of
+ * fuse__light_span_ref fed the floats ef_n10_unpack gives (bits 30-31
+ * ignored, as ef_n10_k does). */
+void fuse__light_span_n10_ref(const fuse__light_prep *p, int y, int x0, int x1,
+                              const uint8_t *P, const uint8_t *mask,
+                              const uint32_t *normal, uint8_t *out);
 
 /* Resamples and composites one output row inside the viewport: q0/q1 are
  * the two source rows (already chosen and clamped), fy the 8-bit row
@@ -378,6 +385,15 @@ typedef void fuse__light_span_f(const fuse__light_prep *p, int y, int x0, int x1
 typedef fuse__light_span_f *fuse__light_span_fn;
 fuse__light_span_f fuse__light_span_sse2, fuse__light_span_avx2, fuse__light_span_avx512,
     fuse__light_span_neon;
+/* The same with n10 normals (fuse__light_span_n10_ref's bytes): the
+ * lighting kernel of fuse_simd.inl compiled once more per ISA with the
+ * n10 loader in place of the float normals' deinterleave. */
+typedef void fuse__light_span_n10_f(const fuse__light_prep *p, int y, int x0, int x1,
+                                    const uint8_t *P, const uint8_t *mask,
+                                    const uint32_t *normal, uint8_t *out);
+typedef fuse__light_span_n10_f *fuse__light_span_n10_fn;
+fuse__light_span_n10_f fuse__light_span_n10_sse2, fuse__light_span_n10_avx2,
+    fuse__light_span_n10_avx512, fuse__light_span_n10_neon;
 
 void fuse__composite_cols_ref(const uint8_t *q0, const uint8_t *q1, uint32_t fy,
                               const fuse__cols *cols, int c, int n, int sw,
@@ -586,11 +602,16 @@ void fuse__depth_rows(const fuse_depth *d, const fuse_image *Q, int vp_x0,
 int fuse__image_ok(const fuse_image *im);
 int fuse__overlap(const fuse_image *a, const fuse_image *b);
 int fuse__same_image(const fuse_image *a, const fuse_image *b);
-/* Checks of fuse_light / fuse_composite (fuse.h ERRORS), prep filled. */
+/* Checks of fuse_light / fuse_composite (fuse.h ERRORS), prep filled.
+ * The normals: exactly one of normal (3 floats a pixel, normal_stride
+ * floats a row >= 3 width) and normal_n10 (ef_n10, normal_n10_stride
+ * uint32_t a row >= width) is not NULL, else FUSE_ERR_ARGS; the stride of
+ * the NULL one is not looked at. */
 fuse_result fuse__light_check(const fuse_lighting *L, const fuse_intrinsics *K,
                               const fuse_image *P, const uint8_t *mask,
                               int mask_stride, const float *normal,
-                              int normal_stride, const fuse_image *out,
+                              int normal_stride, const uint32_t *normal_n10,
+                              int normal_n10_stride, const fuse_image *out,
                               fuse__light_prep *prep);
 fuse_result fuse__composite_check(const fuse_image *Q, const fuse_image *V,
                                   int vp_x0, int vp_y0, int vp_w, int vp_h,

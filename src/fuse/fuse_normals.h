@@ -44,7 +44,10 @@ extern "C" {
 
 /* nrm, out: 3 floats per pixel, strides in floats (>= 3 width); mask:
  * strides in bytes (>= width); radius 1..FUSE_NORMAL_SMOOTH_MAX; out
- * must not overlap nrm. FUSE_ERR_ARGS otherwise (nothing written). */
+ * must not overlap nrm. FUSE_ERR_ARGS otherwise (nothing written).
+ * Float normals only, in and out: there is no ef_n10 form of it (a
+ * pipeline that smooths lights from the smoothed floats, fuse_eye.normal;
+ * fuse_eye.normal_n10 is for the raster's normals as they are). */
 fuse_result fuse_normal_smooth(const uint8_t *mask, int mask_stride, const float *nrm,
                                int nrm_stride, float *out, int out_stride, int width,
                                int height, int radius);

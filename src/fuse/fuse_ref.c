@@ -5,6 +5,8 @@
  * fuse_internal.h so that other paths share it. */
 #include "fuse_internal.h"
 
+#include "../cpu/ef_n10.h"
+
 #include <stddef.h>
 
 /* Every float parameter of fuse_lighting must lie in [-FUSE_PARAM_MAX,
@@ -157,18 +159,21 @@ static void light_terms(const fuse__light_prep *p, int i, float nx, float ny, fl
     *hh = (hx * hx + hy * hy) + hz * hz;
 }
 
-void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
-                          const uint8_t *P, const uint8_t *mask,
-                          const float *normal, uint8_t *out)
+/* fuse__light_span_ref on float normals (n10 0: normal, 3 floats a pixel)
+ * or ef_n10 ones (n10 1: nq, one uint32_t a pixel, unpacked exactly as
+ * ef_n10_unpack: (float)k * EF_N10_INV); n10 is a constant at each call,
+ * so each function below is compiled with one form only. */
+static inline __attribute__((always_inline)) void light_span_body(
+    const fuse__light_prep *p, int y, int x0, int x1, const uint8_t *P, const uint8_t *mask,
+    const float *normal, const uint32_t *nq, uint8_t *out, int n10)
 {
     /* View ray of the row; the image's y axis points down, view y up. */
     const float py = (((float)y + 0.5f) - p->cy) * p->ify;
     const float pyy = py * py + 1.0f;
     int x, i, c;
     P += 4 * (size_t)x0;
-    normal += 3 * (size_t)x0;
     out += 4 * (size_t)x0;
-    for (x = x0; x < x1; x++, P += 4, normal += 3, out += 4) {
+    for (x = x0; x < x1; x++, P += 4, out += 4) {
         const unsigned M = mask[x];
         float mpx, vv, sv, sn, r, il, inv, vx, vy, vz, nx, ny, nz, nn, ndv, t, t2, fade, m;
         float C[3];
@@ -181,9 +186,15 @@ void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
         vv = mpx * mpx + pyy;
         sv = sqrtf(vv);
         /* n as given, or v when it has no usable length (N = V). */
-        nx = normal[0];
-        ny = normal[1];
-        nz = normal[2];
+        if (n10) {   /* ef_n10_unpack's floats */
+            nx = (float)ef_n10_k(nq[x], 0) * EF_N10_INV;
+            ny = (float)ef_n10_k(nq[x], 1) * EF_N10_INV;
+            nz = (float)ef_n10_k(nq[x], 2) * EF_N10_INV;
+        } else {
+            nx = normal[3 * (size_t)x];
+            ny = normal[3 * (size_t)x + 1];
+            nz = normal[3 * (size_t)x + 2];
+        }
         nn = (nx * nx + ny * ny) + nz * nz;
         if (nn > 1.0e-30f && nn < 1.0e30f) {
             sn = sqrtf(nn);
@@ -247,18 +258,33 @@ void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
     }
 }
 
+void fuse__light_span_ref(const fuse__light_prep *p, int y, int x0, int x1,
+                          const uint8_t *P, const uint8_t *mask,
+                          const float *normal, uint8_t *out)
+{
+    light_span_body(p, y, x0, x1, P, mask, normal, NULL, out, 0);
+}
+
+void fuse__light_span_n10_ref(const fuse__light_prep *p, int y, int x0, int x1,
+                              const uint8_t *P, const uint8_t *mask,
+                              const uint32_t *normal, uint8_t *out)
+{
+    light_span_body(p, y, x0, x1, P, mask, NULL, normal, out, 1);
+}
+
 fuse_result fuse__light_check(const fuse_lighting *L, const fuse_intrinsics *K,
                               const fuse_image *P, const uint8_t *mask,
                               int mask_stride, const float *normal,
-                              int normal_stride, const fuse_image *out,
+                              int normal_stride, const uint32_t *normal_n10,
+                              int normal_n10_stride, const fuse_image *out,
                               fuse__light_prep *prep)
 {
     fuse_result r;
     if (L == NULL || K == NULL || P == NULL || mask == NULL ||
-        normal == NULL || out == NULL)
+        (normal == NULL) == (normal_n10 == NULL) || out == NULL)
         return FUSE_ERR_ARGS;
     if (!fuse__image_ok(P) || !fuse__image_ok(out) || mask_stride < P->width ||
-        normal_stride < 3 * P->width)
+        (normal != NULL ? normal_stride < 3 * P->width : normal_n10_stride < P->width))
         return FUSE_ERR_ARGS;
     r = fuse__light_prepare(L, K, prep);
     if (r != FUSE_OK) return r;

@@ -6,6 +6,7 @@
  *
  *   fuse__light_row     the lighting of one layer row (fuse__light_fn)
  *   fuse__light_span    the same on a span of the row (fuse__light_span_fn)
+ *   fuse__light_span_n10  the same with ef_n10 normals (fuse__light_span_n10_fn)
  *   fuse__pow01_row     the lane power over an array (for the tests)
  *   fuse__depth_row     the depth test on a layer row (fuse__depth_fn)
  *   fuse__depth_mrow    the same on mask bytes (fuse__depth_mask_fn)
@@ -31,6 +32,9 @@
  *       scalar loads (the layer's vf_load3 goes through a stack buffer,
  *       which made the SSE2 lighting about 20% slower); AVX2 from 128-bit
  *       loads and shufps (fewer instructions than its vf_load3).
+ *   FUSE_LOAD_N10(p, x, y, z)  SIMD_W normals packed as ef_n10 into three
+ *       vfloat lvalues; default load_n10 (one load, three shift pairs,
+ *       conversions and multiplies on the layer), which every ISA uses.
  *   FUSE_ALPHA4(q)  (the row cache's vrow) each pixel's alpha, 16-bit
  *       lane 3 of its 4, in all 4 lanes; default vh_bcast3 (two word
  *       shuffles). AVX2 and AVX-512 use one pshufb.
@@ -41,6 +45,8 @@
  *       vm_all (compare, movemask, compare). AVX2: vptest; AVX-512:
  *       vptestmd. */
 #include <string.h>
+
+#include "../cpu/ef_n10.h"
 
 /* 1 if the SIMD_W mask bytes at p are all 0 */
 SIMD_INL int mask_zero(const uint8_t *p)
@@ -100,6 +106,23 @@ SIMD_INL int mask_zero(const uint8_t *p)
 #define LOAD_NORMALS(p, x, y, z) FUSE_LOAD_NORMALS(p, x, y, z)
 #else
 #define LOAD_NORMALS(p, x, y, z) vf_load3(p, &(x), &(y), &(z))
+#endif
+/* SIMD_W normals packed as ef_n10 (src/cpu/ef_n10.h), one int32 lane a
+ * pixel, into three vfloat lvalues: each 10-bit field shifted to the top
+ * of the lane and back down arithmetically (its sign extended; bits 30-31
+ * fall off the top, ignored as ef_n10_k ignores them), converted (exact:
+ * |k| <= 512) and multiplied by EF_N10_INV: ef_n10_unpack's floats, lane
+ * by lane. Written once, on the layer, for every ISA. */
+#ifndef FUSE_LOAD_N10
+SIMD_INL void load_n10(const uint32_t *p, VF *x, VF *y, VF *z)
+{
+    const VI v = vi_loadu((const int32_t *)(const void *)p);
+    const VF s = F1(EF_N10_INV);
+    *x = FMUL(I2F(vi_srai(ISLL(v, 22), 22)), s);
+    *y = FMUL(I2F(vi_srai(ISLL(v, 12), 22)), s);
+    *z = FMUL(I2F(vi_srai(ISLL(v, 2), 22)), s);
+}
+#define FUSE_LOAD_N10(p, x, y, z) load_n10(p, &(x), &(y), &(z))
 #endif
 #define STORE_RGBA(p, v) vi_storeu((int32_t *)(void *)(p), v)
 #define STORE_ZERO(p) vi_storeu((int32_t *)(void *)(p), vi_zero())
@@ -351,13 +374,16 @@ static inline __attribute__((always_inline)) void light_pair_lanes(
 }
 
 /* The pixels x .. x + nu LANES - 1 of the row (fuse__light_span_ref lane
- * by lane), stored to out. pyy = py * py + 1 of the row. two: k->nl == 2
- * (a constant at each call). */
+ * by lane), stored to out. pyy = py * py + 1 of the row. two: k->nl == 2;
+ * n10: the normals are nq's (ef_n10), else normal's (3 floats a pixel);
+ * constants at each call. */
 static inline __attribute__((always_inline)) void light_lanes(const light_vk *k, VF py, VF pyy,
                                                               int x, int nu, const uint8_t *P,
                                                               const uint8_t *mask,
-                                                              const float *normal, uint8_t *out,
-                                                              int fres, int nonneg, int two)
+                                                              const float *normal,
+                                                              const uint32_t *nq, uint8_t *out,
+                                                              int fres, int nonneg, int two,
+                                                              int n10)
 {
     const VF one = F1(1.0f);
     VF mpx[U_MAX], vv[U_MAX], sv[U_MAX], sn[U_MAX], r[U_MAX], il[U_MAX], inv[U_MAX];
@@ -374,7 +400,8 @@ static inline __attribute__((always_inline)) void light_lanes(const light_vk *k,
         vv[u] = FADD(FMUL(mpx[u], mpx[u]), pyy);
     }
     EACH {
-        LOAD_NORMALS(normal + 3 * (size_t)(x + u * LANES), nx[u], ny[u], nz[u]);
+        if (n10) FUSE_LOAD_N10(nq + x + u * LANES, nx[u], ny[u], nz[u]);
+        else LOAD_NORMALS(normal + 3 * (size_t)(x + u * LANES), nx[u], ny[u], nz[u]);
         nn[u] = FADD(FADD(FMUL(nx[u], nx[u]), FMUL(ny[u], ny[u])), FMUL(nz[u], nz[u]));
         ok[u] = MAND(FGT(nn[u], k->nn_min), FLT(nn[u], k->nn_max));
     }
@@ -474,60 +501,87 @@ static inline __attribute__((always_inline)) void light_lanes(const light_vk *k,
 
 /* Two vectors a step where both have mask bytes, one where only one has,
  * a zero store where neither has (the reference's M == 0 pixels). Pixels
- * x0 <= x < x1 of the row (fuse__light_span_ref; the pointers at pixel 0).
- * fres: p->kf != 0 (else the fade, exactly 1, is not computed); nonneg:
- * p->c_nonneg (the output clamp without max0); two: p->light_count == 2;
- * constants at each call, so each of the eight bodies is compiled without
- * the other cases' work. */
-static inline __attribute__((always_inline)) void light_span_body(
-    const fuse__light_prep *p, const light_vk *k, int y, VF py, VF pyy, int x, int width,
-    const uint8_t *P, const uint8_t *mask, const float *normal, uint8_t *out, int fres,
-    int nonneg, int two)
+ * x0 <= x of the row (fuse__light_span_ref; the pointers at pixel 0) in
+ * whole vectors: returns the first pixel not done (x1 - x0 mod LANES are
+ * left, which the caller's reference does). fres: p->kf != 0 (else the
+ * fade, exactly 1, is not computed); nonneg: p->c_nonneg (the output clamp
+ * without max0); two: p->light_count == 2; n10: the normals' form;
+ * constants at each call, so each of the bodies is compiled without the
+ * other cases' work. (The tail is the callers', one call each: a tail
+ * choosing its reference by n10 in here made gcc lay out the float path's
+ * code differently.) */
+static inline __attribute__((always_inline)) int light_span_body(
+    const light_vk *k, VF py, VF pyy, int x, int width,
+    const uint8_t *P, const uint8_t *mask, const float *normal, const uint32_t *nq, uint8_t *out,
+    int fres, int nonneg, int two, int n10)
 {
     for (; x + 2 * LANES <= width; x += 2 * LANES) {
         const int z0 = MASK_ZERO(mask + x), z1 = MASK_ZERO(mask + x + LANES);
         if (!z0 && !z1) {
-            light_lanes(k, py, pyy, x, 2, P, mask, normal, out, fres, nonneg, two);
+            light_lanes(k, py, pyy, x, 2, P, mask, normal, nq, out, fres, nonneg, two, n10);
             continue;
         }
         if (z0) STORE_ZERO(out + 4 * (size_t)x);
-        else light_lanes(k, py, pyy, x, 1, P, mask, normal, out, fres, nonneg, two);
+        else light_lanes(k, py, pyy, x, 1, P, mask, normal, nq, out, fres, nonneg, two, n10);
         if (z1) STORE_ZERO(out + 4 * (size_t)(x + LANES));
-        else light_lanes(k, py, pyy, x + LANES, 1, P, mask, normal, out, fres, nonneg, two);
+        else light_lanes(k, py, pyy, x + LANES, 1, P, mask, normal, nq, out, fres, nonneg, two, n10);
     }
     for (; x + LANES <= width; x += LANES) {
         if (MASK_ZERO(mask + x)) STORE_ZERO(out + 4 * (size_t)x);
-        else light_lanes(k, py, pyy, x, 1, P, mask, normal, out, fres, nonneg, two);
+        else light_lanes(k, py, pyy, x, 1, P, mask, normal, nq, out, fres, nonneg, two, n10);
     }
-    if (x < width)
-        fuse__light_span_ref(p, y, x, width, P, mask, normal, out);
+    return x;
 }
 
 /* one body per (fres, nonneg) pair, for two lights or any number */
-static inline __attribute__((always_inline)) void light_span_lights(
-    const fuse__light_prep *p, const light_vk *k, int y, VF py, VF pyy, int x, int width,
-    const uint8_t *P, const uint8_t *mask, const float *normal, uint8_t *out, int fres,
-    int nonneg)
+static inline __attribute__((always_inline)) int light_span_lights(
+    const light_vk *k, VF py, VF pyy, int x, int width,
+    const uint8_t *P, const uint8_t *mask, const float *normal, const uint32_t *nq, uint8_t *out,
+    int fres, int nonneg, int n10)
 {
-    if (k->nl == 2) light_span_body(p, k, y, py, pyy, x, width, P, mask, normal, out, fres, nonneg, 1);
-    else light_span_body(p, k, y, py, pyy, x, width, P, mask, normal, out, fres, nonneg, 0);
+    if (k->nl == 2)
+        return light_span_body(k, py, pyy, x, width, P, mask, normal, nq, out, fres, nonneg, 1, n10);
+    return light_span_body(k, py, pyy, x, width, P, mask, normal, nq, out, fres, nonneg, 0, n10);
 }
 
-void SIMD_FN(fuse__light_span)(const fuse__light_prep *p, int y, int x0, int width,
-                               const uint8_t *P, const uint8_t *mask,
-                               const float *normal, uint8_t *out)
+/* The span of a row with the normals' form n10 (a constant at each call:
+ * the float and the n10 entry below each get their own eight bodies). */
+static inline __attribute__((always_inline)) int light_span_form(
+    const fuse__light_prep *p, int y, int x0, int width, const uint8_t *P, const uint8_t *mask,
+    const float *normal, const uint32_t *nq, uint8_t *out, int n10)
 {
     const float pys = (((float)y + 0.5f) - p->cy) * p->ify;
     const VF py = F1(pys), pyy = F1(pys * pys + 1.0f);
     light_vk k;
     light_vk_fill(&k, p);
     if (p->kf != 0.0f) {
-        if (p->c_nonneg) light_span_lights(p, &k, y, py, pyy, x0, width, P, mask, normal, out, 1, 1);
-        else light_span_lights(p, &k, y, py, pyy, x0, width, P, mask, normal, out, 1, 0);
+        if (p->c_nonneg)
+            return light_span_lights(&k, py, pyy, x0, width, P, mask, normal, nq, out, 1, 1, n10);
+        else
+            return light_span_lights(&k, py, pyy, x0, width, P, mask, normal, nq, out, 1, 0, n10);
     } else {
-        if (p->c_nonneg) light_span_lights(p, &k, y, py, pyy, x0, width, P, mask, normal, out, 0, 1);
-        else light_span_lights(p, &k, y, py, pyy, x0, width, P, mask, normal, out, 0, 0);
+        if (p->c_nonneg)
+            return light_span_lights(&k, py, pyy, x0, width, P, mask, normal, nq, out, 0, 1, n10);
+        else
+            return light_span_lights(&k, py, pyy, x0, width, P, mask, normal, nq, out, 0, 0, n10);
     }
+}
+
+void SIMD_FN(fuse__light_span)(const fuse__light_prep *p, int y, int x0, int width,
+                               const uint8_t *P, const uint8_t *mask,
+                               const float *normal, uint8_t *out)
+{
+    const int x = light_span_form(p, y, x0, width, P, mask, normal, NULL, out, 0);
+    if (x < width) fuse__light_span_ref(p, y, x, width, P, mask, normal, out);
+}
+
+/* fuse__light_span_n10_fn: the normals packed as ef_n10 */
+void SIMD_FN(fuse__light_span_n10)(const fuse__light_prep *p, int y, int x0, int width,
+                                   const uint8_t *P, const uint8_t *mask,
+                                   const uint32_t *normal, uint8_t *out)
+{
+    const int x = light_span_form(p, y, x0, width, P, mask, NULL, normal, out, 1);
+    if (x < width) fuse__light_span_n10_ref(p, y, x, width, P, mask, normal, out);
 }
 
 void LIGHT_ROW_NAME(const fuse__light_prep *p, int y, int width,

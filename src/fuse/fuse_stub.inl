@@ -18,6 +18,13 @@ void FUSE_STUB(fuse__light_span)(const fuse__light_prep *p, int y, int x0, int x
     fuse__light_span_ref(p, y, x0, x1, P, mask, normal, out);
 }
 
+void FUSE_STUB(fuse__light_span_n10)(const fuse__light_prep *p, int y, int x0, int x1,
+                                     const uint8_t *P, const uint8_t *mask,
+                                     const uint32_t *normal, uint8_t *out)
+{
+    fuse__light_span_n10_ref(p, y, x0, x1, P, mask, normal, out);
+}
+
 void FUSE_STUB(fuse__pow01_row)(const float *x, int n, float s, float *out)
 {
     int i;
