@@ -37,6 +37,7 @@
 
 #include "../src/cpu/cpu.h"
 #include "../src/cpu/ef_mem.h"
+#include "../src/cpu/ef_n10.h"
 #include "../src/pipe/pipe.h"
 #include "../src/pipe/pipe_soft.h"
 #include "support/pipe_frames.h"
@@ -983,8 +984,8 @@ static void determinism_sample_isa(void **state)
     const float n = d.znear, f = d.zfar;
     const ef_isa caps[4] = {EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512, EF_ISA_DEFAULT};
     pipe__reproj r[2];
-    assert_int_equal(pipe__reproj_init(&r[0], w, h), 0);
-    assert_int_equal(pipe__reproj_init(&r[1], w, h), 0);
+    assert_int_equal(pipe__reproj_init(&r[0], w, h, 0), 0);
+    assert_int_equal(pipe__reproj_init(&r[1], w, h, 0), 0);
     long sampled = 0, filled = 0;
     for (int it = 0; it < 3; it++) {
         const int ox = 1 + tu_int(&g, 40), oy = tu_int(&g, 41);
@@ -1005,12 +1006,13 @@ static void determinism_sample_isa(void **state)
             r[0].mask[i] = tu_int(&g, 10) ? 255 : 0;
             const float z = dm * tu_range(&g, 0.9f, 1.1f);
             r[0].depth[i] = 0.5f * ((f + n) - 2.0f * f * n / z) / (f - n) + 0.5f;
-            for (int j = 0; j < 3; j++) r[0].nrm[3 * i + j] = tu_range(&g, -0.5f, 0.5f);
-            r[0].nrm[3 * i + 2] += 0.5f;
+            float nv[3];
+            for (int j = 0; j < 3; j++) nv[j] = tu_range(&g, -0.5f, 0.5f);
+            r[0].n10[i] = ef_n10_pack(nv[0], nv[1], nv[2] + 0.5f);
         }
         memcpy(r[1].mask, r[0].mask, (size_t)w * (size_t)h);
         memcpy(r[1].depth, r[0].depth, sizeof(float) * (size_t)w * (size_t)h);
-        memcpy(r[1].nrm, r[0].nrm, sizeof(float) * 3 * (size_t)w * (size_t)h);
+        memcpy(r[1].n10, r[0].n10, sizeof(uint32_t) * (size_t)w * (size_t)h);
         const fuse_image im = {P, pw, ph, 4 * pw};
         for (int k = -1; k < 4; k++) {
             pipe__reproj *q = &r[k < 0 ? 0 : 1];

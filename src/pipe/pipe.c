@@ -9,6 +9,7 @@
 #include "pipe_nfill.h"
 #include "pipe_soft.h"
 #include "pipe_reproj.h"
+#include "../cpu/ef_n10.h"
 #include "../cpu/mask_rows.h"
 #include "../fit/fit_band.h"
 #include "../fit/fit_holes.h"
@@ -144,6 +145,8 @@ static rast_target cam_target(const pipe_ctx *p, const eye_state *e)
     const int cw = p->geo.crop_width, ch = p->geo.crop_height;
     if (p->desc.eye_view == PIPE_VIEW_REPROJECT && !e->lens)
         return (rast_target){cw, ch, e->depth, cw, e->mask, cw, NULL, 0, 0, NULL, 0};
+    if (e->n10)
+        return (rast_target){cw, ch, e->depth, cw, e->mask, cw, NULL, 0, 3, e->n10, cw};
     return (rast_target){cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3, NULL, 0};
 }
 
@@ -156,7 +159,7 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
     pipe__reproj *r = &e->rp;
     const int w = r->width, h = r->height, cw = p->geo.crop_width, ch = p->geo.crop_height;
     r->cam = kin_sthmd_eye_camera(&p->hmd, &e->head, (kin_eye)e->eye, w, h);
-    rast_target tg = {w, h, r->depth, w, r->mask, w, r->nrm, 3 * w, 3, NULL, 0};
+    rast_target tg = {w, h, r->depth, w, r->mask, w, NULL, 0, 3, r->n10, w};
     int level = e->lod_level;
     rast_result rr = eye_draw(p, e, NULL, &r->cam, &tg, 1, NULL);
     e->lod_level = level;
@@ -198,7 +201,8 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
              * would not hold for it across the other's draws: the
              * context forgets its targets first, and this one is cleared
              * whole (the others next frame) */
-            rast_target ct = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3, NULL, 0};
+            rast_target ct = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, e->nrm ? 3 * cw : 0, 3,
+                              e->n10, e->n10 ? cw : 0};
             rast_context_forget(e->rast);
             rr = eye_draw(p, e, NULL, &e->cam, &ct, 1, NULL);
             e->lod_level = level;
@@ -308,8 +312,19 @@ static void run_eye(pipe_ctx *p, eye_state *e)
         fe.mask = e->soft;
     }
     e->shown = fe.mask;
-    fe.normal = rp ? e->rp.nrm : e->nrm;
-    fe.normal_stride = 3 * cw;
+    /* the normals: the eye's packed, the camera's packed or floats
+     * (pipe_create); smoothing reads floats, so the eye's are unpacked
+     * for it */
+    const uint32_t *n10 = rp ? e->rp.n10 : e->n10;
+    if (rp && p->desc.normal_smooth > 0) {
+        const size_t np = (size_t)cw * (size_t)ch;
+        for (size_t i = 0; i < np; i++) ef_n10_unpack(n10[i], e->rp.nrm + 3 * i);
+        n10 = NULL;
+    }
+    fe.normal = n10 ? NULL : rp ? e->rp.nrm : e->nrm;
+    fe.normal_stride = n10 ? 0 : 3 * cw;
+    fe.normal_n10 = n10;
+    fe.normal_n10_stride = n10 ? cw : 0;
     /* the refined mask's normals come from the model's alone (nfill
      * below: nrm must be 0 outside the model's mask) */
     const int nfill = !rp && refined_in && e->nfill_scratch;
@@ -521,7 +536,7 @@ static void wait_job(pipe_ctx *p, int job)
 static void free_eyes(pipe_ctx *p)
 {
     for (int e = 0; e < 2; e++) {
-        EF_FREE_ALL(p->eye[e].depth, p->eye[e].nrm, p->eye[e].snrm, p->eye[e].nfill_scratch,
+        EF_FREE_ALL(p->eye[e].depth, p->eye[e].nrm, p->eye[e].n10, p->eye[e].snrm, p->eye[e].nfill_scratch,
                     p->eye[e].soft, p->eye[e].clip, p->eye[e].vnrm, p->eye[e].mask, p->eye[e].layer,
                     p->eye[e].layer_zero, p->eye[e].cam_rgba, p->eye[e].refined,
                     p->eye[e].regrow, p->eye[e].prior, p->eye[e].shifted, p->eye[e].unsmoothed,
@@ -609,7 +624,18 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         eye_state *s = &p->eye[e];
         s->eye = e;
         s->depth = malloc(sizeof(float) * px);
-        s->nrm = malloc(sizeof(float) * 3 * px);
+        /* the camera's normals packed (ef_n10.h: 4 bytes a pixel, not 12)
+         * when only the lighting reads them: not through a distorting
+         * lens (its warp moves floats), nor with the refinement's fill,
+         * the smoothing or the anti-aliased fill (they read floats). The
+         * eye's view packs its own always (pipe__reproj_init) */
+        kin_camera c0 = kin_sthmd_camera(&p->hmd, NULL, (kin_eye)e);
+        const int distorts = kin_lens_distorts(&c0.lens);
+        if (!distorts && p->desc.refine_band == 0 && p->desc.normal_smooth <= 0 &&
+            p->desc.aa_samples == 0)
+            s->n10 = malloc(sizeof(uint32_t) * px);
+        else
+            s->nrm = malloc(sizeof(float) * 3 * px);
         s->mask = malloc(px);
         s->layer = malloc(4 * px);
         s->layer_zero = calloc((size_t)p->geo.crop_height, 1);
@@ -623,12 +649,11 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         fuse_context_desc fd = {(ef_isa)p->desc.max_isa, 1};
         s->rast = rast_context_create(&rd);
         s->fuse = fuse_context_create(&fd);
-        ok = ok && s->depth && s->nrm && s->mask && s->layer && s->layer_zero && s->cam_rgba &&
+        ok = ok && s->depth && (s->nrm || s->n10) && s->mask && s->layer && s->layer_zero && s->cam_rgba &&
              s->clip && s->vnrm && s->rast && s->fuse;
         if (ok) {
             /* a calibrated, distorting lens: the mask through it */
-            kin_camera c0 = kin_sthmd_camera(&p->hmd, NULL, (kin_eye)e);
-            if (kin_lens_distorts(&c0.lens)) {
+            if (distorts) {
                 s->lens = calloc(1, sizeof *s->lens);
                 ok = s->lens && pipe_lens_map_init(s->lens, &c0.lens, 1, 3, NULL, 0) == 0;
                 if (ok) { /* the warp writes only what changes: start clear */
@@ -692,7 +717,8 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
          * distorting lens (pipe.h ANTI-ALIASED EDGES) */
         if (ok && p->desc.aa_samples && s->lens) ok = 0;
         if (ok && p->desc.eye_view == PIPE_VIEW_REPROJECT)
-            ok = pipe__reproj_init(&s->rp, p->geo.crop_width, p->geo.crop_height) == 0;
+            ok = pipe__reproj_init(&s->rp, p->geo.crop_width, p->geo.crop_height,
+                                   p->desc.normal_smooth > 0) == 0;
         if (ok && p->desc.aa_samples)
             ok = pipe__aa_init(&s->aa, p->desc.aa_samples, p->geo.crop_width,
                                p->geo.crop_height, p->desc.refine_band > 0) == 0;

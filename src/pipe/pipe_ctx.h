@@ -17,7 +17,10 @@
 
 typedef struct eye_state {
     int eye;
-    float *depth, *nrm, *clip, *vnrm;
+    float *depth, *clip, *vnrm;
+    float *nrm;               /* the camera's normals as floats, or NULL: */
+    uint32_t *n10;            /* packed (ef_n10.h) when nothing but the
+                                 lighting reads them (pipe_create) */
     uint8_t *mask, *layer;
     uint8_t *layer_zero;      /* fuse_eye.q_zero_rows of layer */
     uint8_t *cam_rgba;        /* the cropped camera image, when given raw */

@@ -4,6 +4,7 @@
 
 #include "../cpu/cpu.h"
 #include "../cpu/ef_mem.h"
+#include "../cpu/ef_n10.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -47,20 +48,21 @@ int pipe_view_check(const kin_sthmd_desc *hmd, char *why, int why_size)
     return 0;
 }
 
-int pipe__reproj_init(pipe__reproj *r, int width, int height)
+int pipe__reproj_init(pipe__reproj *r, int width, int height, int float_normals)
 {
     memset(r, 0, sizeof *r);
     size_t px = (size_t)width * (size_t)height;
     r->width = width;
     r->height = height;
     r->depth = malloc(sizeof(float) * px);
-    r->nrm = malloc(sizeof(float) * 3 * px);
+    r->n10 = malloc(sizeof(uint32_t) * px);
+    if (float_normals) r->nrm = malloc(sizeof(float) * 3 * px);
     r->mask = malloc(px);
     r->P = calloc(px, 4);
     r->M = calloc(px, 1);
     r->row = malloc(sizeof(int32_t) * (size_t)width + (size_t)height);
     r->lanes = malloc(sizeof(int32_t) * 8 * ((size_t)width + 16));
-    if (!r->depth || !r->nrm || !r->mask || !r->P || !r->M || !r->row || !r->lanes) {
+    if (!r->depth || !r->n10 || (float_normals && !r->nrm) || !r->mask || !r->P || !r->M || !r->row || !r->lanes) {
         pipe__reproj_free(r);
         return -1;
     }
@@ -69,7 +71,7 @@ int pipe__reproj_init(pipe__reproj *r, int width, int height)
 
 void pipe__reproj_free(pipe__reproj *r)
 {
-    EF_FREE_ALL(r->depth, r->nrm, r->mask, r->P, r->M, r->row, r->lanes);
+    EF_FREE_ALL(r->depth, r->n10, r->nrm, r->mask, r->P, r->M, r->row, r->lanes);
     memset(r, 0, sizeof *r);
 }
 
@@ -85,7 +87,7 @@ enum { ST_NONE = 0, ST_SAMPLED = 1, ST_FILL = 2, ST_UNRESOLVED = 3 };
 /* The scalar reference of the geometry pass (pipe_reproj_simd.inl is
  * this, lane by lane): columns [x, w) of one eye row, the covered ones. */
 static void row_ref(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                    const float *en, float ry, int x, int w, const pipe__reproj_lanes *o,
+                    const uint32_t *en, float ry, int x, int w, const pipe__reproj_lanes *o,
                     long *back, float *mind)
 {
     const float *a = g->a; /* column-major: x' = a0 x + a4 y + a8 z + a12 */
@@ -93,7 +95,8 @@ static void row_ref(const pipe__reproj_geo *g, const uint8_t *em, const float *e
     for (; x < w; x++) {
         if (!em[x]) continue;
         const float rx = g->rxs[x];
-        const float *nv = en + 3 * x;
+        float nv[3];
+        ef_n10_unpack(en[x], nv);
         if (nv[0] * rx + nv[1] * ry - nv[2] > 0.0f) (*back)++;
         const float zn = 2.0f * ed[x] - 1.0f;
         const float dist = g->two_fn / (g->fpn - zn * g->fmn);
@@ -410,7 +413,7 @@ int pipe__reproj_sample(pipe__reproj *r, const kin_camera *cam, const fuse_image
         uint8_t *M = r->M + (size_t)y * (size_t)w;
         uint8_t *Po = r->P + (size_t)y * (size_t)w * 4;
         const float *ed = r->depth + (size_t)y * (size_t)w;
-        const float *en = r->nrm + (size_t)y * (size_t)w * 3;
+        const uint32_t *en = r->n10 + (size_t)y * (size_t)w;
         const float ry = -((float)y + 0.5f - ecy) / efy;
         const long filled0 = filled, sampled0 = sampled;
         memset(M, 0, (size_t)w);

@@ -126,8 +126,10 @@ int pipe_view_check(const kin_sthmd_desc *hmd, char *why, int why_size);
 
 typedef struct pipe__reproj {
     int width, height;        /* the eye layer: the crop's size */
-    float *depth, *nrm;       /* the eye's G-buffer */
-    uint8_t *mask;
+    float *depth;             /* the eye's G-buffer: depth, */
+    uint32_t *n10;            /* normals packed (ef_n10.h), */
+    uint8_t *mask;            /* mask; and the normals as floats for */
+    float *nrm;               /* fuse_normal_smooth, or NULL (init) */
     uint8_t *P;               /* RGBA8: camera colours seen from the eye */
     uint8_t *M;               /* the mask composited (fade, fill) */
     int32_t *row;             /* width: the eye rays' x; then height bytes: the rows' kinds */
@@ -166,7 +168,7 @@ typedef struct pipe__reproj_geo {
 /* The vector geometry pass per ISA (pipe_reproj_simd.inl) over columns
  * [x0, w): the first column it did not do. The pinhole camera only. */
 typedef int pipe__reproj_row_t(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                               const float *en, float ry, int x0, int w,
+                               const uint32_t *en, float ry, int x0, int w,
                                const pipe__reproj_lanes *o, long *back, float *mind);
 typedef pipe__reproj_row_t *pipe__reproj_row_fn;
 pipe__reproj_row_t pipe__reproj_row_sse2, pipe__reproj_row_avx2, pipe__reproj_row_avx512,
@@ -218,7 +220,10 @@ void pipe__reproj_fill(uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P, cons
 void pipe__reproj_fill_cols(const uint8_t *rows, int w, int h, uint8_t *M, uint8_t *P,
                             int32_t *near);
 
-int pipe__reproj_init(pipe__reproj *r, int width, int height);
+/* float_normals: also a float plane of normals (r->nrm) for the
+ * smoothing, which pipe.c unpacks the packed ones into. -1 when out of
+ * memory (r then empty). */
+int pipe__reproj_init(pipe__reproj *r, int width, int height, int float_normals);
 void pipe__reproj_free(pipe__reproj *r);
 /* From the eye's G-buffer (drawn through r->cam), the camera (cam, its
  * lens, its intrinsics those of the crop), the camera image P sampled

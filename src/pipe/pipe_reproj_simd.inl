@@ -10,15 +10,18 @@
  * AVX2/AVX-512 gathers, SSE2/NEON lane by lane), the bilinear in int32
  * lanes, the renormalising division in float (exact, see there). */
 
+#include "../cpu/ef_n10.h"
+
 /* Columns [x0, w) of one eye row, SIMD_W at a time, skipping blocks with
  * no covered pixel; the first column not done (row_ref finishes). back:
  * covered pixels facing away added; *mind: the least distance of a
  * covered pixel. The pinhole camera only (g->pinhole). */
 int SIMD_FN(pipe__reproj_row)(const pipe__reproj_geo *g, const uint8_t *em, const float *ed,
-                              const float *en, float ry_s, int x0, int w,
+                              const uint32_t *en, float ry_s, int x0, int w,
                               const pipe__reproj_lanes *o, long *back, float *mind)
 {
-    const vfloat zero = vf_zero(), one = vf_set1(1.0f), two = vf_set1(2.0f);
+    const vfloat zero = vf_zero(), one = vf_set1(1.0f), two = vf_set1(2.0f),
+                 inv511 = vf_set1(EF_N10_INV);
     const vfloat ry = vf_set1(ry_s), two_fn = vf_set1(g->two_fn), fpn = vf_set1(g->fpn),
                  fmn = vf_set1(g->fmn), nn = vf_set1(g->n);
     const vfloat a0 = vf_set1(g->a[0]), a1 = vf_set1(g->a[1]), a2 = vf_set1(g->a[2]),
@@ -39,8 +42,12 @@ int SIMD_FN(pipe__reproj_row)(const pipe__reproj_geo *g, const uint8_t *em, cons
         const vmask cov = vm_not(vi_eq(vi_load_u8(em + x), vi_zero()));
         if (!vm_any(cov)) continue;
         const vfloat rx = vf_loadu(g->rxs + x);
-        vfloat n0, n1, n2;
-        vf_load3(en + 3 * x, &n0, &n1, &n2);
+        /* the packed normals (ef_n10_unpack: each 10-bit field
+         * sign-extended, k / 511) */
+        const vint pn = vi_loadu((const int32_t *)(en + x));
+        const vfloat n0 = vf_mul(vf_from_vi(vi_srai(vi_slli(pn, 22), 22)), inv511),
+                     n1 = vf_mul(vf_from_vi(vi_srai(vi_slli(pn, 12), 22)), inv511),
+                     n2 = vf_mul(vf_from_vi(vi_srai(vi_slli(pn, 2), 22)), inv511);
         const vmask bm = vf_gt(vf_sub(vf_add(vf_mul(n0, rx), vf_mul(n1, ry)), n2), zero);
         bk += __builtin_popcount(vm_bits(vm_and(bm, cov)));
         const vfloat zn = vf_sub(vf_mul(two, vf_loadu(ed + x)), one);

@@ -117,7 +117,8 @@ static inline void tu_frame_free(tu_frame_bufs *b)
 /* Scratch of the stages by hand for a crop of w x h. */
 typedef struct tu_stages {
     int w, h;
-    float *depth, *nrm;
+    float *depth;
+    uint32_t *n10;            /* the normals, packed as the pipe's (ef_n10.h) */
     uint8_t *mask, *layer;
 } tu_stages;
 
@@ -126,11 +127,11 @@ static inline void tu_stages_make(tu_stages *s, int w, int h)
     s->w = w;
     s->h = h;
     s->depth = malloc(sizeof(float) * (size_t)w * h);
-    s->nrm = malloc(sizeof(float) * 3 * (size_t)w * h);
+    s->n10 = malloc(sizeof(uint32_t) * (size_t)w * h);
     s->mask = malloc((size_t)w * h);
     s->layer = malloc((size_t)4 * w * h);
     assert_non_null(s->depth);
-    assert_non_null(s->nrm);
+    assert_non_null(s->n10);
     assert_non_null(s->mask);
     assert_non_null(s->layer);
 }
@@ -138,14 +139,15 @@ static inline void tu_stages_make(tu_stages *s, int w, int h)
 static inline void tu_stages_free(tu_stages *s)
 {
     free(s->depth);
-    free(s->nrm);
+    free(s->n10);
     free(s->mask);
     free(s->layer);
 }
 
 /* One eye of a tu_quad_model frame by hand: the quad (posed by node 1's
- * rest transform) rastered by cam into s->mask (the crop's size, no
- * culling), the default lighting's first light turned into cam's view,
+ * rest transform) rastered by cam into s->mask and packed normals (the
+ * crop's size, no culling; the pipe packs them when only the lighting
+ * reads them), the default lighting's first light turned into cam's view,
  * the crop P lit into s->layer, faded at the viewport's sides inside V as
  * the pipeline does by default (fuse_edge_fade, PIPE_EDGE_FADE_DEFAULT)
  * and composited over V into R at the viewport (vx, vy, vw, vh). */
@@ -154,7 +156,7 @@ static inline void tu_quad_stages(const kin_model *m, const kin_camera *cam, tu_
                                   int vw, int vh, fuse_image *R)
 {
     const int cw = s->w, ch = s->h;
-    rast_target t = {cw, ch, s->depth, cw, s->mask, cw, s->nrm, cw * 3, 3, NULL, 0};
+    rast_target t = {cw, ch, s->depth, cw, s->mask, cw, NULL, 0, 3, s->n10, cw};
     rast_target_clear(&t);
     float clip[16], vn[12], wpos[12], wn[12];
     kin_mat4 qw = kin_mat4_from_transform(&m->rest[1]);
@@ -171,7 +173,7 @@ static inline void tu_quad_stages(const kin_model *m, const kin_camera *cam, tu_
     L.lights[0].dir[2] = ld.z;
     fuse_intrinsics K = {cam->fx, cam->fy, cam->cx, cam->cy};
     fuse_image Q = {s->layer, cw, ch, cw * 4};
-    assert_int_equal(fuse_light(&L, &K, P, s->mask, cw, s->nrm, cw * 3, &Q), FUSE_OK);
+    assert_int_equal(fuse_light_n10(&L, &K, P, s->mask, cw, s->n10, cw, &Q), FUSE_OK);
     /* the pipeline's default soft edges (pipe_desc.edge_fade 0): the sides
      * of the viewport inside V */
     const unsigned sides = (vx > 0 ? FUSE_EDGE_LEFT : 0u) | (vx + vw < V->width ? FUSE_EDGE_RIGHT : 0u) |
