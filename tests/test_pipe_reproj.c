@@ -1112,6 +1112,67 @@ static void validity_fallback_alternating(void **state)
     kin_model_free(&m);
 }
 
+/* The eye's normals are packed (ef_n10); with normal_smooth the pipe
+ * unpacks them for fuse_normal_smooth. A cube seen on its edge from
+ * outside (the faces' normals summed across the edges): the smoothed
+ * frame is the same on every ISA cap and thread count, every eye is
+ * reprojected, and its layer differs from the unsmoothed one's near the
+ * edges only (inside a face the window's normals are the face's). The
+ * left eye's layer is copied to layer when not NULL. */
+static uint32_t smooth_crc(const kin_model *m, int smooth, int threads, int isa, uint8_t *layer)
+{
+    pipe_desc d = reproj_desc(PIPE_VIEW_REPROJECT, threads, isa);
+    d.normal_smooth = smooth;
+    pipe_ctx *p = pipe_create(&d, m);
+    assert_non_null(p);
+    tu_frame_bufs b;
+    pipe_frame_in in;
+    tu_frame_make(&b, &in, 23, CAMW, CAMH, LCDW, LCDH);
+    const kin_mat4 head = kin_mat4_from_tr(kin_v3(0.09f, 0.08f, 0.2f), kin_quat_identity());
+    in.head_node = -1;
+    in.world_from_head = &head;
+    pipe_frame_stats st;
+    char why[200];
+    assert_int_equal(pipe_frame(p, &in, &st, why, sizeof why), PIPE_OK);
+    uint32_t crc = 0;
+    for (int e = 0; e < 2; e++) {
+        assert_int_equal(st.view[e], PIPE_VIEW_REPROJECT);
+        crc = tu_crc32(crc, b.out[e], (size_t)LCDW * LCDH * 4);
+        crc = tu_crc32(crc, pipe_layer(p, e, NULL, NULL), (size_t)CW * CH * 4);
+    }
+    if (layer) memcpy(layer, pipe_layer(p, 0, NULL, NULL), (size_t)CW * CH * 4);
+    tu_frame_free(&b);
+    pipe_destroy(p);
+    return crc;
+}
+
+static void determinism_smooth_normals(void **state)
+{
+    (void)state;
+    kin_model m;
+    cube_quad_model(&m, 0.05f, 0.06f, -0.3f);
+    uint8_t *ls = malloc((size_t)CW * CH * 4), *l0 = malloc((size_t)CW * CH * 4);
+    assert_non_null(ls);
+    assert_non_null(l0);
+    const uint32_t ref = smooth_crc(&m, 2, 1, EF_ISA_REF, ls);
+    static const int isa[] = {EF_ISA_SSE2, EF_ISA_AVX2, EF_ISA_AVX512, 0};
+    for (int t = 1; t <= 2; t++)
+        for (size_t k = 0; k < sizeof isa / sizeof isa[0]; k++)
+            assert_int_equal(smooth_crc(&m, 2, t, isa[k], NULL), ref);
+    assert_int_not_equal(smooth_crc(&m, 0, 2, 0, l0), ref);
+    long lit = 0, diff = 0;
+    for (size_t i = 0; i < (size_t)CW * CH; i++) {
+        lit += l0[4 * i + 3] != 0;
+        diff += memcmp(ls + 4 * i, l0 + 4 * i, 4) != 0;
+    }
+    print_message("NOTE smoothed eye layer: %ld of %ld lit pixels changed\n", diff, lit);
+    assert_true(lit > 1000);
+    assert_true(diff > 0 && diff < lit / 4);
+    free(ls);
+    free(l0);
+    kin_model_free(&m);
+}
+
 /* NaN depths of the virtual scene: nothing there, the hand is kept; an
  * object in front (0.2 m) hides it; no crash, the same bytes twice. */
 static void validity_nan_virtual_depth(void **state)
@@ -1165,6 +1226,7 @@ TU_MAIN(NULL, NULL,
         cmocka_unit_test(result_full_sensor),
         cmocka_unit_test(determinism_isa_threads),
         cmocka_unit_test(determinism_sample_isa),
+        cmocka_unit_test(determinism_smooth_normals),
         cmocka_unit_test(validity_bad_desc),
         cmocka_unit_test(validity_eye_inside_model),
         cmocka_unit_test(validity_fallback_alternating),
