@@ -287,7 +287,7 @@ test: deps-test
 	@sh tests/run_tests.sh $(BUILD)
 
 # Every public header compiles on its own as C and as C++ (sokol's rule).
-HEADERS := src/cpu/cpu.h src/pipe/pipe.h src/pipe/pipe_pose.h src/pipe/pipe_lod.h src/fit/fit.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
+HEADERS := src/cpu/cpu.h src/cpu/ef_n10.h src/pipe/pipe.h src/pipe/pipe_pose.h src/pipe/pipe_lod.h src/fit/fit.h src/raster/raster.h src/kin/kin.h src/fuse/fuse.h \
            src/fuse/fuse_metrics.h src/fuse/fuse_refine.h src/fuse/fuse_edge.h src/io/io.h src/io/io_dev.h \
            src/io/io_natnet.h src/io/io_display.h src/io/io_sched.h src/io/io_live.h \
            src/io/io_vsrc.h src/io/io_lod.h src/io/io_term.h src/kin/kin_lens.h src/pipe/pipe_lens.h src/io/io_calib.h \
