@@ -5,7 +5,7 @@
  *
  *   bench_fuse [--csv] [--runs N] [--isa ref|sse2|avx2|avx512]
  *              [--threads 1|2] [--case typical|worst] [--no-pixman] [--cpu-time]
- *              [--stage NAME] [--n10]
+ *              [--stage NAME] [--float-normals]
  *
  * Per stereo frame (two eyes: 640x400 camera images lit, resampled into
  * the 1194x746 viewport at (43, 27) of 1280x800, composited over V):
@@ -39,10 +39,11 @@
  *                the viewport (PAD edges): what fuse_composite does
  *     pm_scaled_mask  the camera image (x8r8g8b8) through the a8 mask, both
  *                bilinear into the viewport (a composite without lighting)
- * --n10: the lighting reads the normals packed as ef_n10 (src/cpu/ef_n10.h,
- * packed once at setup with ef_n10_pack): fuse_context_light_n10 and
- * fuse_eye.normal_n10, 4 bytes a pixel instead of 12 (the bytes differ from
- * the float normals' by the packing's rounding only).
+ * The lighting reads the normals packed as ef_n10 (src/cpu/ef_n10.h, packed
+ * once at setup with ef_n10_pack): fuse_context_light_n10 and
+ * fuse_eye.normal_n10, 4 bytes a pixel, as the pipe does by default;
+ * --float-normals reads 3 floats (12 bytes) instead (the bytes differ by
+ * the packing's rounding only).
  * Every number is the median over --runs runs; the ratios are medians of
  * the per-run ratios (each run times memcpy, then the stages, back to
  * back), which cancels most of the noise of a shared machine. The scene V
@@ -81,8 +82,8 @@ static clockid_t clock_id = CLOCK_MONOTONIC;
 static const char *only_stage;
 static int want(const char *name) { return only_stage == NULL || !strcmp(only_stage, name); }
 
-/* --n10: the lighting reads eye_buf.Nq (ef_n10) instead of N (floats). */
-static int use_n10;
+/* the lighting reads eye_buf.Nq (ef_n10), or N (floats: --float-normals) */
+static int use_n10 = 1;
 
 static double now_ms(void) { return bench_now_ms(clock_id); }
 
@@ -424,8 +425,8 @@ static void usage(const char *argv0)
 {
     fprintf(stderr, "usage: %s [--csv] [--runs N] [--isa ref|sse2|avx2|avx512] "
             "[--threads 1|2] [--case typical|worst] [--no-pixman] [--cpu-time] [--stage NAME] "
-            "[--n10]\n"
-            "  --n10: the lighting reads the normals packed as ef_n10\n"
+            "[--float-normals]\n"
+            "  --float-normals: the lighting reads 3 floats per pixel, not ef_n10\n"
             "  --stage light|comp|frame|ip|dp|op|dop|l2|cold|l2c|like|memcpy: only that stage\n", argv0);
     exit(2);
 }
@@ -455,8 +456,8 @@ int main(int argc, char **argv)
             no_pixman = 1;
         else if (!strcmp(argv[a], "--cpu-time"))
             clock_id = CLOCK_THREAD_CPUTIME_ID;
-        else if (!strcmp(argv[a], "--n10"))
-            use_n10 = 1;
+        else if (!strcmp(argv[a], "--float-normals"))
+            use_n10 = 0;
         else if (!strcmp(argv[a], "--stage") && a + 1 < argc) {
             only_stage = argv[++a];
             no_pixman = 1;

@@ -26,14 +26,16 @@
  *                [--isa ref|sse2|avx2|avx512] [--threads 1|2]
  *                [--samples DIR|none] [--cold MB] [--no-pipe]
  *                [--sample-only] [--cull back|none] [--clear-normals]
- *                [--cpu-time] [--n10]
+ *                [--cpu-time] [--float-normals]
  *
  * --sample-only skips the bench scene (its draw rows and pipe rows), --cull
  * runs one cull mode of the pipe rows: for counting instructions of the
  * sample model's stage alone (valgrind --tool=callgrind
  * --toggle-collect=rast_context_draw, docs/bench.md raster section).
- * --n10: the pipe rows draw the normals packed into an attr_n10 plane
- * (rast_target.attr_n10, 4 bytes per pixel) instead of 3 floats.
+ * The pipe rows draw the normals packed into an attr_n10 plane
+ * (rast_target.attr_n10, 4 bytes per pixel) as the pipe does by default
+ * (src/pipe/pipe.h); --float-normals draws 3 floats per pixel instead
+ * (the pipe's plane with a lens, refinement, smoothing or --aa).
  *
  * The same scene through Mesa llvmpipe, with the ratio, is
  * bench/llvmpipe/llvmpipe_raster (built separately: it needs EGL/GLES). */
@@ -78,7 +80,7 @@ typedef struct pipe_scene {
  * reprojected mask, or a lens), else not (rast_context_clear_keep_attr,
  * the pipe's default path, docs/raster.md section 13). */
 static int clear_normals = 0;
-static int use_n10 = 0;   /* --n10 */
+static int use_n10 = 1;   /* 0: --float-normals */
 
 typedef struct pipe_eye {
     rast_context *ctx;
@@ -356,8 +358,8 @@ int main(int argc, char **argv)
             pipe = 0;
         else if (!strcmp(argv[i], "--clear-normals"))
             clear_normals = 1;
-        else if (!strcmp(argv[i], "--n10"))
-            use_n10 = 1;
+        else if (!strcmp(argv[i], "--float-normals"))
+            use_n10 = 0;
         else if (!strcmp(argv[i], "--sample-only"))
             ntl = 0;
         else if (!strcmp(argv[i], "--cpu-time"))
@@ -391,7 +393,7 @@ int main(int argc, char **argv)
             fprintf(stderr, "usage: %s [--csv] [--runs N] [--tris N,N,...] [--size WxH] "
                             "[--isa NAME] [--threads N] [--samples DIR|none] [--cold MB] "
                             "[--no-pipe] [--sample-only] [--cull back|none] [--clear-normals] "
-                            "[--cpu-time] [--n10]\n",
+                            "[--cpu-time] [--float-normals]\n",
                     argv[0]);
             return 2;
         }
