@@ -532,10 +532,10 @@ int main(int argc, char **argv)
     /* The pipeline's configuration (see the top of the file). */
     uint8_t *junk = cold > 0 ? calloc((size_t)cold << 20, 1) : NULL;
     printf("\n%spipeline configuration: the raster stage of run_eye per eye (1-thread "
-           "context per eye, context clear + transforms + draw, normals as 3 attributes), "
+           "context per eye, context clear + transforms + draw, normals %s), "
            "%d MB written between stages (--cold), medians of up to 31 passes (bench scene) "
            "and 9 passes over 12 poses (sample model), ms per eye%s\n",
-           p, junk ? cold : 0,
+           p, use_n10 ? "packed (ef_n10)" : "as 3 floats (--float-normals)", junk ? cold : 0,
            bench_clock == CLOCK_MONOTONIC ? "" : " (thread CPU time, --cpu-time)");
     pipe_print_head(csv);
     for (int ti = 0; ti < ntl; ti++) {
