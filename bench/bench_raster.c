@@ -35,7 +35,7 @@
  * The pipe rows draw the normals packed into an attr_n10 plane
  * (rast_target.attr_n10, 4 bytes per pixel) as the pipe does by default
  * (src/pipe/pipe.h); --float-normals draws 3 floats per pixel instead
- * (the pipe's plane with a lens, refinement, smoothing or --aa).
+ * (the pipe's plane with refinement, smoothing or --aa).
  *
  * The same scene through Mesa llvmpipe, with the ratio, is
  * bench/llvmpipe/llvmpipe_raster (built separately: it needs EGL/GLES). */

@@ -21,6 +21,7 @@
 #include "../src/kin/kin.h"
 #include "../src/pipe/pipe.h"
 #include "../src/pipe/pipe_lens.h"
+#include "../src/cpu/ef_n10.h"
 #include "../src/raster/raster.h"
 #include "support/pipe_frames.h"
 #include "../src/cpu/ef_mem.h"
@@ -367,6 +368,76 @@ static void result_attributes(void **state)
     pipe_lens_map_free(&m);
 }
 
+/* The normals packed (pipe_lens_map_init_n10): the same pinhole render
+ * and warp, frame after frame, with every packed pixel ef_n10_pack of the
+ * float map's normals and the mask and depth those of the float map. */
+static void result_attributes_n10(void **state)
+{
+    (void)state;
+    kin_lens L = barrel();
+    pipe_lens_map mf, mq;
+    char why[200];
+    if (pipe_lens_map_init(&mf, &L, 2, 3, why, sizeof why) != 0) fail_msg("%s", why);
+    if (pipe_lens_map_init_n10(&mq, &L, 2, why, sizeof why) != 0) fail_msg("%s", why);
+    assert_int_equal(mq.pin_width, mf.pin_width);
+    assert_int_equal(mq.pin_height, mf.pin_height);
+    assert_null(mq.attr);
+    kin_camera cam = lens_camera(&L);
+    kin_camera pc = pipe_lens_pinhole(&mf, &cam);
+    rast_target itf = pipe_lens_target(&mf), itq = pipe_lens_target(&mq);
+    assert_non_null(itq.attr_n10);
+    size_t n = (size_t)L.width * L.height;
+    uint8_t *mask = malloc(n), *maskq = malloc(n);
+    float *depth = malloc(sizeof(float) * n), *depthq = malloc(sizeof(float) * n),
+          *attr = malloc(sizeof(float) * 3 * n);
+    uint32_t *n10 = malloc(sizeof(uint32_t) * n);
+    assert_non_null(mask), assert_non_null(maskq), assert_non_null(depth);
+    assert_non_null(depthq), assert_non_null(attr), assert_non_null(n10);
+    rast_target out = {L.width, L.height, depth, L.width, mask, L.width, attr, 3 * L.width, 3,
+                       NULL, 0};
+    rast_target outq = {L.width, L.height, depthq, L.width, maskq, L.width, NULL, 0, 3, n10,
+                        L.width};
+    rast_target_clear(&out);
+    rast_target_clear(&outq);
+    tu_rng g = {77};
+    for (int f = 0; f < 3; f++) {
+        /* a tilted polygon with normals varying per vertex (drawn in
+         * this order: x, y, z, the radii, yaw, pitch) */
+        double a[7];
+        const float lo[7] = {-0.1f, -0.1f, -0.7f, 0.05f, 0.2f, -0.4f, -0.4f},
+                    hi[7] = {0.1f, 0.1f, -0.4f, 0.1f, 0.3f, 0.4f, 0.4f};
+        for (int k = 0; k < 7; k++) a[k] = tu_range(&g, lo[k], hi[k]);
+        poly p = make_poly(a[0], a[1], a[2], a[3], a[4], a[5], a[6], 5 + (uint64_t)f);
+        float pos[3 * (NV + 1)], clip[4 * (NV + 1)], nrm[3 * (NV + 1)];
+        uint32_t idx[3 * NV];
+        poly_point(&p, 0, 0, pos);
+        for (int i = 0; i < NV; i++) {
+            poly_point(&p, p.px[i], p.py[i], pos + 3 * (i + 1));
+            idx[3 * i] = 0, idx[3 * i + 1] = (uint32_t)(i + 1),
+            idx[3 * i + 2] = (uint32_t)((i + 1) % NV + 1);
+        }
+        for (int i = 0; i < 3 * (NV + 1); i++) nrm[i] = tu_range(&g, -1.0f, 1.0f);
+        rast_transform_points(pc.view_proj.m, pos, NV + 1, clip);
+        rast_mesh_desc d = {clip, NV + 1, nrm, 3, idx, NV, RAST_CULL_NONE};
+        rast_target_clear(&itf);
+        rast_target_clear(&itq);
+        assert_int_equal(rast_draw(&itf, &d, NULL), RAST_OK);
+        assert_int_equal(rast_draw(&itq, &d, NULL), RAST_OK);
+        const long set = pipe_lens_warp(&mf, &out);
+        assert_int_equal(pipe_lens_warp(&mq, &outq), set);
+        assert_true(set > 1000);
+        assert_memory_equal(mask, maskq, n);
+        assert_memory_equal(depth, depthq, sizeof(float) * n);
+        for (size_t i = 0; i < n; i++)
+            if (n10[i] != ef_n10_pack(attr[3 * i], attr[3 * i + 1], attr[3 * i + 2]))
+                fail_msg("frame %d pixel %zu: %08x, ef_n10_pack of the floats %08x", f, i, n10[i],
+                         ef_n10_pack(attr[3 * i], attr[3 * i + 1], attr[3 * i + 2]));
+    }
+    free(mask), free(maskq), free(depth), free(depthq), free(attr), free(n10);
+    pipe_lens_map_free(&mf);
+    pipe_lens_map_free(&mq);
+}
+
 static void validity_bad_maps(void **state)
 {
     (void)state;
@@ -491,5 +562,6 @@ TU_MAIN_NAMED("pipe_lens", NULL, NULL,
               cmocka_unit_test(result_barrel_silhouette),
               cmocka_unit_test(result_fisheye_silhouette),
               cmocka_unit_test(result_attributes),
+              cmocka_unit_test(result_attributes_n10),
               cmocka_unit_test(validity_bad_maps),
               cmocka_unit_test(result_pipe_frame_through_lens))

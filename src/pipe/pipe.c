@@ -624,15 +624,14 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         eye_state *s = &p->eye[e];
         s->eye = e;
         s->depth = malloc(sizeof(float) * px);
-        /* the camera's normals packed (ef_n10.h: 4 bytes a pixel, not 12)
-         * when only the lighting reads them: not through a distorting
-         * lens (its warp moves floats), nor with the refinement's fill,
-         * the smoothing or the anti-aliased fill (they read floats). The
+        /* the camera's normals packed (ef_n10.h: 4 bytes a pixel, not 12;
+         * through a distorting lens its pinhole render too) when only the
+         * lighting reads them: not with the refinement's fill, the
+         * smoothing or the anti-aliased fill (they read floats). The
          * eye's view packs its own always (pipe__reproj_init) */
         kin_camera c0 = kin_sthmd_camera(&p->hmd, NULL, (kin_eye)e);
         const int distorts = kin_lens_distorts(&c0.lens);
-        if (!distorts && p->desc.refine_band == 0 && p->desc.normal_smooth <= 0 &&
-            p->desc.aa_samples == 0)
+        if (p->desc.refine_band == 0 && p->desc.normal_smooth <= 0 && p->desc.aa_samples == 0)
             s->n10 = malloc(sizeof(uint32_t) * px);
         else
             s->nrm = malloc(sizeof(float) * 3 * px);
@@ -655,11 +654,12 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
             /* a calibrated, distorting lens: the mask through it */
             if (distorts) {
                 s->lens = calloc(1, sizeof *s->lens);
-                ok = s->lens && pipe_lens_map_init(s->lens, &c0.lens, 1, 3, NULL, 0) == 0;
+                ok = s->lens && (s->n10 ? pipe_lens_map_init_n10(s->lens, &c0.lens, 1, NULL, 0)
+                                        : pipe_lens_map_init(s->lens, &c0.lens, 1, 3, NULL, 0)) == 0;
                 if (ok) { /* the warp writes only what changes: start clear */
-                    rast_target t0 = {p->geo.crop_width, p->geo.crop_height, s->depth,
-                                      p->geo.crop_width, s->mask, p->geo.crop_width, s->nrm,
-                                      3 * p->geo.crop_width, 3, NULL, 0};
+                    const int cw = p->geo.crop_width;
+                    rast_target t0 = {cw, p->geo.crop_height, s->depth, cw, s->mask, cw, s->nrm,
+                                      s->nrm ? 3 * cw : 0, 3, s->n10, s->n10 ? cw : 0};
                     rast_target_clear(&t0);
                 }
             }

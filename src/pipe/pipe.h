@@ -10,9 +10,9 @@
  *   pipe_frame(): poses and skins once per frame (both eyes use the same
  *   skin), then for each eye the STHMD camera from the head pose, the
  *   G-buffer (depth, mask, view-space normals) at the cropped camera
- *   resolution (the normals packed in 32 bits, src/cpu/ef_n10.h, unless a
- *   distorting lens, the refinement, the smoothing or the anti-aliased
- *   fill reads them as floats), the lighting layer on the camera image inside the mask, the
+ *   resolution (the normals packed in 32 bits, src/cpu/ef_n10.h, unless
+ *   the refinement, the smoothing or the anti-aliased fill reads them as
+ *   floats), the lighting layer on the camera image inside the mask, the
  *   bilinear resampling into the viewport and the composite over the
  *   virtual image. With threads = 2 the two eyes run on two threads; the
  *   bytes do not depend on the thread count.

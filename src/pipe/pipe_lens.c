@@ -12,7 +12,7 @@
 void pipe_lens_map_free(pipe_lens_map *m)
 {
     if (!m) return;
-    EF_FREE_ALL(m->src, m->depth, m->mask, m->attr);
+    EF_FREE_ALL(m->src, m->depth, m->mask, m->attr, m->attr_n10);
     memset(m, 0, sizeof *m);
 }
 
@@ -31,8 +31,8 @@ static void fit_range(double *lo, double *hi, double span)
     *hi = fmin(*hi, a);
 }
 
-int pipe_lens_map_init(pipe_lens_map *m, const kin_lens *lens, int supersample, int attr_count,
-                       char *why, int why_size)
+static int map_init(pipe_lens_map *m, const kin_lens *lens, int supersample, int attr_count,
+                    int n10, char *why, int why_size)
 {
     memset(m, 0, sizeof *m);
     if (!lens || lens->width < 1 || lens->height < 1 || lens->width > RAST_MAX_DIM ||
@@ -109,8 +109,11 @@ int pipe_lens_map_init(pipe_lens_map *m, const kin_lens *lens, int supersample, 
     size_t pn = (size_t)m->pin_width * (size_t)m->pin_height;
     m->depth = malloc(sizeof(float) * pn);
     m->mask = malloc(pn);
-    m->attr = attr_count ? malloc(sizeof(float) * (size_t)attr_count * pn) : NULL;
-    if (!m->depth || !m->mask || (attr_count && !m->attr)) {
+    if (n10)
+        m->attr_n10 = malloc(sizeof(uint32_t) * pn);
+    else if (attr_count)
+        m->attr = malloc(sizeof(float) * (size_t)attr_count * pn);
+    if (!m->depth || !m->mask || (n10 ? !m->attr_n10 : attr_count && !m->attr)) {
         pipe_lens_map_free(m);
         return pipe__fail(why, why_size, "out of memory for a %dx%d pinhole render", m->pin_width,
                     m->pin_height);
@@ -118,6 +121,18 @@ int pipe_lens_map_init(pipe_lens_map *m, const kin_lens *lens, int supersample, 
     rast_target t = pipe_lens_target(m);
     rast_target_clear(&t);
     return 0;
+}
+
+int pipe_lens_map_init(pipe_lens_map *m, const kin_lens *lens, int supersample, int attr_count,
+                       char *why, int why_size)
+{
+    return map_init(m, lens, supersample, attr_count, 0, why, why_size);
+}
+
+int pipe_lens_map_init_n10(pipe_lens_map *m, const kin_lens *lens, int supersample, char *why,
+                           int why_size)
+{
+    return map_init(m, lens, supersample, 3, 1, why, why_size);
 }
 
 kin_camera pipe_lens_pinhole(const pipe_lens_map *m, const kin_camera *cam)
@@ -152,7 +167,8 @@ kin_camera pipe_lens_pinhole(const pipe_lens_map *m, const kin_camera *cam)
 rast_target pipe_lens_target(const pipe_lens_map *m)
 {
     rast_target t = {m->pin_width, m->pin_height, m->depth, m->pin_width, m->mask, m->pin_width,
-                     m->attr, m->attr_count * m->pin_width, m->attr_count, NULL, 0};
+                     m->attr, m->attr ? m->attr_count * m->pin_width : 0, m->attr_count,
+                     m->attr_n10, m->attr_n10 ? m->pin_width : 0};
     return t;
 }
 
@@ -164,7 +180,10 @@ long pipe_lens_warp(const pipe_lens_map *m, const rast_target *dst)
         const int32_t *src = m->src + (size_t)y * m->width;
         uint8_t *mk = dst->mask + (size_t)y * dst->mask_stride;
         float *dp = dst->depth ? dst->depth + (size_t)y * dst->depth_stride : NULL;
-        float *at = dst->attr && ac ? dst->attr + (size_t)y * dst->attr_stride : NULL;
+        float *at = dst->attr && m->attr && ac ? dst->attr + (size_t)y * dst->attr_stride : NULL;
+        uint32_t *an = dst->attr_n10 && m->attr_n10
+                           ? dst->attr_n10 + (size_t)y * dst->attr_n10_stride
+                           : NULL;
         for (int x = 0; x < m->width; x++) {
             int32_t i = src[x];
             if (i < 0 || m->mask[i] == 0) {
@@ -174,6 +193,7 @@ long pipe_lens_warp(const pipe_lens_map *m, const rast_target *dst)
                 if (dp) dp[x] = 1.0f;
                 if (at)
                     for (int k = 0; k < ac; k++) at[x * ac + k] = 0.0f;
+                if (an) an[x] = 0;
                 continue;
             }
             mk[x] = m->mask[i];
@@ -181,6 +201,7 @@ long pipe_lens_warp(const pipe_lens_map *m, const rast_target *dst)
             if (dp) dp[x] = m->depth[i];
             if (at)
                 for (int k = 0; k < ac; k++) at[x * ac + k] = m->attr[(size_t)i * ac + k];
+            if (an) an[x] = m->attr_n10[i];
         }
     }
     return set;

@@ -63,6 +63,8 @@ typedef struct pipe_lens_map {
     uint8_t *mask;
     float *attr;
     int attr_count;
+    uint32_t *attr_n10;             /* the normals packed instead of attr
+                                       (pipe_lens_map_init_n10), or NULL */
 } pipe_lens_map;
 
 /* Builds the map for a checked lens with a size (kin_lens_check;
@@ -72,6 +74,11 @@ typedef struct pipe_lens_map {
  * sentence in why (a lens without a size, out of memory). */
 int pipe_lens_map_init(pipe_lens_map *m, const kin_lens *lens, int supersample, int attr_count,
                        char *why, int why_size);
+/* As pipe_lens_map_init with attr_count 3, the normals packed as ef_n10
+ * (src/cpu/ef_n10.h; rast_target.attr_n10): the pinhole target draws
+ * them packed and pipe_lens_warp copies them into dst->attr_n10. */
+int pipe_lens_map_init_n10(pipe_lens_map *m, const kin_lens *lens, int supersample, char *why,
+                           int why_size);
 void pipe_lens_map_free(pipe_lens_map *m);
 
 /* The pinhole camera to draw the model with: cam's pose, view and depth
@@ -79,9 +86,10 @@ void pipe_lens_map_free(pipe_lens_map *m);
 kin_camera pipe_lens_pinhole(const pipe_lens_map *m, const kin_camera *cam);
 /* The map's pinhole planes as a raster target (clear it before drawing). */
 rast_target pipe_lens_target(const pipe_lens_map *m);
-/* Fills dst (m->width x m->height, the same attr_count) from the pinhole
- * planes: every pixel equals the nearest pinhole sample's mask, depth and
- * attributes, or is clear (mask 0, depth 1, attributes 0). Pixels clear
+/* Fills dst (m->width x m->height, the same attr_count, and attr_n10 set
+ * when the map's normals are packed) from the pinhole planes: every pixel
+ * equals the nearest pinhole sample's mask, depth and attributes, or is
+ * clear (mask 0, depth 1, attributes 0). Pixels clear
  * before and after are not written (most of the image: the cost is the
  * model's pixels), so dst must start cleared (rast_target_clear) and hold
  * a clear pixel wherever its mask is 0 between calls, the rasterizer's
