@@ -536,8 +536,8 @@ static void wait_job(pipe_ctx *p, int job)
 static void free_eyes(pipe_ctx *p)
 {
     for (int e = 0; e < 2; e++) {
-        EF_FREE_ALL(p->eye[e].depth, p->eye[e].nrm, p->eye[e].n10, p->eye[e].snrm, p->eye[e].nfill_scratch,
-                    p->eye[e].soft, p->eye[e].clip, p->eye[e].vnrm, p->eye[e].mask, p->eye[e].layer,
+        EF_FREE_ALL(p->eye[e].depth, p->eye[e].nrm, p->eye[e].n10, p->eye[e].snrm,
+                    p->eye[e].nfill_scratch, p->eye[e].soft, p->eye[e].clip, p->eye[e].vnrm, p->eye[e].mask, p->eye[e].layer,
                     p->eye[e].layer_zero, p->eye[e].cam_rgba, p->eye[e].refined,
                     p->eye[e].regrow, p->eye[e].prior, p->eye[e].shifted, p->eye[e].unsmoothed,
                     p->eye[e].refine_scratch);
@@ -648,8 +648,8 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
         fuse_context_desc fd = {(ef_isa)p->desc.max_isa, 1};
         s->rast = rast_context_create(&rd);
         s->fuse = fuse_context_create(&fd);
-        ok = ok && s->depth && (s->nrm || s->n10) && s->mask && s->layer && s->layer_zero && s->cam_rgba &&
-             s->clip && s->vnrm && s->rast && s->fuse;
+        ok = ok && s->depth && (s->nrm || s->n10) && s->mask && s->layer && s->layer_zero &&
+             s->cam_rgba && s->clip && s->vnrm && s->rast && s->fuse;
         if (ok) {
             /* a calibrated, distorting lens: the mask through it */
             if (distorts) {

@@ -62,7 +62,8 @@ int pipe__reproj_init(pipe__reproj *r, int width, int height, int float_normals)
     r->M = calloc(px, 1);
     r->row = malloc(sizeof(int32_t) * (size_t)width + (size_t)height);
     r->lanes = malloc(sizeof(int32_t) * 8 * ((size_t)width + 16));
-    if (!r->depth || !r->n10 || (float_normals && !r->nrm) || !r->mask || !r->P || !r->M || !r->row || !r->lanes) {
+    if (!r->depth || !r->n10 || (float_normals && !r->nrm) || !r->mask || !r->P || !r->M ||
+        !r->row || !r->lanes) {
         pipe__reproj_free(r);
         return -1;
     }
