@@ -122,10 +122,23 @@ static uint32_t packed(tu_rng *r)
         v = ef_n10_pack(a / l, b / l, c / l);
         break;
     }
-    case 1: v = ef_n10_pack(tu_range(r, -1.5f, 1.5f), tu_range(r, -1.5f, 1.5f), tu_range(r, -1.5f, 1.5f)); break;
+    case 1: { /* out of range: clamped (drawn x, y, z in this order) */
+        const float a = tu_range(r, -1.5f, 1.5f), b = tu_range(r, -1.5f, 1.5f),
+                    c = tu_range(r, -1.5f, 1.5f);
+        v = ef_n10_pack(a, b, c);
+        break;
+    }
     case 2: v = 0; break;                                                  /* no normal */
-    case 3: v = code(r) << (10 * tu_int(r, 3)); break;                     /* one axis */
-    default: v = code(r) | code(r) << 10 | code(r) << 20; break;
+    case 3: { /* one axis: its code, then which */
+        const uint32_t k = code(r);
+        v = k << (10 * tu_int(r, 3));
+        break;
+    }
+    default: { /* random codes, x, y, z in this order */
+        const uint32_t x = code(r), y = code(r), z = code(r);
+        v = x | y << 10 | z << 20;
+        break;
+    }
     }
     if (tu_int(r, 4) == 0) v |= (uint32_t)tu_int(r, 4) << 30;              /* garbage, ignored */
     return v;
