@@ -140,14 +140,20 @@ static rast_result eye_draw(pipe_ctx *p, eye_state *e, const pipe_lens_map *lens
  * crop: the lighting reads the eye's, the occlusion test the camera's
  * depth and mask. So its draws (run_eye's, the elbow fit's) write depth
  * and mask only; reproj_eye draws the normals for a fallback. */
+/* The camera's G-buffer with its normals, packed or floats (pipe_create). */
+static rast_target gbuf_target(const pipe_ctx *p, const eye_state *e)
+{
+    const int cw = p->geo.crop_width, ch = p->geo.crop_height;
+    return (rast_target){cw, ch, e->depth, cw, e->mask, cw, e->nrm, e->nrm ? 3 * cw : 0, 3,
+                         e->n10, e->n10 ? cw : 0};
+}
+
 static rast_target cam_target(const pipe_ctx *p, const eye_state *e)
 {
     const int cw = p->geo.crop_width, ch = p->geo.crop_height;
     if (p->desc.eye_view == PIPE_VIEW_REPROJECT && !e->lens)
         return (rast_target){cw, ch, e->depth, cw, e->mask, cw, NULL, 0, 0, NULL, 0};
-    if (e->n10)
-        return (rast_target){cw, ch, e->depth, cw, e->mask, cw, NULL, 0, 3, e->n10, cw};
-    return (rast_target){cw, ch, e->depth, cw, e->mask, cw, e->nrm, 3 * cw, 3, NULL, 0};
+    return gbuf_target(p, e);
 }
 
 /* Reprojection (pipe_reproj.h): the model drawn from the eye, the camera
@@ -201,8 +207,7 @@ static int reproj_eye(pipe_ctx *p, eye_state *e, fuse_eye *fe, fuse_intrinsics *
              * would not hold for it across the other's draws: the
              * context forgets its targets first, and this one is cleared
              * whole (the others next frame) */
-            rast_target ct = {cw, ch, e->depth, cw, e->mask, cw, e->nrm, e->nrm ? 3 * cw : 0, 3,
-                              e->n10, e->n10 ? cw : 0};
+            rast_target ct = gbuf_target(p, e);
             rast_context_forget(e->rast);
             rr = eye_draw(p, e, NULL, &e->cam, &ct, 1, NULL);
             e->lod_level = level;
@@ -317,6 +322,8 @@ static void run_eye(pipe_ctx *p, eye_state *e)
      * for it */
     const uint32_t *n10 = rp ? e->rp.n10 : e->n10;
     if (rp && p->desc.normal_smooth > 0) {
+        /* all of it: the smoothing's windows also read the uncovered
+         * pixels' normals, which must be 0 (the raster's clear) */
         const size_t np = (size_t)cw * (size_t)ch;
         for (size_t i = 0; i < np; i++) ef_n10_unpack(n10[i], e->rp.nrm + 3 * i);
         n10 = NULL;
@@ -657,9 +664,7 @@ pipe_ctx *pipe_create(const pipe_desc *desc, const kin_model *model)
                 ok = s->lens && (s->n10 ? pipe_lens_map_init_n10(s->lens, &c0.lens, 1, NULL, 0)
                                         : pipe_lens_map_init(s->lens, &c0.lens, 1, 3, NULL, 0)) == 0;
                 if (ok) { /* the warp writes only what changes: start clear */
-                    const int cw = p->geo.crop_width;
-                    rast_target t0 = {cw, p->geo.crop_height, s->depth, cw, s->mask, cw, s->nrm,
-                                      s->nrm ? 3 * cw : 0, 3, s->n10, s->n10 ? cw : 0};
+                    rast_target t0 = gbuf_target(p, s);
                     rast_target_clear(&t0);
                 }
             }
